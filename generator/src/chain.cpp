@@ -1,0 +1,282 @@
+#include "chain.h"
+
+#include <algorithm>
+#include <cmath>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace kdm::gen {
+namespace {
+
+inline float sign_of(float r) { return static_cast<float>((r > 0) - (r < 0)); }
+
+}  // namespace
+
+template <int D>
+Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
+    : density_(&density), params_(params), residual_(density.rho.size()) {
+  clear_kernels();
+}
+
+template <int D>
+double Chain<D>::sigma_for(double rho, double w) const {
+  if (!(rho > 0)) return params_.sigma_cap;
+  return std::min(params_.sigma_cap, std::pow(rho / w, -1.0 / D));
+}
+
+template <int D>
+void Chain<D>::clear_kernels() {
+  for (std::size_t i = 0; i < residual_.size(); ++i) residual_[i] = -density_->rho[i];
+}
+
+template <int D>
+void Chain<D>::add(const Footprint<D>& fp, float sign) {
+  float* R = residual_.data();
+  const AxisFactor& ax = fp.axes[0];
+  fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
+    const float pf = sign * static_cast<float>(p);
+    float* row = R + base;
+    for (int a = 0; a < ax.count; ++a) row[ax.index[a]] += pf * ax.value[a];
+  });
+}
+
+template <int D>
+void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
+  const double rho = density_->at(p.x);
+  if (!(rho > 0)) return;
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  add(scratch.old_fp, sign);
+}
+
+template <int D>
+double Chain<D>::energy() const {
+  double e = 0;
+  for (float r : residual_) e += std::fabs(r);
+  return e;
+}
+
+template <int D>
+double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
+  const double rho = density_->at(p.x);
+  if (!(rho > 0)) return 0;
+  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  Vec<D> unused{};
+  return added_change_with_gradient(scratch.new_fp, unused);
+}
+
+template <int D>
+double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) {
+  float* R = residual_.data();
+  const AxisFactor& ax = fp.axes[0];
+  double change = 0;
+  gradient.fill(0);
+  fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
+    const float pf = static_cast<float>(p);
+    float* row = R + base;
+    float sx = 0, sg = 0, e = 0;
+    for (int a = 0; a < ax.count; ++a) {
+      float& r = row[ax.index[a]];
+      const float s = sign_of(r);
+      const float rn = r - pf * ax.value[a];
+      sx += s * ax.deriv[a];
+      sg += s * ax.value[a];
+      e += std::fabs(r) - std::fabs(rn);
+      r = rn;
+    }
+    change += e;
+    gradient[0] += p * sx;
+    for (int k = 1; k < D; ++k) gradient[k] += pd[k] * sg;
+  });
+  return change;
+}
+
+template <int D>
+double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
+  const float* R = residual_.data();
+  const AxisFactor& ax = fp.axes[0];
+  double change = 0;
+  gradient.fill(0);
+  fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
+    const float pf = static_cast<float>(p);
+    const float* row = R + base;
+    float sx = 0, sg = 0, e = 0;
+    for (int a = 0; a < ax.count; ++a) {
+      const float r = row[ax.index[a]];
+      const float rn = r + pf * ax.value[a];
+      const float s = sign_of(rn);
+      sx += s * ax.deriv[a];
+      sg += s * ax.value[a];
+      e += std::fabs(rn) - std::fabs(r);
+    }
+    change += e;
+    gradient[0] += p * sx;
+    for (int k = 1; k < D; ++k) gradient[k] += pd[k] * sg;
+  });
+  return change;
+}
+
+template <int D>
+Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
+  Vec<D> g{};
+  const double rho = density_->at(p.x);
+  if (!(rho > 0)) return g;
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true);
+  remove_with_gradient(scratch.old_fp, g);
+  add(scratch.old_fp, 1.0f);
+  return g;
+}
+
+template <int D>
+bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
+  const double w = p.weight();
+  const double rho_old = density_->at(p.x);
+  if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
+  const double sigma_old = sigma_for(rho_old, w);
+  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true);
+  Vec<D> grad_old;
+  const double removed = remove_with_gradient(scratch.old_fp, grad_old);
+
+  // Eq. 5 with Δt_j = T σ Δt / w: drift -(σ Δt / 2w) ∇E, noise variance T σ Δt / w. A kernel of weight w
+  // carries w times the energy, so dividing by w keeps its step the size of a unit kernel's (as the
+  // reference implementation does); P ∝ exp(-E/T) is unchanged, only the proposal scale.
+  const double T = params_.temperature, dt = params_.step / w;
+  const double var_old = T * sigma_old * dt;
+  Vec<D> drift_old, step;
+  bool too_far = false;
+  for (int k = 0; k < D; ++k) {
+    drift_old[k] = -0.5 * sigma_old * dt * grad_old[k];
+    step[k] = drift_old[k] + (T > 0 ? std::sqrt(var_old) * rng.normal() : 0.0);
+    too_far |= !(std::fabs(step[k]) <= params_.max_step);
+  }
+  auto reject = [&] {
+    add(scratch.old_fp, 1.0f);
+    return false;
+  };
+  if (too_far) return reject();
+  Vec<D> x_new;
+  for (int k = 0; k < D; ++k) x_new[k] = p.x[k] + step[k];
+  if (!grid().canonical(x_new)) return reject();
+  const double rho_new = density_->at(x_new);
+  if (!(rho_new > 0)) return reject();
+  const double sigma_new = sigma_for(rho_new, w);
+  if (sigma_new > params_.sigma_bound) return reject();
+  const bool mh = params_.metropolis && T > 0;
+  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh);
+  Vec<D> grad_new;
+  const double added = added_change_with_gradient(scratch.new_fp, grad_new);
+  const double dE = added - removed;
+
+  bool accept;
+  if (T <= 0) {
+    accept = dE <= 0;
+  } else if (!params_.metropolis) {
+    accept = true;
+  } else {
+    // log q(x'|x) and log q(x|x') of the two Gaussian proposals, up to the shared (2π)^(d/2).
+    const double var_new = T * sigma_new * dt;
+    double forward = 0.5 * D * std::log(var_old), reverse = 0.5 * D * std::log(var_new);
+    for (int k = 0; k < D; ++k) {
+      const double drift_new = -0.5 * sigma_new * dt * grad_new[k];
+      const double f = step[k] - drift_old[k], r = -step[k] - drift_new;
+      forward += f * f / (2 * var_old);
+      reverse += r * r / (2 * var_new);
+    }
+    const double log_alpha = -dE / T - reverse + forward;
+    accept = log_alpha >= 0 || rng.uniform() < std::exp(log_alpha);
+  }
+  if (!accept) return reject();
+  add(scratch.new_fp, 1.0f);
+  p.x = x_new;
+  return true;
+}
+
+template <int D>
+void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index,
+                     int threads, ChainCounters& counters) {
+  const Grid<D>& g = grid();
+  // Cells at least two footprints plus a step wide: same-colour cells never touch the same node.
+  const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 +
+                       std::ceil(std::min(params_.max_step, 1e9));
+  std::array<int, D> ncell{};
+  std::array<double, D> width{};
+  int total_cells = 1;
+  for (int k = 0; k < D; ++k) {
+    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
+    if (c < 1) c = 1;
+    if (g.torus && c > 1 && (c & 1)) --c;
+    ncell[k] = c;
+    width[k] = double(g.dims[k]) / c;
+    total_cells *= c;
+  }
+  auto cell_of = [&](const Vec<D>& x) {
+    int id = 0, mul = 1;
+    for (int k = 0; k < D; ++k) {
+      int c = static_cast<int>(x[k] / width[k]);
+      c = std::clamp(c, 0, ncell[k] - 1);
+      id += c * mul;
+      mul *= ncell[k];
+    }
+    return id;
+  };
+  // Counting sort of the active particles by cell; ascending index within each cell.
+  std::vector<int> start(total_cells + 1, 0);
+  std::vector<int> cell_of_particle(particles.size(), -1);
+  for (std::size_t j = 0; j < particles.size(); ++j) {
+    if (!particles[j].active) continue;
+    cell_of_particle[j] = cell_of(particles[j].x);
+    ++start[cell_of_particle[j] + 1];
+  }
+  for (int c = 0; c < total_cells; ++c) start[c + 1] += start[c];
+  std::vector<int> order(start[total_cells]);
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t j = 0; j < particles.size(); ++j)
+      if (cell_of_particle[j] >= 0) order[fill[cell_of_particle[j]]++] = static_cast<int>(j);
+  }
+  std::array<std::vector<int>, (1 << D)> cells_by_colour;
+  for (int c = 0; c < total_cells; ++c) {
+    int colour = 0, rest = c;
+    for (int k = 0; k < D; ++k) {
+      colour |= ((rest % ncell[k]) & 1) << k;
+      rest /= ncell[k];
+    }
+    cells_by_colour[colour].push_back(c);
+  }
+#ifdef _OPENMP
+  const int nthreads = std::max(1, threads > 0 ? threads : omp_get_max_threads());
+#else
+  const int nthreads = 1;
+  (void)threads;
+#endif
+  std::vector<Scratch> scratch(nthreads);
+  std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
+  for (const std::vector<int>& cells : cells_by_colour) {
+    const int count = static_cast<int>(cells.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads) if (nthreads > 1 && count > 1)
+    for (int ci = 0; ci < count; ++ci) {
+#ifdef _OPENMP
+      Scratch& s = scratch[omp_get_thread_num()];
+#else
+      Scratch& s = scratch[0];
+#endif
+      const int c = cells[ci];
+      std::uint64_t acc = 0;
+      for (int t = start[c]; t < start[c + 1]; ++t) {
+        const int j = order[t];
+        Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
+                static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
+        acc += update(particles[j], rng, s) ? 1 : 0;
+      }
+      accepted_in_cell[c] = acc;
+    }
+  }
+  counters.proposals += order.size();
+  for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
+}
+
+template class Chain<2>;
+template class Chain<3>;
+
+}  // namespace kdm::gen

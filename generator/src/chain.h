@@ -1,0 +1,100 @@
+// Algorithm 1 of Fattal 2011: single-level MH-corrected Langevin relaxation, one point at a time.
+// Proposal (eq. 5): x' = x - (Δt_j / 2T) ∇E + sqrt(Δt_j) ξ with Δt_j = T σ(x) Δt and the gradient of
+// eq. 7 (σ held fixed). Acceptance: the Metropolis–Hastings ratio of eq. 6 with the exact energy change
+// over the union of the old and new footprints. Eq. 6 assumes Δt_j is the same both ways; with a
+// spatially varying σ it is not, so we use the full ratio of the two Gaussian proposal densities
+// (which reduces to eq. 6 when σ(x) = σ(x')). Each accepted or rejected step leaves P ∝ exp(-E/T) invariant.
+//
+// Points whose footprints cannot overlap are updated concurrently (a checkerboard of cells wider than
+// two footprints plus a step); the order of updates and every random number depend only on the seed,
+// so the result is the same for any thread count.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "grid.h"
+#include "kernel.h"
+#include "rng.h"
+
+namespace kdm::gen {
+
+template <int D>
+struct Particle {
+  Vec<D> x{};
+  std::uint8_t splits = 0;  ///< refinements this kernel still splits in; weight w = 2^(D·splits)
+  bool active = true;       ///< relaxed at this level (σ < σmax); inactive kernels are background
+  double weight() const { return std::ldexp(1.0, D * splits); }
+};
+
+struct ChainParams {
+  double temperature = 0.11;  ///< T of eq. 4 (model units); 0 = deterministic descent
+  double step = 1.0;          ///< Δt of eq. 5
+  bool metropolis = true;
+  double sigma_cap = 128;     ///< kernels never wider than this (grid units); only far-below-peak densities hit it
+  double sigma_bound = 1e30;  ///< proposals where σ would exceed this are rejected (a support constraint)
+  double max_step = 1e30;     ///< proposals moving farther than this along any axis are rejected
+};
+
+struct ChainCounters {
+  std::uint64_t proposals = 0;
+  std::uint64_t accepted = 0;
+};
+
+template <int D>
+class Chain {
+ public:
+  struct Scratch {
+    Footprint<D> old_fp, new_fp;
+  };
+
+  /// `density` must outlive the chain.
+  Chain(const DensityGrid<D>& density, const ChainParams& params);
+
+  const Grid<D>& grid() const { return density_->grid; }
+  const DensityGrid<D>& density() const { return *density_; }
+  const ChainParams& params() const { return params_; }
+  void set_params(const ChainParams& params) { params_ = params; }
+  std::vector<float>& residual() { return residual_; }
+
+  /// σ of a kernel with weight w at density rho (grid units).
+  double sigma_for(double rho, double w) const;
+  double sigma_at(const Particle<D>& p) const { return sigma_for(density_->at(p.x), p.weight()); }
+
+  /// R = A - ρ with no kernels.
+  void clear_kernels();
+  /// Adds (sign = +1) or removes (sign = -1) p's kernel.
+  void splat(const Particle<D>& p, float sign, Scratch& scratch);
+  /// Σ |R| over the grid: the energy of eq. 3 with γ = 1.
+  double energy() const;
+  /// Energy change if p's kernel were added (p not yet in R).
+  double energy_change_if_added(const Particle<D>& p, Scratch& scratch) const;
+
+  /// ∇E with respect to p's centre by eq. 7 (σ held fixed); p's kernel must be in R. R is unchanged.
+  Vec<D> gradient(const Particle<D>& p, Scratch& scratch);
+
+  /// One MH-corrected Langevin update of p (whose kernel is in R). `rng` drives only this update.
+  /// Returns true when the proposal was accepted.
+  bool update(Particle<D>& p, Rng& rng, Scratch& scratch);
+
+  /// One sweep over the active particles (in the deterministic checkerboard order).
+  void sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index, int threads,
+             ChainCounters& counters);
+
+ private:
+  // Removes the kernel of `fp` from R, returning Σ(|R_before| - |R_after|) and the gradient of eq. 7.
+  double remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient);
+  // For a kernel `fp` not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
+  double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
+  void add(const Footprint<D>& fp, float sign);
+
+  const DensityGrid<D>* density_;
+  ChainParams params_;
+  std::vector<float> residual_;
+};
+
+extern template class Chain<2>;
+extern template class Chain<3>;
+
+}  // namespace kdm::gen

@@ -1,0 +1,89 @@
+// Computational grids of the KDM model (paper §3): nodes at cell centres i + 1/2 in grid units
+// (Δx = 1), axis 0 fastest in memory. A torus wraps every axis; a box reflects at its walls.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace kdm::gen {
+
+template <int D>
+using Vec = std::array<double, D>;
+
+template <int D>
+struct Grid {
+  std::array<int, D> dims{};
+  bool torus = true;
+
+  std::int64_t size() const {
+    std::int64_t s = 1;
+    for (int k = 0; k < D; ++k) s *= dims[k];
+    return s;
+  }
+  std::int64_t stride(int axis) const {
+    std::int64_t s = 1;
+    for (int k = 0; k < axis; ++k) s *= dims[k];
+    return s;
+  }
+  /// Maps a position into the domain: wraps on a torus; on a box returns false when outside [0, m).
+  bool canonical(Vec<D>& x) const {
+    for (int k = 0; k < D; ++k) {
+      const double m = dims[k];
+      if (torus) {
+        x[k] -= m * std::floor(x[k] / m);
+        if (x[k] >= m) x[k] = 0;  // -tiny wraps to m in floating point
+      } else if (!(x[k] >= 0 && x[k] < m)) {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
+/// The target density at one level of the pyramid, with multilinear interpolation between nodes.
+template <int D>
+struct DensityGrid {
+  Grid<D> grid;
+  std::vector<float> rho;
+
+  /// ρ at position x (grid units). Periodic interpolation on a torus, clamped at box walls.
+  double at(const Vec<D>& x) const {
+    std::array<std::int64_t, D> i0{}, i1{};
+    std::array<double, D> f{};
+    for (int k = 0; k < D; ++k) {
+      const int m = grid.dims[k];
+      const double u = x[k] - 0.5;
+      const double fl = std::floor(u);
+      f[k] = u - fl;
+      std::int64_t a = static_cast<std::int64_t>(fl), b = a + 1;
+      if (grid.torus) {
+        a = ((a % m) + m) % m;
+        b = ((b % m) + m) % m;
+      } else {
+        if (a < 0) a = 0;
+        if (b > m - 1) b = m - 1;
+        if (a > m - 1) a = m - 1;
+        if (b < 0) b = 0;
+      }
+      const std::int64_t s = grid.stride(k);
+      i0[k] = a * s;
+      i1[k] = b * s;
+    }
+    double value = 0;
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      double w = 1;
+      std::int64_t idx = 0;
+      for (int k = 0; k < D; ++k) {
+        const bool hi = (corner >> k) & 1;
+        w *= hi ? f[k] : 1 - f[k];
+        idx += hi ? i1[k] : i0[k];
+      }
+      value += w * rho[idx];
+    }
+    return value;
+  }
+};
+
+}  // namespace kdm::gen

@@ -1,0 +1,314 @@
+#include "multiscale.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "chain.h"
+
+namespace kdm::gen {
+namespace {
+
+constexpr std::uint64_t kInitStream = 0x494e4954;    // "INIT"
+constexpr std::uint64_t kRefineStream = 0x524546;    // "REF"
+
+template <int D>
+Vec<D> node_centre(const Grid<D>& g, std::int64_t i) {
+  Vec<D> x{};
+  for (int k = 0; k < D; ++k) {
+    x[k] = (i % g.dims[k]) + 0.5;
+    i /= g.dims[k];
+  }
+  return x;
+}
+
+/// Splits remaining for a kernel placed where the coarsest density is rho: the largest q <= max_splits
+/// with rho / 2^(D q) <= 1 is the number of refinements before its weight reaches one (paper §3.3).
+template <int D>
+int splits_for(double rho, int max_splits) {
+  int q = 0;
+  while (q < max_splits && rho > std::ldexp(1.0, D * q) * (1 + 1e-6)) ++q;
+  return q;
+}
+
+template <int D>
+struct Driver {
+  const SamplerOptions& options;
+  ModelSetup<D>& setup;
+  ChainParams params;
+  SampleReport report;
+  std::vector<Particle<D>> particles;
+  double total_sweeps = 0, done_sweeps = 0;
+
+  Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
+    params.temperature = o.temperature * kModelTemperaturePerUser;
+    params.step = o.step;
+    params.metropolis = o.metropolis;
+  }
+
+  double total_weight() const {
+    double w = 0;
+    for (const auto& p : particles) w += p.weight();
+    return w;
+  }
+
+  void initial_configuration(Chain<D>& chain) {
+    const Grid<D>& g = chain.grid();
+    const int max_splits = static_cast<int>(setup.levels.size()) - 1;
+    std::vector<std::int64_t> order(static_cast<std::size_t>(g.size()));
+    std::iota(order.begin(), order.end(), 0);
+    Rng rng(options.seed, kInitStream);
+    for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+    typename Chain<D>::Scratch scratch;
+    const std::vector<float>& rho = chain.density().rho;
+    const std::vector<float>& R = chain.residual();
+    const double centre_factor = std::pow(1 - kernel_edge_value(), D);
+    for (std::int64_t node : order) {
+      if (!(rho[node] > 0)) continue;
+      // Most nodes fail the pointwise test: adding the kernel's centre value does not lower |R| there.
+      if (R[node] + 0.5 * rho[node] * centre_factor >= 0) continue;
+      Particle<D> p;
+      p.x = node_centre(g, node);
+      p.splits = static_cast<std::uint8_t>(splits_for<D>(rho[node], max_splits));
+      if (chain.energy_change_if_added(p, scratch) < 0) {
+        chain.splat(p, 1.0f, scratch);
+        particles.push_back(p);
+      }
+    }
+  }
+
+  /// Brings Σw to exactly n on the coarsest grid as far as whole kernels allow: removes the kernels
+  /// whose removal raises E least, then adds kernels at the nodes where that lowers E most.
+  void fix_count_coarse(Chain<D>& chain) {
+    const double n = static_cast<double>(options.n);
+    typename Chain<D>::Scratch scratch;
+    double w = total_weight();
+    while (w > n && !particles.empty()) {
+      std::size_t best = 0;
+      double best_change = std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < particles.size(); ++j) {
+        chain.splat(particles[j], -1.0f, scratch);
+        const double change = -chain.energy_change_if_added(particles[j], scratch);
+        chain.splat(particles[j], 1.0f, scratch);
+        if (change < best_change) best_change = change, best = j;
+      }
+      chain.splat(particles[best], -1.0f, scratch);
+      w -= particles[best].weight();
+      particles.erase(particles.begin() + static_cast<std::ptrdiff_t>(best));
+      ++report.removed_for_exact_count;
+    }
+    const Grid<D>& g = chain.grid();
+    const int max_splits = static_cast<int>(setup.levels.size()) - 1;
+    while (w < n) {
+      double best_change = std::numeric_limits<double>::infinity();
+      Particle<D> best;
+      for (std::int64_t node = 0; node < g.size(); ++node) {
+        const double rho = chain.density().rho[node];
+        if (!(rho > 0)) continue;
+        Particle<D> p;
+        p.x = node_centre(g, node);
+        p.splits = static_cast<std::uint8_t>(splits_for<D>(rho, max_splits));
+        if (w + p.weight() > n) continue;
+        const double change = chain.energy_change_if_added(p, scratch);
+        if (change < best_change) best_change = change, best = p;
+      }
+      if (best_change == std::numeric_limits<double>::infinity()) break;
+      chain.splat(best, 1.0f, scratch);
+      particles.push_back(best);
+      w += best.weight();
+      ++report.inserted_for_exact_count;
+    }
+  }
+
+  /// After each refinement, adds kernels of the level's full weight while Σw + w <= n, each at the node
+  /// with the largest absolute deficit ρ - A (where a kernel lowers E most; a relative deficit would favour
+  /// sparse regions, whose wide frozen kernels leave large relative but small absolute gaps). The level's
+  /// sweeps that follow relax them with everything else; by the finest level the remainder is exact.
+  void fix_count_level(Chain<D>& chain, int level) {
+    typename Chain<D>::Scratch scratch;
+    const Grid<D>& g = chain.grid();
+    const std::vector<float>& rho = chain.density().rho;
+    double w = total_weight();
+    const double n = static_cast<double>(options.n);
+    while (w < n) {
+      std::int64_t best = -1;
+      float best_residual = 0;
+      const std::vector<float>& R = chain.residual();
+      for (std::int64_t node = 0; node < g.size(); ++node) {
+        if (!(rho[node] > 0) || !(R[node] < best_residual)) continue;
+        if (w + std::ldexp(1.0, D * splits_for<D>(rho[node], level)) > n) continue;
+        best_residual = R[node];
+        best = node;
+      }
+      if (best < 0) break;
+      Particle<D> p;
+      p.x = node_centre(g, best);
+      p.splits = static_cast<std::uint8_t>(splits_for<D>(rho[best], level));
+      chain.splat(p, 1.0f, scratch);
+      particles.push_back(p);
+      w += p.weight();
+      ++report.inserted_for_exact_count;
+    }
+  }
+
+  /// Maps the configuration of level l+1 to level l (paper eq. 13, square rule, randomly rotated).
+  void refine(int fine_level) {
+    const DensityGrid<D>& fine = setup.levels[fine_level];
+    std::vector<Particle<D>> next;
+    next.reserve(particles.size() * 2);
+    for (std::size_t j = 0; j < particles.size(); ++j) {
+      const Particle<D>& p = particles[j];
+      Vec<D> centre;
+      for (int k = 0; k < D; ++k) centre[k] = 2 * p.x[k];
+      if (p.splits == 0) {
+        Particle<D> c = p;
+        c.x = centre;
+        next.push_back(c);
+        continue;
+      }
+      Particle<D> child;
+      child.splits = static_cast<std::uint8_t>(p.splits - 1);
+      const double rho = fine.at(centre);
+      const double sigma = rho > 0 ? std::min(params.sigma_cap, std::pow(rho / child.weight(), -1.0 / D)) : 1.0;
+      Rng rng(options.seed, kRefineStream, static_cast<std::uint64_t>(fine_level), j);
+      for (const Vec<D>& z : square_rule(rng)) {
+        for (int k = 0; k < D; ++k) child.x[k] = centre[k] + sigma * z[k];
+        keep_inside(fine.grid, child.x);
+        next.push_back(child);
+      }
+    }
+    particles.swap(next);
+  }
+
+  /// The 2^D corners of a unit-radius square (cube), rotated at random so no axis is preferred.
+  std::array<Vec<D>, (1 << D)> square_rule(Rng& rng) const {
+    std::array<Vec<D>, (1 << D)> z{};
+    const double r = 1.0 / std::sqrt(double(D));
+    for (int c = 0; c < (1 << D); ++c)
+      for (int k = 0; k < D; ++k) z[c][k] = ((c >> k) & 1) ? r : -r;
+    if constexpr (D == 2) {
+      const double a = 6.283185307179586 * rng.uniform(), ca = std::cos(a), sa = std::sin(a);
+      for (auto& v : z) v = {ca * v[0] - sa * v[1], sa * v[0] + ca * v[1]};
+    } else {
+      // Uniform random rotation from a unit quaternion (Shoemake).
+      const double u1 = rng.uniform(), u2 = 6.283185307179586 * rng.uniform(), u3 = 6.283185307179586 * rng.uniform();
+      const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
+      const double qw = a * std::sin(u2), qx = a * std::cos(u2), qy = b * std::sin(u3), qz = b * std::cos(u3);
+      const double m[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+                              {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+                              {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+      for (auto& v : z) {
+        Vec<D> t{};
+        for (int i = 0; i < 3; ++i) t[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
+        v = t;
+      }
+    }
+    return z;
+  }
+
+  static void keep_inside(const Grid<D>& g, Vec<D>& x) {
+    if (g.canonical(x)) return;
+    for (int k = 0; k < D; ++k) {  // box: reflect at the walls
+      const double m = g.dims[k];
+      if (x[k] < 0) x[k] = std::min(-x[k], std::nextafter(m, 0.0));
+      if (x[k] >= m) x[k] = std::max(0.0, 2 * m - x[k] - 1e-9);
+    }
+  }
+
+  void relax_level(int level, int sweeps) {
+    DensityGrid<D>& density = setup.levels[level];
+    Chain<D> chain(density, params);
+    typename Chain<D>::Scratch scratch;
+    const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1;
+    if (coarsest) {
+      initial_configuration(chain);
+      if (options.n > 0) fix_count_coarse(chain);
+    } else {
+      for (const auto& p : particles) chain.splat(p, 1.0f, scratch);
+    }
+    if (!coarsest && options.n > 0) fix_count_level(chain, level);
+
+    // Freeze wide kernels; bound the rest (a support constraint that keeps footprints small).
+    double widest_active = 0;
+    LevelReport lr;
+    for (auto& p : particles) {
+      const double sigma = chain.sigma_at(p);
+      p.active = sigma < options.sigma_max;
+      if (p.active) widest_active = std::max(widest_active, sigma), ++lr.active_points;
+    }
+    ChainParams level_params = params;
+    level_params.sigma_bound = std::min(2 * options.sigma_max, 1.5 * std::max(widest_active, 1.0));
+    level_params.max_step = level_params.sigma_bound;
+    chain.set_params(level_params);
+
+    ChainCounters counters;
+    // Burn-in: the refined configuration has its split kernels crowded together; a few sweeps of pure
+    // descent (T = 0) spread them before the MH chain takes over. Part of the initialisation, like the
+    // refinement itself: the sweeps that follow sample P exactly from wherever this leaves them.
+    ChainParams descent = level_params;
+    descent.temperature = 0;
+    ChainCounters burn_in;
+    for (int s = 0; s < options.burn_in_sweeps; ++s) {
+      chain.set_params(descent);
+      chain.sweep(particles, options.seed, level, -1 - s, options.threads, burn_in);
+    }
+    chain.set_params(level_params);
+    for (int s = 0; s < sweeps; ++s) {
+      chain.sweep(particles, options.seed, level, s, options.threads, counters);
+      done_sweeps += double(lr.active_points) / std::max<double>(1, options.n);
+      if (options.progress) options.progress(std::min(1.0, done_sweeps / std::max(1.0, total_sweeps)));
+    }
+    for (int k = 0; k < D; ++k) lr.grid[k] = density.grid.dims[k];
+    lr.points = static_cast<std::int64_t>(particles.size());
+    lr.sweeps = sweeps;
+    lr.proposals = counters.proposals;
+    lr.accepted = counters.accepted;
+    report.proposals += counters.proposals;
+    report.accepted += counters.accepted;
+    report.levels.push_back(lr);
+    if (level == 0) report.energy_per_point = chain.energy() / std::max<std::size_t>(1, particles.size());
+  }
+
+  SampleResult run() {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int levels = static_cast<int>(setup.levels.size());
+    // Progress is measured in point-sweeps relative to n: level l holds about n / 2^(D l) points.
+    for (int l = 0; l < levels; ++l)
+      total_sweeps += (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
+                      std::ldexp(1.0, -D * l);
+    for (int l = levels - 1; l >= 0; --l) {
+      if (l < levels - 1) refine(l);
+      relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);
+    }
+    report.model_temperature = params.temperature;
+    SampleResult result;
+    result.dim = D;
+    result.points.resize(particles.size() * D);
+    const Grid<D>& g = setup.levels[0].grid;
+    for (std::size_t j = 0; j < particles.size(); ++j) {
+      for (int k = 0; k < D; ++k) {
+        double u = particles[j].x[k] / g.dims[k];
+        if (u >= 1) u = std::nextafter(1.0, 0.0);
+        result.points[j * D + k] = u;
+      }
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    result.report = report;
+    return result;
+  }
+};
+
+}  // namespace
+
+template <int D>
+SampleResult run_multiscale(const SamplerOptions& options, ModelSetup<D>& setup) {
+  Driver<D> driver(options, setup);
+  return driver.run();
+}
+
+template SampleResult run_multiscale<2>(const SamplerOptions&, ModelSetup<2>&);
+template SampleResult run_multiscale<3>(const SamplerOptions&, ModelSetup<3>&);
+
+}  // namespace kdm::gen

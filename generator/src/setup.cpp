@@ -1,0 +1,207 @@
+#include "setup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "kernel.h"
+
+namespace kdm::gen {
+namespace {
+
+template <int D>
+std::string format_position(const double* u) {
+  std::ostringstream s;
+  s << "(";
+  for (int k = 0; k < D; ++k) s << (k ? ", " : "") << u[k];
+  s << ")";
+  return s.str();
+}
+
+/// Samples the density at every node of `grid` (averaging supersamples where the source is finer).
+template <int D>
+std::vector<float> sample_density(const Grid<D>& grid, const Density& density) {
+  std::vector<float> rho(static_cast<std::size_t>(grid.size()));
+  if (!density.function) {
+    std::fill(rho.begin(), rho.end(), 1.0f);
+    return rho;
+  }
+  std::array<int, D> sub{};
+  int subsamples = 1;
+  for (int k = 0; k < D; ++k) {
+    sub[k] = std::clamp((density.native_resolution[k] + grid.dims[k] - 1) / std::max(1, grid.dims[k]), 1, 8);
+    subsamples *= sub[k];
+  }
+  std::array<int, D> node{};
+  for (std::int64_t i = 0; i < grid.size(); ++i) {
+    double sum = 0;
+    for (int s = 0; s < subsamples; ++s) {
+      double u[3] = {0, 0, 0};
+      int rest = s;
+      for (int k = 0; k < D; ++k) {
+        const int j = rest % sub[k];
+        rest /= sub[k];
+        u[k] = (node[k] + (j + 0.5) / sub[k]) / grid.dims[k];
+      }
+      const double v = density.function(u);
+      if (!std::isfinite(v)) throw InvalidArgument("density is not finite at " + format_position<D>(u));
+      if (v < 0) throw InvalidArgument("density is negative at " + format_position<D>(u));
+      sum += v;
+    }
+    rho[i] = static_cast<float>(sum / subsamples);
+    for (int k = 0; k < D; ++k) {
+      if (++node[k] < grid.dims[k]) break;
+      node[k] = 0;
+    }
+  }
+  return rho;
+}
+
+template <int D>
+Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
+  double min_extent = o.extent[0];
+  for (int k = 1; k < D; ++k) min_extent = std::min(min_extent, o.extent[k]);
+  levels = 1;
+  while (shortest / std::ldexp(1.0, levels) >= o.coarsest_grid) ++levels;
+  const double unit = std::ldexp(1.0, levels - 1);
+  Grid<D> g;
+  g.torus = o.domain == Domain::kTorus;
+  double nodes = 1;
+  for (int k = 0; k < D; ++k) {
+    g.dims[k] = static_cast<int>(unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit)));
+    nodes *= g.dims[k];
+  }
+  if (nodes > double(o.max_grid_nodes)) {
+    std::ostringstream s;
+    s << "the density needs a computational grid of " << nodes << " nodes, more than the limit of "
+      << o.max_grid_nodes << " (ask for fewer points or a smaller dynamic range)";
+    throw InvalidArgument(s.str());
+  }
+  return g;
+}
+
+}  // namespace
+
+void validate_options(const SamplerOptions& o) {
+  if (o.dim != 2 && o.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
+  if (o.n < 0) throw InvalidArgument("point count must be >= 0");
+  if (o.n == 0 && o.resolution <= 0) throw InvalidArgument("give a point count n > 0 or a grid resolution > 0");
+  if (!(std::isfinite(o.temperature) && o.temperature >= 0))
+    throw InvalidArgument("temperature must be a finite number >= 0");
+  if (!(std::isfinite(o.step) && o.step > 0)) throw InvalidArgument("step must be a finite number > 0");
+  if (!(o.peak_density > 0 && o.peak_density <= 1)) throw InvalidArgument("peak density must be in (0, 1]");
+  if (!(o.sigma_max >= 1)) throw InvalidArgument("sigma_max must be >= 1");
+  if (o.sweeps < 0 || o.coarsest_sweeps < 0 || o.burn_in_sweeps < 0) throw InvalidArgument("sweep counts must be >= 0");
+  if (o.coarsest_grid < 4) throw InvalidArgument("coarsest grid must have at least 4 nodes per axis");
+  for (int k = 0; k < o.dim; ++k)
+    if (!(std::isfinite(o.extent[k]) && o.extent[k] > 0))
+      throw InvalidArgument("domain extents must be finite and > 0");
+  if (o.n > (std::int64_t(1) << 31)) throw InvalidArgument("point count is too large (limit 2^31)");
+}
+
+template <int D>
+ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
+  validate_options(o);
+  ModelSetup<D> setup;
+  setup.mass_per_point = std::pow(truncated_factor_integral(), D);
+  double extent_product = 1, min_extent = o.extent[0];
+  for (int k = 0; k < D; ++k) extent_product *= o.extent[k], min_extent = std::min(min_extent, o.extent[k]);
+  const double aspect_product = extent_product / std::pow(min_extent, D);
+
+  Grid<D> grid;
+  std::vector<float> rho;
+  int levels = 1;
+  if (o.n > 0) {
+    // Start from a probe of the density's mean and peak, then refine until max ρ <= peak_density.
+    double peak_over_mean = 1;
+    if (density.function) {
+      Grid<D> probe;
+      probe.torus = true;
+      for (int k = 0; k < D; ++k) probe.dims[k] = D == 2 ? 64 : 24;
+      const std::vector<float> p = sample_density<D>(probe, density);
+      double sum = 0, mx = 0;
+      for (float v : p) sum += v, mx = std::max<double>(mx, v);
+      if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
+      peak_over_mean = mx / (sum / p.size());
+    }
+    double shortest = std::pow(o.n * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product),
+                               1.0 / D);
+    for (int attempt = 0;; ++attempt) {
+      grid = make_grid<D>(o, std::max(1.0, shortest), levels);
+      rho = sample_density<D>(grid, density);
+      double sum = 0, mx = 0;
+      for (float v : rho) sum += v, mx = std::max<double>(mx, v);
+      if (!(sum > 0)) throw InvalidArgument("density is zero everywhere");
+      const double scale = o.n * setup.mass_per_point / sum;
+      const double peak = mx * scale;
+      if (peak <= o.peak_density * 1.02 || attempt == 6) {
+        for (float& v : rho) v = static_cast<float>(v * scale);
+        break;
+      }
+      shortest *= std::pow(peak / o.peak_density, 1.0 / D) * 1.01;
+    }
+  } else {
+    grid = make_grid<D>(o, o.resolution, levels);
+    rho = sample_density<D>(grid, density);
+    const double mx = *std::max_element(rho.begin(), rho.end());
+    if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
+    for (float& v : rho) v = static_cast<float>(v * (o.peak_density / mx));
+  }
+
+  setup.levels.push_back({grid, std::move(rho)});
+  for (int l = 1; l < levels; ++l) {
+    const DensityGrid<D>& fine = setup.levels.back();
+    DensityGrid<D> coarse;
+    coarse.grid = fine.grid;
+    for (int k = 0; k < D; ++k) coarse.grid.dims[k] /= 2;
+    coarse.rho.assign(static_cast<std::size_t>(coarse.grid.size()), 0.0f);
+    // Box filter and subsample: coarse node = sum of its 2^D children (the factor 2^D of eq. 12 inside ρ).
+    std::array<int, D> node{};
+    for (std::int64_t i = 0; i < fine.grid.size(); ++i) {
+      std::int64_t ci = 0;
+      for (int k = D - 1; k >= 0; --k) ci = ci * coarse.grid.dims[k] + node[k] / 2;
+      coarse.rho[ci] += fine.rho[i];
+      for (int k = 0; k < D; ++k) {
+        if (++node[k] < fine.grid.dims[k]) break;
+        node[k] = 0;
+      }
+    }
+    setup.levels.push_back(std::move(coarse));
+  }
+  return setup;
+}
+
+template ModelSetup<2> build_model<2>(const SamplerOptions&, const Density&);
+template ModelSetup<3> build_model<3>(const SamplerOptions&, const Density&);
+
+Density Density::from_values(int width, int height, std::vector<float> values) {
+  if (width <= 0 || height <= 0) throw InvalidArgument("density image is empty");
+  if (values.size() != static_cast<std::size_t>(width) * height)
+    throw InvalidArgument("density image has the wrong number of values");
+  bool any = false;
+  for (float v : values) {
+    if (!std::isfinite(v)) throw InvalidArgument("density image holds a non-finite value");
+    if (v < 0) throw InvalidArgument("density image holds a negative value");
+    any |= v > 0;
+  }
+  if (!any) throw InvalidArgument("density image is zero everywhere");
+  Density d;
+  d.native_resolution[0] = width;
+  d.native_resolution[1] = height;
+  auto data = std::make_shared<std::vector<float>>(std::move(values));
+  d.function = [data, width, height](const double* u) {
+    // Pixel centres at (i + 1/2); row 0 is the top of the picture, i.e. u_y near 1.
+    const double fx = std::clamp(u[0] * width - 0.5, 0.0, width - 1.0);
+    const double fy = std::clamp((1.0 - u[1]) * height - 0.5, 0.0, height - 1.0);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+    const double ax = fx - x0, ay = fy - y0;
+    const std::vector<float>& v = *data;
+    auto at = [&](int x, int y) { return double(v[static_cast<std::size_t>(y) * width + x]); };
+    return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) + ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
+  };
+  return d;
+}
+
+}  // namespace kdm::gen

@@ -1,0 +1,27 @@
+// From user options to the model's finest grid: grid size, the density sampled on it and scaled so its
+// mass matches the requested count, and the pyramid of coarser densities (paper §3.2–3.3).
+#pragma once
+
+#include <vector>
+
+#include "grid.h"
+#include "kdm/generator/sampler.h"
+
+namespace kdm::gen {
+
+template <int D>
+struct ModelSetup {
+  std::vector<DensityGrid<D>> levels;  ///< [0] finest ... back() coarsest; ρ_{l+1} sums 2^D nodes of ρ_l
+  double mass_per_point = 0;           ///< ∫ of one unit-weight kernel: J^D
+};
+
+/// Validates `options` and `density` (throws InvalidArgument) and builds the pyramid. With n > 0 the
+/// finest density is scaled so that Σρ = n · mass_per_point (and max ρ <= peak_density); with n == 0
+/// the grid has `resolution` nodes on its shortest axis and max ρ = peak_density.
+template <int D>
+ModelSetup<D> build_model(const SamplerOptions& options, const Density& density);
+
+/// Throws InvalidArgument naming the first bad option.
+void validate_options(const SamplerOptions& options);
+
+}  // namespace kdm::gen

@@ -1,0 +1,9 @@
+#include "kdm/runtime/version.h"
+
+#include "kdm_version_config.h"
+
+namespace kdm {
+
+const char* version_string() { return KDM_VERSION_STRING; }
+
+}  // namespace kdm

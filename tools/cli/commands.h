@@ -1,0 +1,21 @@
+// The kdm subcommands. Each add_*_command registers its options on `app` and sets a callback that
+// runs it; a failing command throws CommandError, which main() prints as one line and exits 1.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace kdm::cli {
+
+struct CommandError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void add_sample_command(CLI::App& app);
+void add_analyze_command(CLI::App& app);
+
+}  // namespace kdm::cli

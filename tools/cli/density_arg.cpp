@@ -1,0 +1,42 @@
+#include "density_arg.h"
+
+#include <cmath>
+#include <cstdlib>
+
+#include "commands.h"
+#include "image_io.h"
+
+namespace kdm::cli {
+
+DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
+  DensityArg arg;
+  if (!(std::isfinite(gamma) && gamma > 0)) throw CommandError("--gamma must be a finite number > 0");
+  if (spec.rfind("const:", 0) == 0) {
+    const std::string value = spec.substr(6);
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !std::isfinite(v) || v <= 0)
+      throw CommandError("--density const:V needs a finite V > 0, got '" + value + "'");
+    arg.density = gen::Density::constant();
+    return arg;
+  }
+  tools::GreyImage image;
+  std::string error;
+  if (!tools::load_grey_image(spec, image, error)) throw CommandError(error);
+  std::vector<float> values(image.pixels.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double tone = invert ? image.pixels[i] : 1.0 - image.pixels[i];
+    values[i] = static_cast<float>(std::pow(std::max(0.0, tone), gamma));
+  }
+  try {
+    arg.density = gen::Density::from_values(image.width, image.height, std::move(values));
+  } catch (const gen::InvalidArgument& e) {
+    throw CommandError("image '" + spec + "': " + e.what() + (invert ? "" : " (an all-white image has no ink)"));
+  }
+  arg.from_image = true;
+  arg.image_width = image.width;
+  arg.image_height = image.height;
+  return arg;
+}
+
+}  // namespace kdm::cli

@@ -1,0 +1,20 @@
+// Parsing of --density: "const:V" or an image whose darkness is the density.
+#pragma once
+
+#include <string>
+
+#include "kdm/generator/sampler.h"
+
+namespace kdm::cli {
+
+struct DensityArg {
+  gen::Density density;
+  bool from_image = false;
+  int image_width = 0, image_height = 0;
+};
+
+/// `spec` is "const:V" (V finite, > 0) or a path to an image. Image darkness (1 - luminance) raised to
+/// `gamma` is the density; `invert` uses luminance instead (bright = dense). Throws CommandError.
+DensityArg parse_density(const std::string& spec, double gamma, bool invert);
+
+}  // namespace kdm::cli

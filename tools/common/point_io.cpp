@@ -1,0 +1,102 @@
+#include "point_io.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "image_io.h"
+
+namespace kdm::tools {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error) {
+  std::ifstream in(path);
+  if (!in) {
+    error = "cannot open point file '" + path + "'";
+    return false;
+  }
+  sets.clear();
+  PointSet current;
+  int file_dim = 0;
+  std::string line;
+  int line_no = 0;
+  auto finish_set = [&] {
+    if (!current.coords.empty()) sets.push_back(current);
+    current.coords.clear();
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos) continue;
+    if (line[first] == '#') {
+      finish_set();
+      continue;
+    }
+    std::vector<double> values;
+    const char* p = line.c_str() + first;
+    while (*p) {
+      char* end = nullptr;
+      const double v = std::strtod(p, &end);
+      if (end == p) {
+        error = path + ":" + std::to_string(line_no) + ": malformed number in '" + line + "'";
+        return false;
+      }
+      if (!std::isfinite(v)) {
+        error = path + ":" + std::to_string(line_no) + ": non-finite coordinate";
+        return false;
+      }
+      values.push_back(v);
+      p = end;
+      while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') ++p;
+    }
+    const int dim = static_cast<int>(values.size());
+    if (dim != 2 && dim != 3) {
+      error = path + ":" + std::to_string(line_no) + ": expected 2 or 3 coordinates, found " + std::to_string(dim);
+      return false;
+    }
+    if (file_dim == 0) file_dim = dim;
+    if (dim != file_dim) {
+      error = path + ":" + std::to_string(line_no) + ": dimension changes from " + std::to_string(file_dim) +
+              " to " + std::to_string(dim);
+      return false;
+    }
+    current.dim = dim;
+    current.coords.insert(current.coords.end(), values.begin(), values.end());
+  }
+  finish_set();
+  if (sets.empty()) {
+    error = "point file '" + path + "' holds no points";
+    return false;
+  }
+  return true;
+}
+
+bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
+                     std::string& error) {
+  const bool csv = ends_with(path, ".csv");
+  std::ostringstream out;
+  out.precision(17);
+  if (csv) {
+    out << (set.dim == 3 ? "x,y,z\n" : "x,y\n");
+  } else {
+    for (const std::string& h : header) out << "# " << h << '\n';
+  }
+  const char sep = csv ? ',' : ' ';
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    for (int k = 0; k < set.dim; ++k) {
+      if (k) out << sep;
+      out << set.coords[i * set.dim + k];
+    }
+    out << '\n';
+  }
+  return write_text_file_atomic(path, out.str(), error);
+}
+
+}  // namespace kdm::tools

@@ -1,0 +1,26 @@
+// Point-set text files as UTK and psa read and write them: '#' lines are comments, and a '#' line that
+// follows points separates one set from the next; every other line holds D coordinates in [0, 1).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace kdm::tools {
+
+/// One point set: `dim` coordinates per point, interleaved (x0 y0 x1 y1 ...).
+struct PointSet {
+  int dim = 2;
+  std::vector<double> coords;
+  std::size_t size() const { return dim > 0 ? coords.size() / dim : 0; }
+};
+
+/// Reads every set in `path`. All sets must share one dimension (2 or 3); coordinates must be finite.
+/// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).
+bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error);
+
+/// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
+/// or as CSV when `path` ends in ".csv". Atomic (temporary file, then rename).
+bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
+                     std::string& error);
+
+}  // namespace kdm::tools
