@@ -37,8 +37,12 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
   const AxisFactor& ax = fp.axes[0];
   fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
     const float pf = sign * static_cast<float>(p);
-    float* row = R + base;
-    for (int a = 0; a < ax.count; ++a) row[ax.index[a]] += pf * ax.value[a];
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      float* __restrict row = R + base + ax.index[off];
+      const float* __restrict v = ax.value.data() + off;
+      for (int a = 0; a < len; ++a) row[a] += pf * v[a];
+    }
   });
 }
 
@@ -74,16 +78,21 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
   gradient.fill(0);
   fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
     const float pf = static_cast<float>(p);
-    float* row = R + base;
     float sx = 0, sg = 0, e = 0;
-    for (int a = 0; a < ax.count; ++a) {
-      float& r = row[ax.index[a]];
-      const float s = sign_of(r);
-      const float rn = r - pf * ax.value[a];
-      sx += s * ax.deriv[a];
-      sg += s * ax.value[a];
-      e += std::fabs(r) - std::fabs(rn);
-      r = rn;
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      float* __restrict row = R + base + ax.index[off];
+      const float* __restrict v = ax.value.data() + off;
+      const float* __restrict dv = ax.deriv.data() + off;
+      for (int a = 0; a < len; ++a) {
+        const float r = row[a];
+        const float s = sign_of(r);
+        const float rn = r - pf * v[a];
+        sx += s * dv[a];
+        sg += s * v[a];
+        e += std::fabs(r) - std::fabs(rn);
+        row[a] = rn;
+      }
     }
     change += e;
     gradient[0] += p * sx;
@@ -100,15 +109,20 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
   gradient.fill(0);
   fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
     const float pf = static_cast<float>(p);
-    const float* row = R + base;
     float sx = 0, sg = 0, e = 0;
-    for (int a = 0; a < ax.count; ++a) {
-      const float r = row[ax.index[a]];
-      const float rn = r + pf * ax.value[a];
-      const float s = sign_of(rn);
-      sx += s * ax.deriv[a];
-      sg += s * ax.value[a];
-      e += std::fabs(rn) - std::fabs(r);
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      const float* __restrict row = R + base + ax.index[off];
+      const float* __restrict v = ax.value.data() + off;
+      const float* __restrict dv = ax.deriv.data() + off;
+      for (int a = 0; a < len; ++a) {
+        const float r = row[a];
+        const float rn = r + pf * v[a];
+        const float s = sign_of(rn);
+        sx += s * dv[a];
+        sg += s * v[a];
+        e += std::fabs(rn) - std::fabs(r);
+      }
     }
     change += e;
     gradient[0] += p * sx;

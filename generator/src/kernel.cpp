@@ -51,6 +51,7 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
       g *= r;
       r *= q;
     }
+    a.build_runs();
     return;
   }
   // Folded: accumulate every virtual node into its image inside [0, m).
@@ -94,6 +95,7 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
     a.fold_value[i] = 0;
     a.fold_deriv[i] = 0;
   }
+  a.build_runs();
 }
 
 }  // namespace kdm::gen

@@ -32,6 +32,20 @@ struct AxisFactor {
   std::vector<float> value;
   std::vector<float> deriv;
   int count = 0;
+  /// The indices as runs of consecutive nodes (usually one, two where a torus wraps), so inner loops
+  /// run over contiguous memory: run k covers index[run_offset[k] .. +run_length[k]).
+  std::vector<int> run_offset, run_length;
+  void build_runs() {
+    run_offset.clear();
+    run_length.clear();
+    for (int k = 0; k < count; ++k) {
+      if (k == 0 || index[k] != index[k - 1] + 1) {
+        run_offset.push_back(k);
+        run_length.push_back(0);
+      }
+      ++run_length.back();
+    }
+  }
   std::vector<double> fold_value, fold_deriv;  // scratch for folding
   std::vector<int> fold_touched;
 };
