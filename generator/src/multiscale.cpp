@@ -44,7 +44,7 @@ struct Driver {
 
   Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
     params.temperature = o.temperature * kModelTemperaturePerUser;
-    params.step = o.step;
+    params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;
   }
 

@@ -163,5 +163,39 @@ TEST(SamplerTest, FollowsExponentialRamp) {
   EXPECT_GT(rightmost, 0.9);
 }
 
+// Mean nearest-neighbour distance on the unit 3-torus over the FCC spacing (√2/n)^(1/3); O(n²), small n.
+double mean_nn_over_fcc_3d(const SampleResult& r) {
+  const std::size_t n = r.size();
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    double best = 1e300;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (i == j) continue;
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        double d = r.points[3 * i + k] - r.points[3 * j + k];
+        d -= std::round(d);
+        d2 += d * d;
+      }
+      best = std::min(best, d2);
+    }
+    sum += std::sqrt(best);
+  }
+  return sum / n / std::cbrt(std::sqrt(2.0) / n);
+}
+
+TEST(SamplerTest, ThreeDimensionalTorusIsBlueNoise) {
+  SamplerOptions o = options_for(2000, Domain::kTorus, 1);
+  o.dim = 3;
+  const SampleResult r = sample(o);
+  ASSERT_EQ(r.size(), 2000u);
+  const double davg = mean_nn_over_fcc_3d(r);
+  std::printf("3D torus n=2000: δavg/FCC = %.4f, acceptance %.3f\n", davg, r.report.acceptance_rate());
+  // Measured .853 for seeds 1 and 2 (spread < .002). Poisson points give about .55 of the FCC spacing,
+  // so .83 separates a relaxed KDM sample clearly from a broken one while allowing seed spread.
+  EXPECT_GT(davg, 0.83);
+  EXPECT_GT(r.report.acceptance_rate(), 0.3);
+}
+
 }  // namespace
 }  // namespace kdm::gen

@@ -90,7 +90,7 @@ void add_sample_command(CLI::App& app) {
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")->capture_default_str();
   cmd->add_option("--sweeps", o.sweeps, "Langevin sweeps per level")->capture_default_str();
-  cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units)")->capture_default_str();
+  cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units; 0 = automatic)")->capture_default_str();
   cmd->add_flag("--unadjusted", args->unadjusted, "Skip the Metropolis-Hastings test (biased; experiments only)");
   cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
