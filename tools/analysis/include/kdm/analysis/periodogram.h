@@ -1,0 +1,57 @@
+// The periodogram of 2D point sets and its radial statistics (DESIGN.md §6):
+//   P(k) = |Σ_j exp(−2πi k·x_j)|² / n on integer k, normalised frequency f = |k| / sqrt(n),
+//   RAPS = mean of P over rings of width one integer step in |k| (ring r holds r − ½ ≤ |k| < r + ½, f =
+//   r/√n), lowP = mean P over 0 < f < 0.5, peak height/position of RAPS, ν_eff = largest f with RAPS < 0.1 on
+//   every ring in (0, f], anisotropy (dB) = mean over rings 0.5 < f < 2.5 of 10·log10(var/mean²).
+// P is exact for periodic (torus) sets; for box sets it includes the square window's leakage.
+// Computed as a complex matrix product S = E_xᵀ E_y of per-axis exponentials, chunked over points.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "point_io.h"
+
+namespace kdm::analysis {
+
+/// A (set-averaged) periodogram on the integer grid kx, ky ∈ [−kmax, kmax].
+struct Periodogram {
+  int kmax = 0;               ///< grid half-width (integer frequencies)
+  double n = 0;               ///< points per set (mean over the sets) — defines f = |k| / sqrt(n)
+  int sets = 0;               ///< number of sets averaged
+  double fmax = 0;            ///< requested normalised frequency limit; rings are complete up to it
+  std::vector<double> power;  ///< (2kmax+1)² values, row-major: index (ky+kmax)(2kmax+1) + (kx+kmax)
+  int side() const { return 2 * kmax + 1; }
+  double at(int kx, int ky) const {
+    return power[static_cast<std::size_t>(ky + kmax) * side() + static_cast<std::size_t>(kx + kmax)];
+  }
+  double frequency(double k_norm) const;  ///< |k| → f = |k| / sqrt(n)
+  int ring_max() const;                   ///< last complete ring: floor(fmax · sqrt(n)), ≤ kmax − 1
+};
+
+/// Periodogram of one 2D set up to normalised frequency `fmax` (kmax = ceil(fmax·√n) + 1). `coords`
+/// interleaved x y in [0,1]². `threads`: 0 = all cores. Cost O(n · kmax²) flops, memory O(kmax²).
+/// Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the result does
+/// not depend on the thread count (fixed summation order).
+Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0);
+
+/// Mean periodogram of several 2D sets (all on the grid of the mean point count). Throws InvalidInput for an
+/// empty list, 3D sets or invalid points. Thread-safe.
+Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads = 0);
+
+/// Radial statistics of a periodogram (see the file comment for definitions).
+struct SpectrumStats {
+  std::vector<double> ring_f;          ///< f of rings r = 1..ring_max (index r−1)
+  std::vector<double> raps;            ///< RAPS of those rings
+  std::vector<std::size_t> ring_size;  ///< number of integer k in each ring
+  double low_p = 0;                    ///< mean P over all k with 0 < f < 0.5
+  double peak = 0, peak_f = 0;         ///< max RAPS and its f
+  double nu_eff = 0;                   ///< 0 when the first ring already has RAPS ≥ 0.1
+  double anisotropy_db = 0;  ///< mean over rings 0.5 < f < 2.5 (and ≤ fmax) of 10·log10(var/mean²)
+  double raps_at(double k_norm) const;  ///< RAPS of the ring holding |k| (NaN outside 1..ring_max)
+};
+
+/// Computes SpectrumStats from `p`. Thread-safe (pure).
+SpectrumStats spectrum_stats(const Periodogram& p);
+
+}  // namespace kdm::analysis

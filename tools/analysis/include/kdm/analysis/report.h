@@ -1,0 +1,64 @@
+// One-call analysis of a collection of point sets: reads the sets (UTK/psa text format via
+// kdm::tools::read_point_sets), runs every metric of DESIGN.md §6 that applies (NN statistics, periodogram
+// and RAPS statistics, g(r), density accuracy, tiling diagnostics) and formats a short text summary.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "kdm/analysis/density.h"
+#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/pair_correlation.h"
+#include "kdm/analysis/periodogram.h"
+#include "kdm/analysis/tiling.h"
+#include "point_io.h"
+
+namespace kdm::analysis {
+
+/// Reads and concatenates the sets of every file in `paths` (in order). Throws InvalidInput with a one-line
+/// message for a missing/empty/malformed/non-finite file, mixed dimensions or points outside [0,1].
+/// Thread-safe (touches only the named files).
+std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths);
+
+struct AnalysisOptions {
+  bool torus = true;         ///< periodic distances (else bounded box)
+  double fmax = 2.5;         ///< periodogram limit in normalised frequency f = |k|/√n (2D only)
+  bool spectrum = true;      ///< compute the periodogram (2D)
+  double gr_rmax = 3.0;      ///< g(r) range, units of the reference spacing
+  int gr_bins = 60;          ///< g(r) bins
+  DensityFunction density;   ///< target density for the density test (empty: skip)
+  double min_expected = 20;  ///< density-test windows expect at least this many points
+  double tile_size = 0;      ///< tile side for the tiling diagnostics (0: skip)
+  int threads = 0;           ///< worker threads, 0 = all cores
+};
+
+struct AnalysisReport {
+  int dim = 2;
+  bool torus = true;
+  std::size_t sets = 0, points_min = 0, points_max = 0;
+  double points_mean = 0;
+  NNStats nn;                        ///< pooled over sets, each normalised by its own spacing (spacing = 1)
+  std::vector<double> dmin_per_set;  ///< δmin of each set
+  double dmin_mean = 0;              ///< mean of dmin_per_set (nn.dmin is the worst)
+  bool has_spectrum = false;
+  Periodogram spectrum;  ///< set-averaged periodogram
+  SpectrumStats spectrum_stats;
+  PairCorrelation gr;
+  bool has_density = false;
+  DensityAccuracy density;  ///< pooled: rms/max over all windows of all sets, summed counts
+  bool has_tiling = false;
+  double tile_size = 0;
+  PeriodicityResult periodicity;  ///< needs the spectrum (NaN ratio otherwise)
+  SeamStats seams;
+  double seconds = 0;  ///< wall time of analyze()
+};
+
+/// Runs the analysis. Throws InvalidInput for an empty list, mixed dimensions, invalid points, sets with
+/// fewer than 2 points, or invalid options. Thread-safe (no shared state).
+AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options);
+
+/// A one-screen human-readable summary of `report` (several lines, '\n'-terminated). Thread-safe.
+std::string format_summary(const AnalysisReport& report);
+
+}  // namespace kdm::analysis

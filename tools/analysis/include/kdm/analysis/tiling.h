@@ -1,0 +1,58 @@
+// Tiling diagnostics for point sets assembled from square tiles of side s (1/s an integer):
+//  - periodicity ratio: mean periodogram power at the tile-lattice frequencies k = (i/s, j/s) ≠ 0 with
+//    |k| inside the analysed rings, divided by the mean RAPS of the rings holding those |k|. ≈ 1 when tiles
+//    do not repeat; ≫ 1 (up to the number of tiles) for a strictly periodic tiling.
+//  - seam statistics: each point's nearest-neighbour link is "seam" when it crosses a tile edge (the domain
+//    edge counts on the torus), else "interior"; δmin/δavg/NN1% per group and a two-sample Kolmogorov–Smirnov
+//    test of the two normalised NN-distance distributions.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/periodogram.h"
+#include "point_io.h"
+
+namespace kdm::analysis {
+
+/// Returns the number of tiles per axis, round(1/s); throws InvalidInput unless 0 < s ≤ 1 and 1/s is an
+/// integer (within 1e-6). Thread-safe.
+int tiles_per_axis(double tile_size);
+
+struct PeriodicityResult {
+  std::size_t frequencies = 0;  ///< lattice frequencies used
+  double mean_power = 0;        ///< mean P at them
+  double mean_raps = 0;         ///< mean RAPS of their rings
+  double ratio = 0;             ///< mean_power / mean_raps (NaN when no lattice frequency is in range)
+};
+
+/// Periodicity ratio of a (set-averaged) periodogram `p` with radial statistics `stats` for tile side
+/// `tile_size` (unit-domain lengths). Thread-safe (pure).
+PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& stats, double tile_size);
+
+/// Two-sample Kolmogorov–Smirnov test.
+struct KsResult {
+  double statistic = 0;  ///< D = sup |F_a − F_b|
+  double p_value = 1;    ///< asymptotic p (Kolmogorov distribution with Stephens' small-sample correction)
+};
+
+/// KS test of samples `a` and `b` (any units). Empty input gives D = 0, p = 1. Thread-safe (pure).
+KsResult ks_two_sample(std::vector<double> a, std::vector<double> b);
+
+struct SeamStats {
+  NNStats seam;      ///< NN links crossing a tile edge (normalised by the reference spacing)
+  NNStats interior;  ///< NN links inside one tile
+  KsResult ks;       ///< seam vs interior NN distances
+};
+
+/// Seam statistics pooled over `sets` (each set normalised by its own reference spacing), tile side
+/// `tile_size`. Throws InvalidInput for invalid sets or tile size. Thread-safe; `threads` 0 = all cores.
+SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, double tile_size, int threads = 0);
+
+/// Seam statistics of one set from precomputed neighbours `nn` (from nearest_neighbors on `coords`).
+/// Appends normalised NN distances to `seam` / `interior`. Thread-safe (pure).
+void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbors& nn, double tile_size,
+                   std::vector<double>& seam, std::vector<double>& interior);
+
+}  // namespace kdm::analysis

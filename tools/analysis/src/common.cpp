@@ -1,0 +1,48 @@
+// Reference spacings (DESIGN.md §6: d_hex = sqrt(2/(sqrt(3) n)) on the unit square; FCC nearest-neighbour
+// spacing (sqrt(2)/n)^(1/3) on the unit cube) and input validation shared by every metric.
+#include "kdm/analysis/common.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+
+namespace kdm::analysis {
+
+double hex_spacing(std::size_t n) {
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  return std::sqrt(2.0 / (std::sqrt(3.0) * static_cast<double>(n)));
+}
+
+double fcc_spacing(std::size_t n) {
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  return std::cbrt(std::sqrt(2.0) / static_cast<double>(n));
+}
+
+double reference_spacing(int dim, std::size_t n) {
+  if (dim == 2) return hex_spacing(n);
+  if (dim == 3) return fcc_spacing(n);
+  throw InvalidInput("dimension must be 2 or 3, got " + std::to_string(dim));
+}
+
+void validate_points(const std::vector<double>& coords, int dim) {
+  if (dim != 2 && dim != 3) throw InvalidInput("dimension must be 2 or 3, got " + std::to_string(dim));
+  if (coords.size() % static_cast<std::size_t>(dim) != 0)
+    throw InvalidInput("coordinate count " + std::to_string(coords.size()) + " is not a multiple of " +
+                       std::to_string(dim));
+  for (std::size_t i = 0; i < coords.size(); ++i) {
+    const double v = coords[i];
+    if (!std::isfinite(v))
+      throw InvalidInput("point " + std::to_string(i / dim) + " has a non-finite coordinate");
+    if (v < 0.0 || v > 1.0)
+      throw InvalidInput("point " + std::to_string(i / dim) + " lies outside the unit domain (coordinate " +
+                         std::to_string(v) + "); normalise points to [0,1)");
+  }
+}
+
+int default_threads() {
+  const unsigned hc = std::thread::hardware_concurrency();
+  return hc == 0 ? 1 : static_cast<int>(hc);
+}
+
+}  // namespace kdm::analysis

@@ -1,0 +1,119 @@
+// Density accuracy: window counts against expected counts of a target density. The density is sampled at
+// raster-cell midpoints (piecewise-constant model), a summed-area table gives window masses, and windows
+// come from recursive equal-mass splits along the longer side, kept only while both halves still expect
+// ≥ min_expected points. z = (count − μ)/√μ per window (Poisson scaling; binomial variance μ(1 − μ/n) ≈ μ).
+#include "kdm/analysis/density.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "kdm/analysis/common.h"
+
+namespace kdm::analysis {
+namespace {
+
+struct Window {
+  int x0, y0, x1, y1;  // raster cells [x0, x1) × [y0, y1)
+};
+
+struct Sat {
+  int r;
+  std::vector<double> s;  // (r+1)² prefix sums
+  double mass(int x0, int y0, int x1, int y1) const {
+    auto at = [&](int x, int y) { return s[static_cast<std::size_t>(y) * (r + 1) + x]; };
+    return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);
+  }
+};
+
+void split(const Sat& sat, const Window& w, double scale, double min_expected, std::vector<Window>& out) {
+  const double mass = sat.mass(w.x0, w.y0, w.x1, w.y1) * scale;
+  const bool along_x = (w.x1 - w.x0) >= (w.y1 - w.y0);
+  const int lo = along_x ? w.x0 : w.y0, hi = along_x ? w.x1 : w.y1;
+  if (hi - lo >= 2 && mass >= 2 * min_expected) {
+    int best = -1;
+    double best_gap = 0;
+    for (int c = lo + 1; c < hi; ++c) {  // window sides are short: a linear scan is cheap
+      const double left = (along_x ? sat.mass(w.x0, w.y0, c, w.y1) : sat.mass(w.x0, w.y0, w.x1, c)) * scale;
+      const double gap = std::abs(left - 0.5 * mass);
+      if (left >= min_expected && mass - left >= min_expected && (best < 0 || gap < best_gap)) {
+        best = c;
+        best_gap = gap;
+      }
+    }
+    if (best >= 0) {
+      Window a = w, b = w;
+      if (along_x)
+        a.x1 = b.x0 = best;
+      else
+        a.y1 = b.y0 = best;
+      split(sat, a, scale, min_expected, out);
+      split(sat, b, scale, min_expected, out);
+      return;
+    }
+  }
+  out.push_back(w);
+}
+
+}  // namespace
+
+DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, const DensityFunction& density,
+                                 const DensityOptions& options) {
+  if (dim != 2) throw InvalidInput("density accuracy is implemented for 2D sets only");
+  validate_points(coords, dim);
+  if (!density) throw InvalidInput("no target density given");
+  if (!(options.min_expected > 0)) throw InvalidInput("min_expected must be positive");
+  const std::size_t n = coords.size() / 2;
+  const double total = options.expected_total > 0 ? options.expected_total : static_cast<double>(n);
+  int r = options.raster;
+  if (r <= 0) {
+    const double side = std::sqrt(options.min_expected / std::max(1.0, total));
+    r = std::clamp(static_cast<int>(std::ceil(8.0 / side)), 256, 4096);
+  }
+  Sat sat{r, std::vector<double>(static_cast<std::size_t>(r + 1) * (r + 1), 0.0)};
+  for (int y = 0; y < r; ++y)
+    for (int x = 0; x < r; ++x) {
+      const double v = density((x + 0.5) / r, (y + 0.5) / r);
+      if (!std::isfinite(v) || v < 0) throw InvalidInput("target density is negative or not finite");
+      const std::size_t i = static_cast<std::size_t>(y + 1) * (r + 1) + (x + 1);
+      sat.s[i] = v + sat.s[i - 1] + sat.s[i - (r + 1)] - sat.s[i - (r + 1) - 1];
+    }
+  const double integral = sat.mass(0, 0, r, r);
+  if (!(integral > 0)) throw InvalidInput("target density is zero everywhere");
+  const double scale = total / integral;  // raster mass → expected count
+  std::vector<Window> windows;
+  split(sat, Window{0, 0, r, r}, scale, options.min_expected, windows);
+  std::vector<int> label(static_cast<std::size_t>(r) * r, 0);
+  for (std::size_t k = 0; k < windows.size(); ++k)
+    for (int y = windows[k].y0; y < windows[k].y1; ++y)
+      for (int x = windows[k].x0; x < windows[k].x1; ++x) label[static_cast<std::size_t>(y) * r + x] = int(k);
+  std::vector<double> counts(windows.size(), 0.0);
+  DensityAccuracy out;
+  out.points = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = coords[2 * i], y = coords[2 * i + 1];
+    const int cx = std::min(r - 1, static_cast<int>(x * r)), cy = std::min(r - 1, static_cast<int>(y * r));
+    counts[label[static_cast<std::size_t>(cy) * r + cx]] += 1;
+    if (density(x, y) == 0) ++out.zero_density;
+  }
+  double sum_z2 = 0, sum_count = 0, sum_mu = 0;
+  for (std::size_t k = 0; k < windows.size(); ++k) {
+    const Window& w = windows[k];
+    const double mu = sat.mass(w.x0, w.y0, w.x1, w.y1) * scale;
+    if (!(mu > 0)) continue;
+    const double z = (counts[k] - mu) / std::sqrt(mu);
+    sum_z2 += z * z;
+    out.max_abs_z = std::max(out.max_abs_z, std::abs(z));
+    sum_count += counts[k];
+    sum_mu += mu;
+    ++out.windows;
+  }
+  if (out.windows) {
+    out.rms_z = std::sqrt(sum_z2 / static_cast<double>(out.windows));
+    out.mean_expected = sum_mu / static_cast<double>(out.windows);
+    out.bias = (sum_count - sum_mu) / sum_mu;
+  }
+  return out;
+}
+
+}  // namespace kdm::analysis

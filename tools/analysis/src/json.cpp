@@ -1,0 +1,186 @@
+// Hand-written JSON output (RFC 8259 subset: no pretty printing beyond newlines between top-level keys)
+// for metrics.json; field names follow DESIGN.md §6 (dmin, davg, nn1, low_p, nu_eff, anisotropy_db, ...).
+#include "kdm/analysis/json.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace kdm::analysis {
+
+std::string json_quote(const std::string& s) {
+  std::string q = "\"";
+  for (unsigned char c : s) {
+    switch (c) {
+      case '"':
+        q += "\\\"";
+        break;
+      case '\\':
+        q += "\\\\";
+        break;
+      case '\n':
+        q += "\\n";
+        break;
+      case '\r':
+        q += "\\r";
+        break;
+      case '\t':
+        q += "\\t";
+        break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          q += buf;
+        } else {
+          q += static_cast<char>(c);  // UTF-8 passes through unchanged
+        }
+    }
+  }
+  return q + "\"";
+}
+
+void JsonWriter::separator() {
+  if (after_key_) {
+    after_key_ = false;
+    return;
+  }
+  if (!first_.empty()) {
+    if (!first_.back()) out_ += ',';
+    first_.back() = false;
+  }
+}
+
+JsonWriter& JsonWriter::begin_object() {
+  separator();
+  out_ += '{';
+  first_.push_back(true);
+  return *this;
+}
+JsonWriter& JsonWriter::end_object() {
+  first_.pop_back();
+  out_ += first_.empty() ? "\n}\n" : "}";
+  return *this;
+}
+JsonWriter& JsonWriter::begin_array() {
+  separator();
+  out_ += '[';
+  first_.push_back(true);
+  return *this;
+}
+JsonWriter& JsonWriter::end_array() {
+  first_.pop_back();
+  out_ += ']';
+  return *this;
+}
+JsonWriter& JsonWriter::key(const std::string& k) {
+  separator();
+  if (first_.size() == 1) out_ += "\n  ";
+  out_ += json_quote(k) + ':';
+  after_key_ = true;
+  return *this;
+}
+JsonWriter& JsonWriter::value(double v) {
+  separator();
+  if (!std::isfinite(v)) {
+    out_ += "null";
+  } else {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", v);
+    out_ += buf;
+  }
+  return *this;
+}
+JsonWriter& JsonWriter::value(long long v) {
+  separator();
+  out_ += std::to_string(v);
+  return *this;
+}
+JsonWriter& JsonWriter::value(bool v) {
+  separator();
+  out_ += v ? "true" : "false";
+  return *this;
+}
+JsonWriter& JsonWriter::value(const std::string& v) {
+  separator();
+  out_ += json_quote(v);
+  return *this;
+}
+JsonWriter& JsonWriter::value(const std::vector<double>& v) {
+  begin_array();
+  for (double x : v) value(x);
+  return end_array();
+}
+
+namespace {
+
+void write_nn(JsonWriter& w, const NNStats& s) {
+  w.begin_object();
+  w.key("count").value(s.count).key("dmin").value(s.dmin).key("davg").value(s.davg).key("nn1").value(s.nn1);
+  w.key("dmax").value(s.dmax).key("histogram_max").value(s.hist_max).key("histogram").begin_array();
+  for (std::size_t c : s.histogram) w.value(c);
+  w.end_array().end_object();
+}
+
+}  // namespace
+
+std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>& inputs) {
+  JsonWriter w;
+  w.begin_object();
+  w.key("inputs").begin_array();
+  for (const std::string& s : inputs) w.value(s);
+  w.end_array();
+  w.key("dim").value(r.dim).key("domain").value(r.torus ? "torus" : "box");
+  w.key("sets").value(r.sets).key("points_min").value(r.points_min).key("points_max").value(r.points_max);
+  w.key("points_mean").value(r.points_mean);
+  w.key("spacing_unit").value(r.dim == 2 ? "d_hex = sqrt(2/(sqrt(3) n))" : "fcc = (sqrt(2)/n)^(1/3)");
+  w.key("nearest_neighbor");
+  write_nn(w, r.nn);
+  w.key("dmin_mean_over_sets").value(r.dmin_mean).key("dmin_per_set").value(r.dmin_per_set);
+  if (r.has_spectrum) {
+    const SpectrumStats& st = r.spectrum_stats;
+    w.key("spectrum").begin_object();
+    w.key("fmax")
+        .value(r.spectrum.fmax)
+        .key("kmax")
+        .value(r.spectrum.kmax)
+        .key("sets")
+        .value(r.spectrum.sets);
+    w.key("low_p").value(st.low_p).key("peak").value(st.peak).key("peak_f").value(st.peak_f);
+    w.key("nu_eff").value(st.nu_eff).key("anisotropy_db").value(st.anisotropy_db);
+    w.key("raps_f").value(st.ring_f).key("raps").value(st.raps);
+    w.end_object();
+  }
+  w.key("pair_correlation").begin_object();
+  w.key("r_max").value(r.gr.r_max).key("r").value(r.gr.r).key("g").value(r.gr.g).end_object();
+  if (r.has_density) {
+    const DensityAccuracy& d = r.density;
+    w.key("density").begin_object();
+    w.key("windows").value(d.windows).key("mean_expected").value(d.mean_expected).key("rms_z").value(d.rms_z);
+    w.key("max_abs_z")
+        .value(d.max_abs_z)
+        .key("bias")
+        .value(d.bias)
+        .key("zero_density_points")
+        .value(d.zero_density);
+    w.end_object();
+  }
+  if (r.has_tiling) {
+    w.key("tiling").begin_object();
+    w.key("tile_size").value(r.tile_size);
+    w.key("periodicity_ratio")
+        .value(r.periodicity.ratio)
+        .key("lattice_frequencies")
+        .value(r.periodicity.frequencies);
+    w.key("seam");
+    write_nn(w, r.seams.seam);
+    w.key("interior");
+    write_nn(w, r.seams.interior);
+    w.key("ks_statistic").value(r.seams.ks.statistic).key("ks_p_value").value(r.seams.ks.p_value);
+    w.end_object();
+  }
+  w.key("seconds").value(r.seconds);
+  w.end_object();
+  return w.str();
+}
+
+}  // namespace kdm::analysis

@@ -1,0 +1,47 @@
+// Internal: a blocking parallel loop over [0, count) on `threads` workers (OpenMP when available, else
+// std::thread). Each index is handled exactly once; the body must only write data owned by its index
+// (or by its worker slot `w`, 0 <= w < workers) so results never depend on the thread count.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <thread>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace kdm::analysis::detail {
+
+/// Number of worker slots parallel_for will use for `threads` (0 = all cores) and `count` items.
+inline int worker_count(int threads, std::ptrdiff_t count) {
+  int t = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (count < t) t = static_cast<int>(std::max<std::ptrdiff_t>(1, count));
+  return t;
+}
+
+/// Calls body(i, w) for every i in [0, count); w is the worker slot. Dynamic scheduling, blocking.
+template <class Body>
+void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
+  const int workers = worker_count(threads, count);
+  if (workers <= 1) {
+    for (std::ptrdiff_t i = 0; i < count; ++i) body(i, 0);
+    return;
+  }
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1) num_threads(workers)
+  for (std::ptrdiff_t i = 0; i < count; ++i) body(i, omp_get_thread_num());
+#else
+  std::atomic<std::ptrdiff_t> next{0};
+  std::vector<std::thread> pool;
+  for (int w = 0; w < workers; ++w)
+    pool.emplace_back([&, w] {
+      for (std::ptrdiff_t i; (i = next.fetch_add(1)) < count;) body(i, w);
+    });
+  for (std::thread& t : pool) t.join();
+#endif
+}
+
+}  // namespace kdm::analysis::detail

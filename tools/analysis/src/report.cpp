@@ -1,0 +1,159 @@
+// Aggregation of the metrics over many point sets (DESIGN.md §6): loading, the per-metric calls, pooling
+// rules (NN distances pooled after per-set normalisation; the periodogram averaged over sets; density z
+// pooled over all windows) and the text summary.
+#include "kdm/analysis/report.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "kdm/analysis/common.h"
+
+namespace kdm::analysis {
+
+std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths) {
+  if (paths.empty()) throw InvalidInput("no point files given");
+  std::vector<tools::PointSet> all;
+  for (const std::string& path : paths) {
+    std::vector<tools::PointSet> sets;
+    std::string error;
+    if (!tools::read_point_sets(path, sets, error)) throw InvalidInput(error);
+    for (std::size_t k = 0; k < sets.size(); ++k) {
+      if (!all.empty() && sets[k].dim != all.front().dim)
+        throw InvalidInput(path + ": " + std::to_string(sets[k].dim) + "D points after " +
+                           std::to_string(all.front().dim) + "D ones");
+      try {
+        validate_points(sets[k].coords, sets[k].dim);
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(path + " (set " + std::to_string(k + 1) + "): " + e.what());
+      }
+      all.push_back(std::move(sets[k]));
+    }
+  }
+  return all;
+}
+
+AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (sets.empty()) throw InvalidInput("no point sets to analyse");
+  AnalysisReport r;
+  r.dim = sets.front().dim;
+  r.torus = o.torus;
+  r.sets = sets.size();
+  r.points_min = sets.front().size();
+  double total = 0;
+  for (const tools::PointSet& s : sets) {
+    if (s.dim != r.dim) throw InvalidInput("point sets mix dimensions");
+    if (s.size() < 2) throw InvalidInput("every point set needs at least 2 points");
+    r.points_min = std::min(r.points_min, s.size());
+    r.points_max = std::max(r.points_max, s.size());
+    total += static_cast<double>(s.size());
+  }
+  r.points_mean = total / static_cast<double>(sets.size());
+  if (o.tile_size > 0) tiles_per_axis(o.tile_size);  // validate options before the expensive parts
+
+  std::vector<double> pooled, seam, interior;
+  for (const tools::PointSet& s : sets) {
+    const NearestNeighbors nn = nearest_neighbors(s.coords, s.dim, o.torus, o.threads);
+    const double spacing = reference_spacing(s.dim, s.size());
+    double lo = nn.distance.front();
+    for (double d : nn.distance) {
+      pooled.push_back(d / spacing);
+      lo = std::min(lo, d);
+    }
+    r.dmin_per_set.push_back(lo / spacing);
+    if (o.tile_size > 0) split_by_seam(s.coords, s.dim, nn, o.tile_size, seam, interior);
+  }
+  r.nn = summarize_nn(pooled, 1.0);
+  r.dmin_mean = 0;
+  for (double d : r.dmin_per_set) r.dmin_mean += d / static_cast<double>(r.dmin_per_set.size());
+
+  if (o.spectrum && r.dim == 2) {
+    r.spectrum = average_periodogram(sets, o.fmax, o.threads);
+    r.spectrum_stats = spectrum_stats(r.spectrum);
+    r.has_spectrum = true;
+  }
+  r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
+
+  if (o.density && r.dim == 2) {
+    DensityOptions dopt;
+    dopt.min_expected = o.min_expected;
+    double z2 = 0, mu = 0, count_sum = 0, mu_sum = 0;
+    for (const tools::PointSet& s : sets) {
+      const DensityAccuracy d = density_accuracy(s.coords, s.dim, o.density, dopt);
+      z2 += d.rms_z * d.rms_z * static_cast<double>(d.windows);
+      mu += d.mean_expected * static_cast<double>(d.windows);
+      mu_sum += d.mean_expected * static_cast<double>(d.windows);
+      count_sum += (1.0 + d.bias) * d.mean_expected * static_cast<double>(d.windows);
+      r.density.points += d.points;
+      r.density.windows += d.windows;
+      r.density.zero_density += d.zero_density;
+      r.density.max_abs_z = std::max(r.density.max_abs_z, d.max_abs_z);
+    }
+    if (r.density.windows) {
+      const double w = static_cast<double>(r.density.windows);
+      r.density.rms_z = std::sqrt(z2 / w);
+      r.density.mean_expected = mu / w;
+      r.density.bias = (count_sum - mu_sum) / mu_sum;
+    }
+    r.has_density = true;
+  }
+
+  if (o.tile_size > 0) {
+    r.has_tiling = true;
+    r.tile_size = o.tile_size;
+    r.seams.seam = summarize_nn(seam, 1.0);
+    r.seams.interior = summarize_nn(interior, 1.0);
+    r.seams.ks = ks_two_sample(seam, interior);
+    if (r.has_spectrum)
+      r.periodicity = periodicity_ratio(r.spectrum, r.spectrum_stats, o.tile_size);
+    else
+      r.periodicity.ratio = std::nan("");
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+std::string format_summary(const AnalysisReport& r) {
+  std::string s;
+  char line[512];
+  auto add = [&](const char* fmt, auto... args) {
+    std::snprintf(line, sizeof line, fmt, args...);
+    s += line;
+  };
+  add("%zu set(s) of %zu", r.sets, r.points_min);
+  if (r.points_max != r.points_min) add("..%zu", r.points_max);
+  add(" %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
+  add("nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n", r.nn.dmin,
+      r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
+  if (r.has_spectrum) {
+    const SpectrumStats& st = r.spectrum_stats;
+    add("spectrum (f ≤ %.2f, %d set(s))  lowP %.4f  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n",
+        r.spectrum.fmax, r.spectrum.sets, st.low_p, st.peak, st.peak_f, st.nu_eff, st.anisotropy_db);
+  }
+  double gmax = 0, rpeak = 0;
+  for (std::size_t b = 0; b < r.gr.g.size(); ++b)
+    if (r.gr.g[b] > gmax) {
+      gmax = r.gr.g[b];
+      rpeak = r.gr.r[b];
+    }
+  add("pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  if (r.has_density)
+    add("density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
+        r.density.windows, r.density.mean_expected, r.density.rms_z, r.density.max_abs_z, r.density.bias,
+        r.density.zero_density);
+  if (r.has_tiling) {
+    add("tiling (s=%g)      periodicity ratio %.2f over %zu frequencies\n", r.tile_size, r.periodicity.ratio,
+        r.periodicity.frequencies);
+    add("  seams   %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f\n", r.seams.seam.count, r.seams.seam.dmin,
+        r.seams.seam.davg, r.seams.seam.nn1);
+    add("  inside  %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f   KS D %.4f  p %.3g\n",
+        r.seams.interior.count, r.seams.interior.dmin, r.seams.interior.davg, r.seams.interior.nn1,
+        r.seams.ks.statistic, r.seams.ks.p_value);
+  }
+  add("analysis time %.2f s\n", r.seconds);
+  return s;
+}
+
+}  // namespace kdm::analysis
