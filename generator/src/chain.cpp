@@ -23,7 +23,8 @@ Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
 template <int D>
 double Chain<D>::sigma_for(double rho, double w) const {
   if (!(rho > 0)) return params_.sigma_cap;
-  return std::min(params_.sigma_cap, std::pow(rho / w, -1.0 / D));
+  const double sigma = D == 2 ? 1.0 / std::sqrt(rho / w) : 1.0 / std::cbrt(rho / w);
+  return std::min(params_.sigma_cap, sigma);
 }
 
 template <int D>
@@ -190,7 +191,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   } else {
     // log q(x'|x) and log q(x|x') of the two Gaussian proposals, up to the shared (2π)^(d/2).
     const double var_new = T * sigma_new * dt;
-    double forward = 0.5 * D * std::log(var_old), reverse = 0.5 * D * std::log(var_new);
+    double forward = 0, reverse = sigma_new == sigma_old ? 0.0 : 0.5 * D * std::log(var_new / var_old);
     for (int k = 0; k < D; ++k) {
       const double drift_new = -0.5 * sigma_new * dt * grad_new[k];
       const double f = step[k] - drift_old[k], r = -step[k] - drift_new;

@@ -57,15 +57,14 @@ struct DensityGrid {
       const double u = x[k] - 0.5;
       const double fl = std::floor(u);
       f[k] = u - fl;
+      // x is canonical (inside [0, m)), so fl is in [-1, m - 1]: wrap or clamp without a division.
       std::int64_t a = static_cast<std::int64_t>(fl), b = a + 1;
       if (grid.torus) {
-        a = ((a % m) + m) % m;
-        b = ((b % m) + m) % m;
+        if (a < 0) a += m;
+        if (b >= m) b -= m;
       } else {
         if (a < 0) a = 0;
         if (b > m - 1) b = m - 1;
-        if (a > m - 1) a = m - 1;
-        if (b < 0) b = 0;
       }
       const std::int64_t s = grid.stride(k);
       i0[k] = a * s;

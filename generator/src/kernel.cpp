@@ -40,7 +40,11 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
       a.value.resize(len);
       a.deriv.resize(len);
     }
-    std::int64_t idx = torus ? ((lo % m) + m) % m : lo;
+    std::int64_t idx = lo;  // direct on a torus means len <= m, so one wrap at most
+    if (torus) {
+      if (idx < 0) idx += m;
+      if (idx >= m) idx -= m;
+    }
     for (int k = 0; k < len; ++k) {
       const double t = t0 + k * h;
       const double v = g - edge;

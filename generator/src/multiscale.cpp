@@ -79,20 +79,25 @@ struct Driver {
     }
   }
 
-  /// Brings Σw to exactly n on the coarsest grid as far as whole kernels allow: removes the kernels
-  /// whose removal raises E least, then adds kernels at the nodes where that lowers E most.
+  /// Brings Σw to exactly n on the coarsest grid as far as whole kernels allow: removes the kernels whose
+  /// removal raises E least per unit of weight, then adds kernels where that lowers E most per unit of
+  /// weight. Per unit of weight, so that light kernels in sparse regions are not the cheapest to remove
+  /// (that would empty the sparse end of a high-dynamic-range density).
   void fix_count_coarse(Chain<D>& chain) {
     const double n = static_cast<double>(options.n);
     typename Chain<D>::Scratch scratch;
     double w = total_weight();
     while (w > n && !particles.empty()) {
-      std::size_t best = 0;
-      double best_change = std::numeric_limits<double>::infinity();
-      for (std::size_t j = 0; j < particles.size(); ++j) {
-        chain.splat(particles[j], -1.0f, scratch);
-        const double change = -chain.energy_change_if_added(particles[j], scratch);
-        chain.splat(particles[j], 1.0f, scratch);
-        if (change < best_change) best_change = change, best = j;
+      std::size_t best = particles.size();
+      double best_cost = std::numeric_limits<double>::infinity();
+      for (int pass = 0; pass < 2 && best == particles.size(); ++pass) {
+        for (std::size_t j = 0; j < particles.size(); ++j) {
+          if (pass == 0 && particles[j].weight() > w - n) continue;  // prefer not to undershoot
+          chain.splat(particles[j], -1.0f, scratch);
+          const double cost = -chain.energy_change_if_added(particles[j], scratch) / particles[j].weight();
+          chain.splat(particles[j], 1.0f, scratch);
+          if (cost < best_cost) best_cost = cost, best = j;
+        }
       }
       chain.splat(particles[best], -1.0f, scratch);
       w -= particles[best].weight();
@@ -102,7 +107,7 @@ struct Driver {
     const Grid<D>& g = chain.grid();
     const int max_splits = static_cast<int>(setup.levels.size()) - 1;
     while (w < n) {
-      double best_change = std::numeric_limits<double>::infinity();
+      double best_gain = std::numeric_limits<double>::infinity();
       Particle<D> best;
       for (std::int64_t node = 0; node < g.size(); ++node) {
         const double rho = chain.density().rho[node];
@@ -111,10 +116,10 @@ struct Driver {
         p.x = node_centre(g, node);
         p.splits = static_cast<std::uint8_t>(splits_for<D>(rho, max_splits));
         if (w + p.weight() > n) continue;
-        const double change = chain.energy_change_if_added(p, scratch);
-        if (change < best_change) best_change = change, best = p;
+        const double gain = chain.energy_change_if_added(p, scratch) / p.weight();
+        if (gain < best_gain) best_gain = gain, best = p;
       }
-      if (best_change == std::numeric_limits<double>::infinity()) break;
+      if (best_gain == std::numeric_limits<double>::infinity()) break;
       chain.splat(best, 1.0f, scratch);
       particles.push_back(best);
       w += best.weight();

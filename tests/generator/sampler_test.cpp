@@ -103,61 +103,72 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   EXPECT_THROW(Density::from_values(0, 0, {}), InvalidArgument);
 }
 
-// Window counts against the density: columns of equal expected count along x (the density varies only
-// along x), each cut into `rows` windows along y. Returns RMS of z = (count - μ) / sqrt(μ).
-double window_z_rms(const SampleResult& r, const std::function<double(double)>& rho_x, double min_expected,
-                    int rows) {
+// Window counts against a density that varies along x only: square windows, as small as possible while
+// each expects at least `min_expected` points (columns as wide as their windows are tall, so no window
+// is a thin strip, whose count a row of points can swing). Returns RMS of z = (count - μ) / sqrt(μ).
+double window_z_rms(const SampleResult& r, const std::function<double(double)>& rho_x, double min_expected) {
   const int steps = 100000;
   std::vector<double> cdf(steps + 1, 0.0);
   for (int i = 0; i < steps; ++i) cdf[i + 1] = cdf[i] + rho_x((i + 0.5) / steps) / steps;
   const double n = static_cast<double>(r.size()), total = cdf[steps];
-  const double per_column = min_expected * rows / n * total;
-  std::vector<double> edges = {0.0};
-  for (int i = 1; i <= steps; ++i)
-    if (cdf[i] - cdf[static_cast<std::size_t>(edges.back() * steps)] >= per_column && total - cdf[i] >= per_column)
-      edges.push_back(double(i) / steps);
-  edges.push_back(1.0);
-  const int columns = static_cast<int>(edges.size()) - 1;
-  std::vector<double> count(columns * rows, 0.0);
-  for (std::size_t j = 0; j < r.size(); ++j) {
-    const double x = r.points[2 * j], y = r.points[2 * j + 1];
-    const int c = static_cast<int>(std::upper_bound(edges.begin(), edges.end(), x) - edges.begin()) - 1;
-    count[c * rows + std::min(rows - 1, static_cast<int>(y * rows))] += 1;
+  auto mass = [&](double a, double b) {
+    return cdf[static_cast<std::size_t>(std::lround(b * steps))] - cdf[static_cast<std::size_t>(std::lround(a * steps))];
+  };
+  struct Column {
+    double x0, x1;
+    int rows;
+  };
+  std::vector<Column> columns;
+  double x = 0;
+  while (x < 1) {
+    // The most rows (smallest square windows, side 1/rows) whose windows here expect >= min_expected.
+    int rows = static_cast<int>(std::sqrt(n / min_expected)) + 1;
+    while (rows > 1 && n * mass(x, std::min(1.0, x + 1.0 / rows)) / total / rows < min_expected) --rows;
+    const double x1 = std::min(1.0, x + 1.0 / rows);
+    columns.push_back({x, x1, rows});
+    x = x1;
+  }
+  // A last column too narrow to hold its windows' share merges into the one before.
+  if (columns.size() > 1 && n * mass(columns.back().x0, 1.0) / total / columns.back().rows < min_expected) {
+    columns[columns.size() - 2].x1 = 1.0;
+    columns.pop_back();
   }
   double sum_z2 = 0;
-  for (int c = 0; c < columns; ++c) {
-    const double mass = cdf[static_cast<std::size_t>(std::lround(edges[c + 1] * steps))] -
-                        cdf[static_cast<std::size_t>(std::lround(edges[c] * steps))];
-    const double mu = n * mass / total / rows;
-    for (int k = 0; k < rows; ++k) sum_z2 += (count[c * rows + k] - mu) * (count[c * rows + k] - mu) / mu;
+  int windows = 0;
+  for (const Column& c : columns) {
+    std::vector<double> count(c.rows, 0.0);
+    for (std::size_t j = 0; j < r.size(); ++j) {
+      const double px = r.points[2 * j], py = r.points[2 * j + 1];
+      if (px >= c.x0 && (px < c.x1 || c.x1 == 1.0)) count[std::min(c.rows - 1, static_cast<int>(py * c.rows))] += 1;
+    }
+    const double mu = n * mass(c.x0, c.x1) / total / c.rows;
+    for (double k : count) sum_z2 += (k - mu) * (k - mu) / mu, ++windows;
   }
-  return std::sqrt(sum_z2 / (columns * rows));
+  return std::sqrt(sum_z2 / windows);
 }
 
 // Poisson points give RMS z ≈ 1; a sampler that follows the density with blue-noise counts gives far
-// less. 0.5 is the issue's bar; measured values are printed.
+// less. 0.5 is the issue's bar; measured values are printed (quadratic: 0.26 at seed 3).
 TEST(SamplerTest, FollowsQuadraticDensityProfile) {
   SamplerOptions o = options_for(4000, Domain::kBox, 3);
   Density d;
   d.function = [](const double* u) { return u[0] * u[0]; };  // paper Fig. 8
   const SampleResult r = sample(o, d);
-  const double z = window_z_rms(r, [](double x) { return x * x; }, 20, 8);
+  const double z = window_z_rms(r, [](double x) { return x * x; }, 20);
   std::printf("quadratic profile: RMS z = %.3f\n", z);
   EXPECT_LE(z, 0.5);
 }
 
-TEST(SamplerTest, FollowsExponentialRamp) {
+TEST(SamplerTest, FollowsHighDynamicRangeRamp) {
   SamplerOptions o = options_for(20000, Domain::kBox, 4);
   Density d;
-  // 1 : 100 across the square. The issue asks 1 : 5000; we do not meet RMS z <= 0.5 there yet (sparse
-  // regions are mis-filled by up to 2x: slow mass transport at the cold coarse levels), see the issue notes.
-  d.function = [](const double* u) { return std::pow(100.0, -u[0]); };
+  // 1 : 5000 across the square (paper Fig. 9's range).
+  d.function = [](const double* u) { return std::pow(5000.0, -u[0]); };
   const SampleResult r = sample(o, d);
-  const double z = window_z_rms(r, [](double x) { return std::pow(100.0, -x); }, 20, 8);
-  std::printf("1:100 ramp: RMS z = %.3f\n", z);
-  // Not yet the issue's bar (0.5): measured 0.614 at this seed, the sparse end under-filled by ~10%.
-  // This bound guards against getting worse while that is open (see the issue notes).
-  EXPECT_LE(z, 0.7);
+  const double z = window_z_rms(r, [](double x) { return std::pow(5000.0, -x); }, 20);
+  std::printf("1:5000 ramp: RMS z = %.3f\n", z);
+  // Measured 0.27, 0.37, 0.29, 0.37 for seeds 4–7; the issue's bar is 0.5.
+  EXPECT_LE(z, 0.5);
   double rightmost = 0;  // the sparse end is reached
   for (std::size_t j = 0; j < r.size(); ++j) rightmost = std::max(rightmost, r.points[2 * j]);
   EXPECT_GT(rightmost, 0.9);
