@@ -1,0 +1,61 @@
+// Blue-noise quality of the full sampler, measured with the analysis library (DESIGN.md §6) against the
+// reference implementation's statistics (shared/reference/README.md: δmin .612, δavg .872, lowP .0044).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/periodogram.h"
+#include "kdm/generator/sampler.h"
+
+namespace kdm::gen {
+namespace {
+
+struct SetStats {
+  double dmin = 0, davg = 0, low_p = 0;
+};
+
+SetStats sample_and_measure(SamplerOptions o, int seeds) {
+  SetStats mean;
+  std::vector<tools::PointSet> sets;
+  for (int s = 1; s <= seeds; ++s) {
+    o.seed = static_cast<std::uint64_t>(s);
+    tools::PointSet set;
+    set.dim = 2;
+    set.coords = sample(o).points;
+    const analysis::NNStats nn = analysis::nn_stats(set.coords, 2, /*torus=*/true);
+    mean.dmin += nn.dmin / seeds;
+    mean.davg += nn.davg / seeds;
+    sets.push_back(std::move(set));
+  }
+  mean.low_p = analysis::spectrum_stats(analysis::average_periodogram(sets, 0.6)).low_p;
+  return mean;
+}
+
+TEST(QualityTest, DefaultTemperatureMatchesTheReferenceLook) {
+  SamplerOptions o;
+  o.n = 4096;
+  const SetStats s = sample_and_measure(o, 8);
+  std::printf("n=4096, 8 seeds: mean δmin %.3f, δavg %.4f, lowP %.4f\n", s.dmin, s.davg, s.low_p);
+  // The issue's bars. Measured (seeds 1–8): δmin .597, δavg .8721, lowP .0058. Seed-to-seed spread of δavg
+  // is about .003 and of δmin .03 (so the 8-seed means sit inside); lowP is the tight one.
+  EXPECT_GE(s.davg, 0.865);
+  EXPECT_LE(s.low_p, 0.006);
+  EXPECT_GE(s.dmin, 0.58);
+}
+
+TEST(QualityTest, LowTemperatureIsMoreOrdered) {
+  SamplerOptions o;
+  o.n = 4096;
+  o.temperature = 0.2;  // the documented low-temperature setting: --temperature 0.2 --sweeps 100
+  o.sweeps = 100;
+  const SetStats s = sample_and_measure(o, 2);
+  std::printf("n=4096, T=0.2, 100 sweeps, 2 seeds: mean δmin %.3f, δavg %.4f, lowP %.4f\n", s.dmin, s.davg,
+              s.low_p);
+  // Measured δavg .904 for seeds 1–2 (spread .001); the issue asks >= .90.
+  EXPECT_GE(s.davg, 0.90);
+}
+
+}  // namespace
+}  // namespace kdm::gen
