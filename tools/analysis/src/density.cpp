@@ -93,8 +93,11 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
   for (std::size_t i = 0; i < n; ++i) {
     const double x = coords[2 * i], y = coords[2 * i + 1];
     const int cx = std::min(r - 1, static_cast<int>(x * r)), cy = std::min(r - 1, static_cast<int>(y * r));
+    if (density(x, y) == 0) {  // counted apart: such points are misplaced, not part of any window's count
+      ++out.zero_density;
+      continue;
+    }
     counts[label[static_cast<std::size_t>(cy) * r + cx]] += 1;
-    if (density(x, y) == 0) ++out.zero_density;
   }
   double sum_z2 = 0, sum_count = 0, sum_mu = 0;
   for (std::size_t k = 0; k < windows.size(); ++k) {

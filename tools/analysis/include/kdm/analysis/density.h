@@ -21,13 +21,13 @@ struct DensityOptions {
 };
 
 struct DensityAccuracy {
-  std::size_t points = 0;        ///< points in the set
-  std::size_t windows = 0;       ///< windows with μ > 0
-  double mean_expected = 0;      ///< mean μ over those windows
-  double rms_z = 0;              ///< sqrt(mean z²) over those windows
-  double max_abs_z = 0;          ///< max |z|
-  double bias = 0;               ///< (Σcount − Σμ) / Σμ over windows with μ > 0
-  std::size_t zero_density = 0;  ///< points where ρ(point) = 0
+  std::size_t points = 0;    ///< points in the set
+  std::size_t windows = 0;   ///< windows with μ > 0
+  double mean_expected = 0;  ///< mean μ over those windows
+  double rms_z = 0;          ///< sqrt(mean z²) over those windows
+  double max_abs_z = 0;      ///< max |z|
+  double bias = 0;  ///< (Σcount − Σμ) / Σμ over windows with μ > 0 (zero-density points excluded)
+  std::size_t zero_density = 0;  ///< points where ρ(point) = 0 (not counted in any window)
 };
 
 /// Measures one 2D set (interleaved x y in [0,1]²) against `density`. Throws InvalidInput for invalid

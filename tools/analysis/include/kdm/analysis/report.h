@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
 #include "kdm/analysis/nearest_neighbor.h"
 #include "kdm/analysis/pair_correlation.h"

@@ -1,0 +1,105 @@
+// Reading point files (read_point_sets / load_point_sets): good files, several sets per file, and every kind
+// of bad input; the JSON writer; the analyze() aggregation on a small input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "kdm/analysis/json.h"
+#include "kdm/analysis/report.h"
+#include "point_io.h"
+#include "test_sets.h"
+
+namespace kdm::analysis {
+namespace {
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "kdm_analysis_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string read_error(const std::string& text, const std::string& name) {
+  std::vector<tools::PointSet> sets;
+  std::string error;
+  EXPECT_FALSE(tools::read_point_sets(write_temp(name, text), sets, error)) << name;
+  return error;
+}
+
+TEST(PointFiles, ReadsSeveralSets) {
+  const std::string path = write_temp("two.txt", "# header\n0.1 0.2\n0.3 0.4\n#\n0.5 0.6\n\n0.7,0.8\r\n");
+  std::vector<tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(tools::read_point_sets(path, sets, error)) << error;
+  ASSERT_EQ(sets.size(), 2u);
+  EXPECT_EQ(sets[0].size(), 2u);
+  EXPECT_EQ(sets[1].size(), 2u);
+  EXPECT_DOUBLE_EQ(sets[1].coords[3], 0.8);
+  const std::vector<tools::PointSet> all = load_point_sets({path, path});
+  EXPECT_EQ(all.size(), 4u);
+}
+
+TEST(PointFiles, RejectsBadInput) {
+  EXPECT_NE(read_error("", "empty.txt").find("no points"), std::string::npos);
+  EXPECT_NE(read_error("# only a comment\n", "comment.txt").find("no points"), std::string::npos);
+  EXPECT_NE(read_error("0.1 0.2\n0.3 abc\n", "malformed.txt").find(":2:"), std::string::npos);
+  EXPECT_NE(read_error("0.1 nan\n", "nan.txt").find("non-finite"), std::string::npos);
+  EXPECT_NE(read_error("0.1 inf\n", "inf.txt").find("non-finite"), std::string::npos);
+  EXPECT_NE(read_error("0.1 1e999\n", "overflow.txt").find("non-finite"), std::string::npos);
+  EXPECT_NE(read_error("0.1\n", "one.txt").find("expected 2 or 3"), std::string::npos);
+  EXPECT_NE(read_error("0.1 0.2\n0.1 0.2 0.3\n", "mixed.txt").find("dimension changes"), std::string::npos);
+  std::vector<tools::PointSet> sets;
+  std::string error;
+  EXPECT_FALSE(tools::read_point_sets("/nonexistent/kdm/points.txt", sets, error));
+  EXPECT_NE(error.find("cannot open"), std::string::npos);
+  EXPECT_THROW(load_point_sets({"/nonexistent/kdm/points.txt"}), InvalidInput);
+  EXPECT_THROW(load_point_sets({write_temp("range.txt", "0.1 1.5\n0.2 0.3\n")}), InvalidInput);
+  EXPECT_THROW(load_point_sets({write_temp("d2.txt", "0.1 0.5\n"), write_temp("d3.txt", "0.1 0.5 0.2\n")}),
+               InvalidInput);
+  EXPECT_THROW(load_point_sets({}), InvalidInput);
+}
+
+TEST(Json, WriterEscapesAndNulls) {
+  JsonWriter w;
+  w.begin_object()
+      .key("a\"b")
+      .value(std::nan(""))
+      .key("v")
+      .value(std::vector<double>{1.5, 2})
+      .key("s")
+      .value("x\ny");
+  w.key("t").value(true).end_object();
+  EXPECT_EQ(w.str(), "{\n  \"a\\\"b\":null,\n  \"v\":[1.5,2],\n  \"s\":\"x\\ny\",\n  \"t\":true\n}\n");
+  EXPECT_EQ(json_quote(std::string("\x01", 1)), "\"\\u0001\"");
+}
+
+TEST(Report, AnalyzeAggregatesSets) {
+  std::vector<tools::PointSet> sets = {testing::uniform_set(1000, 21), testing::uniform_set(1200, 22)};
+  AnalysisOptions o;
+  o.density = [](double, double) { return 1.0; };
+  o.tile_size = 0.25;
+  o.fmax = 1.5;
+  const AnalysisReport r = analyze(sets, o);
+  EXPECT_EQ(r.sets, 2u);
+  EXPECT_EQ(r.points_min, 1000u);
+  EXPECT_EQ(r.points_max, 1200u);
+  EXPECT_EQ(r.nn.count, 2200u);
+  ASSERT_EQ(r.dmin_per_set.size(), 2u);
+  EXPECT_DOUBLE_EQ(r.nn.dmin, std::min(r.dmin_per_set[0], r.dmin_per_set[1]));
+  EXPECT_TRUE(r.has_spectrum && r.has_density && r.has_tiling);
+  EXPECT_EQ(r.seams.seam.count + r.seams.interior.count, 2200u);
+  EXPECT_GT(r.density.windows, 50u);
+  const std::string json = metrics_json(r, {"a.txt"});
+  for (const char* key :
+       {"\"low_p\"", "\"nu_eff\"", "\"davg\"", "\"rms_z\"", "\"periodicity_ratio\"", "\"g\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key;
+  EXPECT_NE(format_summary(r).find("δavg"), std::string::npos);
+  EXPECT_THROW(analyze({}, o), InvalidInput);
+  o.tile_size = 0.3;
+  EXPECT_THROW(analyze(sets, o), InvalidInput);
+}
+
+}  // namespace
+}  // namespace kdm::analysis
