@@ -169,7 +169,7 @@ struct Driver {
       for (int k = 0; k < D; ++k) centre[k] = 2 * p.x[k];
       if (p.splits == 0) {
         Particle<D> c = p;
-        c.x = centre;
+        c.x = fine.at(centre) > 0 ? centre : inside_support(fine, centre);
         next.push_back(c);
         continue;
       }
@@ -181,10 +181,43 @@ struct Driver {
       for (const Vec<D>& z : square_rule(rng)) {
         for (int k = 0; k < D; ++k) child.x[k] = centre[k] + sigma * z[k];
         keep_inside(fine.grid, child.x);
+        if (!(fine.at(child.x) > 0)) child.x = inside_support(fine, centre);
         next.push_back(child);
       }
     }
     particles.swap(next);
+  }
+
+  /// A child must not land where the finer density is zero (a coarse level's support reaches one coarse
+  /// node past a sharp edge, e.g. white paper next to ink): its kernel would be massless and could never
+  /// move again. Moves it to the node of highest density on the nearest ring of nodes around `centre`
+  /// that has any; keeps `centre` if the whole grid is empty nearby (cannot happen for a valid density).
+  static Vec<D> inside_support(const DensityGrid<D>& fine, const Vec<D>& centre) {
+    std::array<int, D> c0{};
+    for (int k = 0; k < D; ++k) c0[k] = static_cast<int>(std::floor(centre[k]));
+    int max_radius = 0;
+    for (int k = 0; k < D; ++k) max_radius = std::max(max_radius, fine.grid.dims[k]);
+    for (int radius = 0; radius <= max_radius; ++radius) {
+      Vec<D> best = centre;
+      double best_rho = 0;
+      const int side = 2 * radius + 1;
+      int cells = 1;
+      for (int k = 0; k < D; ++k) cells *= side;
+      for (int c = 0; c < cells; ++c) {
+        Vec<D> x{};
+        int rest = c, chebyshev = 0;
+        for (int k = 0; k < D; ++k, rest /= side) {
+          const int off = rest % side - radius;
+          chebyshev = std::max(chebyshev, std::abs(off));
+          x[k] = c0[k] + off + 0.5;
+        }
+        if (chebyshev != radius || !fine.grid.canonical(x)) continue;  // the ring only
+        const double rho = fine.at(x);
+        if (rho > best_rho) best_rho = rho, best = x;
+      }
+      if (best_rho > 0) return best;
+    }
+    return centre;
   }
 
   /// The 2^D corners of a unit-radius square (cube), rotated at random so no axis is preferred.

@@ -174,6 +174,19 @@ TEST(SamplerTest, FollowsHighDynamicRangeRamp) {
   EXPECT_GT(rightmost, 0.9);
 }
 
+TEST(SamplerTest, NoPointsWhereTheDensityIsZero) {
+  // Ink on white paper: a disc of density 1, zero outside. Children of split kernels at the disc's edge
+  // must not be left outside, where a massless kernel could never move again.
+  SamplerOptions o = options_for(5000, Domain::kBox, 2);
+  Density d;
+  d.function = [](const double* u) { return std::hypot(u[0] - 0.5, u[1] - 0.5) < 0.3 ? 1.0 : 0.0; };
+  const SampleResult r = sample(o, d);
+  int outside = 0;
+  for (std::size_t j = 0; j < r.size(); ++j)
+    outside += std::hypot(r.points[2 * j] - 0.5, r.points[2 * j + 1] - 0.5) > 0.3 + 0.01;  // ~2 grid nodes
+  EXPECT_EQ(outside, 0);
+}
+
 // Mean nearest-neighbour distance on the unit 3-torus over the FCC spacing (√2/n)^(1/3); O(n²), small n.
 double mean_nn_over_fcc_3d(const SampleResult& r) {
   const std::size_t n = r.size();
