@@ -24,6 +24,7 @@ using Mat = Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic>;
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 constexpr std::ptrdiff_t kChunk = 256;  // points per matrix product
 constexpr int kLanes = 4;               // independent partial sums (fixed: determinism)
+constexpr int kRowBlock = 32;           // kx rows per product (the half-disc is covered by such strips)
 
 // Column j of `e` (rows 0..kmax) gets exp(−2πi k v) for k = 0..kmax: a rotation recurrence, re-anchored
 // with an exact sincos every 32 steps to keep the phase error ≲ 1e-14.
@@ -58,26 +59,38 @@ void accumulate_set(const std::vector<double>& coords, int kmax, int threads, st
   const int kx_count = kmax + 1, ky_count = 2 * kmax + 1;
   const std::ptrdiff_t chunks = (n + kChunk - 1) / kChunk;
   const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(kLanes, std::max<std::ptrdiff_t>(1, chunks)));
+  // Only the half-disc |k| ≤ kmax is needed: rows kx of a block share the ky range of their smallest kx.
+  std::vector<int> block_width;
+  for (int kx0 = 0; kx0 <= kmax; kx0 += kRowBlock)
+    block_width.push_back(static_cast<int>(std::floor(std::sqrt(double(kmax) * kmax - double(kx0) * kx0))));
   std::vector<Mat> partial(lanes, Mat::Zero(kx_count, ky_count));
   detail::parallel_for(lanes, threads, [&](std::ptrdiff_t lane, int) {
-    MatF ex(kx_count, kChunk), ey(ky_count, kChunk), prod(kx_count, ky_count);
+    MatF ex(kx_count, kChunk), ey(ky_count, kChunk), prod(kRowBlock, ky_count);
     for (std::ptrdiff_t c = lane; c < chunks; c += lanes) {
       const std::ptrdiff_t j0 = c * kChunk, m = std::min(kChunk, n - j0);
       for (std::ptrdiff_t j = 0; j < m; ++j) {
         fill_exponentials(ex, j, coords[2 * (j0 + j)], kmax, 0, false);
         fill_exponentials(ey, j, coords[2 * (j0 + j) + 1], kmax, kmax, true);
       }
-      prod.noalias() = ex.leftCols(m) * ey.leftCols(m).transpose();
-      partial[lane] += prod.cast<std::complex<double>>();
+      for (std::size_t b = 0; b < block_width.size(); ++b) {
+        const int kx0 = static_cast<int>(b) * kRowBlock, rows = std::min(kRowBlock, kx_count - kx0);
+        const int w = block_width[b], cols = 2 * w + 1;
+        prod.topLeftCorner(rows, cols).noalias() =
+            ex.block(kx0, 0, rows, m) * ey.block(kmax - w, 0, cols, m).transpose();
+        partial[lane].block(kx0, kmax - w, rows, cols) +=
+            prod.topLeftCorner(rows, cols).cast<std::complex<double>>();
+      }
     }
   });
   for (int l = 1; l < lanes; ++l) partial[0] += partial[l];
   const Mat& s = partial[0];
   const int side = 2 * kmax + 1;
   const double inv_n = 1.0 / static_cast<double>(n);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int kx = 0; kx <= kmax; ++kx)
     for (int ky = -kmax; ky <= kmax; ++ky) {
-      const double p = std::norm(s(kx, ky + kmax)) * inv_n;
+      const bool inside = kx * kx + ky * ky <= kmax * kmax;
+      const double p = inside ? std::norm(s(kx, ky + kmax)) * inv_n : nan;
       acc[static_cast<std::size_t>(ky + kmax) * side + (kx + kmax)] += p;
       if (kx > 0) acc[static_cast<std::size_t>(kmax - ky) * side + (kmax - kx)] += p;
     }

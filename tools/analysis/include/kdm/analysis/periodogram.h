@@ -16,11 +16,13 @@ namespace kdm::analysis {
 
 /// A (set-averaged) periodogram on the integer grid kx, ky ∈ [−kmax, kmax].
 struct Periodogram {
-  int kmax = 0;               ///< grid half-width (integer frequencies)
-  double n = 0;               ///< points per set (mean over the sets) — defines f = |k| / sqrt(n)
-  int sets = 0;               ///< number of sets averaged
-  double fmax = 0;            ///< requested normalised frequency limit; rings are complete up to it
-  std::vector<double> power;  ///< (2kmax+1)² values, row-major: index (ky+kmax)(2kmax+1) + (kx+kmax)
+  int kmax = 0;     ///< grid half-width (integer frequencies)
+  double n = 0;     ///< points per set (mean over the sets) — defines f = |k| / sqrt(n)
+  int sets = 0;     ///< number of sets averaged
+  double fmax = 0;  ///< requested normalised frequency limit; rings are complete up to it
+  /// (2kmax+1)² values, row-major: index (ky+kmax)(2kmax+1) + (kx+kmax). Only the disc |k| ≤ kmax is
+  /// computed; the corners outside it hold NaN.
+  std::vector<double> power;
   int side() const { return 2 * kmax + 1; }
   double at(int kx, int ky) const {
     return power[static_cast<std::size_t>(ky + kmax) * side() + static_cast<std::size_t>(kx + kmax)];
