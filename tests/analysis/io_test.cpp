@@ -41,6 +41,18 @@ TEST(PointFiles, ReadsSeveralSets) {
   EXPECT_EQ(all.size(), 4u);
 }
 
+TEST(PointFiles, CsvRoundTrip) {
+  tools::PointSet s = testing::uniform_set(10, 31);
+  const std::string path = ::testing::TempDir() + "kdm_analysis_round.csv";
+  std::string error;
+  ASSERT_TRUE(tools::write_point_set(path, s, {}, error)) << error;
+  std::vector<tools::PointSet> sets;
+  ASSERT_TRUE(tools::read_point_sets(path, sets, error)) << error;
+  ASSERT_EQ(sets.size(), 1u);
+  EXPECT_EQ(sets[0].coords, s.coords);  // 17 significant digits: exact
+  EXPECT_FALSE(tools::read_point_sets(write_temp("late_header.csv", "0.1,0.2\nx,y\n"), sets, error));
+}
+
 TEST(PointFiles, RejectsBadInput) {
   EXPECT_NE(read_error("", "empty.txt").find("no points"), std::string::npos);
   EXPECT_NE(read_error("# only a comment\n", "comment.txt").find("no points"), std::string::npos);

@@ -39,6 +39,12 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
       finish_set();
       continue;
     }
+    // The CSV files write_point_set produces start with a column header: skip it so they read back.
+    if (line_no == 1) {
+      std::string head = line.substr(first);
+      while (!head.empty() && (head.back() == '\r' || head.back() == ' ')) head.pop_back();
+      if (head == "x,y" || head == "x,y,z") continue;
+    }
     std::vector<double> values;
     const char* p = line.c_str() + first;
     while (*p) {
@@ -58,7 +64,8 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
     }
     const int dim = static_cast<int>(values.size());
     if (dim != 2 && dim != 3) {
-      error = path + ":" + std::to_string(line_no) + ": expected 2 or 3 coordinates, found " + std::to_string(dim);
+      error = path + ":" + std::to_string(line_no) + ": expected 2 or 3 coordinates, found " +
+              std::to_string(dim);
       return false;
     }
     if (file_dim == 0) file_dim = dim;

@@ -1,5 +1,6 @@
 // Point-set text files as UTK and psa read and write them: '#' lines are comments, and a '#' line that
-// follows points separates one set from the next; every other line holds D coordinates in [0, 1).
+// follows points separates one set from the next; every other line holds D coordinates in [0, 1)
+// (separated by blanks or commas; a first line "x,y" or "x,y,z" — the CSV header we write — is skipped).
 #pragma once
 
 #include <string>
