@@ -79,13 +79,13 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   if (o.density && r.dim == 2) {
     DensityOptions dopt;
     dopt.min_expected = o.min_expected;
-    double z2 = 0, mu = 0, count_sum = 0, mu_sum = 0;
+    double z2 = 0, mu_sum = 0, count_sum = 0;  // pooled over all windows of all sets
     for (const tools::PointSet& s : sets) {
       const DensityAccuracy d = density_accuracy(s.coords, s.dim, o.density, dopt);
-      z2 += d.rms_z * d.rms_z * static_cast<double>(d.windows);
-      mu += d.mean_expected * static_cast<double>(d.windows);
-      mu_sum += d.mean_expected * static_cast<double>(d.windows);
-      count_sum += (1.0 + d.bias) * d.mean_expected * static_cast<double>(d.windows);
+      const double w = static_cast<double>(d.windows);
+      z2 += d.rms_z * d.rms_z * w;
+      mu_sum += d.mean_expected * w;
+      count_sum += (1.0 + d.bias) * d.mean_expected * w;  // Σcount of the set's windows
       r.density.points += d.points;
       r.density.windows += d.windows;
       r.density.zero_density += d.zero_density;
@@ -94,7 +94,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     if (r.density.windows) {
       const double w = static_cast<double>(r.density.windows);
       r.density.rms_z = std::sqrt(z2 / w);
-      r.density.mean_expected = mu / w;
+      r.density.mean_expected = mu_sum / w;
       r.density.bias = (count_sum - mu_sum) / mu_sum;
     }
     r.has_density = true;
