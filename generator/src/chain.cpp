@@ -42,6 +42,7 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
       const int off = ax.run_offset[run], len = ax.run_length[run];
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
+#pragma omp simd
       for (int a = 0; a < len; ++a) row[a] += pf * v[a];
     }
   });
@@ -85,6 +86,8 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
+      // Reductions in SIMD lanes: the order is fixed by the binary and the footprint, never by threads.
+#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float s = sign_of(r);
@@ -116,6 +119,7 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
       const float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
+#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float rn = r + pf * v[a];
