@@ -1,0 +1,108 @@
+// kdm tile sets: the data model and the file format (defined here, once; the baker writes it through
+// this header). A tile set is a family of Wang-style corner tiles (Lagae & Dutré 2006): with C corner
+// colours there are C^4 toroidal tiles, each holding a nested multi-density pyramid of points sorted by
+// (level, rank), so any prefix of a tile's points is itself a blue-noise set.
+//
+// File layout (all integers little-endian):
+//   offset  size  field
+//        0     8  magic "KDMTILES"
+//        8     4  format version (kTilesetFormatVersion)
+//       12     4  header size in bytes (64 + recipe size + generator version size)
+//       16     8  payload size in bytes (zstd frame)
+//       24     8  payload size once decompressed
+//       32     4  CRC-32 of the payload bytes
+//       36     4  tile count (= colours^4)
+//       40     4  colours
+//       44     4  levels
+//       48     4  recipe size;  52: generator version size;  56: reserved (0)
+//       60     4  CRC-32 of the whole header with this field read as zero
+//       64     …  recipe text, then generator version text
+//   header size … payload: zstd-compressed cereal portable-binary archive of the tiles
+// The file is exactly header size + payload size bytes long.
+//
+// Thread safety: every function here is reentrant; a TileSet is a plain value (share it read-only).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/version.h"
+
+namespace kdm {
+
+/// Result of reading or writing a tile set. Every failure has its own code.
+enum class Status : int {
+  kOk = 0,
+  kIoError,                  ///< the file could not be opened, read, written or renamed
+  kBadMagic,                 ///< not a kdm tile set
+  kUnsupportedVersion,       ///< written by an incompatible format version
+  kTruncated,                ///< shorter than its header says (or than a header)
+  kTrailingBytes,            ///< longer than its header says
+  kHeaderChecksumMismatch,   ///< header bytes damaged
+  kPayloadChecksumMismatch,  ///< payload bytes damaged
+  kTooLarge,                 ///< a size exceeds the reader's caps (see kMax* below)
+  kDecompressionFailed,      ///< the payload is not a valid zstd frame of the stated size
+  kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
+  kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TileSet)
+};
+
+/// A short English description of `status` (static storage).
+const char* status_message(Status status);
+
+/// Reader caps: files beyond them are refused before anything is allocated.
+inline constexpr std::uint64_t kMaxTilesetPayloadBytes = 512ull << 20;  ///< decompressed payload
+inline constexpr std::uint32_t kMaxTilesetHeaderBytes = 1u << 20;
+inline constexpr std::uint32_t kMaxTileColours = 16;                    ///< at most 16^4 = 65536 tiles
+inline constexpr std::uint32_t kMaxTileLevels = 16;
+
+/// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
+struct TilePoint {
+  std::uint16_t x = 0, y = 0;
+  friend bool operator==(const TilePoint& a, const TilePoint& b) { return a.x == b.x && a.y == b.y; }
+};
+
+struct Tile {
+  /// Sorted by (level, rank): the array index is the point's rank within the whole pyramid.
+  std::vector<TilePoint> points;
+  /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
+  std::vector<std::uint32_t> level_end;
+  friend bool operator==(const Tile& a, const Tile& b) { return a.points == b.points && a.level_end == b.level_end; }
+};
+
+struct TileSet {
+  std::uint32_t colours = 0;      ///< corner colours C; tiles.size() == C^4
+  std::uint32_t levels = 0;       ///< pyramid levels per tile
+  std::vector<Tile> tiles;        ///< index tile_index(sw, se, ne, nw)
+  std::string recipe;             ///< the recipe text that rebuilds this set exactly
+  std::string generator_version;  ///< the kdm version that baked it
+
+  std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
+    return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
+  }
+  friend bool operator==(const TileSet& a, const TileSet& b) {
+    return a.colours == b.colours && a.levels == b.levels && a.tiles == b.tiles && a.recipe == b.recipe &&
+           a.generator_version == b.generator_version;
+  }
+};
+
+/// Checks the structural invariants above (colour and level caps, tile count, level tables).
+/// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
+Status validate_tileset(const TileSet& set, std::string* detail = nullptr);
+
+/// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
+Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::string* detail = nullptr);
+
+/// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
+/// checked before use; nothing is allocated beyond the caps). On failure `out` is left empty.
+Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::string* detail = nullptr);
+
+/// Reads and decodes the file at `path`.
+Status load_tileset(const std::string& path, TileSet& out, std::string* detail = nullptr);
+
+/// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
+/// so an interrupted save never leaves a damaged file at `path`.
+Status save_tileset(const TileSet& set, const std::string& path, std::string* detail = nullptr);
+
+}  // namespace kdm

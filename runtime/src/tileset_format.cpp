@@ -1,0 +1,286 @@
+// Reading and writing kdm tile sets (format described in kdm/runtime/tileset.h). The reader treats its
+// input as untrusted: it checks magic, version, sizes, both checksums and the reader caps before it
+// allocates, decompresses into a buffer of the stated size only, parses counts against the bytes left,
+// and validates the structure it built.
+#include <zstd.h>
+
+#include <cereal/archives/portable_binary.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <streambuf>
+
+#include "crc32.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+namespace {
+
+constexpr char kMagic[8] = {'K', 'D', 'M', 'T', 'I', 'L', 'E', 'S'};
+constexpr std::size_t kFixedHeaderBytes = 64;
+constexpr std::size_t kHeaderCrcOffset = 60;
+
+struct ContentError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+Status fail(Status status, std::string* detail, const std::string& message) {
+  if (detail) *detail = message;
+  return status;
+}
+
+void put32(std::uint8_t* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+void put64(std::uint8_t* p, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+std::uint32_t get32(const std::uint8_t* p) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | p[i];
+  return v;
+}
+std::uint64_t get64(const std::uint8_t* p) {
+  std::uint64_t v = 0;
+  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
+  return v;
+}
+
+std::uint32_t header_crc(const std::uint8_t* header, std::size_t size) {
+  std::uint8_t zero[4] = {0, 0, 0, 0};
+  std::uint32_t crc = detail::crc32(header, kHeaderCrcOffset);
+  crc = detail::crc32(zero, 4, crc);
+  return detail::crc32(header + kFixedHeaderBytes, size - kFixedHeaderBytes, crc);
+}
+
+/// A read-only streambuf over memory that can say how many bytes are left.
+class MemoryBuffer : public std::streambuf {
+ public:
+  MemoryBuffer(const char* data, std::size_t size) {
+    char* p = const_cast<char*>(data);  // never written through: this buffer has no put area
+    setg(p, p, p + size);
+  }
+  std::size_t remaining() const { return static_cast<std::size_t>(egptr() - gptr()); }
+};
+
+using InputArchive = cereal::PortableBinaryInputArchive;
+
+template <class T>
+void save_array(cereal::PortableBinaryOutputArchive& ar, const std::vector<T>& v) {
+  ar(cereal::make_size_tag(static_cast<cereal::size_type>(v.size())));
+  ar(cereal::binary_data(const_cast<T*>(v.data()), v.size() * sizeof(T)));
+}
+
+template <class T>
+void load_array(InputArchive& ar, const MemoryBuffer& buffer, std::vector<T>& v) {
+  cereal::size_type n = 0;
+  ar(cereal::make_size_tag(n));
+  // A count larger than the bytes left cannot be genuine: refuse before allocating.
+  if (n > buffer.remaining() / sizeof(T))
+    throw ContentError("an array claims " + std::to_string(n) + " elements, more than the payload holds");
+  v.resize(static_cast<std::size_t>(n));
+  ar(cereal::binary_data(v.data(), v.size() * sizeof(T)));
+}
+
+std::vector<std::uint8_t> serialize_body(const TileSet& set) {
+  std::ostringstream stream(std::ios::binary);
+  {
+    cereal::PortableBinaryOutputArchive ar(stream);
+    ar(set.colours, set.levels, static_cast<std::uint32_t>(set.tiles.size()));
+    std::vector<std::uint16_t> xy;
+    for (const Tile& tile : set.tiles) {
+      save_array(ar, tile.level_end);
+      xy.resize(tile.points.size() * 2);
+      for (std::size_t i = 0; i < tile.points.size(); ++i) xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
+      save_array(ar, xy);
+    }
+  }
+  const std::string bytes = stream.str();
+  return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+}
+
+void parse_body(const std::vector<char>& body, TileSet& set) {
+  MemoryBuffer buffer(body.data(), body.size());
+  std::istream stream(&buffer);
+  InputArchive ar(stream);
+  std::uint32_t tile_count = 0;
+  ar(set.colours, set.levels, tile_count);
+  // Every tile takes at least two size tags (8 bytes each), which bounds the count by the bytes left.
+  if (tile_count > buffer.remaining() / 16) throw ContentError("tile count exceeds the payload");
+  set.tiles.resize(tile_count);
+  std::vector<std::uint16_t> xy;
+  for (Tile& tile : set.tiles) {
+    load_array(ar, buffer, tile.level_end);
+    load_array(ar, buffer, xy);
+    if (xy.size() % 2) throw ContentError("a tile has an odd number of coordinates");
+    tile.points.resize(xy.size() / 2);
+    for (std::size_t i = 0; i < tile.points.size(); ++i) tile.points[i] = {xy[2 * i], xy[2 * i + 1]};
+  }
+  if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
+}
+
+}  // namespace
+
+const char* status_message(Status status) {
+  switch (status) {
+    case Status::kOk: return "ok";
+    case Status::kIoError: return "I/O error";
+    case Status::kBadMagic: return "not a kdm tile set (bad magic)";
+    case Status::kUnsupportedVersion: return "unsupported tile-set format version";
+    case Status::kTruncated: return "tile set is truncated";
+    case Status::kTrailingBytes: return "tile set has trailing bytes";
+    case Status::kHeaderChecksumMismatch: return "tile-set header checksum mismatch";
+    case Status::kPayloadChecksumMismatch: return "tile-set payload checksum mismatch";
+    case Status::kTooLarge: return "tile set exceeds the reader's size limits";
+    case Status::kDecompressionFailed: return "tile-set payload does not decompress";
+    case Status::kInvalidContent: return "tile-set content is inconsistent";
+    case Status::kInvalidArgument: return "invalid argument";
+  }
+  return "unknown status";
+}
+
+Status validate_tileset(const TileSet& set, std::string* detail) {
+  auto bad = [&](const std::string& m) { return fail(Status::kInvalidContent, detail, m); };
+  if (set.colours < 1 || set.colours > kMaxTileColours)
+    return bad("colour count " + std::to_string(set.colours) + " is outside 1.." + std::to_string(kMaxTileColours));
+  if (set.levels < 1 || set.levels > kMaxTileLevels)
+    return bad("level count " + std::to_string(set.levels) + " is outside 1.." + std::to_string(kMaxTileLevels));
+  const std::size_t expected = std::size_t(set.colours) * set.colours * set.colours * set.colours;
+  if (set.tiles.size() != expected)
+    return bad("expected " + std::to_string(expected) + " tiles, found " + std::to_string(set.tiles.size()));
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const Tile& tile = set.tiles[t];
+    if (tile.level_end.size() != set.levels) return bad("tile " + std::to_string(t) + " has a wrong level table size");
+    for (std::size_t k = 1; k < tile.level_end.size(); ++k)
+      if (tile.level_end[k] < tile.level_end[k - 1]) return bad("tile " + std::to_string(t) + " has a decreasing level table");
+    if (tile.level_end.back() != tile.points.size())
+      return bad("tile " + std::to_string(t) + "'s level table does not end at its point count");
+  }
+  return Status::kOk;
+}
+
+Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::string* detail) {
+  if (validate_tileset(set, detail) != Status::kOk) return Status::kInvalidArgument;
+  if (set.recipe.size() + set.generator_version.size() + kFixedHeaderBytes > kMaxTilesetHeaderBytes)
+    return fail(Status::kInvalidArgument, detail, "recipe text is too long");
+  const std::vector<std::uint8_t> body = serialize_body(set);
+  if (body.size() > kMaxTilesetPayloadBytes) return fail(Status::kTooLarge, detail, "tile set is too large");
+  std::vector<std::uint8_t> payload(ZSTD_compressBound(body.size()));
+  const std::size_t packed = ZSTD_compress(payload.data(), payload.size(), body.data(), body.size(), 19);
+  if (ZSTD_isError(packed)) return fail(Status::kInvalidArgument, detail, ZSTD_getErrorName(packed));
+  payload.resize(packed);
+
+  const std::size_t header_size = kFixedHeaderBytes + set.recipe.size() + set.generator_version.size();
+  out.assign(header_size + payload.size(), 0);
+  std::uint8_t* h = out.data();
+  std::memcpy(h, kMagic, 8);
+  put32(h + 8, kTilesetFormatVersion);
+  put32(h + 12, static_cast<std::uint32_t>(header_size));
+  put64(h + 16, payload.size());
+  put64(h + 24, body.size());
+  put32(h + 32, detail::crc32(payload.data(), payload.size()));
+  put32(h + 36, static_cast<std::uint32_t>(set.tiles.size()));
+  put32(h + 40, set.colours);
+  put32(h + 44, set.levels);
+  put32(h + 48, static_cast<std::uint32_t>(set.recipe.size()));
+  put32(h + 52, static_cast<std::uint32_t>(set.generator_version.size()));
+  std::memcpy(h + kFixedHeaderBytes, set.recipe.data(), set.recipe.size());
+  std::memcpy(h + kFixedHeaderBytes + set.recipe.size(), set.generator_version.data(), set.generator_version.size());
+  put32(h + kHeaderCrcOffset, header_crc(h, header_size));
+  std::memcpy(h + header_size, payload.data(), payload.size());
+  return Status::kOk;
+}
+
+Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::string* detail) {
+  out = TileSet{};
+  const auto* p = static_cast<const std::uint8_t*>(data);
+  if (size < 8 || std::memcmp(p, kMagic, 8) != 0) {
+    const bool prefix = size < 8 && std::memcmp(p, kMagic, size) == 0;
+    return prefix ? fail(Status::kTruncated, detail, "file ends inside the magic number")
+                  : fail(Status::kBadMagic, detail, "file does not start with KDMTILES");
+  }
+  if (size < 12) return fail(Status::kTruncated, detail, "file ends inside the header");
+  const std::uint32_t version = get32(p + 8);
+  if (version != kTilesetFormatVersion)
+    return fail(Status::kUnsupportedVersion, detail,
+                "format version " + std::to_string(version) + ", this reader supports " +
+                    std::to_string(kTilesetFormatVersion));
+  if (size < kFixedHeaderBytes) return fail(Status::kTruncated, detail, "file ends inside the header");
+  const std::uint32_t header_size = get32(p + 12);
+  if (header_size < kFixedHeaderBytes || header_size > kMaxTilesetHeaderBytes)
+    return fail(Status::kHeaderChecksumMismatch, detail, "header size field is implausible (damaged header)");
+  if (size < header_size) return fail(Status::kTruncated, detail, "file ends inside the header");
+  if (header_crc(p, header_size) != get32(p + kHeaderCrcOffset))
+    return fail(Status::kHeaderChecksumMismatch, detail, "header bytes are damaged");
+  const std::uint64_t payload_size = get64(p + 16), body_size = get64(p + 24);
+  const std::uint32_t tile_count = get32(p + 36), colours = get32(p + 40), levels = get32(p + 44);
+  const std::uint64_t recipe_size = get32(p + 48), version_size = get32(p + 52);
+  if (recipe_size + version_size + kFixedHeaderBytes != header_size)
+    return fail(Status::kInvalidContent, detail, "header text sizes do not add up to the header size");
+  if (payload_size > size - header_size) return fail(Status::kTruncated, detail, "file ends inside the payload");
+  if (payload_size < size - header_size) return fail(Status::kTrailingBytes, detail, "bytes follow the payload");
+  if (body_size > kMaxTilesetPayloadBytes)
+    return fail(Status::kTooLarge, detail, "payload decompresses to " + std::to_string(body_size) + " bytes");
+  if (colours < 1 || colours > kMaxTileColours || levels < 1 || levels > kMaxTileLevels ||
+      tile_count != std::uint64_t(colours) * colours * colours * colours)
+    return fail(Status::kInvalidContent, detail, "header counts are inconsistent");
+  const std::uint8_t* payload = p + header_size;
+  if (detail::crc32(payload, payload_size) != get32(p + 32))
+    return fail(Status::kPayloadChecksumMismatch, detail, "payload bytes are damaged");
+  const unsigned long long frame = ZSTD_getFrameContentSize(payload, payload_size);
+  if (frame == ZSTD_CONTENTSIZE_ERROR || frame == ZSTD_CONTENTSIZE_UNKNOWN || frame != body_size)
+    return fail(Status::kDecompressionFailed, detail, "payload is not a zstd frame of the stated size");
+  std::vector<char> body(static_cast<std::size_t>(body_size));
+  const std::size_t unpacked = ZSTD_decompress(body.data(), body.size(), payload, payload_size);
+  if (ZSTD_isError(unpacked) || unpacked != body_size)
+    return fail(Status::kDecompressionFailed, detail, ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
+  TileSet set;
+  try {
+    parse_body(body, set);
+  } catch (const std::exception& e) {
+    return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
+  }
+  if (set.colours != colours || set.levels != levels)
+    return fail(Status::kInvalidContent, detail, "payload disagrees with the header");
+  if (const Status s = validate_tileset(set, detail); s != Status::kOk) return s;
+  set.recipe.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes), recipe_size);
+  set.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size), version_size);
+  out = std::move(set);
+  return Status::kOk;
+}
+
+Status load_tileset(const std::string& path, TileSet& out, std::string* detail) {
+  out = TileSet{};
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return fail(Status::kIoError, detail, "cannot read '" + path + "'");
+  return decode_tileset(bytes.data(), bytes.size(), out, detail);
+}
+
+Status save_tileset(const TileSet& set, const std::string& path, std::string* detail) {
+  std::vector<std::uint8_t> bytes;
+  if (const Status s = encode_tileset(set, bytes, detail); s != Status::kOk) return s;
+  const std::string temp = path + ".partial";
+  {
+    std::ofstream f(temp, std::ios::binary | std::ios::trunc);
+    if (!f) return fail(Status::kIoError, detail, "cannot create '" + temp + "': " + std::strerror(errno));
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    f.flush();
+    if (!f) {
+      std::remove(temp.c_str());
+      return fail(Status::kIoError, detail, "cannot write '" + temp + "'");
+    }
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    std::remove(temp.c_str());
+    return fail(Status::kIoError, detail, "cannot replace '" + path + "': " + reason);
+  }
+  return Status::kOk;
+}
+
+}  // namespace kdm

@@ -1,0 +1,215 @@
+// The tile-set file format on untrusted input (meshoptimizer style: cut at every length, flip bits,
+// craft hostile counts behind valid checksums) and its round trip.
+#include <gtest/gtest.h>
+#include <zstd.h>
+
+#include <cereal/archives/portable_binary.hpp>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "crc32.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+namespace {
+
+TileSet make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1) {
+  std::mt19937 rng(seed);
+  TileSet set;
+  set.colours = colours;
+  set.levels = levels;
+  set.recipe = "seed 1\ncolours 2\nlevels 3\n";
+  set.generator_version = "test";
+  set.tiles.resize(std::size_t(colours) * colours * colours * colours);
+  for (Tile& tile : set.tiles) {
+    std::uint32_t count = 0;
+    for (std::uint32_t k = 0; k < levels; ++k) {
+      count += 4 + rng() % 20;
+      tile.level_end.push_back(count);
+    }
+    for (std::uint32_t i = 0; i < count; ++i)
+      tile.points.push_back({static_cast<std::uint16_t>(rng()), static_cast<std::uint16_t>(rng())});
+  }
+  return set;
+}
+
+std::vector<std::uint8_t> encode(const TileSet& set) {
+  std::vector<std::uint8_t> bytes;
+  EXPECT_EQ(encode_tileset(set, bytes), Status::kOk);
+  return bytes;
+}
+
+Status decode(const std::vector<std::uint8_t>& bytes, std::size_t size) {
+  TileSet out;
+  return decode_tileset(bytes.data(), size, out);
+}
+
+std::uint32_t get32(const std::uint8_t* p) { return p[0] | p[1] << 8 | p[2] << 16 | std::uint32_t(p[3]) << 24; }
+void put32(std::uint8_t* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+void put64(std::uint8_t* p, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+// Rewrites `file`'s payload with `body` (compressed) and fixes every size and checksum, as a hostile
+// writer who knows the format would.
+std::vector<std::uint8_t> with_body(std::vector<std::uint8_t> file, const std::string& body,
+                                    std::uint64_t claimed_body_size = 0) {
+  const std::uint32_t header_size = get32(&file[12]);
+  std::vector<std::uint8_t> payload(ZSTD_compressBound(body.size()));
+  payload.resize(ZSTD_compress(payload.data(), payload.size(), body.data(), body.size(), 3));
+  file.resize(header_size);
+  put64(&file[16], payload.size());
+  put64(&file[24], claimed_body_size ? claimed_body_size : body.size());
+  put32(&file[32], detail::crc32(payload.data(), payload.size()));
+  put32(&file[60], 0);
+  put32(&file[60], detail::crc32(file.data(), file.size()));
+  file.insert(file.end(), payload.begin(), payload.end());
+  return file;
+}
+
+TEST(TilesetFormatTest, RoundTripIsExact) {
+  const TileSet set = make_tileset();
+  const std::vector<std::uint8_t> bytes = encode(set);
+  TileSet back;
+  ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
+  EXPECT_EQ(back, set);
+  const std::string path = testing::TempDir() + "/roundtrip.kdmt";
+  ASSERT_EQ(save_tileset(set, path), Status::kOk);
+  TileSet loaded;
+  ASSERT_EQ(load_tileset(path, loaded), Status::kOk);
+  EXPECT_EQ(loaded, set);
+  std::remove(path.c_str());
+}
+
+TEST(TilesetFormatTest, EveryTruncationIsRejectedAsTruncated) {
+  const std::vector<std::uint8_t> bytes = encode(make_tileset());
+  for (std::size_t len = 0; len < bytes.size(); ++len)
+    ASSERT_EQ(decode(bytes, len), Status::kTruncated) << "cut at " << len << " of " << bytes.size();
+  EXPECT_EQ(decode(bytes, bytes.size()), Status::kOk);
+}
+
+TEST(TilesetFormatTest, TrailingBytesAreRejected) {
+  std::vector<std::uint8_t> bytes = encode(make_tileset());
+  bytes.push_back(0);
+  EXPECT_EQ(decode(bytes, bytes.size()), Status::kTrailingBytes);
+}
+
+TEST(TilesetFormatTest, EveryHeaderBitFlipIsRejected) {
+  const std::vector<std::uint8_t> bytes = encode(make_tileset());
+  const std::uint32_t header_size = get32(&bytes[12]);
+  for (std::size_t bit = 0; bit < header_size * 8; ++bit) {
+    std::vector<std::uint8_t> damaged = bytes;
+    damaged[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+    const Status s = decode(damaged, damaged.size());
+    ASSERT_NE(s, Status::kOk) << "bit " << bit;
+    if (bit >= 16 * 8) {  // past magic, version and header size, the checksum must be what catches it
+      ASSERT_TRUE(s == Status::kHeaderChecksumMismatch) << "bit " << bit << ": " << status_message(s);
+    }
+  }
+}
+
+TEST(TilesetFormatTest, PayloadBitFlipsAreCaughtByTheChecksum) {
+  const std::vector<std::uint8_t> bytes = encode(make_tileset());
+  const std::uint32_t header_size = get32(&bytes[12]);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<std::uint8_t> damaged = bytes;
+    const std::size_t bit = header_size * 8 + rng() % ((bytes.size() - header_size) * 8);
+    damaged[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+    ASSERT_EQ(decode(damaged, damaged.size()), Status::kPayloadChecksumMismatch) << "bit " << bit;
+  }
+}
+
+TEST(TilesetFormatTest, WrongMagicAndVersionAreNamed) {
+  std::vector<std::uint8_t> bytes = encode(make_tileset());
+  std::vector<std::uint8_t> other = bytes;
+  other[0] = 'X';
+  EXPECT_EQ(decode(other, other.size()), Status::kBadMagic);
+  other = bytes;
+  put32(&other[8], kTilesetFormatVersion + 1);
+  EXPECT_EQ(decode(other, other.size()), Status::kUnsupportedVersion);
+  const char png[] = "\x89PNG\r\n\x1a\n....";
+  TileSet out;
+  EXPECT_EQ(decode_tileset(png, sizeof png, out), Status::kBadMagic);
+}
+
+std::string body_bytes(const std::function<void(cereal::PortableBinaryOutputArchive&)>& write) {
+  std::ostringstream s(std::ios::binary);
+  {
+    cereal::PortableBinaryOutputArchive ar(s);
+    write(ar);
+  }
+  return s.str();
+}
+
+TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
+  const TileSet set = make_tileset(1, 2);  // one colour: a single tile
+  const std::vector<std::uint8_t> file = encode(set);
+  // An array that claims 2^40 elements: refused before any allocation.
+  const std::string huge = body_bytes([](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(1) << 40));
+    for (int i = 0; i < 8; ++i) ar(std::uint64_t(0));  // some bytes, far fewer than claimed
+  });
+  TileSet out;
+  std::string why;
+  std::vector<std::uint8_t> bad = with_body(file, huge);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  EXPECT_NE(why.find("more than the payload"), std::string::npos) << "detail: " << why;
+  // A level table that does not end at the point count.
+  const std::string inconsistent = body_bytes([](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(5));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+  });
+  bad = with_body(file, inconsistent);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  // A tile count that disagrees with the header.
+  const std::string miscounted = body_bytes([](auto& ar) { ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(900)); });
+  bad = with_body(file, miscounted);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  // A payload that claims to decompress to more than the cap (a zip bomb) is refused unopened.
+  bad = with_body(file, inconsistent, kMaxTilesetPayloadBytes + 1);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kTooLarge);
+  // And one whose zstd frame disagrees with the stated size.
+  bad = with_body(file, inconsistent, inconsistent.size() + 1);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kDecompressionFailed);
+  EXPECT_TRUE(out.tiles.empty());
+}
+
+TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
+  TileSet set = make_tileset();
+  set.tiles.pop_back();
+  std::vector<std::uint8_t> bytes;
+  std::string why;
+  EXPECT_EQ(encode_tileset(set, bytes, &why), Status::kInvalidArgument);
+  EXPECT_NE(why.find("tiles"), std::string::npos) << why;
+  set = make_tileset();
+  set.tiles[3].level_end[1] = 0;
+  EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
+  set = make_tileset();
+  set.colours = 17;
+  EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
+}
+
+TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
+  const TileSet set = make_tileset();
+  EXPECT_EQ(save_tileset(set, "/nonexistent-dir/x.kdmt"), Status::kIoError);
+  const std::string path = testing::TempDir() + "/atomic.kdmt";
+  { std::ofstream(path) << "old contents"; }
+  ASSERT_EQ(save_tileset(set, path), Status::kOk);
+  TileSet loaded;
+  EXPECT_EQ(load_tileset(path, loaded), Status::kOk);
+  std::ifstream partial(path + ".partial");
+  EXPECT_FALSE(partial.good());  // no temporary left behind
+  std::remove(path.c_str());
+  EXPECT_EQ(load_tileset(path, loaded), Status::kIoError);
+}
+
+}  // namespace
+}  // namespace kdm
