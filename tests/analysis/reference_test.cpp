@@ -1,4 +1,4 @@
-// Cross-check against the reference sets of Fattal's own implementation (../shared/reference/README.md):
+// Cross-check against the reference sets of Fattal's own implementation (tests/data/reference/README.md):
 // 10 torus sets of 4044 points with published statistics. The computation is deterministic on fixed data,
 // so the tolerance is half a unit of the last published digit (the published values are rounded).
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@ TEST(Reference, MatchesPublishedStatistics) {
   for (int i = 1; i <= 10; ++i) {
     char name[64];
     std::snprintf(name, sizeof name, "/reference/ref_T0.5_n4096_%02d.txt", i);
-    files.push_back(std::string(KDM_SHARED_DIR) + name);
+    files.push_back(std::string(KDM_TEST_DATA_DIR) + name);
   }
   const std::vector<tools::PointSet> sets = load_point_sets(files);
   ASSERT_EQ(sets.size(), 10u);
