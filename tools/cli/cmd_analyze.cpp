@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "commands.h"
+#include "density_arg.h"
+#include "kdm/generator/sampler.h"
 #include "image_io.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/json.h"
@@ -25,6 +27,9 @@ struct AnalyzeArgs {
   std::vector<std::string> files;
   bool torus = false, box = false;
   std::string density;
+  double gamma = 1;
+  bool invert = false;
+  bool no_energy = false;
   double tile_size = 0;
   double fmax = 2.5;
   double min_expected = 20;
@@ -32,24 +37,27 @@ struct AnalyzeArgs {
   std::string output;
 };
 
-// "const:V" or an image whose darkness (1 − luminance) is the density; y up, image row 0 at the top.
-analysis::DensityFunction parse_target_density(const std::string& spec) {
-  if (spec.rfind("const:", 0) == 0) {
-    const std::string text = spec.substr(6);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || !std::isfinite(v) || v <= 0)
-      throw CommandError("--density const:V needs a finite V > 0, got '" + spec + "'");
-    return [v](double, double) { return v; };
-  }
-  auto image = std::make_shared<tools::GreyImage>();
-  std::string error;
-  if (!tools::load_grey_image(spec, *image, error)) throw CommandError(error);
-  return [image](double x, double y) {
-    const int px = std::clamp(static_cast<int>(x * image->width), 0, image->width - 1);
-    const int py = std::clamp(static_cast<int>((1.0 - y) * image->height), 0, image->height - 1);
-    return 1.0 - static_cast<double>(image->at(px, py));
+// The analysis reads the same density the sampler does (const:V or an image, darkness = density).
+analysis::DensityFunction as_analysis_density(const gen::Density& density) {
+  if (!density.function) return [](double, double) { return 1.0; };
+  return [f = density.function](double x, double y) {
+    const double u[2] = {x, y};
+    return f(u);
   };
+}
+
+// E/n of each set under the KDM model for its count, domain and density, averaged over the sets.
+double mean_energy_per_point(const std::vector<tools::PointSet>& sets, bool torus, const gen::Density& density) {
+  double sum = 0;
+  for (const tools::PointSet& set : sets) {
+    gen::SamplerOptions o;
+    o.dim = set.dim;
+    o.domain = torus ? gen::Domain::kTorus : gen::Domain::kBox;
+    std::vector<double> coords = set.coords;
+    for (double& c : coords) c = std::min(c, std::nextafter(1.0, 0.0));  // writers may round up to 1
+    sum += gen::energy_per_point(o, density, coords);
+  }
+  return sum / sets.size();
 }
 
 void save_png(const std::string& path, const tools::RgbImage& image) {
@@ -69,7 +77,11 @@ void run_analyze(const AnalyzeArgs& args) {
   o.threads = args.threads;
   try {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
-    if (!args.density.empty()) o.density = parse_target_density(args.density);
+    DensityArg target;
+    if (!args.density.empty()) {
+      target = parse_density(args.density, args.gamma, args.invert);
+      o.density = as_analysis_density(target.density);
+    }
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
@@ -78,7 +90,11 @@ void run_analyze(const AnalyzeArgs& args) {
     if (ec || !std::filesystem::is_directory(args.output))
       throw CommandError("cannot create output directory '" + args.output + "'" +
                          (ec ? ": " + ec.message() : ""));
-    const analysis::AnalysisReport report = analysis::analyze(sets, o);
+    analysis::AnalysisReport report = analysis::analyze(sets, o);
+    if (!args.no_energy) {
+      report.energy_per_point = mean_energy_per_point(sets, o.torus, target.density);
+      report.has_energy = true;
+    }
     std::fputs(analysis::format_summary(report).c_str(), stdout);
     const std::filesystem::path dir(args.output);
     std::string error;
@@ -93,6 +109,8 @@ void run_analyze(const AnalyzeArgs& args) {
     std::fprintf(stderr, "kdm analyze: wrote %s/metrics.json and pictures\n", args.output.c_str());
   } catch (const analysis::InvalidInput& e) {
     throw CommandError(e.what());
+  } catch (const gen::InvalidArgument& e) {
+    throw CommandError(std::string("energy: ") + e.what());
   }
 }
 
@@ -108,6 +126,9 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");
   cmd->add_option("--density", args->density,
                   "Target density for the accuracy test: const:V or an image (dark = dense)");
+  cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")->capture_default_str();
+  cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
+  cmd->add_flag("--no-energy", args->no_energy, "Skip the KDM energy per point");
   cmd->add_option("--tile-size", args->tile_size,
                   "Tile side s (1/s an integer) for periodicity and seam statistics");
   cmd->add_option("--fmax", args->fmax, "Periodogram limit in normalised frequency |k|/sqrt(n)")

@@ -178,6 +178,7 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
     w.key("ks_statistic").value(r.seams.ks.statistic).key("ks_p_value").value(r.seams.ks.p_value);
     w.end_object();
   }
+  if (r.has_energy) w.key("energy_per_point").value(r.energy_per_point);
   w.key("seconds").value(r.seconds);
   w.end_object();
   return w.str();

@@ -53,6 +53,10 @@ struct AnalysisReport {
   PeriodicityResult periodicity;  ///< needs the spectrum (NaN ratio otherwise)
   SeamStats seams;
   double seconds = 0;  ///< wall time of analyze()
+  /// E / n under the KDM model (mean over sets). The analysis library has no model of its own: callers
+  /// that link the generator fill this in (kdm analyze does, via kdm::gen::energy_per_point).
+  bool has_energy = false;
+  double energy_per_point = 0;
 };
 
 /// Runs the analysis. Throws InvalidInput for an empty list, mixed dimensions, invalid points, sets with
