@@ -10,7 +10,9 @@
 namespace kdm::gen {
 namespace {
 
-inline float sign_of(float r) { return static_cast<float>((r > 0) - (r < 0)); }
+inline float sign_of(float r) {
+  return static_cast<float>((r > 0) - (r < 0));
+}
 
 }  // namespace
 

@@ -32,7 +32,8 @@ struct ChainParams {
   double temperature = 0.11;  ///< T of eq. 4 (model units); 0 = deterministic descent
   double step = 1.0;          ///< Δt of eq. 5
   bool metropolis = true;
-  double sigma_cap = 128;     ///< kernels never wider than this (grid units); only far-below-peak densities hit it
+  double sigma_cap =
+      128;  ///< kernels never wider than this (grid units); only far-below-peak densities hit it
   double sigma_bound = 1e30;  ///< proposals where σ would exceed this are rejected (a support constraint)
   double max_step = 1e30;     ///< proposals moving farther than this along any axis are rejected
 };

@@ -21,7 +21,9 @@ inline constexpr double kKernelWidth = 1.5;  // Φ(r) = exp(-(r / 1.5)^2), paper
 inline constexpr double kCut = 3.2;          // footprint half-width in units of σ
 
 /// φ's value at the cut, subtracted so the truncated kernel is continuous.
-inline double kernel_edge_value() { return std::exp(-(kCut / kKernelWidth) * (kCut / kKernelWidth)); }
+inline double kernel_edge_value() {
+  return std::exp(-(kCut / kKernelWidth) * (kCut / kKernelWidth));
+}
 
 /// ∫ of the truncated 1D factor over t in units of σ; the kernel's mass is w·J^d.
 double truncated_factor_integral();

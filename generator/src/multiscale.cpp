@@ -11,8 +11,8 @@
 namespace kdm::gen {
 namespace {
 
-constexpr std::uint64_t kInitStream = 0x494e4954;    // "INIT"
-constexpr std::uint64_t kRefineStream = 0x524546;    // "REF"
+constexpr std::uint64_t kInitStream = 0x494e4954;  // "INIT"
+constexpr std::uint64_t kRefineStream = 0x524546;  // "REF"
 
 template <int D>
 Vec<D> node_centre(const Grid<D>& g, std::int64_t i) {
@@ -176,7 +176,8 @@ struct Driver {
       Particle<D> child;
       child.splits = static_cast<std::uint8_t>(p.splits - 1);
       const double rho = fine.at(centre);
-      const double sigma = rho > 0 ? std::min(params.sigma_cap, std::pow(rho / child.weight(), -1.0 / D)) : 1.0;
+      const double sigma =
+          rho > 0 ? std::min(params.sigma_cap, std::pow(rho / child.weight(), -1.0 / D)) : 1.0;
       Rng rng(options.seed, kRefineStream, static_cast<std::uint64_t>(fine_level), j);
       for (const Vec<D>& z : square_rule(rng)) {
         for (int k = 0; k < D; ++k) child.x[k] = centre[k] + sigma * z[k];
@@ -231,12 +232,14 @@ struct Driver {
       for (auto& v : z) v = {ca * v[0] - sa * v[1], sa * v[0] + ca * v[1]};
     } else {
       // Uniform random rotation from a unit quaternion (Shoemake).
-      const double u1 = rng.uniform(), u2 = 6.283185307179586 * rng.uniform(), u3 = 6.283185307179586 * rng.uniform();
+      const double u1 = rng.uniform(), u2 = 6.283185307179586 * rng.uniform(),
+                   u3 = 6.283185307179586 * rng.uniform();
       const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
       const double qw = a * std::sin(u2), qx = a * std::cos(u2), qy = b * std::sin(u3), qz = b * std::cos(u3);
-      const double m[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
-                              {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
-                              {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+      const double m[3][3] = {
+          {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+          {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+          {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
       for (auto& v : z) {
         Vec<D> t{};
         for (int i = 0; i < 3; ++i) t[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
@@ -314,8 +317,9 @@ struct Driver {
     const int levels = static_cast<int>(setup.levels.size());
     // Progress is measured in point-sweeps relative to n: level l holds about n / 2^(D l) points.
     for (int l = 0; l < levels; ++l)
-      total_sweeps += (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
-                      std::ldexp(1.0, -D * l);
+      total_sweeps +=
+          (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
+          std::ldexp(1.0, -D * l);
     for (int l = levels - 1; l >= 0; --l) {
       if (l < levels - 1) refine(l);
       relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);

@@ -43,7 +43,8 @@ SampleResult sample(const SamplerOptions& options, const Density& density) {
   return options.dim == 2 ? sample_dim<2>(options, density) : sample_dim<3>(options, density);
 }
 
-double energy_per_point(const SamplerOptions& options, const Density& density, const std::vector<double>& points) {
+double energy_per_point(const SamplerOptions& options, const Density& density,
+                        const std::vector<double>& points) {
   if (options.dim != 2 && options.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
   if (points.empty() || points.size() % options.dim != 0)
     throw InvalidArgument("point set is empty or its coordinate count is not a multiple of the dimension");

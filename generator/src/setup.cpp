@@ -69,7 +69,8 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
   g.torus = o.domain == Domain::kTorus;
   double nodes = 1;
   for (int k = 0; k < D; ++k) {
-    g.dims[k] = static_cast<int>(unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit)));
+    g.dims[k] =
+        static_cast<int>(unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit)));
     nodes *= g.dims[k];
   }
   if (nodes > double(o.max_grid_nodes)) {
@@ -86,13 +87,15 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
 void validate_options(const SamplerOptions& o) {
   if (o.dim != 2 && o.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
   if (o.n < 0) throw InvalidArgument("point count must be >= 0");
-  if (o.n == 0 && o.resolution <= 0) throw InvalidArgument("give a point count n > 0 or a grid resolution > 0");
+  if (o.n == 0 && o.resolution <= 0)
+    throw InvalidArgument("give a point count n > 0 or a grid resolution > 0");
   if (!(std::isfinite(o.temperature) && o.temperature >= 0))
     throw InvalidArgument("temperature must be a finite number >= 0");
   if (!(std::isfinite(o.step) && o.step >= 0)) throw InvalidArgument("step must be a finite number >= 0");
   if (!(o.peak_density > 0 && o.peak_density <= 1)) throw InvalidArgument("peak density must be in (0, 1]");
   if (!(o.sigma_max >= 1)) throw InvalidArgument("sigma_max must be >= 1");
-  if (o.sweeps < 0 || o.coarsest_sweeps < 0 || o.burn_in_sweeps < 0) throw InvalidArgument("sweep counts must be >= 0");
+  if (o.sweeps < 0 || o.coarsest_sweeps < 0 || o.burn_in_sweeps < 0)
+    throw InvalidArgument("sweep counts must be >= 0");
   if (o.coarsest_grid < 4) throw InvalidArgument("coarsest grid must have at least 4 nodes per axis");
   for (int k = 0; k < o.dim; ++k)
     if (!(std::isfinite(o.extent[k]) && o.extent[k] > 0))
@@ -125,8 +128,8 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
       peak_over_mean = mx / (sum / p.size());
     }
-    double shortest = std::pow(o.n * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product),
-                               1.0 / D);
+    double shortest =
+        std::pow(o.n * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product), 1.0 / D);
     for (int attempt = 0;; ++attempt) {
       grid = make_grid<D>(o, std::max(1.0, shortest), levels);
       rho = sample_density<D>(grid, density);
@@ -199,7 +202,8 @@ Density Density::from_values(int width, int height, std::vector<float> values) {
     const double ax = fx - x0, ay = fy - y0;
     const std::vector<float>& v = *data;
     auto at = [&](int x, int y) { return double(v[static_cast<std::size_t>(y) * width + x]); };
-    return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) + ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
+    return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x1, y0)) +
+           ay * ((1 - ax) * at(x0, y1) + ax * at(x1, y1));
   };
   return d;
 }

@@ -94,7 +94,8 @@ std::vector<std::uint8_t> serialize_body(const TileSet& set) {
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
       xy.resize(tile.points.size() * 2);
-      for (std::size_t i = 0; i < tile.points.size(); ++i) xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
+      for (std::size_t i = 0; i < tile.points.size(); ++i)
+        xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
       save_array(ar, xy);
     }
   }
@@ -126,18 +127,30 @@ void parse_body(const std::vector<char>& body, TileSet& set) {
 
 const char* status_message(Status status) {
   switch (status) {
-    case Status::kOk: return "ok";
-    case Status::kIoError: return "I/O error";
-    case Status::kBadMagic: return "not a kdm tile set (bad magic)";
-    case Status::kUnsupportedVersion: return "unsupported tile-set format version";
-    case Status::kTruncated: return "tile set is truncated";
-    case Status::kTrailingBytes: return "tile set has trailing bytes";
-    case Status::kHeaderChecksumMismatch: return "tile-set header checksum mismatch";
-    case Status::kPayloadChecksumMismatch: return "tile-set payload checksum mismatch";
-    case Status::kTooLarge: return "tile set exceeds the reader's size limits";
-    case Status::kDecompressionFailed: return "tile-set payload does not decompress";
-    case Status::kInvalidContent: return "tile-set content is inconsistent";
-    case Status::kInvalidArgument: return "invalid argument";
+    case Status::kOk:
+      return "ok";
+    case Status::kIoError:
+      return "I/O error";
+    case Status::kBadMagic:
+      return "not a kdm tile set (bad magic)";
+    case Status::kUnsupportedVersion:
+      return "unsupported tile-set format version";
+    case Status::kTruncated:
+      return "tile set is truncated";
+    case Status::kTrailingBytes:
+      return "tile set has trailing bytes";
+    case Status::kHeaderChecksumMismatch:
+      return "tile-set header checksum mismatch";
+    case Status::kPayloadChecksumMismatch:
+      return "tile-set payload checksum mismatch";
+    case Status::kTooLarge:
+      return "tile set exceeds the reader's size limits";
+    case Status::kDecompressionFailed:
+      return "tile-set payload does not decompress";
+    case Status::kInvalidContent:
+      return "tile-set content is inconsistent";
+    case Status::kInvalidArgument:
+      return "invalid argument";
   }
   return "unknown status";
 }
@@ -145,17 +158,21 @@ const char* status_message(Status status) {
 Status validate_tileset(const TileSet& set, std::string* detail) {
   auto bad = [&](const std::string& m) { return fail(Status::kInvalidContent, detail, m); };
   if (set.colours < 1 || set.colours > kMaxTileColours)
-    return bad("colour count " + std::to_string(set.colours) + " is outside 1.." + std::to_string(kMaxTileColours));
+    return bad("colour count " + std::to_string(set.colours) + " is outside 1.." +
+               std::to_string(kMaxTileColours));
   if (set.levels < 1 || set.levels > kMaxTileLevels)
-    return bad("level count " + std::to_string(set.levels) + " is outside 1.." + std::to_string(kMaxTileLevels));
+    return bad("level count " + std::to_string(set.levels) + " is outside 1.." +
+               std::to_string(kMaxTileLevels));
   const std::size_t expected = std::size_t(set.colours) * set.colours * set.colours * set.colours;
   if (set.tiles.size() != expected)
     return bad("expected " + std::to_string(expected) + " tiles, found " + std::to_string(set.tiles.size()));
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
-    if (tile.level_end.size() != set.levels) return bad("tile " + std::to_string(t) + " has a wrong level table size");
+    if (tile.level_end.size() != set.levels)
+      return bad("tile " + std::to_string(t) + " has a wrong level table size");
     for (std::size_t k = 1; k < tile.level_end.size(); ++k)
-      if (tile.level_end[k] < tile.level_end[k - 1]) return bad("tile " + std::to_string(t) + " has a decreasing level table");
+      if (tile.level_end[k] < tile.level_end[k - 1])
+        return bad("tile " + std::to_string(t) + " has a decreasing level table");
     if (tile.level_end.back() != tile.points.size())
       return bad("tile " + std::to_string(t) + "'s level table does not end at its point count");
   }
@@ -188,7 +205,8 @@ Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::s
   put32(h + 48, static_cast<std::uint32_t>(set.recipe.size()));
   put32(h + 52, static_cast<std::uint32_t>(set.generator_version.size()));
   std::memcpy(h + kFixedHeaderBytes, set.recipe.data(), set.recipe.size());
-  std::memcpy(h + kFixedHeaderBytes + set.recipe.size(), set.generator_version.data(), set.generator_version.size());
+  std::memcpy(h + kFixedHeaderBytes + set.recipe.size(), set.generator_version.data(),
+              set.generator_version.size());
   put32(h + kHeaderCrcOffset, header_crc(h, header_size));
   std::memcpy(h + header_size, payload.data(), payload.size());
   return Status::kOk;
@@ -220,8 +238,10 @@ Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::str
   const std::uint64_t recipe_size = get32(p + 48), version_size = get32(p + 52);
   if (recipe_size + version_size + kFixedHeaderBytes != header_size)
     return fail(Status::kInvalidContent, detail, "header text sizes do not add up to the header size");
-  if (payload_size > size - header_size) return fail(Status::kTruncated, detail, "file ends inside the payload");
-  if (payload_size < size - header_size) return fail(Status::kTrailingBytes, detail, "bytes follow the payload");
+  if (payload_size > size - header_size)
+    return fail(Status::kTruncated, detail, "file ends inside the payload");
+  if (payload_size < size - header_size)
+    return fail(Status::kTrailingBytes, detail, "bytes follow the payload");
   if (body_size > kMaxTilesetPayloadBytes)
     return fail(Status::kTooLarge, detail, "payload decompresses to " + std::to_string(body_size) + " bytes");
   if (colours < 1 || colours > kMaxTileColours || levels < 1 || levels > kMaxTileLevels ||
@@ -236,7 +256,8 @@ Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::str
   std::vector<char> body(static_cast<std::size_t>(body_size));
   const std::size_t unpacked = ZSTD_decompress(body.data(), body.size(), payload, payload_size);
   if (ZSTD_isError(unpacked) || unpacked != body_size)
-    return fail(Status::kDecompressionFailed, detail, ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
+    return fail(Status::kDecompressionFailed, detail,
+                ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
   TileSet set;
   try {
     parse_body(body, set);
@@ -247,7 +268,8 @@ Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::str
     return fail(Status::kInvalidContent, detail, "payload disagrees with the header");
   if (const Status s = validate_tileset(set, detail); s != Status::kOk) return s;
   set.recipe.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes), recipe_size);
-  set.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size), version_size);
+  set.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size),
+                               version_size);
   out = std::move(set);
   return Status::kOk;
 }

@@ -4,6 +4,8 @@
 
 namespace kdm {
 
-const char* version_string() { return KDM_VERSION_STRING; }
+const char* version_string() {
+  return KDM_VERSION_STRING;
+}
 
 }  // namespace kdm

@@ -67,7 +67,8 @@ std::vector<double> exact_bin_probabilities(const DensityGrid<2>& d, const Chain
 }
 
 // Runs the chain on the free point and returns Pearson's χ² of its thinned positions against `expected`.
-double chain_chi_square(const DensityGrid<2>& d, const ChainParams& params, const std::vector<double>& expected) {
+double chain_chi_square(const DensityGrid<2>& d, const ChainParams& params,
+                        const std::vector<double>& expected) {
   Chain<2> chain(d, params);
   Chain<2>::Scratch s;
   for (const auto& p : fixed_points()) chain.splat(p, 1.0f, s);
@@ -82,7 +83,8 @@ double chain_chi_square(const DensityGrid<2>& d, const ChainParams& params, cons
     Rng rng(7, static_cast<std::uint64_t>(t));
     chain.update(free, rng, s);
     if (t % thin == 0) {
-      const int bx = static_cast<int>(free.x[0] / (kM / kBins)), by = static_cast<int>(free.x[1] / (kM / kBins));
+      const int bx = static_cast<int>(free.x[0] / (kM / kBins)),
+                by = static_cast<int>(free.x[1] / (kM / kBins));
       counts[by * kBins + bx] += 1;
     }
   }

@@ -47,7 +47,9 @@ Status decode(const std::vector<std::uint8_t>& bytes, std::size_t size) {
   return decode_tileset(bytes.data(), size, out);
 }
 
-std::uint32_t get32(const std::uint8_t* p) { return p[0] | p[1] << 8 | p[2] << 16 | std::uint32_t(p[3]) << 24; }
+std::uint32_t get32(const std::uint8_t* p) {
+  return p[0] | p[1] << 8 | p[2] << 16 | std::uint32_t(p[3]) << 24;
+}
 void put32(std::uint8_t* p, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
@@ -170,7 +172,8 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   bad = with_body(file, inconsistent);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   // A tile count that disagrees with the header.
-  const std::string miscounted = body_bytes([](auto& ar) { ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(900)); });
+  const std::string miscounted =
+      body_bytes([](auto& ar) { ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(900)); });
   bad = with_body(file, miscounted);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   // A payload that claims to decompress to more than the cap (a zip bomb) is refused unopened.

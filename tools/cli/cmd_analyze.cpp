@@ -13,12 +13,12 @@
 
 #include "commands.h"
 #include "density_arg.h"
-#include "kdm/generator/sampler.h"
 #include "image_io.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/plots.h"
 #include "kdm/analysis/report.h"
+#include "kdm/generator/sampler.h"
 
 namespace kdm::cli {
 namespace {
@@ -47,7 +47,8 @@ analysis::DensityFunction as_analysis_density(const gen::Density& density) {
 }
 
 // E/n of each set under the KDM model for its count, domain and density, averaged over the sets.
-double mean_energy_per_point(const std::vector<tools::PointSet>& sets, bool torus, const gen::Density& density) {
+double mean_energy_per_point(const std::vector<tools::PointSet>& sets, bool torus,
+                             const gen::Density& density) {
   double sum = 0;
   for (const tools::PointSet& set : sets) {
     gen::SamplerOptions o;
@@ -126,7 +127,8 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");
   cmd->add_option("--density", args->density,
                   "Target density for the accuracy test: const:V or an image (dark = dense)");
-  cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")->capture_default_str();
+  cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
+      ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
   cmd->add_flag("--no-energy", args->no_energy, "Skip the KDM energy per point");
   cmd->add_option("--tile-size", args->tile_size,

@@ -18,7 +18,7 @@ struct SampleArgs {
   std::string density = "const:1";
   std::string domain;  // empty: box for images, torus otherwise
   std::string output;
-  double aspect = 0;   // 0: from the image, or 1
+  double aspect = 0;  // 0: from the image, or 1
   double gamma = 1;
   bool invert = false;
   bool unadjusted = false;
@@ -54,8 +54,9 @@ void run_sample(const SampleArgs& args) {
   set.coords = std::move(result.points);
   const gen::SampleReport& r = result.report;
   char line[256];
-  std::snprintf(line, sizeof line, "kdm sample: %zu points, T=%g (model %.4g), seed %llu, acceptance %.3f, %.3f s",
-                set.size(), o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
+  std::snprintf(line, sizeof line,
+                "kdm sample: %zu points, T=%g (model %.4g), seed %llu, acceptance %.3f, %.3f s", set.size(),
+                o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
                 r.acceptance_rate(), r.seconds);
   std::vector<std::string> header = {line, "density " + args.density + ", domain " + domain};
   DrawStyle style;
@@ -65,8 +66,8 @@ void run_sample(const SampleArgs& args) {
   write_points(args.output, set, header, style);
   std::fprintf(stderr, "%s -> %s\n", line, args.output.c_str());
   if (args.timing) {
-    std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(), r.seconds,
-                set.size() / std::max(1e-9, r.seconds), o.threads, r.acceptance_rate());
+    std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
+                r.seconds, set.size() / std::max(1e-9, r.seconds), o.threads, r.acceptance_rate());
   }
 }
 
@@ -76,22 +77,32 @@ void add_sample_command(CLI::App& app) {
   auto args = std::make_shared<SampleArgs>();
   CLI::App* cmd = app.add_subcommand("sample", "Draw a point set from the KDM model (the full sampler)");
   gen::SamplerOptions& o = args->options;
-  cmd->add_option("--n", o.n, "Exact number of points (0: use --resolution)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  cmd->add_option("--resolution", o.resolution, "Finest grid nodes along the short axis, when --n 0")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--n", o.n, "Exact number of points (0: use --resolution)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--resolution", o.resolution, "Finest grid nodes along the short axis, when --n 0")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--dim", o.dim, "Dimension")->capture_default_str()->check(CLI::IsMember({2, 3}));
-  cmd->add_option("--domain", args->domain, "torus (periodic) or box (bounded); default: box for images, torus otherwise")
+  cmd->add_option("--domain", args->domain,
+                  "torus (periodic) or box (bounded); default: box for images, torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
-  cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)")->check(CLI::PositiveNumber);
-  cmd->add_option("--temperature,-T", o.temperature, "Temperature (0.5 = the paper's look; lower = more ordered; 0 = descent)")
+  cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--temperature,-T", o.temperature,
+                  "Temperature (0.5 = the paper's look; lower = more ordered; 0 = descent)")
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "Random seed; the output depends on nothing else")->capture_default_str();
-  cmd->add_option("--density", args->density, "const:V, or an image whose darkness is the density")->capture_default_str();
+  cmd->add_option("--density", args->density, "const:V, or an image whose darkness is the density")
+      ->capture_default_str();
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
-  cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")->capture_default_str();
+  cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")
+      ->capture_default_str();
   cmd->add_option("--sweeps", o.sweeps, "Langevin sweeps per level")->capture_default_str();
-  cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units; 0 = automatic)")->capture_default_str();
-  cmd->add_flag("--unadjusted", args->unadjusted, "Skip the Metropolis-Hastings test (biased; experiments only)");
+  cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units; 0 = automatic)")
+      ->capture_default_str();
+  cmd->add_flag("--unadjusted", args->unadjusted,
+                "Skip the Metropolis-Hastings test (biased; experiments only)");
   cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
   cmd->add_flag("--timing", args->timing, "Print points per second on stdout");

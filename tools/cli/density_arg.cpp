@@ -31,7 +31,8 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
   try {
     arg.density = gen::Density::from_values(image.width, image.height, std::move(values));
   } catch (const gen::InvalidArgument& e) {
-    throw CommandError("image '" + spec + "': " + e.what() + (invert ? "" : " (an all-white image has no ink)"));
+    throw CommandError("image '" + spec + "': " + e.what() +
+                       (invert ? "" : " (an all-white image has no ink)"));
   }
   arg.from_image = true;
   arg.image_width = image.width;

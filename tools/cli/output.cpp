@@ -22,15 +22,16 @@ double auto_radius(const tools::PointSet& points, double width_px, double height
 
 }  // namespace
 
-void write_points(const std::string& path, const tools::PointSet& points, const std::vector<std::string>& header,
-                  const DrawStyle& style) {
+void write_points(const std::string& path, const tools::PointSet& points,
+                  const std::vector<std::string>& header, const DrawStyle& style) {
   std::string error;
   if (ends_with(path, ".txt") || ends_with(path, ".csv")) {
     if (!tools::write_point_set(path, points, header, error)) throw CommandError(error);
     return;
   }
   const bool png = ends_with(path, ".png"), svg = ends_with(path, ".svg");
-  if (!png && !svg) throw CommandError("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
+  if (!png && !svg)
+    throw CommandError("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
   if (points.dim != 2) throw CommandError("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(16, style.width_px);
   const int h = std::max(16, static_cast<int>(std::lround(w / style.aspect)));
@@ -44,8 +45,8 @@ void write_points(const std::string& path, const tools::PointSet& points, const 
     return;
   }
   std::ostringstream out;
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h << "\" viewBox=\"0 0 "
-      << w << ' ' << h << "\">\n";
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
+      << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
   for (const std::string& line : header) out << "<!-- " << line << " -->\n";
   out << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<g fill=\"black\">\n";
   out.precision(6);

@@ -16,7 +16,7 @@ struct DrawStyle {
 
 /// Writes `points` (normalized [0,1)^dim, y up) to `path`, choosing the format by extension.
 /// Throws CommandError on an unknown extension or a write failure.
-void write_points(const std::string& path, const tools::PointSet& points, const std::vector<std::string>& header,
-                  const DrawStyle& style);
+void write_points(const std::string& path, const tools::PointSet& points,
+                  const std::vector<std::string>& header, const DrawStyle& style);
 
 }  // namespace kdm::cli

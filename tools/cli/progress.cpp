@@ -8,9 +8,13 @@
 namespace kdm::cli {
 
 ProgressBar::ProgressBar(std::string label)
-    : label_(std::move(label)), enabled_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
+    : label_(std::move(label)),
+      enabled_(isatty(STDERR_FILENO) != 0),
+      start_(std::chrono::steady_clock::now()) {}
 
-ProgressBar::~ProgressBar() { finish(); }
+ProgressBar::~ProgressBar() {
+  finish();
+}
 
 void ProgressBar::update(double fraction) {
   if (!enabled_) return;
@@ -27,7 +31,8 @@ void ProgressBar::update(double fraction) {
 }
 
 void ProgressBar::finish() {
-  if (enabled_ && last_permille_ >= 0) std::fprintf(stderr, "\r%*s\r", 70 + static_cast<int>(label_.size()), "");
+  if (enabled_ && last_permille_ >= 0)
+    std::fprintf(stderr, "\r%*s\r", 70 + static_cast<int>(label_.size()), "");
   last_permille_ = -1;
 }
 

@@ -17,7 +17,9 @@
 namespace kdm::tools {
 namespace {
 
-std::string temp_path_for(const std::string& path) { return path + ".tmp~"; }
+std::string temp_path_for(const std::string& path) {
+  return path + ".tmp~";
+}
 
 bool commit_temp(const std::string& tmp, const std::string& path, std::string& error) {
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
@@ -36,7 +38,7 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
   std::vector<float> values;
   if (sixteen) {
     std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &channels, 0),
-                                                    stbi_image_free);
+                                                   stbi_image_free);
     if (!data) {
       error = "cannot read image '" + path + "': " + stbi_failure_reason();
       return false;
@@ -45,7 +47,7 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
     for (float& v : values) v /= 65535.0f;
   } else {
     std::unique_ptr<stbi_uc, void (*)(void*)> data(stbi_load(path.c_str(), &w, &h, &channels, 0),
-                                                    stbi_image_free);
+                                                   stbi_image_free);
     if (!data) {
       const char* reason = stbi_failure_reason();
       error = "cannot read image '" + path + "': " + (reason ? reason : "unknown format");
@@ -65,10 +67,20 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
     const float* p = &values[i * channels];
     float lum = 0, alpha = 1;
     switch (channels) {
-      case 1: lum = p[0]; break;
-      case 2: lum = p[0]; alpha = p[1]; break;
-      case 3: lum = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; break;
-      default: lum = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; alpha = p[3]; break;
+      case 1:
+        lum = p[0];
+        break;
+      case 2:
+        lum = p[0];
+        alpha = p[1];
+        break;
+      case 3:
+        lum = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
+        break;
+      default:
+        lum = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
+        alpha = p[3];
+        break;
     }
     out.pixels[i] = std::clamp(lum * alpha + (1.0f - alpha), 0.0f, 1.0f);  // composite on white paper
   }
@@ -101,7 +113,8 @@ void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8
       const double coverage = std::clamp(r + 0.5 - d, 0.0, 1.0);
       if (coverage <= 0) continue;
       std::uint8_t* p = &image.pixels[(static_cast<std::size_t>(y) * image.width + x) * 3];
-      for (int c = 0; c < 3; ++c) p[c] = static_cast<std::uint8_t>(std::lround(p[c] + (rgb[c] - p[c]) * coverage));
+      for (int c = 0; c < 3; ++c)
+        p[c] = static_cast<std::uint8_t>(std::lround(p[c] + (rgb[c] - p[c]) * coverage));
     }
   }
 }

@@ -152,7 +152,9 @@ std::string format_summary(const AnalysisReport& r) {
         r.seams.interior.count, r.seams.interior.dmin, r.seams.interior.davg, r.seams.interior.nn1,
         r.seams.ks.statistic, r.seams.ks.p_value);
   }
-  if (r.has_energy) add("KDM energy         E/n %.4f (finest grid of the model for this count and density)\n", r.energy_per_point);
+  if (r.has_energy)
+    add("KDM energy         E/n %.4f (finest grid of the model for this count and density)\n",
+        r.energy_per_point);
   add("analysis time %.2f s\n", r.seconds);
   return s;
 }

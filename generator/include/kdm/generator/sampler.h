@@ -41,9 +41,10 @@ struct Density {
 };
 
 struct SamplerOptions {
-  int dim = 2;                   ///< 2 or 3
+  int dim = 2;  ///< 2 or 3
   Domain domain = Domain::kTorus;
-  double extent[3] = {1, 1, 1};  ///< relative side lengths (aspect ratio); normalized output is still [0,1)^dim
+  double extent[3] = {1, 1,
+                      1};  ///< relative side lengths (aspect ratio); normalized output is still [0,1)^dim
   /// Exact number of points to return (> 0). Set to 0 to use `resolution` instead.
   std::int64_t n = 4096;
   /// Used when n == 0: finest grid nodes along the shortest axis; the count then follows from the
@@ -53,21 +54,21 @@ struct SamplerOptions {
   /// deterministic energy descent. The model temperature of eq. 4 is temperature * kModelTemperaturePerUser.
   double temperature = 0.5;
   std::uint64_t seed = 1;
-  int threads = 0;               ///< 0 = all hardware threads. Output does not depend on this.
+  int threads = 0;  ///< 0 = all hardware threads. Output does not depend on this.
   /// MH-Langevin sweeps per level. The paper uses 15 (unadjusted); with the MH test we measured 30 to
   /// reach the reference's statistics (README, "How the sampler works").
   int sweeps = 30;
-  int coarsest_sweeps = 60;      ///< sweeps on the coarsest grid, where points start far from equilibrium
+  int coarsest_sweeps = 60;  ///< sweeps on the coarsest grid, where points start far from equilibrium
   /// Deterministic descent sweeps (T = 0) right after each refinement, before the MH sweeps: they spread
   /// the crowded children of split kernels. Initialisation only; the MH sweeps then sample P.
   int burn_in_sweeps = 3;
   /// Δt of eq. 5 (Δt_j = T σ_j Δt / w), model units; 0 = automatic: 0.35 in 2D, 0.1 in 3D (measured to
   /// give acceptance rates near 0.5–0.6, where the chain relaxes fastest per sweep).
   double step = 0;
-  bool metropolis = true;        ///< false = unadjusted Langevin (biased; for experiments only)
-  double peak_density = 0.43;    ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
-  double sigma_max = 4.0;        ///< kernels at least this wide (grid units) are frozen (paper: σmax)
-  int coarsest_grid = 32;        ///< nodes along the shortest axis of the coarsest grid (paper: 32)
+  bool metropolis = true;      ///< false = unadjusted Langevin (biased; for experiments only)
+  double peak_density = 0.43;  ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
+  double sigma_max = 4.0;      ///< kernels at least this wide (grid units) are frozen (paper: σmax)
+  int coarsest_grid = 32;      ///< nodes along the shortest axis of the coarsest grid (paper: 32)
   std::int64_t max_grid_nodes = std::int64_t(1) << 27;  ///< refuse larger finest grids (memory guard)
   /// Called with (fraction done in [0,1]) between sweeps. Optional.
   std::function<void(double)> progress;
@@ -93,7 +94,7 @@ struct SampleReport {
   std::uint64_t accepted = 0;
   double acceptance_rate() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
   double model_temperature = 0;
-  double energy_per_point = 0;      ///< E / n at the end, finest grid
+  double energy_per_point = 0;  ///< E / n at the end, finest grid
   std::int64_t inserted_for_exact_count = 0;
   std::int64_t removed_for_exact_count = 0;
   double seconds = 0;
@@ -112,6 +113,7 @@ SampleResult sample(const SamplerOptions& options, const Density& density = Dens
 /// E / n of `points` (normalized coordinates) under the model sample() would use for the same count,
 /// domain and density: the energy of eq. 3 on the finest grid. Lets any point set (tiles, other
 /// samplers) be compared with full-sampler runs on one scale. Throws InvalidArgument on bad input.
-double energy_per_point(const SamplerOptions& options, const Density& density, const std::vector<double>& points);
+double energy_per_point(const SamplerOptions& options, const Density& density,
+                        const std::vector<double>& points);
 
 }  // namespace kdm::gen

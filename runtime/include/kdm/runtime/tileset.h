@@ -54,7 +54,7 @@ const char* status_message(Status status);
 /// Reader caps: files beyond them are refused before anything is allocated.
 inline constexpr std::uint64_t kMaxTilesetPayloadBytes = 512ull << 20;  ///< decompressed payload
 inline constexpr std::uint32_t kMaxTilesetHeaderBytes = 1u << 20;
-inline constexpr std::uint32_t kMaxTileColours = 16;                    ///< at most 16^4 = 65536 tiles
+inline constexpr std::uint32_t kMaxTileColours = 16;  ///< at most 16^4 = 65536 tiles
 inline constexpr std::uint32_t kMaxTileLevels = 16;
 
 /// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
@@ -68,7 +68,9 @@ struct Tile {
   std::vector<TilePoint> points;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   std::vector<std::uint32_t> level_end;
-  friend bool operator==(const Tile& a, const Tile& b) { return a.points == b.points && a.level_end == b.level_end; }
+  friend bool operator==(const Tile& a, const Tile& b) {
+    return a.points == b.points && a.level_end == b.level_end;
+  }
 };
 
 struct TileSet {
