@@ -40,6 +40,7 @@ struct Driver {
   ChainParams params;
   SampleReport report;
   std::vector<Particle<D>> particles;
+  std::vector<Particle<D>> fixed;  ///< constrained sampling: background kernels on the finest grid
   double total_sweeps = 0, done_sweeps = 0;
 
   Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
@@ -258,10 +259,37 @@ struct Driver {
     }
   }
 
+  /// Constrained sampling on coarse levels: the fixed kernels' mass, box-summed like ρ, is taken out of
+  /// each coarser density, so the new points start where the fixed ones leave room. The finest level
+  /// keeps the true model (fixed kernels as background, full ρ), whose chain samples P(new | fixed).
+  void prepare_fixed_points() {
+    const DensityGrid<D>& finest = setup.levels.front();
+    for (std::size_t j = 0; j < options.fixed_points.size() / D; ++j) {
+      Particle<D> p;
+      for (int k = 0; k < D; ++k) p.x[k] = options.fixed_points[j * D + k] * finest.grid.dims[k];
+      finest.grid.canonical(p.x);
+      p.active = false;
+      fixed.push_back(p);
+    }
+    if (fixed.empty() || setup.levels.size() < 2) return;
+    Chain<D> chain(finest, params);
+    typename Chain<D>::Scratch scratch;
+    for (const auto& p : fixed) chain.splat(p, 1.0f, scratch);
+    std::vector<float> mass(chain.residual());
+    for (std::size_t i = 0; i < mass.size(); ++i) mass[i] += finest.rho[i];  // A_fixed = R + ρ
+    for (std::size_t l = 1; l < setup.levels.size(); ++l) {
+      mass = box_sum_half<D>(setup.levels[l - 1].grid, mass);
+      std::vector<float>& rho = setup.levels[l].rho;
+      for (std::size_t i = 0; i < rho.size(); ++i) rho[i] = std::max(0.0f, rho[i] - mass[i]);
+    }
+  }
+
   void relax_level(int level, int sweeps) {
     DensityGrid<D>& density = setup.levels[level];
     Chain<D> chain(density, params);
     typename Chain<D>::Scratch scratch;
+    if (level == 0)
+      for (const auto& p : fixed) chain.splat(p, 1.0f, scratch);
     const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1;
     if (coarsest) {
       initial_configuration(chain);
@@ -309,7 +337,8 @@ struct Driver {
     report.proposals += counters.proposals;
     report.accepted += counters.accepted;
     report.levels.push_back(lr);
-    if (level == 0) report.energy_per_point = chain.energy() / std::max<std::size_t>(1, particles.size());
+    if (level == 0)
+      report.energy_per_point = chain.energy() / std::max<std::size_t>(1, particles.size() + fixed.size());
   }
 
   SampleResult run() {
@@ -320,6 +349,7 @@ struct Driver {
       total_sweeps +=
           (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
           std::ldexp(1.0, -D * l);
+    prepare_fixed_points();
     for (int l = levels - 1; l >= 0; --l) {
       if (l < levels - 1) refine(l);
       relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);

@@ -101,6 +101,12 @@ void validate_options(const SamplerOptions& o) {
     if (!(std::isfinite(o.extent[k]) && o.extent[k] > 0))
       throw InvalidArgument("domain extents must be finite and > 0");
   if (o.n > (std::int64_t(1) << 31)) throw InvalidArgument("point count is too large (limit 2^31)");
+  if (o.fixed_points.size() % o.dim != 0)
+    throw InvalidArgument("fixed points: coordinate count is not a multiple of the dimension");
+  for (double u : o.fixed_points)
+    if (!(u >= 0 && u < 1)) throw InvalidArgument("fixed points must lie in [0, 1) on every axis");
+  if (!o.fixed_points.empty() && o.n == 0)
+    throw InvalidArgument("constrained sampling needs a point count n > 0");
 }
 
 template <int D>
@@ -128,15 +134,16 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
       peak_over_mean = mx / (sum / p.size());
     }
+    const double total = double(o.n) + double(o.fixed_points.size() / D);
     double shortest =
-        std::pow(o.n * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product), 1.0 / D);
+        std::pow(total * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product), 1.0 / D);
     for (int attempt = 0;; ++attempt) {
       grid = make_grid<D>(o, std::max(1.0, shortest), levels);
       rho = sample_density<D>(grid, density);
       double sum = 0, mx = 0;
       for (float v : rho) sum += v, mx = std::max<double>(mx, v);
       if (!(sum > 0)) throw InvalidArgument("density is zero everywhere");
-      const double scale = o.n * setup.mass_per_point / sum;
+      const double scale = total * setup.mass_per_point / sum;
       const double peak = mx * scale;
       if (peak <= o.peak_density * 1.02 || attempt == 6) {
         for (float& v : rho) v = static_cast<float>(v * scale);
@@ -158,23 +165,33 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     DensityGrid<D> coarse;
     coarse.grid = fine.grid;
     for (int k = 0; k < D; ++k) coarse.grid.dims[k] /= 2;
-    coarse.rho.assign(static_cast<std::size_t>(coarse.grid.size()), 0.0f);
-    // Box filter and subsample: coarse node = sum of its 2^D children (the factor 2^D of eq. 12 inside ρ).
-    std::array<int, D> node{};
-    for (std::int64_t i = 0; i < fine.grid.size(); ++i) {
-      std::int64_t ci = 0;
-      for (int k = D - 1; k >= 0; --k) ci = ci * coarse.grid.dims[k] + node[k] / 2;
-      coarse.rho[ci] += fine.rho[i];
-      for (int k = 0; k < D; ++k) {
-        if (++node[k] < fine.grid.dims[k]) break;
-        node[k] = 0;
-      }
-    }
+    coarse.rho = box_sum_half<D>(fine.grid, fine.rho);
     setup.levels.push_back(std::move(coarse));
   }
   return setup;
 }
 
+template <int D>
+std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values) {
+  std::array<int, D> coarse_dims{};
+  std::size_t size = 1;
+  for (int k = 0; k < D; ++k) coarse_dims[k] = fine.dims[k] / 2, size *= coarse_dims[k];
+  std::vector<float> coarse(size, 0.0f);
+  std::array<int, D> node{};
+  for (std::int64_t i = 0; i < fine.size(); ++i) {
+    std::int64_t ci = 0;
+    for (int k = D - 1; k >= 0; --k) ci = ci * coarse_dims[k] + node[k] / 2;
+    coarse[ci] += values[i];
+    for (int k = 0; k < D; ++k) {
+      if (++node[k] < fine.dims[k]) break;
+      node[k] = 0;
+    }
+  }
+  return coarse;
+}
+
+template std::vector<float> box_sum_half<2>(const Grid<2>&, const std::vector<float>&);
+template std::vector<float> box_sum_half<3>(const Grid<3>&, const std::vector<float>&);
 template ModelSetup<2> build_model<2>(const SamplerOptions&, const Density&);
 template ModelSetup<3> build_model<3>(const SamplerOptions&, const Density&);
 

@@ -21,6 +21,11 @@ struct ModelSetup {
 template <int D>
 ModelSetup<D> build_model(const SamplerOptions& options, const Density& density);
 
+/// The next coarser level of a pyramid: every coarse node is the sum of its 2^D children (a box filter
+/// and subsampling; the factor 2^D of eq. 12 goes inside the values). `fine` dims must be even.
+template <int D>
+std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values);
+
 /// Throws InvalidArgument naming the first bad option.
 void validate_options(const SamplerOptions& options);
 

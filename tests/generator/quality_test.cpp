@@ -59,3 +59,38 @@ TEST(QualityTest, LowTemperatureIsMoreOrdered) {
 
 }  // namespace
 }  // namespace kdm::gen
+
+namespace kdm::gen {
+namespace {
+
+// Constrained sampling (the tile pyramid's step): 1024 fixed points, 3072 new ones sampled from
+// P(new | fixed). The union must be as blue as an unconstrained set of 4096.
+TEST(QualityTest, ConstrainedSamplingFillsAroundFixedPoints) {
+  SamplerOptions base;
+  base.n = 1024;
+  base.seed = 1;
+  const std::vector<double> fixed = sample(base).points;
+  SamplerOptions o;
+  o.n = 3072;
+  o.seed = 2;
+  o.sweeps = 100;  // conditioning slows burn-in: measured E/n .60 after 30 sweeps, .53 (converged) after 100
+  o.fixed_points = fixed;
+  const SampleResult r = sample(o);
+  ASSERT_EQ(r.size(), 3072u);
+  std::vector<double> all = fixed;
+  all.insert(all.end(), r.points.begin(), r.points.end());
+  const analysis::NNStats nn = analysis::nn_stats(all, 2, true);
+  std::printf("1024 fixed + 3072 new: δmin %.3f δavg %.4f E/n %.4f\n", nn.dmin, nn.davg,
+              r.report.energy_per_point);
+  // Measured δmin .569, δavg .874 (seed 2); unconstrained 4096-point sets give δavg .872 ± .003.
+  EXPECT_GE(nn.davg, 0.865);
+  EXPECT_GE(nn.dmin, 0.45);
+  SamplerOptions bad = o;
+  bad.fixed_points.push_back(0.5);  // odd coordinate count
+  EXPECT_THROW(sample(bad), InvalidArgument);
+  bad.fixed_points = {1.5, 0.5};
+  EXPECT_THROW(sample(bad), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace kdm::gen

@@ -70,6 +70,10 @@ struct SamplerOptions {
   double sigma_max = 4.0;      ///< kernels at least this wide (grid units) are frozen (paper: σmax)
   int coarsest_grid = 32;      ///< nodes along the shortest axis of the coarsest grid (paper: 32)
   std::int64_t max_grid_nodes = std::int64_t(1) << 27;  ///< refuse larger finest grids (memory guard)
+  /// Constrained sampling: points already placed (normalized coordinates, dim per point). Their kernels are
+  /// background that never moves; the chain samples the n new points from P(new | fixed). The result
+  /// holds only the new points. The density is scaled for n + fixed count points in all.
+  std::vector<double> fixed_points;
   /// Called with (fraction done in [0,1]) between sweeps. Optional.
   std::function<void(double)> progress;
 };
