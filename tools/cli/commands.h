@@ -17,5 +17,6 @@ struct CommandError : std::runtime_error {
 
 void add_sample_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
+void add_tile_commands(CLI::App& app);  // bake, info
 
 }  // namespace kdm::cli

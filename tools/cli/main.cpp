@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
                                         std::to_string(kdm::kTilesetFormatVersion) + ")");
   app.require_subcommand(1);
   kdm::cli::add_sample_command(app);
+  kdm::cli::add_tile_commands(app);
 #ifdef KDM_HAVE_ANALYZE
   kdm::cli::add_analyze_command(app);
 #endif
