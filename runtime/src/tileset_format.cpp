@@ -151,6 +151,8 @@ const char* status_message(Status status) {
       return "tile-set content is inconsistent";
     case Status::kInvalidArgument:
       return "invalid argument";
+    case Status::kBufferFull:
+      return "output buffer full; resume with the same cursor";
   }
   return "unknown status";
 }

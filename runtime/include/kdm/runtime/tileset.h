@@ -46,6 +46,7 @@ enum class Status : int {
   kDecompressionFailed,      ///< the payload is not a valid zstd frame of the stated size
   kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
   kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TileSet)
+  kBufferFull,               ///< a query filled the caller's buffer; resume with the same cursor
 };
 
 /// A short English description of `status` (static storage).

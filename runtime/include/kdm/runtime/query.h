@@ -1,0 +1,114 @@
+// Real-time blue noise from a baked tile set: the points of a region for a spatially varying density.
+//
+// World space is tiled by squares of side `tile_size`; tile (tx, ty) covers [tx·S, (tx+1)·S) × [ty·S,
+// (ty+1)·S) and shows the set's tile chosen by the colours of its four corners (a hash of the corner's
+// integer coordinates, so any region is assembled locally). A tile's points are sorted by rank; point c of a
+// tile of area A is emitted iff ρ(x_c) · A · scale > c + ½ (DESIGN.md §4): density responds continuously,
+// raising the scale only adds points (zoom coherence), and every decision depends only on the point's
+// canonical tile coordinates, so query(A ∪ B) = query(A) ⊎ query(B) bit for bit.
+//
+// Thread safety: a Tileset is immutable after loading; any number of threads may query it at once.
+// Queries allocate nothing, take no locks and touch no global state.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+
+/// A loaded tile set, ready for queries (immutable).
+class Tileset {
+ public:
+  /// Loads and validates a file / memory buffer (untrusted input; see decode_tileset). On failure the
+  /// returned status says why, `detail` (optional) says more, and `out` is left empty.
+  static Status load_file(const std::string& path, Tileset& out, std::string* detail = nullptr);
+  static Status load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail = nullptr);
+  /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe; decoded once.
+  static const Tileset& builtin();
+
+  const TileSet& data() const { return set_; }
+  bool empty() const { return set_.tiles.empty(); }
+  /// Most points a tile can emit (the top pyramid level): the density limit is this per tile area.
+  std::uint32_t max_points_per_tile() const { return max_points_; }
+  /// The set's tile for tile coordinates (tx, ty). Thread-safe.
+  const Tile& tile_at(std::int64_t tx, std::int64_t ty) const;
+
+ private:
+  TileSet set_;
+  std::uint32_t max_points_ = 0;
+};
+
+/// A point's stable identity: its tile and its rank there (the level follows from the rank).
+struct PointId {
+  std::int64_t tile_x = 0, tile_y = 0;
+  std::uint32_t rank = 0;
+  friend bool operator==(const PointId& a, const PointId& b) {
+    return a.tile_x == b.tile_x && a.tile_y == b.tile_y && a.rank == b.rank;
+  }
+};
+
+struct QueryPoint {
+  double x = 0, y = 0;  ///< world position minus the query origin
+  PointId id;
+};
+
+/// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
+/// Values must be finite and >= 0 (validated by make_density_image). Built once, shared read-only.
+struct DensityImage {
+  int width = 0, height = 0;
+  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  ///< world rectangle covered; row 0 at y0
+  const float* values = nullptr;          ///< width·height, row-major, owned by the caller
+  const float* max_mip = nullptr;         ///< per 8×8 texel block maximum (see make_density_max_mip)
+  int mip_width = 0, mip_height = 0;
+  double at(double x, double y) const;
+  /// Upper bound of the density over a world rectangle (from the max-mip; exact bound, maybe loose).
+  double max_over(double x0, double y0, double x1, double y1) const;
+};
+
+/// Fills `mip` (resized to ceil(w/8)·ceil(h/8)) with 8×8 block maxima of `image.values`, widened by one
+/// texel so they bound bilinear values too, and points the image at it. Returns kInvalidArgument for
+/// empty images or values that are negative or not finite.
+Status make_density_max_mip(DensityImage& image, std::vector<float>& mip);
+
+/// The density of a query: constant, an image, or a callback (called once per candidate point, with
+/// world coordinates; must be thread-safe if queries run concurrently). Negative, NaN and infinite values
+/// from a callback are treated as 0 (documented: a bad value never emits points or crashes).
+struct QueryDensity {
+  enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;
+  double constant = 1;
+  const DensityImage* image = nullptr;
+  double (*callback)(void* user, double x, double y) = nullptr;
+  void* user = nullptr;
+  /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
+  double callback_max = 1;
+};
+
+struct QueryParams {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< half-open world region [x0, x1) × [y0, y1)
+  double origin_x = 0, origin_y = 0;      ///< subtracted from every output position
+  double tile_size = 1;                   ///< world units per tile side
+  double scale = 1;                       ///< points per unit area at density 1
+  QueryDensity density;
+};
+
+/// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call.
+struct QueryCursor {
+  std::int64_t tile_x = 0, tile_y = 0;
+  std::uint32_t rank = 0;
+  bool started = false, finished = false;
+};
+
+/// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
+/// ascending); `*written` receives the count. Returns kOk when the region is complete, kBufferFull when
+/// `out` filled up first — call again with the same cursor (and params) to continue. Empty or inverted
+/// regions and scale 0 give no points. kInvalidArgument for non-finite params, tile_size <= 0, negative
+/// or non-finite scale, a region of more than 2^40 tiles, or a density beyond the tile set's top level
+/// (scale · max density · tile area > max_points_per_tile: needs finer tiles). No allocation.
+Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
+                    std::size_t* written, QueryCursor* cursor);
+
+}  // namespace kdm

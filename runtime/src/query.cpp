@@ -1,0 +1,206 @@
+// Runtime queries over a baked tile set; see kdm/runtime/query.h.
+#include "kdm/runtime/query.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kdm {
+namespace {
+
+std::uint64_t mix64(std::uint64_t z) {  // SplitMix64 finaliser
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+/// Colour of the tile-grid vertex (vx, vy): a hash, so every region is assembled locally.
+std::uint32_t vertex_colour(std::int64_t vx, std::int64_t vy, std::uint32_t colours) {
+  const std::uint64_t h =
+      mix64(mix64(static_cast<std::uint64_t>(vx) + 0x6b647469ull) ^ static_cast<std::uint64_t>(vy));
+  return static_cast<std::uint32_t>(h % colours);
+}
+
+bool finite(double v) {
+  return std::isfinite(v);
+}
+
+double sanitize(double v) {
+  return (v > 0 && v < HUGE_VAL) ? v : 0.0;
+}  // NaN, ±inf, negatives -> 0
+
+constexpr double kInv65536 = 1.0 / 65536.0;
+
+}  // namespace
+
+Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
+  out = Tileset{};
+  TileSet set;
+  const Status s = decode_tileset(data, size, set, detail);
+  if (s != Status::kOk) return s;
+  out.set_ = std::move(set);
+  for (const Tile& t : out.set_.tiles)
+    out.max_points_ = std::max(out.max_points_, static_cast<std::uint32_t>(t.points.size()));
+  // Every tile must reach the same top density, or some tiles would thin out.
+  for (const Tile& t : out.set_.tiles) out.max_points_ = std::min(out.max_points_, t.level_end.back());
+  return Status::kOk;
+}
+
+Status Tileset::load_file(const std::string& path, Tileset& out, std::string* detail) {
+  out = Tileset{};
+  TileSet set;
+  const Status s = load_tileset(path, set, detail);
+  if (s != Status::kOk) return s;
+  std::vector<std::uint8_t> bytes;
+  encode_tileset(set, bytes);  // cheap relative to a load; keeps one code path for the derived fields
+  return load_memory(bytes.data(), bytes.size(), out, detail);
+}
+
+const Tile& Tileset::tile_at(std::int64_t tx, std::int64_t ty) const {
+  const std::uint32_t c = set_.colours;
+  if (c == 1) return set_.tiles.front();
+  return set_.tiles[set_.tile_index(vertex_colour(tx, ty, c), vertex_colour(tx + 1, ty, c),
+                                    vertex_colour(tx + 1, ty + 1, c), vertex_colour(tx, ty + 1, c))];
+}
+
+namespace {
+
+/// World-to-texel transform of a density image, hoisted out of the per-point loop.
+struct ImageSampler {
+  const DensityImage* image;
+  double sx = 0, sy = 0;
+  explicit ImageSampler(const DensityImage* im) : image(im) {
+    if (im) sx = im->width / (im->x1 - im->x0), sy = im->height / (im->y1 - im->y0);
+  }
+  double at(double x, double y) const {
+    const DensityImage& im = *image;
+    const double fx = std::clamp((x - im.x0) * sx - 0.5, 0.0, im.width - 1.0);
+    const double fy = std::clamp((y - im.y0) * sy - 0.5, 0.0, im.height - 1.0);
+    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+    const int jx = std::min(ix + 1, im.width - 1), jy = std::min(iy + 1, im.height - 1);
+    const double ax = fx - ix, ay = fy - iy;
+    const float* r0 = im.values + static_cast<std::size_t>(iy) * im.width;
+    const float* r1 = im.values + static_cast<std::size_t>(jy) * im.width;
+    return (1 - ay) * ((1 - ax) * r0[ix] + ax * r0[jx]) + ay * ((1 - ax) * r1[ix] + ax * r1[jx]);
+  }
+};
+
+}  // namespace
+
+double DensityImage::at(double x, double y) const {
+  return ImageSampler(this).at(x, y);
+}
+
+double DensityImage::max_over(double qx0, double qy0, double qx1, double qy1) const {
+  auto block = [](double v, double lo, double hi, int n, int blocks) {
+    const double t = std::clamp((v - lo) / (hi - lo) * n, 0.0, double(n - 1));
+    return std::min(blocks - 1, static_cast<int>(t) / 8);
+  };
+  const int bx0 = block(qx0, x0, x1, width, mip_width), bx1 = block(qx1, x0, x1, width, mip_width);
+  const int by0 = block(qy0, y0, y1, height, mip_height), by1 = block(qy1, y0, y1, height, mip_height);
+  float m = 0;
+  for (int by = by0; by <= by1; ++by)
+    for (int bx = bx0; bx <= bx1; ++bx)
+      m = std::max(m, max_mip[static_cast<std::size_t>(by) * mip_width + bx]);
+  return m;
+}
+
+Status make_density_max_mip(DensityImage& image, std::vector<float>& mip) {
+  if (image.width <= 0 || image.height <= 0 || !image.values) return Status::kInvalidArgument;
+  if (!(finite(image.x0) && finite(image.x1) && finite(image.y0) && finite(image.y1) && image.x1 > image.x0 &&
+        image.y1 > image.y0))
+    return Status::kInvalidArgument;
+  const std::size_t count = static_cast<std::size_t>(image.width) * image.height;
+  for (std::size_t i = 0; i < count; ++i)
+    if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;
+  image.mip_width = (image.width + 7) / 8;
+  image.mip_height = (image.height + 7) / 8;
+  mip.assign(static_cast<std::size_t>(image.mip_width) * image.mip_height, 0.0f);
+  // Each block also covers one texel around it: bilinear values inside a block mix in its neighbours.
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const float v = image.values[static_cast<std::size_t>(y) * image.width + x];
+      for (int by = std::max(0, (y - 1) / 8); by <= std::min(image.mip_height - 1, (y + 1) / 8); ++by)
+        for (int bx = std::max(0, (x - 1) / 8); bx <= std::min(image.mip_width - 1, (x + 1) / 8); ++bx) {
+          float& m = mip[static_cast<std::size_t>(by) * image.mip_width + bx];
+          m = std::max(m, v);
+        }
+    }
+  image.max_mip = mip.data();
+  return Status::kOk;
+}
+
+Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
+                    std::size_t* written, QueryCursor* cursor) {
+  if (written) *written = 0;
+  if (!written || !cursor || (capacity > 0 && !out) || tileset.empty()) return Status::kInvalidArgument;
+  if (!(finite(q.x0) && finite(q.y0) && finite(q.x1) && finite(q.y1) && finite(q.origin_x) &&
+        finite(q.origin_y) && finite(q.tile_size) && q.tile_size > 0 && finite(q.scale) && q.scale >= 0))
+    return Status::kInvalidArgument;
+  if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {
+    cursor->finished = true;
+    return Status::kOk;
+  }
+  const QueryDensity& d = q.density;
+  double max_density = 0;
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      max_density = sanitize(d.constant);
+      break;
+    case QueryDensity::Kind::kImage:
+      if (!d.image || !d.image->values || !d.image->max_mip) return Status::kInvalidArgument;
+      max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
+      break;
+    case QueryDensity::Kind::kCallback:
+      if (!d.callback || !(finite(d.callback_max) && d.callback_max >= 0)) return Status::kInvalidArgument;
+      max_density = d.callback_max;
+      break;
+  }
+  const double S = q.tile_size, area_scale = S * S * q.scale;
+  const ImageSampler sampler(d.kind == QueryDensity::Kind::kImage ? d.image : nullptr);
+  if (!(max_density * area_scale <= tileset.max_points_per_tile() + 0.5)) return Status::kInvalidArgument;
+  const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
+  const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
+  if (!((tx1d - tx0d) * (ty1d - ty0d) <= 1099511627776.0) || std::fabs(tx0d) > 9e15 ||
+      std::fabs(ty1d) > 9e15 || std::fabs(tx1d) > 9e15 || std::fabs(ty0d) > 9e15)
+    return Status::kInvalidArgument;
+  const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
+  const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
+  if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false};
+
+  std::size_t n = 0;
+  for (std::int64_t ty = cursor->tile_y; ty < ty1; ++ty) {
+    const double wy = double(ty) * S;
+    for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
+      const Tile& tile = tileset.tile_at(tx, ty);
+      const double wx = double(tx) * S;
+      double bound = max_density;
+      if (d.kind == QueryDensity::Kind::kImage) bound = d.image->max_over(wx, wy, wx + S, wy + S);
+      // Ranks c with c + 1/2 < bound · A · scale can be emitted; none beyond.
+      const double limit = bound * area_scale - 0.5;
+      const std::uint32_t candidates =
+          limit <= 0 ? 0 : static_cast<std::uint32_t>(std::min<double>(tile.points.size(), std::ceil(limit)));
+      std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
+      for (; c < candidates; ++c) {
+        const TilePoint p = tile.points[c];
+        const double x = wx + (p.x + 0.5) * kInv65536 * S, y = wy + (p.y + 0.5) * kInv65536 * S;
+        if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
+        if (d.kind != QueryDensity::Kind::kConstant) {
+          const double rho =
+              d.kind == QueryDensity::Kind::kImage ? sampler.at(x, y) : sanitize(d.callback(d.user, x, y));
+          if (!(rho * area_scale > c + 0.5)) continue;
+        }
+        if (n == capacity) {
+          *cursor = QueryCursor{tx, ty, c, true, false};
+          *written = n;
+          return Status::kBufferFull;
+        }
+        out[n++] = QueryPoint{x - q.origin_x, y - q.origin_y, PointId{tx, ty, c}};
+      }
+    }
+  }
+  cursor->finished = true;
+  *written = n;
+  return Status::kOk;
+}
+
+}  // namespace kdm

@@ -1,0 +1,224 @@
+// Runtime queries: chunk consistency, zoom coherence, determinism, resumable buffers, bad input, density
+// accuracy, and no heap allocation on the query path.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <random>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "kdm/analysis/density.h"
+#include "kdm/runtime/query.h"
+
+// Counts heap allocations made by this test binary, to prove queries make none.
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+namespace kdm {
+namespace {
+
+using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, double, double>;
+
+std::vector<Key> run(const QueryParams& q, std::size_t capacity = 1 << 16) {
+  std::vector<QueryPoint> buffer(capacity);
+  std::vector<Key> keys;
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = query_points(Tileset::builtin(), q, buffer.data(), buffer.size(), &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
+    for (std::size_t i = 0; i < written; ++i)
+      keys.emplace_back(buffer[i].id.tile_x, buffer[i].id.tile_y, buffer[i].id.rank, buffer[i].x,
+                        buffer[i].y);
+    if (s != Status::kBufferFull) break;
+  }
+  return keys;
+}
+
+QueryParams region(double x0, double y0, double x1, double y1, double scale) {
+  QueryParams q;
+  q.x0 = x0, q.y0 = y0, q.x1 = x1, q.y1 = y1;
+  q.scale = scale;
+  return q;
+}
+
+TEST(QueryTest, BuiltinTilesetIsAvailable) {
+  const Tileset& t = Tileset::builtin();
+  EXPECT_FALSE(t.empty());
+  EXPECT_EQ(t.max_points_per_tile(), t.data().tiles.front().level_end.back());
+}
+
+TEST(QueryTest, AnyPartitionGivesTheSameUnionBitForBit) {
+  const QueryParams whole = region(-3.3, -2.1, 4.7, 5.9, 900);
+  std::vector<Key> expected = run(whole);
+  std::sort(expected.begin(), expected.end());
+  ASSERT_GT(expected.size(), 10000u);
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 5; ++trial) {
+    // A random grid of cuts (including cuts through tiles and points' neighbourhoods).
+    std::vector<double> xs = {whole.x0, whole.x1}, ys = {whole.y0, whole.y1};
+    for (int i = 0; i < 4; ++i) {
+      xs.push_back(whole.x0 + (whole.x1 - whole.x0) * std::uniform_real_distribution<>(0, 1)(rng));
+      ys.push_back(whole.y0 + (whole.y1 - whole.y0) * std::uniform_real_distribution<>(0, 1)(rng));
+    }
+    std::sort(xs.begin(), xs.end());
+    std::sort(ys.begin(), ys.end());
+    std::vector<Key> got;
+    for (std::size_t i = 0; i + 1 < xs.size(); ++i)
+      for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
+        QueryParams part = whole;
+        part.x0 = xs[i], part.x1 = xs[i + 1], part.y0 = ys[j], part.y1 = ys[j + 1];
+        const std::vector<Key> k = run(part);
+        got.insert(got.end(), k.begin(), k.end());
+      }
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected) << "trial " << trial;
+  }
+}
+
+TEST(QueryTest, RaisingTheScaleKeepsEveryPoint) {
+  std::vector<Key> low = run(region(0, 0, 3, 3, 300)), high = run(region(0, 0, 3, 3, 1300));
+  std::sort(low.begin(), low.end());
+  std::sort(high.begin(), high.end());
+  EXPECT_GT(high.size(), 4 * low.size());
+  EXPECT_TRUE(std::includes(high.begin(), high.end(), low.begin(), low.end()));
+}
+
+TEST(QueryTest, ResumesAFullBufferAndIsDeterministicAcrossThreads) {
+  const QueryParams q = region(0.5, 0.5, 2.5, 2.5, 2000);
+  const std::vector<Key> whole = run(q);
+  EXPECT_EQ(run(q, 7), whole);  // tiny buffer, many resumes
+  std::vector<Key> other;
+  std::thread t([&] { other = run(q); });
+  t.join();
+  EXPECT_EQ(other, whole);
+}
+
+TEST(QueryTest, FarFromTheOriginPositionsStayExact) {
+  const double far = 1e7;
+  QueryParams near_q = region(0.25, 0.25, 1.75, 1.75, 3000);
+  QueryParams far_q = region(far + 0.25, far + 0.25, far + 1.75, far + 1.75, 3000);
+  far_q.origin_x = far_q.origin_y = far;
+  const std::vector<Key> a = run(near_q), b = run(far_q);
+  ASSERT_EQ(a.size(), b.size());  // one tile set, one periodic tile: the same points shifted by 10^7 tiles
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(std::get<3>(a[i]), std::get<3>(b[i]), 1e-8);
+    EXPECT_NEAR(std::get<4>(a[i]), std::get<4>(b[i]), 1e-8);
+  }
+}
+
+double ramp(void*, double x, double) {
+  return 0.1 + 0.9 * std::clamp(x / 8.0, 0.0, 1.0);
+}
+double hostile(void*, double x, double) {
+  return x < 1 ? std::nan("") : (x < 2 ? -5.0 : HUGE_VAL);
+}
+
+TEST(QueryTest, FollowsADensityRamp) {
+  QueryParams q = region(0, 0, 8, 8, 12000);
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = ramp;
+  q.density.callback_max = 1;
+  const std::vector<Key> keys = run(q);
+  std::vector<double> coords;
+  for (const Key& k : keys) coords.insert(coords.end(), {std::get<3>(k) / 8, std::get<4>(k) / 8});
+  analysis::DensityOptions o;
+  o.expected_total = 12000.0 * 64 * 0.55;  // ∫ρ over the region × scale
+  const analysis::DensityAccuracy acc = analysis::density_accuracy(
+      coords, 2, [](double x, double y) { return ramp(nullptr, 8 * x, 8 * y); }, o);
+  std::printf("ramp: %zu points, %zu windows, RMS z %.3f, bias %+.4f\n", keys.size(), acc.windows, acc.rms_z,
+              acc.bias);
+  EXPECT_LE(acc.rms_z, 0.5);
+  EXPECT_LE(std::fabs(acc.bias), 0.005);
+}
+
+TEST(QueryTest, FollowsADensityImage) {
+  // A 64×64 image over the 4×4 region: a 1:1000 radial falloff, bilinear between texels.
+  std::vector<float> values(64 * 64), mip;
+  auto radial = [](double x, double y) {
+    return std::pow(1000.0, -std::min(1.0, std::hypot(x - 2, y - 2) / 2));
+  };
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      values[y * 64 + x] = static_cast<float>(radial((x + 0.5) / 16, (y + 0.5) / 16));
+  DensityImage image;
+  image.width = image.height = 64;
+  image.x1 = image.y1 = 4;
+  image.values = values.data();
+  ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
+  QueryParams q = region(0, 0, 4, 4, 14000);
+  q.density.kind = QueryDensity::Kind::kImage;
+  q.density.image = &image;
+  const std::vector<Key> keys = run(q);
+  std::vector<double> coords;
+  for (const Key& k : keys) coords.insert(coords.end(), {std::get<3>(k) / 4, std::get<4>(k) / 4});
+  const analysis::DensityAccuracy acc =
+      analysis::density_accuracy(coords, 2, [&](double x, double y) { return image.at(4 * x, 4 * y); });
+  std::printf("image: %zu points, %zu windows, RMS z %.3f\n", keys.size(), acc.windows, acc.rms_z);
+  EXPECT_LE(acc.rms_z, 0.5);
+  // Bad images are refused.
+  values[5] = -1;
+  EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
+  values[5] = std::nanf("");
+  EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
+}
+
+TEST(QueryTest, BadInputIsRejectedOrHarmless) {
+  std::vector<QueryPoint> buffer(16);
+  std::size_t written = 7;
+  QueryCursor cursor;
+  QueryParams q = region(0, 0, 1, 1, 100);
+  q.x1 = std::nan("");
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor),
+            Status::kInvalidArgument);
+  EXPECT_EQ(written, 0u);
+  EXPECT_TRUE(run(region(1, 1, 0, 2, 100)).empty());  // inverted
+  EXPECT_TRUE(run(region(1, 1, 1, 2, 100)).empty());  // empty
+  EXPECT_TRUE(run(region(0, 0, 1, 1, 0)).empty());    // scale 0
+  cursor = QueryCursor{};
+  EXPECT_EQ(query_points(Tileset::builtin(), region(0, 0, 1, 1, 1e12), buffer.data(), 16, &written, &cursor),
+            Status::kInvalidArgument);  // denser than the top level
+  cursor = QueryCursor{};
+  EXPECT_EQ(
+      query_points(Tileset::builtin(), region(-1e9, -1e9, 1e9, 1e9, 1), buffer.data(), 16, &written, &cursor),
+      Status::kInvalidArgument);  // 4·10^18 tiles
+  QueryParams h = region(0, 0, 3, 1, 1000);
+  h.density.kind = QueryDensity::Kind::kCallback;
+  h.density.callback = hostile;
+  EXPECT_TRUE(run(h).empty());  // NaN, negative and infinite densities emit nothing
+}
+
+TEST(QueryTest, QueriesDoNotAllocate) {
+  std::vector<QueryPoint> buffer(4096);
+  const Tileset& t = Tileset::builtin();  // decode outside the measured window
+  const long before = g_allocations.load();
+  std::size_t total = 0;
+  for (int i = 0; i < 20; ++i) {
+    QueryCursor cursor;
+    std::size_t written = 0;
+    QueryParams q = region(i * 0.37, 0, i * 0.37 + 2, 2, 500);
+    while (query_points(t, q, buffer.data(), buffer.size(), &written, &cursor) == Status::kBufferFull)
+      total += written;
+    total += written;
+  }
+  EXPECT_GT(total, 0u);
+  EXPECT_EQ(g_allocations.load(), before);
+}
+
+}  // namespace
+}  // namespace kdm
