@@ -18,6 +18,7 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
     if (value.empty() || *end != '\0' || !std::isfinite(v) || v <= 0)
       throw CommandError("--density const:V needs a finite V > 0, got '" + value + "'");
     arg.density = gen::Density::constant();
+    arg.constant = v;
     return arg;
   }
   tools::GreyImage image;
@@ -29,7 +30,8 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
     values[i] = static_cast<float>(std::pow(std::max(0.0, tone), gamma));
   }
   try {
-    arg.density = gen::Density::from_values(image.width, image.height, std::move(values));
+    arg.density = gen::Density::from_values(image.width, image.height, values);
+    arg.values = std::move(values);
   } catch (const gen::InvalidArgument& e) {
     throw CommandError("image '" + spec + "': " + e.what() +
                        (invert ? "" : " (an all-white image has no ink)"));

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "kdm/generator/sampler.h"
 
@@ -11,6 +12,8 @@ struct DensityArg {
   gen::Density density;
   bool from_image = false;
   int image_width = 0, image_height = 0;
+  std::vector<float> values;  ///< the image's density values, row 0 at the top (images only)
+  double constant = 1;        ///< the value of const:V
 };
 
 /// `spec` is "const:V" (V finite, > 0) or a path to an image. Image darkness (1 - luminance) raised to

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
                                         std::to_string(kdm::kTilesetFormatVersion) + ")");
   app.require_subcommand(1);
   kdm::cli::add_sample_command(app);
+  kdm::cli::add_stipple_command(app);
+  kdm::cli::add_query_command(app);
   kdm::cli::add_tile_commands(app);
 #ifdef KDM_HAVE_ANALYZE
   kdm::cli::add_analyze_command(app);

@@ -1,0 +1,59 @@
+#include "runtime_args.h"
+
+#include <algorithm>
+
+#include "commands.h"
+
+namespace kdm::cli {
+
+std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, double x0, double y0, double x1,
+                                                     double y1) {
+  auto d = std::make_unique<RuntimeDensity>();
+  if (!arg.from_image) {
+    d->density.kind = QueryDensity::Kind::kConstant;
+    d->density.constant = arg.constant;
+    d->max_value = d->mean_value = arg.constant;
+    return d;
+  }
+  const int w = arg.image_width, h = arg.image_height;
+  d->values.resize(arg.values.size());
+  for (int y = 0; y < h; ++y)  // DensityImage row 0 is at y0 (the bottom); the picture's row 0 is its top
+    std::copy_n(&arg.values[static_cast<std::size_t>(h - 1 - y) * w], w,
+                &d->values[static_cast<std::size_t>(y) * w]);
+  d->image.width = w, d->image.height = h;
+  d->image.x0 = x0, d->image.y0 = y0, d->image.x1 = x1, d->image.y1 = y1;
+  d->image.values = d->values.data();
+  if (make_density_max_mip(d->image, d->mip) != Status::kOk) throw CommandError("density image is invalid");
+  double sum = 0;
+  for (float v : d->values) sum += v, d->max_value = std::max<double>(d->max_value, v);
+  d->mean_value = sum / d->values.size();
+  d->density.kind = QueryDensity::Kind::kImage;
+  d->density.image = &d->image;
+  return d;
+}
+
+const Tileset& tileset_for(const std::string& path, Tileset& storage) {
+  if (path.empty()) return Tileset::builtin();
+  std::string detail;
+  const Status s = Tileset::load_file(path, storage, &detail);
+  if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  return storage;
+}
+
+void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out) {
+  out.clear();
+  std::vector<QueryPoint> buffer(1 << 16);
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = query_points(tileset, params, buffer.data(), buffer.size(), &written, &cursor);
+    out.insert(out.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(written));
+    if (s == Status::kOk) return;
+    if (s != Status::kBufferFull)
+      throw CommandError(
+          std::string("query: ") + status_message(s) +
+          " (check the region, the scale, and that the density fits the tile set's top level)");
+  }
+}
+
+}  // namespace kdm::cli
