@@ -61,6 +61,11 @@ TEST(BakeTest, ProgressiveOrderFillsLargestHolesFirst) {
 }
 
 TEST(BakeTest, ShippedDefaultSetRebakesBitIdentically) {
+#ifndef KDM_RELEASE_BUILD
+  // Bit-identical output is promised per build configuration; the shipped file comes from a Release
+  // build, and other flags (sanitizers, -O0) round floating point differently.
+  GTEST_SKIP() << "the shipped tile set is reproduced by Release builds";
+#endif
   const std::string dir = std::string(KDM_SOURCE_DIR) + "/tilesets/";
   const BakeRecipe recipe = BakeRecipe::parse(read_file(dir + "default.recipe"));
   const std::vector<std::uint8_t> bytes = encoded(bake_tileset(recipe, 0));
