@@ -1,0 +1,20 @@
+// Uses the installed runtime (built-in tile set) and sampler; exits 0 when both answer sensibly.
+#include <kdm/generator/sampler.h>
+#include <kdm/runtime/query.h>
+
+#include <cstdio>
+
+int main() {
+  kdm::QueryParams q;
+  q.x1 = q.y1 = 4;
+  q.scale = 100;
+  kdm::QueryPoint points[4096];
+  kdm::QueryCursor cursor;
+  std::size_t n = 0;
+  const kdm::Status s = kdm::query_points(kdm::Tileset::builtin(), q, points, 4096, &n, &cursor);
+  kdm::gen::SamplerOptions o;
+  o.n = 100;
+  const std::size_t sampled = kdm::gen::sample(o).size();
+  std::printf("runtime %zu points, sampler %zu points\n", n, sampled);
+  return s == kdm::Status::kOk && n == 1600 && sampled == 100 ? 0 : 1;
+}
