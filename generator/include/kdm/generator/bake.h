@@ -1,7 +1,7 @@
 // Baking tile sets (DESIGN.md §3): every tile is a toroidal multi-density pyramid sampled by the full KDM
 // sampler with constrained sampling — level k+1 keeps all of level k fixed and adds 3× as many points —
-// and the new points of each level are put in a progressive order (farthest-point insertion after the
-// points of earlier levels), so any prefix is itself well spread.
+// and the new points of each level are put in a progressive order (void-and-cluster ranking against the
+// points of earlier levels), so any prefix is itself well spread, down to low frequencies.
 //
 // Status: one corner colour (a single periodic tile). Aperiodic corner tiles (colours > 1) are planned.
 // Thread safety: bake_tileset is reentrant; it uses up to `threads` threads of its own.
@@ -44,8 +44,8 @@ TileSet bake_tileset(const BakeRecipe& recipe, int threads = 0,
                      const std::function<void(double)>& progress = {});
 
 /// The progressive order of `new_points` (interleaved x y on the unit torus) given `fixed` points that
-/// come first: returns indices into new_points, first = rank 0, by farthest-point insertion. O(n·(n+f))
-/// time; n up to a few tens of thousands.
+/// come first: returns indices into new_points, first = rank 0: each next point sits in the deepest void
+/// of a Gaussian-filtered density of everything present. O(n²) time; n up to a few tens of thousands.
 std::vector<std::uint32_t> progressive_order(const std::vector<double>& new_points,
                                              const std::vector<double>& fixed);
 
