@@ -32,27 +32,27 @@ constexpr double kInv65536 = 1.0 / 65536.0;
 
 }  // namespace
 
+void Tileset::adopt(TileSet&& set) {
+  set_ = std::move(set);
+  // A tile's top level bounds the density it can serve; every tile must reach it, or some would thin out.
+  max_points_ = set_.tiles.empty() ? 0 : set_.tiles.front().level_end.back();
+  for (const Tile& t : set_.tiles) max_points_ = std::min(max_points_, t.level_end.back());
+}
+
 Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
   out = Tileset{};
   TileSet set;
   const Status s = decode_tileset(data, size, set, detail);
-  if (s != Status::kOk) return s;
-  out.set_ = std::move(set);
-  for (const Tile& t : out.set_.tiles)
-    out.max_points_ = std::max(out.max_points_, static_cast<std::uint32_t>(t.points.size()));
-  // Every tile must reach the same top density, or some tiles would thin out.
-  for (const Tile& t : out.set_.tiles) out.max_points_ = std::min(out.max_points_, t.level_end.back());
-  return Status::kOk;
+  if (s == Status::kOk) out.adopt(std::move(set));
+  return s;
 }
 
 Status Tileset::load_file(const std::string& path, Tileset& out, std::string* detail) {
   out = Tileset{};
   TileSet set;
   const Status s = load_tileset(path, set, detail);
-  if (s != Status::kOk) return s;
-  std::vector<std::uint8_t> bytes;
-  encode_tileset(set, bytes);  // cheap relative to a load; keeps one code path for the derived fields
-  return load_memory(bytes.data(), bytes.size(), out, detail);
+  if (s == Status::kOk) out.adopt(std::move(set));
+  return s;
 }
 
 const Tile& Tileset::tile_at(std::int64_t tx, std::int64_t ty) const {

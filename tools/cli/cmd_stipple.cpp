@@ -93,8 +93,7 @@ void run_stipple(const StippleArgs& a) {
   style.dot_radius_px = a.dot_size;
   if (style.dot_radius_px <= 0) {  // from the whole image's dot count, so a zoomed region keeps the dot size
     const double full = a.points > 0 ? double(a.points) : double(set.size());
-    style.dot_radius_px =
-        0.25 * std::sqrt(double(a.width_px) * (a.width_px / aspect) / full) * (a.region.empty() ? 1.0 : 1.0);
+    style.dot_radius_px = 0.25 * std::sqrt(double(a.width_px) * (a.width_px / aspect) / full);
   }
   char line[200];
   std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s) in %.3f s", set.size(), how.c_str(), seconds);

@@ -38,6 +38,7 @@ class Tileset {
   const Tile& tile_at(std::int64_t tx, std::int64_t ty) const;
 
  private:
+  void adopt(TileSet&& set);
   TileSet set_;
   std::uint32_t max_points_ = 0;
 };
