@@ -160,7 +160,11 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!(max_density * area_scale <= tileset.max_points_per_tile() + 0.5)) return Status::kInvalidArgument;
   const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
   const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
-  if (!((tx1d - tx0d) * (ty1d - ty0d) <= 1099511627776.0) || std::fabs(tx0d) > 9e15 ||
+  if (!(max_density * area_scale > 0.5)) {  // no tile can emit even its first point
+    cursor->finished = true;
+    return Status::kOk;
+  }
+  if (!((tx1d - tx0d) * (ty1d - ty0d) <= double(kMaxQueryTiles)) || std::fabs(tx0d) > 9e15 ||
       std::fabs(ty1d) > 9e15 || std::fabs(tx1d) > 9e15 || std::fabs(ty0d) > 9e15)
     return Status::kInvalidArgument;
   const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
@@ -168,6 +172,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false};
 
   std::size_t n = 0;
+  std::uint64_t examined = 0;
   for (std::int64_t ty = cursor->tile_y; ty < ty1; ++ty) {
     const double wy = double(ty) * S;
     for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
@@ -181,6 +186,11 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           limit <= 0 ? 0 : static_cast<std::uint32_t>(std::min<double>(tile.points.size(), std::ceil(limit)));
       std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
       for (; c < candidates; ++c) {
+        if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
+          *cursor = QueryCursor{tx, ty, c, true, false};
+          *written = n;
+          return Status::kBufferFull;
+        }
         const TilePoint p = tile.points[c];
         const double x = wx + (p.x + 0.5) * kInv65536 * S, y = wy + (p.y + 0.5) * kInv65536 * S;
         if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;

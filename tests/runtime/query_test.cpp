@@ -201,6 +201,11 @@ TEST(QueryTest, BadInputIsRejectedOrHarmless) {
   EXPECT_EQ(
       query_points(Tileset::builtin(), region(-1e9, -1e9, 1e9, 1e9, 1), buffer.data(), 16, &written, &cursor),
       Status::kInvalidArgument);  // 4·10^18 tiles
+  cursor = QueryCursor{};
+  EXPECT_EQ(
+      query_points(Tileset::builtin(), region(0, 0, 8192, 4097, 1), buffer.data(), 16, &written, &cursor),
+      Status::kInvalidArgument);  // just over kMaxQueryTiles = 2^24 tiles: bounded work per call
+  EXPECT_TRUE(run(region(-1e6, -1e6, 1e6, 1e6, 1e-20)).empty());  // 4·10^12 tiles, but none can emit
   QueryParams h = region(0, 0, 3, 1, 1000);
   h.density.kind = QueryDensity::Kind::kCallback;
   h.density.callback = hostile;

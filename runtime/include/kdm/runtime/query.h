@@ -96,6 +96,14 @@ struct QueryParams {
   QueryDensity density;
 };
 
+/// Most tiles one query may cover (2^24): a bound on the work of a single call, whatever the region.
+/// Larger regions are refused (kInvalidArgument); split them.
+inline constexpr std::uint64_t kMaxQueryTiles = std::uint64_t(1) << 24;
+
+/// Most candidate points one call examines (2^24, a few milliseconds): a call that reaches it returns
+/// kBufferFull with the cursor saved, even if the buffer has room, so no call runs unbounded.
+inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
+
 /// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call.
 struct QueryCursor {
   std::int64_t tile_x = 0, tile_y = 0;
@@ -105,10 +113,11 @@ struct QueryCursor {
 
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
 /// ascending); `*written` receives the count. Returns kOk when the region is complete, kBufferFull when
-/// `out` filled up first — call again with the same cursor (and params) to continue. Empty or inverted
+/// `out` filled up first or the call examined kMaxQueryCandidates points — call again with the same
+/// cursor (and params) to continue. Empty or inverted
 /// regions and scale 0 give no points. kInvalidArgument for non-finite params, tile_size <= 0, negative
-/// or non-finite scale, a region of more than 2^40 tiles, or a density beyond the tile set's top level
-/// (scale · max density · tile area > max_points_per_tile: needs finer tiles). No allocation.
+/// or non-finite scale, a region of more than kMaxQueryTiles tiles, or a density beyond the tile set's top
+/// level (scale · max density · tile area > max_points_per_tile: needs finer tiles). No allocation.
 Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
                     std::size_t* written, QueryCursor* cursor);
 
