@@ -27,10 +27,6 @@ double torus_distance2(const double* a, const double* b) {
 // keeps every mid-level prefix of >= 1792 points at lowP 0.066–0.099 (0.5: up to 0.117; 0.25: 0.136).
 constexpr double kFilterWidth = 0.35;
 
-std::uint16_t quantize(double u) {
-  return static_cast<std::uint16_t>(std::clamp(std::floor(u * 65536.0), 0.0, 65535.0));
-}
-
 }  // namespace
 
 BakeRecipe BakeRecipe::parse(const std::string& text) {
@@ -115,8 +111,8 @@ std::vector<std::uint32_t> progressive_order(const std::vector<double>& new_poin
     const int r = std::min(cells / 2, static_cast<int>(std::ceil(3 * width * cells)) + 1);
     for (int dy = -r; dy <= r; ++dy)
       for (int dx = -r; dx <= r; ++dx) {
-        if ((2 * r + 1 > cells) && (dx < -cells / 2 || dx >= cells - cells / 2 || dy < -cells / 2 ||
-                                    dy >= cells - cells / 2))
+        if ((2 * r + 1 > cells) &&
+            (dx < -cells / 2 || dx >= cells - cells / 2 || dy < -cells / 2 || dy >= cells - cells / 2))
           continue;  // small grids: visit each cell once
         const int gx = ((cx + dx) % cells + cells) % cells, gy = ((cy + dy) % cells + cells) % cells;
         for (std::uint32_t i : grid[static_cast<std::size_t>(gy) * cells + gx]) {
@@ -168,7 +164,7 @@ TileSet bake_tileset(const BakeRecipe& recipe, int threads, const std::function<
   }
   tile.points.resize(points.size() / 2);
   for (std::size_t i = 0; i < tile.points.size(); ++i)
-    tile.points[i] = {quantize(points[2 * i]), quantize(points[2 * i + 1])};
+    tile.points[i] = TilePoint::from_unit(points[2 * i], points[2 * i + 1]);
   set.tiles.push_back(std::move(tile));
   return set;
 }

@@ -28,8 +28,6 @@ double sanitize(double v) {
   return (v > 0 && v < HUGE_VAL) ? v : 0.0;
 }  // NaN, ±inf, negatives -> 0
 
-constexpr double kInv65536 = 1.0 / 65536.0;
-
 }  // namespace
 
 void Tileset::adopt(TileSet&& set) {
@@ -192,7 +190,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           return Status::kBufferFull;
         }
         const TilePoint p = tile.points[c];
-        const double x = wx + (p.x + 0.5) * kInv65536 * S, y = wy + (p.y + 0.5) * kInv65536 * S;
+        const double x = wx + p.unit_x() * S, y = wy + p.unit_y() * S;
         if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
         if (d.kind != QueryDensity::Kind::kConstant) {
           const double rho =

@@ -19,6 +19,14 @@ namespace {
 
 constexpr int kReferenceRuns = 16;
 
+// The first n points of a tile (a pyramid prefix) as unit-square coordinates.
+std::vector<double> prefix_coords(const Tile& tile, std::size_t n) {
+  std::vector<double> coords;
+  for (std::size_t i = 0; i < n; ++i)
+    coords.insert(coords.end(), {tile.points[i].unit_x(), tile.points[i].unit_y()});
+  return coords;
+}
+
 struct Metrics {
   double energy = 0, davg = 0, nn1 = 0;
 };
@@ -52,9 +60,7 @@ TEST(GeneratorTest, EveryLevelOfTheDefaultSetMatchesTheFullSampler) {
     const Tile& tile = set.tiles[t];
     for (std::uint32_t level = 0; level < set.levels; ++level) {
       const std::size_t n = tile.level_end[level];
-      std::vector<double> coords;
-      for (std::size_t i = 0; i < n; ++i)
-        coords.insert(coords.end(), {(tile.points[i].x + 0.5) / 65536.0, (tile.points[i].y + 0.5) / 65536.0});
+      const std::vector<double> coords = prefix_coords(tile, n);
       const Metrics got = measure(coords, recipe.temperature);
 
       Metrics ref;
@@ -122,9 +128,7 @@ TEST(GeneratorTest, MidLevelPrefixesHaveLowLowFrequencyPower) {
         const std::size_t lo = tile.level_end[level - 1], hi = tile.level_end[level];
         const std::size_t n = lo + (hi - lo) * quarter / 4;
         if (n < 1792) continue;
-        std::vector<double> coords;
-        for (std::size_t i = 0; i < n; ++i)
-          coords.insert(coords.end(), {(tile.points[i].x + 0.5) / 65536.0, (tile.points[i].y + 0.5) / 65536.0});
+        const std::vector<double> coords = prefix_coords(tile, n);
         const double low_p = analysis::spectrum_stats(analysis::periodogram(coords, 2, 0.6)).low_p;
         std::printf("level %u + %d/4 (n=%zu): lowP %.4f\n", level, quarter, n, low_p);
         EXPECT_LE(low_p, 0.1) << "n=" << n;  // the bar; measured 0.066–0.099

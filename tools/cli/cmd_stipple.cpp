@@ -125,7 +125,6 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Seed for --method full")->capture_default_str();
   cmd->add_option("--tileset", a->tileset, "Tile-set file (default: the built-in set)");
   cmd->callback([a] {
-    if (a->points <= 0 && a->scale <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
     if (a->scale > 0) a->points = 0;
     run_stipple(*a);
   });

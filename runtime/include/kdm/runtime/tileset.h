@@ -61,6 +61,15 @@ inline constexpr std::uint32_t kMaxTileLevels = 16;
 /// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
 struct TilePoint {
   std::uint16_t x = 0, y = 0;
+  /// The point for unit-square coordinates u, v in [0, 1) (floored to the 1/65536 grid, clamped).
+  static TilePoint from_unit(double u, double v) { return {quantize(u), quantize(v)}; }
+  /// Unit-square position of the grid cell's centre, in [0, 1).
+  double unit_x() const { return (x + 0.5) * (1.0 / 65536.0); }
+  double unit_y() const { return (y + 0.5) * (1.0 / 65536.0); }
+  static std::uint16_t quantize(double u) {
+    const double t = u * 65536.0;
+    return static_cast<std::uint16_t>(t <= 0 ? 0.0 : (t >= 65535.0 ? 65535.0 : t));
+  }
   friend bool operator==(const TilePoint& a, const TilePoint& b) { return a.x == b.x && a.y == b.y; }
 };
 
