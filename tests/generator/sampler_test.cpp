@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "kdm/generator/sampler.h"
@@ -101,6 +102,21 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   EXPECT_THROW(Density::from_values(2, 2, {0, 0, 0, 0}), InvalidArgument);
   EXPECT_THROW(Density::from_values(2, 2, {1, 1, -1, 1}), InvalidArgument);
   EXPECT_THROW(Density::from_values(0, 0, {}), InvalidArgument);
+}
+
+TEST(SamplerTest, MoreThanTheGridCanHoldIsRefusedByName) {
+  // 1000 points need about 16 grid nodes each (kernel mass / peak density), far over a 4096-node limit;
+  // the guard must fire before anything of that size is allocated, and say which limit it hit.
+  SamplerOptions o = options_for(1000, Domain::kTorus);
+  o.max_grid_nodes = 4096;
+  try {
+    sample(o);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("limit of 4096"), std::string::npos) << e.what();
+  }
+  o.n = std::int64_t(1) << 32;
+  EXPECT_THROW(sample(o), InvalidArgument);  // beyond the 2^31 point cap
 }
 
 // Window counts against a density that varies along x only: square windows, as small as possible while

@@ -126,13 +126,15 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_flag("--torus", args->torus, "Periodic distances (default)");
   cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");
   cmd->add_option("--density", args->density,
-                  "Target density for the accuracy test: const:V or an image (dark = dense)");
+                  "Target density for the accuracy test: const:V or an image (dark = dense; default: "
+                  "uniform)");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
-  cmd->add_flag("--no-energy", args->no_energy, "Skip the KDM energy per point");
+  cmd->add_flag("--no-energy", args->no_energy, "Skip the KDM energy per point (default: computed)");
   cmd->add_option("--tile-size", args->tile_size,
-                  "Tile side s (1/s an integer) for periodicity and seam statistics");
+                  "Tile side s in unit-square units (1/s an integer) for periodicity and seam statistics "
+                  "(default: none, no tiling diagnostics)");
   cmd->add_option("--fmax", args->fmax, "Periodogram limit in normalised frequency |k|/sqrt(n)")
       ->capture_default_str();
   cmd->add_option("--min-expected", args->min_expected, "Density windows expect at least this many points")

@@ -62,12 +62,12 @@ void add_query_command(CLI::App& app) {
   auto a = std::make_shared<QueryArgs>();
   CLI::App* cmd = app.add_subcommand("query", "Points of a world rectangle from a tile set (the runtime)");
   cmd->add_option("--tileset", a->tileset, "Tile-set file (default: the built-in set)");
-  cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 (half-open)")->required();
+  cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 in world units (half-open)")->required();
   cmd->add_option("--density", a->density, "const:V, or an image stretched over the rect (dark = dense)")
       ->capture_default_str();
   cmd->add_option("--gamma", a->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
-  cmd->add_option("--scale", a->scale, "Points per unit area at density 1")->capture_default_str();
+  cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();
   cmd->add_option("--tile-size", a->tile_size, "World units per tile side")->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Output: .txt, .csv (normalised to the rect), .svg or .png")
       ->required();

@@ -80,16 +80,20 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--n", o.n, "Exact number of points (0: use --resolution)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--resolution", o.resolution, "Finest grid nodes along the short axis, when --n 0")
+  cmd->add_option("--resolution", o.resolution,
+                  "Finest grid nodes along the short axis, used when --n 0 (default: unset)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--dim", o.dim, "Dimension")->capture_default_str()->check(CLI::IsMember({2, 3}));
+  cmd->add_option("--dim", o.dim, "Dimension of the points (2 or 3)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({2, 3}));
   cmd->add_option("--domain", args->domain,
                   "torus (periodic) or box (bounded); default: box for images, torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--temperature,-T", o.temperature,
-                  "Temperature (0.5 = the paper's look; lower = more ordered; 0 = descent)")
+                  "Temperature in the reference implementation's units (0.5 = the paper's look; lower = more "
+                  "ordered; 0 = deterministic descent)")
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "Random seed; the output depends on nothing else")->capture_default_str();
   cmd->add_option("--density", args->density, "const:V, or an image whose darkness is the density")
@@ -98,15 +102,18 @@ void add_sample_command(CLI::App& app) {
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")
       ->capture_default_str();
-  cmd->add_option("--sweeps", o.sweeps, "Langevin sweeps per level")->capture_default_str();
+  cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points per refinement level")
+      ->capture_default_str();
   cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units; 0 = automatic)")
       ->capture_default_str();
   cmd->add_flag("--unadjusted", args->unadjusted,
                 "Skip the Metropolis-Hastings test (biased; experiments only)");
   cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
-  cmd->add_flag("--timing", args->timing, "Print points per second on stdout");
-  cmd->add_option("-o,--output", args->output, "Output file: .txt, .csv, .svg or .png")->required();
+  cmd->add_flag("--timing", args->timing, "Print points per second on stdout (default: off)");
+  cmd->add_option("-o,--output", args->output,
+                  "Output file: .txt (UTK/psa points in [0,1)), .csv, .svg or .png")
+      ->required();
   cmd->callback([args] { run_sample(*args); });
 }
 

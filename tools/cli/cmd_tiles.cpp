@@ -83,7 +83,8 @@ void add_tile_commands(CLI::App& app) {
                    "temperature, sweeps)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
-  bake->add_option("--threads", *threads, "Worker threads (0 = all)")->capture_default_str();
+  bake->add_option("--threads", *threads, "Worker threads (0 = all); the file does not depend on it")
+      ->capture_default_str();
   bake->callback([=] { run_bake(*recipe, *output, *threads); });
 
   auto info_path = std::make_shared<std::string>();

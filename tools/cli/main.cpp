@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "commands.h"
 #include "kdm/runtime/version.h"
@@ -22,7 +23,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // Bad command lines get the same one-line error as every other failure (CLI11 would add a hint line).
+    std::string message = e.what();
+    for (char& c : message)
+      if (c == '\n') c = ' ';
+    std::fprintf(stderr, "kdm: error: %s (see kdm --help)\n", message.c_str());
+    return 1;
   } catch (const kdm::cli::CommandError& e) {
     std::fprintf(stderr, "kdm: error: %s\n", e.what());
     return 1;

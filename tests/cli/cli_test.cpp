@@ -1,0 +1,359 @@
+// The kdm command line on hostile and edge inputs: images that are empty, 1×1, 16-bit, corrupt, truncated
+// or missing; sampler counts and temperatures at their limits; output paths that cannot be written; plus
+// --version and stipple --frames. Every failure must be one line "kdm: error: ..." and exit status 1.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image_io.h"
+#include "kdm/runtime/version.h"
+#include "point_io.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int status = -1;  // exit status, or -1 if the process did not exit normally (a crash)
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(KDM_CLI_TEST_DIR) / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Runs `kdm ARGS` (ARGS already shell-quoted where needed), capturing stdout and stderr.
+  Outcome kdm(const std::string& args) const {
+    const std::string out = path("stdout"), err = path("stderr");
+    const std::string command =
+        std::string("'") + KDM_EXECUTABLE + "' " + args + " >'" + out + "' 2>'" + err + "'";
+    const int raw = std::system(command.c_str());
+    Outcome r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  // Asserts the one-line error contract and that the message mentions `naming` (the problem or the file).
+  void expect_error(const std::string& args, const std::string& naming) const {
+    const Outcome r = kdm(args);
+    EXPECT_EQ(r.status, 1) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_EQ(r.err.rfind("kdm: error: ", 0), 0u) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_NE(r.err.find(naming), std::string::npos) << "kdm " << args << "\nstderr: " << r.err;
+  }
+
+  fs::path dir_;
+};
+
+// ---- A minimal PNG encoder (stb_image_write cannot write 16-bit or broken files): zlib stored blocks.
+
+std::uint32_t crc32(const std::uint8_t* p, std::size_t n, std::uint32_t crc = 0) {
+  crc = ~crc;
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= p[i];
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+void put32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<std::uint8_t>(v >> s));
+}
+
+void chunk(std::vector<std::uint8_t>& png, const char type[5], const std::vector<std::uint8_t>& data) {
+  put32(png, static_cast<std::uint32_t>(data.size()));
+  const std::size_t start = png.size();
+  png.insert(png.end(), type, type + 4);
+  png.insert(png.end(), data.begin(), data.end());
+  put32(png, crc32(&png[start], png.size() - start));
+}
+
+// A greyscale PNG of `depth` bits (8 or 16); `samples` row-major, top row first.
+std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int depth,
+                                   const std::vector<std::uint16_t>& samples) {
+  std::vector<std::uint8_t> raw;  // filter byte 0 per row, then big-endian samples
+  for (std::uint32_t y = 0; y < h; ++y) {
+    raw.push_back(0);
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const std::uint16_t v = samples[y * w + x];
+      if (depth == 16) raw.push_back(static_cast<std::uint8_t>(v >> 8));
+      raw.push_back(static_cast<std::uint8_t>(v));
+    }
+  }
+  std::vector<std::uint8_t> z = {0x78, 0x01};  // zlib header, then stored blocks of up to 65535 bytes
+  std::size_t at = 0;
+  do {
+    const std::size_t n = std::min<std::size_t>(65535, raw.size() - at);
+    z.push_back(at + n == raw.size() ? 1 : 0);
+    z.insert(z.end(), {static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(n >> 8),
+                       static_cast<std::uint8_t>(~n), static_cast<std::uint8_t>(~n >> 8)});
+    z.insert(z.end(), raw.begin() + at, raw.begin() + at + n);
+    at += n;
+  } while (at < raw.size());
+  std::uint32_t a = 1, b = 0;  // Adler-32
+  for (std::uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
+  put32(z, (b << 16) | a);
+  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  std::vector<std::uint8_t> ihdr;
+  put32(ihdr, w);
+  put32(ihdr, h);
+  ihdr.insert(ihdr.end(), {static_cast<std::uint8_t>(depth), 0, 0, 0, 0});  // greyscale, no interlace
+  chunk(png, "IHDR", ihdr);
+  chunk(png, "IDAT", z);
+  chunk(png, "IEND", {});
+  return png;
+}
+
+void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(f.good()) << path;
+}
+
+// A 64×64 8-bit horizontal ramp: a valid image to cut and damage.
+std::vector<std::uint8_t> ramp_png() {
+  std::vector<std::uint16_t> v(64 * 64);
+  for (int i = 0; i < 64 * 64; ++i) v[i] = static_cast<std::uint16_t>(4 * (i % 64));
+  return grey_png(64, 64, 8, v);
+}
+
+TEST_F(CliTest, TheTestEncoderWritesImagesTheLoaderReads) {
+  write_bytes(path("ramp.png"), ramp_png());
+  kdm::tools::GreyImage image;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("ramp.png"), image, error)) << error;
+  EXPECT_EQ(image.width, 64);
+  EXPECT_FLOAT_EQ(image.at(10, 5), 40.0f / 255.0f);
+}
+
+TEST_F(CliTest, BadImagesGiveOneLineErrors) {
+  const std::vector<std::uint8_t> good = ramp_png();
+  write_bytes(path("empty0x0.png"), grey_png(0, 0, 8, {}));  // IHDR says 0×0
+  write_bytes(path("zero-bytes.png"), {});
+  write_bytes(path("truncated.png"), std::vector<std::uint8_t>(good.begin(), good.begin() + good.size() / 2));
+  std::vector<std::uint8_t> corrupt =
+      good;  // the IDAT's stored-block length no longer matches its complement
+  corrupt[8 + 25 + 8 + 3] ^= 0xFF;
+  write_bytes(path("corrupt.png"), corrupt);
+  write_bytes(path("text.png"), std::vector<std::uint8_t>{'n', 'o', 't', ' ', 'a', 'n', ' ', 'i', 'm', 'g'});
+  write_bytes(path("white.png"), grey_png(1, 1, 8, {255}));  // defined, but no ink: nothing to stipple
+  for (const char* name : {"empty0x0.png", "zero-bytes.png", "truncated.png", "corrupt.png", "text.png",
+                           "missing.png", "white.png"}) {
+    SCOPED_TRACE(name);
+    const std::string image = path(name);
+    expect_error("sample --n 100 --density '" + image + "' -o '" + path("s.txt") + "'", name);
+    expect_error("stipple '" + image + "' -o '" + path("s.png") + "'", name);
+    expect_error("query --rect 0,0,1,1 --density '" + image + "' -o '" + path("q.txt") + "'", name);
+    EXPECT_FALSE(fs::exists(path("s.txt")) || fs::exists(path("s.png")) || fs::exists(path("q.txt")));
+  }
+}
+
+TEST_F(CliTest, OneByOneImageIsAConstantDensity) {
+  write_bytes(path("grey.png"), grey_png(1, 1, 8, {128}));
+  const Outcome sampled =
+      kdm("sample --n 300 --density '" + path("grey.png") + "' -o '" + path("s.txt") + "'");
+  ASSERT_EQ(sampled.status, 0) << sampled.err;
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
+  EXPECT_EQ(sets.at(0).size(), 300u);  // exact count, as for any density
+  const Outcome stippled = kdm("stipple '" + path("grey.png") + "' --points 2000 -o '" + path("t.txt") + "'");
+  ASSERT_EQ(stippled.status, 0) << stippled.err;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("t.txt"), sets, error)) << error;
+  // The runtime's count for a uniform density over many tiles is the expectation up to the rounding of
+  // partly covered edge tiles; 5% is several times that for 2000 dots.
+  EXPECT_NEAR(double(sets.at(0).size()), 2000.0, 100.0);
+}
+
+TEST_F(CliTest, SixteenBitImagesKeepTheirPrecision) {
+  // Two samples that 8 bits cannot tell apart (1000 and 1100 of 65535 both round to 4 of 255).
+  std::vector<std::uint16_t> v(16 * 16);
+  for (int i = 0; i < 16 * 16; ++i) v[i] = i % 16 < 8 ? 1000 : 1100;
+  write_bytes(path("deep.png"), grey_png(16, 16, 16, v));
+  kdm::tools::GreyImage image;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("deep.png"), image, error)) << error;
+  EXPECT_NEAR(image.at(0, 0), 1000.0 / 65535, 1e-7);
+  EXPECT_NEAR(image.at(15, 15), 1100.0 / 65535, 1e-7);
+  const Outcome r = kdm("stipple '" + path("deep.png") + "' --points 500 -o '" + path("deep.svg") + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::file_size(path("deep.svg")) > 0);
+}
+
+TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
+  const std::string out = " -o '" + path("s.txt") + "'";
+  expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"
+  expect_error("sample --n 4000000000" + out, "too large");  // beyond 2^31 points
+  expect_error("sample --n 100000000" + out, "limit");       // the grid would exceed max_grid_nodes
+  expect_error("sample --n 100 --temperature nan" + out, "temperature");
+  expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
+  expect_error("sample --n 100 --density const:0" + out, "const:V");  // all-zero density
+  expect_error("sample --n 100 --density const:-1" + out, "const:V");
+  const Outcome one = kdm("sample --n 1" + out);
+  ASSERT_EQ(one.status, 0) << one.err;
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
+  EXPECT_EQ(sets.at(0).size(), 1u);
+}
+
+TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
+  const std::string out = " -o '" + path("q.txt") + "'";
+  const Outcome zero = kdm("query --rect 0,0,1,1 --scale 0" + out);  // defined: no points
+  EXPECT_EQ(zero.status, 0) << zero.err;
+  EXPECT_NE(zero.err.find("kdm query: 0 points"), std::string::npos) << zero.err;
+  expect_error("query --rect 0,0,1,1 --scale 1e12" + out, "invalid argument");  // beyond the top level
+  expect_error("query --rect 0,0,1,1 --scale -1" + out, "invalid argument");
+}
+
+TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
+  // A path below a regular file cannot be created, even by root (CI runs as root).
+  write_bytes(path("file"), {'x'});
+  const std::string bad = path("file") + "/sub";
+  write_bytes(path("grey.png"), grey_png(2, 2, 8, {0, 64, 128, 192}));
+  const std::string image = "'" + path("grey.png") + "'";
+  std::ofstream(path("r.recipe")) << "levels 2\nbase_points 8\nsweeps 2\n";
+  const char* prefix = "cannot";  // "cannot write ...", "cannot create ..."
+  expect_error("sample --n 50 -o '" + bad + ".txt'", prefix);
+  expect_error("sample --n 50 -o '" + bad + ".png'", prefix);
+  expect_error("sample --n 50 -o '" + bad + ".svg'", prefix);
+  expect_error("stipple " + image + " -o '" + bad + ".png'", prefix);
+  expect_error("stipple " + image + " --region 0,0,.6,.6 --frames 3 -o '" + bad + ".txt'", prefix);
+  expect_error("query --rect 0,0,1,1 -o '" + bad + ".csv'", prefix);
+  write_bytes(path("pts.txt"),
+              {'0', '.', '5', ' ', '0', '.', '5', '\n', '0', '.', '1', ' ', '0', '.', '2', '\n'});
+  expect_error("analyze '" + path("pts.txt") + "' -o '" + bad + "'", prefix);
+  expect_error("bake '" + path("r.recipe") + "' -o '" + bad + ".kdmt'", prefix);
+  // A directory in the way of the output file.
+  fs::create_directories(path("dir.txt"));
+  expect_error("sample --n 50 -o '" + path("dir.txt") + "'", "dir.txt");
+}
+
+TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
+  const Outcome r = kdm("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find(std::string("kdm ") + kdm::version_string()), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tile-set format " + std::to_string(kdm::kTilesetFormatVersion)), std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliTest, HelpDescribesEveryOption) {
+  for (const char* sub : {"", "sample", "stipple", "query", "analyze", "bake", "info"}) {
+    const Outcome r = kdm(std::string(sub) + " --help");
+    EXPECT_EQ(r.status, 0) << sub;
+    // CLI11 prints "  --name TYPE  description"; an option without a description ends its line at the type.
+    std::istringstream lines(r.out);
+    std::vector<std::string> all;
+    for (std::string line; std::getline(lines, line);) all.push_back(line);
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      std::string line = all[i];
+      if (line.rfind("  -", 0) != 0) continue;
+      if (i + 1 < all.size() && all[i + 1].rfind("      ", 0) == 0) line += all[i + 1];  // wrapped text
+      std::istringstream words(line);
+      std::vector<std::string> w{std::istream_iterator<std::string>(words), {}};
+      const bool has_text = std::any_of(w.begin(), w.end(), [](const std::string& s) {
+        return s.size() > 1 && std::islower(static_cast<unsigned char>(s[0])) && s[0] != '-';
+      });
+      EXPECT_TRUE(has_text) << "kdm " << sub << " --help: option without a description: " << line;
+    }
+  }
+}
+
+// Reads a frame written by `stipple --frames`: its points in image UV and its rectangle (from the header).
+struct Frame {
+  double region[4] = {0, 0, 0, 0};
+  std::vector<double> uv;
+};
+
+Frame read_frame(const std::string& path) {
+  Frame f;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("# region ", 0) == 0)
+      std::sscanf(line.c_str(), "# region %lf,%lf,%lf,%lf", &f.region[0], &f.region[1], &f.region[2],
+                  &f.region[3]);
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  EXPECT_TRUE(kdm::tools::read_point_sets(path, sets, error)) << error;
+  if (sets.empty()) return f;
+  for (std::size_t i = 0; i < sets[0].size(); ++i)
+    for (int k = 0; k < 2; ++k)
+      f.uv.push_back(f.region[k] + sets[0].coords[2 * i + k] * (f.region[k + 2] - f.region[k]));
+  return f;
+}
+
+TEST_F(CliTest, StippleFramesZoomCoherently) {
+  const std::string image = std::string(KDM_SOURCE_DIR) + "/examples/sphere.png";
+  const Outcome r = kdm("stipple '" + image + "' --points 4000 --region 0.3,0.35,0.85,0.9 --frames 4 -o '" +
+                        path("zoom.txt") + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(path("zoom.txt")));
+  EXPECT_FALSE(fs::exists(path("zoom_0004.txt")));
+  std::vector<Frame> frames;
+  for (int i = 0; i < 4; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "zoom_%04d.txt", i);
+    ASSERT_TRUE(fs::exists(path(name))) << name;
+    frames.push_back(read_frame(path(name)));
+  }
+  EXPECT_EQ(std::vector<double>(frames[0].region, frames[0].region + 4), (std::vector<double>{0, 0, 1, 1}));
+  EXPECT_EQ(std::vector<double>(frames[3].region, frames[3].region + 4),
+            (std::vector<double>{0.3, 0.35, 0.85, 0.9}));
+  for (int i = 0; i + 1 < 4; ++i) {
+    const Frame &a = frames[i], &b = frames[i + 1];
+    // Geometric zoom: the extents shrink by the same factor every frame (0.55^(1/3) here).
+    EXPECT_NEAR((b.region[2] - b.region[0]) / (a.region[2] - a.region[0]), std::cbrt(0.55), 1e-9);
+    // Coherence: every dot of frame i inside frame i+1's rectangle (away from its edges by more than the
+    // .txt rounding) is a dot of frame i+1 at the same place.
+    std::size_t kept = 0;
+    for (std::size_t p = 0; p < a.uv.size(); p += 2) {
+      const double x = a.uv[p], y = a.uv[p + 1], eps = 1e-9;
+      if (!(x > b.region[0] + eps && x < b.region[2] - eps && y > b.region[1] + eps && y < b.region[3] - eps))
+        continue;
+      bool found = false;
+      for (std::size_t q = 0; q < b.uv.size() && !found; q += 2)
+        found = std::fabs(b.uv[q] - x) < 1e-9 && std::fabs(b.uv[q + 1] - y) < 1e-9;
+      EXPECT_TRUE(found) << "frame " << i << " dot (" << x << ", " << y << ") is gone from frame " << i + 1;
+      kept += found;
+    }
+    EXPECT_GT(kept, 500u) << "frame " << i;                            // the check above is not vacuous
+    EXPECT_GT(b.uv.size() / 2, kept + kept / 5) << "frame " << i + 1;  // the zoom adds dots (~1.7×)
+  }
+}
+
+TEST_F(CliTest, StippleFramesRejectBadCounts) {
+  const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  const std::string out = " -o '" + path("z.png") + "'";
+  expect_error("stipple " + image + " --frames 1 --region 0,0,.5,.5" + out, "--frames");
+  expect_error("stipple " + image + " --frames -3 --region 0,0,.5,.5" + out, "--frames");
+  expect_error("stipple " + image + " --frames 5" + out, "--region");
+  expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2" + out, "2×");
+  expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
+  EXPECT_FALSE(fs::exists(path("z_0000.png")));  // refused before any frame is written
+}
+
+}  // namespace
