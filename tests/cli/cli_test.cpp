@@ -253,6 +253,20 @@ TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   expect_error("sample --n 50 -o '" + path("dir.txt") + "'", "dir.txt");
 }
 
+TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
+  const std::string out = " -o '" + path("x.txt") + "'";
+  expect_error("", "subcommand");
+  expect_error("frobnicate", "unknown subcommand 'frobnicate'");
+  expect_error("sample --n abc" + out, "--n");
+  expect_error("sample --n -5" + out, "--n");
+  expect_error("sample --n 10", "--output");
+  expect_error("sample --n 10 --aspect -1" + out, "--aspect");
+  expect_error("sample --n 10 --width 0 -o '" + path("x.png") + "'", "--width");
+  expect_error("sample --n 10 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
+  expect_error("stipple --frames 2x a.png" + out, "--frames");
+  expect_error("query --rect 0,0,1" + out, "--rect");
+}
+
 TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
   const Outcome r = kdm("--version");
   EXPECT_EQ(r.status, 0);
@@ -279,6 +293,15 @@ TEST_F(CliTest, HelpDescribesEveryOption) {
         return s.size() > 1 && std::islower(static_cast<unsigned char>(s[0])) && s[0] != '-';
       });
       EXPECT_TRUE(has_text) << "kdm " << sub << " --help: option without a description: " << line;
+      // An option that takes a value (a TYPE word after its name) shows its default or is required.
+      const std::string type = w.size() > 1 ? w[1].substr(0, w[1].find_first_of(":=")) : "";
+      const bool takes_value = !type.empty() && std::all_of(type.begin(), type.end(), [](char c) {
+        return std::isupper(static_cast<unsigned char>(c));
+      });
+      const bool default_shown =
+          takes_value && (w[1].find('=') != std::string::npos || line.find("default") != std::string::npos ||
+                          line.find("REQUIRED") != std::string::npos);
+      EXPECT_TRUE(!takes_value || default_shown) << "kdm " << sub << " --help: no default: " << line;
     }
   }
 }

@@ -1,6 +1,7 @@
 // `kdm sample`: the full KDM sampler from the command line.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -28,6 +29,14 @@ struct SampleArgs {
 };
 
 void run_sample(const SampleArgs& args) {
+  // Range checks here rather than CLI11's validators, whose messages print the whole double range.
+  if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
+  if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");
+  if (!(args.aspect >= 0 && std::isfinite(args.aspect))) throw CommandError("--aspect must be a number > 0");
+  if (!(args.width_px >= 1 && args.width_px <= 65536))
+    throw CommandError("--width must be 1 to 65536 pixels");
+  if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
+    throw CommandError("--dot-size must be >= 0");
   DensityArg density = parse_density(args.density, args.gamma, args.invert);
   gen::SamplerOptions o = args.options;
   const std::string domain = args.domain.empty() ? (density.from_image ? "box" : "torus") : args.domain;
@@ -77,20 +86,16 @@ void add_sample_command(CLI::App& app) {
   auto args = std::make_shared<SampleArgs>();
   CLI::App* cmd = app.add_subcommand("sample", "Draw a point set from the KDM model (the full sampler)");
   gen::SamplerOptions& o = args->options;
-  cmd->add_option("--n", o.n, "Exact number of points (0: use --resolution)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--n", o.n, "Exact number of points (0: use --resolution)")->capture_default_str();
   cmd->add_option("--resolution", o.resolution,
-                  "Finest grid nodes along the short axis, used when --n 0 (default: unset)")
-      ->check(CLI::NonNegativeNumber);
+                  "Finest grid nodes along the short axis, used when --n 0 (default: unset)");
   cmd->add_option("--dim", o.dim, "Dimension of the points (2 or 3)")
       ->capture_default_str()
       ->check(CLI::IsMember({2, 3}));
   cmd->add_option("--domain", args->domain,
                   "torus (periodic) or box (bounded); default: box for images, torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
-  cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)");
   cmd->add_option("--temperature,-T", o.temperature,
                   "Temperature in the reference implementation's units (0.5 = the paper's look; lower = more "
                   "ordered; 0 = deterministic descent)")

@@ -26,6 +26,12 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // Bad command lines get the same one-line error as every other failure (CLI11 would add a hint line).
     std::string message = e.what();
+    if (argc > 1 && argv[1][0] != '-') {  // CLI11 calls an unknown subcommand "a subcommand is required"
+      bool known = false;
+      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+        known = known || sub->get_name() == argv[1];
+      if (!known) message = std::string("unknown subcommand '") + argv[1] + "'";
+    }
     for (char& c : message)
       if (c == '\n') c = ' ';
     std::fprintf(stderr, "kdm: error: %s (see kdm --help)\n", message.c_str());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "commands.h"
 #include "image_io.h"
@@ -35,6 +36,9 @@ void write_points(const std::string& path, const tools::PointSet& points,
   if (points.dim != 2) throw CommandError("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(16, style.width_px);
   const int h = std::max(16, static_cast<int>(std::lround(w / style.aspect)));
+  if (double(w) * h > double(1 << 28))  // 768 MiB of RGB: refuse rather than die allocating
+    throw CommandError("a picture of " + std::to_string(w) + "x" + std::to_string(h) +
+                       " pixels is too large (limit 2^28 pixels); lower --width");
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
   if (png) {
     tools::RgbImage image(w, h, 255);
