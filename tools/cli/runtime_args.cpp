@@ -48,6 +48,9 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
     std::size_t written = 0;
     const Status s = query_points(tileset, params, buffer.data(), buffer.size(), &written, &cursor);
     out.insert(out.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(written));
+    if (out.size() > kMaxCommandLinePoints)  // 1 GiB of points: stop before memory runs out
+      throw CommandError(
+          "the query emits more than 2^25 points; lower --scale or --points, or split the region");
     if (s == Status::kOk) return;
     if (s != Status::kBufferFull)
       throw CommandError(

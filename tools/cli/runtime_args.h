@@ -27,7 +27,11 @@ std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, doub
 /// Loads --tileset or returns the built-in set; throws CommandError naming the problem.
 const Tileset& tileset_for(const std::string& path, Tileset& storage);
 
-/// Runs a query to completion into `out` (growing it), throwing CommandError on bad parameters.
+/// Most points a command-line query collects (2^25, 1 GiB as QueryPoint) before it gives up.
+inline constexpr std::size_t kMaxCommandLinePoints = std::size_t(1) << 25;
+
+/// Runs a query to completion into `out` (growing it), throwing CommandError on bad parameters or when
+/// more than kMaxCommandLinePoints points would be emitted.
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out);
 
 }  // namespace kdm::cli
