@@ -1,5 +1,7 @@
 #include "chain.h"
 
+#include "simd.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -19,6 +21,9 @@ inline float sign_of(float r) {
 template <int D>
 Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
     : density_(&density), params_(params), residual_(density.rho.size()) {
+  const std::vector<float>& rho = density.rho;
+  uniform_ = !rho.empty() && std::all_of(rho.begin(), rho.end(), [&](float r) { return r == rho[0]; });
+  uniform_rho_ = uniform_ ? rho[0] : 0.0;
   clear_kernels();
 }
 
@@ -35,8 +40,29 @@ void Chain<D>::clear_kernels() {
 }
 
 template <int D>
+std::size_t footprint_nodes(const Footprint<D>& fp) {
+  std::size_t n = fp.contiguous ? fp.width : fp.axes[0].count;
+  for (int k = 1; k < D; ++k) n *= fp.axes[k].count;
+  return n;
+}
+
+// Each pass below has a lane-vector form for contiguous footprints and a general form over index runs.
+// Both evaluate every node the same way: R ± p·v in float, the sign of R with the kernel in it for the
+// gradient. The lane sums make the reduction order a property of the footprint alone.
+
+template <int D>
 void Chain<D>::add(const Footprint<D>& fp, float sign) {
   float* R = residual_.data();
+  if (fp.contiguous) {
+    const float* v = fp.row_value.data();
+    const int width = fp.width;
+    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
+      const F4 pf = splat4(sign * static_cast<float>(p));
+      float* row = R + base + fp.start;
+      for (int a = 0; a < width; a += 4) store4(row + a, load4(row + a) + pf * load4(v + a));
+    });
+    return;
+  }
   const AxisFactor& ax = fp.axes[0];
   fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
     const float pf = sign * static_cast<float>(p);
@@ -44,7 +70,6 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
       const int off = ax.run_offset[run], len = ax.run_length[run];
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
-#pragma omp simd
       for (int a = 0; a < len; ++a) row[a] += pf * v[a];
     }
   });
@@ -52,7 +77,7 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
 
 template <int D>
 void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return;
   scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
   add(scratch.old_fp, sign);
@@ -67,7 +92,7 @@ double Chain<D>::energy() const {
 
 template <int D>
 double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
   scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
   Vec<D> unused{};
@@ -75,8 +100,35 @@ double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) 
 }
 
 template <int D>
-double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) {
+double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved) {
   float* R = residual_.data();
+  if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
+  float* out = saved.data();
+  if (fp.contiguous) {
+    const float *v = fp.row_value.data(), *dv = fp.row_deriv.data();
+    const int width = fp.width;
+    F4 e = splat4(0);
+    std::array<F4, D> g{};
+    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
+      const F4 pf = splat4(static_cast<float>(p));
+      float* row = R + base + fp.start;
+      F4 sx = splat4(0), sg = splat4(0);
+      for (int a = 0; a < width; a += 4) {
+        const F4 r = load4(row + a), va = load4(v + a);
+        const F4 rn = r - pf * va;
+        sx += signed_by(r, load4(dv + a));
+        sg += signed_by(r, va);
+        e += abs4(r) - abs4(rn);
+        store4(out + a, r);
+        store4(row + a, rn);
+      }
+      out += width;
+      g[0] += pf * sx;
+      for (int k = 1; k < D; ++k) g[k] += splat4(static_cast<float>(pd[k])) * sg;
+    });
+    for (int k = 0; k < D; ++k) gradient[k] = sum4(g[k]);
+    return sum4(e);
+  }
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -88,8 +140,6 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
-      // Reductions in SIMD lanes: the order is fixed by the binary and the footprint, never by threads.
-#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float s = sign_of(r);
@@ -97,6 +147,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
         sx += s * dv[a];
         sg += s * v[a];
         e += std::fabs(r) - std::fabs(rn);
+        *out++ = r;
         row[a] = rn;
       }
     }
@@ -108,8 +159,52 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
 }
 
 template <int D>
+void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) {
+  float* R = residual_.data();
+  const float* in = saved.data();
+  if (fp.contiguous) {
+    const int width = fp.width;
+    fp.for_each_row(grid(), [&](std::int64_t base, double, const std::array<double, D>&) {
+      std::copy(in, in + width, R + base + fp.start);
+      in += width;
+    });
+    return;
+  }
+  const AxisFactor& ax = fp.axes[0];
+  fp.for_each_row(grid(), [&](std::int64_t base, double, const std::array<double, D>&) {
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      std::copy(in, in + len, R + base + ax.index[off]);
+      in += len;
+    }
+  });
+}
+
+template <int D>
 double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
   const float* R = residual_.data();
+  if (fp.contiguous) {
+    const float *v = fp.row_value.data(), *dv = fp.row_deriv.data();
+    const int width = fp.width;
+    F4 e = splat4(0);
+    std::array<F4, D> g{};
+    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
+      const F4 pf = splat4(static_cast<float>(p));
+      const float* row = R + base + fp.start;
+      F4 sx = splat4(0), sg = splat4(0);
+      for (int a = 0; a < width; a += 4) {
+        const F4 r = load4(row + a), va = load4(v + a);
+        const F4 rn = r + pf * va;
+        sx += signed_by(rn, load4(dv + a));
+        sg += signed_by(rn, va);
+        e += abs4(rn) - abs4(r);
+      }
+      g[0] += pf * sx;
+      for (int k = 1; k < D; ++k) g[k] += splat4(static_cast<float>(pd[k])) * sg;
+    });
+    for (int k = 0; k < D; ++k) gradient[k] = sum4(g[k]);
+    return sum4(e);
+  }
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -121,7 +216,6 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
       const float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
-#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float rn = r + pf * v[a];
@@ -141,23 +235,23 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
 template <int D>
 Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
   Vec<D> g{};
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return g;
   scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true);
-  remove_with_gradient(scratch.old_fp, g);
-  add(scratch.old_fp, 1.0f);
+  remove_with_gradient(scratch.old_fp, g, scratch.saved);
+  restore(scratch.old_fp, scratch.saved);
   return g;
 }
 
 template <int D>
 bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   const double w = p.weight();
-  const double rho_old = density_->at(p.x);
+  const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
   const double sigma_old = sigma_for(rho_old, w);
   scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true);
   Vec<D> grad_old;
-  const double removed = remove_with_gradient(scratch.old_fp, grad_old);
+  const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
 
   // Eq. 5 with Δt_j = T σ Δt / w: drift -(σ Δt / 2w) ∇E, noise variance T σ Δt / w. A kernel of weight w
   // carries w times the energy, so dividing by w keeps its step the size of a unit kernel's (as the
@@ -172,14 +266,14 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
     too_far |= !(std::fabs(step[k]) <= params_.max_step);
   }
   auto reject = [&] {
-    add(scratch.old_fp, 1.0f);
+    restore(scratch.old_fp, scratch.saved);
     return false;
   };
   if (too_far) return reject();
   Vec<D> x_new;
   for (int k = 0; k < D; ++k) x_new[k] = p.x[k] + step[k];
   if (!grid().canonical(x_new)) return reject();
-  const double rho_new = density_->at(x_new);
+  const double rho_new = rho_at(x_new);
   if (!(rho_new > 0)) return reject();
   const double sigma_new = sigma_for(rho_new, w);
   if (sigma_new > params_.sigma_bound) return reject();
@@ -218,7 +312,8 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
                      int threads, ChainCounters& counters) {
   const Grid<D>& g = grid();
   // Cells at least two footprints plus a step wide: same-colour cells never touch the same node.
-  const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 +
+  // The 3 is a footprint's lane padding (kernel.h).
+  const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 + 3 +
                        std::ceil(std::min(params_.max_step, 1e9));
   std::array<int, D> ncell{};
   std::array<double, D> width{};
@@ -273,6 +368,9 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
 #endif
   std::vector<Scratch> scratch(nthreads);
   std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
+  // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
+  local_.resize(order.size());
+  for (std::size_t t = 0; t < order.size(); ++t) local_[t] = particles[order[t]];
   for (const std::vector<int>& cells : cells_by_colour) {
     const int count = static_cast<int>(cells.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads) if (nthreads > 1 && count > 1)
@@ -285,16 +383,45 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
       const int c = cells[ci];
       std::uint64_t acc = 0;
       for (int t = start[c]; t < start[c + 1]; ++t) {
+        if (t + 1 < start[c + 1]) prefetch(local_[t + 1]);
         const int j = order[t];
         Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
                 static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
-        acc += update(particles[j], rng, s) ? 1 : 0;
+        acc += update(local_[t], rng, s) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     }
   }
+  for (std::size_t t = 0; t < order.size(); ++t) particles[order[t]] = local_[t];
   counters.proposals += order.size();
   for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
+}
+
+template <int D>
+void Chain<D>::prefetch(const Particle<D>& p) const {
+  // A footprint's rows are ~10 scattered cache lines that the hardware cannot predict; fetching them one
+  // update ahead hides most of their latency.
+  const Grid<D>& g = grid();
+  const double sigma = sigma_at(p);
+  std::array<std::int64_t, D> lo{}, hi{};
+  for (int k = 0; k < D; ++k) axis_reach(p.x[k], sigma, lo[k], hi[k]);
+  const std::int64_t x0 = std::clamp<std::int64_t>(lo[0], 0, g.dims[0] - 1),
+                     x1 = std::clamp<std::int64_t>(hi[0], 0, g.dims[0] - 1);
+  const float* R = residual_.data();
+  auto row = [&](std::int64_t base) {
+    for (std::int64_t i = x0; i <= x1; i += 16) __builtin_prefetch(R + base + i, 1);
+    __builtin_prefetch(R + base + x1, 1);
+  };
+  auto wrap = [&](std::int64_t i, int m) {
+    return std::clamp<std::int64_t>(i < 0 ? i + m : i >= m ? i - m : i, 0, m - 1);
+  };
+  if constexpr (D == 2) {
+    for (std::int64_t y = lo[1]; y <= hi[1]; ++y) row(wrap(y, g.dims[1]) * g.dims[0]);
+  } else {
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+        row((wrap(z, g.dims[2]) * g.dims[1] + wrap(y, g.dims[1])) * g.dims[0]);
+  }
 }
 
 template class Chain<2>;
