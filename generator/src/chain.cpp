@@ -79,7 +79,7 @@ template <int D>
 void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
   add(scratch.old_fp, sign);
 }
 
@@ -94,7 +94,7 @@ template <int D>
 double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
-  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
   Vec<D> unused{};
   return added_change_with_gradient(scratch.new_fp, unused);
 }
@@ -237,7 +237,7 @@ Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
   Vec<D> g{};
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return g;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, uniform_);
   remove_with_gradient(scratch.old_fp, g, scratch.saved);
   restore(scratch.old_fp, scratch.saved);
   return g;
@@ -249,7 +249,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
   const double sigma_old = sigma_for(rho_old, w);
-  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true);
+  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, uniform_);
   Vec<D> grad_old;
   const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
 
@@ -278,7 +278,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   const double sigma_new = sigma_for(rho_new, w);
   if (sigma_new > params_.sigma_bound) return reject();
   const bool mh = params_.metropolis && T > 0;
-  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh);
+  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh, uniform_);
   Vec<D> grad_new;
   const double added = added_change_with_gradient(scratch.new_fp, grad_new);
   const double dE = added - removed;
