@@ -1,6 +1,6 @@
 #include "chain.h"
 
-#include "simd.h"
+#include "lanes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,8 +12,10 @@
 namespace kdm::gen {
 namespace {
 
+// The sign in eq. 7's gradient. Where R is exactly ±0 any value in [-1, 1] is a subgradient; copysign
+// matches the lane passes' sign flip.
 inline float sign_of(float r) {
-  return static_cast<float>((r > 0) - (r < 0));
+  return std::copysign(1.0f, r);
 }
 
 }  // namespace
@@ -46,21 +48,15 @@ std::size_t footprint_nodes(const Footprint<D>& fp) {
   return n;
 }
 
-// Each pass below has a lane-vector form for contiguous footprints and a general form over index runs.
-// Both evaluate every node the same way: R ± p·v in float, the sign of R with the kernel in it for the
-// gradient. The lane sums make the reduction order a property of the footprint alone.
+// Each pass below has a lane-vector form for contiguous footprints (lanes.h) and a general form over index
+// runs. Both evaluate every node the same way: R ± p·v in float, the sign of R with the kernel in it for
+// the gradient.
 
 template <int D>
 void Chain<D>::add(const Footprint<D>& fp, float sign) {
   float* R = residual_.data();
   if (fp.contiguous) {
-    const float* v = fp.row_value.data();
-    const int width = fp.width;
-    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
-      const F4 pf = splat4(sign * static_cast<float>(p));
-      float* row = R + base + fp.start;
-      for (int a = 0; a < width; a += 4) store4(row + a, load4(row + a) + pf * load4(v + a));
-    });
+    lanes::by_width(fp.width, [&](auto n) { lanes::add<decltype(n)::value>(R, grid(), fp, sign); });
     return;
   }
   const AxisFactor& ax = fp.axes[0];
@@ -104,31 +100,9 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
   float* R = residual_.data();
   if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
   float* out = saved.data();
-  if (fp.contiguous) {
-    const float *v = fp.row_value.data(), *dv = fp.row_deriv.data();
-    const int width = fp.width;
-    F4 e = splat4(0);
-    std::array<F4, D> g{};
-    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
-      const F4 pf = splat4(static_cast<float>(p));
-      float* row = R + base + fp.start;
-      F4 sx = splat4(0), sg = splat4(0);
-      for (int a = 0; a < width; a += 4) {
-        const F4 r = load4(row + a), va = load4(v + a);
-        const F4 rn = r - pf * va;
-        sx += signed_by(r, load4(dv + a));
-        sg += signed_by(r, va);
-        e += abs4(r) - abs4(rn);
-        store4(out + a, r);
-        store4(row + a, rn);
-      }
-      out += width;
-      g[0] += pf * sx;
-      for (int k = 1; k < D; ++k) g[k] += splat4(static_cast<float>(pd[k])) * sg;
-    });
-    for (int k = 0; k < D; ++k) gradient[k] = sum4(g[k]);
-    return sum4(e);
-  }
+  if (fp.contiguous)
+    return lanes::by_width(
+        fp.width, [&](auto n) { return lanes::remove<decltype(n)::value>(R, grid(), fp, gradient, out); });
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -163,11 +137,7 @@ void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) 
   float* R = residual_.data();
   const float* in = saved.data();
   if (fp.contiguous) {
-    const int width = fp.width;
-    fp.for_each_row(grid(), [&](std::int64_t base, double, const std::array<double, D>&) {
-      std::copy(in, in + width, R + base + fp.start);
-      in += width;
-    });
+    lanes::by_width(fp.width, [&](auto n) { lanes::restore<decltype(n)::value>(R, grid(), fp, in); });
     return;
   }
   const AxisFactor& ax = fp.axes[0];
@@ -183,28 +153,9 @@ void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) 
 template <int D>
 double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
   const float* R = residual_.data();
-  if (fp.contiguous) {
-    const float *v = fp.row_value.data(), *dv = fp.row_deriv.data();
-    const int width = fp.width;
-    F4 e = splat4(0);
-    std::array<F4, D> g{};
-    fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
-      const F4 pf = splat4(static_cast<float>(p));
-      const float* row = R + base + fp.start;
-      F4 sx = splat4(0), sg = splat4(0);
-      for (int a = 0; a < width; a += 4) {
-        const F4 r = load4(row + a), va = load4(v + a);
-        const F4 rn = r + pf * va;
-        sx += signed_by(rn, load4(dv + a));
-        sg += signed_by(rn, va);
-        e += abs4(rn) - abs4(r);
-      }
-      g[0] += pf * sx;
-      for (int k = 1; k < D; ++k) g[k] += splat4(static_cast<float>(pd[k])) * sg;
-    });
-    for (int k = 0; k < D; ++k) gradient[k] = sum4(g[k]);
-    return sum4(e);
-  }
+  if (fp.contiguous)
+    return lanes::by_width(fp.width,
+                           [&](auto n) { return lanes::added<decltype(n)::value>(R, grid(), fp, gradient); });
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -248,7 +199,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   const double w = p.weight();
   const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
-  const double sigma_old = sigma_for(rho_old, w);
+  const double sigma_old = sigma_for(rho_old, w, scratch);
   scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, uniform_);
   Vec<D> grad_old;
   const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
@@ -275,7 +226,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   if (!grid().canonical(x_new)) return reject();
   const double rho_new = rho_at(x_new);
   if (!(rho_new > 0)) return reject();
-  const double sigma_new = sigma_for(rho_new, w);
+  const double sigma_new = sigma_for(rho_new, w, scratch);
   if (sigma_new > params_.sigma_bound) return reject();
   const bool mh = params_.metropolis && T > 0;
   scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh, uniform_);
@@ -366,7 +317,8 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   const int nthreads = 1;
   (void)threads;
 #endif
-  std::vector<Scratch> scratch(nthreads);
+  if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
+  std::vector<Scratch>& scratch = scratch_;
   std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
   // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
   local_.resize(order.size());
@@ -383,7 +335,7 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
       const int c = cells[ci];
       std::uint64_t acc = 0;
       for (int t = start[c]; t < start[c + 1]; ++t) {
-        if (t + 1 < start[c + 1]) prefetch(local_[t + 1]);
+        if (t + 1 < start[c + 1]) prefetch(local_[t + 1], s);
         const int j = order[t];
         Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
                 static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
@@ -398,11 +350,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
 }
 
 template <int D>
-void Chain<D>::prefetch(const Particle<D>& p) const {
+void Chain<D>::prefetch(const Particle<D>& p, Scratch& scratch) const {
   // A footprint's rows are ~10 scattered cache lines that the hardware cannot predict; fetching them one
   // update ahead hides most of their latency.
   const Grid<D>& g = grid();
-  const double sigma = sigma_at(p);
+  const double sigma = sigma_for(rho_at(p.x), p.weight(), scratch);
   std::array<std::int64_t, D> lo{}, hi{};
   for (int k = 0; k < D; ++k) axis_reach(p.x[k], sigma, lo[k], hi[k]);
   const std::int64_t x0 = std::clamp<std::int64_t>(lo[0], 0, g.dims[0] - 1),

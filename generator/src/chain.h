@@ -52,6 +52,7 @@ class Chain {
   struct Scratch {
     Footprint<D> old_fp, new_fp;
     std::vector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
+    double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
 
   /// `density` must outlive the chain.
@@ -97,12 +98,18 @@ class Chain {
   // For a kernel `fp` not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
-  void prefetch(const Particle<D>& p) const;
+  void prefetch(const Particle<D>& p, Scratch& scratch) const;
+  double sigma_for(double rho, double w, Scratch& scratch) const {
+    if (rho != scratch.memo_rho || w != scratch.memo_w)
+      scratch.memo_rho = rho, scratch.memo_w = w, scratch.memo_sigma = sigma_for(rho, w);
+    return scratch.memo_sigma;
+  }
 
   const DensityGrid<D>* density_;
   ChainParams params_;
   std::vector<float> residual_;
   std::vector<Particle<D>> local_;  // sweep(): the active particles in update order
+  std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
   bool uniform_ = false;            // every node has the same ρ: skip the interpolation
   double uniform_rho_ = 0;
 };

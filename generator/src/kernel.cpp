@@ -49,7 +49,7 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
   // Lanes are numbered from the node c = floor(x) whose cell holds x (u = x - c in [0, 1)), in double
   // first: x may be thousands of nodes out. Each value then depends only on x, σ and the node, never on
   // the window it is written into.
-  const double cell = std::floor(x), u = x - cell;
+  const double cell = floor_small(x), u = x - cell;
   const std::int64_t c = static_cast<std::int64_t>(cell);
   const int rounded = round_up4(count);
   const std::int32_t j0 = static_cast<std::int32_t>(first - c);  // lane k is node c + j0 + k
@@ -63,12 +63,12 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
     const float* row = table->coef.data() + std::size_t(piece) * KernelTable::kCoefs * KernelTable::kLanes +
                        (j0 + KernelTable::kHalf);
     constexpr int L = KernelTable::kLanes;
-    for (int q = 0; q < rounded; q += 4) {
-      const I4 j = I4{q, q + 1, q + 2, q + 3} + j0;
+    I4 j = I4{0, 1, 2, 3} + j0;
+    for (int q = 0; q < rounded; q += 4, j += 4) {
       const float* r = row + q;
       const F4 g = ((load4(r + 3 * L) * s + load4(r + 2 * L)) * s + load4(r + L)) * s + load4(r);
       const F4 value = g - edge;
-      const I4 keep = (j >= jlo) & (j <= jhi) & (value > 0);
+      const I4 keep = (j > jlo - 1) & (jhi + 1 > j) & (value > 0);
       store4(v + q, reinterpret_cast<F4>(reinterpret_cast<I4>(value) & keep));
       const F4 d =
           with_derivative ? (load4(r + 6 * L) * s + load4(r + 5 * L)) * s + load4(r + 4 * L) : splat4(0);
@@ -77,12 +77,12 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
     return;
   }
   const float a = static_cast<float>((0.5 - u) * (1.0 / (kKernelWidth * sigma)));  // t at node c
-  for (int q = 0; q < rounded; q += 4) {
-    const I4 j = I4{q, q + 1, q + 2, q + 3} + j0;
+  I4 j = I4{0, 1, 2, 3} + j0;
+  for (int q = 0; q < rounded; q += 4, j += 4) {
     const F4 t = splat4(a) + __builtin_convertvector(j, F4) * inv;
     const F4 g = exp4(-(t * t));
     const F4 value = g - edge;
-    const I4 keep = (j >= jlo) & (j <= jhi) & (value > 0);
+    const I4 keep = (j > jlo - 1) & (jhi + 1 > j) & (value > 0);
     store4(v + q, reinterpret_cast<F4>(reinterpret_cast<I4>(value) & keep));
     const F4 d = with_derivative ? g * dscale * t : splat4(0);
     store4(dv + q, reinterpret_cast<F4>(reinterpret_cast<I4>(d) & keep));
@@ -105,14 +105,16 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
   const bool direct = (torus && len <= m) || (!torus && lo >= 0 && hi < m);
   if (direct) {
     a.count = len;
-    std::int64_t idx = lo;  // direct on a torus means len <= m, so one wrap at most
-    if (torus) {
+    if (lo >= 0 && hi < m) {
+      for (int k = 0; k < len; ++k) a.index[k] = static_cast<int>(lo) + k;
+    } else {
+      std::int64_t idx = lo;  // direct on a torus means len <= m, so one wrap at most
       if (idx < 0) idx += m;
       if (idx >= m) idx -= m;
-    }
-    for (int k = 0; k < len; ++k) {
-      a.index[k] = static_cast<int>(idx);
-      if (++idx == m) idx = 0;
+      for (int k = 0; k < len; ++k) {
+        a.index[k] = static_cast<int>(idx);
+        if (++idx == m) idx = 0;
+      }
     }
     if (runs) a.build_runs();
     return;

@@ -33,8 +33,8 @@ double truncated_factor_integral();
 /// before wrapping or folding.
 inline void axis_reach(double x, double sigma, std::int64_t& lo, std::int64_t& hi) {
   const double reach = kCut * sigma;
-  lo = static_cast<std::int64_t>(std::ceil(x - 0.5 - reach));
-  hi = static_cast<std::int64_t>(std::floor(x - 0.5 + reach));
+  lo = static_cast<std::int64_t>(ceil_small(x - 0.5 - reach));
+  hi = static_cast<std::int64_t>(floor_small(x - 0.5 + reach));
 }
 
 inline int round_up4(int n) {

@@ -25,10 +25,10 @@ inline F4 splat4(float x) {
 inline F4 abs4(F4 x) {
   return reinterpret_cast<F4>(reinterpret_cast<I4>(x) & 0x7fffffff);
 }
-/// sign(r)·x with sign(0) = 0, exactly (a sign flip and a mask, no rounding).
+/// copysign(1, r)·x: x with its sign flipped where r is negative (or -0), exactly.
 inline F4 signed_by(F4 r, F4 x) {
-  const I4 flip = reinterpret_cast<I4>(r) & static_cast<std::int32_t>(0x80000000u);
-  return reinterpret_cast<F4>((reinterpret_cast<I4>(x) ^ flip) & (r != 0));
+  return reinterpret_cast<F4>(reinterpret_cast<I4>(x) ^
+                              (reinterpret_cast<I4>(r) & static_cast<std::int32_t>(0x80000000u)));
 }
 inline double sum4(F4 x) {
   return (double(x[0]) + double(x[1])) + (double(x[2]) + double(x[3]));
