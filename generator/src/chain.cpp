@@ -360,19 +360,34 @@ void Chain<D>::prefetch(const Particle<D>& p, Scratch& scratch) const {
   const std::int64_t x0 = std::clamp<std::int64_t>(lo[0], 0, g.dims[0] - 1),
                      x1 = std::clamp<std::int64_t>(hi[0], 0, g.dims[0] - 1);
   const float* R = residual_.data();
+  // Each row's window spans at most a few lines: prefetch its first and last node and every 16th between.
   auto row = [&](std::int64_t base) {
-    for (std::int64_t i = x0; i <= x1; i += 16) __builtin_prefetch(R + base + i, 1);
+    __builtin_prefetch(R + base + x0, 1);
+    for (std::int64_t i = x0 + 16; i < x1; i += 16) __builtin_prefetch(R + base + i, 1);
     __builtin_prefetch(R + base + x1, 1);
   };
-  auto wrap = [&](std::int64_t i, int m) {
-    return std::clamp<std::int64_t>(i < 0 ? i + m : i >= m ? i - m : i, 0, m - 1);
+  // Rows wrap at most once: the support is smaller than half the grid.
+  auto first_row = [&](std::int64_t i, int m) {
+    return std::clamp<std::int64_t>(i < 0 ? i + m : i, 0, m - 1);
   };
+  const std::int64_t m1 = g.dims[1], s1 = g.dims[0];
   if constexpr (D == 2) {
-    for (std::int64_t y = lo[1]; y <= hi[1]; ++y) row(wrap(y, g.dims[1]) * g.dims[0]);
+    std::int64_t y = first_row(lo[1], g.dims[1]);
+    for (std::int64_t n = lo[1]; n <= hi[1]; ++n) {
+      row(y * s1);
+      if (++y == m1) y = 0;
+    }
   } else {
-    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-        row((wrap(z, g.dims[2]) * g.dims[1] + wrap(y, g.dims[1])) * g.dims[0]);
+    const std::int64_t m2 = g.dims[2];
+    std::int64_t z = first_row(lo[2], g.dims[2]);
+    for (std::int64_t nz = lo[2]; nz <= hi[2]; ++nz) {
+      std::int64_t y = first_row(lo[1], g.dims[1]);
+      for (std::int64_t n = lo[1]; n <= hi[1]; ++n) {
+        row((z * m1 + y) * s1);
+        if (++y == m1) y = 0;
+      }
+      if (++z == m2) z = 0;
+    }
   }
 }
 

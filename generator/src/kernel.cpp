@@ -43,8 +43,6 @@ void KernelTable::prepare(double s) {
 
 void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int64_t lo, std::int64_t hi,
                 bool with_derivative, float* v, float* dv, const KernelTable* table) {
-  const float inv = static_cast<float>(1.0 / (kKernelWidth * sigma));
-  const float dscale = 2 * inv;  // d/dx φ((p - x)/s) = φ · 2 (p - x) / s^2 = φ · 2 t / s
   const float edge = static_cast<float>(kernel_edge_value());
   // Lanes are numbered from the node c = floor(x) whose cell holds x (u = x - c in [0, 1)), in double
   // first: x may be thousands of nodes out. Each value then depends only on x, σ and the node, never on
@@ -76,6 +74,8 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
     }
     return;
   }
+  const float inv = static_cast<float>(1.0 / (kKernelWidth * sigma));
+  const float dscale = 2 * inv;  // d/dx φ((p - x)/s) = φ · 2 (p - x) / s^2 = φ · 2 t / s
   const float a = static_cast<float>((0.5 - u) * (1.0 / (kKernelWidth * sigma)));  // t at node c
   I4 j = I4{0, 1, 2, 3} + j0;
   for (int q = 0; q < rounded; q += 4, j += 4) {
