@@ -270,7 +270,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   std::array<double, D> width{};
   int total_cells = 1;
   for (int k = 0; k < D; ++k) {
-    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
+    // Wider cells where the grid has room for at least 8 along the axis: each colour then touches less
+    // of the grid through its cells' borders (the residual is streamed once per colour). Depends on the
+    // grid only, never on the thread count.
+    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / std::max(2 * reach, 64.0))));
+    if (c < 8) c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
     if (c < 1) c = 1;
     if (g.torus && c > 1 && (c & 1)) --c;
     ncell[k] = c;
@@ -334,8 +338,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
 #endif
       const int c = cells[ci];
       std::uint64_t acc = 0;
+      // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
+      const int next_cell_first = ci + 1 < count ? start[cells[ci + 1]] : -1;
       for (int t = start[c]; t < start[c + 1]; ++t) {
-        if (t + 1 < start[c + 1]) prefetch(local_[t + 1], s);
+        const int next = t + 1 < start[c + 1] ? t + 1 : next_cell_first;
+        if (next >= 0 && next < static_cast<int>(local_.size())) prefetch(local_[next], s);
         const int j = order[t];
         Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
                 static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
