@@ -103,11 +103,6 @@ struct Footprint {
   bool contiguous = false;
   int start = 0, width = 0;
   alignas(16) std::array<float, kMaxWindow> row_value{}, row_deriv{};
-  /// 2D contiguous footprints: per row (axis 1), the window's flat index and amplitude × factor (and its
-  /// derivative) in float, as the passes use them.
-  bool rows_ready = false;
-  std::array<std::int64_t, kMaxWindow> row_base{};
-  std::array<float, kMaxWindow> row_p{}, row_pd{};
   KernelTable table;
 
   /// `tabulated`: the model's kernel is KernelTable's interpolant (a model-wide choice, never per kernel).
@@ -135,16 +130,6 @@ struct Footprint {
       axis_lanes(x[0], sigma, start, width, lo, hi, with_derivative, row_value.data(), row_deriv.data(), tab);
     } else {
       build_axis(axes[0], x[0], sigma, m, grid.torus, with_derivative, tab, true);
-    }
-    if constexpr (D == 2) {
-      // Each pass walks the rows: their origins and float factors once here, not once per pass.
-      const AxisFactor& ay = axes[1];
-      rows_ready = contiguous && ay.count <= kMaxWindow;
-      for (int b = 0; rows_ready && b < ay.count; ++b) {
-        row_base[b] = ay.index[b] * std::int64_t(m) + start;
-        row_p[b] = static_cast<float>(amp * ay.value[b]);
-        row_pd[b] = static_cast<float>(amp * ay.deriv[b]);
-      }
     }
   }
 

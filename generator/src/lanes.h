@@ -39,12 +39,6 @@ inline void rows(const Grid<D>& grid, const Footprint<D>& fp, RowFn&& row) {
   const int* iy = ay.index.data();
   const float *vy = ay.value.data(), *dy = ay.deriv.data();
   if constexpr (D == 2) {
-    if (fp.rows_ready) {
-      const std::int64_t* base = fp.row_base.data();
-      const float *p = fp.row_p.data(), *pd = fp.row_pd.data();
-      for (int b = 0; b < ny; ++b) row(base[b], p[b], std::array<float, D>{0, pd[b]});
-      return;
-    }
     for (int b = 0; b < ny; ++b)
       row(iy[b] * s1 + start, static_cast<float>(amp * vy[b]),
           std::array<float, D>{0, static_cast<float>(amp * dy[b])});
