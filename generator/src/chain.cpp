@@ -1,5 +1,7 @@
 #include "chain.h"
 
+#include "lanes.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -10,8 +12,10 @@
 namespace kdm::gen {
 namespace {
 
+// The sign in eq. 7's gradient. Where R is exactly ±0 any value in [-1, 1] is a subgradient; copysign
+// matches the lane passes' sign flip.
 inline float sign_of(float r) {
-  return static_cast<float>((r > 0) - (r < 0));
+  return std::copysign(1.0f, r);
 }
 
 }  // namespace
@@ -19,6 +23,9 @@ inline float sign_of(float r) {
 template <int D>
 Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
     : density_(&density), params_(params), residual_(density.rho.size()) {
+  const std::vector<float>& rho = density.rho;
+  uniform_ = !rho.empty() && std::all_of(rho.begin(), rho.end(), [&](float r) { return r == rho[0]; });
+  uniform_rho_ = uniform_ ? rho[0] : 0.0;
   clear_kernels();
 }
 
@@ -35,8 +42,23 @@ void Chain<D>::clear_kernels() {
 }
 
 template <int D>
+std::size_t footprint_nodes(const Footprint<D>& fp) {
+  std::size_t n = fp.contiguous ? fp.width : fp.axes[0].count;
+  for (int k = 1; k < D; ++k) n *= fp.axes[k].count;
+  return n;
+}
+
+// Each pass below has a lane-vector form for contiguous footprints (lanes.h) and a general form over index
+// runs. Both evaluate every node the same way: R ± p·v in float, the sign of R with the kernel in it for
+// the gradient.
+
+template <int D>
 void Chain<D>::add(const Footprint<D>& fp, float sign) {
   float* R = residual_.data();
+  if (fp.contiguous) {
+    lanes::by_width(fp.width, [&](auto n) { lanes::add<decltype(n)::value>(R, grid(), fp, sign); });
+    return;
+  }
   const AxisFactor& ax = fp.axes[0];
   fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>&) {
     const float pf = sign * static_cast<float>(p);
@@ -44,7 +66,6 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
       const int off = ax.run_offset[run], len = ax.run_length[run];
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
-#pragma omp simd
       for (int a = 0; a < len; ++a) row[a] += pf * v[a];
     }
   });
@@ -52,9 +73,9 @@ void Chain<D>::add(const Footprint<D>& fp, float sign) {
 
 template <int D>
 void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
   add(scratch.old_fp, sign);
 }
 
@@ -67,16 +88,21 @@ double Chain<D>::energy() const {
 
 template <int D>
 double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
-  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false);
+  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
   Vec<D> unused{};
   return added_change_with_gradient(scratch.new_fp, unused);
 }
 
 template <int D>
-double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) {
+double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved) {
   float* R = residual_.data();
+  if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
+  float* out = saved.data();
+  if (fp.contiguous)
+    return lanes::by_width(
+        fp.width, [&](auto n) { return lanes::remove<decltype(n)::value>(R, grid(), fp, gradient, out); });
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -88,8 +114,6 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
       float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
-      // Reductions in SIMD lanes: the order is fixed by the binary and the footprint, never by threads.
-#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float s = sign_of(r);
@@ -97,6 +121,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
         sx += s * dv[a];
         sg += s * v[a];
         e += std::fabs(r) - std::fabs(rn);
+        *out++ = r;
         row[a] = rn;
       }
     }
@@ -108,8 +133,29 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) 
 }
 
 template <int D>
+void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) {
+  float* R = residual_.data();
+  const float* in = saved.data();
+  if (fp.contiguous) {
+    lanes::by_width(fp.width, [&](auto n) { lanes::restore<decltype(n)::value>(R, grid(), fp, in); });
+    return;
+  }
+  const AxisFactor& ax = fp.axes[0];
+  fp.for_each_row(grid(), [&](std::int64_t base, double, const std::array<double, D>&) {
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      std::copy(in, in + len, R + base + ax.index[off]);
+      in += len;
+    }
+  });
+}
+
+template <int D>
 double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
   const float* R = residual_.data();
+  if (fp.contiguous)
+    return lanes::by_width(fp.width,
+                           [&](auto n) { return lanes::added<decltype(n)::value>(R, grid(), fp, gradient); });
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -121,7 +167,6 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
       const float* __restrict row = R + base + ax.index[off];
       const float* __restrict v = ax.value.data() + off;
       const float* __restrict dv = ax.deriv.data() + off;
-#pragma omp simd reduction(+ : sx, sg, e)
       for (int a = 0; a < len; ++a) {
         const float r = row[a];
         const float rn = r + pf * v[a];
@@ -141,23 +186,23 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
 template <int D>
 Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
   Vec<D> g{};
-  const double rho = density_->at(p.x);
+  const double rho = rho_at(p.x);
   if (!(rho > 0)) return g;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true);
-  remove_with_gradient(scratch.old_fp, g);
-  add(scratch.old_fp, 1.0f);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, uniform_);
+  remove_with_gradient(scratch.old_fp, g, scratch.saved);
+  restore(scratch.old_fp, scratch.saved);
   return g;
 }
 
 template <int D>
 bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   const double w = p.weight();
-  const double rho_old = density_->at(p.x);
+  const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
-  const double sigma_old = sigma_for(rho_old, w);
-  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true);
+  const double sigma_old = sigma_for(rho_old, w, scratch);
+  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, uniform_);
   Vec<D> grad_old;
-  const double removed = remove_with_gradient(scratch.old_fp, grad_old);
+  const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
 
   // Eq. 5 with Δt_j = T σ Δt / w: drift -(σ Δt / 2w) ∇E, noise variance T σ Δt / w. A kernel of weight w
   // carries w times the energy, so dividing by w keeps its step the size of a unit kernel's (as the
@@ -172,19 +217,19 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
     too_far |= !(std::fabs(step[k]) <= params_.max_step);
   }
   auto reject = [&] {
-    add(scratch.old_fp, 1.0f);
+    restore(scratch.old_fp, scratch.saved);
     return false;
   };
   if (too_far) return reject();
   Vec<D> x_new;
   for (int k = 0; k < D; ++k) x_new[k] = p.x[k] + step[k];
   if (!grid().canonical(x_new)) return reject();
-  const double rho_new = density_->at(x_new);
+  const double rho_new = rho_at(x_new);
   if (!(rho_new > 0)) return reject();
-  const double sigma_new = sigma_for(rho_new, w);
+  const double sigma_new = sigma_for(rho_new, w, scratch);
   if (sigma_new > params_.sigma_bound) return reject();
   const bool mh = params_.metropolis && T > 0;
-  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh);
+  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh, uniform_);
   Vec<D> grad_new;
   const double added = added_change_with_gradient(scratch.new_fp, grad_new);
   const double dE = added - removed;
@@ -218,13 +263,18 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
                      int threads, ChainCounters& counters) {
   const Grid<D>& g = grid();
   // Cells at least two footprints plus a step wide: same-colour cells never touch the same node.
-  const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 +
+  // The 3 is a footprint's lane padding (kernel.h).
+  const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 + 3 +
                        std::ceil(std::min(params_.max_step, 1e9));
   std::array<int, D> ncell{};
   std::array<double, D> width{};
   int total_cells = 1;
   for (int k = 0; k < D; ++k) {
-    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
+    // Wider cells where the grid has room for at least 8 along the axis: each colour then touches less
+    // of the grid through its cells' borders (the residual is streamed once per colour). Depends on the
+    // grid only, never on the thread count.
+    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / std::max(2 * reach, 64.0))));
+    if (c < 8) c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
     if (c < 1) c = 1;
     if (g.torus && c > 1 && (c & 1)) --c;
     ncell[k] = c;
@@ -271,8 +321,12 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   const int nthreads = 1;
   (void)threads;
 #endif
-  std::vector<Scratch> scratch(nthreads);
+  if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
+  std::vector<Scratch>& scratch = scratch_;
   std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
+  // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
+  local_.resize(order.size());
+  for (std::size_t t = 0; t < order.size(); ++t) local_[t] = particles[order[t]];
   for (const std::vector<int>& cells : cells_by_colour) {
     const int count = static_cast<int>(cells.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads) if (nthreads > 1 && count > 1)
@@ -284,17 +338,64 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
 #endif
       const int c = cells[ci];
       std::uint64_t acc = 0;
+      // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
+      const int next_cell_first = ci + 1 < count ? start[cells[ci + 1]] : -1;
       for (int t = start[c]; t < start[c + 1]; ++t) {
+        const int next = t + 1 < start[c + 1] ? t + 1 : next_cell_first;
+        if (next >= 0 && next < static_cast<int>(local_.size())) prefetch(local_[next], s);
         const int j = order[t];
         Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
                 static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
-        acc += update(particles[j], rng, s) ? 1 : 0;
+        acc += update(local_[t], rng, s) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     }
   }
+  for (std::size_t t = 0; t < order.size(); ++t) particles[order[t]] = local_[t];
   counters.proposals += order.size();
   for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
+}
+
+template <int D>
+void Chain<D>::prefetch(const Particle<D>& p, Scratch& scratch) const {
+  // A footprint's rows are ~10 scattered cache lines that the hardware cannot predict; fetching them one
+  // update ahead hides most of their latency.
+  const Grid<D>& g = grid();
+  const double sigma = sigma_for(rho_at(p.x), p.weight(), scratch);
+  std::array<std::int64_t, D> lo{}, hi{};
+  for (int k = 0; k < D; ++k) axis_reach(p.x[k], sigma, lo[k], hi[k]);
+  const std::int64_t x0 = std::clamp<std::int64_t>(lo[0], 0, g.dims[0] - 1),
+                     x1 = std::clamp<std::int64_t>(hi[0], 0, g.dims[0] - 1);
+  const float* R = residual_.data();
+  // Each row's window spans at most a few lines: prefetch its first and last node and every 16th between.
+  auto row = [&](std::int64_t base) {
+    __builtin_prefetch(R + base + x0, 1);
+    for (std::int64_t i = x0 + 16; i < x1; i += 16) __builtin_prefetch(R + base + i, 1);
+    __builtin_prefetch(R + base + x1, 1);
+  };
+  // Rows wrap at most once: the support is smaller than half the grid.
+  auto first_row = [&](std::int64_t i, int m) {
+    return std::clamp<std::int64_t>(i < 0 ? i + m : i, 0, m - 1);
+  };
+  const std::int64_t m1 = g.dims[1], s1 = g.dims[0];
+  if constexpr (D == 2) {
+    std::int64_t y = first_row(lo[1], g.dims[1]);
+    for (std::int64_t n = lo[1]; n <= hi[1]; ++n) {
+      row(y * s1);
+      if (++y == m1) y = 0;
+    }
+  } else {
+    const std::int64_t m2 = g.dims[2];
+    std::int64_t z = first_row(lo[2], g.dims[2]);
+    for (std::int64_t nz = lo[2]; nz <= hi[2]; ++nz) {
+      std::int64_t y = first_row(lo[1], g.dims[1]);
+      for (std::int64_t n = lo[1]; n <= hi[1]; ++n) {
+        row((z * m1 + y) * s1);
+        if (++y == m1) y = 0;
+      }
+      if (++z == m2) z = 0;
+    }
+  }
 }
 
 template class Chain<2>;

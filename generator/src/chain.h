@@ -25,7 +25,10 @@ struct Particle {
   Vec<D> x{};
   std::uint8_t splits = 0;  ///< refinements this kernel still splits in; weight w = 2^(D·splits)
   bool active = true;       ///< relaxed at this level (σ < σmax); inactive kernels are background
-  double weight() const { return std::ldexp(1.0, D * splits); }
+  double weight() const {
+    return D * splits < 63 ? static_cast<double>(std::uint64_t(1) << (D * splits))
+                           : std::ldexp(1.0, D * splits);
+  }
 };
 
 struct ChainParams {
@@ -48,6 +51,8 @@ class Chain {
  public:
   struct Scratch {
     Footprint<D> old_fp, new_fp;
+    std::vector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
+    double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
 
   /// `density` must outlive the chain.
@@ -61,7 +66,9 @@ class Chain {
 
   /// σ of a kernel with weight w at density rho (grid units).
   double sigma_for(double rho, double w) const;
-  double sigma_at(const Particle<D>& p) const { return sigma_for(density_->at(p.x), p.weight()); }
+  /// ρ at x as the model sees it: the density grid's interpolation, or its value when it is constant.
+  double rho_at(const Vec<D>& x) const { return uniform_ ? uniform_rho_ : density_->at(x); }
+  double sigma_at(const Particle<D>& p) const { return sigma_for(rho_at(p.x), p.weight()); }
 
   /// R = A - ρ with no kernels.
   void clear_kernels();
@@ -84,15 +91,27 @@ class Chain {
              ChainCounters& counters);
 
  private:
-  // Removes the kernel of `fp` from R, returning Σ(|R_before| - |R_after|) and the gradient of eq. 7.
-  double remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient);
+  // Removes the kernel of `fp` from R, returning Σ(|R_before| - |R_after|) and the gradient of eq. 7;
+  // keeps R_before in `saved` for restore().
+  double remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved);
+  void restore(const Footprint<D>& fp, const std::vector<float>& saved);
   // For a kernel `fp` not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
+  void prefetch(const Particle<D>& p, Scratch& scratch) const;
+  double sigma_for(double rho, double w, Scratch& scratch) const {
+    if (rho != scratch.memo_rho || w != scratch.memo_w)
+      scratch.memo_rho = rho, scratch.memo_w = w, scratch.memo_sigma = sigma_for(rho, w);
+    return scratch.memo_sigma;
+  }
 
   const DensityGrid<D>* density_;
   ChainParams params_;
   std::vector<float> residual_;
+  std::vector<Particle<D>> local_;  // sweep(): the active particles in update order
+  std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
+  bool uniform_ = false;            // every node has the same ρ: skip the interpolation
+  double uniform_rho_ = 0;
 };
 
 extern template class Chain<2>;

@@ -22,11 +22,43 @@ inline constexpr double kCut = 3.2;          // footprint half-width in units of
 
 /// φ's value at the cut, subtracted so the truncated kernel is continuous.
 inline double kernel_edge_value() {
-  return std::exp(-(kCut / kKernelWidth) * (kCut / kKernelWidth));
+  static const double value = std::exp(-(kCut / kKernelWidth) * (kCut / kKernelWidth));
+  return value;
 }
 
 /// ∫ of the truncated 1D factor over t in units of σ; the kernel's mass is w·J^d.
 double truncated_factor_integral();
+
+/// The nodes [lo, hi] a kernel centred at x (grid units) with scale sigma reaches along one axis,
+/// before wrapping or folding.
+inline void axis_reach(double x, double sigma, std::int64_t& lo, std::int64_t& hi) {
+  const double reach = kCut * sigma;
+  lo = static_cast<std::int64_t>(ceil_small(x - 0.5 - reach));
+  hi = static_cast<std::int64_t>(floor_small(x - 0.5 + reach));
+}
+
+inline int round_up4(int n) {
+  return (n + 3) & ~3;
+}
+
+/// The axis factor for one σ as a function of where x lies in its cell (u = x - floor(x)): a piecewise
+/// cubic Hermite interpolant in u, exact values and derivatives at the piece ends, for the nodes within
+/// kHalf of x. Models with one σ everywhere (constant density) use it as their kernel: within 1e-8 of the
+/// Gaussian factor, C1 in x, and a few multiply-adds per node instead of an exp.
+struct KernelTable {
+  static constexpr int kHalf = 16, kLanes = 2 * kHalf + 4, kPieces = 16, kCoefs = 7;
+  double sigma = 0;
+  std::vector<float> coef;  ///< [piece][value c0..c3, derivative e0..e2][lane = j + kHalf]
+  /// Rebuilds the table if it is not for `s`.
+  void prepare(double s);
+};
+
+/// The truncated factor φ and its derivative with respect to x at the unwrapped nodes first, first+1, ...
+/// (count rounded up to whole lane vectors: v and dv need that room), zero outside [lo, hi]. This is the
+/// one definition of the kernel's values: every footprint, whatever its shape, is built from it. With a
+/// `table` (prepared for sigma) the factor is the table's interpolant where it reaches, else exp(-t^2).
+void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int64_t lo, std::int64_t hi,
+                bool with_derivative, float* v, float* dv, const KernelTable* table);
 
 /// One axis of a footprint: grid indices and the factor (and its derivative w.r.t. the kernel centre).
 struct AxisFactor {
@@ -48,22 +80,57 @@ struct AxisFactor {
       ++run_length.back();
     }
   }
-  std::vector<double> fold_value, fold_deriv;  // scratch for folding
+  std::vector<float> fold_value, fold_deriv;  // scratch for folding
   std::vector<int> fold_touched;
 };
 
-/// Fills `a` for a kernel centred at `x` (grid units) with scale `sigma` on an axis of `m` nodes.
-void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool with_derivative);
+/// Fills `a` for a kernel centred at `x` (grid units) with scale `sigma` on an axis of `m` nodes; `runs`
+/// also fills its runs (only axis 0 is walked by runs).
+void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool with_derivative,
+                const KernelTable* table, bool runs);
+
+/// Widest axis-0 window (nodes) of a contiguous footprint; wider kernels take the general path.
+inline constexpr int kMaxWindow = 64;
 
 /// A kernel's footprint on a grid: amplitude times the product of the axis factors.
 template <int D>
 struct Footprint {
-  std::array<AxisFactor, D> axes;
+  std::array<AxisFactor, D> axes;  ///< axes[0] is filled only when !contiguous
   double amplitude = 0;
+  /// Usually axis 0 neither wraps nor folds: its factor is then kept as one window of `width` nodes (a
+  /// multiple of 4, zero-padded) from `start`, so each row is whole lane vectors over contiguous memory.
+  /// The padding lies within 3 nodes of the footprint; it is read and rewritten unchanged.
+  bool contiguous = false;
+  int start = 0, width = 0;
+  alignas(16) std::array<float, kMaxWindow> row_value{}, row_deriv{};
+  KernelTable table;
 
-  void build(const Grid<D>& grid, const Vec<D>& x, double sigma, double amp, bool with_derivative) {
+  /// `tabulated`: the model's kernel is KernelTable's interpolant (a model-wide choice, never per kernel).
+  void build(const Grid<D>& grid, const Vec<D>& x, double sigma, double amp, bool with_derivative,
+             bool tabulated) {
     amplitude = amp;
-    for (int k = 0; k < D; ++k) build_axis(axes[k], x[k], sigma, grid.dims[k], grid.torus, with_derivative);
+    const KernelTable* tab = nullptr;
+    if (tabulated) {
+      table.prepare(sigma);
+      tab = &table;
+    }
+    for (int k = 1; k < D; ++k)
+      build_axis(axes[k], x[k], sigma, grid.dims[k], grid.torus, with_derivative, tab, false);
+    std::int64_t lo, hi;
+    axis_reach(x[0], sigma, lo, hi);
+    const int m = grid.dims[0];
+    const std::int64_t len = hi - lo + 1;
+    contiguous = false;
+    if (lo >= 0 && hi < m && len <= kMaxWindow - 3) {
+      width = round_up4(static_cast<int>(len));
+      start = static_cast<int>(lo + width <= m ? lo : hi + 1 - width);
+      contiguous = start >= 0;
+    }
+    if (contiguous) {
+      axis_lanes(x[0], sigma, start, width, lo, hi, with_derivative, row_value.data(), row_deriv.data(), tab);
+    } else {
+      build_axis(axes[0], x[0], sigma, m, grid.torus, with_derivative, tab, true);
+    }
   }
 
   /// Calls row(base, P, Pd) for every row along axis 0: `base` is the flat index of the row's axis-0
