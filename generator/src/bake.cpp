@@ -2,10 +2,14 @@
 #include "kdm/generator/bake.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
+#include <tuple>
 
+#include "corner_layout.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/version.h"
 #include "rng.h"
@@ -13,19 +17,10 @@
 namespace kdm::gen {
 namespace {
 
-double torus_distance2(const double* a, const double* b) {
-  double d2 = 0;
-  for (int k = 0; k < 2; ++k) {
-    double d = std::fabs(a[k] - b[k]);
-    d = std::min(d, 1.0 - d);
-    d2 += d * d;
-  }
-  return d2;
-}
-
-// Void-and-cluster filter width in units of the fixed points' spacing. Measured on the default set: 0.35
-// keeps every mid-level prefix of >= 1792 points at lowP 0.066–0.099 (0.5: up to 0.117; 0.25: 0.136).
-constexpr double kFilterWidth = 0.35;
+// Void-and-cluster filter width in units of the current point spacing (progressive_order narrows it as
+// points are added). Measured on a 4-level set: 0.35 gives mid-level δavg .71–.83 but lowP up to .112;
+// 0.7 gives δavg .65–.81 and lowP up to .112; 0.5 gives δavg .69–.82 and lowP at most .099.
+constexpr double kFilterWidth = 0.5;
 
 }  // namespace
 
@@ -55,14 +50,20 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     if (key == "seed")
       r.seed = static_cast<std::uint64_t>(whole(0, 9007199254740992.0));
     else if (key == "colours")
-      r.colours = static_cast<std::uint32_t>(whole(1, 1));
+      r.colours = static_cast<std::uint32_t>(whole(1, kMaxTileColours));
     else if (key == "levels")
       r.levels = static_cast<std::uint32_t>(whole(1, 10));
     else if (key == "base_points")
       r.base_points = static_cast<std::uint32_t>(whole(1, 1 << 16));
     else if (key == "sweeps")
       r.sweeps = static_cast<int>(whole(1, 10000));
-    else if (key == "temperature") {
+    else if (key == "band") {
+      if (!(v > 0 && v < 0.5)) throw InvalidArgument(where + "band must be in (0, 0.5)");
+      r.band = v;
+    } else if (key == "erosion") {
+      if (!(v >= 0 && v <= 8)) throw InvalidArgument(where + "erosion must be in [0, 8]");
+      r.erosion = v;
+    } else if (key == "temperature") {
       if (v < 0) throw InvalidArgument(where + "temperature must be >= 0");
       r.temperature = v;
     } else {
@@ -70,6 +71,10 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     }
   }
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
+  if (patch_widths(r.band, r.erosion, r.nominal_counts()).empty())
+    throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
+                          std::to_string(r.erosion) +
+                          " leaves some level's edge patches narrower than half a point spacing");
   return r;
 }
 
@@ -82,91 +87,201 @@ std::string BakeRecipe::to_text() const {
   std::ostringstream s;
   s.precision(17);
   s << "seed " << seed << "\ncolours " << colours << "\nlevels " << levels << "\nbase_points " << base_points
-    << "\ntemperature " << temperature << "\nsweeps " << sweeps << "\n";
+    << "\ntemperature " << temperature << "\nsweeps " << sweeps << "\nband " << band << "\nerosion "
+    << erosion << "\n";
   return s.str();
 }
 
-std::vector<std::uint32_t> progressive_order(const std::vector<double>& new_points,
-                                             const std::vector<double>& fixed) {
-  // Void-and-cluster ranking (Ulichney 1993) against everything already present: each next point is the
-  // candidate in the deepest void of a Gaussian-filtered density of the fixed points and the points placed
-  // so far. The filter is as wide as the spacing of the fixed points, so each prefix is even at the scale
-  // of its own spacing and above (low frequencies), not only locally.
-  const std::size_t n = new_points.size() / 2, f = fixed.size() / 2;
-  if (n == 0) return {};
-  const double spacing = std::sqrt(1.0 / std::max(1.0, double(f > 0 ? f : n)));
-  const double width = kFilterWidth * spacing, inv2w2 = 1.0 / (2 * width * width);
-  const double reach2 = 9 * width * width;  // 3 filter widths
-  // Candidates bucketed on a uniform grid of cells about 3 filter widths wide, for neighbourhood updates.
-  const int cells = std::max(1, std::min(1024, static_cast<int>(1.0 / (3 * width))));
-  std::vector<std::vector<std::uint32_t>> grid(static_cast<std::size_t>(cells) * cells);
-  auto cell = [&](double u) { return std::min(cells - 1, static_cast<int>(u * cells)); };
-  for (std::size_t i = 0; i < n; ++i)
-    grid[static_cast<std::size_t>(cell(new_points[2 * i + 1])) * cells + cell(new_points[2 * i])].push_back(
-        static_cast<std::uint32_t>(i));
-  std::vector<double> field(n, 0.0);
-  std::vector<char> placed(n, 0);
-  auto splat = [&](const double* p) {
-    const int cx = cell(p[0]), cy = cell(p[1]);
-    const int r = std::min(cells / 2, static_cast<int>(std::ceil(3 * width * cells)) + 1);
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx) {
-        if ((2 * r + 1 > cells) &&
-            (dx < -cells / 2 || dx >= cells - cells / 2 || dy < -cells / 2 || dy >= cells - cells / 2))
-          continue;  // small grids: visit each cell once
-        const int gx = ((cx + dx) % cells + cells) % cells, gy = ((cy + dy) % cells + cells) % cells;
-        for (std::uint32_t i : grid[static_cast<std::size_t>(gy) * cells + gx]) {
-          const double d2 = torus_distance2(p, &new_points[2 * i]);
-          if (d2 < reach2) field[i] += std::exp(-d2 * inv2w2);
-        }
-      }
-  };
-  for (std::size_t j = 0; j < f; ++j) splat(&fixed[2 * j]);
-  std::vector<std::uint32_t> order;
-  order.reserve(n);
-  for (std::size_t step = 0; step < n; ++step) {
-    std::size_t next = n;
-    for (std::size_t i = 0; i < n; ++i)
-      if (!placed[i] && (next == n || field[i] < field[next])) next = i;
-    placed[next] = 1;
-    order.push_back(static_cast<std::uint32_t>(next));
-    splat(&new_points[2 * next]);
-  }
-  return order;
+std::vector<std::uint32_t> BakeRecipe::nominal_counts() const {
+  std::vector<std::uint32_t> n;
+  for (std::uint32_t k = 0; k < levels; ++k) n.push_back(base_points << (2 * k));
+  return n;
 }
 
-TileSet bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
-  if (recipe.colours != 1) throw InvalidArgument("only one corner colour is supported so far");
-  TileSet set;
-  set.colours = recipe.colours;
-  set.levels = recipe.levels;
-  set.recipe = recipe.to_text();
-  set.generator_version = version_string();
-  Tile tile;
-  std::vector<double> points;  // all levels so far, in rank order
-  const double total = double(recipe.top_level_points());
-  for (std::uint32_t level = 0; level < recipe.levels; ++level) {
-    SamplerOptions o;
-    o.n = level == 0 ? recipe.base_points : 3 * static_cast<std::int64_t>(points.size() / 2);
-    o.temperature = recipe.temperature;
-    o.sweeps = recipe.sweeps_for(points.size() / 2 + static_cast<std::uint64_t>(o.n));
-    o.coarsest_sweeps = std::max(o.coarsest_sweeps, o.sweeps);
-    o.threads = threads;
-    o.seed = mix64(recipe.seed ^ mix64(0x42414b45ull + level));  // "BAKE"
-    o.fixed_points = points;
-    const double done = double(points.size() / 2), adding = double(o.n);
-    if (progress) o.progress = [&](double f) { progress((done + f * adding) / total); };
-    const SampleResult r = sample(o);
-    const std::vector<std::uint32_t> order = progressive_order(r.points, points);
-    for (std::uint32_t i : order) points.insert(points.end(), {r.points[2 * i], r.points[2 * i + 1]});
-    tile.level_end.push_back(static_cast<std::uint32_t>(points.size() / 2));
-    if (progress) progress(double(points.size() / 2) / total);
+namespace {
+
+/// One sampler run of the bake: a w×h torus of tiles with its vertex colours, producing the patches of
+/// one stage (corners; horizontal edges; vertical edges; interiors) that are not done yet.
+struct Run {
+  int stage = 0;  ///< the PatchKind it makes
+  int w = 1, h = 1;
+  std::vector<std::uint32_t> grid;  ///< vertex colours, row-major
+};
+
+// The stages of a level are the patch kinds in order (PatchKind): corners, horizontal edges, vertical
+// edges, interiors. Vertical edges come after horizontal ones so that the 1×1 runs see both.
+
+/// The runs of one level (the same for every level): each patch comes from the first run that holds it.
+std::vector<Run> plan_runs(std::uint32_t colours) {
+  std::vector<Run> runs;
+  for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({0, 1, 1, {c}});
+  for (int stage = 1; stage <= 2; ++stage) {
+    for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({stage, 1, 1, {c}});
+    for (std::uint32_t a = 0; a < colours; ++a)
+      for (std::uint32_t b = a + 1; b < colours; ++b)  // edges (a, b) and (b, a) along x, or along y
+        runs.push_back(stage == 1 ? Run{1, 2, 1, {a, b}} : Run{2, 1, 2, {a, b}});
   }
-  tile.points.resize(points.size() / 2);
-  for (std::size_t i = 0; i < tile.points.size(); ++i)
-    tile.points[i] = TilePoint::from_unit(points[2 * i], points[2 * i + 1]);
-  set.tiles.push_back(std::move(tile));
-  return set;
+  const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
+  std::vector<char> covered(tiles, 0);
+  for (std::size_t t = 0; t < tiles; ++t) {
+    if (covered[t]) continue;
+    const Colouring around = Colouring::around_tile(colours, t);
+    Run run{3, 2, 2, {around.at(0, 0), around.at(1, 0), around.at(0, 1), around.at(1, 1)}};
+    for (int ty = 0; ty < 2; ++ty)
+      for (int tx = 0; tx < 2; ++tx) covered[around.tile_at(tx, ty)] = 1;
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+class Baker {
+ public:
+  Baker(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress)
+      : recipe_(recipe),
+        threads_(threads),
+        progress_(progress),
+        nominal_(recipe.nominal_counts()),
+        widths_(patch_widths(recipe.band, recipe.erosion, nominal_)),
+        runs_(plan_runs(recipe.colours)) {
+    if (widths_.empty()) throw InvalidArgument("recipe: the patches of some level are too narrow");
+    for (std::uint32_t k = 0; k < recipe.levels; ++k)
+      for (const Run& run : runs_) total_work_ += work(k, run);
+  }
+
+  TileSet bake() {
+    for (std::uint32_t k = 0; k < recipe_.levels; ++k) {
+      levels_.emplace_back(recipe_.colours);
+      for (std::size_t r = 0; r < runs_.size(); ++r) {
+        sample_run(k, r);
+        done_work_ += work(k, runs_[r]);
+        if (progress_) progress_(done_work_ / total_work_);
+      }
+    }
+    return assemble();
+  }
+
+ private:
+  double work(std::uint32_t level, const Run& run) const {
+    return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
+  }
+
+  /// Samples run `r` of level k and keeps (ranks) the patches of its stage that no earlier run made.
+  void sample_run(std::uint32_t k, std::size_t r) {
+    const Run& run = runs_[r];
+    const Colouring col = Colouring::torus(recipe_.colours, run.w, run.h, run.grid);
+    // Context: every earlier level, and this level's patches of earlier stages (with their keys).
+    RankingInput rank;
+    rank.width = run.w, rank.height = run.h;
+    for (std::uint32_t j = 0; j < k; ++j)
+      gather(levels_[j], col, {true, true, true, true}, 0, 0, run.w, run.h, rank.fixed, nullptr);
+    std::array<bool, 4> earlier{};
+    for (int kind = 0; kind < run.stage; ++kind) earlier[kind] = true;
+    gather(levels_[k], col, earlier, 0, 0, run.w, run.h, rank.timed, &rank.timed_keys);
+
+    SamplerOptions o;
+    o.extent[0] = run.w, o.extent[1] = run.h;
+    const std::int64_t present = static_cast<std::int64_t>((rank.fixed.size() + rank.timed.size()) / 2);
+    o.n = std::int64_t(run.w * run.h) * nominal_[k] - present;
+    if (o.n <= 0) throw InvalidArgument("recipe: a patch's context already holds all of its level's points");
+    o.temperature = recipe_.temperature;
+    o.sweeps = recipe_.sweeps_for(nominal_[k]);
+    o.coarsest_sweeps = std::max(o.coarsest_sweeps, o.sweeps);
+    // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
+    // resolve a residual density confined to patches between fixed bands, and spread the new points
+    // unevenly between patches (measured: interiors of one run off by up to ±12%, E/n +13%; from two
+    // levels below the finest, ±2% and the full sampler's E/n).
+    const double nodes_per_tile = std::sqrt(nominal_[k] * 7.07 / o.peak_density);  // sampler.h, `resolution`
+    o.coarsest_grid =
+        std::max(o.coarsest_grid, static_cast<int>(nodes_per_tile * std::min(run.w, run.h) / 4));
+    o.threads = threads_;
+    o.seed = mix64(recipe_.seed ^ mix64(0x42414b45ull + 4096ull * k + r));  // "BAKE"
+    for (std::size_t i = 0; i < rank.fixed.size(); i += 2)
+      o.fixed_points.insert(o.fixed_points.end(), {rank.fixed[i] / run.w, rank.fixed[i + 1] / run.h});
+    for (std::size_t i = 0; i < rank.timed.size(); i += 2)
+      o.fixed_points.insert(o.fixed_points.end(), {rank.timed[i] / run.w, rank.timed[i + 1] / run.h});
+    const SampleResult result = sample(o);
+
+    // The new points by the patch they fall in; only patches of this run's stage not made before.
+    LevelPatches& level = levels_[k];
+    std::map<std::pair<int, std::size_t>, std::vector<std::pair<double, double>>> found;  // -> torus xy
+    std::map<std::pair<int, std::size_t>, std::vector<std::pair<double, double>>> relative;
+    std::map<std::pair<int, std::size_t>, std::pair<std::int64_t, std::int64_t>> anchors;
+    for (std::size_t i = 0; i < result.size(); ++i) {
+      const double x = result.points[2 * i] * run.w, y = result.points[2 * i + 1] * run.h;
+      Placement p;
+      const auto stage_kind = static_cast<PatchKind>(run.stage);
+      if (!place_new_point(x, y, stage_kind, widths_[k], col, p) || level.of(p.kind)[p.patch].done) continue;
+      const int kind = static_cast<int>(p.kind);
+      // A patch can appear at two anchors of a small torus (e.g. both interiors of one tile type): keep
+      // the first anchor's copy only.
+      const std::pair<std::int64_t, std::int64_t> at{(p.anchor_x % run.w + run.w) % run.w,
+                                                     (p.anchor_y % run.h + run.h) % run.h};
+      if (anchors.try_emplace({kind, p.patch}, at).first->second != at) continue;
+      found[{kind, p.patch}].push_back({x, y});
+      relative[{kind, p.patch}].push_back({p.rx, p.ry});
+    }
+    rank.filter_width = kFilterWidth / std::sqrt(k ? nominal_[k - 1] : nominal_[0] / 4.0);
+    rank.filter_width_end = kFilterWidth / std::sqrt(double(nominal_[k]));
+    for (const auto& [id, points] : found) {
+      rank.candidates.clear();
+      for (const auto& [x, y] : points) rank.candidates.insert(rank.candidates.end(), {x, y});
+      const std::vector<std::uint32_t> order = progressive_order(rank);
+      Patch& patch = level.of(static_cast<PatchKind>(id.first))[id.second];
+      const auto& rel = relative[id];
+      for (std::size_t s = 0; s < order.size(); ++s)
+        patch.add(rel[order[s]].first, rel[order[s]].second, rank_key(s, order.size()));
+    }
+    for (const auto& [id, points] : found) level.of(static_cast<PatchKind>(id.first))[id.second].done = true;
+  }
+
+  /// Every tile (sw, se, ne, nw): its share of the patches around it, level by level, sorted by key.
+  TileSet assemble() const {
+    TileSet set;
+    set.colours = recipe_.colours;
+    set.levels = recipe_.levels;
+    set.level_nominal = nominal_;
+    set.recipe = recipe_.to_text();
+    set.generator_version = version_string();
+    const std::size_t count = std::size_t(set.colours) * set.colours * set.colours * set.colours;
+    for (std::size_t t = 0; t < count; ++t) {
+      const Colouring col = Colouring::around_tile(set.colours, t);
+      Tile tile;
+      for (const LevelPatches& level : levels_) {
+        std::vector<double> xy;
+        std::vector<std::uint16_t> keys;
+        gather(level, col, {true, true, true, true}, 0, 0, 1, 1, xy, &keys);
+        std::vector<std::size_t> order(keys.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        const auto point = [&](std::size_t i) { return TilePoint::from_unit(xy[2 * i], xy[2 * i + 1]); };
+        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+          const TilePoint pa = point(a), pb = point(b);
+          return std::tie(keys[a], pa.y, pa.x) < std::tie(keys[b], pb.y, pb.x);
+        });
+        for (std::size_t i : order) {
+          tile.points.push_back(point(i));
+          tile.keys.push_back(keys[i]);
+        }
+        tile.level_end.push_back(static_cast<std::uint32_t>(tile.points.size()));
+      }
+      set.tiles.push_back(std::move(tile));
+    }
+    return set;
+  }
+
+  const BakeRecipe& recipe_;
+  int threads_;
+  const std::function<void(double)>& progress_;
+  std::vector<std::uint32_t> nominal_;
+  std::vector<PatchWidths> widths_;
+  std::vector<Run> runs_;
+  std::vector<LevelPatches> levels_;
+  double total_work_ = 0, done_work_ = 0;
+};
+
+}  // namespace
+
+TileSet bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
+  return Baker(recipe, threads, progress).bake();
 }
 
 }  // namespace kdm::gen

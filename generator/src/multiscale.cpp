@@ -290,14 +290,15 @@ struct Driver {
     typename Chain<D>::Scratch scratch;
     if (level == 0)
       for (const auto& p : fixed) chain.splat(p, 1.0f, scratch);
-    const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1;
+    const bool relaxing = !options.initial_points.empty();
+    const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1 && !relaxing;
     if (coarsest) {
       initial_configuration(chain);
       if (options.n > 0) fix_count_coarse(chain);
     } else {
       for (const auto& p : particles) chain.splat(p, 1.0f, scratch);
     }
-    if (!coarsest && options.n > 0) fix_count_level(chain, level);
+    if (!coarsest && !relaxing && options.n > 0) fix_count_level(chain, level);
 
     // Freeze wide kernels; bound the rest (a support constraint that keeps footprints small).
     double widest_active = 0;
@@ -350,9 +351,21 @@ struct Driver {
           (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
           std::ldexp(1.0, -D * l);
     prepare_fixed_points();
-    for (int l = levels - 1; l >= 0; --l) {
-      if (l < levels - 1) refine(l);
-      relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);
+    if (!options.initial_points.empty()) {  // relaxation: the finest level only, from the given points
+      const Grid<D>& g = setup.levels.front().grid;
+      for (std::size_t j = 0; j < options.initial_points.size() / D; ++j) {
+        Particle<D> p;
+        for (int k = 0; k < D; ++k) p.x[k] = options.initial_points[j * D + k] * g.dims[k];
+        g.canonical(p.x);
+        particles.push_back(p);
+      }
+      total_sweeps = options.burn_in_sweeps + options.sweeps;
+      relax_level(0, options.sweeps);
+    } else {
+      for (int l = levels - 1; l >= 0; --l) {
+        if (l < levels - 1) refine(l);
+        relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);
+      }
     }
     report.model_temperature = params.temperature;
     SampleResult result;

@@ -39,6 +39,17 @@ double energy_dim(const SamplerOptions& options, const Density& density, const s
 }  // namespace
 
 SampleResult sample(const SamplerOptions& options, const Density& density) {
+  if (!options.initial_points.empty()) {
+    if (options.dim != 2 && options.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
+    if (options.initial_points.size() % options.dim != 0)
+      throw InvalidArgument("initial points: coordinate count is not a multiple of the dimension");
+    for (double u : options.initial_points)
+      if (!(u >= 0 && u < 1)) throw InvalidArgument("initial points must lie in [0, 1) on every axis");
+    SamplerOptions o = options;
+    o.n = static_cast<std::int64_t>(options.initial_points.size() / options.dim);
+    validate_options(o);
+    return o.dim == 2 ? sample_dim<2>(o, density) : sample_dim<3>(o, density);
+  }
   validate_options(options);
   return options.dim == 2 ? sample_dim<2>(options, density) : sample_dim<3>(options, density);
 }

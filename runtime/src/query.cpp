@@ -32,9 +32,16 @@ double sanitize(double v) {
 
 void Tileset::adopt(TileSet&& set) {
   set_ = std::move(set);
-  // A tile's top level bounds the density it can serve; every tile must reach it, or some would thin out.
-  max_points_ = set_.tiles.empty() ? 0 : set_.tiles.front().level_end.back();
-  for (const Tile& t : set_.tiles) max_points_ = std::min(max_points_, t.level_end.back());
+  // Thresholds once per load, so the query loop compares instead of interpolating.
+  thresholds_.assign(set_.tiles.size(), {});
+  for (std::size_t t = 0; t < set_.tiles.size(); ++t) {
+    const Tile& tile = set_.tiles[t];
+    std::vector<float>& out = thresholds_[t];
+    out.resize(tile.points.size());
+    for (std::uint32_t k = 0, i = 0; k < set_.levels; ++k)
+      for (; i < tile.level_end[k]; ++i)
+        out[i] = static_cast<float>(set_.emission_threshold(k, tile.keys[i]));
+  }
 }
 
 Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
@@ -53,11 +60,11 @@ Status Tileset::load_file(const std::string& path, Tileset& out, std::string* de
   return s;
 }
 
-const Tile& Tileset::tile_at(std::int64_t tx, std::int64_t ty) const {
+std::size_t Tileset::tile_index_at(std::int64_t tx, std::int64_t ty) const {
   const std::uint32_t c = set_.colours;
-  if (c == 1) return set_.tiles.front();
-  return set_.tiles[set_.tile_index(vertex_colour(tx, ty, c), vertex_colour(tx + 1, ty, c),
-                                    vertex_colour(tx + 1, ty + 1, c), vertex_colour(tx, ty + 1, c))];
+  if (c == 1) return 0;
+  return set_.tile_index(vertex_colour(tx, ty, c), vertex_colour(tx + 1, ty, c),
+                         vertex_colour(tx + 1, ty + 1, c), vertex_colour(tx, ty + 1, c));
 }
 
 namespace {
@@ -158,7 +165,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!(max_density * area_scale <= tileset.max_points_per_tile() + 0.5)) return Status::kInvalidArgument;
   const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
   const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
-  if (!(max_density * area_scale > 0.5)) {  // no tile can emit even its first point
+  if (!(max_density * area_scale > 0)) {  // no tile can emit even its first point
     cursor->finished = true;
     return Status::kOk;
   }
@@ -174,14 +181,18 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   for (std::int64_t ty = cursor->tile_y; ty < ty1; ++ty) {
     const double wy = double(ty) * S;
     for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
-      const Tile& tile = tileset.tile_at(tx, ty);
+      const std::size_t index = tileset.tile_index_at(tx, ty);
+      const Tile& tile = tileset.data().tiles[index];
+      const float* thresholds = tileset.thresholds(index);
       const double wx = double(tx) * S;
       double bound = max_density;
       if (d.kind == QueryDensity::Kind::kImage) bound = d.image->max_over(wx, wy, wx + S, wy + S);
-      // Ranks c with c + 1/2 < bound · A · scale can be emitted; none beyond.
-      const double limit = bound * area_scale - 0.5;
+      // Thresholds are sorted: the points below bound · A · scale are a prefix; none beyond can be emitted.
+      const double limit = bound * area_scale;
       const std::uint32_t candidates =
-          limit <= 0 ? 0 : static_cast<std::uint32_t>(std::min<double>(tile.points.size(), std::ceil(limit)));
+          static_cast<std::uint32_t>(std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
+                                                      [](float t, double l) { return double(t) < l; }) -
+                                     thresholds);
       std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
       for (; c < candidates; ++c) {
         if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
@@ -195,7 +206,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         if (d.kind != QueryDensity::Kind::kConstant) {
           const double rho =
               d.kind == QueryDensity::Kind::kImage ? sampler.at(x, y) : sanitize(d.callback(d.user, x, y));
-          if (!(rho * area_scale > c + 0.5)) continue;
+          if (!(rho * area_scale > thresholds[c])) continue;
         }
         if (n == capacity) {
           *cursor = QueryCursor{tx, ty, c, true, false};

@@ -90,6 +90,7 @@ std::vector<std::uint8_t> serialize_body(const TileSet& set) {
   {
     cereal::PortableBinaryOutputArchive ar(stream);
     ar(set.colours, set.levels, static_cast<std::uint32_t>(set.tiles.size()));
+    save_array(ar, set.level_nominal);
     std::vector<std::uint16_t> xy;
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
@@ -97,6 +98,7 @@ std::vector<std::uint8_t> serialize_body(const TileSet& set) {
       for (std::size_t i = 0; i < tile.points.size(); ++i)
         xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
       save_array(ar, xy);
+      save_array(ar, tile.keys);
     }
   }
   const std::string bytes = stream.str();
@@ -109,8 +111,9 @@ void parse_body(const std::vector<char>& body, TileSet& set) {
   InputArchive ar(stream);
   std::uint32_t tile_count = 0;
   ar(set.colours, set.levels, tile_count);
-  // Every tile takes at least two size tags (8 bytes each), which bounds the count by the bytes left.
-  if (tile_count > buffer.remaining() / 16) throw ContentError("tile count exceeds the payload");
+  load_array(ar, buffer, set.level_nominal);
+  // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
+  if (tile_count > buffer.remaining() / 24) throw ContentError("tile count exceeds the payload");
   set.tiles.resize(tile_count);
   std::vector<std::uint16_t> xy;
   for (Tile& tile : set.tiles) {
@@ -119,6 +122,7 @@ void parse_body(const std::vector<char>& body, TileSet& set) {
     if (xy.size() % 2) throw ContentError("a tile has an odd number of coordinates");
     tile.points.resize(xy.size() / 2);
     for (std::size_t i = 0; i < tile.points.size(); ++i) tile.points[i] = {xy[2 * i], xy[2 * i + 1]};
+    load_array(ar, buffer, tile.keys);
   }
   if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
 }
@@ -165,6 +169,10 @@ Status validate_tileset(const TileSet& set, std::string* detail) {
   if (set.levels < 1 || set.levels > kMaxTileLevels)
     return bad("level count " + std::to_string(set.levels) + " is outside 1.." +
                std::to_string(kMaxTileLevels));
+  if (set.level_nominal.size() != set.levels) return bad("the nominal level table has a wrong size");
+  for (std::size_t k = 0; k < set.level_nominal.size(); ++k)
+    if (set.level_nominal[k] <= (k ? set.level_nominal[k - 1] : 0u))
+      return bad("nominal level counts are not strictly increasing");
   const std::size_t expected = std::size_t(set.colours) * set.colours * set.colours * set.colours;
   if (set.tiles.size() != expected)
     return bad("expected " + std::to_string(expected) + " tiles, found " + std::to_string(set.tiles.size()));
@@ -177,6 +185,13 @@ Status validate_tileset(const TileSet& set, std::string* detail) {
         return bad("tile " + std::to_string(t) + " has a decreasing level table");
     if (tile.level_end.back() != tile.points.size())
       return bad("tile " + std::to_string(t) + "'s level table does not end at its point count");
+    if (tile.keys.size() != tile.points.size())
+      return bad("tile " + std::to_string(t) + " has " + std::to_string(tile.keys.size()) + " keys for " +
+                 std::to_string(tile.points.size()) + " points");
+    for (std::uint32_t k = 0; k < set.levels; ++k)
+      for (std::uint32_t i = (k ? tile.level_end[k - 1] : 0) + 1; i < tile.level_end[k]; ++i)
+        if (tile.keys[i] < tile.keys[i - 1])
+          return bad("tile " + std::to_string(t) + " has unsorted keys in level " + std::to_string(k));
   }
   return Status::kOk;
 }

@@ -172,6 +172,21 @@ TEST(Tiling, SeamClassification) {
   EXPECT_NEAR(s.interior.davg, 0.02 / hex_spacing(6), 1e-9);
 }
 
+TEST(Tiling, OneSidedKolmogorovSmirnovAsksOnlyWhetherTheFirstIsSmaller) {
+  std::mt19937_64 rng(15);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<double> a, b, smaller, larger;
+  for (int i = 0; i < 2000; ++i)
+    a.push_back(g(rng)), b.push_back(g(rng)), smaller.push_back(g(rng) - 0.2), larger.push_back(g(rng) + 0.2);
+  EXPECT_GT(ks_smaller(a, b).p_value, 0.01);
+  EXPECT_LT(ks_smaller(smaller, b).p_value, 1e-6);
+  EXPECT_GT(ks_smaller(larger, b).p_value, 0.5);  // larger values are no evidence of "smaller"
+  EXPECT_DOUBLE_EQ(ks_smaller({1, 2, 3}, {4, 5, 6}).statistic, 1.0);
+  EXPECT_DOUBLE_EQ(ks_smaller({4, 5, 6}, {1, 2, 3}).statistic, 0.0);
+  // Smirnov's bound: D+ = 1 with m = 1.5 gives exp(-3).
+  EXPECT_NEAR(ks_smaller({1, 2, 3}, {4, 5, 6}).p_value, std::exp(-3.0), 1e-12);
+}
+
 TEST(Tiling, KolmogorovSmirnov) {
   EXPECT_DOUBLE_EQ(ks_two_sample({1, 2, 3}, {4, 5, 6}).statistic, 1.0);
   EXPECT_DOUBLE_EQ(ks_two_sample({1, 2, 3, 4}, {1, 2, 3, 4}).statistic, 0.0);

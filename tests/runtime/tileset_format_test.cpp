@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cereal/archives/portable_binary.hpp>
 #include <cstdio>
 #include <cstring>
@@ -24,10 +25,16 @@ TileSet make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::u
   set.recipe = "seed 1\ncolours 2\nlevels 3\n";
   set.generator_version = "test";
   set.tiles.resize(std::size_t(colours) * colours * colours * colours);
+  for (std::uint32_t k = 0; k < levels; ++k) set.level_nominal.push_back(12u << (2 * k));
   for (Tile& tile : set.tiles) {
     std::uint32_t count = 0;
     for (std::uint32_t k = 0; k < levels; ++k) {
-      count += 4 + rng() % 20;
+      const std::uint32_t added = 4 + rng() % 20;
+      std::vector<std::uint16_t> keys(added);
+      for (auto& key : keys) key = static_cast<std::uint16_t>(rng());
+      std::sort(keys.begin(), keys.end());
+      tile.keys.insert(tile.keys.end(), keys.begin(), keys.end());
+      count += added;
       tile.level_end.push_back(count);
     }
     for (std::uint32_t i = 0; i < count; ++i)
@@ -153,8 +160,12 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   const TileSet set = make_tileset(1, 2);  // one colour: a single tile
   const std::vector<std::uint8_t> file = encode(set);
   // An array that claims 2^40 elements: refused before any allocation.
-  const std::string huge = body_bytes([](auto& ar) {
+  const auto nominal = [](auto& ar) {
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+  };
+  const std::string huge = body_bytes([&](auto& ar) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    nominal(ar);
     ar(cereal::make_size_tag(cereal::size_type(1) << 40));
     for (int i = 0; i < 8; ++i) ar(std::uint64_t(0));  // some bytes, far fewer than claimed
   });
@@ -164,13 +175,37 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   EXPECT_NE(why.find("more than the payload"), std::string::npos) << "detail: " << why;
   // A level table that does not end at the point count.
-  const std::string inconsistent = body_bytes([](auto& ar) {
+  const std::string inconsistent = body_bytes([&](auto& ar) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    nominal(ar);
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(5));
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+    ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
   });
   bad = with_body(file, inconsistent);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  // Keys out of order within a level, and a nominal table that does not increase.
+  const std::string unsorted = body_bytes([&](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    nominal(ar);
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(3));
+    ar(cereal::make_size_tag(cereal::size_type(6)));
+    for (int i = 0; i < 6; ++i) ar(std::uint16_t(i));
+    ar(cereal::make_size_tag(cereal::size_type(3)), std::uint16_t(0), std::uint16_t(9), std::uint16_t(8));
+  });
+  bad = with_body(file, unsorted);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  EXPECT_NE(why.find("unsorted keys"), std::string::npos) << "detail: " << why;
+  const std::string flat = body_bytes([&](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(4));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+    ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+  });
+  bad = with_body(file, flat);
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  EXPECT_NE(why.find("nominal"), std::string::npos) << "detail: " << why;
   // A tile count that disagrees with the header.
   const std::string miscounted =
       body_bytes([](auto& ar) { ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(900)); });
@@ -197,6 +232,9 @@ TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
   EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
   set = make_tileset();
   set.colours = 17;
+  EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
+  set = make_tileset();
+  set.tiles[2].keys.pop_back();
   EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
 }
 

@@ -1,6 +1,7 @@
 // `kdm bake` and `kdm info`: baking tile sets from a recipe, and describing a tile-set file.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -47,7 +48,7 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   if (s != Status::kOk) throw CommandError(std::string(status_message(s)) + ": " + detail);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "kdm bake: %zu tile(s), %u levels, %u points per tile -> %s (%.1f s)\n",
-               set.tiles.size(), set.levels, set.tiles.front().level_end.back(), output.c_str(), seconds);
+               set.tiles.size(), set.levels, set.level_nominal.back(), output.c_str(), seconds);
 }
 
 void run_info(const std::string& path) {
@@ -60,11 +61,14 @@ void run_info(const std::string& path) {
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
   std::printf("levels         %u\n", set.levels);
   std::printf("points/level   ");
-  const Tile& first = set.tiles.front();
-  for (std::uint32_t k = 0; k < set.levels; ++k) std::printf("%s%u", k ? " " : "", first.level_end[k]);
-  std::printf("  (tile 0, cumulative)\n");
+  for (std::uint32_t k = 0; k < set.levels; ++k) std::printf("%s%u", k ? " " : "", set.level_nominal[k]);
+  std::printf("  (nominal per tile, cumulative)\n");
+  std::uint32_t fewest = ~0u, most = 0;
+  for (const Tile& t : set.tiles)
+    fewest = std::min(fewest, t.level_end.back()), most = std::max(most, t.level_end.back());
+  std::printf("points/tile    %u to %u (top level, actual)\n", fewest, most);
   std::printf("density range  1 : %.0f (level 0 to level %u)\n",
-              double(first.level_end.back()) / std::max(1u, first.level_end.front()), set.levels - 1);
+              double(set.level_nominal.back()) / set.level_nominal.front(), set.levels - 1);
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());
@@ -80,7 +84,7 @@ void add_tile_commands(CLI::App& app) {
       app.add_subcommand("bake", "Bake a tile set from a recipe (deterministic for any --threads)");
   bake->add_option("recipe", *recipe,
                    "Recipe file: 'key value' lines (seed, colours, levels, base_points, "
-                   "temperature, sweeps)")
+                   "temperature, sweeps, band, erosion)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   bake->add_option("--threads", *threads, "Worker threads (0 = all); the file does not depend on it")

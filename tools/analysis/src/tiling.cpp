@@ -73,6 +73,25 @@ KsResult ks_two_sample(std::vector<double> a, std::vector<double> b) {
   return r;
 }
 
+KsResult ks_smaller(std::vector<double> a, std::vector<double> b) {
+  KsResult r;
+  if (a.empty() || b.empty()) return r;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
+  std::size_t i = 0, j = 0;
+  double d = 0;
+  while (i < a.size() && j < b.size()) {
+    const double v = std::min(a[i], b[j]);
+    while (i < a.size() && a[i] <= v) ++i;
+    while (j < b.size() && b[j] <= v) ++j;
+    d = std::max(d, static_cast<double>(i) / na - static_cast<double>(j) / nb);
+  }
+  r.statistic = d;
+  r.p_value = std::min(1.0, std::exp(-2.0 * na * nb / (na + nb) * d * d));
+  return r;
+}
+
 void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbors& nn, double tile_size,
                    std::vector<double>& seam, std::vector<double>& interior) {
   const int t = tiles_per_axis(tile_size);

@@ -1,15 +1,27 @@
-// Baking tile sets (DESIGN.md §3): every tile is a toroidal multi-density pyramid sampled by the full KDM
-// sampler with constrained sampling — level k+1 keeps all of level k fixed and adds 3× as many points —
-// and the new points of each level are put in a progressive order (void-and-cluster ranking against the
-// points of earlier levels), so any prefix is itself well spread, down to low frequencies.
+// Baking tile sets (DESIGN.md §3): aperiodic corner tiles (Lagae & Dutré 2006) holding a nested
+// multi-density pyramid, every patch sampled by the full KDM sampler with everything it touches fixed.
 //
-// Status: one corner colour (a single periodic tile). Aperiodic corner tiles (colours > 1) are planned.
+// Per level k (N_k = base_points·4^k points per tile), with all of levels < k fixed:
+//  1. corner patches, one per colour, each from a run on the 1×1 torus of the tile whose corners all have
+//     that colour;
+//  2. horizontal edge patches, one per ordered colour pair, from runs on 1×1 and 2×1 tori, with the
+//     level's corner patches fixed; then vertical ones (1×1 and 1×2 tori) with the horizontal ones fixed
+//     too, since the two touch diagonally at the corner patches' corners;
+//  3. interiors, one per tile, from runs on the 2×2 torus around the tile, with corners and edges fixed.
+// Each run samples the whole torus and keeps only the patches it is for: the rest is context that is
+// sampled and dropped, so each patch is drawn from P(patch | what it touches) of the full model.
+// The new points of every patch are then ranked by void-and-cluster against the points present by then
+// (earlier levels, and the level's earlier patches up to the same fraction of their own ranking), and the
+// fraction becomes the point's emission key (kdm/runtime/tileset.h): any density between two levels
+// emits the same prefix of a shared patch in every tile.
+//
 // Thread safety: bake_tileset is reentrant; it uses up to `threads` threads of its own.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "kdm/runtime/tileset.h"
 
@@ -20,14 +32,17 @@ namespace kdm::gen {
 /// the same bytes, for any thread count.
 struct BakeRecipe {
   std::uint64_t seed = 1;
-  std::uint32_t colours = 1;       ///< corner colours (only 1 for now)
-  std::uint32_t levels = 6;        ///< pyramid levels; level k holds base_points·4^k points
-  std::uint32_t base_points = 16;  ///< points of level 0 per tile
+  std::uint32_t colours = 2;       ///< corner colours C: C^4 tiles
+  std::uint32_t levels = 6;        ///< pyramid levels; level k holds base_points·4^k points per tile
+  std::uint32_t base_points = 32;  ///< points of level 0 per tile
   double temperature = 0.5;        ///< user-facing temperature, as in kdm sample
   int sweeps = 100;                ///< MH sweeps per sampler level (constrained sampling needs more than 15)
+  double band = 0.35;              ///< half-width of level 0's corner and edge patches, in tile sides
+  /// How much each finer level's patches shrink, in that level's point spacings (corner_layout.h).
+  double erosion = 1.5;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
-  /// out-of-range count).
+  /// out-of-range count, patches that erode away).
   static BakeRecipe parse(const std::string& text);
   /// The canonical text form (parse(to_text()) == *this).
   std::string to_text() const;
@@ -36,6 +51,8 @@ struct BakeRecipe {
   /// closer to equilibrium. The generator test draws its reference runs with the same schedule.
   int sweeps_for(std::uint64_t level_points) const;
   std::uint64_t top_level_points() const { return std::uint64_t(base_points) << (2 * (levels - 1)); }
+  /// N_k for every level: the tile set's level_nominal.
+  std::vector<std::uint32_t> nominal_counts() const;
 };
 
 /// Bakes `recipe`. `progress` (optional) receives the fraction done. Throws InvalidArgument on a bad
@@ -43,10 +60,23 @@ struct BakeRecipe {
 TileSet bake_tileset(const BakeRecipe& recipe, int threads = 0,
                      const std::function<void(double)>& progress = {});
 
-/// The progressive order of `new_points` (interleaved x y on the unit torus) given `fixed` points that
-/// come first: returns indices into new_points, first = rank 0: each next point sits in the deepest void
-/// of a Gaussian-filtered density of everything present. O(n²) time; n up to a few tens of thousands.
-std::vector<std::uint32_t> progressive_order(const std::vector<double>& new_points,
-                                             const std::vector<double>& fixed);
+/// Input of progressive_order: positions in tile units on a width × height torus.
+struct RankingInput {
+  double width = 1, height = 1;
+  std::vector<double> candidates;         ///< x y pairs to rank
+  std::vector<double> fixed;              ///< present from the start
+  std::vector<double> timed;              ///< present once the ranking reaches their key:
+  std::vector<std::uint16_t> timed_keys;  ///< before candidate s of n is chosen, keys < rank_key(s, n)
+  double filter_width = 0.1;              ///< σ of the Gaussian filter at the first pick, tile units
+  double filter_width_end = 0;            ///< σ at the last pick (0: the same); 1/σ² moves linearly
+};
+
+/// The emission key of the s-th of n ranked points: floor((s + ½) / n · 65536).
+std::uint16_t rank_key(std::size_t s, std::size_t n);
+
+/// The progressive order of the candidates: indices, first = rank 0; each next one is the candidate in
+/// the deepest void of a Gaussian-filtered density of everything present. O(n log n) for a filter a few
+/// spacings wide. Deterministic.
+std::vector<std::uint32_t> progressive_order(const RankingInput& input);
 
 }  // namespace kdm::gen

@@ -74,6 +74,11 @@ struct SamplerOptions {
   /// background that never moves; the chain samples the n new points from P(new | fixed). The result
   /// holds only the new points. The density is scaled for n + fixed count points in all.
   std::vector<double> fixed_points;
+  /// Relaxation instead of sampling: when not empty, the free points start here (normalized coordinates,
+  /// dim per point; n is taken as their count) and only `burn_in_sweeps` descent and `sweeps` MH sweeps run
+  /// on the finest grid, with no multi-scale. The result keeps their order. For checking that a point set
+  /// already is an equilibrium sample (it then neither drifts nor drops in energy).
+  std::vector<double> initial_points;
   /// Called with (fraction done in [0,1]) between sweeps. Optional.
   std::function<void(double)> progress;
 };

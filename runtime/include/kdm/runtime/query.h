@@ -3,9 +3,10 @@
 // World space is tiled by squares of side `tile_size`; tile (tx, ty) covers [tx·S, (tx+1)·S) × [ty·S,
 // (ty+1)·S) and shows the set's tile chosen by the colours of its four corners (a hash of the corner's
 // integer coordinates, so any region is assembled locally). A tile's points are sorted by rank; point c of a
-// tile of area A is emitted iff ρ(x_c) · A · scale > c + ½ (DESIGN.md §4): density responds continuously,
-// raising the scale only adds points (zoom coherence), and every decision depends only on the point's
-// canonical tile coordinates, so query(A ∪ B) = query(A) ⊎ query(B) bit for bit.
+// tile of area A is emitted iff ρ(x_c) · A · scale > t_c, its emission threshold (tileset.h: about c + ½,
+// but equal for the points that neighbouring tiles share, so mid-level densities have no seams). Density
+// responds continuously, raising the scale only adds points (zoom coherence), and every decision depends
+// only on the point's canonical tile coordinates, so query(A ∪ B) = query(A) ⊎ query(B) bit for bit.
 //
 // Thread safety: a Tileset is immutable after loading; any number of threads may query it at once.
 // Queries allocate nothing, take no locks and touch no global state.
@@ -32,15 +33,21 @@ class Tileset {
 
   const TileSet& data() const { return set_; }
   bool empty() const { return set_.tiles.empty(); }
-  /// Most points a tile can emit (the top pyramid level): the density limit is this per tile area.
-  std::uint32_t max_points_per_tile() const { return max_points_; }
-  /// The set's tile for tile coordinates (tx, ty). Thread-safe.
-  const Tile& tile_at(std::int64_t tx, std::int64_t ty) const;
+  /// The expected points per tile at which every tile has emitted all its points (the nominal count of
+  /// the top pyramid level): the density limit is this per tile area.
+  std::uint32_t max_points_per_tile() const {
+    return set_.level_nominal.empty() ? 0 : set_.level_nominal.back();
+  }
+  /// Index into data().tiles of the tile shown at tile coordinates (tx, ty). Thread-safe.
+  std::size_t tile_index_at(std::int64_t tx, std::int64_t ty) const;
+  const Tile& tile_at(std::int64_t tx, std::int64_t ty) const { return set_.tiles[tile_index_at(tx, ty)]; }
+  /// Emission thresholds of tile `index`'s points (TileSet::emission_threshold), non-decreasing.
+  const float* thresholds(std::size_t index) const { return thresholds_[index].data(); }
 
  private:
   void adopt(TileSet&& set);
   TileSet set_;
-  std::uint32_t max_points_ = 0;
+  std::vector<std::vector<float>> thresholds_;
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).

@@ -1,7 +1,14 @@
 // kdm tile sets: the data model and the file format (defined here, once; the baker writes it through
-// this header). A tile set is a family of Wang-style corner tiles (Lagae & Dutré 2006): with C corner
-// colours there are C^4 toroidal tiles, each holding a nested multi-density pyramid of points sorted by
-// (level, rank), so any prefix of a tile's points is itself a blue-noise set.
+// this header). A tile set is a family of corner tiles (Lagae & Dutré 2006): with C corner colours there
+// are C^4 tiles, one per colouring (sw, se, ne, nw) of their corners; tiles whose shared corners have the
+// same colours fit together without seams. Each tile holds a nested multi-density pyramid: level k+1 holds
+// every point of level k plus about 3× as many new ones, sorted by (level, key).
+//
+// Emission keys: every point carries a key q in [0, 65536) within its level. Level k spans the nominal
+// counts (N_{k-1}, N_k] (level_nominal, N_{-1} = 0), and the point appears once the expected count of
+// points in its tile exceeds its threshold N_{k-1} + (q + 1/2) / 65536 · (N_k − N_{k-1})
+// (emission_threshold). Points that several tiles share near corners and edges have the same key in all of
+// them, so every tile emits the same subset of them at any density: mid-level densities stay seamless.
 //
 // File layout (all integers little-endian):
 //   offset  size  field
@@ -17,7 +24,8 @@
 //       48     4  recipe size;  52: generator version size;  56: reserved (0)
 //       60     4  CRC-32 of the whole header with this field read as zero
 //       64     …  recipe text, then generator version text
-//   header size … payload: zstd-compressed cereal portable-binary archive of the tiles
+//   header size … payload: zstd-compressed cereal portable-binary archive: colours, levels, tile count,
+//                  level_nominal, then per tile its level_end, x y pairs and keys
 // The file is exactly header size + payload size bytes long.
 //
 // Thread safety: every function here is reentrant; a TileSet is a plain value (share it read-only).
@@ -74,18 +82,23 @@ struct TilePoint {
 };
 
 struct Tile {
-  /// Sorted by (level, rank): the array index is the point's rank within the whole pyramid.
+  /// Sorted by (level, key): the array index is the point's rank within the whole pyramid.
   std::vector<TilePoint> points;
+  /// Emission key of each point within its level (see the top of this file); non-decreasing per level.
+  std::vector<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   std::vector<std::uint32_t> level_end;
   friend bool operator==(const Tile& a, const Tile& b) {
-    return a.points == b.points && a.level_end == b.level_end;
+    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end;
   }
 };
 
 struct TileSet {
-  std::uint32_t colours = 0;      ///< corner colours C; tiles.size() == C^4
-  std::uint32_t levels = 0;       ///< pyramid levels per tile
+  std::uint32_t colours = 0;  ///< corner colours C; tiles.size() == C^4
+  std::uint32_t levels = 0;   ///< pyramid levels per tile
+  /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
+  /// strictly increasing, positive. Emission thresholds are placed between these.
+  std::vector<std::uint32_t> level_nominal;
   std::vector<Tile> tiles;        ///< index tile_index(sw, se, ne, nw)
   std::string recipe;             ///< the recipe text that rebuilds this set exactly
   std::string generator_version;  ///< the kdm version that baked it
@@ -93,13 +106,19 @@ struct TileSet {
   std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
     return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
   }
+  /// The expected point count per tile above which a point of `level` with key `key` is emitted.
+  double emission_threshold(std::uint32_t level, std::uint16_t key) const {
+    const double lo = level == 0 ? 0.0 : level_nominal[level - 1], hi = level_nominal[level];
+    return lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo);
+  }
   friend bool operator==(const TileSet& a, const TileSet& b) {
-    return a.colours == b.colours && a.levels == b.levels && a.tiles == b.tiles && a.recipe == b.recipe &&
-           a.generator_version == b.generator_version;
+    return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
+           a.tiles == b.tiles && a.recipe == b.recipe && a.generator_version == b.generator_version;
   }
 };
 
-/// Checks the structural invariants above (colour and level caps, tile count, level tables).
+/// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
+/// counts, one key per point, keys sorted within each level).
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
 Status validate_tileset(const TileSet& set, std::string* detail = nullptr);
 

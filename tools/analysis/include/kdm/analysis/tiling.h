@@ -43,6 +43,12 @@ struct KsResult {
 /// KS test of samples `a` and `b` (any units). Empty input gives D = 0, p = 1. Thread-safe (pure).
 KsResult ks_two_sample(std::vector<double> a, std::vector<double> b);
 
+/// One-sided two-sample Kolmogorov–Smirnov test of "a tends to be smaller than b": D+ = sup (F_a − F_b),
+/// p ≈ exp(−2 m D+²) with m = n_a n_b / (n_a + n_b) (Smirnov's asymptotic bound). Seam defects shorten
+/// nearest-neighbour links, so this asks whether links across seams are shorter than elsewhere. Empty
+/// input gives D = 0, p = 1. Thread-safe (pure).
+KsResult ks_smaller(std::vector<double> a, std::vector<double> b);
+
 struct SeamStats {
   NNStats seam;      ///< NN links crossing a tile edge (normalised by the reference spacing)
   NNStats interior;  ///< NN links inside one tile
