@@ -42,6 +42,9 @@ void Tileset::adopt(TileSet&& set) {
       for (; i < tile.level_end[k]; ++i)
         out[i] = static_cast<float>(set_.emission_threshold(k, tile.keys[i]));
   }
+  min_threshold_ = HUGE_VAL;
+  for (const std::vector<float>& t : thresholds_)
+    if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
 }
 
 Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
@@ -165,7 +168,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!(max_density * area_scale <= tileset.max_points_per_tile() + 0.5)) return Status::kInvalidArgument;
   const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
   const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
-  if (!(max_density * area_scale > 0)) {  // no tile can emit even its first point
+  if (!(max_density * area_scale > tileset.min_threshold())) {  // no tile can emit even its first point
     cursor->finished = true;
     return Status::kOk;
   }

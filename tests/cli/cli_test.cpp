@@ -236,7 +236,7 @@ TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   const std::string bad = path("file") + "/sub";
   write_bytes(path("grey.png"), grey_png(2, 2, 8, {0, 64, 128, 192}));
   const std::string image = "'" + path("grey.png") + "'";
-  std::ofstream(path("r.recipe")) << "levels 2\nbase_points 8\nsweeps 2\n";
+  std::ofstream(path("r.recipe")) << "levels 2\nbase_points 32\nsweeps 2\n";
   const char* prefix = "cannot";  // "cannot write ...", "cannot create ..."
   expect_error("sample --n 50 -o '" + bad + ".txt'", prefix);
   expect_error("sample --n 50 -o '" + bad + ".png'", prefix);

@@ -25,14 +25,14 @@ std::vector<std::uint8_t> encoded(const TileSet& set) {
 
 TEST(BakeTest, RecipeRoundTripAndErrors) {
   const BakeRecipe r = BakeRecipe::parse(
-      "# comment\nseed 7\nlevels 3 # trailing\nbase_points 16\ntemperature 0.25\ncolours 3\nband 0.3\n"
+      "# comment\nseed 7\nlevels 3 # trailing\nbase_points 32\ntemperature 0.25\ncolours 3\nband 0.34\n"
       "erosion 1\n");
   EXPECT_EQ(r.seed, 7u);
   EXPECT_EQ(r.levels, 3u);
-  EXPECT_EQ(r.base_points, 16u);
+  EXPECT_EQ(r.base_points, 32u);
   EXPECT_EQ(r.colours, 3u);
   EXPECT_DOUBLE_EQ(r.temperature, 0.25);
-  EXPECT_DOUBLE_EQ(r.band, 0.3);
+  EXPECT_DOUBLE_EQ(r.band, 0.34);
   EXPECT_DOUBLE_EQ(r.erosion, 1.0);
   EXPECT_EQ(BakeRecipe::parse(r.to_text()).to_text(), r.to_text());
   EXPECT_THROW(BakeRecipe::parse("levels three\n"), InvalidArgument);
@@ -132,6 +132,10 @@ TEST(BakeTest, ShippedDefaultSetRebakesBitIdentically) {
   // Bit-identical output is promised per build configuration; the shipped file comes from a Release
   // build, and other flags (sanitizers, -O0) round floating point differently.
   GTEST_SKIP() << "the shipped tile set is reproduced by Release builds";
+#endif
+#ifndef KDM_SLOW_TESTS
+  // Baking the default set takes minutes: .ci/run rebakes it with `kdm bake` and compares the bytes.
+  GTEST_SKIP() << "configure with -DKDM_SLOW_TESTS=ON to rebake the shipped set here";
 #endif
   const std::string dir = std::string(KDM_SOURCE_DIR) + "/tilesets/";
   const BakeRecipe recipe = BakeRecipe::parse(read_file(dir + "default.recipe"));

@@ -16,5 +16,6 @@ int main() {
   o.n = 100;
   const std::size_t sampled = kdm::gen::sample(o).size();
   std::printf("runtime %zu points, sampler %zu points\n", n, sampled);
-  return s == kdm::Status::kOk && n == 1600 && sampled == 100 ? 0 : 1;
+  // 4×4 tiles at 100 points each: tiles hold their level's nominal count within a few percent.
+  return s == kdm::Status::kOk && n > 1540 && n < 1660 && sampled == 100 ? 0 : 1;
 }

@@ -43,11 +43,14 @@ class Tileset {
   const Tile& tile_at(std::int64_t tx, std::int64_t ty) const { return set_.tiles[tile_index_at(tx, ty)]; }
   /// Emission thresholds of tile `index`'s points (TileSet::emission_threshold), non-decreasing.
   const float* thresholds(std::size_t index) const { return thresholds_[index].data(); }
+  /// The lowest threshold of any point: below it no tile emits anything.
+  double min_threshold() const { return min_threshold_; }
 
  private:
   void adopt(TileSet&& set);
   TileSet set_;
   std::vector<std::vector<float>> thresholds_;
+  double min_threshold_ = 0;
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).
