@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -250,6 +251,37 @@ TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
   EXPECT_FALSE(partial.good());  // no temporary left behind
   std::remove(path.c_str());
   EXPECT_EQ(load_tileset(path, loaded), Status::kIoError);
+}
+
+}  // namespace
+}  // namespace kdm
+
+namespace kdm {
+namespace {
+
+// The shipped set itself: every cut within the header and the first 4 KiB of payload, then 2,000 cuts
+// spread over the rest, is refused as truncated; 300 random payload bit flips are caught by the checksum.
+TEST(TilesetFormatTest, TheShippedSetCutOrDamagedIsRejected) {
+  std::ifstream in(std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt", std::ios::binary);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 100000u);
+  ASSERT_EQ(decode(bytes, bytes.size()), Status::kOk);
+  const std::size_t header_size = get32(&bytes[12]);
+  for (std::size_t len = 0; len < header_size + 4096; ++len)
+    ASSERT_EQ(decode(bytes, len), Status::kTruncated) << "cut at " << len;
+  for (int i = 0; i < 2000; ++i) {
+    const std::size_t len = header_size + 4096 + (bytes.size() - header_size - 4096) * std::size_t(i) / 2000;
+    ASSERT_EQ(decode(bytes, len), Status::kTruncated) << "cut at " << len;
+  }
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> damaged = bytes;
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::size_t bit = header_size * 8 + rng() % ((bytes.size() - header_size) * 8);
+    damaged[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+    ASSERT_EQ(decode(damaged, damaged.size()), Status::kPayloadChecksumMismatch) << "bit " << bit;
+    damaged[bit / 8] = bytes[bit / 8];
+  }
 }
 
 }  // namespace
