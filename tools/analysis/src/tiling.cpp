@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "kdm/analysis/common.h"
 
@@ -44,20 +45,32 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
   return out;
 }
 
-KsResult ks_two_sample(std::vector<double> a, std::vector<double> b) {
-  KsResult r;
-  if (a.empty() || b.empty()) return r;
+namespace {
+
+/// Sorts both samples and walks their empirical CDFs: returns {sup (F_a − F_b), sup |F_a − F_b|}.
+std::pair<double, double> ecdf_gaps(std::vector<double>& a, std::vector<double>& b) {
   std::sort(a.begin(), a.end());
   std::sort(b.begin(), b.end());
   const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
   std::size_t i = 0, j = 0;
-  double d = 0;
+  double above = 0, both = 0;
   while (i < a.size() && j < b.size()) {
     const double v = std::min(a[i], b[j]);
     while (i < a.size() && a[i] <= v) ++i;  // step past ties in both samples together
     while (j < b.size() && b[j] <= v) ++j;
-    d = std::max(d, std::abs(static_cast<double>(i) / na - static_cast<double>(j) / nb));
+    const double d = static_cast<double>(i) / na - static_cast<double>(j) / nb;
+    above = std::max(above, d), both = std::max(both, std::abs(d));
   }
+  return {above, both};
+}
+
+}  // namespace
+
+KsResult ks_two_sample(std::vector<double> a, std::vector<double> b) {
+  KsResult r;
+  if (a.empty() || b.empty()) return r;
+  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
+  const double d = ecdf_gaps(a, b).second;
   r.statistic = d;
   const double m = std::sqrt(na * nb / (na + nb));
   const double lambda = (m + 0.12 + 0.11 / m) * d;
@@ -76,19 +89,9 @@ KsResult ks_two_sample(std::vector<double> a, std::vector<double> b) {
 KsResult ks_smaller(std::vector<double> a, std::vector<double> b) {
   KsResult r;
   if (a.empty() || b.empty()) return r;
-  std::sort(a.begin(), a.end());
-  std::sort(b.begin(), b.end());
   const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
-  std::size_t i = 0, j = 0;
-  double d = 0;
-  while (i < a.size() && j < b.size()) {
-    const double v = std::min(a[i], b[j]);
-    while (i < a.size() && a[i] <= v) ++i;
-    while (j < b.size() && b[j] <= v) ++j;
-    d = std::max(d, static_cast<double>(i) / na - static_cast<double>(j) / nb);
-  }
-  r.statistic = d;
-  r.p_value = std::min(1.0, std::exp(-2.0 * na * nb / (na + nb) * d * d));
+  r.statistic = ecdf_gaps(a, b).first;
+  r.p_value = std::min(1.0, std::exp(-2.0 * na * nb / (na + nb) * r.statistic * r.statistic));
   return r;
 }
 
