@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "corner_layout.h"
@@ -149,12 +151,41 @@ class Baker {
   }
 
   TileSet bake() {
+    const int workers =
+        threads_ > 0 ? threads_ : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
     for (std::uint32_t k = 0; k < recipe_.levels; ++k) {
       levels_.emplace_back(recipe_.colours);
-      for (std::size_t r = 0; r < runs_.size(); ++r) {
-        sample_run(k, r);
-        done_work_ += work(k, runs_[r]);
-        if (progress_) progress_(done_work_ / total_work_);
+      // The runs of one stage read only earlier stages: they sample concurrently (one thread each), and
+      // their patches are kept in run order, so the result is the same for any thread count.
+      for (std::size_t first = 0; first < runs_.size();) {
+        std::size_t last = first;
+        while (last < runs_.size() && runs_[last].stage == runs_[first].stage &&
+               last - first < static_cast<std::size_t>(workers))
+          ++last;
+        std::vector<Sampled> batch(last - first);
+        if (batch.size() == 1) {
+          batch[0] = sample_run(k, first, threads_);
+        } else {
+          std::vector<std::exception_ptr> errors(batch.size());
+          std::vector<std::thread> pool;
+          for (std::size_t i = 0; i < batch.size(); ++i)
+            pool.emplace_back([&, i] {
+              try {
+                batch[i] = sample_run(k, first + i, 1);
+              } catch (...) {
+                errors[i] = std::current_exception();
+              }
+            });
+          for (std::thread& t : pool) t.join();
+          for (const std::exception_ptr& e : errors)
+            if (e) std::rethrow_exception(e);
+        }
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+          keep_patches(k, first + i, batch[i]);
+          done_work_ += work(k, runs_[first + i]);
+          if (progress_) progress_(done_work_ / total_work_);
+        }
+        first = last;
       }
     }
     return assemble();
@@ -165,10 +196,17 @@ class Baker {
     return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
   }
 
-  /// Samples run `r` of level k and keeps (ranks) the patches of its stage that no earlier run made.
-  void sample_run(std::uint32_t k, std::size_t r) {
+  /// A sampled run: its torus, the points it conditioned on and what it drew.
+  struct Sampled {
+    Colouring col;
+    RankingInput rank;
+    SampleResult result;
+  };
+
+  /// Samples run `r` of level k (reads earlier levels and stages only; safe to call concurrently).
+  Sampled sample_run(std::uint32_t k, std::size_t r, int threads) const {
     const Run& run = runs_[r];
-    const Colouring col = Colouring::torus(recipe_.colours, run.w, run.h, run.grid);
+    Colouring col = Colouring::torus(recipe_.colours, run.w, run.h, run.grid);
     // Context: every earlier level, and this level's patches of earlier stages (with their keys).
     RankingInput rank;
     rank.width = run.w, rank.height = run.h;
@@ -193,14 +231,21 @@ class Baker {
     const double nodes_per_tile = std::sqrt(nominal_[k] * 7.07 / o.peak_density);  // sampler.h, `resolution`
     o.coarsest_grid =
         std::max(o.coarsest_grid, static_cast<int>(nodes_per_tile * std::min(run.w, run.h) / 4));
-    o.threads = threads_;
+    o.threads = threads;
     o.seed = mix64(recipe_.seed ^ mix64(0x42414b45ull + 4096ull * k + r));  // "BAKE"
     for (std::size_t i = 0; i < rank.fixed.size(); i += 2)
       o.fixed_points.insert(o.fixed_points.end(), {rank.fixed[i] / run.w, rank.fixed[i + 1] / run.h});
     for (std::size_t i = 0; i < rank.timed.size(); i += 2)
       o.fixed_points.insert(o.fixed_points.end(), {rank.timed[i] / run.w, rank.timed[i + 1] / run.h});
-    const SampleResult result = sample(o);
+    return {col, std::move(rank), sample(o)};
+  }
 
+  /// Keeps (and ranks) the patches of run `r`'s stage that no earlier run made.
+  void keep_patches(std::uint32_t k, std::size_t r, Sampled& sampled) {
+    const Run& run = runs_[r];
+    const Colouring& col = sampled.col;
+    RankingInput& rank = sampled.rank;
+    const SampleResult& result = sampled.result;
     // The new points by the patch they fall in; only patches of this run's stage not made before.
     LevelPatches& level = levels_[k];
     std::map<std::pair<int, std::size_t>, std::vector<std::pair<double, double>>> found;  // -> torus xy
