@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "image_io.h"
+#include "kdm/runtime/tileset.h"
 #include "kdm/runtime/version.h"
 #include "point_io.h"
 
@@ -253,6 +254,34 @@ TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   expect_error("sample --n 50 -o '" + path("dir.txt") + "'", "dir.txt");
 }
 
+// kdm verify: a table per level on stdout; exit 0 when every check passes, else a one-line error. One level
+// and two reference runs keep it short; the generator test runs the whole thing on the shipped set.
+TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
+  const std::string shipped = std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt";
+  const std::string quick = " --level 2 --runs 2 --no-seams";
+  const Outcome good = kdm("verify '" + shipped + "'" + quick);
+  EXPECT_EQ(good.status, 0) << good.out << good.err;
+  EXPECT_NE(good.out.find("level 2, 512 points per tile"), std::string::npos) << good.out;
+  EXPECT_NE(good.out.find("checks passed"), std::string::npos) << good.out;
+
+  kdm::TileSet set;
+  ASSERT_EQ(kdm::load_tileset(shipped, set), kdm::Status::kOk);
+  kdm::Tile& tile = set.tiles[3];
+  for (std::uint32_t i = tile.level_end[1], j = 0; i < tile.level_end[2]; ++i, ++j)  // a clump in a corner
+    tile.points[i] = kdm::TilePoint::from_unit(0.1 + 0.001 * (j % 37), 0.1 + 0.001 * (j / 37));
+  ASSERT_EQ(kdm::save_tileset(set, path("bad.kdmt")), kdm::Status::kOk);
+  const Outcome bad = kdm("verify '" + path("bad.kdmt") + "'" + quick);
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_EQ(bad.err.rfind("kdm: error: ", 0), 0u) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  EXPECT_NE(bad.err.find("failed"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.out.find("FAIL tile 3 level 2"), std::string::npos) << bad.out;
+
+  expect_error("verify '" + path("missing.kdmt") + "'", "missing.kdmt");
+  expect_error("verify '" + shipped + "' --level 9", "level 9");
+  expect_error("verify '" + shipped + "' --runs 1", "runs");
+}
+
 TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   const std::string out = " -o '" + path("x.txt") + "'";
   expect_error("", "subcommand");
@@ -276,7 +305,7 @@ TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
 }
 
 TEST_F(CliTest, HelpDescribesEveryOption) {
-  for (const char* sub : {"", "sample", "stipple", "query", "analyze", "bake", "info"}) {
+  for (const char* sub : {"", "sample", "stipple", "query", "analyze", "bake", "info", "verify"}) {
     const Outcome r = kdm(std::string(sub) + " --help");
     EXPECT_EQ(r.status, 0) << sub;
     // CLI11 prints "  --name TYPE  description"; an option without a description ends its line at the type.

@@ -17,6 +17,7 @@ struct CommandError : std::runtime_error {
 
 void add_sample_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
+void add_verify_command(CLI::App& app);
 void add_tile_commands(CLI::App& app);  // bake, info
 void add_stipple_command(CLI::App& app);
 void add_query_command(CLI::App& app);

@@ -17,9 +17,8 @@ int main(int argc, char** argv) {
   kdm::cli::add_stipple_command(app);
   kdm::cli::add_query_command(app);
   kdm::cli::add_tile_commands(app);
-#ifdef KDM_HAVE_ANALYZE
   kdm::cli::add_analyze_command(app);
-#endif
+  kdm::cli::add_verify_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

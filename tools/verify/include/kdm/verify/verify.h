@@ -1,0 +1,132 @@
+// The generator test as a library: every tile and level of a baked tile set judged directly against the
+// full KDM sampler (DESIGN.md §5; the tile-baking issue's "generator test"). `kdm verify` prints its report;
+// tests/generator/generator_test.cpp asserts it on the shipped set.
+//
+// Corner tiles are not periodic one by one, so each tile is judged among neighbours: on the 2×2 torus of
+// tiles whose tile (0, 0) it is (every tile has one, and its three other tiles are valid neighbours), with
+// the points the runtime would emit there at an expected count D per tile (kdm/runtime/tileset.h).
+//  1. Statistics, per tile and level, against R unconstrained full-sampler runs with the level's nominal
+//     density and the recipe's temperature (default options otherwise: what a user of `kdm sample` gets):
+//     E/n, δavg, NN1%, lowP and RAPS in bands of 0.25 over 0.5 ≤ f < 2. The runs sample the same 2×2 torus
+//     for levels of up to 2048 points per tile, where E/n still depends on the count (measured: .51 at 32
+//     points, .54 from 2048 on), and the unit torus above, to save time; every metric is per point or
+//     normalised by d_hex, so from there on the two compare.
+//  2. The direct check: the tile's points freed among its fixed neighbours for 15 MH sweeps. An
+//     equilibrium sample loses no energy, and its points move no more than a full-sampler set's do.
+//  3. Seams, at every complete level and at the quarters between levels: per tile, the δmin of links
+//     (nearest-neighbour pairs) crossing a tile edge against that of its other links; pooled over the
+//     tiles, edge links against links crossing the lines halfway between tile edges (one-sided KS D+).
+//  4. Between levels (rank prefixes): lowP per tile.
+// Spectra cost O(n · f²): tori above `spectrum_budget` points skip lowP and RAPS (reported as NaN).
+//
+// Thread safety: verify_tileset is reentrant (no shared state); it uses up to `threads` threads.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/tileset.h"
+
+namespace kdm::verify {
+
+/// The pass marks. Defaults are the tile-baking issue's, except where a comment says why (verify.cpp has
+/// the measurements behind each).
+struct Bars {
+  double energy = 1.05;  ///< E/n ≤ energy × reference mean
+  double davg = 0.015;   ///< δavg ≥ reference mean − davg
+  double nn1 = 0.85;     ///< NN1% ≥ nn1 × reference mean
+  /// lowP ≤ low_p × reference mean where the torus has ≥ 100 frequencies below f = 0.5; fewer average
+  /// too few (exponentially distributed) values, so there lowP ≤ low_p_of_largest × the largest run's.
+  double low_p = 1.5, low_p_of_largest = 1.0;
+  double raps = 0.1;  ///< |RAPS − reference| per band, or 4 standard deviations of a band mean if wider
+  double raps_min_points = 4096;  ///< levels below this many points per tile skip RAPS (see verify.cpp)
+  /// Levels whose tiles are less than this many point spacings wide get the small-tile bars below.
+  double small_tile_spacings = 16;
+  double small_energy = 1.20, small_low_p = 3.0, small_low_p_of_largest = 3.0, small_nn1 = 0.80;
+  double energy_drop = 0.03;  ///< direct check: 1 − E_after / E_before ≤ this (small tiles: the next)
+  double small_energy_drop = 0.06;
+  double drift = 1.25;       ///< direct check: mean drift ≤ drift × a full-sampler set's
+  double edge_dmin = 0.9;    ///< per tile: δmin of edge links ≥ edge_dmin × δmin of the other links
+  double ks_d_plus = 0.1;    ///< pooled edge vs midline links: one-sided KS D+ ≤ this
+  double mid_low_p = 0.105;  ///< between levels: lowP ≤ this, on tori of at least mid_low_p_min_points
+  double mid_low_p_min_points = 1792;
+};
+
+struct VerifyOptions {
+  int reference_runs = 16;              ///< full-sampler runs per level (≥ 2)
+  std::size_t spectrum_budget = 40000;  ///< largest torus (points) whose spectra are computed
+  std::vector<std::uint32_t> levels;    ///< levels to judge (statistics, direct check); empty = all
+  bool statistics = true;               ///< run part 1
+  bool direct_check = true;             ///< run part 2
+  bool seams = true;                    ///< run parts 3 and 4 (every density of the judged levels)
+  int threads = 0;                      ///< worker threads, 0 = all; results do not depend on it
+  Bars bars;
+  std::function<void(double)> progress;  ///< fraction done in [0, 1], from the calling thread (optional)
+};
+
+/// One measured value and its bar.
+struct Check {
+  std::string name;  ///< e.g. "E/n", "δavg", "RAPS f 0.75-1"
+  double value = 0;
+  double bar = 0;
+  bool at_most = true;  ///< passes iff value ≤ bar (else value ≥ bar)
+  bool passed() const { return at_most ? value <= bar : value >= bar; }
+};
+
+/// The reference of one level: means over the full-sampler runs, and the direct check's control.
+struct LevelReference {
+  std::uint32_t level = 0;
+  std::uint32_t points_per_tile = 0;           ///< nominal
+  double side = 1;                             ///< torus of the runs, in tiles
+  double energy = 0, davg = 0, nn1 = 0;        ///< NaN when statistics are not run (likewise below)
+  double low_p = 0, low_p_max = 0;             ///< mean and largest over the runs
+  double control_drop = 0, control_drift = 0;  ///< a full-sampler set freed for 15 sweeps (NaN if skipped)
+};
+
+/// One tile at one complete level.
+struct TileResult {
+  std::size_t tile = 0;
+  std::uint32_t colours[4] = {0, 0, 0, 0};  ///< sw, se, ne, nw
+  std::uint32_t level = 0;
+  std::size_t points = 0;                ///< on its 2×2 torus
+  double energy = 0, davg = 0, nn1 = 0;  ///< NaN when statistics are not run
+  double low_p = 0;                      ///< NaN when over the spectrum budget
+  double drop = 0, drift = 0;            ///< direct check (NaN when not run); drift in point spacings
+  std::vector<Check> checks;
+  bool passed() const;
+};
+
+/// One density (expected points per tile): a complete level or a quarter between two.
+struct DensityResult {
+  double points_per_tile = 0;
+  bool complete_level = false;
+  double davg = 0;              ///< mean over the tiles' tori
+  double worst_low_p = 0;       ///< largest lowP over the tiles (NaN if none measured)
+  double worst_edge_ratio = 0;  ///< smallest edge-link δmin / other-link δmin over the tiles
+  std::size_t edge_links = 0, midline_links = 0;
+  double ks_d_plus = 0, ks_p = 1;  ///< edge links shorter than midline links?
+  std::vector<Check> checks;
+  bool passed() const;
+};
+
+struct Report {
+  std::vector<LevelReference> levels;
+  std::vector<TileResult> tiles;  ///< level-major
+  std::vector<DensityResult> densities;
+  std::size_t failed_checks() const;
+  bool passed() const { return failed_checks() == 0; }
+};
+
+/// Runs the generator test on `set` (a valid set: validate_tileset passes). The recipe's temperature is
+/// the reference runs'. Throws std::invalid_argument (gen::InvalidArgument) for an unreadable recipe,
+/// fewer than 2 reference runs or an unknown level; never for a tile that fails (that is in the report).
+Report verify_tileset(const TileSet& set, const VerifyOptions& options = {});
+
+/// Writes `report` as tables (one row per tile and level, one per density; failing values marked '!').
+void print_report(const Report& report, std::FILE* out);
+
+}  // namespace kdm::verify

@@ -1,0 +1,97 @@
+// The generator test's report as text tables (kdm verify).
+#include <cmath>
+#include <string>
+
+#include "kdm/verify/verify.h"
+
+namespace kdm::verify {
+namespace {
+
+// The check whose name starts with `prefix` that failed, else the first with that prefix (or null).
+const Check* find(const std::vector<Check>& checks, const std::string& prefix) {
+  const Check* found = nullptr;
+  for (const Check& c : checks)
+    if (c.name.compare(0, prefix.size(), prefix) == 0) {
+      if (!c.passed()) return &c;
+      if (!found) found = &c;
+    }
+  return found;
+}
+
+// `value` in a column of `width`, marked '!' when the check named `prefix` failed, '-' when NaN.
+std::string cell(double value, const char* format, const std::vector<Check>& checks,
+                 const std::string& prefix, int width) {
+  char text[48];
+  if (std::isnan(value))
+    std::snprintf(text, sizeof text, "-");
+  else
+    std::snprintf(text, sizeof text, format, value);
+  std::string s = text;
+  const Check* c = find(checks, prefix);
+  if (c && !c->passed()) s += "!";
+  while (int(s.size()) < width) s.insert(s.begin(), ' ');
+  return s;
+}
+
+void print_failures(const std::vector<Check>& checks, const std::string& what, std::FILE* out) {
+  for (const Check& c : checks)
+    if (!c.passed())
+      std::fprintf(out, "  FAIL %s: %s %.4g, bar %s %.4g\n", what.c_str(), c.name.c_str(), c.value,
+                   c.at_most ? "<=" : ">=", c.bar);
+}
+
+}  // namespace
+
+void print_report(const Report& report, std::FILE* out) {
+  std::size_t checks = 0;
+  bool tile_checks = false;
+  for (const TileResult& t : report.tiles) tile_checks = tile_checks || !t.checks.empty();
+  for (const LevelReference& level : report.levels) {
+    if (!tile_checks) break;
+    std::fprintf(
+        out,
+        "\nlevel %u, %u points per tile; reference: full-sampler runs on the %g×%g torus: E/n %.4f  "
+        "δavg %.4f  NN1%% %.3f  lowP %.4f (largest %.4f); freed for 15 sweeps: drop %.4f, drift %.3f\n",
+        level.level, level.points_per_tile, level.side, level.side, level.energy, level.davg, level.nn1,
+        level.low_p, level.low_p_max, level.control_drop, level.control_drift);
+    std::fprintf(out, "%5s %11s %7s %8s %8s %7s %8s %5s %8s %7s  %s\n", "tile", "sw se ne nw", "points",
+                 "E/n", "δavg", "NN1%", "lowP", "RAPS", "drop", "drift", "result");
+    for (const TileResult& t : report.tiles) {
+      if (t.level != level.level) continue;
+      const Check* raps = find(t.checks, "|ΔRAPS|");
+      std::fprintf(
+          out, "%5zu %2u %2u %2u %2u %7zu %s %s %s %s %5s %s %s  %s\n", t.tile, t.colours[0], t.colours[1],
+          t.colours[2], t.colours[3], t.points, cell(t.energy, "%.4f", t.checks, "E/n", 8).c_str(),
+          cell(t.davg, "%.4f", t.checks, "δavg", 8).c_str(), cell(t.nn1, "%.3f", t.checks, "NN1%", 7).c_str(),
+          cell(t.low_p, "%.4f", t.checks, "lowP", 8).c_str(), raps ? (raps->passed() ? "ok" : "FAIL!") : "-",
+          cell(t.drop, "%.4f", t.checks, "energy drop", 8).c_str(),
+          cell(t.drift, "%.3f", t.checks, "drift", 7).c_str(), t.passed() ? "pass" : "FAIL");
+      checks += t.checks.size();
+    }
+  }
+  if (!report.densities.empty()) {
+    std::fprintf(out, "\nseams and in-between densities, over every tile's torus\n");
+    std::fprintf(out, "%11s %7s %7s %10s %8s %9s %10s  %s\n", "points/tile", "kind", "δavg", "edge/other",
+                 "KS D+", "p", "worst lowP", "result");
+    for (const DensityResult& d : report.densities) {
+      std::fprintf(out, "%11.1f %7s %7.4f %s %s %9.2g %s  %s\n", d.points_per_tile,
+                   d.complete_level ? "level" : "between", d.davg,
+                   cell(d.worst_edge_ratio, "%.3f", d.checks, "edge δmin", 10).c_str(),
+                   cell(d.ks_d_plus, "%.4f", d.checks, "edge vs midline", 8).c_str(), d.ks_p,
+                   cell(d.worst_low_p, "%.4f", d.checks, "lowP", 10).c_str(), d.passed() ? "pass" : "FAIL");
+      checks += d.checks.size();
+    }
+  }
+  std::fprintf(out, "\n");
+  for (const TileResult& t : report.tiles)
+    print_failures(t.checks, "tile " + std::to_string(t.tile) + " level " + std::to_string(t.level), out);
+  for (const DensityResult& d : report.densities)
+    print_failures(d.checks, "at " + std::to_string(int(d.points_per_tile)) + " points per tile", out);
+  const std::size_t failed = report.failed_checks();
+  if (failed)
+    std::fprintf(out, "%zu of %zu checks failed\n", failed, checks);
+  else
+    std::fprintf(out, "all %zu checks passed\n", checks);
+}
+
+}  // namespace kdm::verify

@@ -1,0 +1,30 @@
+// Shared pieces of the generator test: the 2×2 torus around a tile, and freeing points among fixed ones.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "kdm/runtime/tileset.h"
+
+namespace kdm::verify {
+
+/// The points the 2×2 torus around tile `t` emits at expected count `count` per tile, normalised to the
+/// unit square; `own` (optional) receives tile (0, 0)'s points separately and `others` the rest.
+std::vector<double> torus_points(const TileSet& set, std::size_t t, double count,
+                                 std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
+
+struct Relaxed {
+  double drop = 0;   ///< 1 − E_after / E_before
+  double drift = 0;  ///< mean displacement of the freed points / point spacing
+};
+
+/// Frees `own` among the fixed `others` on a side × side torus (normalised coordinates) and runs 15 MH
+/// sweeps of the full sampler at user temperature `temperature`. `spacing` normalises the drift.
+Relaxed relax(const std::vector<double>& own, const std::vector<double>& others, double side,
+              double temperature, double spacing, std::uint64_t seed, int threads);
+
+/// The expected counts per tile judged for `levels`: each complete level and the quarters below it.
+std::vector<double> densities(const TileSet& set, const std::vector<std::uint32_t>& levels);
+
+}  // namespace kdm::verify
