@@ -50,8 +50,7 @@ void add_verify_command(CLI::App& app) {
       "Judge every tile and level of a tile set against the full KDM sampler (the generator test); "
       "prints a table per level and exits 1 if any check fails");
   cmd->add_option("file", args->path, "Tile-set file")->required();
-  cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level")
-      ->check(CLI::Range(2, 1000))
+  cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (>= 2)")
       ->capture_default_str();
   cmd->add_option("--level", args->options.levels, "Judge only these levels (repeatable; default: all)");
   cmd->add_option("--spectrum-budget", args->options.spectrum_budget,
