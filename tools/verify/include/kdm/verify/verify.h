@@ -49,9 +49,11 @@ struct Bars {
   double small_energy = 1.20, small_low_p = 3.0, small_low_p_of_largest = 3.0, small_nn1 = 0.80;
   double energy_drop = 0.03;  ///< direct check: 1 − E_after / E_before ≤ this (small tiles: the next)
   double small_energy_drop = 0.06;
-  double drift = 1.25;       ///< direct check: mean drift ≤ drift × a full-sampler set's
-  double edge_dmin = 0.9;    ///< per tile: δmin of edge links ≥ edge_dmin × δmin of the other links
-  double ks_d_plus = 0.1;    ///< pooled edge vs midline links: one-sided KS D+ ≤ this
+  double drift = 1.25;     ///< direct check: mean drift ≤ drift × a full-sampler set's
+  double edge_dmin = 0.9;  ///< per tile: δmin of edge links ≥ edge_dmin × δmin of the other links
+  /// Pooled edge vs midline links: a seam defect is an excess of short edge links that is both large
+  /// (one-sided KS D+ > ks_d_plus) and significant (p < ks_p).
+  double ks_d_plus = 0.1, ks_p = 0.001;
   double mid_low_p = 0.105;  ///< between levels: lowP ≤ this, on tori of at least mid_low_p_min_points
   double mid_low_p_min_points = 1792;
 };
