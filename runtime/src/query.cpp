@@ -47,6 +47,18 @@ void Tileset::adopt(TileSet&& set) {
     if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
 }
 
+std::size_t Tileset::resident_bytes() const {
+  std::size_t bytes = sizeof(*this) + set_.level_nominal.capacity() * sizeof(std::uint32_t) +
+                      set_.tiles.capacity() * sizeof(Tile) +
+                      thresholds_.capacity() * sizeof(std::vector<float>) + set_.recipe.capacity() +
+                      set_.generator_version.capacity();
+  for (const Tile& t : set_.tiles)
+    bytes += t.points.capacity() * sizeof(TilePoint) + t.keys.capacity() * sizeof(std::uint16_t) +
+             t.level_end.capacity() * sizeof(std::uint32_t);
+  for (const std::vector<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
+  return bytes;
+}
+
 Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
   out = Tileset{};
   TileSet set;

@@ -66,6 +66,12 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_FALSE(t.empty());
   EXPECT_EQ(t.max_points_per_tile(), t.data().level_nominal.back());
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
+  // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, plus small tables.
+  std::size_t points = 0;
+  for (const Tile& tile : t.data().tiles) points += tile.points.size();
+  EXPECT_GE(t.resident_bytes(), 10 * points);
+  EXPECT_LE(t.resident_bytes(), 10 * points + 64 * 1024);
+  EXPECT_LT(Tileset{}.resident_bytes(), 1024u);
 }
 
 TEST(QueryTest, AnyPartitionGivesTheSameUnionBitForBit) {

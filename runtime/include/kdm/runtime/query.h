@@ -45,6 +45,10 @@ class Tileset {
   const float* thresholds(std::size_t index) const { return thresholds_[index].data(); }
   /// The lowest threshold of any point: below it no tile emits anything.
   double min_threshold() const { return min_threshold_; }
+  /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
+  /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
+  /// same size; its compressed bytes in the library's data section are extra. Thread-safe.
+  std::size_t resident_bytes() const;
 
  private:
   void adopt(TileSet&& set);
