@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
+#include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
 #include "progress.h"
 
@@ -55,7 +56,10 @@ void run_info(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   const long long bytes = in ? static_cast<long long>(in.tellg()) : -1;
   const TileSet set = load_or_throw(path);
+  Tileset loaded;  // as the runtime holds it, for its resident size
+  Tileset::load_file(path, loaded);
   std::printf("file           %s (%lld bytes)\n", path.c_str(), bytes);
+  std::printf("resident       %.2f MB once loaded by the runtime\n", double(loaded.resident_bytes()) / (1 << 20));
   std::printf("format         version %u\n", kTilesetFormatVersion);
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
