@@ -57,6 +57,10 @@ void kdm_tileset_free(kdm_tileset* tileset) {
   if (tileset != kdm_tileset_builtin()) delete tileset;
 }
 
+size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset) {
+  return tileset ? tileset->set.resident_bytes() : 0;
+}
+
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
                             size_t capacity, size_t* written, kdm_cursor* cursor) {
   if (!tileset || !query || !written || !cursor) return KDM_INVALID_ARGUMENT;

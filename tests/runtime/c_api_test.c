@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
     const size_t a = count_points(builtin, &q, 64), b = count_points(loaded, &q, 5);
     CHECK(a > 1000 && a == b); /* same set from the file and built in; resumed buffers lose nothing */
   }
+  CHECK(kdm_tileset_resident_bytes(loaded) == kdm_tileset_resident_bytes(builtin));
+  CHECK(kdm_tileset_resident_bytes(loaded) > 1000000 && kdm_tileset_resident_bytes(NULL) == 0);
   q.x1 = 0.0 / 0.0;
   CHECK(count_points(builtin, &q, 64) == (size_t)-1);
   CHECK(kdm_query_points(NULL, &q, NULL, 0, NULL, NULL) == KDM_INVALID_ARGUMENT);

@@ -63,6 +63,8 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
 /* The default tile set compiled into the library. Never free it. */
 const kdm_tileset* kdm_tileset_builtin(void);
 void kdm_tileset_free(kdm_tileset* tileset);
+/* Heap bytes a loaded set occupies (positions, keys, emission thresholds, tables); 0 for NULL. */
+size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset);
 
 /* Writes up to `capacity` points into `out`, *written = count. KDM_OK when the region is complete,
  * KDM_BUFFER_FULL to be resumed with the same cursor, KDM_INVALID_ARGUMENT for bad parameters. */
