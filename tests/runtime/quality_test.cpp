@@ -259,6 +259,32 @@ TEST(RuntimeQualityTest, FollowsADensityStep) {
   }
 }
 
+// Queries a w×h density image spread over the side × side square at `origin` (bilinear between texels)
+// and measures the emitted points against it, printing the figures under `label`.
+analysis::DensityAccuracy image_accuracy(const char* label, const std::vector<float>& values, int w, int h,
+                                         const double* origin, double side, double scale, double expected) {
+  std::vector<float> mip;
+  DensityImage image;
+  image.width = w, image.height = h;
+  image.x0 = origin[0], image.y0 = origin[1], image.x1 = origin[0] + side, image.y1 = origin[1] + side;
+  image.values = values.data();
+  EXPECT_EQ(make_density_max_mip(image, mip), Status::kOk);
+  QueryParams q;
+  q.x0 = q.origin_x = origin[0], q.y0 = q.origin_y = origin[1];
+  q.x1 = q.x0 + side, q.y1 = q.y0 + side;
+  q.scale = scale;
+  q.density.kind = QueryDensity::Kind::kImage;
+  q.density.image = &image;
+  const analysis::DensityAccuracy acc = accuracy(
+      q, [&](double x, double y) { return image.at(image.x0 + side * x, image.y0 + side * y); }, expected);
+  std::printf(
+      "%s at (%g, %g): %zu points (expected %.0f), %zu windows, RMS z %.3f, max |z| %.2f, bias %+.5f, %zu at "
+      "zero density\n",
+      label, origin[0], origin[1], acc.points, expected, acc.windows, acc.rms_z, acc.max_abs_z, acc.bias,
+      acc.zero_density);
+  return acc;
+}
+
 TEST(RuntimeQualityTest, FollowsAPhotograph) {
   // examples/sphere.png (320×320, 8-bit grey, CC0) as `kdm query --density` reads it: darkness is the
   // density (gamma 1), the picture's top row at the top of the region, bilinear between texels, over 8×8
@@ -270,7 +296,7 @@ TEST(RuntimeQualityTest, FollowsAPhotograph) {
   ASSERT_TRUE(tools::load_grey_image(std::string(KDM_SOURCE_DIR) + "/examples/sphere.png", picture, error))
       << error;
   const int w = picture.width, h = picture.height;
-  std::vector<float> values(static_cast<std::size_t>(w) * h), mip;
+  std::vector<float> values(static_cast<std::size_t>(w) * h);
   double sum = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -283,25 +309,8 @@ TEST(RuntimeQualityTest, FollowsAPhotograph) {
   // Bilinear interpolation clamped at the edges integrates to exactly texel area × Σ texels.
   const double expected = kScale * (kSide / w) * (kSide / h) * sum;
   for (const auto& origin : kOrigins) {
-    DensityImage image;
-    image.width = w, image.height = h;
-    image.x0 = origin[0], image.y0 = origin[1], image.x1 = origin[0] + kSide, image.y1 = origin[1] + kSide;
-    image.values = values.data();
-    ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
-    QueryParams q;
-    q.x0 = q.origin_x = origin[0], q.y0 = q.origin_y = origin[1];
-    q.x1 = q.x0 + kSide, q.y1 = q.y0 + kSide;
-    q.scale = kScale;
-    q.density.kind = QueryDensity::Kind::kImage;
-    q.density.image = &image;
-    const analysis::DensityAccuracy acc = accuracy(
-        q, [&](double x, double y) { return image.at(image.x0 + kSide * x, image.y0 + kSide * y); },
-        expected);
-    std::printf(
-        "sphere.png at (%g, %g): %zu points (expected %.0f), %zu windows, RMS z %.3f, max |z| %.2f, "
-        "bias %+.5f, %zu at zero density\n",
-        origin[0], origin[1], acc.points, expected, acc.windows, acc.rms_z, acc.max_abs_z, acc.bias,
-        acc.zero_density);
+    const analysis::DensityAccuracy acc =
+        image_accuracy("sphere.png", values, w, h, origin, kSide, kScale, expected);
     EXPECT_LE(acc.rms_z, kRmsZ);
     EXPECT_LE(std::fabs(acc.bias), kBias);
     EXPECT_EQ(acc.zero_density, 0u);  // nothing is emitted where the picture is white
@@ -317,7 +326,7 @@ TEST(RuntimeQualityTest, FollowsARadial1To1000Map) {
   constexpr int kTexelsPerTile = 16;
   constexpr double kSide = 8, kScale = 30000;
   const int n = kTexelsPerTile * static_cast<int>(kSide);
-  std::vector<float> values(static_cast<std::size_t>(n) * n), mip;
+  std::vector<float> values(static_cast<std::size_t>(n) * n);
   double sum = 0;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
@@ -330,24 +339,8 @@ TEST(RuntimeQualityTest, FollowsARadial1To1000Map) {
   // Bilinear interpolation clamped at the edges integrates to exactly texel area × Σ texels.
   const double expected = kScale * sum / (kTexelsPerTile * kTexelsPerTile);
   for (const auto& origin : kOrigins) {
-    DensityImage image;
-    image.width = image.height = n;
-    image.x0 = origin[0], image.y0 = origin[1], image.x1 = origin[0] + kSide, image.y1 = origin[1] + kSide;
-    image.values = values.data();
-    ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
-    QueryParams q;
-    q.x0 = q.origin_x = origin[0], q.y0 = q.origin_y = origin[1];
-    q.x1 = q.x0 + kSide, q.y1 = q.y0 + kSide;
-    q.scale = kScale;
-    q.density.kind = QueryDensity::Kind::kImage;
-    q.density.image = &image;
-    const analysis::DensityAccuracy acc = accuracy(
-        q, [&](double x, double y) { return image.at(image.x0 + kSide * x, image.y0 + kSide * y); },
-        expected);
-    std::printf(
-        "radial 1:1000 at (%g, %g): %zu points (expected %.0f), %zu windows, RMS z %.3f, max |z| %.2f, "
-        "bias %+.5f\n",
-        origin[0], origin[1], acc.points, expected, acc.windows, acc.rms_z, acc.max_abs_z, acc.bias);
+    const analysis::DensityAccuracy acc =
+        image_accuracy("radial 1:1000", values, n, n, origin, kSide, kScale, expected);
     EXPECT_LE(acc.rms_z, kRmsZ);
     EXPECT_LE(std::fabs(acc.bias), kBias);
   }
