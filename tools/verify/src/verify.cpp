@@ -3,7 +3,7 @@
 //  - Small tiles. The bars are E/n ≤ ref + 5%, lowP ≤ 1.5 × ref and NN1% ≥ 0.85 × ref. Levels whose
 //    tiles are less than 16 point spacings wide (the default set's levels 0 and 1: 5.7 and 11.3) cannot meet
 //    them all: there the corner and edge patches are one to three spacings wide and their boundaries show
-//    as local density errors (measured worst: E/n +17%, lowP 2.3 × ref and 2.1 × the largest, NN1% 0.847 ×
+//    as local density errors (measured worst: E/n +12.5%, lowP 2.7 × ref and 2.1 × the largest, NN1% 0.847 ×
 //    ref). They are held to E/n ≤ ref + 20%, lowP ≤ 3 × ref (or 3 × the largest reference where few
 //    frequencies count) and NN1% ≥ 0.8 × ref instead — still far from white noise (lowP 1).
 //    The direct check's energy drop is held to 3% (the bar) from 16 spacings on, where the default
