@@ -25,14 +25,6 @@ std::string read_text(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-TileSet load_or_throw(const std::string& path) {
-  TileSet set;
-  std::string detail;
-  const Status s = load_tileset(path, set, &detail);
-  if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
-  return set;
-}
-
 void run_bake(const std::string& recipe_path, const std::string& output, int threads) {
   gen::BakeRecipe recipe;
   try {
@@ -55,11 +47,14 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
 void run_info(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   const long long bytes = in ? static_cast<long long>(in.tellg()) : -1;
-  const TileSet set = load_or_throw(path);
-  Tileset loaded;  // as the runtime holds it, for its resident size
-  Tileset::load_file(path, loaded);
+  Tileset loaded;  // as the runtime holds it: the set, and its resident size
+  std::string detail;
+  const Status s = Tileset::load_file(path, loaded, &detail);
+  if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  const TileSet& set = loaded.data();
   std::printf("file           %s (%lld bytes)\n", path.c_str(), bytes);
-  std::printf("resident       %.2f MB once loaded by the runtime\n", double(loaded.resident_bytes()) / (1 << 20));
+  std::printf("resident       %.2f MB once loaded by the runtime\n",
+              double(loaded.resident_bytes()) / (1 << 20));
   std::printf("format         version %u\n", kTilesetFormatVersion);
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());

@@ -27,14 +27,19 @@ std::vector<double> torus_points(const TileSet& set, std::size_t t, double count
   return all;
 }
 
+gen::SamplerOptions torus_options(double temperature, double side, int threads) {
+  gen::SamplerOptions o;
+  o.temperature = temperature;
+  o.extent[0] = o.extent[1] = side;
+  o.threads = threads;
+  return o;
+}
+
 Relaxed relax(const std::vector<double>& own, const std::vector<double>& others, double side,
               double temperature, double spacing, std::uint64_t seed, int threads) {
   std::vector<double> all = own;
   all.insert(all.end(), others.begin(), others.end());
-  gen::SamplerOptions model;
-  model.temperature = temperature;
-  model.extent[0] = model.extent[1] = side;
-  model.threads = threads;
+  const gen::SamplerOptions model = torus_options(temperature, side, threads);
   const double before = gen::energy_per_point(model, gen::Density::constant(), all);
   // Not `o` for the energy after: with fixed points the model is scaled for n + fixed points.
   gen::SamplerOptions o = model;

@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
+#include "kdm/verify/verify.h"
 
 namespace kdm::verify {
 
@@ -13,6 +15,9 @@ namespace kdm::verify {
 /// unit square; `own` (optional) receives tile (0, 0)'s points separately and `others` the rest.
 std::vector<double> torus_points(const TileSet& set, std::size_t t, double count,
                                  std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
+
+/// The full sampler's options for a side × side torus (in tiles) at user temperature `temperature`.
+gen::SamplerOptions torus_options(double temperature, double side, int threads);
 
 struct Relaxed {
   double drop = 0;   ///< 1 − E_after / E_before
@@ -26,5 +31,10 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
 
 /// The expected counts per tile judged for `levels`: each complete level and the quarters below it.
 std::vector<double> densities(const TileSet& set, const std::vector<std::uint32_t>& levels);
+
+/// Parts 3 and 4 of the generator test (seams.cpp): appends a DensityResult per density to `report`;
+/// `done` receives the points measured.
+void judge_densities(const TileSet& set, const VerifyOptions& options, Report& report,
+                     const std::function<void(double)>& done);
 
 }  // namespace kdm::verify

@@ -36,20 +36,9 @@
 
 namespace kdm::verify {
 
-void judge_densities(const TileSet& set, const VerifyOptions& options, Report& report,
-                     const std::function<void(double)>& done);  // seams.cpp
-
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-gen::SamplerOptions torus_options(double temperature, double side, int threads) {
-  gen::SamplerOptions o;
-  o.temperature = temperature;
-  o.extent[0] = o.extent[1] = side;
-  o.threads = threads;
-  return o;
-}
 
 struct Metrics {
   double energy = 0, davg = 0, nn1 = 0;
@@ -177,12 +166,17 @@ void judge_tile(const TileSet& set, std::size_t t, const Reference& ref, double 
 
 }  // namespace
 
-bool TileResult::passed() const {
+namespace {
+bool all_passed(const std::vector<Check>& checks) {
   return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed(); });
 }
+}  // namespace
 
+bool TileResult::passed() const {
+  return all_passed(checks);
+}
 bool DensityResult::passed() const {
-  return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.passed(); });
+  return all_passed(checks);
 }
 
 std::size_t Report::failed_checks() const {
