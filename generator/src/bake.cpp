@@ -223,6 +223,7 @@ class Baker {
     if (o.n <= 0) throw InvalidArgument("recipe: a patch's context already holds all of its level's points");
     o.temperature = recipe_.temperature;
     o.sweeps = recipe_.sweeps_for(nominal_[k]);
+    o.coarse_sweeps = o.sweeps;
     o.coarsest_sweeps = std::max(o.coarsest_sweeps, o.sweeps);
     // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
     // resolve a residual density confined to patches between fixed bands, and spread the new points

@@ -75,7 +75,7 @@ template <int D>
 void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
   add(scratch.old_fp, sign);
 }
 
@@ -90,7 +90,7 @@ template <int D>
 double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
-  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, uniform_);
+  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
   Vec<D> unused{};
   return added_change_with_gradient(scratch.new_fp, unused);
 }
@@ -188,36 +188,47 @@ Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
   Vec<D> g{};
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return g;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, uniform_);
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, table(scratch));
   remove_with_gradient(scratch.old_fp, g, scratch.saved);
   restore(scratch.old_fp, scratch.saved);
   return g;
 }
 
 template <int D>
-bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
+bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached) {
   const double w = p.weight();
   const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
+  const double T = params_.temperature;
+  // The noise does not depend on the gradient: drawn first, its libm calls overlap the remove pass.
+  Vec<D> noise{};
+  if (T > 0)
+    for (int k = 0; k < D; ++k) noise[k] = rng.normal();
   const double sigma_old = sigma_for(rho_old, w, scratch);
-  scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, uniform_);
+  const bool was_cached = cached && cached->holds(p.x, sigma_old, rho_old);
+  if (was_cached)
+    cached->load(scratch.old_fp);
+  else
+    scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, table(scratch));
   Vec<D> grad_old;
   const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
 
   // Eq. 5 with Δt_j = T σ Δt / w: drift -(σ Δt / 2w) ∇E, noise variance T σ Δt / w. A kernel of weight w
   // carries w times the energy, so dividing by w keeps its step the size of a unit kernel's (as the
   // reference implementation does); P ∝ exp(-E/T) is unchanged, only the proposal scale.
-  const double T = params_.temperature, dt = params_.step / w;
+  const double dt = params_.step / w;
   const double var_old = T * sigma_old * dt;
+  const double noise_scale = T > 0 ? std::sqrt(var_old) : 0.0;
   Vec<D> drift_old, step;
   bool too_far = false;
   for (int k = 0; k < D; ++k) {
     drift_old[k] = -0.5 * sigma_old * dt * grad_old[k];
-    step[k] = drift_old[k] + (T > 0 ? std::sqrt(var_old) * rng.normal() : 0.0);
+    step[k] = drift_old[k] + noise_scale * noise[k];
     too_far |= !(std::fabs(step[k]) <= params_.max_step);
   }
   auto reject = [&] {
     restore(scratch.old_fp, scratch.saved);
+    if (cached && !was_cached) cached->keep(scratch.old_fp, p.x, sigma_old);
     return false;
   };
   if (too_far) return reject();
@@ -228,11 +239,10 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   if (!(rho_new > 0)) return reject();
   const double sigma_new = sigma_for(rho_new, w, scratch);
   if (sigma_new > params_.sigma_bound) return reject();
-  const bool mh = params_.metropolis && T > 0;
-  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, mh, uniform_);
+  // With the derivative even when the test does not need it: the footprint may be cached for later.
+  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, true, table(scratch));
   Vec<D> grad_new;
-  const double added = added_change_with_gradient(scratch.new_fp, grad_new);
-  const double dE = added - removed;
+  const double dE = added_change_with_gradient(scratch.new_fp, grad_new) - removed;
 
   bool accept;
   if (T <= 0) {
@@ -255,6 +265,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch) {
   if (!accept) return reject();
   add(scratch.new_fp, 1.0f);
   p.x = x_new;
+  if (cached) cached->keep(scratch.new_fp, x_new, sigma_new);
   return true;
 }
 
@@ -292,17 +303,17 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
     return id;
   };
   // Counting sort of the active particles by cell; ascending index within each cell.
-  std::vector<int> start(total_cells + 1, 0);
+  std::vector<int> first_in_cell(total_cells + 1, 0);
   std::vector<int> cell_of_particle(particles.size(), -1);
   for (std::size_t j = 0; j < particles.size(); ++j) {
     if (!particles[j].active) continue;
     cell_of_particle[j] = cell_of(particles[j].x);
-    ++start[cell_of_particle[j] + 1];
+    ++first_in_cell[cell_of_particle[j] + 1];
   }
-  for (int c = 0; c < total_cells; ++c) start[c + 1] += start[c];
-  std::vector<int> order(start[total_cells]);
+  for (int c = 0; c < total_cells; ++c) first_in_cell[c + 1] += first_in_cell[c];
+  std::vector<int> order(first_in_cell[total_cells]);
   {
-    std::vector<int> fill(start.begin(), start.end() - 1);
+    std::vector<int> fill(first_in_cell.begin(), first_in_cell.end() - 1);
     for (std::size_t j = 0; j < particles.size(); ++j)
       if (cell_of_particle[j] >= 0) order[fill[cell_of_particle[j]]++] = static_cast<int>(j);
   }
@@ -322,31 +333,38 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   (void)threads;
 #endif
   if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
-  std::vector<Scratch>& scratch = scratch_;
   std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
   // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
   local_.resize(order.size());
   for (std::size_t t = 0; t < order.size(); ++t) local_[t] = particles[order[t]];
+  if (cache_.size() != particles.size()) cache_.assign(particles.size(), CachedFootprint<D>{});
+  // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
+  const std::uint64_t sweep_key =
+      Rng::keyed(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
+                 static_cast<std::uint64_t>(sweep_index));
   for (const std::vector<int>& cells : cells_by_colour) {
     const int count = static_cast<int>(cells.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads) if (nthreads > 1 && count > 1)
     for (int ci = 0; ci < count; ++ci) {
 #ifdef _OPENMP
-      Scratch& s = scratch[omp_get_thread_num()];
+      Scratch& s = scratch_[omp_get_thread_num()];
 #else
-      Scratch& s = scratch[0];
+      Scratch& s = scratch_[0];
 #endif
       const int c = cells[ci];
       std::uint64_t acc = 0;
       // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
-      const int next_cell_first = ci + 1 < count ? start[cells[ci + 1]] : -1;
-      for (int t = start[c]; t < start[c + 1]; ++t) {
-        const int next = t + 1 < start[c + 1] ? t + 1 : next_cell_first;
-        if (next >= 0 && next < static_cast<int>(local_.size())) prefetch(local_[next], s);
+      const int next_cell_first = ci + 1 < count ? first_in_cell[cells[ci + 1]] : -1;
+      for (int t = first_in_cell[c]; t < first_in_cell[c + 1]; ++t) {
+        const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
+        if (next >= 0 && next < static_cast<int>(local_.size())) {
+          prefetch(local_[next], s);
+          const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
+          for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
+        }
         const int j = order[t];
-        Rng rng(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
-                static_cast<std::uint64_t>(sweep_index), static_cast<std::uint64_t>(j));
-        acc += update(local_[t], rng, s) ? 1 : 0;
+        Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
+        acc += update(local_[t], rng, s, &cache_[j]) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     }

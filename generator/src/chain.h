@@ -51,6 +51,7 @@ class Chain {
  public:
   struct Scratch {
     Footprint<D> old_fp, new_fp;
+    KernelTable table;         ///< the tabulated kernel of uniform models, shared by old_fp and new_fp
     std::vector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
     double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
@@ -83,8 +84,9 @@ class Chain {
   Vec<D> gradient(const Particle<D>& p, Scratch& scratch);
 
   /// One MH-corrected Langevin update of p (whose kernel is in R). `rng` drives only this update.
-  /// Returns true when the proposal was accepted.
-  bool update(Particle<D>& p, Rng& rng, Scratch& scratch);
+  /// `cached` (optional) is p's own footprint cache: read when it holds p's footprint, and left holding
+  /// the footprint at p's position afterwards. Returns true when the proposal was accepted.
+  bool update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached = nullptr);
 
   /// One sweep over the active particles (in the deterministic checkerboard order).
   void sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index, int threads,
@@ -99,6 +101,7 @@ class Chain {
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
   void prefetch(const Particle<D>& p, Scratch& scratch) const;
+  KernelTable* table(Scratch& scratch) const { return uniform_ ? &scratch.table : nullptr; }
   double sigma_for(double rho, double w, Scratch& scratch) const {
     if (rho != scratch.memo_rho || w != scratch.memo_w)
       scratch.memo_rho = rho, scratch.memo_w = w, scratch.memo_sigma = sigma_for(rho, w);
@@ -108,9 +111,10 @@ class Chain {
   const DensityGrid<D>* density_;
   ChainParams params_;
   std::vector<float> residual_;
-  std::vector<Particle<D>> local_;  // sweep(): the active particles in update order
-  std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
-  bool uniform_ = false;            // every node has the same ρ: skip the interpolation
+  std::vector<Particle<D>> local_;         // sweep(): the active particles in update order
+  std::vector<Scratch> scratch_;           // sweep(): one per thread, kept for its kernel tables
+  std::vector<CachedFootprint<D>> cache_;  // sweep(): each particle's footprint, by particle index
+  bool uniform_ = false;                   // every node has the same ρ: skip the interpolation
   double uniform_rho_ = 0;
 };
 

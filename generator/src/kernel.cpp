@@ -94,7 +94,7 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
   std::int64_t lo, hi;
   axis_reach(x, sigma, lo, hi);
   const int len = static_cast<int>(std::max<std::int64_t>(0, hi - lo + 1));
-  const int room = round_up4(len);
+  const int room = std::max(round_up4(len), CachedFootprint<2>::kLanes);
   if (static_cast<int>(a.value.size()) < room) {
     a.index.resize(room);
     a.value.resize(room);

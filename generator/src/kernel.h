@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "grid.h"
@@ -103,16 +104,17 @@ struct Footprint {
   bool contiguous = false;
   int start = 0, width = 0;
   alignas(16) std::array<float, kMaxWindow> row_value{}, row_deriv{};
-  KernelTable table;
 
-  /// `tabulated`: the model's kernel is KernelTable's interpolant (a model-wide choice, never per kernel).
+  /// `table`: when not null, the model's kernel is KernelTable's interpolant (a model-wide choice, never per
+  /// kernel); it is prepared for `sigma` here. One table serves both footprints of an update: two would
+  /// fill the L1 cache between them.
   void build(const Grid<D>& grid, const Vec<D>& x, double sigma, double amp, bool with_derivative,
-             bool tabulated) {
+             KernelTable* table) {
     amplitude = amp;
     const KernelTable* tab = nullptr;
-    if (tabulated) {
-      table.prepare(sigma);
-      tab = &table;
+    if (table) {
+      table->prepare(sigma);
+      tab = table;
     }
     for (int k = 1; k < D; ++k)
       build_axis(axes[k], x[k], sigma, grid.dims[k], grid.torus, with_derivative, tab, false);
@@ -160,6 +162,68 @@ struct Footprint {
           row(az.index[c] * s2 + ay.index[b] * s1, p, pd);
         }
       }
+    }
+  }
+};
+
+/// A small footprint kept with its particle between sweeps: a particle's next update starts where this
+/// one ended, so its footprint there need not be built again (building is a quarter of an update). Used
+/// only for the exact position, σ and amplitude it was built from, so results do not change.
+template <int D>
+struct CachedFootprint {
+  static constexpr int kLanes = 12;  ///< the common footprint at the peak density fits in 12 lanes per axis
+  Vec<D> x{};
+  double sigma = -1, amplitude = 0;
+  std::int32_t start = 0, width = 0;
+  std::array<std::int32_t, D> count{};  ///< per axis k >= 1
+  alignas(16) std::array<float, kLanes> row_value{}, row_deriv{};
+  std::array<std::array<float, kLanes>, D - 1> value{}, deriv{};
+  std::array<std::array<std::int32_t, kLanes>, D - 1> index{};
+
+  bool holds(const Vec<D>& at, double s, double amp) const {
+    return s == sigma && amp == amplitude && at == x;
+  }
+  /// Keeps `fp` (built at `at` with scale `s`, with its derivative) if it is small enough; else forgets.
+  void keep(const Footprint<D>& fp, const Vec<D>& at, double s) {
+    sigma = -1;
+    if (!fp.contiguous || fp.width > kLanes) return;
+    for (int k = 1; k < D; ++k)
+      if (fp.axes[k].count > kLanes) return;
+    x = at;
+    sigma = s;
+    amplitude = fp.amplitude;
+    start = fp.start;
+    width = fp.width;
+    std::memcpy(row_value.data(), fp.row_value.data(), kLanes * sizeof(fp.row_value[0]));
+    std::memcpy(row_deriv.data(), fp.row_deriv.data(), kLanes * sizeof(fp.row_deriv[0]));
+    for (int k = 1; k < D; ++k) {
+      const AxisFactor& a = fp.axes[k];
+      count[k] = a.count;
+      // Whole arrays: fixed-size copies are a few vector moves (build_axis keeps at least kLanes).
+      std::memcpy(value[k - 1].data(), a.value.data(), kLanes * sizeof(a.value[0]));
+      std::memcpy(deriv[k - 1].data(), a.deriv.data(), kLanes * sizeof(a.deriv[0]));
+      std::memcpy(index[k - 1].data(), a.index.data(), kLanes * sizeof(a.index[0]));
+    }
+  }
+  /// Writes the kept footprint into `fp` (whose axis arrays are resized if needed).
+  void load(Footprint<D>& fp) const {
+    fp.amplitude = amplitude;
+    fp.contiguous = true;
+    fp.start = start;
+    fp.width = width;
+    std::memcpy(fp.row_value.data(), row_value.data(), kLanes * sizeof(row_value[0]));
+    std::memcpy(fp.row_deriv.data(), row_deriv.data(), kLanes * sizeof(row_deriv[0]));
+    for (int k = 1; k < D; ++k) {
+      AxisFactor& a = fp.axes[k];
+      if (static_cast<int>(a.value.size()) < kLanes) {
+        a.index.resize(kLanes);
+        a.value.resize(kLanes);
+        a.deriv.resize(kLanes);
+      }
+      a.count = count[k];
+      std::memcpy(a.value.data(), value[k - 1].data(), kLanes * sizeof(value[k - 1][0]));
+      std::memcpy(a.deriv.data(), deriv[k - 1].data(), kLanes * sizeof(deriv[k - 1][0]));
+      std::memcpy(a.index.data(), index[k - 1].data(), kLanes * sizeof(index[k - 1][0]));
     }
   }
 };

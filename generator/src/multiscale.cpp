@@ -342,14 +342,19 @@ struct Driver {
       report.energy_per_point = chain.energy() / std::max<std::size_t>(1, particles.size() + fixed.size());
   }
 
+  /// MH sweeps at level l (0 = finest).
+  int sweeps_at(int l) const {
+    const int levels = static_cast<int>(setup.levels.size());
+    if (l == levels - 1) return options.coarsest_sweeps;
+    return l == 0 ? options.sweeps : options.coarse_sweeps;
+  }
+
   SampleResult run() {
     const auto t0 = std::chrono::steady_clock::now();
     const int levels = static_cast<int>(setup.levels.size());
     // Progress is measured in point-sweeps relative to n: level l holds about n / 2^(D l) points.
     for (int l = 0; l < levels; ++l)
-      total_sweeps +=
-          (options.burn_in_sweeps + (l == levels - 1 ? options.coarsest_sweeps : options.sweeps)) *
-          std::ldexp(1.0, -D * l);
+      total_sweeps += (options.burn_in_sweeps + sweeps_at(l)) * std::ldexp(1.0, -D * l);
     prepare_fixed_points();
     if (!options.initial_points.empty()) {  // relaxation: the finest level only, from the given points
       const Grid<D>& g = setup.levels.front().grid;
@@ -364,7 +369,7 @@ struct Driver {
     } else {
       for (int l = levels - 1; l >= 0; --l) {
         if (l < levels - 1) refine(l);
-        relax_level(l, l == levels - 1 ? options.coarsest_sweeps : options.sweeps);
+        relax_level(l, sweeps_at(l));
       }
     }
     report.model_temperature = params.temperature;

@@ -19,7 +19,14 @@ class Rng {
  public:
   explicit Rng(std::uint64_t seed, std::uint64_t a = 0, std::uint64_t b = 0, std::uint64_t c = 0,
                std::uint64_t d = 0)
-      : state_(mix64(mix64(mix64(mix64(seed ^ 0x6a09e667f3bcc909ull) + a) + b) + c) + d) {}
+      : state_(keyed(seed, a, b, c) + d) {}
+
+  /// Rng(seed, a, b, c, d) is Rng::from_key(keyed(seed, a, b, c), d): streams that differ only in d (one
+  /// per point) share the first part, computed once.
+  static std::uint64_t keyed(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+    return mix64(mix64(mix64(mix64(seed ^ 0x6a09e667f3bcc909ull) + a) + b) + c);
+  }
+  static Rng from_key(std::uint64_t key, std::uint64_t d) { return Rng(key + d, Tag{}); }
 
   std::uint64_t next() {
     state_ += 0x9e3779b97f4a7c15ull;
@@ -47,6 +54,8 @@ class Rng {
   }
 
  private:
+  struct Tag {};
+  Rng(std::uint64_t state, Tag) : state_(state) {}
   std::uint64_t state_;
   double spare_ = 0;
   bool has_spare_ = false;

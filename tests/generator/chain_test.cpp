@@ -2,7 +2,9 @@
 // against finite differences of E.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "chain.h"
@@ -176,6 +178,47 @@ TEST(ChainTest, GradientMatchesFiniteDifferences) {
     for (int k = 0; k < 2; ++k) EXPECT_NEAR(g[k], fd[k], 0.02 * (std::fabs(fd[k]) + 0.05)) << "axis " << k;
   }
   EXPECT_GE(checked, 10);
+}
+
+}  // namespace
+}  // namespace kdm::gen
+
+namespace kdm::gen {
+namespace {
+
+// A footprint kept between sweeps must be the footprint a fresh build gives, field for field, and must
+// not be used for any other position or scale.
+TEST(ChainTest, CachedFootprintIsTheFreshBuild) {
+  Grid<2> grid;
+  grid.dims = {64, 48};
+  KernelTable table;
+  for (const Vec<2> x : {Vec<2>{20.3, 17.8}, Vec<2>{30.0, 47.9}, Vec<2>{63.2, 5.5}}) {
+    Footprint<2> built, loaded;
+    built.build(grid, x, 1.52, 0.43, true, &table);
+    CachedFootprint<2> cache;
+    cache.keep(built, x, 1.52);
+    if (!built.contiguous) {  // wraps along axis 0: never kept
+      EXPECT_FALSE(cache.holds(x, 1.52, 0.43));
+      continue;
+    }
+    ASSERT_TRUE(cache.holds(x, 1.52, 0.43));
+    EXPECT_FALSE(cache.holds(Vec<2>{x[0] + 1e-9, x[1]}, 1.52, 0.43));
+    EXPECT_FALSE(cache.holds(x, 1.53, 0.43));
+    cache.load(loaded);
+    EXPECT_EQ(loaded.amplitude, built.amplitude);
+    EXPECT_EQ(loaded.start, built.start);
+    ASSERT_EQ(loaded.width, built.width);
+    for (int k = 0; k < built.width; ++k) {
+      EXPECT_EQ(loaded.row_value[k], built.row_value[k]);
+      EXPECT_EQ(loaded.row_deriv[k], built.row_deriv[k]);
+    }
+    ASSERT_EQ(loaded.axes[1].count, built.axes[1].count);
+    for (int b = 0; b < built.axes[1].count; ++b) {
+      EXPECT_EQ(loaded.axes[1].index[b], built.axes[1].index[b]);
+      EXPECT_EQ(loaded.axes[1].value[b], built.axes[1].value[b]);
+      EXPECT_EQ(loaded.axes[1].deriv[b], built.axes[1].deriv[b]);
+    }
+  }
 }
 
 }  // namespace

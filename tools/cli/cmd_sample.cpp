@@ -107,7 +107,10 @@ void add_sample_command(CLI::App& app) {
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")
       ->capture_default_str();
-  cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points per refinement level")
+  cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points on the finest level")
+      ->capture_default_str();
+  cmd->add_option("--coarse-sweeps", o.coarse_sweeps,
+                  "Metropolis-Hastings sweeps on each level between the coarsest and the finest")
       ->capture_default_str();
   cmd->add_option("--step", o.step, "Langevin step factor (Δt of eq. 5, model units; 0 = automatic)")
       ->capture_default_str();
