@@ -203,7 +203,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
   // The noise does not depend on the gradient: drawn first, its libm calls overlap the remove pass.
   Vec<D> noise{};
   if (T > 0)
-    for (int k = 0; k < D; ++k) noise[k] = rng.normal();
+    for (int k = 0; k < D; ++k) noise[k] = params_.box_muller ? rng.normal_box_muller() : rng.normal();
   const double sigma_old = sigma_for(rho_old, w, scratch);
   const bool was_cached = cached && cached->holds(p.x, sigma_old, rho_old);
   if (was_cached)
@@ -337,7 +337,10 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
   local_.resize(order.size());
   for (std::size_t t = 0; t < order.size(); ++t) local_[t] = particles[order[t]];
-  if (cache_.size() != particles.size()) cache_.assign(particles.size(), CachedFootprint<D>{});
+  // The footprint cache costs ~300 bytes per point: past its budget (by default about 900,000 points)
+  // updates build both footprints instead, which gives the same bits.
+  const bool caching = particles.size() * sizeof(CachedFootprint<D>) <= params_.cache_bytes;
+  if (caching && cache_.size() != particles.size()) cache_.assign(particles.size(), CachedFootprint<D>{});
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =
       Rng::keyed(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
@@ -359,12 +362,14 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
         const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
         if (next >= 0 && next < static_cast<int>(local_.size())) {
           prefetch(local_[next], s);
-          const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
-          for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
+          if (caching) {
+            const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
+            for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
+          }
         }
         const int j = order[t];
         Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
-        acc += update(local_[t], rng, s, &cache_[j]) ? 1 : 0;
+        acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     }

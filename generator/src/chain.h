@@ -39,6 +39,8 @@ struct ChainParams {
       128;  ///< kernels never wider than this (grid units); only far-below-peak densities hit it
   double sigma_bound = 1e30;  ///< proposals where σ would exceed this are rejected (a support constraint)
   double max_step = 1e30;     ///< proposals moving farther than this along any axis are rejected
+  bool box_muller = false;    ///< normal deviates by Rng::normal_box_muller() instead of the ziggurat
+  std::size_t cache_bytes = std::size_t(256) << 20;  ///< budget of the footprint cache (CachedFootprint)
 };
 
 struct ChainCounters {

@@ -47,6 +47,8 @@ struct Driver {
     params.temperature = o.temperature * kModelTemperaturePerUser;
     params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;
+    params.box_muller = o.normals == NormalDeviates::kBoxMuller;
+    params.cache_bytes = o.footprint_cache_bytes;
   }
 
   double total_weight() const {

@@ -2,6 +2,7 @@
 // sampler's output depends on the seed only — not on thread count or scheduling.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -13,6 +14,36 @@ inline std::uint64_t mix64(std::uint64_t z) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
 }
+
+/// The layers of the ziggurat for the standard normal (Marsaglia and Tsang, "The Ziggurat Method for
+/// Generating Random Variables", J. Stat. Softw. 5(8), 2000), 256 layers of equal area.
+struct NormalZiggurat {
+  static constexpr int kLayers = 256;
+  static constexpr double kTailStart = 3.6541528853610088;  ///< r: where the base layer's tail begins
+  static constexpr double kLayerArea = 0.00492867323399;    ///< v: the area of every layer
+  /// x[i]: layer i's half-width; x[0] is the base layer's equivalent width (area v / f(r)), x[256] = 0.
+  std::array<double, kLayers + 1> x{};
+  /// f(x[i]) with f(t) = exp(-t²/2), the unnormalized density.
+  std::array<double, kLayers + 1> f{};
+  /// x[i + 1] / x[i]: |u| below this is inside layer i's sure part.
+  std::array<double, kLayers> inner{};
+
+  NormalZiggurat() {
+    const double fr = std::exp(-0.5 * kTailStart * kTailStart);
+    x[0] = kLayerArea / fr;
+    x[1] = kTailStart;
+    for (int i = 1; i < kLayers - 1; ++i)
+      x[i + 1] = std::sqrt(-2 * std::log(kLayerArea / x[i] + density(x[i])));
+    x[kLayers] = 0;
+    for (int i = 0; i <= kLayers; ++i) f[i] = density(x[i]);
+    for (int i = 0; i < kLayers; ++i) inner[i] = x[i + 1] / x[i];
+  }
+  static double density(double t) { return std::exp(-0.5 * t * t); }
+  static const NormalZiggurat& get() {
+    static const NormalZiggurat table;
+    return table;
+  }
+};
 
 /// SplitMix64 generator with a keyed start. Small, fast, and good enough for proposals and tests.
 class Rng {
@@ -38,8 +69,33 @@ class Rng {
   std::uint64_t below(std::uint64_t bound) {
     return static_cast<std::uint64_t>((static_cast<unsigned __int128>(next()) * bound) >> 64);
   }
-  /// Standard normal (Box–Muller; the second value is cached).
+  /// Standard normal by the ziggurat: one 64-bit draw and a comparison 99% of the time. Box–Muller's log,
+  /// sin and cos made normal_box_muller() a sixth of the sampler's run time.
   double normal() {
+    const NormalZiggurat& z = NormalZiggurat::get();
+    for (;;) {
+      const std::uint64_t bits = next();
+      const int layer = static_cast<int>(bits & (NormalZiggurat::kLayers - 1));
+      // The top 53 bits as a signed fraction u in [-1, 1); the layer used the low 8.
+      const double u = static_cast<double>(static_cast<std::int64_t>(bits) >> 11) * 0x1.0p-52;
+      if (std::fabs(u) < z.inner[layer]) return u * z.x[layer];
+      if (layer == 0) {  // the tail beyond r (Marsaglia 1964)
+        double a, b;
+        do {
+          a = -std::log1p(-uniform()) / NormalZiggurat::kTailStart;
+          b = -std::log1p(-uniform());
+        } while (b + b < a * a);
+        return u < 0 ? -(NormalZiggurat::kTailStart + a) : NormalZiggurat::kTailStart + a;
+      }
+      const double t = u * z.x[layer];
+      // Layer i spans heights f(x[i]) .. f(x[i + 1]); accept t under the curve.
+      if (z.f[layer] + uniform() * (z.f[layer + 1] - z.f[layer]) < NormalZiggurat::density(t)) return t;
+    }
+  }
+
+  /// Standard normal by Box–Muller (the second value is cached): the stream tile baking keeps, so that a
+  /// recipe bakes the same tiles in every kdm version.
+  double normal_box_muller() {
     if (has_spare_) {
       has_spare_ = false;
       return spare_;

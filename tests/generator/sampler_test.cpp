@@ -70,6 +70,21 @@ TEST(SamplerTest, SameSeedSameBitsForAnyThreadCount) {
   EXPECT_NE(sample(o).points, a.points);
 }
 
+// The footprint cache only saves work: with no room for it, and on a varying density (every kernel its
+// own σ), the bits are the same. The two normal generators are two different streams.
+TEST(SamplerTest, FootprintCacheDoesNotChangeTheOutput) {
+  for (const Domain domain : {Domain::kTorus, Domain::kBox}) {
+    SamplerOptions o = options_for(2000, domain, 4);
+    Density ramp;
+    ramp.function = [](const double* u) { return 0.05 + u[0]; };
+    const SampleResult cached = sample(o, ramp);
+    o.footprint_cache_bytes = 0;
+    EXPECT_EQ(sample(o, ramp).points, cached.points);
+    o.normals = NormalDeviates::kBoxMuller;
+    EXPECT_NE(sample(o, ramp).points, cached.points);
+  }
+}
+
 TEST(SamplerTest, ZeroTemperatureIsADeterministicDescent) {
   SamplerOptions o = options_for(1000, Domain::kTorus);
   o.temperature = 0;

@@ -40,6 +40,12 @@ struct Density {
   static Density from_values(int width, int height, std::vector<float> values);
 };
 
+/// Generators of the Langevin noise (see SamplerOptions::normals).
+enum class NormalDeviates {
+  kZiggurat,   ///< Marsaglia–Tsang ziggurat: the default, and the fastest
+  kBoxMuller,  ///< the stream of kdm's first versions, kept by tile baking (bake.h) so recipes rebake exactly
+};
+
 struct SamplerOptions {
   int dim = 2;  ///< 2 or 3
   Domain domain = Domain::kTorus;
@@ -69,7 +75,14 @@ struct SamplerOptions {
   /// Δt of eq. 5 (Δt_j = T σ_j Δt / w), model units; 0 = automatic: 0.35 in 2D, 0.1 in 3D (measured to
   /// give acceptance rates near 0.5–0.6, where the chain relaxes fastest per sweep).
   double step = 0;
-  bool metropolis = true;      ///< false = unadjusted Langevin (biased; for experiments only)
+  bool metropolis = true;  ///< false = unadjusted Langevin (biased; for experiments only)
+  /// How the Langevin noise is drawn. Both give standard normal deviates; they are different random streams,
+  /// so the same seed gives different (equally good) point sets.
+  NormalDeviates normals = NormalDeviates::kZiggurat;
+  /// Memory for keeping each point's kernel footprint between sweeps (about 300 bytes per point in 2D):
+  /// a quarter less work per update. Levels with more points than fit skip it. The output does not depend
+  /// on it.
+  std::size_t footprint_cache_bytes = std::size_t(256) << 20;
   double peak_density = 0.43;  ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
   double sigma_max = 4.0;      ///< kernels at least this wide (grid units) are frozen (paper: σmax)
   int coarsest_grid = 32;      ///< nodes along the shortest axis of the coarsest grid (paper: 32)
