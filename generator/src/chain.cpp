@@ -200,7 +200,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
   const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
   const double T = params_.temperature;
-  // The noise does not depend on the gradient: drawn first, its libm calls overlap the remove pass.
+  // The noise does not depend on the gradient: drawn first, its work overlaps the remove pass.
   Vec<D> noise{};
   if (T > 0)
     for (int k = 0; k < D; ++k) noise[k] = params_.box_muller ? rng.normal_box_muller() : rng.normal();
