@@ -10,8 +10,8 @@
 //    set's tiles measure at most 2.1% (1.4% from level 3 on); the smaller levels' patch boundaries relax
 //    measurably (level 1: 2.7%; level 0: up to 3.8%, its E/n being up to 12% above the reference), so
 //    there the bar is 6%. For scale: a full-sampler
-//    set with default options, freed the same way, drops 2–5% (it is sampled with 30 sweeps per level, the
-//    tiles with 100 or more), which the report prints as the control.
+//    set with default options, freed the same way, drops −3% to 5% (it is sampled with 15–30 sweeps per
+//    level, the tiles with 100 or more), which the report prints as the control.
 //  - lowP of one set averages few frequencies when n is small (the torus at level 0 holds ~128 points:
 //    ~25 frequencies, each roughly exponential); there the 1.5× bar is noise, so tori with fewer than 100
 //    frequencies below f = 0.5 must instead stay within (a multiple of) the range of the reference runs.
