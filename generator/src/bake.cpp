@@ -224,9 +224,8 @@ class Baker {
     o.temperature = recipe_.temperature;
     o.sweeps = recipe_.sweeps_for(nominal_[k]);
     o.coarse_sweeps = o.sweeps;
-    // Box–Muller noise, as when the tile format was first baked: a recipe must give the same tiles in every
-    // kdm version.
-    o.normals = NormalDeviates::kBoxMuller;
+    // The arithmetic of the first bakes: a recipe must give the same tiles in every kdm version.
+    o.numerics = Numerics::kOriginal;
     o.coarsest_sweeps = std::max(o.coarsest_sweeps, o.sweeps);
     // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
     // resolve a residual density confined to patches between fixed bands, and spread the new points

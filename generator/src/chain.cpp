@@ -26,6 +26,7 @@ Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
   const std::vector<float>& rho = density.rho;
   uniform_ = !rho.empty() && std::all_of(rho.begin(), rho.end(), [&](float r) { return r == rho[0]; });
   uniform_rho_ = uniform_ ? rho[0] : 0.0;
+  set_params(params);
   clear_kernels();
 }
 
@@ -48,13 +49,15 @@ std::size_t footprint_nodes(const Footprint<D>& fp) {
   return n;
 }
 
-// Each pass below has a lane-vector form for contiguous footprints (lanes.h) and a general form over index
-// runs. Both evaluate every node the same way: R ± p·v in float, the sign of R with the kernel in it for
-// the gradient.
+// Each pass below has lane-vector forms for contiguous footprints (lanes.h, and lanes_wide.h where the CPU
+// has AVX-512) and a general form over index runs. All evaluate every node the same way: R ± p·v in float,
+// the sign of R with the kernel in it for the gradient. Windows of 8, 12 or 16 nodes keep their sums per
+// lane (unless four_lane_sums), which the four- and sixteen-lane passes add up alike.
 
 template <int D>
 void Chain<D>::add(const Footprint<D>& fp, float sign) {
   float* R = residual_.data();
+  if (wide_ && wide::fits(fp)) return wide::add<D>(R, grid(), fp, sign);
   if (fp.contiguous) {
     lanes::by_width(fp.width, [&](auto n) { lanes::add<decltype(n)::value>(R, grid(), fp, sign); });
     return;
@@ -100,9 +103,17 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
   float* R = residual_.data();
   if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
   float* out = saved.data();
-  if (fp.contiguous)
-    return lanes::by_width(
-        fp.width, [&](auto n) { return lanes::remove<decltype(n)::value>(R, grid(), fp, gradient, out); });
+  if (fp.contiguous) {
+    if (wide_ && !params_.four_lane_sums && wide::fits(fp))
+      return wide::remove<D>(R, grid(), fp, gradient, out);
+    return lanes::by_width(fp.width, [&](auto n) {
+      constexpr int N = decltype(n)::value;
+      if constexpr (N > 0) {
+        if (!params_.four_lane_sums) return lanes::remove_per_lane<N>(R, grid(), fp, gradient, out);
+      }
+      return lanes::remove<N>(R, grid(), fp, gradient, out);
+    });
+  }
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);
@@ -136,6 +147,7 @@ template <int D>
 void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) {
   float* R = residual_.data();
   const float* in = saved.data();
+  if (wide_ && wide::fits(fp)) return wide::restore<D>(R, grid(), fp, in);
   if (fp.contiguous) {
     lanes::by_width(fp.width, [&](auto n) { lanes::restore<decltype(n)::value>(R, grid(), fp, in); });
     return;
@@ -153,9 +165,16 @@ void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) 
 template <int D>
 double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
   const float* R = residual_.data();
-  if (fp.contiguous)
-    return lanes::by_width(fp.width,
-                           [&](auto n) { return lanes::added<decltype(n)::value>(R, grid(), fp, gradient); });
+  if (fp.contiguous) {
+    if (wide_ && !params_.four_lane_sums && wide::fits(fp)) return wide::added<D>(R, grid(), fp, gradient);
+    return lanes::by_width(fp.width, [&](auto n) {
+      constexpr int N = decltype(n)::value;
+      if constexpr (N > 0) {
+        if (!params_.four_lane_sums) return lanes::added_per_lane<N>(R, grid(), fp, gradient);
+      }
+      return lanes::added<N>(R, grid(), fp, gradient);
+    });
+  }
   const AxisFactor& ax = fp.axes[0];
   double change = 0;
   gradient.fill(0);

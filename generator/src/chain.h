@@ -16,6 +16,7 @@
 
 #include "grid.h"
 #include "kernel.h"
+#include "lanes_wide.h"
 #include "rng.h"
 
 namespace kdm::gen {
@@ -37,9 +38,11 @@ struct ChainParams {
   bool metropolis = true;
   double sigma_cap =
       128;  ///< kernels never wider than this (grid units); only far-below-peak densities hit it
-  double sigma_bound = 1e30;  ///< proposals where σ would exceed this are rejected (a support constraint)
-  double max_step = 1e30;     ///< proposals moving farther than this along any axis are rejected
-  bool box_muller = false;    ///< normal deviates by Rng::normal_box_muller() instead of the ziggurat
+  double sigma_bound = 1e30;    ///< proposals where σ would exceed this are rejected (a support constraint)
+  double max_step = 1e30;       ///< proposals moving farther than this along any axis are rejected
+  bool box_muller = false;      ///< normal deviates by Rng::normal_box_muller() instead of the ziggurat
+  bool four_lane_sums = false;  ///< Numerics::kOriginal's sums (lanes.h) instead of per-lane sums
+  bool wide_vectors = true;     ///< the sixteen-lane passes (lanes_wide.h) where the CPU has them
   std::size_t cache_bytes = std::size_t(256) << 20;  ///< budget of the footprint cache (CachedFootprint)
 };
 
@@ -64,7 +67,10 @@ class Chain {
   const Grid<D>& grid() const { return density_->grid; }
   const DensityGrid<D>& density() const { return *density_; }
   const ChainParams& params() const { return params_; }
-  void set_params(const ChainParams& params) { params_ = params; }
+  void set_params(const ChainParams& params) {
+    params_ = params;
+    wide_ = params.wide_vectors && wide::available();
+  }
   std::vector<float>& residual() { return residual_; }
 
   /// σ of a kernel with weight w at density rho (grid units).
@@ -103,7 +109,10 @@ class Chain {
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
   void prefetch(const Particle<D>& p, Scratch& scratch) const;
-  KernelTable* table(Scratch& scratch) const { return uniform_ ? &scratch.table : nullptr; }
+  KernelTable* table(Scratch& scratch) const {
+    scratch.table.wide = wide_;
+    return uniform_ ? &scratch.table : nullptr;
+  }
   double sigma_for(double rho, double w, Scratch& scratch) const {
     if (rho != scratch.memo_rho || w != scratch.memo_w)
       scratch.memo_rho = rho, scratch.memo_w = w, scratch.memo_sigma = sigma_for(rho, w);
@@ -117,6 +126,7 @@ class Chain {
   std::vector<Scratch> scratch_;           // sweep(): one per thread, kept for its kernel tables
   std::vector<CachedFootprint<D>> cache_;  // sweep(): each particle's footprint, by particle index
   bool uniform_ = false;                   // every node has the same ρ: skip the interpolation
+  bool wide_ = false;                      // the sixteen-lane passes run where a footprint fits them
   double uniform_rho_ = 0;
 };
 

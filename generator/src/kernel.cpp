@@ -1,5 +1,6 @@
 #include "kernel.h"
 
+#include "lanes_wide.h"
 #include "simd.h"
 
 namespace kdm::gen {
@@ -61,6 +62,10 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
     const float* row = table->coef.data() + std::size_t(piece) * KernelTable::kCoefs * KernelTable::kLanes +
                        (j0 + KernelTable::kHalf);
     constexpr int L = KernelTable::kLanes;
+    if (table->wide && wide::fits_width(rounded)) {
+      wide::tabulated_axis(row, L, rounded, s[0], j0, jlo, jhi, edge, with_derivative, v, dv);
+      return;
+    }
     I4 j = I4{0, 1, 2, 3} + j0;
     for (int q = 0; q < rounded; q += 4, j += 4) {
       const float* r = row + q;

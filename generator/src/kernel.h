@@ -49,6 +49,7 @@ inline int round_up4(int n) {
 struct KernelTable {
   static constexpr int kHalf = 16, kLanes = 2 * kHalf + 4, kPieces = 16, kCoefs = 7;
   double sigma = 0;
+  bool wide = false;  ///< evaluate sixteen lanes at a time (lanes_wide.h; the same bits) where the CPU can
   std::vector<float> coef;  ///< [piece][value c0..c3, derivative e0..e2][lane = j + kHalf]
   /// Rebuilds the table if it is not for `s`.
   void prepare(double s);

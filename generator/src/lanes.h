@@ -132,6 +132,66 @@ double added(const float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradie
   return sum4(e);
 }
 
+// Per-lane sums: each of the window's 4N lanes keeps its own energy and gradient sums across rows, added up
+// in one fixed order at the end (lane vectors in order, then sum4). The sums then do not depend on how many
+// lanes a machine's vectors hold, so the 16-lane passes (lanes_wide.h) give these bits exactly.
+
+template <int N>
+inline double sum_lanes(const F4 (&v)[N]) {
+  F4 t = v[0];
+  for (int q = 1; q < N; ++q) t += v[q];
+  return sum4(t);
+}
+
+/// remove() with per-lane sums, for windows of 4N = 8, 12 or 16 nodes.
+template <int N, int D, class Gradient>
+double remove_per_lane(float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient,
+                       float* saved) {
+  static_assert(N > 0, "per-lane sums need the window's width at compile time");
+  const Window<N> w(fp);
+  float* __restrict out = saved;
+  F4 e[N] = {}, g[D][N] = {};
+  rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
+    const F4 pf = splat4(p);
+    float* __restrict row = R + base;
+    for (int q = 0; q < N; ++q) {
+      const F4 r = load4(row + 4 * q), va = w.value(q);
+      const F4 rn = r - pf * va;
+      g[0][q] += pf * signed_by(r, w.deriv(q));
+      const F4 sv = signed_by(r, va);
+      for (int k = 1; k < D; ++k) g[k][q] += splat4(pd[k]) * sv;
+      e[q] += abs4(r) - abs4(rn);
+      store4(out + 4 * q, r);
+      store4(row + 4 * q, rn);
+    }
+    out += 4 * N;
+  });
+  for (int k = 0; k < D; ++k) gradient[k] = sum_lanes<N>(g[k]);
+  return sum_lanes<N>(e);
+}
+
+/// added() with per-lane sums, for windows of 4N = 8, 12 or 16 nodes.
+template <int N, int D, class Gradient>
+double added_per_lane(const float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient) {
+  static_assert(N > 0, "per-lane sums need the window's width at compile time");
+  const Window<N> w(fp);
+  F4 e[N] = {}, g[D][N] = {};
+  rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
+    const F4 pf = splat4(p);
+    const float* row = R + base;
+    for (int q = 0; q < N; ++q) {
+      const F4 r = load4(row + 4 * q), va = w.value(q);
+      const F4 rn = r + pf * va;
+      g[0][q] += pf * signed_by(rn, w.deriv(q));
+      const F4 sv = signed_by(rn, va);
+      for (int k = 1; k < D; ++k) g[k][q] += splat4(pd[k]) * sv;
+      e[q] += abs4(rn) - abs4(r);
+    }
+  });
+  for (int k = 0; k < D; ++k) gradient[k] = sum_lanes<N>(g[k]);
+  return sum_lanes<N>(e);
+}
+
 template <int N, int D>
 void add(float* R, const Grid<D>& grid, const Footprint<D>& fp, float sign) {
   const Window<N> w(fp);

@@ -47,7 +47,9 @@ struct Driver {
     params.temperature = o.temperature * kModelTemperaturePerUser;
     params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;
-    params.box_muller = o.normals == NormalDeviates::kBoxMuller;
+    params.box_muller = o.numerics == Numerics::kOriginal;
+    params.four_lane_sums = o.numerics == Numerics::kOriginal;
+    params.wide_vectors = o.wide_vectors;
     params.cache_bytes = o.footprint_cache_bytes;
   }
 

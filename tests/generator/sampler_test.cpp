@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kdm/generator/sampler.h"
+#include "lanes_wide.h"
 
 namespace kdm::gen {
 namespace {
@@ -71,7 +72,7 @@ TEST(SamplerTest, SameSeedSameBitsForAnyThreadCount) {
 }
 
 // The footprint cache only saves work: with no room for it, and on a varying density (every kernel its
-// own σ), the bits are the same. The two normal generators are two different streams.
+// own σ), the bits are the same. The two arithmetics (Numerics) are two different streams.
 TEST(SamplerTest, FootprintCacheDoesNotChangeTheOutput) {
   for (const Domain domain : {Domain::kTorus, Domain::kBox}) {
     SamplerOptions o = options_for(2000, domain, 4);
@@ -80,9 +81,29 @@ TEST(SamplerTest, FootprintCacheDoesNotChangeTheOutput) {
     const SampleResult cached = sample(o, ramp);
     o.footprint_cache_bytes = 0;
     EXPECT_EQ(sample(o, ramp).points, cached.points);
-    o.normals = NormalDeviates::kBoxMuller;
+    o.numerics = Numerics::kOriginal;
     EXPECT_NE(sample(o, ramp).points, cached.points);
   }
+}
+
+// The sixteen-lane passes give the four-lane passes' bits (lanes_test checks each pass), so whole point sets
+// do not depend on the CPU: uniform and varying densities, torus and box, 2D and 3D, both arithmetics.
+TEST(SamplerTest, WideVectorsDoNotChangeTheOutput) {
+  if (!wide::available()) GTEST_SKIP() << "this CPU has no AVX-512: the sixteen-lane passes never run here";
+  Density ramp;
+  ramp.function = [](const double* u) { return 0.05 + u[0]; };
+  for (const Numerics numerics : {Numerics::kFast, Numerics::kOriginal})
+    for (const Domain domain : {Domain::kTorus, Domain::kBox})
+      for (const int dim : {2, 3}) {
+        SamplerOptions o = options_for(dim == 2 ? 2000 : 1500, domain, 5);
+        o.dim = dim;
+        o.numerics = numerics;
+        const Density density = domain == Domain::kBox ? ramp : Density::constant();
+        const SampleResult wide = sample(o, density);
+        o.wide_vectors = false;
+        EXPECT_EQ(sample(o, density).points, wide.points)
+            << "numerics " << int(numerics) << " domain " << int(domain) << " dim " << dim;
+      }
 }
 
 TEST(SamplerTest, ZeroTemperatureIsADeterministicDescent) {

@@ -32,8 +32,8 @@ gen::SamplerOptions torus_options(double temperature, double side, int threads) 
   o.temperature = temperature;
   o.extent[0] = o.extent[1] = side;
   o.threads = threads;
-  // The baker's noise (bake.cpp): a set's verdict, like its tiles, must not change between kdm versions.
-  o.normals = gen::NormalDeviates::kBoxMuller;
+  // The baker's arithmetic (bake.cpp): a set's verdict, like its tiles, must not change between kdm versions.
+  o.numerics = gen::Numerics::kOriginal;
   return o;
 }
 

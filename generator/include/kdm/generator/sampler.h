@@ -40,10 +40,17 @@ struct Density {
   static Density from_values(int width, int height, std::vector<float> values);
 };
 
-/// Generators of the Langevin noise (see SamplerOptions::normals).
-enum class NormalDeviates {
-  kZiggurat,   ///< Marsaglia–Tsang ziggurat: the default, and the fastest
-  kBoxMuller,  ///< the stream of kdm's first versions, kept by tile baking (bake.h) so recipes rebake exactly
+/// The sampler's arithmetic (see SamplerOptions::numerics). Each gives the same bits on every machine and
+/// for every thread count; the two differ from each other in their random stream and last bits, so the same
+/// seed gives different (equally good) point sets.
+enum class Numerics {
+  /// The default and the fastest: Langevin noise from a ziggurat, and energy and gradient sums kept per
+  /// vector lane, so the update passes run sixteen lanes wide on CPUs with AVX-512 with the same result.
+  kFast,
+  /// kdm's first versions: Box–Muller noise and four-lane sums. Tile baking (bake.h) and `kdm verify` keep
+  /// it,
+  /// so a recipe bakes the same tiles in every version.
+  kOriginal,
 };
 
 struct SamplerOptions {
@@ -76,9 +83,10 @@ struct SamplerOptions {
   /// give acceptance rates near 0.5–0.6, where the chain relaxes fastest per sweep).
   double step = 0;
   bool metropolis = true;  ///< false = unadjusted Langevin (biased; for experiments only)
-  /// How the Langevin noise is drawn. Both give standard normal deviates; they are different random streams,
-  /// so the same seed gives different (equally good) point sets.
-  NormalDeviates normals = NormalDeviates::kZiggurat;
+  Numerics numerics = Numerics::kFast;
+  /// Run the update passes sixteen lanes wide where the CPU has AVX-512. The output does not depend on it
+  /// (the passes give the same bits either way); false is for testing that.
+  bool wide_vectors = true;
   /// Memory for keeping each point's kernel footprint between sweeps (about 300 bytes per point in 2D):
   /// a quarter less work per update. Levels with more points than fit skip it. The output does not depend
   /// on it.

@@ -1,0 +1,51 @@
+// The passes of Algorithm 1 (Fattal 2011, chain.h) sixteen lanes wide, for x86-64 CPUs with AVX-512:
+// a footprint row of 8, 12 or 16 nodes is one masked vector, where lanes.h takes two to four four-lane
+// vectors. They give exactly the bits of lanes.h's per-lane passes (remove_per_lane, added_per_lane, add,
+// restore): every node is evaluated by the same float operations, never fused, and each lane's sums are
+// added up in the same order. So a point set does not depend on whether the machine has AVX-512.
+#pragma once
+
+#include <cstdint>
+
+#include "grid.h"
+#include "kernel.h"
+
+namespace kdm::gen::wide {
+
+/// Whether this CPU runs the sixteen-lane passes (x86-64 with AVX-512F). Checked once; thread-safe.
+bool available();
+
+/// Whether the sixteen-lane code takes a row of this many lanes.
+inline bool fits_width(int width) {
+  return width == 8 || width == 12 || width == 16;
+}
+
+/// Whether the sixteen-lane passes take this footprint: a contiguous window of 8, 12 or 16 nodes.
+template <int D>
+bool fits(const Footprint<D>& fp) {
+  return fp.contiguous && fits_width(fp.width);
+}
+
+// Each requires available() and fits(fp); they are lanes.h's passes of the same name with per-lane sums.
+
+/// Removes fp's kernel from R, returning Σ(|R_before| - |R_after|) and eq. 7's gradient; R_before goes to
+/// `saved` (width × rows floats).
+template <int D>
+double remove(float* R, const Grid<D>& grid, const Footprint<D>& fp, Vec<D>& gradient, float* saved);
+/// For fp's kernel not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
+template <int D>
+double added(const float* R, const Grid<D>& grid, const Footprint<D>& fp, Vec<D>& gradient);
+/// R += sign · K.
+template <int D>
+void add(float* R, const Grid<D>& grid, const Footprint<D>& fp, float sign);
+/// Writes `saved` (from remove) back into fp's nodes.
+template <int D>
+void restore(float* R, const Grid<D>& grid, const Footprint<D>& fp, const float* saved);
+
+/// kernel.cpp's tabulated axis factor (axis_lanes with a KernelTable) for 8, 12 or 16 lanes, with the same
+/// bits: lane k is node j0 + k; `coef` points at the table piece's lane for j0, with `stride` floats between
+/// its coefficient rows; `s` is the position within the piece. Writes `width` lanes of v and dv.
+void tabulated_axis(const float* coef, int stride, int width, float s, std::int32_t j0, std::int32_t jlo,
+                    std::int32_t jhi, float edge, bool with_derivative, float* v, float* dv);
+
+}  // namespace kdm::gen::wide
