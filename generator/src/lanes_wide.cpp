@@ -95,11 +95,10 @@ KDM_AVX512 inline void store_row(float* p, __m512 v) {
 // lanes.h's sum_lanes over the W / 4 lane vectors of a row.
 template <int W>
 KDM_AVX512 inline double sum_lanes(__m512 v) {
-  alignas(64) float lane[16];
-  _mm512_store_ps(lane, v);
-  F4 t = load4(lane);
-  for (int q = 4; q < W; q += 4) t += load4(lane + q);
-  return sum4(t);
+  __m128 t = _mm_add_ps(_mm512_castps512_ps128(v), _mm512_extractf32x4_ps(v, 1));
+  if constexpr (W >= 12) t = _mm_add_ps(t, _mm512_extractf32x4_ps(v, 2));
+  if constexpr (W == 16) t = _mm_add_ps(t, _mm512_extractf32x4_ps(v, 3));
+  return sum4(reinterpret_cast<F4>(t));
 }
 
 // The window's lanes and the per-lane sums shared by the two measuring passes.
