@@ -48,8 +48,7 @@ enum class Numerics {
   /// vector lane, so the update passes run sixteen lanes wide on CPUs with AVX-512 with the same result.
   kFast,
   /// kdm's first versions: Box–Muller noise and four-lane sums. Tile baking (bake.h) and `kdm verify` keep
-  /// it,
-  /// so a recipe bakes the same tiles in every version.
+  /// it, so a recipe bakes the same tiles in every version.
   kOriginal,
 };
 
