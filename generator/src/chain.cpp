@@ -377,7 +377,14 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
       std::uint64_t acc = 0;
       // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
       const int next_cell_first = ci + 1 < count ? first_in_cell[cells[ci + 1]] : -1;
+      CellBlock block = ci + 1 < count
+                            ? cell_block(cells[ci + 1], ncell, width, first_in_cell[c + 1] - first_in_cell[c])
+                            : CellBlock{};
       for (int t = first_in_cell[c]; t < first_in_cell[c + 1]; ++t) {
+        // This update's share of the next cell's block. Here, not in a function of its own: GCC drops calls
+        // to a function that does nothing but prefetch.
+        for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
+          __builtin_prefetch(block.next(grid(), residual_.data()), 1);
         const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
         if (next >= 0 && next < static_cast<int>(local_.size())) {
           prefetch(local_[next], s);
@@ -396,6 +403,28 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   for (std::size_t t = 0; t < order.size(); ++t) particles[order[t]] = local_[t];
   counters.proposals += order.size();
   for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
+}
+
+template <int D>
+typename Chain<D>::CellBlock Chain<D>::cell_block(int cell, const std::array<int, D>& ncell,
+                                                  const std::array<double, D>& width, int updates) const {
+  const Grid<D>& g = grid();
+  CellBlock b;
+  for (int k = 0, rest = cell; k < D; ++k) {
+    const int at = rest % ncell[k];
+    rest /= ncell[k];
+    b.lo[k] = std::max<std::int64_t>(0, static_cast<std::int64_t>(at * width[k]) - kCellBlockMargin);
+    b.hi[k] = std::min<std::int64_t>(g.dims[k] - 1,
+                                     static_cast<std::int64_t>((at + 1) * width[k]) + kCellBlockMargin);
+    b.at[k] = b.lo[k];
+  }
+  b.lines_per_row = (b.hi[0] - b.lo[0] + 1 + 15) / 16 + 1;  // 16 floats a line; the ends may straddle lines
+  std::int64_t lines = b.lines_per_row;
+  for (int k = 1; k < D; ++k) lines *= b.hi[k] - b.lo[k] + 1;
+  b.left = lines;
+  b.per_update = updates > 0 ? (lines + updates - 1) / updates : 0;
+  b.row = residual_.data() + b.row_offset(g);
+  return b;
 }
 
 template <int D>

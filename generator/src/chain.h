@@ -109,6 +109,37 @@ class Chain {
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
   void prefetch(const Particle<D>& p, Scratch& scratch) const;
+  // The block of R that a cell's updates touch: the cell and a margin of kCellBlockMargin nodes (a
+  // footprint's reach at the peak density, its lane padding and a step). sweep() fetches the next cell's
+  // block a slice per update, so a cell does not start by missing the cache on every row it touches first: at
+  // n = 262,144, where R is 17 MB, those misses made the remove pass half as slow again as at n = 16,384, and
+  // fetching the blocks makes the whole run 10% faster.
+  struct CellBlock {
+    std::array<std::int64_t, D> lo{}, hi{}, at{};  // the block, and the row of the next line (at[0] unused)
+    std::int64_t lines_per_row = 0, column = 0;    // lines in a row; the next line's place in its row
+    std::int64_t left = 0, per_update = 0;         // lines not yet fetched; lines to fetch per update
+    const float* row = nullptr;                    // the next line's row, at lo[0]
+
+    std::int64_t row_offset(const Grid<D>& g) const {
+      std::int64_t offset = lo[0], stride = 1;
+      for (int k = 1; k < D; ++k) offset += at[k] * (stride *= g.dims[k - 1]);
+      return offset;
+    }
+    // The next line's address; moves on to the line after it. Requires left > 0.
+    const float* next(const Grid<D>& g, const float* R) {
+      const float* line = row + std::min(column * 16, hi[0] - lo[0]);
+      --left;
+      if (++column == lines_per_row) {
+        column = 0;
+        for (int k = 1; k < D && ++at[k] > hi[k]; ++k) at[k] = lo[k];
+        row = R + row_offset(g);
+      }
+      return line;
+    }
+  };
+  static constexpr int kCellBlockMargin = 8;  // 4 to 9 measured the same
+  CellBlock cell_block(int cell, const std::array<int, D>& ncell, const std::array<double, D>& width,
+                       int updates) const;
   KernelTable* table(Scratch& scratch) const {
     scratch.table.wide = wide_;
     return uniform_ ? &scratch.table : nullptr;
