@@ -29,9 +29,11 @@ decltype(auto) by_width(int width, F&& f) {
 
 /// Calls row(base, p, pd) for every row of a contiguous footprint: `base` the flat index of its window,
 /// p and pd[k] as in Footprint::for_each_row, rounded to float. Everything it reads is hoisted into
-/// locals, so stores through R inside `row` cannot force reloads.
+/// locals, so stores through R inside `row` cannot force reloads. Always inlined, so that the AVX-512
+/// passes (lanes_wide.cpp) get their row bodies inlined too: a function of the baseline target can be
+/// inlined into an AVX-512 one, but the AVX-512 body cannot be inlined into a baseline one.
 template <int D, class RowFn>
-inline void rows(const Grid<D>& grid, const Footprint<D>& fp, RowFn&& row) {
+__attribute__((always_inline)) inline void rows(const Grid<D>& grid, const Footprint<D>& fp, RowFn&& row) {
   const double amp = fp.amplitude;
   const std::int64_t s1 = grid.dims[0], start = fp.start;
   const AxisFactor& ay = fp.axes[1];

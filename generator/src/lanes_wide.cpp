@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <type_traits>
 
+#include "lanes.h"
 #include "simd.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -36,35 +37,6 @@ bool available() {
 }
 
 namespace {
-
-// Calls pass.row(base, p, pd) for every row of a contiguous footprint with exactly lanes::rows' factors.
-// A member function rather than a lambda: a lambda would not inherit the AVX-512 target.
-template <int D, class Pass>
-KDM_AVX512 inline void walk_rows(const Grid<D>& grid, const Footprint<D>& fp, Pass& pass) {
-  const double amp = fp.amplitude;
-  const std::int64_t s1 = grid.dims[0], start = fp.start;
-  const AxisFactor& ay = fp.axes[1];
-  const int ny = ay.count;
-  const int* iy = ay.index.data();
-  const float *vy = ay.value.data(), *dy = ay.deriv.data();
-  if constexpr (D == 2) {
-    for (int b = 0; b < ny; ++b)
-      pass.row(iy[b] * s1 + start, static_cast<float>(amp * vy[b]),
-               std::array<float, D>{0, static_cast<float>(amp * dy[b])});
-  } else {
-    static_assert(D == 3, "kdm supports dimensions 2 and 3");
-    const std::int64_t s2 = s1 * grid.dims[1];
-    const AxisFactor& az = fp.axes[2];
-    const int nz = az.count;
-    const int* iz = az.index.data();
-    const float *vz = az.value.data(), *dz = az.deriv.data();
-    for (int c = 0; c < nz; ++c)
-      for (int b = 0; b < ny; ++b)
-        pass.row(iz[c] * s2 + iy[b] * s1 + start, static_cast<float>(amp * vy[b] * vz[c]),
-                 std::array<float, D>{0, static_cast<float>(amp * dy[b] * vz[c]),
-                                      static_cast<float>(amp * vy[b] * dz[c])});
-  }
-}
 
 KDM_AVX512 inline __m512 signed_by(__m512 r, __m512 x) {
   const __m512i sign = _mm512_and_si512(_mm512_castps_si512(r), _mm512_set1_epi32(INT32_MIN));
@@ -125,33 +97,26 @@ struct Sums {
   }
 };
 
-template <int D, int W>
-struct RemovePass {
+// The remove pass (kRemove: R -= K, the old R kept in `out`) and the measuring pass (R + K, nothing
+// written) are one pass seen from either side: the kernel is in R `with` and not `without`.
+template <int D, int W, bool kRemove>
+struct MeasurePass {
   Sums<D, W> sums;
-  float* R;
-  float* out;
-  KDM_AVX512 void row(std::int64_t base, float p, const std::array<float, D>& pd) {
+  std::conditional_t<kRemove, float*, const float*> R;
+  float* out;  // kRemove only
+  KDM_AVX512 void operator()(std::int64_t base, float p, const std::array<float, D>& pd) {
     const __m512 pf = _mm512_set1_ps(p);
     const __m512 r = load_row<W>(R + base);
-    const __m512 rn = _mm512_sub_ps(r, _mm512_mul_ps(pf, sums.value));
-    sums.add_gradient(r, pf, pd);
-    sums.energy = _mm512_add_ps(sums.energy, _mm512_sub_ps(_mm512_abs_ps(r), _mm512_abs_ps(rn)));
-    store_row<W>(out, r);
-    store_row<W>(R + base, rn);
-    out += W;
-  }
-};
-
-template <int D, int W>
-struct AddedPass {
-  Sums<D, W> sums;
-  const float* R;
-  KDM_AVX512 void row(std::int64_t base, float p, const std::array<float, D>& pd) {
-    const __m512 pf = _mm512_set1_ps(p);
-    const __m512 r = load_row<W>(R + base);
-    const __m512 rn = _mm512_add_ps(r, _mm512_mul_ps(pf, sums.value));
-    sums.add_gradient(rn, pf, pd);
-    sums.energy = _mm512_add_ps(sums.energy, _mm512_sub_ps(_mm512_abs_ps(rn), _mm512_abs_ps(r)));
+    const __m512 rn = kRemove ? _mm512_sub_ps(r, _mm512_mul_ps(pf, sums.value))
+                              : _mm512_add_ps(r, _mm512_mul_ps(pf, sums.value));
+    const __m512 with = kRemove ? r : rn, without = kRemove ? rn : r;
+    sums.add_gradient(with, pf, pd);
+    sums.energy = _mm512_add_ps(sums.energy, _mm512_sub_ps(_mm512_abs_ps(with), _mm512_abs_ps(without)));
+    if constexpr (kRemove) {
+      store_row<W>(out, r);
+      store_row<W>(R + base, rn);
+      out += W;
+    }
   }
 };
 
@@ -160,7 +125,7 @@ struct AddPass {
   __m512 value;
   float* R;
   float sign;
-  KDM_AVX512 void row(std::int64_t base, float p, const std::array<float, D>&) {
+  KDM_AVX512 void operator()(std::int64_t base, float p, const std::array<float, D>&) {
     const __m512 r = load_row<W>(R + base);
     store_row<W>(R + base, _mm512_add_ps(r, _mm512_mul_ps(_mm512_set1_ps(sign * p), value)));
   }
@@ -170,7 +135,7 @@ template <int D, int W>
 struct RestorePass {
   float* R;
   const float* in;
-  KDM_AVX512 void row(std::int64_t base, float, const std::array<float, D>&) {
+  KDM_AVX512 void operator()(std::int64_t base, float, const std::array<float, D>&) {
     store_row<W>(R + base, load_row<W>(in));
     in += W;
   }
@@ -179,29 +144,29 @@ struct RestorePass {
 template <int D, int W>
 KDM_AVX512 double remove_avx512(float* R, const Grid<D>& grid, const Footprint<D>& fp, Vec<D>& gradient,
                                 float* saved) {
-  RemovePass<D, W> pass{Sums<D, W>(fp), R, saved};
-  walk_rows(grid, fp, pass);
+  MeasurePass<D, W, true> pass{Sums<D, W>(fp), R, saved};
+  lanes::rows(grid, fp, pass);
   return pass.sums.finish(gradient);
 }
 
 template <int D, int W>
 KDM_AVX512 double added_avx512(const float* R, const Grid<D>& grid, const Footprint<D>& fp,
                                Vec<D>& gradient) {
-  AddedPass<D, W> pass{Sums<D, W>(fp), R};
-  walk_rows(grid, fp, pass);
+  MeasurePass<D, W, false> pass{Sums<D, W>(fp), R, nullptr};
+  lanes::rows(grid, fp, pass);
   return pass.sums.finish(gradient);
 }
 
 template <int D, int W>
 KDM_AVX512 void add_avx512(float* R, const Grid<D>& grid, const Footprint<D>& fp, float sign) {
   AddPass<D, W> pass{load_row<W>(fp.row_value.data()), R, sign};
-  walk_rows(grid, fp, pass);
+  lanes::rows(grid, fp, pass);
 }
 
 template <int D, int W>
 KDM_AVX512 void restore_avx512(float* R, const Grid<D>& grid, const Footprint<D>& fp, const float* saved) {
   RestorePass<D, W> pass{R, saved};
-  walk_rows(grid, fp, pass);
+  lanes::rows(grid, fp, pass);
 }
 
 template <int W>
