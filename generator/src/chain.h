@@ -132,7 +132,7 @@ class Chain {
       if (++column == lines_per_row) {
         column = 0;
         for (int k = 1; k < D && ++at[k] > hi[k]; ++k) at[k] = lo[k];
-        row = R + row_offset(g);
+        if (left > 0) row = R + row_offset(g);  // past the last row the offset may leave the grid
       }
       return line;
     }
