@@ -109,7 +109,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
     return lanes::by_width(fp.width, [&](auto n) {
       constexpr int N = decltype(n)::value;
       if constexpr (N > 0) {
-        if (!params_.four_lane_sums) return lanes::remove_per_lane<N>(R, grid(), fp, gradient, out);
+        if (!params_.four_lane_sums) return lanes::measure_per_lane<N, true>(R, grid(), fp, gradient, out);
       }
       return lanes::remove<N>(R, grid(), fp, gradient, out);
     });
@@ -170,7 +170,8 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
     return lanes::by_width(fp.width, [&](auto n) {
       constexpr int N = decltype(n)::value;
       if constexpr (N > 0) {
-        if (!params_.four_lane_sums) return lanes::added_per_lane<N>(R, grid(), fp, gradient);
+        if (!params_.four_lane_sums)
+          return lanes::measure_per_lane<N, false>(R, grid(), fp, gradient, nullptr);
       }
       return lanes::added<N>(R, grid(), fp, gradient);
     });

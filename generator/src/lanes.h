@@ -145,50 +145,33 @@ inline double sum_lanes(const F4 (&v)[N]) {
   return sum4(t);
 }
 
-/// remove() with per-lane sums, for windows of 4N = 8, 12 or 16 nodes.
-template <int N, int D, class Gradient>
-double remove_per_lane(float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient,
-                       float* saved) {
+/// remove() (kRemove: R -= K, the old R kept in `saved`) or added() (R + K, nothing written) with per-lane
+/// sums, for windows of 4N = 8, 12 or 16 nodes. One pass seen from either side: the kernel is in R `with`
+/// and not `without`.
+template <int N, bool kRemove, int D, class Gradient>
+double measure_per_lane(std::conditional_t<kRemove, float*, const float*> R, const Grid<D>& grid,
+                        const Footprint<D>& fp, Gradient& gradient, float* saved) {
   static_assert(N > 0, "per-lane sums need the window's width at compile time");
   const Window<N> w(fp);
   float* __restrict out = saved;
   F4 e[N] = {}, g[D][N] = {};
   rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
     const F4 pf = splat4(p);
-    float* __restrict row = R + base;
+    auto* __restrict row = R + base;
     for (int q = 0; q < N; ++q) {
       const F4 r = load4(row + 4 * q), va = w.value(q);
-      const F4 rn = r - pf * va;
-      g[0][q] += pf * signed_by(r, w.deriv(q));
-      const F4 sv = signed_by(r, va);
+      const F4 rn = kRemove ? r - pf * va : r + pf * va;
+      const F4 with = kRemove ? r : rn, without = kRemove ? rn : r;
+      g[0][q] += pf * signed_by(with, w.deriv(q));
+      const F4 sv = signed_by(with, va);
       for (int k = 1; k < D; ++k) g[k][q] += splat4(pd[k]) * sv;
-      e[q] += abs4(r) - abs4(rn);
-      store4(out + 4 * q, r);
-      store4(row + 4 * q, rn);
+      e[q] += abs4(with) - abs4(without);
+      if constexpr (kRemove) {
+        store4(out + 4 * q, r);
+        store4(row + 4 * q, rn);
+      }
     }
-    out += 4 * N;
-  });
-  for (int k = 0; k < D; ++k) gradient[k] = sum_lanes<N>(g[k]);
-  return sum_lanes<N>(e);
-}
-
-/// added() with per-lane sums, for windows of 4N = 8, 12 or 16 nodes.
-template <int N, int D, class Gradient>
-double added_per_lane(const float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient) {
-  static_assert(N > 0, "per-lane sums need the window's width at compile time");
-  const Window<N> w(fp);
-  F4 e[N] = {}, g[D][N] = {};
-  rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
-    const F4 pf = splat4(p);
-    const float* row = R + base;
-    for (int q = 0; q < N; ++q) {
-      const F4 r = load4(row + 4 * q), va = w.value(q);
-      const F4 rn = r + pf * va;
-      g[0][q] += pf * signed_by(rn, w.deriv(q));
-      const F4 sv = signed_by(rn, va);
-      for (int k = 1; k < D; ++k) g[k][q] += splat4(pd[k]) * sv;
-      e[q] += abs4(rn) - abs4(r);
-    }
+    if constexpr (kRemove) out += 4 * N;
   });
   for (int k = 0; k < D; ++k) gradient[k] = sum_lanes<N>(g[k]);
   return sum_lanes<N>(e);

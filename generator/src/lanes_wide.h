@@ -1,8 +1,8 @@
 // The passes of Algorithm 1 (Fattal 2011, chain.h) sixteen lanes wide, for x86-64 CPUs with AVX-512:
-// a footprint row of 8, 12 or 16 nodes is one masked vector, where lanes.h takes two to four four-lane
-// vectors. They give exactly the bits of lanes.h's per-lane passes (remove_per_lane, added_per_lane, add,
-// restore): every node is evaluated by the same float operations, never fused, and each lane's sums are
-// added up in the same order. So a point set does not depend on whether the machine has AVX-512.
+// a footprint row of 8, 12 or 16 nodes is one vector, where lanes.h takes two to four four-lane vectors.
+// They give exactly the bits of lanes.h's per-lane passes (measure_per_lane, add, restore): every node is
+// evaluated by the same float operations, never fused, and each lane's sums are added up in the same order.
+// So a point set does not depend on whether the machine has AVX-512.
 #pragma once
 
 #include <cstdint>

@@ -63,7 +63,6 @@ std::vector<Footprint<D>> wide_footprints(const Grid<D>& grid, Rng& rng, KernelT
   return out;
 }
 
-template <int D>
 void expect_same_bits(const std::vector<float>& a, const std::vector<float>& b, const char* what) {
   ASSERT_EQ(a.size(), b.size());
   std::size_t differ = 0;
@@ -88,27 +87,28 @@ void check_wide_passes() {
 
     const double wide_e = wide::remove<D>(wide_r.data(), grid, fp, wide_g, wide_saved.data());
     const double lane_e = per_lane_width(fp.width, [&](auto n) {
-      return lanes::remove_per_lane<n()>(lane_r.data(), grid, fp, lane_g, lane_saved.data());
+      return lanes::measure_per_lane<n(), true>(lane_r.data(), grid, fp, lane_g, lane_saved.data());
     });
     EXPECT_EQ(bits(wide_e), bits(lane_e)) << "remove, width " << fp.width;
     for (int k = 0; k < D; ++k) EXPECT_EQ(bits(wide_g[k]), bits(lane_g[k])) << "remove gradient " << k;
-    expect_same_bits<D>(wide_r, lane_r, "R after remove");
-    expect_same_bits<D>(wide_saved, lane_saved, "saved nodes");
+    expect_same_bits(wide_r, lane_r, "R after remove");
+    expect_same_bits(wide_saved, lane_saved, "saved nodes");
 
     const double wide_a = wide::added<D>(wide_r.data(), grid, fp, wide_g);
-    const double lane_a = per_lane_width(
-        fp.width, [&](auto n) { return lanes::added_per_lane<n()>(lane_r.data(), grid, fp, lane_g); });
+    const double lane_a = per_lane_width(fp.width, [&](auto n) {
+      return lanes::measure_per_lane<n(), false>(lane_r.data(), grid, fp, lane_g, nullptr);
+    });
     EXPECT_EQ(bits(wide_a), bits(lane_a)) << "added, width " << fp.width;
     for (int k = 0; k < D; ++k) EXPECT_EQ(bits(wide_g[k]), bits(lane_g[k])) << "added gradient " << k;
 
     wide::add<D>(wide_r.data(), grid, fp, -0.5f);
     per_lane_width(fp.width, [&](auto n) { lanes::add<n()>(lane_r.data(), grid, fp, -0.5f); });
-    expect_same_bits<D>(wide_r, lane_r, "R after add");
+    expect_same_bits(wide_r, lane_r, "R after add");
 
     wide::restore<D>(wide_r.data(), grid, fp, wide_saved.data());
     per_lane_width(fp.width,
                    [&](auto n) { lanes::restore<n()>(lane_r.data(), grid, fp, lane_saved.data()); });
-    expect_same_bits<D>(wide_r, lane_r, "R after restore");
+    expect_same_bits(wide_r, lane_r, "R after restore");
     if (::testing::Test::HasFailure()) return;
   }
   for (const int w : {8, 12, 16}) EXPECT_GT(widths[w], 2) << "too few footprints " << w << " nodes wide";
@@ -164,14 +164,15 @@ void check_per_lane_sums() {
     const std::vector<float> start = random_residual(grid.size(), rng);
     std::vector<float> a = start, b = start, saved(16 * 64 * 64);
     Vec<D> ga, gb;
-    const double ea = per_lane_width(
-        fp.width, [&](auto n) { return lanes::remove_per_lane<n()>(a.data(), grid, fp, ga, saved.data()); });
+    const double ea = per_lane_width(fp.width, [&](auto n) {
+      return lanes::measure_per_lane<n(), true>(a.data(), grid, fp, ga, saved.data());
+    });
     const double eb = per_lane_width(
         fp.width, [&](auto n) { return lanes::remove<n()>(b.data(), grid, fp, gb, saved.data()); });
     const double tolerance = 2e-4;
     EXPECT_NEAR(ea, eb, tolerance);
     for (int k = 0; k < D; ++k) EXPECT_NEAR(ga[k], gb[k], tolerance);
-    expect_same_bits<D>(a, b, "R after remove (no sums involved)");
+    expect_same_bits(a, b, "R after remove (no sums involved)");
     // Both must be the real energy change, which the removal shows as a difference of Σ|R| over the grid.
     double before = 0, after = 0;
     for (std::size_t i = 0; i < start.size(); ++i) before += std::fabs(start[i]), after += std::fabs(a[i]);
