@@ -371,38 +371,59 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
                  static_cast<std::uint64_t>(sweep_index));
   for (const std::vector<int>& cells : cells_by_colour) {
     const int count = static_cast<int>(cells.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(nthreads) if (nthreads > 1 && count > 1)
-    for (int ci = 0; ci < count; ++ci) {
-#ifdef _OPENMP
-      Scratch& s = scratch_[omp_get_thread_num()];
-#else
-      Scratch& s = scratch_[0];
-#endif
-      const int c = cells[ci];
-      std::uint64_t acc = 0;
-      // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
-      const int next_cell_first = ci + 1 < count ? first_in_cell[cells[ci + 1]] : -1;
-      CellBlock block = ci + 1 < count
-                            ? cell_block(cells[ci + 1], ncell, width, first_in_cell[c + 1] - first_in_cell[c])
-                            : CellBlock{};
-      for (int t = first_in_cell[c]; t < first_in_cell[c + 1]; ++t) {
-        // This update's share of the next cell's block. Here, not in a function of its own: GCC drops calls
-        // to a function that does nothing but prefetch.
-        for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
-          __builtin_prefetch(block.next(grid(), residual_.data()), 1);
-        const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
-        if (next >= 0 && next < static_cast<int>(local_.size())) {
-          prefetch(local_[next], s);
-          if (caching) {
-            const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
-            for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
-          }
-        }
-        const int j = order[t];
-        Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
-        acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
+    // The colour's cells are cut into nthreads runs in storage order, each holding about as many updates:
+    // a run is the same band of the grid in every colour and sweep, so the rows of R it touches stay in the
+    // cache of the core that updates them (cells dealt out dynamically doubled the cost of the first pass
+    // over R on two threads). Which thread takes which cell never changes the result.
+    std::vector<int> run_start(nthreads + 1, count);
+    run_start[0] = 0;
+    {
+      std::int64_t total = 0, seen = 0;
+      for (int c : cells) total += first_in_cell[c + 1] - first_in_cell[c];
+      for (int ci = 0, r = 1; ci < count && r < nthreads; ++ci) {
+        seen += first_in_cell[cells[ci] + 1] - first_in_cell[cells[ci]];
+        while (r < nthreads && seen * nthreads >= total * r) run_start[r++] = ci + 1;
       }
-      accepted_in_cell[c] = acc;
+    }
+#pragma omp parallel num_threads(nthreads) if (nthreads > 1 && count > 1)
+    {
+#ifdef _OPENMP
+      const int thread = omp_get_thread_num(), team = omp_get_num_threads();
+#else
+      const int thread = 0, team = 1;
+#endif
+      Scratch& s = scratch_[thread];
+      // A team smaller than asked for (OMP_THREAD_LIMIT, nesting) shares out the runs.
+      for (int run = thread; run < nthreads; run += team)
+        for (int ci = run_start[run]; ci < run_start[run + 1]; ++ci) {
+          const int c = cells[ci];
+          std::uint64_t acc = 0;
+          // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
+          const bool has_next_cell = ci + 1 < run_start[run + 1];
+          const int next_cell_first = has_next_cell ? first_in_cell[cells[ci + 1]] : -1;
+          CellBlock block =
+              has_next_cell ? cell_block(cells[ci + 1], ncell, width, first_in_cell[c + 1] - first_in_cell[c])
+                            : CellBlock{};
+          for (int t = first_in_cell[c]; t < first_in_cell[c + 1]; ++t) {
+            // This update's share of the next cell's block. Here, not in a function of its own: GCC drops
+            // calls to a function that does nothing but prefetch.
+            for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
+              __builtin_prefetch(block.next(grid(), residual_.data()), 1);
+            const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
+            if (next >= 0 && next < static_cast<int>(local_.size())) {
+              prefetch(local_[next], s);
+              if (caching) {
+                const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
+                for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64)
+                  __builtin_prefetch(entry + b);
+              }
+            }
+            const int j = order[t];
+            Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
+            acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
+          }
+          accepted_in_cell[c] = acc;
+        }
     }
   }
 #pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
