@@ -292,70 +292,20 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
 template <int D>
 void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index,
                      int threads, ChainCounters& counters) {
-  const Grid<D>& g = grid();
-  // Cells at least two footprints plus a step wide: same-colour cells never touch the same node.
-  // The 3 is a footprint's lane padding (kernel.h).
+  // Cells at least two footprints plus a step wide. The 3 is a footprint's lane padding (kernel.h).
   const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 + 3 +
                        std::ceil(std::min(params_.max_step, 1e9));
-  std::array<int, D> ncell{};
-  std::array<double, D> width{};
-  int total_cells = 1;
-  for (int k = 0; k < D; ++k) {
-    // Wider cells where the grid has room for at least 8 along the axis: each colour then touches less
-    // of the grid through its cells' borders (the residual is streamed once per colour). Depends on the
-    // grid only, never on the thread count.
-    int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / std::max(2 * reach, 64.0))));
-    if (c < 8) c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / (2 * reach))));
-    if (c < 1) c = 1;
-    if (g.torus && c > 1 && (c & 1)) --c;
-    ncell[k] = c;
-    width[k] = double(g.dims[k]) / c;
-    total_cells *= c;
-  }
-  auto cell_of = [&](const Vec<D>& x) {
-    int id = 0, mul = 1;
-    for (int k = 0; k < D; ++k) {
-      int c = static_cast<int>(x[k] / width[k]);
-      c = std::clamp(c, 0, ncell[k] - 1);
-      id += c * mul;
-      mul *= ncell[k];
-    }
-    return id;
-  };
+  board_.layout(grid(), reach);
 #ifdef _OPENMP
   const int nthreads = std::max(1, threads > 0 ? threads : omp_get_max_threads());
 #else
   const int nthreads = 1;
   (void)threads;
 #endif
-  // Counting sort of the active particles by cell; ascending index within each cell. The loops over every
-  // particle run on all threads: serial, they were a tenth of a two-thread run.
-  const std::int64_t n = static_cast<std::int64_t>(particles.size());
-  std::vector<int> cell_of_particle(particles.size(), -1);
-#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
-  for (std::int64_t j = 0; j < n; ++j)
-    if (particles[j].active) cell_of_particle[j] = cell_of(particles[j].x);
-  std::vector<int> first_in_cell(total_cells + 1, 0);
-  for (const int c : cell_of_particle)
-    if (c >= 0) ++first_in_cell[c + 1];
-  for (int c = 0; c < total_cells; ++c) first_in_cell[c + 1] += first_in_cell[c];
-  std::vector<int> order(first_in_cell[total_cells]);
-  {
-    std::vector<int> fill(first_in_cell.begin(), first_in_cell.end() - 1);
-    for (std::size_t j = 0; j < particles.size(); ++j)
-      if (cell_of_particle[j] >= 0) order[fill[cell_of_particle[j]]++] = static_cast<int>(j);
-  }
-  std::array<std::vector<int>, (1 << D)> cells_by_colour;
-  for (int c = 0; c < total_cells; ++c) {
-    int colour = 0, rest = c;
-    for (int k = 0; k < D; ++k) {
-      colour |= ((rest % ncell[k]) & 1) << k;
-      rest /= ncell[k];
-    }
-    cells_by_colour[colour].push_back(c);
-  }
+  board_.sort(particles, nthreads);
+  const std::vector<int>& order = board_.order();
   if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
-  std::vector<std::uint64_t> accepted_in_cell(total_cells, 0);
+  std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
   // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
   const std::int64_t active = static_cast<std::int64_t>(order.size());
   local_.resize(order.size());
@@ -364,27 +314,41 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   // The footprint cache costs ~300 bytes per point: past its budget (by default about 900,000 points)
   // updates build both footprints instead, which gives the same bits.
   const bool caching = particles.size() * sizeof(CachedFootprint<D>) <= params_.cache_bytes;
-  if (caching && cache_.size() != particles.size()) cache_.assign(particles.size(), CachedFootprint<D>{});
+  if (caching && cache_.size() != particles.size()) cache_.reset(particles.size(), nthreads);
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =
       Rng::keyed(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
                  static_cast<std::uint64_t>(sweep_index));
-  for (const std::vector<int>& cells : cells_by_colour) {
+  for (int colour = 0; colour < (1 << D); ++colour) {
+    const std::vector<int>& cells = board_.cells_of_colour(colour);
     const int count = static_cast<int>(cells.size());
-    // The colour's cells are cut into nthreads runs in storage order, each holding about as many updates:
-    // a run is the same band of the grid in every colour and sweep, so the rows of R it touches stay in the
-    // cache of the core that updates them (cells dealt out dynamically doubled the cost of the first pass
-    // over R on two threads). Which thread takes which cell never changes the result.
-    std::vector<int> run_start(nthreads + 1, count);
-    run_start[0] = 0;
-    {
-      std::int64_t total = 0, seen = 0;
-      for (int c : cells) total += first_in_cell[c + 1] - first_in_cell[c];
-      for (int ci = 0, r = 1; ci < count && r < nthreads; ++ci) {
-        seen += first_in_cell[cells[ci] + 1] - first_in_cell[cells[ci]];
-        while (r < nthreads && seen * nthreads >= total * r) run_start[r++] = ci + 1;
+    runs_.share(count, nthreads, [&](int i) { return board_.updates_in(cells[i]); });
+    auto update_cell = [&](int ci, int next_ci, Scratch& s) {
+      const int c = cells[ci];
+      const int end = board_.first(c + 1);
+      // The next update's rows: in this cell, else the next cell's first.
+      const int next_cell_first = next_ci >= 0 ? board_.first(cells[next_ci]) : -1;
+      CellBlock block = next_ci >= 0 ? cell_block(cells[next_ci], board_.updates_in(c)) : CellBlock{};
+      std::uint64_t acc = 0;
+      for (int t = board_.first(c); t < end; ++t) {
+        // This update's share of the next cell's block. Here, not in a function of its own: GCC drops
+        // calls to a function that does nothing but prefetch.
+        for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
+          __builtin_prefetch(block.next(grid(), residual_.data()), 1);
+        const int next = t + 1 < end ? t + 1 : next_cell_first;
+        if (next >= 0 && next < static_cast<int>(local_.size())) {
+          prefetch(local_[next], s);
+          if (caching) {
+            const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
+            for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
+          }
+        }
+        const int j = order[t];
+        Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
+        acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
       }
-    }
+      accepted_in_cell[c] = acc;
+    };
 #pragma omp parallel num_threads(nthreads) if (nthreads > 1 && count > 1)
     {
 #ifdef _OPENMP
@@ -393,37 +357,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
       const int thread = 0, team = 1;
 #endif
       Scratch& s = scratch_[thread];
-      // A team smaller than asked for (OMP_THREAD_LIMIT, nesting) shares out the runs.
+      int ci, next;
       for (int run = thread; run < nthreads; run += team)
-        for (int ci = run_start[run]; ci < run_start[run + 1]; ++ci) {
-          const int c = cells[ci];
-          std::uint64_t acc = 0;
-          // The next update's rows: in this cell, else the next cell's first (usually this thread's next).
-          const bool has_next_cell = ci + 1 < run_start[run + 1];
-          const int next_cell_first = has_next_cell ? first_in_cell[cells[ci + 1]] : -1;
-          CellBlock block =
-              has_next_cell ? cell_block(cells[ci + 1], ncell, width, first_in_cell[c + 1] - first_in_cell[c])
-                            : CellBlock{};
-          for (int t = first_in_cell[c]; t < first_in_cell[c + 1]; ++t) {
-            // This update's share of the next cell's block. Here, not in a function of its own: GCC drops
-            // calls to a function that does nothing but prefetch.
-            for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
-              __builtin_prefetch(block.next(grid(), residual_.data()), 1);
-            const int next = t + 1 < first_in_cell[c + 1] ? t + 1 : next_cell_first;
-            if (next >= 0 && next < static_cast<int>(local_.size())) {
-              prefetch(local_[next], s);
-              if (caching) {
-                const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
-                for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64)
-                  __builtin_prefetch(entry + b);
-              }
-            }
-            const int j = order[t];
-            Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
-            acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
-          }
-          accepted_in_cell[c] = acc;
-        }
+        while ((ci = runs_.claim(run, true, next)) >= 0) update_cell(ci, next, s);
+      for (int k = 1; k < nthreads; ++k)  // also covers the runs of threads a smaller team lacks
+        while ((ci = runs_.claim((thread + k) % nthreads, false, next)) >= 0) update_cell(ci, -1, s);
     }
   }
 #pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
@@ -433,9 +371,10 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
 }
 
 template <int D>
-typename Chain<D>::CellBlock Chain<D>::cell_block(int cell, const std::array<int, D>& ncell,
-                                                  const std::array<double, D>& width, int updates) const {
+typename Chain<D>::CellBlock Chain<D>::cell_block(int cell, int updates) const {
   const Grid<D>& g = grid();
+  const std::array<int, D>& ncell = board_.cells_per_axis();
+  const std::array<double, D>& width = board_.cell_width();
   CellBlock b;
   for (int k = 0, rest = cell; k < D; ++k) {
     const int at = rest % ncell[k];

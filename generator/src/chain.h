@@ -14,23 +14,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "checkerboard.h"
 #include "grid.h"
 #include "kernel.h"
 #include "lanes_wide.h"
+#include "particle.h"
 #include "rng.h"
 
 namespace kdm::gen {
-
-template <int D>
-struct Particle {
-  Vec<D> x{};
-  std::uint8_t splits = 0;  ///< refinements this kernel still splits in; weight w = 2^(D·splits)
-  bool active = true;       ///< relaxed at this level (σ < σmax); inactive kernels are background
-  double weight() const {
-    return D * splits < 63 ? static_cast<double>(std::uint64_t(1) << (D * splits))
-                           : std::ldexp(1.0, D * splits);
-  }
-};
 
 struct ChainParams {
   double temperature = 0.11;  ///< T of eq. 4 (model units); 0 = deterministic descent
@@ -138,8 +129,7 @@ class Chain {
     }
   };
   static constexpr int kCellBlockMargin = 8;  // 4 to 9 measured the same
-  CellBlock cell_block(int cell, const std::array<int, D>& ncell, const std::array<double, D>& width,
-                       int updates) const;
+  CellBlock cell_block(int cell, int updates) const;
   KernelTable* table(Scratch& scratch) const {
     scratch.table.wide = wide_;
     return uniform_ ? &scratch.table : nullptr;
@@ -153,11 +143,13 @@ class Chain {
   const DensityGrid<D>* density_;
   ChainParams params_;
   std::vector<float> residual_;
-  std::vector<Particle<D>> local_;         // sweep(): the active particles in update order
-  std::vector<Scratch> scratch_;           // sweep(): one per thread, kept for its kernel tables
-  std::vector<CachedFootprint<D>> cache_;  // sweep(): each particle's footprint, by particle index
-  bool uniform_ = false;                   // every node has the same ρ: skip the interpolation
-  bool wide_ = false;                      // the sixteen-lane passes run where a footprint fits them
+  std::vector<Particle<D>> local_;  // sweep(): the active particles in update order
+  std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
+  Checkerboard<D> board_;           // sweep(): the cells and the update order
+  CellRuns runs_;                   // sweep(): a colour's cells shared out among threads
+  FootprintCache<D> cache_;         // sweep(): each particle's footprint, by particle index
+  bool uniform_ = false;            // every node has the same ρ: skip the interpolation
+  bool wide_ = false;               // the sixteen-lane passes run where a footprint fits them
   double uniform_rho_ = 0;
 };
 

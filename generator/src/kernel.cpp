@@ -3,6 +3,10 @@
 #include "lanes_wide.h"
 #include "simd.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace kdm::gen {
 
 double truncated_factor_integral() {
@@ -157,5 +161,22 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
   }
   if (runs) a.build_runs();
 }
+
+template <int D>
+void FootprintCache<D>::reset(std::size_t n, int threads) {
+  entries_.reset();
+  size_ = 0;
+  if (n == 0) return;
+  entries_.reset(static_cast<CachedFootprint<D>*>(
+      ::operator new (n * sizeof(CachedFootprint<D>), std::align_val_t{alignof(CachedFootprint<D>)})));
+  CachedFootprint<D>* entries = entries_.get();
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  for (std::int64_t j = 0; j < count; ++j) new (entries + j) CachedFootprint<D>();
+  size_ = n;
+}
+
+template class FootprintCache<2>;
+template class FootprintCache<3>;
 
 }  // namespace kdm::gen

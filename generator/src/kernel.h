@@ -12,6 +12,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
+#include <new>
+#include <type_traits>
 #include <vector>
 
 #include "grid.h"
@@ -228,5 +231,30 @@ struct CachedFootprint {
     }
   }
 };
+
+/// One CachedFootprint per particle. Set up on all threads, so each first touches, and faults in, its own
+/// share of the pages: at n = 65,536 the 19 MB took 10 ms on one thread, most of it page faults.
+template <int D>
+class FootprintCache {
+ public:
+  std::size_t size() const { return size_; }
+  CachedFootprint<D>& operator[](std::size_t j) { return entries_.get()[j]; }
+  const CachedFootprint<D>& operator[](std::size_t j) const { return entries_.get()[j]; }
+  /// n entries holding nothing, set up on up to `threads` OpenMP threads. Not thread-safe.
+  void reset(std::size_t n, int threads);
+
+ private:
+  struct Release {
+    void operator()(CachedFootprint<D>* p) const {
+      ::operator delete (p, std::align_val_t{alignof(CachedFootprint<D>)});
+    }
+  };
+  static_assert(std::is_trivially_destructible_v<CachedFootprint<D>>);
+  std::unique_ptr<CachedFootprint<D>, Release> entries_;
+  std::size_t size_ = 0;
+};
+
+extern template class FootprintCache<2>;
+extern template class FootprintCache<3>;
 
 }  // namespace kdm::gen
