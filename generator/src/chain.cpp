@@ -83,6 +83,51 @@ void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
 }
 
 template <int D>
+void Chain<D>::splat_all(const std::vector<Particle<D>>& particles, int threads) {
+  const int bands = std::max(1, threads);
+  if (static_cast<int>(scratch_.size()) < bands) scratch_.resize(bands);
+  const int m = grid().dims[D - 1];
+  const std::int64_t n = static_cast<std::int64_t>(particles.size());
+#pragma omp parallel num_threads(bands) if (bands > 1 && n > 1)
+  {
+#ifdef _OPENMP
+    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
+#else
+    const int thread = 0, team = 1;
+#endif
+    Scratch& s = scratch_[thread];
+    for (int band = thread; band < bands; band += team) {
+      const int first_row = static_cast<int>(std::int64_t(m) * band / bands);
+      const int end_row = static_cast<int>(std::int64_t(m) * (band + 1) / bands);
+      for (const Particle<D>& p : particles) {
+        const double rho = rho_at(p.x);
+        if (!(rho > 0)) continue;
+        const double sigma = sigma_for(rho, p.weight(), s);
+        std::int64_t lo, hi;
+        axis_reach(p.x[D - 1], sigma, lo, hi);
+        // Rows past an edge wrap or fold: such kernels are built and their rows sorted out below.
+        if (lo >= 0 && hi < m && (hi < first_row || lo >= end_row)) continue;
+        s.old_fp.build(grid(), p.x, sigma, rho, false, table(s));
+        if (bands > 1) {
+          AxisFactor& outer = s.old_fp.axes[D - 1];
+          int kept = 0;
+          for (int i = 0; i < outer.count; ++i) {
+            if (outer.index[i] < first_row || outer.index[i] >= end_row) continue;
+            outer.index[kept] = outer.index[i];
+            outer.value[kept] = outer.value[i];
+            outer.deriv[kept] = outer.deriv[i];
+            ++kept;
+          }
+          outer.count = kept;
+          if (kept == 0) continue;
+        }
+        add(s.old_fp, 1.0f);
+      }
+    }
+  }
+}
+
+template <int D>
 double Chain<D>::energy() const {
   double e = 0;
   for (float r : residual_) e += std::fabs(r);

@@ -74,6 +74,10 @@ class Chain {
   void clear_kernels();
   /// Adds (sign = +1) or removes (sign = -1) p's kernel.
   void splat(const Particle<D>& p, float sign, Scratch& scratch);
+  /// Adds every kernel of `particles`: the same bits as splat() on each in turn. Uses up to `threads`
+  /// OpenMP threads (each adds the rows in its own band of the grid along the last axis, so every node
+  /// still sums the same terms in the same order). Not thread-safe.
+  void splat_all(const std::vector<Particle<D>>& particles, int threads);
   /// Σ |R| over the grid: the energy of eq. 3 with γ = 1.
   double energy() const;
   /// Energy change if p's kernel were added (p not yet in R).

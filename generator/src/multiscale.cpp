@@ -8,6 +8,10 @@
 
 #include "chain.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace kdm::gen {
 namespace {
 
@@ -42,8 +46,12 @@ struct Driver {
   std::vector<Particle<D>> particles;
   std::vector<Particle<D>> fixed;  ///< constrained sampling: background kernels on the finest grid
   double total_sweeps = 0, done_sweeps = 0;
+  int threads = 1;  ///< OpenMP threads for the set-up of each level (sweeps take options.threads)
 
   Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
+#ifdef _OPENMP
+    threads = std::max(1, o.threads > 0 ? o.threads : omp_get_max_threads());
+#endif
     params.temperature = o.temperature * kModelTemperaturePerUser;
     params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;
@@ -166,16 +174,20 @@ struct Driver {
   /// Maps the configuration of level l+1 to level l (paper eq. 13, square rule, randomly rotated).
   void refine(int fine_level) {
     const DensityGrid<D>& fine = setup.levels[fine_level];
-    std::vector<Particle<D>> next;
-    next.reserve(particles.size() * 2);
-    for (std::size_t j = 0; j < particles.size(); ++j) {
+    const std::int64_t n = static_cast<std::int64_t>(particles.size());
+    std::vector<std::int64_t> first_child(particles.size() + 1, 0);
+    for (std::int64_t j = 0; j < n; ++j)
+      first_child[j + 1] = first_child[j] + (particles[j].splits ? 1 << D : 1);
+    std::vector<Particle<D>> next(static_cast<std::size_t>(first_child[n]));
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+    for (std::int64_t j = 0; j < n; ++j) {
       const Particle<D>& p = particles[j];
+      Particle<D>* out = next.data() + first_child[j];
       Vec<D> centre;
       for (int k = 0; k < D; ++k) centre[k] = 2 * p.x[k];
       if (p.splits == 0) {
-        Particle<D> c = p;
-        c.x = fine.at(centre) > 0 ? centre : inside_support(fine, centre);
-        next.push_back(c);
+        *out = p;
+        out->x = fine.at(centre) > 0 ? centre : inside_support(fine, centre);
         continue;
       }
       Particle<D> child;
@@ -183,12 +195,13 @@ struct Driver {
       const double rho = fine.at(centre);
       const double sigma =
           rho > 0 ? std::min(params.sigma_cap, std::pow(rho / child.weight(), -1.0 / D)) : 1.0;
-      Rng rng(options.seed, kRefineStream, static_cast<std::uint64_t>(fine_level), j);
+      Rng rng(options.seed, kRefineStream, static_cast<std::uint64_t>(fine_level),
+              static_cast<std::uint64_t>(j));
       for (const Vec<D>& z : square_rule(rng)) {
         for (int k = 0; k < D; ++k) child.x[k] = centre[k] + sigma * z[k];
         keep_inside(fine.grid, child.x);
         if (!(fine.at(child.x) > 0)) child.x = inside_support(fine, centre);
-        next.push_back(child);
+        *out++ = child;
       }
     }
     particles.swap(next);
@@ -300,7 +313,7 @@ struct Driver {
       initial_configuration(chain);
       if (options.n > 0) fix_count_coarse(chain);
     } else {
-      for (const auto& p : particles) chain.splat(p, 1.0f, scratch);
+      chain.splat_all(particles, threads);
     }
     if (!coarsest && !relaxing && options.n > 0) fix_count_level(chain, level);
 
