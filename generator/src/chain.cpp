@@ -347,15 +347,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   const int nthreads = 1;
   (void)threads;
 #endif
-  board_.sort(particles, nthreads);
+  // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
+  board_.sort(particles, nthreads, local_);
   const std::vector<int>& order = board_.order();
   if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
   std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
-  // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
-  const std::int64_t active = static_cast<std::int64_t>(order.size());
-  local_.resize(order.size());
-#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
-  for (std::int64_t t = 0; t < active; ++t) local_[t] = particles[order[t]];
   // The footprint cache costs ~300 bytes per point: past its budget (by default about 900,000 points)
   // updates build both footprints instead, which gives the same bits.
   const bool caching = particles.size() * sizeof(CachedFootprint<D>) <= params_.cache_bytes;
@@ -409,8 +405,13 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
         while ((ci = runs_.claim((thread + k) % nthreads, false, next)) >= 0) update_cell(ci, -1, s);
     }
   }
+  // Back by particle index, so each thread writes its own stretch of `particles` (written in update
+  // order, every cache line of it went back and forth between the cores).
+  const std::vector<int>& update_of = board_.update_of_particle();
+  const std::int64_t n = static_cast<std::int64_t>(particles.size());
 #pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
-  for (std::int64_t t = 0; t < active; ++t) particles[order[t]] = local_[t];
+  for (std::int64_t j = 0; j < n; ++j)
+    if (update_of[j] >= 0) particles[j] = local_[update_of[j]];
   counters.proposals += order.size();
   for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
 }

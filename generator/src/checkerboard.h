@@ -24,9 +24,10 @@ class Checkerboard {
   /// their centre. Depends on the grid and the reach only.
   void layout(const Grid<D>& g, double reach);
 
-  /// Sorts the active particles by cell, ascending index within each cell. Uses up to `threads` OpenMP
-  /// threads; the order does not depend on how many. Not thread-safe (call from one thread).
-  void sort(const std::vector<Particle<D>>& particles, int threads);
+  /// Sorts the active particles by cell, ascending index within each cell, and copies them in that order
+  /// into `sorted` (resized to fit). Uses up to `threads` OpenMP threads; the order does not depend on how
+  /// many. Not thread-safe (call from one thread).
+  void sort(const std::vector<Particle<D>>& particles, int threads, std::vector<Particle<D>>& sorted);
 
   int cell_count() const { return total_cells_; }
   const std::array<int, D>& cells_per_axis() const { return ncell_; }
@@ -37,15 +38,18 @@ class Checkerboard {
   int updates_in(int cell) const { return first_in_cell_[cell + 1] - first_in_cell_[cell]; }
   /// Particle index of each update, cell by cell.
   const std::vector<int>& order() const { return order_; }
+  /// The inverse: each particle's place in order(), or -1 if it is not active.
+  const std::vector<int>& update_of_particle() const { return update_of_particle_; }
 
  private:
   int cell_of(const Vec<D>& x) const;
+  static constexpr std::int64_t kParallelFrom = 4096;  // particles; fewer sort faster on one thread
 
   std::array<int, D> ncell_{};
   std::array<double, D> width_{};
   int total_cells_ = 0;
   std::array<std::vector<int>, (1 << D)> cells_by_colour_;
-  std::vector<int> cell_of_particle_, first_in_cell_, order_;
+  std::vector<int> cell_of_particle_, first_in_cell_, order_, update_of_particle_;
   std::vector<int> run_slots_;  // sort(): per run of particles and cell, the next free place in order_
 };
 
