@@ -21,8 +21,11 @@ inline float sign_of(float r) {
 }  // namespace
 
 template <int D>
-Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params)
-    : density_(&density), params_(params), residual_(density.rho.size()) {
+Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params, FootprintCache<D>* cache)
+    : density_(&density),
+      params_(params),
+      residual_(density.rho.size()),
+      cache_(cache ? cache : &own_cache_) {
   const std::vector<float>& rho = density.rho;
   uniform_ = !rho.empty() && std::all_of(rho.begin(), rho.end(), [&](float r) { return r == rho[0]; });
   uniform_rho_ = uniform_ ? rho[0] : 0.0;
@@ -355,7 +358,11 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   // The footprint cache costs ~300 bytes per point: past its budget (by default about 900,000 points)
   // updates build both footprints instead, which gives the same bits.
   const bool caching = particles.size() * sizeof(CachedFootprint<D>) <= params_.cache_bytes;
-  if (caching && cache_.size() != particles.size()) cache_.reset(particles.size(), nthreads);
+  if (caching && (!cache_emptied_ || cache_->size() != particles.size())) {
+    cache_->reset(particles.size(), nthreads);
+    cache_emptied_ = true;
+  }
+  FootprintCache<D>& cache = *cache_;
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =
       Rng::keyed(seed, 0x5357454550ull /* "SWEEP" */, static_cast<std::uint64_t>(level),
@@ -380,13 +387,13 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
         if (next >= 0 && next < static_cast<int>(local_.size())) {
           prefetch(local_[next], s);
           if (caching) {
-            const char* entry = reinterpret_cast<const char*>(&cache_[order[next]]);
+            const char* entry = reinterpret_cast<const char*>(&cache[order[next]]);
             for (std::size_t b = 0; b < sizeof(CachedFootprint<D>); b += 64) __builtin_prefetch(entry + b);
           }
         }
         const int j = order[t];
         Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
-        acc += update(local_[t], rng, s, caching ? &cache_[j] : nullptr) ? 1 : 0;
+        acc += update(local_[t], rng, s, caching ? &cache[j] : nullptr) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     };

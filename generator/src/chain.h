@@ -52,8 +52,12 @@ class Chain {
     double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
 
-  /// `density` must outlive the chain.
-  Chain(const DensityGrid<D>& density, const ChainParams& params);
+  /// `density` must outlive the chain, and so must `cache` if given: sweep() then keeps its footprints
+  /// there (emptied at the first sweep) instead of in storage of its own, so that a caller running one
+  /// chain after another sets up that storage once.
+  Chain(const DensityGrid<D>& density, const ChainParams& params, FootprintCache<D>* cache = nullptr);
+  Chain(const Chain&) = delete;  // cache_ may point into the chain itself
+  Chain& operator=(const Chain&) = delete;
 
   const Grid<D>& grid() const { return density_->grid; }
   const DensityGrid<D>& density() const { return *density_; }
@@ -151,9 +155,11 @@ class Chain {
   std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
   Checkerboard<D> board_;           // sweep(): the cells and the update order
   CellRuns runs_;                   // sweep(): a colour's cells shared out among threads
-  FootprintCache<D> cache_;         // sweep(): each particle's footprint, by particle index
-  bool uniform_ = false;            // every node has the same ρ: skip the interpolation
-  bool wide_ = false;               // the sixteen-lane passes run where a footprint fits them
+  FootprintCache<D> own_cache_;
+  FootprintCache<D>* cache_;    // sweep(): each particle's footprint, by particle index
+  bool cache_emptied_ = false;  // cache_ has been emptied for this chain
+  bool uniform_ = false;        // every node has the same ρ: skip the interpolation
+  bool wide_ = false;           // the sixteen-lane passes run where a footprint fits them
   double uniform_rho_ = 0;
 };
 

@@ -163,12 +163,18 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
 }
 
 template <int D>
-void FootprintCache<D>::reset(std::size_t n, int threads) {
+void FootprintCache<D>::reserve(std::size_t n) {
+  if (n <= capacity_) return;
   entries_.reset();
-  size_ = 0;
-  if (n == 0) return;
+  size_ = capacity_ = 0;
   entries_.reset(static_cast<CachedFootprint<D>*>(
       ::operator new (n * sizeof(CachedFootprint<D>), std::align_val_t{alignof(CachedFootprint<D>)})));
+  capacity_ = n;
+}
+
+template <int D>
+void FootprintCache<D>::reset(std::size_t n, int threads) {
+  reserve(n);
   CachedFootprint<D>* entries = entries_.get();
   const std::int64_t count = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)

@@ -232,8 +232,8 @@ struct CachedFootprint {
   }
 };
 
-/// One CachedFootprint per particle. Set up on all threads, so each first touches, and faults in, its own
-/// share of the pages: at n = 65,536 the 19 MB took 10 ms on one thread, most of it page faults.
+/// One CachedFootprint per particle. The storage is kept while it is large enough (the sampler lends one
+/// cache to every level's chain) and set up on all threads, each faulting in its own share of the pages.
 template <int D>
 class FootprintCache {
  public:
@@ -242,6 +242,8 @@ class FootprintCache {
   const CachedFootprint<D>& operator[](std::size_t j) const { return entries_.get()[j]; }
   /// n entries holding nothing, set up on up to `threads` OpenMP threads. Not thread-safe.
   void reset(std::size_t n, int threads);
+  /// Room for n entries without setting them up (size() becomes 0 if it grows). Not thread-safe.
+  void reserve(std::size_t n);
 
  private:
   struct Release {
@@ -251,7 +253,7 @@ class FootprintCache {
   };
   static_assert(std::is_trivially_destructible_v<CachedFootprint<D>>);
   std::unique_ptr<CachedFootprint<D>, Release> entries_;
-  std::size_t size_ = 0;
+  std::size_t size_ = 0, capacity_ = 0;
 };
 
 extern template class FootprintCache<2>;

@@ -46,7 +46,8 @@ struct Driver {
   std::vector<Particle<D>> particles;
   std::vector<Particle<D>> fixed;  ///< constrained sampling: background kernels on the finest grid
   double total_sweeps = 0, done_sweeps = 0;
-  int threads = 1;  ///< OpenMP threads for the set-up of each level (sweeps take options.threads)
+  int threads = 1;          ///< OpenMP threads for the set-up of each level (sweeps take options.threads)
+  FootprintCache<D> cache;  ///< lent to every level's chain
 
   Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
 #ifdef _OPENMP
@@ -303,7 +304,7 @@ struct Driver {
 
   void relax_level(int level, int sweeps) {
     DensityGrid<D>& density = setup.levels[level];
-    Chain<D> chain(density, params);
+    Chain<D> chain(density, params, &cache);
     typename Chain<D>::Scratch scratch;
     if (level == 0)
       for (const auto& p : fixed) chain.splat(p, 1.0f, scratch);
@@ -372,6 +373,8 @@ struct Driver {
     // Progress is measured in point-sweeps relative to n: level l holds about n / 2^(D l) points.
     for (int l = 0; l < levels; ++l)
       total_sweeps += (options.burn_in_sweeps + sweeps_at(l)) * std::ldexp(1.0, -D * l);
+    // Room for the finest level's footprints from the start: each level would otherwise fault in new pages.
+    if (std::size_t(options.n) * sizeof(CachedFootprint<D>) <= params.cache_bytes) cache.reserve(options.n);
     prepare_fixed_points();
     if (!options.initial_points.empty()) {  // relaxation: the finest level only, from the given points
       const Grid<D>& g = setup.levels.front().grid;
