@@ -69,6 +69,17 @@ TEST(SamplerTest, SameSeedSameBitsForAnyThreadCount) {
   EXPECT_EQ(a.points, c.points);
   o.seed = 10;
   EXPECT_NE(sample(o).points, a.points);
+  // Large enough that the sweeps' sort, the refinement and the splats of a level run on every thread,
+  // in a box with a varying density (cells of unequal load, kernels folded at the walls).
+  Density ramp;
+  ramp.function = [](const double* u) { return 0.05 + u[0] * u[1]; };
+  SamplerOptions big = options_for(20000, Domain::kBox, 3);
+  big.threads = 1;
+  const SampleResult one = sample(big, ramp);
+  for (const int threads : {2, 3}) {
+    big.threads = threads;
+    EXPECT_EQ(sample(big, ramp).points, one.points) << threads << " threads";
+  }
 }
 
 // The footprint cache only saves work: with no room for it, and on a varying density (every kernel its
