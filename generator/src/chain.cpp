@@ -1,6 +1,7 @@
 #include "chain.h"
 
 #include "lanes.h"
+#include "parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -91,43 +92,35 @@ void Chain<D>::splat_all(const std::vector<Particle<D>>& particles, int threads)
   if (static_cast<int>(scratch_.size()) < bands) scratch_.resize(bands);
   const int m = grid().dims[D - 1];
   const std::int64_t n = static_cast<std::int64_t>(particles.size());
-#pragma omp parallel num_threads(bands) if (bands > 1 && n > 1)
-  {
-#ifdef _OPENMP
-    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int thread = 0, team = 1;
-#endif
+  for_each_part(bands, n > 1, [&](int band, int thread) {
     Scratch& s = scratch_[thread];
-    for (int band = thread; band < bands; band += team) {
-      const int first_row = static_cast<int>(std::int64_t(m) * band / bands);
-      const int end_row = static_cast<int>(std::int64_t(m) * (band + 1) / bands);
-      for (const Particle<D>& p : particles) {
-        const double rho = rho_at(p.x);
-        if (!(rho > 0)) continue;
-        const double sigma = sigma_for(rho, p.weight(), s);
-        std::int64_t lo, hi;
-        axis_reach(p.x[D - 1], sigma, lo, hi);
-        // Rows past an edge wrap or fold: such kernels are built and their rows sorted out below.
-        if (lo >= 0 && hi < m && (hi < first_row || lo >= end_row)) continue;
-        s.old_fp.build(grid(), p.x, sigma, rho, false, table(s));
-        if (bands > 1) {
-          AxisFactor& outer = s.old_fp.axes[D - 1];
-          int kept = 0;
-          for (int i = 0; i < outer.count; ++i) {
-            if (outer.index[i] < first_row || outer.index[i] >= end_row) continue;
-            outer.index[kept] = outer.index[i];
-            outer.value[kept] = outer.value[i];
-            outer.deriv[kept] = outer.deriv[i];
-            ++kept;
-          }
-          outer.count = kept;
-          if (kept == 0) continue;
+    const int first_row = static_cast<int>(std::int64_t(m) * band / bands);
+    const int end_row = static_cast<int>(std::int64_t(m) * (band + 1) / bands);
+    for (const Particle<D>& p : particles) {
+      const double rho = rho_at(p.x);
+      if (!(rho > 0)) continue;
+      const double sigma = sigma_for(rho, p.weight(), s);
+      std::int64_t lo, hi;
+      axis_reach(p.x[D - 1], sigma, lo, hi);
+      // Rows past an edge wrap or fold: such kernels are built and their rows sorted out below.
+      if (lo >= 0 && hi < m && (hi < first_row || lo >= end_row)) continue;
+      s.old_fp.build(grid(), p.x, sigma, rho, false, table(s));
+      if (bands > 1) {
+        AxisFactor& outer = s.old_fp.axes[D - 1];
+        int kept = 0;
+        for (int i = 0; i < outer.count; ++i) {
+          if (outer.index[i] < first_row || outer.index[i] >= end_row) continue;
+          outer.index[kept] = outer.index[i];
+          outer.value[kept] = outer.value[i];
+          outer.deriv[kept] = outer.deriv[i];
+          ++kept;
         }
-        add(s.old_fp, 1.0f);
+        outer.count = kept;
+        if (kept == 0) continue;
       }
+      add(s.old_fp, 1.0f);
     }
-  }
+  });
 }
 
 template <int D>
@@ -397,20 +390,14 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
       }
       accepted_in_cell[c] = acc;
     };
-#pragma omp parallel num_threads(nthreads) if (nthreads > 1 && count > 1)
-    {
-#ifdef _OPENMP
-      const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-      const int thread = 0, team = 1;
-#endif
+    run_team(nthreads, count > 1, [&](int thread, int team) {
       Scratch& s = scratch_[thread];
       int ci, next;
       for (int run = thread; run < nthreads; run += team)
         while ((ci = runs_.claim(run, true, next)) >= 0) update_cell(ci, next, s);
       for (int k = 1; k < nthreads; ++k)  // also covers the runs of threads a smaller team lacks
         while ((ci = runs_.claim((thread + k) % nthreads, false, next)) >= 0) update_cell(ci, -1, s);
-    }
+    });
   }
   // Back by particle index, so each thread writes its own stretch of `particles` (written in update
   // order, every cache line of it went back and forth between the cores).

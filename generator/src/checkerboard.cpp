@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "parallel.h"
 
 namespace kdm::gen {
 
@@ -66,24 +64,16 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
   };
   // Small levels sort faster on one thread than the team takes to start.
   const bool parallel = runs > 1 && n >= kParallelFrom;
-#pragma omp parallel num_threads(runs) if (parallel)
-  {
-#ifdef _OPENMP
-    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int thread = 0, team = 1;
-#endif
-    for (int run = thread; run < runs; run += team) {
-      std::int64_t lo, hi;
-      run_range(run, lo, hi);
-      int* count = run_slots_.data() + stride * run;
-      for (std::int64_t j = lo; j < hi; ++j) {
-        const int c = particles[j].active ? cell_of(particles[j].x) : -1;
-        cell_of_particle_[j] = c;
-        if (c >= 0) ++count[c];
-      }
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(run, lo, hi);
+    int* count = run_slots_.data() + stride * run;
+    for (std::int64_t j = lo; j < hi; ++j) {
+      const int c = particles[j].active ? cell_of(particles[j].x) : -1;
+      cell_of_particle_[j] = c;
+      if (c >= 0) ++count[c];
     }
-  }
+  });
   first_in_cell_.resize(cells + 1);
   int placed = 0;
   for (std::size_t c = 0; c < cells; ++c) {
@@ -97,25 +87,17 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
   first_in_cell_[cells] = placed;
   order_.resize(static_cast<std::size_t>(placed));
   sorted.resize(static_cast<std::size_t>(placed));
-#pragma omp parallel num_threads(runs) if (parallel)
-  {
-#ifdef _OPENMP
-    const int thread = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int thread = 0, team = 1;
-#endif
-    for (int run = thread; run < runs; run += team) {
-      std::int64_t lo, hi;
-      run_range(run, lo, hi);
-      int* slot = run_slots_.data() + stride * run;
-      for (std::int64_t j = lo; j < hi; ++j) {
-        const int c = cell_of_particle_[j];
-        const int update = c >= 0 ? slot[c]++ : -1;
-        if (update >= 0) order_[update] = static_cast<int>(j), sorted[update] = particles[j];
-        update_of_particle_[j] = update;
-      }
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(run, lo, hi);
+    int* slot = run_slots_.data() + stride * run;
+    for (std::int64_t j = lo; j < hi; ++j) {
+      const int c = cell_of_particle_[j];
+      const int update = c >= 0 ? slot[c]++ : -1;
+      if (update >= 0) order_[update] = static_cast<int>(j), sorted[update] = particles[j];
+      update_of_particle_[j] = update;
     }
-  }
+  });
 }
 
 template class Checkerboard<2>;
