@@ -152,7 +152,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
       if constexpr (N > 0) {
         if (!params_.four_lane_sums) return lanes::measure_per_lane<N, true>(R, grid(), fp, gradient, out);
       }
-      return lanes::remove<N>(R, grid(), fp, gradient, out);
+      return lanes::measure<N, true>(R, grid(), fp, gradient, out);
     });
   }
   const AxisFactor& ax = fp.axes[0];
@@ -214,7 +214,7 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
         if (!params_.four_lane_sums)
           return lanes::measure_per_lane<N, false>(R, grid(), fp, gradient, nullptr);
       }
-      return lanes::added<N>(R, grid(), fp, gradient);
+      return lanes::measure<N, false>(R, grid(), fp, gradient, nullptr);
     });
   }
   const AxisFactor& ax = fp.axes[0];

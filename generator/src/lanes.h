@@ -82,51 +82,34 @@ struct Window {
   }
 };
 
-/// Removes the kernel, returning Σ(|R_before| - |R_after|) and eq. 7's gradient; R_before goes to `out`.
-template <int N, int D, class Gradient>
-double remove(float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient, float* saved) {
+/// Removes the kernel (kRemove: R -= K, R_before kept in `saved`), returning Σ(|R_before| - |R_after|) and
+/// eq. 7's gradient; or, for a kernel not in R (!kRemove, nothing written), Σ(|R + K| - |R|) and the
+/// gradient at the new configuration. Four-lane sums (Numerics::kOriginal), any window (N = 0: its width at
+/// run time). One pass seen from either side: the kernel is in R `with` and not `without`.
+template <int N, bool kRemove, int D, class Gradient>
+double measure(std::conditional_t<kRemove, float*, const float*> R, const Grid<D>& grid,
+               const Footprint<D>& fp, Gradient& gradient, float* saved) {
   const Window<N> w(fp);
   float* __restrict out = saved;
   F4 e = splat4(0);
   std::array<F4, D> g{};
   rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
     const F4 pf = splat4(p);
-    float* __restrict row = R + base;
+    auto* __restrict row = R + base;
     F4 sx = splat4(0), sg = splat4(0);
     for (int q = 0; 4 * q < w.width; ++q) {
       const F4 r = load4(row + 4 * q), va = w.value(q);
-      const F4 rn = r - pf * va;
-      sx += signed_by(r, w.deriv(q));
-      sg += signed_by(r, va);
-      e += abs4(r) - abs4(rn);
-      store4(out + 4 * q, r);
-      store4(row + 4 * q, rn);
+      const F4 rn = kRemove ? r - pf * va : r + pf * va;
+      const F4 with = kRemove ? r : rn, without = kRemove ? rn : r;
+      sx += signed_by(with, w.deriv(q));
+      sg += signed_by(with, va);
+      e += abs4(with) - abs4(without);
+      if constexpr (kRemove) {
+        store4(out + 4 * q, r);
+        store4(row + 4 * q, rn);
+      }
     }
-    out += w.width;
-    g[0] += pf * sx;
-    for (int k = 1; k < D; ++k) g[k] += splat4(pd[k]) * sg;
-  });
-  for (int k = 0; k < D; ++k) gradient[k] = sum4(g[k]);
-  return sum4(e);
-}
-
-/// For a kernel not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
-template <int N, int D, class Gradient>
-double added(const float* R, const Grid<D>& grid, const Footprint<D>& fp, Gradient& gradient) {
-  const Window<N> w(fp);
-  F4 e = splat4(0);
-  std::array<F4, D> g{};
-  rows(grid, fp, [&](std::int64_t base, float p, const std::array<float, D>& pd) {
-    const F4 pf = splat4(p);
-    const float* row = R + base;
-    F4 sx = splat4(0), sg = splat4(0);
-    for (int q = 0; 4 * q < w.width; ++q) {
-      const F4 r = load4(row + 4 * q), va = w.value(q);
-      const F4 rn = r + pf * va;
-      sx += signed_by(rn, w.deriv(q));
-      sg += signed_by(rn, va);
-      e += abs4(rn) - abs4(r);
-    }
+    if constexpr (kRemove) out += w.width;
     g[0] += pf * sx;
     for (int k = 1; k < D; ++k) g[k] += splat4(pd[k]) * sg;
   });
@@ -145,9 +128,7 @@ inline double sum_lanes(const F4 (&v)[N]) {
   return sum4(t);
 }
 
-/// remove() (kRemove: R -= K, the old R kept in `saved`) or added() (R + K, nothing written) with per-lane
-/// sums, for windows of 4N = 8, 12 or 16 nodes. One pass seen from either side: the kernel is in R `with`
-/// and not `without`.
+/// measure() with per-lane sums, for windows of 4N = 8, 12 or 16 nodes.
 template <int N, bool kRemove, int D, class Gradient>
 double measure_per_lane(std::conditional_t<kRemove, float*, const float*> R, const Grid<D>& grid,
                         const Footprint<D>& fp, Gradient& gradient, float* saved) {

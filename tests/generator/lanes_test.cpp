@@ -168,7 +168,7 @@ void check_per_lane_sums() {
       return lanes::measure_per_lane<n(), true>(a.data(), grid, fp, ga, saved.data());
     });
     const double eb = per_lane_width(
-        fp.width, [&](auto n) { return lanes::remove<n()>(b.data(), grid, fp, gb, saved.data()); });
+        fp.width, [&](auto n) { return lanes::measure<n(), true>(b.data(), grid, fp, gb, saved.data()); });
     const double tolerance = 2e-4;
     EXPECT_NEAR(ea, eb, tolerance);
     for (int k = 0; k < D; ++k) EXPECT_NEAR(ga[k], gb[k], tolerance);
