@@ -61,7 +61,7 @@ std::size_t footprint_nodes(const Footprint<D>& fp) {
 template <int D>
 void Chain<D>::add(const Footprint<D>& fp, float sign) {
   float* R = residual_.data();
-  if (wide_ && wide::fits(fp)) return wide::add<D>(R, grid(), fp, sign);
+  if (isa_ != wide::Isa::kNone && wide::fits(fp)) return wide::add<D>(isa_, R, grid(), fp, sign);
   if (fp.contiguous) {
     lanes::by_width(fp.width, [&](auto n) { lanes::add<decltype(n)::value>(R, grid(), fp, sign); });
     return;
@@ -145,8 +145,8 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
   if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
   float* out = saved.data();
   if (fp.contiguous) {
-    if (wide_ && !params_.four_lane_sums && wide::fits(fp))
-      return wide::remove<D>(R, grid(), fp, gradient, out);
+    if (isa_ != wide::Isa::kNone && !params_.four_lane_sums && wide::fits(fp))
+      return wide::remove<D>(isa_, R, grid(), fp, gradient, out);
     return lanes::by_width(fp.width, [&](auto n) {
       constexpr int N = decltype(n)::value;
       if constexpr (N > 0) {
@@ -188,7 +188,7 @@ template <int D>
 void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) {
   float* R = residual_.data();
   const float* in = saved.data();
-  if (wide_ && wide::fits(fp)) return wide::restore<D>(R, grid(), fp, in);
+  if (isa_ != wide::Isa::kNone && wide::fits(fp)) return wide::restore<D>(isa_, R, grid(), fp, in);
   if (fp.contiguous) {
     lanes::by_width(fp.width, [&](auto n) { lanes::restore<decltype(n)::value>(R, grid(), fp, in); });
     return;
@@ -207,7 +207,8 @@ template <int D>
 double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const {
   const float* R = residual_.data();
   if (fp.contiguous) {
-    if (wide_ && !params_.four_lane_sums && wide::fits(fp)) return wide::added<D>(R, grid(), fp, gradient);
+    if (isa_ != wide::Isa::kNone && !params_.four_lane_sums && wide::fits(fp))
+      return wide::added<D>(isa_, R, grid(), fp, gradient);
     return lanes::by_width(fp.width, [&](auto n) {
       constexpr int N = decltype(n)::value;
       if constexpr (N > 0) {

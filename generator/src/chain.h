@@ -33,7 +33,7 @@ struct ChainParams {
   double max_step = 1e30;       ///< proposals moving farther than this along any axis are rejected
   bool box_muller = false;      ///< normal deviates by Rng::normal_box_muller() instead of the ziggurat
   bool four_lane_sums = false;  ///< Numerics::kOriginal's sums (lanes.h) instead of per-lane sums
-  bool wide_vectors = true;     ///< the sixteen-lane passes (lanes_wide.h) where the CPU has them
+  int vector_lanes = 16;        ///< the widest passes (lanes_wide.h) the CPU has, up to this many lanes
   std::size_t cache_bytes = std::size_t(256) << 20;  ///< budget of the footprint cache (CachedFootprint)
 };
 
@@ -64,7 +64,7 @@ class Chain {
   const ChainParams& params() const { return params_; }
   void set_params(const ChainParams& params) {
     params_ = params;
-    wide_ = params.wide_vectors && wide::available();
+    isa_ = wide::widest(params.vector_lanes);
   }
   std::vector<float>& residual() { return residual_; }
 
@@ -139,7 +139,7 @@ class Chain {
   static constexpr int kCellBlockMargin = 8;  // 4 to 9 measured the same
   CellBlock cell_block(int cell, int updates) const;
   KernelTable* table(Scratch& scratch) const {
-    scratch.table.wide = wide_;
+    scratch.table.isa = isa_;
     return uniform_ ? &scratch.table : nullptr;
   }
   double sigma_for(double rho, double w, Scratch& scratch) const {
@@ -156,10 +156,10 @@ class Chain {
   Checkerboard<D> board_;           // sweep(): the cells and the update order
   CellRuns runs_;                   // sweep(): a colour's cells shared out among threads
   FootprintCache<D> own_cache_;
-  FootprintCache<D>* cache_;    // sweep(): each particle's footprint, by particle index
-  bool cache_emptied_ = false;  // cache_ has been emptied for this chain
-  bool uniform_ = false;        // every node has the same ρ: skip the interpolation
-  bool wide_ = false;           // the sixteen-lane passes run where a footprint fits them
+  FootprintCache<D>* cache_;          // sweep(): each particle's footprint, by particle index
+  bool cache_emptied_ = false;        // cache_ has been emptied for this chain
+  bool uniform_ = false;              // every node has the same ρ: skip the interpolation
+  wide::Isa isa_ = wide::Isa::kNone;  // the wide passes' instruction set, where a footprint fits them
   double uniform_rho_ = 0;
 };
 

@@ -66,8 +66,8 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
     const float* row = table->coef.data() + std::size_t(piece) * KernelTable::kCoefs * KernelTable::kLanes +
                        (j0 + KernelTable::kHalf);
     constexpr int L = KernelTable::kLanes;
-    if (table->wide && wide::fits_width(rounded)) {
-      wide::tabulated_axis(row, L, rounded, s[0], j0, jlo, jhi, edge, with_derivative, v, dv);
+    if (table->isa != wide::Isa::kNone && wide::fits_width(rounded)) {
+      wide::tabulated_axis(table->isa, row, L, rounded, s[0], j0, jlo, jhi, edge, with_derivative, v, dv);
       return;
     }
     I4 j = I4{0, 1, 2, 3} + j0;

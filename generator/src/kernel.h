@@ -49,10 +49,16 @@ inline int round_up4(int n) {
 /// cubic Hermite interpolant in u, exact values and derivatives at the piece ends, for the nodes within
 /// kHalf of x. Models with one σ everywhere (constant density) use it as their kernel: within 1e-8 of the
 /// Gaussian factor, C1 in x, and a few multiply-adds per node instead of an exp.
+namespace wide {
+/// The instruction sets of lanes_wide.h's passes, narrowest first.
+enum class Isa : std::uint8_t { kNone, kAvx2, kAvx512 };
+}  // namespace wide
+
 struct KernelTable {
   static constexpr int kHalf = 16, kLanes = 2 * kHalf + 4, kPieces = 16, kCoefs = 7;
   double sigma = 0;
-  bool wide = false;  ///< evaluate sixteen lanes at a time (lanes_wide.h; the same bits) where the CPU can
+  wide::Isa isa =
+      wide::Isa::kNone;     ///< evaluate 8, 12 or 16 lanes at a time with it (lanes_wide.h; the same bits)
   std::vector<float> coef;  ///< [piece][value c0..c3, derivative e0..e2][lane = j + kHalf]
   /// Rebuilds the table if it is not for `s`.
   void prepare(double s);

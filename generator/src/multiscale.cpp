@@ -58,7 +58,7 @@ struct Driver {
     params.metropolis = o.metropolis;
     params.box_muller = o.numerics == Numerics::kOriginal;
     params.four_lane_sums = o.numerics == Numerics::kOriginal;
-    params.wide_vectors = o.wide_vectors;
+    params.vector_lanes = o.vector_lanes;
     params.cache_bytes = o.footprint_cache_bytes;
   }
 

@@ -70,9 +70,18 @@ void expect_same_bits(const std::vector<float>& a, const std::vector<float>& b, 
   EXPECT_EQ(differ, 0u) << what;
 }
 
+// The instruction sets of the wide passes this CPU runs (AVX-512 CPUs run the AVX2 passes too).
+std::vector<wide::Isa> wide_isas() {
+  std::vector<wide::Isa> isas;
+  if (wide::widest(8) == wide::Isa::kAvx2) isas.push_back(wide::Isa::kAvx2);
+  if (wide::widest(16) == wide::Isa::kAvx512) isas.push_back(wide::Isa::kAvx512);
+  return isas;
+}
+constexpr const char* kNoWidePasses = "this CPU has neither AVX2 nor AVX-512: the wide passes never run here";
+
 template <int D>
-void check_wide_passes() {
-  if (!wide::available()) GTEST_SKIP() << "this CPU has no AVX-512: the sixteen-lane passes never run here";
+void check_wide_passes(wide::Isa isa) {
+  SCOPED_TRACE(isa == wide::Isa::kAvx512 ? "AVX-512" : "AVX2");
   const Grid<D> grid = test_grid<D>();
   Rng rng(7, 1, 2, 3, D);
   KernelTable table;
@@ -85,7 +94,7 @@ void check_wide_passes() {
     std::vector<float> wide_saved(16 * 64 * 64), lane_saved(wide_saved.size());
     Vec<D> wide_g, lane_g;
 
-    const double wide_e = wide::remove<D>(wide_r.data(), grid, fp, wide_g, wide_saved.data());
+    const double wide_e = wide::remove<D>(isa, wide_r.data(), grid, fp, wide_g, wide_saved.data());
     const double lane_e = per_lane_width(fp.width, [&](auto n) {
       return lanes::measure_per_lane<n(), true>(lane_r.data(), grid, fp, lane_g, lane_saved.data());
     });
@@ -94,18 +103,18 @@ void check_wide_passes() {
     expect_same_bits(wide_r, lane_r, "R after remove");
     expect_same_bits(wide_saved, lane_saved, "saved nodes");
 
-    const double wide_a = wide::added<D>(wide_r.data(), grid, fp, wide_g);
+    const double wide_a = wide::added<D>(isa, wide_r.data(), grid, fp, wide_g);
     const double lane_a = per_lane_width(fp.width, [&](auto n) {
       return lanes::measure_per_lane<n(), false>(lane_r.data(), grid, fp, lane_g, nullptr);
     });
     EXPECT_EQ(bits(wide_a), bits(lane_a)) << "added, width " << fp.width;
     for (int k = 0; k < D; ++k) EXPECT_EQ(bits(wide_g[k]), bits(lane_g[k])) << "added gradient " << k;
 
-    wide::add<D>(wide_r.data(), grid, fp, -0.5f);
+    wide::add<D>(isa, wide_r.data(), grid, fp, -0.5f);
     per_lane_width(fp.width, [&](auto n) { lanes::add<n()>(lane_r.data(), grid, fp, -0.5f); });
     expect_same_bits(wide_r, lane_r, "R after add");
 
-    wide::restore<D>(wide_r.data(), grid, fp, wide_saved.data());
+    wide::restore<D>(isa, wide_r.data(), grid, fp, wide_saved.data());
     per_lane_width(fp.width,
                    [&](auto n) { lanes::restore<n()>(lane_r.data(), grid, fp, lane_saved.data()); });
     expect_same_bits(wide_r, lane_r, "R after restore");
@@ -115,19 +124,21 @@ void check_wide_passes() {
 }
 
 TEST(LanesTest, WidePassesGiveThePerLaneBits2D) {
-  check_wide_passes<2>();
+  if (wide_isas().empty()) GTEST_SKIP() << kNoWidePasses;
+  for (const wide::Isa isa : wide_isas()) check_wide_passes<2>(isa);
 }
 TEST(LanesTest, WidePassesGiveThePerLaneBits3D) {
-  check_wide_passes<3>();
+  if (wide_isas().empty()) GTEST_SKIP() << kNoWidePasses;
+  for (const wide::Isa isa : wide_isas()) check_wide_passes<3>(isa);
 }
 
-// The tabulated kernel evaluated sixteen lanes at a time gives the four-lane evaluation's factors exactly.
-TEST(LanesTest, WideKernelTableGivesTheSameFactors) {
-  if (!wide::available()) GTEST_SKIP() << "this CPU has no AVX-512: the sixteen-lane passes never run here";
+// The tabulated kernel evaluated on wide vectors gives the four-lane evaluation's factors exactly.
+void check_wide_kernel_table(wide::Isa isa) {
+  SCOPED_TRACE(isa == wide::Isa::kAvx512 ? "AVX-512" : "AVX2");
   const Grid<2> grid = test_grid<2>();
   Rng rng(9, 1, 2, 3, 4);
   KernelTable four, sixteen;
-  sixteen.wide = true;
+  sixteen.isa = isa;
   int wide_rows = 0;
   for (const double sigma : {0.95, 1.52, 2.2, 4.0})
     for (const bool with_derivative : {false, true})
@@ -150,6 +161,11 @@ TEST(LanesTest, WideKernelTableGivesTheSameFactors) {
         if (::testing::Test::HasFailure()) return;
       }
   EXPECT_GT(wide_rows, 50);
+}
+
+TEST(LanesTest, WideKernelTableGivesTheSameFactors) {
+  if (wide_isas().empty()) GTEST_SKIP() << kNoWidePasses;
+  for (const wide::Isa isa : wide_isas()) check_wide_kernel_table(isa);
 }
 
 // Per-lane and four-lane sums add the same terms in another order, so they agree to float rounding. Over

@@ -97,10 +97,12 @@ TEST(SamplerTest, FootprintCacheDoesNotChangeTheOutput) {
   }
 }
 
-// The sixteen-lane passes give the four-lane passes' bits (lanes_test checks each pass), so whole point sets
-// do not depend on the CPU: uniform and varying densities, torus and box, 2D and 3D, both arithmetics.
+// The wide passes give the four-lane passes' bits (lanes_test checks each pass), so whole point sets do not
+// depend on the CPU: uniform and varying densities, torus and box, 2D and 3D, both arithmetics, 16, 8 and 4
+// lanes.
 TEST(SamplerTest, WideVectorsDoNotChangeTheOutput) {
-  if (!wide::available()) GTEST_SKIP() << "this CPU has no AVX-512: the sixteen-lane passes never run here";
+  if (!wide::available())
+    GTEST_SKIP() << "this CPU has neither AVX2 nor AVX-512: the wide passes never run here";
   Density ramp;
   ramp.function = [](const double* u) { return 0.05 + u[0]; };
   for (const Numerics numerics : {Numerics::kFast, Numerics::kOriginal})
@@ -110,10 +112,13 @@ TEST(SamplerTest, WideVectorsDoNotChangeTheOutput) {
         o.dim = dim;
         o.numerics = numerics;
         const Density density = domain == Domain::kBox ? ramp : Density::constant();
-        const SampleResult wide = sample(o, density);
-        o.wide_vectors = false;
-        EXPECT_EQ(sample(o, density).points, wide.points)
-            << "numerics " << int(numerics) << " domain " << int(domain) << " dim " << dim;
+        const SampleResult widest = sample(o, density);
+        for (const int lanes : {8, 4}) {
+          o.vector_lanes = lanes;
+          EXPECT_EQ(sample(o, density).points, widest.points)
+              << "numerics " << int(numerics) << " domain " << int(domain) << " dim " << dim << " lanes "
+              << lanes;
+        }
       }
 }
 

@@ -119,6 +119,11 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
   cmd->add_flag("--timing", args->timing, "Print points per second on stdout (default: off)");
+  cmd->add_option("--vector-lanes", o.vector_lanes,
+                  "Widest vectors the updates use: 16 (AVX-512 where the CPU has it), 8 (AVX2), 4 (SSE2); "
+                  "the output is the same")
+      ->check(CLI::IsMember({4, 8, 16}))
+      ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
                   "Output file: .txt (UTK/psa points in [0,1)), .csv, .svg or .png")
       ->required();

@@ -83,9 +83,10 @@ struct SamplerOptions {
   double step = 0;
   bool metropolis = true;  ///< false = unadjusted Langevin (biased; for experiments only)
   Numerics numerics = Numerics::kFast;
-  /// Run the update passes sixteen lanes wide where the CPU has AVX-512. The output does not depend on it
-  /// (the passes give the same bits either way); false is for testing that.
-  bool wide_vectors = true;
+  /// The widest vectors the update passes may use: 16 lanes (AVX-512, where the CPU has it), 8 (AVX2),
+  /// 4 (SSE2, every x86-64). The output does not depend on it (the passes give the same bits at every
+  /// width); lower values are for testing that and for measuring.
+  int vector_lanes = 16;
   /// Memory for keeping each point's kernel footprint between sweeps (about 300 bytes per point in 2D):
   /// a quarter less work per update. Levels with more points than fit skip it. The output does not depend
   /// on it.
