@@ -214,6 +214,7 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
   expect_error("sample --n 100 --density const:0" + out, "const:V");  // all-zero density
   expect_error("sample --n 100 --density const:-1" + out, "const:V");
+  expect_error("sample --n 100 --vector-lanes 5" + out, "vector-lanes");  // 16, 8 or 4 only
   const Outcome one = kdm("sample --n 1" + out);
   ASSERT_EQ(one.status, 0) << one.err;
   std::vector<kdm::tools::PointSet> sets;
