@@ -93,7 +93,6 @@ class CellRuns {
       }
     }
   }
-  int runs() const { return runs_; }
 
  private:
   struct alignas(64) Span {
