@@ -6,10 +6,6 @@
 #include <algorithm>
 #include <cmath>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace kdm::gen {
 namespace {
 
@@ -338,12 +334,7 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
   const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 + 3 +
                        std::ceil(std::min(params_.max_step, 1e9));
   board_.layout(grid(), reach);
-#ifdef _OPENMP
-  const int nthreads = std::max(1, threads > 0 ? threads : omp_get_max_threads());
-#else
-  const int nthreads = 1;
-  (void)threads;
-#endif
+  const int nthreads = thread_count(threads);
   // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
   board_.sort(particles, nthreads, local_);
   const std::vector<int>& order = board_.order();

@@ -3,10 +3,6 @@
 #include "lanes_wide.h"
 #include "simd.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 namespace kdm::gen {
 
 double truncated_factor_integral() {
@@ -177,6 +173,7 @@ void FootprintCache<D>::reset(std::size_t n, int threads) {
   reserve(n);
   CachedFootprint<D>* entries = entries_.get();
   const std::int64_t count = static_cast<std::int64_t>(n);
+  (void)threads;  // used only by OpenMP
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
   for (std::int64_t j = 0; j < count; ++j) new (entries + j) CachedFootprint<D>();
   size_ = n;

@@ -7,10 +7,7 @@
 #include <numeric>
 
 #include "chain.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "parallel.h"
 
 namespace kdm::gen {
 namespace {
@@ -49,10 +46,7 @@ struct Driver {
   int threads = 1;          ///< OpenMP threads for the set-up of each level (sweeps take options.threads)
   FootprintCache<D> cache;  ///< lent to every level's chain
 
-  Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s) {
-#ifdef _OPENMP
-    threads = std::max(1, o.threads > 0 ? o.threads : omp_get_max_threads());
-#endif
+  Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s), threads(thread_count(o.threads)) {
     params.temperature = o.temperature * kModelTemperaturePerUser;
     params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;

@@ -8,6 +8,17 @@
 
 namespace kdm::gen {
 
+/// The threads to ask for when a caller requests `requested` (0 or less: as many as OpenMP would use);
+/// 1 without OpenMP.
+inline int thread_count(int requested) {
+#ifdef _OPENMP
+  return requested > 0 ? requested : (omp_get_max_threads() > 0 ? omp_get_max_threads() : 1);
+#else
+  (void)requested;
+  return 1;
+#endif
+}
+
 /// Runs body(thread, team) on each thread of a team of up to `threads` (one thread without OpenMP, or when
 /// `parallel` is false).
 template <class Body>
