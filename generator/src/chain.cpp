@@ -328,18 +328,15 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
 }
 
 template <int D>
-void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index,
-                     int threads, ChainCounters& counters) {
+void Chain<D>::sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys, int count, int threads,
+                      ChainCounters& counters, const std::function<void()>& after_sweep) {
+  if (count <= 0) return;
   // Cells at least two footprints plus a step wide. The 3 is a footprint's lane padding (kernel.h).
   const double reach = std::ceil(kCut * std::min(params_.sigma_bound, params_.sigma_cap)) + 1 + 3 +
                        std::ceil(std::min(params_.max_step, 1e9));
   board_.layout(grid(), reach);
   const int nthreads = thread_count(threads);
-  // Updates run on a copy in cell order, so consecutive updates read consecutive particles.
-  board_.sort(particles, nthreads, local_);
-  const std::vector<int>& order = board_.order();
   if (static_cast<int>(scratch_.size()) < nthreads) scratch_.resize(nthreads);
-  std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
   // The footprint cache costs ~300 bytes per point: past its budget (by default about 900,000 points)
   // updates build both footprints instead, which gives the same bits.
   const bool caching = particles.size() * sizeof(CachedFootprint<D>) <= params_.cache_bytes;
@@ -347,6 +344,25 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
     cache_->reset(particles.size(), nthreads);
     cache_emptied_ = true;
   }
+  // The sweeps run on a copy in cell order, so consecutive updates read consecutive particles, and it
+  // stays in that order between sweeps (resort()), so each thread keeps its band's particles.
+  board_.sort(particles, nthreads, local_);
+  for (int s = 0; s < count; ++s) {
+    if (s > 0) board_.resort(local_, nthreads);
+    sweep(keys.seed, keys.level, keys.first_index + s * keys.index_step, nthreads, caching, counters);
+    if (after_sweep) after_sweep();
+  }
+  const std::vector<int>& order = board_.order();
+  const std::int64_t updates = static_cast<std::int64_t>(order.size());
+#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
+  for (std::int64_t t = 0; t < updates; ++t) particles[order[t]] = local_[t];
+}
+
+template <int D>
+void Chain<D>::sweep(std::uint64_t seed, int level, int sweep_index, int nthreads, bool caching,
+                     ChainCounters& counters) {
+  const std::vector<int>& order = board_.order();
+  std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
   FootprintCache<D>& cache = *cache_;
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =
@@ -391,13 +407,6 @@ void Chain<D>::sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, in
         while ((ci = runs_.claim((thread + k) % nthreads, false, next)) >= 0) update_cell(ci, -1, s);
     });
   }
-  // Back by particle index, so each thread writes its own stretch of `particles` (written in update
-  // order, every cache line of it went back and forth between the cores).
-  const std::vector<int>& update_of = board_.update_of_particle();
-  const std::int64_t n = static_cast<std::int64_t>(particles.size());
-#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
-  for (std::int64_t j = 0; j < n; ++j)
-    if (update_of[j] >= 0) particles[j] = local_[update_of[j]];
   counters.proposals += order.size();
   for (std::uint64_t a : accepted_in_cell) counters.accepted += a;
 }

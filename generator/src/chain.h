@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "checkerboard.h"
@@ -52,7 +53,7 @@ class Chain {
     double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
 
-  /// `density` must outlive the chain, and so must `cache` if given: sweep() then keeps its footprints
+  /// `density` must outlive the chain, and so must `cache` if given: sweeps() then keeps its footprints
   /// there (emptied at the first sweep) instead of in storage of its own, so that a caller running one
   /// chain after another sets up that storage once.
   Chain(const DensityGrid<D>& density, const ChainParams& params, FootprintCache<D>* cache = nullptr);
@@ -95,9 +96,17 @@ class Chain {
   /// the footprint at p's position afterwards. Returns true when the proposal was accepted.
   bool update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached = nullptr);
 
-  /// One sweep over the active particles (in the deterministic checkerboard order).
-  void sweep(std::vector<Particle<D>>& particles, std::uint64_t seed, int level, int sweep_index, int threads,
-             ChainCounters& counters);
+  /// Where a run of sweeps takes its random numbers: sweep s draws from the stream of (seed, level,
+  /// first_index + s * index_step).
+  struct SweepKeys {
+    std::uint64_t seed = 0;
+    int level = 0, first_index = 0, index_step = 1;
+  };
+  /// `count` sweeps over the active particles, each in the deterministic checkerboard order, on up to
+  /// `threads` OpenMP threads (the result does not depend on how many), calling after_sweep (if set)
+  /// after each. `particles` is read before the first and written after the last. Not thread-safe.
+  void sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys, int count, int threads,
+              ChainCounters& counters, const std::function<void()>& after_sweep = {});
 
  private:
   // Removes the kernel of `fp` from R, returning Σ(|R_before| - |R_after|) and the gradient of eq. 7;
@@ -108,6 +117,9 @@ class Chain {
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
   void prefetch(const Particle<D>& p, Scratch& scratch) const;
+  // One sweep over local_ in board_'s order.
+  void sweep(std::uint64_t seed, int level, int sweep_index, int nthreads, bool caching,
+             ChainCounters& counters);
   // The block of R that a cell's updates touch: the cell and a margin of kCellBlockMargin nodes (a
   // footprint's reach at the peak density, its lane padding and a step). sweep() fetches the next cell's
   // block a slice per update, so a cell does not start by missing the cache on every row it touches first: at
@@ -151,12 +163,12 @@ class Chain {
   const DensityGrid<D>* density_;
   ChainParams params_;
   std::vector<float> residual_;
-  std::vector<Particle<D>> local_;  // sweep(): the active particles in update order
-  std::vector<Scratch> scratch_;    // sweep(): one per thread, kept for its kernel tables
-  Checkerboard<D> board_;           // sweep(): the cells and the update order
-  CellRuns runs_;                   // sweep(): a colour's cells shared out among threads
+  std::vector<Particle<D>> local_;  // sweeps(): the active particles in update order
+  std::vector<Scratch> scratch_;    // sweeps(): one per thread, kept for its kernel tables
+  Checkerboard<D> board_;           // sweeps(): the cells and the update order
+  CellRuns runs_;                   // sweeps(): a colour's cells shared out among threads
   FootprintCache<D> own_cache_;
-  FootprintCache<D>* cache_;          // sweep(): each particle's footprint, by particle index
+  FootprintCache<D>* cache_;          // sweeps(): each particle's footprint, by particle index
   bool cache_emptied_ = false;        // cache_ has been emptied for this chain
   bool uniform_ = false;              // every node has the same ρ: skip the interpolation
   wide::Isa isa_ = wide::Isa::kNone;  // the wide passes' instruction set, where a footprint fits them

@@ -44,36 +44,8 @@ int Checkerboard<D>::cell_of(const Vec<D>& x) const {
 }
 
 template <int D>
-void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int threads,
-                           std::vector<Particle<D>>& sorted) {
-  // A counting sort in three passes, the first and last over `runs` contiguous runs of particles at once.
-  // Each run counts its particles per cell; a run's particles of cell c go after those of earlier runs,
-  // which is the serial order exactly.
-  const std::int64_t n = static_cast<std::int64_t>(particles.size());
-  const int runs = std::max(1, threads);
+int Checkerboard<D>::place_runs(int runs, std::size_t stride) {
   const std::size_t cells = static_cast<std::size_t>(total_cells_);
-  // Each run's counters on cache lines of their own: shared lines made the sort of a 1,024-point level
-  // ten times slower on two threads than on one.
-  const std::size_t stride = (cells + 15) / 16 * 16 + 16;
-  cell_of_particle_.resize(particles.size());
-  update_of_particle_.resize(particles.size());
-  run_slots_.assign(stride * runs, 0);
-  auto run_range = [&](int run, std::int64_t& lo, std::int64_t& hi) {
-    lo = n * run / runs;
-    hi = n * (run + 1) / runs;
-  };
-  // Small levels sort faster on one thread than the team takes to start.
-  const bool parallel = runs > 1 && n >= kParallelFrom;
-  for_each_part(runs, parallel, [&](int run, int) {
-    std::int64_t lo, hi;
-    run_range(run, lo, hi);
-    int* count = run_slots_.data() + stride * run;
-    for (std::int64_t j = lo; j < hi; ++j) {
-      const int c = particles[j].active ? cell_of(particles[j].x) : -1;
-      cell_of_particle_[j] = c;
-      if (c >= 0) ++count[c];
-    }
-  });
   first_in_cell_.resize(cells + 1);
   int placed = 0;
   for (std::size_t c = 0; c < cells; ++c) {
@@ -85,17 +57,109 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
     }
   }
   first_in_cell_[cells] = placed;
+  return placed;
+}
+
+namespace {
+
+// Each run's counters on cache lines of their own: shared lines made the sort of a 1,024-point level
+// ten times slower on two threads than on one.
+std::size_t run_stride(int cells) {
+  return (static_cast<std::size_t>(cells) + 15) / 16 * 16 + 16;
+}
+
+// [lo, hi) of run `run` of `runs` over n items.
+void run_range(std::int64_t n, int run, int runs, std::int64_t& lo, std::int64_t& hi) {
+  lo = n * run / runs;
+  hi = n * (run + 1) / runs;
+}
+
+}  // namespace
+
+template <int D>
+void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int threads,
+                           std::vector<Particle<D>>& sorted) {
+  // A counting sort in three passes, the first and last over `runs` contiguous runs of particles at once.
+  // Each run counts its particles per cell; a run's particles of cell c go after those of earlier runs,
+  // which is the serial order exactly.
+  const std::int64_t n = static_cast<std::int64_t>(particles.size());
+  const int runs = std::max(1, threads);
+  const std::size_t stride = run_stride(total_cells_);
+  cell_.resize(particles.size());
+  run_slots_.assign(stride * runs, 0);
+  // Small levels sort faster on one thread than the team takes to start.
+  const bool parallel = runs > 1 && n >= kParallelFrom;
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(n, run, runs, lo, hi);
+    int* count = run_slots_.data() + stride * run;
+    for (std::int64_t j = lo; j < hi; ++j) {
+      const int c = particles[j].active ? cell_of(particles[j].x) : -1;
+      cell_[j] = c;
+      if (c >= 0) ++count[c];
+    }
+  });
+  const int placed = place_runs(runs, stride);
   order_.resize(static_cast<std::size_t>(placed));
   sorted.resize(static_cast<std::size_t>(placed));
   for_each_part(runs, parallel, [&](int run, int) {
     std::int64_t lo, hi;
-    run_range(run, lo, hi);
+    run_range(n, run, runs, lo, hi);
     int* slot = run_slots_.data() + stride * run;
     for (std::int64_t j = lo; j < hi; ++j) {
-      const int c = cell_of_particle_[j];
-      const int update = c >= 0 ? slot[c]++ : -1;
-      if (update >= 0) order_[update] = static_cast<int>(j), sorted[update] = particles[j];
-      update_of_particle_[j] = update;
+      const int c = cell_[j];
+      if (c < 0) continue;
+      const int update = slot[c]++;
+      order_[update] = static_cast<int>(j), sorted[update] = particles[j];
+    }
+  });
+}
+
+template <int D>
+void Checkerboard<D>::resort(std::vector<Particle<D>>& sorted, int threads) {
+  // The counting sort of sort(), over the current order instead of particle index. A cell then receives
+  // its particles ordered by (old cell, index): the ones that stayed, in index order, and those that
+  // arrived from each neighbour, in index order too; an insertion sort per cell merges them, which costs
+  // little since few particles change cells in a sweep.
+  const std::int64_t n = static_cast<std::int64_t>(sorted.size());
+  const int runs = std::max(1, threads);
+  const std::size_t stride = run_stride(total_cells_);
+  cell_.resize(sorted.size());
+  run_slots_.assign(stride * runs, 0);
+  spare_order_.resize(sorted.size());
+  spare_sorted_.resize(sorted.size());
+  const bool parallel = runs > 1 && n >= kParallelFrom;
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(n, run, runs, lo, hi);
+    int* count = run_slots_.data() + stride * run;
+    for (std::int64_t t = lo; t < hi; ++t) ++count[cell_[t] = cell_of(sorted[t].x)];
+  });
+  place_runs(runs, stride);
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(n, run, runs, lo, hi);
+    int* slot = run_slots_.data() + stride * run;
+    for (std::int64_t t = lo; t < hi; ++t) {
+      const int to = slot[cell_[t]]++;
+      spare_order_[to] = order_[t], spare_sorted_[to] = sorted[t];
+    }
+  });
+  order_.swap(spare_order_);
+  sorted.swap(spare_sorted_);
+  for_each_part(runs, parallel, [&](int run, int) {
+    std::int64_t lo, hi;
+    run_range(total_cells_, run, runs, lo, hi);
+    for (std::int64_t c = lo; c < hi; ++c) {
+      const int first = first_in_cell_[c], end = first_in_cell_[c + 1];
+      for (int t = first + 1; t < end; ++t) {
+        if (order_[t - 1] < order_[t]) continue;
+        const int index = order_[t];
+        const Particle<D> p = sorted[t];
+        int u = t;
+        for (; u > first && order_[u - 1] > index; --u) order_[u] = order_[u - 1], sorted[u] = sorted[u - 1];
+        order_[u] = index, sorted[u] = p;
+      }
     }
   });
 }

@@ -28,6 +28,13 @@ class Checkerboard {
   /// into `sorted` (resized to fit). Uses up to `threads` OpenMP threads; the order does not depend on how
   /// many. Not thread-safe (call from one thread).
   void sort(const std::vector<Particle<D>>& particles, int threads, std::vector<Particle<D>>& sorted);
+  /// Sorts `sorted` again after its particles have moved: `sorted` must be the last sort's result (in
+  /// order()'s order, possibly with new positions). Gives the same order() and `sorted` as sort() on the
+  /// particles in index order, but splits the work by stretches of the current order, i.e. by bands of the
+  /// grid, so each thread moves the particles its own cells hold (sorting by particle index, each thread
+  /// wrote half of every cell's particles, and the sweep then fetched them from the other core). Uses up to
+  /// `threads` OpenMP threads; not thread-safe.
+  void resort(std::vector<Particle<D>>& sorted, int threads);
 
   int cell_count() const { return total_cells_; }
   const std::array<int, D>& cells_per_axis() const { return ncell_; }
@@ -38,19 +45,23 @@ class Checkerboard {
   int updates_in(int cell) const { return first_in_cell_[cell + 1] - first_in_cell_[cell]; }
   /// Particle index of each update, cell by cell.
   const std::vector<int>& order() const { return order_; }
-  /// The inverse: each particle's place in order(), or -1 if it is not active.
-  const std::vector<int>& update_of_particle() const { return update_of_particle_; }
 
  private:
   int cell_of(const Vec<D>& x) const;
+  // Turns each run's counts per cell (in run_slots_) into its first place in each cell, runs in order
+  // within a cell; sets first_in_cell_. Returns the number of places.
+  int place_runs(int runs, std::size_t stride);
   static constexpr std::int64_t kParallelFrom = 4096;  // particles; fewer sort faster on one thread
 
   std::array<int, D> ncell_{};
   std::array<double, D> width_{};
   int total_cells_ = 0;
   std::array<std::vector<int>, (1 << D)> cells_by_colour_;
-  std::vector<int> cell_of_particle_, first_in_cell_, order_, update_of_particle_;
-  std::vector<int> run_slots_;  // sort(): per run of particles and cell, the next free place in order_
+  std::vector<int> first_in_cell_, order_;
+  std::vector<int> cell_;         // sort(), resort(): each particle's (entry's) cell, -1 if inactive
+  std::vector<int> run_slots_;    // sort(), resort(): per run and cell, the next free place in order_
+  std::vector<int> spare_order_;  // resort(): the new order, swapped in
+  std::vector<Particle<D>> spare_sorted_;  // resort(): the new `sorted`, swapped in
 };
 
 /// A colour's cells shared out among threads. Run r of `runs` is a stretch of the colour's cells in

@@ -15,6 +15,11 @@ namespace {
 constexpr std::uint64_t kInitStream = 0x494e4954;  // "INIT"
 constexpr std::uint64_t kRefineStream = 0x524546;  // "REF"
 
+using Clock = std::chrono::steady_clock;
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
 template <int D>
 Vec<D> node_centre(const Grid<D>& g, std::int64_t i) {
   Vec<D> x{};
@@ -297,13 +302,15 @@ struct Driver {
   }
 
   void relax_level(int level, int sweeps) {
+    const auto t0 = Clock::now();
+    const bool relaxing = !options.initial_points.empty();
+    const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1 && !relaxing;
+    if (!coarsest && !relaxing) refine(level);
     DensityGrid<D>& density = setup.levels[level];
     Chain<D> chain(density, params, &cache);
     typename Chain<D>::Scratch scratch;
     if (level == 0)
       for (const auto& p : fixed) chain.splat(p, 1.0f, scratch);
-    const bool relaxing = !options.initial_points.empty();
-    const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1 && !relaxing;
     if (coarsest) {
       initial_configuration(chain);
       if (options.n > 0) fix_count_coarse(chain);
@@ -332,16 +339,19 @@ struct Driver {
     ChainParams descent = level_params;
     descent.temperature = 0;
     ChainCounters burn_in;
-    for (int s = 0; s < options.burn_in_sweeps; ++s) {
-      chain.set_params(descent);
-      chain.sweep(particles, options.seed, level, -1 - s, options.threads, burn_in);
-    }
+    const auto t1 = Clock::now();
+    chain.set_params(descent);
+    chain.sweeps(particles, {options.seed, level, -1, -1}, options.burn_in_sweeps, options.threads, burn_in);
     chain.set_params(level_params);
-    for (int s = 0; s < sweeps; ++s) {
-      chain.sweep(particles, options.seed, level, s, options.threads, counters);
+    const auto t2 = Clock::now();
+    chain.sweeps(particles, {options.seed, level, 0, 1}, sweeps, options.threads, counters, [&] {
       done_sweeps += double(lr.active_points) / std::max<double>(1, options.n);
       if (options.progress) options.progress(std::min(1.0, done_sweeps / std::max(1.0, total_sweeps)));
-    }
+    });
+    const auto t3 = Clock::now();
+    lr.setup_seconds = seconds_between(t0, t1);
+    lr.burn_in_seconds = seconds_between(t1, t2);
+    lr.sweep_seconds = seconds_between(t2, t3);
     for (int k = 0; k < D; ++k) lr.grid[k] = density.grid.dims[k];
     lr.points = static_cast<std::int64_t>(particles.size());
     lr.sweeps = sweeps;
@@ -362,7 +372,7 @@ struct Driver {
   }
 
   SampleResult run() {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const int levels = static_cast<int>(setup.levels.size());
     // Progress is measured in point-sweeps relative to n: level l holds about n / 2^(D l) points.
     for (int l = 0; l < levels; ++l)
@@ -381,10 +391,7 @@ struct Driver {
       total_sweeps = options.burn_in_sweeps + options.sweeps;
       relax_level(0, options.sweeps);
     } else {
-      for (int l = levels - 1; l >= 0; --l) {
-        if (l < levels - 1) refine(l);
-        relax_level(l, sweeps_at(l));
-      }
+      for (int l = levels - 1; l >= 0; --l) relax_level(l, sweeps_at(l));
     }
     report.model_temperature = params.temperature;
     SampleResult result;
@@ -398,7 +405,7 @@ struct Driver {
         result.points[j * D + k] = u;
       }
     }
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    report.seconds = seconds_between(t0, Clock::now());
     result.report = report;
     return result;
   }

@@ -1,6 +1,7 @@
 // Public entry points of the KDM sampler; see kdm/generator/sampler.h and multiscale.h.
 #include "kdm/generator/sampler.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "chain.h"
@@ -12,8 +13,13 @@ namespace {
 
 template <int D>
 SampleResult sample_dim(const SamplerOptions& options, const Density& density) {
+  const auto t0 = std::chrono::steady_clock::now();
   ModelSetup<D> setup = build_model<D>(options, density);
-  return run_multiscale<D>(options, setup);
+  const double model_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  SampleResult result = run_multiscale<D>(options, setup);
+  result.report.model_seconds = model_seconds;
+  result.report.seconds += model_seconds;
+  return result;
 }
 
 template <int D>

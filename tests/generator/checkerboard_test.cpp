@@ -40,6 +40,22 @@ int cell_index(const Checkerboard<D>& board, const Vec<D>& x) {
   return id;
 }
 
+// The definition of the order: cells in storage order, ascending particle index within a cell.
+template <int D>
+void expect_serial_order(const Checkerboard<D>& board, const std::vector<Particle<D>>& particles,
+                         const std::vector<Particle<D>>& sorted, const char* what, int threads) {
+  std::vector<int> expected;
+  for (int c = 0; c < board.cell_count(); ++c) {
+    ASSERT_EQ(board.first(c), static_cast<int>(expected.size())) << what << ", threads " << threads;
+    for (std::size_t j = 0; j < particles.size(); ++j)
+      if (particles[j].active && cell_index<D>(board, particles[j].x) == c)
+        expected.push_back(static_cast<int>(j));
+  }
+  ASSERT_EQ(board.order(), expected) << what << ", threads " << threads;
+  ASSERT_EQ(sorted.size(), expected.size());
+  for (std::size_t t = 0; t < expected.size(); ++t) ASSERT_EQ(sorted[t].x, particles[expected[t]].x) << what;
+}
+
 TEST(CheckerboardTest, SortMatchesTheSerialDefinitionForAnyThreadCount) {
   Grid<2> g;
   g.dims = {1008, 760};
@@ -49,24 +65,33 @@ TEST(CheckerboardTest, SortMatchesTheSerialDefinitionForAnyThreadCount) {
     board.layout(g, 15.0);
     std::vector<Particle<2>> sorted;
     board.sort(particles, threads, sorted);
-    // The definition: cells in storage order, ascending particle index within a cell.
-    std::vector<int> expected;
-    for (int c = 0; c < board.cell_count(); ++c) {
-      ASSERT_EQ(board.first(c), static_cast<int>(expected.size())) << "threads " << threads;
-      for (std::size_t j = 0; j < particles.size(); ++j)
-        if (particles[j].active && cell_index<2>(board, particles[j].x) == c)
-          expected.push_back(static_cast<int>(j));
-    }
-    ASSERT_EQ(board.order(), expected) << "threads " << threads;
-    ASSERT_EQ(sorted.size(), expected.size());
-    for (std::size_t t = 0; t < expected.size(); ++t) {
-      ASSERT_EQ(sorted[t].x, particles[expected[t]].x);
-      ASSERT_EQ(board.update_of_particle()[expected[t]], static_cast<int>(t));
-    }
-    for (std::size_t j = 0; j < particles.size(); ++j)
-      if (!particles[j].active) {
-        ASSERT_EQ(board.update_of_particle()[j], -1);
+    expect_serial_order(board, particles, sorted, "sort", threads);
+  }
+}
+
+// After the particles move (most a little, as in a sweep, some across several cells), resorting the last
+// order gives what sorting them afresh by index gives, sweep after sweep.
+TEST(CheckerboardTest, ResortMatchesTheSerialDefinitionForAnyThreadCount) {
+  Grid<2> g;
+  g.dims = {1008, 760};
+  for (const int threads : {1, 2, 3, 5}) {
+    auto particles = random_particles(g, 30000, 4);
+    Checkerboard<2> board;
+    board.layout(g, 15.0);
+    std::vector<Particle<2>> sorted;
+    board.sort(particles, threads, sorted);
+    Rng rng(9, static_cast<std::uint64_t>(threads));
+    for (int sweep = 0; sweep < 3; ++sweep) {
+      for (std::size_t t = 0; t < sorted.size(); ++t) {
+        Particle<2>& p = particles[board.order()[t]];
+        const double reach = rng.below(20) == 0 ? 200.0 : 8.0;
+        for (int k = 0; k < 2; ++k)
+          p.x[k] = std::fmod(p.x[k] + (2 * rng.uniform() - 1) * reach + g.dims[k], double(g.dims[k]));
+        sorted[t] = p;
       }
+      board.resort(sorted, threads);
+      expect_serial_order(board, particles, sorted, "resort", threads);
+    }
   }
 }
 

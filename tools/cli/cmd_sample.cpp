@@ -77,6 +77,11 @@ void run_sample(const SampleArgs& args) {
   if (args.timing) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
                 r.seconds, set.size() / std::max(1e-9, r.seconds), o.threads, r.acceptance_rate());
+    std::printf("model seconds %.4f\n", r.model_seconds);
+    for (const gen::LevelReport& l : r.levels)
+      std::printf("level grid %dx%d points %lld sweeps %d setup %.4f burn_in %.4f sweeps_seconds %.4f\n",
+                  l.grid[0], l.grid[1], static_cast<long long>(l.points), l.sweeps, l.setup_seconds,
+                  l.burn_in_seconds, l.sweep_seconds);
   }
 }
 
@@ -118,7 +123,8 @@ void add_sample_command(CLI::App& app) {
                 "Skip the Metropolis-Hastings test (biased; experiments only)");
   cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
-  cmd->add_flag("--timing", args->timing, "Print points per second on stdout (default: off)");
+  cmd->add_flag("--timing", args->timing,
+                "Print points per second and each level's time on stdout (default: off)");
   cmd->add_option("--vector-lanes", o.vector_lanes,
                   "Widest vectors the updates use: 16 (AVX-512 where the CPU has it), 8 (AVX2), 4 (SSE2); "
                   "the output is the same")

@@ -120,6 +120,9 @@ struct LevelReport {
   int sweeps = 0;
   std::uint64_t proposals = 0;
   std::uint64_t accepted = 0;
+  /// Wall seconds: refinement, splats, initial configuration and count fixing; the descent (burn-in)
+  /// sweeps; the MH sweeps. For finding where a run's time goes (`kdm sample --timing`).
+  double setup_seconds = 0, burn_in_seconds = 0, sweep_seconds = 0;
 };
 
 struct SampleReport {
@@ -131,7 +134,8 @@ struct SampleReport {
   double energy_per_point = 0;  ///< E / n at the end, finest grid
   std::int64_t inserted_for_exact_count = 0;
   std::int64_t removed_for_exact_count = 0;
-  double seconds = 0;
+  double model_seconds = 0;  ///< building the density pyramid (before the levels run)
+  double seconds = 0;        ///< the whole call, model_seconds included
 };
 
 struct SampleResult {
