@@ -223,6 +223,44 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   EXPECT_EQ(sets.at(0).size(), 1u);
 }
 
+// --timing: the throughput line, the model's time, then one line per level (coarsest first, grids doubling)
+// whose set-up, burn-in and sweep times add up to no more than the whole run (within the printed rounding).
+TEST_F(CliTest, SampleTimingReportsEveryLevel) {
+  const Outcome r = kdm("sample --n 4096 --timing -o '" + path("s.txt") + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  double total = -1, model = -1, levels_sum = 0;
+  std::vector<int> grids;
+  while (std::getline(lines, line)) {
+    long long points = 0;
+    int gx = 0, gy = 0, sweeps = 0;
+    double seconds = 0, setup = -1, burn_in = -1, sweep_seconds = -1;
+    if (std::sscanf(line.c_str(), "points %lld seconds %lf", &points, &seconds) == 2) {
+      EXPECT_EQ(points, 4096);
+      total = seconds;
+    } else if (std::sscanf(line.c_str(), "model seconds %lf", &seconds) == 1) {
+      model = seconds;
+    } else if (std::sscanf(line.c_str(),
+                           "level grid %dx%d points %lld sweeps %d setup %lf burn_in %lf sweeps_seconds %lf",
+                           &gx, &gy, &points, &sweeps, &setup, &burn_in, &sweep_seconds) == 7) {
+      grids.push_back(gx);
+      EXPECT_GT(sweeps, 0) << line;
+      EXPECT_GE(setup, 0) << line;
+      EXPECT_GE(burn_in, 0) << line;
+      EXPECT_GT(sweep_seconds, 0) << line;
+      levels_sum += setup + burn_in + sweep_seconds;
+    } else {
+      ADD_FAILURE() << "unexpected line: " << line;
+    }
+  }
+  ASSERT_GE(grids.size(), 2u) << r.out;
+  for (std::size_t l = 1; l < grids.size(); ++l) EXPECT_EQ(grids[l], 2 * grids[l - 1]) << r.out;
+  EXPECT_GT(model, 0) << r.out;
+  EXPECT_GT(total, 0) << r.out;
+  EXPECT_LE(levels_sum + model, total + 5e-4) << r.out;  // each figure printed to 0.1 ms
+}
+
 TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
   const std::string out = " -o '" + path("q.txt") + "'";
   const Outcome zero = kdm("query --rect 0,0,1,1 --scale 0" + out);  // defined: no points
