@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "kernel.h"
+#include "parallel.h"
 
 namespace kdm::gen {
 namespace {
@@ -19,9 +20,11 @@ std::string format_position(const double* u) {
   return s.str();
 }
 
-/// Samples the density at every node of `grid` (averaging supersamples where the source is finer).
+/// Samples the density at every node of `grid` (averaging supersamples where the source is finer), on up
+/// to `threads` threads when the density may be called concurrently. Throws InvalidArgument naming the
+/// first node (in storage order) where the density is not finite or negative, whatever the thread count.
 template <int D>
-std::vector<float> sample_density(const Grid<D>& grid, const Density& density) {
+std::vector<float> sample_density(const Grid<D>& grid, const Density& density, int threads) {
   std::vector<float> rho(static_cast<std::size_t>(grid.size()));
   if (!density.function) {
     std::fill(rho.begin(), rho.end(), 1.0f);
@@ -33,28 +36,45 @@ std::vector<float> sample_density(const Grid<D>& grid, const Density& density) {
     sub[k] = std::clamp((density.native_resolution[k] + grid.dims[k] - 1) / std::max(1, grid.dims[k]), 1, 8);
     subsamples *= sub[k];
   }
-  std::array<int, D> node{};
-  for (std::int64_t i = 0; i < grid.size(); ++i) {
-    double sum = 0;
-    for (int s = 0; s < subsamples; ++s) {
-      double u[3] = {0, 0, 0};
-      int rest = s;
-      for (int k = 0; k < D; ++k) {
-        const int j = rest % sub[k];
-        rest /= sub[k];
-        u[k] = (node[k] + (j + 0.5) / sub[k]) / grid.dims[k];
+  // Rows along the first axis, cut into one stretch per part; each part stops at its first bad node.
+  const std::int64_t rows = grid.size() / grid.dims[0];
+  const int parts = density.thread_safe && grid.size() >= (1 << 16) ? std::max(1, threads) : 1;
+  std::vector<std::int64_t> bad_node(static_cast<std::size_t>(parts), grid.size());
+  std::vector<std::string> bad_message(static_cast<std::size_t>(parts));
+  for_each_part(parts, parts > 1, [&](int part, int) {
+    for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
+      std::array<int, D> node{};
+      std::int64_t rest = row;
+      for (int k = 1; k < D; ++k) {
+        node[k] = static_cast<int>(rest % grid.dims[k]);
+        rest /= grid.dims[k];
       }
-      const double v = density.function(u);
-      if (!std::isfinite(v)) throw InvalidArgument("density is not finite at " + format_position<D>(u));
-      if (v < 0) throw InvalidArgument("density is negative at " + format_position<D>(u));
-      sum += v;
+      for (node[0] = 0; node[0] < grid.dims[0]; ++node[0]) {
+        double sum = 0;
+        for (int s = 0; s < subsamples; ++s) {
+          double u[3] = {0, 0, 0};
+          int rest = s;
+          for (int k = 0; k < D; ++k) {
+            const int j = rest % sub[k];
+            rest /= sub[k];
+            u[k] = (node[k] + (j + 0.5) / sub[k]) / grid.dims[k];
+          }
+          const double v = density.function(u);
+          if (!std::isfinite(v) || v < 0) {
+            bad_node[part] = row * grid.dims[0] + node[0];
+            bad_message[part] =
+                std::string(std::isfinite(v) ? "density is negative at " : "density is not finite at ") +
+                format_position<D>(u);
+            return;
+          }
+          sum += v;
+        }
+        rho[static_cast<std::size_t>(row * grid.dims[0] + node[0])] = static_cast<float>(sum / subsamples);
+      }
     }
-    rho[i] = static_cast<float>(sum / subsamples);
-    for (int k = 0; k < D; ++k) {
-      if (++node[k] < grid.dims[k]) break;
-      node[k] = 0;
-    }
-  }
+  });
+  const auto first_bad = std::min_element(bad_node.begin(), bad_node.end());
+  if (*first_bad < grid.size()) throw InvalidArgument(bad_message[first_bad - bad_node.begin()]);
   return rho;
 }
 
@@ -112,6 +132,7 @@ void validate_options(const SamplerOptions& o) {
 template <int D>
 ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
   validate_options(o);
+  const int threads = thread_count(o.threads);
   ModelSetup<D> setup;
   setup.mass_per_point = std::pow(truncated_factor_integral(), D);
   double extent_product = 1, min_extent = o.extent[0];
@@ -128,7 +149,7 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       Grid<D> probe;
       probe.torus = true;
       for (int k = 0; k < D; ++k) probe.dims[k] = D == 2 ? 64 : 24;
-      const std::vector<float> p = sample_density<D>(probe, density);
+      const std::vector<float> p = sample_density<D>(probe, density, 1);
       double sum = 0, mx = 0;
       for (float v : p) sum += v, mx = std::max<double>(mx, v);
       if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
@@ -139,7 +160,7 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
         std::pow(total * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product), 1.0 / D);
     for (int attempt = 0;; ++attempt) {
       grid = make_grid<D>(o, std::max(1.0, shortest), levels);
-      rho = sample_density<D>(grid, density);
+      rho = sample_density<D>(grid, density, threads);
       double sum = 0, mx = 0;
       for (float v : rho) sum += v, mx = std::max<double>(mx, v);
       if (!(sum > 0)) throw InvalidArgument("density is zero everywhere");
@@ -153,7 +174,7 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     }
   } else {
     grid = make_grid<D>(o, o.resolution, levels);
-    rho = sample_density<D>(grid, density);
+    rho = sample_density<D>(grid, density, threads);
     const double mx = *std::max_element(rho.begin(), rho.end());
     if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
     for (float& v : rho) v = static_cast<float>(v * (o.peak_density / mx));
@@ -207,6 +228,7 @@ Density Density::from_values(int width, int height, std::vector<float> values) {
   }
   if (!any) throw InvalidArgument("density image is zero everywhere");
   Density d;
+  d.thread_safe = true;  // the lambda below only reads its shared, immutable values
   d.native_resolution[0] = width;
   d.native_resolution[1] = height;
   auto data = std::make_shared<std::vector<float>>(std::move(values));

@@ -1,6 +1,7 @@
 // The full sampler (Algorithm 2) end to end: exact counts, determinism, density accuracy, bad input.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -69,10 +70,12 @@ TEST(SamplerTest, SameSeedSameBitsForAnyThreadCount) {
   EXPECT_EQ(a.points, c.points);
   o.seed = 10;
   EXPECT_NE(sample(o).points, a.points);
-  // Large enough that the sweeps' sort, the refinement and the splats of a level run on every thread,
-  // in a box with a varying density (cells of unequal load, kernels folded at the walls).
+  // Large enough that the density's sampling, the sweeps' sort, the refinement and the splats of a level
+  // run on every thread, in a box with a varying density (cells of unequal load, kernels folded at the
+  // walls).
   Density ramp;
   ramp.function = [](const double* u) { return 0.05 + u[0] * u[1]; };
+  ramp.thread_safe = true;
   SamplerOptions big = options_for(20000, Domain::kBox, 3);
   big.threads = 1;
   const SampleResult one = sample(big, ramp);
@@ -154,6 +157,44 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   EXPECT_THROW(Density::from_values(2, 2, {0, 0, 0, 0}), InvalidArgument);
   EXPECT_THROW(Density::from_values(2, 2, {1, 1, -1, 1}), InvalidArgument);
   EXPECT_THROW(Density::from_values(0, 0, {}), InvalidArgument);
+}
+
+// A density sampled on several threads still names the first bad node in storage order, as one thread
+// does; a density not marked thread-safe is never called from two threads at once.
+TEST(SamplerTest, DensitySamplingOnThreadsKeepsItsErrorsAndItsContract) {
+  SamplerOptions o = options_for(20000, Domain::kBox, 2);
+  Density holes;  // NaN in two patches; the one lower in y comes first in storage order
+  holes.function = [](const double* u) {
+    const bool low = u[0] > 0.7 && u[1] > 0.2 && u[1] < 0.25, high = u[0] < 0.1 && u[1] > 0.8;
+    return low || high ? std::nan("") : 1.0;
+  };
+  holes.thread_safe = true;
+  std::string first;
+  for (const int threads : {1, 2, 3}) {
+    o.threads = threads;
+    try {
+      sample(o, holes);
+      ADD_FAILURE() << "no error on " << threads << " threads";
+    } catch (const InvalidArgument& e) {
+      if (first.empty()) first = e.what();
+      EXPECT_EQ(e.what(), first) << threads << " threads";
+    }
+  }
+  EXPECT_NE(first.find("not finite at (0.7"), std::string::npos) << first;
+
+  std::atomic<int> inside{0}, most{0};
+  Density serial;
+  serial.function = [&](const double* u) {
+    const int now = ++inside;
+    int seen = most.load();
+    while (now > seen && !most.compare_exchange_weak(seen, now)) {
+    }
+    --inside;
+    return 0.1 + u[0];
+  };
+  o.threads = 2;
+  EXPECT_EQ(sample(o, serial).size(), 20000u);
+  EXPECT_EQ(most.load(), 1);
 }
 
 TEST(SamplerTest, MoreThanTheGridCanHoldIsRefusedByName) {

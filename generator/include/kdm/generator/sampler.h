@@ -24,7 +24,7 @@ struct InvalidArgument : std::invalid_argument {
 enum class Domain { kTorus, kBox };
 
 /// Relative target density at normalized position u in [0, 1)^dim. Must return a finite value >= 0.
-/// Called from one thread at a time, only during the setup of sample().
+/// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe.
 using DensityFunction = std::function<double(const double* u)>;
 
 /// The target density. Only its shape matters: the sampler scales it to the requested point count.
@@ -33,6 +33,9 @@ struct Density {
   /// For densities sampled from an image: its size in pixels per axis. When the computational grid is
   /// coarser than this, each grid node averages several samples so no image detail aliases.
   int native_resolution[3] = {0, 0, 0};
+  /// `function` may be called from several threads at once: the set-up then samples it on up to
+  /// SamplerOptions::threads threads (the result is the same). from_values() sets it.
+  bool thread_safe = false;
 
   static Density constant() { return {}; }
   /// A 2D density from `width`×`height` values (row 0 at the top, i.e. at u_y near 1), bilinearly
