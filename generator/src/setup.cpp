@@ -44,10 +44,10 @@ std::vector<float> sample_density(const Grid<D>& grid, const Density& density, i
   for_each_part(parts, parts > 1, [&](int part, int) {
     for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
       std::array<int, D> node{};
-      std::int64_t rest = row;
+      std::int64_t higher_axes = row;
       for (int k = 1; k < D; ++k) {
-        node[k] = static_cast<int>(rest % grid.dims[k]);
-        rest /= grid.dims[k];
+        node[k] = static_cast<int>(higher_axes % grid.dims[k]);
+        higher_axes /= grid.dims[k];
       }
       for (node[0] = 0; node[0] < grid.dims[0]; ++node[0]) {
         double sum = 0;

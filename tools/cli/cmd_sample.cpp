@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "commands.h"
 #include "density_arg.h"
@@ -78,10 +79,13 @@ void run_sample(const SampleArgs& args) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
                 r.seconds, set.size() / std::max(1e-9, r.seconds), o.threads, r.acceptance_rate());
     std::printf("model seconds %.4f\n", r.model_seconds);
-    for (const gen::LevelReport& l : r.levels)
-      std::printf("level grid %dx%d points %lld sweeps %d setup %.4f burn_in %.4f sweeps_seconds %.4f\n",
-                  l.grid[0], l.grid[1], static_cast<long long>(l.points), l.sweeps, l.setup_seconds,
+    for (const gen::LevelReport& l : r.levels) {
+      std::string grid = std::to_string(l.grid[0]);
+      for (int k = 1; k < set.dim; ++k) grid += "x" + std::to_string(l.grid[k]);
+      std::printf("level grid %s points %lld sweeps %d setup %.4f burn_in %.4f sweeps_seconds %.4f\n",
+                  grid.c_str(), static_cast<long long>(l.points), l.sweeps, l.setup_seconds,
                   l.burn_in_seconds, l.sweep_seconds);
+    }
   }
 }
 
