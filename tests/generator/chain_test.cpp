@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <vector>
 
 #include "chain.h"
+#include "huge_pages.h"
 
 namespace kdm::gen {
 namespace {
@@ -248,6 +250,38 @@ TEST(ChainTest, CachedFootprintIsTheFreshBuild) {
       EXPECT_EQ(loaded.axes[1].value[b], built.axes[1].value[b]);
       EXPECT_EQ(loaded.axes[1].deriv[b], built.axes[1].deriv[b]);
     }
+  }
+}
+
+// The footprint cache is advised into huge pages. Advice must never touch contents (MADV_DONTNEED or
+// MADV_FREE in its place would zero pages that were written), whatever the range's alignment.
+TEST(HugePagesTest, AdviceKeepsTheContentsOfAnyRange) {
+  std::vector<std::uint64_t> buffer((std::size_t(6) << 20) / sizeof(std::uint64_t));
+  for (std::size_t i = 0; i < buffer.size(); ++i) buffer[i] = i * 0x9e3779b97f4a7c15ull;
+  char* bytes = reinterpret_cast<char*>(buffer.data());
+  const std::size_t size = buffer.size() * sizeof(std::uint64_t);
+  advise_huge_pages(bytes, size);
+  advise_huge_pages(bytes + 3, size - 5);
+  advise_huge_pages(bytes + 4096, 100);
+  advise_huge_pages(nullptr, 0);
+  for (std::size_t i = 0; i < buffer.size(); ++i) ASSERT_EQ(buffer[i], i * 0x9e3779b97f4a7c15ull) << i;
+}
+
+TEST(HugePagesTest, LargeFootprintCacheHoldsNothingUntilKept) {
+  FootprintCache<2> cache;
+  const std::size_t n = (std::size_t(8) << 20) / sizeof(CachedFootprint<2>);  // advised: 8 MiB
+  cache.reset(n, 2);
+  ASSERT_EQ(cache.size(), n);
+  Grid<2> grid;
+  grid.dims = {64, 48};
+  KernelTable table;
+  Footprint<2> built;
+  const Vec<2> x{20.3, 17.8};
+  built.build(grid, x, 1.52, 0.43, true, &table);
+  for (std::size_t j : {std::size_t(0), n / 2, n - 1}) {
+    EXPECT_FALSE(cache[j].holds(x, 1.52, 0.43)) << j;
+    cache[j].keep(built, x, 1.52);
+    EXPECT_TRUE(cache[j].holds(x, 1.52, 0.43)) << j;
   }
 }
 
