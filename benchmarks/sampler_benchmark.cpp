@@ -101,4 +101,26 @@ BENCHMARK(BM_TwoThreadsOverOne)->Arg(16384)->Iterations(31)->ArgName("n")->Unit(
 BENCHMARK(BM_TwoThreadsOverOne)->Arg(65536)->Iterations(15)->ArgName("n")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TwoThreadsOverOne)->Arg(262144)->Iterations(7)->ArgName("n")->Unit(benchmark::kMillisecond);
 
+// Linear in n: rounds of n = 16,384 then n = 262,144 on one thread, back to back. Counters: ratio, the
+// median of t(262,144)/t(16,384) over the rounds (18 or less is the target; 16 would be exactly linear),
+// with its quartiles.
+static void BM_LinearInN(benchmark::State& state) {
+  kdm::gen::SamplerOptions small, large;
+  small.n = 16384;
+  large.n = 262144;
+  small.threads = large.threads = 1;
+  seconds_to_sample(small);  // warm-up, as above
+  seconds_to_sample(large);
+  std::vector<double> ratio;
+  for (auto _ : state) {
+    const double t_small = seconds_to_sample(small);
+    ratio.push_back(seconds_to_sample(large) / t_small);
+    ++small.seed, ++large.seed;
+  }
+  state.counters["ratio"] = quantile(ratio, 0.5);
+  state.counters["ratio_q1"] = quantile(ratio, 0.25);
+  state.counters["ratio_q3"] = quantile(ratio, 0.75);
+}
+BENCHMARK(BM_LinearInN)->Iterations(7)->Unit(benchmark::kMillisecond);
+
 BENCHMARK_MAIN();
