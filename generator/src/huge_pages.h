@@ -10,9 +10,9 @@
 namespace kdm::gen {
 
 /// Asks the system to back the 2 MiB-aligned pages inside [p, p + bytes) with huge pages when they are
-/// first touched (Linux madvise; a no-op elsewhere, where transparent huge pages are off, or for buffers
-/// smaller than two huge pages). Advice only: the buffer works the same either way. Memory already touched
-/// keeps its pages. Thread-safe.
+/// first touched (Linux madvise; a no-op elsewhere, where transparent huge pages are off, or when the range
+/// holds no whole aligned 2 MiB page). Advice only: the buffer and its contents stay the same either way.
+/// Memory already touched keeps its pages. Thread-safe.
 void advise_huge_pages(void* p, std::size_t bytes) noexcept;
 
 }  // namespace kdm::gen

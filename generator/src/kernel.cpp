@@ -166,8 +166,8 @@ void FootprintCache<D>::reserve(std::size_t n) {
   size_ = capacity_ = 0;
   entries_.reset(static_cast<CachedFootprint<D>*>(
       ::operator new (n * sizeof(CachedFootprint<D>), std::align_val_t{alignof(CachedFootprint<D>)})));
-  // Touched by every update of every sweep in an order unrelated to its layout: huge pages also spare
-  // the TLB (8% of the run time at n = 262,144).
+  // Faulted in 512 times less often, and, touched by every update in an order unrelated to its layout,
+  // kinder to the TLB: 7-9% of the run time at n = 262,144 (README, "Measured").
   advise_huge_pages(entries_.get(), n * sizeof(CachedFootprint<D>));
   capacity_ = n;
 }
