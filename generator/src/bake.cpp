@@ -24,6 +24,10 @@ namespace {
 // 0.7 gives δavg .65–.81 and lowP up to .112; 0.5 gives δavg .69–.82 and lowP at most .099.
 constexpr double kFilterWidth = 0.5;
 
+// The coarsest level's sweeps in the versions that baked the first tile sets (SamplerOptions's default was
+// then 60): a recipe must bake the same tiles in every kdm version.
+constexpr int kFirstCoarsestSweeps = 60;
+
 }  // namespace
 
 BakeRecipe BakeRecipe::parse(const std::string& text) {
@@ -226,7 +230,7 @@ class Baker {
     o.coarse_sweeps = o.sweeps;
     // The arithmetic of the first bakes: a recipe must give the same tiles in every kdm version.
     o.numerics = Numerics::kOriginal;
-    o.coarsest_sweeps = std::max(o.coarsest_sweeps, o.sweeps);
+    o.coarsest_sweeps = std::max(kFirstCoarsestSweeps, o.sweeps);
     // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
     // resolve a residual density confined to patches between fixed bands, and spread the new points
     // unevenly between patches (measured: interiors of one run off by up to ±12%, E/n +13%; from two

@@ -136,6 +136,17 @@ double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) 
 }
 
 template <int D>
+double Chain<D>::energy_change_if_removed(const Particle<D>& p, Scratch& scratch) {
+  const double rho = rho_at(p.x);
+  if (!(rho > 0)) return 0;
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
+  Vec<D> unused{};
+  const double lowered = remove_with_gradient(scratch.old_fp, unused, scratch.saved);
+  restore(scratch.old_fp, scratch.saved);
+  return -lowered;
+}
+
+template <int D>
 double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved) {
   float* R = residual_.data();
   if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));

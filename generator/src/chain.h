@@ -87,6 +87,8 @@ class Chain {
   double energy() const;
   /// Energy change if p's kernel were added (p not yet in R).
   double energy_change_if_added(const Particle<D>& p, Scratch& scratch) const;
+  /// Energy change if p's kernel (in R) were removed. Leaves R as it was, bit for bit.
+  double energy_change_if_removed(const Particle<D>& p, Scratch& scratch);
 
   /// ∇E with respect to p's centre by eq. 7 (σ held fixed); p's kernel must be in R. R is unchanged.
   Vec<D> gradient(const Particle<D>& p, Scratch& scratch);

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "chain.h"
+#include "count_fixing.h"
 #include "parallel.h"
 
 namespace kdm::gen {
@@ -100,23 +101,9 @@ struct Driver {
     const double n = static_cast<double>(options.n);
     typename Chain<D>::Scratch scratch;
     double w = total_weight();
-    while (w > n && !particles.empty()) {
-      std::size_t best = particles.size();
-      double best_cost = std::numeric_limits<double>::infinity();
-      for (int pass = 0; pass < 2 && best == particles.size(); ++pass) {
-        for (std::size_t j = 0; j < particles.size(); ++j) {
-          if (pass == 0 && particles[j].weight() > w - n) continue;  // prefer not to undershoot
-          chain.splat(particles[j], -1.0f, scratch);
-          const double cost = -chain.energy_change_if_added(particles[j], scratch) / particles[j].weight();
-          chain.splat(particles[j], 1.0f, scratch);
-          if (cost < best_cost) best_cost = cost, best = j;
-        }
-      }
-      chain.splat(particles[best], -1.0f, scratch);
-      w -= particles[best].weight();
-      particles.erase(particles.begin() + static_cast<std::ptrdiff_t>(best));
-      ++report.removed_for_exact_count;
-    }
+    report.removed_for_exact_count += options.numerics == Numerics::kOriginal
+                                          ? remove_surplus_as_first_versions(chain, particles, n, w)
+                                          : remove_surplus(chain, particles, n, w);
     const Grid<D>& g = chain.grid();
     const int max_splits = static_cast<int>(setup.levels.size()) - 1;
     while (w < n) {

@@ -1,0 +1,30 @@
+// Exact point counts for Algorithm 2 of Fattal 2011 (multiscale.h): the greedy initial configuration
+// gives about n points, and kernels are then removed where that raises E = Σ|R| least. The paper has no
+// such step; users ask for exactly n points.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "chain.h"
+#include "particle.h"
+
+namespace kdm::gen {
+
+/// Removes kernels from `particles` (every one of them in `chain`'s R) while their total weight `w` exceeds
+/// `n`: each time the one whose removal raises E least per unit of weight, preferring kernels no heavier
+/// than the surplus; ties go to the lowest index. Takes each removed kernel out of R and lowers `w`.
+/// Returns how many were removed. Each kernel's cost is worked out once and again only after a removal
+/// changed R under its footprint, which chooses exactly what working out every cost each time would.
+/// Not thread-safe (one chain, one thread).
+template <int D>
+std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles, double n, double& w);
+
+/// remove_surplus() as kdm's first versions did it, kept for Numerics::kOriginal: every cost worked out
+/// again after each removal by taking the kernel out of R and putting it back, which may change R's last
+/// bits and so the choices after.
+template <int D>
+std::int64_t remove_surplus_as_first_versions(Chain<D>& chain, std::vector<Particle<D>>& particles, double n,
+                                              double& w);
+
+}  // namespace kdm::gen
