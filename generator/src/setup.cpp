@@ -162,7 +162,10 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       grid = make_grid<D>(o, std::max(1.0, shortest), levels);
       rho = sample_density<D>(grid, density, threads);
       double sum = 0, mx = 0;
-      for (float v : rho) sum += v, mx = std::max<double>(mx, v);
+      if (!density.function)
+        sum = static_cast<double>(rho.size()), mx = 1;  // every node 1: what the loop would add up exactly
+      else
+        for (float v : rho) sum += v, mx = std::max<double>(mx, v);
       if (!(sum > 0)) throw InvalidArgument("density is zero everywhere");
       const double scale = total * setup.mass_per_point / sum;
       const double peak = mx * scale;
@@ -186,33 +189,45 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     DensityGrid<D> coarse;
     coarse.grid = fine.grid;
     for (int k = 0; k < D; ++k) coarse.grid.dims[k] /= 2;
-    coarse.rho = box_sum_half<D>(fine.grid, fine.rho);
+    coarse.rho = box_sum_half<D>(fine.grid, fine.rho, threads);
     setup.levels.push_back(std::move(coarse));
   }
   return setup;
 }
 
 template <int D>
-std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values) {
+std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values, int threads) {
   std::array<int, D> coarse_dims{};
-  std::size_t size = 1;
+  std::int64_t size = 1;
   for (int k = 0; k < D; ++k) coarse_dims[k] = fine.dims[k] / 2, size *= coarse_dims[k];
-  std::vector<float> coarse(size, 0.0f);
-  std::array<int, D> node{};
-  for (std::int64_t i = 0; i < fine.size(); ++i) {
-    std::int64_t ci = 0;
-    for (int k = D - 1; k >= 0; --k) ci = ci * coarse_dims[k] + node[k] / 2;
-    coarse[ci] += values[i];
-    for (int k = 0; k < D; ++k) {
-      if (++node[k] < fine.dims[k]) break;
-      node[k] = 0;
+  std::vector<float> coarse(static_cast<std::size_t>(size));
+  // Each coarse node adds its children in storage order, starting from 0: the same bits as adding every
+  // fine value into its parent in one pass over the fine grid, for any number of threads.
+  std::array<std::int64_t, (1 << D)> child{};
+  for (int c = 0; c < (1 << D); ++c)
+    for (int k = 0; k < D; ++k) child[c] += ((c >> k) & 1) * fine.stride(k);
+  const std::int64_t rows = size / coarse_dims[0];
+  const int parts = size >= (1 << 16) ? std::max(1, threads) : 1;
+  for_each_part(parts, parts > 1, [&](int part, int) {
+    for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
+      std::int64_t first = 0, rest = row;  // the fine index of the row's first child
+      for (int k = 1; k < D; ++k) {
+        first += 2 * (rest % coarse_dims[k]) * fine.stride(k);
+        rest /= coarse_dims[k];
+      }
+      float* out = coarse.data() + row * coarse_dims[0];
+      for (int x = 0; x < coarse_dims[0]; ++x, first += 2) {
+        float sum = 0;
+        for (int c = 0; c < (1 << D); ++c) sum += values[static_cast<std::size_t>(first + child[c])];
+        out[x] = sum;
+      }
     }
-  }
+  });
   return coarse;
 }
 
-template std::vector<float> box_sum_half<2>(const Grid<2>&, const std::vector<float>&);
-template std::vector<float> box_sum_half<3>(const Grid<3>&, const std::vector<float>&);
+template std::vector<float> box_sum_half<2>(const Grid<2>&, const std::vector<float>&, int);
+template std::vector<float> box_sum_half<3>(const Grid<3>&, const std::vector<float>&, int);
 template ModelSetup<2> build_model<2>(const SamplerOptions&, const Density&);
 template ModelSetup<3> build_model<3>(const SamplerOptions&, const Density&);
 

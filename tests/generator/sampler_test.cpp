@@ -8,6 +8,8 @@
 
 #include "kdm/generator/sampler.h"
 #include "lanes_wide.h"
+#include "rng.h"
+#include "setup.h"
 
 namespace kdm::gen {
 namespace {
@@ -25,6 +27,37 @@ void expect_inside_unit_square(const SampleResult& r) {
     ASSERT_GE(u, 0.0);
     ASSERT_LT(u, 1.0);
   }
+}
+
+// The coarse levels' densities (box_sum_half) against adding every fine value into its parent in one
+// pass over the fine grid, the first versions' way: the same bits, on 1 and 2 threads, in 2D and 3D.
+template <int D>
+void expect_box_sums_as_one_pass(const std::array<int, D>& dims) {
+  Grid<D> fine;
+  fine.dims = dims;
+  std::vector<float> values(static_cast<std::size_t>(fine.size()));
+  Rng rng(3);
+  for (float& v : values) v = static_cast<float>(rng.uniform() * 3);
+  std::array<int, D> coarse_dims{};
+  std::size_t size = 1;
+  for (int k = 0; k < D; ++k) coarse_dims[k] = dims[k] / 2, size *= coarse_dims[k];
+  std::vector<float> expected(size, 0.0f);
+  std::array<int, D> node{};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::size_t parent = 0;
+    for (int k = D - 1; k >= 0; --k) parent = parent * coarse_dims[k] + node[k] / 2;
+    expected[parent] += values[i];
+    for (int k = 0; k < D && ++node[k] == dims[k]; ++k) node[k] = 0;
+  }
+  EXPECT_EQ(box_sum_half<D>(fine, values, 1), expected);
+  EXPECT_EQ(box_sum_half<D>(fine, values, 2), expected);
+}
+
+TEST(ModelTest, CoarseDensitiesAreTheFirstVersionsBoxSums) {
+  expect_box_sums_as_one_pass<2>({10, 6});
+  expect_box_sums_as_one_pass<2>({520, 512});  // 66,560 coarse nodes: shared between threads
+  expect_box_sums_as_one_pass<3>({8, 6, 4});
+  expect_box_sums_as_one_pass<3>({64, 66, 64});
 }
 
 TEST(SamplerTest, ReturnsExactlyTheRequestedCountOnTorusAndBox) {
