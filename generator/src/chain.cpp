@@ -147,7 +147,7 @@ double Chain<D>::energy_change_if_removed(const Particle<D>& p, Scratch& scratch
 }
 
 template <int D>
-double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved) {
+double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, LineVector<float>& saved) {
   float* R = residual_.data();
   if (saved.size() < footprint_nodes(fp)) saved.resize(footprint_nodes(fp));
   float* out = saved.data();
@@ -192,7 +192,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
 }
 
 template <int D>
-void Chain<D>::restore(const Footprint<D>& fp, const std::vector<float>& saved) {
+void Chain<D>::restore(const Footprint<D>& fp, const LineVector<float>& saved) {
   float* R = residual_.data();
   const float* in = saved.data();
   if (isa_ != wide::Isa::kNone && wide::fits(fp)) return wide::restore<D>(isa_, R, grid(), fp, in);

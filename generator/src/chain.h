@@ -46,10 +46,10 @@ struct ChainCounters {
 template <int D>
 class Chain {
  public:
-  struct Scratch {
+  struct alignas(64) Scratch {  // whole cache lines: each thread writes its own on every update
     Footprint<D> old_fp, new_fp;
     KernelTable table;         ///< the tabulated kernel of uniform models, shared by old_fp and new_fp
-    std::vector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
+    LineVector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
     double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };
 
@@ -113,8 +113,8 @@ class Chain {
  private:
   // Removes the kernel of `fp` from R, returning Σ(|R_before| - |R_after|) and the gradient of eq. 7;
   // keeps R_before in `saved` for restore().
-  double remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, std::vector<float>& saved);
-  void restore(const Footprint<D>& fp, const std::vector<float>& saved);
+  double remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, LineVector<float>& saved);
+  void restore(const Footprint<D>& fp, const LineVector<float>& saved);
   // For a kernel `fp` not in R: Σ(|R + K| - |R|) and the gradient at the new configuration.
   double added_change_with_gradient(const Footprint<D>& fp, Vec<D>& gradient) const;
   void add(const Footprint<D>& fp, float sign);
