@@ -44,26 +44,25 @@ std::vector<Particle<D>> random_kernels(Chain<D>& chain, int count, std::uint64_
   return particles;
 }
 
-// The rule of remove_surplus() with every cost worked out again before each choice.
+// The rule of remove_surplus(), stated directly: among the kernels no heavier than the surplus (all of
+// them if none is), the first of lowest cost, with every cost worked out again before each choice.
 template <int D>
 std::int64_t remove_with_fresh_costs(Chain<D>& chain, std::vector<Particle<D>>& particles, double n,
                                      double& w) {
-  typename Chain<D>::Scratch scratch;
   std::int64_t removed = 0;
-  while (w > n && !particles.empty()) {
-    std::vector<double> cost(particles.size());
-    for (std::size_t j = 0; j < particles.size(); ++j)
-      cost[j] = chain.energy_change_if_removed(particles[j], scratch) / particles[j].weight();
-    std::size_t best = particles.size();
-    for (int pass = 0; pass < 2 && best == particles.size(); ++pass)
-      for (std::size_t j = 0; j < particles.size(); ++j) {
-        if (pass == 0 && particles[j].weight() > w - n) continue;
-        if (best == particles.size() || cost[j] < cost[best]) best = j;
-      }
+  for (typename Chain<D>::Scratch scratch; w > n && !particles.empty(); ++removed) {
+    std::vector<std::pair<double, std::size_t>> light, all;  // (cost, index): pairs order ties by index
+    for (std::size_t j = 0; j < particles.size(); ++j) {
+      const double cost = chain.energy_change_if_removed(particles[j], scratch) / particles[j].weight();
+      all.emplace_back(cost, j);
+      if (particles[j].weight() <= w - n) light.emplace_back(cost, j);
+    }
+    const std::size_t best =
+        std::min_element(light.empty() ? all.begin() : light.begin(), light.empty() ? all.end() : light.end())
+            ->second;
     chain.splat(particles[best], -1.0f, scratch);
     w -= particles[best].weight();
     particles.erase(particles.begin() + static_cast<std::ptrdiff_t>(best));
-    ++removed;
   }
   return removed;
 }
