@@ -48,7 +48,7 @@ class Chain {
  public:
   struct alignas(64) Scratch {  // whole cache lines: each thread writes its own on every update
     Footprint<D> old_fp, new_fp;
-    KernelTable table;         ///< the tabulated kernel of uniform models, shared by old_fp and new_fp
+    KernelTable table;        ///< the tabulated kernel of uniform models, shared by old_fp and new_fp
     LineVector<float> saved;  ///< R under old_fp before its removal, restored exactly on rejection
     double memo_rho = -1, memo_w = -1, memo_sigma = 0;  ///< the last sigma_for(), usually asked again
   };

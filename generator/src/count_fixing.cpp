@@ -25,7 +25,8 @@ template <int D>
 std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles, double n, double& w) {
   typename Chain<D>::Scratch scratch;
   // Kept costs: at n = 16,384 a full rescan after each of some 30 removals took about 2 ms, a third of
-  // the coarsest level; keeping them, a few tenths.
+  // the coarsest level, and in 3D at n = 32,768 (some 440 removals) 2.5 s of a 4.5 s run; keeping them,
+  // 0.5 ms and 0.12 s.
   std::vector<double> cost(particles.size()), reach(particles.size());
   auto cost_of = [&](std::size_t j) {
     return chain.energy_change_if_removed(particles[j], scratch) / particles[j].weight();

@@ -82,10 +82,12 @@ struct LineAllocator {
   template <class U>
   LineAllocator(const LineAllocator<U>&) {}
   static std::size_t bytes(std::size_t n) { return (n * sizeof(T) + 63) / 64 * 64; }
-  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(bytes(n), std::align_val_t{64})); }
-  void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new (bytes(n), std::align_val_t{64})); }
+  void deallocate(T* p, std::size_t) { ::operator delete (p, std::align_val_t{64}); }
   template <class U>
-  bool operator==(const LineAllocator<U>&) const { return true; }
+  bool operator==(const LineAllocator<U>&) const {
+    return true;
+  }
 };
 template <class T>
 using LineVector = std::vector<T, LineAllocator<T>>;

@@ -253,8 +253,6 @@ TEST(ChainTest, CachedFootprintIsTheFreshBuild) {
   }
 }
 
-// The footprint cache is advised into huge pages. Advice must never touch contents (MADV_DONTNEED or
-// MADV_FREE in its place would zero pages that were written), whatever the range's alignment.
 // Scratch that one thread writes on every update must not share a cache line with anything else: small
 // buffers from the allocator do (glibc's chunks are 16 bytes apart), and that made half the seeds a third
 // slower on two threads (kernel.h, LineAllocator).
@@ -281,6 +279,8 @@ TEST(LineAllocatorTest, SmallBuffersShareNoCacheLineWithLaterAllocations) {
   EXPECT_EQ(sizeof(Chain<2>::Scratch) % 64, 0u);
 }
 
+// The footprint cache is advised into huge pages. Advice must never touch contents (MADV_DONTNEED or
+// MADV_FREE in its place would zero pages that were written), whatever the range's alignment.
 TEST(HugePagesTest, AdviceKeepsTheContentsOfAnyRange) {
   std::vector<std::uint64_t> buffer((std::size_t(6) << 20) / sizeof(std::uint64_t));
   for (std::size_t i = 0; i < buffer.size(); ++i) buffer[i] = i * 0x9e3779b97f4a7c15ull;

@@ -75,9 +75,8 @@ double total_weight(const std::vector<Particle<D>>& particles) {
 }
 
 template <int D>
-void expect_same_choices_as_fresh_costs(int side, int count, double surplus, bool torus,
-                                        bool varying = true) {
-  const DensityGrid<D> density = varying_density<D>(side, torus, varying);
+void expect_same_choices_as_fresh_costs(int side, int count, double surplus, bool torus) {
+  const DensityGrid<D> density = varying_density<D>(side, torus);
   ChainParams params;
   Chain<D> kept_chain(density, params), fresh_chain(density, params);
   std::vector<Particle<D>> kept = random_kernels(kept_chain, count, 7);
