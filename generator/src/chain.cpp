@@ -365,7 +365,7 @@ void Chain<D>::sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys
   }
   const std::vector<int>& order = board_.order();
   const std::int64_t updates = static_cast<std::int64_t>(order.size());
-#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1)
+#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1 && updates >= 4096)
   for (std::int64_t t = 0; t < updates; ++t) particles[order[t]] = local_[t];
 }
 

@@ -14,11 +14,17 @@ namespace kdm::gen {
 /// Removes kernels from `particles` (every one of them in `chain`'s R) while their total weight `w` exceeds
 /// `n`: each time the one whose removal raises E least per unit of weight, preferring kernels no heavier
 /// than the surplus; ties go to the lowest index. Takes each removed kernel out of R and lowers `w`.
-/// Returns how many were removed. Each kernel's cost is worked out once and again only after a removal
-/// changed R under its footprint, which chooses exactly what working out every cost each time would.
+/// Returns how many were removed. Chooses exactly what working out every cost before each choice would,
+/// but works out again only the costs that a removal changed and that might now be the lowest.
 /// Not thread-safe (one chain, one thread).
 template <int D>
 std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles, double n, double& w);
+
+/// How far Chain::energy_change_if_removed() (float sums of |r| - |r - k| over the footprint) may lie from
+/// the same sum in exact arithmetic on the same R, for the footprint `fp` it built, when |r| <= max_abs_r
+/// at every node. Thread-safe.
+template <int D>
+double removal_rounding_bound(const Footprint<D>& fp, double max_abs_r);
 
 /// remove_surplus() as kdm's first versions did it, kept for Numerics::kOriginal: every cost worked out
 /// again after each removal by taking the kernel out of R and putting it back, which may change R's last

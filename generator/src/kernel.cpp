@@ -178,7 +178,8 @@ void FootprintCache<D>::reset(std::size_t n, int threads) {
   CachedFootprint<D>* entries = entries_.get();
   const std::int64_t count = static_cast<std::int64_t>(n);
   (void)threads;  // used only by OpenMP
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
+  // A few thousand entries are set faster than a sleeping team wakes up.
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && count >= 4096)
   for (std::int64_t j = 0; j < count; ++j) new (entries + j) CachedFootprint<D>();
   size_ = n;
 }
