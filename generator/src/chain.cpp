@@ -1,5 +1,6 @@
 #include "chain.h"
 
+#include "huge_pages.h"
 #include "lanes.h"
 #include "parallel.h"
 
@@ -21,7 +22,7 @@ template <int D>
 Chain<D>::Chain(const DensityGrid<D>& density, const ChainParams& params, FootprintCache<D>* cache)
     : density_(&density),
       params_(params),
-      residual_(density.rho.size()),
+      residual_(vector_on_huge_pages<float>(density.rho.size(), 0.0f)),
       cache_(cache ? cache : &own_cache_) {
   const std::vector<float>& rho = density.rho;
   uniform_ = !rho.empty() && std::all_of(rho.begin(), rho.end(), [&](float r) { return r == rho[0]; });

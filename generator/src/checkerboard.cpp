@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "huge_pages.h"
 #include "parallel.h"
 
 namespace kdm::gen {
@@ -85,7 +86,7 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
   const std::int64_t n = static_cast<std::int64_t>(particles.size());
   const int runs = std::max(1, threads);
   const std::size_t stride = run_stride(total_cells_);
-  cell_.resize(particles.size());
+  resize_on_huge_pages(cell_, particles.size());
   run_slots_.assign(stride * runs, 0);
   // Small levels sort faster on one thread than the team takes to start.
   const bool parallel = runs > 1 && n >= kParallelFrom;
@@ -100,8 +101,8 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
     }
   });
   const int placed = place_runs(runs, stride);
-  order_.resize(static_cast<std::size_t>(placed));
-  sorted.resize(static_cast<std::size_t>(placed));
+  resize_on_huge_pages(order_, static_cast<std::size_t>(placed));
+  resize_on_huge_pages(sorted, static_cast<std::size_t>(placed));
   for_each_part(runs, parallel, [&](int run, int) {
     std::int64_t lo, hi;
     run_range(n, run, runs, lo, hi);
@@ -124,10 +125,10 @@ void Checkerboard<D>::resort(std::vector<Particle<D>>& sorted, int threads) {
   const std::int64_t n = static_cast<std::int64_t>(sorted.size());
   const int runs = std::max(1, threads);
   const std::size_t stride = run_stride(total_cells_);
-  cell_.resize(sorted.size());
+  resize_on_huge_pages(cell_, sorted.size());
   run_slots_.assign(stride * runs, 0);
-  spare_order_.resize(sorted.size());
-  spare_sorted_.resize(sorted.size());
+  resize_on_huge_pages(spare_order_, sorted.size());
+  resize_on_huge_pages(spare_sorted_, sorted.size());
   const bool parallel = runs > 1 && n >= kParallelFrom;
   for_each_part(runs, parallel, [&](int run, int) {
     std::int64_t lo, hi;

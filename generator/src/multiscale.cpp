@@ -8,6 +8,7 @@
 
 #include "chain.h"
 #include "count_fixing.h"
+#include "huge_pages.h"
 #include "parallel.h"
 
 namespace kdm::gen {
@@ -165,7 +166,8 @@ struct Driver {
     std::vector<std::int64_t> first_child(particles.size() + 1, 0);
     for (std::int64_t j = 0; j < n; ++j)
       first_child[j + 1] = first_child[j] + (particles[j].splits ? 1 << D : 1);
-    std::vector<Particle<D>> next(static_cast<std::size_t>(first_child[n]));
+    std::vector<Particle<D>> next =
+        vector_on_huge_pages(static_cast<std::size_t>(first_child[n]), Particle<D>{});
 #pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
     for (std::int64_t j = 0; j < n; ++j) {
       const Particle<D>& p = particles[j];

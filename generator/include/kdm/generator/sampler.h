@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +28,12 @@ enum class Domain { kTorus, kBox };
 /// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe.
 using DensityFunction = std::function<double(const double* u)>;
 
+/// A density given as `width`×`height` values, row 0 at the top of the picture (u_y near 1).
+struct DensityImage {
+  int width = 0, height = 0;
+  std::vector<float> values;  ///< finite and >= 0, row by row
+};
+
 /// The target density. Only its shape matters: the sampler scales it to the requested point count.
 struct Density {
   DensityFunction function;  ///< empty means constant
@@ -36,6 +43,11 @@ struct Density {
   /// `function` may be called from several threads at once: the set-up then samples it on up to
   /// SamplerOptions::threads threads (the result is the same). from_values() sets it.
   bool thread_safe = false;
+  /// Set by from_values() to the values `function` interpolates: sample() then reads them itself, which
+  /// gives the same values as calling `function` at each node, without a call per node (at 65,536 points
+  /// on examples/sphere.png, setting up the model took 0.33 s of a 1.78 s run that way). Leave it empty
+  /// for a density of your own; if you change `function`, reset it.
+  std::shared_ptr<const DensityImage> image;
 
   static Density constant() { return {}; }
   /// A 2D density from `width`×`height` values (row 0 at the top, i.e. at u_y near 1), bilinearly
