@@ -79,7 +79,7 @@ template <int D>
 void Chain<D>::splat(const Particle<D>& p, float sign, Scratch& scratch) {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch), isa_);
   add(scratch.old_fp, sign);
 }
 
@@ -101,7 +101,7 @@ void Chain<D>::splat_all(const std::vector<Particle<D>>& particles, int threads)
       axis_reach(p.x[D - 1], sigma, lo, hi);
       // Rows past an edge wrap or fold: such kernels are built and their rows sorted out below.
       if (lo >= 0 && hi < m && (hi < first_row || lo >= end_row)) continue;
-      s.old_fp.build(grid(), p.x, sigma, rho, false, table(s));
+      s.old_fp.build(grid(), p.x, sigma, rho, false, table(s), isa_);
       if (bands > 1) {
         AxisFactor& outer = s.old_fp.axes[D - 1];
         int kept = 0;
@@ -131,7 +131,7 @@ template <int D>
 double Chain<D>::energy_change_if_added(const Particle<D>& p, Scratch& scratch) const {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
-  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
+  scratch.new_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch), isa_);
   Vec<D> unused{};
   return added_change_with_gradient(scratch.new_fp, unused);
 }
@@ -140,7 +140,7 @@ template <int D>
 double Chain<D>::energy_change_if_removed(const Particle<D>& p, Scratch& scratch) {
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return 0;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch));
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, false, table(scratch), isa_);
   Vec<D> unused{};
   const double lowered = remove_with_gradient(scratch.old_fp, unused, scratch.saved);
   restore(scratch.old_fp, scratch.saved);
@@ -258,7 +258,7 @@ Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
   Vec<D> g{};
   const double rho = rho_at(p.x);
   if (!(rho > 0)) return g;
-  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, table(scratch));
+  scratch.old_fp.build(grid(), p.x, sigma_for(rho, p.weight()), rho, true, table(scratch), isa_);
   remove_with_gradient(scratch.old_fp, g, scratch.saved);
   restore(scratch.old_fp, scratch.saved);
   return g;
@@ -279,7 +279,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
   if (was_cached)
     cached->load(scratch.old_fp);
   else
-    scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, table(scratch));
+    scratch.old_fp.build(grid(), p.x, sigma_old, rho_old, true, table(scratch), isa_);
   Vec<D> grad_old;
   const double removed = remove_with_gradient(scratch.old_fp, grad_old, scratch.saved);
 
@@ -310,7 +310,7 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
   const double sigma_new = sigma_for(rho_new, w, scratch);
   if (sigma_new > params_.sigma_bound) return reject();
   // With the derivative even when the test does not need it: the footprint may be cached for later.
-  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, true, table(scratch));
+  scratch.new_fp.build(grid(), x_new, sigma_new, rho_new, true, table(scratch), isa_);
   Vec<D> grad_new;
   const double dE = added_change_with_gradient(scratch.new_fp, grad_new) - removed;
 

@@ -44,7 +44,7 @@ void KernelTable::prepare(double s) {
 }
 
 void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int64_t lo, std::int64_t hi,
-                bool with_derivative, float* v, float* dv, const KernelTable* table) {
+                bool with_derivative, float* v, float* dv, const KernelTable* table, wide::Isa isa) {
   const float edge = static_cast<float>(kernel_edge_value());
   // Lanes are numbered from the node c = floor(x) whose cell holds x (u = x - c in [0, 1)), in double
   // first: x may be thousands of nodes out. Each value then depends only on x, σ and the node, never on
@@ -83,6 +83,10 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
   const float inv = static_cast<float>(1.0 / (kKernelWidth * sigma));
   const float dscale = 2 * inv;  // d/dx φ((p - x)/s) = φ · 2 (p - x) / s^2 = φ · 2 t / s
   const float a = static_cast<float>((0.5 - u) * (1.0 / (kKernelWidth * sigma)));  // t at node c
+  if (isa != wide::Isa::kNone && wide::fits_width(rounded)) {
+    wide::computed_axis(isa, rounded, a, inv, dscale, j0, jlo, jhi, edge, with_derivative, v, dv);
+    return;
+  }
   I4 j = I4{0, 1, 2, 3} + j0;
   for (int q = 0; q < rounded; q += 4, j += 4) {
     const F4 t = splat4(a) + __builtin_convertvector(j, F4) * inv;
@@ -96,7 +100,7 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
 }
 
 void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool with_derivative,
-                const KernelTable* table, bool runs) {
+                const KernelTable* table, bool runs, wide::Isa isa) {
   std::int64_t lo, hi;
   axis_reach(x, sigma, lo, hi);
   const int len = static_cast<int>(std::max<std::int64_t>(0, hi - lo + 1));
@@ -106,7 +110,7 @@ void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool w
     a.value.resize(room);
     a.deriv.resize(room);
   }
-  axis_lanes(x, sigma, lo, len, lo, hi, with_derivative, a.value.data(), a.deriv.data(), table);
+  axis_lanes(x, sigma, lo, len, lo, hi, with_derivative, a.value.data(), a.deriv.data(), table, isa);
 
   const bool direct = (torus && len <= m) || (!torus && lo >= 0 && hi < m);
   if (direct) {

@@ -69,7 +69,8 @@ struct KernelTable {
 /// one definition of the kernel's values: every footprint, whatever its shape, is built from it. With a
 /// `table` (prepared for sigma) the factor is the table's interpolant where it reaches, else exp(-t^2).
 void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int64_t lo, std::int64_t hi,
-                bool with_derivative, float* v, float* dv, const KernelTable* table);
+                bool with_derivative, float* v, float* dv, const KernelTable* table,
+                wide::Isa isa = wide::Isa::kNone);
 
 /// Allocates whole cache lines (64-byte aligned, sizes rounded up to 64 bytes), so a thread's scratch
 /// buffers never share a line with memory another thread writes. With glibc's 16-byte chunks, the small
@@ -119,7 +120,7 @@ struct AxisFactor {
 /// Fills `a` for a kernel centred at `x` (grid units) with scale `sigma` on an axis of `m` nodes; `runs`
 /// also fills its runs (only axis 0 is walked by runs).
 void build_axis(AxisFactor& a, double x, double sigma, int m, bool torus, bool with_derivative,
-                const KernelTable* table, bool runs);
+                const KernelTable* table, bool runs, wide::Isa isa = wide::Isa::kNone);
 
 /// Widest axis-0 window (nodes) of a contiguous footprint; wider kernels take the general path.
 inline constexpr int kMaxWindow = 64;
@@ -139,8 +140,9 @@ struct Footprint {
   /// `table`: when not null, the model's kernel is KernelTable's interpolant (a model-wide choice, never per
   /// kernel); it is prepared for `sigma` here. One table serves both footprints of an update: two would
   /// fill the L1 cache between them.
+  /// `isa`: where no table serves, the widest vectors to compute the factors with (the same bits).
   void build(const Grid<D>& grid, const Vec<D>& x, double sigma, double amp, bool with_derivative,
-             KernelTable* table) {
+             KernelTable* table, wide::Isa isa = wide::Isa::kNone) {
     amplitude = amp;
     const KernelTable* tab = nullptr;
     if (table) {
@@ -148,7 +150,7 @@ struct Footprint {
       tab = table;
     }
     for (int k = 1; k < D; ++k)
-      build_axis(axes[k], x[k], sigma, grid.dims[k], grid.torus, with_derivative, tab, false);
+      build_axis(axes[k], x[k], sigma, grid.dims[k], grid.torus, with_derivative, tab, false, isa);
     std::int64_t lo, hi;
     axis_reach(x[0], sigma, lo, hi);
     const int m = grid.dims[0];
@@ -160,9 +162,10 @@ struct Footprint {
       contiguous = start >= 0;
     }
     if (contiguous) {
-      axis_lanes(x[0], sigma, start, width, lo, hi, with_derivative, row_value.data(), row_deriv.data(), tab);
+      axis_lanes(x[0], sigma, start, width, lo, hi, with_derivative, row_value.data(), row_deriv.data(), tab,
+                 isa);
     } else {
-      build_axis(axes[0], x[0], sigma, m, grid.torus, with_derivative, tab, true);
+      build_axis(axes[0], x[0], sigma, m, grid.torus, with_derivative, tab, true, isa);
     }
   }
 

@@ -60,4 +60,9 @@ void tabulated_axis(Isa isa, const float* coef, int stride, int width, float s, 
                     std::int32_t jlo, std::int32_t jhi, float edge, bool with_derivative, float* v,
                     float* dv);
 
+/// kernel.cpp's computed axis factor (axis_lanes without a table: simd.h's exp4 of -t², t = a + k'·inv at
+/// lane k, k' = j0 + k) for 8, 12 or 16 lanes, with the same bits. Writes `width` lanes of v and dv.
+void computed_axis(Isa isa, int width, float a, float inv, float dscale, std::int32_t j0, std::int32_t jlo,
+                   std::int32_t jhi, float edge, bool with_derivative, float* v, float* dv);
+
 }  // namespace kdm::gen::wide

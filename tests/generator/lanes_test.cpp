@@ -132,8 +132,9 @@ TEST(LanesTest, WidePassesGiveThePerLaneBits3D) {
   for (const wide::Isa isa : wide_isas()) check_wide_passes<3>(isa);
 }
 
-// The tabulated kernel evaluated on wide vectors gives the four-lane evaluation's factors exactly.
-void check_wide_kernel_table(wide::Isa isa) {
+// The kernel evaluated on wide vectors gives the four-lane evaluation's factors exactly: from the table
+// (uniform models) or computed with exp (every other model; `tabulated` false).
+void check_wide_kernel_factors(wide::Isa isa, bool tabulated) {
   SCOPED_TRACE(isa == wide::Isa::kAvx512 ? "AVX-512" : "AVX2");
   const Grid<2> grid = test_grid<2>();
   Rng rng(9, 1, 2, 3, 4);
@@ -145,8 +146,13 @@ void check_wide_kernel_table(wide::Isa isa) {
       for (int trial = 0; trial < 24; ++trial) {
         const Vec<2> x{rng.uniform() * grid.dims[0], rng.uniform() * grid.dims[1]};
         Footprint<2> a, b;
-        a.build(grid, x, sigma, 0.43, with_derivative, &four);
-        b.build(grid, x, sigma, 0.43, with_derivative, &sixteen);
+        if (tabulated) {
+          a.build(grid, x, sigma, 0.43, with_derivative, &four);
+          b.build(grid, x, sigma, 0.43, with_derivative, &sixteen);
+        } else {
+          a.build(grid, x, sigma, 0.43, with_derivative, nullptr);
+          b.build(grid, x, sigma, 0.43, with_derivative, nullptr, isa);
+        }
         ASSERT_EQ(a.contiguous, b.contiguous);
         wide_rows += b.contiguous && wide::fits_width(b.width);
         for (int k = 0; k < kMaxWindow; ++k) {
@@ -165,7 +171,11 @@ void check_wide_kernel_table(wide::Isa isa) {
 
 TEST(LanesTest, WideKernelTableGivesTheSameFactors) {
   if (wide_isas().empty()) GTEST_SKIP() << kNoWidePasses;
-  for (const wide::Isa isa : wide_isas()) check_wide_kernel_table(isa);
+  for (const wide::Isa isa : wide_isas()) check_wide_kernel_factors(isa, true);
+}
+TEST(LanesTest, WideComputedKernelGivesTheSameFactors) {
+  if (wide_isas().empty()) GTEST_SKIP() << kNoWidePasses;
+  for (const wide::Isa isa : wide_isas()) check_wide_kernel_factors(isa, false);
 }
 
 // Per-lane and four-lane sums add the same terms in another order, so they agree to float rounding. Over
