@@ -293,6 +293,27 @@ TEST(HugePagesTest, AdviceKeepsTheContentsOfAnyRange) {
   for (std::size_t i = 0; i < buffer.size(); ++i) ASSERT_EQ(buffer[i], i * 0x9e3779b97f4a7c15ull) << i;
 }
 
+// The grids and particle arrays use these in place of the vector constructor and resize(): they must be
+// those, contents and all, however large (6 MiB holds whole 2 MiB pages to advise) or small.
+TEST(HugePagesTest, VectorHelpersKeepTheirContents) {
+  const std::size_t big = (std::size_t(6) << 20) / sizeof(float);
+  const std::vector<float> filled = vector_on_huge_pages(big, 2.5f);
+  ASSERT_EQ(filled.size(), big);
+  EXPECT_EQ(std::count(filled.begin(), filled.end(), 2.5f), static_cast<std::ptrdiff_t>(big));
+  EXPECT_TRUE(vector_on_huge_pages(0, 1.0f).empty());
+  std::vector<int> v = {7, 8, 9};
+  resize_on_huge_pages(v, big);  // grows: new storage, old contents first, then zeros
+  ASSERT_EQ(v.size(), big);
+  EXPECT_EQ(v[0], 7);
+  EXPECT_EQ(v[2], 9);
+  EXPECT_EQ(std::count(v.begin() + 3, v.end(), 0), static_cast<std::ptrdiff_t>(big - 3));
+  v[big - 1] = 5;
+  resize_on_huge_pages(v, 2);  // shrinks in place
+  EXPECT_EQ(v, (std::vector<int>{7, 8}));
+  resize_on_huge_pages(v, 4);
+  EXPECT_EQ(v, (std::vector<int>{7, 8, 0, 0}));
+}
+
 TEST(HugePagesTest, LargeFootprintCacheHoldsNothingUntilKept) {
   FootprintCache<2> cache;
   const std::size_t n = (std::size_t(8) << 20) / sizeof(CachedFootprint<2>);  // advised: 8 MiB

@@ -43,10 +43,9 @@ struct Density {
   /// `function` may be called from several threads at once: the set-up then samples it on up to
   /// SamplerOptions::threads threads (the result is the same). from_values() sets it.
   bool thread_safe = false;
-  /// Set by from_values() to the values `function` interpolates: sample() then reads them itself, which
-  /// gives the same values as calling `function` at each node, without a call per node (at 65,536 points
-  /// on examples/sphere.png, setting up the model took 0.33 s of a 1.78 s run that way). Leave it empty
-  /// for a density of your own; if you change `function`, reset it.
+  /// Set by from_values() to the values `function` interpolates: sample() then reads them itself, with
+  /// the same result as calling `function` at each node but without a call per node. Leave it empty for a
+  /// density of your own; if you change `function`, reset it.
   std::shared_ptr<const DensityImage> image;
 
   static Density constant() { return {}; }
