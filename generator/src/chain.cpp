@@ -397,6 +397,9 @@ void Chain<D>::sweep(std::uint64_t seed, int level, int sweep_index, int nthread
         for (std::int64_t k = 0; k < block.per_update && block.left > 0; ++k)
           __builtin_prefetch(block.next(grid(), residual_.data()), 1);
         const int next = t + 1 < end ? t + 1 : next_cell_first;
+        // prefetch() below reads ρ where the next particle sits; fetch it for the one after, one update
+        // early.
+        if (!uniform_ && t + 2 < end) density_->prefetch(local_[t + 2].x);
         if (next >= 0 && next < static_cast<int>(local_.size())) {
           prefetch(local_[next], s);
           if (caching) {

@@ -64,6 +64,39 @@ struct DensityGrid {
   double at(const Vec<D>& x) const {
     std::array<std::int64_t, D> i0{}, i1{};
     std::array<double, D> f{};
+    corners(x, i0, i1, f);
+    double value = 0;
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      double w = 1;
+      std::int64_t idx = 0;
+      for (int k = 0; k < D; ++k) {
+        const bool hi = (corner >> k) & 1;
+        w *= hi ? f[k] : 1 - f[k];
+        idx += hi ? i1[k] : i0[k];
+      }
+      value += w * rho[idx];
+    }
+    return value;
+  }
+
+  /// Starts fetching the nodes at(x) reads: on a grid larger than the caches, an update's first look at
+  /// ρ otherwise waits for memory.
+  void prefetch(const Vec<D>& x) const {
+    std::array<std::int64_t, D> i0{}, i1{};
+    std::array<double, D> f{};
+    corners(x, i0, i1, f);
+    for (int corner = 0; corner < (1 << D); corner += 2) {  // both x-neighbours share a line but at its end
+      std::int64_t idx = 0;
+      for (int k = 1; k < D; ++k) idx += ((corner >> k) & 1) ? i1[k] : i0[k];
+      __builtin_prefetch(rho.data() + idx + i0[0]);
+      __builtin_prefetch(rho.data() + idx + i1[0]);
+    }
+  }
+
+ private:
+  // The 2^D nodes around x along each axis (flat offsets i0, i1) and x's fraction f between them.
+  void corners(const Vec<D>& x, std::array<std::int64_t, D>& i0, std::array<std::int64_t, D>& i1,
+               std::array<double, D>& f) const {
     for (int k = 0; k < D; ++k) {
       const int m = grid.dims[k];
       const double u = x[k] - 0.5;
@@ -82,18 +115,6 @@ struct DensityGrid {
       i0[k] = a * s;
       i1[k] = b * s;
     }
-    double value = 0;
-    for (int corner = 0; corner < (1 << D); ++corner) {
-      double w = 1;
-      std::int64_t idx = 0;
-      for (int k = 0; k < D; ++k) {
-        const bool hi = (corner >> k) & 1;
-        w *= hi ? f[k] : 1 - f[k];
-        idx += hi ? i1[k] : i0[k];
-      }
-      value += w * rho[idx];
-    }
-    return value;
   }
 };
 
