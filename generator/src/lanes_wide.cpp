@@ -127,23 +127,14 @@ KDM_TARGET inline V lane_nodes(std::int32_t j0) {
 KDM_TARGET inline V negate(V x) {
   return _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(x), _mm512_set1_epi32(INT32_MIN)));
 }
-// simd.h's exp4, step for step.
-KDM_TARGET inline V exp_of(V y) {
-  y = _mm512_mask_mov_ps(y, _mm512_cmp_ps_mask(y, set1(-87.0f), _CMP_LT_OQ), set1(-87.0f));
-  const V magic = set1(12582912.0f);
-  const V n = sub(add(mul(y, set1(1.44269504088896341f)), magic), magic);
-  V f = sub(y, mul(n, set1(0.693359375f)));
-  f = sub(f, mul(n, set1(-2.12194440e-4f)));
-  V p = set1(1.9875691500e-4f);
-  p = add(mul(p, f), set1(1.3981999507e-3f));
-  p = add(mul(p, f), set1(8.3334519073e-3f));
-  p = add(mul(p, f), set1(4.1665795894e-2f));
-  p = add(mul(p, f), set1(1.6666665459e-1f));
-  p = add(mul(p, f), set1(5.0000001201e-1f));
-  p = add(add(mul(mul(p, f), f), f), set1(1.0f));
-  const __m512i scale =
-      _mm512_slli_epi32(_mm512_add_epi32(_mm512_cvttps_epi32(n), _mm512_set1_epi32(127)), 23);
-  return mul(p, _mm512_castsi512_ps(scale));
+// y where y >= c, else c (simd.h's exp4 clamps its argument so).
+KDM_TARGET inline V at_least(V y, float c) {
+  return _mm512_mask_mov_ps(y, _mm512_cmp_ps_mask(y, set1(c), _CMP_LT_OQ), set1(c));
+}
+// 2^n for whole numbers n held as floats, built in the exponent bits as exp4 does.
+KDM_TARGET inline V two_to(V n) {
+  return _mm512_castsi512_ps(
+      _mm512_slli_epi32(_mm512_add_epi32(_mm512_cvttps_epi32(n), _mm512_set1_epi32(127)), 23));
 }
 
 #include "lanes_wide_passes.inc"
@@ -221,27 +212,17 @@ KDM_TARGET inline V negate(V x) {
   const __m256 sign = _mm256_set1_ps(-0.0f);
   return {_mm256_xor_ps(x.low, sign), _mm256_xor_ps(x.high, sign)};
 }
-// simd.h's exp4, step for step, on eight lanes.
-KDM_TARGET inline __m256 exp8(__m256 y) {
-  y = _mm256_blendv_ps(y, _mm256_set1_ps(-87.0f), _mm256_cmp_ps(y, _mm256_set1_ps(-87.0f), _CMP_LT_OQ));
-  const __m256 magic = _mm256_set1_ps(12582912.0f);
-  const __m256 n =
-      _mm256_sub_ps(_mm256_add_ps(_mm256_mul_ps(y, _mm256_set1_ps(1.44269504088896341f)), magic), magic);
-  __m256 f = _mm256_sub_ps(y, _mm256_mul_ps(n, _mm256_set1_ps(0.693359375f)));
-  f = _mm256_sub_ps(f, _mm256_mul_ps(n, _mm256_set1_ps(-2.12194440e-4f)));
-  __m256 p = _mm256_set1_ps(1.9875691500e-4f);
-  p = _mm256_add_ps(_mm256_mul_ps(p, f), _mm256_set1_ps(1.3981999507e-3f));
-  p = _mm256_add_ps(_mm256_mul_ps(p, f), _mm256_set1_ps(8.3334519073e-3f));
-  p = _mm256_add_ps(_mm256_mul_ps(p, f), _mm256_set1_ps(4.1665795894e-2f));
-  p = _mm256_add_ps(_mm256_mul_ps(p, f), _mm256_set1_ps(1.6666665459e-1f));
-  p = _mm256_add_ps(_mm256_mul_ps(p, f), _mm256_set1_ps(5.0000001201e-1f));
-  p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(p, f), f), f), _mm256_set1_ps(1.0f));
-  const __m256i scale =
-      _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvttps_epi32(n), _mm256_set1_epi32(127)), 23);
-  return _mm256_mul_ps(p, _mm256_castsi256_ps(scale));
+KDM_TARGET inline V at_least(V y, float c) {
+  const __m256 floor = _mm256_set1_ps(c);
+  return {_mm256_blendv_ps(y.low, floor, _mm256_cmp_ps(y.low, floor, _CMP_LT_OQ)),
+          _mm256_blendv_ps(y.high, floor, _mm256_cmp_ps(y.high, floor, _CMP_LT_OQ))};
 }
-KDM_TARGET inline V exp_of(V y) {
-  return {exp8(y.low), exp8(y.high)};
+KDM_TARGET inline __m256 two_to8(__m256 n) {
+  return _mm256_castsi256_ps(
+      _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvttps_epi32(n), _mm256_set1_epi32(127)), 23));
+}
+KDM_TARGET inline V two_to(V n) {
+  return {two_to8(n.low), two_to8(n.high)};
 }
 
 #include "lanes_wide_passes.inc"
