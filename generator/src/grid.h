@@ -85,7 +85,7 @@ struct DensityGrid {
     std::array<std::int64_t, D> i0{}, i1{};
     std::array<double, D> f{};
     corners(x, i0, i1, f);
-    for (int corner = 0; corner < (1 << D); corner += 2) {  // both x-neighbours share a line but at its end
+    for (int corner = 0; corner < (1 << D); corner += 2) {  // each row's two nodes: one line, or two
       std::int64_t idx = 0;
       for (int k = 1; k < D; ++k) idx += ((corner >> k) & 1) ? i1[k] : i0[k];
       __builtin_prefetch(rho.data() + idx + i0[0]);
