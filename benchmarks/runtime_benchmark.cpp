@@ -85,7 +85,7 @@ void BM_QueryDensityImage(benchmark::State& state) {
   for (int y = 0; y < 256; ++y)
     for (int x = 0; x < 256; ++x)
       values[y * 256 + x] = static_cast<float>(std::exp(-std::hypot(x - 128, y - 128) / 90.0));
-  kdm::DensityImage image;
+  kdm::DensityImageView image;
   image.width = image.height = 256;
   image.x1 = image.y1 = kSide;
   image.values = values.data();

@@ -1,7 +1,7 @@
 // Points per second of the full KDM sampler (uniform torus, default temperature) for n = 16k, 64k, 256k
 // on 1 and 2 threads, in a process that has already sampled (a warm-up run of the same size and thread
-// count): what a program that samples repeatedly gets. A process's first call also starts the OpenMP
-// team and faults in its memory; `kdm sample --timing` shows that cost (README, "Measured").
+// count): what a program that samples repeatedly gets. A process's first call also starts the worker
+// team and faults in its memory; `kdm sample --timing` shows that cost (docs/performance.md).
 // BM_TwoThreadsOverOne gives the two-thread speed-up as the median of back-to-back rounds (one thread,
 // then two, same seed), which holds still while this machine's speed drifts from one minute to the next,
 // and sets it against what two independent one-thread samplers get from the same machine.
@@ -72,7 +72,7 @@ static void BM_TwoThreadsOverOne(benchmark::State& state) {
   o.n = state.range(0);
   o.seed = 1;
   o.threads = 1;
-  seconds_to_sample(o);  // warm-up: the first call starts the OpenMP team and faults in memory
+  seconds_to_sample(o);  // warm-up: the first call starts the worker threads and faults in memory
   o.threads = 2;
   seconds_to_sample(o);
   seconds_for_two_side_by_side(o);

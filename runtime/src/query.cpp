@@ -4,14 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kdm/runtime/hash.h"
+
 namespace kdm {
 namespace {
-
-std::uint64_t mix64(std::uint64_t z) {  // SplitMix64 finaliser
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
 
 /// Colour of the tile-grid vertex (vx, vy): a hash, so every region is assembled locally.
 std::uint32_t vertex_colour(std::int64_t vx, std::int64_t vy, std::uint32_t colours) {
@@ -30,7 +26,7 @@ double sanitize(double v) {
 
 }  // namespace
 
-void Tileset::adopt(TileSet&& set) {
+void Tileset::adopt(TilesetData&& set) {
   set_ = std::move(set);
   // Thresholds once per load, so the query loop compares instead of interpolating.
   thresholds_.assign(set_.tiles.size(), {});
@@ -39,8 +35,7 @@ void Tileset::adopt(TileSet&& set) {
     std::vector<float>& out = thresholds_[t];
     out.resize(tile.points.size());
     for (std::uint32_t k = 0, i = 0; k < set_.levels; ++k)
-      for (; i < tile.level_end[k]; ++i)
-        out[i] = static_cast<float>(set_.emission_threshold(k, tile.keys[i]));
+      for (; i < tile.level_end[k]; ++i) out[i] = set_.emission_threshold(k, tile.keys[i]);
   }
   min_threshold_ = HUGE_VAL;
   for (const std::vector<float>& t : thresholds_)
@@ -61,7 +56,7 @@ std::size_t Tileset::resident_bytes() const {
 
 Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
   out = Tileset{};
-  TileSet set;
+  TilesetData set;
   const Status s = decode_tileset(data, size, set, detail);
   if (s == Status::kOk) out.adopt(std::move(set));
   return s;
@@ -69,7 +64,7 @@ Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, st
 
 Status Tileset::load_file(const std::string& path, Tileset& out, std::string* detail) {
   out = Tileset{};
-  TileSet set;
+  TilesetData set;
   const Status s = load_tileset(path, set, detail);
   if (s == Status::kOk) out.adopt(std::move(set));
   return s;
@@ -86,13 +81,13 @@ namespace {
 
 /// World-to-texel transform of a density image, hoisted out of the per-point loop.
 struct ImageSampler {
-  const DensityImage* image;
+  const DensityImageView* image;
   double sx = 0, sy = 0;
-  explicit ImageSampler(const DensityImage* im) : image(im) {
+  explicit ImageSampler(const DensityImageView* im) : image(im) {
     if (im) sx = im->width / (im->x1 - im->x0), sy = im->height / (im->y1 - im->y0);
   }
   double at(double x, double y) const {
-    const DensityImage& im = *image;
+    const DensityImageView& im = *image;
     const double fx = std::clamp((x - im.x0) * sx - 0.5, 0.0, im.width - 1.0);
     const double fy = std::clamp((y - im.y0) * sy - 0.5, 0.0, im.height - 1.0);
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
@@ -106,11 +101,11 @@ struct ImageSampler {
 
 }  // namespace
 
-double DensityImage::at(double x, double y) const {
+double DensityImageView::at(double x, double y) const {
   return ImageSampler(this).at(x, y);
 }
 
-double DensityImage::max_over(double qx0, double qy0, double qx1, double qy1) const {
+double DensityImageView::max_over(double qx0, double qy0, double qx1, double qy1) const {
   auto block = [](double v, double lo, double hi, int n, int blocks) {
     const double t = std::clamp((v - lo) / (hi - lo) * n, 0.0, double(n - 1));
     return std::min(blocks - 1, static_cast<int>(t) / 8);
@@ -124,7 +119,7 @@ double DensityImage::max_over(double qx0, double qy0, double qx1, double qy1) co
   return m;
 }
 
-Status make_density_max_mip(DensityImage& image, std::vector<float>& mip) {
+Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
   if (image.width <= 0 || image.height <= 0 || !image.values) return Status::kInvalidArgument;
   if (!(finite(image.x0) && finite(image.x1) && finite(image.y0) && finite(image.y1) && image.x1 > image.x0 &&
         image.y1 > image.y0))
@@ -204,10 +199,10 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       if (d.kind == QueryDensity::Kind::kImage) bound = d.image->max_over(wx, wy, wx + S, wy + S);
       // Thresholds are sorted: the points below bound · A · scale are a prefix; none beyond can be emitted.
       const double limit = bound * area_scale;
-      const std::uint32_t candidates =
-          static_cast<std::uint32_t>(std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
-                                                      [](float t, double l) { return double(t) < l; }) -
-                                     thresholds);
+      const std::uint32_t candidates = static_cast<std::uint32_t>(
+          std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
+                           [](float t, double l) { return TilesetData::emits(t, l); }) -
+          thresholds);
       std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
       for (; c < candidates; ++c) {
         if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
@@ -221,7 +216,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         if (d.kind != QueryDensity::Kind::kConstant) {
           const double rho =
               d.kind == QueryDensity::Kind::kImage ? sampler.at(x, y) : sanitize(d.callback(d.user, x, y));
-          if (!(rho * area_scale > thresholds[c])) continue;
+          if (!TilesetData::emits(thresholds[c], rho * area_scale)) continue;
         }
         if (n == capacity) {
           *cursor = QueryCursor{tx, ty, c, true, false};

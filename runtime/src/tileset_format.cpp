@@ -85,7 +85,7 @@ void load_array(InputArchive& ar, const MemoryBuffer& buffer, std::vector<T>& v)
   ar(cereal::binary_data(v.data(), v.size() * sizeof(T)));
 }
 
-std::vector<std::uint8_t> serialize_body(const TileSet& set) {
+std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
   std::ostringstream stream(std::ios::binary);
   {
     cereal::PortableBinaryOutputArchive ar(stream);
@@ -105,7 +105,7 @@ std::vector<std::uint8_t> serialize_body(const TileSet& set) {
   return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
 }
 
-void parse_body(const std::vector<char>& body, TileSet& set) {
+void parse_body(const std::vector<char>& body, TilesetData& set) {
   MemoryBuffer buffer(body.data(), body.size());
   std::istream stream(&buffer);
   InputArchive ar(stream);
@@ -161,7 +161,7 @@ const char* status_message(Status status) {
   return "unknown status";
 }
 
-Status validate_tileset(const TileSet& set, std::string* detail) {
+Status validate_tileset(const TilesetData& set, std::string* detail) {
   auto bad = [&](const std::string& m) { return fail(Status::kInvalidContent, detail, m); };
   if (set.colours < 1 || set.colours > kMaxTileColours)
     return bad("colour count " + std::to_string(set.colours) + " is outside 1.." +
@@ -196,7 +196,7 @@ Status validate_tileset(const TileSet& set, std::string* detail) {
   return Status::kOk;
 }
 
-Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::string* detail) {
+Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, std::string* detail) {
   if (validate_tileset(set, detail) != Status::kOk) return Status::kInvalidArgument;
   if (set.recipe.size() + set.generator_version.size() + kFixedHeaderBytes > kMaxTilesetHeaderBytes)
     return fail(Status::kInvalidArgument, detail, "recipe text is too long");
@@ -229,8 +229,8 @@ Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::s
   return Status::kOk;
 }
 
-Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::string* detail) {
-  out = TileSet{};
+Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std::string* detail) {
+  out = TilesetData{};
   const auto* p = static_cast<const std::uint8_t*>(data);
   if (size < 8 || std::memcmp(p, kMagic, 8) != 0) {
     const bool prefix = size < 8 && std::memcmp(p, kMagic, size) == 0;
@@ -275,7 +275,7 @@ Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::str
   if (ZSTD_isError(unpacked) || unpacked != body_size)
     return fail(Status::kDecompressionFailed, detail,
                 ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
-  TileSet set;
+  TilesetData set;
   try {
     parse_body(body, set);
   } catch (const std::exception& e) {
@@ -291,8 +291,8 @@ Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::str
   return Status::kOk;
 }
 
-Status load_tileset(const std::string& path, TileSet& out, std::string* detail) {
-  out = TileSet{};
+Status load_tileset(const std::string& path, TilesetData& out, std::string* detail) {
+  out = TilesetData{};
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
   std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -300,7 +300,7 @@ Status load_tileset(const std::string& path, TileSet& out, std::string* detail) 
   return decode_tileset(bytes.data(), bytes.size(), out, detail);
 }
 
-Status save_tileset(const TileSet& set, const std::string& path, std::string* detail) {
+Status save_tileset(const TilesetData& set, const std::string& path, std::string* detail) {
   std::vector<std::uint8_t> bytes;
   if (const Status s = encode_tileset(set, bytes, detail); s != Status::kOk) return s;
   const std::string temp = path + ".partial";

@@ -15,6 +15,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image_io.h"
@@ -45,11 +46,12 @@ class CliTest : public ::testing::Test {
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
-  // Runs `kdm ARGS` (ARGS already shell-quoted where needed), capturing stdout and stderr.
-  Outcome kdm(const std::string& args) const {
+  // Runs `PREFIX kdm ARGS` (ARGS already shell-quoted where needed; PREFIX e.g. an environment or
+  // `taskset`), capturing stdout and stderr.
+  Outcome kdm(const std::string& args, const std::string& prefix = "") const {
     const std::string out = path("stdout"), err = path("stderr");
     const std::string command =
-        std::string("'") + KDM_EXECUTABLE + "' " + args + " >'" + out + "' 2>'" + err + "'";
+        prefix + " '" + KDM_EXECUTABLE + "' " + args + " >'" + out + "' 2>'" + err + "'";
     const int raw = std::system(command.c_str());
     Outcome r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -261,6 +263,25 @@ TEST_F(CliTest, SampleTimingReportsEveryLevel) {
   EXPECT_LE(levels_sum + model, total + 5e-4) << r.out;  // each figure printed to 0.1 ms
 }
 
+// Without --threads a run takes its thread count from OMP_NUM_THREADS, else from the CPUs its affinity
+// mask allows (what a build tool or container gives it), never from the hardware alone.
+TEST_F(CliTest, DefaultThreadsFollowTheEnvironmentAndTheAffinityMask) {
+  auto threads_used = [&](const std::string& args, const std::string& prefix) {
+    const Outcome r = kdm("sample --n 300 --timing " + args + " -o '" + path("t.txt") + "'", prefix);
+    EXPECT_EQ(r.status, 0) << prefix << " kdm " << args << "\n" << r.err;
+    int threads = -1;
+    const std::size_t at = r.out.find(" threads ");
+    if (at != std::string::npos) threads = std::atoi(r.out.c_str() + at + 9);
+    return threads;
+  };
+  EXPECT_EQ(threads_used("", "OMP_NUM_THREADS=3"), 3);
+  EXPECT_EQ(threads_used("", "OMP_NUM_THREADS=1,2"), 1);  // a nesting list: its first level
+  EXPECT_EQ(threads_used("--threads 2", "OMP_NUM_THREADS=1"), 2);
+  if (std::system("taskset -c 0 true >/dev/null 2>&1") == 0) {
+    EXPECT_EQ(threads_used("", "env -u OMP_NUM_THREADS taskset -c 0"), 1);
+  }
+}
+
 TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
   const std::string out = " -o '" + path("q.txt") + "'";
   const Outcome zero = kdm("query --rect 0,0,1,1 --scale 0" + out);  // defined: no points
@@ -303,7 +324,7 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   EXPECT_NE(good.out.find("level 2, 512 points per tile"), std::string::npos) << good.out;
   EXPECT_NE(good.out.find("checks passed"), std::string::npos) << good.out;
 
-  kdm::TileSet set;
+  kdm::TilesetData set;
   ASSERT_EQ(kdm::load_tileset(shipped, set), kdm::Status::kOk);
   kdm::Tile& tile = set.tiles[3];
   for (std::uint32_t i = tile.level_end[1], j = 0; i < tile.level_end[2]; ++i, ++j)  // a clump in a corner
@@ -445,6 +466,31 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2" + out, "2×");
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
   EXPECT_FALSE(fs::exists(path("z_0000.png")));  // refused before any frame is written
+}
+
+// Users diff and commit point files: the same command must write the same bytes (no times, no dates).
+TEST_F(CliTest, PointFilesAreByteIdenticalAcrossRuns) {
+  const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  const std::vector<std::pair<std::string, std::string>> commands = {
+      {"sample --n 3000 --seed 4 --threads 2", "sample"},
+      {"sample --n 500 --density " + image + " --seed 2", "sample_image"},
+      {"query --rect 0,0,4,4 --scale 300", "query"},
+      {"query --rect 0,0,4,4 --scale 300 --density " + image, "query_image"},
+      {"stipple " + image + " --points 4000", "stipple_tiles"},
+      {"stipple " + image + " --points 1000 --method full", "stipple_full"},
+  };
+  for (const auto& [args, name] : commands)
+    for (const char* ext : {".txt", ".csv", ".svg", ".png"}) {
+      std::string bytes[2];
+      for (int run = 0; run < 2; ++run) {
+        const std::string file = path(name + std::to_string(run) + ext);
+        const Outcome r = kdm(args + " -o '" + file + "'");
+        ASSERT_EQ(r.status, 0) << "kdm " << args << "\nstderr: " << r.err;
+        bytes[run] = slurp(file);
+      }
+      EXPECT_GT(bytes[0].size(), 100u) << name << ext;
+      EXPECT_EQ(bytes[0], bytes[1]) << "kdm " << args << " -o X" << ext << " wrote different bytes twice";
+    }
 }
 
 }  // namespace

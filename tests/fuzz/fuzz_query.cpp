@@ -38,7 +38,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   double value = r.next();
   static float texels[4 * 4];
   for (float& t : texels) t = static_cast<float>(r.next());
-  kdm::DensityImage image;
+  kdm::DensityImageView image;
   image.width = image.height = 4;
   image.x0 = r.next(), image.y0 = r.next(), image.x1 = r.next(), image.y1 = r.next();
   image.values = texels;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "bake/progressive_order.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
@@ -18,7 +19,7 @@ std::string read_file(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-std::vector<std::uint8_t> encoded(const TileSet& set) {
+std::vector<std::uint8_t> encoded(const TilesetData& set) {
   std::vector<std::uint8_t> bytes;
   EXPECT_EQ(encode_tileset(set, bytes), Status::kOk);
   return bytes;
@@ -59,8 +60,8 @@ BakeRecipe small_recipe() {
 
 TEST(BakeTest, DeterministicNestedCornerTiles) {
   const BakeRecipe r = small_recipe();
-  const TileSet a = bake_tileset(r, 1);
-  const TileSet b = bake_tileset(r, 2);
+  const TilesetData a = bake_tileset(r, 1);
+  const TilesetData b = bake_tileset(r, 2);
   EXPECT_EQ(encoded(a), encoded(b));  // same bytes for any thread count
   ASSERT_EQ(a.tiles.size(), 16u);
   EXPECT_EQ(validate_tileset(a), Status::kOk);
@@ -77,7 +78,7 @@ TEST(BakeTest, DeterministicNestedCornerTiles) {
 // Tiles that share a corner colour hold the same points near that corner (the corner patch), and tiles
 // that share an edge's colours hold the same points along it; tiles differ in their interiors.
 TEST(BakeTest, TilesShareTheirCornerAndEdgePatches) {
-  const TileSet set = bake_tileset(small_recipe(), 0);
+  const TilesetData set = bake_tileset(small_recipe(), 0);
   const std::uint32_t C = set.colours;
   auto points_in = [&](std::size_t t, double x0, double y0, double x1, double y1) {
     std::vector<std::pair<std::uint16_t, std::uint16_t>> out;

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "chain.h"
-#include "huge_pages.h"
+#include "platform/huge_pages.h"
+#include "sampler/chain.h"
 
 namespace kdm::gen {
 namespace {

@@ -10,9 +10,9 @@
 #include <thread>
 #include <vector>
 
-#include "chain.h"
-#include "checkerboard.h"
-#include "rng.h"
+#include "sampler/chain.h"
+#include "sampler/checkerboard.h"
+#include "sampler/rng.h"
 
 namespace kdm::gen {
 namespace {

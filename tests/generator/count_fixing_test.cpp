@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "count_fixing.h"
-#include "rng.h"
+#include "sampler/count_fixing.h"
+#include "sampler/rng.h"
 
 namespace kdm::gen {
 namespace {

@@ -24,9 +24,9 @@ constexpr std::size_t kSpectrumBudget = std::size_t(1) << 30;
 constexpr std::size_t kSpectrumBudget = 40000;
 #endif
 
-const TileSet& shipped() {
-  static const TileSet set = [] {
-    TileSet out;
+const TilesetData& shipped() {
+  static const TilesetData set = [] {
+    TilesetData out;
     std::string detail;
     const char* path = std::getenv("KDM_TILESET");  // another set to judge the same way
     const std::string file = path ? path : std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt";
@@ -78,7 +78,7 @@ TEST(GeneratorTest, TileEdgesAndInBetweenDensitiesLookLikeTheRest) {
 // check must flag it (white noise: δavg about .55 of a blue set's, E/n far above), and its neighbours'
 // tori, which hold it too, must not all pass either.
 TEST(GeneratorTest, VerifierFlagsAWhiteNoiseTile) {
-  TileSet damaged = shipped();
+  TilesetData damaged = shipped();
   const std::uint32_t level = 2;
   const std::size_t victim = 5;
   Tile& tile = damaged.tiles[victim];
@@ -107,7 +107,7 @@ TEST(GeneratorTest, VerifierFlagsAWhiteNoiseTile) {
 // A tile with the content of another tile whose NW corner has a different colour: its corner and edge
 // patches no longer match its neighbours', so points meet across its edges — the seam checks must fail.
 TEST(GeneratorTest, VerifierFlagsMismatchedTileEdges) {
-  TileSet damaged = shipped();
+  TilesetData damaged = shipped();
   ASSERT_GE(damaged.colours, 2u);
   damaged.tiles[damaged.tile_index(0, 0, 0, 1)] = damaged.tiles[damaged.tile_index(0, 0, 0, 0)];
   VerifyOptions o = parts(false, false, true);

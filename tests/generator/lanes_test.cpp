@@ -9,9 +9,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "lanes.h"
-#include "lanes_wide.h"
-#include "rng.h"
+#include "platform/lanes.h"
+#include "platform/lanes_wide.h"
+#include "sampler/rng.h"
 
 namespace kdm::gen {
 namespace {

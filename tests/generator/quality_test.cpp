@@ -1,5 +1,5 @@
-// Blue-noise quality of the full sampler, measured with the analysis library (DESIGN.md §6) against the
-// reference implementation's statistics (shared/reference/README.md: δmin .612, δavg .872, lowP .0044).
+// Blue-noise quality of the full sampler, measured with the analysis library (docs/design.md §6) against the
+// reference implementation's statistics (tests/data/reference/README.md: δmin .612, δavg .872, lowP .0044).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -38,7 +38,7 @@ TEST(QualityTest, DefaultTemperatureMatchesTheReferenceLook) {
   o.n = 4096;
   const SetStats s = sample_and_measure(o, 8);
   std::printf("n=4096, 8 seeds: mean δmin %.3f, δavg %.4f, lowP %.4f\n", s.dmin, s.davg, s.low_p);
-  // The issue's bars. Measured (seeds 1–8): δmin .606, δavg .8722, lowP .0057; over seeds 1–64: δmin .600
+  // The targets. Measured (seeds 1–8): δmin .606, δavg .8722, lowP .0057; over seeds 1–64: δmin .600
   // (standard deviation of one set's δmin .036, so an 8-seed mean spreads about .013), δavg .8724,
   // lowP .0057. Seed-to-seed spread of δavg is about .003; lowP is the tight one.
   EXPECT_GE(s.davg, 0.865);
@@ -54,7 +54,7 @@ TEST(QualityTest, LowTemperatureIsMoreOrdered) {
   const SetStats s = sample_and_measure(o, 2);
   std::printf("n=4096, T=0.2, 100 sweeps, 2 seeds: mean δmin %.3f, δavg %.4f, lowP %.4f\n", s.dmin, s.davg,
               s.low_p);
-  // Measured δavg .904 for seeds 1–2 (spread .001); the issue asks >= .90.
+  // Measured δavg .904 for seeds 1–2 (spread .001); the target is >= .90.
   EXPECT_GE(s.davg, 0.90);
 }
 

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "kdm/generator/sampler.h"
-#include "lanes_wide.h"
-#include "rng.h"
-#include "setup.h"
+#include "platform/lanes_wide.h"
+#include "sampler/rng.h"
+#include "sampler/setup.h"
 
 namespace kdm::gen {
 namespace {
@@ -350,7 +350,7 @@ double window_z_rms(const SampleResult& r, const std::function<double(double)>& 
 }
 
 // Poisson points give RMS z ≈ 1; a sampler that follows the density with blue-noise counts gives far
-// less. 0.5 is the bar; measured values are printed (quadratic: 0.25 at seed 3).
+// less. 0.5 is the target; measured values are printed (quadratic: 0.25 at seed 3).
 TEST(SamplerTest, FollowsQuadraticDensityProfile) {
   SamplerOptions o = options_for(4000, Domain::kBox, 3);
   Density d;
@@ -371,7 +371,7 @@ TEST(SamplerTest, FollowsHighDynamicRangeRamp) {
   const double z = window_z_rms(
       r, [](double x) { return std::pow(5000.0, -x); }, 20);
   std::printf("1:5000 ramp: RMS z = %.3f\n", z);
-  // Measured 0.28, 0.38, 0.33, 0.33 for seeds 4–7; the bar is 0.5.
+  // Measured 0.28, 0.38, 0.33, 0.33 for seeds 4–7; the target is 0.5.
   EXPECT_LE(z, 0.5);
   double rightmost = 0;  // the sparse end is reached
   for (std::size_t j = 0; j < r.size(); ++j) rightmost = std::max(rightmost, r.points[2 * j]);

@@ -46,7 +46,7 @@ TEST(ConcurrencyTest, ThreadsQueryingOneTilesetMatchASingleThreadedRun) {
   std::vector<float> texels(32 * 32), mip;
   for (int i = 0; i < 32 * 32; ++i)
     texels[i] = 0.2f + 0.8f * static_cast<float>((i % 32) * (i / 32)) / (31 * 31);
-  DensityImage image;
+  DensityImageView image;
   image.width = image.height = 32;
   image.x0 = -1, image.y0 = -1, image.x1 = 3, image.y1 = 3;
   image.values = texels.data();

@@ -1,16 +1,16 @@
-// Issue #5's quality bars for what the runtime emits from the built-in tile set (16 corner tiles, levels of
+// The quality targets for what the runtime emits from the built-in tile set (16 corner tiles, levels of
 // 32·4^k points per tile): uniform density over 32×32 tiles at complete levels and between them (δavg,
 // NN1%, lowP, links across tile edges, periodicity at the tile-lattice frequencies), and spatially varying
 // densities (a step, a 1:1000 radial map and a photograph: window z-scores and global bias). The ramp is
 // in query_test.cpp.
 //
-// Every figure is printed. A bar of the issue that the set meets is asserted as the issue states it. A bar
+// Every figure is printed. A target that the set meets is asserted as stated. A bar
 // it does not meet (the periodicity ratio everywhere; δavg and lowP between some levels) is asserted at the
 // measured value plus a margin of several times its spread, so a regression fails; each such place names
-// the issue's bar and the measured value. The spreads quoted below come from the same measurement on 7
+// the target and the measured value. The spreads quoted below come from the same measurement on 7
 // disjoint 32×32-tile regions (origins (0,0), (32,0), (0,32), (32,32), (1000,−2000), (−64,96),
-// (12345,678)); the test itself uses [0,32)², the region of the README's command. With only 16 tiles every
-// region shows every corner configuration many times, so the spreads are small.
+// (12345,678)); the test itself uses [0,32)², the region of docs/quality.md's command. With only 16 tiles
+// every region shows every corner configuration many times, so the spreads are small.
 //
 // Procedure, as `kdm query --rect 0,0,32,32 --scale S -o u.txt && kdm analyze u.txt --box --tile-size 0.03125
 // --fmax 0.6 -o a` does it: coordinates normalised to the rectangle, NN statistics with box distances
@@ -18,7 +18,7 @@
 // hashes, so `kdm analyze`'s default --torus would join points across the domain edge that are no
 // neighbours in the tiling; measured at complete levels, it counts such links as seam links and drags seam
 // NN1% to .53–.60 of d_hex, 0.83 × interior NN1%, under the bar of 0.9), the periodogram on integer
-// frequencies of the unit square up to f = 0.6 (the README's fmax; it covers lowP's band f < 0.5 and the
+// frequencies of the unit square up to f = 0.6 (docs/quality.md's fmax; it covers lowP's band f < 0.5 and the
 // first lattice rings), the periodicity ratio over the lattice frequencies k = 32·(i, j) inside those rings.
 // On integer frequencies a uniform density has no window leakage (its transform vanishes there), so a box
 // set's lowP only gains the edge effects, which are small: complete levels give lowP .006–.009.
@@ -53,9 +53,9 @@ constexpr std::size_t kSpectrumBudget = std::size_t(1) << 20;
 #else
 constexpr std::size_t kSpectrumBudget = 150000;
 #endif
-constexpr int kTiles = 32;          // region side in tiles (the issue: at least 32×32)
-constexpr double kFmax = 0.6;       // periodogram limit, as in the README's command
-constexpr double kSeamRatio = 0.9;  // issue #5: NN1% of links across tile edges ≥ 0.9 × interior NN1%
+constexpr int kTiles = 32;          // region side in tiles (at least 32×32)
+constexpr double kFmax = 0.6;       // periodogram limit, as in docs/quality.md's command
+constexpr double kSeamRatio = 0.9;  // target: NN1% of links across tile edges ≥ 0.9 × interior NN1%
 
 /// Every point of `q`, in the query's fixed order.
 std::vector<QueryPoint> query_all(const QueryParams& q) {
@@ -84,7 +84,7 @@ std::vector<double> normalised(const std::vector<QueryPoint>& points, double w, 
 }
 
 // One uniform density: its expected points per tile and the bars it is held to. Where the set meets the
-// issue's bar, the bar is the issue's; elsewhere it is the measured value with a margin (see each table).
+// target, the bar is the target; elsewhere it is the measured value with a margin (see each table).
 struct UniformCase {
   double points_per_tile;
   const char* what;
@@ -156,14 +156,14 @@ void check_uniform(const UniformCase& c) {
   }
 }
 
-// Issue #5's periodicity bar is a ratio < 1.5 at the tile-lattice frequencies. NOT MET: every vertex of
+// The periodicity target is a ratio < 1.5 at the tile-lattice frequencies. NOT MET: every vertex of
 // the tiling shows one of two corner patches (2 colours), so the lattice frequencies carry 47–119 times
 // the radial mean (a strictly periodic tile would give about 1024, the number of tiles). Each case below
 // asserts its measured ratio on [0,32)² × 1.1; over the 7 regions the ratio deviates from that value by
 // −2.1% … +3.4% (at 32 points per tile 47.2 … 49.0 for 47.4; measured up to 128 points per tile).
 
 TEST(RuntimeQualityTest, UniformAtCompleteLevels) {
-  // Issue #5 at complete levels: δavg ≥ .85 and lowP ≤ .01 — both met. Measured on [0,32)² (spread over
+  // Targets at complete levels: δavg ≥ .85 and lowP ≤ .01 — both met. Measured on [0,32)² (spread over
   // the 7 regions in brackets): δavg .876 [.8756–.8765] at 32 per tile, .878 [.8774–.8779] at 128, .878 at
   // 512, .876 at 2048; lowP .0090 [.0090–.0095] at 32, .0075 [.0074–.0076] at 128, .0063 at 512. Seam
   // NN1% / interior NN1% 1.04 at 32, 1.20 at 128, 1.03 at 512, 1.11 at 2048 (bar 0.9: met).
@@ -178,17 +178,17 @@ TEST(RuntimeQualityTest, UniformAtCompleteLevels) {
 }
 
 TEST(RuntimeQualityTest, UniformBetweenLevels) {
-  // Issue #5 between levels: δavg ≥ .80 and lowP ≤ .1. Measured on [0,32)² a quarter, half and three
+  // Targets between levels: δavg ≥ .80 and lowP ≤ .1. Measured on [0,32)² a quarter, half and three
   // quarters of the way between levels k and k+1 (spread over the 7 regions: δavg ±.0007; lowP ±1.5%,
   // measured up to 128 points per tile):
   //   32→128:    δavg .690 / .739 / .810, lowP .120 / .118 / .107
   //   128→512:   δavg .692 / .748 / .816, lowP .088 / .101 / .102
   //   512→2048:  δavg .695 / .750 / .816, lowP .074 / – / – (1.3M and 1.7M points: no spectra)
-  // δavg: met at three quarters only (a partly emitted level is less even than a complete one; the README
+  // δavg: met at three quarters only (a partly emitted level is less even than a complete one; kdm verify
   // gives .69/.75/.81 on the generator's 2×2 tori). NOT MET a quarter and half way: asserted at
   // measured − .01 (14× the spread).
   // lowP: met a quarter of the way from 128 to 512 and from 512 to 2048. NOT MET elsewhere (.101–.120: over
-  // 32×32 tiles the spectrum reaches lower frequencies than on a 2×2 torus, where the README measured ≤
+  // 32×32 tiles the spectrum reaches lower frequencies than on a 2×2 torus, where kdm verify measured ≤
   // .100): asserted at measured × 1.1 (7× the spread). Seam NN1% / interior NN1% 0.96–1.12 everywhere (bar
   // 0.9: met). Periodicity (bar 1.5, not met): 82–119, asserted at measured × 1.1.
   const UniformCase cases[] = {
@@ -218,7 +218,7 @@ analysis::DensityAccuracy accuracy(const QueryParams& q, const analysis::Density
   return analysis::density_accuracy(coords, 2, density_unit, o);
 }
 
-// Issue #5 for spatially varying densities: window z-scores RMS ≤ 0.5 and global bias ≤ 0.5%.
+// Targets for spatially varying densities: window z-scores RMS ≤ 0.5 and global bias ≤ 0.5%.
 constexpr double kRmsZ = 0.5, kBias = 0.005;
 
 // The regions each density test runs on (world origins of its square): translating the region changes the
@@ -264,7 +264,7 @@ TEST(RuntimeQualityTest, FollowsADensityStep) {
 analysis::DensityAccuracy image_accuracy(const char* label, const std::vector<float>& values, int w, int h,
                                          const double* origin, double side, double scale, double expected) {
   std::vector<float> mip;
-  DensityImage image;
+  DensityImageView image;
   image.width = w, image.height = h;
   image.x0 = origin[0], image.y0 = origin[1], image.x1 = origin[0] + side, image.y1 = origin[1] + side;
   image.values = values.data();
@@ -300,7 +300,7 @@ TEST(RuntimeQualityTest, FollowsAPhotograph) {
   double sum = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      // DensityImage row 0 is at the bottom of its rectangle; the picture's row 0 is its top.
+      // DensityImageView row 0 is at the bottom of its rectangle; the picture's row 0 is its top.
       const float v = static_cast<float>(1.0 - picture.at(x, h - 1 - y));
       values[static_cast<std::size_t>(y) * w + x] = v;
       sum += v;

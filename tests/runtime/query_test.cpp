@@ -172,7 +172,7 @@ TEST(QueryTest, FollowsADensityImage) {
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x)
       values[y * 64 + x] = static_cast<float>(radial((x + 0.5) / 16, (y + 0.5) / 16));
-  DensityImage image;
+  DensityImageView image;
   image.width = image.height = 64;
   image.x1 = image.y1 = 4;
   image.values = values.data();

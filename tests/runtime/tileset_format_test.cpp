@@ -18,9 +18,9 @@
 namespace kdm {
 namespace {
 
-TileSet make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1) {
+TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1) {
   std::mt19937 rng(seed);
-  TileSet set;
+  TilesetData set;
   set.colours = colours;
   set.levels = levels;
   set.recipe = "seed 1\ncolours 2\nlevels 3\n";
@@ -44,14 +44,14 @@ TileSet make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::u
   return set;
 }
 
-std::vector<std::uint8_t> encode(const TileSet& set) {
+std::vector<std::uint8_t> encode(const TilesetData& set) {
   std::vector<std::uint8_t> bytes;
   EXPECT_EQ(encode_tileset(set, bytes), Status::kOk);
   return bytes;
 }
 
 Status decode(const std::vector<std::uint8_t>& bytes, std::size_t size) {
-  TileSet out;
+  TilesetData out;
   return decode_tileset(bytes.data(), size, out);
 }
 
@@ -83,14 +83,14 @@ std::vector<std::uint8_t> with_body(std::vector<std::uint8_t> file, const std::s
 }
 
 TEST(TilesetFormatTest, RoundTripIsExact) {
-  const TileSet set = make_tileset();
+  const TilesetData set = make_tileset();
   const std::vector<std::uint8_t> bytes = encode(set);
-  TileSet back;
+  TilesetData back;
   ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
   EXPECT_EQ(back, set);
   const std::string path = testing::TempDir() + "/roundtrip.kdmt";
   ASSERT_EQ(save_tileset(set, path), Status::kOk);
-  TileSet loaded;
+  TilesetData loaded;
   ASSERT_EQ(load_tileset(path, loaded), Status::kOk);
   EXPECT_EQ(loaded, set);
   std::remove(path.c_str());
@@ -144,7 +144,7 @@ TEST(TilesetFormatTest, WrongMagicAndVersionAreNamed) {
   put32(&other[8], kTilesetFormatVersion + 1);
   EXPECT_EQ(decode(other, other.size()), Status::kUnsupportedVersion);
   const char png[] = "\x89PNG\r\n\x1a\n....";
-  TileSet out;
+  TilesetData out;
   EXPECT_EQ(decode_tileset(png, sizeof png, out), Status::kBadMagic);
 }
 
@@ -158,7 +158,7 @@ std::string body_bytes(const std::function<void(cereal::PortableBinaryOutputArch
 }
 
 TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
-  const TileSet set = make_tileset(1, 2);  // one colour: a single tile
+  const TilesetData set = make_tileset(1, 2);  // one colour: a single tile
   const std::vector<std::uint8_t> file = encode(set);
   // An array that claims 2^40 elements: refused before any allocation.
   const auto nominal = [](auto& ar) {
@@ -170,7 +170,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
     ar(cereal::make_size_tag(cereal::size_type(1) << 40));
     for (int i = 0; i < 8; ++i) ar(std::uint64_t(0));  // some bytes, far fewer than claimed
   });
-  TileSet out;
+  TilesetData out;
   std::string why;
   std::vector<std::uint8_t> bad = with_body(file, huge);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
@@ -222,7 +222,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
 }
 
 TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
-  TileSet set = make_tileset();
+  TilesetData set = make_tileset();
   set.tiles.pop_back();
   std::vector<std::uint8_t> bytes;
   std::string why;
@@ -240,12 +240,12 @@ TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
 }
 
 TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
-  const TileSet set = make_tileset();
+  const TilesetData set = make_tileset();
   EXPECT_EQ(save_tileset(set, "/nonexistent-dir/x.kdmt"), Status::kIoError);
   const std::string path = testing::TempDir() + "/atomic.kdmt";
   { std::ofstream(path) << "old contents"; }
   ASSERT_EQ(save_tileset(set, path), Status::kOk);
-  TileSet loaded;
+  TilesetData loaded;
   EXPECT_EQ(load_tileset(path, loaded), Status::kOk);
   std::ifstream partial(path + ".partial");
   EXPECT_FALSE(partial.good());  // no temporary left behind

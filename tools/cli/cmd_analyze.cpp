@@ -1,5 +1,5 @@
-// `kdm analyze`: point-set metrics (DESIGN.md §6) for one or more files of sets — a one-screen summary on
-// stdout, DIR/metrics.json, and pictures DIR/points.png, DIR/spectrum.png, DIR/raps.png.
+// `kdm analyze`: point-set metrics (docs/design.md §6) for one or more files of sets — a one-screen summary
+// on stdout, DIR/metrics.json, and pictures DIR/points.png, DIR/spectrum.png, DIR/raps.png.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 #include "commands.h"
 #include "density_arg.h"
@@ -22,11 +21,7 @@ struct QueryArgs {
 
 void run_query_command(const QueryArgs& a) {
   double r[4];
-  std::istringstream in(a.rect);
-  char comma;
-  if (!(in >> r[0] >> comma >> r[1] >> comma >> r[2] >> comma >> r[3]))
-    throw CommandError("--rect must be x0,y0,x1,y1, got '" + a.rect + "'");
-  if (!(r[2] > r[0] && r[3] > r[1])) throw CommandError("--rect is empty or inverted: '" + a.rect + "'");
+  parse_rect(a.rect, "--rect", r);
   const DensityArg arg = parse_density(a.density, a.gamma, a.invert);
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
@@ -41,19 +36,15 @@ void run_query_command(const QueryArgs& a) {
   std::vector<QueryPoint> points;
   query_all(tiles, q, points);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  tools::PointSet set;
-  set.dim = 2;
+  const tools::PointSet set = normalise_to_rect(points, r);
   const double w = r[2] - r[0], h = r[3] - r[1];
-  for (const QueryPoint& p : points)
-    set.coords.insert(set.coords.end(), {std::min(p.x / w, std::nextafter(1.0, 0.0)),
-                                         std::min(p.y / h, std::nextafter(1.0, 0.0))});
   char line[200];
-  std::snprintf(line, sizeof line, "kdm query: %zu points in %.4f s (rect %s, scale %g, tile size %g)",
-                set.size(), seconds, a.rect.c_str(), a.scale, a.tile_size);
+  std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", set.size(),
+                a.rect.c_str(), a.scale, a.tile_size);
   DrawStyle style;
   style.aspect = w / h;
   write_points(a.output, set, {line, "coordinates normalised to the rect"}, style);
-  std::fprintf(stderr, "%s -> %s\n", line, a.output.c_str());
+  std::fprintf(stderr, "%s in %.4f s -> %s\n", line, seconds, a.output.c_str());
 }
 
 }  // namespace

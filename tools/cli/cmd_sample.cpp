@@ -63,21 +63,22 @@ void run_sample(const SampleArgs& args) {
   set.dim = result.dim;
   set.coords = std::move(result.points);
   const gen::SampleReport& r = result.report;
+  // The file's header holds only what the inputs determine, so the same options give the same bytes;
+  // the time goes to stderr.
   char line[256];
-  std::snprintf(line, sizeof line,
-                "kdm sample: %zu points, T=%g (model %.4g), seed %llu, acceptance %.3f, %.3f s", set.size(),
-                o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
-                r.acceptance_rate(), r.seconds);
+  std::snprintf(line, sizeof line, "kdm sample: %zu points, T=%g (model %.4g), seed %llu, acceptance %.3f",
+                set.size(), o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
+                r.acceptance_rate());
   std::vector<std::string> header = {line, "density " + args.density + ", domain " + domain};
   DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;
   style.aspect = aspect;
   write_points(args.output, set, header, style);
-  std::fprintf(stderr, "%s -> %s\n", line, args.output.c_str());
+  std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds, args.output.c_str());
   if (args.timing) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
-                r.seconds, set.size() / std::max(1e-9, r.seconds), o.threads, r.acceptance_rate());
+                r.seconds, set.size() / std::max(1e-9, r.seconds), r.threads, r.acceptance_rate());
     std::printf("model seconds %.4f\n", r.model_seconds);
     for (const gen::LevelReport& l : r.levels) {
       std::string grid = std::to_string(l.grid[0]);
@@ -114,7 +115,9 @@ void add_sample_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
-  cmd->add_option("--threads", o.threads, "Worker threads (0 = all); output does not depend on it")
+  cmd->add_option("--threads", o.threads,
+                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); output does not "
+                  "depend on it")
       ->capture_default_str();
   cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points on the finest level")
       ->capture_default_str();

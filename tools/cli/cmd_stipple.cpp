@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "commands.h"
@@ -31,10 +30,8 @@ struct StippleArgs {
 
 /// "x0,y0,x1,y1" in UV units (y up), inside [0, 1]².
 void parse_region(const std::string& text, double r[4]) {
-  std::istringstream in(text);
-  char comma;
-  if (!(in >> r[0] >> comma >> r[1] >> comma >> r[2] >> comma >> r[3]) || !(r[0] >= 0 && r[1] >= 0) ||
-      !(r[2] <= 1 && r[3] <= 1) || !(r[2] > r[0] && r[3] > r[1]))
+  parse_rect(text, "--region", r);
+  if (!(r[0] >= 0 && r[1] >= 0 && r[2] <= 1 && r[3] <= 1))
     throw CommandError("--region must be x0,y0,x1,y1 with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1, got '" +
                        text + "'");
 }
@@ -87,13 +84,8 @@ class TileStippler {
     q.density = density_->density;
     std::vector<QueryPoint> points;
     query_all(tiles_, q, points);
-    const double w = q.x1 - q.x0, h = q.y1 - q.y0;
-    tools::PointSet set;
-    set.coords.reserve(points.size() * 2);
-    for (const QueryPoint& p : points)
-      set.coords.insert(set.coords.end(), {std::min(p.x / w, std::nextafter(1.0, 0.0)),
-                                           std::min(p.y / h, std::nextafter(1.0, 0.0))});
-    return set;
+    const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
+    return normalise_to_rect(points, rect);
   }
 
  private:
@@ -161,12 +153,11 @@ void run_stipple(const StippleArgs& a) {
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
     char line[200], where[160];
-    std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s) in %.3f s", set.size(), how.c_str(),
-                  seconds);
+    std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(), how.c_str());
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     write_points(path, set, {line, "image " + a.image, where}, style);
-    std::fprintf(stderr, "%s -> %s\n", line, path.c_str());
+    std::fprintf(stderr, "%s in %.3f s -> %s\n", line, seconds, path.c_str());
   }
 }
 

@@ -34,7 +34,7 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   }
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("baking");
-  const TileSet set = gen::bake_tileset(recipe, threads, [&bar](double f) { bar.update(f); });
+  const TilesetData set = gen::bake_tileset(recipe, threads, [&bar](double f) { bar.update(f); });
   bar.finish();
   std::string detail;
   const Status s = save_tileset(set, output, &detail);
@@ -51,7 +51,7 @@ void run_info(const std::string& path) {
   std::string detail;
   const Status s = Tileset::load_file(path, loaded, &detail);
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
-  const TileSet& set = loaded.data();
+  const TilesetData& set = loaded.data();
   std::printf("file           %s (%lld bytes)\n", path.c_str(), bytes);
   std::printf("resident       %.2f MB once loaded by the runtime\n",
               double(loaded.resident_bytes()) / (1 << 20));
@@ -86,7 +86,9 @@ void add_tile_commands(CLI::App& app) {
                    "temperature, sweeps, band, erosion)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
-  bake->add_option("--threads", *threads, "Worker threads (0 = all); the file does not depend on it")
+  bake->add_option("--threads", *threads,
+                   "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); the file does "
+                   "not depend on it")
       ->capture_default_str();
   bake->callback([=] { run_bake(*recipe, *output, *threads); });
 

@@ -19,7 +19,7 @@ struct VerifyArgs {
 };
 
 void run_verify(VerifyArgs args) {
-  TileSet set;
+  TilesetData set;
   std::string detail;
   const Status s = load_tileset(args.path, set, &detail);
   if (s != Status::kOk) throw CommandError("'" + args.path + "': " + status_message(s) + " (" + detail + ")");
@@ -58,7 +58,9 @@ void add_verify_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-seams", args->no_seams, "Skip the seam and in-between-density checks");
   cmd->add_flag("--no-direct", args->no_direct, "Skip the direct check (tiles freed for 15 sweeps)");
-  cmd->add_option("--threads", args->options.threads, "Worker threads (0 = all); results do not depend on it")
+  cmd->add_option("--threads", args->options.threads,
+                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); results do not "
+                  "depend on it")
       ->capture_default_str();
   cmd->callback([args] { run_verify(*args); });
 }

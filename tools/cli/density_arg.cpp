@@ -24,11 +24,14 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
   tools::GreyImage image;
   std::string error;
   if (!tools::load_grey_image(spec, image, error)) throw CommandError(error);
+  // Densities keep row 0 at the bottom (y up); the picture's row 0 is its top: flipped here, once.
   std::vector<float> values(image.pixels.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const double tone = invert ? image.pixels[i] : 1.0 - image.pixels[i];
-    values[i] = static_cast<float>(std::pow(std::max(0.0, tone), gamma));
-  }
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const double grey = image.at(x, image.height - 1 - y), tone = invert ? grey : 1.0 - grey;
+      values[static_cast<std::size_t>(y) * image.width + x] =
+          static_cast<float>(std::pow(std::max(0.0, tone), gamma));
+    }
   try {
     arg.density = gen::Density::from_values(image.width, image.height, values);
     arg.values = std::move(values);

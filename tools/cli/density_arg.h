@@ -12,7 +12,7 @@ struct DensityArg {
   gen::Density density;
   bool from_image = false;
   int image_width = 0, image_height = 0;
-  std::vector<float> values;  ///< the image's density values, row 0 at the top (images only)
+  std::vector<float> values;  ///< the image's density values, row 0 at the bottom (images only)
   double constant = 1;        ///< the value of const:V
 };
 

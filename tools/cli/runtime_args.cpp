@@ -1,6 +1,8 @@
 #include "runtime_args.h"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 
 #include "commands.h"
 
@@ -16,10 +18,7 @@ std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, doub
     return d;
   }
   const int w = arg.image_width, h = arg.image_height;
-  d->values.resize(arg.values.size());
-  for (int y = 0; y < h; ++y)  // DensityImage row 0 is at y0 (the bottom); the picture's row 0 is its top
-    std::copy_n(&arg.values[static_cast<std::size_t>(h - 1 - y) * w], w,
-                &d->values[static_cast<std::size_t>(y) * w]);
+  d->values = arg.values;  // row 0 at y0, as DensityImageView has it
   d->image.width = w, d->image.height = h;
   d->image.x0 = x0, d->image.y0 = y0, d->image.x1 = x1, d->image.y1 = y1;
   d->image.values = d->values.data();
@@ -30,6 +29,29 @@ std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, doub
   d->density.kind = QueryDensity::Kind::kImage;
   d->density.image = &d->image;
   return d;
+}
+
+void parse_rect(const std::string& text, const char* option, double r[4]) {
+  std::istringstream in(text);
+  char c[3] = {0, 0, 0};
+  const bool parsed = static_cast<bool>(in >> r[0] >> c[0] >> r[1] >> c[1] >> r[2] >> c[2] >> r[3]) &&
+                      c[0] == ',' && c[1] == ',' && c[2] == ',' && (in >> std::ws).eof();
+  if (!parsed || !(std::isfinite(r[0]) && std::isfinite(r[1]) && std::isfinite(r[2]) && std::isfinite(r[3])))
+    throw CommandError(std::string(option) + " must be x0,y0,x1,y1 (four finite numbers), got '" + text +
+                       "'");
+  if (!(r[2] > r[0] && r[3] > r[1]))
+    throw CommandError(std::string(option) + " is empty or inverted (needs x0 < x1 and y0 < y1): '" + text +
+                       "'");
+}
+
+tools::PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]) {
+  const double w = r[2] - r[0], h = r[3] - r[1], below_one = std::nextafter(1.0, 0.0);
+  tools::PointSet set;
+  set.dim = 2;
+  set.coords.reserve(points.size() * 2);
+  for (const QueryPoint& p : points)
+    set.coords.insert(set.coords.end(), {std::min(p.x / w, below_one), std::min(p.y / h, below_one)});
+  return set;
 }
 
 const Tileset& tileset_for(const std::string& path, Tileset& storage) {

@@ -8,14 +8,15 @@
 
 #include "density_arg.h"
 #include "kdm/runtime/query.h"
+#include "point_io.h"
 
 namespace kdm::cli {
 
 /// A runtime density over the world rectangle [x0, x1) × [y0, y1): constant, or the image stretched over
-/// it (rows flipped so that y grows upwards). Owns the image data and its max-mip.
+/// it. Owns the image data and its max-mip.
 struct RuntimeDensity {
   QueryDensity density;
-  DensityImage image;
+  DensityImageView image;
   std::vector<float> values, mip;
   double max_value = 0, mean_value = 0;
 };
@@ -26,6 +27,14 @@ std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, doub
 
 /// Loads --tileset or returns the built-in set; throws CommandError naming the problem.
 const Tileset& tileset_for(const std::string& path, Tileset& storage);
+
+/// Parses `text`, the value of `option` (named in errors), as "x0,y0,x1,y1": four finite numbers with
+/// x0 < x1 and y0 < y1. Throws CommandError.
+void parse_rect(const std::string& text, const char* option, double r[4]);
+
+/// Query points whose origin is the corner (r[0], r[1]) of the rectangle r, as a 2D point set normalised
+/// to it: [0, 1) on both axes.
+tools::PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]);
 
 /// Most points a command-line query collects (2^25, 1 GiB as QueryPoint) before it gives up.
 inline constexpr std::size_t kMaxCommandLinePoints = std::size_t(1) << 25;

@@ -1,5 +1,5 @@
-// Reference spacings (DESIGN.md §6: d_hex = sqrt(2/(sqrt(3) n)) on the unit square; FCC nearest-neighbour
-// spacing (sqrt(2)/n)^(1/3) on the unit cube) and input validation shared by every metric.
+// Reference spacings (docs/design.md §6: d_hex = sqrt(2/(sqrt(3) n)) on the unit square; FCC
+// nearest-neighbour spacing (sqrt(2)/n)^(1/3) on the unit cube) and input validation shared by every metric.
 #include "kdm/analysis/common.h"
 
 #include <cmath>

@@ -1,5 +1,6 @@
 // Hand-written JSON output (RFC 8259 subset: no pretty printing beyond newlines between top-level keys)
-// for metrics.json; field names follow DESIGN.md §6 (dmin, davg, nn1, low_p, nu_eff, anisotropy_db, ...).
+// for metrics.json; field names follow docs/design.md §6 (dmin, davg, nn1, low_p, nu_eff, anisotropy_db,
+// ...).
 #include "kdm/analysis/json.h"
 
 #include <cmath>

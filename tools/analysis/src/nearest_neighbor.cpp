@@ -1,6 +1,6 @@
 // Nearest-neighbour distances with a uniform cell list (expanding Chebyshev rings of cells around each
 // point, stopped once no unvisited cell can hold a closer point), and their summary statistics
-// δmin / δavg / NN1% / histogram as defined in DESIGN.md §6 (normalised by d_hex or the FCC spacing).
+// δmin / δavg / NN1% / histogram as defined in docs/design.md §6 (normalised by d_hex or the FCC spacing).
 #include "kdm/analysis/nearest_neighbor.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Periodogram P(k) = |Σ_j exp(−2πi k·x_j)|² / n on the integer grid (DESIGN.md §6), evaluated as the
+// Periodogram P(k) = |Σ_j exp(−2πi k·x_j)|² / n on the integer grid (docs/design.md §6), evaluated as the
 // complex matrix product S = E_xᵀ E_y where E_x(j, kx) = exp(−2πi kx x_j) for kx ∈ [0, kmax] and
 // E_y(j, ky) = exp(−2πi ky y_j) for ky ∈ [−kmax, kmax]; P(−k) = P(k) fills the other half-plane.
 // Points are processed in chunks (bounded memory) on a fixed number of accumulation lanes, so the

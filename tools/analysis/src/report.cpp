@@ -1,4 +1,4 @@
-// Aggregation of the metrics over many point sets (DESIGN.md §6): loading, the per-metric calls, pooling
+// Aggregation of the metrics over many point sets (docs/design.md §6): loading, the per-metric calls, pooling
 // rules (NN distances pooled after per-set normalisation; the periodogram averaged over sets; density z
 // pooled over all windows) and the text summary.
 #include "kdm/analysis/report.h"

@@ -9,16 +9,16 @@
 // of edge links over midline links shorter than any length. A density fails when the excess is both
 // significant (p < 0.001) and large (D+ > 0.1: a visible seam, a tenth of the edge links pushed short).
 // Significance alone is no bar: with 10^4 links per density p falls below 0.001 already at D+ = 0.03, and
-// the default set's top level measures D+ 0.035, p 7e-8, a small real excess of short edge links (noted
-// on the tile-baking issue). Size alone is none either: a set of one tile has a few dozen edge links at
-// its lowest level, where D+ 0.4 is chance (p 0.02). On the default set D+ is at most 0.096. A two-sided
-// test would also flag edge links that are longer than midline links, no defect.
+// the default set's top level measures D+ 0.035, p 7e-8, a small real excess of short edge links. Size alone
+// is none either: a set of one tile has a few dozen edge links at its lowest level, where D+ 0.4 is chance (p
+// 0.02). On the default set D+ is at most 0.096. A two-sided test would also flag edge links that are longer
+// than midline links, no defect.
 //
 // Between complete levels (what the runtime emits at in-between densities) the tiles stay blue at low
 // frequencies: lowP ≤ 0.105 on every tile's torus once it holds ≥ 1792 points (fewer average too few
-// frequencies for lowP to mean much). The issue's bar is 0.1; on the default set the worst of the 16 tiles
+// frequencies for lowP to mean much). The target is 0.1; on the default set the worst of the 16 tiles
 // × 9 densities measures 0.1002 (3/4 of the way from 512 to 2048 points per tile), the rest at most
-// 0.0962 (noted on the tile-baking issue).
+// 0.0962.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -32,7 +32,7 @@
 
 namespace kdm::verify {
 
-void judge_densities(const TileSet& set, const VerifyOptions& options, Report& report,
+void judge_densities(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done) {
   const Bars& b = options.bars;
   for (double count : densities(set, options.levels)) {

@@ -3,21 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
-#include "corner_layout.h"
+#include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 
 namespace kdm::verify {
 
-std::vector<double> torus_points(const TileSet& set, std::size_t t, double count, std::vector<double>* own,
-                                 std::vector<double>* others) {
-  const gen::Colouring col = gen::Colouring::around_tile(set.colours, t);
+std::vector<double> torus_points(const TilesetData& set, std::size_t t, double count,
+                                 std::vector<double>* own, std::vector<double>* others) {
   std::vector<double> all;
   for (int ty = 0; ty < 2; ++ty)
     for (int tx = 0; tx < 2; ++tx) {
-      const Tile& tile = set.tiles[col.tile_at(tx, ty)];
+      const Tile& tile = set.tiles[gen::tile_around(set.colours, t, tx, ty)];
       for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
         for (; i < tile.level_end[k]; ++i) {
-          if (!(set.emission_threshold(k, tile.keys[i]) < count)) continue;
+          if (!TilesetData::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
           const double x = (tx + tile.points[i].unit_x()) / 2, y = (ty + tile.points[i].unit_y()) / 2;
           all.insert(all.end(), {x, y});
           std::vector<double>* part = (tx == 0 && ty == 0) ? own : others;
@@ -64,7 +63,7 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
   return out;
 }
 
-std::vector<double> densities(const TileSet& set, const std::vector<std::uint32_t>& levels) {
+std::vector<double> densities(const TilesetData& set, const std::vector<std::uint32_t>& levels) {
   std::vector<double> out;
   for (std::uint32_t k : levels) {
     const double lo = k ? set.level_nominal[k - 1] : 0.0, hi = set.level_nominal[k];

@@ -13,7 +13,7 @@ namespace kdm::verify {
 
 /// The points the 2×2 torus around tile `t` emits at expected count `count` per tile, normalised to the
 /// unit square; `own` (optional) receives tile (0, 0)'s points separately and `others` the rest.
-std::vector<double> torus_points(const TileSet& set, std::size_t t, double count,
+std::vector<double> torus_points(const TilesetData& set, std::size_t t, double count,
                                  std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
 
 /// The full sampler's options for a side × side torus (in tiles) at user temperature `temperature`.
@@ -30,11 +30,11 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
               double temperature, double spacing, std::uint64_t seed, int threads);
 
 /// The expected counts per tile judged for `levels`: each complete level and the quarters below it.
-std::vector<double> densities(const TileSet& set, const std::vector<std::uint32_t>& levels);
+std::vector<double> densities(const TilesetData& set, const std::vector<std::uint32_t>& levels);
 
 /// Parts 3 and 4 of the generator test (seams.cpp): appends a DensityResult per density to `report`;
 /// `done` receives the points measured.
-void judge_densities(const TileSet& set, const VerifyOptions& options, Report& report,
+void judge_densities(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 
 }  // namespace kdm::verify

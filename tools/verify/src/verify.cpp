@@ -1,12 +1,12 @@
 // Parts 1 and 2 of the generator test (verify.h): every tile and level against full-sampler runs, and
 // the direct check. Why the bars are what they are (measured on the default set, tilesets/default.recipe):
-//  - Small tiles. The bars are E/n ≤ ref + 5%, lowP ≤ 1.5 × ref and NN1% ≥ 0.85 × ref. Levels whose
+//  - Small tiles. The targets are E/n ≤ ref + 5%, lowP ≤ 1.5 × ref and NN1% ≥ 0.85 × ref. Levels whose
 //    tiles are less than 16 point spacings wide (the default set's levels 0 and 1: 5.7 and 11.3) cannot meet
 //    them all: there the corner and edge patches are one to three spacings wide and their boundaries show
 //    as local density errors (measured worst: E/n +12.5%, lowP 2.7 × ref and 2.1 × the largest, NN1% 0.847 ×
 //    ref). They are held to E/n ≤ ref + 20%, lowP ≤ 3 × ref (or 3 × the largest reference where few
 //    frequencies count) and NN1% ≥ 0.8 × ref instead — still far from white noise (lowP 1).
-//    The direct check's energy drop is held to 3% (the bar) from 16 spacings on, where the default
+//    The direct check's energy drop is held to 3% (the target) from 16 spacings on, where the default
 //    set's tiles measure at most 2.1% (1.4% from level 3 on); the smaller levels' patch boundaries relax
 //    measurably (level 1: 2.7%; level 0: up to 3.8%, its E/n being up to 12% above the reference), so
 //    there the bar is 6%. For scale: a full-sampler
@@ -71,8 +71,8 @@ struct Reference {
   analysis::SpectrumStats spectrum;  ///< of the averaged periodogram up to f = 2; empty over budget
 };
 
-Reference reference(const TileSet& set, std::uint32_t level, double temperature, const VerifyOptions& options,
-                    const std::function<void(double)>& done) {
+Reference reference(const TilesetData& set, std::uint32_t level, double temperature,
+                    const VerifyOptions& options, const std::function<void(double)>& done) {
   const std::uint32_t n = set.level_nominal[level];
   Reference ref;
   LevelReference& s = ref.summary;
@@ -144,7 +144,7 @@ void judge_statistics(const std::vector<double>& coords, const Reference& ref, d
   }
 }
 
-void judge_tile(const TileSet& set, std::size_t t, const Reference& ref, double temperature,
+void judge_tile(const TilesetData& set, std::size_t t, const Reference& ref, double temperature,
                 const VerifyOptions& options, TileResult& out) {
   const LevelReference& level = ref.summary;
   const Bars& b = options.bars;
@@ -188,7 +188,7 @@ std::size_t Report::failed_checks() const {
   return failed;
 }
 
-Report verify_tileset(const TileSet& set, const VerifyOptions& options_in) {
+Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
   VerifyOptions options = options_in;
   if (options.reference_runs < 2) throw gen::InvalidArgument("verify: at least 2 reference runs are needed");
   if (options.levels.empty())

@@ -1,4 +1,4 @@
-// Baking tile sets (DESIGN.md §3): aperiodic corner tiles (Lagae & Dutré 2006) holding a nested
+// Baking tile sets (docs/design.md §3): aperiodic corner tiles (Lagae & Dutré 2006) holding a nested
 // multi-density pyramid, every patch sampled by the full KDM sampler with everything it touches fixed.
 //
 // Per level k (N_k = base_points·4^k points per tile), with all of levels < k fixed:
@@ -57,26 +57,12 @@ struct BakeRecipe {
 
 /// Bakes `recipe`. `progress` (optional) receives the fraction done. Throws InvalidArgument on a bad
 /// recipe.
-TileSet bake_tileset(const BakeRecipe& recipe, int threads = 0,
-                     const std::function<void(double)>& progress = {});
+TilesetData bake_tileset(const BakeRecipe& recipe, int threads = 0,
+                         const std::function<void(double)>& progress = {});
 
-/// Input of progressive_order: positions in tile units on a width × height torus.
-struct RankingInput {
-  double width = 1, height = 1;
-  std::vector<double> candidates;         ///< x y pairs to rank
-  std::vector<double> fixed;              ///< present from the start
-  std::vector<double> timed;              ///< present once the ranking reaches their key:
-  std::vector<std::uint16_t> timed_keys;  ///< before candidate s of n is chosen, keys < rank_key(s, n)
-  double filter_width = 0.1;              ///< σ of the Gaussian filter at the first pick, tile units
-  double filter_width_end = 0;            ///< σ at the last pick (0: the same); 1/σ² moves linearly
-};
-
-/// The emission key of the s-th of n ranked points: floor((s + ½) / n · 65536).
-std::uint16_t rank_key(std::size_t s, std::size_t n);
-
-/// The progressive order of the candidates: indices, first = rank 0; each next one is the candidate in
-/// the deepest void of a Gaussian-filtered density of everything present. O(n log n) for a filter a few
-/// spacings wide. Deterministic.
-std::vector<std::uint32_t> progressive_order(const RankingInput& input);
+/// The 2×2 torus of tiles around tile `index` of a set with `colours` corner colours, on which the baker
+/// samples that tile's interior and the generator test judges it: the index of the tile at (tx, ty),
+/// tx, ty in {0, 1}, with (0, 0) the tile itself. Its vertices carry the tile's four corner colours.
+std::size_t tile_around(std::uint32_t colours, std::size_t index, int tx, int ty);
 
 }  // namespace kdm::gen

@@ -28,7 +28,9 @@ enum class Domain { kTorus, kBox };
 /// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe.
 using DensityFunction = std::function<double(const double* u)>;
 
-/// A density given as `width`×`height` values, row 0 at the top of the picture (u_y near 1).
+/// A density given as `width`×`height` values, row 0 at the bottom (u_y near 0): kdm's one row
+/// convention, the runtime's too (kdm::DensityImageView); picture files, stored top row first, are
+/// flipped once when they are read.
 struct DensityImage {
   int width = 0, height = 0;
   std::vector<float> values;  ///< finite and >= 0, row by row
@@ -49,7 +51,7 @@ struct Density {
   std::shared_ptr<const DensityImage> image;
 
   static Density constant() { return {}; }
-  /// A 2D density from `width`×`height` values (row 0 at the top, i.e. at u_y near 1), bilinearly
+  /// A 2D density from `width`×`height` values (row 0 at the bottom, i.e. at u_y near 0), bilinearly
   /// interpolated. Values must be finite and >= 0, and not all zero. Throws InvalidArgument otherwise.
   static Density from_values(int width, int height, std::vector<float> values);
 };
@@ -80,17 +82,15 @@ struct SamplerOptions {
   /// deterministic energy descent. The model temperature of eq. 4 is temperature * kModelTemperaturePerUser.
   double temperature = 0.5;
   std::uint64_t seed = 1;
-  int threads = 0;  ///< 0 = all hardware threads. Output does not depend on this.
-  /// MH-Langevin sweeps on the finest level. The paper uses 15 (unadjusted); with the MH test we measured
-  /// 30 to reach the reference's statistics (README, "How the sampler works").
+  int threads = 0;  ///< 0 = default_thread_count(). The output does not depend on this.
+  /// MH-Langevin sweeps on the finest level. The paper uses 15 (unadjusted); with the MH test 30 reach
+  /// the reference implementation's statistics (docs/design.md §2).
   int sweeps = 30;
   /// MH-Langevin sweeps on each level between the coarsest and the finest: the paper's 15. The finest
-  /// level's sweeps set the local statistics; 30 here changed nothing we measure at n = 4096 (over 64 seeds:
-  /// δavg .8728 vs .8726, lowP .0057 both) and cost 10–16% more time.
+  /// level's sweeps set the local statistics; more here cost time and change nothing measurable.
   int coarse_sweeps = 15;
-  /// Sweeps on the coarsest grid, where points start far from equilibrium. This level is too small to cut
-  /// into cells for two threads (README, "Measured"), so its sweeps run on one. Over 64 seeds at n = 4096,
-  /// 60 here gave δavg .873, lowP .0057, E/n .5407; 30 gave .872, .0058, .5412 (tile baking keeps 60).
+  /// Sweeps on the coarsest grid, where points start far from equilibrium (tile baking keeps 60). This
+  /// level is too small to cut into cells for two threads, so its sweeps run on one.
   int coarsest_sweeps = 30;
   /// Deterministic descent sweeps (T = 0) right after each refinement, before the MH sweeps: they spread
   /// the crowded children of split kernels. Initialisation only; the MH sweeps then sample P.
@@ -152,6 +152,7 @@ struct SampleReport {
   std::int64_t inserted_for_exact_count = 0;
   std::int64_t removed_for_exact_count = 0;
   double model_seconds = 0;  ///< building the density pyramid (before the levels run)
+  int threads = 1;           ///< threads the run used (SamplerOptions::threads, or default_thread_count())
   double seconds = 0;        ///< the whole call, model_seconds included
 };
 
@@ -161,6 +162,13 @@ struct SampleResult {
   SampleReport report;
   std::size_t size() const { return points.size() / dim; }
 };
+
+/// The threads sample() and bake_tileset() use when given 0: the first number in OMP_NUM_THREADS if it is
+/// set (build tools set it to share the machine), else the CPUs this process may run on (its affinity
+/// mask, as `taskset` or a container sets it), capped by its cgroup's CPU quota (a CI runner's share).
+/// At least 1. Worked out once per process. Waiting threads spin for at most 50 µs and then sleep, so a
+/// run on a busy machine does not burn the cores its own threads are waiting for.
+int default_thread_count();
 
 /// Draws one point set from the KDM model. Throws InvalidArgument on bad options or density.
 SampleResult sample(const SamplerOptions& options, const Density& density = Density::constant());

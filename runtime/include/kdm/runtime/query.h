@@ -31,7 +31,7 @@ class Tileset {
   /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe; decoded once.
   static const Tileset& builtin();
 
-  const TileSet& data() const { return set_; }
+  const TilesetData& data() const { return set_; }
   bool empty() const { return set_.tiles.empty(); }
   /// The expected points per tile at which every tile has emitted all its points (the nominal count of
   /// the top pyramid level): the density limit is this per tile area.
@@ -41,7 +41,7 @@ class Tileset {
   /// Index into data().tiles of the tile shown at tile coordinates (tx, ty). Thread-safe.
   std::size_t tile_index_at(std::int64_t tx, std::int64_t ty) const;
   const Tile& tile_at(std::int64_t tx, std::int64_t ty) const { return set_.tiles[tile_index_at(tx, ty)]; }
-  /// Emission thresholds of tile `index`'s points (TileSet::emission_threshold), non-decreasing.
+  /// Emission thresholds of tile `index`'s points (TilesetData::emission_threshold), non-decreasing.
   const float* thresholds(std::size_t index) const { return thresholds_[index].data(); }
   /// The lowest threshold of any point: below it no tile emits anything.
   double min_threshold() const { return min_threshold_; }
@@ -51,8 +51,8 @@ class Tileset {
   std::size_t resident_bytes() const;
 
  private:
-  void adopt(TileSet&& set);
-  TileSet set_;
+  void adopt(TilesetData&& set);
+  TilesetData set_;
   std::vector<std::vector<float>> thresholds_;
   double min_threshold_ = 0;
 };
@@ -72,8 +72,8 @@ struct QueryPoint {
 };
 
 /// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
-/// Values must be finite and >= 0 (validated by make_density_image). Built once, shared read-only.
-struct DensityImage {
+/// Values must be finite and >= 0 (validated by make_density_max_mip). Built once, shared read-only.
+struct DensityImageView {
   int width = 0, height = 0;
   double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  ///< world rectangle covered; row 0 at y0
   const float* values = nullptr;          ///< width·height, row-major, owned by the caller
@@ -87,7 +87,7 @@ struct DensityImage {
 /// Fills `mip` (resized to ceil(w/8)·ceil(h/8)) with 8×8 block maxima of `image.values`, widened by one
 /// texel so they bound bilinear values too, and points the image at it. Returns kInvalidArgument for
 /// empty images or values that are negative or not finite.
-Status make_density_max_mip(DensityImage& image, std::vector<float>& mip);
+Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
 
 /// The density of a query: constant, an image, or a callback (called once per candidate point, with
 /// world coordinates; must be thread-safe if queries run concurrently). Negative, NaN and infinite values
@@ -95,7 +95,7 @@ Status make_density_max_mip(DensityImage& image, std::vector<float>& mip);
 struct QueryDensity {
   enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;
   double constant = 1;
-  const DensityImage* image = nullptr;
+  const DensityImageView* image = nullptr;
   double (*callback)(void* user, double x, double y) = nullptr;
   void* user = nullptr;
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).

@@ -28,7 +28,7 @@
 //                  level_nominal, then per tile its level_end, x y pairs and keys
 // The file is exactly header size + payload size bytes long.
 //
-// Thread safety: every function here is reentrant; a TileSet is a plain value (share it read-only).
+// Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
 #pragma once
 
 #include <cstddef>
@@ -53,7 +53,7 @@ enum class Status : int {
   kTooLarge,                 ///< a size exceeds the reader's caps (see kMax* below)
   kDecompressionFailed,      ///< the payload is not a valid zstd frame of the stated size
   kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
-  kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TileSet)
+  kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TilesetData)
   kBufferFull,               ///< a query filled the caller's buffer; resume with the same cursor
 };
 
@@ -93,7 +93,7 @@ struct Tile {
   }
 };
 
-struct TileSet {
+struct TilesetData {
   std::uint32_t colours = 0;  ///< corner colours C; tiles.size() == C^4
   std::uint32_t levels = 0;   ///< pyramid levels per tile
   /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
@@ -106,12 +106,16 @@ struct TileSet {
   std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
     return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
   }
-  /// The expected point count per tile above which a point of `level` with key `key` is emitted.
-  double emission_threshold(std::uint32_t level, std::uint16_t key) const {
+  /// The expected point count per tile above which a point of `level` with key `key` is emitted, in
+  /// the float precision the runtime stores it in (4 bytes per point).
+  float emission_threshold(std::uint32_t level, std::uint16_t key) const {
     const double lo = level == 0 ? 0.0 : level_nominal[level - 1], hi = level_nominal[level];
-    return lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo);
+    return static_cast<float>(lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo));
   }
-  friend bool operator==(const TileSet& a, const TileSet& b) {
+  /// The emission rule, stated once for the runtime and the generator test: a point with threshold
+  /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
+  static bool emits(float threshold, double expected) { return expected > threshold; }
+  friend bool operator==(const TilesetData& a, const TilesetData& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
            a.tiles == b.tiles && a.recipe == b.recipe && a.generator_version == b.generator_version;
   }
@@ -120,20 +124,20 @@ struct TileSet {
 /// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
 /// counts, one key per point, keys sorted within each level).
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
-Status validate_tileset(const TileSet& set, std::string* detail = nullptr);
+Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 
 /// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
-Status encode_tileset(const TileSet& set, std::vector<std::uint8_t>& out, std::string* detail = nullptr);
+Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, std::string* detail = nullptr);
 
 /// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
 /// checked before use; nothing is allocated beyond the caps). On failure `out` is left empty.
-Status decode_tileset(const void* data, std::size_t size, TileSet& out, std::string* detail = nullptr);
+Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std::string* detail = nullptr);
 
 /// Reads and decodes the file at `path`.
-Status load_tileset(const std::string& path, TileSet& out, std::string* detail = nullptr);
+Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
 /// so an interrupted save never leaves a damaged file at `path`.
-Status save_tileset(const TileSet& set, const std::string& path, std::string* detail = nullptr);
+Status save_tileset(const TilesetData& set, const std::string& path, std::string* detail = nullptr);
 
 }  // namespace kdm

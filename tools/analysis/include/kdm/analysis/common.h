@@ -1,4 +1,4 @@
-// Shared conventions of the point-set analysis (DESIGN.md §6): the point representation, the reference
+// Shared conventions of the point-set analysis (docs/design.md §6): the point representation, the reference
 // spacings that normalise every distance (d_hex in 2D, the FCC spacing in 3D), input validation and the
 // minimum-image displacement used for periodic (torus) distances.
 #pragma once

@@ -1,5 +1,5 @@
-// Nearest-neighbour (NN) statistics of a point set (DESIGN.md §6): per-point NN distance and index, and the
-// summary δmin, δavg, NN1% (1st percentile) and a histogram, all normalised by the reference spacing
+// Nearest-neighbour (NN) statistics of a point set (docs/design.md §6): per-point NN distance and index, and
+// the summary δmin, δavg, NN1% (1st percentile) and a histogram, all normalised by the reference spacing
 // (d_hex in 2D, FCC spacing in 3D). Uses a uniform cell list: O(n) expected time.
 #pragma once
 

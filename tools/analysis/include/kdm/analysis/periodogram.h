@@ -1,4 +1,4 @@
-// The periodogram of 2D point sets and its radial statistics (DESIGN.md §6):
+// The periodogram of 2D point sets and its radial statistics (docs/design.md §6):
 //   P(k) = |Σ_j exp(−2πi k·x_j)|² / n on integer k, normalised frequency f = |k| / sqrt(n),
 //   RAPS = mean of P over rings of width one integer step in |k| (ring r holds r − ½ ≤ |k| < r + ½, f =
 //   r/√n), lowP = mean P over 0 < f < 0.5, peak height/position of RAPS, ν_eff = largest f with RAPS < 0.1 on

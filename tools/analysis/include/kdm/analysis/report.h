@@ -1,6 +1,7 @@
 // One-call analysis of a collection of point sets: reads the sets (UTK/psa text format via
-// kdm::tools::read_point_sets), runs every metric of DESIGN.md §6 that applies (NN statistics, periodogram
-// and RAPS statistics, g(r), density accuracy, tiling diagnostics) and formats a short text summary.
+// kdm::tools::read_point_sets), runs every metric of docs/design.md §6 that applies (NN statistics,
+// periodogram and RAPS statistics, g(r), density accuracy, tiling diagnostics) and formats a short text
+// summary.
 #pragma once
 
 #include <cstddef>

@@ -1,5 +1,5 @@
 // The generator test as a library: every tile and level of a baked tile set judged directly against the
-// full KDM sampler (DESIGN.md §5; the tile-baking issue's "generator test"). `kdm verify` prints its report;
+// full KDM sampler (docs/design.md §5: the "generator test"). `kdm verify` prints its report;
 // tests/generator/generator_test.cpp asserts it on the shipped set.
 //
 // Corner tiles are not periodic one by one, so each tile is judged among neighbours: on the 2×2 torus of
@@ -33,8 +33,8 @@
 
 namespace kdm::verify {
 
-/// The pass marks. Defaults are the tile-baking issue's, except where a comment says why (verify.cpp has
-/// the measurements behind each).
+/// The pass marks. Defaults are the design's targets (docs/design.md §5), except where a comment says why
+/// (verify.cpp has the measurements behind each).
 struct Bars {
   double energy = 1.05;  ///< E/n ≤ energy × reference mean
   double davg = 0.015;   ///< δavg ≥ reference mean − davg
@@ -126,7 +126,7 @@ struct Report {
 /// Runs the generator test on `set` (a valid set: validate_tileset passes). The recipe's temperature is
 /// the reference runs'. Throws std::invalid_argument (gen::InvalidArgument) for an unreadable recipe,
 /// fewer than 2 reference runs or an unknown level; never for a tile that fails (that is in the report).
-Report verify_tileset(const TileSet& set, const VerifyOptions& options = {});
+Report verify_tileset(const TilesetData& set, const VerifyOptions& options = {});
 
 /// Writes `report` as tables (one row per tile and level, one per density; failing values marked '!').
 void print_report(const Report& report, std::FILE* out);

@@ -41,7 +41,7 @@ struct Patch {
 };
 
 /// Every patch of one density level. Edge patches are indexed by (first, second) end colour:
-/// first·C + second, left→right or bottom→top; interiors by TileSet::tile_index(sw, se, ne, nw).
+/// first·C + second, left→right or bottom→top; interiors by TilesetData::tile_index(sw, se, ne, nw).
 struct LevelPatches {
   std::vector<Patch> corners, horizontal, vertical, interiors;
   explicit LevelPatches(std::uint32_t colours = 1)

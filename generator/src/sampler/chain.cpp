@@ -1,11 +1,12 @@
-#include "chain.h"
+#include "sampler/chain.h"
 
-#include "huge_pages.h"
-#include "lanes.h"
-#include "parallel.h"
+#include "platform/huge_pages.h"
+#include "platform/lanes.h"
+#include "platform/parallel.h"
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace kdm::gen {
 namespace {
@@ -14,6 +15,44 @@ namespace {
 // matches the lane passes' sign flip.
 inline float sign_of(float r) {
   return std::copysign(1.0f, r);
+}
+
+/// The general passes (footprints whose rows wrap around a torus or fold at a box's walls, as runs):
+/// eq. 7's gradient and the change in Σ|R| of taking fp's kernel out of R (kRemove: R changes and its old
+/// values go to `saved`) or of putting it in (R unchanged). The lane passes compute the same per node.
+template <bool kRemove, int D>
+double measure_runs(std::conditional_t<kRemove, float*, const float*> R, const Grid<D>& grid,
+                    const Footprint<D>& fp, Vec<D>& gradient, float* saved) {
+  const AxisFactor& ax = fp.axes[0];
+  double change = 0;
+  gradient.fill(0);
+  fp.for_each_row(grid, [&](std::int64_t base, double p, const std::array<double, D>& pd) {
+    const float pf = static_cast<float>(p);
+    float sx = 0, sg = 0, e = 0;
+    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
+      const int off = ax.run_offset[run], len = ax.run_length[run];
+      auto* __restrict row = R + base + ax.index[off];
+      const float* __restrict v = ax.value.data() + off;
+      const float* __restrict dv = ax.deriv.data() + off;
+      for (int a = 0; a < len; ++a) {
+        const float r = row[a];
+        const float rn = kRemove ? r - pf * v[a] : r + pf * v[a];
+        const float with = kRemove ? r : rn, without = kRemove ? rn : r;  // R with and without the kernel
+        const float s = sign_of(with);
+        sx += s * dv[a];
+        sg += s * v[a];
+        e += std::fabs(with) - std::fabs(without);
+        if constexpr (kRemove) {
+          *saved++ = r;
+          row[a] = rn;
+        }
+      }
+    }
+    change += e;
+    gradient[0] += p * sx;
+    for (int k = 1; k < D; ++k) gradient[k] += pd[k] * sg;
+  });
+  return change;
 }
 
 }  // namespace
@@ -163,33 +202,7 @@ double Chain<D>::remove_with_gradient(const Footprint<D>& fp, Vec<D>& gradient, 
       return lanes::measure<N, true>(R, grid(), fp, gradient, out);
     });
   }
-  const AxisFactor& ax = fp.axes[0];
-  double change = 0;
-  gradient.fill(0);
-  fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
-    const float pf = static_cast<float>(p);
-    float sx = 0, sg = 0, e = 0;
-    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
-      const int off = ax.run_offset[run], len = ax.run_length[run];
-      float* __restrict row = R + base + ax.index[off];
-      const float* __restrict v = ax.value.data() + off;
-      const float* __restrict dv = ax.deriv.data() + off;
-      for (int a = 0; a < len; ++a) {
-        const float r = row[a];
-        const float s = sign_of(r);
-        const float rn = r - pf * v[a];
-        sx += s * dv[a];
-        sg += s * v[a];
-        e += std::fabs(r) - std::fabs(rn);
-        *out++ = r;
-        row[a] = rn;
-      }
-    }
-    change += e;
-    gradient[0] += p * sx;
-    for (int k = 1; k < D; ++k) gradient[k] += pd[k] * sg;
-  });
-  return change;
+  return measure_runs<true, D>(R, grid(), fp, gradient, out);
 }
 
 template <int D>
@@ -226,31 +239,7 @@ double Chain<D>::added_change_with_gradient(const Footprint<D>& fp, Vec<D>& grad
       return lanes::measure<N, false>(R, grid(), fp, gradient, nullptr);
     });
   }
-  const AxisFactor& ax = fp.axes[0];
-  double change = 0;
-  gradient.fill(0);
-  fp.for_each_row(grid(), [&](std::int64_t base, double p, const std::array<double, D>& pd) {
-    const float pf = static_cast<float>(p);
-    float sx = 0, sg = 0, e = 0;
-    for (std::size_t run = 0; run < ax.run_offset.size(); ++run) {
-      const int off = ax.run_offset[run], len = ax.run_length[run];
-      const float* __restrict row = R + base + ax.index[off];
-      const float* __restrict v = ax.value.data() + off;
-      const float* __restrict dv = ax.deriv.data() + off;
-      for (int a = 0; a < len; ++a) {
-        const float r = row[a];
-        const float rn = r + pf * v[a];
-        const float s = sign_of(rn);
-        sx += s * dv[a];
-        sg += s * v[a];
-        e += std::fabs(rn) - std::fabs(r);
-      }
-    }
-    change += e;
-    gradient[0] += p * sx;
-    for (int k = 1; k < D; ++k) gradient[k] += pd[k] * sg;
-  });
-  return change;
+  return measure_runs<false, D>(R, grid(), fp, gradient, nullptr);
 }
 
 template <int D>
@@ -366,8 +355,7 @@ void Chain<D>::sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys
   }
   const std::vector<int>& order = board_.order();
   const std::int64_t updates = static_cast<std::int64_t>(order.size());
-#pragma omp parallel for schedule(static) num_threads(nthreads) if (nthreads > 1 && updates >= 4096)
-  for (std::int64_t t = 0; t < updates; ++t) particles[order[t]] = local_[t];
+  parallel_for(updates, nthreads, updates >= 4096, [&](std::int64_t t) { particles[order[t]] = local_[t]; });
 }
 
 template <int D>

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "kdm/generator/sampler.h"
-#include "setup.h"
+#include "sampler/setup.h"
 
 namespace kdm::gen {
 

@@ -1,4 +1,4 @@
-#include "multiscale.h"
+#include "sampler/multiscale.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,10 +6,10 @@
 #include <limits>
 #include <numeric>
 
-#include "chain.h"
-#include "count_fixing.h"
-#include "huge_pages.h"
-#include "parallel.h"
+#include "platform/huge_pages.h"
+#include "platform/parallel.h"
+#include "sampler/chain.h"
+#include "sampler/count_fixing.h"
 
 namespace kdm::gen {
 namespace {
@@ -50,7 +50,7 @@ struct Driver {
   std::vector<Particle<D>> particles;
   std::vector<Particle<D>> fixed;  ///< constrained sampling: background kernels on the finest grid
   double total_sweeps = 0, done_sweeps = 0;
-  int threads = 1;          ///< OpenMP threads for the set-up of each level (sweeps take options.threads)
+  int threads = 1;          ///< threads for the set-up of each level (sweeps take options.threads)
   FootprintCache<D> cache;  ///< lent to every level's chain
 
   Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s), threads(thread_count(o.threads)) {
@@ -168,8 +168,7 @@ struct Driver {
       first_child[j + 1] = first_child[j] + (particles[j].splits ? 1 << D : 1);
     std::vector<Particle<D>> next =
         vector_on_huge_pages(static_cast<std::size_t>(first_child[n]), Particle<D>{});
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1)
-    for (std::int64_t j = 0; j < n; ++j) {
+    parallel_for(n, threads, true, [&](std::int64_t j) {
       const Particle<D>& p = particles[j];
       Particle<D>* out = next.data() + first_child[j];
       Vec<D> centre;
@@ -177,7 +176,7 @@ struct Driver {
       if (p.splits == 0) {
         *out = p;
         out->x = fine.at(centre) > 0 ? centre : inside_support(fine, centre);
-        continue;
+        return;
       }
       Particle<D> child;
       child.splits = static_cast<std::uint8_t>(p.splits - 1);
@@ -192,7 +191,7 @@ struct Driver {
         if (!(fine.at(child.x) > 0)) child.x = inside_support(fine, centre);
         *out++ = child;
       }
-    }
+    });
     particles.swap(next);
   }
 

@@ -1,10 +1,11 @@
 // Progressive ranking by void-and-cluster: R. Ulichney, "The void-and-cluster method for dither array
 // generation", SPIE 1913, 1993 — its "void" phase: each next point is the candidate in the deepest void of
-// a Gaussian-filtered density of everything already present. See kdm/generator/bake.h.
+// a Gaussian-filtered density of everything already present. See progressive_order.h.
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include "kdm/generator/bake.h"
+#include "bake/progressive_order.h"
 
 namespace kdm::gen {
 namespace {

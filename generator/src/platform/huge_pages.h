@@ -1,8 +1,8 @@
 // Transparent huge pages for the sampler's largest buffers. Every first touch of a 4 KiB page is a fault,
-// and on virtual machines a fault is slow: on the machine the README's figures come from, faulting in
-// 5 MiB took 17 ms as 4 KiB pages against 3.6 ms as 2 MiB pages. A buffer larger than glibc's largest
-// mmap threshold (32 MiB) is mapped afresh, and faulted in again, by every call: the footprint cache from
-// n of about 110,000 up.
+// and on virtual machines a fault is slow: on the machine docs/performance.md's figures come from, faulting
+// in 5 MiB took 17 ms as 4 KiB pages against 3.6 ms as 2 MiB pages. A buffer larger than glibc's largest mmap
+// threshold (32 MiB) is mapped afresh, and faulted in again, by every call: the footprint cache from n of
+// about 110,000 up.
 #pragma once
 
 #include <cstddef>

@@ -6,14 +6,9 @@
 #include <cmath>
 #include <cstdint>
 
-namespace kdm::gen {
+#include "kdm/runtime/hash.h"
 
-inline std::uint64_t mix64(std::uint64_t z) {
-  // SplitMix64 finaliser (Steele, Lea, Flood 2014).
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
+namespace kdm::gen {
 
 /// The layers of the ziggurat for the standard normal (Marsaglia and Tsang, "The Ziggurat Method for
 /// Generating Random Variables", J. Stat. Softw. 5(8), 2000), 256 layers of equal area.

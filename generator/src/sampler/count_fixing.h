@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "chain.h"
-#include "particle.h"
+#include "sampler/chain.h"
+#include "sampler/particle.h"
 
 namespace kdm::gen {
 

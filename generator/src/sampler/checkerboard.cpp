@@ -1,10 +1,11 @@
-#include "checkerboard.h"
+#include "sampler/checkerboard.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "huge_pages.h"
-#include "parallel.h"
+#include "kdm/runtime/check.h"
+#include "platform/huge_pages.h"
+#include "platform/parallel.h"
 
 namespace kdm::gen {
 
@@ -122,6 +123,7 @@ void Checkerboard<D>::resort(std::vector<Particle<D>>& sorted, int threads) {
   // its particles ordered by (old cell, index): the ones that stayed, in index order, and those that
   // arrived from each neighbour, in index order too; an insertion sort per cell merges them, which costs
   // little since few particles change cells in a sweep.
+  KDM_CHECK(sorted.size() == order_.size());
   const std::int64_t n = static_cast<std::int64_t>(sorted.size());
   const int runs = std::max(1, threads);
   const std::size_t stride = run_stride(total_cells_);

@@ -11,10 +11,11 @@
 #include <thread>
 #include <tuple>
 
-#include "corner_layout.h"
+#include "bake/corner_layout.h"
+#include "bake/progressive_order.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/version.h"
-#include "rng.h"
+#include "sampler/rng.h"
 
 namespace kdm::gen {
 namespace {
@@ -154,9 +155,8 @@ class Baker {
       for (const Run& run : runs_) total_work_ += work(k, run);
   }
 
-  TileSet bake() {
-    const int workers =
-        threads_ > 0 ? threads_ : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  TilesetData bake() {
+    const int workers = threads_ > 0 ? threads_ : default_thread_count();
     for (std::uint32_t k = 0; k < recipe_.levels; ++k) {
       levels_.emplace_back(recipe_.colours);
       // The runs of one stage read only earlier stages: they sample concurrently (one thread each), and
@@ -287,8 +287,8 @@ class Baker {
   }
 
   /// Every tile (sw, se, ne, nw): its share of the patches around it, level by level, sorted by key.
-  TileSet assemble() const {
-    TileSet set;
+  TilesetData assemble() const {
+    TilesetData set;
     set.colours = recipe_.colours;
     set.levels = recipe_.levels;
     set.level_nominal = nominal_;
@@ -332,7 +332,7 @@ class Baker {
 
 }  // namespace
 
-TileSet bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
+TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
   return Baker(recipe, threads, progress).bake();
 }
 

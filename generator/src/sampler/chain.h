@@ -15,12 +15,13 @@
 #include <functional>
 #include <vector>
 
-#include "checkerboard.h"
-#include "grid.h"
-#include "kernel.h"
-#include "lanes_wide.h"
-#include "particle.h"
-#include "rng.h"
+#include "kdm/runtime/check.h"
+#include "platform/lanes_wide.h"
+#include "sampler/checkerboard.h"
+#include "sampler/grid.h"
+#include "sampler/kernel.h"
+#include "sampler/particle.h"
+#include "sampler/rng.h"
 
 namespace kdm::gen {
 
@@ -80,7 +81,7 @@ class Chain {
   /// Adds (sign = +1) or removes (sign = -1) p's kernel.
   void splat(const Particle<D>& p, float sign, Scratch& scratch);
   /// Adds every kernel of `particles`: the same bits as splat() on each in turn. Uses up to `threads`
-  /// OpenMP threads (each adds the rows in its own band of the grid along the last axis, so every node
+  /// threads (each adds the rows in its own band of the grid along the last axis, so every node
   /// still sums the same terms in the same order). Not thread-safe.
   void splat_all(const std::vector<Particle<D>>& particles, int threads);
   /// Σ |R| over the grid: the energy of eq. 3 with γ = 1.
@@ -105,7 +106,7 @@ class Chain {
     int level = 0, first_index = 0, index_step = 1;
   };
   /// `count` sweeps over the active particles, each in the deterministic checkerboard order, on up to
-  /// `threads` OpenMP threads (the result does not depend on how many), calling after_sweep (if set)
+  /// `threads` threads (the result does not depend on how many), calling after_sweep (if set)
   /// after each. `particles` is read before the first and written after the last. Not thread-safe.
   void sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys, int count, int threads,
               ChainCounters& counters, const std::function<void()>& after_sweep = {});
@@ -138,8 +139,9 @@ class Chain {
       for (int k = 1; k < D; ++k) offset += at[k] * (stride *= g.dims[k - 1]);
       return offset;
     }
-    // The next line's address; moves on to the line after it. Requires left > 0.
+    // The next line's address; moves on to the line after it.
     const float* next(const Grid<D>& g, const float* R) {
+      KDM_CHECK(left > 0);
       const float* line = row + std::min(column * 16, hi[0] - lo[0]);
       --left;
       if (++column == lines_per_row) {

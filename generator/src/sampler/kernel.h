@@ -17,7 +17,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "grid.h"
+#include "sampler/grid.h"
 
 namespace kdm::gen {
 
@@ -270,7 +270,7 @@ class FootprintCache {
   std::size_t size() const { return size_; }
   CachedFootprint<D>& operator[](std::size_t j) { return entries_.get()[j]; }
   const CachedFootprint<D>& operator[](std::size_t j) const { return entries_.get()[j]; }
-  /// n entries holding nothing, set up on up to `threads` OpenMP threads. Not thread-safe.
+  /// n entries holding nothing, set up on up to `threads` threads. Not thread-safe.
   void reset(std::size_t n, int threads);
   /// Room for n entries without setting them up (size() becomes 0 if it grows). Not thread-safe.
   void reserve(std::size_t n);

@@ -4,15 +4,16 @@
 // said the CPU has them: the rest of the program keeps the baseline instruction set. The target is set per
 // function rather than for this file, so no inline function that other files share is ever compiled here
 // with wider instructions.
-#include "lanes_wide.h"
+#include "platform/lanes_wide.h"
 
 #include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <type_traits>
 
-#include "lanes.h"
-#include "simd.h"
+#include "kdm/runtime/check.h"
+#include "platform/lanes.h"
+#include "platform/simd.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define KDM_HAVE_WIDE_PASSES 1
@@ -137,7 +138,7 @@ KDM_TARGET inline V two_to(V n) {
       _mm512_slli_epi32(_mm512_add_epi32(_mm512_cvttps_epi32(n), _mm512_set1_epi32(127)), 23));
 }
 
-#include "lanes_wide_passes.inc"
+#include "platform/lanes_wide_passes.inc"
 #undef KDM_TARGET
 }  // namespace avx512
 
@@ -225,7 +226,7 @@ KDM_TARGET inline V two_to(V n) {
   return {two_to8(n.low), two_to8(n.high)};
 }
 
-#include "lanes_wide_passes.inc"
+#include "platform/lanes_wide_passes.inc"
 #undef KDM_TARGET
 }  // namespace avx2
 
@@ -245,6 +246,7 @@ Isa widest(int lanes) {
 template <int D>
 double remove(Isa isa, float* R, const Grid<D>& grid, const Footprint<D>& fp, Vec<D>& gradient,
               float* saved) {
+  KDM_CHECK(fits(fp) && isa != Isa::kNone && isa <= best());
   return by_width(fp.width, [&](auto w) {
     return isa == Isa::kAvx512 ? avx512::remove_rows<D, w()>(R, grid, fp, gradient, saved)
                                : avx2::remove_rows<D, w()>(R, grid, fp, gradient, saved);
@@ -252,6 +254,7 @@ double remove(Isa isa, float* R, const Grid<D>& grid, const Footprint<D>& fp, Ve
 }
 template <int D>
 double added(Isa isa, const float* R, const Grid<D>& grid, const Footprint<D>& fp, Vec<D>& gradient) {
+  KDM_CHECK(fits(fp) && isa != Isa::kNone && isa <= best());
   return by_width(fp.width, [&](auto w) {
     return isa == Isa::kAvx512 ? avx512::added_rows<D, w()>(R, grid, fp, gradient)
                                : avx2::added_rows<D, w()>(R, grid, fp, gradient);
@@ -259,6 +262,7 @@ double added(Isa isa, const float* R, const Grid<D>& grid, const Footprint<D>& f
 }
 template <int D>
 void add(Isa isa, float* R, const Grid<D>& grid, const Footprint<D>& fp, float sign) {
+  KDM_CHECK(fits(fp) && isa != Isa::kNone && isa <= best());
   by_width(fp.width, [&](auto w) {
     if (isa == Isa::kAvx512) return avx512::add_rows<D, w()>(R, grid, fp, sign);
     avx2::add_rows<D, w()>(R, grid, fp, sign);
@@ -266,6 +270,7 @@ void add(Isa isa, float* R, const Grid<D>& grid, const Footprint<D>& fp, float s
 }
 template <int D>
 void restore(Isa isa, float* R, const Grid<D>& grid, const Footprint<D>& fp, const float* saved) {
+  KDM_CHECK(fits(fp) && isa != Isa::kNone && isa <= best());
   by_width(fp.width, [&](auto w) {
     if (isa == Isa::kAvx512) return avx512::restore_rows<D, w()>(R, grid, fp, saved);
     avx2::restore_rows<D, w()>(R, grid, fp, saved);

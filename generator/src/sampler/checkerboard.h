@@ -12,8 +12,8 @@
 #include <memory>
 #include <vector>
 
-#include "grid.h"
-#include "particle.h"
+#include "sampler/grid.h"
+#include "sampler/particle.h"
 
 namespace kdm::gen {
 
@@ -25,7 +25,7 @@ class Checkerboard {
   void layout(const Grid<D>& g, double reach);
 
   /// Sorts the active particles by cell, ascending index within each cell, and copies them in that order
-  /// into `sorted` (resized to fit). Uses up to `threads` OpenMP threads; the order does not depend on how
+  /// into `sorted` (resized to fit). Uses up to `threads` threads; the order does not depend on how
   /// many. Not thread-safe (call from one thread).
   void sort(const std::vector<Particle<D>>& particles, int threads, std::vector<Particle<D>>& sorted);
   /// Sorts `sorted` again after its particles have moved: `sorted` must be the last sort's result (in
@@ -33,7 +33,7 @@ class Checkerboard {
   /// particles in index order, but splits the work by stretches of the current order, i.e. by bands of the
   /// grid, so each thread moves the particles its own cells hold (sorting by particle index, each thread
   /// wrote half of every cell's particles, and the sweep then fetched them from the other core). Uses up to
-  /// `threads` OpenMP threads; not thread-safe.
+  /// `threads` threads; not thread-safe.
   void resort(std::vector<Particle<D>>& sorted, int threads);
 
   int cell_count() const { return total_cells_; }

@@ -7,8 +7,8 @@
 
 #include <cstdint>
 
-#include "grid.h"
-#include "kernel.h"
+#include "sampler/grid.h"
+#include "sampler/kernel.h"
 
 namespace kdm::gen::wide {
 

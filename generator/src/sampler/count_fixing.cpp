@@ -1,4 +1,4 @@
-#include "count_fixing.h"
+#include "sampler/count_fixing.h"
 
 #include <algorithm>
 #include <array>

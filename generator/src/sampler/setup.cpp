@@ -1,13 +1,14 @@
-#include "setup.h"
+#include "sampler/setup.h"
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <sstream>
 
-#include "huge_pages.h"
-#include "kernel.h"
-#include "parallel.h"
+#include "kdm/runtime/check.h"
+#include "platform/huge_pages.h"
+#include "platform/parallel.h"
+#include "sampler/kernel.h"
 
 namespace kdm::gen {
 namespace {
@@ -22,12 +23,12 @@ std::string format_position(const double* u) {
 }
 
 /// Where normalized coordinate u falls between an image's pixel centres, which sit at (i + 1/2) / pixels,
-/// clamped at the edges; `flip` for rows, which count down from the top of the picture.
+/// clamped at the edges (columns from the left, rows from the bottom).
 struct PixelLerp {
   int lo, hi;
   double t;
-  PixelLerp(double u, int pixels, bool flip) {
-    const double f = std::clamp((flip ? 1.0 - u : u) * pixels - 0.5, 0.0, pixels - 1.0);
+  PixelLerp(double u, int pixels) {
+    const double f = std::clamp(u * pixels - 0.5, 0.0, pixels - 1.0);
     lo = static_cast<int>(f);
     hi = std::min(lo + 1, pixels - 1);
     t = f - lo;
@@ -105,18 +106,18 @@ std::vector<float> sample_image(const Grid<2>& grid, const Density& density, int
       image.values.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height))
     throw InvalidArgument("density image: its size does not match its values");
   // Each subsample's place between pixels along each axis, worked out once per column and per row.
-  auto lerps = [](int nodes, int sub, int pixels, bool flip) {
+  auto lerps = [](int nodes, int sub, int pixels) {
     std::vector<PixelLerp> out;
     out.reserve(static_cast<std::size_t>(nodes) * sub);
     for (int i = 0; i < nodes; ++i)
-      for (int j = 0; j < sub; ++j) out.emplace_back((i + (j + 0.5) / sub) / nodes, pixels, flip);
+      for (int j = 0; j < sub; ++j) out.emplace_back((i + (j + 0.5) / sub) / nodes, pixels);
     return out;
   };
   const int* native = density.native_resolution;  // as sample_function() takes it
   const int sub_x = std::clamp((native[0] + grid.dims[0] - 1) / std::max(1, grid.dims[0]), 1, 8);
   const int sub_y = std::clamp((native[1] + grid.dims[1] - 1) / std::max(1, grid.dims[1]), 1, 8);
-  const std::vector<PixelLerp> xs = lerps(grid.dims[0], sub_x, image.width, false);
-  const std::vector<PixelLerp> ys = lerps(grid.dims[1], sub_y, image.height, true);
+  const std::vector<PixelLerp> xs = lerps(grid.dims[0], sub_x, image.width);
+  const std::vector<PixelLerp> ys = lerps(grid.dims[1], sub_y, image.height);
   std::vector<float> rho = vector_on_huge_pages<float>(static_cast<std::size_t>(grid.size()), 0.0f);
   const int parts = grid.size() >= (1 << 16) ? std::max(1, threads) : 1;
   for_each_part(parts, parts > 1, [&](int part, int) {
@@ -266,7 +267,10 @@ template <int D>
 std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values, int threads) {
   std::array<int, D> coarse_dims{};
   std::int64_t size = 1;
-  for (int k = 0; k < D; ++k) coarse_dims[k] = fine.dims[k] / 2, size *= coarse_dims[k];
+  for (int k = 0; k < D; ++k) {
+    KDM_CHECK(fine.dims[k] % 2 == 0);
+    coarse_dims[k] = fine.dims[k] / 2, size *= coarse_dims[k];
+  }
   std::vector<float> coarse = vector_on_huge_pages<float>(static_cast<std::size_t>(size), 0.0f);
   // Each coarse node adds its children in storage order, starting from 0: the same bits as adding every
   // fine value into its parent in one pass over the fine grid, for any number of threads.
@@ -319,7 +323,7 @@ Density Density::from_values(int width, int height, std::vector<float> values) {
   image->values = std::move(values);
   d.image = image;
   d.function = [image](const double* u) {
-    return image_value(*image, PixelLerp(u[0], image->width, false), PixelLerp(u[1], image->height, true));
+    return image_value(*image, PixelLerp(u[0], image->width), PixelLerp(u[1], image->height));
   };
   return d;
 }

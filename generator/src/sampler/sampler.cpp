@@ -4,9 +4,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "chain.h"
-#include "multiscale.h"
-#include "setup.h"
+#include "platform/parallel.h"
+#include "sampler/chain.h"
+#include "sampler/multiscale.h"
+#include "sampler/setup.h"
 
 namespace kdm::gen {
 namespace {
@@ -18,6 +19,7 @@ SampleResult sample_dim(const SamplerOptions& options, const Density& density) {
   const double model_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   SampleResult result = run_multiscale<D>(options, setup);
   result.report.model_seconds = model_seconds;
+  result.report.threads = thread_count(options.threads);
   result.report.seconds += model_seconds;
   return result;
 }

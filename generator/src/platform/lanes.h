@@ -7,9 +7,9 @@
 #include <array>
 #include <type_traits>
 
-#include "grid.h"
-#include "kernel.h"
-#include "simd.h"
+#include "platform/simd.h"
+#include "sampler/grid.h"
+#include "sampler/kernel.h"
 
 namespace kdm::gen::lanes {
 

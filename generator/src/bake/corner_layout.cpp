@@ -1,5 +1,8 @@
 // Corner-tile geometry; see corner_layout.h.
-#include "corner_layout.h"
+#include "bake/corner_layout.h"
+
+#include "kdm/generator/bake.h"
+#include "kdm/runtime/check.h"
 
 #include <cmath>
 
@@ -103,6 +106,11 @@ std::vector<PatchWidths> patch_widths(double band, double erosion,
     if (!(widths.back().edge >= 0.5 * spacing)) return {};
   }
   return widths;
+}
+
+std::size_t tile_around(std::uint32_t colours, std::size_t index, int tx, int ty) {
+  KDM_CHECK(colours > 0 && tx >= 0 && tx < 2 && ty >= 0 && ty < 2);
+  return Colouring::around_tile(colours, index).tile_at(tx, ty);
 }
 
 }  // namespace kdm::gen

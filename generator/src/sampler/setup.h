@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "grid.h"
 #include "kdm/generator/sampler.h"
+#include "sampler/grid.h"
 
 namespace kdm::gen {
 
@@ -23,7 +23,7 @@ ModelSetup<D> build_model(const SamplerOptions& options, const Density& density)
 
 /// The next coarser level of a pyramid: every coarse node is the sum of its 2^D children (a box filter
 /// and subsampling; the factor 2^D of eq. 12 goes inside the values). `fine` dims must be even. Uses up to
-/// `threads` OpenMP threads on large grids; the result does not depend on how many. Not thread-safe.
+/// `threads` threads on large grids; the result does not depend on how many. Not thread-safe.
 template <int D>
 std::vector<float> box_sum_half(const Grid<D>& fine, const std::vector<float>& values, int threads = 1);
 

@@ -1,8 +1,9 @@
-#include "kernel.h"
+#include "sampler/kernel.h"
 
-#include "huge_pages.h"
-#include "lanes_wide.h"
-#include "simd.h"
+#include "platform/huge_pages.h"
+#include "platform/lanes_wide.h"
+#include "platform/parallel.h"
+#include "platform/simd.h"
 
 namespace kdm::gen {
 
@@ -171,7 +172,7 @@ void FootprintCache<D>::reserve(std::size_t n) {
   entries_.reset(static_cast<CachedFootprint<D>*>(
       ::operator new (n * sizeof(CachedFootprint<D>), std::align_val_t{alignof(CachedFootprint<D>)})));
   // Faulted in 512 times less often, and, touched by every update in an order unrelated to its layout,
-  // kinder to the TLB: 7-9% of the run time at n = 262,144 (README, "Measured").
+  // kinder to the TLB: 7-9% of the run time at n = 262,144 (docs/performance.md).
   advise_huge_pages(entries_.get(), n * sizeof(CachedFootprint<D>));
   capacity_ = n;
 }
@@ -181,10 +182,9 @@ void FootprintCache<D>::reset(std::size_t n, int threads) {
   reserve(n);
   CachedFootprint<D>* entries = entries_.get();
   const std::int64_t count = static_cast<std::int64_t>(n);
-  (void)threads;  // used only by OpenMP
   // A few thousand entries are set faster than a sleeping team wakes up.
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads > 1 && count >= 4096)
-  for (std::int64_t j = 0; j < count; ++j) new (entries + j) CachedFootprint<D>();
+  parallel_for(count, threads, count >= 4096,
+               [&](std::int64_t j) { new (entries + j) CachedFootprint<D>(); });
   size_ = n;
 }
 

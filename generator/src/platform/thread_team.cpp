@@ -1,0 +1,141 @@
+#include "platform/thread_team.h"
+
+#include "kdm/generator/sampler.h"
+
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <system_error>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace kdm::gen {
+namespace {
+
+constexpr std::uint64_t kTeamBits = 16;
+constexpr std::uint64_t kTeamMask = (std::uint64_t(1) << kTeamBits) - 1;
+
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#endif
+}
+
+/// Spins until pred() holds or kSpinMicroseconds pass; returns whether it holds.
+template <class Pred>
+bool spin_until(Pred&& pred) {
+  const auto end =
+      std::chrono::steady_clock::now() + std::chrono::microseconds(ThreadTeam::kSpinMicroseconds);
+  for (unsigned i = 1;; ++i) {
+    if (pred()) return true;
+    cpu_relax();
+    if (i % 64 == 0 && std::chrono::steady_clock::now() >= end) return pred();
+  }
+}
+
+/// The CPU quota of this process's cgroup in CPUs (rounded up), or 0 if it has none or none can be read.
+int cgroup_cpu_quota() {
+  double quota = 0, period = 0;
+  std::ifstream v2("/sys/fs/cgroup/cpu.max");  // cgroup v2: "max 100000" or "200000 100000"
+  std::string first;
+  if (v2 >> first >> period) {
+    if (first == "max" || !(period > 0)) return 0;
+    quota = std::strtod(first.c_str(), nullptr);
+  } else {
+    std::ifstream q("/sys/fs/cgroup/cpu/cpu.cfs_quota_us"), p("/sys/fs/cgroup/cpu/cpu.cfs_period_us");
+    if (!(q >> quota && p >> period) || quota <= 0 || period <= 0) return 0;
+  }
+  return quota > 0 ? std::max(1, static_cast<int>(std::ceil(quota / period))) : 0;
+}
+
+}  // namespace
+
+int default_thread_count() {
+  static const int count = [] {
+    if (const char* env = std::getenv("OMP_NUM_THREADS")) {
+      const long n = std::strtol(env, nullptr, 10);  // "4" or a nesting list "4,2": the first level
+      if (n > 0) return static_cast<int>(std::min(n, 1024L));
+    }
+    int cpus = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    cpu_set_t mask;
+    if (sched_getaffinity(0, sizeof mask, &mask) == 0) cpus = std::max(1, CPU_COUNT(&mask));
+    const int quota = cgroup_cpu_quota();
+    return quota > 0 ? std::min(cpus, quota) : cpus;
+  }();
+  return count;
+}
+
+ThreadTeam& ThreadTeam::for_this_thread() {
+  thread_local ThreadTeam team;
+  return team;
+}
+
+ThreadTeam::~ThreadTeam() {
+  if (workers_.empty()) return;
+  publish(0);
+  for (std::thread& t : workers_) t.join();
+}
+
+void ThreadTeam::notify(std::condition_variable& cv) {
+  // Whoever checked its condition under the lock before our change is asleep by now or sees the change.
+  if (sleepers_.load() > 0) {
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    cv.notify_all();
+  }
+}
+
+void ThreadTeam::publish(std::uint64_t team) {
+  const std::uint64_t generation = (job_.load() >> kTeamBits) + 1;
+  job_.store(generation << kTeamBits | team);
+  notify(wake_);
+}
+
+void ThreadTeam::run(int threads, const std::function<void(int, int)>& body) {
+  threads = std::min(threads, static_cast<int>(kTeamMask));
+  while (static_cast<int>(workers_.size()) < threads - 1) {
+    try {
+      workers_.emplace_back(&ThreadTeam::work, this, static_cast<int>(workers_.size()) + 1, job_.load());
+    } catch (const std::system_error&) {
+      break;  // no more threads to be had: a smaller team
+    }
+  }
+  const int team = std::min(threads, static_cast<int>(workers_.size()) + 1);
+  if (team <= 1) return body(0, 1);
+  body_ = &body;
+  running_.store(team - 1);
+  publish(static_cast<std::uint64_t>(team));
+  body(0, team);
+  auto finished = [&] { return running_.load() == 0; };
+  if (spin_until(finished)) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  ++sleepers_;
+  done_.wait(lock, finished);
+  --sleepers_;
+}
+
+void ThreadTeam::work(int index, std::uint64_t seen) {
+  for (;;) {
+    auto changed = [&] { return job_.load() != seen; };
+    if (!spin_until(changed)) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      ++sleepers_;
+      wake_.wait(lock, changed);
+      --sleepers_;
+    }
+    // A worker that was not in a run may miss it for a later one; one that was is always waited for.
+    seen = job_.load();
+    const int team = static_cast<int>(seen & kTeamMask);
+    if (team == 0) return;
+    if (index >= team) continue;
+    (*body_)(index, team);
+    if (--running_ == 0) notify(done_);
+  }
+}
+
+}  // namespace kdm::gen
