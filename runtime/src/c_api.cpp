@@ -1,11 +1,21 @@
-// The C interface (kdm_runtime.h) over kdm/runtime/query.h. No exception crosses it.
+// The C interface (kdm_runtime.h) over kdm/runtime/query.h. Nothing here throws (it builds with
+// -fno-exceptions); allocations that fail return KDM_OUT_OF_MEMORY where the library checks them.
+#include <algorithm>
+#include <cstring>
 #include <new>
+#include <vector>
 
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 
 struct kdm_tileset {
-  kdm::Tileset set;
+  kdm::Tileset owned;                   // empty for the built-in set
+  const kdm::Tileset* set = &owned;     // what queries read: `owned`, or the one built-in copy
+};
+
+struct kdm_density_image {
+  kdm::DensityImageView view;
+  std::vector<float> values, mip;
 };
 
 namespace {
@@ -18,25 +28,50 @@ template <class Load>
 kdm_status load_into(kdm_tileset** out, Load&& load) {
   if (!out) return KDM_INVALID_ARGUMENT;
   *out = nullptr;
-  try {
-    auto* handle = new kdm_tileset;
-    const kdm::Status s = load(handle->set);
-    if (s != kdm::Status::kOk) {
-      delete handle;
-      return to_c(s);
-    }
-    *out = handle;
-    return KDM_OK;
-  } catch (const std::bad_alloc&) {
-    return KDM_OUT_OF_MEMORY;
-  } catch (...) {
-    return KDM_INVALID_CONTENT;
+  auto* handle = new (std::nothrow) kdm_tileset;
+  if (!handle) return KDM_OUT_OF_MEMORY;
+  const kdm::Status s = load(handle->owned);
+  if (s != kdm::Status::kOk) {
+    delete handle;
+    return to_c(s);
   }
+  *out = handle;
+  return KDM_OK;
 }
+
+/// A caller's struct of `size` bytes (its struct_size) as this header's version: the bytes it has, the
+/// rest zero. False if it is shorter than the first version that had struct_size.
+template <class T>
+bool read_grown(const T* in, std::size_t first_version_size, T& out) {
+  if (!in || in->struct_size < first_version_size) return false;
+  std::memset(&out, 0, sizeof out);
+  std::memcpy(&out, in, std::min(in->struct_size, sizeof(T)));
+  return true;
+}
+
+/// Writes `value` into the caller's struct, no more bytes than its struct_size, which it keeps.
+template <class T>
+void write_grown(const T& value, T* out) {
+  const std::size_t size = out->struct_size;
+  std::memcpy(out, &value, std::min(size, sizeof(T)));
+  out->struct_size = size;
+}
+
+constexpr std::size_t kQueryV1 = sizeof(kdm_query);
+constexpr std::size_t kProblemV1 = sizeof(kdm_query_problem);
+constexpr std::size_t kInfoV1 = sizeof(kdm_tileset_info);
 
 }  // namespace
 
 extern "C" {
+
+const char* kdm_version(void) {
+  return kdm::version_string();
+}
+
+uint32_t kdm_tileset_format_version(void) {
+  return kdm::kTilesetFormatVersion;
+}
 
 kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out) {
   if (!path) return KDM_INVALID_ARGUMENT;
@@ -49,8 +84,10 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
 }
 
 const kdm_tileset* kdm_tileset_builtin(void) {
-  static const kdm_tileset* builtin = new kdm_tileset{kdm::Tileset::builtin()};
-  return builtin;
+  static kdm_tileset builtin;
+  static const bool shared = (builtin.set = &kdm::Tileset::builtin(), true);  // no second decoded copy
+  (void)shared;
+  return &builtin;
 }
 
 void kdm_tileset_free(kdm_tileset* tileset) {
@@ -58,37 +95,108 @@ void kdm_tileset_free(kdm_tileset* tileset) {
 }
 
 size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset) {
-  return tileset ? tileset->set.resident_bytes() : 0;
+  return tileset ? tileset->set->resident_bytes() : 0;
+}
+
+kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info) {
+  kdm_tileset_info v;
+  if (!tileset || !read_grown(info, kInfoV1, v)) return KDM_INVALID_ARGUMENT;
+  const kdm::TilesetData& d = tileset->set->data();
+  v.format_version = kdm::kTilesetFormatVersion;
+  v.colours = d.colours;
+  v.tiles = static_cast<uint32_t>(d.tiles.size());
+  v.levels = d.levels;
+  v.max_points_per_tile = tileset->set->max_points_per_tile();
+  for (std::size_t k = 0; k < d.level_nominal.size() && k < 16; ++k) v.level_points[k] = d.level_nominal[k];
+  v.resident_bytes = tileset->set->resident_bytes();
+  v.generator_version = d.generator_version.c_str();
+  v.recipe = d.recipe.c_str();
+  write_grown(v, info);
+  return KDM_OK;
+}
+
+kdm_status kdm_density_image_create(int width, int height, const float* values, double x0, double y0,
+                                    double x1, double y1, kdm_density_image** out) {
+  if (!out) return KDM_INVALID_ARGUMENT;
+  *out = nullptr;
+  if (!values || width <= 0 || height <= 0) return KDM_INVALID_ARGUMENT;
+  auto* image = new (std::nothrow) kdm_density_image;
+  if (!image) return KDM_OUT_OF_MEMORY;
+  image->values.assign(values, values + static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  kdm::DensityImageView& v = image->view;
+  v.width = width, v.height = height, v.x0 = x0, v.y0 = y0, v.x1 = x1, v.y1 = y1;
+  v.values = image->values.data();
+  const kdm::Status s = kdm::make_density_max_mip(v, image->mip);
+  if (s != kdm::Status::kOk) {
+    delete image;
+    return to_c(s);
+  }
+  *out = image;
+  return KDM_OK;
+}
+
+void kdm_density_image_free(kdm_density_image* image) {
+  delete image;
 }
 
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
-                            size_t capacity, size_t* written, kdm_cursor* cursor) {
-  if (!tileset || !query || !written || !cursor) return KDM_INVALID_ARGUMENT;
+                            size_t capacity, size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
   static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
-  kdm::QueryParams q;
-  q.x0 = query->x0, q.y0 = query->y0, q.x1 = query->x1, q.y1 = query->y1;
-  q.origin_x = query->origin_x, q.origin_y = query->origin_y;
-  q.tile_size = query->tile_size, q.scale = query->scale;
-  if (query->density_callback) {
-    q.density.kind = kdm::QueryDensity::Kind::kCallback;
-    q.density.callback = query->density_callback;
-    q.density.user = query->user;
-    q.density.callback_max = query->density_max;
+  if (written) *written = 0;
+  kdm::QueryProblem why;
+  kdm_status status = KDM_INVALID_ARGUMENT;
+  kdm_query c;
+  if (!tileset) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "tileset";
+  } else if (!query) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "query";
+  } else if (!read_grown(query, kQueryV1, c)) {
+    why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = "query.struct_size";
+    why.value = static_cast<double>(query->struct_size), why.limit = static_cast<double>(kQueryV1);
+  } else if (!cursor) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "cursor";
   } else {
-    q.density.constant = query->density;
+    kdm::QueryParams q;
+    q.x0 = c.x0, q.y0 = c.y0, q.x1 = c.x1, q.y1 = c.y1;
+    q.origin_x = c.origin_x, q.origin_y = c.origin_y;
+    q.tile_size = c.tile_size, q.scale = c.scale;
+    if (c.density_image) {
+      q.density.kind = kdm::QueryDensity::Kind::kImage;
+      q.density.image = &c.density_image->view;
+    } else if (c.density_callback) {
+      q.density.kind = kdm::QueryDensity::Kind::kCallback;
+      q.density.callback = c.density_callback;
+      q.density.user = c.user;
+      q.density.callback_max = c.density_max;
+    } else {
+      q.density.constant = c.density;
+    }
+    kdm::QueryCursor k{cursor->tile_x,      cursor->tile_y,       cursor->rank,
+                       cursor->started != 0, cursor->finished != 0, cursor->fingerprint};
+    // kdm_point and QueryPoint share their layout (asserted above): write straight into the caller's buffer.
+    status = to_c(kdm::query_points(*tileset->set, q, reinterpret_cast<kdm::QueryPoint*>(out), capacity,
+                                    written, &k, &why));
+    *cursor = kdm_cursor{k.tile_x, k.tile_y, k.rank, k.started ? 1 : 0, k.finished ? 1 : 0, k.fingerprint};
   }
-  kdm::QueryCursor c{cursor->tile_x, cursor->tile_y, cursor->rank, cursor->started != 0,
-                     cursor->finished != 0};
-  // kdm_point and QueryPoint share their layout (asserted above): write straight into the caller's buffer.
-  const kdm::Status s =
-      kdm::query_points(tileset->set, q, reinterpret_cast<kdm::QueryPoint*>(out), capacity, written, &c);
-  *cursor = kdm_cursor{c.tile_x, c.tile_y, c.rank, c.started ? 1 : 0, c.finished ? 1 : 0};
-  return to_c(s);
+  if (problem && problem->struct_size >= kProblemV1) {
+    kdm_query_problem p;
+    std::memset(&p, 0, sizeof p);
+    p.kind = static_cast<kdm_problem_kind>(static_cast<int>(why.kind));
+    p.parameter = why.parameter;
+    p.value = why.value, p.limit = why.limit;
+    p.largest_valid = why.largest_valid, p.largest_tile_size = why.largest_tile_size;
+    write_grown(p, problem);
+  }
+  return status;
 }
 
 const char* kdm_status_message(kdm_status status) {
   if (status == KDM_OUT_OF_MEMORY) return "out of memory";
   return kdm::status_message(static_cast<kdm::Status>(static_cast<int>(status)));
+}
+
+const char* kdm_problem_message(kdm_problem_kind kind) {
+  return kdm::query_problem_message(static_cast<kdm::QueryProblem::Kind>(static_cast<int>(kind)));
 }
 
 }  // extern "C"

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <utility>
 
 #include "kdm/runtime/hash.h"
 
@@ -145,14 +147,32 @@ Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
 }
 
 Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
-                    std::size_t* written, QueryCursor* cursor) {
-  if (written) *written = 0;
-  if (!written || !cursor || (capacity > 0 && !out) || tileset.empty()) return Status::kInvalidArgument;
-  if (!(finite(q.x0) && finite(q.y0) && finite(q.x1) && finite(q.y1) && finite(q.origin_x) &&
-        finite(q.origin_y) && finite(q.tile_size) && q.tile_size > 0 && finite(q.scale) && q.scale >= 0))
+                    std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
+  QueryProblem unused;
+  QueryProblem& why = problem ? *problem : unused;
+  why = QueryProblem{};
+  auto refuse = [&](QueryProblem::Kind kind, const char* parameter, double value = 0, double limit = 0) {
+    why.kind = kind, why.parameter = parameter, why.value = value, why.limit = limit;
     return Status::kInvalidArgument;
+  };
+  using Kind = QueryProblem::Kind;
+  if (written) *written = 0;
+  if (!written) return refuse(Kind::kMissingArgument, "written");
+  if (!cursor) return refuse(Kind::kMissingArgument, "cursor");
+  if (capacity > 0 && !out) return refuse(Kind::kMissingArgument, "out");
+  if (tileset.empty()) return refuse(Kind::kMissingArgument, "tileset");
+  const std::pair<const char*, double> numbers[] = {{"x0", q.x0},        {"y0", q.y0},
+                                                    {"x1", q.x1},        {"y1", q.y1},
+                                                    {"origin_x", q.origin_x}, {"origin_y", q.origin_y},
+                                                    {"tile_size", q.tile_size}, {"scale", q.scale}};
+  for (const auto& [name, value] : numbers)
+    if (!finite(value)) return refuse(Kind::kNotFinite, name, value);
+  if (!(q.tile_size > 0)) return refuse(Kind::kNotPositive, "tile_size", q.tile_size);
+  if (q.scale < 0) return refuse(Kind::kNegative, "scale", q.scale);
+  const std::uint64_t fingerprint = query_fingerprint(q);
+  if (cursor->started && cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
   if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {
-    cursor->finished = true;
+    *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
   const QueryDensity& d = q.density;
@@ -162,29 +182,40 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       max_density = sanitize(d.constant);
       break;
     case QueryDensity::Kind::kImage:
-      if (!d.image || !d.image->values || !d.image->max_mip) return Status::kInvalidArgument;
+      if (!d.image || !d.image->values || !d.image->max_mip) return refuse(Kind::kBadDensity, "density.image");
       max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
       break;
     case QueryDensity::Kind::kCallback:
-      if (!d.callback || !(finite(d.callback_max) && d.callback_max >= 0)) return Status::kInvalidArgument;
+      if (!d.callback) return refuse(Kind::kBadDensity, "density.callback");
+      if (!finite(d.callback_max)) return refuse(Kind::kNotFinite, "density.callback_max", d.callback_max);
+      if (d.callback_max < 0) return refuse(Kind::kNegative, "density.callback_max", d.callback_max);
       max_density = d.callback_max;
       break;
   }
   const double S = q.tile_size, area_scale = S * S * q.scale;
   const ImageSampler sampler(d.kind == QueryDensity::Kind::kImage ? d.image : nullptr);
-  if (!(max_density * area_scale <= tileset.max_points_per_tile() + 0.5)) return Status::kInvalidArgument;
+  const double top = tileset.max_points_per_tile();
+  if (!(max_density * area_scale <= top + 0.5)) {
+    refuse(Kind::kDensityTooHigh, "scale", max_density * area_scale, top);
+    why.largest_valid = top / (max_density * S * S);
+    why.largest_tile_size = std::sqrt(top / (max_density * q.scale));
+    return Status::kInvalidArgument;
+  }
   const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
   const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
   if (!(max_density * area_scale > tileset.min_threshold())) {  // no tile can emit even its first point
-    cursor->finished = true;
+    *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
-  if (!((tx1d - tx0d) * (ty1d - ty0d) <= double(kMaxQueryTiles)) || std::fabs(tx0d) > 9e15 ||
-      std::fabs(ty1d) > 9e15 || std::fabs(tx1d) > 9e15 || std::fabs(ty0d) > 9e15)
-    return Status::kInvalidArgument;
+  const double tiles = (tx1d - tx0d) * (ty1d - ty0d);
+  if (!(tiles <= double(kMaxQueryTiles)))
+    return refuse(Kind::kTooManyTiles, "x0", tiles, double(kMaxQueryTiles));
+  if (std::fabs(tx0d) > 9e15 || std::fabs(tx1d) > 9e15)  // tile coordinates must fit an int64 exactly
+    return refuse(Kind::kNotFinite, "x0", q.x0);
+  if (std::fabs(ty0d) > 9e15 || std::fabs(ty1d) > 9e15) return refuse(Kind::kNotFinite, "y0", q.y0);
   const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
   const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
-  if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false};
+  if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false, fingerprint};
 
   std::size_t n = 0;
   std::uint64_t examined = 0;
@@ -206,7 +237,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
       for (; c < candidates; ++c) {
         if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
-          *cursor = QueryCursor{tx, ty, c, true, false};
+          *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
           *written = n;
           return Status::kBufferFull;
         }
@@ -219,7 +250,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           if (!TilesetData::emits(thresholds[c], rho * area_scale)) continue;
         }
         if (n == capacity) {
-          *cursor = QueryCursor{tx, ty, c, true, false};
+          *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
           *written = n;
           return Status::kBufferFull;
         }
@@ -230,6 +261,48 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   cursor->finished = true;
   *written = n;
   return Status::kOk;
+}
+
+const char* query_problem_message(QueryProblem::Kind kind) {
+  switch (kind) {
+    case QueryProblem::Kind::kNone:
+      return "no problem";
+    case QueryProblem::Kind::kMissingArgument:
+      return "a required argument is null, or the tile set is empty";
+    case QueryProblem::Kind::kNotFinite:
+      return "a parameter is not a finite number (or too far from the origin)";
+    case QueryProblem::Kind::kNotPositive:
+      return "a parameter must be greater than 0";
+    case QueryProblem::Kind::kNegative:
+      return "a parameter must not be negative";
+    case QueryProblem::Kind::kBadDensity:
+      return "the density's image (with its max-mip) or callback is missing";
+    case QueryProblem::Kind::kTooManyTiles:
+      return "the region covers more tiles than one query may (split it)";
+    case QueryProblem::Kind::kDensityTooHigh:
+      return "the density asks for more points per tile than the tile set's top level holds";
+    case QueryProblem::Kind::kCursorMismatch:
+      return "the cursor was started by a query with other parameters";
+  }
+  return "unknown problem";
+}
+
+std::uint64_t query_fingerprint(const QueryParams& q) {
+  std::uint64_t h = 0x6b646d71756572ull;  // "kdmquer"
+  auto add = [&](std::uint64_t v) { h = mix64(h ^ v); };
+  auto add_double = [&](double v) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    add(bits);
+  };
+  for (double v : {q.x0, q.y0, q.x1, q.y1, q.origin_x, q.origin_y, q.tile_size, q.scale, q.density.constant,
+                   q.density.callback_max})
+    add_double(v);
+  add(static_cast<std::uint64_t>(q.density.kind));
+  add(reinterpret_cast<std::uintptr_t>(q.density.image));
+  add(reinterpret_cast<std::uintptr_t>(q.density.callback));
+  add(reinterpret_cast<std::uintptr_t>(q.density.user));
+  return h;
 }
 
 }  // namespace kdm

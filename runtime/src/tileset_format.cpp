@@ -106,6 +106,8 @@ std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
 }
 
 void parse_body(const std::vector<char>& body, TilesetData& set) {
+  // cereal's endianness flag: 1 little-, 0 big-endian; cereal itself would take anything else as "other".
+  if (body.empty() || (body[0] != 0 && body[0] != 1)) throw ContentError("bad byte-order flag");
   MemoryBuffer buffer(body.data(), body.size());
   std::istream stream(&buffer);
   InputArchive ar(stream);
@@ -268,8 +270,9 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   if (detail::crc32(payload, payload_size) != get32(p + 32))
     return fail(Status::kPayloadChecksumMismatch, detail, "payload bytes are damaged");
   const unsigned long long frame = ZSTD_getFrameContentSize(payload, payload_size);
-  if (frame == ZSTD_CONTENTSIZE_ERROR || frame == ZSTD_CONTENTSIZE_UNKNOWN || frame != body_size)
-    return fail(Status::kDecompressionFailed, detail, "payload is not a zstd frame of the stated size");
+  if (frame == ZSTD_CONTENTSIZE_ERROR || frame == ZSTD_CONTENTSIZE_UNKNOWN || frame != body_size ||
+      ZSTD_findFrameCompressedSize(payload, payload_size) != payload_size)  // one frame, nothing after it
+    return fail(Status::kDecompressionFailed, detail, "payload is not one zstd frame of the stated size");
   std::vector<char> body(static_cast<std::size_t>(body_size));
   const std::size_t unpacked = ZSTD_decompress(body.data(), body.size(), payload, payload_size);
   if (ZSTD_isError(unpacked) || unpacked != body_size)

@@ -287,8 +287,8 @@ TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
   const Outcome zero = kdm("query --rect 0,0,1,1 --scale 0" + out);  // defined: no points
   EXPECT_EQ(zero.status, 0) << zero.err;
   EXPECT_NE(zero.err.find("kdm query: 0 points"), std::string::npos) << zero.err;
-  expect_error("query --rect 0,0,1,1 --scale 1e12" + out, "invalid argument");  // beyond the top level
-  expect_error("query --rect 0,0,1,1 --scale -1" + out, "invalid argument");
+  expect_error("query --rect 0,0,1,1 --scale 1e12" + out, "--scale 32768 or less");  // beyond the top level
+  expect_error("query --rect 0,0,1,1 --scale -1" + out, "'scale' = -1");
 }
 
 TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
@@ -491,6 +491,81 @@ TEST_F(CliTest, PointFilesAreByteIdenticalAcrossRuns) {
       EXPECT_GT(bytes[0].size(), 100u) << name << ext;
       EXPECT_EQ(bytes[0], bytes[1]) << "kdm " << args << " -o X" << ext << " wrote different bytes twice";
     }
+}
+
+// Data lines of a query's .csv (its header checked and dropped), sorted.
+std::vector<std::string> sorted_rows(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,y,tile_x,tile_y,rank,level");
+  std::vector<std::string> rows;
+  while (std::getline(in, line)) rows.push_back(line);
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+// kdm query writes world coordinates with each point's id and level, so the files of a partition of a
+// region hold exactly the region's lines; an image placed by --density-rect keeps that true.
+TEST_F(CliTest, QueryPartitionsConcatenateToTheWhole) {
+  const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  for (const std::string& density : {std::string("const:0.7"), image + " --density-rect -1,-2,9,8"}) {
+    const std::string common = " --scale 200 --tile-size 0.5 --density " + density + " -o '";
+    ASSERT_EQ(kdm("query --rect 0,0,6,5" + common + path("whole.csv") + "'").status, 0);
+    ASSERT_EQ(kdm("query --rect 0,0,2.3,5" + common + path("left.csv") + "'").status, 0);
+    ASSERT_EQ(kdm("query --rect 2.3,0,6,1.7" + common + path("right_low.csv") + "'").status, 0);
+    ASSERT_EQ(kdm("query --rect 2.3,1.7,6,5" + common + path("right_high.csv") + "'").status, 0);
+    const std::vector<std::string> whole = sorted_rows(slurp(path("whole.csv")));
+    std::vector<std::string> parts;
+    for (const char* part : {"left.csv", "right_low.csv", "right_high.csv"})
+      for (const std::string& row : sorted_rows(slurp(path(part)))) parts.push_back(row);
+    std::sort(parts.begin(), parts.end());
+    EXPECT_GT(whole.size(), 1000u) << density;
+    EXPECT_EQ(parts, whole) << density;
+    // Rows are world positions inside the rectangle, then the id and a level of the built-in set.
+    double x = -1, y = -1;
+    long long tx = 0, ty = 0;
+    unsigned rank = 0, level = 99;
+    ASSERT_EQ(std::sscanf(whole.front().c_str(), "%lf,%lf,%lld,%lld,%u,%u", &x, &y, &tx, &ty, &rank, &level),
+              6);
+    EXPECT_TRUE(x >= 0 && x < 6 && y >= 0 && y < 5 && level < 6) << whole.front();
+    EXPECT_EQ(tx, static_cast<long long>(std::floor(x / 0.5)));
+  }
+}
+
+TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
+  ASSERT_EQ(kdm("query --rect 1,1,3,2 --scale 100 -o '" + path("q.json") + "'").status, 0);
+  const std::string json = slurp(path("q.json"));
+  EXPECT_EQ(json.rfind("{\"rect\": [1, 1, 3, 2], \"normalised\": false, \"points\": [", 0), 0u)
+      << json.substr(0, 80);
+  EXPECT_NE(json.find("\"tile_x\": 1, \"tile_y\": 1, \"rank\": 0, \"level\": 0"), std::string::npos);
+  EXPECT_EQ(json.substr(json.size() - 4), "\n]}\n");
+  ASSERT_EQ(kdm("query --rect 1,1,3,2 --scale 100 --normalised -o '" + path("n.csv") + "'").status, 0);
+  for (const std::string& row : sorted_rows(slurp(path("n.csv")))) {
+    const double x = std::atof(row.c_str()), y = std::atof(row.c_str() + row.find(',') + 1);
+    EXPECT_TRUE(x >= 0 && x < 1 && y >= 0 && y < 1) << row;
+  }
+  const Outcome zero = kdm("query --rect 0,0,4,4 --density const:0 -o '" + path("z.csv") + "'");
+  ASSERT_EQ(zero.status, 0) << zero.err;
+  EXPECT_TRUE(sorted_rows(slurp(path("z.csv"))).empty());
+  expect_error("query --rect 0,0,4,4 --density const:-1 -o '" + path("z.csv") + "'", ">= 0");
+  expect_error("query --rect 0,0,4,4 --density-rect 0,0,1,1 -o '" + path("z.csv") + "'", "--density-rect");
+  expect_error("query --rect 0,0,10,10 --scale 100000 -o '" + path("z.csv") + "'", "--tile-size 0.572433");
+  expect_error("sample --n 100 --density const:0 -o '" + path("z.txt") + "'", "> 0");
+}
+
+TEST_F(CliTest, SmallFrictions) {
+  expect_error("analyze '" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt' -o '" +
+                   path("metrics.json") + "'",
+               "output directory");
+  EXPECT_FALSE(fs::exists(path("metrics.json")));
+  const Outcome sampled = kdm("sample -n 200 -o '" + path("s.txt") + "'");
+  ASSERT_EQ(sampled.status, 0) << sampled.err;
+  EXPECT_NE(slurp(path("s.txt")).find("kdm sample: 200 points"), std::string::npos);
+  const Outcome info = kdm("info '" + std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt'");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("  band 0.35\n"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find(" bytes ("), std::string::npos) << info.out;
 }
 
 }  // namespace

@@ -1,14 +1,16 @@
-/* The C interface from C: load, query into a small buffer with resumes, bad input, status codes. */
+/* The C interface from C: load, query into a small buffer with resumes, density images, tile-set info,
+ * bad input with its detail, cursor misuse, status codes. */
 #include <kdm/runtime/kdm_runtime.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#define CHECK(cond)                                                  \
-  do {                                                               \
-    if (!(cond)) {                                                   \
+#define CHECK(cond)                                                            \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
       fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-      return 1;                                                      \
-    }                                                                \
+      return 1;                                                                \
+    }                                                                          \
   } while (0)
 
 static size_t count_points(const kdm_tileset* set, const kdm_query* q, size_t capacity) {
@@ -18,30 +20,114 @@ static size_t count_points(const kdm_tileset* set, const kdm_query* q, size_t ca
   kdm_status s;
   memset(&cursor, 0, sizeof cursor);
   do {
-    s = kdm_query_points(set, q, buffer, capacity, &written, &cursor);
+    s = kdm_query_points(set, q, buffer, capacity, &written, &cursor, NULL);
     total += written;
   } while (s == KDM_BUFFER_FULL);
   return s == KDM_OK ? total : (size_t)-1;
 }
 
+static kdm_query uniform_query(void) {
+  kdm_query q;
+  memset(&q, 0, sizeof q);
+  q.struct_size = sizeof q;
+  q.x0 = 0, q.y0 = 0, q.x1 = 2, q.y1 = 2, q.tile_size = 1, q.scale = 500, q.density = 1;
+  return q;
+}
+
 int main(int argc, char** argv) {
   kdm_tileset* loaded = NULL;
-  kdm_query q;
+  kdm_query q = uniform_query();
+  kdm_query_problem problem;
   const kdm_tileset* builtin = kdm_tileset_builtin();
   CHECK(argc == 2);
   CHECK(builtin != NULL);
   CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OK && loaded != NULL);
-  memset(&q, 0, sizeof q);
-  q.x0 = 0, q.y0 = 0, q.x1 = 2, q.y1 = 2, q.tile_size = 1, q.scale = 500, q.density = 1;
   {
     const size_t a = count_points(builtin, &q, 64), b = count_points(loaded, &q, 5);
     CHECK(a > 1000 && a == b); /* same set from the file and built in; resumed buffers lose nothing */
   }
   CHECK(kdm_tileset_resident_bytes(loaded) == kdm_tileset_resident_bytes(builtin));
   CHECK(kdm_tileset_resident_bytes(loaded) > 1000000 && kdm_tileset_resident_bytes(NULL) == 0);
+
+  /* Tile-set info and versions. */
+  {
+    kdm_tileset_info info;
+    memset(&info, 0, sizeof info);
+    CHECK(kdm_tileset_get_info(builtin, &info) == KDM_INVALID_ARGUMENT); /* struct_size not set */
+    info.struct_size = sizeof info;
+    CHECK(kdm_tileset_get_info(builtin, &info) == KDM_OK);
+    CHECK(info.struct_size == sizeof info);
+    CHECK(info.format_version == kdm_tileset_format_version() && info.format_version >= 2);
+    CHECK(info.colours == 2 && info.tiles == 16 && info.levels == 6);
+    CHECK(info.level_points[0] == 32 && info.level_points[5] == 32768 && info.max_points_per_tile == 32768);
+    CHECK(info.resident_bytes == kdm_tileset_resident_bytes(builtin));
+    CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
+    CHECK(strchr(kdm_version(), '.') != NULL);
+  }
+
+  /* A density image: zero on the left half, 1 on the right half of [0, 2)^2, so no point has x < 0.9. */
+  {
+    const float values[4] = {0, 1, 0, 1}; /* 2x2, row 0 at y0 */
+    kdm_density_image* image = NULL;
+    kdm_point buffer[4096];
+    kdm_cursor cursor;
+    size_t written = 0, i;
+    const float bad[4] = {0, -1, 0, 1};
+    CHECK(kdm_density_image_create(2, 2, bad, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT && image == NULL);
+    CHECK(kdm_density_image_create(0, 2, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_image_create(2, 2, values, 0, 0, 0, 2, &image) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_image_create(2, 2, values, 0, 0, 2, 2, &image) == KDM_OK && image != NULL);
+    q.density_image = image;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, buffer, 4096, &written, &cursor, NULL) == KDM_OK);
+    CHECK(written > 300 && written < 1200); /* about half of the ~2000 uniform points, fewer at the ramp */
+    for (i = 0; i < written; ++i) CHECK(buffer[i].x >= 0.5);
+    kdm_density_image_free(image);
+    q.density_image = NULL;
+  }
+
+  /* Bad input: the status says invalid, the problem says which parameter and what limit. */
+  problem.struct_size = sizeof problem;
   q.x1 = 0.0 / 0.0;
   CHECK(count_points(builtin, &q, 64) == (size_t)-1);
-  CHECK(kdm_query_points(NULL, &q, NULL, 0, NULL, NULL) == KDM_INVALID_ARGUMENT);
+  {
+    kdm_cursor cursor;
+    size_t written = 7;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(written == 0 && problem.kind == KDM_PROBLEM_NOT_FINITE && strcmp(problem.parameter, "x1") == 0);
+    q = uniform_query();
+    q.scale = 100000; /* 100,000 points per tile: past the top level of 32,768 */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_DENSITY_TOO_HIGH && strcmp(problem.parameter, "scale") == 0);
+    CHECK(problem.limit == 32768 && fabs(problem.largest_valid - 32768) < 1e-6);
+    CHECK(fabs(problem.largest_tile_size - sqrt(0.32768)) < 1e-9);
+    CHECK(strlen(kdm_problem_message(problem.kind)) > 0);
+    q.struct_size = sizeof q - 8; /* a struct older than the first one with struct_size */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(strcmp(problem.parameter, "query.struct_size") == 0);
+  }
+  CHECK(kdm_query_points(NULL, &q, NULL, 0, NULL, NULL, NULL) == KDM_INVALID_ARGUMENT);
+
+  /* A cursor belongs to its query: a finished one gives nothing more, and other parameters are refused. */
+  {
+    kdm_point buffer[16];
+    kdm_cursor cursor;
+    size_t written = 0;
+    q = uniform_query();
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_BUFFER_FULL);
+    q.x1 = 3;
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH && written == 0);
+    q.x1 = 0.5, q.y1 = 0.5, q.scale = 20;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK && cursor.finished);
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK && written == 0);
+    q.x0 = 1, q.x1 = 1.5;
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
+  }
   {
     kdm_tileset* bad = NULL;
     CHECK(kdm_tileset_load_memory("not a tile set", 14, &bad) == KDM_BAD_MAGIC && bad == NULL);

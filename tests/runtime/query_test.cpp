@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "kdm/analysis/density.h"
+#include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 
 // Counts heap allocations made by this test binary, to prove queries make none. The replacement pairs
@@ -222,6 +223,99 @@ TEST(QueryTest, BadInputIsRejectedOrHarmless) {
   h.density.kind = QueryDensity::Kind::kCallback;
   h.density.callback = hostile;
   EXPECT_TRUE(run(h).empty());  // NaN, negative and infinite densities emit nothing
+}
+
+// Each refusal names its parameter and, for limits, the limit and the largest value that passes.
+TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
+  std::vector<QueryPoint> buffer(16);
+  std::size_t written = 0;
+  auto problem_of = [&](const QueryParams& q) {
+    QueryCursor cursor;
+    QueryProblem problem;
+    EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+              Status::kInvalidArgument);
+    EXPECT_STRNE(query_problem_message(problem.kind), "unknown problem");
+    return problem;
+  };
+  QueryParams q = region(0, 0, 1, 1, 100);
+  q.y0 = HUGE_VAL;
+  QueryProblem p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_STREQ(p.parameter, "y0");
+  q = region(0, 0, 1, 1, 100);
+  q.tile_size = -2;
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kNotPositive);
+  EXPECT_STREQ(p.parameter, "tile_size");
+  EXPECT_EQ(p.value, -2);
+  p = problem_of(region(0, 0, 1, 1, -1));
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kNegative);
+  EXPECT_STREQ(p.parameter, "scale");
+  q = region(0, 0, 1, 1, 100);
+  q.density.kind = QueryDensity::Kind::kImage;
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kBadDensity);
+  EXPECT_STREQ(p.parameter, "density.image");
+  p = problem_of(region(0, 0, 8192, 4097, 1));
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
+  EXPECT_EQ(p.limit, double(kMaxQueryTiles));
+  EXPECT_EQ(p.value, 8192.0 * 4097.0);
+  // 100,000 points per unit area at density 0.5 on tiles of side 2: 200,000 per tile, past the top level.
+  q = region(0, 0, 4, 4, 100000);
+  q.tile_size = 2, q.density.constant = 0.5;
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kDensityTooHigh);
+  EXPECT_STREQ(p.parameter, "scale");
+  EXPECT_EQ(p.limit, Tileset::builtin().max_points_per_tile());
+  EXPECT_DOUBLE_EQ(p.value, 200000);
+  EXPECT_DOUBLE_EQ(p.largest_valid, 32768.0 / (0.5 * 4));
+  EXPECT_DOUBLE_EQ(p.largest_tile_size, std::sqrt(32768.0 / (0.5 * 100000)));
+  q.scale = p.largest_valid;  // the suggested values pass
+  EXPECT_FALSE(run(q).empty());
+  q.scale = 100000, q.tile_size = p.largest_tile_size * (1 - 1e-12);
+  EXPECT_FALSE(run(q).empty());
+  QueryCursor cursor;
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, nullptr, &cursor),
+            Status::kInvalidArgument);
+  QueryProblem missing;
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, nullptr, &missing),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(missing.parameter, "cursor");
+}
+
+// A cursor belongs to the parameters that started it: resuming or reusing it with others is refused.
+TEST(QueryTest, ACursorIsRefusedWithOtherParameters) {
+  std::vector<QueryPoint> buffer(16);
+  std::size_t written = 0;
+  QueryCursor cursor;
+  QueryProblem problem;
+  QueryParams q = region(0, 0, 2, 2, 500);
+  ASSERT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+            Status::kBufferFull);
+  q.scale = 501;  // changed while resuming
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+            Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+  EXPECT_EQ(written, 0u);
+  q = region(0, 0, 0.5, 0.5, 20);
+  cursor = QueryCursor{};
+  ASSERT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem), Status::kOk);
+  EXPECT_TRUE(cursor.finished);
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem), Status::kOk);
+  EXPECT_EQ(written, 0u);  // a finished cursor with its own parameters: nothing more
+  q.x0 = 3, q.x1 = 3.5;    // a finished cursor on a new region
+  EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+            Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+  EXPECT_NE(query_fingerprint(region(0, 0, 1, 1, 1)), query_fingerprint(region(0, 0, 1, 1, 2)));
+}
+
+// The C API's built-in handle is the C++ built-in set, not a second decoded copy.
+TEST(QueryTest, TheCApiSharesTheBuiltinSet) {
+  kdm_tileset_info info{};
+  info.struct_size = sizeof info;
+  ASSERT_EQ(kdm_tileset_get_info(kdm_tileset_builtin(), &info), KDM_OK);
+  EXPECT_EQ(info.recipe, Tileset::builtin().data().recipe.c_str());
 }
 
 TEST(QueryTest, QueriesDoNotAllocate) {

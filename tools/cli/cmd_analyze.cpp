@@ -86,7 +86,17 @@ void run_analyze(const AnalyzeArgs& args) {
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
+    // -o names a directory; a name like metrics.json is a mistake that would make a directory of it.
+    const std::string ext = std::filesystem::path(args.output).extension().string();
+    for (const char* file_ext : {".json", ".png", ".txt", ".csv", ".svg"})
+      if (ext == file_ext && !std::filesystem::is_directory(args.output))
+        throw CommandError(
+            "-o is the output directory (it receives metrics.json and pictures), got the file "
+            "name '" +
+            args.output + "'");
     std::error_code ec;
+    if (std::filesystem::exists(args.output) && !std::filesystem::is_directory(args.output))
+      throw CommandError("-o must be a directory, but '" + args.output + "' is a file");
     std::filesystem::create_directories(args.output, ec);
     if (ec || !std::filesystem::is_directory(args.output))
       throw CommandError("cannot create output directory '" + args.output + "'" +

@@ -1,4 +1,5 @@
-// `kdm query`: the runtime from the command line — points of a world rectangle for a density.
+// `kdm query`: the runtime from the command line — points of a world rectangle for a density, in world
+// units with their stable ids (.csv, .json), or normalised to the rectangle (.txt, pictures).
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -7,6 +8,7 @@
 
 #include "commands.h"
 #include "density_arg.h"
+#include "image_io.h"
 #include "output.h"
 #include "runtime_args.h"
 
@@ -14,36 +16,86 @@ namespace kdm::cli {
 namespace {
 
 struct QueryArgs {
-  std::string tileset, rect, density = "const:1", output;
+  std::string tileset, rect, density_rect, density = "const:1", output;
   double scale = 1000, tile_size = 1, gamma = 1;
-  bool invert = false;
+  bool invert = false, normalised = false;
 };
 
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level. Positions
+/// are world coordinates printed exactly (%.17g), so the points of any partition of a region are the same
+/// lines as the region's own; or, with `normalised`, coordinates in [0, 1) of the rectangle.
+std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset& tiles, const double r[4],
+                            bool normalised, bool json) {
+  const tools::PointSet unit = normalise_to_rect(points, r);
+  std::string out = json ? "{\"rect\": [" : "x,y,tile_x,tile_y,rank,level\n";
+  char line[192];
+  if (json) {
+    std::snprintf(line, sizeof line, "%.17g, %.17g, %.17g, %.17g], \"normalised\": %s, \"points\": [", r[0],
+                  r[1], r[2], r[3], normalised ? "true" : "false");
+    out += line;
+  }
+  out.reserve(out.size() + points.size() * 64);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const QueryPoint& p = points[i];
+    const double x = normalised ? unit.coords[2 * i] : p.x, y = normalised ? unit.coords[2 * i + 1] : p.y;
+    const unsigned level = tiles.tile_at(p.id.tile_x, p.id.tile_y).level_of(p.id.rank);
+    const long long tx = p.id.tile_x, ty = p.id.tile_y;
+    if (json)
+      std::snprintf(line, sizeof line,
+                    "%s\n  {\"x\": %.17g, \"y\": %.17g, \"tile_x\": %lld, \"tile_y\": %lld, \"rank\": %u, "
+                    "\"level\": %u}",
+                    i ? "," : "", x, y, tx, ty, p.id.rank, level);
+    else
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%lld,%lld,%u,%u\n", x, y, tx, ty, p.id.rank, level);
+    out += line;
+  }
+  if (json) out += "\n]}\n";
+  return out;
+}
+
 void run_query_command(const QueryArgs& a) {
-  double r[4];
+  double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
-  const DensityArg arg = parse_density(a.density, a.gamma, a.invert);
+  const DensityArg arg = parse_density(a.density, a.gamma, a.invert, /*allow_zero=*/true);
+  if (!a.density_rect.empty() && !arg.from_image)
+    throw CommandError("--density-rect needs an image --density");
+  if (a.density_rect.empty()) {
+    std::copy(r, r + 4, dr);  // the image stretched over the rectangle queried
+  } else {
+    parse_rect(a.density_rect, "--density-rect", dr);
+  }
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
-  const auto density = make_runtime_density(arg, r[0], r[1], r[2], r[3]);  // an image covers the rect
+  const auto density = make_runtime_density(arg, dr[0], dr[1], dr[2], dr[3]);
   QueryParams q;
   q.x0 = r[0], q.y0 = r[1], q.x1 = r[2], q.y1 = r[3];
-  q.origin_x = r[0], q.origin_y = r[1];
   q.tile_size = a.tile_size;
   q.scale = a.scale;
   q.density = density->density;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<QueryPoint> points;
-  query_all(tiles, q, points);
+  query_all(tiles, q, points);  // origin 0: positions are world coordinates, the same bits in any query
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const tools::PointSet set = normalise_to_rect(points, r);
-  const double w = r[2] - r[0], h = r[3] - r[1];
   char line[200];
-  std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", set.size(),
+  std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
                 a.rect.c_str(), a.scale, a.tile_size);
-  DrawStyle style;
-  style.aspect = w / h;
-  write_points(a.output, set, {line, "coordinates normalised to the rect"}, style);
+  const bool csv = ends_with(a.output, ".csv"), json = ends_with(a.output, ".json");
+  if (csv || json) {
+    std::string error;
+    if (!tools::write_text_file_atomic(a.output, points_with_ids(points, tiles, r, a.normalised, json),
+                                       error))
+      throw CommandError(error);
+  } else {
+    // .txt is the UTK/psa format, [0, 1) by definition; pictures show the rectangle.
+    for (QueryPoint& p : points) p.x -= r[0], p.y -= r[1];
+    DrawStyle style;
+    style.aspect = (r[2] - r[0]) / (r[3] - r[1]);
+    write_points(a.output, normalise_to_rect(points, r), {line, "coordinates normalised to the rect"}, style);
+  }
   std::fprintf(stderr, "%s in %.4f s -> %s\n", line, seconds, a.output.c_str());
 }
 
@@ -54,13 +106,20 @@ void add_query_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("query", "Points of a world rectangle from a tile set (the runtime)");
   cmd->add_option("--tileset", a->tileset, "Tile-set file (default: the built-in set)");
   cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 in world units (half-open)")->required();
-  cmd->add_option("--density", a->density, "const:V, or an image stretched over the rect (dark = dense)")
+  cmd->add_option("--density", a->density, "const:V (V >= 0), or an image (dark = dense)")
       ->capture_default_str();
+  cmd->add_option("--density-rect", a->density_rect,
+                  "World rectangle x0,y0,x1,y1 the image covers (default: --rect); fix it to query parts of "
+                  "one region and get exactly the region's points");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
   cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();
   cmd->add_option("--tile-size", a->tile_size, "World units per tile side")->capture_default_str();
-  cmd->add_option("-o,--output", a->output, "Output: .txt, .csv (normalised to the rect), .svg or .png")
+  cmd->add_flag("--normalised", a->normalised,
+                ".csv/.json coordinates in [0, 1) of --rect instead of world units");
+  cmd->add_option("-o,--output", a->output,
+                  "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level), .txt (UTK format, "
+                  "normalised to the rect), .svg or .png")
       ->required();
   cmd->callback([a] { run_query_command(*a); });
 }

@@ -53,8 +53,9 @@ void run_info(const std::string& path) {
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
   const TilesetData& set = loaded.data();
   std::printf("file           %s (%lld bytes)\n", path.c_str(), bytes);
-  std::printf("resident       %.2f MB once loaded by the runtime\n",
-              double(loaded.resident_bytes()) / (1 << 20));
+  const std::size_t resident = loaded.resident_bytes();
+  std::printf("resident       %zu bytes (%.3g MiB) once loaded by the runtime\n", resident,
+              double(resident) / (1 << 20));
   std::printf("format         version %u\n", kTilesetFormatVersion);
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());

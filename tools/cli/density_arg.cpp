@@ -8,15 +8,16 @@
 
 namespace kdm::cli {
 
-DensityArg parse_density(const std::string& spec, double gamma, bool invert) {
+DensityArg parse_density(const std::string& spec, double gamma, bool invert, bool allow_zero) {
   DensityArg arg;
   if (!(std::isfinite(gamma) && gamma > 0)) throw CommandError("--gamma must be a finite number > 0");
   if (spec.rfind("const:", 0) == 0) {
     const std::string value = spec.substr(6);
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0' || !std::isfinite(v) || v <= 0)
-      throw CommandError("--density const:V needs a finite V > 0, got '" + value + "'");
+    if (value.empty() || *end != '\0' || !std::isfinite(v) || v < 0 || (v == 0 && !allow_zero))
+      throw CommandError(std::string("--density const:V needs a finite V ") + (allow_zero ? ">= 0" : "> 0") +
+                         ", got '" + value + "'");
     arg.density = gen::Density::constant();
     arg.constant = v;
     return arg;

@@ -16,8 +16,9 @@ struct DensityArg {
   double constant = 1;        ///< the value of const:V
 };
 
-/// `spec` is "const:V" (V finite, > 0) or a path to an image. Image darkness (1 - luminance) raised to
-/// `gamma` is the density; `invert` uses luminance instead (bright = dense). Throws CommandError.
-DensityArg parse_density(const std::string& spec, double gamma, bool invert);
+/// `spec` is "const:V" (V finite, > 0; or >= 0 with `allow_zero`, for queries, where 0 emits nothing) or
+/// a path to an image. Image darkness (1 - luminance) raised to `gamma` is the density; `invert` uses
+/// luminance instead (bright = dense). Throws CommandError.
+DensityArg parse_density(const std::string& spec, double gamma, bool invert, bool allow_zero = false);
 
 }  // namespace kdm::cli

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "commands.h"
@@ -62,22 +63,42 @@ const Tileset& tileset_for(const std::string& path, Tileset& storage) {
   return storage;
 }
 
+std::string describe(const QueryProblem& p) {
+  char text[400];
+  switch (p.kind) {
+    case QueryProblem::Kind::kDensityTooHigh:
+      std::snprintf(
+          text, sizeof text,
+          "%s: %.6g points per tile where the tile set holds at most %.0f; use --scale %.6g or less, "
+          "or --tile-size %.6g or less",
+          query_problem_message(p.kind), p.value, p.limit, p.largest_valid, p.largest_tile_size);
+      break;
+    case QueryProblem::Kind::kTooManyTiles:
+      std::snprintf(text, sizeof text,
+                    "%s: %.6g tiles, at most %.0f; use a larger --tile-size or a smaller --rect",
+                    query_problem_message(p.kind), p.value, p.limit);
+      break;
+    default:
+      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
+                    p.value);
+  }
+  return text;
+}
+
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out) {
   out.clear();
   std::vector<QueryPoint> buffer(1 << 16);
   QueryCursor cursor;
   for (;;) {
     std::size_t written = 0;
-    const Status s = query_points(tileset, params, buffer.data(), buffer.size(), &written, &cursor);
+    QueryProblem problem;
+    const Status s = query_points(tileset, params, buffer.data(), buffer.size(), &written, &cursor, &problem);
     out.insert(out.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(written));
     if (out.size() > kMaxCommandLinePoints)  // 1 GiB of points: stop before memory runs out
       throw CommandError(
           "the query emits more than 2^25 points; lower --scale or --points, or split the region");
     if (s == Status::kOk) return;
-    if (s != Status::kBufferFull)
-      throw CommandError(
-          std::string("query: ") + status_message(s) +
-          " (check the region, the scale, and that the density fits the tile set's top level)");
+    if (s != Status::kBufferFull) throw CommandError("query: " + describe(problem));
   }
 }
 

@@ -39,6 +39,9 @@ tools::PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const d
 /// Most points a command-line query collects (2^25, 1 GiB as QueryPoint) before it gives up.
 inline constexpr std::size_t kMaxCommandLinePoints = std::size_t(1) << 25;
 
+/// A refused query's problem in one line for the command line (which option, which limit, what works).
+std::string describe(const QueryProblem& problem);
+
 /// Runs a query to completion into `out` (growing it), throwing CommandError on bad parameters or when
 /// more than kMaxCommandLinePoints points would be emitted.
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -91,11 +92,16 @@ int BakeRecipe::sweeps_for(std::uint64_t level_points) const {
 }
 
 std::string BakeRecipe::to_text() const {
+  // The shortest text that reads back as the same double: "band 0.35", not 0.34999999999999998.
+  auto shortest = [](double v) {
+    char text[32];
+    const std::to_chars_result r = std::to_chars(text, text + sizeof text, v);
+    return std::string(text, r.ptr);
+  };
   std::ostringstream s;
-  s.precision(17);
   s << "seed " << seed << "\ncolours " << colours << "\nlevels " << levels << "\nbase_points " << base_points
-    << "\ntemperature " << temperature << "\nsweeps " << sweeps << "\nband " << band << "\nerosion "
-    << erosion << "\n";
+    << "\ntemperature " << shortest(temperature) << "\nsweeps " << sweeps << "\nband " << shortest(band)
+    << "\nerosion " << shortest(erosion) << "\n";
   return s.str();
 }
 

@@ -1,13 +1,20 @@
 /* kdm runtime, C interface: load a baked tile set and query blue-noise points, for engines and FFI
  * (C#, Rust, Godot). Same library and semantics as kdm/runtime/query.h.
  *
- * Thread safety: a loaded kdm_tileset is immutable; queries on it may run concurrently. No function
- * here throws; every failure is a status code. Queries allocate nothing. */
+ * Growing structs: kdm_query, kdm_query_problem and kdm_tileset_info begin with `struct_size`, which the
+ * caller sets to sizeof(the struct) as its header declares it. A newer library reads only that many bytes
+ * (later fields keep their defaults) and writes only that many, so programs built against an older header
+ * keep working.
+ *
+ * Thread safety: a loaded kdm_tileset and a kdm_density_image are immutable; queries on them may run
+ * concurrently. No function here throws; every failure is a status code. Queries allocate nothing. */
 #ifndef KDM_RUNTIME_H
 #define KDM_RUNTIME_H
 
 #include <stddef.h>
 #include <stdint.h>
+
+#include "kdm/runtime/export.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -25,54 +32,110 @@ typedef enum kdm_status {
   KDM_TOO_LARGE = 8,
   KDM_DECOMPRESSION_FAILED = 9,
   KDM_INVALID_CONTENT = 10,
-  KDM_INVALID_ARGUMENT = 11,
+  KDM_INVALID_ARGUMENT = 11, /* kdm_query_points: see kdm_query_problem for which argument and limit */
   KDM_BUFFER_FULL = 12,
   KDM_OUT_OF_MEMORY = 13
 } kdm_status;
 
-typedef struct kdm_tileset kdm_tileset;
+typedef struct kdm_tileset kdm_tileset;             /* a loaded tile set */
+typedef struct kdm_density_image kdm_density_image; /* a density image with its max-mip, ready to query */
 
 typedef struct kdm_point {
   double x, y;            /* world position minus the query origin */
   int64_t tile_x, tile_y; /* stable id: tile coordinates ... */
-  uint32_t rank;          /* ... and rank within the tile */
+  uint32_t rank;          /* ... and rank within the tile (its level follows from kdm_tileset_info) */
 } kdm_point;
 
 typedef struct kdm_query {
+  size_t struct_size;        /* sizeof(kdm_query) */
   double x0, y0, x1, y1;     /* half-open world region [x0, x1) x [y0, y1) */
   double origin_x, origin_y; /* subtracted from every output position */
   double tile_size;          /* world units per tile side (> 0) */
   double scale;              /* points per unit area at density 1 (>= 0) */
-  double density;            /* constant density, used when density_callback is NULL */
+  double density;            /* constant density, used when neither an image nor a callback is given */
   /* Optional: density at world (x, y); NaN, negative and infinite values count as 0. */
   double (*density_callback)(void* user, double x, double y);
   void* user;
-  double density_max; /* upper bound of the callback's values */
+  double density_max;                     /* upper bound of the callback's values */
+  const kdm_density_image* density_image; /* optional; takes precedence over the callback */
 } kdm_query;
 
 typedef struct kdm_cursor {
   int64_t tile_x, tile_y;
   uint32_t rank;
   int started, finished;
-} kdm_cursor; /* zero-initialise before the first call */
+  uint64_t fingerprint; /* of the query that started it: a cursor is refused with other parameters */
+} kdm_cursor;           /* zero-initialise before the first call */
+
+/* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
+typedef enum kdm_problem_kind {
+  KDM_PROBLEM_NONE = 0,
+  KDM_PROBLEM_MISSING_ARGUMENT = 1,  /* `parameter` is NULL (or the tile set is empty) */
+  KDM_PROBLEM_NOT_FINITE = 2,        /* `parameter` is NaN or infinite; `value` holds it */
+  KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 */
+  KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
+  KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing */
+  KDM_PROBLEM_TOO_MANY_TILES = 6,    /* `value` tiles, more than `limit`: split the region */
+  KDM_PROBLEM_DENSITY_TOO_HIGH = 7,  /* `value` points per tile > `limit`; see largest_valid (scale) and
+                                        largest_tile_size */
+  KDM_PROBLEM_CURSOR_MISMATCH = 8    /* the cursor was started by a query with other parameters */
+} kdm_problem_kind;
+
+typedef struct kdm_query_problem {
+  size_t struct_size; /* sizeof(kdm_query_problem) */
+  kdm_problem_kind kind;
+  const char* parameter; /* the kdm_query field or argument at fault (static string) */
+  double value, limit, largest_valid, largest_tile_size;
+} kdm_query_problem;
+
+typedef struct kdm_tileset_info {
+  size_t struct_size;            /* sizeof(kdm_tileset_info) */
+  uint32_t format_version;       /* of the file it was loaded from */
+  uint32_t colours, tiles, levels;
+  uint32_t max_points_per_tile;  /* the densest query: scale * density * tile_size^2 up to this */
+  uint32_t level_points[16];     /* nominal points per tile of levels 0 .. levels - 1 */
+  size_t resident_bytes;         /* heap bytes the loaded set occupies */
+  const char* generator_version; /* the kdm version that baked it; valid while the tile set lives */
+  const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
+} kdm_tileset_info;
+
+/* The library version, "MAJOR.MINOR.PATCH" (static string). */
+KDM_RUNTIME_API const char* kdm_version(void);
+/* The tile-set format version this library reads and writes. */
+KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 
 /* Loads a tile-set file / memory buffer (untrusted input is validated). *out receives a new handle to
  * free with kdm_tileset_free, or NULL on failure. */
-kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
-kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
-/* The default tile set compiled into the library. Never free it. */
-const kdm_tileset* kdm_tileset_builtin(void);
-void kdm_tileset_free(kdm_tileset* tileset);
+KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
+KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
+/* The default tile set compiled into the library: decoded on first use (tens of milliseconds; call it
+ * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). Never free
+ * it. */
+KDM_RUNTIME_API const kdm_tileset* kdm_tileset_builtin(void);
+KDM_RUNTIME_API void kdm_tileset_free(kdm_tileset* tileset);
 /* Heap bytes a loaded set occupies (positions, keys, emission thresholds, tables); 0 for NULL. */
-size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset);
+KDM_RUNTIME_API size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset);
+/* Fills `info` (set info->struct_size first). KDM_INVALID_ARGUMENT for NULL or a struct_size too small. */
+KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info);
+
+/* A density image over the world rectangle [x0, x1) x [y0, y1): `width` x `height` values, row-major,
+ * row 0 at y0, bilinear between texel centres and clamped at the edges. The values are copied and an
+ * 8x8 max-mip is built, so queries skip what cannot be emitted. KDM_INVALID_ARGUMENT for an empty image,
+ * a NULL or negative or non-finite value, or an empty rectangle. Free with kdm_density_image_free. */
+KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const float* values, double x0,
+                                                    double y0, double x1, double y1, kdm_density_image** out);
+KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 
 /* Writes up to `capacity` points into `out`, *written = count. KDM_OK when the region is complete,
- * KDM_BUFFER_FULL to be resumed with the same cursor, KDM_INVALID_ARGUMENT for bad parameters. */
-kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
-                            size_t capacity, size_t* written, kdm_cursor* cursor);
+ * KDM_BUFFER_FULL to be resumed with the same cursor and query, KDM_INVALID_ARGUMENT for bad parameters,
+ * with `problem` (optional: NULL, or with struct_size set) saying which and why. */
+KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
+                                            size_t capacity, size_t* written, kdm_cursor* cursor,
+                                            kdm_query_problem* problem);
 
-/* A static English description of `status`. */
-const char* kdm_status_message(kdm_status status);
+/* A static English description of `status` / of a problem kind. */
+KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
+KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
 
 #ifdef __cplusplus
 }

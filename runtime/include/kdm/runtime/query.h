@@ -22,7 +22,7 @@
 namespace kdm {
 
 /// A loaded tile set, ready for queries (immutable).
-class Tileset {
+class KDM_RUNTIME_API Tileset {
  public:
   /// Loads and validates a file / memory buffer (untrusted input; see decode_tileset). On failure the
   /// returned status says why, `detail` (optional) says more, and `out` is left empty.
@@ -73,7 +73,7 @@ struct QueryPoint {
 
 /// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
 /// Values must be finite and >= 0 (validated by make_density_max_mip). Built once, shared read-only.
-struct DensityImageView {
+struct KDM_RUNTIME_API DensityImageView {
   int width = 0, height = 0;
   double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  ///< world rectangle covered; row 0 at y0
   const float* values = nullptr;          ///< width·height, row-major, owned by the caller
@@ -87,7 +87,7 @@ struct DensityImageView {
 /// Fills `mip` (resized to ceil(w/8)·ceil(h/8)) with 8×8 block maxima of `image.values`, widened by one
 /// texel so they bound bilinear values too, and points the image at it. Returns kInvalidArgument for
 /// empty images or values that are negative or not finite.
-Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
+KDM_RUNTIME_API Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
 
 /// The density of a query: constant, an image, or a callback (called once per candidate point, with
 /// world coordinates; must be thread-safe if queries run concurrently). Negative, NaN and infinite values
@@ -118,21 +118,53 @@ inline constexpr std::uint64_t kMaxQueryTiles = std::uint64_t(1) << 24;
 /// kBufferFull with the cursor saved, even if the buffer has room, so no call runs unbounded.
 inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 
-/// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call.
+/// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call; a cursor
+/// belongs to the parameters of the call that started it (their fingerprint), and is refused with others.
 struct QueryCursor {
   std::int64_t tile_x = 0, tile_y = 0;
   std::uint32_t rank = 0;
   bool started = false, finished = false;
+  std::uint64_t fingerprint = 0;  ///< of the parameters that started it (query_fingerprint)
 };
 
+/// Why query_points returned kInvalidArgument: which parameter and, for a limit, the limit and the
+/// largest value that passes (Detour-style detail, in plain values: nothing is allocated).
+struct QueryProblem {
+  enum class Kind : int {
+    kNone = 0,            ///< no problem
+    kMissingArgument,     ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
+    kNotFinite,           ///< `parameter` is NaN or infinite; `value` holds it
+    kNotPositive,         ///< `parameter` ("tile_size") must be > 0; `value` holds it
+    kNegative,            ///< `parameter` ("scale", "density.callback_max") must be >= 0; `value` holds it
+    kBadDensity,          ///< `parameter` ("density.image", "density.callback") is missing or not prepared
+    kTooManyTiles,        ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
+    kDensityTooHigh,      ///< `value` expected points per tile exceed `limit` (max_points_per_tile):
+                          ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
+                          ///< largest tile size that fits this scale
+    kCursorMismatch,      ///< the cursor was started by a call with other parameters (or damaged)
+  };
+  Kind kind = Kind::kNone;
+  const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage
+  double value = 0, limit = 0, largest_valid = 0, largest_tile_size = 0;
+};
+
+/// A short English description of a problem kind (static storage).
+KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
+
+/// A hash of every field of `params` (their bits, and the image and callback pointers): the identity a
+/// cursor keeps of the call that started it.
+KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
+
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
-/// ascending); `*written` receives the count. Returns kOk when the region is complete, kBufferFull when
-/// `out` filled up first or the call examined kMaxQueryCandidates points — call again with the same
-/// cursor (and params) to continue. Empty or inverted
-/// regions and scale 0 give no points. kInvalidArgument for non-finite params, tile_size <= 0, negative
-/// or non-finite scale, a region of more than kMaxQueryTiles tiles, or a density beyond the tile set's top
-/// level (scale · max density · tile area > max_points_per_tile: needs finer tiles). No allocation.
-Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
-                    std::size_t* written, QueryCursor* cursor);
+/// ascending); `*written` receives the count. Returns kOk when the region is complete (a finished cursor
+/// called again with the same params gives kOk and no points), kBufferFull when `out` filled up first or
+/// the call examined kMaxQueryCandidates points — call again with the same cursor and params to continue.
+/// Empty or inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional)
+/// saying which parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative
+/// scale, a missing image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the
+/// tile set's top level (scale · max density · tile_size² > max_points_per_tile: use smaller tiles or a
+/// lower scale), or a cursor started with other params. No allocation.
+KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
+                    std::size_t* written, QueryCursor* cursor, QueryProblem* problem = nullptr);
 
 }  // namespace kdm

@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "kdm/runtime/export.h"
 #include "kdm/runtime/version.h"
 
 namespace kdm {
@@ -58,7 +59,7 @@ enum class Status : int {
 };
 
 /// A short English description of `status` (static storage).
-const char* status_message(Status status);
+KDM_RUNTIME_API const char* status_message(Status status);
 
 /// Reader caps: files beyond them are refused before anything is allocated.
 inline constexpr std::uint64_t kMaxTilesetPayloadBytes = 512ull << 20;  ///< decompressed payload
@@ -88,6 +89,12 @@ struct Tile {
   std::vector<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   std::vector<std::uint32_t> level_end;
+  /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
+  std::uint32_t level_of(std::uint32_t rank) const {
+    std::uint32_t k = 0;
+    while (k + 1 < level_end.size() && rank >= level_end[k]) ++k;
+    return k;
+  }
   friend bool operator==(const Tile& a, const Tile& b) {
     return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end;
   }
@@ -124,20 +131,23 @@ struct TilesetData {
 /// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
 /// counts, one key per point, keys sorted within each level).
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
-Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
+KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 
 /// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
-Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, std::string* detail = nullptr);
+KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out,
+                                      std::string* detail = nullptr);
 
 /// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
 /// checked before use; nothing is allocated beyond the caps). On failure `out` is left empty.
-Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std::string* detail = nullptr);
+KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, TilesetData& out,
+                                      std::string* detail = nullptr);
 
 /// Reads and decodes the file at `path`.
-Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
+KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
 /// so an interrupted save never leaves a damaged file at `path`.
-Status save_tileset(const TilesetData& set, const std::string& path, std::string* detail = nullptr);
+KDM_RUNTIME_API Status save_tileset(const TilesetData& set, const std::string& path,
+                                    std::string* detail = nullptr);
 
 }  // namespace kdm

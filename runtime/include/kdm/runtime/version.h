@@ -3,12 +3,14 @@
 
 #include <cstdint>
 
+#include "kdm/runtime/export.h"
+
 namespace kdm {
 
 /// Version of the tile-set file format this build reads and writes. Bumped on any incompatible change.
 inline constexpr std::uint32_t kTilesetFormatVersion = 2;
 
 /// The library version, "MAJOR.MINOR.PATCH". Thread-safe; returns a static string.
-const char* version_string();
+KDM_RUNTIME_API const char* version_string();
 
 }  // namespace kdm

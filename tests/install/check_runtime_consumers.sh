@@ -1,0 +1,21 @@
+#!/bin/sh
+# Builds and runs the runtime-only consumers against an installed kdm at PREFIX, in WORK: through
+# find_package(kdm COMPONENTS runtime) and through pkg-config, C and C++ (-fno-exceptions -fno-rtti).
+# Usage: check_runtime_consumers.sh PREFIX WORK
+set -eu
+prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
+rm -rf "$work" && mkdir -p "$work"
+cmake -S "$here/runtime_consumer" -B "$work/cmake" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/cmake" >/dev/null
+"$work/cmake/runtime_c"
+"$work/cmake/runtime_cpp"
+pc_dir=$(dirname "$(find "$prefix" -name kdm-runtime.pc | head -n 1)")
+flags=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs kdm-runtime)
+# shellcheck disable=SC2086  # the flags are words
+cc -o "$work/pc_c" "$here/runtime_consumer/main.c" $flags
+# shellcheck disable=SC2086
+c++ -std=c++17 -fno-exceptions -fno-rtti -o "$work/pc_cpp" "$here/runtime_consumer/main.cpp" $flags
+libdir=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --variable=libdir kdm-runtime)
+LD_LIBRARY_PATH="$libdir" "$work/pc_c"
+LD_LIBRARY_PATH="$libdir" "$work/pc_cpp"
+echo "runtime consumers ok"

@@ -1,0 +1,95 @@
+// Prints a canonical summary of a tile set as the C++ runtime decodes it (kdm::load_tileset), in exactly
+// the format of `tools/tileset_reader.py FILE --summary`. The ctest runtime.independent_python_reader.*
+// diffs the two: the Python reader is written from docs/tileset-format.md alone, so agreement shows the
+// document is complete. Usage: tileset_summary FILE; exit status 1 with one line on stderr if the runtime
+// refuses the file.
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/version.h"
+
+namespace {
+
+// The CRC-32 of zlib (reflected 0xEDB88320, initial and final XOR all ones), computed here rather than
+// taken from the runtime so that this program uses the runtime's public API only.
+std::uint32_t crc32(const std::vector<std::uint8_t>& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const std::uint8_t b : bytes) {
+    crc ^= b;
+    for (int k = 0; k < 8; ++k) crc = (crc & 1) ? 0xEDB88320u ^ (crc >> 1) : crc >> 1;
+  }
+  return ~crc;
+}
+
+void put16(std::vector<std::uint8_t>& out, std::uint16_t v) {
+  out.push_back(static_cast<std::uint8_t>(v));
+  out.push_back(static_cast<std::uint8_t>(v >> 8));
+}
+
+// Text from the file is untrusted: printable ASCII as is, every other byte (and the backslash) as \xNN,
+// so the summary is one line per field whatever the bytes.
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (c >= 0x20 && c < 0x7f && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      char buf[5];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: tileset_summary FILE\n");
+    return 2;
+  }
+  kdm::TilesetData set;
+  std::string detail;
+  const kdm::Status status = kdm::load_tileset(argv[1], set, &detail);
+  if (status != kdm::Status::kOk) {
+    std::fprintf(stderr, "tileset_summary: error: %s: %s (%s)\n", argv[1], kdm::status_message(status),
+                 detail.c_str());
+    return 1;
+  }
+  // load_tileset accepts exactly this version, so it is the file's.
+  std::printf("format_version %u\n", static_cast<unsigned>(kdm::kTilesetFormatVersion));
+  std::printf("colours %u\nlevels %u\ntiles %zu\nlevel_nominal", set.colours, set.levels, set.tiles.size());
+  for (const std::uint32_t n : set.level_nominal) std::printf(" %u", n);
+  std::printf("\nrecipe_bytes %zu\nrecipe_crc32 %08x\ngenerator_version %s\n", set.recipe.size(),
+              crc32({set.recipe.begin(), set.recipe.end()}), escaped(set.generator_version).c_str());
+  std::vector<std::uint8_t> triples, thresholds;
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const kdm::Tile& tile = set.tiles[t];
+    // (x, y, key) as three little-endian u16 per point, and each point's float32 emission threshold as
+    // its little-endian IEEE bits: the checksums cover every decoded value and the emission rule.
+    triples.clear();
+    thresholds.clear();
+    std::uint32_t level = 0;
+    for (std::size_t i = 0; i < tile.points.size(); ++i) {
+      put16(triples, tile.points[i].x);
+      put16(triples, tile.points[i].y);
+      put16(triples, tile.keys[i]);
+      while (i >= tile.level_end[level]) ++level;
+      const float threshold = set.emission_threshold(level, tile.keys[i]);
+      std::uint32_t bits = 0;
+      static_assert(sizeof bits == sizeof threshold);
+      std::memcpy(&bits, &threshold, sizeof bits);
+      put16(thresholds, static_cast<std::uint16_t>(bits));
+      put16(thresholds, static_cast<std::uint16_t>(bits >> 16));
+    }
+    std::printf("tile %zu points %zu level_end", t, tile.points.size());
+    for (const std::uint32_t e : tile.level_end) std::printf(" %u", e);
+    std::printf(" points_crc32 %08x thresholds_crc32 %08x\n", crc32(triples), crc32(thresholds));
+  }
+  return 0;
+}

@@ -1,0 +1,348 @@
+#!/usr/bin/python3
+"""An independent reader of kdm tile sets (.kdmt, format version 2).
+
+Written from docs/tileset-format.md alone, not from the C++ sources: the test
+runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
+set, which shows the document is complete and exact. Needs the standard library and python3-zstandard
+(Debian; scripts/deps installs it).
+
+  tileset_reader.py FILE --summary     canonical summary: counts, texts, per-tile checksums
+  tileset_reader.py FILE --points TILE one line "x y key level" per point of tile TILE, x and y as
+                                       unit-square doubles (repr)
+
+Every check the document asks of a reader is made; a failure exits with status 1 and one line
+"tileset_reader.py: error: FILE: problem" on stderr.
+"""
+import argparse
+import array
+import struct
+import sys
+import zlib
+
+try:
+    import zstandard
+except ImportError:  # the reader is useless without it: say what to install
+    zstandard = None
+
+FORMAT_VERSION = 2
+MAGIC = b"KDMTILES"
+FIXED_HEADER_BYTES = 64
+HEADER_CRC_OFFSET = 60
+MAX_HEADER_BYTES = 1 << 20  # kMaxTilesetHeaderBytes
+MAX_BODY_BYTES = 512 << 20  # kMaxTilesetPayloadBytes, applies to the decompressed body
+MAX_COLOURS = 16
+MAX_LEVELS = 16
+
+
+class TilesetError(Exception):
+    """The file is not a valid version-2 tile set; the message names the first problem (doc §3 order)."""
+
+
+class Tile:
+    def __init__(self, level_end, xs, ys, keys):
+        self.level_end = level_end  # list of L ints
+        self.xs = xs  # array('H'), x of each point in 1/65536 of the tile side
+        self.ys = ys
+        self.keys = keys  # array('H'), emission key of each point
+
+    def levels_of_points(self):
+        """The level of every point: point i is in level k iff level_end[k-1] <= i < level_end[k]."""
+        out, start = [], 0
+        for k, end in enumerate(self.level_end):
+            out.extend([k] * (end - start))
+            start = end
+        return out
+
+
+class Tileset:
+    def __init__(self):
+        self.version = 0
+        self.colours = 0
+        self.levels = 0
+        self.level_nominal = []
+        self.tiles = []
+        self.recipe = b""
+        self.generator_version = b""
+
+    def threshold(self, level, key):
+        """Doc §7: the float32 emission threshold, returned as the float32 value (widened to a double)."""
+        lo = 0 if level == 0 else self.level_nominal[level - 1]
+        hi = self.level_nominal[level]
+        value = lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo)  # IEEE double, this order
+        return struct.unpack("<f", struct.pack("<f", value))[0]
+
+    def emits(self, level, key, expected):
+        """Doc §7: emitted iff the tile's expected point count exceeds the threshold."""
+        return expected > self.threshold(level, key)
+
+
+def _u32(data, offset):
+    return struct.unpack_from("<I", data, offset)[0]
+
+
+def _u64(data, offset):
+    return struct.unpack_from("<Q", data, offset)[0]
+
+
+def _crc32(data):
+    return zlib.crc32(data) & 0xFFFFFFFF
+
+
+class _Body:
+    """Doc §5: the decompressed body, read field by field in the byte order its first byte announces."""
+
+    def __init__(self, body):
+        self.body = body
+        if len(body) < 1:
+            raise TilesetError("body is empty: no endianness flag")
+        flag = body[0]
+        if flag not in (0, 1):
+            raise TilesetError(f"body endianness flag is {flag}, not 1 (little-endian) or 0 (big-endian)")
+        self.order = "<" if flag == 1 else ">"
+        self.swap = (flag == 1) != (sys.byteorder == "little")  # array() reads native order
+        self.pos = 1
+
+    def remaining(self):
+        return len(self.body) - self.pos
+
+    def _take(self, size, what):
+        if size > self.remaining():
+            raise TilesetError(f"body ends inside {what}")
+        chunk = self.body[self.pos : self.pos + size]
+        self.pos += size
+        return chunk
+
+    def u32(self, what):
+        return struct.unpack(self.order + "I", self._take(4, what))[0]
+
+    def array(self, typecode, what):
+        """A size tag (u64 element count) then that many raw elements."""
+        n = struct.unpack(self.order + "Q", self._take(8, what + " size tag"))[0]
+        size = array.array(typecode).itemsize
+        if n > self.remaining() // size:
+            raise TilesetError(f"{what} claims {n} elements, more than {self.remaining()} body bytes hold")
+        values = array.array(typecode)
+        values.frombytes(self._take(n * size, what))
+        if self.swap:
+            values.byteswap()
+        return values
+
+
+def _uint32_typecode():
+    for code in ("I", "L"):
+        if array.array(code).itemsize == 4:
+            return code
+    raise RuntimeError("no 4-byte unsigned array type on this platform")
+
+
+U32 = _uint32_typecode()
+
+
+def decode(data):
+    """Decodes and validates a whole .kdmt file given as bytes; returns a Tileset or raises TilesetError."""
+    size = len(data)
+    # Doc §1 and §3, in order.
+    if size < 8 or data[:8] != MAGIC:
+        if size < 8 and MAGIC.startswith(data):
+            raise TilesetError("truncated: file ends inside the magic number")
+        raise TilesetError("bad magic: file does not start with KDMTILES")
+    if size < 12:
+        raise TilesetError("truncated: file ends inside the header")
+    version = _u32(data, 8)
+    if version != FORMAT_VERSION:
+        raise TilesetError(f"unsupported format version {version} (this reader reads {FORMAT_VERSION})")
+    if size < FIXED_HEADER_BYTES:
+        raise TilesetError("truncated: file ends inside the header")
+    header_size = _u32(data, 12)
+    if not FIXED_HEADER_BYTES <= header_size <= MAX_HEADER_BYTES:
+        raise TilesetError(f"header size {header_size} is outside {FIXED_HEADER_BYTES}..{MAX_HEADER_BYTES}")
+    if size < header_size:
+        raise TilesetError(f"truncated: file ends inside the {header_size}-byte header")
+    # Doc §2: the CRC of the whole header with its own field read as zero.
+    header = bytearray(data[:header_size])
+    header[HEADER_CRC_OFFSET : HEADER_CRC_OFFSET + 4] = b"\0\0\0\0"
+    stored, computed = _u32(data, HEADER_CRC_OFFSET), _crc32(header)
+    if stored != computed:
+        raise TilesetError(f"header CRC-32 mismatch: stored {stored:08x}, computed {computed:08x}")
+    payload_size, body_size = _u64(data, 16), _u64(data, 24)
+    payload_crc, tile_count = _u32(data, 32), _u32(data, 36)
+    colours, levels = _u32(data, 40), _u32(data, 44)
+    recipe_size, version_size = _u32(data, 48), _u32(data, 52)
+    if FIXED_HEADER_BYTES + recipe_size + version_size != header_size:
+        raise TilesetError(
+            f"header text sizes {recipe_size} + {version_size} + 64 differ from the header size {header_size}"
+        )
+    if header_size + payload_size > size:
+        raise TilesetError(f"truncated: file ends inside the {payload_size}-byte payload")
+    if header_size + payload_size < size:
+        raise TilesetError(f"trailing bytes: {size - header_size - payload_size} bytes follow the payload")
+    if body_size > MAX_BODY_BYTES:
+        raise TilesetError(f"too large: body of {body_size} bytes exceeds the cap of {MAX_BODY_BYTES}")
+    if not 1 <= colours <= MAX_COLOURS:
+        raise TilesetError(f"colour count {colours} is outside 1..{MAX_COLOURS}")
+    if not 1 <= levels <= MAX_LEVELS:
+        raise TilesetError(f"level count {levels} is outside 1..{MAX_LEVELS}")
+    if tile_count != colours**4:
+        raise TilesetError(f"header tile count {tile_count} is not colours^4 = {colours ** 4}")
+    payload = data[header_size:]
+    computed = _crc32(payload)
+    if computed != payload_crc:
+        raise TilesetError(f"payload CRC-32 mismatch: stored {payload_crc:08x}, computed {computed:08x}")
+
+    # Doc §4: exactly one zstd frame that states its content size, which must be the body size.
+    if zstandard is None:
+        raise TilesetError("cannot decompress: module zstandard missing (apt-get install python3-zstandard)")
+    try:
+        frame_size = zstandard.get_frame_parameters(payload).content_size
+    except zstandard.ZstdError as e:
+        raise TilesetError(f"payload is not a zstd frame: {e}") from None
+    if frame_size == zstandard.CONTENTSIZE_UNKNOWN:
+        raise TilesetError("payload zstd frame does not state its content size")
+    if frame_size != body_size:
+        raise TilesetError(f"payload zstd frame holds {frame_size} bytes, the header says {body_size}")
+    try:
+        body = zstandard.ZstdDecompressor().decompress(
+            payload, max_output_size=body_size, allow_extra_data=False
+        )
+    except zstandard.ZstdError as e:
+        raise TilesetError(f"payload does not decompress: {e}") from None
+    if len(body) != body_size:
+        raise TilesetError(f"payload decompresses to {len(body)} bytes, the header says {body_size}")
+
+    # Doc §5.
+    reader = _Body(body)
+    ts = Tileset()
+    ts.version = version
+    ts.colours = reader.u32("colours")
+    ts.levels = reader.u32("levels")
+    body_tiles = reader.u32("tile count")
+    if ts.colours != colours or ts.levels != levels:
+        raise TilesetError(
+            f"body says {ts.colours} colours and {ts.levels} levels, the header {colours} and {levels}"
+        )
+    if body_tiles != tile_count:
+        raise TilesetError(f"body says {body_tiles} tiles, the header {tile_count}")
+    ts.level_nominal = list(reader.array(U32, "level_nominal"))
+    if body_tiles > reader.remaining() // 24:
+        raise TilesetError(f"tile count {body_tiles} exceeds what {reader.remaining()} body bytes can hold")
+    for t in range(body_tiles):
+        level_end = list(reader.array(U32, f"tile {t} level_end"))
+        xy = reader.array("H", f"tile {t} xy")
+        if len(xy) % 2:
+            raise TilesetError(f"tile {t} has an odd number of coordinates ({len(xy)})")
+        keys = reader.array("H", f"tile {t} keys")
+        ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys))
+    if reader.remaining():
+        raise TilesetError(f"body has {reader.remaining()} bytes after the last tile")
+
+    _validate(ts)
+    ts.recipe = bytes(data[FIXED_HEADER_BYTES : FIXED_HEADER_BYTES + recipe_size])
+    ts.generator_version = bytes(data[FIXED_HEADER_BYTES + recipe_size : header_size])
+    return ts
+
+
+def _validate(ts):
+    """Doc §6: the structural invariants."""
+    if len(ts.level_nominal) != ts.levels:
+        raise TilesetError(f"level_nominal has {len(ts.level_nominal)} entries for {ts.levels} levels")
+    previous = 0
+    for k, n in enumerate(ts.level_nominal):
+        if n <= previous:
+            raise TilesetError(f"level_nominal is not strictly increasing and positive at level {k} ({n})")
+        previous = n
+    if len(ts.tiles) != ts.colours**4:
+        raise TilesetError(f"expected {ts.colours ** 4} tiles, found {len(ts.tiles)}")
+    for t, tile in enumerate(ts.tiles):
+        if len(tile.level_end) != ts.levels:
+            raise TilesetError(f"tile {t} has {len(tile.level_end)} level_end entries for {ts.levels} levels")
+        for k in range(1, ts.levels):
+            if tile.level_end[k] < tile.level_end[k - 1]:
+                raise TilesetError(f"tile {t} has a decreasing level_end at level {k}")
+        if tile.level_end[-1] != len(tile.xs):
+            raise TilesetError(f"tile {t}'s level_end ends at {tile.level_end[-1]}, not at its point count")
+        if len(tile.keys) != len(tile.xs):
+            raise TilesetError(f"tile {t} has {len(tile.keys)} keys for {len(tile.xs)} points")
+        start = 0
+        for k, end in enumerate(tile.level_end):
+            keys = tile.keys[start:end]
+            if any(a > b for a, b in zip(keys, keys[1:])):
+                raise TilesetError(f"tile {t} has unsorted keys in level {k}")
+            start = end
+
+
+def load(path):
+    with open(path, "rb") as f:
+        return decode(f.read())
+
+
+def _escaped(text):
+    """Printable ASCII as is; other bytes and the backslash as \\xNN (one line whatever the bytes)."""
+    return "".join(chr(b) if 0x20 <= b < 0x7F and b != 0x5C else f"\\x{b:02x}" for b in text)
+
+
+def _le_bytes(values):
+    """The little-endian bytes of an array, whatever the host's byte order."""
+    if sys.byteorder != "little":
+        values = array.array(values.typecode, values)
+        values.byteswap()
+    return values.tobytes()
+
+
+def summary(ts):
+    """The canonical summary; tests/runtime/tileset_summary.cpp prints the same from the C++ decoder."""
+    lines = [
+        f"format_version {ts.version}",
+        f"colours {ts.colours}",
+        f"levels {ts.levels}",
+        f"tiles {len(ts.tiles)}",
+        "level_nominal " + " ".join(str(n) for n in ts.level_nominal),
+        f"recipe_bytes {len(ts.recipe)}",
+        f"recipe_crc32 {_crc32(ts.recipe):08x}",
+        f"generator_version {_escaped(ts.generator_version)}",
+    ]
+    for t, tile in enumerate(ts.tiles):
+        # (x, y, key) as three little-endian u16 per point; each point's float32 threshold as its bits.
+        triples = array.array("H", bytes(6 * len(tile.xs)))
+        triples[0::3], triples[1::3], triples[2::3] = tile.xs, tile.ys, tile.keys
+        levels = tile.levels_of_points()
+        thresholds = array.array("f", [ts.threshold(k, q) for k, q in zip(levels, tile.keys)])
+        lines.append(
+            f"tile {t} points {len(tile.xs)} level_end {' '.join(str(e) for e in tile.level_end)}"
+            f" points_crc32 {_crc32(_le_bytes(triples)):08x}"
+            f" thresholds_crc32 {_crc32(_le_bytes(thresholds)):08x}"
+        )
+    return "".join(line + "\n" for line in lines)
+
+
+def point_lines(ts, t):
+    """Doc §7: one "x y key level" line per point, x and y at their grid cell's centre in the unit square."""
+    tile = ts.tiles[t]
+    return "".join(
+        f"{(x + 0.5) / 65536.0!r} {(y + 0.5) / 65536.0!r} {q} {k}\n"
+        for x, y, q, k in zip(tile.xs, tile.ys, tile.keys, tile.levels_of_points())
+    )
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format version 2).")
+    parser.add_argument("file")
+    mode = parser.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--summary", action="store_true", help="print the canonical summary")
+    mode.add_argument("--points", type=int, metavar="TILE", help="print a tile's points as 'x y key level'")
+    args = parser.parse_args(argv)
+    try:
+        ts = load(args.file)
+        if args.summary:
+            sys.stdout.write(summary(ts))
+        else:
+            if not 0 <= args.points < len(ts.tiles):
+                raise TilesetError(f"tile {args.points} does not exist (the set has {len(ts.tiles)} tiles)")
+            sys.stdout.write(point_lines(ts, args.points))
+    except (TilesetError, OSError) as e:
+        print(f"tileset_reader.py: error: {args.file}: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
