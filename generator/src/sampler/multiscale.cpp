@@ -32,8 +32,9 @@ Vec<D> node_centre(const Grid<D>& g, std::int64_t i) {
   return x;
 }
 
-/// Splits remaining for a kernel placed where the coarsest density is rho: the largest q <= max_splits
-/// with rho / 2^(D q) <= 1 is the number of refinements before its weight reaches one (paper §3.3).
+/// Splits remaining for a kernel placed where the coarsest density is rho: the smallest q with
+/// rho / 2^(D q) <= 1 (at most max_splits), the number of refinements before its weight reaches one
+/// (paper §3.3).
 template <int D>
 int splits_for(double rho, int max_splits) {
   int q = 0;
