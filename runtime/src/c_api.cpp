@@ -9,8 +9,8 @@
 #include "kdm/runtime/query.h"
 
 struct kdm_tileset {
-  kdm::Tileset owned;                   // empty for the built-in set
-  const kdm::Tileset* set = &owned;     // what queries read: `owned`, or the one built-in copy
+  kdm::Tileset owned;                // empty for the built-in set
+  const kdm::Tileset* set = &owned;  // what queries read: `owned`, or the one built-in copy
 };
 
 struct kdm_density_image {
@@ -64,6 +64,11 @@ constexpr std::size_t kInfoV1 = sizeof(kdm_tileset_info);
 }  // namespace
 
 extern "C" {
+
+void kdm_set_tileset_allocator(void* (*allocate)(size_t, size_t, void*),
+                               void (*deallocate)(void*, size_t, size_t, void*), void* user) {
+  kdm::set_tileset_allocator(kdm::AllocatorHooks{allocate, deallocate, user});
+}
 
 const char* kdm_version(void) {
   return kdm::version_string();
@@ -140,7 +145,8 @@ void kdm_density_image_free(kdm_density_image* image) {
 }
 
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
-                            size_t capacity, size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
+                            size_t capacity, size_t* written, kdm_cursor* cursor,
+                            kdm_query_problem* problem) {
   static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
   if (written) *written = 0;
   kdm::QueryProblem why;
@@ -171,7 +177,7 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
     } else {
       q.density.constant = c.density;
     }
-    kdm::QueryCursor k{cursor->tile_x,      cursor->tile_y,       cursor->rank,
+    kdm::QueryCursor k{cursor->tile_x,       cursor->tile_y,        cursor->rank,
                        cursor->started != 0, cursor->finished != 0, cursor->fingerprint};
     // kdm_point and QueryPoint share their layout (asserted above): write straight into the caller's buffer.
     status = to_c(kdm::query_points(*tileset->set, q, reinterpret_cast<kdm::QueryPoint*>(out), capacity,

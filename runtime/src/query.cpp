@@ -28,31 +28,43 @@ double sanitize(double v) {
 
 }  // namespace
 
+namespace {
+AllocatorHooks g_tileset_hooks;  // written only by set_tileset_allocator (documented: not during loads)
+}  // namespace
+
+void set_tileset_allocator(const AllocatorHooks& hooks) {
+  g_tileset_hooks = (hooks.allocate && hooks.deallocate) ? hooks : AllocatorHooks{};
+}
+
+AllocatorHooks tileset_allocator() {
+  return g_tileset_hooks;
+}
+
 void Tileset::adopt(TilesetData&& set) {
   set_ = std::move(set);
   // Thresholds once per load, so the query loop compares instead of interpolating.
   thresholds_.assign(set_.tiles.size(), {});
   for (std::size_t t = 0; t < set_.tiles.size(); ++t) {
     const Tile& tile = set_.tiles[t];
-    std::vector<float>& out = thresholds_[t];
+    TilesetArray<float>& out = thresholds_[t];
     out.resize(tile.points.size());
     for (std::uint32_t k = 0, i = 0; k < set_.levels; ++k)
       for (; i < tile.level_end[k]; ++i) out[i] = set_.emission_threshold(k, tile.keys[i]);
   }
   min_threshold_ = HUGE_VAL;
-  for (const std::vector<float>& t : thresholds_)
+  for (const TilesetArray<float>& t : thresholds_)
     if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
 }
 
 std::size_t Tileset::resident_bytes() const {
   std::size_t bytes = sizeof(*this) + set_.level_nominal.capacity() * sizeof(std::uint32_t) +
                       set_.tiles.capacity() * sizeof(Tile) +
-                      thresholds_.capacity() * sizeof(std::vector<float>) + set_.recipe.capacity() +
+                      thresholds_.capacity() * sizeof(TilesetArray<float>) + set_.recipe.capacity() +
                       set_.generator_version.capacity();
   for (const Tile& t : set_.tiles)
     bytes += t.points.capacity() * sizeof(TilePoint) + t.keys.capacity() * sizeof(std::uint16_t) +
              t.level_end.capacity() * sizeof(std::uint32_t);
-  for (const std::vector<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
+  for (const TilesetArray<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
   return bytes;
 }
 
@@ -161,10 +173,14 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!cursor) return refuse(Kind::kMissingArgument, "cursor");
   if (capacity > 0 && !out) return refuse(Kind::kMissingArgument, "out");
   if (tileset.empty()) return refuse(Kind::kMissingArgument, "tileset");
-  const std::pair<const char*, double> numbers[] = {{"x0", q.x0},        {"y0", q.y0},
-                                                    {"x1", q.x1},        {"y1", q.y1},
-                                                    {"origin_x", q.origin_x}, {"origin_y", q.origin_y},
-                                                    {"tile_size", q.tile_size}, {"scale", q.scale}};
+  const std::pair<const char*, double> numbers[] = {{"x0", q.x0},
+                                                    {"y0", q.y0},
+                                                    {"x1", q.x1},
+                                                    {"y1", q.y1},
+                                                    {"origin_x", q.origin_x},
+                                                    {"origin_y", q.origin_y},
+                                                    {"tile_size", q.tile_size},
+                                                    {"scale", q.scale}};
   for (const auto& [name, value] : numbers)
     if (!finite(value)) return refuse(Kind::kNotFinite, name, value);
   if (!(q.tile_size > 0)) return refuse(Kind::kNotPositive, "tile_size", q.tile_size);
@@ -182,7 +198,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       max_density = sanitize(d.constant);
       break;
     case QueryDensity::Kind::kImage:
-      if (!d.image || !d.image->values || !d.image->max_mip) return refuse(Kind::kBadDensity, "density.image");
+      if (!d.image || !d.image->values || !d.image->max_mip)
+        return refuse(Kind::kBadDensity, "density.image");
       max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
       break;
     case QueryDensity::Kind::kCallback:

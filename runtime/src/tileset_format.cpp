@@ -69,14 +69,16 @@ class MemoryBuffer : public std::streambuf {
 
 using InputArchive = cereal::PortableBinaryInputArchive;
 
-template <class T>
-void save_array(cereal::PortableBinaryOutputArchive& ar, const std::vector<T>& v) {
+template <class Array>
+void save_array(cereal::PortableBinaryOutputArchive& ar, const Array& v) {
+  using T = typename Array::value_type;
   ar(cereal::make_size_tag(static_cast<cereal::size_type>(v.size())));
   ar(cereal::binary_data(const_cast<T*>(v.data()), v.size() * sizeof(T)));
 }
 
-template <class T>
-void load_array(InputArchive& ar, const MemoryBuffer& buffer, std::vector<T>& v) {
+template <class Array>
+void load_array(InputArchive& ar, const MemoryBuffer& buffer, Array& v) {
+  using T = typename Array::value_type;
   cereal::size_type n = 0;
   ar(cereal::make_size_tag(n));
   // A count larger than the bytes left cannot be genuine: refuse before allocating.

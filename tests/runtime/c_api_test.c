@@ -3,6 +3,7 @@
 #include <kdm/runtime/kdm_runtime.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define CHECK(cond)                                                            \
@@ -24,6 +25,18 @@ static size_t count_points(const kdm_tileset* set, const kdm_query* q, size_t ca
     total += written;
   } while (s == KDM_BUFFER_FULL);
   return s == KDM_OK ? total : (size_t)-1;
+}
+
+static size_t g_hooked_bytes = 0;
+static void* hooked_allocate(size_t bytes, size_t alignment, void* user) {
+  (void)alignment;
+  *(size_t*)user += bytes;
+  return malloc(bytes ? bytes : 1);
+}
+static void hooked_deallocate(void* p, size_t bytes, size_t alignment, void* user) {
+  (void)alignment;
+  *(size_t*)user -= bytes;
+  free(p);
 }
 
 static kdm_query uniform_query(void) {
@@ -122,7 +135,8 @@ int main(int argc, char** argv) {
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH && written == 0);
     q.x1 = 0.5, q.y1 = 0.5, q.scale = 20;
     memset(&cursor, 0, sizeof cursor);
-    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK && cursor.finished);
+    CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK &&
+          cursor.finished);
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK && written == 0);
     q.x0 = 1, q.x1 = 1.5;
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
@@ -136,6 +150,14 @@ int main(int argc, char** argv) {
   CHECK(strlen(kdm_status_message(KDM_TRUNCATED)) > 0);
   kdm_tileset_free(loaded);
   kdm_tileset_free((kdm_tileset*)builtin); /* ignored for the built-in set */
+
+  /* An engine's allocator holds a loaded set's arrays and gets them all back. */
+  kdm_set_tileset_allocator(hooked_allocate, hooked_deallocate, &g_hooked_bytes);
+  CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OK);
+  kdm_set_tileset_allocator(NULL, NULL, NULL);
+  CHECK(g_hooked_bytes > 4000000 && g_hooked_bytes <= kdm_tileset_resident_bytes(loaded));
+  kdm_tileset_free(loaded);
+  CHECK(g_hooked_bytes == 0);
   printf("c api ok\n");
   return 0;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cereal/archives/portable_binary.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -13,6 +14,7 @@
 #include <sstream>
 
 #include "crc32.h"
+#include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
 
 namespace kdm {
@@ -282,6 +284,44 @@ TEST(TilesetFormatTest, TheShippedSetCutOrDamagedIsRejected) {
     ASSERT_EQ(decode(damaged, damaged.size()), Status::kPayloadChecksumMismatch) << "bit " << bit;
     damaged[bit / 8] = bytes[bit / 8];
   }
+}
+
+// An engine's allocator serves every array of a loaded tile set, and gets all of it back, even when
+// other hooks are installed in between.
+struct CountingHeap {
+  std::size_t live_bytes = 0, allocations = 0, frees = 0;
+};
+void* counting_allocate(std::size_t bytes, std::size_t, void* user) {
+  auto* heap = static_cast<CountingHeap*>(user);
+  heap->live_bytes += bytes, ++heap->allocations;
+  return std::malloc(bytes ? bytes : 1);
+}
+void counting_deallocate(void* p, std::size_t bytes, std::size_t, void* user) {
+  auto* heap = static_cast<CountingHeap*>(user);
+  heap->live_bytes -= bytes, ++heap->frees;
+  std::free(p);
+}
+
+TEST(TilesetAllocatorTest, TheTileSetsArraysGoThroughTheHook) {
+  CountingHeap heap;
+  set_tileset_allocator({counting_allocate, counting_deallocate, &heap});
+  EXPECT_EQ(tileset_allocator().user, &heap);
+  {
+    Tileset loaded;
+    ASSERT_EQ(Tileset::load_file(std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt", loaded),
+              Status::kOk);
+    set_tileset_allocator({});  // later allocations use operator new; the set's memory still returns here
+    EXPECT_EQ(tileset_allocator().allocate, nullptr);
+    const TilesetData& d = loaded.data();
+    // Everything resident but the object itself and its two texts: positions, keys, tables, thresholds.
+    EXPECT_EQ(heap.live_bytes, loaded.resident_bytes() - sizeof(Tileset) - d.recipe.capacity() -
+                                   d.generator_version.capacity());
+    EXPECT_GT(heap.live_bytes, std::size_t(4) << 20);
+    TilesetData copy = d;  // copies keep the source's allocator (propagation), so they count here too
+    EXPECT_GT(heap.allocations, 3 * d.tiles.size());
+  }
+  EXPECT_EQ(heap.live_bytes, 0u);
+  EXPECT_EQ(heap.allocations, heap.frees);
 }
 
 }  // namespace

@@ -297,7 +297,7 @@ class Baker {
     TilesetData set;
     set.colours = recipe_.colours;
     set.levels = recipe_.levels;
-    set.level_nominal = nominal_;
+    set.level_nominal.assign(nominal_.begin(), nominal_.end());
     set.recipe = recipe_.to_text();
     set.generator_version = version_string();
     const std::size_t count = std::size_t(set.colours) * set.colours * set.colours * set.colours;

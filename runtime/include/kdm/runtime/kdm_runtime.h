@@ -70,15 +70,15 @@ typedef struct kdm_cursor {
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {
   KDM_PROBLEM_NONE = 0,
-  KDM_PROBLEM_MISSING_ARGUMENT = 1,  /* `parameter` is NULL (or the tile set is empty) */
-  KDM_PROBLEM_NOT_FINITE = 2,        /* `parameter` is NaN or infinite; `value` holds it */
-  KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 */
-  KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
-  KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing */
-  KDM_PROBLEM_TOO_MANY_TILES = 6,    /* `value` tiles, more than `limit`: split the region */
-  KDM_PROBLEM_DENSITY_TOO_HIGH = 7,  /* `value` points per tile > `limit`; see largest_valid (scale) and
-                                        largest_tile_size */
-  KDM_PROBLEM_CURSOR_MISMATCH = 8    /* the cursor was started by a query with other parameters */
+  KDM_PROBLEM_MISSING_ARGUMENT = 1, /* `parameter` is NULL (or the tile set is empty) */
+  KDM_PROBLEM_NOT_FINITE = 2,       /* `parameter` is NaN or infinite; `value` holds it */
+  KDM_PROBLEM_NOT_POSITIVE = 3,     /* `parameter` must be > 0 */
+  KDM_PROBLEM_NEGATIVE = 4,         /* `parameter` must be >= 0 */
+  KDM_PROBLEM_BAD_DENSITY = 5,      /* the density image or callback is missing */
+  KDM_PROBLEM_TOO_MANY_TILES = 6,   /* `value` tiles, more than `limit`: split the region */
+  KDM_PROBLEM_DENSITY_TOO_HIGH = 7, /* `value` points per tile > `limit`; see largest_valid (scale) and
+                                       largest_tile_size */
+  KDM_PROBLEM_CURSOR_MISMATCH = 8   /* the cursor was started by a query with other parameters */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
@@ -89,8 +89,8 @@ typedef struct kdm_query_problem {
 } kdm_query_problem;
 
 typedef struct kdm_tileset_info {
-  size_t struct_size;            /* sizeof(kdm_tileset_info) */
-  uint32_t format_version;       /* of the file it was loaded from */
+  size_t struct_size;      /* sizeof(kdm_tileset_info) */
+  uint32_t format_version; /* of the file it was loaded from */
   uint32_t colours, tiles, levels;
   uint32_t max_points_per_tile;  /* the densest query: scale * density * tile_size^2 up to this */
   uint32_t level_points[16];     /* nominal points per tile of levels 0 .. levels - 1 */
@@ -98,6 +98,15 @@ typedef struct kdm_tileset_info {
   const char* generator_version; /* the kdm version that baked it; valid while the tile set lives */
   const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
 } kdm_tileset_info;
+
+/* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`
+ * returns `bytes` bytes aligned to `alignment` or NULL, `deallocate` frees them. Both NULL: malloc-like
+ * operator new again. Memory always returns to the functions it came from. Call it while no other thread
+ * is loading a tile set. */
+KDM_RUNTIME_API void kdm_set_tileset_allocator(void* (*allocate)(size_t bytes, size_t alignment, void* user),
+                                               void (*deallocate)(void* p, size_t bytes, size_t alignment,
+                                                                  void* user),
+                                               void* user);
 
 /* The library version, "MAJOR.MINOR.PATCH" (static string). */
 KDM_RUNTIME_API const char* kdm_version(void);
@@ -129,9 +138,9 @@ KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 /* Writes up to `capacity` points into `out`, *written = count. KDM_OK when the region is complete,
  * KDM_BUFFER_FULL to be resumed with the same cursor and query, KDM_INVALID_ARGUMENT for bad parameters,
  * with `problem` (optional: NULL, or with struct_size set) saying which and why. */
-KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
-                                            size_t capacity, size_t* written, kdm_cursor* cursor,
-                                            kdm_query_problem* problem);
+KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
+                                            kdm_point* out, size_t capacity, size_t* written,
+                                            kdm_cursor* cursor, kdm_query_problem* problem);
 
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);

@@ -55,7 +55,7 @@ class KDM_RUNTIME_API Tileset {
  private:
   void adopt(TilesetData&& set);
   TilesetData set_;
-  std::vector<std::vector<float>> thresholds_;
+  TilesetArray<TilesetArray<float>> thresholds_;
   double min_threshold_ = 0;
 };
 

@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "kdm/runtime/allocator.h"
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/version.h"
 
@@ -84,11 +85,11 @@ struct TilePoint {
 
 struct Tile {
   /// Sorted by (level, key): the array index is the point's rank within the whole pyramid.
-  std::vector<TilePoint> points;
+  TilesetArray<TilePoint> points;
   /// Emission key of each point within its level (see the top of this file); non-decreasing per level.
-  std::vector<std::uint16_t> keys;
+  TilesetArray<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
-  std::vector<std::uint32_t> level_end;
+  TilesetArray<std::uint32_t> level_end;
   /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
   std::uint32_t level_of(std::uint32_t rank) const {
     std::uint32_t k = 0;
@@ -105,8 +106,8 @@ struct TilesetData {
   std::uint32_t levels = 0;   ///< pyramid levels per tile
   /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
   /// strictly increasing, positive. Emission thresholds are placed between these.
-  std::vector<std::uint32_t> level_nominal;
-  std::vector<Tile> tiles;        ///< index tile_index(sw, se, ne, nw)
+  TilesetArray<std::uint32_t> level_nominal;
+  TilesetArray<Tile> tiles;       ///< index tile_index(sw, se, ne, nw)
   std::string recipe;             ///< the recipe text that rebuilds this set exactly
   std::string generator_version;  ///< the kdm version that baked it
 

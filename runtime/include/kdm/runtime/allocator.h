@@ -1,0 +1,86 @@
+// Where a tile set's memory comes from: one hook, so an engine can put loaded tile sets in its own heap
+// and count them. Everything a TilesetData and a loaded Tileset hold in arrays (positions, keys, level
+// tables, emission thresholds) is allocated through it; the short recipe and version texts are not.
+#pragma once
+
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+#include <type_traits>
+#include <vector>
+
+#include "kdm/runtime/export.h"
+
+namespace kdm {
+
+/// An allocation hook. Both functions must be set, or neither (operator new / delete then serve).
+struct AllocatorHooks {
+  /// Returns `bytes` bytes aligned to `alignment` (a power of two, at most alignof(std::max_align_t)), or
+  /// null when out of memory.
+  void* (*allocate)(std::size_t bytes, std::size_t alignment, void* user) = nullptr;
+  /// Frees what `allocate` returned, with the same size and alignment.
+  void (*deallocate)(void* p, std::size_t bytes, std::size_t alignment, void* user) = nullptr;
+  void* user = nullptr;
+};
+
+/// Installs `hooks` for tile-set memory allocated from now on (default hooks restore operator new).
+/// Memory is always freed through the hooks it came from, so switching is safe, but call it while no
+/// other thread is loading or copying a tile set (at start-up, typically).
+KDM_RUNTIME_API void set_tileset_allocator(const AllocatorHooks& hooks);
+
+/// The hooks in force (what new tile-set arrays will use).
+KDM_RUNTIME_API AllocatorHooks tileset_allocator();
+
+/// A standard allocator over the hooks in force when it was made; it keeps them, so its memory goes
+/// back where it came from. An allocation the hook refuses ends the program (std::abort) when exceptions
+/// are off, or throws std::bad_alloc.
+template <class T>
+struct TilesetAllocator {
+  using value_type = T;
+  using propagate_on_container_copy_assignment = std::true_type;
+  using propagate_on_container_move_assignment = std::true_type;
+  using propagate_on_container_swap = std::true_type;
+
+  AllocatorHooks hooks = tileset_allocator();
+
+  TilesetAllocator() = default;
+  template <class U>
+  TilesetAllocator(const TilesetAllocator<U>& other) : hooks(other.hooks) {}
+
+  T* allocate(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+    void* p = hooks.allocate ? hooks.allocate(bytes, alignof(T), hooks.user) : ::operator new(bytes);
+    if (!p) out_of_memory();
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, std::size_t n) {
+    if (hooks.deallocate)
+      hooks.deallocate(p, n * sizeof(T), alignof(T), hooks.user);
+    else
+      ::operator delete(p);
+  }
+  template <class U>
+  friend bool operator==(const TilesetAllocator& a, const TilesetAllocator<U>& b) {
+    return a.hooks.allocate == b.hooks.allocate && a.hooks.deallocate == b.hooks.deallocate &&
+           a.hooks.user == b.hooks.user;
+  }
+  template <class U>
+  friend bool operator!=(const TilesetAllocator& a, const TilesetAllocator<U>& b) {
+    return !(a == b);
+  }
+
+ private:
+  [[noreturn]] static void out_of_memory() {
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+    throw std::bad_alloc();
+#else
+    std::abort();
+#endif
+  }
+};
+
+/// The arrays of tile-set data: std::vector on the tile-set allocator.
+template <class T>
+using TilesetArray = std::vector<T, TilesetAllocator<T>>;
+
+}  // namespace kdm
