@@ -232,6 +232,10 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (std::fabs(ty0d) > 9e15 || std::fabs(ty1d) > 9e15) return refuse(Kind::kNotFinite, "y0", q.y0);
   const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
   const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
+  if (tx1 <= tx0 || ty1 <= ty0) {  // x1 / S rounded onto x0 / S: no tile column (or row) to visit at all
+    *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
+    return Status::kOk;
+  }
   if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false, fingerprint};
 
   std::size_t n = 0;

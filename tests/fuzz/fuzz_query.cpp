@@ -1,17 +1,44 @@
-// Fuzz target: query_points against the built-in set with parameters taken from the input bytes
-// (any doubles, including NaN and infinities), a density of every kind, and a small resumable buffer.
+// Fuzz target: query_points on the built-in tile set, with every parameter taken from the input: per
+// parameter a selector bit picks a raw double (NaN, infinities and extremes included) or a small value
+// from one byte; the density is a constant, a 4×4 image (raw or byte texels) or a callback. The work per
+// input is bounded: when the region would hold more than kBudget candidate points it is cut to a few
+// tiles and then the scale lowered (huge regions and scales are the unit tests' business). Checks:
+//  - every point, origin added back, lies in [x0, x1) × [y0, y1) and in the tile its id names;
+//  - points come in the documented order (tiles row by row, ranks ascending), so ids are unique;
+//  - collecting with a buffer of 1-8 points, resuming from the cursor, gives exactly the points of one
+//    call with a large buffer, in the same order; kBufferFull only with a full buffer; a finished cursor
+//    gives no more points;
+//  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B)).
+// A failed check aborts.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <tuple>
+#include <vector>
 
 #include "kdm/runtime/query.h"
 
 namespace {
 
+// Candidate points per input, about (a call examines them all): small, so that runs reach 10^4 inputs/s.
+constexpr double kBudget = 256;
+constexpr std::size_t kBigCapacity = 4096;  // far above kBudget: the thresholds are only about c + ½
+
 struct Reader {
   const std::uint8_t* data;
   std::size_t size;
-  double next() {
+  std::uint32_t raw_bits = 0;  // selector: bit i set = the i-th number is a raw double
+  int index = 0;
+  std::uint8_t byte() {
+    if (size == 0) return 0;
+    --size;
+    return *data++;
+  }
+  double raw() {
     double v = 0;
     if (size >= sizeof v) {
       std::memcpy(&v, data, sizeof v);
@@ -19,52 +46,185 @@ struct Reader {
     }
     return v;
   }
+  // The next number: raw, or `small(byte)`.
+  template <class Small>
+  double next(Small small) {
+    return (raw_bits >> index++) & 1 ? raw() : small(byte());
+  }
 };
+
+double coordinate(std::uint8_t b) {
+  return static_cast<std::int8_t>(b) / 8.0;
+}
 
 double callback(void* user, double x, double y) {
   const double v = *static_cast<const double*>(user);
   return v * (x - y);  // any value, hostile ones included
 }
 
+[[noreturn]] void fail() {
+  std::abort();
+}
+
+// `out` (a query output) plus `origin` lies in [lo, hi): exact when there is no origin, else up to the
+// rounding of subtracting and adding it back.
+bool inside(double out, double origin, double lo, double hi) {
+  const double w = out + origin;
+  const double tol = origin == 0 ? 0 : 4 * DBL_EPSILON * std::max(std::fabs(out), std::fabs(origin));
+  return w >= lo - tol && w < hi + tol;
+}
+
+bool in_tile(double out, double origin, std::int64_t t, double size) {
+  const double w = out + origin, lo = double(t) * size, hi = double(t + 1) * size;
+  const double tol = 4 * DBL_EPSILON * (std::fabs(out) + std::fabs(origin) + std::fabs(lo) + std::fabs(hi));
+  return w >= lo - tol && w <= hi + tol;
+}
+
+auto order_key(const kdm::QueryPoint& p) {
+  return std::make_tuple(p.id.tile_y, p.id.tile_x, p.id.rank);
+}
+
+bool same(const kdm::QueryPoint& a, const kdm::QueryPoint& b) {
+  return std::memcmp(&a.x, &b.x, sizeof a.x) == 0 && std::memcmp(&a.y, &b.y, sizeof a.y) == 0 && a.id == b.id;
+}
+
+// A query's points from one call with a large buffer (reused: nothing is cleared per input).
+struct Points {
+  kdm::QueryPoint data[kBigCapacity];
+  std::size_t size = 0;
+  kdm::Status status = kdm::Status::kOk;
+  // False if they do not fit (the input is then over budget).
+  bool query(const kdm::QueryParams& q) {
+    kdm::QueryCursor cursor;
+    status = kdm::query_points(kdm::Tileset::builtin(), q, data, kBigCapacity, &size, &cursor);
+    return status != kdm::Status::kBufferFull;
+  }
+  const kdm::QueryPoint& operator[](std::size_t i) const { return data[i]; }
+};
+
+// Expected candidate points of a query, about: per tile, the overhead and every rank whose threshold
+// (~ c + ½) is below the tile's density bound, at most `peak` (the density's maximum anywhere). 0 when
+// the query is refused or empty before any work (with a margin: the rounding may differ from the query's).
+double work(const kdm::QueryParams& q, double peak) {
+  const double S = q.tile_size, top = kdm::Tileset::builtin().max_points_per_tile();
+  if (!(std::isfinite(q.x0) && std::isfinite(q.x1) && std::isfinite(q.y0) && std::isfinite(q.y1) &&
+        std::isfinite(S) && std::isfinite(q.scale) && S > 0 && q.scale > 0 && q.x1 > q.x0 && q.y1 > q.y0))
+    return 0;
+  double density = peak;  // the bound the query checks against the top level
+  if (q.density.kind == kdm::QueryDensity::Kind::kImage)
+    density = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
+  const double area_scale = S * S * q.scale;
+  if (!(density * area_scale <= top * 1.000001 + 1)) return 0;  // refused: density too high
+  const double tiles =
+      (std::ceil(q.x1 / S) - std::floor(q.x0 / S)) * (std::ceil(q.y1 / S) - std::floor(q.y0 / S));
+  if (!(tiles <= double(kdm::kMaxQueryTiles) * 1.000001)) return 0;  // refused: too many tiles
+  return tiles * (8 + std::min(peak * area_scale, top));
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  if (size < 1) return 0;
-  Reader r{data + 1, size - 1};
+  if (size < 3) return 0;
+  const int kind = data[0] % 3;
+  const std::size_t capacity = 1 + (data[0] >> 2) % 8;
+  Reader r{data + 3, size - 3, std::uint32_t(data[1]) | std::uint32_t(data[2]) << 8};
   kdm::QueryParams q;
-  q.x0 = r.next(), q.y0 = r.next(), q.x1 = r.next(), q.y1 = r.next();
-  q.origin_x = r.next(), q.origin_y = r.next();
-  q.tile_size = r.next(), q.scale = r.next();
-  double value = r.next();
-  static float texels[4 * 4];
-  for (float& t : texels) t = static_cast<float>(r.next());
+  q.x0 = r.next(coordinate), q.y0 = r.next(coordinate), q.x1 = r.next(coordinate), q.y1 = r.next(coordinate);
+  q.origin_x = r.next(coordinate), q.origin_y = r.next(coordinate);
+  q.tile_size = r.next([](std::uint8_t b) { return b / 64.0; });
+  q.scale = r.next([](std::uint8_t b) { return b ? std::exp2((b - 128) / 8.0) : 0.0; });
+  double value = r.next([](std::uint8_t b) { return static_cast<std::int8_t>(b) / 16.0; });
+  const double callback_max = r.next([](std::uint8_t b) { return b / 16.0; });
   kdm::DensityImageView image;
+  image.x0 = r.next(coordinate), image.y0 = r.next(coordinate);
+  image.x1 = r.next(coordinate), image.y1 = r.next(coordinate);
+  const bool raw_texels = (r.raw_bits >> 14) & 1;
+  const double split = r.byte() / 256.0;
+  float texels[4 * 4];
+  for (float& t : texels) {
+    if (raw_texels) {
+      t = 0;
+      if (r.size >= sizeof t) std::memcpy(&t, r.data, sizeof t), r.data += sizeof t, r.size -= sizeof t;
+    } else {
+      t = r.byte() / 64.0f;
+    }
+  }
   image.width = image.height = 4;
-  image.x0 = r.next(), image.y0 = r.next(), image.x1 = r.next(), image.y1 = r.next();
   image.values = texels;
-  std::vector<float> mip;
-  switch (data[0] % 3) {
+  static std::vector<float> mip;  // reused: no allocation per input
+  double peak = 0;                // the density's maximum anywhere (as the query bounds it)
+  switch (kind) {
     case 0:
       q.density.constant = value;
+      peak = value > 0 ? value : 0;
       break;
     case 1:
       if (kdm::make_density_max_mip(image, mip) != kdm::Status::kOk) return 0;
       q.density.kind = kdm::QueryDensity::Kind::kImage;
       q.density.image = &image;
+      peak = *std::max_element(mip.begin(), mip.end());
       break;
     default:
       q.density.kind = kdm::QueryDensity::Kind::kCallback;
       q.density.callback = callback;
       q.density.user = &value;
-      q.density.callback_max = r.next();
+      q.density.callback_max = peak = callback_max;
   }
-  kdm::QueryPoint out[64];
+
+  // Bound the work: a few tiles at most, then a lower scale.
+  if (work(q, peak) > kBudget) {
+    q.x1 = std::min(q.x1, q.x0 + 2 * q.tile_size);
+    q.y1 = std::min(q.y1, q.y0 + 2 * q.tile_size);
+    if (const double w = work(q, peak); w > kBudget) q.scale *= kBudget / w;
+    if (work(q, peak) > kBudget) return 0;
+  }
+
+  static Points all, a, b;
+  if (!all.query(q) || all.status != kdm::Status::kOk) return 0;  // over budget, or refused
+
+  for (std::size_t i = 0; i < all.size; ++i) {
+    const kdm::QueryPoint& p = all[i];
+    if (!inside(p.x, q.origin_x, q.x0, q.x1) || !inside(p.y, q.origin_y, q.y0, q.y1)) fail();
+    if (!in_tile(p.x, q.origin_x, p.id.tile_x, q.tile_size) ||
+        !in_tile(p.y, q.origin_y, p.id.tile_y, q.tile_size))
+      fail();
+    if (p.id.rank >= kdm::Tileset::builtin().tile_at(p.id.tile_x, p.id.tile_y).points.size()) fail();
+    if (i > 0 && !(order_key(all[i - 1]) < order_key(p))) fail();  // documented order, so ids are unique
+  }
+
+  // Resumed with a small buffer: the same points in the same order.
+  kdm::QueryPoint small[8];
   kdm::QueryCursor cursor;
-  std::size_t written = 0;
-  // Bounded: a few resumes (each call examines at most kMaxQueryCandidates points).
-  for (int i = 0; i < 4 && kdm::query_points(kdm::Tileset::builtin(), q, out, 64, &written, &cursor) ==
-                               kdm::Status::kBufferFull;
-       ++i) {
+  std::size_t at = 0, written = 0;
+  for (std::size_t calls = 0;; ++calls) {
+    if (calls > all.size / capacity + 1) fail();  // no progress
+    const kdm::Status status =
+        kdm::query_points(kdm::Tileset::builtin(), q, small, capacity, &written, &cursor);
+    if (status != kdm::Status::kOk && status != kdm::Status::kBufferFull) fail();
+    if (status == kdm::Status::kBufferFull && written != capacity) fail();  // under kMaxQueryCandidates
+    if (at + written > all.size) fail();
+    for (std::size_t i = 0; i < written; ++i)
+      if (!same(small[i], all[at + i])) fail();
+    at += written;
+    if (status == kdm::Status::kOk) break;
+  }
+  if (at != all.size) fail();
+  if (kdm::query_points(kdm::Tileset::builtin(), q, small, capacity, &written, &cursor) != kdm::Status::kOk ||
+      written != 0)
+    fail();
+
+  // Split at x = xm: both halves are accepted (their density bounds are no higher), and together they
+  // hold exactly the region's points.
+  const double xm = q.x0 + split * (q.x1 - q.x0);
+  if (!(xm > q.x0 && xm < q.x1)) return 0;
+  kdm::QueryParams qa = q, qb = q;
+  qa.x1 = xm, qb.x0 = xm;
+  if (!a.query(qa) || a.status != kdm::Status::kOk || !b.query(qb) || b.status != kdm::Status::kOk) fail();
+  if (a.size + b.size != all.size) fail();
+  std::size_t ia = 0, ib = 0;
+  for (std::size_t i = 0; i < all.size; ++i) {
+    const bool from_a = ia < a.size && (ib == b.size || order_key(a[ia]) < order_key(b[ib]));
+    if (!same(all[i], from_a ? a[ia++] : b[ib++])) fail();
   }
   return 0;
 }

@@ -219,6 +219,11 @@ TEST(QueryTest, BadInputIsRejectedOrHarmless) {
       query_points(Tileset::builtin(), region(0, 0, 8192, 4097, 1), buffer.data(), 16, &written, &cursor),
       Status::kInvalidArgument);  // just over kMaxQueryTiles = 2^24 tiles: bounded work per call
   EXPECT_TRUE(run(region(-1e6, -1e6, 1e6, 1e6, 1e-20)).empty());  // 4·10^12 tiles, but none can emit
+  // x1 / tile_size rounds to x0 / tile_size: zero columns of 2.5·10^14 rows. Once, the row loop visited
+  // them all (found by fuzz_query; tests/fuzz/crashes/query/zero_columns_many_rows).
+  QueryParams thin = region(0, 0, 5e-324, 1e15, 1);
+  thin.tile_size = 4;
+  EXPECT_TRUE(run(thin).empty());
   QueryParams h = region(0, 0, 3, 1, 1000);
   h.density.kind = QueryDensity::Kind::kCallback;
   h.density.callback = hostile;

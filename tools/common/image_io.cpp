@@ -4,12 +4,20 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <memory>
+#include <utility>
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
+// Zeroed memory: stb 2.27 reads some of its allocations before writing them, e.g. the Huffman tables of a
+// JPEG scan that no DHT segment defined (whose garbage offsets then index out of bounds).
+#define STBI_MALLOC(size) std::calloc(1, size)
+#define STBI_REALLOC(p, size) std::realloc(p, size)
+#define STBI_FREE(p) std::free(p)
 #include <stb_image.h>
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
@@ -30,41 +38,191 @@ bool commit_temp(const std::string& tmp, const std::string& path, std::string& e
   return true;
 }
 
-}  // namespace
+// ---- Faults of the stb_image kdm builds with (2.27, Debian 12's libstb-dev), found by
+// tests/fuzz/fuzz_image: inputs that reach them are refused before stb reads them. Each check mirrors how stb
+// walks the format and refuses only inputs stb cannot decode anyway (corrupt or truncated), so no valid image
+// is turned away.
 
-bool load_grey_image(const std::string& path, GreyImage& out, std::string& error) {
-  int w = 0, h = 0, channels = 0;
-  const bool sixteen = stbi_is_16_bit(path.c_str()) != 0;
-  std::vector<float> values;
-  if (sixteen) {
-    std::unique_ptr<stbi_us, void (*)(void*)> data(stbi_load_16(path.c_str(), &w, &h, &channels, 0),
-                                                   stbi_image_free);
-    if (!data) {
-      error = "cannot read image '" + path + "': " + stbi_failure_reason();
-      return false;
-    }
-    values.assign(data.get(), data.get() + static_cast<std::size_t>(w) * h * channels);
-    for (float& v : values) v /= 65535.0f;
-  } else {
-    std::unique_ptr<stbi_uc, void (*)(void*)> data(stbi_load(path.c_str(), &w, &h, &channels, 0),
-                                                   stbi_image_free);
-    if (!data) {
-      const char* reason = stbi_failure_reason();
-      error = "cannot read image '" + path + "': " + (reason ? reason : "unknown format");
-      return false;
-    }
-    values.assign(data.get(), data.get() + static_cast<std::size_t>(w) * h * channels);
-    for (float& v : values) v /= 255.0f;
+struct Bytes {  // stb's reading conventions: zeros past the end
+  const std::uint8_t* data;
+  std::size_t size, pos = 0;
+  bool eof() const { return pos >= size; }
+  int get8() { return pos < size ? data[pos++] : 0; }
+  int get16() {
+    const int high = get8();
+    return high << 8 | get8();
   }
-  if (w <= 0 || h <= 0) {
-    error = "image '" + path + "' is empty";
-    return false;
+  void skip(std::size_t n) { pos = n < size - std::min(pos, size) ? pos + n : size; }
+};
+
+enum class Segment { kRead, kFault, kStop };  // stb reads on; stb would write out of bounds; stb stops
+
+// A JPEG DHT segment (after its marker) as stbi__process_marker reads it. A table of more than 256 codes
+// makes stb write past its Huffman arrays (and later read through the damaged ones): heap corruption.
+Segment jpeg_huffman_tables(Bytes& b) {
+  int left = b.get16() - 2;
+  while (left > 0) {
+    const int q = b.get8();
+    if ((q >> 4) > 1 || (q & 15) > 3) return Segment::kStop;
+    int codes = 0;
+    for (int i = 0; i < 16; ++i) codes += b.get8();
+    if (codes > 256) return Segment::kFault;
+    b.skip(static_cast<std::size_t>(codes));
+    left -= 17 + codes;
   }
-  out.width = w;
-  out.height = h;
-  out.pixels.resize(static_cast<std::size_t>(w) * h);
-  for (std::size_t i = 0; i < out.pixels.size(); ++i) {
-    const float* p = &values[i * channels];
+  return left == 0 ? Segment::kRead : Segment::kStop;
+}
+
+// Whether stb would fault on a JPEG's Huffman tables. The markers before the frame header are walked as
+// stbi__decode_jpeg_header does, skipping what it skips (APPn and COM payloads, quantisation tables);
+// from the frame header on, or wherever stb would give up, every FF C4 pair is taken for a DHT marker, as
+// stb may take any of them for one (scans end at the first marker, and stb resynchronises on 0xFF).
+bool jpeg_faults(const std::uint8_t* data, std::size_t size) {
+  constexpr int kNone = 0xFF;  // stb's "no marker"
+  Bytes b{data, size};
+  auto marker = [&b] {
+    int x = b.get8();
+    if (x != 0xFF) return kNone;
+    while (x == 0xFF) x = b.get8();
+    return x;
+  };
+  if (marker() != 0xD8) return false;  // no SOI: stb does not read it as a JPEG
+  for (int m = marker(); m != 0xC0 && m != 0xC1 && m != 0xC2;) {
+    Segment s = Segment::kStop;
+    if (m == 0xC4) {
+      s = jpeg_huffman_tables(b);
+    } else if (m == 0xDB) {  // quantisation tables
+      int left = b.get16() - 2;
+      s = Segment::kRead;
+      while (left > 0 && s == Segment::kRead) {
+        const int q = b.get8();
+        if ((q >> 4) > 1 || (q & 15) > 3) s = Segment::kStop;
+        b.skip(q >> 4 ? 128 : 64);
+        left -= q >> 4 ? 129 : 65;
+      }
+      if (left != 0) s = Segment::kStop;
+    } else if (m == 0xDD) {  // restart interval
+      s = b.get16() == 4 ? Segment::kRead : Segment::kStop;
+      b.skip(2);
+    } else if ((m >= 0xE0 && m <= 0xEF) || m == 0xFE) {  // APPn, COM
+      const int length = b.get16();
+      if (length >= 2) s = Segment::kRead, b.skip(static_cast<std::size_t>(length - 2));
+    }
+    if (s == Segment::kFault) return true;
+    if (s == Segment::kStop) break;
+    m = marker();
+    while (m == kNone) {  // stb scans over padding between segments
+      if (b.eof()) return false;
+      m = marker();
+    }
+  }
+  for (std::size_t i = b.pos == 0 ? 0 : b.pos - 1; i + 1 < size; ++i)
+    if (data[i] == 0xFF && data[i + 1] == 0xC4) {
+      Bytes dht{data, size, i + 2};
+      if (jpeg_huffman_tables(dht) == Segment::kFault) return true;
+    }
+  return false;
+}
+
+// Whether a PNG's chunks claim more bytes than there are: stb allocates an IDAT buffer of the claimed
+// length before reading it (gigabytes from a few bytes).
+bool png_truncated(const std::uint8_t* data, std::size_t size) {
+  static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (size < 8 || std::memcmp(data, kSignature, 8) != 0) return false;
+  auto be32 = [data](std::size_t at) {
+    return std::uint32_t(data[at]) << 24 | std::uint32_t(data[at + 1]) << 16 |
+           std::uint32_t(data[at + 2]) << 8 | data[at + 3];
+  };
+  for (std::size_t pos = 8; size - pos >= 8;) {
+    const std::uint32_t length = be32(pos), type = be32(pos + 4);
+    if (type == 0x49454E44) return false;  // IEND: stb reads no further
+    if (length > size - pos - 8) return true;
+    pos += 8 + std::size_t(length);
+    if (size - pos < 4) return false;  // no CRC: stb fails on the next chunk header
+    pos += 4;
+  }
+  return false;
+}
+
+// A binary PGM/PPM header (P5, P6) as stbi__pnm_info reads it.
+struct PnmHeader {
+  bool pnm = false, overflow = false;  // overflow: a number past INT_MAX (undefined behaviour in stb)
+  std::int64_t width = 0, height = 0, max_value = 0;
+  int channels = 0;
+  std::size_t pixels_at = 0;  // offset of the first sample
+  std::uint64_t pixel_bytes() const {
+    return std::uint64_t(width) * std::uint64_t(height) * channels * (max_value > 255 ? 2 : 1);
+  }
+};
+
+PnmHeader pnm_header(const std::uint8_t* data, std::size_t size) {
+  PnmHeader header;
+  Bytes b{data, size};
+  const int p = b.get8(), t = b.get8();
+  if (p != 'P' || (t != '5' && t != '6')) return header;
+  header.pnm = true;
+  header.channels = t == '6' ? 3 : 1;
+  // As stb: c is the last byte read; "eof" means nothing is left after it.
+  int c = b.get8();
+  auto space = [](int ch) {
+    return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\v' || ch == '\f' || ch == '\r';
+  };
+  auto skip_space = [&] {
+    for (;;) {
+      while (!b.eof() && space(c)) c = b.get8();
+      if (b.eof() || c != '#') break;
+      while (!b.eof() && c != '\n' && c != '\r') c = b.get8();
+    }
+  };
+  auto integer = [&] {
+    std::int64_t value = 0;
+    while (!b.eof() && c >= '0' && c <= '9') {
+      value = value * 10 + (c - '0');
+      if (value > std::numeric_limits<int>::max())
+        header.overflow = true, value = std::numeric_limits<int>::max();
+      c = b.get8();
+    }
+    return value;
+  };
+  skip_space();
+  header.width = integer();
+  skip_space();
+  header.height = integer();
+  skip_space();
+  header.max_value = integer();
+  header.pixels_at = b.pos;
+  return header;
+}
+
+// Whether a PGM/PPM header overflows stb's int parser, or its pixels are cut short (stb ignores that and
+// returns the missing ones uninitialised).
+bool pnm_faults(const std::uint8_t* data, std::size_t size) {
+  const PnmHeader h = pnm_header(data, size);
+  if (!h.pnm) return false;
+  if (h.overflow) return true;
+  return h.max_value <= 65535 && h.pixel_bytes() > size - h.pixels_at;  // (stb refuses larger maxima)
+}
+
+// The input stb would fault on, or nullptr.
+const char* stb_fault(const std::uint8_t* data, std::size_t size) {
+  if (jpeg_faults(data, size)) return "corrupt JPEG (a Huffman table of more than 256 codes)";
+  if (png_truncated(data, size)) return "corrupt PNG (a chunk runs past the end of the file)";
+  if (pnm_faults(data, size)) return "corrupt PGM/PPM (a header number too large, or pixels cut short)";
+  return nullptr;
+}
+
+std::string stb_reason() {
+  const char* reason = stbi_failure_reason();
+  return reason ? reason : "unknown format";
+}
+
+// Luminance of `channels`-channel samples of full scale `full`, composited on white paper. The samples are
+// converted to float and divided first, as kdm always did, so that outputs stay bit for bit the same.
+template <class Sample>
+void to_luminance(const Sample* data, int channels, float full, std::vector<float>& pixels) {
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    float p[4] = {0, 0, 0, 1};
+    for (int c = 0; c < channels; ++c) p[c] = static_cast<float>(data[i * channels + c]) / full;
     float lum = 0, alpha = 1;
     switch (channels) {
       case 1:
@@ -82,9 +240,118 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
         alpha = p[3];
         break;
     }
-    out.pixels[i] = std::clamp(lum * alpha + (1.0f - alpha), 0.0f, 1.0f);  // composite on white paper
+    pixels[i] = std::clamp(lum * alpha + (1.0f - alpha), 0.0f, 1.0f);
   }
+}
+
+// Both loaders end here, with the image file's bytes: the known faults of stb refused, then the header
+// read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
+bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& name, std::uint64_t max_pixels,
+               GreyImage& out, std::string& error) {
+  if (size == 0) {
+    error = "cannot read image '" + name + "': the file is empty";
+    return false;
+  }
+  if (size > static_cast<std::size_t>(std::numeric_limits<int>::max())) {  // stb's byte count is an int
+    error = "cannot read image '" + name + "': larger than 2 GiB";
+    return false;
+  }
+  if (const char* fault = stb_fault(bytes, size)) {
+    error = "cannot read image '" + name + "': " + fault;
+    return false;
+  }
+  const int length = static_cast<int>(size);
+  int w = 0, h = 0, header_channels = 0;  // PNGs may decode to one more channel (a tRNS chunk): not used
+  if (!stbi_info_from_memory(bytes, length, &w, &h, &header_channels)) {
+    error = "cannot read image '" + name + "': " + stb_reason();
+    return false;
+  }
+  if (w <= 0 || h <= 0) {
+    error = "image '" + name + "' is empty or has a corrupt header";
+    return false;
+  }
+  const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+  if (pixels > max_pixels) {
+    const auto side = static_cast<std::uint64_t>(std::sqrt(double(max_pixels)));
+    error = "image '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) +
+            " pixels, more than the limit of " + std::to_string(max_pixels) + " pixels" +
+            (side * side == max_pixels ? " (" + std::to_string(side) + "x" + std::to_string(side) + ")" : "");
+    return false;
+  }
+  int lw = 0, lh = 0, channels = 0;
+  GreyImage image;
+  // The decoder must return the header's size, so that the limit holds for what is kept.
+  auto decoded = [&](const void* data) {
+    if (!data) {
+      error = "cannot read image '" + name + "': " + stb_reason();
+      return false;
+    }
+    if (lw != w || lh != h || channels < 1 || channels > 4) {
+      error = "cannot read image '" + name + "': its header and its pixels disagree";
+      return false;
+    }
+    image.pixels.resize(pixels);
+    return true;
+  };
+  if (stbi_is_16_bit_from_memory(bytes, length)) {
+    std::unique_ptr<stbi_us, void (*)(void*)> data(
+        stbi_load_16_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
+    if (!decoded(data.get())) return false;
+    // stb 2.27 copies 16-bit PGM/PPM samples in host byte order; Netpbm stores them big-endian.
+    if (const PnmHeader pnm = pnm_header(bytes, size);
+        pnm.pnm && pnm.max_value > 255 && pnm.channels == channels)
+      for (std::size_t i = 0; i < pixels * channels; ++i)
+        data.get()[i] =
+            static_cast<stbi_us>(bytes[pnm.pixels_at + 2 * i] << 8 | bytes[pnm.pixels_at + 2 * i + 1]);
+    to_luminance(data.get(), channels, 65535.0f, image.pixels);
+  } else {
+    std::unique_ptr<stbi_uc, void (*)(void*)> data(
+        stbi_load_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
+    if (!decoded(data.get())) return false;
+    to_luminance(data.get(), channels, 255.0f, image.pixels);
+  }
+  image.width = w;
+  image.height = h;
+  out = std::move(image);
   return true;
+}
+
+}  // namespace
+
+bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels) {
+  // Read whole, once: the checks and the decoder see the same bytes, whatever happens to the file.
+  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+  if (!file) {
+    error = "cannot read image '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  const auto too_large = [&] {
+    error = "cannot read image '" + path + "': larger than 2 GiB";
+    return false;
+  };
+  constexpr auto kMaxBytes = static_cast<std::size_t>(std::numeric_limits<int>::max());  // stb's byte count
+  std::vector<std::uint8_t> bytes;
+  if (std::fseek(file.get(), 0, SEEK_END) == 0) {  // a regular file: its size up front
+    const long size = std::ftell(file.get());
+    if (size > 0 && static_cast<std::size_t>(size) > kMaxBytes) return too_large();
+    if (size > 0) bytes.reserve(static_cast<std::size_t>(size));
+    std::rewind(file.get());
+  }
+  std::uint8_t chunk[1 << 16];
+  for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, file.get())) > 0;) {
+    if (bytes.size() + n > kMaxBytes) return too_large();
+    bytes.insert(bytes.end(), chunk, chunk + n);
+  }
+  if (std::ferror(file.get())) {
+    error = "cannot read image '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  return load_grey(bytes.data(), bytes.size(), path, max_pixels, out, error);
+}
+
+bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
+                            const std::string& name, std::uint64_t max_pixels) {
+  return load_grey(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error);
 }
 
 bool write_png(const std::string& path, const RgbImage& image, std::string& error) {

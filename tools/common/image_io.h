@@ -2,6 +2,7 @@
 // stb_image reads) and PNG writing. Not thread-safe to call concurrently on the same path.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,9 +27,25 @@ struct RgbImage {
       : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 3, fill) {}
 };
 
+/// The largest image the loaders accept, in pixels (width · height): 2^26, e.g. 8192 × 8192. Images are
+/// untrusted input and a header of a few bytes can claim any size: this is checked on the header alone,
+/// before any pixel is allocated. At the limit, decoding takes up to 8 bytes per pixel (16-bit RGBA,
+/// 512 MiB) and the luminance 4 more (256 MiB), besides the file's bytes. Larger images are refused with
+/// an error naming the file, its size and this limit.
+inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
+
 /// Loads an image as luminance in [0, 1] (16-bit PNGs keep their precision; alpha is composited on white).
+/// The file is read whole (at most 2 GiB); images of more than `max_pixels` pixels are refused from their
+/// header (see kMaxImagePixels), and so are inputs that would reach a known fault of the system's stb_image
+/// (tests/fuzz/crashes/README.md).
 /// Returns false and sets `error` to a one-line message naming the file and the problem.
-bool load_grey_image(const std::string& path, GreyImage& out, std::string& error);
+bool load_grey_image(const std::string& path, GreyImage& out, std::string& error,
+                     std::uint64_t max_pixels = kMaxImagePixels);
+
+/// The same for an image file's bytes in memory; `name` stands for the file in error messages.
+bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
+                            const std::string& name = "image in memory",
+                            std::uint64_t max_pixels = kMaxImagePixels);
 
 /// Writes `image` as PNG atomically (temporary file, then rename). Returns false with `error` set on failure.
 bool write_png(const std::string& path, const RgbImage& image, std::string& error);

@@ -22,6 +22,11 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
     error = "cannot open point file '" + path + "'";
     return false;
   }
+  return read_point_sets(in, path, sets, error);
+}
+
+bool read_point_sets(std::istream& in, const std::string& path, std::vector<PointSet>& sets,
+                     std::string& error) {
   sets.clear();
   PointSet current;
   int file_dim = 0;
@@ -46,8 +51,10 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
       if (head == "x,y" || head == "x,y,z") continue;
     }
     std::vector<double> values;
+    // To the line's end, not its first NUL: a NUL byte is malformed, not the end of the line.
     const char* p = line.c_str() + first;
-    while (*p) {
+    const char* const line_end = line.c_str() + line.size();
+    while (p < line_end) {
       char* end = nullptr;
       const double v = std::strtod(p, &end);
       if (end == p) {

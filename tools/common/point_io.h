@@ -3,6 +3,8 @@
 // (separated by blanks or commas; a first line "x,y" or "x,y,z" — the CSV header we write — is skipped).
 #pragma once
 
+#include <cstddef>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,10 @@ struct PointSet {
 /// Reads every set in `path`. All sets must share one dimension (2 or 3); coordinates must be finite.
 /// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error);
+
+/// The same for a stream holding a point file's text; `name` stands for the file in error messages.
+bool read_point_sets(std::istream& in, const std::string& name, std::vector<PointSet>& sets,
+                     std::string& error);
 
 /// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
 /// or as CSV when `path` ends in ".csv". Atomic (temporary file, then rename).

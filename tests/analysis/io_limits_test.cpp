@@ -1,0 +1,225 @@
+// Untrusted input files (tools/common): the image pixel limit, read from the header before any pixel is
+// allocated; the hostile images the fuzzer found (tests/fuzz/crashes/image) refused or read cleanly; the
+// memory and path loaders agreeing on the fuzz seeds; NUL bytes in point files.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image_io.h"
+#include "point_io.h"
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define KDM_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define KDM_SANITIZED 1
+#endif
+
+namespace {
+
+using kdm::tools::GreyImage;
+
+void put32(std::vector<std::uint8_t>& v, std::uint32_t x) {
+  for (int s = 24; s >= 0; s -= 8) v.push_back(static_cast<std::uint8_t>(x >> s));
+}
+
+std::uint32_t crc32(const std::uint8_t* p, std::size_t n) {
+  std::uint32_t crc = ~0u;
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= p[i];
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+void chunk(std::vector<std::uint8_t>& png, const char* type, const std::vector<std::uint8_t>& data) {
+  put32(png, static_cast<std::uint32_t>(data.size()));
+  const std::size_t start = png.size();
+  png.insert(png.end(), type, type + 4);
+  png.insert(png.end(), data.begin(), data.end());
+  put32(png, crc32(&png[start], png.size() - start));
+}
+
+// An 8-bit greyscale PNG whose header says w×h; its data is one zero row in a zlib stored block, enough
+// for the header to be well formed (a decoder would find the pixels short only after allocating them).
+std::vector<std::uint8_t> grey_png_header(std::uint32_t w, std::uint32_t h) {
+  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'}, ihdr, z = {0x78, 0x01};
+  put32(ihdr, w);
+  put32(ihdr, h);
+  ihdr.insert(ihdr.end(), {8, 0, 0, 0, 0});
+  const std::size_t row = std::min<std::size_t>(w + 1, 65535);
+  z.insert(z.end(), {1, static_cast<std::uint8_t>(row), static_cast<std::uint8_t>(row >> 8),
+                     static_cast<std::uint8_t>(~row), static_cast<std::uint8_t>(~row >> 8)});
+  z.insert(z.end(), row, 0);
+  put32(z, static_cast<std::uint32_t>(row % 65521) << 16 | 1);  // Adler-32 of `row` zeros
+  chunk(png, "IHDR", ihdr);
+  chunk(png, "IDAT", z);
+  chunk(png, "IEND", {});
+  return png;
+}
+
+std::string write_temp(const std::string& name, const std::vector<std::uint8_t>& bytes) {
+  const std::string path = ::testing::TempDir() + "kdm_io_limits_" + name;
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+TEST(ImageLimit, HugeHeaderIsRefusedWithAClearError) {
+  const std::vector<std::uint8_t> png = grey_png_header(20000, 20000);
+  GreyImage image;
+  image.width = 7;  // untouched on failure
+  std::string error;
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(png.data(), png.size(), image, error, "huge.png"));
+  EXPECT_TRUE(contains(error, "'huge.png'")) << error;
+  EXPECT_TRUE(contains(error, "20000x20000")) << error;
+  EXPECT_TRUE(contains(error, "limit of 67108864 pixels (8192x8192)")) << error;
+  EXPECT_EQ(image.width, 7);
+  EXPECT_TRUE(image.pixels.empty());
+  const std::string path = write_temp("huge.png", png);
+  error.clear();
+  EXPECT_FALSE(kdm::tools::load_grey_image(path, image, error));
+  EXPECT_TRUE(contains(error, path) && contains(error, "20000x20000")) << error;
+}
+
+// The header alone decides, before anything of the image's size is allocated: in a child process whose
+// address space has 256 MiB to spare, the 20000 × 20000 header is refused by the limit; with the limit
+// lifted, the same bytes make stb try to allocate its 400 MB of pixels, and fail for want of memory.
+TEST(ImageLimit, HugeHeaderAllocatesNothingOfItsSize) {
+#ifdef KDM_SANITIZED
+  GTEST_SKIP() << "sanitizers reserve terabytes of address space: RLIMIT_AS cannot be used";
+#else
+  const std::vector<std::uint8_t> png = grey_png_header(20000, 20000);
+  auto run_limited = [&png](std::uint64_t max_pixels) {
+    const pid_t child = fork();
+    if (child == 0) {
+      long pages = 0;
+      std::ifstream("/proc/self/statm") >> pages;
+      const rlim_t spare = rlim_t(256) << 20, now = static_cast<rlim_t>(pages) * sysconf(_SC_PAGESIZE);
+      const rlimit limit{now + spare, now + spare};
+      if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(3);
+      GreyImage image;
+      std::string error;
+      const bool loaded =
+          kdm::tools::load_grey_image_memory(png.data(), png.size(), image, error, "huge.png", max_pixels);
+      _exit(loaded ? 2 : contains(error, "limit of") ? 0 : 1);  // 0 refused by the limit, 1 otherwise
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(run_limited(kdm::tools::kMaxImagePixels), 0);
+  EXPECT_EQ(run_limited(std::numeric_limits<std::uint64_t>::max()), 1);  // the control: stb ran out
+#endif
+}
+
+TEST(ImageLimit, LimitIsWidthTimesHeight) {
+  GreyImage image;
+  std::string error;
+  const std::vector<std::uint8_t> over = grey_png_header(8193, 8192);
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(over.data(), over.size(), image, error, "over.png"));
+  EXPECT_TRUE(contains(error, "8193x8192")) << error;
+  // A lower limit, as the fuzzer sets: 5 × 5 needs 25 pixels.
+  const std::vector<std::uint8_t> small = grey_png_header(5, 5);
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(small.data(), small.size(), image, error, "s.png", 24));
+  EXPECT_TRUE(contains(error, "5x5 pixels, more than the limit of 24 pixels")) << error;
+  // At the limit it is read (its data is short: one row of the five, so stb refuses it after the header).
+  error.clear();
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(small.data(), small.size(), image, error, "s.png", 25));
+  EXPECT_FALSE(contains(error, "limit")) << error;
+  const std::vector<std::uint8_t> one = grey_png_header(1, 1);
+  EXPECT_TRUE(kdm::tools::load_grey_image_memory(one.data(), one.size(), image, error, "one.png", 1))
+      << error;
+  EXPECT_EQ(image.width * image.height, 1);
+}
+
+// The inputs that made stb_image fault under the image fuzzer (tests/fuzz/crashes/README.md): refused
+// before stb reads them, or, for a JPEG without Huffman tables, read from zeroed memory. No crash, no
+// sanitizer report, an error naming the file.
+TEST(ImageLimit, FuzzerFoundImagesAreRefusedCleanly) {
+  const std::string dir = std::string(KDM_SOURCE_DIR) + "/tests/fuzz/crashes/image/";
+  const struct {
+    const char* file;
+    const char* problem;
+  } cases[] = {{"jpeg_huffman_overflow.jpg", "Huffman table of more than 256 codes"},
+               {"jpeg_no_huffman_tables.jpg", ""},
+               {"png_chunk_past_end.png", "runs past the end of the file"},
+               {"pnm_header_overflow.pgm", "header number too large"},
+               {"pnm_pixels_cut_short.pgm", "pixels cut short"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.file);
+    const std::vector<std::uint8_t> bytes = read_bytes(dir + c.file);
+    ASSERT_FALSE(bytes.empty());
+    GreyImage image;
+    std::string error;
+    EXPECT_FALSE(kdm::tools::load_grey_image(dir + c.file, image, error));
+    EXPECT_TRUE(contains(error, c.file) && contains(error, c.problem)) << error;
+    error.clear();
+    EXPECT_FALSE(kdm::tools::load_grey_image_memory(bytes.data(), bytes.size(), image, error, c.file));
+    EXPECT_TRUE(contains(error, c.file) && contains(error, c.problem)) << error;
+  }
+}
+
+// Every image seed of the fuzzer (PNG 1/8/16-bit grey, grey+alpha, RGB, RGBA, palette and tRNS, Adam7;
+// JPEG, BMP, TGA, PGM, PPM) loads, the same from a path as from memory, with values in [0, 1].
+TEST(ImageLimit, PathAndMemoryLoadersAgreeOnTheSeeds) {
+  const std::string dir = std::string(KDM_SOURCE_DIR) + "/tests/fuzz/corpus/image/";
+  for (const char* file : {"grey1.png", "grey8.png", "grey16.png", "grey_alpha8.png", "rgb8.png",
+                           "rgba16.png", "palette_trns.png", "grey8_trns.png", "interlaced.png", "tiny.jpg",
+                           "rgb.bmp", "grey.tga", "grey.pgm", "deep.pgm", "rgb.ppm"}) {
+    SCOPED_TRACE(file);
+    GreyImage from_path, from_memory;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::load_grey_image(dir + file, from_path, error)) << error;
+    const std::vector<std::uint8_t> bytes = read_bytes(dir + file);
+    ASSERT_TRUE(kdm::tools::load_grey_image_memory(bytes.data(), bytes.size(), from_memory, error)) << error;
+    EXPECT_EQ(from_path.width, from_memory.width);
+    EXPECT_EQ(from_path.height, from_memory.height);
+    EXPECT_EQ(from_path.pixels, from_memory.pixels);
+    ASSERT_EQ(from_path.pixels.size(), std::size_t(from_path.width) * from_path.height);
+    for (float v : from_path.pixels) EXPECT_TRUE(v >= 0 && v <= 1) << v;
+  }
+  GreyImage image;
+  std::string error;
+  const std::vector<std::uint8_t> deep = read_bytes(dir + "deep.pgm");  // 16-bit: 1000 and 60000 of 65535
+  ASSERT_TRUE(kdm::tools::load_grey_image_memory(deep.data(), deep.size(), image, error)) << error;
+  EXPECT_FLOAT_EQ(image.at(0, 0), 1000.0f / 65535.0f);
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(deep.data(), 0, image, error, "empty.png"));
+  EXPECT_TRUE(contains(error, "'empty.png'")) << error;
+}
+
+// A NUL byte inside a line is malformed, not the line's end (the reader used to stop there silently).
+TEST(PointFileInput, NulBytesAreMalformed) {
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  const char text[] = "0.1 0.2\n0.3 0.4\0 0.5\n";
+  std::istringstream nul(std::string(text, sizeof text - 1));
+  EXPECT_FALSE(kdm::tools::read_point_sets(nul, "nul.txt", sets, error));
+  EXPECT_TRUE(contains(error, "nul.txt:2: malformed")) << error;
+  std::istringstream good("x,y\n0.1,0.2\n#\n0.3 0.4\n");
+  ASSERT_TRUE(kdm::tools::read_point_sets(good, "good.csv", sets, error)) << error;
+  EXPECT_EQ(sets.size(), 2u);
+}
+
+}  // namespace

@@ -1,0 +1,45 @@
+// Fuzz target: read_point_sets, the reader of the point files `kdm analyze` takes (text, '#' lines between
+// sets, blanks or commas between coordinates, an optional CSV header), on arbitrary bytes. Checks: it
+// either fails with an error naming the file or returns at least one set, every set non-empty, all of one
+// dimension (2 or 3), with whole points of finite coordinates, and no more points than lines.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "point_io.h"
+
+namespace {
+
+[[noreturn]] void fail() {
+  std::abort();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  std::istringstream in(text);
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  if (!kdm::tools::read_point_sets(in, "fuzz.txt", sets, error)) {
+    if (error.find("fuzz.txt") == std::string::npos) fail();
+    return 0;
+  }
+  if (sets.empty()) fail();
+  const std::size_t lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+  std::size_t points = 0;
+  for (const kdm::tools::PointSet& set : sets) {
+    if (set.dim != sets[0].dim || (set.dim != 2 && set.dim != 3)) fail();
+    if (set.coords.empty() || set.coords.size() % set.dim != 0) fail();
+    for (double c : set.coords)
+      if (!std::isfinite(c)) fail();
+    points += set.size();
+  }
+  if (points > lines) fail();
+  return 0;
+}
