@@ -568,4 +568,36 @@ TEST_F(CliTest, SmallFrictions) {
   EXPECT_NE(info.out.find(" bytes ("), std::string::npos) << info.out;
 }
 
+// The per-band bias table users check their own maps with: a ramp sampled and analysed by the same spec
+// holds its target in every band that expects enough points (the sampler's own tolerance is tested in
+// density_bias_test; here the table's plumbing and the spec's errors).
+TEST_F(CliTest, AnalyzeReportsTheBiasOfEveryDensityBand) {
+  const Outcome sampled = kdm("sample -n 3000 --density ramp:100 -o '" + path("ramp.txt") + "'");
+  ASSERT_EQ(sampled.status, 0) << sampled.err;
+  EXPECT_NE(slurp(path("ramp.txt")).find("domain box"), std::string::npos);  // a ramp's edges do not meet
+  const Outcome analysed =
+      kdm("analyze '" + path("ramp.txt") + "' --box --density ramp:100 --density-bands 5 -o '" +
+          path("ramp_metrics") + "'");
+  ASSERT_EQ(analysed.status, 0) << analysed.err;
+  std::istringstream lines(analysed.out);
+  int bands = 0;
+  for (std::string line; std::getline(lines, line);) {
+    double lo = 0, hi = 0, expected = 0, count = 0, ratio = 0;
+    if (std::sscanf(line.c_str(), " %lf–%lf %lf %lf %lf", &lo, &hi, &expected, &count, &ratio) != 5) continue;
+    ++bands;
+    EXPECT_NEAR(ratio, count / expected, 1e-3) << line;
+    if (expected >= 300) {  // measured within 1.5% (seed 1); 5% leaves room for the sampler's changes
+      EXPECT_NEAR(ratio, 1.0, 0.05) << line;
+    }
+  }
+  EXPECT_EQ(bands, 5) << analysed.out;
+  const std::string json = slurp(path("ramp_metrics/metrics.json"));
+  EXPECT_NE(json.find("\"bands\""), std::string::npos);
+  EXPECT_NE(json.find("\"rho_lo\""), std::string::npos);
+  expect_error("sample -n 100 --density ramp:0.5 -o '" + path("z.txt") + "'", "[1, 1e9]");
+  expect_error("sample -n 100 --density radial: -o '" + path("z.txt") + "'", "dynamic range");
+  expect_error("query --rect 0,0,1,1 --density ramp:10 -o '" + path("z.csv") + "'", "test maps");
+  expect_error("analyze '" + path("ramp.txt") + "' --density-bands 0 -o '" + path("m") + "'", "1 to 1000");
+}
+
 }  // namespace

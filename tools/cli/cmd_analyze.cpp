@@ -33,6 +33,7 @@ struct AnalyzeArgs {
   double tile_size = 0;
   double fmax = 2.5;
   double min_expected = 20;
+  int density_bands = 10;
   int threads = 0;
   std::string output;
 };
@@ -74,6 +75,9 @@ void run_analyze(const AnalyzeArgs& args) {
   o.torus = !args.box;
   o.fmax = args.fmax;
   o.min_expected = args.min_expected;
+  if (args.density_bands < 1 || args.density_bands > 1000)
+    throw CommandError("--density-bands must be 1 to 1000, got " + std::to_string(args.density_bands));
+  o.density_bands = args.density_bands;
   o.tile_size = args.tile_size;
   o.threads = args.threads;
   try {
@@ -136,8 +140,8 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_flag("--torus", args->torus, "Periodic distances (default)");
   cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");
   cmd->add_option("--density", args->density,
-                  "Target density for the accuracy test: const:V or an image (dark = dense; default: "
-                  "uniform)");
+                  "Target density for the accuracy test and the per-band bias table: const:V, an image "
+                  "(dark = dense) or ramp:R / radial:R, as given to kdm sample (default: uniform)");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
@@ -148,6 +152,10 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_option("--fmax", args->fmax, "Periodogram limit in normalised frequency |k|/sqrt(n)")
       ->capture_default_str();
   cmd->add_option("--min-expected", args->min_expected, "Density windows expect at least this many points")
+      ->capture_default_str();
+  cmd->add_option("--density-bands", args->density_bands,
+                  "Bands of the per-band bias table: the points where the target density lies in each "
+                  "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "Worker threads (0 = all)")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();

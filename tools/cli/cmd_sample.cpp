@@ -18,7 +18,7 @@ namespace {
 struct SampleArgs {
   gen::SamplerOptions options;
   std::string density = "const:1";
-  std::string domain;  // empty: box for images, torus otherwise
+  std::string domain;  // empty: box for images and ramps, torus otherwise
   std::string output;
   double aspect = 0;  // 0: from the image, or 1
   double gamma = 1;
@@ -40,7 +40,9 @@ void run_sample(const SampleArgs& args) {
     throw CommandError("--dot-size must be >= 0");
   DensityArg density = parse_density(args.density, args.gamma, args.invert);
   gen::SamplerOptions o = args.options;
-  const std::string domain = args.domain.empty() ? (density.from_image ? "box" : "torus") : args.domain;
+  // A ramp or a picture has edges that do not meet: a box, unless asked otherwise.
+  const bool edged = density.from_image || args.density.rfind("ramp:", 0) == 0;
+  const std::string domain = args.domain.empty() ? (edged ? "box" : "torus") : args.domain;
   o.domain = domain == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
   double aspect = args.aspect;
   if (aspect <= 0) aspect = density.from_image ? double(density.image_width) / density.image_height : 1.0;
@@ -80,6 +82,9 @@ void run_sample(const SampleArgs& args) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
                 r.seconds, set.size() / std::max(1e-9, r.seconds), r.threads, r.acceptance_rate());
     std::printf("model seconds %.4f\n", r.model_seconds);
+    if (r.count_mismatch_before > 0)
+      std::printf("count balance mismatch before %.4f after %.4f\n", r.count_mismatch_before,
+                  r.count_mismatch_after);
     for (const gen::LevelReport& l : r.levels) {
       std::string grid = std::to_string(l.grid[0]);
       for (int k = 1; k < set.dim; ++k) grid += "x" + std::to_string(l.grid[k]);
@@ -103,7 +108,7 @@ void add_sample_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({2, 3}));
   cmd->add_option("--domain", args->domain,
-                  "torus (periodic) or box (bounded); default: box for images, torus otherwise")
+                  "torus (periodic) or box (bounded); default: box for images and ramp:R, torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)");
   cmd->add_option("--temperature,-T", o.temperature,
@@ -111,7 +116,9 @@ void add_sample_command(CLI::App& app) {
                   "ordered; 0 = deterministic descent)")
       ->capture_default_str();
   cmd->add_option("--seed", o.seed, "Random seed; the output depends on nothing else")->capture_default_str();
-  cmd->add_option("--density", args->density, "const:V, or an image whose darkness is the density")
+  cmd->add_option("--density", args->density,
+                  "const:V, an image whose darkness is the density, or a test map: ramp:R (R^-x, dynamic "
+                  "range R) or radial:R (R^-(2r) around the centre)")
       ->capture_default_str();
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");

@@ -1,7 +1,9 @@
 #include "density_arg.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 #include "commands.h"
 #include "image_io.h"
@@ -20,6 +22,27 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert, boo
                          ", got '" + value + "'");
     arg.density = gen::Density::constant();
     arg.constant = v;
+    return arg;
+  }
+  for (const char* kind : {"ramp:", "radial:"}) {
+    const std::size_t len = std::char_traits<char>::length(kind);
+    if (spec.compare(0, len, kind) != 0) continue;
+    const std::string value = spec.substr(len);
+    char* end = nullptr;
+    const double range = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !(range >= 1 && range <= 1e9))
+      throw CommandError("--density " + std::string(kind) + "R needs a dynamic range R in [1, 1e9], got '" +
+                         value + "'");
+    const double a = std::log(range);
+    if (kind[1] == 'a')
+      arg.density.function = [a](const double* u) { return std::exp(-a * u[0]); };
+    else
+      arg.density.function = [a](const double* u) {
+        const double dx = u[0] - 0.5, dy = u[1] - 0.5;
+        return std::exp(-a * std::min(1.0, 2 * std::sqrt(dx * dx + dy * dy)));
+      };
+    arg.density.thread_safe = true;
+    arg.analytic = true;
     return arg;
   }
   tools::GreyImage image;

@@ -11,6 +11,10 @@ namespace kdm::cli {
 
 std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, double x0, double y0, double x1,
                                                      double y1) {
+  if (arg.analytic)
+    throw CommandError(
+        "ramp:R and radial:R are test maps for kdm sample and kdm analyze; give the runtime "
+        "const:V or an image");
   auto d = std::make_unique<RuntimeDensity>();
   if (!arg.from_image) {
     d->density.kind = QueryDensity::Kind::kConstant;

@@ -9,13 +9,23 @@
 #include "platform/huge_pages.h"
 #include "platform/parallel.h"
 #include "sampler/chain.h"
+#include "sampler/count_balance.h"
 #include "sampler/count_fixing.h"
+#include "sampler/setup.h"
 
 namespace kdm::gen {
 namespace {
 
 constexpr std::uint64_t kInitStream = 0x494e4954;  // "INIT"
 constexpr std::uint64_t kRefineStream = 0x524546;  // "REF"
+/// Count balance compares counts on grids holding at least this many points per node (on average for
+/// the first, unrestricted pass; at each node for the finer passes).
+constexpr double kBalancePointsPerNode = 8;
+/// The largest grid a count balance solves on: the bias it corrects is large-scale, and the solve costs
+/// about nodes^1.5.
+constexpr double kBalanceMaxNodes = 16384;
+/// Levels finer than a balance grid that its target is binned from.
+constexpr int kBalanceSourceLevels = 2;
 
 using Clock = std::chrono::steady_clock;
 double seconds_between(Clock::time_point a, Clock::time_point b) {
@@ -160,6 +170,47 @@ struct Driver {
     }
   }
 
+  /// Corrects the refined configuration's large-scale counts before the finest sweeps (count_balance.h),
+  /// first on the finest pyramid level that averages kBalancePointsPerNode or more, then on each finer
+  /// level up to kBalanceMaxNodes where its nodes hold that many.
+  /// Only for varying densities sampled freely: a uniform density has nothing to correct, and constrained
+  /// sampling (tile baking) takes its coarse densities from the fixed points.
+  void balance_finest_counts() {
+    if (!options.count_balance || setup.uniform || !fixed.empty() || options.n <= 0) return;
+    const double max_nodes = std::min(double(options.n) / kBalancePointsPerNode, kBalanceMaxNodes);
+    const int levels = static_cast<int>(setup.levels.size());
+    int l = 1;  // the first grid: level l of the pyramid, or coarser still
+    while ((l < levels ? double(setup.levels[l].grid.size()) : nodes_at(l)) > max_nodes) {
+      bool halves = true;  // past the pyramid's coarsest level, while its dims halve evenly
+      for (int k = 0; l >= levels - 1 && k < D; ++k)
+        halves &= setup.levels.back().grid.dims[k] % (2 << (l - levels + 1)) == 0;
+      if (!halves) break;
+      ++l;
+    }
+    if (nodes_at(l) > 4 * max_nodes) return;  // under 2 points per node: counts too noisy to compare
+    auto source_for = [&](int level) {  // a few levels finer: the targets follow ρ's shape within a node
+      return std::min(std::max(0, level - kBalanceSourceLevels), levels - 1);
+    };
+    const int s0 = source_for(l);
+    const CountBalanceReport b =
+        balance_counts(particles, setup.levels[0], setup.levels[s0], 1 << s0, 1 << l);
+    report.count_mismatch_before = b.mismatch_before;
+    report.count_mismatch_after = b.mismatch_after;
+    // Finer passes where the density gives their nodes enough points: the dense parts of a varying
+    // density have structure the first grid cannot resolve.
+    for (int f = l - 1; f >= 1 && nodes_at(f) <= kBalanceMaxNodes; --f) {
+      const int sf = source_for(f);
+      balance_counts(particles, setup.levels[0], setup.levels[sf], 1 << sf, 1 << f, kBalancePointsPerNode);
+    }
+  }
+
+  /// Nodes of the pyramid's level l, continued past its coarsest level by halving.
+  double nodes_at(int l) const {
+    double nodes = 1;
+    for (int k = 0; k < D; ++k) nodes *= std::ldexp(double(setup.levels[0].grid.dims[k]), -l);
+    return nodes;
+  }
+
   /// Maps the configuration of level l+1 to level l (paper eq. 13, square rule, randomly rotated).
   void refine(int fine_level) {
     const DensityGrid<D>& fine = setup.levels[fine_level];
@@ -295,6 +346,7 @@ struct Driver {
     const bool relaxing = !options.initial_points.empty();
     const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1 && !relaxing;
     if (!coarsest && !relaxing) refine(level);
+    if (level == 0 && !coarsest && !relaxing) balance_finest_counts();
     DensityGrid<D>& density = setup.levels[level];
     Chain<D> chain(density, params, &cache);
     typename Chain<D>::Scratch scratch;

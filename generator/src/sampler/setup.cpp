@@ -251,6 +251,8 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     for (float& v : rho) v = static_cast<float>(v * (o.peak_density / mx));
   }
 
+  const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
+  setup.uniform = *lo == *hi;
   setup.levels.push_back({grid, std::move(rho)});
   for (int l = 1; l < levels; ++l) {
     const DensityGrid<D>& fine = setup.levels.back();

@@ -13,6 +13,7 @@ template <int D>
 struct ModelSetup {
   std::vector<DensityGrid<D>> levels;  ///< [0] finest ... back() coarsest; ρ_{l+1} sums 2^D nodes of ρ_l
   double mass_per_point = 0;           ///< ∫ of one unit-weight kernel: J^D
+  bool uniform = false;                ///< every node of the finest density has the same value
 };
 
 /// Validates `options` and `density` (throws InvalidArgument) and builds the pyramid. With n > 0 the

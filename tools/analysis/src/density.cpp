@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "kdm/analysis/common.h"
@@ -63,6 +64,7 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
   validate_points(coords, dim);
   if (!density) throw InvalidInput("no target density given");
   if (!(options.min_expected > 0)) throw InvalidInput("min_expected must be positive");
+  if (options.bands < 1) throw InvalidInput("density bands must be at least 1");
   const std::size_t n = coords.size() / 2;
   const double total = options.expected_total > 0 ? options.expected_total : static_cast<double>(n);
   int r = options.raster;
@@ -81,6 +83,33 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
   const double integral = sat.mass(0, 0, r, r);
   if (!(integral > 0)) throw InvalidInput("target density is zero everywhere");
   const double scale = total / integral;  // raster mass → expected count
+  std::vector<double> cell_rho(static_cast<std::size_t>(r) * r);
+  double rho_min = std::numeric_limits<double>::infinity(), rho_max = 0;
+  for (int y = 0; y < r; ++y)
+    for (int x = 0; x < r; ++x) {
+      const double v = sat.mass(x, y, x + 1, y + 1);
+      cell_rho[static_cast<std::size_t>(y) * r + x] = v;
+      if (v > 0) rho_min = std::min(rho_min, v), rho_max = std::max(rho_max, v);
+    }
+  const int band_count = rho_max > rho_min * 1.01 ? options.bands : 1;
+  const double log_span = std::log(rho_max / rho_min);
+  auto band_of = [&](double v) {  // v > 0
+    const int b = static_cast<int>(std::floor(std::log(v / rho_min) / log_span * band_count));
+    return std::clamp(b, 0, band_count - 1);
+  };
+  std::vector<int> cell_band(cell_rho.size(), -1);
+  DensityAccuracy out;
+  out.bands.resize(static_cast<std::size_t>(band_count));
+  for (int b = 0; b < band_count; ++b) {
+    DensityBand& band = out.bands[static_cast<std::size_t>(b)];
+    band.lo = band_count == 1 ? rho_min / rho_max : std::exp(log_span * (double(b) / band_count - 1));
+    band.hi = band_count == 1 ? 1.0 : std::exp(log_span * (double(b + 1) / band_count - 1));
+  }
+  for (std::size_t i = 0; i < cell_rho.size(); ++i)
+    if (cell_rho[i] > 0) {
+      cell_band[i] = band_of(cell_rho[i]);
+      out.bands[static_cast<std::size_t>(cell_band[i])].expected += cell_rho[i] * scale;
+    }
   std::vector<Window> windows;
   split(sat, Window{0, 0, r, r}, scale, options.min_expected, windows);
   std::vector<int> label(static_cast<std::size_t>(r) * r, 0);
@@ -88,7 +117,6 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
     for (int y = windows[k].y0; y < windows[k].y1; ++y)
       for (int x = windows[k].x0; x < windows[k].x1; ++x) label[static_cast<std::size_t>(y) * r + x] = int(k);
   std::vector<double> counts(windows.size(), 0.0);
-  DensityAccuracy out;
   out.points = n;
   for (std::size_t i = 0; i < n; ++i) {
     const double x = coords[2 * i], y = coords[2 * i + 1];
@@ -97,7 +125,9 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
       ++out.zero_density;
       continue;
     }
-    counts[label[static_cast<std::size_t>(cy) * r + cx]] += 1;
+    const std::size_t cell = static_cast<std::size_t>(cy) * r + cx;
+    counts[label[cell]] += 1;
+    if (cell_band[cell] >= 0) out.bands[static_cast<std::size_t>(cell_band[cell])].count += 1;
   }
   double sum_z2 = 0, sum_count = 0, sum_mu = 0;
   for (std::size_t k = 0; k < windows.size(); ++k) {

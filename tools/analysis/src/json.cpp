@@ -163,6 +163,12 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
         .value(d.bias)
         .key("zero_density_points")
         .value(d.zero_density);
+    w.key("bands").begin_array();
+    for (const DensityBand& b : d.bands) {
+      w.begin_object().key("rho_lo").value(b.lo).key("rho_hi").value(b.hi).key("expected").value(b.expected);
+      w.key("count").value(b.count).key("bias").value(b.bias()).end_object();
+    }
+    w.end_array();
     w.end_object();
   }
   if (r.has_tiling) {

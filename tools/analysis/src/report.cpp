@@ -79,6 +79,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   if (o.density && r.dim == 2) {
     DensityOptions dopt;
     dopt.min_expected = o.min_expected;
+    dopt.bands = o.density_bands;
     double z2 = 0, mu_sum = 0, count_sum = 0;  // pooled over all windows of all sets
     for (const tools::PointSet& s : sets) {
       const DensityAccuracy d = density_accuracy(s.coords, s.dim, o.density, dopt);
@@ -90,6 +91,13 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
       r.density.windows += d.windows;
       r.density.zero_density += d.zero_density;
       r.density.max_abs_z = std::max(r.density.max_abs_z, d.max_abs_z);
+      if (r.density.bands.empty())
+        r.density.bands = d.bands;  // same density and raster: same bands
+      else
+        for (std::size_t b = 0; b < d.bands.size(); ++b) {
+          r.density.bands[b].expected += d.bands[b].expected;
+          r.density.bands[b].count += d.bands[b].count;
+        }
     }
     if (r.density.windows) {
       const double w = static_cast<double>(r.density.windows);
@@ -143,6 +151,12 @@ std::string format_summary(const AnalysisReport& r) {
     add("density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
         r.density.windows, r.density.mean_expected, r.density.rms_z, r.density.max_abs_z, r.density.bias,
         r.density.zero_density);
+  if (r.has_density && r.density.bands.size() > 1) {
+    add("density bands      ρ/ρmax from        expected      points  count/target   ±1σ (Poisson)\n");
+    for (const DensityBand& b : r.density.bands)
+      add("                   %.3g–%-10.3g %10.1f  %10.0f  %12.4f  %8.4f\n", b.lo, b.hi, b.expected, b.count,
+          1 + b.bias(), b.expected > 0 ? 1 / std::sqrt(b.expected) : 0.0);
+  }
   if (r.has_tiling) {
     add("tiling (s=%g)      periodicity ratio %.2f over %zu frequencies\n", r.tile_size, r.periodicity.ratio,
         r.periodicity.frequencies);

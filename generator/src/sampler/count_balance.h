@@ -1,0 +1,40 @@
+// Large-scale count balance of a refined configuration, before the finest level's sweeps.
+//
+// Fattal's coarse-to-fine scheme (KDM, SIGGRAPH 2011, §3.3) hands the finest chain a configuration whose
+// low frequencies should already be at equilibrium. For spatially varying densities they are not: the
+// coarse levels leave sparse regions short of points, and the finest chain moves mass across the domain
+// far too slowly to repair it, while started from the right counts it keeps them (docs/design.md §2).
+// So the counts are corrected where they go wrong, in the initialisation: a smooth displacement (a
+// linearised density-equalising map on a coarse grid) moves the points so that their counts match the
+// target; the finest sweeps then sample the model from there.
+#pragma once
+
+#include <vector>
+
+#include "sampler/grid.h"
+#include "sampler/particle.h"
+
+namespace kdm::gen {
+
+/// What one call did, for the sampler's report and the tests.
+struct CountBalanceReport {
+  int grid[3] = {0, 0, 0};  ///< the coarse grid the counts were compared on
+  int iterations = 0;       ///< displacement steps taken
+  /// Σ|count − target| / Σtarget over the coarse grid's nodes, before and after (counts binned
+  /// multilinearly, so a perfect set is not exactly 0).
+  double mismatch_before = 0, mismatch_after = 0;
+};
+
+/// Moves `particles` (positions in `finest` grid units, weights counted) so that their counts on a coarse
+/// grid, whose nodes each cover `factor` finest nodes per axis, match the target density there.
+/// `source` is a level of the density pyramid (its nodes each cover `source_factor` finest nodes; its
+/// values need only be proportional to the target); the finer it is, the more exact the target. Nodes
+/// whose target is below `min_target` points are left as they are (too few points to compare), and so are
+/// the points near them. Points are never moved onto zero density. Deterministic and single-threaded (the
+/// coarse grid is small). Requires 1 <= source_factor <= factor, both dividing the finest dims.
+template <int D>
+CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const DensityGrid<D>& finest,
+                                  const DensityGrid<D>& source, int source_factor, int factor,
+                                  double min_target = 0);
+
+}  // namespace kdm::gen
