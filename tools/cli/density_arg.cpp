@@ -34,7 +34,7 @@ DensityArg parse_density(const std::string& spec, double gamma, bool invert, boo
       throw CommandError("--density " + std::string(kind) + "R needs a dynamic range R in [1, 1e9], got '" +
                          value + "'");
     const double a = std::log(range);
-    if (kind[1] == 'a')
+    if (std::string(kind) == "ramp:")
       arg.density.function = [a](const double* u) { return std::exp(-a * u[0]); };
     else
       arg.density.function = [a](const double* u) {

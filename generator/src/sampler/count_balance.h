@@ -25,16 +25,35 @@ struct CountBalanceReport {
   double mismatch_before = 0, mismatch_after = 0;
 };
 
-/// Moves `particles` (positions in `finest` grid units, weights counted) so that their counts on a coarse
+template <int D>
+struct CountBalanceSettings {
+  /// Nodes expecting fewer points than this are left as they are (too few points to compare), and so
+  /// are the points near them.
+  double min_target = 0;
+  /// ρ / w below which a kernel is frozen (σ >= σmax) on the grid being balanced: no sweep there will
+  /// relax a neighbourhood the balance changes. Such kernels are balanced on the coarser levels where they
+  /// are still relaxed; on the finest level, what those levels' sweeps left is corrected too
+  /// (`move_frozen`), but a kernel moved to frozen territory keeps half the local spacing to every other.
+  double frozen_below = 0;
+  bool move_frozen = false;
+  /// The finest density, when `finest` is a coarser level, and its nodes per `finest` node: points are
+  /// moved only where the finest density is positive all around (or to denser places).
+  const DensityGrid<D>* support = nullptr;
+  double support_scale = 1;
+  int max_iterations = 12;    ///< displacement steps at most (fewer once a step gains under 2%)
+  double mass_per_point = 1;  ///< of a unit kernel: the local spacing is (mass_per_point w / ρ)^(1/D)
+};
+
+/// Moves `particles` (positions in `finest` grid units, weights counted; `finest` is the level being
+/// balanced) so that their counts on a coarse
 /// grid, whose nodes each cover `factor` finest nodes per axis, match the target density there.
 /// `source` is a level of the density pyramid (its nodes each cover `source_factor` finest nodes; its
-/// values need only be proportional to the target); the finer it is, the more exact the target. Nodes
-/// whose target is below `min_target` points are left as they are (too few points to compare), and so are
-/// the points near them. Points are never moved onto zero density. Deterministic and single-threaded (the
-/// coarse grid is small). Requires 1 <= source_factor <= factor, both dividing the finest dims.
+/// values need only be proportional to the target); the finer it is, the more exact the target. Points are
+/// never moved onto zero density. Deterministic and single-threaded (the coarse grid is small). Requires
+/// 1 <= source_factor <= factor, both dividing the finest dims.
 template <int D>
 CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const DensityGrid<D>& finest,
                                   const DensityGrid<D>& source, int source_factor, int factor,
-                                  double min_target = 0);
+                                  const CountBalanceSettings<D>& settings);
 
 }  // namespace kdm::gen

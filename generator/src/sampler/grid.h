@@ -2,9 +2,11 @@
 // (Δx = 1), axis 0 fastest in memory. A torus wraps every axis; a box reflects at its walls.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace kdm::gen {
@@ -77,6 +79,21 @@ struct DensityGrid {
       value += w * rho[idx];
     }
     return value;
+  }
+
+  /// The smallest of the 2^D node values at(x) interpolates: > 0 when x lies wholly inside the density's
+  /// support, not in the fringe where interpolation fades to zero.
+  double min_around(const Vec<D>& x) const {
+    std::array<std::int64_t, D> i0{}, i1{};
+    std::array<double, D> f{};
+    corners(x, i0, i1, f);
+    double lo = std::numeric_limits<double>::infinity();
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      std::int64_t idx = 0;
+      for (int k = 0; k < D; ++k) idx += ((corner >> k) & 1) ? i1[k] : i0[k];
+      lo = std::min<double>(lo, rho[idx]);
+    }
+    return lo;
   }
 
   /// Starts fetching the nodes at(x) reads: on a grid larger than the caches, an update's first look at

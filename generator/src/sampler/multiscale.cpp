@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <numeric>
 
@@ -170,16 +172,17 @@ struct Driver {
     }
   }
 
-  /// Corrects the refined configuration's large-scale counts before the finest sweeps (count_balance.h),
-  /// first on the finest pyramid level that averages kBalancePointsPerNode or more, then on each finer
-  /// level up to kBalanceMaxNodes where its nodes hold that many.
-  /// Only for varying densities sampled freely: a uniform density has nothing to correct, and constrained
-  /// sampling (tile baking) takes its coarse densities from the fixed points.
-  void balance_finest_counts() {
+  /// Corrects the refined configuration's large-scale counts before a level's sweeps (count_balance.h):
+  /// first on the pyramid level that averages kBalancePointsPerNode or more, then on each finer one up to
+  /// kBalanceMaxNodes where its nodes hold that many. On every level, so that kernels are balanced while
+  /// they are still relaxed: the sparse regions' kernels freeze on coarse levels. Only for varying densities
+  /// sampled freely: a uniform density has nothing to correct, and constrained sampling (tile baking)
+  /// takes its coarse densities from the fixed points.
+  void balance_counts_at(int base) {
     if (!options.count_balance || setup.uniform || !fixed.empty() || options.n <= 0) return;
     const double max_nodes = std::min(double(options.n) / kBalancePointsPerNode, kBalanceMaxNodes);
     const int levels = static_cast<int>(setup.levels.size());
-    int l = 1;  // the first grid: level l of the pyramid, or coarser still
+    int l = base + 1;  // the first grid: level l of the pyramid, or coarser still
     while ((l < levels ? double(setup.levels[l].grid.size()) : nodes_at(l)) > max_nodes) {
       bool halves = true;  // past the pyramid's coarsest level, while its dims halve evenly
       for (int k = 0; l >= levels - 1 && k < D; ++k)
@@ -189,18 +192,36 @@ struct Driver {
     }
     if (nodes_at(l) > 4 * max_nodes) return;  // under 2 points per node: counts too noisy to compare
     auto source_for = [&](int level) {  // a few levels finer: the targets follow ρ's shape within a node
-      return std::min(std::max(0, level - kBalanceSourceLevels), levels - 1);
+      return std::min(std::max(base, level - kBalanceSourceLevels), levels - 1);
     };
+    CountBalanceSettings<D> settings;
+    if (base > 0) settings.support = &setup.levels[0], settings.support_scale = std::ldexp(1.0, base);
+    settings.frozen_below = std::pow(options.sigma_max, -D);  // σ = (ρ/w)^(-1/D) >= σmax
+    settings.move_frozen = base == 0;
+    settings.mass_per_point = setup.mass_per_point;
+    const DensityGrid<D>& here = setup.levels[base];
     const int s0 = source_for(l);
+    auto T0 = Clock::now();
     const CountBalanceReport b =
-        balance_counts(particles, setup.levels[0], setup.levels[s0], 1 << s0, 1 << l);
-    report.count_mismatch_before = b.mismatch_before;
-    report.count_mismatch_after = b.mismatch_after;
+        balance_counts(particles, here, setup.levels[s0], 1 << (s0 - base), 1 << (l - base), settings);
+    if (std::getenv("KDM_BT"))
+      std::fprintf(stderr, "base %d first grid %d it %d %.4f s\n", base, b.grid[0], b.iterations,
+                   seconds_between(T0, Clock::now()));
+    if (base == 0) {
+      report.count_mismatch_before = b.mismatch_before;
+      report.count_mismatch_after = b.mismatch_after;
+    }
     // Finer passes where the density gives their nodes enough points: the dense parts of a varying
     // density have structure the first grid cannot resolve.
-    for (int f = l - 1; f >= 1 && nodes_at(f) <= kBalanceMaxNodes; --f) {
+    settings.min_target = kBalancePointsPerNode;
+    for (int f = l - 1; f > base && nodes_at(f) <= kBalanceMaxNodes; --f) {
       const int sf = source_for(f);
-      balance_counts(particles, setup.levels[0], setup.levels[sf], 1 << sf, 1 << f, kBalancePointsPerNode);
+      auto T1 = Clock::now();
+      auto bb =
+          balance_counts(particles, here, setup.levels[sf], 1 << (sf - base), 1 << (f - base), settings);
+      if (std::getenv("KDM_BT"))
+        std::fprintf(stderr, "base %d fine grid %d it %d %.4f s\n", base, bb.grid[0], bb.iterations,
+                     seconds_between(T1, Clock::now()));
     }
   }
 
@@ -345,8 +366,10 @@ struct Driver {
     const auto t0 = Clock::now();
     const bool relaxing = !options.initial_points.empty();
     const bool coarsest = level == static_cast<int>(setup.levels.size()) - 1 && !relaxing;
-    if (!coarsest && !relaxing) refine(level);
-    if (level == 0 && !coarsest && !relaxing) balance_finest_counts();
+    if (!coarsest && !relaxing) {
+      refine(level);
+      balance_counts_at(level);
+    }
     DensityGrid<D>& density = setup.levels[level];
     Chain<D> chain(density, params, &cache);
     typename Chain<D>::Scratch scratch;
