@@ -8,6 +8,7 @@
 namespace kdm::gen {
 namespace {
 
+constexpr double kNegligibleStep = 0.003;  ///< coarse nodes: a few percent of a point spacing
 constexpr double kMinImprovement = 0.02;  ///< stop when a step lowers the mismatch by less than this
 /// Moves into frozen territory keep at least this share of the local spacing to every other point.
 constexpr double kFrozenMinSpacing = 0.5;
@@ -290,7 +291,8 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
       }
     const std::vector<Particle<D>> before = particles;
     const Buckets<D> buckets(g, particles, scale);
-    for (auto& p : particles) {
+    for (std::int32_t member : buckets.members) {  // node by node: the finest grid is read in order
+      Particle<D>& p = particles[static_cast<std::size_t>(member)];
       const Corners<D> c(g, to_coarse(p.x));
       Vec<D> f{};
       double l = 0;
@@ -300,13 +302,20 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
         l += c.weight[j] * lambda[c.index[j]];
         unresolved |= target[c.index[j]] < min_target;
       }
-      const double rho_old = rho_of[static_cast<std::size_t>(&p - particles.data())];
+      const std::size_t j = static_cast<std::size_t>(member);
+      const double rho_old = rho_of[j];
       const bool frozen = rho_old < settings.frozen_below * p.weight();
       if (unresolved || !(l > 0) || (frozen && !settings.move_frozen)) continue;
+      Vec<D> u;
+      double largest = 0;
+      for (int k = 0; k < D; ++k) {
+        u[k] = std::clamp(f[k] / l, -kMaxStep, kMaxStep);
+        largest = std::max(largest, std::abs(u[k]));
+      }
+      if (largest < kNegligibleStep) continue;  // spares the density lookups where little is left to do
       Vec<D> x = p.x;
       for (int k = 0; k < D; ++k) {
-        const double u = std::clamp(f[k] / l, -kMaxStep, kMaxStep);
-        x[k] += u * factor;
+        x[k] += u[k] * factor;
         if (!finest.grid.torus) {  // reflect at the walls, as refinement does
           const double m = finest.grid.dims[k];
           if (x[k] < 0) x[k] = std::min(-x[k], std::nextafter(m, 0.0));
@@ -317,7 +326,6 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
       // Not into the fringe where interpolation fades to zero: kernels there are so wide that they freeze
       // where they land. A point already in it may still move towards denser places.
       const double rho_new = finest.at(x);
-      const std::size_t j = static_cast<std::size_t>(&p - particles.data());
       const bool inside = inside_support(x);
       if (!(rho_new > 0) || !(inside || (!inside_of[j] && rho_new >= rho_old))) continue;
       if (rho_new < settings.frozen_below * p.weight()) {  // where no sweep will relax it

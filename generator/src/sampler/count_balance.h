@@ -1,12 +1,12 @@
-// Large-scale count balance of a refined configuration, before the finest level's sweeps.
+// Large-scale count balance of a refined configuration, before a level's sweeps.
 //
 // Fattal's coarse-to-fine scheme (KDM, SIGGRAPH 2011, §3.3) hands the finest chain a configuration whose
 // low frequencies should already be at equilibrium. For spatially varying densities they are not: the
 // coarse levels leave sparse regions short of points, and the finest chain moves mass across the domain
 // far too slowly to repair it, while started from the right counts it keeps them (docs/design.md §2).
-// So the counts are corrected where they go wrong, in the initialisation: a smooth displacement (a
-// linearised density-equalising map on a coarse grid) moves the points so that their counts match the
-// target; the finest sweeps then sample the model from there.
+// So the counts are corrected where they go wrong, in the initialisation: after each refinement a smooth
+// displacement (a linearised density-equalising map on a coarse grid) moves the kernels so that their
+// counts match the target; the level's sweeps then relax them, and the finest sweeps sample the model.
 #pragma once
 
 #include <vector>

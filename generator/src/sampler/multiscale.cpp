@@ -20,9 +20,11 @@ namespace {
 
 constexpr std::uint64_t kInitStream = 0x494e4954;  // "INIT"
 constexpr std::uint64_t kRefineStream = 0x524546;  // "REF"
-/// Count balance compares counts on grids holding at least this many points per node (on average for
-/// the first, unrestricted pass; at each node for the finer passes).
+/// Count balance compares counts first on a grid holding at least this many points per node on average,
 constexpr double kBalancePointsPerNode = 8;
+/// then on finer grids at the nodes that hold at least this many (blue-noise counts vary little, and the
+/// steep parts of a density need the finer grids).
+constexpr double kBalanceFinePointsPerNode = 2;
 /// The largest grid a count balance solves on: the bias it corrects is large-scale, and the solve costs
 /// about nodes^1.5.
 constexpr double kBalanceMaxNodes = 16384;
@@ -174,10 +176,10 @@ struct Driver {
 
   /// Corrects the refined configuration's large-scale counts before a level's sweeps (count_balance.h):
   /// first on the pyramid level that averages kBalancePointsPerNode or more, then on each finer one up to
-  /// kBalanceMaxNodes where its nodes hold that many. On every level, so that kernels are balanced while
-  /// they are still relaxed: the sparse regions' kernels freeze on coarse levels. Only for varying densities
-  /// sampled freely: a uniform density has nothing to correct, and constrained sampling (tile baking)
-  /// takes its coarse densities from the fixed points.
+  /// kBalanceMaxNodes where its nodes hold kBalanceFinePointsPerNode. On every level, so that kernels are
+  /// balanced while they are still relaxed: the sparse regions' kernels freeze on coarse levels. Only for
+  /// varying densities sampled freely: a uniform density has nothing to correct, and constrained sampling
+  /// (tile baking) takes its coarse densities from the fixed points.
   void balance_counts_at(int base) {
     if (!options.count_balance || setup.uniform || !fixed.empty() || options.n <= 0) return;
     const double max_nodes = std::min(double(options.n) / kBalancePointsPerNode, kBalanceMaxNodes);
@@ -201,27 +203,18 @@ struct Driver {
     settings.mass_per_point = setup.mass_per_point;
     const DensityGrid<D>& here = setup.levels[base];
     const int s0 = source_for(l);
-    auto T0 = Clock::now();
     const CountBalanceReport b =
         balance_counts(particles, here, setup.levels[s0], 1 << (s0 - base), 1 << (l - base), settings);
-    if (std::getenv("KDM_BT"))
-      std::fprintf(stderr, "base %d first grid %d it %d %.4f s\n", base, b.grid[0], b.iterations,
-                   seconds_between(T0, Clock::now()));
     if (base == 0) {
       report.count_mismatch_before = b.mismatch_before;
       report.count_mismatch_after = b.mismatch_after;
     }
-    // Finer passes where the density gives their nodes enough points: the dense parts of a varying
+    // Finer passes where the density gives their nodes enough points: the steep parts of a varying
     // density have structure the first grid cannot resolve.
-    settings.min_target = kBalancePointsPerNode;
+    settings.min_target = kBalanceFinePointsPerNode;
     for (int f = l - 1; f > base && nodes_at(f) <= kBalanceMaxNodes; --f) {
       const int sf = source_for(f);
-      auto T1 = Clock::now();
-      auto bb =
-          balance_counts(particles, here, setup.levels[sf], 1 << (sf - base), 1 << (f - base), settings);
-      if (std::getenv("KDM_BT"))
-        std::fprintf(stderr, "base %d fine grid %d it %d %.4f s\n", base, bb.grid[0], bb.iterations,
-                     seconds_between(T1, Clock::now()));
+      balance_counts(particles, here, setup.levels[sf], 1 << (sf - base), 1 << (f - base), settings);
     }
   }
 
@@ -248,7 +241,7 @@ struct Driver {
       for (int k = 0; k < D; ++k) centre[k] = 2 * p.x[k];
       if (p.splits == 0) {
         *out = p;
-        out->x = fine.at(centre) > 0 ? centre : inside_support(fine, centre);
+        out->x = fine.at(centre) > 0 ? centre : relocate(fine, centre);
         return;
       }
       Particle<D> child;
@@ -261,7 +254,7 @@ struct Driver {
       for (const Vec<D>& z : square_rule(rng)) {
         for (int k = 0; k < D; ++k) child.x[k] = centre[k] + sigma * z[k];
         keep_inside(fine.grid, child.x);
-        if (!(fine.at(child.x) > 0)) child.x = inside_support(fine, centre);
+        if (!(fine.at(child.x) > 0)) child.x = relocate(fine, child.x);
         *out++ = child;
       }
     });
@@ -298,6 +291,17 @@ struct Driver {
       if (best_rho > 0) return best;
     }
     return centre;
+  }
+
+  /// Where a kernel goes that would land on zero density: into the node inside_support() finds, a quarter
+  /// node from its centre towards where it wanted to be, so kernels relocated to one node stay apart.
+  static Vec<D> relocate(const DensityGrid<D>& fine, const Vec<D>& wanted) {
+    Vec<D> x = inside_support(fine, wanted);
+    double reach = 0;
+    for (int k = 0; k < D; ++k) reach = std::max(reach, std::abs(wanted[k] - x[k]));
+    if (reach > 0)
+      for (int k = 0; k < D; ++k) x[k] += (wanted[k] - x[k]) * std::min(1.0, 0.25 / reach);
+    return x;
   }
 
   /// The 2^D corners of a unit-radius square (cube), rotated at random so no axis is preferred.
