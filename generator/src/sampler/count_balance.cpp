@@ -8,7 +8,7 @@
 namespace kdm::gen {
 namespace {
 
-constexpr double kNegligibleStep = 0.003;  ///< coarse nodes: a few percent of a point spacing
+constexpr double kNegligibleStep = 0.003;  ///< coarse nodes: about 1% of a point spacing
 constexpr double kMinImprovement = 0.02;  ///< stop when a step lowers the mismatch by less than this
 /// Moves into frozen territory keep at least this share of the local spacing to every other point.
 constexpr double kFrozenMinSpacing = 0.5;
@@ -339,7 +339,6 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
     const double mismatch = bin();
     if (!(mismatch < report.mismatch_after)) {  // no longer helping: keep the better configuration
       particles = before;
-      std::vector<char> inside_of(particles.size());  // and whether it lies wholly inside the support
       for (std::size_t j = 0; j < particles.size(); ++j)
         rho_of[j] = finest.at(particles[j].x), inside_of[j] = inside_support(particles[j].x);
       bin();
