@@ -159,6 +159,37 @@ TEST(Tiling, PeriodicityRatioDetectsRepeatedTile) {
   EXPECT_NEAR(rw.ratio, 1.0, 5 * std::sqrt(2.0 / rw.frequencies) + 0.02);
 }
 
+// Uniform random points have the mean density at every distance from the tile edges: each band's count is
+// Poisson, so its ratio has sd 1/sqrt(expected); 5 sd allowed. A set whose points keep away from the edges
+// shows the gap in the first bands and the surplus further in.
+TEST(Tiling, EdgeBandsMeasureDensityNearTileEdges) {
+  EdgeBands uniform;
+  for (unsigned s = 0; s < 8; ++s) add_edge_bands(uniform_set(20000, 500 + s).coords, 2, 1.0 / 8, uniform);
+  for (int b = 0; b < EdgeBands::kBands; ++b)
+    EXPECT_NEAR(uniform.ratio(b), 1.0, 5 / std::sqrt(uniform.expected[b])) << "band " << b;
+  double all = 0;
+  for (int b = 0; b < EdgeBands::kBands; ++b) all += uniform.expected[b];
+  EXPECT_NEAR(all / 8, 20000 * (1 - std::pow(1 - 2 * 2 * std::sqrt(2 / (std::sqrt(3.0) * 20000)) * 8, 2)),
+              1e-6 * all);  // the bands cover 2 d_hex from each edge
+  const tools::PointSet p = uniform_set(20000, 520);
+  std::vector<double> kept;  // drop the points within 0.5 d_hex of an edge of the 8×8 tiles
+  const double half = 0.5 * std::sqrt(2 / (std::sqrt(3.0) * 20000));
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double d = 1;
+    for (int k = 0; k < 2; ++k) {
+      const double f = p.coords[2 * i + k] * 8 - std::floor(p.coords[2 * i + k] * 8);
+      d = std::min(d, std::min(f, 1 - f) / 8);
+    }
+    if (d >= half) kept.push_back(p.coords[2 * i]), kept.push_back(p.coords[2 * i + 1]);
+  }
+  EdgeBands gapped;
+  add_edge_bands(kept, 2, 1.0 / 8, gapped);
+  EXPECT_LT(gapped.ratio(0), 0.05);  // bands 0 and 1 are the removed half spacing (n is smaller now, so
+  EXPECT_LT(gapped.first_spacing_ratio(), 0.8);  // its d_hex a little larger: band 2 is partly empty too)
+  EXPECT_GT(gapped.ratio(7), 1.0);               // the kept points are all further in
+  EXPECT_THROW(add_edge_bands(kept, 2, 0.3, gapped), InvalidInput);
+}
+
 TEST(Tiling, SeamClassification) {
   // Pairs: across x = 0.5 (seam), inside a tile (interior), across the torus edge x = 0 (seam on the torus).
   const std::vector<double> c = {0.49, 0.30, 0.51, 0.30, 0.20, 0.80, 0.22, 0.80, 0.005, 0.62, 0.995, 0.62};

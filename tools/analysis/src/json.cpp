@@ -183,6 +183,14 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
     w.key("interior");
     write_nn(w, r.seams.interior);
     w.key("ks_statistic").value(r.seams.ks.statistic).key("ks_p_value").value(r.seams.ks.p_value);
+    if (r.dim == 2) {
+      std::vector<double> ratios;
+      for (int b = 0; b < EdgeBands::kBands; ++b) ratios.push_back(r.edges.ratio(b));
+      w.key("edge_band_density_ratio")
+          .value(r.edges.first_spacing_ratio())
+          .key("edge_band_profile")
+          .value(ratios);
+    }
     w.end_object();
   }
   if (r.has_energy) w.key("energy_per_point").value(r.energy_per_point);

@@ -64,6 +64,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     }
     r.dmin_per_set.push_back(lo / spacing);
     if (o.tile_size > 0) split_by_seam(s.coords, s.dim, nn, o.tile_size, seam, interior);
+    if (o.tile_size > 0 && s.dim == 2) add_edge_bands(s.coords, s.dim, o.tile_size, r.edges);
   }
   r.nn = summarize_nn(pooled, 1.0);
   r.dmin_mean = 0;
@@ -165,6 +166,12 @@ std::string format_summary(const AnalysisReport& r) {
     add("  inside  %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f   KS D %.4f  p %.3g\n",
         r.seams.interior.count, r.seams.interior.dmin, r.seams.interior.davg, r.seams.interior.nn1,
         r.seams.ks.statistic, r.seams.ks.p_value);
+    if (r.dim == 2) {
+      add("  edges   density within one spacing of tile edges %+.2f%% of the mean; by quarter spacing:",
+          100 * (r.edges.first_spacing_ratio() - 1));
+      for (int b = 0; b < EdgeBands::kBands; ++b) add(" %+.1f", 100 * (r.edges.ratio(b) - 1));
+      add("%%\n");
+    }
   }
   if (r.has_energy)
     add("KDM energy         E/n %.4f (finest grid of the model for this count and density)\n",

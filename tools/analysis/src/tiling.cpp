@@ -130,4 +130,27 @@ SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, doubl
   return out;
 }
 
+void add_edge_bands(const std::vector<double>& coords, int dim, double tile_size, EdgeBands& bands) {
+  if (dim != 2) throw InvalidInput("edge bands are implemented for 2D sets only");
+  const int tiles = tiles_per_axis(tile_size);
+  const std::size_t n = coords.size() / 2;
+  if (n == 0) return;
+  const double s = 1.0 / tiles, step = std::sqrt(2 / (std::sqrt(3.0) * double(n))) / 4;  // d_hex / 4
+  for (int b = 0; b < EdgeBands::kBands; ++b) {
+    // Area of a tile at distance [a, c) from its nearest edge: (s − 2a)² − (s − 2c)², clipped at the centre.
+    const double a = std::min(b * step, s / 2), c = std::min((b + 1) * step, s / 2);
+    bands.expected[b] += double(n) * ((s - 2 * a) * (s - 2 * a) - (s - 2 * c) * (s - 2 * c)) / (s * s);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    double d = s;
+    for (int k = 0; k < 2; ++k) {
+      const double u = coords[2 * i + k] * tiles;
+      const double f = (u - std::floor(u)) * s;  // position inside its tile
+      d = std::min(d, std::min(f, s - f));
+    }
+    const int b = static_cast<int>(d / step);
+    if (b < EdgeBands::kBands) bands.count[b] += 1;
+  }
+}
+
 }  // namespace kdm::analysis

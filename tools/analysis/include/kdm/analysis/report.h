@@ -54,6 +54,7 @@ struct AnalysisReport {
   double tile_size = 0;
   PeriodicityResult periodicity;  ///< needs the spectrum (NaN ratio otherwise)
   SeamStats seams;
+  EdgeBands edges;     ///< density near tile edges (2D)
   double seconds = 0;  ///< wall time of analyze()
   /// E / n under the KDM model (mean over sets). The analysis library has no model of its own: callers
   /// that link the generator fill this in (kdm analyze does, via kdm::gen::energy_per_point).

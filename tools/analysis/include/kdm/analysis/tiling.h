@@ -8,6 +8,9 @@
 //    is more likely to cross an edge, so even an untiled set shows seam δavg slightly above interior δavg
 //    and, with many points, a small KS p-value (Fattal's reference sets at s = 1/8: δavg .876 vs .871,
 //    D = 0.037). Compare against the same statistics of an untiled set of the same kind.
+//  - edge bands: the point density at each distance from the nearest tile edge, in steps of a quarter of
+//    the hexagonal spacing d_hex up to 2 d_hex, against the set's mean density. Tiles whose edges hold too
+//    few or too many points show as lines in a blurred picture; this measures them.
 #pragma once
 
 #include <cstddef>
@@ -63,5 +66,24 @@ SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, doubl
 /// Appends normalised NN distances to `seam` / `interior`. Thread-safe (pure).
 void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbors& nn, double tile_size,
                    std::vector<double>& seam, std::vector<double>& interior);
+
+/// Density by distance from the nearest tile edge: band b holds the points whose distance to their tile's
+/// nearest edge is in [b, b + 1) · d_hex / 4 (d_hex of each set's own count), for b < kBands.
+struct EdgeBands {
+  static constexpr int kBands = 8;
+  double count[kBands] = {};     ///< points in each band, pooled over sets
+  double expected[kBands] = {};  ///< their expected count at the mean density
+  double ratio(int b) const { return expected[b] > 0 ? count[b] / expected[b] : 0; }
+  /// The first spacing from the edges (bands 0–3): the figure to quote.
+  double first_spacing_ratio() const {
+    double c = 0, e = 0;
+    for (int b = 0; b < 4; ++b) c += count[b], e += expected[b];
+    return e > 0 ? c / e : 0;
+  }
+};
+
+/// Adds one 2D set's points (interleaved x y in [0, 1)²) to `bands` for tile side `tile_size` (1/s an
+/// integer). Throws InvalidInput for a bad tile size or dim != 2. Thread-safe (pure but for `bands`).
+void add_edge_bands(const std::vector<double>& coords, int dim, double tile_size, EdgeBands& bands);
 
 }  // namespace kdm::analysis
