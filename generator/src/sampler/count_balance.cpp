@@ -9,47 +9,11 @@ namespace kdm::gen {
 namespace {
 
 constexpr double kNegligibleStep = 0.003;  ///< coarse nodes: about 1% of a point spacing
-constexpr double kMinImprovement = 0.02;  ///< stop when a step lowers the mismatch by less than this
+constexpr double kMinImprovement = 0.02;   ///< stop when a step lowers the mismatch by less than this
 /// Moves into frozen territory keep at least this share of the local spacing to every other point.
 constexpr double kFrozenMinSpacing = 0.5;
 constexpr double kMaxStep = 0.5;     ///< coarse nodes per iteration: the map stays smooth and one-to-one
 constexpr double kTolerance = 1e-4;  ///< relative residual of the Poisson solve: flux to well under 1%
-
-/// Multilinear (cloud-in-cell) weights of position `x` (coarse units) on the 2^D surrounding nodes.
-/// A torus wraps; a box folds the outside node onto the edge node, so no weight leaves the grid.
-template <int D>
-struct Corners {
-  std::array<std::int64_t, (1 << D)> index{};
-  std::array<double, (1 << D)> weight{};
-
-  Corners(const Grid<D>& g, const Vec<D>& x) {
-    std::array<std::int64_t, D> lo{}, hi{};
-    std::array<double, D> f{};
-    for (int k = 0; k < D; ++k) {
-      const double t = x[k] - 0.5;
-      const double t0 = std::floor(t);
-      f[k] = t - t0;
-      std::int64_t i0 = static_cast<std::int64_t>(t0), i1 = i0 + 1;
-      const std::int64_t m = g.dims[k];
-      if (g.torus) {
-        i0 = (i0 % m + m) % m, i1 = (i1 % m + m) % m;
-      } else {
-        i0 = std::clamp<std::int64_t>(i0, 0, m - 1), i1 = std::clamp<std::int64_t>(i1, 0, m - 1);
-      }
-      lo[k] = i0 * g.stride(k), hi[k] = i1 * g.stride(k);
-    }
-    for (int c = 0; c < (1 << D); ++c) {
-      double w = 1;
-      std::int64_t idx = 0;
-      for (int k = 0; k < D; ++k) {
-        const bool up = (c >> k) & 1;
-        w *= up ? f[k] : 1 - f[k];
-        idx += up ? hi[k] : lo[k];
-      }
-      index[c] = idx, weight[c] = w;
-    }
-  }
-};
 
 /// The particles of each coarse node at the start of a step (a counting sort), for the spacing test.
 template <int D>
@@ -234,7 +198,7 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
       x[k] = (rest % source.grid.dims[k] + 0.5) * source_factor;
       rest /= source.grid.dims[k];
     }
-    const Corners<D> c(g, to_coarse(x));
+    const NodeCorners<D> c(g, to_coarse(x));
     for (int j = 0; j < (1 << D); ++j) target[c.index[j]] += c.weight[j] * v;
     total_rho += v;
   }
@@ -245,7 +209,7 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
   auto bin = [&] {
     std::fill(count.begin(), count.end(), 0.0);
     for (const auto& p : particles) {
-      const Corners<D> c(g, to_coarse(p.x));
+      const NodeCorners<D> c(g, to_coarse(p.x));
       for (int j = 0; j < (1 << D); ++j) count[c.index[j]] += c.weight[j] * p.weight();
     }
     double off = 0;
@@ -293,7 +257,7 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
     const Buckets<D> buckets(g, particles, scale);
     for (std::int32_t member : buckets.members) {  // node by node: the finest grid is read in order
       Particle<D>& p = particles[static_cast<std::size_t>(member)];
-      const Corners<D> c(g, to_coarse(p.x));
+      const NodeCorners<D> c(g, to_coarse(p.x));
       Vec<D> f{};
       double l = 0;
       bool unresolved = false;
