@@ -7,6 +7,7 @@
 // -DKDM_SLOW_TESTS=ON to check every level.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -119,6 +120,35 @@ TEST(GeneratorTest, VerifierFlagsMismatchedTileEdges) {
   for (const DensityResult& d : report.densities)
     for (const Check& c : d.checks) seam_failed = seam_failed || (c.name.find("edge") == 0 && !c.passed());
   EXPECT_TRUE(seam_failed);
+}
+
+// One point of a level moved next to another (0.1 spacings away, inside the tile): the closest-pair check
+// must fail at that level.
+TEST(GeneratorTest, VerifierFlagsNearCoincidentPoints) {
+  TilesetData damaged = shipped();
+  const std::uint32_t level = 2;
+  Tile& tile = damaged.tiles[3];
+  const double spacing = std::sqrt(2 / (std::sqrt(3.0) * damaged.level_nominal[level]));
+  std::uint32_t moved = 0;
+  for (std::uint32_t i = 0; i < tile.level_end[level]; ++i)
+    if (std::fabs(tile.points[i].unit_x() - 0.5) < 0.2 && std::fabs(tile.points[i].unit_y() - 0.5) < 0.2) {
+      const std::uint32_t last = tile.level_end[level] - 1;
+      tile.points[last] =
+          TilePoint::from_unit(tile.points[i].unit_x() + 0.1 * spacing, tile.points[i].unit_y());
+      moved = last;
+      break;
+    }
+  ASSERT_GT(moved, 0u);
+  VerifyOptions o = parts(false, false, true);
+  o.levels = {level};
+  o.bars.closest_pair = 0.3;
+  EXPECT_TRUE(verify_tileset(shipped(), o).passed());  // 512 points per tile and below: no close pair
+  const Report report = verify_tileset(damaged, o);
+  bool flagged = false;
+  for (const DensityResult& d : report.densities)
+    for (const Check& c : d.checks)
+      flagged = flagged || (d.complete_level && c.name.find("closest pair") == 0 && !c.passed());
+  EXPECT_TRUE(flagged);
 }
 
 TEST(GeneratorTest, VerifierRefusesBadOptions) {

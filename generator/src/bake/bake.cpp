@@ -14,6 +14,7 @@
 
 #include "bake/corner_layout.h"
 #include "bake/progressive_order.h"
+#include "bake/spacing_guard.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/version.h"
 #include "sampler/rng.h"
@@ -29,6 +30,12 @@ constexpr double kFilterWidth = 0.5;
 // The coarsest level's sweeps in the versions that baked the first tile sets (SamplerOptions's default was
 // then 60): a recipe must bake the same tiles in every kdm version.
 constexpr int kFirstCoarsestSweeps = 60;
+
+// With the hard core on (BakeRecipe::min_distance), new points lying deeper than this many point spacings
+// (of their level) inside a region of an earlier patch kind are dropped: such a point has other neighbours
+// in every tile, and the margin between levels (corner_layout.h) must still separate it from the next
+// level's patches, which are sampled without it.
+constexpr double kMaxSlip = 0.1;
 
 }  // namespace
 
@@ -71,6 +78,14 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "erosion") {
       if (!(v >= 0 && v <= 8)) throw InvalidArgument(where + "erosion must be in [0, 8]");
       r.erosion = v;
+    } else if (key == "edge_gap") {
+      if (!(v >= 0.5 && v <= 4)) throw InvalidArgument(where + "edge_gap must be in [0.5, 4]");
+      r.edge_gap = v;
+    } else if (key == "rank_context") {
+      r.rank_context = whole(0, 1) != 0;
+    } else if (key == "min_distance") {
+      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "min_distance must be in [0, 0.7]");
+      r.min_distance = v;
     } else if (key == "temperature") {
       if (v < 0) throw InvalidArgument(where + "temperature must be >= 0");
       r.temperature = v;
@@ -79,9 +94,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     }
   }
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
-  if (patch_widths(r.band, r.erosion, r.nominal_counts()).empty())
+  if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty())
     throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
-                          std::to_string(r.erosion) +
+                          std::to_string(r.erosion) + " and edge gap " + std::to_string(r.edge_gap) +
                           " leaves some level's edge patches narrower than half a point spacing");
   return r;
 }
@@ -102,6 +117,10 @@ std::string BakeRecipe::to_text() const {
   s << "seed " << seed << "\ncolours " << colours << "\nlevels " << levels << "\nbase_points " << base_points
     << "\ntemperature " << shortest(temperature) << "\nsweeps " << sweeps << "\nband " << shortest(band)
     << "\nerosion " << shortest(erosion) << "\n";
+  // Written only when set, so recipes from before the key keep their text (and their bytes).
+  if (edge_gap != kFirstEdgeGap) s << "edge_gap " << shortest(edge_gap) << "\n";
+  if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
+  if (rank_context) s << "rank_context 1\n";
   return s.str();
 }
 
@@ -154,7 +173,7 @@ class Baker {
         threads_(threads),
         progress_(progress),
         nominal_(recipe.nominal_counts()),
-        widths_(patch_widths(recipe.band, recipe.erosion, nominal_)),
+        widths_(patch_widths(recipe.band, recipe.erosion, recipe.edge_gap, nominal_)),
         runs_(plan_runs(recipe.colours)) {
     if (widths_.empty()) throw InvalidArgument("recipe: the patches of some level are too narrow");
     for (std::uint32_t k = 0; k < recipe.levels; ++k)
@@ -264,30 +283,73 @@ class Baker {
     std::map<std::pair<int, std::size_t>, std::vector<std::pair<double, double>>> found;  // -> torus xy
     std::map<std::pair<int, std::size_t>, std::vector<std::pair<double, double>>> relative;
     std::map<std::pair<int, std::size_t>, std::pair<std::int64_t, std::int64_t>> anchors;
+    // Every point the run held fixed, then each new point kept: a new point too close to any is dropped.
+    const double hex_spacing = std::sqrt(2.0 / (std::sqrt(3.0) * nominal_[k]));
+    SpacingGuard guard(run.w, run.h, recipe_.min_distance * hex_spacing,
+                       std::size_t(run.w * run.h) * nominal_[k]);
+    for (const std::vector<double>* fixed : {&rank.fixed, &rank.timed})
+      for (std::size_t i = 0; i < fixed->size(); i += 2) guard.add((*fixed)[i], (*fixed)[i + 1]);
+    // With rank_context, the run's other new points (regions of later stages, patches made by other runs)
+    // are ranked too, as stand-ins for the points those regions will get: ranked alone, a patch's points
+    // next to such a region face a void there and come first, and the patch's middle (a tile edge, for an
+    // edge patch) fills last.
+    std::vector<double> context;
     for (std::size_t i = 0; i < result.size(); ++i) {
       const double x = result.points[2 * i] * run.w, y = result.points[2 * i + 1] * run.h;
       Placement p;
       const auto stage_kind = static_cast<PatchKind>(run.stage);
-      if (!place_new_point(x, y, stage_kind, widths_[k], col, p) || level.of(p.kind)[p.patch].done) continue;
+      const bool placed = place_new_point(x, y, stage_kind, widths_[k], col, p);
+      if (!placed || level.of(p.kind)[p.patch].done) {
+        if (recipe_.rank_context && (placed || p.kind > stage_kind)) context.insert(context.end(), {x, y});
+        continue;
+      }
       const int kind = static_cast<int>(p.kind);
       // A patch can appear at two anchors of a small torus (e.g. both interiors of one tile type): keep
       // the first anchor's copy only.
       const std::pair<std::int64_t, std::int64_t> at{(p.anchor_x % run.w + run.w) % run.w,
                                                      (p.anchor_y % run.h + run.h) % run.h};
-      if (anchors.try_emplace({kind, p.patch}, at).first->second != at) continue;
+      if (anchors.try_emplace({kind, p.patch}, at).first->second != at) {
+        if (recipe_.rank_context) context.insert(context.end(), {x, y});
+        continue;
+      }
+      // A point deep inside an earlier kind's region sits where another tile has other points near it
+      // (its patch was sampled with this tile's context only): finer levels could not see it.
+      if (recipe_.min_distance > 0 && p.slip > kMaxSlip / std::sqrt(double(nominal_[k]))) continue;
+      if (!guard.clear(x, y)) continue;
+      guard.add(x, y);
       found[{kind, p.patch}].push_back({x, y});
       relative[{kind, p.patch}].push_back({p.rx, p.ry});
     }
     rank.filter_width = kFilterWidth / std::sqrt(k ? nominal_[k - 1] : nominal_[0] / 4.0);
     rank.filter_width_end = kFilterWidth / std::sqrt(double(nominal_[k]));
-    for (const auto& [id, points] : found) {
-      rank.candidates.clear();
-      for (const auto& [x, y] : points) rank.candidates.insert(rank.candidates.end(), {x, y});
-      const std::vector<std::uint32_t> order = progressive_order(rank);
-      Patch& patch = level.of(static_cast<PatchKind>(id.first))[id.second];
-      const auto& rel = relative[id];
-      for (std::size_t s = 0; s < order.size(); ++s)
-        patch.add(rel[order[s]].first, rel[order[s]].second, rank_key(s, order.size()));
+    if (recipe_.rank_context) {
+      // One ranking of every new point; each patch keeps its own points' order, keyed within the patch.
+      rank.candidates = context;
+      std::vector<std::pair<const std::pair<int, std::size_t>*, std::size_t>> owner(context.size() / 2);
+      for (const auto& [id, points] : found)
+        for (std::size_t i = 0; i < points.size(); ++i) {
+          rank.candidates.insert(rank.candidates.end(), {points[i].first, points[i].second});
+          owner.push_back({&id, i});
+        }
+      std::map<std::pair<int, std::size_t>, std::vector<std::size_t>> order_in_patch;
+      for (std::uint32_t c : progressive_order(rank))
+        if (owner[c].first) order_in_patch[*owner[c].first].push_back(owner[c].second);
+      for (const auto& [id, order] : order_in_patch) {
+        Patch& patch = level.of(static_cast<PatchKind>(id.first))[id.second];
+        const auto& rel = relative[id];
+        for (std::size_t s = 0; s < order.size(); ++s)
+          patch.add(rel[order[s]].first, rel[order[s]].second, rank_key(s, order.size()));
+      }
+    } else {
+      for (const auto& [id, points] : found) {
+        rank.candidates.clear();
+        for (const auto& [x, y] : points) rank.candidates.insert(rank.candidates.end(), {x, y});
+        const std::vector<std::uint32_t> order = progressive_order(rank);
+        Patch& patch = level.of(static_cast<PatchKind>(id.first))[id.second];
+        const auto& rel = relative[id];
+        for (std::size_t s = 0; s < order.size(); ++s)
+          patch.add(rel[order[s]].first, rel[order[s]].second, rank_key(s, order.size()));
+      }
     }
     for (const auto& [id, points] : found) level.of(static_cast<PatchKind>(id.first))[id.second].done = true;
   }

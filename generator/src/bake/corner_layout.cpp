@@ -4,6 +4,7 @@
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/check.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace kdm::gen {
@@ -56,19 +57,25 @@ bool place_new_point(double x, double y, PatchKind kind, PatchWidths w, const Co
   const std::int64_t fx = floor_int(x), fy = floor_int(y);
   const std::size_t C = col.colours;
   const double dx = x - double(vx), dy = y - double(vy);
+  // Depth inside the corner square, and inside the horizontal and vertical bands (0 if outside).
+  const double corner = std::fabs(dx) < w.corner && std::fabs(dy) < w.corner
+                            ? std::min(w.corner - std::fabs(dx), w.corner - std::fabs(dy))
+                            : 0.0;
+  const double in_h = std::max(0.0, w.edge - std::fabs(dy)), in_v = std::max(0.0, w.edge - std::fabs(dx));
   switch (kind) {
     case PatchKind::kCorner:
       return false;
     case PatchKind::kHorizontalEdge:  // slipped into a corner patch
       if (!(std::fabs(dy) < w.edge)) return false;
-      out = {kind, col.at(fx, vy) * C + col.at(fx + 1, vy), fx, vy, x - double(fx), dy};
+      out = {kind, col.at(fx, vy) * C + col.at(fx + 1, vy), fx, vy, x - double(fx), dy, corner};
       return true;
-    case PatchKind::kVerticalEdge:  // slipped into a corner patch or a horizontal edge
+    case PatchKind::kVerticalEdge:  // slipped into a corner patch (a horizontal edge lies inside one)
       if (!(std::fabs(dx) < w.edge)) return false;
-      out = {kind, col.at(vx, fy) * C + col.at(vx, fy + 1), vx, fy, dx, y - double(fy)};
+      out = {kind, col.at(vx, fy) * C + col.at(vx, fy + 1), vx, fy, dx, y - double(fy), corner};
       return true;
     case PatchKind::kInterior:  // slipped into its tile's band
-      out = {kind, col.tile_at(fx, fy), fx, fy, x - double(fx), y - double(fy)};
+      out = {kind,           col.tile_at(fx, fy),           fx, fy, x - double(fx),
+             y - double(fy), std::max({corner, in_h, in_v})};
       return true;
   }
   return false;
@@ -96,13 +103,13 @@ void gather(const LevelPatches& level, const Colouring& col, std::array<bool, 4>
     }
 }
 
-std::vector<PatchWidths> patch_widths(double band, double erosion,
+std::vector<PatchWidths> patch_widths(double band, double erosion, double edge_gap,
                                       const std::vector<std::uint32_t>& nominal) {
   std::vector<PatchWidths> widths;
   for (std::size_t k = 0; k < nominal.size(); ++k) {
     const double spacing = 1.0 / std::sqrt(double(nominal[k]));
     const double corner = k == 0 ? band : widths.back().corner - erosion * spacing;
-    widths.push_back({corner, corner - kEdgeGap * spacing});
+    widths.push_back({corner, corner - edge_gap * spacing});
     if (!(widths.back().edge >= 0.5 * spacing)) return {};
   }
   return widths;

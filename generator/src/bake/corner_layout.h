@@ -85,6 +85,9 @@ struct Placement {
   std::size_t patch;
   std::int64_t anchor_x, anchor_y;
   double rx, ry;
+  /// How deep (tile units) the point lies inside the region of a patch kind sampled before its own
+  /// (place_new_point); 0 when it lies in its own kind's region.
+  double slip = 0;
 };
 Placement classify(double x, double y, PatchWidths widths, const Colouring& colouring);
 
@@ -101,13 +104,12 @@ bool place_new_point(double x, double y, PatchKind kind, PatchWidths widths, con
 void gather(const LevelPatches& level, const Colouring& colouring, std::array<bool, 4> kinds, double x0,
             double y0, double x1, double y1, std::vector<double>& xy, std::vector<std::uint16_t>* keys);
 
-/// Gap between a level's corner and edge half-widths, in that level's point spacings: H and V edge
-/// patches then stay √2 · 1.25 ≈ 1.8 spacings apart.
-inline constexpr double kEdgeGap = 1.25;
-
 /// The patch half-widths of each level: corner h_0 = band, then shrinking by erosion / sqrt(points of
-/// level k per tile) per level; edge b_k = h_k − kEdgeGap spacings. Empty if some b_k would be below half a
-/// spacing of its own level (too thin to hold a patch).
-std::vector<PatchWidths> patch_widths(double band, double erosion, const std::vector<std::uint32_t>& nominal);
+/// level k per tile) per level; edge b_k = h_k − edge_gap spacings of level k (H and V edge patches then
+/// stay √2 · edge_gap spacings apart). Edge bands thus shrink by (erosion − edge_gap) spacings per level:
+/// the margin between a level's edge patches and the interiors of the level before it. Empty if some b_k
+/// would be below half a spacing of its own level (too thin to hold a patch).
+std::vector<PatchWidths> patch_widths(double band, double erosion, double edge_gap,
+                                      const std::vector<std::uint32_t>& nominal);
 
 }  // namespace kdm::gen

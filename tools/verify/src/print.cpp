@@ -71,14 +71,17 @@ void print_report(const Report& report, std::FILE* out) {
   }
   if (!report.densities.empty()) {
     std::fprintf(out, "\nseams and in-between densities, over every tile's torus\n");
-    std::fprintf(out, "%11s %7s %7s %10s %10s %8s %9s %10s  %s\n", "points/tile", "kind", "δavg",
-                 "edge/other", "edge links", "KS D+", "p", "worst lowP", "result");
+    std::fprintf(out, "%11s %7s %7s %10s %10s %8s %9s %10s %8s %9s  %s\n", "points/tile", "kind", "δavg",
+                 "edge/other", "edge links", "KS D+", "p", "worst lowP", "closest", "edge band", "result");
     for (const DensityResult& d : report.densities) {
-      std::fprintf(out, "%11.1f %7s %7.4f %s %10zu %s %9.2g %s  %s\n", d.points_per_tile,
+      std::fprintf(out, "%11.1f %7s %7.4f %s %10zu %s %9.2g %s %s %s  %s\n", d.points_per_tile,
                    d.complete_level ? "level" : "between", d.davg,
                    cell(d.worst_edge_ratio, "%.3f", d.checks, "edge δmin", 10).c_str(), d.edge_links,
                    cell(d.ks_d_plus, "%.4f", d.checks, "edge vs midline", 8).c_str(), d.ks_p,
-                   cell(d.worst_low_p, "%.4f", d.checks, "lowP", 10).c_str(), d.passed() ? "pass" : "FAIL");
+                   cell(d.worst_low_p, "%.4f", d.checks, "lowP", 10).c_str(),
+                   cell(d.closest_pair, "%.3f", d.checks, "closest pair", 8).c_str(),
+                   cell(100 * (d.edge_band - 1), "%+.1f%%", d.checks, "|edge band", 9).c_str(),
+                   d.passed() ? "pass" : "FAIL");
       checks += d.checks.size();
     }
   }

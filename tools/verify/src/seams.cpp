@@ -43,14 +43,18 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
     row.worst_low_p = std::numeric_limits<double>::quiet_NaN();
     row.worst_edge_ratio = std::numeric_limits<double>::infinity();
     std::vector<double> edge_pool, midline_pool;
+    row.closest_pair = std::numeric_limits<double>::infinity();
+    analysis::EdgeBands bands;
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {
       const std::vector<double> coords = torus_points(set, t, count);
       const std::size_t n = coords.size() / 2;
       done(double(n));
       if (n < 2) continue;
       const analysis::NearestNeighbors nn = analysis::nearest_neighbors(coords, 2, true, options.threads);
-      row.davg +=
-          analysis::summarize_nn(nn.distance, analysis::hex_spacing(n)).davg / double(set.tiles.size());
+      const analysis::NNStats summary = analysis::summarize_nn(nn.distance, analysis::hex_spacing(n));
+      row.davg += summary.davg / double(set.tiles.size());
+      row.closest_pair = std::min(row.closest_pair, summary.dmin);
+      analysis::add_edge_bands(coords, 2, 0.5, bands);
       std::vector<double> edge, inside;
       analysis::split_by_seam(coords, 2, nn, 0.5, edge, inside);
       if (!edge.empty() && !inside.empty())
@@ -78,6 +82,11 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
     row.checks.push_back(
         {"edge vs midline KS D+ (significant)", ks.p_value < b.ks_p ? ks.statistic : 0.0, b.ks_d_plus, true});
     if (!std::isnan(row.worst_low_p)) row.checks.push_back({"lowP", row.worst_low_p, b.mid_low_p, true});
+    if (std::isfinite(row.closest_pair) && b.closest_pair > 0)
+      row.checks.push_back({"closest pair / d_hex", row.closest_pair, b.closest_pair, false});
+    row.edge_band = bands.first_spacing_ratio();
+    if (b.edge_band > 0)
+      row.checks.push_back({"|edge band density − 1|", std::fabs(row.edge_band - 1), b.edge_band, true});
     report.densities.push_back(std::move(row));
   }
 }

@@ -27,6 +27,9 @@
 
 namespace kdm::gen {
 
+/// The edge gap of the recipes written before the key existed.
+inline constexpr double kFirstEdgeGap = 1.25;
+
 /// Everything that determines a baked tile set; `kdm bake` reads it from a small text file of
 /// "key value" lines ('#' starts a comment). Baking the same recipe with the same kdm version gives
 /// the same bytes, for any thread count.
@@ -40,6 +43,14 @@ struct BakeRecipe {
   double band = 0.35;              ///< half-width of level 0's corner and edge patches, in tile sides
   /// How much each finer level's patches shrink, in that level's point spacings (corner_layout.h).
   double erosion = 1.5;
+  /// Each level's gap between its corner and edge half-widths, in its point spacings (corner_layout.h).
+  double edge_gap = kFirstEdgeGap;
+  /// Hard core: a new point closer than this fraction of its level's hexagonal spacing to a point placed
+  /// before it is dropped (spacing_guard.h says why). 0 (off) in recipes that do not name it.
+  double min_distance = 0;
+  /// Rank each patch's points together with the run's other new points (bake.cpp says why): points along
+  /// a tile edge then appear at the same rate as elsewhere between levels. Off in recipes without it.
+  bool rank_context = false;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).
