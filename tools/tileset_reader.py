@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""An independent reader of kdm tile sets (.kdmt, format version 2).
+"""An independent reader of kdm tile sets (.kdmt, format versions 2 and 3).
 
 Written from docs/tileset-format.md alone, not from the C++ sources: the test
 runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
@@ -24,7 +24,9 @@ try:
 except ImportError:  # the reader is useless without it: say what to install
     zstandard = None
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
+OLDEST_FORMAT_VERSION = 2
+MAX_KEYFRAMES = 256
 MAGIC = b"KDMTILES"
 FIXED_HEADER_BYTES = 64
 HEADER_CRC_OFFSET = 60
@@ -35,15 +37,16 @@ MAX_LEVELS = 16
 
 
 class TilesetError(Exception):
-    """The file is not a valid version-2 tile set; the message names the first problem (doc §3 order)."""
+    """The file is not a valid tile set; the message names the first problem (doc §3 order)."""
 
 
 class Tile:
-    def __init__(self, level_end, xs, ys, keys):
+    def __init__(self, level_end, xs, ys, keys, glide):
         self.level_end = level_end  # list of L ints
         self.xs = xs  # array('H'), x of each point in 1/65536 of the tile side
         self.ys = ys
         self.keys = keys  # array('H'), emission key of each point
+        self.glide = glide  # array('h'), gliding offsets (x, y pairs), empty without keyframes
 
     def levels_of_points(self):
         """The level of every point: point i is in level k iff level_end[k-1] <= i < level_end[k]."""
@@ -60,6 +63,7 @@ class Tileset:
         self.colours = 0
         self.levels = 0
         self.level_nominal = []
+        self.keyframe_nominal = []
         self.tiles = []
         self.recipe = b""
         self.generator_version = b""
@@ -74,6 +78,14 @@ class Tileset:
     def emits(self, level, key, expected):
         """Doc §7: emitted iff the tile's expected point count exceeds the threshold."""
         return expected > self.threshold(level, key)
+
+    def glide_count(self, tile, g):
+        """Doc §8: the points with a position at keyframe g, those emitted at the next keyframe's count
+        (every point at the last keyframe)."""
+        if g + 1 == len(self.keyframe_nominal):
+            return len(tile.xs)
+        count = self.keyframe_nominal[g + 1]
+        return sum(1 for k, q in zip(tile.levels_of_points(), tile.keys) if self.emits(k, q, count))
 
 
 def _u32(data, offset):
@@ -149,8 +161,10 @@ def decode(data):
     if size < 12:
         raise TilesetError("truncated: file ends inside the header")
     version = _u32(data, 8)
-    if version != FORMAT_VERSION:
-        raise TilesetError(f"unsupported format version {version} (this reader reads {FORMAT_VERSION})")
+    if not OLDEST_FORMAT_VERSION <= version <= FORMAT_VERSION:
+        raise TilesetError(
+            f"unsupported format version {version} (this reader reads {OLDEST_FORMAT_VERSION} to {FORMAT_VERSION})"
+        )
     if size < FIXED_HEADER_BYTES:
         raise TilesetError("truncated: file ends inside the header")
     header_size = _u32(data, 12)
@@ -223,7 +237,10 @@ def decode(data):
     if body_tiles != tile_count:
         raise TilesetError(f"body says {body_tiles} tiles, the header {tile_count}")
     ts.level_nominal = list(reader.array(U32, "level_nominal"))
-    if body_tiles > reader.remaining() // 24:
+    gliding = version >= 3
+    if gliding:
+        ts.keyframe_nominal = list(reader.array(U32, "keyframe_nominal"))
+    if body_tiles > reader.remaining() // (32 if gliding else 24):
         raise TilesetError(f"tile count {body_tiles} exceeds what {reader.remaining()} body bytes can hold")
     for t in range(body_tiles):
         level_end = list(reader.array(U32, f"tile {t} level_end"))
@@ -231,7 +248,8 @@ def decode(data):
         if len(xy) % 2:
             raise TilesetError(f"tile {t} has an odd number of coordinates ({len(xy)})")
         keys = reader.array("H", f"tile {t} keys")
-        ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys))
+        glide = reader.array("h", f"tile {t} glide") if gliding else array.array("h")
+        ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys, glide))
     if reader.remaining():
         raise TilesetError(f"body has {reader.remaining()} bytes after the last tile")
 
@@ -268,6 +286,19 @@ def _validate(ts):
             if any(a > b for a, b in zip(keys, keys[1:])):
                 raise TilesetError(f"tile {t} has unsorted keys in level {k}")
             start = end
+    if len(ts.keyframe_nominal) > MAX_KEYFRAMES:
+        raise TilesetError(f"{len(ts.keyframe_nominal)} keyframes, more than {MAX_KEYFRAMES}")
+    previous = 0
+    for n in ts.keyframe_nominal:
+        if n <= previous:
+            raise TilesetError("keyframe counts are not strictly increasing")
+        previous = n
+    if ts.keyframe_nominal and ts.keyframe_nominal[-1] != ts.level_nominal[-1]:
+        raise TilesetError("the last keyframe is not the top level's count")
+    for t, tile in enumerate(ts.tiles):
+        needed = 2 * sum(ts.glide_count(tile, g) for g in range(len(ts.keyframe_nominal)))
+        if len(tile.glide) != needed:
+            raise TilesetError(f"tile {t} has {len(tile.glide)} glide offsets, its keyframes need {needed}")
 
 
 def load(path):
@@ -296,6 +327,7 @@ def summary(ts):
         f"levels {ts.levels}",
         f"tiles {len(ts.tiles)}",
         "level_nominal " + " ".join(str(n) for n in ts.level_nominal),
+        "keyframe_nominal" + "".join(f" {n}" for n in ts.keyframe_nominal),
         f"recipe_bytes {len(ts.recipe)}",
         f"recipe_crc32 {_crc32(ts.recipe):08x}",
         f"generator_version {_escaped(ts.generator_version)}",
@@ -310,6 +342,7 @@ def summary(ts):
             f"tile {t} points {len(tile.xs)} level_end {' '.join(str(e) for e in tile.level_end)}"
             f" points_crc32 {_crc32(_le_bytes(triples)):08x}"
             f" thresholds_crc32 {_crc32(_le_bytes(thresholds)):08x}"
+            f" glide_crc32 {_crc32(_le_bytes(tile.glide)):08x}"
         )
     return "".join(line + "\n" for line in lines)
 
@@ -324,7 +357,7 @@ def point_lines(ts, t):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format version 2).")
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 and 3).")
     parser.add_argument("file")
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--summary", action="store_true", help="print the canonical summary")

@@ -51,6 +51,16 @@ void Tileset::adopt(TilesetData&& set) {
     for (std::uint32_t k = 0, i = 0; k < set_.levels; ++k)
       for (; i < tile.level_end[k]; ++i) out[i] = set_.emission_threshold(k, tile.keys[i]);
   }
+  // Where each keyframe's offsets start in every tile, and how far any point glides.
+  glide_start_.assign(set_.tiles.size(), {});
+  glide_reach_ = 0;
+  for (std::size_t t = 0; t < set_.tiles.size() && has_glide(); ++t) {
+    TilesetArray<std::uint32_t>& start = glide_start_[t];
+    start.assign(set_.keyframe_nominal.size() + 1, 0);
+    for (std::size_t g = 0; g < set_.keyframe_nominal.size(); ++g)
+      start[g + 1] = start[g] + set_.glide_count(set_.tiles[t], g);
+    for (std::int16_t v : set_.tiles[t].glide) glide_reach_ = std::max(glide_reach_, std::fabs(v) / 65536.0);
+  }
   min_threshold_ = HUGE_VAL;
   for (const TilesetArray<float>& t : thresholds_)
     if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
@@ -65,6 +75,10 @@ std::size_t Tileset::resident_bytes() const {
     bytes += t.points.capacity() * sizeof(TilePoint) + t.keys.capacity() * sizeof(std::uint16_t) +
              t.level_end.capacity() * sizeof(std::uint32_t);
   for (const TilesetArray<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
+  bytes += glide_start_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
+           set_.keyframe_nominal.capacity() * sizeof(std::uint32_t);
+  for (const TilesetArray<std::uint32_t>& t : glide_start_) bytes += t.capacity() * sizeof(std::uint32_t);
+  for (const Tile& t : set_.tiles) bytes += t.glide.capacity() * sizeof(std::int16_t);
   return bytes;
 }
 
@@ -112,6 +126,31 @@ struct ImageSampler {
     return (1 - ay) * ((1 - ax) * r0[ix] + ax * r0[jx]) + ay * ((1 - ax) * r1[ix] + ax * r1[jx]);
   }
 };
+
+/// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the fraction t
+/// of the way from g0 to g1 (linear in the count).
+struct GlideBracket {
+  std::uint32_t g0 = 0, g1 = 0;
+  double t = 0;
+  GlideBracket(const TilesetData& set, double expected) {
+    const std::uint32_t* k = set.keyframe_nominal.data();
+    const auto n = static_cast<std::uint32_t>(set.keyframe_nominal.size());
+    g1 = static_cast<std::uint32_t>(std::lower_bound(k, k + n, expected) - k);  // first K >= expected
+    if (g1 == 0) return;                    // at or below the first keyframe: no motion yet
+    if (g1 == n) g0 = g1 = n - 1;           // the top: every point at its last position
+    else g0 = g1 - 1, t = (expected - k[g0]) / double(k[g1] - k[g0]);
+  }
+};
+
+/// Point `rank`'s glide offset (1/65536 tile sides) at `b`: linear between its offsets at the two
+/// keyframes (an emitted point has both: tileset.h, glide_count).
+inline void glide_offset(const std::int16_t* glide, const std::uint32_t* start, std::uint32_t rank,
+                         const GlideBracket& b, double& dx, double& dy) {
+  const std::int16_t* o1 = glide + 2 * (std::size_t(start[b.g1]) + rank);
+  const std::int16_t* o0 = glide + 2 * (std::size_t(start[b.g0]) + rank);
+  dx = o0[0] + b.t * (o1[0] - o0[0]);
+  dy = o0[1] + b.t * (o1[1] - o0[1]);
+}
 
 }  // namespace
 
@@ -185,6 +224,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     if (!finite(value)) return refuse(Kind::kNotFinite, name, value);
   if (!(q.tile_size > 0)) return refuse(Kind::kNotPositive, "tile_size", q.tile_size);
   if (q.scale < 0) return refuse(Kind::kNegative, "scale", q.scale);
+  if (q.mode != QueryMode::kStable && q.mode != QueryMode::kSmooth)
+    return refuse(Kind::kBadMode, "mode", static_cast<double>(static_cast<int>(q.mode)));
   const std::uint64_t fingerprint = query_fingerprint(q);
   if (cursor->started && cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
   if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {
@@ -218,8 +259,11 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     why.largest_tile_size = std::sqrt(top / (max_density * q.scale));
     return Status::kInvalidArgument;
   }
-  const double tx0d = std::floor(q.x0 / S), tx1d = std::ceil(q.x1 / S);
-  const double ty0d = std::floor(q.y0 / S), ty1d = std::ceil(q.y1 / S);
+  // Smooth mode visits the tiles whose points can glide into the region too.
+  const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide();
+  const double reach = glide ? tileset.glide_reach() * S : 0.0;
+  const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
+  const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);
   if (!(max_density * area_scale > tileset.min_threshold())) {  // no tile can emit even its first point
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
@@ -256,6 +300,9 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
                            [](float t, double l) { return TilesetData::emits(t, l); }) -
           thresholds);
       std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
+      const std::int16_t* glide_offsets = glide ? tile.glide.data() : nullptr;
+      const std::uint32_t* glide_start = glide ? tileset.glide_start(index) : nullptr;
+      const GlideBracket tile_bracket(tileset.data(), glide ? limit : 0.0);  // a constant density's
       for (; c < candidates; ++c) {
         if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
           *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
@@ -263,12 +310,23 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           return Status::kBufferFull;
         }
         const TilePoint p = tile.points[c];
-        const double x = wx + p.unit_x() * S, y = wy + p.unit_y() * S;
-        if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
+        double x = wx + p.unit_x() * S, y = wy + p.unit_y() * S;
+        if (!glide && (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1)) continue;
+        double expected = limit;
         if (d.kind != QueryDensity::Kind::kConstant) {
           const double rho =
               d.kind == QueryDensity::Kind::kImage ? sampler.at(x, y) : sanitize(d.callback(d.user, x, y));
-          if (!TilesetData::emits(thresholds[c], rho * area_scale)) continue;
+          expected = rho * area_scale;
+          if (!TilesetData::emits(thresholds[c], expected)) continue;
+        }
+        if (glide) {
+          double dx, dy;
+          glide_offset(glide_offsets, glide_start, c,
+                       d.kind == QueryDensity::Kind::kConstant ? tile_bracket
+                                                                : GlideBracket(tileset.data(), expected),
+                       dx, dy);
+          x = wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * S, y = wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * S;
+          if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
         }
         if (n == capacity) {
           *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
@@ -304,6 +362,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
       return "the density asks for more points per tile than the tile set's top level holds";
     case QueryProblem::Kind::kCursorMismatch:
       return "the cursor was started by a query with other parameters";
+    case QueryProblem::Kind::kBadMode:
+      return "the mode is neither stable nor smooth";
   }
   return "unknown problem";
 }
@@ -320,6 +380,7 @@ std::uint64_t query_fingerprint(const QueryParams& q) {
                    q.density.callback_max})
     add_double(v);
   add(static_cast<std::uint64_t>(q.density.kind));
+  add(static_cast<std::uint64_t>(q.mode));
   add(reinterpret_cast<std::uintptr_t>(q.density.image));
   add(reinterpret_cast<std::uintptr_t>(q.density.callback));
   add(reinterpret_cast<std::uintptr_t>(q.density.user));

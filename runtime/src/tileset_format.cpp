@@ -94,6 +94,7 @@ std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
     cereal::PortableBinaryOutputArchive ar(stream);
     ar(set.colours, set.levels, static_cast<std::uint32_t>(set.tiles.size()));
     save_array(ar, set.level_nominal);
+    save_array(ar, set.keyframe_nominal);
     std::vector<std::uint16_t> xy;
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
@@ -102,13 +103,14 @@ std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
         xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
       save_array(ar, xy);
       save_array(ar, tile.keys);
+      save_array(ar, tile.glide);
     }
   }
   const std::string bytes = stream.str();
   return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
 }
 
-void parse_body(const char* body, std::size_t size, TilesetData& set) {
+void parse_body(const char* body, std::size_t size, std::uint32_t version, TilesetData& set) {
   // cereal's endianness flag: 1 little-, 0 big-endian; cereal itself would take anything else as "other".
   if (size == 0 || (body[0] != 0 && body[0] != 1)) throw ContentError("bad byte-order flag");
   MemoryBuffer buffer(body, size);
@@ -117,8 +119,10 @@ void parse_body(const char* body, std::size_t size, TilesetData& set) {
   std::uint32_t tile_count = 0;
   ar(set.colours, set.levels, tile_count);
   load_array(ar, buffer, set.level_nominal);
+  const bool gliding = version >= 3;
+  if (gliding) load_array(ar, buffer, set.keyframe_nominal);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
-  if (tile_count > buffer.remaining() / 24) throw ContentError("tile count exceeds the payload");
+  if (tile_count > buffer.remaining() / (gliding ? 32 : 24)) throw ContentError("tile count exceeds the payload");
   set.tiles.resize(tile_count);
   std::vector<std::uint16_t> xy;
   for (Tile& tile : set.tiles) {
@@ -128,6 +132,7 @@ void parse_body(const char* body, std::size_t size, TilesetData& set) {
     tile.points.resize(xy.size() / 2);
     for (std::size_t i = 0; i < tile.points.size(); ++i) tile.points[i] = {xy[2 * i], xy[2 * i + 1]};
     load_array(ar, buffer, tile.keys);
+    if (gliding) load_array(ar, buffer, tile.glide);
   }
   if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
 }
@@ -198,6 +203,21 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
         if (tile.keys[i] < tile.keys[i - 1])
           return bad("tile " + std::to_string(t) + " has unsorted keys in level " + std::to_string(k));
   }
+  const std::size_t keyframes = set.keyframe_nominal.size();
+  if (keyframes > kMaxKeyframes)
+    return bad(std::to_string(keyframes) + " keyframes, more than " + std::to_string(kMaxKeyframes));
+  for (std::size_t g = 0; g < keyframes; ++g)
+    if (set.keyframe_nominal[g] <= (g ? set.keyframe_nominal[g - 1] : 0u))
+      return bad("keyframe counts are not strictly increasing");
+  if (keyframes && set.keyframe_nominal.back() != set.level_nominal.back())
+    return bad("the last keyframe is not the top level's count");
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    std::uint64_t present = 0;  // offset pairs the keyframes need
+    for (std::size_t g = 0; g < keyframes; ++g) present += set.glide_count(set.tiles[t], g);
+    if (set.tiles[t].glide.size() != 2 * present)
+      return bad("tile " + std::to_string(t) + " has " + std::to_string(set.tiles[t].glide.size()) +
+                 " glide offsets, its keyframes need " + std::to_string(2 * present));
+  }
   return Status::kOk;
 }
 
@@ -244,10 +264,10 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   }
   if (size < 12) return fail(Status::kTruncated, detail, "file ends inside the header");
   const std::uint32_t version = get32(p + 8);
-  if (version != kTilesetFormatVersion)
+  if (version < kOldestTilesetFormatVersion || version > kTilesetFormatVersion)
     return fail(Status::kUnsupportedVersion, detail,
                 "format version " + std::to_string(version) + ", this reader supports " +
-                    std::to_string(kTilesetFormatVersion));
+                    std::to_string(kOldestTilesetFormatVersion) + " to " + std::to_string(kTilesetFormatVersion));
   if (size < kFixedHeaderBytes) return fail(Status::kTruncated, detail, "file ends inside the header");
   const std::uint32_t header_size = get32(p + 12);
   if (header_size < kFixedHeaderBytes || header_size > kMaxTilesetHeaderBytes)
@@ -284,7 +304,7 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
                 ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
   TilesetData set;
   try {
-    parse_body(body.get(), body_size, set);
+    parse_body(body.get(), body_size, version, set);
   } catch (const std::exception& e) {
     return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
   }

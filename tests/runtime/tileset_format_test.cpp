@@ -163,9 +163,12 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   const TilesetData set = make_tileset(1, 2);  // one colour: a single tile
   const std::vector<std::uint8_t> file = encode(set);
   // An array that claims 2^40 elements: refused before any allocation.
+  // The level table, then an empty keyframe table (no gliding track).
   const auto nominal = [](auto& ar) {
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+    ar(cereal::make_size_tag(cereal::size_type(0)));
   };
+  const auto no_glide = [](auto& ar) { ar(cereal::make_size_tag(cereal::size_type(0))); };
   const std::string huge = body_bytes([&](auto& ar) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
     nominal(ar);
@@ -184,6 +187,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(5));
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
     ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+    no_glide(ar);
   });
   bad = with_body(file, inconsistent);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
@@ -195,6 +199,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
     ar(cereal::make_size_tag(cereal::size_type(6)));
     for (int i = 0; i < 6; ++i) ar(std::uint16_t(i));
     ar(cereal::make_size_tag(cereal::size_type(3)), std::uint16_t(0), std::uint16_t(9), std::uint16_t(8));
+    no_glide(ar);
   });
   bad = with_body(file, unsorted);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
@@ -202,13 +207,40 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   const std::string flat = body_bytes([&](auto& ar) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(4));
+    ar(cereal::make_size_tag(cereal::size_type(0)));
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
     ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+    no_glide(ar);
   });
   bad = with_body(file, flat);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   EXPECT_NE(why.find("nominal"), std::string::npos) << "detail: " << why;
+  // Gliding tracks: keyframes that do not increase, that stop short of the top level, and a glide array
+  // of the wrong size for its keyframes (one point, present at both keyframes: 2 pairs needed).
+  const auto one_point = [&](auto& ar, std::uint32_t k0, std::uint32_t k1, std::size_t offsets) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+    ar(cereal::make_size_tag(cereal::size_type(2)), k0, k1);
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+    ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+    ar(cereal::make_size_tag(cereal::size_type(offsets)));
+    for (std::size_t i = 0; i < offsets; ++i) ar(std::int16_t(-3));
+  };
+  const struct {
+    std::uint32_t k0, k1;
+    std::size_t offsets;
+    const char* says;
+  } gliding[] = {{8, 8, 4, "keyframe counts"}, {4, 8, 4, "last keyframe"}, {4, 16, 2, "glide offsets"}};
+  for (const auto& g : gliding) {
+    bad = with_body(file, body_bytes([&](auto& ar) { one_point(ar, g.k0, g.k1, g.offsets); }));
+    EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent) << g.says;
+    EXPECT_NE(why.find(g.says), std::string::npos) << "detail: " << why;
+  }
+  bad = with_body(file, body_bytes([&](auto& ar) { one_point(ar, 4, 16, 4); }));
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kOk) << why;
+  EXPECT_EQ(out.tiles[0].glide.size(), 4u);
   // A tile count that disagrees with the header.
   const std::string miscounted =
       body_bytes([](auto& ar) { ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(900)); });

@@ -25,6 +25,16 @@ std::uint32_t crc32(const std::vector<std::uint8_t>& bytes) {
   return ~crc;
 }
 
+/// The format version in the file's header (bytes 8..11, little-endian); the decoder accepts several.
+unsigned file_version(const char* path) {
+  std::uint8_t bytes[12] = {};
+  if (std::FILE* f = std::fopen(path, "rb")) {
+    if (std::fread(bytes, 1, sizeof bytes, f) != sizeof bytes) bytes[8] = bytes[9] = bytes[10] = bytes[11] = 0;
+    std::fclose(f);
+  }
+  return bytes[8] | bytes[9] << 8 | bytes[10] << 16 | unsigned(bytes[11]) << 24;
+}
+
 void put16(std::vector<std::uint8_t>& out, std::uint16_t v) {
   out.push_back(static_cast<std::uint8_t>(v));
   out.push_back(static_cast<std::uint8_t>(v >> 8));
@@ -61,10 +71,11 @@ int main(int argc, char** argv) {
                  detail.c_str());
     return 1;
   }
-  // load_tileset accepts exactly this version, so it is the file's.
-  std::printf("format_version %u\n", static_cast<unsigned>(kdm::kTilesetFormatVersion));
+  std::printf("format_version %u\n", file_version(argv[1]));
   std::printf("colours %u\nlevels %u\ntiles %zu\nlevel_nominal", set.colours, set.levels, set.tiles.size());
   for (const std::uint32_t n : set.level_nominal) std::printf(" %u", n);
+  std::printf("\nkeyframe_nominal");
+  for (const std::uint32_t n : set.keyframe_nominal) std::printf(" %u", n);
   std::printf("\nrecipe_bytes %zu\nrecipe_crc32 %08x\ngenerator_version %s\n", set.recipe.size(),
               crc32({set.recipe.begin(), set.recipe.end()}), escaped(set.generator_version).c_str());
   std::vector<std::uint8_t> triples, thresholds;
@@ -89,7 +100,10 @@ int main(int argc, char** argv) {
     }
     std::printf("tile %zu points %zu level_end", t, tile.points.size());
     for (const std::uint32_t e : tile.level_end) std::printf(" %u", e);
-    std::printf(" points_crc32 %08x thresholds_crc32 %08x\n", crc32(triples), crc32(thresholds));
+    std::vector<std::uint8_t> glide;
+    for (const std::int16_t v : tile.glide) put16(glide, static_cast<std::uint16_t>(v));
+    std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x\n", crc32(triples), crc32(thresholds),
+                crc32(glide));
   }
   return 0;
 }

@@ -16,7 +16,7 @@ namespace kdm::cli {
 namespace {
 
 struct QueryArgs {
-  std::string tileset, rect, density_rect, density = "const:1", output;
+  std::string tileset, rect, density_rect, density = "const:1", output, mode = "stable";
   double scale = 1000, tile_size = 1, gamma = 1;
   bool invert = false, normalised = false;
 };
@@ -76,6 +76,7 @@ void run_query_command(const QueryArgs& a) {
   q.tile_size = a.tile_size;
   q.scale = a.scale;
   q.density = density->density;
+  q.mode = parse_mode(a.mode);
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<QueryPoint> points;
   query_all(tiles, q, points);  // origin 0: positions are world coordinates, the same bits in any query
@@ -115,6 +116,11 @@ void add_query_command(CLI::App& app) {
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
   cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();
   cmd->add_option("--tile-size", a->tile_size, "World units per tile side")->capture_default_str();
+  cmd->add_option("--mode", a->mode,
+                  "stable: points never move once they appear (placing objects); smooth: points glide with "
+                  "the density, so every density is good blue noise (stippling, sample patterns)")
+      ->check(CLI::IsMember({"stable", "smooth"}))
+      ->capture_default_str();
   cmd->add_flag("--normalised", a->normalised,
                 ".csv/.json coordinates in [0, 1) of --rect instead of world units");
   cmd->add_option("-o,--output", a->output,

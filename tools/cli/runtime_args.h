@@ -28,6 +28,11 @@ std::unique_ptr<RuntimeDensity> make_runtime_density(const DensityArg& arg, doub
 /// Loads --tileset or returns the built-in set; throws CommandError naming the problem.
 const Tileset& tileset_for(const std::string& path, Tileset& storage);
 
+/// "stable" or "smooth" (the --mode values, checked by CLI11) as a QueryMode.
+inline QueryMode parse_mode(const std::string& text) {
+  return text == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
+}
+
 /// Parses `text`, the value of `option` (named in errors), as "x0,y0,x1,y1": four finite numbers with
 /// x0 < x1 and y0 < y1. Throws CommandError.
 void parse_rect(const std::string& text, const char* option, double r[4]);

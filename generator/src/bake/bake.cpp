@@ -5,6 +5,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <map>
@@ -13,9 +15,12 @@
 #include <tuple>
 
 #include "bake/corner_layout.h"
+#include "bake/keyframes.h"
 #include "bake/progressive_order.h"
+#include "bake/run_stages.h"
 #include "bake/spacing_guard.h"
 #include "kdm/generator/sampler.h"
+#include "kdm/runtime/check.h"
 #include "kdm/runtime/version.h"
 #include "sampler/rng.h"
 
@@ -86,6 +91,10 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "min_distance") {
       if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "min_distance must be in [0, 0.7]");
       r.min_distance = v;
+    } else if (key == "keyframes") {
+      r.keyframes = static_cast<std::uint32_t>(whole(0, 32));
+    } else if (key == "glide_sweeps") {
+      r.glide_sweeps = static_cast<int>(whole(1, 1000));
     } else if (key == "temperature") {
       if (v < 0) throw InvalidArgument(where + "temperature must be >= 0");
       r.temperature = v;
@@ -94,6 +103,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     }
   }
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
+  if (keyframe_counts(r.nominal_counts(), r.keyframes).size() > kMaxKeyframes)
+    throw InvalidArgument("recipe: more than " + std::to_string(kMaxKeyframes) + " keyframes in all");
   if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty())
     throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
                           std::to_string(r.erosion) + " and edge gap " + std::to_string(r.edge_gap) +
@@ -121,6 +132,7 @@ std::string BakeRecipe::to_text() const {
   if (edge_gap != kFirstEdgeGap) s << "edge_gap " << shortest(edge_gap) << "\n";
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
   if (rank_context) s << "rank_context 1\n";
+  if (keyframes) s << "keyframes " << keyframes << "\nglide_sweeps " << glide_sweeps << "\n";
   return s.str();
 }
 
@@ -131,40 +143,6 @@ std::vector<std::uint32_t> BakeRecipe::nominal_counts() const {
 }
 
 namespace {
-
-/// One sampler run of the bake: a w×h torus of tiles with its vertex colours, producing the patches of
-/// one stage (corners; horizontal edges; vertical edges; interiors) that are not done yet.
-struct Run {
-  int stage = 0;  ///< the PatchKind it makes
-  int w = 1, h = 1;
-  std::vector<std::uint32_t> grid;  ///< vertex colours, row-major
-};
-
-// The stages of a level are the patch kinds in order (PatchKind): corners, horizontal edges, vertical
-// edges, interiors. Vertical edges come after horizontal ones so that the 1×1 runs see both.
-
-/// The runs of one level (the same for every level): each patch comes from the first run that holds it.
-std::vector<Run> plan_runs(std::uint32_t colours) {
-  std::vector<Run> runs;
-  for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({0, 1, 1, {c}});
-  for (int stage = 1; stage <= 2; ++stage) {
-    for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({stage, 1, 1, {c}});
-    for (std::uint32_t a = 0; a < colours; ++a)
-      for (std::uint32_t b = a + 1; b < colours; ++b)  // edges (a, b) and (b, a) along x, or along y
-        runs.push_back(stage == 1 ? Run{1, 2, 1, {a, b}} : Run{2, 1, 2, {a, b}});
-  }
-  const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
-  std::vector<char> covered(tiles, 0);
-  for (std::size_t t = 0; t < tiles; ++t) {
-    if (covered[t]) continue;
-    const Colouring around = Colouring::around_tile(colours, t);
-    Run run{3, 2, 2, {around.at(0, 0), around.at(1, 0), around.at(0, 1), around.at(1, 1)}};
-    for (int ty = 0; ty < 2; ++ty)
-      for (int tx = 0; tx < 2; ++tx) covered[around.tile_at(tx, ty)] = 1;
-    runs.push_back(std::move(run));
-  }
-  return runs;
-}
 
 class Baker {
  public:
@@ -177,52 +155,73 @@ class Baker {
         runs_(plan_runs(recipe.colours)) {
     if (widths_.empty()) throw InvalidArgument("recipe: the patches of some level are too narrow");
     for (std::uint32_t k = 0; k < recipe.levels; ++k)
-      for (const Run& run : runs_) total_work_ += work(k, run);
+      for (const BakeRun& run : runs_) total_work_ += work(k, run);
+    for (std::uint32_t count : keyframe_counts(nominal_, recipe_.keyframes)) total_work_ += glide_work(count);
   }
 
   TilesetData bake() {
-    const int workers = threads_ > 0 ? threads_ : default_thread_count();
     for (std::uint32_t k = 0; k < recipe_.levels; ++k) {
       levels_.emplace_back(recipe_.colours);
-      // The runs of one stage read only earlier stages: they sample concurrently (one thread each), and
-      // their patches are kept in run order, so the result is the same for any thread count.
-      for (std::size_t first = 0; first < runs_.size();) {
-        std::size_t last = first;
-        while (last < runs_.size() && runs_[last].stage == runs_[first].stage &&
-               last - first < static_cast<std::size_t>(workers))
-          ++last;
-        std::vector<Sampled> batch(last - first);
-        if (batch.size() == 1) {
-          batch[0] = sample_run(k, first, threads_);
-        } else {
-          std::vector<std::exception_ptr> errors(batch.size());
-          std::vector<std::thread> pool;
-          for (std::size_t i = 0; i < batch.size(); ++i)
-            pool.emplace_back([&, i] {
-              try {
-                batch[i] = sample_run(k, first + i, 1);
-              } catch (...) {
-                errors[i] = std::current_exception();
-              }
-            });
-          for (std::thread& t : pool) t.join();
-          for (const std::exception_ptr& e : errors)
-            if (e) std::rethrow_exception(e);
-        }
-        for (std::size_t i = 0; i < batch.size(); ++i) {
-          keep_patches(k, first + i, batch[i]);
-          done_work_ += work(k, runs_[first + i]);
-          if (progress_) progress_(done_work_ / total_work_);
-        }
-        first = last;
-      }
+      for_each_run(
+          runs_, threads_, [&](std::size_t r, int threads) { return sample_run(k, r, threads); },
+          [&](std::size_t r, Sampled& sampled) {
+            keep_patches(k, r, sampled);
+            done_work_ += work(k, runs_[r]);
+            if (progress_) progress_(done_work_ / total_work_);
+          });
+    }
+    table_.colours = recipe_.colours;
+    table_.levels = recipe_.levels;
+    table_.level_nominal.assign(nominal_.begin(), nominal_.end());
+    const std::vector<std::uint32_t> keyframes = keyframe_counts(nominal_, recipe_.keyframes);
+    table_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
+    for (std::size_t g = 0; g < keyframes.size(); ++g) {
+      relax_keyframe(levels_, widths_, runs_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
+      if (std::getenv("KDM_GLIDE_DEBUG")) debug_keyframe(g);
+      done_work_ += glide_work(keyframes[g]);
+      if (progress_) progress_(done_work_ / total_work_);
     }
     return assemble();
   }
 
  private:
-  double work(std::uint32_t level, const Run& run) const {
+  double work(std::uint32_t level, const BakeRun& run) const {
     return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
+  }
+
+  void debug_keyframe(std::size_t g) const {
+    const double dh = std::sqrt(2.0 / (std::sqrt(3.0) * table_.keyframe_nominal[g]));
+    int pairs = 0;
+    for (std::size_t t = 0; t < 16; ++t) {
+      const Colouring col = Colouring::around_tile(recipe_.colours, t);
+      struct P { double x, y; int level, kind; double sx, sy; };
+      std::vector<P> pts;
+      for (std::uint32_t j = 0; j < levels_.size(); ++j)
+        for (int kind = 0; kind < 4; ++kind) {
+          std::array<bool, 4> kinds{};
+          kinds[kind] = true;
+          std::vector<double> xy; std::vector<std::uint16_t> keys; std::vector<PatchPointRef> refs;
+          gather(levels_[j], col, kinds, 0, 0, 1, 1, xy, &keys, &refs);
+          for (std::size_t i = 0; i < refs.size(); ++i) {
+            if (!TilesetData::emits(table_.emission_threshold(j, keys[i]), table_.keyframe_nominal[g])) continue;
+            const auto& f = refs[i].patch->frames;
+            if (f.size() <= g || f[g].empty()) { std::printf("missing frame g=%zu level %u kind %d\n", g, j, kind); continue; }
+            pts.push_back({refs[i].anchor_x + f[g][2 * refs[i].index], refs[i].anchor_y + f[g][2 * refs[i].index + 1], int(j), kind, xy[2*i], xy[2*i+1]});
+          }
+        }
+      for (std::size_t a = 0; a < pts.size(); ++a)
+        for (std::size_t b = a + 1; b < pts.size(); ++b)
+          if (std::hypot(pts[a].x - pts[b].x, pts[a].y - pts[b].y) < 0.3 * dh && pairs++ < 10)
+            std::printf("g=%zu tile %zu: L%d k%d (%.3f %.3f) stable (%.3f %.3f) ~ L%d k%d (%.3f %.3f) stable (%.3f %.3f)\n", g, t,
+                        pts[a].level, pts[a].kind, pts[a].x, pts[a].y, pts[a].sx, pts[a].sy, pts[b].level, pts[b].kind, pts[b].x, pts[b].y, pts[b].sx, pts[b].sy);
+    }
+    std::printf("g=%zu close pairs %d\n", g, pairs);
+  }
+
+  double glide_work(std::uint32_t count) const {
+    double area = 0;
+    for (const BakeRun& run : runs_) area += run.w * run.h;
+    return area * count * recipe_.glide_sweeps;
   }
 
   /// A sampled run: its torus, the points it conditioned on and what it drew.
@@ -234,7 +233,7 @@ class Baker {
 
   /// Samples run `r` of level k (reads earlier levels and stages only; safe to call concurrently).
   Sampled sample_run(std::uint32_t k, std::size_t r, int threads) const {
-    const Run& run = runs_[r];
+    const BakeRun& run = runs_[r];
     Colouring col = Colouring::torus(recipe_.colours, run.w, run.h, run.grid);
     // Context: every earlier level, and this level's patches of earlier stages (with their keys).
     RankingInput rank;
@@ -274,7 +273,7 @@ class Baker {
 
   /// Keeps (and ranks) the patches of run `r`'s stage that no earlier run made.
   void keep_patches(std::uint32_t k, std::size_t r, Sampled& sampled) {
-    const Run& run = runs_[r];
+    const BakeRun& run = runs_[r];
     const Colouring& col = sampled.col;
     RankingInput& rank = sampled.rank;
     const SampleResult& result = sampled.result;
@@ -356,20 +355,19 @@ class Baker {
 
   /// Every tile (sw, se, ne, nw): its share of the patches around it, level by level, sorted by key.
   TilesetData assemble() const {
-    TilesetData set;
-    set.colours = recipe_.colours;
-    set.levels = recipe_.levels;
-    set.level_nominal.assign(nominal_.begin(), nominal_.end());
+    TilesetData set = table_;
     set.recipe = recipe_.to_text();
     set.generator_version = version_string();
     const std::size_t count = std::size_t(set.colours) * set.colours * set.colours * set.colours;
     for (std::size_t t = 0; t < count; ++t) {
       const Colouring col = Colouring::around_tile(set.colours, t);
       Tile tile;
+      std::vector<PatchPointRef> ranked;  // where each point of the tile comes from, by rank
       for (const LevelPatches& level : levels_) {
         std::vector<double> xy;
         std::vector<std::uint16_t> keys;
-        gather(level, col, {true, true, true, true}, 0, 0, 1, 1, xy, &keys);
+        std::vector<PatchPointRef> refs;
+        gather(level, col, {true, true, true, true}, 0, 0, 1, 1, xy, &keys, &refs);
         std::vector<std::size_t> order(keys.size());
         for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
         const auto point = [&](std::size_t i) { return TilePoint::from_unit(xy[2 * i], xy[2 * i + 1]); };
@@ -380,9 +378,21 @@ class Baker {
         for (std::size_t i : order) {
           tile.points.push_back(point(i));
           tile.keys.push_back(keys[i]);
+          ranked.push_back(refs[i]);
         }
         tile.level_end.push_back(static_cast<std::uint32_t>(tile.points.size()));
       }
+      for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+        for (std::uint32_t c = 0, n = set.glide_count(tile, g); c < n; ++c)
+          for (int axis = 0; axis < 2; ++axis) {
+            const PatchPointRef& ref = ranked[c];
+            KDM_CHECK(ref.patch->frames.size() > g && !ref.patch->frames[g].empty());
+            const double u = (axis ? ref.anchor_y : ref.anchor_x) + ref.patch->frames[g][2 * ref.index + axis];
+            const std::int64_t offset = std::llround(u * 65536.0 - 0.5) -
+                                        (axis ? tile.points[c].y : tile.points[c].x);
+            KDM_CHECK(offset >= -32768 && offset <= 32767);  // a point never glides half a tile
+            tile.glide.push_back(static_cast<std::int16_t>(offset));
+          }
       set.tiles.push_back(std::move(tile));
     }
     return set;
@@ -393,8 +403,9 @@ class Baker {
   const std::function<void(double)>& progress_;
   std::vector<std::uint32_t> nominal_;
   std::vector<PatchWidths> widths_;
-  std::vector<Run> runs_;
+  std::vector<BakeRun> runs_;
   std::vector<LevelPatches> levels_;
+  TilesetData table_;  ///< the level and keyframe counts (no tiles)
   double total_work_ = 0, done_work_ = 0;
 };
 

@@ -82,7 +82,8 @@ bool place_new_point(double x, double y, PatchKind kind, PatchWidths w, const Co
 }
 
 void gather(const LevelPatches& level, const Colouring& col, std::array<bool, 4> kinds, double x0, double y0,
-            double x1, double y1, std::vector<double>& xy, std::vector<std::uint16_t>* keys) {
+            double x1, double y1, std::vector<double>& xy, std::vector<std::uint16_t>* keys,
+            std::vector<PatchPointRef>* refs) {
   const std::size_t C = col.colours;
   const std::int64_t ax0 = floor_int(x0) - 1, ax1 = floor_int(x1) + 1;
   const std::int64_t ay0 = floor_int(y0) - 1, ay1 = floor_int(y1) + 1;
@@ -92,6 +93,7 @@ void gather(const LevelPatches& level, const Colouring& col, std::array<bool, 4>
       if (x < x0 || x >= x1 || y < y0 || y >= y1) continue;
       xy.insert(xy.end(), {x - x0, y - y0});
       if (keys) keys->push_back(patch.keys[i]);
+      if (refs) refs->push_back({&patch, static_cast<std::uint32_t>(i), double(anchor_x) - x0, double(anchor_y) - y0});
     }
   };
   for (std::int64_t ay = ay0; ay <= ay1; ++ay)
@@ -113,6 +115,28 @@ std::vector<PatchWidths> patch_widths(double band, double erosion, double edge_g
     if (!(widths.back().edge >= 0.5 * spacing)) return {};
   }
   return widths;
+}
+
+std::vector<BakeRun> plan_runs(std::uint32_t colours) {
+  std::vector<BakeRun> runs;
+  for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({0, 1, 1, {c}});
+  for (int stage = 1; stage <= 2; ++stage) {
+    for (std::uint32_t c = 0; c < colours; ++c) runs.push_back({stage, 1, 1, {c}});
+    for (std::uint32_t a = 0; a < colours; ++a)
+      for (std::uint32_t b = a + 1; b < colours; ++b)  // edges (a, b) and (b, a) along x, or along y
+        runs.push_back(stage == 1 ? BakeRun{1, 2, 1, {a, b}} : BakeRun{2, 1, 2, {a, b}});
+  }
+  const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
+  std::vector<char> covered(tiles, 0);
+  for (std::size_t t = 0; t < tiles; ++t) {
+    if (covered[t]) continue;
+    const Colouring around = Colouring::around_tile(colours, t);
+    BakeRun run{3, 2, 2, {around.at(0, 0), around.at(1, 0), around.at(0, 1), around.at(1, 1)}};
+    for (int ty = 0; ty < 2; ++ty)
+      for (int tx = 0; tx < 2; ++tx) covered[around.tile_at(tx, ty)] = 1;
+    runs.push_back(std::move(run));
+  }
+  return runs;
 }
 
 std::size_t tile_around(std::uint32_t colours, std::size_t index, int tx, int ty) {

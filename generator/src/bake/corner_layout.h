@@ -33,6 +33,9 @@ struct Patch {
   std::vector<double> xy;
   std::vector<std::uint16_t> keys;
   bool done = false;
+  /// Gliding track: frames[g] holds every point's position (relative to the anchor, like xy) at keyframe
+  /// g; points not present there keep their stable position. Empty until keyframe g is relaxed.
+  std::vector<std::vector<double>> frames;
   std::size_t size() const { return keys.size(); }
   void add(double x, double y, std::uint16_t key) {
     xy.insert(xy.end(), {x, y});
@@ -98,11 +101,34 @@ Placement classify(double x, double y, PatchWidths widths, const Colouring& colo
 bool place_new_point(double x, double y, PatchKind kind, PatchWidths widths, const Colouring& colouring,
                      Placement& out);
 
+/// One point of a patch as gather() finds it: the patch, the point's index there and the anchor (minus the
+/// window's origin) its copy hangs from.
+struct PatchPointRef {
+  const Patch* patch = nullptr;
+  std::uint32_t index = 0;
+  double anchor_x = 0, anchor_y = 0;
+};
+
 /// Appends the points of `level`'s patches of the given kinds that fall in the window [x0, x1) × [y0, y1)
 /// (tile units) of the arrangement `colouring`, as (x − x0, y − y0) pairs to `xy` and their keys to `keys`
-/// (optional). Patches not yet sampled are empty and add nothing.
+/// (optional) and where they come from to `refs` (optional). Patches not yet sampled are empty and add
+/// nothing.
 void gather(const LevelPatches& level, const Colouring& colouring, std::array<bool, 4> kinds, double x0,
-            double y0, double x1, double y1, std::vector<double>& xy, std::vector<std::uint16_t>* keys);
+            double y0, double x1, double y1, std::vector<double>& xy, std::vector<std::uint16_t>* keys,
+            std::vector<PatchPointRef>* refs = nullptr);
+
+/// One sampler run of the bake: a w×h torus of tiles with its vertex colours, producing the patches of
+/// one stage (corners; horizontal edges; vertical edges; interiors) that are not done yet.
+struct BakeRun {
+  int stage = 0;  ///< the PatchKind it makes
+  int w = 1, h = 1;
+  std::vector<std::uint32_t> grid;  ///< vertex colours, row-major
+};
+
+/// The runs of one level (the same for every level), stage by stage: corners, horizontal edges, vertical
+/// edges (after the horizontal ones, so that the 1×1 runs see both), interiors. Each patch comes from the
+/// first run that holds it.
+std::vector<BakeRun> plan_runs(std::uint32_t colours);
 
 /// The patch half-widths of each level: corner h_0 = band, then shrinking by erosion / sqrt(points of
 /// level k per tile) per level; edge b_k = h_k − edge_gap spacings of level k (H and V edge patches then

@@ -51,6 +51,10 @@ struct BakeRecipe {
   /// Rank each patch's points together with the run's other new points (bake.cpp says why): points along
   /// a tile edge then appear at the same rate as elsewhere between levels. Off in recipes without it.
   bool rank_context = false;
+  /// Gliding track (keyframes.h): keyframes per level (0 = none, the set then only serves stable queries),
+  /// and the descent sweeps that relax each keyframe.
+  std::uint32_t keyframes = 0;
+  int glide_sweeps = 10;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).

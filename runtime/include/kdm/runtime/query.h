@@ -8,6 +8,12 @@
 // responds continuously, raising the scale only adds points (zoom coherence), and every decision depends
 // only on the point's canonical tile coordinates, so query(A ∪ B) = query(A) ⊎ query(B) bit for bit.
 //
+// Two emission modes (QueryMode): stable, where a point sits at one position from the density it appears
+// at on, and smooth, where points glide with the density between the set's keyframes (tileset.h), so every
+// density is a good blue-noise set. Both emit the same points (the same ids at the same densities); in
+// smooth mode the expected count that decides emission, taken at the point's stable position, also sets
+// where it glides to, so chunk consistency and determinism hold the same way.
+//
 // Thread safety: a Tileset is immutable after loading; any number of threads may query it at once.
 // Queries allocate nothing, take no locks and touch no global state.
 #pragma once
@@ -47,6 +53,15 @@ class KDM_RUNTIME_API Tileset {
   const float* thresholds(std::size_t index) const { return thresholds_[index].data(); }
   /// The lowest threshold of any point: below it no tile emits anything.
   double min_threshold() const { return min_threshold_; }
+  /// Whether the set has a gliding track (smooth queries then glide; without one they emit stable
+  /// positions).
+  bool has_glide() const { return !set_.keyframe_nominal.empty(); }
+  /// Tile `index`'s start of each keyframe's offsets in Tile::glide, in offset pairs (keyframes + 1
+  /// entries: keyframe g's pairs are [start[g], start[g + 1]), one per rank below keyframe_count).
+  const std::uint32_t* glide_start(std::size_t index) const { return glide_start_[index].data(); }
+  /// The largest distance any point glides from its stable position, per axis, in tile sides: smooth
+  /// queries look this far beyond their region for points that glide into it.
+  double glide_reach() const { return glide_reach_; }
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
   /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
   /// same size; its compressed bytes in the library's data section are extra. Thread-safe.
@@ -56,7 +71,9 @@ class KDM_RUNTIME_API Tileset {
   void adopt(TilesetData&& set);
   TilesetData set_;
   TilesetArray<TilesetArray<float>> thresholds_;
+  TilesetArray<TilesetArray<std::uint32_t>> glide_start_;
   double min_threshold_ = 0;
+  double glide_reach_ = 0;
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).
@@ -104,12 +121,25 @@ struct QueryDensity {
   double callback_max = 1;
 };
 
+/// How emitted points move as the density changes.
+enum class QueryMode : int {
+  /// A point never moves once it appears: for placing objects that must not shift when the density or the
+  /// level of detail changes. The sets are nested, so densities between the tile set's levels (×4 apart)
+  /// are poorer blue noise than the levels themselves (docs/quality.md).
+  kStable = 0,
+  /// Points glide continuously with the density (never jump), so every density is a good blue-noise set:
+  /// for stippling and sample patterns. Ids, emission densities and zoom coherence by id are those of
+  /// stable mode. A tile set without a gliding track emits its stable positions.
+  kSmooth = 1,
+};
+
 struct QueryParams {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< half-open world region [x0, x1) × [y0, y1)
   double origin_x = 0, origin_y = 0;      ///< subtracted from every output position
   double tile_size = 1;                   ///< world units per tile side
   double scale = 1;                       ///< points per unit area at density 1
   QueryDensity density;
+  QueryMode mode = QueryMode::kStable;
 };
 
 /// Most tiles one query may cover (2^24): a bound on the work of a single call, whatever the region.
@@ -144,6 +174,7 @@ struct QueryProblem {
                           ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
                           ///< largest tile size that fits this scale
     kCursorMismatch,      ///< the cursor was started by a call with other parameters (or damaged)
+    kBadMode,             ///< `parameter` ("mode") is not a QueryMode; `value` holds it
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage

@@ -10,6 +10,14 @@
 // (emission_threshold). Points that several tiles share near corners and edges have the same key in all of
 // them, so every tile emits the same subset of them at any density: mid-level densities stay seamless.
 //
+// Gliding (smooth emission): a set may also carry keyframes, expected counts K_0 < … < K_{G-1} = N_top
+// per tile (keyframe_nominal). At keyframe g every point emitted there (threshold < K_g) has a position
+// of its own, stored as an offset from its stable position (Tile::glide); between two keyframes a point
+// moves linearly from its position at the one to its position at the next. A point that appears between
+// them has a position at the earlier one too (where it enters), so it glides in from there. Each keyframe
+// was relaxed as a whole, so densities between levels are good blue noise too, and points still appear in
+// rank order.
+//
 // File layout (all integers little-endian):
 //   offset  size  field
 //        0     8  magic "KDMTILES"
@@ -25,7 +33,8 @@
 //       60     4  CRC-32 of the whole header with this field read as zero
 //       64     …  recipe text, then generator version text
 //   header size … payload: zstd-compressed cereal portable-binary archive: colours, levels, tile count,
-//                  level_nominal, then per tile its level_end, x y pairs and keys
+//                  level_nominal, keyframe_nominal, then per tile its level_end, x y pairs, keys and
+//                  glide offsets (format 2, still read: no keyframe_nominal and no glide)
 // The file is exactly header size + payload size bytes long.
 //
 // Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
@@ -67,6 +76,7 @@ inline constexpr std::uint64_t kMaxTilesetPayloadBytes = 512ull << 20;  ///< dec
 inline constexpr std::uint32_t kMaxTilesetHeaderBytes = 1u << 20;
 inline constexpr std::uint32_t kMaxTileColours = 16;  ///< at most 16^4 = 65536 tiles
 inline constexpr std::uint32_t kMaxTileLevels = 16;
+inline constexpr std::uint32_t kMaxKeyframes = 256;
 
 /// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
 struct TilePoint {
@@ -90,6 +100,11 @@ struct Tile {
   TilesetArray<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   TilesetArray<std::uint32_t> level_end;
+  /// Gliding offsets (x, y pairs, in units of 1/65536 of the tile side, from the point's stable position):
+  /// keyframe 0's for ranks [0, count_0), then keyframe 1's for [0, count_1), …, where count_g is
+  /// TilesetData::glide_count (the points present at keyframe g or appearing before the next one).
+  /// Empty without keyframes.
+  TilesetArray<std::int16_t> glide;
   /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
   std::uint32_t level_of(std::uint32_t rank) const {
     std::uint32_t k = 0;
@@ -97,7 +112,7 @@ struct Tile {
     return k;
   }
   friend bool operator==(const Tile& a, const Tile& b) {
-    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end;
+    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end && a.glide == b.glide;
   }
 };
 
@@ -107,6 +122,9 @@ struct TilesetData {
   /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
   /// strictly increasing, positive. Emission thresholds are placed between these.
   TilesetArray<std::uint32_t> level_nominal;
+  /// Keyframes of the gliding track, expected points per tile: strictly increasing, the last one the top
+  /// level's nominal count. Empty: the set has no gliding track (smooth queries then emit stable positions).
+  TilesetArray<std::uint32_t> keyframe_nominal;
   TilesetArray<Tile> tiles;       ///< index tile_index(sw, se, ne, nw)
   std::string recipe;             ///< the recipe text that rebuilds this set exactly
   std::string generator_version;  ///< the kdm version that baked it
@@ -123,14 +141,34 @@ struct TilesetData {
   /// The emission rule, stated once for the runtime and the generator test: a point with threshold
   /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
   static bool emits(float threshold, double expected) { return expected > threshold; }
+  /// How many of `tile`'s points have a position at keyframe g: those present there or appearing before
+  /// the next keyframe (they glide in from it); every point at the last keyframe. A prefix of its ranks.
+  std::uint32_t glide_count(const Tile& tile, std::size_t g) const {
+    return g + 1 < keyframe_nominal.size() ? keyframe_count(tile, g + 1)
+                                           : static_cast<std::uint32_t>(tile.points.size());
+  }
+  /// How many of `tile`'s points are present at keyframe g (threshold < K_g: a prefix of its ranks).
+  std::uint32_t keyframe_count(const Tile& tile, std::size_t g) const {
+    std::uint32_t lo = 0, hi = static_cast<std::uint32_t>(tile.points.size());
+    while (lo < hi) {  // thresholds grow with rank
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      if (emits(emission_threshold(tile.level_of(mid), tile.keys[mid]), keyframe_nominal[g]))
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    return lo;
+  }
   friend bool operator==(const TilesetData& a, const TilesetData& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
+           a.keyframe_nominal == b.keyframe_nominal &&
            a.tiles == b.tiles && a.recipe == b.recipe && a.generator_version == b.generator_version;
   }
 };
 
 /// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
-/// counts, one key per point, keys sorted within each level).
+/// counts, one key per point, keys sorted within each level, keyframes increasing up to the top level,
+/// one glide offset pair per point present at each keyframe).
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
 KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 

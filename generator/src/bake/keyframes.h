@@ -1,0 +1,36 @@
+// The gliding track of a tile set (kdm/runtime/tileset.h): keyframes between the pyramid's levels, at each
+// of which the points present are relaxed as a whole, so that a query in smooth mode shows a good
+// blue-noise set at every density, not only at the levels.
+//
+// Nested sets cannot do that: when no point ever moves, the worst density between two levels ×4 apart has
+// δavg ≈ .70 whatever the ranking (docs/design.md §4). Here the points present at keyframe g (a prefix of
+// every tile's ranks, chosen by the same thresholds as the stable emission) start where keyframe g − 1 left
+// them, the new ones at their stable positions, and descend the KDM energy (T = 0) for a few sweeps.
+//
+// Shared patches stay shared: keyframes are relaxed with the pyramid's own schedule of runs (run_stages.h).
+// A run of stage s moves every point of patches of kind >= s on its torus, with the kinds before s fixed at
+// their positions of this keyframe, and keeps the moves of the patches of kind s it is the first to hold,
+// so each point moves once per keyframe, the same way in every tile that holds it.
+//
+// Thread safety: relax_keyframe uses up to `threads` threads of its own; calls must not overlap.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "bake/corner_layout.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm::gen {
+
+/// The keyframe counts: N_0, then `per_level` steps per level in geometric progression, each level's last
+/// step its nominal count (rounded to whole points). Empty if per_level is 0.
+std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal, std::uint32_t per_level);
+
+/// Relaxes keyframe g: every patch of the levels up to `table.keyframe_nominal[g]` gets frames[g] (keyframe
+/// g − 1 must be done). `table` supplies the nominal and keyframe counts (its tiles are not read). Descends
+/// `sweeps` sweeps; `seed` picks the sweep order.
+void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<PatchWidths>& widths,
+                    const std::vector<BakeRun>& runs, const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed, int threads);
+
+}  // namespace kdm::gen
