@@ -1,6 +1,7 @@
 // The C interface (kdm_runtime.h) over kdm/runtime/query.h. Nothing here throws (it builds with
 // -fno-exceptions); allocations that fail return KDM_OUT_OF_MEMORY where the library checks them.
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <new>
 #include <vector>
@@ -57,9 +58,10 @@ void write_grown(const T& value, T* out) {
   out->struct_size = size;
 }
 
-constexpr std::size_t kQueryV1 = sizeof(kdm_query);
+// The sizes of the first versions of the structs: later fields read as zero from older callers.
+constexpr std::size_t kQueryV1 = offsetof(kdm_query, mode);
 constexpr std::size_t kProblemV1 = sizeof(kdm_query_problem);
-constexpr std::size_t kInfoV1 = sizeof(kdm_tileset_info);
+constexpr std::size_t kInfoV1 = offsetof(kdm_tileset_info, keyframes);
 
 }  // namespace
 
@@ -116,6 +118,7 @@ kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* in
   v.resident_bytes = tileset->set->resident_bytes();
   v.generator_version = d.generator_version.c_str();
   v.recipe = d.recipe.c_str();
+  v.keyframes = static_cast<uint32_t>(d.keyframe_nominal.size());
   write_grown(v, info);
   return KDM_OK;
 }
@@ -166,6 +169,7 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
     q.x0 = c.x0, q.y0 = c.y0, q.x1 = c.x1, q.y1 = c.y1;
     q.origin_x = c.origin_x, q.origin_y = c.origin_y;
     q.tile_size = c.tile_size, q.scale = c.scale;
+    q.mode = static_cast<kdm::QueryMode>(c.mode);  // query_points refuses values it does not know
     if (c.density_image) {
       q.density.kind = kdm::QueryDensity::Kind::kImage;
       q.density.image = &c.density_image->view;

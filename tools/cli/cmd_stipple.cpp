@@ -19,7 +19,7 @@ namespace kdm::cli {
 namespace {
 
 struct StippleArgs {
-  std::string image, output, method = "tiles", region, tileset;
+  std::string image, output, method = "tiles", region, tileset, mode = "smooth";
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0;
   bool invert = false;
@@ -64,7 +64,7 @@ std::string frame_path(const std::string& output, int i) {
 class TileStippler {
  public:
   TileStippler(const StippleArgs& a, const DensityArg& arg, double aspect)
-      : tiles_(tileset_for(a.tileset, storage_)), aspect_(aspect) {
+      : tiles_(tileset_for(a.tileset, storage_)), aspect_(aspect), mode_(parse_mode(a.mode)) {
     density_ = make_runtime_density(arg, 0, 0, aspect, 1);
     // The scale that gives --points over the whole image (∫ρ dA = mean · aspect).
     scale_ = a.points > 0 ? a.points / (density_->mean_value * aspect) : a.scale;
@@ -82,6 +82,7 @@ class TileStippler {
     q.tile_size = tile_size_;
     q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
     q.density = density_->density;
+    q.mode = mode_;
     std::vector<QueryPoint> points;
     query_all(tiles_, q, points);
     const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
@@ -92,6 +93,7 @@ class TileStippler {
   Tileset storage_;
   const Tileset& tiles_;
   double aspect_, scale_ = 0, tile_size_ = 1;
+  QueryMode mode_;
   std::unique_ptr<RuntimeDensity> density_;
 };
 
@@ -194,6 +196,11 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
   cmd->add_option("--seed", a->seed, "Random seed for --method full")->capture_default_str();
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
+  cmd->add_option("--mode", a->mode,
+                  "--method tiles: smooth (dots glide with the density: good blue noise at every tone) or "
+                  "stable (dots never move as the density or zoom changes)")
+      ->check(CLI::IsMember({"stable", "smooth"}))
+      ->capture_default_str();
   cmd->callback([a] {
     if (a->scale > 0) a->points = 0;
     run_stipple(*a);

@@ -5,8 +5,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <map>
@@ -176,8 +174,7 @@ class Baker {
     const std::vector<std::uint32_t> keyframes = keyframe_counts(nominal_, recipe_.keyframes);
     table_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
-      relax_keyframe(levels_, widths_, runs_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
-      if (std::getenv("KDM_GLIDE_DEBUG")) debug_keyframe(g);
+      relax_keyframe(levels_, runs_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
@@ -187,35 +184,6 @@ class Baker {
  private:
   double work(std::uint32_t level, const BakeRun& run) const {
     return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
-  }
-
-  void debug_keyframe(std::size_t g) const {
-    const double dh = std::sqrt(2.0 / (std::sqrt(3.0) * table_.keyframe_nominal[g]));
-    int pairs = 0;
-    for (std::size_t t = 0; t < 16; ++t) {
-      const Colouring col = Colouring::around_tile(recipe_.colours, t);
-      struct P { double x, y; int level, kind; double sx, sy; };
-      std::vector<P> pts;
-      for (std::uint32_t j = 0; j < levels_.size(); ++j)
-        for (int kind = 0; kind < 4; ++kind) {
-          std::array<bool, 4> kinds{};
-          kinds[kind] = true;
-          std::vector<double> xy; std::vector<std::uint16_t> keys; std::vector<PatchPointRef> refs;
-          gather(levels_[j], col, kinds, 0, 0, 1, 1, xy, &keys, &refs);
-          for (std::size_t i = 0; i < refs.size(); ++i) {
-            if (!TilesetData::emits(table_.emission_threshold(j, keys[i]), table_.keyframe_nominal[g])) continue;
-            const auto& f = refs[i].patch->frames;
-            if (f.size() <= g || f[g].empty()) { std::printf("missing frame g=%zu level %u kind %d\n", g, j, kind); continue; }
-            pts.push_back({refs[i].anchor_x + f[g][2 * refs[i].index], refs[i].anchor_y + f[g][2 * refs[i].index + 1], int(j), kind, xy[2*i], xy[2*i+1]});
-          }
-        }
-      for (std::size_t a = 0; a < pts.size(); ++a)
-        for (std::size_t b = a + 1; b < pts.size(); ++b)
-          if (std::hypot(pts[a].x - pts[b].x, pts[a].y - pts[b].y) < 0.3 * dh && pairs++ < 10)
-            std::printf("g=%zu tile %zu: L%d k%d (%.3f %.3f) stable (%.3f %.3f) ~ L%d k%d (%.3f %.3f) stable (%.3f %.3f)\n", g, t,
-                        pts[a].level, pts[a].kind, pts[a].x, pts[a].y, pts[a].sx, pts[a].sy, pts[b].level, pts[b].kind, pts[b].x, pts[b].y, pts[b].sx, pts[b].sy);
-    }
-    std::printf("g=%zu close pairs %d\n", g, pairs);
   }
 
   double glide_work(std::uint32_t count) const {

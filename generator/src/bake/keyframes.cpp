@@ -3,8 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include "bake/run_stages.h"
@@ -133,8 +131,7 @@ void separate(std::vector<double>& xy, const std::vector<std::size_t>& moving, c
   }
 }
 
-FrameRun relax_run(const std::vector<LevelPatches>& levels, const std::vector<PatchWidths>& widths,
-                   const BakeRun& run, const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed,
+FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed,
                    int threads) {
   const Colouring col = Colouring::torus(table.colours, run.w, run.h, run.grid);
   const std::uint32_t count = table.keyframe_nominal[g];
@@ -214,64 +211,24 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const std::vector<Pa
     double dx = out.start[2 * i] - stable[2 * i], dy = out.start[2 * i + 1] - stable[2 * i + 1];
     out.shift[2 * i] = dx - run.w * std::round(dx / run.w), out.shift[2 * i + 1] = dy - run.h * std::round(dy / run.h);
   }
-  // A corner or edge point moves only inside its kind's region of this keyframe's level: beyond it, its
-  // neighbours differ from tile to tile, and a move worked out on this torus would land on some of them.
-  const PatchWidths region = widths[top];
-  std::vector<char> frozen(out.refs.size(), 0);
-  for (std::size_t i = 0; i < out.refs.size(); ++i)
-    if (out.kinds[i] == run.stage && run.stage < 3 && !std::getenv("KDM_NO_FREEZE"))
-      frozen[i] = static_cast<int>(classify(out.start[2 * i], out.start[2 * i + 1], region, col).kind) != run.stage;
   out.end = out.start;
   SamplerOptions o;
   o.extent[0] = run.w, o.extent[1] = run.h;
-  const char* env = std::getenv("KDM_GLIDE_T");
-  o.temperature = env ? std::atof(env) : 0.0;
-  o.burn_in_sweeps = o.temperature > 0 ? 3 : sweeps;
-  o.sweeps = o.temperature > 0 ? sweeps : 0;
+  o.temperature = 0;
+  o.burn_in_sweeps = sweeps;  // descent; no MH sweeps follow at T = 0
+  o.sweeps = 0;
   o.numerics = Numerics::kOriginal;
   o.threads = threads;
   o.seed = seed;
-  const std::size_t fixed_count = fixed.size();
   o.fixed_points = std::move(fixed);
-  std::vector<std::size_t> moving;
-  for (std::size_t i = 0; i < out.refs.size(); ++i) {
-    const double u[2] = {out.start[2 * i] / run.w, out.start[2 * i + 1] / run.h};
-    (frozen[i] ? o.fixed_points : o.initial_points).insert(frozen[i] ? o.fixed_points.end() : o.initial_points.end(), u, u + 2);
-    if (!frozen[i]) moving.push_back(i);
-  }
-  if (!moving.empty()) {
-    const SampleResult relaxed = sample(o);
-    for (std::size_t m = 0; m < moving.size(); ++m) {
-      out.end[2 * moving[m]] = relaxed.points[2 * m] * run.w;
-      out.end[2 * moving[m] + 1] = relaxed.points[2 * m + 1] * run.h;
-    }
-  }
-  // Every point this run owns may be pushed: frozen ones too (a frozen arrival can land on a neighbour).
-  std::vector<std::size_t> owned(out.refs.size());
-  for (std::size_t i = 0; i < owned.size(); ++i) owned[i] = i;
-  o.fixed_points.resize(fixed_count);  // the frozen ones are in out.end
-  separate(out.end, owned, o.fixed_points, run.w, run.h, kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * count)));
-  if (std::getenv("KDM_GLIDE_DEBUG")) {
-    const double dh = 0.3 * std::sqrt(2.0 / (std::sqrt(3.0) * count));
-    int pairs = 0;
-    std::vector<double> all(o.fixed_points);
-    for (std::size_t i = 0; i < all.size(); i += 2) all[i] *= run.w, all[i + 1] *= run.h;
-    for (std::size_t i = 0; i < out.refs.size(); ++i) {
-      if (out.kinds[i] != run.stage || frozen[i]) continue;
-      for (std::size_t k = 0; k < all.size(); k += 2) {
-        double ex = all[k] - out.end[2 * i], ey = all[k + 1] - out.end[2 * i + 1];
-        ex -= run.w * std::round(ex / run.w), ey -= run.h * std::round(ey / run.h);
-        if (std::hypot(ex, ey) < dh) ++pairs;
-      }
-      for (std::size_t k = 0; k < out.refs.size(); ++k) {
-        if (k == i) continue;
-        double ex = out.end[2 * k] - out.end[2 * i], ey = out.end[2 * k + 1] - out.end[2 * i + 1];
-        ex -= run.w * std::round(ex / run.w), ey -= run.h * std::round(ey / run.h);
-        if (std::hypot(ex, ey) < dh) ++pairs;
-      }
-    }
-    if (pairs) std::printf("  run stage %d %dx%d g=%zu torus pairs %d\n", run.stage, run.w, run.h, g, pairs);
-  }
+  for (std::size_t i = 0; i < out.start.size(); i += 2)
+    o.initial_points.insert(o.initial_points.end(), {out.start[i] / run.w, out.start[i + 1] / run.h});
+  const SampleResult relaxed = sample(o);
+  for (std::size_t i = 0; i < out.end.size(); i += 2)
+    out.end[i] = relaxed.points[i] * run.w, out.end[i + 1] = relaxed.points[i + 1] * run.h;
+  std::vector<std::size_t> moving(out.refs.size());
+  for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i;
+  separate(out.end, moving, o.fixed_points, run.w, run.h, kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * count)));
   return out;
 }
 
@@ -292,12 +249,12 @@ std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nom
   return counts;
 }
 
-void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<PatchWidths>& widths,
-                    const std::vector<BakeRun>& runs, const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed, int threads) {
+void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
+                    const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed, int threads) {
   for_each_run(
       runs, threads,
       [&](std::size_t r, int run_threads) {
-        return relax_run(levels, widths, runs[r], table, g, sweeps, mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)),
+        return relax_run(levels, runs[r], table, g, sweeps, mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)),
                          run_threads);
       },
       [&](std::size_t r, FrameRun& result) {

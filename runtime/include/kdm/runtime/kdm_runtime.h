@@ -58,7 +58,12 @@ typedef struct kdm_query {
   void* user;
   double density_max;                     /* upper bound of the callback's values */
   const kdm_density_image* density_image; /* optional; takes precedence over the callback */
+  /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
+  int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
+               density, so every density is good blue noise (tile sets with a gliding track) */
 } kdm_query;
+
+enum { KDM_MODE_STABLE = 0, KDM_MODE_SMOOTH = 1 };
 
 typedef struct kdm_cursor {
   int64_t tile_x, tile_y;
@@ -78,7 +83,8 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_TOO_MANY_TILES = 6,   /* `value` tiles, more than `limit`: split the region */
   KDM_PROBLEM_DENSITY_TOO_HIGH = 7, /* `value` points per tile > `limit`; see largest_valid (scale) and
                                        largest_tile_size */
-  KDM_PROBLEM_CURSOR_MISMATCH = 8   /* the cursor was started by a query with other parameters */
+  KDM_PROBLEM_CURSOR_MISMATCH = 8,  /* the cursor was started by a query with other parameters */
+  KDM_PROBLEM_BAD_MODE = 9          /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
@@ -97,6 +103,8 @@ typedef struct kdm_tileset_info {
   size_t resident_bytes;         /* heap bytes the loaded set occupies */
   const char* generator_version; /* the kdm version that baked it; valid while the tile set lives */
   const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
+  /* Added in 0.2: */
+  uint32_t keyframes; /* keyframes of its gliding track (0: none; smooth queries emit stable positions) */
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`
