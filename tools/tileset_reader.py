@@ -248,12 +248,14 @@ def decode(data):
         if len(xy) % 2:
             raise TilesetError(f"tile {t} has an odd number of coordinates ({len(xy)})")
         keys = reader.array("H", f"tile {t} keys")
-        glide = reader.array("h", f"tile {t} glide") if gliding else array.array("h")
+        glide = reader.array("H", f"tile {t} glide") if gliding else array.array("H")
         ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys, glide))
     if reader.remaining():
         raise TilesetError(f"body has {reader.remaining()} bytes after the last tile")
 
     _validate(ts)
+    for tile in ts.tiles:
+        tile.glide = _glide_from_stored(ts, tile, tile.glide)
     ts.recipe = bytes(data[FIXED_HEADER_BYTES : FIXED_HEADER_BYTES + recipe_size])
     ts.generator_version = bytes(data[FIXED_HEADER_BYTES + recipe_size : header_size])
     return ts
@@ -299,6 +301,18 @@ def _validate(ts):
         needed = 2 * sum(ts.glide_count(tile, g) for g in range(len(ts.keyframe_nominal)))
         if len(tile.glide) != needed:
             raise TilesetError(f"tile {t} has {len(tile.glide)} glide offsets, its keyframes need {needed}")
+
+
+def _glide_from_stored(ts, tile, stored):
+    """Doc §8: an offset with one at the keyframe before is stored as the difference (mod 2^16)."""
+    values = list(stored)
+    at, before = 0, 0
+    for g in range(len(ts.keyframe_nominal)):
+        n = 2 * ts.glide_count(tile, g)
+        for i in range(min(before, n)):
+            values[at + i] = (values[at + i] + values[at - before + i]) & 0xFFFF
+        at, before = at + n, n
+    return array.array("h", [v - 65536 if v >= 32768 else v for v in values])
 
 
 def load(path):

@@ -2,6 +2,7 @@
  * bad input with its detail, cursor misuse, status codes. */
 #include <kdm/runtime/kdm_runtime.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -116,9 +117,16 @@ int main(int argc, char** argv) {
     CHECK(problem.limit == 32768 && fabs(problem.largest_valid - 32768) < 1e-6);
     CHECK(fabs(problem.largest_tile_size - sqrt(0.32768)) < 1e-9);
     CHECK(strlen(kdm_problem_message(problem.kind)) > 0);
-    q.struct_size = sizeof q - 8; /* a struct older than the first one with struct_size */
+    q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(strcmp(problem.parameter, "query.struct_size") == 0);
+    q = uniform_query();
+    q.mode = 7;
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_BAD_MODE && strcmp(problem.parameter, "mode") == 0);
+    q.struct_size = offsetof(kdm_query, mode); /* a caller built before `mode`: stable, whatever follows */
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_BUFFER_FULL);
   }
   CHECK(kdm_query_points(NULL, &q, NULL, 0, NULL, NULL, NULL) == KDM_INVALID_ARGUMENT);
 
