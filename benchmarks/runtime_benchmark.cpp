@@ -28,6 +28,13 @@ kdm::QueryParams params() {
   return q;
 }
 
+// The query benchmarks take the mode as their argument: smooth:0 stable, smooth:1 smooth (gliding).
+kdm::QueryParams params(const benchmark::State& state) {
+  kdm::QueryParams q = params();
+  q.mode = state.range(0) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable;
+  return q;
+}
+
 std::size_t run_query(const kdm::QueryParams& q, std::vector<kdm::QueryPoint>& buffer) {
   kdm::QueryCursor cursor;
   std::size_t written = 0, total = 0;
@@ -80,7 +87,7 @@ void run_against_baseline(benchmark::State& state, Query&& query) {
 
 void BM_QueryConstant(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 20);
-  run_against_baseline(state, [&] { return run_query(params(), buffer); });
+  run_against_baseline(state, [&] { return run_query(params(state), buffer); });
 }
 
 void BM_QueryDensityImage(benchmark::State& state) {
@@ -94,7 +101,7 @@ void BM_QueryDensityImage(benchmark::State& state) {
   image.x1 = image.y1 = kSide;
   image.values = values.data();
   kdm::make_density_max_mip(image, mip);
-  kdm::QueryParams q = params();
+  kdm::QueryParams q = params(state);
   q.density.kind = kdm::QueryDensity::Kind::kImage;
   q.density.image = &image;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
@@ -106,7 +113,7 @@ double ramp(void*, double x, double) {
 }
 
 void BM_QueryDensityCallback(benchmark::State& state) {
-  kdm::QueryParams q = params();
+  kdm::QueryParams q = params(state);
   q.density.kind = kdm::QueryDensity::Kind::kCallback;
   q.density.callback = ramp;
   q.density.callback_max = 1;
@@ -134,9 +141,9 @@ void BM_LoadBuiltinSet(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_QueryConstant)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_QueryDensityImage)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_QueryDensityCallback)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryDensityCallback)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

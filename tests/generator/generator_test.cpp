@@ -41,6 +41,13 @@ VerifyOptions parts(bool statistics, bool direct_check, bool seams) {
   VerifyOptions o;
   o.spectrum_budget = kSpectrumBudget;
   o.statistics = statistics, o.direct_check = direct_check, o.seams = seams;
+  o.keyframes = false;
+  return o;
+}
+
+VerifyOptions keyframes_only() {
+  VerifyOptions o = parts(false, false, false);
+  o.keyframes = true;
   return o;
 }
 
@@ -54,6 +61,10 @@ void expect_all_pass(const Report& report) {
     for (const Check& c : d.checks)
       EXPECT_TRUE(c.passed()) << d.points_per_tile << " points per tile: " << c.name << " " << c.value
                               << (c.at_most ? " > " : " < ") << c.bar;
+  for (const KeyframeResult& k : report.keyframes)
+    for (const Check& c : k.checks)
+      EXPECT_TRUE(c.passed()) << "gliding at " << k.points_per_tile << " points per tile: " << c.name << " "
+                              << c.value << (c.at_most ? " > " : " < ") << c.bar;
 }
 
 TEST(GeneratorTest, EveryTileAndLevelMatchesTheFullSampler) {
@@ -73,6 +84,30 @@ TEST(GeneratorTest, TileEdgesAndInBetweenDensitiesLookLikeTheRest) {
   const Report report = verify_tileset(shipped(), parts(false, false, true));
   EXPECT_EQ(report.densities.size(), 4 * shipped().levels - 3);  // complete levels and quarters between
   expect_all_pass(report);
+}
+
+TEST(GeneratorTest, GlidingTrackIsBlueAtAndBetweenKeyframesAndMovesLittle) {
+  ASSERT_FALSE(shipped().keyframe_nominal.empty()) << "the shipped set has a gliding track";
+  const Report report = verify_tileset(shipped(), keyframes_only());
+  EXPECT_EQ(report.keyframes.size(), 2 * shipped().keyframe_nominal.size() - 1);  // keyframes, half-ways
+  for (const KeyframeResult& k : report.keyframes) EXPECT_GE(k.checks.size(), 1u);  // δavg at least
+  expect_all_pass(report);
+}
+
+// A tile whose gliding offsets at one keyframe are shifted by a tenth of a tile: the motion into and out
+// of that keyframe must be flagged.
+TEST(GeneratorTest, VerifierFlagsAJumpInTheGlidingTrack) {
+  TilesetData damaged = shipped();
+  ASSERT_GT(damaged.keyframe_nominal.size(), 4u);
+  Tile& tile = damaged.tiles[5];
+  std::size_t at = 0;
+  for (std::size_t g = 0; g < 3; ++g) at += 2 * damaged.glide_count(tile, g);
+  for (std::size_t i = 0; i < 2 * damaged.glide_count(tile, 3); ++i) tile.glide[at + i] += 6554;
+  const Report report = verify_tileset(damaged, keyframes_only());
+  bool flagged = false;
+  for (const KeyframeResult& k : report.keyframes)
+    for (const Check& c : k.checks) flagged = flagged || (c.name == "motion p99" && !c.passed());
+  EXPECT_TRUE(flagged);
 }
 
 // A tile whose points of one level are replaced by uniformly random ones: the statistics and the direct

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <new>
 #include <random>
 #include <thread>
@@ -55,28 +56,39 @@ std::vector<Key> run(const QueryParams& q, std::size_t capacity = 1 << 16) {
   return keys;
 }
 
-QueryParams region(double x0, double y0, double x1, double y1, double scale) {
+QueryParams region(double x0, double y0, double x1, double y1, double scale,
+                   QueryMode mode = QueryMode::kStable) {
   QueryParams q;
   q.x0 = x0, q.y0 = y0, q.x1 = x1, q.y1 = y1;
   q.scale = scale;
+  q.mode = mode;
   return q;
 }
+
+constexpr QueryMode kModes[] = {QueryMode::kStable, QueryMode::kSmooth};
 
 TEST(QueryTest, BuiltinTilesetIsAvailable) {
   const Tileset& t = Tileset::builtin();
   EXPECT_FALSE(t.empty());
   EXPECT_EQ(t.max_points_per_tile(), t.data().level_nominal.back());
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
-  // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, plus small tables.
-  std::size_t points = 0;
-  for (const Tile& tile : t.data().tiles) points += tile.points.size();
-  EXPECT_GE(t.resident_bytes(), 10 * points);
-  EXPECT_LE(t.resident_bytes(), 10 * points + 64 * 1024);
+  // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, 4 per gliding position,
+  // plus small tables.
+  ASSERT_TRUE(t.has_glide());
+  std::size_t points = 0, glide = 0;
+  for (const Tile& tile : t.data().tiles) points += tile.points.size(), glide += tile.glide.size();
+  EXPECT_GE(t.resident_bytes(), 10 * points + 2 * glide);
+  EXPECT_LE(t.resident_bytes(), 10 * points + 2 * glide + 64 * 1024);
   EXPECT_LT(Tileset{}.resident_bytes(), 1024u);
 }
 
-TEST(QueryTest, AnyPartitionGivesTheSameUnionBitForBit) {
-  const QueryParams whole = region(-3.3, -2.1, 4.7, 5.9, 900);
+class ModeTest : public ::testing::TestWithParam<QueryMode> {};
+INSTANTIATE_TEST_SUITE_P(QueryTest, ModeTest, ::testing::ValuesIn(kModes), [](const auto& info) {
+  return std::string(info.param == QueryMode::kStable ? "Stable" : "Smooth");
+});
+
+TEST_P(ModeTest, AnyPartitionGivesTheSameUnionBitForBit) {
+  const QueryParams whole = region(-3.3, -2.1, 4.7, 5.9, 900, GetParam());
   std::vector<Key> expected = run(whole);
   std::sort(expected.begin(), expected.end());
   ASSERT_GT(expected.size(), 10000u);
@@ -103,6 +115,26 @@ TEST(QueryTest, AnyPartitionGivesTheSameUnionBitForBit) {
   }
 }
 
+TEST(QueryTest, SmoothModeKeepsEveryPointAsTheScaleRisesAndGlides) {
+  // The same ids as stable mode at every scale (zoom coherence by id); positions differ, but little: a
+  // point glides at most Tileset::glide_reach() tile sides from its stable position.
+  for (double scale : {300.0, 1300.0}) {
+    std::vector<Key> stable = run(region(-1, -1, 4, 4, scale)), smooth = run(region(-1, -1, 4, 4, scale, QueryMode::kSmooth));
+    std::map<std::tuple<std::int64_t, std::int64_t, std::uint32_t>, std::pair<double, double>> at;
+    for (const auto& [tx, ty, rank, x, y] : smooth) at[{tx, ty, rank}] = {x, y};
+    std::size_t inside = 0, moved = 0;
+    for (const auto& [tx, ty, rank, x, y] : stable) {
+      if (x < 0 || x >= 3 || y < 0 || y >= 3) continue;  // away from the border, where points glide in and out
+      ++inside;
+      const auto it = at.find({tx, ty, rank});
+      ASSERT_NE(it, at.end());
+      EXPECT_LE(std::hypot(it->second.first - x, it->second.second - y), Tileset::builtin().glide_reach() * 1.5);
+      moved += it->second.first != x || it->second.second != y;
+    }
+    EXPECT_GT(moved, inside / 2);
+  }
+}
+
 TEST(QueryTest, RaisingTheScaleKeepsEveryPoint) {
   std::vector<Key> low = run(region(0, 0, 3, 3, 300)), high = run(region(0, 0, 3, 3, 1300));
   std::sort(low.begin(), low.end());
@@ -111,8 +143,8 @@ TEST(QueryTest, RaisingTheScaleKeepsEveryPoint) {
   EXPECT_TRUE(std::includes(high.begin(), high.end(), low.begin(), low.end()));
 }
 
-TEST(QueryTest, ResumesAFullBufferAndIsDeterministicAcrossThreads) {
-  const QueryParams q = region(0.5, 0.5, 2.5, 2.5, 2000);
+TEST_P(ModeTest, ResumesAFullBufferAndIsDeterministicAcrossThreads) {
+  const QueryParams q = region(0.5, 0.5, 2.5, 2.5, 2000, GetParam());
   const std::vector<Key> whole = run(q);
   EXPECT_EQ(run(q, 7), whole);  // tiny buffer, many resumes
   std::vector<Key> other;
@@ -323,7 +355,7 @@ TEST(QueryTest, TheCApiSharesTheBuiltinSet) {
   EXPECT_EQ(info.recipe, Tileset::builtin().data().recipe.c_str());
 }
 
-TEST(QueryTest, QueriesDoNotAllocate) {
+TEST_P(ModeTest, QueriesDoNotAllocate) {
   std::vector<QueryPoint> buffer(4096);
   const Tileset& t = Tileset::builtin();  // decode outside the measured window
   const long before = g_allocations.load();
@@ -331,7 +363,7 @@ TEST(QueryTest, QueriesDoNotAllocate) {
   for (int i = 0; i < 20; ++i) {
     QueryCursor cursor;
     std::size_t written = 0;
-    QueryParams q = region(i * 0.37, 0, i * 0.37 + 2, 2, 500);
+    QueryParams q = region(i * 0.37, 0, i * 0.37 + 2, 2, 500, GetParam());
     while (query_points(t, q, buffer.data(), buffer.size(), &written, &cursor) == Status::kBufferFull)
       total += written;
     total += written;

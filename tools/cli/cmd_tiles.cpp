@@ -56,7 +56,9 @@ void run_info(const std::string& path) {
   const std::size_t resident = loaded.resident_bytes();
   std::printf("resident       %zu bytes (%.3g MiB) once loaded by the runtime\n", resident,
               double(resident) / (1 << 20));
-  std::printf("format         version %u\n", kTilesetFormatVersion);
+  unsigned char header[12] = {};
+  std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(header), sizeof header);  // loaded: ok
+  std::printf("format         version %u\n", header[8] | header[9] << 8 | header[10] << 16 | unsigned(header[11]) << 24);
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
   std::printf("levels         %u\n", set.levels);
@@ -69,6 +71,12 @@ void run_info(const std::string& path) {
   std::printf("points/tile    %u to %u (top level, actual)\n", fewest, most);
   std::printf("density range  1 : %.0f (level 0 to level %u)\n",
               double(set.level_nominal.back()) / set.level_nominal.front(), set.levels - 1);
+  if (set.keyframe_nominal.empty())
+    std::printf("gliding track  none (--mode smooth emits stable positions)\n");
+  else
+    std::printf("gliding track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
+                set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
+                loaded.glide_reach());
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());

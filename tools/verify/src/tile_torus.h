@@ -37,4 +37,8 @@ std::vector<double> densities(const TilesetData& set, const std::vector<std::uin
 void judge_densities(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 
+/// Part 5 (glide.cpp): appends a KeyframeResult per keyframe and half-way density to `report`.
+void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
+                     const std::function<void(double)>& done);
+
 }  // namespace kdm::verify

@@ -175,6 +175,10 @@ bool all_passed(const std::vector<Check>& checks) {
 bool TileResult::passed() const {
   return all_passed(checks);
 }
+bool KeyframeResult::passed() const {
+  return all_passed(checks);
+}
+
 bool DensityResult::passed() const {
   return all_passed(checks);
 }
@@ -185,6 +189,8 @@ std::size_t Report::failed_checks() const {
     for (const Check& c : t.checks) failed += !c.passed();
   for (const DensityResult& d : densities)
     for (const Check& c : d.checks) failed += !c.passed();
+  for (const KeyframeResult& k : keyframes)
+    for (const Check& c : k.checks) failed += !c.passed();
   return failed;
 }
 
@@ -208,6 +214,8 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     if (options.direct_check) total += set.tiles.size() * 4 * n;
     if (options.seams) total += set.tiles.size() * 4 * n * (k ? 4 : 1);
   }
+  if (options.keyframes)
+    for (std::uint32_t n : set.keyframe_nominal) total += set.tiles.size() * 4 * 2.0 * n;
   const auto done = [&](double units) {
     finished += units;
     if (options.progress) options.progress(std::min(1.0, finished / total));
@@ -227,6 +235,7 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     }
   }
   if (options.seams) judge_densities(set, options, report, done);
+  if (options.keyframes) judge_keyframes(set, options, report, done);
   if (options.progress) options.progress(1.0);
   return report;
 }

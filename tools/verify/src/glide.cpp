@@ -1,0 +1,102 @@
+// Part 5 of the generator test (verify.h): the gliding track. For every keyframe, over every tile's 2×2
+// torus, the points at their keyframe positions (δavg, closest pair), the same half-way to the next
+// keyframe (where the points present glide between two relaxed sets), and how far the points move from
+// one keyframe to the next, in point spacings (d_hex) of the later one.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "kdm/analysis/common.h"
+#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/generator/bake.h"
+#include "kdm/verify/verify.h"
+#include "tile_torus.h"
+
+namespace kdm::verify {
+namespace {
+
+/// Where each keyframe's offsets of tile `t` start in its glide array (in offset pairs).
+std::vector<std::size_t> glide_starts(const TilesetData& set, const Tile& tile) {
+  std::vector<std::size_t> start(set.keyframe_nominal.size() + 1, 0);
+  for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) start[g + 1] = start[g] + set.glide_count(tile, g);
+  return start;
+}
+
+/// The 2×2 torus around tile `t` at expected count `count` in smooth mode between keyframes g0 and g1
+/// (fraction s from g0), normalised to the unit square; `ids` (optional) receives (tile slot, rank).
+std::vector<double> glide_torus(const TilesetData& set, std::size_t t, double count, std::size_t g0,
+                                std::size_t g1, double s, std::vector<std::pair<int, std::uint32_t>>* ids) {
+  std::vector<double> all;
+  for (int ty = 0; ty < 2; ++ty)
+    for (int tx = 0; tx < 2; ++tx) {
+      const Tile& tile = set.tiles[gen::tile_around(set.colours, t, tx, ty)];
+      const std::vector<std::size_t> start = glide_starts(set, tile);
+      for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
+        for (; i < tile.level_end[k]; ++i) {
+          if (!TilesetData::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
+          const std::int16_t* o0 = &tile.glide[2 * (start[g0] + i)];
+          const std::int16_t* o1 = &tile.glide[2 * (start[g1] + i)];
+          double u = (tile.points[i].x + 0.5 + o0[0] + s * (o1[0] - o0[0])) / 65536.0;
+          double v = (tile.points[i].y + 0.5 + o0[1] + s * (o1[1] - o0[1])) / 65536.0;
+          u = (tx + u) / 2, v = (ty + v) / 2;
+          u -= std::floor(u), v -= std::floor(v);
+          all.insert(all.end(), {u, v});
+          if (ids) ids->push_back({2 * ty + tx, i});
+        }
+    }
+  return all;
+}
+
+}  // namespace
+
+void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
+                     const std::function<void(double)>& done) {
+  const Bars& b = options.bars;
+  const std::size_t keyframes = set.keyframe_nominal.size();
+  for (std::size_t g = 0; g < keyframes; ++g)
+    for (int half = 0; half < (g + 1 < keyframes ? 2 : 1); ++half) {
+      KeyframeResult row;
+      const double k0 = set.keyframe_nominal[g], k1 = g + 1 < keyframes ? set.keyframe_nominal[g + 1] : k0;
+      row.points_per_tile = half ? (k0 + k1) / 2 : k0;
+      row.keyframe = !half;
+      row.closest_pair = std::numeric_limits<double>::infinity();
+      std::vector<double> moves;
+      for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+        std::vector<std::pair<int, std::uint32_t>> ids;
+        const std::vector<double> coords =
+            half ? glide_torus(set, t, row.points_per_tile, g, g + 1, 0.5, &ids)
+                 : glide_torus(set, t, row.points_per_tile, g, g, 0, &ids);
+        const std::size_t n = coords.size() / 2;
+        done(double(n));
+        if (n < 2) continue;
+        const analysis::NearestNeighbors nn = analysis::nearest_neighbors(coords, 2, true, options.threads);
+        const analysis::NNStats summary = analysis::summarize_nn(nn.distance, analysis::hex_spacing(n));
+        row.davg += summary.davg / double(set.tiles.size());
+        row.closest_pair = std::min(row.closest_pair, summary.dmin);
+        if (half || g == 0) continue;
+        // Motion into this keyframe, of the tile's own points present at the last one (or entering there).
+        const Tile& tile = set.tiles[t];
+        const std::vector<std::size_t> start = glide_starts(set, tile);
+        const double spacing = analysis::hex_spacing(std::size_t(k0));  // tile sides: d_hex at K_g
+        for (std::uint32_t i = 0; i < set.glide_count(tile, g - 1); ++i) {
+          const std::int16_t* a = &tile.glide[2 * (start[g - 1] + i)];
+          const std::int16_t* c = &tile.glide[2 * (start[g] + i)];
+          moves.push_back(std::hypot(c[0] - a[0], c[1] - a[1]) / 65536.0 / spacing);
+        }
+      }
+      if (!moves.empty()) {
+        double sum = 0;
+        for (double m : moves) sum += m;
+        row.motion_mean = sum / double(moves.size());
+        row.motion_p99 = analysis::quantile(moves, 0.99);
+        row.checks.push_back({"motion p99", row.motion_p99, b.glide_motion, true});
+      } else {
+        row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
+      }
+      row.checks.push_back({"δavg", row.davg, half ? b.glide_between_davg : b.glide_keyframe_davg, false});
+      if (b.closest_pair > 0) row.checks.push_back({"closest pair", row.closest_pair, b.closest_pair, false});
+      report.keyframes.push_back(std::move(row));
+    }
+}
+
+}  // namespace kdm::verify
