@@ -136,9 +136,11 @@ struct GlideBracket {
     const std::uint32_t* k = set.keyframe_nominal.data();
     const auto n = static_cast<std::uint32_t>(set.keyframe_nominal.size());
     g1 = static_cast<std::uint32_t>(std::lower_bound(k, k + n, expected) - k);  // first K >= expected
-    if (g1 == 0) return;                    // at or below the first keyframe: no motion yet
-    if (g1 == n) g0 = g1 = n - 1;           // the top: every point at its last position
-    else g0 = g1 - 1, t = (expected - k[g0]) / double(k[g1] - k[g0]);
+    if (g1 == 0) return;  // at or below the first keyframe: no motion yet
+    if (g1 == n)
+      g0 = g1 = n - 1;  // the top: every point at its last position
+    else
+      g0 = g1 - 1, t = (expected - k[g0]) / double(k[g1] - k[g0]);
   }
 };
 
@@ -321,10 +323,10 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         }
         if (glide) {
           double dx, dy;
-          glide_offset(glide_offsets, glide_start, c,
-                       d.kind == QueryDensity::Kind::kConstant ? tile_bracket
-                                                                : GlideBracket(tileset.data(), expected),
-                       dx, dy);
+          glide_offset(
+              glide_offsets, glide_start, c,
+              d.kind == QueryDensity::Kind::kConstant ? tile_bracket : GlideBracket(tileset.data(), expected),
+              dx, dy);
           x = wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * S, y = wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * S;
           if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
         }

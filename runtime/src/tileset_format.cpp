@@ -96,10 +96,12 @@ std::vector<std::uint16_t> glide_to_stored(const TilesetData& set, const Tile& t
   std::vector<std::uint16_t> v(tile.glide.begin(), tile.glide.end());
   std::size_t at = v.size();
   for (std::size_t g = set.keyframe_nominal.size(); g-- > 1;) {  // backwards: the earlier keyframe is intact
-    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g)), before = 2 * std::size_t(set.glide_count(tile, g - 1));
+    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g)),
+                      before = 2 * std::size_t(set.glide_count(tile, g - 1));
     at -= n;
     for (std::size_t i = 0; i < before; ++i)
-      v[at + i] = static_cast<std::uint16_t>(v[at + i] - static_cast<std::uint16_t>(tile.glide[at - before + i]));
+      v[at + i] =
+          static_cast<std::uint16_t>(v[at + i] - static_cast<std::uint16_t>(tile.glide[at - before + i]));
   }
   return v;
 }
@@ -113,7 +115,8 @@ void glide_from_stored(const TilesetData& set, const std::vector<std::uint16_t>&
     const std::size_t before = g ? 2 * std::size_t(set.glide_count(tile, g - 1)) : 0;
     for (std::size_t i = 0; i < n; ++i) {
       auto v = stored[at + i];
-      if (i < before) v = static_cast<std::uint16_t>(v + static_cast<std::uint16_t>(tile.glide[at - before + i]));
+      if (i < before)
+        v = static_cast<std::uint16_t>(v + static_cast<std::uint16_t>(tile.glide[at - before + i]));
       tile.glide[at + i] = static_cast<std::int16_t>(v);
     }
     at += n;
@@ -155,7 +158,8 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
   const bool gliding = version >= 3;
   if (gliding) load_array(ar, buffer, set.keyframe_nominal);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
-  if (tile_count > buffer.remaining() / (gliding ? 32 : 24)) throw ContentError("tile count exceeds the payload");
+  if (tile_count > buffer.remaining() / (gliding ? 32 : 24))
+    throw ContentError("tile count exceeds the payload");
   set.tiles.resize(tile_count);
   std::vector<std::uint16_t> xy;
   for (Tile& tile : set.tiles) {
@@ -304,7 +308,8 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   if (version < kOldestTilesetFormatVersion || version > kTilesetFormatVersion)
     return fail(Status::kUnsupportedVersion, detail,
                 "format version " + std::to_string(version) + ", this reader supports " +
-                    std::to_string(kOldestTilesetFormatVersion) + " to " + std::to_string(kTilesetFormatVersion));
+                    std::to_string(kOldestTilesetFormatVersion) + " to " +
+                    std::to_string(kTilesetFormatVersion));
   if (size < kFixedHeaderBytes) return fail(Status::kTruncated, detail, "file ends inside the header");
   const std::uint32_t header_size = get32(p + 12);
   if (header_size < kFixedHeaderBytes || header_size > kMaxTilesetHeaderBytes)

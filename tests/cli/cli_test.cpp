@@ -421,8 +421,9 @@ Frame read_frame(const std::string& path) {
 TEST_F(CliTest, StippleFramesZoomCoherently) {
   const std::string image = std::string(KDM_SOURCE_DIR) + "/examples/sphere.png";
   // Stable mode: a dot stays where it is as the zoom raises the density (smooth mode glides them).
-  const Outcome r = kdm("stipple '" + image + "' --points 4000 --region 0.3,0.35,0.85,0.9 --frames 4 --mode stable -o '" +
-                        path("zoom.txt") + "'");
+  const Outcome r =
+      kdm("stipple '" + image + "' --points 4000 --region 0.3,0.35,0.85,0.9 --frames 4 --mode stable -o '" +
+          path("zoom.txt") + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_FALSE(fs::exists(path("zoom.txt")));
   EXPECT_FALSE(fs::exists(path("zoom_0004.txt")));

@@ -89,7 +89,7 @@ TEST(GeneratorTest, TileEdgesAndInBetweenDensitiesLookLikeTheRest) {
 TEST(GeneratorTest, GlidingTrackIsBlueAtAndBetweenKeyframesAndMovesLittle) {
   ASSERT_FALSE(shipped().keyframe_nominal.empty()) << "the shipped set has a gliding track";
   const Report report = verify_tileset(shipped(), keyframes_only());
-  EXPECT_EQ(report.keyframes.size(), 2 * shipped().keyframe_nominal.size() - 1);  // keyframes, half-ways
+  EXPECT_EQ(report.keyframes.size(), 2 * shipped().keyframe_nominal.size() - 1);    // keyframes, half-ways
   for (const KeyframeResult& k : report.keyframes) EXPECT_GE(k.checks.size(), 1u);  // δavg at least
   expect_all_pass(report);
 }

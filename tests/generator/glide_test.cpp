@@ -46,7 +46,8 @@ std::map<Key, QueryPoint> query(const Tileset& set, double x0, double y0, double
     std::size_t n = 0;
     const Status s = query_points(set, q, buffer.data(), buffer.size(), &n, &cursor);
     EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    for (std::size_t i = 0; i < n; ++i) out[{buffer[i].id.tile_x, buffer[i].id.tile_y, buffer[i].id.rank}] = buffer[i];
+    for (std::size_t i = 0; i < n; ++i)
+      out[{buffer[i].id.tile_x, buffer[i].id.tile_y, buffer[i].id.rank}] = buffer[i];
     if (s != Status::kBufferFull) break;
   }
   return out;
@@ -120,7 +121,9 @@ TEST(GlideTest, PointsGlideContinuouslyAcrossKeyframes) {
     }
 }
 
-double ramp(void*, double x, double) { return 0.2 + 0.8 * std::clamp(x / 6, 0.0, 1.0); }
+double ramp(void*, double x, double) {
+  return 0.2 + 0.8 * std::clamp(x / 6, 0.0, 1.0);
+}
 
 TEST(GlideTest, SmoothQueriesAreChunkConsistent) {
   QueryDensity varying;
@@ -130,8 +133,8 @@ TEST(GlideTest, SmoothQueriesAreChunkConsistent) {
   for (const QueryDensity& density : {QueryDensity{}, varying}) {
     const auto whole = query(small_set(), 0, 0, 6, 6, 77, QueryMode::kSmooth, density);
     std::map<Key, QueryPoint> parts;
-    for (const auto& [x0, y0, x1, y1] : {std::tuple{0.0, 0.0, 2.37, 6.0}, {2.37, 0.0, 6.0, 3.71},
-                                         {2.37, 3.71, 6.0, 6.0}}) {
+    for (const auto& [x0, y0, x1, y1] :
+         {std::tuple{0.0, 0.0, 2.37, 6.0}, {2.37, 0.0, 6.0, 3.71}, {2.37, 3.71, 6.0, 6.0}}) {
       for (const auto& [id, p] : query(small_set(), x0, y0, x1, y1, 77, QueryMode::kSmooth, density)) {
         EXPECT_TRUE(parts.emplace(id, p).second) << "a point in two parts";
       }

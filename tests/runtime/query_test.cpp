@@ -119,16 +119,19 @@ TEST(QueryTest, SmoothModeKeepsEveryPointAsTheScaleRisesAndGlides) {
   // The same ids as stable mode at every scale (zoom coherence by id); positions differ, but little: a
   // point glides at most Tileset::glide_reach() tile sides from its stable position.
   for (double scale : {300.0, 1300.0}) {
-    std::vector<Key> stable = run(region(-1, -1, 4, 4, scale)), smooth = run(region(-1, -1, 4, 4, scale, QueryMode::kSmooth));
+    std::vector<Key> stable = run(region(-1, -1, 4, 4, scale)),
+                     smooth = run(region(-1, -1, 4, 4, scale, QueryMode::kSmooth));
     std::map<std::tuple<std::int64_t, std::int64_t, std::uint32_t>, std::pair<double, double>> at;
     for (const auto& [tx, ty, rank, x, y] : smooth) at[{tx, ty, rank}] = {x, y};
     std::size_t inside = 0, moved = 0;
     for (const auto& [tx, ty, rank, x, y] : stable) {
-      if (x < 0 || x >= 3 || y < 0 || y >= 3) continue;  // away from the border, where points glide in and out
+      if (x < 0 || x >= 3 || y < 0 || y >= 3)
+        continue;  // away from the border, where points glide in and out
       ++inside;
       const auto it = at.find({tx, ty, rank});
       ASSERT_NE(it, at.end());
-      EXPECT_LE(std::hypot(it->second.first - x, it->second.second - y), Tileset::builtin().glide_reach() * 1.5);
+      EXPECT_LE(std::hypot(it->second.first - x, it->second.second - y),
+                Tileset::builtin().glide_reach() * 1.5);
       moved += it->second.first != x || it->second.second != y;
     }
     EXPECT_GT(moved, inside / 2);

@@ -29,7 +29,8 @@ std::uint32_t crc32(const std::vector<std::uint8_t>& bytes) {
 unsigned file_version(const char* path) {
   std::uint8_t bytes[12] = {};
   if (std::FILE* f = std::fopen(path, "rb")) {
-    if (std::fread(bytes, 1, sizeof bytes, f) != sizeof bytes) bytes[8] = bytes[9] = bytes[10] = bytes[11] = 0;
+    if (std::fread(bytes, 1, sizeof bytes, f) != sizeof bytes)
+      bytes[8] = bytes[9] = bytes[10] = bytes[11] = 0;
     std::fclose(f);
   }
   return bytes[8] | bytes[9] << 8 | bytes[10] << 16 | unsigned(bytes[11]) << 24;
@@ -102,8 +103,8 @@ int main(int argc, char** argv) {
     for (const std::uint32_t e : tile.level_end) std::printf(" %u", e);
     std::vector<std::uint8_t> glide;
     for (const std::int16_t v : tile.glide) put16(glide, static_cast<std::uint16_t>(v));
-    std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x\n", crc32(triples), crc32(thresholds),
-                crc32(glide));
+    std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x\n", crc32(triples),
+                crc32(thresholds), crc32(glide));
   }
   return 0;
 }

@@ -58,7 +58,8 @@ void run_info(const std::string& path) {
               double(resident) / (1 << 20));
   unsigned char header[12] = {};
   std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(header), sizeof header);  // loaded: ok
-  std::printf("format         version %u\n", header[8] | header[9] << 8 | header[10] << 16 | unsigned(header[11]) << 24);
+  std::printf("format         version %u\n",
+              header[8] | header[9] << 8 | header[10] << 16 | unsigned(header[11]) << 24);
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
   std::printf("levels         %u\n", set.levels);
@@ -74,9 +75,10 @@ void run_info(const std::string& path) {
   if (set.keyframe_nominal.empty())
     std::printf("gliding track  none (--mode smooth emits stable positions)\n");
   else
-    std::printf("gliding track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
-                set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
-                loaded.glide_reach());
+    std::printf(
+        "gliding track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
+        set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
+        loaded.glide_reach());
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());

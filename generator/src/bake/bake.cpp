@@ -355,9 +355,10 @@ class Baker {
           for (int axis = 0; axis < 2; ++axis) {
             const PatchPointRef& ref = ranked[c];
             KDM_CHECK(ref.patch->frames.size() > g && !ref.patch->frames[g].empty());
-            const double u = (axis ? ref.anchor_y : ref.anchor_x) + ref.patch->frames[g][2 * ref.index + axis];
-            const std::int64_t offset = std::llround(u * 65536.0 - 0.5) -
-                                        (axis ? tile.points[c].y : tile.points[c].x);
+            const double u =
+                (axis ? ref.anchor_y : ref.anchor_x) + ref.patch->frames[g][2 * ref.index + axis];
+            const std::int64_t offset =
+                std::llround(u * 65536.0 - 0.5) - (axis ? tile.points[c].y : tile.points[c].x);
             KDM_CHECK(offset >= -32768 && offset <= 32767);  // a point never glides half a tile
             tile.glide.push_back(static_cast<std::int16_t>(offset));
           }

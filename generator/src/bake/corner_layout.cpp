@@ -93,7 +93,9 @@ void gather(const LevelPatches& level, const Colouring& col, std::array<bool, 4>
       if (x < x0 || x >= x1 || y < y0 || y >= y1) continue;
       xy.insert(xy.end(), {x - x0, y - y0});
       if (keys) keys->push_back(patch.keys[i]);
-      if (refs) refs->push_back({&patch, static_cast<std::uint32_t>(i), double(anchor_x) - x0, double(anchor_y) - y0});
+      if (refs)
+        refs->push_back(
+            {&patch, static_cast<std::uint32_t>(i), double(anchor_x) - x0, double(anchor_y) - y0});
     }
   };
   for (std::int64_t ay = ay0; ay <= ay1; ++ay)

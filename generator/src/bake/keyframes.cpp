@@ -44,9 +44,7 @@ class DriftField {
     nx_ = std::max(1, static_cast<int>(w / cell_)), ny_ = std::max(1, static_cast<int>(h / cell_));
     cells_.resize(std::size_t(nx_) * ny_);
   }
-  void add(double x, double y, double dx, double dy) {
-    cells_[cell(x, y)].push_back({x, y, dx, dy});
-  }
+  void add(double x, double y, double dx, double dy) { cells_[cell(x, y)].push_back({x, y, dx, dy}); }
   void at(double x, double y, double& dx, double& dy) const {
     const int cx = static_cast<int>(x / w_ * nx_) % nx_, cy = static_cast<int>(y / h_ * ny_) % ny_;
     double sw = 0, sx = 0, sy = 0;
@@ -76,17 +74,19 @@ class DriftField {
 /// Pushes apart the moving points (indices into xy) that lie closer than `r` to any other point, moving or
 /// fixed (`fixed`: normalized coordinates). With γ = 1 the energy's pull towards a gap next to a point is as
 /// strong as the push of overlapping kernels, so the descent can settle a point right beside a fixed one.
-void separate(std::vector<double>& xy, const std::vector<std::size_t>& moving, const std::vector<double>& fixed,
-              int w, int h, double r) {
+void separate(std::vector<double>& xy, const std::vector<std::size_t>& moving,
+              const std::vector<double>& fixed, int w, int h, double r) {
   std::vector<double> still;
-  for (std::size_t i = 0; i < fixed.size(); i += 2) still.insert(still.end(), {fixed[i] * w, fixed[i + 1] * h});
+  for (std::size_t i = 0; i < fixed.size(); i += 2)
+    still.insert(still.end(), {fixed[i] * w, fixed[i + 1] * h});
   std::vector<char> is_moving(xy.size() / 2, 0);
   for (std::size_t i : moving) is_moving[i] = 1;
   for (std::size_t i = 0; i < is_moving.size(); ++i)
     if (!is_moving[i]) still.insert(still.end(), {xy[2 * i], xy[2 * i + 1]});
   const int nx = std::max(1, static_cast<int>(w / r)), ny = std::max(1, static_cast<int>(h / r));
   auto cell_of = [&](double x, double y) {
-    const int cx = std::min(nx - 1, static_cast<int>(x / w * nx)), cy = std::min(ny - 1, static_cast<int>(y / h * ny));
+    const int cx = std::min(nx - 1, static_cast<int>(x / w * nx)),
+              cy = std::min(ny - 1, static_cast<int>(y / h * ny));
     return std::pair<int, int>{cx, cy};
   };
   std::vector<std::vector<std::size_t>> still_cells(std::size_t(nx) * ny);
@@ -131,8 +131,8 @@ void separate(std::vector<double>& xy, const std::vector<std::size_t>& moving, c
   }
 }
 
-FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed,
-                   int threads) {
+FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, const TilesetData& table,
+                   std::size_t g, int sweeps, std::uint64_t seed, int threads) {
   const Colouring col = Colouring::torus(table.colours, run.w, run.h, run.grid);
   const std::uint32_t count = table.keyframe_nominal[g];
   const std::uint32_t previous = g ? table.keyframe_nominal[g - 1] : 0;
@@ -203,13 +203,15 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, 
   {
     std::vector<double> others = fixed;
     for (std::size_t i = 0; i < out.refs.size(); ++i)
-      if (!out.arrives[i]) others.insert(others.end(), {out.start[2 * i] / run.w, out.start[2 * i + 1] / run.h});
+      if (!out.arrives[i])
+        others.insert(others.end(), {out.start[2 * i] / run.w, out.start[2 * i + 1] / run.h});
     separate(out.start, arrivals, others, run.w, run.h,
              kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * std::max<double>(1, previous))));
   }
   for (std::size_t i : arrivals) {
     double dx = out.start[2 * i] - stable[2 * i], dy = out.start[2 * i + 1] - stable[2 * i + 1];
-    out.shift[2 * i] = dx - run.w * std::round(dx / run.w), out.shift[2 * i + 1] = dy - run.h * std::round(dy / run.h);
+    out.shift[2 * i] = dx - run.w * std::round(dx / run.w),
+                  out.shift[2 * i + 1] = dy - run.h * std::round(dy / run.h);
   }
   out.end = out.start;
   SamplerOptions o;
@@ -228,13 +230,15 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, 
     out.end[i] = relaxed.points[i] * run.w, out.end[i + 1] = relaxed.points[i + 1] * run.h;
   std::vector<std::size_t> moving(out.refs.size());
   for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i;
-  separate(out.end, moving, o.fixed_points, run.w, run.h, kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * count)));
+  separate(out.end, moving, o.fixed_points, run.w, run.h,
+           kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * count)));
   return out;
 }
 
 }  // namespace
 
-std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal, std::uint32_t per_level) {
+std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal,
+                                           std::uint32_t per_level) {
   std::vector<std::uint32_t> counts;
   if (per_level == 0 || nominal.empty()) return counts;
   counts.push_back(nominal[0]);
@@ -242,8 +246,8 @@ std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nom
     for (std::uint32_t i = 1; i <= per_level; ++i) {
       const double ratio = double(nominal[k]) / nominal[k - 1];
       const auto c = i == per_level ? nominal[k]
-                                    : static_cast<std::uint32_t>(std::lround(nominal[k - 1] *
-                                                                             std::pow(ratio, double(i) / per_level)));
+                                    : static_cast<std::uint32_t>(std::lround(
+                                          nominal[k - 1] * std::pow(ratio, double(i) / per_level)));
       if (c > counts.back()) counts.push_back(c);
     }
   return counts;
@@ -254,8 +258,8 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
   for_each_run(
       runs, threads,
       [&](std::size_t r, int run_threads) {
-        return relax_run(levels, runs[r], table, g, sweeps, mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)),
-                         run_threads);
+        return relax_run(levels, runs[r], table, g, sweeps,
+                         mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)), run_threads);
       },
       [&](std::size_t r, FrameRun& result) {
         const BakeRun& run = runs[r];
@@ -282,11 +286,14 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
           }
           if (!it->second) continue;
           // The move, unwrapped across the torus seam, added to the point's own coordinates.
-          double dx = result.end[2 * i] - result.start[2 * i], dy = result.end[2 * i + 1] - result.start[2 * i + 1];
+          double dx = result.end[2 * i] - result.start[2 * i],
+                 dy = result.end[2 * i + 1] - result.start[2 * i + 1];
           dx -= run.w * std::round(dx / run.w), dy -= run.h * std::round(dy / run.h);
           const std::vector<double>& before =
-              g > 0 && patch.frames.size() > g - 1 && !patch.frames[g - 1].empty() ? patch.frames[g - 1] : patch.xy;
-          const double x = before[2 * ref.index] + result.shift[2 * i], y = before[2 * ref.index + 1] + result.shift[2 * i + 1];
+              g > 0 && patch.frames.size() > g - 1 && !patch.frames[g - 1].empty() ? patch.frames[g - 1]
+                                                                                   : patch.xy;
+          const double x = before[2 * ref.index] + result.shift[2 * i],
+                       y = before[2 * ref.index + 1] + result.shift[2 * i + 1];
           patch.frames[g][2 * ref.index] = x + dx;
           patch.frames[g][2 * ref.index + 1] = y + dy;
           if (result.arrives[i]) {  // where it enters: its position at keyframe g - 1

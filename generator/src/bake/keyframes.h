@@ -25,7 +25,8 @@ namespace kdm::gen {
 
 /// The keyframe counts: N_0, then `per_level` steps per level in geometric progression, each level's last
 /// step its nominal count (rounded to whole points). Empty if per_level is 0.
-std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal, std::uint32_t per_level);
+std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal,
+                                           std::uint32_t per_level);
 
 /// Relaxes keyframe g: every patch of the levels up to `table.keyframe_nominal[g]` gets frames[g] (keyframe
 /// g − 1 must be done). `table` supplies the nominal and keyframe counts (its tiles are not read). Descends

@@ -18,7 +18,8 @@ namespace {
 /// Where each keyframe's offsets of tile `t` start in its glide array (in offset pairs).
 std::vector<std::size_t> glide_starts(const TilesetData& set, const Tile& tile) {
   std::vector<std::size_t> start(set.keyframe_nominal.size() + 1, 0);
-  for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) start[g + 1] = start[g] + set.glide_count(tile, g);
+  for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+    start[g + 1] = start[g] + set.glide_count(tile, g);
   return start;
 }
 
@@ -63,9 +64,9 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
       std::vector<double> moves;
       for (std::size_t t = 0; t < set.tiles.size(); ++t) {
         std::vector<std::pair<int, std::uint32_t>> ids;
-        const std::vector<double> coords =
-            half ? glide_torus(set, t, row.points_per_tile, g, g + 1, 0.5, &ids)
-                 : glide_torus(set, t, row.points_per_tile, g, g, 0, &ids);
+        const std::vector<double> coords = half
+                                               ? glide_torus(set, t, row.points_per_tile, g, g + 1, 0.5, &ids)
+                                               : glide_torus(set, t, row.points_per_tile, g, g, 0, &ids);
         const std::size_t n = coords.size() / 2;
         done(double(n));
         if (n < 2) continue;

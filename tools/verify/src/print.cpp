@@ -86,13 +86,16 @@ void print_report(const Report& report, std::FILE* out) {
     }
   }
   if (!report.keyframes.empty()) {
-    std::fprintf(out, "\ngliding track (smooth mode), over every tile's torus; motion from the keyframe before, in d_hex\n");
-    std::fprintf(out, "%11s %9s %7s %8s %11s %10s  %s\n", "points/tile", "kind", "δavg", "closest", "motion mean",
-                 "motion p99", "result");
+    std::fprintf(out,
+                 "\ngliding track (smooth mode), over every tile's torus; motion from the keyframe before, "
+                 "in d_hex\n");
+    std::fprintf(out, "%11s %9s %7s %8s %11s %10s  %s\n", "points/tile", "kind", "δavg", "closest",
+                 "motion mean", "motion p99", "result");
     for (const KeyframeResult& k : report.keyframes) {
-      std::fprintf(out, "%11.1f %9s %7.4f %s %11.3f %s  %s\n", k.points_per_tile, k.keyframe ? "keyframe" : "half-way",
-                   k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
-                   cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(), k.passed() ? "pass" : "FAIL");
+      std::fprintf(
+          out, "%11.1f %9s %7.4f %s %11.3f %s  %s\n", k.points_per_tile, k.keyframe ? "keyframe" : "half-way",
+          k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
+          cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(), k.passed() ? "pass" : "FAIL");
       checks += k.checks.size();
     }
   }
@@ -102,7 +105,8 @@ void print_report(const Report& report, std::FILE* out) {
   for (const DensityResult& d : report.densities)
     print_failures(d.checks, "at " + std::to_string(int(d.points_per_tile)) + " points per tile", out);
   for (const KeyframeResult& k : report.keyframes)
-    print_failures(k.checks, "gliding at " + std::to_string(int(k.points_per_tile)) + " points per tile", out);
+    print_failures(k.checks, "gliding at " + std::to_string(int(k.points_per_tile)) + " points per tile",
+                   out);
   const std::size_t failed = report.failed_checks();
   if (failed)
     std::fprintf(out, "%zu of %zu checks failed\n", failed, checks);

@@ -163,18 +163,18 @@ struct QueryCursor {
 /// largest value that passes (Detour-style detail, in plain values: nothing is allocated).
 struct QueryProblem {
   enum class Kind : int {
-    kNone = 0,            ///< no problem
-    kMissingArgument,     ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
-    kNotFinite,           ///< `parameter` is NaN or infinite; `value` holds it
-    kNotPositive,         ///< `parameter` ("tile_size") must be > 0; `value` holds it
-    kNegative,            ///< `parameter` ("scale", "density.callback_max") must be >= 0; `value` holds it
-    kBadDensity,          ///< `parameter` ("density.image", "density.callback") is missing or not prepared
-    kTooManyTiles,        ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
-    kDensityTooHigh,      ///< `value` expected points per tile exceed `limit` (max_points_per_tile):
-                          ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
-                          ///< largest tile size that fits this scale
-    kCursorMismatch,      ///< the cursor was started by a call with other parameters (or damaged)
-    kBadMode,             ///< `parameter` ("mode") is not a QueryMode; `value` holds it
+    kNone = 0,         ///< no problem
+    kMissingArgument,  ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
+    kNotFinite,        ///< `parameter` is NaN or infinite; `value` holds it
+    kNotPositive,      ///< `parameter` ("tile_size") must be > 0; `value` holds it
+    kNegative,         ///< `parameter` ("scale", "density.callback_max") must be >= 0; `value` holds it
+    kBadDensity,       ///< `parameter` ("density.image", "density.callback") is missing or not prepared
+    kTooManyTiles,     ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
+    kDensityTooHigh,   ///< `value` expected points per tile exceed `limit` (max_points_per_tile):
+                       ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
+                       ///< largest tile size that fits this scale
+    kCursorMismatch,   ///< the cursor was started by a call with other parameters (or damaged)
+    kBadMode,          ///< `parameter` ("mode") is not a QueryMode; `value` holds it
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage
@@ -197,7 +197,8 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// scale, a missing image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the
 /// tile set's top level (scale · max density · tile_size² > max_points_per_tile: use smaller tiles or a
 /// lower scale), or a cursor started with other params. No allocation.
-KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
-                    std::size_t* written, QueryCursor* cursor, QueryProblem* problem = nullptr);
+KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
+                                    std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                    QueryProblem* problem = nullptr);
 
 }  // namespace kdm

@@ -161,8 +161,8 @@ struct TilesetData {
   }
   friend bool operator==(const TilesetData& a, const TilesetData& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
-           a.keyframe_nominal == b.keyframe_nominal &&
-           a.tiles == b.tiles && a.recipe == b.recipe && a.generator_version == b.generator_version;
+           a.keyframe_nominal == b.keyframe_nominal && a.tiles == b.tiles && a.recipe == b.recipe &&
+           a.generator_version == b.generator_version;
   }
 };
 

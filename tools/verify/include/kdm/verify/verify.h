@@ -140,11 +140,11 @@ struct DensityResult {
 /// One keyframe of the gliding track, or the density half-way to the next one (part 5).
 struct KeyframeResult {
   double points_per_tile = 0;
-  bool keyframe = true;         ///< false: half-way between two keyframes
-  double davg = 0;              ///< mean over the tiles' tori, in smooth mode
-  double closest_pair = 0;      ///< in d_hex, over every tile's torus
-  double motion_mean = 0;       ///< keyframes: mean move from the keyframe before, in d_hex (NaN: none)
-  double motion_p99 = 0;        ///< its 99th percentile
+  bool keyframe = true;     ///< false: half-way between two keyframes
+  double davg = 0;          ///< mean over the tiles' tori, in smooth mode
+  double closest_pair = 0;  ///< in d_hex, over every tile's torus
+  double motion_mean = 0;   ///< keyframes: mean move from the keyframe before, in d_hex (NaN: none)
+  double motion_p99 = 0;    ///< its 99th percentile
   std::vector<Check> checks;
   bool passed() const;
 };
