@@ -20,7 +20,9 @@
 namespace kdm {
 namespace {
 
-TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1) {
+// A valid random set; with `glide`, a gliding track too (format 3's optional arrays, filled).
+TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1,
+                         bool glide = true) {
   std::mt19937 rng(seed);
   TilesetData set;
   set.colours = colours;
@@ -42,6 +44,16 @@ TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, st
     }
     for (std::uint32_t i = 0; i < count; ++i)
       tile.points.push_back({static_cast<std::uint16_t>(rng()), static_cast<std::uint16_t>(rng())});
+  }
+  if (glide && levels > 1) {
+    for (std::uint32_t k = 0; k < levels; ++k) {  // N_k and a step half-way to the next level
+      set.keyframe_nominal.push_back(set.level_nominal[k]);
+      if (k + 1 < levels) set.keyframe_nominal.push_back((set.level_nominal[k] + set.level_nominal[k + 1]) / 2);
+    }
+    for (Tile& tile : set.tiles)
+      for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+        for (std::uint32_t i = 0; i < 2 * set.glide_count(tile, g); ++i)
+          tile.glide.push_back(static_cast<std::int16_t>(rng()));
   }
   return set;
 }
@@ -85,9 +97,14 @@ std::vector<std::uint8_t> with_body(std::vector<std::uint8_t> file, const std::s
 }
 
 TEST(TilesetFormatTest, RoundTripIsExact) {
-  const TilesetData set = make_tileset();
-  const std::vector<std::uint8_t> bytes = encode(set);
+  const TilesetData without = make_tileset(2, 3, 1, /*glide=*/false);
+  const std::vector<std::uint8_t> plain = encode(without);
   TilesetData back;
+  ASSERT_EQ(decode_tileset(plain.data(), plain.size(), back), Status::kOk);
+  EXPECT_TRUE(back == without);
+  const TilesetData set = make_tileset();
+  ASSERT_FALSE(set.tiles[0].glide.empty());
+  const std::vector<std::uint8_t> bytes = encode(set);
   ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
   EXPECT_EQ(back, set);
   const std::string path = testing::TempDir() + "/roundtrip.kdmt";
@@ -253,6 +270,31 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   bad = with_body(file, inconsistent, inconsistent.size() + 1);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kDecompressionFailed);
   EXPECT_TRUE(out.tiles.empty());
+}
+
+TEST(TilesetFormatTest, Version2FilesStillLoad) {
+  // A format-2 file: the same header, a body without keyframe_nominal and glide arrays.
+  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
+  put32(&file[8], 2);
+  file = with_body(file, body_bytes([](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(2));
+    ar(cereal::make_size_tag(cereal::size_type(4)), std::uint16_t(7), std::uint16_t(9), std::uint16_t(70),
+       std::uint16_t(90));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(5), std::uint16_t(3));
+  }));
+  TilesetData out;
+  std::string why;
+  ASSERT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kOk) << why;
+  EXPECT_EQ(out.tiles[0].points.size(), 2u);
+  EXPECT_TRUE(out.keyframe_nominal.empty());
+  EXPECT_TRUE(out.tiles[0].glide.empty());
+  // The same body under version 3 lacks its arrays: refused, never misread.
+  put32(&file[8], 3);
+  put32(&file[60], 0);
+  put32(&file[60], detail::crc32(file.data(), get32(&file[12])));
+  EXPECT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kInvalidContent);
 }
 
 TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
