@@ -53,13 +53,15 @@ void Tileset::adopt(TilesetData&& set) {
   }
   // Where each keyframe's offsets start in every tile, and how far any point glides.
   glide_start_.assign(set_.tiles.size(), {});
-  glide_reach_ = 0;
+  glide_reach_.assign(set_.keyframe_nominal.size(), 0.0);
   for (std::size_t t = 0; t < set_.tiles.size() && has_glide(); ++t) {
     TilesetArray<std::uint32_t>& start = glide_start_[t];
     start.assign(set_.keyframe_nominal.size() + 1, 0);
-    for (std::size_t g = 0; g < set_.keyframe_nominal.size(); ++g)
+    for (std::size_t g = 0; g < set_.keyframe_nominal.size(); ++g) {
       start[g + 1] = start[g] + set_.glide_count(set_.tiles[t], g);
-    for (std::int16_t v : set_.tiles[t].glide) glide_reach_ = std::max(glide_reach_, std::fabs(v) / 65536.0);
+      for (std::size_t i = 2 * std::size_t(start[g]); i < 2 * std::size_t(start[g + 1]); ++i)
+        glide_reach_[g] = std::max(glide_reach_[g], std::fabs(set_.tiles[t].glide[i]) / 65536.0);
+    }
   }
   min_threshold_ = HUGE_VAL;
   for (const TilesetArray<float>& t : thresholds_)
@@ -76,7 +78,8 @@ std::size_t Tileset::resident_bytes() const {
              t.level_end.capacity() * sizeof(std::uint32_t);
   for (const TilesetArray<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
   bytes += glide_start_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
-           set_.keyframe_nominal.capacity() * sizeof(std::uint32_t);
+           set_.keyframe_nominal.capacity() * sizeof(std::uint32_t) +
+           glide_reach_.capacity() * sizeof(double);
   for (const TilesetArray<std::uint32_t>& t : glide_start_) bytes += t.capacity() * sizeof(std::uint32_t);
   for (const Tile& t : set_.tiles) bytes += t.glide.capacity() * sizeof(std::int16_t);
   return bytes;
@@ -261,9 +264,15 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     why.largest_tile_size = std::sqrt(top / (max_density * q.scale));
     return Status::kInvalidArgument;
   }
-  // Smooth mode visits the tiles whose points can glide into the region too.
+  // Smooth mode visits the tiles whose points can glide into the region too: as far as any glides at the
+  // keyframes a constant density's points sit between, or at any keyframe up to a varying one's maximum.
   const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide();
-  const double reach = glide ? tileset.glide_reach() * S : 0.0;
+  double reach = 0;
+  if (glide) {
+    const GlideBracket top(tileset.data(), max_density * area_scale);
+    for (std::uint32_t g = d.kind == QueryDensity::Kind::kConstant ? top.g0 : 0; g <= top.g1; ++g)
+      reach = std::max(reach, tileset.glide_reach(g) * S);
+  }
   const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
   const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);
   if (!(max_density * area_scale > tileset.min_threshold())) {  // no tile can emit even its first point
@@ -313,7 +322,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         }
         const TilePoint p = tile.points[c];
         double x = wx + p.unit_x() * S, y = wy + p.unit_y() * S;
-        if (!glide && (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1)) continue;
+        if (x < q.x0 - reach || x >= q.x1 + reach || y < q.y0 - reach || y >= q.y1 + reach) continue;
         double expected = limit;
         if (d.kind != QueryDensity::Kind::kConstant) {
           const double rho =

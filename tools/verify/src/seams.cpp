@@ -50,10 +50,8 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
       const std::size_t n = coords.size() / 2;
       done(double(n));
       if (n < 2) continue;
-      const analysis::NearestNeighbors nn = analysis::nearest_neighbors(coords, 2, true, options.threads);
-      const analysis::NNStats summary = analysis::summarize_nn(nn.distance, analysis::hex_spacing(n));
-      row.davg += summary.davg / double(set.tiles.size());
-      row.closest_pair = std::min(row.closest_pair, summary.dmin);
+      analysis::NearestNeighbors nn;
+      add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
       analysis::add_edge_bands(coords, 2, 0.5, bands);
       std::vector<double> edge, inside;
       analysis::split_by_seam(coords, 2, nn, 0.5, edge, inside);

@@ -1,10 +1,13 @@
 // Shared pieces of the generator test: the 2×2 torus around a tile, and freeing points among fixed ones.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "kdm/analysis/common.h"
+#include "kdm/analysis/nearest_neighbor.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
 #include "kdm/verify/verify.h"
@@ -28,6 +31,20 @@ struct Relaxed {
 /// sweeps of the full sampler at user temperature `temperature`. `spacing` normalises the drift.
 Relaxed relax(const std::vector<double>& own, const std::vector<double>& others, double side,
               double temperature, double spacing, std::uint64_t seed, int threads);
+
+/// Nearest neighbours of a tile's torus (`coords`, normalised, at least 2 points) into `nn`, and their
+/// summary in d_hex of its point count; adds the summary's δavg / `tiles` and δmin to `row`'s davg and
+/// closest_pair (a DensityResult or KeyframeResult).
+template <class Row>
+analysis::NNStats add_torus_nn(const std::vector<double>& coords, std::size_t tiles, int threads,
+                               analysis::NearestNeighbors& nn, Row& row) {
+  nn = analysis::nearest_neighbors(coords, 2, true, threads);
+  const analysis::NNStats summary =
+      analysis::summarize_nn(nn.distance, analysis::hex_spacing(coords.size() / 2));
+  row.davg += summary.davg / double(tiles);
+  row.closest_pair = std::min(row.closest_pair, summary.dmin);
+  return summary;
+}
 
 /// The expected counts per tile judged for `levels`: each complete level and the quarters below it.
 std::vector<double> densities(const TilesetData& set, const std::vector<std::uint32_t>& levels);

@@ -18,6 +18,7 @@
 // Queries allocate nothing, take no locks and touch no global state.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -59,9 +60,14 @@ class KDM_RUNTIME_API Tileset {
   /// Tile `index`'s start of each keyframe's offsets in Tile::glide, in offset pairs (keyframes + 1
   /// entries: keyframe g's pairs are [start[g], start[g + 1]), one per rank below keyframe_count).
   const std::uint32_t* glide_start(std::size_t index) const { return glide_start_[index].data(); }
-  /// The largest distance any point glides from its stable position, per axis, in tile sides: smooth
-  /// queries look this far beyond their region for points that glide into it.
-  double glide_reach() const { return glide_reach_; }
+  /// The largest distance any point glides from its stable position, per axis, in tile sides, at keyframe
+  /// g or at any: smooth queries look this far beyond their region for points that glide into it.
+  double glide_reach(std::size_t g) const { return glide_reach_[g]; }
+  double glide_reach() const {
+    double r = 0;
+    for (double v : glide_reach_) r = std::max(r, v);
+    return r;
+  }
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
   /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
   /// same size; its compressed bytes in the library's data section are extra. Thread-safe.
@@ -73,7 +79,7 @@ class KDM_RUNTIME_API Tileset {
   TilesetArray<TilesetArray<float>> thresholds_;
   TilesetArray<TilesetArray<std::uint32_t>> glide_start_;
   double min_threshold_ = 0;
-  double glide_reach_ = 0;
+  TilesetArray<double> glide_reach_;
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).
