@@ -125,7 +125,7 @@ KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
  * free with kdm_tileset_free, or NULL on failure. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
-/* The default tile set compiled into the library: decoded on first use (tens of milliseconds; call it
+/* The default tile set compiled into the library: decoded on first use (about 0.1 s; call it
  * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). Never free
  * it. */
 KDM_RUNTIME_API const kdm_tileset* kdm_tileset_builtin(void);

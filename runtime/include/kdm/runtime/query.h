@@ -36,7 +36,7 @@ class KDM_RUNTIME_API Tileset {
   static Status load_file(const std::string& path, Tileset& out, std::string* detail = nullptr);
   static Status load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail = nullptr);
   /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe. It is decoded on
-  /// the first call, which takes tens of milliseconds (docs/performance.md): call it once at start-up to
+  /// the first call, which takes about 0.1 s (docs/performance.md): call it once at start-up to
   /// keep that out of a frame. The C API's kdm_tileset_builtin() shares this copy.
   static const Tileset& builtin();
 
