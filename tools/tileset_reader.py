@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""An independent reader of kdm tile sets (.kdmt, format versions 2 and 3).
+"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 4).
 
 Written from docs/tileset-format.md alone, not from the C++ sources: the test
 runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
@@ -15,6 +15,7 @@ Every check the document asks of a reader is made; a failure exits with status 1
 """
 import argparse
 import array
+import math
 import struct
 import sys
 import zlib
@@ -24,9 +25,10 @@ try:
 except ImportError:  # the reader is useless without it: say what to install
     zstandard = None
 
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 OLDEST_FORMAT_VERSION = 2
 MAX_KEYFRAMES = 256
+GLIDE_UNITS_PER_SPACING = 32.0
 MAGIC = b"KDMTILES"
 FIXED_HEADER_BYTES = 64
 HEADER_CRC_OFFSET = 60
@@ -46,7 +48,7 @@ class Tile:
         self.xs = xs  # array('H'), x of each point in 1/65536 of the tile side
         self.ys = ys
         self.keys = keys  # array('H'), emission key of each point
-        self.glide = glide  # array('h'), gliding offsets (x, y pairs), empty without keyframes
+        self.glide = glide  # array('b'), gliding offsets (x, y pairs, Tileset.glide_unit), empty without keyframes
 
     def levels_of_points(self):
         """The level of every point: point i is in level k iff level_end[k-1] <= i < level_end[k]."""
@@ -78,6 +80,10 @@ class Tileset:
     def emits(self, level, key, expected):
         """Doc §7: emitted iff the tile's expected point count exceeds the threshold."""
         return expected > self.threshold(level, key)
+
+    def glide_unit(self, g):
+        """Doc §8: keyframe g's glide offset unit in tile sides."""
+        return 1.0 / (GLIDE_UNITS_PER_SPACING * math.sqrt(self.keyframe_nominal[g]))
 
     def glide_count(self, tile, g):
         """Doc §8: the points with a position at keyframe g, those emitted at the next keyframe's count
@@ -248,14 +254,18 @@ def decode(data):
         if len(xy) % 2:
             raise TilesetError(f"tile {t} has an odd number of coordinates ({len(xy)})")
         keys = reader.array("H", f"tile {t} keys")
-        glide = reader.array("H", f"tile {t} glide") if gliding else array.array("H")
+        glide = reader.array("H" if version == 3 else "B", f"tile {t} glide") if gliding else array.array("b")
         ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys, glide))
     if reader.remaining():
         raise TilesetError(f"body has {reader.remaining()} bytes after the last tile")
 
     _validate(ts)
     for tile in ts.tiles:
-        tile.glide = _glide_from_stored(ts, tile, tile.glide)
+        if version == 3:
+            tile.glide = _glide_from_format3(ts, tile, _glide_sums(ts, tile, tile.glide, 0xFFFF))
+        elif version >= 4:
+            sums = _glide_sums(ts, tile, tile.glide, 0xFF)
+            tile.glide = array.array("b", [v - 256 if v >= 128 else v for v in sums])
     ts.recipe = bytes(data[FIXED_HEADER_BYTES : FIXED_HEADER_BYTES + recipe_size])
     ts.generator_version = bytes(data[FIXED_HEADER_BYTES + recipe_size : header_size])
     return ts
@@ -303,16 +313,40 @@ def _validate(ts):
             raise TilesetError(f"tile {t} has {len(tile.glide)} glide offsets, its keyframes need {needed}")
 
 
-def _glide_from_stored(ts, tile, stored):
-    """Doc §8: an offset with one at the keyframe before is stored as the difference (mod 2^16)."""
+def _round_half_away(v):
+    """C's round(): the nearest integer, halves away from zero (the subtraction below is exact)."""
+    whole = math.floor(abs(v))
+    if abs(v) - whole >= 0.5:
+        whole += 1
+    return whole if v >= 0 else -whole
+
+
+def _glide_sums(ts, tile, stored, mask):
+    """Doc §8: an offset with one at the keyframe before is stored as the difference (mod 2^8, format 3:
+    mod 2^16); returns the offsets as unsigned values."""
     values = list(stored)
     at, before = 0, 0
     for g in range(len(ts.keyframe_nominal)):
         n = 2 * ts.glide_count(tile, g)
         for i in range(min(before, n)):
-            values[at + i] = (values[at + i] + values[at - before + i]) & 0xFFFF
+            values[at + i] = (values[at + i] + values[at - before + i]) & mask
         at, before = at + n, n
-    return array.array("h", [v - 65536 if v >= 32768 else v for v in values])
+    return values
+
+
+def _glide_from_format3(ts, tile, offsets):
+    """Doc §8: format 3's 16-bit offsets (in 1/65536 tile sides) into 8-bit units of glide_unit, rounded
+    half away from zero and clamped to +-127."""
+    out = array.array("b", bytes(len(offsets)))
+    at = 0
+    for g in range(len(ts.keyframe_nominal)):
+        n = 2 * ts.glide_count(tile, g)
+        units = 1.0 / (65536.0 * ts.glide_unit(g))
+        for i in range(at, at + n):
+            v = offsets[i] - 65536 if offsets[i] >= 32768 else offsets[i]
+            out[i] = max(-127, min(127, _round_half_away(v * units)))
+        at += n
+    return out
 
 
 def load(path):
@@ -371,7 +405,7 @@ def point_lines(ts, t):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 and 3).")
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 4).")
     parser.add_argument("file")
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--summary", action="store_true", help="print the canonical summary")

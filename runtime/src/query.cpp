@@ -18,6 +18,19 @@ std::uint32_t vertex_colour(std::int64_t vx, std::int64_t vy, std::uint32_t colo
   return static_cast<std::uint32_t>(h % colours);
 }
 
+/// Buckets of expected counts for Tileset::first_keyframe_at_least: 16 per power of two from 2^-32 to
+/// 2^32 (smaller counts share the first, larger ones the last), from the double's exponent and leading
+/// mantissa bits. A bucket's smallest count is (1 + m/16) · 2^e.
+constexpr int kCountBuckets = 64 * 16;
+int count_bucket(double v) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  const int e = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
+  if (e < -32) return 0;
+  if (e > 31) return kCountBuckets - 1;
+  return (e + 32) * 16 + static_cast<int>((bits >> 48) & 0xf);
+}
+
 bool finite(double v) {
   return std::isfinite(v);
 }
@@ -51,18 +64,37 @@ void Tileset::adopt(TilesetData&& set) {
     for (std::uint32_t k = 0, i = 0; k < set_.levels; ++k)
       for (; i < tile.level_end[k]; ++i) out[i] = set_.emission_threshold(k, tile.keys[i]);
   }
-  // Where each keyframe's offsets start in every tile, and how far any point glides.
+  // Where each keyframe's offsets start in every tile, their units, and how far any point glides.
   glide_start_.assign(set_.tiles.size(), {});
   glide_reach_.assign(set_.keyframe_nominal.size(), 0.0);
+  glide_scale_.assign(set_.keyframe_nominal.size(), 0.0);
+  for (std::size_t g = 0; g < set_.keyframe_nominal.size(); ++g)
+    glide_scale_[g] = 65536.0 * set_.glide_unit(g);
+  keyframe_guess_.assign(kCountBuckets, 0);
+  for (int b = 0; b < kCountBuckets; ++b) {  // the first keyframe at least the bucket's smallest count
+    const double lowest = std::ldexp(1.0 + (b % 16) / 16.0, b / 16 - 32);
+    const std::uint32_t* k = set_.keyframe_nominal.data();
+    keyframe_guess_[b] =
+        static_cast<std::uint16_t>(std::lower_bound(k, k + set_.keyframe_nominal.size(), lowest) - k);
+  }
+  keyframe_ranks_.assign(set_.tiles.size(), {});
   for (std::size_t t = 0; t < set_.tiles.size() && has_glide(); ++t) {
     TilesetArray<std::uint32_t>& start = glide_start_[t];
     start.assign(set_.keyframe_nominal.size() + 1, 0);
+    keyframe_ranks_[t].assign(set_.keyframe_nominal.size(), 0);
     for (std::size_t g = 0; g < set_.keyframe_nominal.size(); ++g) {
       start[g + 1] = start[g] + set_.glide_count(set_.tiles[t], g);
+      keyframe_ranks_[t][g] = set_.keyframe_count(set_.tiles[t], g);
+      int largest = 0;
       for (std::size_t i = 2 * std::size_t(start[g]); i < 2 * std::size_t(start[g + 1]); ++i)
-        glide_reach_[g] = std::max(glide_reach_[g], std::fabs(set_.tiles[t].glide[i]) / 65536.0);
+        largest = std::max(largest, std::abs(int(set_.tiles[t].glide[i])));
+      glide_reach_[g] = std::max(glide_reach_[g], largest * set_.glide_unit(g));
     }
   }
+  glide_reach_from_.assign(glide_reach_.size(), 0.0);
+  for (std::size_t g = glide_reach_.size(); g-- > 0;)
+    glide_reach_from_[g] =
+        std::max(glide_reach_[g], g + 1 < glide_reach_.size() ? glide_reach_from_[g + 1] : 0.0);
   min_threshold_ = HUGE_VAL;
   for (const TilesetArray<float>& t : thresholds_)
     if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
@@ -77,11 +109,15 @@ std::size_t Tileset::resident_bytes() const {
     bytes += t.points.capacity() * sizeof(TilePoint) + t.keys.capacity() * sizeof(std::uint16_t) +
              t.level_end.capacity() * sizeof(std::uint32_t);
   for (const TilesetArray<float>& t : thresholds_) bytes += t.capacity() * sizeof(float);
-  bytes += glide_start_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
-           set_.keyframe_nominal.capacity() * sizeof(std::uint32_t) +
-           glide_reach_.capacity() * sizeof(double);
+  bytes +=
+      glide_start_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
+      set_.keyframe_nominal.capacity() * sizeof(std::uint32_t) +
+      (glide_reach_.capacity() + glide_reach_from_.capacity() + glide_scale_.capacity()) * sizeof(double) +
+      keyframe_ranks_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
+      keyframe_guess_.capacity() * sizeof(std::uint16_t);
   for (const TilesetArray<std::uint32_t>& t : glide_start_) bytes += t.capacity() * sizeof(std::uint32_t);
-  for (const Tile& t : set_.tiles) bytes += t.glide.capacity() * sizeof(std::int16_t);
+  for (const TilesetArray<std::uint32_t>& t : keyframe_ranks_) bytes += t.capacity() * sizeof(std::uint32_t);
+  for (const Tile& t : set_.tiles) bytes += t.glide.capacity() * sizeof(std::int8_t);
   return bytes;
 }
 
@@ -130,31 +166,151 @@ struct ImageSampler {
   }
 };
 
-/// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the fraction t
-/// of the way from g0 to g1 (linear in the count).
-struct GlideBracket {
-  std::uint32_t g0 = 0, g1 = 0;
-  double t = 0;
-  GlideBracket(const TilesetData& set, double expected) {
-    const std::uint32_t* k = set.keyframe_nominal.data();
-    const auto n = static_cast<std::uint32_t>(set.keyframe_nominal.size());
-    g1 = static_cast<std::uint32_t>(std::lower_bound(k, k + n, expected) - k);  // first K >= expected
-    if (g1 == 0) return;  // at or below the first keyframe: no motion yet
-    if (g1 == n)
-      g0 = g1 = n - 1;  // the top: every point at its last position
-    else
-      g0 = g1 - 1, t = (expected - k[g0]) / double(k[g1] - k[g0]);
+/// A set's keyframe tables as plain pointers (a query's copy: see TileJob).
+struct KeyframeTable {
+  const std::uint32_t* counts = nullptr;  ///< K_g
+  std::uint32_t n = 0;
+  const double* scale = nullptr;         ///< Tileset::glide_scale
+  const std::uint16_t* guess = nullptr;  ///< the first keyframe at least each count_bucket's smallest count
+  /// The first g with K_g >= expected (> 0), or n.
+  std::uint32_t first_at_least(double expected) const {
+    std::uint32_t g = guess ? guess[count_bucket(expected)] : 0;
+    g += g < n && counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
+    while (g < n && counts[g] < expected) ++g;
+    return g;
   }
 };
 
-/// Point `rank`'s glide offset (1/65536 tile sides) at `b`: linear between its offsets at the two
-/// keyframes (an emitted point has both: tileset.h, glide_count).
-inline void glide_offset(const std::int16_t* glide, const std::uint32_t* start, std::uint32_t rank,
-                         const GlideBracket& b, double& dx, double& dy) {
-  const std::int16_t* o1 = glide + 2 * (std::size_t(start[b.g1]) + rank);
-  const std::int16_t* o0 = glide + 2 * (std::size_t(start[b.g0]) + rank);
-  dx = o0[0] + b.t * (o1[0] - o0[0]);
-  dy = o0[1] + b.t * (o1[1] - o0[1]);
+/// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the weights of
+/// their offsets, w0 = (1 − t) and w1 = t times each keyframe's unit (Tileset::glide_scale), t the fraction
+/// of the way from g0 to g1 (linear in the count).
+struct GlideBracket {
+  std::uint32_t g0 = 0, g1 = 0;
+  double w0 = 0, w1 = 0;
+  GlideBracket(const KeyframeTable& k, double expected) {
+    if (k.n == 0) return;
+    g1 = k.first_at_least(expected);
+    double t = 0;
+    if (g1 == 0) {
+      // at or below the first keyframe: no motion yet
+    } else if (g1 == k.n) {
+      g0 = g1 = k.n - 1;  // the top: every point at its last position
+    } else {
+      g0 = g1 - 1, t = (expected - k.counts[g0]) / double(k.counts[g1] - k.counts[g0]);
+    }
+    w0 = (1 - t) * k.scale[g0], w1 = t * k.scale[g1];
+  }
+};
+
+/// What the per-point loop of one tile reads, copied out of the caller's structures: the output buffer
+/// could alias them, and the compiler would reload each after every point written.
+struct TileJob {
+  const Tileset* set;
+  KeyframeTable keyframes;
+  const TilePoint* points;
+  const float* thresholds;
+  const std::int8_t* glide;     ///< smooth mode: the tile's offsets
+  const std::uint32_t* starts;  ///< smooth mode: where each keyframe's begin
+  std::int64_t tx, ty;
+  double wx, wy, S;
+  double x0, y0, x1, y1, origin_x, origin_y;
+  /// Smooth mode: the stable positions (1/65536 tile sides) that can glide into the region, for points
+  /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
+  double cull_x0, cull_y0, cull_x1, cull_y1, reach;
+  const std::uint32_t* ranks;  ///< smooth mode, varying density: Tileset::keyframe_ranks
+  double area_scale, limit;
+  const QueryDensity* density;
+  const ImageSampler* sampler;
+};
+
+/// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
+/// it stopped at (end, or the first point that did not fit).
+template <bool kSmooth, QueryDensity::Kind kKind>
+std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, QueryPoint* out,
+                        std::size_t capacity, std::size_t& written) {
+  const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
+  std::size_t n = written;
+  constexpr bool kConstant = kKind == QueryDensity::Kind::kConstant;
+  const GlideBracket constant(j.keyframes, kSmooth && kConstant ? j.limit : 0.0);
+  const std::int8_t* c0 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g0]) : nullptr;
+  const std::int8_t* c1 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g1]) : nullptr;
+  // Culling bounds; with a varying density they narrow with the rank: a point whose threshold is at least
+  // K_g is emitted only above it, where it glides no farther than any point does from keyframe g on.
+  const std::size_t keyframes = kSmooth ? j.keyframes.n : 0;
+  std::size_t segment = 0;  // varying: the keyframes whose count the thresholds from rank c on reach
+  double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+  auto set_reach = [&](double reach) {
+    lo_x = j.cull_x0 - reach * 65536.0, hi_x = j.cull_x1 + reach * 65536.0;
+    lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
+  };
+  if (kSmooth) set_reach(kConstant ? j.reach : j.set->glide_reach_from(0));
+  for (; c < end; ++c) {
+    const TilePoint p = j.points[c];
+    double x, y;
+    if (kSmooth) {
+      if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
+        while (segment < keyframes && j.ranks[segment] <= c) ++segment;
+        set_reach(j.set->glide_reach_from(segment - 1));
+      }
+      const double sx = p.x + 0.5, sy = p.y + 0.5;
+      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) continue;
+      x = j.wx + sx * (1.0 / 65536.0) * j.S, y = j.wy + sy * (1.0 / 65536.0) * j.S;  // stable, for ρ
+    } else {
+      x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+      if (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1) continue;
+    }
+    double expected = j.limit;
+    if (kKind != QueryDensity::Kind::kConstant) {
+      const double rho = kKind == QueryDensity::Kind::kImage
+                             ? j.sampler->at(x, y)
+                             : sanitize(j.density->callback(j.density->user, x, y));
+      expected = rho * j.area_scale;
+      if (!TilesetData::emits(j.thresholds[c], expected)) continue;
+    }
+    if (kSmooth) {
+      const std::int8_t *o0 = c0 + 2 * std::size_t(c), *o1 = c1 + 2 * std::size_t(c);
+      double w0 = constant.w0, w1 = constant.w1;
+      if (kKind != QueryDensity::Kind::kConstant) {
+        const GlideBracket b(j.keyframes, expected);
+        o0 = j.glide + 2 * (std::size_t(j.starts[b.g0]) + c),
+        o1 = j.glide + 2 * (std::size_t(j.starts[b.g1]) + c);
+        w0 = b.w0, w1 = b.w1;
+      }
+      const double dx = o0[0] * w0 + o1[0] * w1, dy = o0[1] * w0 + o1[1] * w1;
+      x = j.wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * j.S,
+      y = j.wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * j.S;
+      if (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1) continue;
+    }
+    if (n == capacity) break;
+    out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
+  }
+  written = n;
+  return c;
+}
+
+KeyframeTable keyframe_table(const Tileset& set) {
+  KeyframeTable k;
+  k.counts = set.data().keyframe_nominal.data();
+  k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
+  k.scale = set.glide_scale();
+  k.guess = set.keyframe_guess();
+  return k;
+}
+
+using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t, QueryPoint*, std::size_t,
+                                   std::size_t&);
+
+EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
+  using K = QueryDensity::Kind;
+  switch (kind) {
+    case K::kConstant:
+      return smooth ? emit_tile<true, K::kConstant> : emit_tile<false, K::kConstant>;
+    case K::kImage:
+      return smooth ? emit_tile<true, K::kImage> : emit_tile<false, K::kImage>;
+    case K::kCallback:
+      break;
+  }
+  return smooth ? emit_tile<true, K::kCallback> : emit_tile<false, K::kCallback>;
 }
 
 }  // namespace
@@ -269,7 +425,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide();
   double reach = 0;
   if (glide) {
-    const GlideBracket top(tileset.data(), max_density * area_scale);
+    const GlideBracket top(keyframe_table(tileset), max_density * area_scale);
     for (std::uint32_t g = d.kind == QueryDensity::Kind::kConstant ? top.g0 : 0; g <= top.g1; ++g)
       reach = std::max(reach, tileset.glide_reach(g) * S);
   }
@@ -295,6 +451,13 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
 
   std::size_t n = 0;
   std::uint64_t examined = 0;
+  const EmitTile emit = pick_emitter(glide, d.kind);
+  TileJob job{};
+  job.set = &tileset;
+  job.keyframes = keyframe_table(tileset);
+  job.S = S, job.x0 = q.x0, job.y0 = q.y0, job.x1 = q.x1, job.y1 = q.y1;
+  job.origin_x = q.origin_x, job.origin_y = q.origin_y, job.area_scale = area_scale;
+  job.density = &d, job.sampler = &sampler;
   for (std::int64_t ty = cursor->tile_y; ty < ty1; ++ty) {
     const double wy = double(ty) * S;
     for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
@@ -310,47 +473,42 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
                            [](float t, double l) { return TilesetData::emits(t, l); }) -
           thresholds);
-      std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
-      const std::int16_t* glide_offsets = glide ? tile.glide.data() : nullptr;
-      const std::uint32_t* glide_start = glide ? tileset.glide_start(index) : nullptr;
-      const GlideBracket tile_bracket(tileset.data(), glide ? limit : 0.0);  // a constant density's
-      for (; c < candidates; ++c) {
-        if (++examined > kMaxQueryCandidates) {  // bounded work per call, whatever the region and density
-          *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
-          *written = n;
-          return Status::kBufferFull;
+      const std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
+      if (c >= candidates) continue;
+      // Bounded work per call, whatever the region and density.
+      const std::uint64_t budget = kMaxQueryCandidates - examined;
+      const std::uint32_t end = candidates - c > budget ? static_cast<std::uint32_t>(c + budget) : candidates;
+      job.points = tile.points.data(), job.thresholds = thresholds, job.tx = tx, job.ty = ty;
+      job.wx = wx, job.wy = wy, job.limit = limit;
+      if (glide) {
+        job.glide = tile.glide.data(), job.starts = tileset.glide_start(index);
+        job.ranks = tileset.keyframe_ranks(index);
+        // The region in the tile's 1/65536 units, widened by a unit so that the culling is never stricter
+        // than the exact test after the glide; a constant density's points glide as far as the two
+        // keyframes around it let them.
+        job.cull_x0 = (q.x0 - wx) / S * 65536.0 - 1, job.cull_x1 = (q.x1 - wx) / S * 65536.0 + 1;
+        job.cull_y0 = (q.y0 - wy) / S * 65536.0 - 1, job.cull_y1 = (q.y1 - wy) / S * 65536.0 + 1;
+        if (d.kind == QueryDensity::Kind::kConstant) {
+          const GlideBracket b(job.keyframes, limit);
+          job.reach = std::max(tileset.glide_reach(b.g0), tileset.glide_reach(b.g1));
         }
-        const TilePoint p = tile.points[c];
-        double x = wx + p.unit_x() * S, y = wy + p.unit_y() * S;
-        if (x < q.x0 - reach || x >= q.x1 + reach || y < q.y0 - reach || y >= q.y1 + reach) continue;
-        double expected = limit;
-        if (d.kind != QueryDensity::Kind::kConstant) {
-          const double rho =
-              d.kind == QueryDensity::Kind::kImage ? sampler.at(x, y) : sanitize(d.callback(d.user, x, y));
-          expected = rho * area_scale;
-          if (!TilesetData::emits(thresholds[c], expected)) continue;
-        }
-        if (glide) {
-          double dx, dy;
-          glide_offset(
-              glide_offsets, glide_start, c,
-              d.kind == QueryDensity::Kind::kConstant ? tile_bracket : GlideBracket(tileset.data(), expected),
-              dx, dy);
-          x = wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * S, y = wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * S;
-          if (x < q.x0 || x >= q.x1 || y < q.y0 || y >= q.y1) continue;
-        }
-        if (n == capacity) {
-          *cursor = QueryCursor{tx, ty, c, true, false, fingerprint};
-          *written = n;
-          return Status::kBufferFull;
-        }
-        out[n++] = QueryPoint{x - q.origin_x, y - q.origin_y, PointId{tx, ty, c}};
+      }
+      const std::uint32_t stopped = emit(job, c, end, out, capacity, n);
+      examined += stopped - c;
+      if (stopped < candidates) {  // the buffer is full, or the budget spent
+        *cursor = QueryCursor{tx, ty, stopped, true, false, fingerprint};
+        *written = n;
+        return Status::kBufferFull;
       }
     }
   }
   cursor->finished = true;
   *written = n;
   return Status::kOk;
+}
+
+std::uint32_t Tileset::first_keyframe_at_least(double expected) const {
+  return keyframe_table(*this).first_at_least(expected);
 }
 
 const char* query_problem_message(QueryProblem::Kind kind) {

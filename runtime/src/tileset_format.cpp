@@ -6,6 +6,7 @@
 
 #include <cereal/archives/portable_binary.hpp>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -88,36 +89,47 @@ void load_array(InputArchive& ar, const MemoryBuffer& buffer, Array& v) {
   ar(cereal::binary_data(v.data(), v.size() * sizeof(T)));
 }
 
-/// The glide offsets as stored: each keyframe's offset of a point that also has one at the keyframe before
-/// is written as the difference (mod 2^16), so the values are a point's motion between two keyframes, a
-/// fraction of a spacing (a tenth fewer bytes once compressed than the offsets themselves, measured on a
-/// three-level set). `set` must be valid.
-std::vector<std::uint16_t> glide_to_stored(const TilesetData& set, const Tile& tile) {
-  std::vector<std::uint16_t> v(tile.glide.begin(), tile.glide.end());
+/// Each keyframe's offset of a point that also has one at the keyframe before is stored as the difference
+/// (mod 2^8): the values are then the point's motion between two keyframes, a fraction of a spacing (a
+/// sixth fewer bytes once compressed than the offsets themselves, measured on a four-level set).
+/// glide_differences and glide_sums undo each other; sizes must be valid (validate_tileset).
+template <class Value>
+std::vector<Value> glide_differences(const TilesetData& set, const Tile& tile,
+                                     const std::vector<Value>& offsets) {
+  std::vector<Value> v(offsets);
   std::size_t at = v.size();
   for (std::size_t g = set.keyframe_nominal.size(); g-- > 1;) {  // backwards: the earlier keyframe is intact
     const std::size_t n = 2 * std::size_t(set.glide_count(tile, g)),
                       before = 2 * std::size_t(set.glide_count(tile, g - 1));
     at -= n;
     for (std::size_t i = 0; i < before; ++i)
-      v[at + i] =
-          static_cast<std::uint16_t>(v[at + i] - static_cast<std::uint16_t>(tile.glide[at - before + i]));
+      v[at + i] = static_cast<Value>(v[at + i] - offsets[at - before + i]);
   }
   return v;
 }
-
-/// Undoes glide_to_stored into tile.glide (sizes already validated).
-void glide_from_stored(const TilesetData& set, const std::vector<std::uint16_t>& stored, Tile& tile) {
-  tile.glide.resize(stored.size());
+template <class Value>
+void glide_sums(const TilesetData& set, const Tile& tile, std::vector<Value>& v) {
   std::size_t at = 0;
   for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) {
     const std::size_t n = 2 * std::size_t(set.glide_count(tile, g));
     const std::size_t before = g ? 2 * std::size_t(set.glide_count(tile, g - 1)) : 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      auto v = stored[at + i];
-      if (i < before)
-        v = static_cast<std::uint16_t>(v + static_cast<std::uint16_t>(tile.glide[at - before + i]));
-      tile.glide[at + i] = static_cast<std::int16_t>(v);
+    for (std::size_t i = 0; i < before; ++i) v[at + i] = static_cast<Value>(v[at + i] + v[at - before + i]);
+    at += n;
+  }
+}
+
+/// Format 3's glide offsets (16-bit differences, in 1/65536 tile sides) into tile.glide's 8-bit units,
+/// rounded and clamped: format 3 sets keep their gliding track to within a 64th of a spacing.
+void glide_from_format3(const TilesetData& set, std::vector<std::uint16_t>& stored, Tile& tile) {
+  glide_sums(set, tile, stored);
+  tile.glide.resize(stored.size());
+  std::size_t at = 0;
+  for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) {
+    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g));
+    const double units = 1.0 / (65536.0 * set.glide_unit(g));
+    for (std::size_t i = at; i < at + n; ++i) {
+      const double u = std::round(static_cast<std::int16_t>(stored[i]) * units);
+      tile.glide[i] = static_cast<std::int8_t>(u < -127 ? -127 : (u > 127 ? 127 : u));
     }
     at += n;
   }
@@ -138,7 +150,8 @@ std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
         xy[2 * i] = tile.points[i].x, xy[2 * i + 1] = tile.points[i].y;
       save_array(ar, xy);
       save_array(ar, tile.keys);
-      save_array(ar, glide_to_stored(set, tile));
+      const std::vector<std::uint8_t> offsets(tile.glide.begin(), tile.glide.end());
+      save_array(ar, glide_differences(set, tile, offsets));
     }
   }
   const std::string bytes = stream.str();
@@ -146,7 +159,8 @@ std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
 }
 
 void parse_body(const char* body, std::size_t size, std::uint32_t version, TilesetData& set,
-                std::vector<std::vector<std::uint16_t>>& glide) {
+                std::vector<std::vector<std::uint16_t>>& glide16,
+                std::vector<std::vector<std::uint8_t>>& glide) {
   // cereal's endianness flag: 1 little-, 0 big-endian; cereal itself would take anything else as "other".
   if (size == 0 || (body[0] != 0 && body[0] != 1)) throw ContentError("bad byte-order flag");
   MemoryBuffer buffer(body, size);
@@ -169,10 +183,14 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
     tile.points.resize(xy.size() / 2);
     for (std::size_t i = 0; i < tile.points.size(); ++i) tile.points[i] = {xy[2 * i], xy[2 * i + 1]};
     load_array(ar, buffer, tile.keys);
-    if (gliding) {
+    if (version == 3) {
+      glide16.emplace_back();
+      load_array(ar, buffer, glide16.back());
+      tile.glide.resize(glide16.back().size());  // the size for validation; the values after it
+    } else if (gliding) {
       glide.emplace_back();
       load_array(ar, buffer, glide.back());
-      tile.glide.resize(glide.back().size());  // the size for validation; the values after it
+      tile.glide.resize(glide.back().size());
     }
   }
   if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
@@ -345,16 +363,21 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
     return fail(Status::kDecompressionFailed, detail,
                 ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
   TilesetData set;
-  std::vector<std::vector<std::uint16_t>> glide;  // stored glide offsets per tile (glide_to_stored)
+  std::vector<std::vector<std::uint16_t>> glide16;  // stored glide offsets per tile: format 3's
+  std::vector<std::vector<std::uint8_t>> glide;     // and format 4's (glide_differences)
   try {
-    parse_body(body.get(), body_size, version, set, glide);
+    parse_body(body.get(), body_size, version, set, glide16, glide);
   } catch (const std::exception& e) {
     return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
   }
   if (set.colours != colours || set.levels != levels)
     return fail(Status::kInvalidContent, detail, "payload disagrees with the header");
   if (const Status s = validate_tileset(set, detail); s != Status::kOk) return s;
-  for (std::size_t t = 0; t < glide.size(); ++t) glide_from_stored(set, glide[t], set.tiles[t]);
+  for (std::size_t t = 0; t < glide16.size(); ++t) glide_from_format3(set, glide16[t], set.tiles[t]);
+  for (std::size_t t = 0; t < glide.size(); ++t) {
+    glide_sums(set, set.tiles[t], glide[t]);
+    std::copy(glide[t].begin(), glide[t].end(), set.tiles[t].glide.begin());  // two's complement bytes
+  }
   set.recipe.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes), recipe_size);
   set.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size),
                                version_size);

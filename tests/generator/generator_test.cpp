@@ -7,6 +7,8 @@
 // -DKDM_SLOW_TESTS=ON to check every level.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -94,15 +96,16 @@ TEST(GeneratorTest, GlidingTrackIsBlueAtAndBetweenKeyframesAndMovesLittle) {
   expect_all_pass(report);
 }
 
-// A tile whose gliding offsets at one keyframe are shifted by a tenth of a tile: the motion into and out
-// of that keyframe must be flagged.
+// A tile whose gliding offsets at one keyframe are shifted by 40 units (1.25 spacings 1/√K along x): the
+// motion into and out of that keyframe must be flagged.
 TEST(GeneratorTest, VerifierFlagsAJumpInTheGlidingTrack) {
   TilesetData damaged = shipped();
   ASSERT_GT(damaged.keyframe_nominal.size(), 4u);
   Tile& tile = damaged.tiles[5];
   std::size_t at = 0;
   for (std::size_t g = 0; g < 3; ++g) at += 2 * damaged.glide_count(tile, g);
-  for (std::size_t i = 0; i < 2 * damaged.glide_count(tile, 3); ++i) tile.glide[at + i] += 6554;
+  for (std::size_t i = 0; i < 2 * damaged.glide_count(tile, 3); i += 2)
+    tile.glide[at + i] = static_cast<std::int8_t>(std::clamp(tile.glide[at + i] + 40, -127, 127));
   const Report report = verify_tileset(damaged, keyframes_only());
   bool flagged = false;
   for (const KeyframeResult& k : report.keyframes)

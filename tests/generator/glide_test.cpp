@@ -1,5 +1,6 @@
-// The gliding track: keyframes from the baker, format 3 round trips, and smooth queries (same ids as
-// stable ones, continuous motion, chunk consistency, better blue noise between levels).
+// The gliding track: keyframes from the baker, its paths kept apart, format round trips, and smooth queries
+// (same ids as stable ones, continuous and bounded motion, no close pairs at any density, chunk
+// consistency, better blue noise between levels).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <map>
 #include <tuple>
 
+#include "bake/glide_paths.h"
 #include "bake/keyframes.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/nearest_neighbor.h"
@@ -17,10 +19,12 @@
 namespace kdm::gen {
 namespace {
 
-// A small gliding set: two levels (32 and 128 points per tile), eight keyframes between them (about 2 s).
+// A small gliding set: two levels (32 and 128 points per tile), the default set's 16 keyframes per level
+// between them (about 2 s).
 const Tileset& small_set() {
   static const Tileset set = [] {
-    BakeRecipe r = BakeRecipe::parse("seed 3\nlevels 2\nbase_points 32\nsweeps 30\nkeyframes 8\n");
+    BakeRecipe r =
+        BakeRecipe::parse("seed 3\nlevels 2\nbase_points 32\nsweeps 30\nkeyframes 16\nglide_sweeps 30\n");
     std::vector<std::uint8_t> bytes;
     EXPECT_EQ(encode_tileset(bake_tileset(r), bytes), Status::kOk);
     Tileset t;
@@ -66,17 +70,16 @@ TEST(GlideTest, KeyframesStepGeometricallyThroughEveryLevel) {
 TEST(GlideTest, BakedTrackHasAnOffsetPerPointAndKeyframeAndRoundTrips) {
   const TilesetData& d = small_set().data();
   ASSERT_TRUE(small_set().has_glide());
-  const std::vector<std::uint32_t> expected = keyframe_counts({32, 128}, 8);
+  const std::vector<std::uint32_t> expected = keyframe_counts({32, 128}, 16);
   EXPECT_EQ(std::vector<std::uint32_t>(d.keyframe_nominal.begin(), d.keyframe_nominal.end()), expected);
   for (const Tile& tile : d.tiles) {
     std::size_t pairs = 0;
     for (std::size_t g = 0; g < d.keyframe_nominal.size(); ++g) pairs += d.glide_count(tile, g);
     EXPECT_EQ(tile.glide.size(), 2 * pairs);
   }
-  // Some points glide, none as far as half a tile (the offsets' range; this set: 0.34 tile sides, about
-  // two spacings of its first level).
+  // Some points glide, none farther than the offsets' range: 3.97 spacings of the first keyframe.
   EXPECT_GT(small_set().glide_reach(), 0.0);
-  EXPECT_LT(small_set().glide_reach(), 0.5);
+  EXPECT_LE(small_set().glide_reach(), 127 / (kGlideUnitsPerSpacing * std::sqrt(32.0)));
   std::vector<std::uint8_t> bytes;
   ASSERT_EQ(encode_tileset(d, bytes), Status::kOk);
   TilesetData back;
@@ -119,6 +122,92 @@ TEST(GlideTest, PointsGlideContinuouslyAcrossKeyframes) {
       }
       EXPECT_LT(worst, 1e-2) << "keyframe " << g << " + " << at;
     }
+}
+
+// Keyframe g's offset of `rank` in `tile`, in tile sides; `start` = where keyframe g's offsets begin.
+void offset_at(const TilesetData& d, const Tile& tile, std::size_t start, std::size_t g, std::uint32_t rank,
+               double& x, double& y) {
+  x = tile.glide[2 * (start + rank)] * d.glide_unit(g);
+  y = tile.glide[2 * (start + rank) + 1] * d.glide_unit(g);
+}
+
+TEST(GlideTest, NoPointMovesMoreThanTheCapBetweenKeyframes) {
+  // keyframes.cpp caps a step at 0.55 d_hex of the later keyframe; each stored offset is rounded by up to
+  // half a unit per axis (1/64 of a spacing 1/√K, 0.0145 d_hex), so a stored step, the difference of two
+  // offsets, can exceed it by 2 · √2 · 0.0145 = 0.041.
+  const TilesetData& d = small_set().data();
+  double worst = 0;
+  for (const Tile& tile : d.tiles) {
+    std::size_t start = 0;
+    for (std::size_t g = 1; g < d.keyframe_nominal.size(); ++g) {
+      const std::size_t before = start;
+      start += d.glide_count(tile, g - 1);
+      const double spacing = analysis::hex_spacing(d.keyframe_nominal[g]);
+      for (std::uint32_t i = 0; i < d.glide_count(tile, g - 1); ++i) {
+        double ax, ay, bx, by;
+        offset_at(d, tile, before, g - 1, i, ax, ay);
+        offset_at(d, tile, start, g, i, bx, by);
+        worst = std::max(worst, std::hypot(bx - ax, by - ay) / spacing);
+      }
+    }
+  }
+  EXPECT_GT(worst, 0.3);  // points do move
+  EXPECT_LE(worst, 0.55 + 0.041);
+}
+
+TEST(GlideTest, NoTwoPointsComeCloserThanAThirdOfTheSpacingAtAnyDensity) {
+  // 64 densities per ×4 (every keyframe, the quarters between them and more), 6×6 tiles: the closest pair
+  // of each, against the bar of 0.3 d_hex (the path separation aims at 0.4). Without it, a point entering
+  // next to one still moving away came as close as 0.2 d_hex, some at every few densities.
+  double worst = HUGE_VAL;
+  for (int i = 0; i <= 64; ++i) {
+    const double scale = 32 * std::pow(4.0, i / 64.0);
+    std::vector<double> coords;
+    for (const auto& [id, p] : query(small_set(), 0, 0, 6, 6, scale, QueryMode::kSmooth))
+      coords.insert(coords.end(), {p.x / 6, p.y / 6});
+    const analysis::NNStats nn = analysis::nn_stats(coords, 2, /*torus=*/false);
+    worst = std::min(worst, nn.dmin);
+  }
+  EXPECT_GE(worst, 0.3);
+}
+
+TEST(GlidePathsTest, ClosestApproachOfTwoPathsOnATorus) {
+  // Two points swapping places through each other meet half-way; one shown only from 0.75 on meets the
+  // other there, 0.1 apart; across the torus seam the short way round counts.
+  GlidePath p{0.4, 0.5, 0.6, 0.5}, q{0.6, 0.5, 0.4, 0.5};
+  double t;
+  EXPECT_NEAR(closest_approach(p, q, 1, 1, t), 0.0, 1e-12);
+  EXPECT_NEAR(t, 0.5, 1e-12);
+  q.appear = 0.75;
+  EXPECT_NEAR(closest_approach(p, q, 1, 1, t), 0.1, 1e-12);
+  EXPECT_NEAR(t, 0.75, 1e-12);
+  const GlidePath a{0.98, 0.5, 0.98, 0.5}, b{0.01, 0.5, 0.01, 0.5};
+  EXPECT_NEAR(closest_approach(a, b, 1, 1, t), 0.03, 1e-12);
+}
+
+TEST(GlidePathsTest, SeparatingMovesTheMovableEndsOnly) {
+  // The swapping pair again, with only the later ends movable: afterwards they pass at least the radius
+  // apart, and the earlier ends did not move. A fixed pair too close from its start is left alone.
+  std::vector<GlidePath> paths = {
+      {0.4, 0.5, 0.6, 0.5}, {0.6, 0.5, 0.4, 0.5}, {0.1, 0.1, 0.1, 0.1}, {0.11, 0.1, 0.11, 0.1}};
+  paths[0].move_b = paths[1].move_b = true;
+  const double r = 0.05;
+  const std::size_t left = separate_paths(
+      paths, 1, 1, [&](double) { return r; }, r, [](GlidePath&, std::size_t) {}, 24);
+  EXPECT_EQ(left, 0u);
+  double t;
+  EXPECT_GE(closest_approach(paths[0], paths[1], 1, 1, t), r * 0.999);
+  EXPECT_EQ(paths[0].ax, 0.4);
+  EXPECT_EQ(paths[1].ax, 0.6);
+  EXPECT_EQ(paths[2].bx, 0.1);
+  EXPECT_EQ(paths[3].bx, 0.11);
+  // An entering point whose entry may move: it need not come near the other at all.
+  std::vector<GlidePath> entering = {{0.5, 0.5, 0.5, 0.5}, {0.5, 0.51, 0.5, 0.7}};
+  entering[1].appear = 0.2, entering[1].move_a = entering[1].move_b = true;
+  separate_paths(
+      entering, 1, 1, [&](double) { return r; }, r, [](GlidePath&, std::size_t) {}, 24);
+  EXPECT_GE(closest_approach(entering[0], entering[1], 1, 1, t), r * 0.999);
+  EXPECT_EQ(entering[0].ax, 0.5);
 }
 
 double ramp(void*, double x, double) {

@@ -20,7 +20,7 @@
 namespace kdm {
 namespace {
 
-// A valid random set; with `glide`, a gliding track too (format 3's optional arrays, filled).
+// A valid random set; with `glide`, a gliding track too (the optional arrays since format 3, filled).
 TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1,
                          bool glide = true) {
   std::mt19937 rng(seed);
@@ -48,12 +48,13 @@ TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, st
   if (glide && levels > 1) {
     for (std::uint32_t k = 0; k < levels; ++k) {  // N_k and a step half-way to the next level
       set.keyframe_nominal.push_back(set.level_nominal[k]);
-      if (k + 1 < levels) set.keyframe_nominal.push_back((set.level_nominal[k] + set.level_nominal[k + 1]) / 2);
+      if (k + 1 < levels)
+        set.keyframe_nominal.push_back((set.level_nominal[k] + set.level_nominal[k + 1]) / 2);
     }
     for (Tile& tile : set.tiles)
       for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
         for (std::uint32_t i = 0; i < 2 * set.glide_count(tile, g); ++i)
-          tile.glide.push_back(static_cast<std::int16_t>(rng()));
+          tile.glide.push_back(static_cast<std::int8_t>(rng()));
   }
   return set;
 }
@@ -243,7 +244,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
     ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
     ar(cereal::make_size_tag(cereal::size_type(offsets)));
-    for (std::size_t i = 0; i < offsets; ++i) ar(std::int16_t(-3));
+    for (std::size_t i = 0; i < offsets; ++i) ar(std::int8_t(-3));
   };
   const struct {
     std::uint32_t k0, k1;
@@ -277,13 +278,13 @@ TEST(TilesetFormatTest, Version2FilesStillLoad) {
   std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
   put32(&file[8], 2);
   file = with_body(file, body_bytes([](auto& ar) {
-    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
-    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
-    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(2));
-    ar(cereal::make_size_tag(cereal::size_type(4)), std::uint16_t(7), std::uint16_t(9), std::uint16_t(70),
-       std::uint16_t(90));
-    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(5), std::uint16_t(3));
-  }));
+                     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(2));
+                     ar(cereal::make_size_tag(cereal::size_type(4)), std::uint16_t(7), std::uint16_t(9),
+                        std::uint16_t(70), std::uint16_t(90));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(5), std::uint16_t(3));
+                   }));
   TilesetData out;
   std::string why;
   ASSERT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kOk) << why;
@@ -295,6 +296,35 @@ TEST(TilesetFormatTest, Version2FilesStillLoad) {
   put32(&file[60], 0);
   put32(&file[60], detail::crc32(file.data(), get32(&file[12])));
   EXPECT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kInvalidContent);
+}
+
+TEST(TilesetFormatTest, Version3GlideOffsetsAreConvertedToEightBits) {
+  // A format-3 file: one point present at keyframes K = 4 and 65536, its offsets 16-bit in 1/65536 tile
+  // sides, the second stored as the difference from the first. Format 4's units are 1/(32 √K) tile sides:
+  // 1024 and 8 sixty-five-thousandths, so (2048, -3000) becomes (2, -3) (-2.93 rounded) and (-400, 5000)
+  // becomes (-50, 127) (625 clamped).
+  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
+  put32(&file[8], 3);
+  file = with_body(file, body_bytes([](auto& ar) {
+                     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
+                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+                     ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+                     ar(cereal::make_size_tag(cereal::size_type(4)), std::int16_t(2048), std::int16_t(-3000),
+                        std::int16_t(-400 - 2048), std::int16_t(5000 + 3000));
+                   }));
+  TilesetData out;
+  std::string why;
+  ASSERT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kOk) << why;
+  ASSERT_EQ(out.tiles[0].glide.size(), 4u);
+  EXPECT_EQ(out.tiles[0].glide[0], 2);
+  EXPECT_EQ(out.tiles[0].glide[1], -3);
+  EXPECT_EQ(out.tiles[0].glide[2], -50);
+  EXPECT_EQ(out.tiles[0].glide[3], 127);
+  EXPECT_DOUBLE_EQ(out.glide_unit(0), 1.0 / 64);
+  EXPECT_DOUBLE_EQ(out.glide_unit(1), 1.0 / 8192);
 }
 
 TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {

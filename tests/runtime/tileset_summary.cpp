@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     std::printf("tile %zu points %zu level_end", t, tile.points.size());
     for (const std::uint32_t e : tile.level_end) std::printf(" %u", e);
     std::vector<std::uint8_t> glide;
-    for (const std::int16_t v : tile.glide) put16(glide, static_cast<std::uint16_t>(v));
+    for (const std::int8_t v : tile.glide) glide.push_back(static_cast<std::uint8_t>(v));
     std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x\n", crc32(triples),
                 crc32(thresholds), crc32(glide));
   }

@@ -174,7 +174,7 @@ class Baker {
     const std::vector<std::uint32_t> keyframes = keyframe_counts(nominal_, recipe_.keyframes);
     table_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
-      relax_keyframe(levels_, runs_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
+      relax_keyframe(levels_, runs_, widths_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
@@ -357,10 +357,10 @@ class Baker {
             KDM_CHECK(ref.patch->frames.size() > g && !ref.patch->frames[g].empty());
             const double u =
                 (axis ? ref.anchor_y : ref.anchor_x) + ref.patch->frames[g][2 * ref.index + axis];
-            const std::int64_t offset =
-                std::llround(u * 65536.0 - 0.5) - (axis ? tile.points[c].y : tile.points[c].x);
-            KDM_CHECK(offset >= -32768 && offset <= 32767);  // a point never glides half a tile
-            tile.glide.push_back(static_cast<std::int16_t>(offset));
+            const double stable = axis ? tile.points[c].unit_y() : tile.points[c].unit_x();
+            const std::int64_t offset = std::llround((u - stable) / set.glide_unit(g));
+            KDM_CHECK(offset >= -127 && offset <= 127);  // keyframes.cpp keeps offsets within kMaxOffset
+            tile.glide.push_back(static_cast<std::int8_t>(offset));
           }
       set.tiles.push_back(std::move(tile));
     }

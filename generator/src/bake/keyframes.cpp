@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "bake/glide_paths.h"
 #include "bake/run_stages.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/check.h"
@@ -13,28 +14,69 @@
 namespace kdm::gen {
 namespace {
 
-/// No two points of a keyframe closer than this fraction of its hexagonal spacing (separate()).
+// Distances below are in hexagonal spacings d_hex of the keyframe's count (hex_spacing), the units the
+// generator test and kdm analyze measure in; figures are from 4-level sets of the default recipe
+// (docs/design.md §3).
+
+/// No two points of a keyframe closer than this (separate_points).
 constexpr double kMinDistance = 0.45;
+/// No two paths between keyframes closer than this at any count on the way (separate_paths): the bar is 0.3.
+constexpr double kPathDistance = 0.4;
+/// No point moves farther than this from one keyframe to the next. The descent alone moves a few points
+/// much farther (99th percentile up to 0.76 of the nearest-neighbour distance at 16 keyframes per level);
+/// capped here, the keyframes lose under .005 of δavg.
+constexpr double kMaxMove = 0.55;
+/// Interior points stay this far off their tile's edges. The interiors of two neighbouring tiles are never
+/// relaxed together (each meets a stand-in of the other on its own torus): without this, points of both
+/// glide into the thin edge band between them and meet (pairs 0.01 d_hex apart at 128 points per tile),
+/// and points that slipped there when the pyramid was sampled stay as close as they were (0.005 d_hex
+/// from 11,585 points per tile up: the stable set's near-coincident pairs).
+constexpr double kEdgeMargin = 0.25;
+
+/// Entering points keep off the points of later kinds they meet in other tiles (entry_obstacles) where
+/// they are shown before this fraction of the way to the next keyframe; from there on, the runs that move
+/// those points can move them out of the way (a pair drifts apart by the fraction times their move).
+constexpr double kObstacleFraction = 0.25;
 
 /// Each keyframe starts the points this fraction of the way back to their stable positions. Relaxed from
-/// where the last keyframe left them, points drift without bound (a random walk over the keyframes:
-/// measured on a 3-level set, the 99th percentile of the offsets grows to 3.4 point spacings at 512 points
-/// per tile, a third of a tile side on the shipped set), and a point whose emission is decided at its
-/// stable position then shows far from it: dots outside a sharp edge of a density image. Pulled back by a
-/// quarter, offsets stay within about a spacing (99th percentile 0.9–1.0), the keyframes and the densities
-/// between them measure as well or better (δavg .85–.88 and .81–.83), and points move no more per step.
+/// where the last keyframe left them, points drift without bound (a random walk over the keyframes: the
+/// 99th percentile of the offsets grows to several spacings, a third of a tile side on an 8-keyframe
+/// set), and a point whose emission is decided at its stable position then shows far from it: dots outside
+/// a sharp edge of a density image. Pulled back by a quarter, offsets stay within about a spacing (99th
+/// percentile 1.3), and the keyframes measure better than with no pull (δavg +.007).
 constexpr double kPull = 0.25;
 
-/// A run's points at one keyframe: where each free point (patches of the run's kind and later) came from,
-/// its start and where the descent left it, in torus coordinates.
+/// The descent's grid and step. The sampler's default grid (peak density 0.43) resolves the γ = 1 energy
+/// too coarsely for a descent: the keyframes stall at δavg .86–.87 whatever the sweeps. On a grid twice
+/// as fine per axis they reach .87–.89; the shorter step keeps the moves as small.
+constexpr double kPeakDensity = 0.2;
+constexpr double kStep = 0.2;
+
+/// Offsets stay within this many square-grid spacings (1/√K) along each axis: what the file's 8-bit offsets
+/// hold (kGlideUnitsPerSpacing), less a rounding margin. Rarely binding (the 99th percentile is 1.4).
+constexpr double kMaxOffset = (127 - 2) / kGlideUnitsPerSpacing;
+
+/// d_hex of `count` points per tile, in tile sides.
+double hex_spacing(double count) {
+  return std::sqrt(2.0 / (std::sqrt(3.0) * std::max(1.0, count)));
+}
+
+/// Sweeps of the descent at a keyframe of `count` points per tile: small counts get more (up to 4×), as
+/// the pyramid's small levels do; they cost little, and on tiles of a few hundred points the patch
+/// boundaries hold the descent back.
+int sweeps_at(int sweeps, double count) {
+  return static_cast<int>(std::lround(sweeps * std::clamp(std::sqrt(512.0 / count), 1.0, 4.0)));
+}
+
+/// A run's free points (patches of the run's kind and later) at one keyframe: where each comes from and
+/// its path from keyframe g − 1 (a: its position there, or where it enters) to g (b: where it settled), in
+/// torus coordinates.
 struct FrameRun {
   std::vector<PatchPointRef> refs;
   std::vector<int> kinds;
   std::vector<std::uint64_t> ids;  ///< (kind, patch index): the same patch of every level
-  std::vector<double> start, end;
-  std::vector<double> base;   ///< where each starts, relative to its patch's anchor (before `shift`)
-  std::vector<double> shift;  ///< how far a new point's start was moved from its stable position
-  std::vector<char> arrives;  ///< new at this keyframe: its start is its position at the last keyframe
+  std::vector<char> arrives;       ///< new at this keyframe: its entry point a is its own
+  std::vector<GlidePath> paths;
 };
 
 /// The level whose nominal range holds keyframe count K: the first with N_L >= K.
@@ -81,84 +123,115 @@ class DriftField {
   std::vector<std::vector<Sample>> cells_;
 };
 
-/// Pushes apart the moving points (indices into xy) that lie closer than `r` to any other point, moving or
-/// fixed (`fixed`: normalized coordinates). With γ = 1 the energy's pull towards a gap next to a point is as
-/// strong as the push of overlapping kernels, so the descent can settle a point right beside a fixed one.
-void separate(std::vector<double>& xy, const std::vector<std::size_t>& moving,
-              const std::vector<double>& fixed, int w, int h, double r) {
-  std::vector<double> still;
-  for (std::size_t i = 0; i < fixed.size(); i += 2)
-    still.insert(still.end(), {fixed[i] * w, fixed[i + 1] * h});
-  std::vector<char> is_moving(xy.size() / 2, 0);
-  for (std::size_t i : moving) is_moving[i] = 1;
-  for (std::size_t i = 0; i < is_moving.size(); ++i)
-    if (!is_moving[i]) still.insert(still.end(), {xy[2 * i], xy[2 * i + 1]});
-  const int nx = std::max(1, static_cast<int>(w / r)), ny = std::max(1, static_cast<int>(h / r));
-  auto cell_of = [&](double x, double y) {
-    const int cx = std::min(nx - 1, static_cast<int>(x / w * nx)),
-              cy = std::min(ny - 1, static_cast<int>(y / h * ny));
-    return std::pair<int, int>{cx, cy};
-  };
-  std::vector<std::vector<std::size_t>> still_cells(std::size_t(nx) * ny);
-  for (std::size_t k = 0; k < still.size(); k += 2) {
-    const auto [cx, cy] = cell_of(still[k], still[k + 1]);
-    still_cells[std::size_t(cy) * nx + cx].push_back(k);
-  }
-  for (int pass = 0; pass < 4; ++pass) {
-    std::vector<std::vector<std::size_t>> cells(std::size_t(nx) * ny);
-    for (std::size_t i : moving) {
-      const auto [cx, cy] = cell_of(xy[2 * i], xy[2 * i + 1]);
-      cells[std::size_t(cy) * nx + cx].push_back(i);
-    }
-    bool moved = false;
-    for (std::size_t i : moving) {
-      const auto [cx, cy] = cell_of(xy[2 * i], xy[2 * i + 1]);
-      for (int j = -1; j <= 1; ++j)
-        for (int k = -1; k <= 1; ++k) {
-          const std::size_t c = std::size_t((cy + j + ny) % ny) * nx + (cx + k + nx) % nx;
-          auto push = [&](double ox, double oy, std::size_t other, bool other_moves) {
-            double ex = xy[2 * i] - ox, ey = xy[2 * i + 1] - oy;
-            ex -= w * std::round(ex / w), ey -= h * std::round(ey / h);
-            const double d = std::hypot(ex, ey);
-            if (d >= r) return;
-            if (d == 0) ex = 1, ey = 0;  // coincident: any direction
-            const double norm = d > 0 ? d : 1.0, gap = (r - d) * (other_moves ? 0.5 : 1.0);
-            xy[2 * i] += gap * ex / norm, xy[2 * i + 1] += gap * ey / norm;
-            if (other_moves) xy[2 * other] -= gap * ex / norm, xy[2 * other + 1] -= gap * ey / norm;
-            moved = true;
-          };
-          for (std::size_t s : still_cells[c]) push(still[s], still[s + 1], 0, false);
-          for (std::size_t o : cells[c])
-            if (o > i) push(xy[2 * o], xy[2 * o + 1], o, true);
-        }
-    }
-    for (std::size_t i : moving) {
-      xy[2 * i] -= w * std::floor(xy[2 * i] / w), xy[2 * i + 1] -= h * std::floor(xy[2 * i + 1] / h);
-      if (xy[2 * i] >= w) xy[2 * i] = 0;
-      if (xy[2 * i + 1] >= h) xy[2 * i + 1] = 0;
-    }
-    if (!moved) break;
-  }
+/// One coordinate of an interior point (tile units from its tile's corner) kept no nearer to either edge
+/// than `margin` (kEdgeMargin). A bound per axis, so keeping a point in moves it no farther from any point
+/// inside, and a capped move (kMaxMove) stays so.
+double keep_off_edges(double v, double margin) {
+  return std::clamp(v, margin, 1.0 - margin);
 }
 
-FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, const TilesetData& table,
-                   std::size_t g, int sweeps, std::uint64_t seed, int threads) {
+/// A patch of a later kind that the patch of `kind` and `index` meets in some tile, and its anchor relative
+/// to that patch's anchor. Interiors meet none (their neighbours' interiors stay apart: kEdgeMargin), and
+/// horizontal edges no vertical ones (they stay √2 edge gaps apart).
+struct LaterNeighbour {
+  PatchKind kind;
+  std::size_t index;
+  int dx, dy;
+};
+
+std::vector<LaterNeighbour> later_neighbours(PatchKind kind, std::size_t index, std::uint32_t colours) {
+  const std::uint32_t C = colours;
+  auto tile = [&](std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) {
+    return ((std::size_t(sw) * C + se) * C + ne) * C + nw;
+  };
+  std::vector<LaterNeighbour> out;
+  using K = PatchKind;
+  if (kind == K::kCorner) {
+    const auto c = static_cast<std::uint32_t>(index);
+    for (std::uint32_t x = 0; x < C; ++x)
+      out.insert(out.end(), {{K::kHorizontalEdge, std::size_t(c) * C + x, 0, 0},
+                             {K::kHorizontalEdge, std::size_t(x) * C + c, -1, 0},
+                             {K::kVerticalEdge, std::size_t(c) * C + x, 0, 0},
+                             {K::kVerticalEdge, std::size_t(x) * C + c, 0, -1}});
+    for (std::uint32_t a = 0; a < C; ++a)
+      for (std::uint32_t b = 0; b < C; ++b)
+        for (std::uint32_t d = 0; d < C; ++d)
+          out.insert(out.end(), {{K::kInterior, tile(c, a, b, d), 0, 0},
+                                 {K::kInterior, tile(a, c, b, d), -1, 0},
+                                 {K::kInterior, tile(a, b, c, d), -1, -1},
+                                 {K::kInterior, tile(a, b, d, c), 0, -1}});
+  } else if (kind != K::kInterior) {
+    const auto a = static_cast<std::uint32_t>(index / C), b = static_cast<std::uint32_t>(index % C);
+    for (std::uint32_t x = 0; x < C; ++x)
+      for (std::uint32_t y = 0; y < C; ++y) {
+        if (kind == K::kHorizontalEdge)  // a left, b right: the tiles above and below
+          out.insert(out.end(),
+                     {{K::kInterior, tile(a, b, x, y), 0, 0}, {K::kInterior, tile(x, y, b, a), 0, -1}});
+        else  // a bottom, b top: the tiles right and left
+          out.insert(out.end(),
+                     {{K::kInterior, tile(a, x, y, b), 0, 0}, {K::kInterior, tile(x, a, b, y), -1, 0}});
+      }
+  }
+  return out;
+}
+
+/// Where the points of later kinds that a patch (kind, index) meets in some tile were at keyframe g − 1
+/// (relative to its anchor, within `reach` of its region at level `top`): obstacles for its entering
+/// points. No run moves them any more, and the runs that sample the patch know them only as stand-ins.
+std::vector<double> entry_obstacles(const std::vector<LevelPatches>& levels, const PatchWidths& w,
+                                    std::uint32_t top, PatchKind kind, std::size_t index,
+                                    const TilesetData& table, std::size_t g, double reach) {
+  std::vector<double> out;
+  const double previous = table.keyframe_nominal[g - 1];
+  for (const LaterNeighbour& n : later_neighbours(kind, index, table.colours))
+    for (std::uint32_t j = 0; j <= top; ++j) {
+      const Patch& patch = levels[j].of(n.kind)[n.index];
+      const bool moved = patch.frames.size() > g - 1 && !patch.frames[g - 1].empty();
+      const std::vector<double>& at = moved ? patch.frames[g - 1] : patch.xy;
+      for (std::size_t i = 0; i < patch.size(); ++i) {
+        if (!TilesetData::emits(table.emission_threshold(j, patch.keys[i]), previous)) continue;
+        const double x = at[2 * i] + n.dx, y = at[2 * i + 1] + n.dy;
+        const bool near = kind == PatchKind::kCorner
+                              ? std::fabs(x) < w.corner + reach && std::fabs(y) < w.corner + reach
+                          : kind == PatchKind::kHorizontalEdge
+                              ? std::fabs(y) < w.edge + reach && x > -reach && x < 1 + reach
+                              : std::fabs(x) < w.edge + reach && y > -reach && y < 1 + reach;
+        if (near) out.insert(out.end(), {x, y});
+      }
+    }
+  return out;
+}
+
+/// A point's position relative to its patch's anchor, taken to the copy nearest its stable position
+/// (patch coordinates `stable`) from torus coordinates (x, y).
+void relative(const PatchPointRef& ref, const double* stable, int w, int h, double x, double y, double* out) {
+  const double dx = x - (ref.anchor_x + stable[0]), dy = y - (ref.anchor_y + stable[1]);
+  out[0] = stable[0] + dx - w * std::round(dx / w);
+  out[1] = stable[1] + dy - h * std::round(dy / h);
+}
+
+FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
+                   const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                   int sweeps, std::uint64_t seed, int threads) {
   const Colouring col = Colouring::torus(table.colours, run.w, run.h, run.grid);
   const std::uint32_t count = table.keyframe_nominal[g];
   const std::uint32_t previous = g ? table.keyframe_nominal[g - 1] : 0;
+  const double spacing = hex_spacing(count);
   const std::uint32_t top = level_of_count(table, count);
-  FrameRun out;
-  std::vector<double> fixed;
-  std::vector<double> unused;
-  std::vector<std::uint16_t> keys;
-  std::vector<PatchPointRef> refs;
-  DriftField drift(run.w, run.h, 1.0 / std::sqrt(std::max<double>(1, previous)));
-  std::vector<std::size_t> arrivals;  // free points new at this keyframe (their start is their stable spot)
   auto wrap = [&](double& x, double& y) {
     x -= run.w * std::floor(x / run.w), y -= run.h * std::floor(y / run.h);
     if (x >= run.w) x = 0;  // rounding of a tiny negative value
     if (y >= run.h) y = 0;
   };
+  FrameRun out;
+  std::vector<double> fixed,
+      start;  // fixed: normalised, at keyframe g; start: where free points descend from
+  std::vector<GlidePath> fixed_paths;
+  std::vector<std::size_t> arrivals;  // free points new at this keyframe
+  DriftField drift(run.w, run.h, 1.0 / std::sqrt(std::max<double>(1, previous)));
+  std::vector<double> unused;
+  std::vector<std::uint16_t> keys;
+  std::vector<PatchPointRef> refs;
   for (std::uint32_t j = 0; j <= top; ++j)
     for (int kind = 0; kind < 4; ++kind) {
       std::array<bool, 4> kinds{};
@@ -171,80 +244,164 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run, 
         const bool arrives = !TilesetData::emits(threshold, previous);
         const Patch& patch = *refs[i].patch;
         const std::size_t at = 2 * refs[i].index;
-        // Earlier kinds are final for this keyframe; the rest start where the last keyframe left them.
-        const std::vector<double>* from = &patch.xy;
-        if (kind < run.stage) {
-          KDM_CHECK(patch.frames.size() > g && !patch.frames[g].empty());
-          from = &patch.frames[g];
-        } else if (g > 0 && patch.frames.size() > g - 1 && !patch.frames[g - 1].empty()) {
-          from = &patch.frames[g - 1];
-        }
-        double bx = (*from)[at], by = (*from)[at + 1];  // relative to the patch's anchor
-        if (kind >= run.stage) bx += kPull * (patch.xy[at] - bx), by += kPull * (patch.xy[at + 1] - by);
-        double x = refs[i].anchor_x + bx, y = refs[i].anchor_y + by;
-        wrap(x, y);
-        if (!arrives) {
-          double sx = refs[i].anchor_x + patch.xy[at], sy = refs[i].anchor_y + patch.xy[at + 1];
+        const double ax = refs[i].anchor_x, ay = refs[i].anchor_y;
+        // Where it is at keyframe g - 1: its frame there (an entering point's entry, set by its own run),
+        // else its stable position. It is shown from fraction `appear` of the way to g on.
+        const std::vector<double>& last = g > 0 && patch.frames.size() > g - 1 && !patch.frames[g - 1].empty()
+                                              ? patch.frames[g - 1]
+                                              : patch.xy;
+        GlidePath path;
+        path.ax = ax + last[at], path.ay = ay + last[at + 1];
+        wrap(path.ax, path.ay);
+        path.appear =
+            arrives ? std::clamp((double(threshold) - previous) / (double(count) - previous), 0.0, 1.0) : 0.0;
+        if (!arrives) {  // how far it has moved from its stable position, for the points entering near it
+          double sx = ax + patch.xy[at], sy = ay + patch.xy[at + 1];
           wrap(sx, sy);
-          drift.add(sx, sy, bx - patch.xy[at], by - patch.xy[at + 1]);
+          drift.add(sx, sy, last[at] - patch.xy[at], last[at + 1] - patch.xy[at + 1]);
         }
-        if (kind < run.stage) {
-          fixed.insert(fixed.end(), {x / run.w, y / run.h});
-        } else {
-          if (arrives && g > 0) arrivals.push_back(out.refs.size());
-          out.refs.push_back(refs[i]);
-          out.kinds.push_back(kind);
-          out.ids.push_back((std::uint64_t(kind) << 32) |
-                            std::uint64_t(refs[i].patch - levels[j].of(static_cast<PatchKind>(kind)).data()));
-          out.start.insert(out.start.end(), {x, y});
-          out.base.insert(out.base.end(), {bx, by});
+        if (kind < run.stage) {  // earlier kinds are final for this keyframe
+          KDM_CHECK(patch.frames.size() > g && !patch.frames[g].empty());
+          path.bx = ax + patch.frames[g][at], path.by = ay + patch.frames[g][at + 1];
+          wrap(path.bx, path.by);
+          fixed.insert(fixed.end(), {path.bx / run.w, path.by / run.h});
+          fixed_paths.push_back(path);
+          continue;
         }
+        // Free points start where the last keyframe left them, pulled back towards their stable spots.
+        double x = ax + last[at] + kPull * (patch.xy[at] - last[at]);
+        double y = ay + last[at + 1] + kPull * (patch.xy[at + 1] - last[at + 1]);
+        wrap(x, y);
+        if (arrives && g > 0) arrivals.push_back(out.refs.size());
+        out.refs.push_back(refs[i]);
+        out.kinds.push_back(kind);
+        out.ids.push_back((std::uint64_t(kind) << 32) |
+                          std::uint64_t(refs[i].patch - levels[j].of(static_cast<PatchKind>(kind)).data()));
+        out.arrives.push_back(arrives && g > 0);
+        out.paths.push_back(path);
+        start.insert(start.end(), {x, y});
       }
     }
+
+  // Where a free point may be: offsets within what the file holds, interiors off their tile's edges.
+  const double max_offset = kMaxOffset / std::sqrt(double(count));
+  auto confine_point = [&](double& x, double& y, std::size_t i) {
+    if (i >= out.refs.size()) return;  // a fixed point
+    const PatchPointRef& ref = out.refs[i];
+    const double* stable = &ref.patch->xy[2 * ref.index];
+    double rel[2];
+    relative(ref, stable, run.w, run.h, x, y, rel);
+    for (int a = 0; a < 2; ++a) {
+      rel[a] = std::clamp(rel[a], stable[a] - max_offset, stable[a] + max_offset);
+      if (out.kinds[i] == int(PatchKind::kInterior)) rel[a] = keep_off_edges(rel[a], kEdgeMargin * spacing);
+    }
+    x = ref.anchor_x + rel[0], y = ref.anchor_y + rel[1];
+    wrap(x, y);
+  };
+  // ... and, at keyframe g, no farther than kMaxMove from where it was at g - 1.
+  auto limit_move = [&](const GlidePath& p, double& x, double& y) {
+    if (g == 0) return;
+    double dx = x - p.ax, dy = y - p.ay;
+    dx -= run.w * std::round(dx / run.w), dy -= run.h * std::round(dy / run.h);
+    const double m = std::hypot(dx, dy), cap = kMaxMove * spacing;
+    if (m <= cap) return;
+    x = p.ax + dx * cap / m, y = p.ay + dy * cap / m;
+    wrap(x, y);
+  };
+  auto confine_end = [&](std::vector<double>& xy, std::size_t i) {
+    confine_point(xy[2 * i], xy[2 * i + 1], i);
+    limit_move(out.paths[i], xy[2 * i], xy[2 * i + 1]);
+    confine_point(xy[2 * i], xy[2 * i + 1], i);
+  };
+
   // New points enter where the nested set puts them, moved with their neighbours and kept off them; that
-  // spot is also their position at the last keyframe, so they glide in from it.
-  out.shift.assign(out.start.size(), 0.0);
-  out.arrives.assign(out.refs.size(), 0);
-  const std::vector<double> stable = out.start;
+  // spot is also their position at the last keyframe (their entry), so they glide in from it.
   for (std::size_t i : arrivals) {
     double dx, dy;
-    drift.at(out.start[2 * i], out.start[2 * i + 1], dx, dy);
-    out.start[2 * i] += dx, out.start[2 * i + 1] += dy;
-    wrap(out.start[2 * i], out.start[2 * i + 1]);
-    out.arrives[i] = 1;
+    drift.at(start[2 * i], start[2 * i + 1], dx, dy);
+    start[2 * i] += dx, start[2 * i + 1] += dy;
+    wrap(start[2 * i], start[2 * i + 1]);
+  }
+  // Obstacles for the entering points of the run's own patches: what they meet in other tiles (each copy
+  // on the torus gets its patch's), shown near the start of the way only (later, the runs that move those
+  // points keep them apart).
+  std::vector<GlidePath> obstacles;
+  {
+    std::map<std::pair<const Patch*, std::pair<double, double>>, char> copies;
+    for (std::size_t i : arrivals)
+      if (out.kinds[i] == run.stage)
+        copies[{out.refs[i].patch, {out.refs[i].anchor_x, out.refs[i].anchor_y}}] = 1;
+    std::map<const Patch*, std::vector<double>> near;
+    for (const auto& [copy, unused_flag] : copies) {
+      const auto kind = static_cast<PatchKind>(run.stage);
+      auto [it, fresh] = near.emplace(copy.first, std::vector<double>{});
+      if (fresh)
+        it->second = entry_obstacles(levels, widths[top], top, kind,
+                                     std::size_t(copy.first - levels[top].of(kind).data()), table, g,
+                                     2 * hex_spacing(previous));
+      for (std::size_t k = 0; k < it->second.size(); k += 2) {
+        GlidePath o;
+        o.ax = o.bx = copy.second.first + it->second[k], o.ay = o.by = copy.second.second + it->second[k + 1];
+        wrap(o.ax, o.ay), wrap(o.bx, o.by);
+        o.vanish = kObstacleFraction, o.obstacle = true;
+        obstacles.push_back(o);
+      }
+    }
   }
   {
     std::vector<double> others = fixed;
     for (std::size_t i = 0; i < out.refs.size(); ++i)
-      if (!out.arrives[i])
-        others.insert(others.end(), {out.start[2 * i] / run.w, out.start[2 * i + 1] / run.h});
-    separate(out.start, arrivals, others, run.w, run.h,
-             kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * std::max<double>(1, previous))));
+      if (!out.arrives[i]) others.insert(others.end(), {start[2 * i] / run.w, start[2 * i + 1] / run.h});
+    for (const GlidePath& o : obstacles) others.insert(others.end(), {o.ax / run.w, o.ay / run.h});
+    separate_points(
+        start, arrivals, others, run.w, run.h, kMinDistance * hex_spacing(previous),
+        [&](std::vector<double>& xy, std::size_t i) { confine_point(xy[2 * i], xy[2 * i + 1], i); });
   }
-  for (std::size_t i : arrivals) {
-    double dx = out.start[2 * i] - stable[2 * i], dy = out.start[2 * i + 1] - stable[2 * i + 1];
-    out.shift[2 * i] = dx - run.w * std::round(dx / run.w),
-                  out.shift[2 * i + 1] = dy - run.h * std::round(dy / run.h);
-  }
-  out.end = out.start;
+  for (std::size_t i : arrivals) out.paths[i].ax = start[2 * i], out.paths[i].ay = start[2 * i + 1];
+
+  // The descent: T = 0 on the run's torus, earlier kinds fixed at this keyframe.
   SamplerOptions o;
   o.extent[0] = run.w, o.extent[1] = run.h;
   o.temperature = 0;
-  o.burn_in_sweeps = sweeps;  // descent; no MH sweeps follow at T = 0
+  o.burn_in_sweeps = sweeps_at(sweeps, count);  // descent; no MH sweeps follow at T = 0
   o.sweeps = 0;
+  o.step = kStep;
+  o.peak_density = kPeakDensity;
   o.numerics = Numerics::kOriginal;
   o.threads = threads;
   o.seed = seed;
   o.fixed_points = std::move(fixed);
-  for (std::size_t i = 0; i < out.start.size(); i += 2)
-    o.initial_points.insert(o.initial_points.end(), {out.start[i] / run.w, out.start[i + 1] / run.h});
+  for (std::size_t i = 0; i < start.size(); i += 2)
+    o.initial_points.insert(o.initial_points.end(), {start[i] / run.w, start[i + 1] / run.h});
   const SampleResult relaxed = sample(o);
-  for (std::size_t i = 0; i < out.end.size(); i += 2)
-    out.end[i] = relaxed.points[i] * run.w, out.end[i + 1] = relaxed.points[i + 1] * run.h;
+  std::vector<double> end(start.size());
+  for (std::size_t i = 0; i < end.size(); i += 2)
+    end[i] = relaxed.points[i] * run.w, end[i + 1] = relaxed.points[i + 1] * run.h;
   std::vector<std::size_t> moving(out.refs.size());
-  for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i;
-  separate(out.end, moving, o.fixed_points, run.w, run.h,
-           kMinDistance * std::sqrt(2.0 / (std::sqrt(3.0) * count)));
+  for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i, confine_end(end, i);
+  separate_points(end, moving, o.fixed_points, run.w, run.h, kMinDistance * spacing, confine_end);
+  for (std::size_t i = 0; i < moving.size(); ++i)
+    out.paths[i].bx = end[2 * i], out.paths[i].by = end[2 * i + 1];
+  if (g == 0) return out;
+
+  // Between the keyframes: paths kept apart, moving this keyframe's positions and the entry points.
+  std::vector<GlidePath> paths = out.paths;
+  for (std::size_t i = 0; i < paths.size(); ++i) paths[i].move_b = true, paths[i].move_a = out.arrives[i];
+  paths.insert(paths.end(), fixed_paths.begin(), fixed_paths.end());
+  paths.insert(paths.end(), obstacles.begin(), obstacles.end());
+  auto radius = [&](double t) {
+    return kPathDistance * hex_spacing(previous + t * (double(count) - previous));
+  };
+  separate_paths(
+      paths, run.w, run.h, radius, radius(0),
+      [&](GlidePath& p, std::size_t i) {
+        if (i >= out.refs.size()) return;
+        if (p.move_a) confine_point(p.ax, p.ay, i);
+        confine_point(p.bx, p.by, i);
+        limit_move(p, p.bx, p.by), confine_point(p.bx, p.by, i);
+      },
+      24);
+  std::copy(paths.begin(), paths.begin() + std::ptrdiff_t(out.paths.size()), out.paths.begin());
   return out;
 }
 
@@ -267,11 +424,12 @@ std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nom
 }
 
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
-                    const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed, int threads) {
+                    const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                    int sweeps, std::uint64_t seed, int threads) {
   for_each_run(
       runs, threads,
       [&](std::size_t r, int run_threads) {
-        return relax_run(levels, runs[r], table, g, sweeps,
+        return relax_run(levels, runs[r], widths, table, g, sweeps,
                          mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)), run_threads);
       },
       [&](std::size_t r, FrameRun& result) {
@@ -298,18 +456,12 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
             }
           }
           if (!it->second) continue;
-          // The move, unwrapped across the torus seam, added to the point's own coordinates.
-          double dx = result.end[2 * i] - result.start[2 * i],
-                 dy = result.end[2 * i + 1] - result.start[2 * i + 1];
-          dx -= run.w * std::round(dx / run.w), dy -= run.h * std::round(dy / run.h);
-          const double x = result.base[2 * i] + result.shift[2 * i],
-                       y = result.base[2 * i + 1] + result.shift[2 * i + 1];
-          patch.frames[g][2 * ref.index] = x + dx;
-          patch.frames[g][2 * ref.index + 1] = y + dy;
+          const double* stable = &patch.xy[2 * ref.index];
+          const GlidePath& path = result.paths[i];
+          relative(ref, stable, run.w, run.h, path.bx, path.by, &patch.frames[g][2 * ref.index]);
           if (result.arrives[i]) {  // where it enters: its position at keyframe g - 1
             if (patch.frames[g - 1].empty()) patch.frames[g - 1] = patch.xy;
-            patch.frames[g - 1][2 * ref.index] = x;
-            patch.frames[g - 1][2 * ref.index + 1] = y;
+            relative(ref, stable, run.w, run.h, path.ax, path.ay, &patch.frames[g - 1][2 * ref.index]);
           }
         }
       });

@@ -32,6 +32,7 @@ std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nom
 /// g − 1 must be done). `table` supplies the nominal and keyframe counts (its tiles are not read). Descends
 /// `sweeps` sweeps; `seed` picks the sweep order.
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
-                    const TilesetData& table, std::size_t g, int sweeps, std::uint64_t seed, int threads);
+                    const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                    int sweeps, std::uint64_t seed, int threads);
 
 }  // namespace kdm::gen

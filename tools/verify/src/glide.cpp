@@ -1,7 +1,7 @@
 // Part 5 of the generator test (verify.h): the gliding track. For every keyframe, over every tile's 2×2
 // torus, the points at their keyframe positions (δavg, closest pair), the same half-way to the next
 // keyframe (where the points present glide between two relaxed sets), and how far the points move from
-// one keyframe to the next, in point spacings (d_hex) of the later one.
+// one keyframe to the next, in mean nearest-neighbour distances of the later one.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -35,10 +35,11 @@ std::vector<double> glide_torus(const TilesetData& set, std::size_t t, double co
       for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
         for (; i < tile.level_end[k]; ++i) {
           if (!TilesetData::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
-          const std::int16_t* o0 = &tile.glide[2 * (start[g0] + i)];
-          const std::int16_t* o1 = &tile.glide[2 * (start[g1] + i)];
-          double u = (tile.points[i].x + 0.5 + o0[0] + s * (o1[0] - o0[0])) / 65536.0;
-          double v = (tile.points[i].y + 0.5 + o0[1] + s * (o1[1] - o0[1])) / 65536.0;
+          const std::int8_t* o0 = &tile.glide[2 * (start[g0] + i)];
+          const std::int8_t* o1 = &tile.glide[2 * (start[g1] + i)];
+          const double e0 = set.glide_unit(g0), e1 = set.glide_unit(g1);
+          double u = tile.points[i].unit_x() + o0[0] * e0 + s * (o1[0] * e1 - o0[0] * e0);
+          double v = tile.points[i].unit_y() + o0[1] * e0 + s * (o1[1] * e1 - o0[1] * e0);
           u = (tx + u) / 2, v = (ty + v) / 2;
           u -= std::floor(u), v -= std::floor(v);
           all.insert(all.end(), {u, v});
@@ -78,14 +79,15 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
         const std::vector<std::size_t> start = glide_starts(set, tile);
         const double spacing = analysis::hex_spacing(std::size_t(k0));  // tile sides: d_hex at K_g
         for (std::uint32_t i = 0; i < set.glide_count(tile, g - 1); ++i) {
-          const std::int16_t* a = &tile.glide[2 * (start[g - 1] + i)];
-          const std::int16_t* c = &tile.glide[2 * (start[g] + i)];
-          moves.push_back(std::hypot(c[0] - a[0], c[1] - a[1]) / 65536.0 / spacing);
+          const std::int8_t* a = &tile.glide[2 * (start[g - 1] + i)];
+          const std::int8_t* c = &tile.glide[2 * (start[g] + i)];
+          const double ea = set.glide_unit(g - 1), ec = set.glide_unit(g);
+          moves.push_back(std::hypot(c[0] * ec - a[0] * ea, c[1] * ec - a[1] * ea) / spacing);
         }
       }
       if (!moves.empty()) {
         double sum = 0;
-        for (double m : moves) sum += m;
+        for (double& m : moves) sum += (m /= row.davg);  // in mean nearest-neighbour distances
         row.motion_mean = sum / double(moves.size());
         row.motion_p99 = analysis::quantile(moves, 0.99);
         row.checks.push_back({"motion p99", row.motion_p99, b.glide_motion, true});
@@ -93,7 +95,8 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
         row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
       }
       row.checks.push_back({"δavg", row.davg, half ? b.glide_between_davg : b.glide_keyframe_davg, false});
-      if (b.closest_pair > 0) row.checks.push_back({"closest pair", row.closest_pair, b.closest_pair, false});
+      if (b.glide_closest_pair > 0)
+        row.checks.push_back({"closest pair", row.closest_pair, b.glide_closest_pair, false});
       report.keyframes.push_back(std::move(row));
     }
 }

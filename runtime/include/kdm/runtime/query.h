@@ -63,6 +63,18 @@ class KDM_RUNTIME_API Tileset {
   /// The largest distance any point glides from its stable position, per axis, in tile sides, at keyframe
   /// g or at any: smooth queries look this far beyond their region for points that glide into it.
   double glide_reach(std::size_t g) const { return glide_reach_[g]; }
+  /// The largest of glide_reach(g') for g' >= g.
+  double glide_reach_from(std::size_t g) const { return glide_reach_from_[g]; }
+  /// Per keyframe g, how many of the tile's points are present there (TilesetData::keyframe_count).
+  const std::uint32_t* keyframe_ranks(std::size_t index) const { return keyframe_ranks_[index].data(); }
+  /// Per keyframe, 1/65536 tile sides per glide offset unit (65536 · TilesetData::glide_unit(g)).
+  const double* glide_scale() const { return glide_scale_.data(); }
+  /// The first keyframe whose count is at least `expected` (> 0), or the keyframe count if none: a table
+  /// lookup on the number's exponent and leading bits, then a step or two.
+  std::uint32_t first_keyframe_at_least(double expected) const;
+  const std::uint16_t* keyframe_guess() const {
+    return keyframe_guess_.empty() ? nullptr : keyframe_guess_.data();
+  }
   double glide_reach() const {
     double r = 0;
     for (double v : glide_reach_) r = std::max(r, v);
@@ -80,6 +92,10 @@ class KDM_RUNTIME_API Tileset {
   TilesetArray<TilesetArray<std::uint32_t>> glide_start_;
   double min_threshold_ = 0;
   TilesetArray<double> glide_reach_;
+  TilesetArray<double> glide_reach_from_;
+  TilesetArray<double> glide_scale_;
+  TilesetArray<TilesetArray<std::uint32_t>> keyframe_ranks_;
+  TilesetArray<std::uint16_t> keyframe_guess_;  ///< first_keyframe_at_least per count_bucket
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).

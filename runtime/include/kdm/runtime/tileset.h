@@ -12,11 +12,11 @@
 //
 // Gliding (smooth emission): a set may also carry keyframes, expected counts K_0 < … < K_{G-1} = N_top
 // per tile (keyframe_nominal). At keyframe g every point emitted there (threshold < K_g) has a position
-// of its own, stored as an offset from its stable position (Tile::glide); between two keyframes a point
-// moves linearly from its position at the one to its position at the next. A point that appears between
-// them has a position at the earlier one too (where it enters), so it glides in from there. Each keyframe
-// was relaxed as a whole, so densities between levels are good blue noise too, and points still appear in
-// rank order.
+// of its own, stored as an 8-bit offset from its stable position in units of a 32nd of that keyframe's
+// spacing 1/√K_g (Tile::glide, TilesetData::glide_unit); between two keyframes a point moves linearly from
+// its position at the one to its position at the next. A point that appears between them has a position
+// at the earlier one too (where it enters), so it glides in from there. Each keyframe was relaxed as a
+// whole, so densities between levels are good blue noise too, and points still appear in rank order.
 //
 // File layout (all integers little-endian):
 //   offset  size  field
@@ -34,12 +34,14 @@
 //       64     …  recipe text, then generator version text
 //   header size … payload: zstd-compressed cereal portable-binary archive: colours, levels, tile count,
 //                  level_nominal, keyframe_nominal, then per tile its level_end, x y pairs, keys and
-//                  glide offsets (format 2, still read: no keyframe_nominal and no glide)
+//                  glide offsets (still read: format 2, no keyframe_nominal and no glide; format 3, glide
+//                  offsets as 16-bit differences in 1/65536 tile sides, converted to 8 bits on reading)
 // The file is exactly header size + payload size bytes long.
 //
 // Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -78,6 +80,10 @@ inline constexpr std::uint32_t kMaxTileColours = 16;  ///< at most 16^4 = 65536 
 inline constexpr std::uint32_t kMaxTileLevels = 16;
 inline constexpr std::uint32_t kMaxKeyframes = 256;
 
+/// Glide offsets count in 1/kGlideUnitsPerSpacing of a keyframe's square-grid spacing 1/√K (8 bits: up to
+/// ±3.97 spacings, in steps of 0.03 of the point spacing).
+inline constexpr double kGlideUnitsPerSpacing = 32;
+
 /// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
 struct TilePoint {
   std::uint16_t x = 0, y = 0;
@@ -100,11 +106,11 @@ struct Tile {
   TilesetArray<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   TilesetArray<std::uint32_t> level_end;
-  /// Gliding offsets (x, y pairs, in units of 1/65536 of the tile side, from the point's stable position):
-  /// keyframe 0's for ranks [0, count_0), then keyframe 1's for [0, count_1), …, where count_g is
+  /// Gliding offsets (x, y pairs from the point's stable position, in TilesetData::glide_unit(g) tile
+  /// sides): keyframe 0's for ranks [0, count_0), then keyframe 1's for [0, count_1), …, where count_g is
   /// TilesetData::glide_count (the points present at keyframe g or appearing before the next one).
   /// Empty without keyframes.
-  TilesetArray<std::int16_t> glide;
+  TilesetArray<std::int8_t> glide;
   /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
   std::uint32_t level_of(std::uint32_t rank) const {
     std::uint32_t k = 0;
@@ -141,6 +147,10 @@ struct TilesetData {
   /// The emission rule, stated once for the runtime and the generator test: a point with threshold
   /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
   static bool emits(float threshold, double expected) { return expected > threshold; }
+  /// The unit of keyframe g's glide offsets in tile sides: 1 / (kGlideUnitsPerSpacing · √K_g).
+  double glide_unit(std::size_t g) const {
+    return 1.0 / (kGlideUnitsPerSpacing * std::sqrt(double(keyframe_nominal[g])));
+  }
   /// How many of `tile`'s points have a position at keyframe g: those present there or appearing before
   /// the next keyframe (they glide in from it); every point at the last keyframe. A prefix of its ranks.
   std::uint32_t glide_count(const Tile& tile, std::size_t g) const {
