@@ -26,11 +26,10 @@ constexpr double kPathDistance = 0.4;
 /// much farther (99th percentile up to 0.76 of the nearest-neighbour distance at 16 keyframes per level);
 /// capped here, the keyframes lose under .005 of δavg.
 constexpr double kMaxMove = 0.55;
-/// Interior points stay this far off their tile's edges. The interiors of two neighbouring tiles are never
-/// relaxed together (each meets a stand-in of the other on its own torus): without this, points of both
-/// glide into the thin edge band between them and meet (pairs 0.01 d_hex apart at 128 points per tile),
-/// and points that slipped there when the pyramid was sampled stay as close as they were (0.005 d_hex
-/// from 11,585 points per tile up: the stable set's near-coincident pairs).
+/// Interior points stay this far off their tile's edges (keep_in_bounds). The interiors of two
+/// neighbouring tiles are never relaxed together (each meets a stand-in of the other on its own torus):
+/// without this, points of both glide into the thin edge band between them and meet (pairs 0.01 d_hex
+/// apart at 128 points per tile).
 constexpr double kEdgeMargin = 0.25;
 
 /// Entering points keep off the points of later kinds they meet in other tiles (entry_obstacles) where
@@ -74,8 +73,9 @@ int sweeps_at(int sweeps, double count) {
 struct FrameRun {
   std::vector<PatchPointRef> refs;
   std::vector<int> kinds;
-  std::vector<std::uint64_t> ids;  ///< (kind, patch index): the same patch of every level
-  std::vector<char> arrives;       ///< new at this keyframe: its entry point a is its own
+  std::vector<std::uint32_t> levels;  ///< the level of each point's patch
+  std::vector<std::uint64_t> ids;     ///< (kind, patch index): the same patch of every level
+  std::vector<char> arrives;          ///< new at this keyframe: its entry point a is its own
   std::vector<GlidePath> paths;
 };
 
@@ -123,11 +123,28 @@ class DriftField {
   std::vector<std::vector<Sample>> cells_;
 };
 
-/// One coordinate of an interior point (tile units from its tile's corner) kept no nearer to either edge
-/// than `margin` (kEdgeMargin). A bound per axis, so keeping a point in moves it no farther from any point
-/// inside, and a capped move (kMaxMove) stays so.
-double keep_off_edges(double v, double margin) {
-  return std::clamp(v, margin, 1.0 - margin);
+/// Keeps a free point (patch coordinates `rel`) where no run misses a neighbour it can meet: an interior
+/// point kEdgeMargin spacings (`margin`) off its tile's edges, an edge point out of the corner squares at
+/// its ends (half-width `corner`, at its level). A run of vertical edges on a 1×2 torus sees the
+/// horizontal edges of that torus, not those a tile puts at the edge's ends, so two edge points that
+/// slipped into a corner square when the pyramid was sampled met nothing there that kept them apart
+/// (pairs 0.005 d_hex apart from 11,585 points per tile up: the stable set's near-coincident pairs).
+/// Bounds per axis, so keeping a point in moves it no farther from any point inside, and a capped move
+/// (kMaxMove) stays so.
+void keep_in_bounds(PatchKind kind, double margin, double corner, double* rel) {
+  switch (kind) {
+    case PatchKind::kInterior:  // anchored at its tile's corner
+      rel[0] = std::clamp(rel[0], margin, 1.0 - margin), rel[1] = std::clamp(rel[1], margin, 1.0 - margin);
+      break;
+    case PatchKind::kHorizontalEdge:  // anchored at its left vertex
+      rel[0] = std::clamp(rel[0], corner, 1.0 - corner);
+      break;
+    case PatchKind::kVerticalEdge:  // anchored at its bottom vertex
+      rel[1] = std::clamp(rel[1], corner, 1.0 - corner);
+      break;
+    case PatchKind::kCorner:
+      break;
+  }
 }
 
 /// A patch of a later kind that the patch of `kind` and `index` meets in some tile, and its anchor relative
@@ -275,6 +292,7 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
         if (arrives && g > 0) arrivals.push_back(out.refs.size());
         out.refs.push_back(refs[i]);
         out.kinds.push_back(kind);
+        out.levels.push_back(j);
         out.ids.push_back((std::uint64_t(kind) << 32) |
                           std::uint64_t(refs[i].patch - levels[j].of(static_cast<PatchKind>(kind)).data()));
         out.arrives.push_back(arrives && g > 0);
@@ -291,10 +309,9 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
     const double* stable = &ref.patch->xy[2 * ref.index];
     double rel[2];
     relative(ref, stable, run.w, run.h, x, y, rel);
-    for (int a = 0; a < 2; ++a) {
-      rel[a] = std::clamp(rel[a], stable[a] - max_offset, stable[a] + max_offset);
-      if (out.kinds[i] == int(PatchKind::kInterior)) rel[a] = keep_off_edges(rel[a], kEdgeMargin * spacing);
-    }
+    keep_in_bounds(static_cast<PatchKind>(out.kinds[i]), kEdgeMargin * spacing, widths[out.levels[i]].corner,
+                   rel);
+    for (int a = 0; a < 2; ++a) rel[a] = std::clamp(rel[a], stable[a] - max_offset, stable[a] + max_offset);
     x = ref.anchor_x + rel[0], y = ref.anchor_y + rel[1];
     wrap(x, y);
   };
