@@ -3,9 +3,11 @@
 // blue-noise set at every density, not only at the levels.
 //
 // Nested sets cannot do that: when no point ever moves, the worst density between two levels ×4 apart has
-// δavg ≈ .70 whatever the ranking (docs/design.md §4). Here the points present at keyframe g (a prefix of
+// δavg ≈ .70 whatever the ranking (docs/design.md §3). Here the points present at keyframe g (a prefix of
 // every tile's ranks, chosen by the same thresholds as the stable emission) start where keyframe g − 1 left
-// them, the new ones at their stable positions, and descend the KDM energy (T = 0) for a few sweeps.
+// them, the new ones at their stable positions, and descend the KDM energy (T = 0) for a few sweeps; each
+// moves at most a bounded step, and pairs are kept apart at the keyframe and on the straight paths between
+// keyframes that smooth queries follow (glide_paths.h).
 //
 // Shared patches stay shared: keyframes are relaxed with the pyramid's own schedule of runs (run_stages.h).
 // A run of stage s moves every point of patches of kind >= s on its torus, with the kinds before s fixed at

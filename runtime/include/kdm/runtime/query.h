@@ -63,6 +63,11 @@ class KDM_RUNTIME_API Tileset {
   /// The largest distance any point glides from its stable position, per axis, in tile sides, at keyframe
   /// g or at any: smooth queries look this far beyond their region for points that glide into it.
   double glide_reach(std::size_t g) const { return glide_reach_[g]; }
+  double glide_reach() const {
+    double r = 0;
+    for (double v : glide_reach_) r = std::max(r, v);
+    return r;
+  }
   /// The largest of glide_reach(g') for g' >= g.
   double glide_reach_from(std::size_t g) const { return glide_reach_from_[g]; }
   /// Per keyframe g, how many of the tile's points are present there (TilesetData::keyframe_count).
@@ -72,13 +77,10 @@ class KDM_RUNTIME_API Tileset {
   /// The first keyframe whose count is at least `expected` (> 0), or the keyframe count if none: a table
   /// lookup on the number's exponent and leading bits, then a step or two.
   std::uint32_t first_keyframe_at_least(double expected) const;
+  /// Its table: per bucket of counts (16 per power of two from 2^-32 to 2^32, by the double's exponent and
+  /// leading mantissa bits), the first keyframe at least the bucket's smallest count; null if not loaded.
   const std::uint16_t* keyframe_guess() const {
     return keyframe_guess_.empty() ? nullptr : keyframe_guess_.data();
-  }
-  double glide_reach() const {
-    double r = 0;
-    for (double v : glide_reach_) r = std::max(r, v);
-    return r;
   }
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
   /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
