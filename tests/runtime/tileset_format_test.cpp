@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 #include <sstream>
@@ -273,18 +274,25 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   EXPECT_TRUE(out.tiles.empty());
 }
 
+// A file of format `version` (one colour, two levels) whose body `write` writes by hand; the header is a
+// valid one's, with every size and checksum fixed.
+std::vector<std::uint8_t> older_file(std::uint32_t version,
+                                     const std::function<void(cereal::PortableBinaryOutputArchive&)>& write) {
+  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
+  put32(&file[8], version);
+  return with_body(file, body_bytes(write));
+}
+
 TEST(TilesetFormatTest, Version2FilesStillLoad) {
   // A format-2 file: the same header, a body without keyframe_nominal and glide arrays.
-  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
-  put32(&file[8], 2);
-  file = with_body(file, body_bytes([](auto& ar) {
-                     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(2));
-                     ar(cereal::make_size_tag(cereal::size_type(4)), std::uint16_t(7), std::uint16_t(9),
-                        std::uint16_t(70), std::uint16_t(90));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(5), std::uint16_t(3));
-                   }));
+  std::vector<std::uint8_t> file = older_file(2, [](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(2));
+    ar(cereal::make_size_tag(cereal::size_type(4)), std::uint16_t(7), std::uint16_t(9), std::uint16_t(70),
+       std::uint16_t(90));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(5), std::uint16_t(3));
+  });
   TilesetData out;
   std::string why;
   ASSERT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kOk) << why;
@@ -303,18 +311,16 @@ TEST(TilesetFormatTest, Version3GlideOffsetsAreConvertedToEightBits) {
   // sides, the second stored as the difference from the first. Format 4's units are 1/(32 √K) tile sides:
   // 1024 and 8 sixty-five-thousandths, so (2048, -3000) becomes (2, -3) (-2.93 rounded) and (-400, 5000)
   // becomes (-50, 127) (625 clamped).
-  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
-  put32(&file[8], 3);
-  file = with_body(file, body_bytes([](auto& ar) {
-                     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
-                     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
-                     ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
-                     ar(cereal::make_size_tag(cereal::size_type(4)), std::int16_t(2048), std::int16_t(-3000),
-                        std::int16_t(-400 - 2048), std::int16_t(5000 + 3000));
-                   }));
+  const std::vector<std::uint8_t> file = older_file(3, [](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(65536));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(1));
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint16_t(7), std::uint16_t(9));
+    ar(cereal::make_size_tag(cereal::size_type(1)), std::uint16_t(0));
+    ar(cereal::make_size_tag(cereal::size_type(4)), std::int16_t(2048), std::int16_t(-3000),
+       std::int16_t(-400 - 2048), std::int16_t(5000 + 3000));
+  });
   TilesetData out;
   std::string why;
   ASSERT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kOk) << why;
