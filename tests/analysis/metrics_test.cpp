@@ -218,6 +218,16 @@ TEST(Tiling, OneSidedKolmogorovSmirnovAsksOnlyWhetherTheFirstIsSmaller) {
   EXPECT_NEAR(ks_smaller({1, 2, 3}, {4, 5, 6}).p_value, std::exp(-3.0), 1e-12);
 }
 
+TEST(Tiling, OneSidedKolmogorovSmirnovCanLookBelowALengthOnly) {
+  // a's values bunch at and above b's median (0.9): an excess above it, none below.
+  const std::vector<double> a = {0.9, 0.9, 0.9, 0.9, 0.92, 0.97}, b = {0.6, 0.7, 0.8, 0.9, 0.95, 1.0};
+  EXPECT_NEAR(ks_smaller(a, b).statistic, 1.0 / 6, 1e-12);
+  EXPECT_DOUBLE_EQ(ks_smaller(a, b, 0.9).statistic, 0.0);
+  // Below the cut the excess is the same as without it.
+  EXPECT_NEAR(ks_smaller({0.5, 0.9}, b, 0.85).statistic, 0.5, 1e-12);
+  EXPECT_NEAR(ks_smaller({0.5, 0.9}, b).statistic, 0.5, 1e-12);
+}
+
 TEST(Tiling, KolmogorovSmirnov) {
   EXPECT_DOUBLE_EQ(ks_two_sample({1, 2, 3}, {4, 5, 6}).statistic, 1.0);
   EXPECT_DOUBLE_EQ(ks_two_sample({1, 2, 3, 4}, {1, 2, 3, 4}).statistic, 0.0);

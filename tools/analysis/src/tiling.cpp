@@ -47,8 +47,10 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
 
 namespace {
 
-/// Sorts both samples and walks their empirical CDFs: returns {sup (F_a − F_b), sup |F_a − F_b|}.
-std::pair<double, double> ecdf_gaps(std::vector<double>& a, std::vector<double>& b) {
+/// Sorts both samples and walks their empirical CDFs: returns {sup (F_a − F_b), sup |F_a − F_b|}, both over
+/// values below `up_to`.
+std::pair<double, double> ecdf_gaps(std::vector<double>& a, std::vector<double>& b,
+                                    double up_to = std::numeric_limits<double>::infinity()) {
   std::sort(a.begin(), a.end());
   std::sort(b.begin(), b.end());
   const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
@@ -56,6 +58,7 @@ std::pair<double, double> ecdf_gaps(std::vector<double>& a, std::vector<double>&
   double above = 0, both = 0;
   while (i < a.size() && j < b.size()) {
     const double v = std::min(a[i], b[j]);
+    if (v >= up_to) break;
     while (i < a.size() && a[i] <= v) ++i;  // step past ties in both samples together
     while (j < b.size() && b[j] <= v) ++j;
     const double d = static_cast<double>(i) / na - static_cast<double>(j) / nb;
@@ -86,11 +89,11 @@ KsResult ks_two_sample(std::vector<double> a, std::vector<double> b) {
   return r;
 }
 
-KsResult ks_smaller(std::vector<double> a, std::vector<double> b) {
+KsResult ks_smaller(std::vector<double> a, std::vector<double> b, double up_to) {
   KsResult r;
   if (a.empty() || b.empty()) return r;
   const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
-  r.statistic = ecdf_gaps(a, b).first;
+  r.statistic = ecdf_gaps(a, b, up_to).first;
   r.p_value = std::min(1.0, std::exp(-2.0 * na * nb / (na + nb) * r.statistic * r.statistic));
   return r;
 }

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "kdm/analysis/nearest_neighbor.h"
@@ -48,9 +49,11 @@ KsResult ks_two_sample(std::vector<double> a, std::vector<double> b);
 
 /// One-sided two-sample Kolmogorov–Smirnov test of "a tends to be smaller than b": D+ = sup (F_a − F_b),
 /// p ≈ exp(−2 m D+²) with m = n_a n_b / (n_a + n_b) (Smirnov's asymptotic bound). Seam defects shorten
-/// nearest-neighbour links, so this asks whether links across seams are shorter than elsewhere. Empty
-/// input gives D = 0, p = 1. Thread-safe (pure).
-KsResult ks_smaller(std::vector<double> a, std::vector<double> b);
+/// nearest-neighbour links, so this asks whether links across seams are shorter than elsewhere. With
+/// `up_to`, the supremum runs over values below it only (e.g. b's median: the short half). Empty input
+/// gives D = 0, p = 1. Thread-safe (pure).
+KsResult ks_smaller(std::vector<double> a, std::vector<double> b,
+                    double up_to = std::numeric_limits<double>::infinity());
 
 struct SeamStats {
   NNStats seam;      ///< NN links crossing a tile edge (normalised by the reference spacing)
