@@ -224,8 +224,9 @@ struct TileJob {
 };
 
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
-/// it stopped at (end, or the first point that did not fit).
-template <bool kSmooth, QueryDensity::Kind kKind>
+/// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
+/// or not, lies inside the region, so no point is tested against it.
+template <bool kSmooth, QueryDensity::Kind kKind, bool kInside>
 std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, QueryPoint* out,
                         std::size_t capacity, std::size_t& written) {
   const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
@@ -243,21 +244,21 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     lo_x = j.cull_x0 - reach * 65536.0, hi_x = j.cull_x1 + reach * 65536.0;
     lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
   };
-  if (kSmooth) set_reach(kConstant ? j.reach : j.set->glide_reach_from(0));
+  if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.set->glide_reach_from(0));
   for (; c < end; ++c) {
     const TilePoint p = j.points[c];
     double x, y;
     if (kSmooth) {
-      if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
+      if (!kInside && !kConstant && segment < keyframes && j.ranks[segment] <= c) {
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
         set_reach(j.set->glide_reach_from(segment - 1));
       }
       const double sx = p.x + 0.5, sy = p.y + 0.5;
-      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) continue;
+      if (!kInside && (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y)) continue;
       x = j.wx + sx * (1.0 / 65536.0) * j.S, y = j.wy + sy * (1.0 / 65536.0) * j.S;  // stable, for ρ
     } else {
       x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
-      if (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1) continue;
+      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) continue;
     }
     double expected = j.limit;
     if (kKind != QueryDensity::Kind::kConstant) {
@@ -279,7 +280,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       const double dx = o0[0] * w0 + o1[0] * w1, dy = o0[1] * w0 + o1[1] * w1;
       x = j.wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * j.S,
       y = j.wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * j.S;
-      if (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1) continue;
+      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) continue;
     }
     if (n == capacity) break;
     out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
@@ -300,17 +301,18 @@ KeyframeTable keyframe_table(const Tileset& set) {
 using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t, QueryPoint*, std::size_t,
                                    std::size_t&);
 
+template <bool kInside>
 EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
   using K = QueryDensity::Kind;
   switch (kind) {
     case K::kConstant:
-      return smooth ? emit_tile<true, K::kConstant> : emit_tile<false, K::kConstant>;
+      return smooth ? emit_tile<true, K::kConstant, kInside> : emit_tile<false, K::kConstant, kInside>;
     case K::kImage:
-      return smooth ? emit_tile<true, K::kImage> : emit_tile<false, K::kImage>;
+      return smooth ? emit_tile<true, K::kImage, kInside> : emit_tile<false, K::kImage, kInside>;
     case K::kCallback:
       break;
   }
-  return smooth ? emit_tile<true, K::kCallback> : emit_tile<false, K::kCallback>;
+  return smooth ? emit_tile<true, K::kCallback, kInside> : emit_tile<false, K::kCallback, kInside>;
 }
 
 }  // namespace
@@ -451,7 +453,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
 
   std::size_t n = 0;
   std::uint64_t examined = 0;
-  const EmitTile emit = pick_emitter(glide, d.kind);
+  const EmitTile emit_edge = pick_emitter<false>(glide, d.kind),
+                 emit_inside = pick_emitter<true>(glide, d.kind);
   TileJob job{};
   job.set = &tileset;
   job.keyframes = keyframe_table(tileset);
@@ -493,7 +496,13 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           job.reach = std::max(tileset.glide_reach(b.g0), tileset.glide_reach(b.g1));
         }
       }
-      const std::uint32_t stopped = emit(job, c, end, out, capacity, n);
+      // Inside: the tile widened by the farthest any of its points can glide (and two position units, for
+      // rounding) lies in the region. Such tiles skip every test, and the positions are computed as
+      // elsewhere.
+      const double margin = reach + S * (2.0 / 65536.0);
+      const bool inside =
+          wx - margin >= q.x0 && wx + S + margin < q.x1 && wy - margin >= q.y0 && wy + S + margin < q.y1;
+      const std::uint32_t stopped = (inside ? emit_inside : emit_edge)(job, c, end, out, capacity, n);
       examined += stopped - c;
       if (stopped < candidates) {  // the buffer is full, or the budget spent
         *cursor = QueryCursor{tx, ty, stopped, true, false, fingerprint};
