@@ -25,10 +25,10 @@ constexpr int kCountBuckets = 64 * 16;
 int count_bucket(double v) {
   std::uint64_t bits;
   std::memcpy(&bits, &v, sizeof bits);
-  const int e = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
-  if (e < -32) return 0;
-  if (e > 31) return kCountBuckets - 1;
-  return (e + 32) * 16 + static_cast<int>((bits >> 48) & 0xf);
+  // Exponent and leading 4 mantissa bits are the top 16 bits of a positive double: (e + 1023) · 16 + m.
+  const std::uint64_t b = (bits >> 48) - (1023 - 32) * 16;
+  if (b < kCountBuckets) return static_cast<int>(b);
+  return v < 1 ? 0 : kCountBuckets - 1;  // beyond the table (or negative: sign bit set)
 }
 
 bool finite(double v) {
@@ -95,9 +95,45 @@ void Tileset::adopt(TilesetData&& set) {
   for (std::size_t g = glide_reach_.size(); g-- > 0;)
     glide_reach_from_[g] =
         std::max(glide_reach_[g], g + 1 < glide_reach_.size() ? glide_reach_from_[g + 1] : 0.0);
+  const std::size_t keyframes = set_.keyframe_nominal.size();
+  keyframe_counts_.assign(keyframes + 1, HUGE_VAL);
+  for (std::size_t g = 0; g < keyframes; ++g) keyframe_counts_[g] = set_.keyframe_nominal[g];
+  glide_spans_.assign(keyframes ? keyframes + 1 : 0, {});
+  for (std::size_t g = 0; g < glide_spans_.size(); ++g) {
+    GlideSpan& span = glide_spans_[g];
+    span.g0 = static_cast<std::uint32_t>(g - (g > 0)),
+    span.g1 = static_cast<std::uint32_t>(g - (g == keyframes));
+    span.base = keyframe_counts_[span.g0];
+    if (span.g1 > span.g0) span.inverse_gap = 1.0 / (keyframe_counts_[span.g1] - keyframe_counts_[span.g0]);
+    span.scale0 = glide_scale_[span.g0], span.scale1 = glide_scale_[span.g1];
+  }
+  index_edges();
   min_threshold_ = HUGE_VAL;
   for (const TilesetArray<float>& t : thresholds_)
     if (!t.empty()) min_threshold_ = std::min(min_threshold_, double(t.front()));
+}
+
+void Tileset::index_edges() {
+  edge_start_.assign(5 * set_.tiles.size(), 0);
+  edge_ranks_.assign(set_.tiles.size(), {});
+  if (!has_glide()) return;
+  for (std::size_t t = 0; t < set_.tiles.size(); ++t) {
+    const Tile& tile = set_.tiles[t];
+    const std::uint32_t* ranks = keyframe_ranks_[t].data();
+    TilesetArray<std::uint32_t>& out = edge_ranks_[t];
+    for (int side = 0; side < 4; ++side) {
+      std::size_t segment = 0;  // the keyframes whose count rank c is at least: it appears after the last
+      for (std::uint32_t c = 0; c < tile.points.size(); ++c) {
+        while (segment < keyframe_ranks_[t].size() && ranks[segment] <= c) ++segment;
+        // The same reach as the query's culling (emit_tile), so a point left out would be culled there.
+        const double reach = glide_reach_from(segment ? segment - 1 : 0) * 65536.0 + kEdgeSlack;
+        const double u = (side < 2 ? tile.points[c].x : tile.points[c].y) + 0.5;
+        if ((side % 2 == 0) ? u < reach : u > 65536.0 - reach) out.push_back(c);
+      }
+      edge_start_[5 * t + side + 1] = static_cast<std::uint32_t>(out.size());
+    }
+    out.shrink_to_fit();
+  }
 }
 
 std::size_t Tileset::resident_bytes() const {
@@ -118,6 +154,10 @@ std::size_t Tileset::resident_bytes() const {
   for (const TilesetArray<std::uint32_t>& t : glide_start_) bytes += t.capacity() * sizeof(std::uint32_t);
   for (const TilesetArray<std::uint32_t>& t : keyframe_ranks_) bytes += t.capacity() * sizeof(std::uint32_t);
   for (const Tile& t : set_.tiles) bytes += t.glide.capacity() * sizeof(std::int8_t);
+  bytes += keyframe_counts_.capacity() * sizeof(double) + glide_spans_.capacity() * sizeof(GlideSpan) +
+           edge_ranks_.capacity() * sizeof(TilesetArray<std::uint32_t>) +
+           edge_start_.capacity() * sizeof(std::uint32_t);
+  for (const TilesetArray<std::uint32_t>& t : edge_ranks_) bytes += t.capacity() * sizeof(std::uint32_t);
   return bytes;
 }
 
@@ -166,39 +206,41 @@ struct ImageSampler {
   }
 };
 
+/// Every signed byte as a double: a load instead of a conversion with its false dependency.
+struct SignedByteTable {
+  double value[256];
+  constexpr SignedByteTable() : value() {
+    for (int i = 0; i < 256; ++i) value[i] = i - 128;
+  }
+};
+constexpr SignedByteTable kSignedByte;
+
 /// A set's keyframe tables as plain pointers (a query's copy: see TileJob).
 struct KeyframeTable {
-  const std::uint32_t* counts = nullptr;  ///< K_g
+  const double* counts = nullptr;  ///< K_g, then +∞ (Tileset::keyframe_counts)
   std::uint32_t n = 0;
-  const double* scale = nullptr;         ///< Tileset::glide_scale
+  const GlideSpan* spans = nullptr;      ///< Tileset::glide_spans
   const std::uint16_t* guess = nullptr;  ///< the first keyframe at least each count_bucket's smallest count
   /// The first g with K_g >= expected (> 0), or n.
   std::uint32_t first_at_least(double expected) const {
-    std::uint32_t g = guess ? guess[count_bucket(expected)] : 0;
-    g += g < n && counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
-    while (g < n && counts[g] < expected) ++g;
+    std::uint32_t g = guess[count_bucket(expected)];
+    g += counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
+    while (counts[g] < expected) ++g;
     return g;
   }
 };
 
 /// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the weights of
 /// their offsets, w0 = (1 − t) and w1 = t times each keyframe's unit (Tileset::glide_scale), t the fraction
-/// of the way from g0 to g1 (linear in the count).
+/// of the way from g0 to g1 (linear in the count; 0 below the first keyframe and above the last).
 struct GlideBracket {
   std::uint32_t g0 = 0, g1 = 0;
   double w0 = 0, w1 = 0;
+  GlideBracket() = default;
   GlideBracket(const KeyframeTable& k, double expected) {
-    if (k.n == 0) return;
-    g1 = k.first_at_least(expected);
-    double t = 0;
-    if (g1 == 0) {
-      // at or below the first keyframe: no motion yet
-    } else if (g1 == k.n) {
-      g0 = g1 = k.n - 1;  // the top: every point at its last position
-    } else {
-      g0 = g1 - 1, t = (expected - k.counts[g0]) / double(k.counts[g1] - k.counts[g0]);
-    }
-    w0 = (1 - t) * k.scale[g0], w1 = t * k.scale[g1];
+    const GlideSpan& span = k.spans[k.first_at_least(expected)];
+    const double t = (expected - span.base) * span.inverse_gap;
+    g0 = span.g0, g1 = span.g1, w0 = (1 - t) * span.scale0, w1 = t * span.scale1;
   }
 };
 
@@ -218,6 +260,8 @@ struct TileJob {
   /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
   double cull_x0, cull_y0, cull_x1, cull_y1, reach;
   const std::uint32_t* ranks;  ///< smooth mode, varying density: Tileset::keyframe_ranks
+  /// Smooth mode, a tile beside the region: the only ranks that can glide into it (Tileset::edge_ranks).
+  const std::uint32_t *listed, *listed_end;
   double area_scale, limit;
   const QueryDensity* density;
   const ImageSampler* sampler;
@@ -225,14 +269,15 @@ struct TileJob {
 
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
-/// or not, lies inside the region, so no point is tested against it.
-template <bool kSmooth, QueryDensity::Kind kKind, bool kInside>
+/// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
+/// job.listed are visited (the others are culled, as the full scan would).
+template <bool kSmooth, QueryDensity::Kind kKind, bool kInside, bool kListed>
 std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, QueryPoint* out,
                         std::size_t capacity, std::size_t& written) {
   const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
   std::size_t n = written;
   constexpr bool kConstant = kKind == QueryDensity::Kind::kConstant;
-  const GlideBracket constant(j.keyframes, kSmooth && kConstant ? j.limit : 0.0);
+  const GlideBracket constant = kSmooth && kConstant ? GlideBracket(j.keyframes, j.limit) : GlideBracket();
   const std::int8_t* c0 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g0]) : nullptr;
   const std::int8_t* c1 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g1]) : nullptr;
   // Culling bounds; with a varying density they narrow with the rank: a point whose threshold is at least
@@ -245,55 +290,91 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
   };
   if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.set->glide_reach_from(0));
-  for (; c < end; ++c) {
-    const TilePoint p = j.points[c];
-    double x, y;
+  // Places candidate c, emitted at `expected`: false when the buffer is full.
+  // Places candidate c at its stable position (x, y) plus, in smooth mode, its offsets o0 and o1 weighted
+  // by w0 and w1 (GlideBracket): false when the buffer is full.
+  const double unit = j.S * (1.0 / 65536.0);  // world units per position unit
+  auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
+                   double w0, double w1) -> bool {
     if (kSmooth) {
-      if (!kInside && !kConstant && segment < keyframes && j.ranks[segment] <= c) {
+      const double* v = kSignedByte.value + 128;
+      x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
+      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
+    }
+    if (n == capacity) return false;
+    out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
+    return true;
+  };
+  // Smooth mode with a varying density: the emitted candidates wait in a batch, so that the long chain from
+  // a point's density to its glided position overlaps between points instead of restarting after every
+  // mispredicted emission test.
+  constexpr bool kBatched = kSmooth && !kConstant;
+  constexpr std::uint32_t kNone = ~0u;
+  constexpr int kBatch = kBatched ? 64 : 1;
+  std::uint32_t pending_rank[kBatch];
+  double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
+  int pending = 0;
+  auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
+    // Two passes, each short enough for the processor to overlap many points' latency chains.
+    const std::int8_t *o0[kBatch], *o1[kBatch];
+    double w0[kBatch], w1[kBatch];
+    for (int i = 0; i < pending; ++i) {
+      const GlideBracket b(j.keyframes, pending_expected[i]);
+      o0[i] = j.glide + 2 * (std::size_t(j.starts[b.g0]) + pending_rank[i]);
+      o1[i] = j.glide + 2 * (std::size_t(j.starts[b.g1]) + pending_rank[i]);
+      w0[i] = b.w0, w1[i] = b.w1;
+    }
+    for (int i = 0; i < pending; ++i)
+      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i]))
+        return pending = 0, pending_rank[i];
+    pending = 0;
+    return kNone;
+  };
+  // One candidate: the rank that did not fit, or kNone. Positions: the stable one (for ρ and in stable
+  // mode), then the glide added to it.
+  auto visit = [&](std::uint32_t c) -> std::uint32_t {
+    const TilePoint p = j.points[c];
+    if (kSmooth && !kInside) {
+      if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
         set_reach(j.set->glide_reach_from(segment - 1));
       }
       const double sx = p.x + 0.5, sy = p.y + 0.5;
-      if (!kInside && (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y)) continue;
-      x = j.wx + sx * (1.0 / 65536.0) * j.S, y = j.wy + sy * (1.0 / 65536.0) * j.S;  // stable, for ρ
-    } else {
-      x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
-      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) continue;
+      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) return kNone;
     }
-    double expected = j.limit;
-    if (kKind != QueryDensity::Kind::kConstant) {
-      const double rho = kKind == QueryDensity::Kind::kImage
-                             ? j.sampler->at(x, y)
-                             : sanitize(j.density->callback(j.density->user, x, y));
-      expected = rho * j.area_scale;
-      if (!TilesetData::emits(j.thresholds[c], expected)) continue;
-    }
-    if (kSmooth) {
-      const std::int8_t *o0 = c0 + 2 * std::size_t(c), *o1 = c1 + 2 * std::size_t(c);
-      double w0 = constant.w0, w1 = constant.w1;
-      if (kKind != QueryDensity::Kind::kConstant) {
-        const GlideBracket b(j.keyframes, expected);
-        o0 = j.glide + 2 * (std::size_t(j.starts[b.g0]) + c),
-        o1 = j.glide + 2 * (std::size_t(j.starts[b.g1]) + c);
-        w0 = b.w0, w1 = b.w1;
-      }
-      const double dx = o0[0] * w0 + o1[0] * w1, dy = o0[1] * w0 + o1[1] * w1;
-      x = j.wx + (p.x + 0.5 + dx) * (1.0 / 65536.0) * j.S,
-      y = j.wy + (p.y + 0.5 + dy) * (1.0 / 65536.0) * j.S;
-      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) continue;
-    }
-    if (n == capacity) break;
-    out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
+    const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+    if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
+    if (kConstant)
+      return place(c, x, y, c0 + 2 * std::size_t(c), c1 + 2 * std::size_t(c), constant.w0, constant.w1)
+                 ? kNone
+                 : c;
+    const double rho = kKind == QueryDensity::Kind::kImage
+                           ? j.sampler->at(x, y)
+                           : sanitize(j.density->callback(j.density->user, x, y));
+    const double expected = rho * j.area_scale;
+    if (!TilesetData::emits(j.thresholds[c], expected)) return kNone;
+    if (!kBatched) return place(c, x, y, nullptr, nullptr, 0, 0) ? kNone : c;
+    pending_rank[pending] = c, pending_expected[pending] = expected;
+    pending_x[pending] = x, pending_y[pending] = y;
+    return ++pending == kBatch ? flush() : kNone;
+  };
+  std::uint32_t stopped = kNone;
+  if constexpr (kListed) {
+    const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
+    for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
+  } else {
+    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   }
+  if (kBatched && stopped == kNone) stopped = flush();
   written = n;
-  return c;
+  return stopped == kNone ? end : stopped;
 }
 
 KeyframeTable keyframe_table(const Tileset& set) {
   KeyframeTable k;
-  k.counts = set.data().keyframe_nominal.data();
+  k.counts = set.keyframe_counts();
   k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
-  k.scale = set.glide_scale();
+  k.spans = set.glide_spans();
   k.guess = set.keyframe_guess();
   return k;
 }
@@ -301,18 +382,37 @@ KeyframeTable keyframe_table(const Tileset& set) {
 using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t, QueryPoint*, std::size_t,
                                    std::size_t&);
 
-template <bool kInside>
+template <bool kInside, bool kListed = false>
 EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
   using K = QueryDensity::Kind;
   switch (kind) {
     case K::kConstant:
-      return smooth ? emit_tile<true, K::kConstant, kInside> : emit_tile<false, K::kConstant, kInside>;
+      return smooth ? emit_tile<true, K::kConstant, kInside, kListed>
+                    : emit_tile<false, K::kConstant, kInside, false>;
     case K::kImage:
-      return smooth ? emit_tile<true, K::kImage, kInside> : emit_tile<false, K::kImage, kInside>;
+      return smooth ? emit_tile<true, K::kImage, kInside, kListed>
+                    : emit_tile<false, K::kImage, kInside, false>;
     case K::kCallback:
       break;
   }
-  return smooth ? emit_tile<true, K::kCallback, kInside> : emit_tile<false, K::kCallback, kInside>;
+  return smooth ? emit_tile<true, K::kCallback, kInside, kListed>
+                : emit_tile<false, K::kCallback, kInside, false>;
+}
+
+/// Smooth mode: when the region lies beyond one side of the tile (to within a few position units), only the
+/// points that can glide across that side can be emitted: job.listed is set to the shortest such side's
+/// list (Tileset::edge_ranks), whose every other point the culling bounds reject (the list adds
+/// Tileset::kEdgeSlack units to each reach, the bounds at most one).
+void pick_edge_list(const Tileset& set, std::size_t index, TileJob& job) {
+  constexpr double kNear = Tileset::kEdgeSlack / 2;
+  const bool beyond[4] = {job.cull_x1 <= kNear, job.cull_x0 >= 65536.0 - kNear, job.cull_y1 <= kNear,
+                          job.cull_y0 >= 65536.0 - kNear};
+  std::uint32_t best = ~0u;
+  for (int side = 0; side < 4; ++side) {
+    std::uint32_t count = 0;
+    const std::uint32_t* ranks = set.edge_ranks(index, side, count);
+    if (beyond[side] && count < best) best = count, job.listed = ranks, job.listed_end = ranks + count;
+  }
 }
 
 }  // namespace
@@ -454,7 +554,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   std::size_t n = 0;
   std::uint64_t examined = 0;
   const EmitTile emit_edge = pick_emitter<false>(glide, d.kind),
-                 emit_inside = pick_emitter<true>(glide, d.kind);
+                 emit_inside = pick_emitter<true>(glide, d.kind),
+                 emit_listed = pick_emitter<false, true>(glide, d.kind);
   TileJob job{};
   job.set = &tileset;
   job.keyframes = keyframe_table(tileset);
@@ -495,6 +596,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           const GlideBracket b(job.keyframes, limit);
           job.reach = std::max(tileset.glide_reach(b.g0), tileset.glide_reach(b.g1));
         }
+        job.listed = nullptr;
+        pick_edge_list(tileset, index, job);
       }
       // Inside: the tile widened by the farthest any of its points can glide (and two position units, for
       // rounding) lies in the region. Such tiles skip every test, and the positions are computed as
@@ -502,7 +605,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       const double margin = reach + S * (2.0 / 65536.0);
       const bool inside =
           wx - margin >= q.x0 && wx + S + margin < q.x1 && wy - margin >= q.y0 && wy + S + margin < q.y1;
-      const std::uint32_t stopped = (inside ? emit_inside : emit_edge)(job, c, end, out, capacity, n);
+      const EmitTile emit = inside ? emit_inside : job.listed ? emit_listed : emit_edge;
+      const std::uint32_t stopped = emit(job, c, end, out, capacity, n);
       examined += stopped - c;
       if (stopped < candidates) {  // the buffer is full, or the budget spent
         *cursor = QueryCursor{tx, ty, stopped, true, false, fingerprint};
@@ -517,7 +621,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
 }
 
 std::uint32_t Tileset::first_keyframe_at_least(double expected) const {
-  return keyframe_table(*this).first_at_least(expected);
+  return has_glide() ? keyframe_table(*this).first_at_least(expected) : 0;
 }
 
 const char* query_problem_message(QueryProblem::Kind kind) {

@@ -73,12 +73,20 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_EQ(t.max_points_per_tile(), t.data().level_nominal.back());
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
   // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, 2 per gliding position
-  // (one per coordinate), plus small tables.
+  // (one per coordinate), 4 per entry of the edge lists, plus small tables.
   ASSERT_TRUE(t.has_glide());
-  std::size_t points = 0, glide = 0;
+  std::size_t points = 0, glide = 0, listed = 0;
   for (const Tile& tile : t.data().tiles) points += tile.points.size(), glide += tile.glide.size();
-  EXPECT_GE(t.resident_bytes(), 10 * points + glide);
-  EXPECT_LE(t.resident_bytes(), 10 * points + glide + 64 * 1024);
+  for (std::size_t i = 0; i < t.data().tiles.size(); ++i)
+    for (int side = 0; side < 4; ++side) {
+      std::uint32_t count = 0;
+      t.edge_ranks(i, side, count);
+      listed += count;
+    }
+  EXPECT_GT(listed, 0u);
+  EXPECT_LT(listed, points);  // a tile's sides list a small share of its points
+  EXPECT_GE(t.resident_bytes(), 10 * points + glide + 4 * listed);
+  EXPECT_LE(t.resident_bytes(), 10 * points + glide + 4 * listed + 64 * 1024);
   EXPECT_LT(Tileset{}.resident_bytes(), 1024u);
 }
 
@@ -130,6 +138,40 @@ TEST_P(ModeTest, AnyPartitionGivesTheSameUnionBitForBit) {
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, expected) << "trial " << trial;
   }
+}
+
+TEST(QueryTest, EdgeListsHoldEveryPointThatCanGlideAcrossASide) {
+  // From the stored offsets alone: a point whose stable position lies within its farthest glide (at any
+  // keyframe it has an offset at) of a tile side must be in that side's list, which a query scans alone
+  // for a tile beside its region. The lists must also be sorted, and leave most points out.
+  const Tileset& t = Tileset::builtin();
+  const TilesetData& set = t.data();
+  std::size_t listed = 0, points = 0;
+  for (std::size_t i = 0; i < set.tiles.size(); ++i) {
+    const Tile& tile = set.tiles[i];
+    const std::uint32_t* start = t.glide_start(i);
+    std::vector<double> farthest(tile.points.size(), 0.0);  // position units, per axis
+    for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+      for (std::uint32_t c = 0; c < start[g + 1] - start[g]; ++c)
+        for (int axis = 0; axis < 2; ++axis)
+          farthest[c] = std::max(
+              farthest[c], std::abs(tile.glide[2 * (start[g] + c) + axis]) * set.glide_unit(g) * 65536.0);
+    for (int side = 0; side < 4; ++side) {
+      std::uint32_t count = 0;
+      const std::uint32_t* ranks = t.edge_ranks(i, side, count);
+      ASSERT_TRUE(std::is_sorted(ranks, ranks + count));
+      for (std::uint32_t c = 0; c < tile.points.size(); ++c) {
+        const double u = (side < 2 ? tile.points[c].x : tile.points[c].y) + 0.5;
+        const double gap = side % 2 == 0 ? u : 65536.0 - u;  // to the side
+        if (gap <= farthest[c] + 1) {
+          EXPECT_TRUE(std::binary_search(ranks, ranks + count, c)) << i << side << c;
+        }
+      }
+      listed += count;
+    }
+    points += tile.points.size();
+  }
+  EXPECT_LT(listed, points / 2) << "the lists should be a small share of four sides' worth of points";
 }
 
 TEST(QueryTest, SmoothModeKeepsEveryPointAsTheScaleRisesAndGlides) {
@@ -196,6 +238,39 @@ double ramp(void*, double x, double) {
 }
 double hostile(void*, double x, double) {
   return x < 1 ? std::nan("") : (x < 2 ? -5.0 : HUGE_VAL);
+}
+
+TEST(QueryTest, TilesBesideASmoothRegionGiveWhatAFullScanGives) {
+  // A small region's neighbouring tiles are scanned through their edge lists; in a larger region the same
+  // tiles are scanned in full. The small region's points must be the large one's points that lie in it,
+  // at low densities (where points glide farthest) and high ones, constant and varying.
+  std::ptrdiff_t glided_in = 0;
+  for (double scale : {40.0, 90.0, 700.0, 5000.0})
+    for (bool varying : {false, true}) {
+      QueryParams small = region(0.01, 0.02, 0.985, 1.97, scale, QueryMode::kSmooth);
+      if (varying) {
+        small.density.kind = QueryDensity::Kind::kCallback;
+        small.density.callback = [](void*, double x, double y) {
+          return 0.2 + 0.8 * std::fabs(std::sin(3 * x + y));
+        };
+        small.density.callback_max = 1;
+      }
+      QueryParams large = small;
+      large.x0 = large.y0 = -2, large.x1 = large.y1 = 4;
+      std::vector<Key> expected;
+      for (const Key& k : run(large))
+        if (std::get<3>(k) >= small.x0 && std::get<3>(k) < small.x1 && std::get<4>(k) >= small.y0 &&
+            std::get<4>(k) < small.y1)
+          expected.push_back(k);
+      std::vector<Key> got = run(small);
+      std::sort(expected.begin(), expected.end()), std::sort(got.begin(), got.end());
+      ASSERT_GT(got.size(), 10u);
+      EXPECT_EQ(got, expected) << "scale " << scale << (varying ? " varying" : " constant");
+      glided_in += std::count_if(got.begin(), got.end(), [](const Key& k) {
+        return std::get<0>(k) != 0 || std::get<1>(k) < 0 || std::get<1>(k) > 1;  // not tiles (0, 0), (0, 1)
+      });
+    }
+  EXPECT_GT(glided_in, 5) << "some points should come from the neighbouring tiles, glided in";
 }
 
 TEST(QueryTest, FollowsADensityRamp) {

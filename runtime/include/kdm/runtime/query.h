@@ -28,6 +28,15 @@
 
 namespace kdm {
 
+/// How a point glides at an expected count c per tile between keyframes K_g0 ≤ c ≤ K_g1: its offset is
+/// o_g0 · (1 − t) · scale0 + o_g1 · t · scale1 with t = (c − base) · inverse_gap, in 1/65536 tile sides.
+/// Below the first keyframe and above the last g0 = g1 and t = 0: no motion there.
+struct GlideSpan {
+  std::uint32_t g0 = 0, g1 = 0;
+  double base = 0, inverse_gap = 0;  ///< K_g0 and 1 / (K_g1 − K_g0) (0 when g0 = g1)
+  double scale0 = 0, scale1 = 0;     ///< Tileset::glide_scale of g0 and g1
+};
+
 /// A loaded tile set, ready for queries (immutable).
 class KDM_RUNTIME_API Tileset {
  public:
@@ -74,6 +83,21 @@ class KDM_RUNTIME_API Tileset {
   const std::uint32_t* keyframe_ranks(std::size_t index) const { return keyframe_ranks_[index].data(); }
   /// Per keyframe, 1/65536 tile sides per glide offset unit (65536 · TilesetData::glide_unit(g)).
   const double* glide_scale() const { return glide_scale_.data(); }
+  /// The keyframe counts K_g as doubles, then +∞ (keyframes + 1 entries): searches stop without a bound.
+  const double* keyframe_counts() const { return keyframe_counts_.data(); }
+  /// Per g = first_keyframe_at_least(count) (keyframes + 1 entries), how a count there glides.
+  const GlideSpan* glide_spans() const { return glide_spans_.data(); }
+  /// Smooth mode: the ranks of tile `index`'s points that can glide across its side `side` (0: x = 0,
+  /// 1: x = 1, 2: y = 0, 3: y = 1), ascending; `count` receives how many. A point is listed when its
+  /// stable position lies within glide_reach_from(the keyframe it appears after) · 65536 + kEdgeSlack
+  /// position units of that side, so a tile beside a region is scanned through one list, not in full.
+  const std::uint32_t* edge_ranks(std::size_t index, int side, std::uint32_t& count) const {
+    const std::uint32_t* start = edge_start_.data() + 5 * index;
+    count = start[side + 1] - start[side];
+    return edge_ranks_[index].data() + start[side];
+  }
+  /// Position units (1/65536 tile side) edge_ranks adds to each point's reach, for rounding.
+  static constexpr double kEdgeSlack = 8;
   /// The first keyframe whose count is at least `expected` (> 0), or the keyframe count if none: a table
   /// lookup on the number's exponent and leading bits, then a step or two.
   std::uint32_t first_keyframe_at_least(double expected) const;
@@ -89,6 +113,7 @@ class KDM_RUNTIME_API Tileset {
 
  private:
   void adopt(TilesetData&& set);
+  void index_edges();  ///< edge_ranks_ and edge_start_, from the glide tables adopt has built
   TilesetData set_;
   TilesetArray<TilesetArray<float>> thresholds_;
   TilesetArray<TilesetArray<std::uint32_t>> glide_start_;
@@ -98,6 +123,10 @@ class KDM_RUNTIME_API Tileset {
   TilesetArray<double> glide_scale_;
   TilesetArray<TilesetArray<std::uint32_t>> keyframe_ranks_;
   TilesetArray<std::uint16_t> keyframe_guess_;  ///< first_keyframe_at_least per count_bucket
+  TilesetArray<double> keyframe_counts_;
+  TilesetArray<GlideSpan> glide_spans_;
+  TilesetArray<TilesetArray<std::uint32_t>> edge_ranks_;  ///< per tile, its four sides' lists in turn
+  TilesetArray<std::uint32_t> edge_start_;                ///< per tile, 5 offsets into its edge_ranks_
 };
 
 /// A point's stable identity: its tile and its rank there (the level follows from the rank).
