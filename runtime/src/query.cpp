@@ -77,6 +77,9 @@ void Tileset::adopt(TilesetData&& set) {
     keyframe_guess_[b] =
         static_cast<std::uint16_t>(std::lower_bound(k, k + set_.keyframe_nominal.size(), lowest) - k);
   }
+  keyframe_one_step_ = true;  // no bucket holds two keyframes (true unless they are under 6.25% apart)
+  for (int b = 0; b + 1 < kCountBuckets; ++b)
+    keyframe_one_step_ = keyframe_one_step_ && keyframe_guess_[b + 1] <= keyframe_guess_[b] + 1;
   keyframe_ranks_.assign(set_.tiles.size(), {});
   for (std::size_t t = 0; t < set_.tiles.size() && has_glide(); ++t) {
     TilesetArray<std::uint32_t>& start = glide_start_[t];
@@ -220,12 +223,14 @@ struct KeyframeTable {
   const double* counts = nullptr;  ///< K_g, then +∞ (Tileset::keyframe_counts)
   std::uint32_t n = 0;
   const GlideSpan* spans = nullptr;      ///< Tileset::glide_spans
+  bool one_step = false;                 ///< Tileset::keyframe_one_step
   const std::uint16_t* guess = nullptr;  ///< the first keyframe at least each count_bucket's smallest count
   /// The first g with K_g >= expected (> 0), or n.
   std::uint32_t first_at_least(double expected) const {
     std::uint32_t g = guess[count_bucket(expected)];
     g += counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
-    while (counts[g] < expected) ++g;
+    if (!one_step)
+      while (counts[g] < expected) ++g;
     return g;
   }
 };
@@ -375,6 +380,7 @@ KeyframeTable keyframe_table(const Tileset& set) {
   k.counts = set.keyframe_counts();
   k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
   k.spans = set.glide_spans();
+  k.one_step = set.keyframe_one_step();
   k.guess = set.keyframe_guess();
   return k;
 }

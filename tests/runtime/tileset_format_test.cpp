@@ -13,6 +13,7 @@
 #include <iterator>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "crc32.h"
 #include "kdm/runtime/query.h"
@@ -410,6 +411,51 @@ void counting_deallocate(void* p, std::size_t bytes, std::size_t, void* user) {
   auto* heap = static_cast<CountingHeap*>(user);
   heap->live_bytes -= bytes, ++heap->frees;
   std::free(p);
+}
+
+TEST(TilesetFormatTest, KeyframesCloserThanTheLookupTableStillFindTheirBracket) {
+  // A keyframe at every count from the first level to the top (1 apart, under the lookup table's 6.25%
+  // buckets): the one-step lookup no longer holds, and the search must still match std::lower_bound, and a
+  // smooth query with a varying density must emit the same ids as a stable one.
+  TilesetData set = make_tileset(2, 3, 4, /*glide=*/false);
+  for (std::uint32_t k = set.level_nominal.front(); k <= set.level_nominal.back(); ++k)
+    set.keyframe_nominal.push_back(k);
+  std::mt19937 rng(5);
+  for (Tile& tile : set.tiles)
+    for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+      for (std::uint32_t i = 0; i < 2 * set.glide_count(tile, g); ++i)
+        tile.glide.push_back(static_cast<std::int8_t>(rng() % 9) - 4);
+  const std::vector<std::uint8_t> bytes = encode(set);
+  Tileset t;
+  ASSERT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
+  EXPECT_FALSE(t.keyframe_one_step());
+  EXPECT_TRUE(Tileset::builtin().keyframe_one_step());
+  const auto& k = set.keyframe_nominal;
+  for (double c = 0.25; c < 400; c += 0.125)
+    ASSERT_EQ(t.first_keyframe_at_least(c), std::lower_bound(k.begin(), k.end(), c) - k.begin()) << c;
+
+  QueryParams q;
+  q.x1 = q.y1 = 3;
+  q.scale = 90;  // up to 180 expected per tile, of 192 at the top
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = [](void*, double x, double y) { return 0.1 + 0.3 * (x + y); };
+  q.density.callback_max = 2;
+  std::vector<QueryPoint> stable(4096), smooth(4096);
+  std::size_t stable_n = 0, smooth_n = 0;
+  QueryCursor a, b;
+  ASSERT_EQ(query_points(t, q, stable.data(), stable.size(), &stable_n, &a), Status::kOk);
+  q.mode = QueryMode::kSmooth;
+  ASSERT_EQ(query_points(t, q, smooth.data(), smooth.size(), &smooth_n, &b), Status::kOk);
+  std::vector<std::tuple<std::int64_t, std::int64_t, std::uint32_t>> ids_stable, ids_smooth;
+  for (std::size_t i = 0; i < stable_n; ++i)
+    if (stable[i].x > 0.5 && stable[i].x < 2.5 && stable[i].y > 0.5 && stable[i].y < 2.5)
+      ids_stable.emplace_back(stable[i].id.tile_x, stable[i].id.tile_y, stable[i].id.rank);
+  for (std::size_t i = 0; i < smooth_n; ++i)
+    ids_smooth.emplace_back(smooth[i].id.tile_x, smooth[i].id.tile_y, smooth[i].id.rank);
+  std::sort(ids_smooth.begin(), ids_smooth.end());
+  ASSERT_GT(ids_stable.size(), 50u);
+  for (const auto& id : ids_stable)  // away from the border, where points glide in and out
+    EXPECT_TRUE(std::binary_search(ids_smooth.begin(), ids_smooth.end(), id));
 }
 
 TEST(TilesetAllocatorTest, TheTileSetsArraysGoThroughTheHook) {

@@ -106,6 +106,9 @@ class KDM_RUNTIME_API Tileset {
   const std::uint16_t* keyframe_guess() const {
     return keyframe_guess_.empty() ? nullptr : keyframe_guess_.data();
   }
+  /// Whether one step from keyframe_guess() always finds first_keyframe_at_least (true when consecutive
+  /// keyframes are over 6.25% apart, as in baked sets).
+  bool keyframe_one_step() const { return keyframe_one_step_; }
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
   /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
   /// same size; its compressed bytes in the library's data section are extra. Thread-safe.
@@ -123,6 +126,7 @@ class KDM_RUNTIME_API Tileset {
   TilesetArray<double> glide_scale_;
   TilesetArray<TilesetArray<std::uint32_t>> keyframe_ranks_;
   TilesetArray<std::uint16_t> keyframe_guess_;  ///< first_keyframe_at_least per count_bucket
+  bool keyframe_one_step_ = false;
   TilesetArray<double> keyframe_counts_;
   TilesetArray<GlideSpan> glide_spans_;
   TilesetArray<TilesetArray<std::uint32_t>> edge_ranks_;  ///< per tile, its four sides' lists in turn
