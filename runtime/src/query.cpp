@@ -315,7 +315,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   // mispredicted emission test.
   constexpr bool kBatched = kSmooth && !kConstant;
   constexpr std::uint32_t kNone = ~0u;
-  constexpr int kBatch = kBatched ? 64 : 1;
+  constexpr int kBatch = kBatched ? 32 : 1;
   std::uint32_t pending_rank[kBatch];
   double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
   int pending = 0;
