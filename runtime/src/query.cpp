@@ -357,11 +357,19 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
                            ? j.sampler->at(x, y)
                            : sanitize(j.density->callback(j.density->user, x, y));
     const double expected = rho * j.area_scale;
-    if (!TilesetData::emits(j.thresholds[c], expected)) return kNone;
-    if (!kBatched) return place(c, x, y, nullptr, nullptr, 0, 0) ? kNone : c;
+    // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
+    // written (or queued) at the next slot, which only an emitted one then keeps.
+    const bool emitted = TilesetData::emits(j.thresholds[c], expected);
+    if (!kBatched) {
+      if (n == capacity) return emitted ? c : kNone;
+      out[n] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
+      n += emitted;
+      return kNone;
+    }
     pending_rank[pending] = c, pending_expected[pending] = expected;
     pending_x[pending] = x, pending_y[pending] = y;
-    return ++pending == kBatch ? flush() : kNone;
+    pending += emitted;
+    return pending == kBatch ? flush() : kNone;
   };
   std::uint32_t stopped = kNone;
   if constexpr (kListed) {

@@ -246,9 +246,10 @@ KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
-/// ascending); `*written` receives the count. Returns kOk when the region is complete (a finished cursor
-/// called again with the same params gives kOk and no points), kBufferFull when `out` filled up first or
-/// the call examined kMaxQueryCandidates points — call again with the same cursor and params to continue.
+/// ascending); `*written` receives the count, and slots from there to capacity may be overwritten too (a
+/// candidate is written before it is known to be kept). Returns kOk when the region is complete (a finished
+/// cursor called again with the same params gives kOk and no points), kBufferFull when `out` filled up first
+/// or the call examined kMaxQueryCandidates points — call again with the same cursor and params to continue.
 /// Empty or inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional)
 /// saying which parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative
 /// scale, a missing image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the
