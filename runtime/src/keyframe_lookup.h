@@ -1,0 +1,67 @@
+// Internal: finding the keyframes around an expected count, shared by loading (its tables) and queries.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "kdm/runtime/query.h"
+
+namespace kdm {
+namespace detail {
+
+/// Buckets of expected counts for Tileset::first_keyframe_at_least: 16 per power of two from 2^-32 to
+/// 2^32 (smaller counts share the first, larger ones the last), from the double's exponent and leading
+/// mantissa bits. A bucket's smallest count is (1 + m/16) · 2^e.
+inline constexpr int kCountBuckets = 64 * 16;
+inline int count_bucket(double v) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  // Exponent and leading 4 mantissa bits are the top 16 bits of a positive double: (e + 1023) · 16 + m.
+  const std::uint64_t b = (bits >> 48) - (1023 - 32) * 16;
+  if (b < kCountBuckets) return static_cast<int>(b);
+  return v < 1 ? 0 : kCountBuckets - 1;  // beyond the table (or negative: sign bit set)
+}
+
+/// A set's keyframe tables as plain pointers (a query's copy: see TileJob).
+struct KeyframeTable {
+  const double* counts = nullptr;  ///< K_g, then +∞ (Tileset::keyframe_counts)
+  std::uint32_t n = 0;
+  const GlideSpan* spans = nullptr;      ///< Tileset::glide_spans
+  bool one_step = false;                 ///< Tileset::keyframe_one_step
+  const std::uint16_t* guess = nullptr;  ///< the first keyframe at least each count_bucket's smallest count
+  /// The first g with K_g >= expected (> 0), or n.
+  std::uint32_t first_at_least(double expected) const {
+    std::uint32_t g = guess[count_bucket(expected)];
+    g += counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
+    if (!one_step)
+      while (counts[g] < expected) ++g;
+    return g;
+  }
+};
+
+/// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the weights of
+/// their offsets, w0 = (1 − t) and w1 = t times each keyframe's unit (Tileset::glide_scale), t the fraction
+/// of the way from g0 to g1 (linear in the count; 0 below the first keyframe and above the last).
+struct GlideBracket {
+  std::uint32_t g0 = 0, g1 = 0;
+  double w0 = 0, w1 = 0;
+  GlideBracket() = default;
+  GlideBracket(const KeyframeTable& k, double expected) {
+    const GlideSpan& span = k.spans[k.first_at_least(expected)];
+    const double t = (expected - span.base) * span.inverse_gap;
+    g0 = span.g0, g1 = span.g1, w0 = (1 - t) * span.scale0, w1 = t * span.scale1;
+  }
+};
+
+inline KeyframeTable keyframe_table(const Tileset& set) {
+  KeyframeTable k;
+  k.counts = set.keyframe_counts();
+  k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
+  k.spans = set.glide_spans();
+  k.one_step = set.keyframe_one_step();
+  k.guess = set.keyframe_guess();
+  return k;
+}
+
+}  // namespace detail
+}  // namespace kdm
