@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "bake/close_pairs.h"
 #include "bake/progressive_order.h"
 #include "bake/spacing_guard.h"
 #include "kdm/generator/bake.h"
@@ -45,6 +46,10 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_DOUBLE_EQ(guarded.min_distance, 0.35);
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(guarded.to_text()).min_distance, 0.35);
   EXPECT_THROW(BakeRecipe::parse("min_distance 0.8\n"), InvalidArgument);
+  EXPECT_EQ(r.separation, 0.0);  // off unless named, and then not written
+  EXPECT_EQ(r.to_text().find("separation"), std::string::npos);
+  EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("separation 0.3\n").to_text()).separation, 0.3);
+  EXPECT_THROW(BakeRecipe::parse("separation -0.1\n"), InvalidArgument);
   EXPECT_EQ(r.edge_gap, kFirstEdgeGap);
   EXPECT_FALSE(r.rank_context);
   const BakeRecipe later = BakeRecipe::parse("edge_gap 1\nrank_context 1\nerosion 2\nband 0.36\n");
@@ -94,12 +99,13 @@ TEST(BakeTest, DeterministicNestedCornerTiles) {
 
 // Tiles that share a corner colour hold the same points near that corner (the corner patch), and tiles
 // that share an edge's colours hold the same points along it; tiles differ in their interiors.
-// Both with the first recipes' settings and with the hard core, its margins and context ranking.
+// Both with the first recipes' settings and with the hard core, its margins, context ranking and separation.
 class SharedPatches : public testing::TestWithParam<bool> {};
 
 TEST_P(SharedPatches, TilesShareTheirCornerAndEdgePatches) {
   BakeRecipe r = small_recipe();
-  if (GetParam()) r.erosion = 2, r.edge_gap = 1, r.min_distance = 0.35, r.rank_context = true;
+  if (GetParam())
+    r.erosion = 2, r.edge_gap = 1, r.min_distance = 0.35, r.rank_context = true, r.separation = 0.3;
   const TilesetData set = bake_tileset(r, 0);
   const std::uint32_t C = set.colours;
   auto points_in = [&](std::size_t t, double x0, double y0, double x1, double y1) {
@@ -206,6 +212,52 @@ TEST(BakeTest, HardCoreKeepsPointsApartAtEveryDensity) {
   ASSERT_EQ(load(r, guarded), Status::kOk);
   for (double count : {512.0, 768.0, 1024.0, 1536.0, 2048.0})
     EXPECT_GE(closest_pair(guarded, count, 4), 0.3) << count << " points per tile";
+}
+
+// The separation pass on its own (the first recipes' margins, no hard core): the same few-sweep recipe
+// has near-coincident points without it (the control), and none closer than 0.3 hexagonal spacings with
+// it, at the complete levels and between them.
+TEST(BakeTest, SeparationRemovesNearCoincidentPointsAtEveryDensity) {
+  BakeRecipe r;
+  r.levels = 2, r.base_points = 512, r.sweeps = 20, r.band = 0.2;
+  auto load = [](const BakeRecipe& recipe, Tileset& set) {
+    const std::vector<std::uint8_t> bytes = encoded(bake_tileset(recipe, 0));
+    return Tileset::load_memory(bytes.data(), bytes.size(), set);
+  };
+  Tileset plain, separated;
+  ASSERT_EQ(load(r, plain), Status::kOk);
+  EXPECT_LT(closest_pair(plain, 2048, 4), 0.3);
+  r.separation = 0.3;
+  ASSERT_EQ(load(r, separated), Status::kOk);
+  for (double count : {300.0, 512.0, 768.0, 1024.0, 1536.0, 2048.0})
+    EXPECT_GE(closest_pair(separated, count, 4), 0.3) << count << " points per tile";
+}
+
+// drop_close_pairs by hand: one tile (one colour), a corner point and two interior points. The interior
+// point beside the corner point appears later and goes; the far one stays; the radius is that of the
+// later point's density.
+TEST(BakeTest, DropClosePairsRemovesTheLaterPoint) {
+  std::vector<LevelPatches> levels(2, LevelPatches(1));
+  TilesetData table;
+  table.level_nominal = {16, 64};
+  levels[0].corners[0].add(0.2, 0.2, 100);     // threshold 0.03: first
+  levels[1].interiors[0].add(0.21, 0.2, 300);  // 0.01 away, threshold 16.2: d_hex(16.2) = 0.27
+  levels[1].interiors[0].add(0.5, 0.5, 200);   // far from both
+  levels[0].interiors[0].add(0.7, 0.7, 60000);
+  levels[1].interiors[0].add(0.75, 0.7, 65000);  // 0.05 away, threshold 63.6: 0.3 · d_hex = 0.040 < 0.05
+  // Below the first level's count (outside the set's range) the radius stays that of 16: 0.081 < 0.09.
+  levels[0].interiors[0].add(0.3, 0.85, 16384);   // threshold 4
+  levels[0].interiors[0].add(0.39, 0.85, 40960);  // threshold 10: 0.3 · d_hex(10) = 0.10 would drop it
+  EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 1u);
+  EXPECT_EQ(levels[0].interiors[0].size(), 3u);
+  EXPECT_EQ(levels[0].corners[0].size(), 1u);
+  ASSERT_EQ(levels[1].interiors[0].size(), 2u);
+  EXPECT_EQ(levels[1].interiors[0].keys, (std::vector<std::uint16_t>{200, 65000}));
+  EXPECT_EQ(levels[1].interiors[0].xy, (std::vector<double>{0.5, 0.5, 0.75, 0.7}));
+  EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.4), 2u);  // now 0.05 < 0.4 · 0.135, 0.09 < 0.4 · 0.27
+  EXPECT_EQ(levels[1].interiors[0].keys, (std::vector<std::uint16_t>{200}));
+  EXPECT_EQ(levels[0].interiors[0].keys, (std::vector<std::uint16_t>{60000, 16384}));
+  EXPECT_EQ(drop_close_pairs(levels, 1, table, 0), 0u);
 }
 
 TEST(BakeTest, ShippedDefaultSetRebakesBitIdentically) {

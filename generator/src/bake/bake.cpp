@@ -12,6 +12,7 @@
 #include <thread>
 #include <tuple>
 
+#include "bake/close_pairs.h"
 #include "bake/corner_layout.h"
 #include "bake/keyframes.h"
 #include "bake/progressive_order.h"
@@ -89,6 +90,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "min_distance") {
       if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "min_distance must be in [0, 0.7]");
       r.min_distance = v;
+    } else if (key == "separation") {
+      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "separation must be in [0, 0.7]");
+      r.separation = v;
     } else if (key == "keyframes") {
       r.keyframes = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "glide_sweeps") {
@@ -130,6 +134,7 @@ std::string BakeRecipe::to_text() const {
   if (edge_gap != kFirstEdgeGap) s << "edge_gap " << shortest(edge_gap) << "\n";
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
   if (rank_context) s << "rank_context 1\n";
+  if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (keyframes) s << "keyframes " << keyframes << "\nglide_sweeps " << glide_sweeps << "\n";
   return s.str();
 }
@@ -171,6 +176,7 @@ class Baker {
     table_.colours = recipe_.colours;
     table_.levels = recipe_.levels;
     table_.level_nominal.assign(nominal_.begin(), nominal_.end());
+    dropped_ = drop_close_pairs(levels_, recipe_.colours, table_, recipe_.separation);
     const std::vector<std::uint32_t> keyframes = keyframe_counts(nominal_, recipe_.keyframes);
     table_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
@@ -376,6 +382,7 @@ class Baker {
   std::vector<LevelPatches> levels_;
   TilesetData table_;  ///< the level and keyframe counts (no tiles)
   double total_work_ = 0, done_work_ = 0;
+  std::size_t dropped_ = 0;  ///< points drop_close_pairs removed (for a test to read)
 };
 
 }  // namespace

@@ -48,6 +48,10 @@ struct BakeRecipe {
   /// Hard core: a new point closer than this fraction of its level's hexagonal spacing to a point placed
   /// before it is dropped (spacing_guard.h says why). 0 (off) in recipes that do not name it.
   double min_distance = 0;
+  /// After the pyramid is sampled, the later of any two points of a tile closer than this many hexagonal
+  /// spacings (at the density where the later one appears) is removed (bake/close_pairs.h says why). 0 (off)
+  /// in recipes that do not name it.
+  double separation = 0;
   /// Rank each patch's points together with the run's other new points (bake.cpp says why): points along
   /// a tile edge then appear at the same rate as elsewhere between levels. Off in recipes without it.
   bool rank_context = false;
