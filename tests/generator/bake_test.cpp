@@ -260,6 +260,20 @@ TEST(BakeTest, DropClosePairsRemovesTheLaterPoint) {
   EXPECT_EQ(drop_close_pairs(levels, 1, table, 0), 0u);
 }
 
+// A pair across a tile edge (one tile colour: the interior meets itself): 0.015 apart in the world, 0.985
+// within the tile. The pass looks across edges too, and removes the later point.
+TEST(BakeTest, DropClosePairsLooksAcrossTileEdges) {
+  std::vector<LevelPatches> levels(2, LevelPatches(1));
+  TilesetData table;
+  table.level_nominal = {16, 64};
+  levels[1].interiors[0].add(0.99, 0.5, 1000);   // threshold 16.7
+  levels[1].interiors[0].add(0.005, 0.5, 2000);  // threshold 17.5: later
+  levels[1].interiors[0].add(0.5, 0.995, 3000);
+  levels[1].interiors[0].add(0.5, 0.01, 100);  // earlier than the one above, across the top edge
+  EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 2u);
+  EXPECT_EQ(levels[1].interiors[0].keys, (std::vector<std::uint16_t>{1000, 100}));
+}
+
 TEST(BakeTest, ShippedDefaultSetRebakesBitIdentically) {
 #ifndef KDM_RELEASE_BUILD
   // Bit-identical output is promised per build configuration; the shipped file comes from a Release
