@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 
 #include "bake/close_pairs.h"
@@ -194,43 +195,45 @@ double closest_pair(const Tileset& set, double points_per_tile, double side) {
   return best / std::sqrt(2 / (std::sqrt(3.0) * points_per_tile));
 }
 
-// The hard core (min_distance) with margins of a spacing between levels (erosion − edge_gap = 1): no two
-// points closer than 0.3 hexagonal spacings at the complete levels and between them. Few sweeps make
-// near-coincident points common without it (measured with this recipe: 107 pairs per 166,000 points at
-// 2048 per tile), so the control below shows the test can fail.
-TEST(BakeTest, HardCoreKeepsPointsApartAtEveryDensity) {
-  BakeRecipe r;
-  r.levels = 2, r.base_points = 512, r.sweeps = 20, r.band = 0.2, r.erosion = 2, r.edge_gap = 1;
+// Bakes `remedied` without its remedy (`plain`, the control, which must show a pair closer than 0.3
+// hexagonal spacings at 2048 points per tile, so the test can fail) and with it, where no pair may be that
+// close at any of `counts` points per tile.
+void expect_remedy_keeps_points_apart(const BakeRecipe& plain, const BakeRecipe& remedied,
+                                      std::initializer_list<double> counts) {
   auto load = [](const BakeRecipe& recipe, Tileset& set) {
     const std::vector<std::uint8_t> bytes = encoded(bake_tileset(recipe, 0));
     return Tileset::load_memory(bytes.data(), bytes.size(), set);
   };
-  Tileset plain, guarded;
-  ASSERT_EQ(load(r, plain), Status::kOk);
-  EXPECT_LT(closest_pair(plain, 2048, 4), 0.3);
-  r.min_distance = 0.35;
-  ASSERT_EQ(load(r, guarded), Status::kOk);
-  for (double count : {512.0, 768.0, 1024.0, 1536.0, 2048.0})
-    EXPECT_GE(closest_pair(guarded, count, 4), 0.3) << count << " points per tile";
+  Tileset without, with;
+  ASSERT_EQ(load(plain, without), Status::kOk);
+  EXPECT_LT(closest_pair(without, 2048, 4), 0.3);
+  ASSERT_EQ(load(remedied, with), Status::kOk);
+  for (double count : counts) EXPECT_GE(closest_pair(with, count, 4), 0.3) << count << " points per tile";
 }
 
-// The separation pass on its own (the first recipes' margins, no hard core): the same few-sweep recipe
-// has near-coincident points without it (the control), and none closer than 0.3 hexagonal spacings with
-// it, at the complete levels and between them.
-TEST(BakeTest, SeparationRemovesNearCoincidentPointsAtEveryDensity) {
+// A recipe whose few sweeps make near-coincident points common (measured with margins of a spacing:
+// 107 pairs per 166,000 points at 2048 per tile).
+BakeRecipe few_sweeps() {
   BakeRecipe r;
   r.levels = 2, r.base_points = 512, r.sweeps = 20, r.band = 0.2;
-  auto load = [](const BakeRecipe& recipe, Tileset& set) {
-    const std::vector<std::uint8_t> bytes = encoded(bake_tileset(recipe, 0));
-    return Tileset::load_memory(bytes.data(), bytes.size(), set);
-  };
-  Tileset plain, separated;
-  ASSERT_EQ(load(r, plain), Status::kOk);
-  EXPECT_LT(closest_pair(plain, 2048, 4), 0.3);
-  r.separation = 0.3;
-  ASSERT_EQ(load(r, separated), Status::kOk);
-  for (double count : {300.0, 512.0, 768.0, 1024.0, 1536.0, 2048.0})
-    EXPECT_GE(closest_pair(separated, count, 4), 0.3) << count << " points per tile";
+  return r;
+}
+
+// The hard core (min_distance) with margins of a spacing between levels (erosion − edge_gap = 1): no two
+// points closer than 0.3 hexagonal spacings at the complete levels and between them.
+TEST(BakeTest, HardCoreKeepsPointsApartAtEveryDensity) {
+  BakeRecipe plain = few_sweeps();
+  plain.erosion = 2, plain.edge_gap = 1;
+  BakeRecipe guarded = plain;
+  guarded.min_distance = 0.35;
+  expect_remedy_keeps_points_apart(plain, guarded, {512.0, 768.0, 1024.0, 1536.0, 2048.0});
+}
+
+// The separation pass on its own (the first recipes' margins, no hard core), likewise.
+TEST(BakeTest, SeparationRemovesNearCoincidentPointsAtEveryDensity) {
+  BakeRecipe separated = few_sweeps();
+  separated.separation = 0.3;
+  expect_remedy_keeps_points_apart(few_sweeps(), separated, {300.0, 512.0, 768.0, 1024.0, 1536.0, 2048.0});
 }
 
 // drop_close_pairs by hand: one tile (one colour), a corner point and two interior points. The interior
