@@ -21,7 +21,9 @@ bool same(const kdm::gen::BakeRecipe& a, const kdm::gen::BakeRecipe& b) {
   return a.seed == b.seed && a.colours == b.colours && a.levels == b.levels &&
          a.base_points == b.base_points && a.temperature == b.temperature && a.sweeps == b.sweeps &&
          a.band == b.band && a.erosion == b.erosion && a.edge_gap == b.edge_gap &&
-         a.min_distance == b.min_distance && a.rank_context == b.rank_context;
+         a.min_distance == b.min_distance && a.rank_context == b.rank_context &&
+         a.separation == b.separation && a.keyframes == b.keyframes &&
+         (a.keyframes == 0 || a.glide_sweeps == b.glide_sweeps);
 }
 
 }  // namespace
@@ -40,8 +42,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       r.sweeps > 10000)
     fail();
   if (!(r.band > 0 && r.band < 0.5) || !(r.erosion >= 0 && r.erosion <= 8) ||
-      !(r.min_distance >= 0 && r.min_distance <= 0.7) || !(r.edge_gap >= 0.5 && r.edge_gap <= 4) ||
-      !(r.temperature >= 0 && std::isfinite(r.temperature)))
+      !(r.min_distance >= 0 && r.min_distance <= 0.7) || !(r.separation >= 0 && r.separation <= 0.7) ||
+      !(r.edge_gap >= 0.5 && r.edge_gap <= 4) || !(r.temperature >= 0 && std::isfinite(r.temperature)))
     fail();
   if (r.top_level_points() > (1u << 22)) fail();
   const auto counts = r.nominal_counts();

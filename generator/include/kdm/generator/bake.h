@@ -50,7 +50,8 @@ struct BakeRecipe {
   double min_distance = 0;
   /// After the pyramid is sampled, the later of any two points of a tile closer than this many hexagonal
   /// spacings (at the density where the later one appears) is removed (bake/close_pairs.h says why). 0 (off)
-  /// in recipes that do not name it.
+  /// in recipes that do not name it. It visits every pair of tiles that can meet (C^6 for C colours):
+  /// seconds for 2 colours, but C² times the tiles' own work, which grows fast from 5 colours up.
   double separation = 0;
   /// Rank each patch's points together with the run's other new points (bake.cpp says why): points along
   /// a tile edge then appear at the same rate as elsewhere between levels. Off in recipes without it.
