@@ -159,7 +159,8 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
     if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
     if (kConstant)
-      return place(c, x, y, c0 + 2 * std::size_t(c), c1 + 2 * std::size_t(c), constant.w0, constant.w1)
+      return place(c, x, y, kSmooth ? c0 + 2 * std::size_t(c) : nullptr,
+                   kSmooth ? c1 + 2 * std::size_t(c) : nullptr, constant.w0, constant.w1)
                  ? kNone
                  : c;
     const double rho = kKind == QueryDensity::Kind::kImage
