@@ -114,6 +114,12 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       const double* v = kSignedByte.value + 128;
       x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
       if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
+      // A point never shows where there is no density: one decided at its stable position could glide up
+      // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
+      if (kKind == QueryDensity::Kind::kImage && !(j.sampler->at(x, y) > 0)) return true;
+      if (kKind == QueryDensity::Kind::kCallback &&
+          !(sanitize(j.density->callback(j.density->user, x, y)) > 0))
+        return true;
     }
     if (n == capacity) return false;
     out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};

@@ -273,6 +273,39 @@ TEST(QueryTest, TilesBesideASmoothRegionGiveWhatAFullScanGives) {
   EXPECT_GT(glided_in, 5) << "some points should come from the neighbouring tiles, glided in";
 }
 
+double step(void*, double x, double) {
+  return x < 1.5 ? 1.0 : 0.0;
+}
+
+TEST(QueryTest, SmoothModeShowsNoPointWhereTheDensityIsZero) {
+  // A step from density 1 to 0 at x = 1.5. Emission is decided at stable positions, all left of the step;
+  // glided, some would land right of it. None may, in either mode, for a callback or an image.
+  for (double scale : {60.0, 400.0, 3000.0})
+    for (QueryMode mode : kModes) {
+      QueryParams q = region(0, 0, 3, 3, scale, mode);
+      q.density.kind = QueryDensity::Kind::kCallback;
+      q.density.callback = step;
+      const std::vector<Key> keys = run(q);
+      const double spacing = 1 / std::sqrt(scale);
+      std::size_t near = 0;
+      for (const Key& k : keys) {
+        EXPECT_LT(std::get<3>(k), 1.5) << "scale " << scale;
+        near += std::get<3>(k) > 1.5 - spacing / 4;
+      }
+      EXPECT_GT(near, 0u) << "points should reach the step, scale " << scale;
+      // A step as a 6 × 1 image over [0, 3) × [0, 3): texel centres 0.25 apart, bilinear from 1 at x = 1.25
+      // to 0 at 1.75, zero from there on.
+      std::vector<float> values = {1, 1, 1, 0, 0, 0}, mip;
+      DensityImageView image;
+      image.values = values.data(), image.width = 6, image.height = 1;
+      image.x0 = image.y0 = 0, image.x1 = image.y1 = 3;
+      ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
+      q.density.kind = QueryDensity::Kind::kImage;
+      q.density.image = &image;
+      for (const Key& k : run(q)) EXPECT_LT(std::get<3>(k), 1.75) << "image, scale " << scale;
+    }
+}
+
 TEST(QueryTest, FollowsADensityRamp) {
   QueryParams q = region(0, 0, 8, 8, 12000);
   q.density.kind = QueryDensity::Kind::kCallback;

@@ -86,7 +86,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       if (!(v >= 0.5 && v <= 4)) throw InvalidArgument(where + "edge_gap must be in [0.5, 4]");
       r.edge_gap = v;
     } else if (key == "rank_context") {
-      r.rank_context = whole(0, 1) != 0;
+      r.rank_context = static_cast<int>(whole(0, 2));
     } else if (key == "min_distance") {
       if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "min_distance must be in [0, 0.7]");
       r.min_distance = v;
@@ -133,7 +133,7 @@ std::string BakeRecipe::to_text() const {
   // Written only when set, so recipes from before the key keep their text (and their bytes).
   if (edge_gap != kFirstEdgeGap) s << "edge_gap " << shortest(edge_gap) << "\n";
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
-  if (rank_context) s << "rank_context 1\n";
+  if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (keyframes) s << "keyframes " << keyframes << "\nglide_sweeps " << glide_sweeps << "\n";
   return s.str();
@@ -295,7 +295,7 @@ class Baker {
     }
     rank.filter_width = kFilterWidth / std::sqrt(k ? nominal_[k - 1] : nominal_[0] / 4.0);
     rank.filter_width_end = kFilterWidth / std::sqrt(double(nominal_[k]));
-    if (recipe_.rank_context) {
+    if (recipe_.rank_context == 1) {
       // One ranking of every new point; each patch keeps its own points' order, keyed within the patch.
       rank.candidates = context;
       std::vector<std::pair<const std::pair<int, std::size_t>*, std::size_t>> owner(context.size() / 2);
@@ -315,6 +315,12 @@ class Baker {
       }
     } else {
       for (const auto& [id, points] : found) {
+        if (recipe_.rank_context == 2) {  // the run's other new points, present in proportion
+          rank.pending = context;
+          for (const auto& [other, other_points] : found)
+            if (other != id)
+              for (const auto& [x, y] : other_points) rank.pending.insert(rank.pending.end(), {x, y});
+        }
         rank.candidates.clear();
         for (const auto& [x, y] : points) rank.candidates.insert(rank.candidates.end(), {x, y});
         const std::vector<std::uint32_t> order = progressive_order(rank);

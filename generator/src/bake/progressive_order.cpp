@@ -91,8 +91,13 @@ std::vector<std::uint32_t> progressive_order(const RankingInput& in) {
   for (std::uint32_t i = 0; i < n; ++i)
     cells[static_cast<std::size_t>(cell_y(in.candidates[2 * i + 1])) * cx + cell_x(in.candidates[2 * i])]
         .push_back(i);
-  std::vector<double> field(n, 0.0);
+  // field: what is present; spread: the pending points at full weight; depth (what the heap orders):
+  // field + fraction · spread, the fraction stepping in kSteps so that the heap is rebuilt only that often.
+  std::vector<double> field(n, 0.0), spread(n, 0.0), depth(n, 0.0);
+  constexpr std::size_t kSteps = 64;
+  double fraction = 0;
   VoidHeap* heap = nullptr;
+  std::vector<double>* into = &field;
   auto splat = [&](const double* p) {
     const int px = cell_x(p[0]), py = cell_y(p[1]);
     // Three columns (rows) around the point, or every one once when the grid is narrower than that.
@@ -107,32 +112,49 @@ std::vector<std::uint32_t> progressive_order(const RankingInput& in) {
           ddx = std::min(ddx, w - ddx), ddy = std::min(ddy, h - ddy);
           const double d2 = ddx * ddx + ddy * ddy;
           if (d2 >= reach2) continue;
-          field[i] += std::exp(-d2 * inv2s2);
-          if (heap) heap->grew(i);
+          const double g = std::exp(-d2 * inv2s2);
+          (*into)[i] += g;
+          if (heap) depth[i] += g, heap->grew(i);
         }
       }
   };
   std::vector<const double*> present;
   for (std::size_t j = 0; j + 1 < in.fixed.size(); j += 2) present.push_back(&in.fixed[j]);
-  for (const double* p : present) splat(p);
+  auto refilter = [&]() {  // field and spread at the current width, depth from them; the heap is off
+    std::fill(field.begin(), field.end(), 0.0);
+    std::fill(spread.begin(), spread.end(), 0.0);
+    heap = nullptr;
+    into = &field;
+    for (const double* p : present) splat(p);
+    into = &spread;
+    for (std::size_t j = 0; j + 1 < in.pending.size(); j += 2) splat(&in.pending[j]);
+    into = &field;
+    for (std::size_t i = 0; i < n; ++i) depth[i] = field[i] + fraction * spread[i];
+  };
+  refilter();
   std::vector<std::size_t> timed(in.timed_keys.size());
   std::iota(timed.begin(), timed.end(), std::size_t(0));
   std::stable_sort(timed.begin(), timed.end(),
                    [&](std::size_t a, std::size_t b) { return in.timed_keys[a] < in.timed_keys[b]; });
-  VoidHeap voids(field);
+  VoidHeap voids(depth);
   heap = &voids;
   std::vector<std::uint32_t> order;
   order.reserve(n);
   std::size_t next_timed = 0;
   for (std::size_t s = 0; s < n; ++s) {
     const std::uint16_t key = rank_key(s, n);
+    const double step_fraction =
+        in.pending.empty() ? 0.0 : double(s * kSteps / n) / double(kSteps);  // floor(s / n, 1 / kSteps)
     if (sigma_at(s) < 0.95 * sigma) {  // re-filter everything present at the new width
       sigma = sigma_at(s);
       reach2 = 9 * sigma * sigma, inv2s2 = 1.0 / (2 * sigma * sigma);
-      std::fill(field.begin(), field.end(), 0.0);
-      heap = nullptr;
-      for (const double* p : present) splat(p);
+      fraction = step_fraction;
+      refilter();
       heap = &voids;
+      voids.rebuild();
+    } else if (step_fraction != fraction) {
+      fraction = step_fraction;
+      for (std::size_t i = 0; i < n; ++i) depth[i] = field[i] + fraction * spread[i];
       voids.rebuild();
     }
     for (; next_timed < timed.size() && in.timed_keys[timed[next_timed]] < key; ++next_timed) {

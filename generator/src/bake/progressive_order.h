@@ -15,8 +15,12 @@ struct RankingInput {
   std::vector<double> fixed;              ///< present from the start
   std::vector<double> timed;              ///< present once the ranking reaches their key:
   std::vector<std::uint16_t> timed_keys;  ///< before candidate s of n is chosen, keys < rank_key(s, n)
-  double filter_width = 0.1;              ///< σ of the Gaussian filter at the first pick, tile units
-  double filter_width_end = 0;            ///< σ at the last pick (0: the same); 1/σ² moves linearly
+  /// x y pairs present in proportion: before candidate s of n is chosen, each weighs s / n of a point.
+  /// Stand-ins for regions ranked apart that fill at the same pace, so that no candidate sees a void
+  /// there that the runtime will have filled.
+  std::vector<double> pending;
+  double filter_width = 0.1;    ///< σ of the Gaussian filter at the first pick, tile units
+  double filter_width_end = 0;  ///< σ at the last pick (0: the same); 1/σ² moves linearly
 };
 
 /// The emission key of the s-th of n ranked points: floor((s + ½) / n · 65536).

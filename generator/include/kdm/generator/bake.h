@@ -53,9 +53,10 @@ struct BakeRecipe {
   /// in recipes that do not name it. It visits every pair of tiles that can meet (C^6 for C colours):
   /// seconds for 2 colours, but C² times the tiles' own work, which grows fast from 5 colours up.
   double separation = 0;
-  /// Rank each patch's points together with the run's other new points (bake.cpp says why): points along
-  /// a tile edge then appear at the same rate as elsewhere between levels. Off in recipes without it.
-  bool rank_context = false;
+  /// How a patch's points are ranked against the run's other new points, stand-ins for the regions ranked
+  /// apart (bake.cpp says why): 0 (recipes without the key) not at all; 1 ranked together with them; 2
+  /// present in proportion, each weighing the fraction of the patch already ranked.
+  int rank_context = 0;
   /// Gliding track (keyframes.h): keyframes per level (0 = none, the set then only serves stable queries),
   /// and the descent sweeps that relax each keyframe.
   std::uint32_t keyframes = 0;

@@ -12,7 +12,9 @@
 // at on, and smooth, where points glide with the density between the set's keyframes (tileset.h), so every
 // density is a good blue-noise set. Both emit the same points (the same ids at the same densities); in
 // smooth mode the expected count that decides emission, taken at the point's stable position, also sets
-// where it glides to, so chunk consistency and determinism hold the same way.
+// where it glides to, so chunk consistency and determinism hold the same way. One exception to "the same
+// points": a smooth point whose glided position has zero density is not emitted, so no point shows where
+// the density is zero (it could glide up to a spacing past a sharp edge of the density).
 //
 // Thread safety: a Tileset is immutable after loading; any number of threads may query it at once.
 // Queries allocate nothing, take no locks and touch no global state.
@@ -165,8 +167,9 @@ struct KDM_RUNTIME_API DensityImageView {
 /// empty images or values that are negative or not finite.
 KDM_RUNTIME_API Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
 
-/// The density of a query: constant, an image, or a callback (called once per candidate point, with
-/// world coordinates; must be thread-safe if queries run concurrently). Negative, NaN and infinite values
+/// The density of a query: constant, an image, or a callback (called once per candidate point, and in
+/// smooth mode once more at each emitted point's glided position, with world coordinates; must be
+/// thread-safe if queries run concurrently). Negative, NaN and infinite values
 /// from a callback are treated as 0 (documented: a bad value never emits points or crashes).
 struct QueryDensity {
   enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;
@@ -186,7 +189,8 @@ enum class QueryMode : int {
   kStable = 0,
   /// Points glide continuously with the density (never jump), so every density is a good blue-noise set:
   /// for stippling and sample patterns. Ids, emission densities and zoom coherence by id are those of
-  /// stable mode. A tile set without a gliding track emits its stable positions.
+  /// stable mode, except that no point shows where the density is zero. A tile set without a gliding
+  /// track emits its stable positions.
   kSmooth = 1,
 };
 

@@ -131,7 +131,7 @@ struct DensityResult {
   double worst_edge_ratio = 0;  ///< smallest edge-link δmin / other-link δmin over the tiles
   double closest_pair = 0;      ///< smallest distance between two points of any tile's torus, in d_hex
   double edge_band = 0;         ///< density within one d_hex of tile edges / the mean, pooled
-  std::size_t edge_links = 0, midline_links = 0;
+  std::size_t edge_links = 0, midline_links = 0;  ///< distinct links crossing tile edges, midlines
   double ks_d_plus = 0, ks_p = 1;  ///< edge links shorter than midline links?
   std::vector<Check> checks;
   bool passed() const;
