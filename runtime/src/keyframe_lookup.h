@@ -9,15 +9,18 @@
 namespace kdm {
 namespace detail {
 
-/// Buckets of expected counts for Tileset::first_keyframe_at_least: 16 per power of two from 2^-32 to
-/// 2^32 (smaller counts share the first, larger ones the last), from the double's exponent and leading
-/// mantissa bits. A bucket's smallest count is (1 + m/16) · 2^e.
-inline constexpr int kCountBuckets = 64 * 16;
+/// Buckets of expected counts for Tileset::first_keyframe_at_least: kBucketsPerOctave per power of two
+/// from 2^-32 to 2^32 (smaller counts share the first, larger ones the last), from the double's exponent
+/// and leading mantissa bits. A bucket's smallest count is (1 + m / kBucketsPerOctave) · 2^e, and none is
+/// wider than 1 / kBucketsPerOctave of it (3.1%): keyframes farther apart than that are one step away.
+inline constexpr int kMantissaBits = 5;
+inline constexpr int kBucketsPerOctave = 1 << kMantissaBits;
+inline constexpr int kCountBuckets = 64 * kBucketsPerOctave;
 inline int count_bucket(double v) {
   std::uint64_t bits;
   std::memcpy(&bits, &v, sizeof bits);
-  // Exponent and leading 4 mantissa bits are the top 16 bits of a positive double: (e + 1023) · 16 + m.
-  const std::uint64_t b = (bits >> 48) - (1023 - 32) * 16;
+  // The exponent and leading mantissa bits of a positive double: (e + 1023) · kBucketsPerOctave + m.
+  const std::uint64_t b = (bits >> (52 - kMantissaBits)) - std::uint64_t(1023 - 32) * kBucketsPerOctave;
   if (b < kCountBuckets) return static_cast<int>(b);
   return v < 1 ? 0 : kCountBuckets - 1;  // beyond the table (or negative: sign bit set)
 }

@@ -52,12 +52,13 @@ void Tileset::adopt(TilesetData&& set) {
     glide_scale_[g] = 65536.0 * set_.glide_unit(g);
   keyframe_guess_.assign(kCountBuckets, 0);
   for (int b = 0; b < kCountBuckets; ++b) {  // the first keyframe at least the bucket's smallest count
-    const double lowest = std::ldexp(1.0 + (b % 16) / 16.0, b / 16 - 32);
+    const double lowest = std::ldexp(1.0 + double(b % detail::kBucketsPerOctave) / detail::kBucketsPerOctave,
+                                     b / detail::kBucketsPerOctave - 32);
     const std::uint32_t* k = set_.keyframe_nominal.data();
     keyframe_guess_[b] =
         static_cast<std::uint16_t>(std::lower_bound(k, k + set_.keyframe_nominal.size(), lowest) - k);
   }
-  keyframe_one_step_ = true;  // no bucket holds two keyframes (true unless they are under 6.25% apart)
+  keyframe_one_step_ = true;  // no bucket holds two keyframes (true unless they are under 3.1% apart)
   for (int b = 0; b + 1 < kCountBuckets; ++b)
     keyframe_one_step_ = keyframe_one_step_ && keyframe_guess_[b + 1] <= keyframe_guess_[b] + 1;
   keyframe_ranks_.assign(set_.tiles.size(), {});

@@ -23,7 +23,7 @@ bool same(const kdm::gen::BakeRecipe& a, const kdm::gen::BakeRecipe& b) {
          a.band == b.band && a.erosion == b.erosion && a.edge_gap == b.edge_gap &&
          a.min_distance == b.min_distance && a.rank_context == b.rank_context &&
          a.separation == b.separation && a.keyframes == b.keyframes &&
-         (a.keyframes == 0 || a.glide_sweeps == b.glide_sweeps);
+         a.glide_separation == b.glide_separation && (a.keyframes == 0 || a.glide_sweeps == b.glide_sweeps);
 }
 
 }  // namespace

@@ -317,6 +317,35 @@ TEST(BakeTest, DropClosePairsLooksAcrossTileEdges) {
   EXPECT_EQ(levels[1].interiors[0].keys, (std::vector<std::uint16_t>{1000, 100}));
 }
 
+// Two points far apart at every keyframe whose paths cross half-way between two: the later one goes, with
+// its frames. Paths that do not cross keep both.
+TEST(BakeTest, DropCloseGlidesRemovesPointsWhosePathsMeet) {
+  TilesetData table;
+  table.level_nominal = {16, 64};
+  table.keyframe_nominal = {16, 32, 64};
+  for (bool cross : {false, true}) {
+    std::vector<LevelPatches> levels(2, LevelPatches(1));
+    Patch& patch = levels[0].interiors[0];
+    patch.add(0.3, 0.5, 100);  // thresholds 0.03 and 0.05: both shown at every keyframe
+    patch.add(0.7, 0.5, 200);
+    patch.add(0.5, 0.1, 300);  // far from both
+    // 0.4 apart at keyframes 0 and 2; at keyframe 1 the crossing pair has swapped sides, and half-way to
+    // it (24 points per tile: 0.3 · d_hex = 0.066) both stand at x = 0.5.
+    const double a1 = cross ? 0.7 : 0.3, b1 = cross ? 0.3 : 0.7;
+    patch.frames = {
+        {0.3, 0.5, 0.7, 0.5, 0.5, 0.1}, {a1, 0.5, b1, 0.5, 0.5, 0.1}, {0.3, 0.5, 0.7, 0.5, 0.5, 0.1}};
+    EXPECT_EQ(drop_close_glides(levels, 1, table, 0), 0u);
+    EXPECT_EQ(drop_close_glides(levels, 1, table, 0.3), cross ? 1u : 0u);
+    const std::vector<std::uint16_t> kept =
+        cross ? std::vector<std::uint16_t>{100, 300} : std::vector<std::uint16_t>{100, 200, 300};
+    EXPECT_EQ(patch.keys, kept);
+    for (const std::vector<double>& frame : patch.frames) EXPECT_EQ(frame.size(), patch.xy.size());
+    if (cross) {
+      EXPECT_EQ(patch.frames[1], (std::vector<double>{0.7, 0.5, 0.5, 0.1}));
+    }
+  }
+}
+
 TEST(BakeTest, ShippedDefaultSetRebakesBitIdentically) {
 #ifndef KDM_RELEASE_BUILD
   // Bit-identical output is promised per build configuration; the shipped file comes from a Release

@@ -414,7 +414,7 @@ void counting_deallocate(void* p, std::size_t bytes, std::size_t, void* user) {
 }
 
 TEST(TilesetFormatTest, KeyframesCloserThanTheLookupTableStillFindTheirBracket) {
-  // A keyframe at every count from the first level to the top (1 apart, under the lookup table's 6.25%
+  // A keyframe at every count from the first level to the top (1 apart, under the lookup table's 3.1%
   // buckets): the one-step lookup no longer holds, and the search must still match std::lower_bound, and a
   // smooth query with a varying density must emit the same ids as a stable one.
   TilesetData set = make_tileset(2, 3, 4, /*glide=*/false);

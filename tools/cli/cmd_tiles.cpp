@@ -94,7 +94,8 @@ void add_tile_commands(CLI::App& app) {
       app.add_subcommand("bake", "Bake a tile set from a recipe (deterministic for any --threads)");
   bake->add_option("recipe", *recipe,
                    "Recipe file: 'key value' lines (seed, colours, levels, base_points, "
-                   "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, keyframes, glide_sweeps)")
+                   "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
+                   "keyframes, glide_sweeps, glide_separation)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   bake->add_option("--threads", *threads,

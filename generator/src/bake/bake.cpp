@@ -93,6 +93,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "separation") {
       if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "separation must be in [0, 0.7]");
       r.separation = v;
+    } else if (key == "glide_separation") {
+      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "glide_separation must be in [0, 0.7]");
+      r.glide_separation = v;
     } else if (key == "keyframes") {
       r.keyframes = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "glide_sweeps") {
@@ -136,6 +139,7 @@ std::string BakeRecipe::to_text() const {
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (keyframes) s << "keyframes " << keyframes << "\nglide_sweeps " << glide_sweeps << "\n";
+  if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
   return s.str();
 }
 
@@ -184,6 +188,7 @@ class Baker {
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
+    drop_close_glides(levels_, recipe_.colours, table_, recipe_.glide_separation);
     return assemble();
   }
 

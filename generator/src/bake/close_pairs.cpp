@@ -19,6 +19,8 @@ struct Candidate {
   int kind;
   std::size_t level, patch;
   std::uint32_t index;
+  const Patch* source;        ///< for its frames
+  double anchor_x, anchor_y;  ///< of its patch, in the window
   auto order() const { return std::tie(threshold, kind, level, patch, index); }
 };
 
@@ -40,9 +42,10 @@ std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Co
       gather(levels[k], col, only, x0, y0, x1, y1, xy, &keys, &refs);
       const std::vector<Patch>& patches = levels[k].of(kind);
       for (std::size_t i = 0; i < keys.size(); ++i)
-        points.push_back(
-            {xy[2 * i], xy[2 * i + 1], table.emission_threshold(static_cast<std::uint32_t>(k), keys[i]),
-             static_cast<int>(kind), k, std::size_t(refs[i].patch - patches.data()), refs[i].index});
+        points.push_back({xy[2 * i], xy[2 * i + 1],
+                          table.emission_threshold(static_cast<std::uint32_t>(k), keys[i]),
+                          static_cast<int>(kind), k, std::size_t(refs[i].patch - patches.data()),
+                          refs[i].index, refs[i].patch, refs[i].anchor_x, refs[i].anchor_y});
     }
   return points;
 }
@@ -71,6 +74,71 @@ void find_pairs(std::vector<Candidate> points, double width, double height, cons
           if (std::hypot(points[j].x - p.x, points[j].y - p.y) < r)
             victims.insert({p.level, p.kind, p.patch, p.index});
     grid[std::size_t(cell_y(p.y)) * nx + cell_x(p.x)].push_back(i);
+  }
+}
+
+/// Adds to `victims` the later of every two points of `at` (positions, in the order of `points`, which is
+/// by Candidate::order) closer than `radius`; only the first `present` points are shown.
+void find_close(const std::vector<Candidate>& points, const std::vector<double>& at, std::size_t present,
+                double x0, double y0, double x1, double y1, double radius, Victims& victims) {
+  const int nx = std::max(1, static_cast<int>((x1 - x0) / radius)),
+            ny = std::max(1, static_cast<int>((y1 - y0) / radius));
+  std::vector<std::vector<std::uint32_t>> grid(std::size_t(nx) * ny);
+  auto cell_x = [&](double v) { return std::clamp(static_cast<int>((v - x0) / (x1 - x0) * nx), 0, nx - 1); };
+  auto cell_y = [&](double v) { return std::clamp(static_cast<int>((v - y0) / (y1 - y0) * ny), 0, ny - 1); };
+  for (std::uint32_t i = 0; i < present; ++i) {
+    const double x = at[2 * i], y = at[2 * i + 1];
+    if (x < x0 || x >= x1 || y < y0 || y >= y1) continue;
+    for (int cy = cell_y(y - radius); cy <= cell_y(y + radius); ++cy)
+      for (int cx = cell_x(x - radius); cx <= cell_x(x + radius); ++cx)
+        for (std::uint32_t j : grid[std::size_t(cy) * nx + cx])
+          if (std::hypot(at[2 * j] - x, at[2 * j + 1] - y) < radius) {
+            const Candidate& p = points[i];
+            victims.insert({p.level, p.kind, p.patch, p.index});
+          }
+    grid[std::size_t(cell_y(y)) * nx + cell_x(x)].push_back(i);
+  }
+}
+
+/// The gliding track's close pairs among `points` (stable positions in a window): at every sampled density,
+/// the points shown there at their glided positions, those inside [x0, x1) × [y0, y1).
+void find_close_glides(std::vector<Candidate> points, const TilesetData& table, double separation, double x0,
+                       double y0, double x1, double y1, Victims& victims) {
+  std::sort(points.begin(), points.end(),
+            [](const Candidate& a, const Candidate& b) { return a.order() < b.order(); });
+  const auto& K = table.keyframe_nominal;
+  std::vector<double> at(2 * points.size());
+  constexpr int kSteps = 8;
+  for (std::size_t g = 0; g < K.size(); ++g)
+    for (int step = 0; step < (g + 1 < K.size() ? kSteps : 1); ++step) {
+      const double t = double(step) / kSteps;
+      const double count = g + 1 < K.size() ? K[g] + t * (double(K[g + 1]) - K[g]) : K[g];
+      std::size_t present = 0;
+      while (present < points.size() && TilesetData::emits(points[present].threshold, count)) ++present;
+      for (std::size_t i = 0; i < present; ++i) {
+        const Candidate& p = points[i];
+        const std::vector<double>& f0 = p.source->frames[g];
+        const std::vector<double>& f1 = p.source->frames[g + 1 < K.size() ? g + 1 : g];
+        for (int a = 0; a < 2; ++a)
+          at[2 * i + a] =
+              (a ? p.anchor_y : p.anchor_x) + (1 - t) * f0[2 * p.index + a] + t * f1[2 * p.index + a];
+      }
+      const double radius = separation * std::sqrt(2.0 / (std::sqrt(3.0) * count));
+      find_close(points, at, present, x0, y0, x1, y1, radius, victims);
+    }
+}
+
+/// Removes `victims` from their patches (and their frames), highest index first so the others keep theirs.
+void remove(std::vector<LevelPatches>& levels, const Victims& victims) {
+  for (auto it = victims.rbegin(); it != victims.rend(); ++it) {
+    const auto& [level, kind, patch_index, index] = *it;
+    Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
+    KDM_CHECK(index < patch.size());
+    const auto at = 2 * std::ptrdiff_t(index);
+    patch.xy.erase(patch.xy.begin() + at, patch.xy.begin() + at + 2);
+    patch.keys.erase(patch.keys.begin() + index);
+    for (std::vector<double>& frame : patch.frames)
+      if (!frame.empty()) frame.erase(frame.begin() + at, frame.begin() + at + 2);
   }
 }
 
@@ -113,15 +181,41 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
     find_pairs(collect(levels, pair_of_tiles(colours, false, v), table, 0, 1 - reach, 1, 1 + reach), 1,
                2 * reach, radius, victims);
   }
-  // Remove them, highest index first so the others keep theirs.
-  for (auto it = victims.rbegin(); it != victims.rend(); ++it) {
-    const auto& [level, kind, patch_index, index] = *it;
-    Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
-    KDM_CHECK(patch.frames.empty() && index < patch.size());
-    patch.xy.erase(patch.xy.begin() + 2 * std::ptrdiff_t(index),
-                   patch.xy.begin() + 2 * std::ptrdiff_t(index) + 2);
-    patch.keys.erase(patch.keys.begin() + index);
+  remove(levels, victims);
+  return victims.size();
+}
+
+std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                              const TilesetData& table, double separation) {
+  if (!(separation > 0) || table.keyframe_nominal.empty()) return 0;
+  const double s = separation + kGlideMargin;
+  Victims victims;
+  const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
+  for (std::size_t t = 0; t < tiles; ++t)
+    find_close_glides(collect(levels, Colouring::around_tile(colours, t), table, 0, 0, 1, 1), table, s, 0, 0,
+                      1, 1, victims);
+  // Across a tile edge: points whose stable positions lie within the farthest glide of it, shown within the
+  // pair distance of it.
+  double reach = 0;
+  for (const LevelPatches& level : levels)
+    for (const PatchKind kind :
+         {PatchKind::kCorner, PatchKind::kHorizontalEdge, PatchKind::kVerticalEdge, PatchKind::kInterior})
+      for (const Patch& patch : level.of(kind))
+        for (const std::vector<double>& frame : patch.frames)
+          for (std::size_t i = 0; i < frame.size(); ++i)
+            reach = std::max(reach, std::fabs(frame[i] - patch.xy[i]));
+  const double near = s * std::sqrt(2.0 / (std::sqrt(3.0) * table.keyframe_nominal.front()));
+  std::vector<std::uint32_t> v(6);
+  for (std::size_t code = 0; code < std::size_t(tiles) * colours * colours; ++code) {
+    std::size_t rest = code;
+    for (std::uint32_t& c : v) c = static_cast<std::uint32_t>(rest % colours), rest /= colours;
+    const double w = reach + near;
+    find_close_glides(collect(levels, pair_of_tiles(colours, true, v), table, 1 - w, 0, 1 + w, 1), table, s,
+                      w - near, 0, w + near, 1, victims);
+    find_close_glides(collect(levels, pair_of_tiles(colours, false, v), table, 0, 1 - w, 1, 1 + w), table, s,
+                      0, w - near, 1, w + near, victims);
   }
+  remove(levels, victims);
   return victims.size();
 }
 

@@ -24,4 +24,17 @@ namespace kdm::gen {
 std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
                              const TilesetData& table, double separation);
 
+/// The same along the gliding track, once it is relaxed: removes the later point of every pair closer than
+/// `separation` hexagonal spacings (plus kGlideMargin, for the file's 8-bit offsets) at some density where
+/// both are shown, in some tile or across an edge two tiles can share. Densities are sampled at the
+/// keyframes and at 7 more between each two (the half-way density among them). Paths are pushed apart
+/// while keyframes are relaxed (keyframes.h); this catches the few that bounds keep from moving. Returns
+/// how many points were removed.
+std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                              const TilesetData& table, double separation);
+
+/// kGlideMargin: offsets are rounded to 1/64 of a keyframe's spacing per axis, which moves a pair's
+/// distance by at most 0.04 hexagonal spacings.
+inline constexpr double kGlideMargin = 0.04;
+
 }  // namespace kdm::gen

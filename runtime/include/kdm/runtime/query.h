@@ -109,7 +109,7 @@ class KDM_RUNTIME_API Tileset {
     return keyframe_guess_.empty() ? nullptr : keyframe_guess_.data();
   }
   /// Whether one step from keyframe_guess() always finds first_keyframe_at_least (true when consecutive
-  /// keyframes are over 6.25% apart, as in baked sets).
+  /// keyframes are over 3.1% apart, as in baked sets).
   bool keyframe_one_step() const { return keyframe_one_step_; }
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
   /// thresholds, recipe text), not counting allocator overhead. The builtin set's decoded copy is the
