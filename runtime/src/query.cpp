@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "kdm/runtime/hash.h"
@@ -79,6 +80,8 @@ struct TileJob {
   double area_scale, limit;
   const QueryDensity* density;
   const ImageSampler* sampler;
+  /// Smooth mode with an image: whether the density can be 0 where the tile's points glide (min-mip).
+  bool zero_possible;
 };
 
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
@@ -116,7 +119,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
       // A point never shows where there is no density: one decided at its stable position could glide up
       // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
-      if (kKind == QueryDensity::Kind::kImage && !(j.sampler->at(x, y) > 0)) return true;
+      if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
       if (kKind == QueryDensity::Kind::kCallback &&
           !(sanitize(j.density->callback(j.density->user, x, y)) > 0))
         return true;
@@ -241,18 +244,37 @@ double DensityImageView::at(double x, double y) const {
   return ImageSampler(this).at(x, y);
 }
 
-double DensityImageView::max_over(double qx0, double qy0, double qx1, double qy1) const {
+namespace {
+
+/// The max-mip's or min-mip's blocks over a world rectangle, folded with `pick` from `start`.
+template <class Pick>
+double fold_blocks(const DensityImageView& im, const float* mip, double qx0, double qy0, double qx1,
+                   double qy1, float start, Pick pick) {
   auto block = [](double v, double lo, double hi, int n, int blocks) {
     const double t = std::clamp((v - lo) / (hi - lo) * n, 0.0, double(n - 1));
     return std::min(blocks - 1, static_cast<int>(t) / 8);
   };
-  const int bx0 = block(qx0, x0, x1, width, mip_width), bx1 = block(qx1, x0, x1, width, mip_width);
-  const int by0 = block(qy0, y0, y1, height, mip_height), by1 = block(qy1, y0, y1, height, mip_height);
-  float m = 0;
+  const int bx0 = block(qx0, im.x0, im.x1, im.width, im.mip_width),
+            bx1 = block(qx1, im.x0, im.x1, im.width, im.mip_width);
+  const int by0 = block(qy0, im.y0, im.y1, im.height, im.mip_height),
+            by1 = block(qy1, im.y0, im.y1, im.height, im.mip_height);
+  float m = start;
   for (int by = by0; by <= by1; ++by)
-    for (int bx = bx0; bx <= bx1; ++bx)
-      m = std::max(m, max_mip[static_cast<std::size_t>(by) * mip_width + bx]);
+    for (int bx = bx0; bx <= bx1; ++bx) m = pick(m, mip[static_cast<std::size_t>(by) * im.mip_width + bx]);
   return m;
+}
+
+}  // namespace
+
+double DensityImageView::max_over(double qx0, double qy0, double qx1, double qy1) const {
+  return fold_blocks(*this, max_mip, qx0, qy0, qx1, qy1, 0.0f,
+                     [](float a, float b) { return std::max(a, b); });
+}
+
+double DensityImageView::min_over(double qx0, double qy0, double qx1, double qy1) const {
+  if (!min_mip) return 0;
+  return fold_blocks(*this, min_mip, qx0, qy0, qx1, qy1, std::numeric_limits<float>::infinity(),
+                     [](float a, float b) { return std::min(a, b); });
 }
 
 Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
@@ -265,18 +287,20 @@ Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
     if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;
   image.mip_width = (image.width + 7) / 8;
   image.mip_height = (image.height + 7) / 8;
-  mip.assign(static_cast<std::size_t>(image.mip_width) * image.mip_height, 0.0f);
+  const std::size_t blocks = static_cast<std::size_t>(image.mip_width) * image.mip_height;
+  mip.assign(2 * blocks, 0.0f);
+  std::fill(mip.begin() + std::ptrdiff_t(blocks), mip.end(), std::numeric_limits<float>::infinity());
   // Each block also covers one texel around it: bilinear values inside a block mix in its neighbours.
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
       const float v = image.values[static_cast<std::size_t>(y) * image.width + x];
       for (int by = std::max(0, (y - 1) / 8); by <= std::min(image.mip_height - 1, (y + 1) / 8); ++by)
         for (int bx = std::max(0, (x - 1) / 8); bx <= std::min(image.mip_width - 1, (x + 1) / 8); ++bx) {
-          float& m = mip[static_cast<std::size_t>(by) * image.mip_width + bx];
-          m = std::max(m, v);
+          const std::size_t b = static_cast<std::size_t>(by) * image.mip_width + bx;
+          mip[b] = std::max(mip[b], v), mip[blocks + b] = std::min(mip[blocks + b], v);
         }
     }
-  image.max_mip = mip.data();
+  image.max_mip = mip.data(), image.min_mip = mip.data() + blocks;
   return Status::kOk;
 }
 
@@ -418,6 +442,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         }
         job.listed = nullptr;
         pick_edge_list(tileset, index, job);
+        job.zero_possible = d.kind == QueryDensity::Kind::kImage &&
+                            !(d.image->min_over(wx - reach, wy - reach, wx + S + reach, wy + S + reach) > 0);
       }
       // Inside: the tile widened by the farthest any of its points can glide (and two position units, for
       // rounding) lies in the region. Such tiles skip every test, and the positions are computed as

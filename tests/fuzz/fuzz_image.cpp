@@ -64,6 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double u = i / 8.0, v = (8 - i) / 8.0, rho = view.at(u, v);
     if (!(rho >= 0 && rho <= bound)) fail();
     if (!(rho <= view.max_over(u, v, u, v) * slack)) fail();
+    if (!(rho >= view.min_over(u, v, u, v) / slack)) fail();
   }
 
   // The sampler's density (kdm sample, stipple): refused only when zero everywhere.

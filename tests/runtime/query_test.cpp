@@ -355,6 +355,27 @@ TEST(QueryTest, FollowsADensityImage) {
   EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
 }
 
+TEST(QueryTest, MipsBoundAnImageFromAboveAndBelow) {
+  // 24 × 1 texels over [0, 24): 1 on texels 0–15, 0 from 16 on. Blocks of 8 texels, each widened by one:
+  // block 0 sees only ones, block 1 reaches texel 16.
+  std::vector<float> values(24, 0.0f), mip;
+  std::fill(values.begin(), values.begin() + 16, 1.0f);
+  DensityImageView image;
+  image.values = values.data(), image.width = 24, image.height = 1;
+  image.x1 = 24, image.y1 = 1;
+  ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
+  EXPECT_EQ(mip.size(), 6u);
+  EXPECT_EQ(image.min_over(0, 0, 7.9, 1), 1.0);
+  EXPECT_EQ(image.min_over(0, 0, 12, 1), 0.0);
+  EXPECT_EQ(image.max_over(17, 0, 24, 1), 1.0);  // block 2 reaches texel 15
+  for (double x = 0; x < 24; x += 0.125) {
+    EXPECT_LE(image.min_over(x, 0.5, x, 0.5), image.at(x, 0.5));
+    EXPECT_GE(image.max_over(x, 0.5, x, 0.5), image.at(x, 0.5));
+  }
+  image.min_mip = nullptr;  // a view without one: no lower bound
+  EXPECT_EQ(image.min_over(0, 0, 7.9, 1), 0.0);
+}
+
 TEST(QueryTest, BadInputIsRejectedOrHarmless) {
   std::vector<QueryPoint> buffer(16);
   std::size_t written = 7;
