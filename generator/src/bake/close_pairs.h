@@ -1,4 +1,5 @@
-// Near-coincident points of different runs. Each patch is sampled with what its run holds fixed, but a
+// Near-coincident points of different runs, and (drop_close_glides) of paths along the gliding track that
+// the keyframes' relaxation could not keep apart. Each patch is sampled with what its run holds fixed, but a
 // run never sees every patch a tile puts next to it (a vertical edge's run sees its torus's horizontal
 // edges, not those of every tile), so two points of different patches can land almost on top of each
 // other: the shipped set without this pass showed 180 pairs closer than 0.3 hexagonal spacings in
