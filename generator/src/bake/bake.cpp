@@ -41,6 +41,13 @@ constexpr int kFirstCoarsestSweeps = 60;
 // level's patches, which are sampled without it.
 constexpr double kMaxSlip = 0.1;
 
+/// The shortest text that reads back as the same double: "band 0.35", not 0.34999999999999998.
+std::string shortest(double v) {
+  char text[32];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
+}
+
 }  // namespace
 
 BakeRecipe BakeRecipe::parse(const std::string& text) {
@@ -66,6 +73,11 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
                               "]");
       return v;
     };
+    auto within = [&](double lo, double hi) {  // a number in [lo, hi]
+      if (!(v >= lo && v <= hi))
+        throw InvalidArgument(where + key + " must be in [" + shortest(lo) + ", " + shortest(hi) + "]");
+      return v;
+    };
     if (key == "seed")
       r.seed = static_cast<std::uint64_t>(whole(0, 9007199254740992.0));
     else if (key == "colours")
@@ -80,22 +92,17 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       if (!(v > 0 && v < 0.5)) throw InvalidArgument(where + "band must be in (0, 0.5)");
       r.band = v;
     } else if (key == "erosion") {
-      if (!(v >= 0 && v <= 8)) throw InvalidArgument(where + "erosion must be in [0, 8]");
-      r.erosion = v;
+      r.erosion = within(0, 8);
     } else if (key == "edge_gap") {
-      if (!(v >= 0.5 && v <= 4)) throw InvalidArgument(where + "edge_gap must be in [0.5, 4]");
-      r.edge_gap = v;
+      r.edge_gap = within(0.5, 4);
     } else if (key == "rank_context") {
       r.rank_context = static_cast<int>(whole(0, 2));
     } else if (key == "min_distance") {
-      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "min_distance must be in [0, 0.7]");
-      r.min_distance = v;
+      r.min_distance = within(0, 0.7);
     } else if (key == "separation") {
-      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "separation must be in [0, 0.7]");
-      r.separation = v;
+      r.separation = within(0, 0.7);
     } else if (key == "glide_separation") {
-      if (!(v >= 0 && v <= 0.7)) throw InvalidArgument(where + "glide_separation must be in [0, 0.7]");
-      r.glide_separation = v;
+      r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
       r.keyframes = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "glide_sweeps") {
@@ -123,12 +130,6 @@ int BakeRecipe::sweeps_for(std::uint64_t level_points) const {
 }
 
 std::string BakeRecipe::to_text() const {
-  // The shortest text that reads back as the same double: "band 0.35", not 0.34999999999999998.
-  auto shortest = [](double v) {
-    char text[32];
-    const std::to_chars_result r = std::to_chars(text, text + sizeof text, v);
-    return std::string(text, r.ptr);
-  };
   std::ostringstream s;
   s << "seed " << seed << "\ncolours " << colours << "\nlevels " << levels << "\nbase_points " << base_points
     << "\ntemperature " << shortest(temperature) << "\nsweeps " << sweeps << "\nband " << shortest(band)
