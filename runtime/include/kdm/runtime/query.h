@@ -103,7 +103,7 @@ class KDM_RUNTIME_API Tileset {
   /// The first keyframe whose count is at least `expected` (> 0), or the keyframe count if none: a table
   /// lookup on the number's exponent and leading bits, then a step or two.
   std::uint32_t first_keyframe_at_least(double expected) const;
-  /// Its table: per bucket of counts (16 per power of two from 2^-32 to 2^32, by the double's exponent and
+  /// Its table: per bucket of counts (32 per power of two from 2^-32 to 2^32, by the double's exponent and
   /// leading mantissa bits), the first keyframe at least the bucket's smallest count; null if not loaded.
   const std::uint16_t* keyframe_guess() const {
     return keyframe_guess_.empty() ? nullptr : keyframe_guess_.data();
