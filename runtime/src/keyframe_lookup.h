@@ -4,13 +4,13 @@
 #include <cstdint>
 #include <cstring>
 
-#include "kdm/runtime/query.h"
+#include "query_tables.h"
 
 namespace kdm {
 namespace detail {
 
-/// Buckets of expected counts for Tileset::first_keyframe_at_least: kBucketsPerOctave per power of two
-/// from 2^-32 to 2^32 (smaller counts share the first, larger ones the last), from the double's exponent
+/// Buckets of expected counts for first_keyframe_at_least (query_tables.h): kBucketsPerOctave per power of
+/// two from 2^-32 to 2^32 (smaller counts share the first, larger ones the last), from the double's exponent
 /// and leading mantissa bits. A bucket's smallest count is (1 + m / kBucketsPerOctave) · 2^e, and none is
 /// wider than 1 / kBucketsPerOctave of it (3.1%): keyframes farther apart than that are one step away.
 inline constexpr int kMantissaBits = 5;
@@ -27,10 +27,10 @@ inline int count_bucket(double v) {
 
 /// A set's keyframe tables as plain pointers (a query's copy: see TileJob).
 struct KeyframeTable {
-  const double* counts = nullptr;  ///< K_g, then +∞ (Tileset::keyframe_counts)
+  const double* counts = nullptr;  ///< K_g, then +∞ (QueryTables::keyframe_counts)
   std::uint32_t n = 0;
-  const GlideSpan* spans = nullptr;      ///< Tileset::glide_spans
-  bool one_step = false;                 ///< Tileset::keyframe_one_step
+  const GlideSpan* spans = nullptr;      ///< QueryTables::glide_spans
+  bool one_step = false;                 ///< QueryTables::keyframe_one_step
   const std::uint16_t* guess = nullptr;  ///< the first keyframe at least each count_bucket's smallest count
   /// The first g with K_g >= expected (> 0), or n.
   std::uint32_t first_at_least(double expected) const {
@@ -43,8 +43,8 @@ struct KeyframeTable {
 };
 
 /// Where between two keyframes an expected count per tile falls: keyframes g0 <= g1 and the weights of
-/// their offsets, w0 = (1 − t) and w1 = t times each keyframe's unit (Tileset::glide_scale), t the fraction
-/// of the way from g0 to g1 (linear in the count; 0 below the first keyframe and above the last).
+/// their offsets, w0 = (1 − t) and w1 = t times each keyframe's unit (QueryTables::glide_scale), t the
+/// fraction of the way from g0 to g1 (linear in the count; 0 below the first keyframe and above the last).
 struct GlideBracket {
   std::uint32_t g0 = 0, g1 = 0;
   double w0 = 0, w1 = 0;
@@ -57,12 +57,13 @@ struct GlideBracket {
 };
 
 inline KeyframeTable keyframe_table(const Tileset& set) {
+  const QueryTables& t = TilesetInternals::tables(set);
   KeyframeTable k;
-  k.counts = set.keyframe_counts();
+  k.counts = t.keyframe_counts.data();
   k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
-  k.spans = set.glide_spans();
-  k.one_step = set.keyframe_one_step();
-  k.guess = set.keyframe_guess();
+  k.spans = t.glide_spans.data();
+  k.one_step = t.keyframe_one_step;
+  k.guess = t.keyframe_guess.data();
   return k;
 }
 

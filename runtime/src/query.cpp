@@ -7,14 +7,18 @@
 #include <limits>
 #include <utility>
 
+#include "image_sampler.h"
 #include "kdm/runtime/hash.h"
 #include "keyframe_lookup.h"
+#include "query_tables.h"
 
 namespace kdm {
 
 using detail::GlideBracket;
+using detail::ImageSampler;
 using detail::keyframe_table;
 using detail::KeyframeTable;
+using detail::QueryTables;
 
 namespace {
 
@@ -25,30 +29,6 @@ bool finite(double v) {
 double sanitize(double v) {
   return (v > 0 && v < HUGE_VAL) ? v : 0.0;
 }  // NaN, ±inf, negatives -> 0
-
-}  // namespace
-
-namespace {
-
-/// World-to-texel transform of a density image, hoisted out of the per-point loop.
-struct ImageSampler {
-  const DensityImageView* image;
-  double sx = 0, sy = 0;
-  explicit ImageSampler(const DensityImageView* im) : image(im) {
-    if (im) sx = im->width / (im->x1 - im->x0), sy = im->height / (im->y1 - im->y0);
-  }
-  double at(double x, double y) const {
-    const DensityImageView& im = *image;
-    const double fx = std::clamp((x - im.x0) * sx - 0.5, 0.0, im.width - 1.0);
-    const double fy = std::clamp((y - im.y0) * sy - 0.5, 0.0, im.height - 1.0);
-    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
-    const int jx = std::min(ix + 1, im.width - 1), jy = std::min(iy + 1, im.height - 1);
-    const double ax = fx - ix, ay = fy - iy;
-    const float* r0 = im.values + static_cast<std::size_t>(iy) * im.width;
-    const float* r1 = im.values + static_cast<std::size_t>(jy) * im.width;
-    return (1 - ay) * ((1 - ax) * r0[ix] + ax * r0[jx]) + ay * ((1 - ax) * r1[ix] + ax * r1[jx]);
-  }
-};
 
 /// Every signed byte as a double: a load instead of a conversion with its false dependency.
 struct SignedByteTable {
@@ -62,7 +42,7 @@ constexpr SignedByteTable kSignedByte;
 /// What the per-point loop of one tile reads, copied out of the caller's structures: the output buffer
 /// could alias them, and the compiler would reload each after every point written.
 struct TileJob {
-  const Tileset* set;
+  const QueryTables* tables;
   KeyframeTable keyframes;
   const TilePoint* points;
   const float* thresholds;
@@ -74,8 +54,8 @@ struct TileJob {
   /// Smooth mode: the stable positions (1/65536 tile sides) that can glide into the region, for points
   /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
   double cull_x0, cull_y0, cull_x1, cull_y1, reach;
-  const std::uint32_t* ranks;  ///< smooth mode, varying density: Tileset::keyframe_ranks
-  /// Smooth mode, a tile beside the region: the only ranks that can glide into it (Tileset::edge_ranks).
+  const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::keyframe_ranks
+  /// Smooth mode, a tile beside the region: the only ranks that can glide into it (QueryTables::edges).
   const std::uint32_t *listed, *listed_end;
   double area_scale, limit;
   const QueryDensity* density;
@@ -106,7 +86,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     lo_x = j.cull_x0 - reach * 65536.0, hi_x = j.cull_x1 + reach * 65536.0;
     lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
   };
-  if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.set->glide_reach_from(0));
+  if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.tables->glide_reach_from[0]);
   // Places candidate c, emitted at `expected`: false when the buffer is full.
   // Places candidate c at its stable position (x, y) plus, in smooth mode, its offsets o0 and o1 weighted
   // by w0 and w1 (GlideBracket): false when the buffer is full.
@@ -160,7 +140,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     if (kSmooth && !kInside) {
       if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
-        set_reach(j.set->glide_reach_from(segment - 1));
+        set_reach(j.tables->glide_reach_from[segment - 1]);
       }
       const double sx = p.x + 0.5, sy = p.y + 0.5;
       if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) return kNone;
@@ -224,85 +204,21 @@ EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
 
 /// Smooth mode: when the region lies beyond one side of the tile (to within a few position units), only the
 /// points that can glide across that side can be emitted: job.listed is set to the shortest such side's
-/// list (Tileset::edge_ranks), whose every other point the culling bounds reject (the list adds
-/// Tileset::kEdgeSlack units to each reach, the bounds at most one).
-void pick_edge_list(const Tileset& set, std::size_t index, TileJob& job) {
-  constexpr double kNear = Tileset::kEdgeSlack / 2;
+/// list (QueryTables::edges), whose every other point the culling bounds reject (the list adds
+/// detail::kEdgeSlack units to each reach, the bounds at most one).
+void pick_edge_list(const QueryTables& tables, std::size_t index, TileJob& job) {
+  constexpr double kNear = detail::kEdgeSlack / 2;
   const bool beyond[4] = {job.cull_x1 <= kNear, job.cull_x0 >= 65536.0 - kNear, job.cull_y1 <= kNear,
                           job.cull_y0 >= 65536.0 - kNear};
   std::uint32_t best = ~0u;
   for (int side = 0; side < 4; ++side) {
     std::uint32_t count = 0;
-    const std::uint32_t* ranks = set.edge_ranks(index, side, count);
+    const std::uint32_t* ranks = tables.edges(index, side, count);
     if (beyond[side] && count < best) best = count, job.listed = ranks, job.listed_end = ranks + count;
   }
 }
 
 }  // namespace
-
-double DensityImageView::at(double x, double y) const {
-  return ImageSampler(this).at(x, y);
-}
-
-namespace {
-
-/// The max-mip's or min-mip's blocks over a world rectangle, folded with `pick` from `start`.
-template <class Pick>
-double fold_blocks(const DensityImageView& im, const float* mip, double qx0, double qy0, double qx1,
-                   double qy1, float start, Pick pick) {
-  auto block = [](double v, double lo, double hi, int n, int blocks) {
-    const double t = std::clamp((v - lo) / (hi - lo) * n, 0.0, double(n - 1));
-    return std::min(blocks - 1, static_cast<int>(t) / 8);
-  };
-  const int bx0 = block(qx0, im.x0, im.x1, im.width, im.mip_width),
-            bx1 = block(qx1, im.x0, im.x1, im.width, im.mip_width);
-  const int by0 = block(qy0, im.y0, im.y1, im.height, im.mip_height),
-            by1 = block(qy1, im.y0, im.y1, im.height, im.mip_height);
-  float m = start;
-  for (int by = by0; by <= by1; ++by)
-    for (int bx = bx0; bx <= bx1; ++bx) m = pick(m, mip[static_cast<std::size_t>(by) * im.mip_width + bx]);
-  return m;
-}
-
-}  // namespace
-
-double DensityImageView::max_over(double qx0, double qy0, double qx1, double qy1) const {
-  return fold_blocks(*this, max_mip, qx0, qy0, qx1, qy1, 0.0f,
-                     [](float a, float b) { return std::max(a, b); });
-}
-
-double DensityImageView::min_over(double qx0, double qy0, double qx1, double qy1) const {
-  if (!min_mip) return 0;
-  return fold_blocks(*this, min_mip, qx0, qy0, qx1, qy1, std::numeric_limits<float>::infinity(),
-                     [](float a, float b) { return std::min(a, b); });
-}
-
-Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
-  if (image.width <= 0 || image.height <= 0 || !image.values) return Status::kInvalidArgument;
-  if (!(finite(image.x0) && finite(image.x1) && finite(image.y0) && finite(image.y1) && image.x1 > image.x0 &&
-        image.y1 > image.y0))
-    return Status::kInvalidArgument;
-  const std::size_t count = static_cast<std::size_t>(image.width) * image.height;
-  for (std::size_t i = 0; i < count; ++i)
-    if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;
-  image.mip_width = (image.width + 7) / 8;
-  image.mip_height = (image.height + 7) / 8;
-  const std::size_t blocks = static_cast<std::size_t>(image.mip_width) * image.mip_height;
-  mip.assign(2 * blocks, 0.0f);
-  std::fill(mip.begin() + std::ptrdiff_t(blocks), mip.end(), std::numeric_limits<float>::infinity());
-  // Each block also covers one texel around it: bilinear values inside a block mix in its neighbours.
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) {
-      const float v = image.values[static_cast<std::size_t>(y) * image.width + x];
-      for (int by = std::max(0, (y - 1) / 8); by <= std::min(image.mip_height - 1, (y + 1) / 8); ++by)
-        for (int bx = std::max(0, (x - 1) / 8); bx <= std::min(image.mip_width - 1, (x + 1) / 8); ++bx) {
-          const std::size_t b = static_cast<std::size_t>(by) * image.mip_width + bx;
-          mip[b] = std::max(mip[b], v), mip[blocks + b] = std::min(mip[blocks + b], v);
-        }
-    }
-  image.max_mip = mip.data(), image.min_mip = mip.data() + blocks;
-  return Status::kOk;
-}
 
 Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
                     std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
@@ -319,6 +235,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (!cursor) return refuse(Kind::kMissingArgument, "cursor");
   if (capacity > 0 && !out) return refuse(Kind::kMissingArgument, "out");
   if (tileset.empty()) return refuse(Kind::kMissingArgument, "tileset");
+  const QueryTables& tables = detail::TilesetInternals::tables(tileset);
   const std::pair<const char*, double> numbers[] = {{"x0", q.x0},
                                                     {"y0", q.y0},
                                                     {"x1", q.x1},
@@ -373,11 +290,11 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (glide) {
     const GlideBracket top(keyframe_table(tileset), max_density * area_scale);
     for (std::uint32_t g = d.kind == QueryDensity::Kind::kConstant ? top.g0 : 0; g <= top.g1; ++g)
-      reach = std::max(reach, tileset.glide_reach(g) * S);
+      reach = std::max(reach, tables.glide_reach[g] * S);
   }
   const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
   const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);
-  if (!(max_density * area_scale > tileset.min_threshold())) {  // no tile can emit even its first point
+  if (!(max_density * area_scale > tables.min_threshold)) {  // no tile can emit even its first point
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
@@ -401,7 +318,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
                  emit_inside = pick_emitter<true>(glide, d.kind),
                  emit_listed = pick_emitter<false, true>(glide, d.kind);
   TileJob job{};
-  job.set = &tileset;
+  job.tables = &tables;
   job.keyframes = keyframe_table(tileset);
   job.S = S, job.x0 = q.x0, job.y0 = q.y0, job.x1 = q.x1, job.y1 = q.y1;
   job.origin_x = q.origin_x, job.origin_y = q.origin_y, job.area_scale = area_scale;
@@ -411,7 +328,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
       const std::size_t index = tileset.tile_index_at(tx, ty);
       const Tile& tile = tileset.data().tiles[index];
-      const float* thresholds = tileset.thresholds(index);
+      const float* thresholds = tables.thresholds[index].data();
       const double wx = double(tx) * S;
       double bound = max_density;
       if (d.kind == QueryDensity::Kind::kImage) bound = d.image->max_over(wx, wy, wx + S, wy + S);
@@ -429,8 +346,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       job.points = tile.points.data(), job.thresholds = thresholds, job.tx = tx, job.ty = ty;
       job.wx = wx, job.wy = wy, job.limit = limit;
       if (glide) {
-        job.glide = tile.glide.data(), job.starts = tileset.glide_start(index);
-        job.ranks = tileset.keyframe_ranks(index);
+        job.glide = tile.glide.data(), job.starts = tables.glide_start[index].data();
+        job.ranks = tables.keyframe_ranks[index].data();
         // The region in the tile's 1/65536 units, widened by a unit so that the culling is never stricter
         // than the exact test after the glide; a constant density's points glide as far as the two
         // keyframes around it let them.
@@ -438,10 +355,10 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
         job.cull_y0 = (q.y0 - wy) / S * 65536.0 - 1, job.cull_y1 = (q.y1 - wy) / S * 65536.0 + 1;
         if (d.kind == QueryDensity::Kind::kConstant) {
           const GlideBracket b(job.keyframes, limit);
-          job.reach = std::max(tileset.glide_reach(b.g0), tileset.glide_reach(b.g1));
+          job.reach = std::max(tables.glide_reach[b.g0], tables.glide_reach[b.g1]);
         }
         job.listed = nullptr;
-        pick_edge_list(tileset, index, job);
+        pick_edge_list(tables, index, job);
         job.zero_possible = d.kind == QueryDensity::Kind::kImage &&
                             !(d.image->min_over(wx - reach, wy - reach, wx + S + reach, wy + S + reach) > 0);
       }

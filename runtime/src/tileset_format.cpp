@@ -16,7 +16,7 @@
 #include <streambuf>
 
 #include "crc32.h"
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm {
 namespace {
@@ -197,38 +197,6 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
 }
 
 }  // namespace
-
-const char* status_message(Status status) {
-  switch (status) {
-    case Status::kOk:
-      return "ok";
-    case Status::kIoError:
-      return "I/O error";
-    case Status::kBadMagic:
-      return "not a kdm tile set (bad magic)";
-    case Status::kUnsupportedVersion:
-      return "unsupported tile-set format version";
-    case Status::kTruncated:
-      return "tile set is truncated";
-    case Status::kTrailingBytes:
-      return "tile set has trailing bytes";
-    case Status::kHeaderChecksumMismatch:
-      return "tile-set header checksum mismatch";
-    case Status::kPayloadChecksumMismatch:
-      return "tile-set payload checksum mismatch";
-    case Status::kTooLarge:
-      return "tile set exceeds the reader's size limits";
-    case Status::kDecompressionFailed:
-      return "tile-set payload does not decompress";
-    case Status::kInvalidContent:
-      return "tile-set content is inconsistent";
-    case Status::kInvalidArgument:
-      return "invalid argument";
-    case Status::kBufferFull:
-      return "output buffer full; resume with the same cursor";
-  }
-  return "unknown status";
-}
 
 Status validate_tileset(const TilesetData& set, std::string* detail) {
   auto bad = [&](const std::string& m) { return fail(Status::kInvalidContent, detail, m); };

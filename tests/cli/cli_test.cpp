@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "image_io.h"
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 #include "kdm/runtime/version.h"
 #include "point_io.h"
 

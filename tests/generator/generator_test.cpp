@@ -15,7 +15,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
 
 namespace kdm::verify {

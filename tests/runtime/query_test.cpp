@@ -16,6 +16,7 @@
 #include "kdm/analysis/density.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
+#include "query_tables.h"
 
 // Counts heap allocations made by this test binary, to prove queries make none. The replacement pairs
 // malloc with free on purpose; GCC's mismatch warning cannot see that both sides are replaced.
@@ -80,7 +81,7 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   for (std::size_t i = 0; i < t.data().tiles.size(); ++i)
     for (int side = 0; side < 4; ++side) {
       std::uint32_t count = 0;
-      t.edge_ranks(i, side, count);
+      detail::TilesetInternals::tables(t).edges(i, side, count);
       listed += count;
     }
   EXPECT_GT(listed, 0u);
@@ -104,7 +105,8 @@ TEST(QueryTest, FirstKeyframeLookupMatchesABinarySearch) {
   std::uniform_real_distribution<double> exponent(-12, 12);
   for (int i = 0; i < 20000; ++i) counts.push_back(std::pow(10.0, exponent(rng)));
   for (const double c : counts)
-    ASSERT_EQ(t.first_keyframe_at_least(c), std::lower_bound(k.begin(), k.end(), c) - k.begin()) << c;
+    ASSERT_EQ(detail::first_keyframe_at_least(t, c), std::lower_bound(k.begin(), k.end(), c) - k.begin())
+        << c;
 }
 
 class ModeTest : public ::testing::TestWithParam<QueryMode> {};
@@ -149,7 +151,7 @@ TEST(QueryTest, EdgeListsHoldEveryPointThatCanGlideAcrossASide) {
   std::size_t listed = 0, points = 0;
   for (std::size_t i = 0; i < set.tiles.size(); ++i) {
     const Tile& tile = set.tiles[i];
-    const std::uint32_t* start = t.glide_start(i);
+    const std::uint32_t* start = detail::TilesetInternals::tables(t).glide_start[i].data();
     std::vector<double> farthest(tile.points.size(), 0.0);  // position units, per axis
     for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
       for (std::uint32_t c = 0; c < start[g + 1] - start[g]; ++c)
@@ -158,7 +160,7 @@ TEST(QueryTest, EdgeListsHoldEveryPointThatCanGlideAcrossASide) {
               farthest[c], std::abs(tile.glide[2 * (start[g] + c) + axis]) * set.glide_unit(g) * 65536.0);
     for (int side = 0; side < 4; ++side) {
       std::uint32_t count = 0;
-      const std::uint32_t* ranks = t.edge_ranks(i, side, count);
+      const std::uint32_t* ranks = detail::TilesetInternals::tables(t).edges(i, side, count);
       ASSERT_TRUE(std::is_sorted(ranks, ranks + count));
       for (std::uint32_t c = 0; c < tile.points.size(); ++c) {
         const double u = (side < 2 ? tile.points[c].x : tile.points[c].y) + 0.5;

@@ -18,6 +18,7 @@
 #include "crc32.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
+#include "query_tables.h"
 
 namespace kdm {
 namespace {
@@ -428,11 +429,12 @@ TEST(TilesetFormatTest, KeyframesCloserThanTheLookupTableStillFindTheirBracket) 
   const std::vector<std::uint8_t> bytes = encode(set);
   Tileset t;
   ASSERT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
-  EXPECT_FALSE(t.keyframe_one_step());
-  EXPECT_TRUE(Tileset::builtin().keyframe_one_step());
+  EXPECT_FALSE(detail::TilesetInternals::tables(t).keyframe_one_step);
+  EXPECT_TRUE(detail::TilesetInternals::tables(Tileset::builtin()).keyframe_one_step);
   const auto& k = set.keyframe_nominal;
   for (double c = 0.25; c < 400; c += 0.125)
-    ASSERT_EQ(t.first_keyframe_at_least(c), std::lower_bound(k.begin(), k.end(), c) - k.begin()) << c;
+    ASSERT_EQ(detail::first_keyframe_at_least(t, c), std::lower_bound(k.begin(), k.end(), c) - k.begin())
+        << c;
 
   QueryParams q;
   q.x1 = q.y1 = 3;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 #include "kdm/runtime/version.h"
 
 namespace {

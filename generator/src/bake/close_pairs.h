@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "corner_layout.h"
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
 

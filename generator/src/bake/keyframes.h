@@ -1,5 +1,5 @@
-// The gliding track of a tile set (kdm/runtime/tileset.h): keyframes between the pyramid's levels, at each
-// of which the points present are relaxed as a whole, so that a query in smooth mode shows a good
+// The gliding track of a tile set (kdm/runtime/tileset_format.h): keyframes between the pyramid's levels, at
+// each of which the points present are relaxed as a whole, so that a query in smooth mode shows a good
 // blue-noise set at every density, not only at the levels.
 //
 // Nested sets cannot do that: when no point ever moves, the worst density between two levels ×4 apart has
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "bake/corner_layout.h"
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
 

@@ -9,7 +9,7 @@
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/nearest_neighbor.h"
 #include "kdm/generator/sampler.h"
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
 
 namespace kdm::verify {

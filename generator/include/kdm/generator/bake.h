@@ -12,7 +12,7 @@
 // sampled and dropped, so each patch is drawn from P(patch | what it touches) of the full model.
 // The new points of every patch are then ranked by void-and-cluster against the points present by then
 // (earlier levels, and the level's earlier patches up to the same fraction of their own ranking), and the
-// fraction becomes the point's emission key (kdm/runtime/tileset.h): any density between two levels
+// fraction becomes the point's emission key (kdm/runtime/tileset_format.h): any density between two levels
 // emits the same prefix of a shared patch in every tile.
 //
 // Thread safety: bake_tileset is reentrant; it uses up to `threads` threads of its own.
@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
 

@@ -4,7 +4,7 @@
 //
 // Corner tiles are not periodic one by one, so each tile is judged among neighbours: on the 2×2 torus of
 // tiles whose tile (0, 0) it is (every tile has one, and its three other tiles are valid neighbours), with
-// the points the runtime would emit there at an expected count D per tile (kdm/runtime/tileset.h).
+// the points the runtime would emit there at an expected count D per tile (kdm/runtime/tileset_format.h).
 //  1. Statistics, per tile and level, against R unconstrained full-sampler runs with the level's nominal
 //     density and the recipe's temperature (default options otherwise: what a user of `kdm sample` gets):
 //     E/n, δavg, NN1%, lowP and RAPS in bands of 0.25 over 0.5 ≤ f < 2. The runs sample the same 2×2 torus
@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "kdm/runtime/tileset.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm::verify {
 
@@ -132,7 +132,7 @@ struct DensityResult {
   double closest_pair = 0;      ///< smallest distance between two points of any tile's torus, in d_hex
   double edge_band = 0;         ///< density within one d_hex of tile edges / the mean, pooled
   std::size_t edge_links = 0, midline_links = 0;  ///< distinct links crossing tile edges, midlines
-  double ks_d_plus = 0, ks_p = 1;  ///< edge links shorter than midline links?
+  double ks_d_plus = 0, ks_p = 1;                 ///< edge links shorter than midline links?
   std::vector<Check> checks;
   bool passed() const;
 };

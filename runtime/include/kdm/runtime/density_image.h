@@ -1,0 +1,35 @@
+// A density image for queries (kdm/runtime/query.h): caller-owned texels over a world rectangle, with the
+// block bounds that let a query skip what the density can never emit.
+#pragma once
+
+#include <vector>
+
+#include "kdm/runtime/export.h"
+#include "kdm/runtime/status.h"
+
+namespace kdm {
+
+/// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
+/// Values must be finite and >= 0 (validated by make_density_max_mip). Built once, shared read-only.
+struct KDM_RUNTIME_API DensityImageView {
+  int width = 0, height = 0;
+  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  ///< world rectangle covered; row 0 at y0
+  const float* values = nullptr;          ///< width·height, row-major, owned by the caller
+  const float* max_mip = nullptr;         ///< per 8×8 texel block maximum (see make_density_max_mip)
+  const float* min_mip = nullptr;         ///< per 8×8 texel block minimum (optional: null means 0)
+  int mip_width = 0, mip_height = 0;
+  /// The density at world position (x, y).
+  double at(double x, double y) const;
+  /// Upper bound of the density over a world rectangle (from the max-mip; exact bound, maybe loose).
+  double max_over(double x0, double y0, double x1, double y1) const;
+  /// Lower bound of the density over a world rectangle (from the min-mip; 0 without one).
+  double min_over(double x0, double y0, double x1, double y1) const;
+};
+
+/// Fills `mip` (resized to 2·ceil(w/8)·ceil(h/8)) with the 8×8 block maxima of `image.values`, then their
+/// minima, each block widened by one texel so they bound bilinear values too, and points the image's
+/// max_mip and min_mip at them. Returns kInvalidArgument for empty images or values that are negative or
+/// not finite.
+KDM_RUNTIME_API Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
+
+}  // namespace kdm

@@ -1,0 +1,183 @@
+// kdm tile sets: the data model and the file format (defined here, once; the baker writes it through
+// this header). A tile set is a family of corner tiles (Lagae & Dutré 2006): with C corner colours there
+// are C^4 tiles, one per colouring (sw, se, ne, nw) of their corners; tiles whose shared corners have the
+// same colours fit together without seams. Each tile holds a nested multi-density pyramid: level k+1 holds
+// every point of level k plus about 3× as many new ones, sorted by (level, key).
+//
+// Emission keys: every point carries a key q in [0, 65536) within its level. Level k spans the nominal
+// counts (N_{k-1}, N_k] (level_nominal, N_{-1} = 0), and the point appears once the expected count of
+// points in its tile exceeds its threshold N_{k-1} + (q + 1/2) / 65536 · (N_k − N_{k-1})
+// (emission_threshold). Points that several tiles share near corners and edges have the same key in all of
+// them, so every tile emits the same subset of them at any density: mid-level densities stay seamless.
+//
+// Gliding (smooth emission): a set may also carry keyframes, expected counts K_0 < … < K_{G-1} = N_top
+// per tile (keyframe_nominal). At keyframe g every point emitted there (threshold < K_g) has a position
+// of its own, stored as an 8-bit offset from its stable position in units of a 32nd of that keyframe's
+// spacing 1/√K_g (Tile::glide, TilesetData::glide_unit); between two keyframes a point moves linearly from
+// its position at the one to its position at the next. A point that appears between them has a position
+// at the earlier one too (where it enters), so it glides in from there. Each keyframe was relaxed as a
+// whole, so densities between levels are good blue noise too, and points still appear in rank order.
+//
+// File layout (all integers little-endian):
+//   offset  size  field
+//        0     8  magic "KDMTILES"
+//        8     4  format version (kTilesetFormatVersion)
+//       12     4  header size in bytes (64 + recipe size + generator version size)
+//       16     8  payload size in bytes (zstd frame)
+//       24     8  payload size once decompressed
+//       32     4  CRC-32 of the payload bytes
+//       36     4  tile count (= colours^4)
+//       40     4  colours
+//       44     4  levels
+//       48     4  recipe size;  52: generator version size;  56: reserved (0)
+//       60     4  CRC-32 of the whole header with this field read as zero
+//       64     …  recipe text, then generator version text
+//   header size … payload: zstd-compressed cereal portable-binary archive: colours, levels, tile count,
+//                  level_nominal, keyframe_nominal, then per tile its level_end, x y pairs, keys and
+//                  glide offsets (still read: format 2, no keyframe_nominal and no glide; format 3, glide
+//                  offsets as 16-bit differences in 1/65536 tile sides, converted to 8 bits on reading)
+// The file is exactly header size + payload size bytes long.
+//
+// Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/allocator.h"
+#include "kdm/runtime/export.h"
+#include "kdm/runtime/status.h"
+#include "kdm/runtime/version.h"
+
+namespace kdm {
+
+/// Reader caps: files beyond them are refused before anything is allocated.
+inline constexpr std::uint64_t kMaxTilesetPayloadBytes = 512ull << 20;  ///< decompressed payload
+inline constexpr std::uint32_t kMaxTilesetHeaderBytes = 1u << 20;
+inline constexpr std::uint32_t kMaxTileColours = 16;  ///< at most 16^4 = 65536 tiles
+inline constexpr std::uint32_t kMaxTileLevels = 16;
+inline constexpr std::uint32_t kMaxKeyframes = 256;
+
+/// Glide offsets count in 1/kGlideUnitsPerSpacing of a keyframe's square-grid spacing 1/√K (8 bits: up to
+/// ±3.97 spacings, in steps of 0.03 of the point spacing).
+inline constexpr double kGlideUnitsPerSpacing = 32;
+
+/// A point's position inside its tile in units of 1/65536 of the tile side: x, y in [0, 65536).
+struct TilePoint {
+  std::uint16_t x = 0, y = 0;
+  /// The point for unit-square coordinates u, v in [0, 1) (floored to the 1/65536 grid, clamped).
+  static TilePoint from_unit(double u, double v) { return {quantize(u), quantize(v)}; }
+  /// Unit-square position of the grid cell's centre, in [0, 1).
+  double unit_x() const { return (x + 0.5) * (1.0 / 65536.0); }
+  double unit_y() const { return (y + 0.5) * (1.0 / 65536.0); }
+  static std::uint16_t quantize(double u) {
+    const double t = u * 65536.0;
+    return static_cast<std::uint16_t>(t <= 0 ? 0.0 : (t >= 65535.0 ? 65535.0 : t));
+  }
+  friend bool operator==(const TilePoint& a, const TilePoint& b) { return a.x == b.x && a.y == b.y; }
+};
+
+struct Tile {
+  /// Sorted by (level, key): the array index is the point's rank within the whole pyramid.
+  TilesetArray<TilePoint> points;
+  /// Emission key of each point within its level (see the top of this file); non-decreasing per level.
+  TilesetArray<std::uint16_t> keys;
+  /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
+  TilesetArray<std::uint32_t> level_end;
+  /// Gliding offsets (x, y pairs from the point's stable position, in TilesetData::glide_unit(g) tile
+  /// sides): keyframe 0's for ranks [0, count_0), then keyframe 1's for [0, count_1), …, where count_g is
+  /// TilesetData::glide_count (the points present at keyframe g or appearing before the next one).
+  /// Empty without keyframes.
+  TilesetArray<std::int8_t> glide;
+  /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
+  std::uint32_t level_of(std::uint32_t rank) const {
+    std::uint32_t k = 0;
+    while (k + 1 < level_end.size() && rank >= level_end[k]) ++k;
+    return k;
+  }
+  friend bool operator==(const Tile& a, const Tile& b) {
+    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end && a.glide == b.glide;
+  }
+};
+
+struct TilesetData {
+  std::uint32_t colours = 0;  ///< corner colours C; tiles.size() == C^4
+  std::uint32_t levels = 0;   ///< pyramid levels per tile
+  /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
+  /// strictly increasing, positive. Emission thresholds are placed between these.
+  TilesetArray<std::uint32_t> level_nominal;
+  /// Keyframes of the gliding track, expected points per tile: strictly increasing, the last one the top
+  /// level's nominal count. Empty: the set has no gliding track (smooth queries then emit stable positions).
+  TilesetArray<std::uint32_t> keyframe_nominal;
+  TilesetArray<Tile> tiles;       ///< index tile_index(sw, se, ne, nw)
+  std::string recipe;             ///< the recipe text that rebuilds this set exactly
+  std::string generator_version;  ///< the kdm version that baked it
+
+  std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
+    return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
+  }
+  /// The expected point count per tile above which a point of `level` with key `key` is emitted, in
+  /// the float precision the runtime stores it in (4 bytes per point).
+  float emission_threshold(std::uint32_t level, std::uint16_t key) const {
+    const double lo = level == 0 ? 0.0 : level_nominal[level - 1], hi = level_nominal[level];
+    return static_cast<float>(lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo));
+  }
+  /// The emission rule, stated once for the runtime and the generator test: a point with threshold
+  /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
+  static bool emits(float threshold, double expected) { return expected > threshold; }
+  /// The unit of keyframe g's glide offsets in tile sides: 1 / (kGlideUnitsPerSpacing · √K_g).
+  double glide_unit(std::size_t g) const {
+    return 1.0 / (kGlideUnitsPerSpacing * std::sqrt(double(keyframe_nominal[g])));
+  }
+  /// How many of `tile`'s points have a position at keyframe g: those present there or appearing before
+  /// the next keyframe (they glide in from it); every point at the last keyframe. A prefix of its ranks.
+  std::uint32_t glide_count(const Tile& tile, std::size_t g) const {
+    return g + 1 < keyframe_nominal.size() ? keyframe_count(tile, g + 1)
+                                           : static_cast<std::uint32_t>(tile.points.size());
+  }
+  /// How many of `tile`'s points are present at keyframe g (threshold < K_g: a prefix of its ranks).
+  std::uint32_t keyframe_count(const Tile& tile, std::size_t g) const {
+    std::uint32_t lo = 0, hi = static_cast<std::uint32_t>(tile.points.size());
+    while (lo < hi) {  // thresholds grow with rank
+      const std::uint32_t mid = lo + (hi - lo) / 2;
+      if (emits(emission_threshold(tile.level_of(mid), tile.keys[mid]), keyframe_nominal[g]))
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    return lo;
+  }
+  friend bool operator==(const TilesetData& a, const TilesetData& b) {
+    return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
+           a.keyframe_nominal == b.keyframe_nominal && a.tiles == b.tiles && a.recipe == b.recipe &&
+           a.generator_version == b.generator_version;
+  }
+};
+
+/// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
+/// counts, one key per point, keys sorted within each level, keyframes increasing up to the top level,
+/// one glide offset pair per point present at each keyframe).
+/// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
+KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
+
+/// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
+KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out,
+                                      std::string* detail = nullptr);
+
+/// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
+/// checked before use; nothing is allocated beyond the caps). On failure `out` is left empty.
+KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, TilesetData& out,
+                                      std::string* detail = nullptr);
+
+/// Reads and decodes the file at `path`.
+KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
+
+/// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
+/// so an interrupted save never leaves a damaged file at `path`.
+KDM_RUNTIME_API Status save_tileset(const TilesetData& set, const std::string& path,
+                                    std::string* detail = nullptr);
+
+}  // namespace kdm

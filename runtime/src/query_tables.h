@@ -1,0 +1,84 @@
+// Internal: the tables a loaded Tileset keeps for the query loop, built once per load from its
+// TilesetData (emission thresholds, the gliding track's starts, reaches and brackets, the edge lists).
+// Installed headers never show them; tests reach them through kdm_runtime_internal.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kdm/runtime/allocator.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm::detail {
+
+/// How a point glides at an expected count c per tile between keyframes K_g0 ≤ c ≤ K_g1: its offset is
+/// o_g0 · (1 − t) · scale0 + o_g1 · t · scale1 with t = (c − base) · inverse_gap, in 1/65536 tile sides.
+/// Below the first keyframe and above the last g0 = g1 and t = 0: no motion there.
+struct GlideSpan {
+  std::uint32_t g0 = 0, g1 = 0;
+  double base = 0, inverse_gap = 0;  ///< K_g0 and 1 / (K_g1 − K_g0) (0 when g0 = g1)
+  double scale0 = 0, scale1 = 0;     ///< QueryTables::glide_scale of g0 and g1
+};
+
+/// Position units (1/65536 tile side) the edge lists add to each point's reach, for rounding.
+inline constexpr double kEdgeSlack = 8;
+
+struct QueryTables {
+  /// Per tile, its points' emission thresholds (TilesetData::emission_threshold), non-decreasing.
+  TilesetArray<TilesetArray<float>> thresholds;
+  /// The lowest threshold of any point: below it no tile emits anything.
+  double min_threshold = 0;
+  /// Per tile, where each keyframe's offsets start in Tile::glide, in offset pairs (keyframes + 1 entries:
+  /// keyframe g's pairs are [start[g], start[g + 1]), one per rank below TilesetData::glide_count).
+  TilesetArray<TilesetArray<std::uint32_t>> glide_start;
+  /// The largest distance any point glides from its stable position, per axis, in tile sides, at keyframe
+  /// g (smooth queries look this far beyond their region), and the largest of those from keyframe g on.
+  TilesetArray<double> glide_reach, glide_reach_from;
+  /// Per keyframe, 1/65536 tile sides per glide offset unit (65536 · TilesetData::glide_unit(g)).
+  TilesetArray<double> glide_scale;
+  /// Per tile and keyframe g, how many of its points are present there (TilesetData::keyframe_count).
+  TilesetArray<TilesetArray<std::uint32_t>> keyframe_ranks;
+  /// The keyframe counts K_g as doubles, then +∞ (keyframes + 1 entries): searches stop without a bound.
+  TilesetArray<double> keyframe_counts;
+  /// Per g = first_keyframe_at_least(count) (keyframes + 1 entries), how a count there glides.
+  TilesetArray<GlideSpan> glide_spans;
+  /// Per bucket of counts (keyframe_lookup.h), the first keyframe at least the bucket's smallest count.
+  TilesetArray<std::uint16_t> keyframe_guess;
+  /// Whether one step from keyframe_guess always finds the first keyframe at least a count (true when
+  /// consecutive keyframes are over 3.1% apart, as in baked sets).
+  bool keyframe_one_step = false;
+  /// Smooth mode: per tile, the ranks of its points that can glide across each side (0: x = 0, 1: x = 1,
+  /// 2: y = 0, 3: y = 1), ascending, the four lists in turn; edge_start holds 5 offsets per tile into
+  /// them. A point is listed when its stable position lies within glide_reach_from(the keyframe it
+  /// appears after) · 65536 + kEdgeSlack position units of that side, so a tile beside a region is
+  /// scanned through one list, not in full.
+  TilesetArray<TilesetArray<std::uint32_t>> edge_ranks;
+  TilesetArray<std::uint32_t> edge_start;
+  /// The allocator hooks this object itself came from (Tileset allocates it through them).
+  AllocatorHooks hooks;
+
+  /// Builds every table from `set` (validated).
+  explicit QueryTables(const TilesetData& set);
+  /// Heap bytes the tables hold, this object included.
+  std::size_t resident_bytes() const;
+  /// Side `side`'s list of tile `index` (see edge_ranks); `count` receives its length.
+  const std::uint32_t* edges(std::size_t index, int side, std::uint32_t& count) const {
+    const std::uint32_t* start = edge_start.data() + 5 * index;
+    count = start[side + 1] - start[side];
+    return edge_ranks[index].data() + start[side];
+  }
+
+ private:
+  void index_edges(const TilesetData& set);
+};
+
+/// A Tileset's tables: what the query loop reads besides its TilesetData.
+struct TilesetInternals {
+  static const QueryTables& tables(const Tileset& set) { return *set.tables_; }
+};
+
+/// The first keyframe of `set` whose count is at least `expected` (> 0), or the keyframe count if none
+/// (0 without keyframes): a table lookup on the number's exponent and leading bits, then a step or two.
+std::uint32_t first_keyframe_at_least(const Tileset& set, double expected);
+
+}  // namespace kdm::detail
