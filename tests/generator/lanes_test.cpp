@@ -9,8 +9,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "platform/lanes.h"
-#include "platform/lanes_wide.h"
+#include "sampler/lanes.h"
+#include "sampler/lanes_wide.h"
 #include "sampler/rng.h"
 
 namespace kdm::gen {

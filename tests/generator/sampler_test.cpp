@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "kdm/generator/sampler.h"
-#include "platform/lanes_wide.h"
+#include "sampler/lanes_wide.h"
 #include "sampler/rng.h"
 #include "sampler/setup.h"
 

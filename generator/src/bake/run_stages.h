@@ -11,6 +11,7 @@
 
 #include "bake/corner_layout.h"
 #include "kdm/generator/sampler.h"
+#include "platform/thread_count.h"
 
 namespace kdm::gen {
 
@@ -20,7 +21,7 @@ namespace kdm::gen {
 template <class Sample, class Keep>
 void for_each_run(const std::vector<BakeRun>& runs, int threads, Sample&& sample, Keep&& keep) {
   using Result = decltype(sample(std::size_t{}, int{}));
-  const int workers = threads > 0 ? threads : default_thread_count();
+  const int workers = thread_count(threads);
   for (std::size_t first = 0; first < runs.size();) {
     std::size_t last = first;
     while (last < runs.size() && runs[last].stage == runs[first].stage &&

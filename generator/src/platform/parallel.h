@@ -5,15 +5,10 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "kdm/generator/sampler.h"
+#include "platform/thread_count.h"
 #include "platform/thread_team.h"
 
 namespace kdm::gen {
-
-/// The threads to use when a caller requests `requested` (0 or less: default_thread_count()).
-inline int thread_count(int requested) {
-  return requested > 0 ? requested : default_thread_count();
-}
 
 /// Runs body(thread, team) on each thread of a team of up to `threads` (one thread when `parallel` is
 /// false).

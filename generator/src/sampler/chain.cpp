@@ -1,7 +1,7 @@
 #include "sampler/chain.h"
 
 #include "platform/huge_pages.h"
-#include "platform/lanes.h"
+#include "sampler/lanes.h"
 #include "platform/parallel.h"
 
 #include <algorithm>

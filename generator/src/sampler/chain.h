@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "kdm/runtime/check.h"
-#include "platform/lanes_wide.h"
+#include "sampler/lanes_wide.h"
 #include "sampler/checkerboard.h"
 #include "sampler/grid.h"
 #include "sampler/kernel.h"

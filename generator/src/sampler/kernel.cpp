@@ -1,9 +1,9 @@
 #include "sampler/kernel.h"
 
 #include "platform/huge_pages.h"
-#include "platform/lanes_wide.h"
+#include "sampler/lanes_wide.h"
 #include "platform/parallel.h"
-#include "platform/simd.h"
+#include "sampler/simd.h"
 
 namespace kdm::gen {
 

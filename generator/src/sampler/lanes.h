@@ -7,9 +7,9 @@
 #include <array>
 #include <type_traits>
 
-#include "platform/simd.h"
 #include "sampler/grid.h"
 #include "sampler/kernel.h"
+#include "sampler/simd.h"
 
 namespace kdm::gen::lanes {
 

@@ -4,7 +4,7 @@
 // said the CPU has them: the rest of the program keeps the baseline instruction set. The target is set per
 // function rather than for this file, so no inline function that other files share is ever compiled here
 // with wider instructions.
-#include "platform/lanes_wide.h"
+#include "sampler/lanes_wide.h"
 
 #include <array>
 #include <cstdint>
@@ -12,8 +12,8 @@
 #include <type_traits>
 
 #include "kdm/runtime/check.h"
-#include "platform/lanes.h"
-#include "platform/simd.h"
+#include "sampler/lanes.h"
+#include "sampler/simd.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define KDM_HAVE_WIDE_PASSES 1
@@ -138,7 +138,7 @@ KDM_TARGET inline V two_to(V n) {
       _mm512_slli_epi32(_mm512_add_epi32(_mm512_cvttps_epi32(n), _mm512_set1_epi32(127)), 23));
 }
 
-#include "platform/lanes_wide_passes.inc"
+#include "sampler/lanes_wide_passes.inc"
 #undef KDM_TARGET
 }  // namespace avx512
 
@@ -226,7 +226,7 @@ KDM_TARGET inline V two_to(V n) {
   return {two_to8(n.low), two_to8(n.high)};
 }
 
-#include "platform/lanes_wide_passes.inc"
+#include "sampler/lanes_wide_passes.inc"
 #undef KDM_TARGET
 }  // namespace avx2
 
