@@ -13,6 +13,7 @@
 
 #include "commands.h"
 #include "density_arg.h"
+#include "generator_density.h"
 #include "image_io.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/json.h"
@@ -82,10 +83,10 @@ void run_analyze(const AnalyzeArgs& args) {
   o.threads = args.threads;
   try {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
-    DensityArg target;
+    gen::Density target = gen::Density::constant();
     if (!args.density.empty()) {
-      target = parse_density(args.density, args.gamma, args.invert);
-      o.density = as_analysis_density(target.density);
+      target = to_generator_density(parse_density(args.density, args.gamma, args.invert));
+      o.density = as_analysis_density(target);
     }
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
@@ -107,7 +108,7 @@ void run_analyze(const AnalyzeArgs& args) {
                          (ec ? ": " + ec.message() : ""));
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (!args.no_energy) {
-      report.energy_per_point = mean_energy_per_point(sets, o.torus, target.density);
+      report.energy_per_point = mean_energy_per_point(sets, o.torus, target);
       report.has_energy = true;
     }
     std::fputs(analysis::format_summary(report).c_str(), stdout);
@@ -157,7 +158,10 @@ void add_analyze_command(CLI::App& app) {
                   "Bands of the per-band bias table: the points where the target density lies in each "
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "Worker threads (0 = all)")->capture_default_str();
+  cmd->add_option("--threads", args->threads,
+                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); results do not "
+                  "depend on it")
+      ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->callback([args] { run_analyze(*args); });
 }

@@ -60,9 +60,9 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset
 void run_query_command(const QueryArgs& a) {
   double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
-  const DensityArg arg = parse_density(a.density, a.gamma, a.invert, /*allow_zero=*/true);
-  if (!a.density_rect.empty() && !arg.from_image)
-    throw CommandError("--density-rect needs an image --density");
+  const tools::DensitySpec spec = parse_density(a.density, a.gamma, a.invert);
+  if (!a.density_rect.empty() && spec.kind == tools::DensitySpec::Kind::kConstant)
+    throw CommandError("--density-rect needs an image or a test map --density");
   if (a.density_rect.empty()) {
     std::copy(r, r + 4, dr);  // the image stretched over the rectangle queried
   } else {
@@ -70,7 +70,7 @@ void run_query_command(const QueryArgs& a) {
   }
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
-  const auto density = make_runtime_density(arg, dr[0], dr[1], dr[2], dr[3]);
+  const auto density = make_runtime_density(spec, dr[0], dr[1], dr[2], dr[3]);
   QueryParams q;
   q.x0 = r[0], q.y0 = r[1], q.x1 = r[2], q.y1 = r[3];
   q.tile_size = a.tile_size;
@@ -107,11 +107,15 @@ void add_query_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("query", "Points of a world rectangle from a tile set (the runtime)");
   cmd->add_option("--tileset", a->tileset, "Tile-set file (default: the built-in set)");
   cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 in world units (half-open)")->required();
-  cmd->add_option("--density", a->density, "const:V (V >= 0), or an image (dark = dense)")
+  cmd->add_option(
+         "--density", a->density,
+         "const:V (V >= 0), an image (dark = dense), or a test map ramp:R or radial:R (dynamic range "
+         "R), stretched over --density-rect")
       ->capture_default_str();
-  cmd->add_option("--density-rect", a->density_rect,
-                  "World rectangle x0,y0,x1,y1 the image covers (default: --rect); fix it to query parts of "
-                  "one region and get exactly the region's points");
+  cmd->add_option(
+      "--density-rect", a->density_rect,
+      "World rectangle x0,y0,x1,y1 the image or test map covers (default: --rect); fix it to query parts of "
+      "one region and get exactly the region's points");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
   cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "density_arg.h"
+#include "generator_density.h"
 #include "kdm/generator/sampler.h"
 #include "output.h"
 #include "progress.h"
@@ -38,15 +39,17 @@ void run_sample(const SampleArgs& args) {
     throw CommandError("--width must be 1 to 65536 pixels");
   if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
     throw CommandError("--dot-size must be >= 0");
-  DensityArg density = parse_density(args.density, args.gamma, args.invert);
+  const tools::DensitySpec spec = parse_density(args.density, args.gamma, args.invert);
+  const bool image = spec.kind == tools::DensitySpec::Kind::kImage;
   gen::SamplerOptions o = args.options;
   // A ramp or a picture has edges that do not meet: a box, unless asked otherwise.
-  const bool edged = density.from_image || args.density.rfind("ramp:", 0) == 0;
+  const bool edged = image || spec.kind == tools::DensitySpec::Kind::kRamp;
   const std::string domain = args.domain.empty() ? (edged ? "box" : "torus") : args.domain;
   o.domain = domain == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
   double aspect = args.aspect;
-  if (aspect <= 0) aspect = density.from_image ? double(density.image_width) / density.image_height : 1.0;
-  if (density.from_image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
+  if (aspect <= 0) aspect = image ? double(spec.width) / spec.height : 1.0;
+  if (image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
+  const gen::Density density = to_generator_density(spec);
   o.extent[0] = aspect;
   o.extent[1] = 1;
   o.metropolis = !args.unadjusted;
@@ -56,7 +59,7 @@ void run_sample(const SampleArgs& args) {
   o.progress = [&bar](double f) { bar.update(f); };
   gen::SampleResult result;
   try {
-    result = gen::sample(o, density.density);
+    result = gen::sample(o, density);
   } catch (const gen::InvalidArgument& e) {
     throw CommandError(e.what());
   }

@@ -11,9 +11,9 @@
 
 #include "commands.h"
 #include "density_arg.h"
-#include "kdm/generator/sampler.h"
 #include "output.h"
 #include "runtime_args.h"
+#include "stipple_full.h"
 
 namespace kdm::cli {
 namespace {
@@ -63,9 +63,9 @@ std::string frame_path(const std::string& output, int i) {
 /// The runtime (tiles) method: the dots of one UV rectangle of the image, normalised to the rectangle.
 class TileStippler {
  public:
-  TileStippler(const StippleArgs& a, const DensityArg& arg, double aspect)
+  TileStippler(const StippleArgs& a, const tools::DensitySpec& spec, double aspect)
       : tiles_(tileset_for(a.tileset, storage_)), aspect_(aspect), mode_(parse_mode(a.mode)) {
-    density_ = make_runtime_density(arg, 0, 0, aspect, 1);
+    density_ = make_runtime_density(spec, 0, 0, aspect, 1);
     // The scale that gives --points over the whole image (∫ρ dA = mean · aspect).
     scale_ = a.points > 0 ? a.points / (density_->mean_value * aspect) : a.scale;
     // Tiles small enough that 4× the image's peak density (a 2× zoom with --region) fits the top level.
@@ -105,10 +105,13 @@ void run_stipple(const StippleArgs& a) {
   if (a.frames > 0 && a.region.empty()) throw CommandError("--frames needs --region (where the zoom ends)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
-  const DensityArg arg = parse_density(a.image, a.gamma, a.invert);
-  if (!arg.from_image)
+  const tools::DensitySpec spec = parse_density(a.image, a.gamma, a.invert);
+  if (spec.kind != tools::DensitySpec::Kind::kImage)
     throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
-  const double aspect = double(arg.image_width) / arg.image_height;  // world: [0, aspect] × [0, 1]
+  if (!(spec.max_value() > 0))
+    throw CommandError("image '" + a.image + "' has no ink: nothing to stipple" +
+                       (a.invert ? "" : " (an all-white image has no ink)"));
+  const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
   if (a.method == "full" && !a.region.empty())
@@ -116,7 +119,7 @@ void run_stipple(const StippleArgs& a) {
   if (1 / std::max(region[2] - region[0], region[3] - region[1]) > 2 + 1e-9)  // before writing any frame
     throw CommandError("--region zooms more than 2× (the tile set's density range)");
   std::unique_ptr<TileStippler> stippler;
-  if (a.method != "full") stippler = std::make_unique<TileStippler>(a, arg, aspect);
+  if (a.method != "full") stippler = std::make_unique<TileStippler>(a, spec, aspect);
   const int frames = std::max(1, a.frames);
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
   for (int i = 0; i < frames; ++i) {
@@ -130,16 +133,7 @@ void run_stipple(const StippleArgs& a) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      gen::SamplerOptions o;
-      o.n = a.points > 0 ? a.points : std::llround(a.scale * aspect);
-      o.domain = gen::Domain::kBox;
-      o.extent[0] = aspect;
-      o.seed = a.seed;
-      try {
-        set.coords = gen::sample(o, arg.density).points;
-      } catch (const gen::InvalidArgument& e) {
-        throw CommandError(e.what());
-      }
+      set = stipple_full(spec, a.points > 0 ? a.points : std::llround(a.scale * aspect), aspect, a.seed);
       how = "full KDM sampler";
     } else {
       set = stippler->render(uv);

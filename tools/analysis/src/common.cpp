@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <thread>
 
 namespace kdm::analysis {
 
@@ -38,11 +37,6 @@ void validate_points(const std::vector<double>& coords, int dim) {
       throw InvalidInput("point " + std::to_string(i / dim) + " lies outside the unit domain (coordinate " +
                          std::to_string(v) + "); normalise points to [0,1)");
   }
-}
-
-int default_threads() {
-  const unsigned hc = std::thread::hardware_concurrency();
-  return hc == 0 ? 1 : static_cast<int>(hc);
 }
 
 }  // namespace kdm::analysis

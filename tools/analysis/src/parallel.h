@@ -9,15 +9,18 @@
 #include <thread>
 #include <vector>
 
+#include "kdm/generator/sampler.h"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
 namespace kdm::analysis::detail {
 
-/// Number of worker slots parallel_for will use for `threads` (0 = all cores) and `count` items.
+/// Number of worker slots parallel_for will use for `threads` (0 = gen::default_thread_count(), as in
+/// every kdm library) and `count` items.
 inline int worker_count(int threads, std::ptrdiff_t count) {
-  int t = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int t = threads > 0 ? threads : gen::default_thread_count();
   if (count < t) t = static_cast<int>(std::max<std::ptrdiff_t>(1, count));
   return t;
 }

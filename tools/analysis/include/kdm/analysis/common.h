@@ -46,7 +46,5 @@ inline double axis_delta(double a, double b, bool torus) {
   return d;
 }
 
-/// Number of worker threads used by the analysis when the caller passes 0 (hardware concurrency, ≥ 1).
-int default_threads();
 
 }  // namespace kdm::analysis

@@ -20,7 +20,7 @@ struct NearestNeighbors {
 
 /// Finds every point's nearest other point. `coords`: interleaved, `dim` ∈ {2,3}, in [0,1]^dim; `torus`:
 /// periodic distances. Ties go to the lowest index. Needs n ≥ 2 (throws InvalidInput otherwise, and for
-/// invalid coordinates). `threads`: 0 = all cores. Thread-safe (no shared state); result independent of
+/// invalid coordinates). `threads`: 0 = gen::default_thread_count(). Thread-safe (no shared state); result independent of
 /// the thread count.
 NearestNeighbors nearest_neighbors(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
 

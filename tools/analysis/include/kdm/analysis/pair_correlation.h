@@ -20,8 +20,8 @@ struct PairCorrelation {
 
 /// g(r) pooled over `sets` (numerators and expected counts are summed over sets, each set using its own n).
 /// `r_max` in units of the reference spacing (default 3), `bins` ≥ 1. O(n · pairs within r_max) with a cell
-/// list. Throws InvalidInput for empty/invalid sets or mixed dimensions. Thread-safe; `threads` 0 = all
-/// cores.
+/// list. Throws InvalidInput for empty/invalid sets or mixed dimensions. Thread-safe; `threads` 0 =
+/// gen::default_thread_count().
 PairCorrelation pair_correlation(const std::vector<tools::PointSet>& sets, bool torus, double r_max = 3.0,
                                  int bins = 60, int threads = 0);
 

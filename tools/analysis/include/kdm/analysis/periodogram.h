@@ -32,7 +32,7 @@ struct Periodogram {
 };
 
 /// Periodogram of one 2D set up to normalised frequency `fmax` (kmax = ceil(fmax·√n) + 1). `coords`
-/// interleaved x y in [0,1]². `threads`: 0 = all cores. Cost O(n · kmax²) flops, memory O(kmax²).
+/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n · kmax²) flops, memory O(kmax²).
 /// Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the result does
 /// not depend on the thread count (fixed summation order). With threads = 1 the matrix products themselves
 /// may still use Eigen's OpenMP threads. Measured: n = 65,536, fmax = 2.5 (kmax 641):

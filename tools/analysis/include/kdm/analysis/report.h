@@ -33,7 +33,7 @@ struct AnalysisOptions {
   double min_expected = 20;  ///< density-test windows expect at least this many points
   int density_bands = 10;    ///< bands of the per-band bias table (equal steps in log ρ)
   double tile_size = 0;      ///< tile side for the tiling diagnostics (0: skip)
-  int threads = 0;           ///< worker threads, 0 = all cores
+  int threads = 0;           ///< worker threads, 0 = gen::default_thread_count()
 };
 
 struct AnalysisReport {

@@ -62,7 +62,8 @@ struct SeamStats {
 };
 
 /// Seam statistics pooled over `sets` (each set normalised by its own reference spacing), tile side
-/// `tile_size`. Throws InvalidInput for invalid sets or tile size. Thread-safe; `threads` 0 = all cores.
+/// `tile_size`. Throws InvalidInput for invalid sets or tile size. Thread-safe; `threads` 0 =
+/// gen::default_thread_count().
 SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, double tile_size, int threads = 0);
 
 /// Seam statistics of one set from precomputed neighbours `nn` (from nearest_neighbors on `coords`).

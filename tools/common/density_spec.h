@@ -1,0 +1,40 @@
+// A density as a user names it ("const:V", the test maps "ramp:R" and "radial:R", or an image whose
+// darkness is the density), parsed once into a neutral description: the full sampler's commands convert it
+// for the generator, the runtime's commands for a query, and neither needs the other's headers.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace kdm::tools {
+
+struct DensitySpec {
+  enum class Kind { kConstant, kRamp, kRadial, kImage };
+  Kind kind = Kind::kConstant;
+  double constant = 1;        ///< kConstant: the value (>= 0)
+  double range = 1;           ///< kRamp, kRadial: the dynamic range R (in [1, 1e9])
+  int width = 0, height = 0;  ///< kImage: its size in pixels
+  std::vector<float> values;  ///< kImage: density per pixel (finite, >= 0), row 0 at the bottom
+  bool inverted = false;      ///< kImage: luminance is the density (else darkness)
+  std::string text;           ///< what it was parsed from (for messages)
+
+  /// Whether the density is a function of position (the test maps), not a constant or an image.
+  bool analytic() const { return kind == Kind::kRamp || kind == Kind::kRadial; }
+  /// The test maps at unit position (u, v) in [0, 1]²: ramp R^-u (1 at the left edge, 1/R at the right),
+  /// radial R^-(r/0.5) with r the distance from the centre, 1/R beyond r = 0.5 (continuous across a
+  /// torus's edges). 1 for other kinds.
+  double map_at(double u, double v) const;
+  /// The largest value anywhere (1 for the test maps), and the mean over the unit square.
+  double max_value() const;
+  double mean_value() const;
+};
+
+/// A density that does not parse: a malformed or out-of-range value (std::invalid_argument), or an image
+/// that cannot be read (std::runtime_error, naming the file). Messages are one line.
+/// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
+/// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance.
+DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false);
+
+}  // namespace kdm::tools
