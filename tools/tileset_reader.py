@@ -85,7 +85,7 @@ class Tileset:
         """Doc §8: keyframe g's glide offset unit in tile sides."""
         return 1.0 / (GLIDE_UNITS_PER_SPACING * math.sqrt(self.keyframe_nominal[g]))
 
-    def glide_count(self, tile, g):
+    def offsets_at_keyframe(self, tile, g):
         """Doc §8: the points with a position at keyframe g, those emitted at the next keyframe's count
         (every point at the last keyframe)."""
         if g + 1 == len(self.keyframe_nominal):
@@ -308,7 +308,7 @@ def _validate(ts):
     if ts.keyframe_nominal and ts.keyframe_nominal[-1] != ts.level_nominal[-1]:
         raise TilesetError("the last keyframe is not the top level's count")
     for t, tile in enumerate(ts.tiles):
-        needed = 2 * sum(ts.glide_count(tile, g) for g in range(len(ts.keyframe_nominal)))
+        needed = 2 * sum(ts.offsets_at_keyframe(tile, g) for g in range(len(ts.keyframe_nominal)))
         if len(tile.glide) != needed:
             raise TilesetError(f"tile {t} has {len(tile.glide)} glide offsets, its keyframes need {needed}")
 
@@ -327,7 +327,7 @@ def _glide_sums(ts, tile, stored, mask):
     values = list(stored)
     at, before = 0, 0
     for g in range(len(ts.keyframe_nominal)):
-        n = 2 * ts.glide_count(tile, g)
+        n = 2 * ts.offsets_at_keyframe(tile, g)
         for i in range(min(before, n)):
             values[at + i] = (values[at + i] + values[at - before + i]) & mask
         at, before = at + n, n
@@ -340,7 +340,7 @@ def _glide_from_format3(ts, tile, offsets):
     out = array.array("b", bytes(len(offsets)))
     at = 0
     for g in range(len(ts.keyframe_nominal)):
-        n = 2 * ts.glide_count(tile, g)
+        n = 2 * ts.offsets_at_keyframe(tile, g)
         units = 1.0 / (65536.0 * ts.glide_unit(g))
         for i in range(at, at + n):
             v = offsets[i] - 65536 if offsets[i] >= 32768 else offsets[i]

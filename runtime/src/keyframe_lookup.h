@@ -27,7 +27,7 @@ inline int count_bucket(double v) {
 
 /// A set's keyframe tables as plain pointers (a query's copy: see TileJob).
 struct KeyframeTable {
-  const double* counts = nullptr;  ///< K_g, then +∞ (QueryTables::keyframe_counts)
+  const double* nominal = nullptr;  ///< K_g, then +∞ (QueryTables::keyframe_nominal)
   std::uint32_t n = 0;
   const GlideSpan* spans = nullptr;      ///< QueryTables::glide_spans
   bool one_step = false;                 ///< QueryTables::keyframe_one_step
@@ -35,9 +35,9 @@ struct KeyframeTable {
   /// The first g with K_g >= expected (> 0), or n.
   std::uint32_t first_at_least(double expected) const {
     std::uint32_t g = guess[count_bucket(expected)];
-    g += counts[g] < expected;  // one step at most with a few keyframes per power of two: no branch
+    g += nominal[g] < expected;  // one step at most with a few keyframes per power of two: no branch
     if (!one_step)
-      while (counts[g] < expected) ++g;
+      while (nominal[g] < expected) ++g;
     return g;
   }
 };
@@ -59,7 +59,7 @@ struct GlideBracket {
 inline KeyframeTable keyframe_table(const Tileset& set) {
   const QueryTables& t = TilesetInternals::tables(set);
   KeyframeTable k;
-  k.counts = t.keyframe_counts.data();
+  k.nominal = t.keyframe_nominal.data();
   k.n = static_cast<std::uint32_t>(set.data().keyframe_nominal.size());
   k.spans = t.glide_spans.data();
   k.one_step = t.keyframe_one_step;

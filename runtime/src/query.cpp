@@ -26,7 +26,7 @@ bool finite(double v) {
   return std::isfinite(v);
 }
 
-double sanitize(double v) {
+double density_or_zero(double v) {
   return (v > 0 && v < HUGE_VAL) ? v : 0.0;
 }  // NaN, ±inf, negatives -> 0
 
@@ -54,7 +54,7 @@ struct TileJob {
   /// Smooth mode: the stable positions (1/65536 tile sides) that can glide into the region, for points
   /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
   double cull_x0, cull_y0, cull_x1, cull_y1, reach;
-  const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::keyframe_ranks
+  const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::points_at_keyframe
   /// Smooth mode, a tile beside the region: the only ranks that can glide into it (QueryTables::edges).
   const std::uint32_t *listed, *listed_end;
   double area_scale, limit;
@@ -101,7 +101,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
       if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
       if (kKind == QueryDensity::Kind::kCallback &&
-          !(sanitize(j.density->callback(j.density->user, x, y)) > 0))
+          !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
         return true;
     }
     if (n == capacity) return false;
@@ -154,11 +154,11 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
                  : c;
     const double rho = kKind == QueryDensity::Kind::kImage
                            ? j.sampler->at(x, y)
-                           : sanitize(j.density->callback(j.density->user, x, y));
+                           : density_or_zero(j.density->callback(j.density->user, x, y));
     const double expected = rho * j.area_scale;
     // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
     // written (or queued) at the next slot, which only an emitted one then keeps.
-    const bool emitted = TilesetData::emits(j.thresholds[c], expected);
+    const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
     if (!kBatched) {
       if (n == capacity) return emitted ? c : kNone;
       out[n] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
@@ -260,7 +260,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   double max_density = 0;
   switch (d.kind) {
     case QueryDensity::Kind::kConstant:
-      max_density = sanitize(d.constant);
+      max_density = density_or_zero(d.constant);
       break;
     case QueryDensity::Kind::kImage:
       if (!d.image || !d.image->values || !d.image->max_mip)
@@ -285,7 +285,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   }
   // Smooth mode visits the tiles whose points can glide into the region too: as far as any glides at the
   // keyframes a constant density's points sit between, or at any keyframe up to a varying one's maximum.
-  const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide();
+  const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide_track();
   double reach = 0;
   if (glide) {
     const GlideBracket top(keyframe_table(tileset), max_density * area_scale);
@@ -336,7 +336,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       const double limit = bound * area_scale;
       const std::uint32_t candidates = static_cast<std::uint32_t>(
           std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
-                           [](float t, double l) { return TilesetData::emits(t, l); }) -
+                           [](float t, double l) { return TilesetShape::emits(t, l); }) -
           thresholds);
       const std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
       if (c >= candidates) continue;
@@ -347,7 +347,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
       job.wx = wx, job.wy = wy, job.limit = limit;
       if (glide) {
         job.glide = tile.glide.data(), job.starts = tables.glide_start[index].data();
-        job.ranks = tables.keyframe_ranks[index].data();
+        job.ranks = tables.points_at_keyframe[index].data();
         // The region in the tile's 1/65536 units, widened by a unit so that the culling is never stricter
         // than the exact test after the glide; a constant density's points glide as far as the two
         // keyframes around it let them.

@@ -38,14 +38,14 @@ QueryTables::QueryTables(const TilesetData& set) {
   keyframe_one_step = true;  // no bucket holds two keyframes (true unless they are under 3.1% apart)
   for (int b = 0; b + 1 < kCountBuckets; ++b)
     keyframe_one_step = keyframe_one_step && keyframe_guess[b + 1] <= keyframe_guess[b] + 1;
-  keyframe_ranks.assign(set.tiles.size(), {});
+  points_at_keyframe.assign(set.tiles.size(), {});
   for (std::size_t t = 0; t < set.tiles.size() && keyframes > 0; ++t) {
     TilesetArray<std::uint32_t>& start = glide_start[t];
     start.assign(keyframes + 1, 0);
-    keyframe_ranks[t].assign(keyframes, 0);
+    points_at_keyframe[t].assign(keyframes, 0);
     for (std::size_t g = 0; g < keyframes; ++g) {
-      start[g + 1] = start[g] + set.glide_count(set.tiles[t], g);
-      keyframe_ranks[t][g] = set.keyframe_count(set.tiles[t], g);
+      start[g + 1] = start[g] + set.offsets_at_keyframe(set.tiles[t], g);
+      points_at_keyframe[t][g] = set.points_at_keyframe(set.tiles[t], g);
       int largest = 0;
       for (std::size_t i = 2 * std::size_t(start[g]); i < 2 * std::size_t(start[g + 1]); ++i)
         largest = std::max(largest, std::abs(int(set.tiles[t].glide[i])));
@@ -55,15 +55,15 @@ QueryTables::QueryTables(const TilesetData& set) {
   glide_reach_from.assign(keyframes, 0.0);
   for (std::size_t g = keyframes; g-- > 0;)
     glide_reach_from[g] = std::max(glide_reach[g], g + 1 < keyframes ? glide_reach_from[g + 1] : 0.0);
-  keyframe_counts.assign(keyframes + 1, HUGE_VAL);
-  for (std::size_t g = 0; g < keyframes; ++g) keyframe_counts[g] = set.keyframe_nominal[g];
+  keyframe_nominal.assign(keyframes + 1, HUGE_VAL);
+  for (std::size_t g = 0; g < keyframes; ++g) keyframe_nominal[g] = set.keyframe_nominal[g];
   glide_spans.assign(keyframes ? keyframes + 1 : 0, {});
   for (std::size_t g = 0; g < glide_spans.size(); ++g) {
     GlideSpan& span = glide_spans[g];
     span.g0 = static_cast<std::uint32_t>(g - (g > 0)),
     span.g1 = static_cast<std::uint32_t>(g - (g == keyframes));
-    span.base = keyframe_counts[span.g0];
-    if (span.g1 > span.g0) span.inverse_gap = 1.0 / (keyframe_counts[span.g1] - keyframe_counts[span.g0]);
+    span.base = keyframe_nominal[span.g0];
+    if (span.g1 > span.g0) span.inverse_gap = 1.0 / (keyframe_nominal[span.g1] - keyframe_nominal[span.g0]);
     span.scale0 = glide_scale[span.g0], span.scale1 = glide_scale[span.g1];
   }
   index_edges(set);
@@ -75,12 +75,12 @@ void QueryTables::index_edges(const TilesetData& set) {
   if (set.keyframe_nominal.empty()) return;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
-    const std::uint32_t* ranks = keyframe_ranks[t].data();
+    const std::uint32_t* ranks = points_at_keyframe[t].data();
     TilesetArray<std::uint32_t>& out = edge_ranks[t];
     for (int side = 0; side < 4; ++side) {
       std::size_t segment = 0;  // the keyframes whose count rank c is at least: it appears after the last
       for (std::uint32_t c = 0; c < tile.points.size(); ++c) {
-        while (segment < keyframe_ranks[t].size() && ranks[segment] <= c) ++segment;
+        while (segment < points_at_keyframe[t].size() && ranks[segment] <= c) ++segment;
         // The same reach as the query's culling (emit_tile), so a point left out would be culled there.
         const double reach = glide_reach_from[segment ? segment - 1 : 0] * 65536.0 + kEdgeSlack;
         const double u = (side < 2 ? tile.points[c].x : tile.points[c].y) + 0.5;
@@ -110,13 +110,13 @@ std::size_t flat_bytes(const TilesetArray<T>& v) {
 
 std::size_t QueryTables::resident_bytes() const {
   return sizeof(*this) + nested_bytes(thresholds) + nested_bytes(glide_start) + flat_bytes(glide_reach) +
-         flat_bytes(glide_reach_from) + flat_bytes(glide_scale) + nested_bytes(keyframe_ranks) +
-         flat_bytes(keyframe_counts) + flat_bytes(glide_spans) + flat_bytes(keyframe_guess) +
+         flat_bytes(glide_reach_from) + flat_bytes(glide_scale) + nested_bytes(points_at_keyframe) +
+         flat_bytes(keyframe_nominal) + flat_bytes(glide_spans) + flat_bytes(keyframe_guess) +
          nested_bytes(edge_ranks) + flat_bytes(edge_start);
 }
 
 std::uint32_t first_keyframe_at_least(const Tileset& set, double expected) {
-  return set.has_glide() ? keyframe_table(set).first_at_least(expected) : 0;
+  return set.has_glide_track() ? keyframe_table(set).first_at_least(expected) : 0;
 }
 
 }  // namespace kdm::detail

@@ -1,5 +1,5 @@
 // Internal: the tables a loaded Tileset keeps for the query loop, built once per load from its
-// TilesetData (emission thresholds, the gliding track's starts, reaches and brackets, the edge lists).
+// TilesetData (emission thresholds, the glide track's starts, reaches and brackets, the edge lists).
 // Installed headers never show them; tests reach them through kdm_runtime_internal.
 #pragma once
 
@@ -24,22 +24,23 @@ struct GlideSpan {
 inline constexpr double kEdgeSlack = 8;
 
 struct QueryTables {
-  /// Per tile, its points' emission thresholds (TilesetData::emission_threshold), non-decreasing.
+  /// Per tile, its points' emission thresholds (TilesetShape::emission_threshold), non-decreasing.
   TilesetArray<TilesetArray<float>> thresholds;
   /// The lowest threshold of any point: below it no tile emits anything.
   double min_threshold = 0;
   /// Per tile, where each keyframe's offsets start in Tile::glide, in offset pairs (keyframes + 1 entries:
-  /// keyframe g's pairs are [start[g], start[g + 1]), one per rank below TilesetData::glide_count).
+  /// keyframe g's pairs are [start[g], start[g + 1]), one per rank below TilesetShape::offsets_at_keyframe).
   TilesetArray<TilesetArray<std::uint32_t>> glide_start;
   /// The largest distance any point glides from its stable position, per axis, in tile sides, at keyframe
   /// g (smooth queries look this far beyond their region), and the largest of those from keyframe g on.
   TilesetArray<double> glide_reach, glide_reach_from;
-  /// Per keyframe, 1/65536 tile sides per glide offset unit (65536 · TilesetData::glide_unit(g)).
+  /// Per keyframe, 1/65536 tile sides per glide offset unit (65536 · TilesetShape::glide_unit(g)).
   TilesetArray<double> glide_scale;
-  /// Per tile and keyframe g, how many of its points are present there (TilesetData::keyframe_count).
-  TilesetArray<TilesetArray<std::uint32_t>> keyframe_ranks;
-  /// The keyframe counts K_g as doubles, then +∞ (keyframes + 1 entries): searches stop without a bound.
-  TilesetArray<double> keyframe_counts;
+  /// Per tile and keyframe g, how many of its points are present there (TilesetShape::points_at_keyframe).
+  TilesetArray<TilesetArray<std::uint32_t>> points_at_keyframe;
+  /// TilesetShape::keyframe_nominal as doubles, then +∞ (keyframes + 1 entries): searches stop without a
+  /// bound.
+  TilesetArray<double> keyframe_nominal;
   /// Per g = first_keyframe_at_least(count) (keyframes + 1 entries), how a count there glides.
   TilesetArray<GlideSpan> glide_spans;
   /// Per bucket of counts (keyframe_lookup.h), the first keyframe at least the bucket's smallest count.

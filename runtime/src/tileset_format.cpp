@@ -90,8 +90,8 @@ void load_array(InputArchive& ar, const MemoryBuffer& buffer, Array& v) {
 }
 
 /// Each keyframe's offset of a point that also has one at the keyframe before is stored as the difference
-/// (mod 2^8): the values are then the point's motion between two keyframes, a fraction of a spacing (a
-/// sixth fewer bytes once compressed than the offsets themselves, measured on a four-level set).
+/// (mod 2^8): the values are then the point's motion between two keyframes, a fraction of a spacing, which
+/// compresses better than the offsets themselves.
 /// glide_differences and glide_sums undo each other; sizes must be valid (validate_tileset).
 template <class Value>
 std::vector<Value> glide_differences(const TilesetData& set, const Tile& tile,
@@ -99,8 +99,8 @@ std::vector<Value> glide_differences(const TilesetData& set, const Tile& tile,
   std::vector<Value> v(offsets);
   std::size_t at = v.size();
   for (std::size_t g = set.keyframe_nominal.size(); g-- > 1;) {  // backwards: the earlier keyframe is intact
-    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g)),
-                      before = 2 * std::size_t(set.glide_count(tile, g - 1));
+    const std::size_t n = 2 * std::size_t(set.offsets_at_keyframe(tile, g)),
+                      before = 2 * std::size_t(set.offsets_at_keyframe(tile, g - 1));
     at -= n;
     for (std::size_t i = 0; i < before; ++i)
       v[at + i] = static_cast<Value>(v[at + i] - offsets[at - before + i]);
@@ -111,21 +111,21 @@ template <class Value>
 void glide_sums(const TilesetData& set, const Tile& tile, std::vector<Value>& v) {
   std::size_t at = 0;
   for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) {
-    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g));
-    const std::size_t before = g ? 2 * std::size_t(set.glide_count(tile, g - 1)) : 0;
+    const std::size_t n = 2 * std::size_t(set.offsets_at_keyframe(tile, g));
+    const std::size_t before = g ? 2 * std::size_t(set.offsets_at_keyframe(tile, g - 1)) : 0;
     for (std::size_t i = 0; i < before; ++i) v[at + i] = static_cast<Value>(v[at + i] + v[at - before + i]);
     at += n;
   }
 }
 
 /// Format 3's glide offsets (16-bit differences, in 1/65536 tile sides) into tile.glide's 8-bit units,
-/// rounded and clamped: format 3 sets keep their gliding track to within a 64th of a spacing.
+/// rounded and clamped: format 3 sets keep their glide track to within a 64th of a spacing.
 void glide_from_format3(const TilesetData& set, std::vector<std::uint16_t>& stored, Tile& tile) {
   glide_sums(set, tile, stored);
   tile.glide.resize(stored.size());
   std::size_t at = 0;
   for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) {
-    const std::size_t n = 2 * std::size_t(set.glide_count(tile, g));
+    const std::size_t n = 2 * std::size_t(set.offsets_at_keyframe(tile, g));
     const double units = 1.0 / (65536.0 * set.glide_unit(g));
     for (std::size_t i = at; i < at + n; ++i) {
       const double u = std::round(static_cast<std::int16_t>(stored[i]) * units);
@@ -135,7 +135,7 @@ void glide_from_format3(const TilesetData& set, std::vector<std::uint16_t>& stor
   }
 }
 
-std::vector<std::uint8_t> serialize_body(const TilesetData& set) {
+std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
   std::ostringstream stream(std::ios::binary);
   {
     cereal::PortableBinaryOutputArchive ar(stream);
@@ -240,7 +240,7 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
     return bad("the last keyframe is not the top level's count");
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     std::uint64_t present = 0;  // offset pairs the keyframes need
-    for (std::size_t g = 0; g < keyframes; ++g) present += set.glide_count(set.tiles[t], g);
+    for (std::size_t g = 0; g < keyframes; ++g) present += set.offsets_at_keyframe(set.tiles[t], g);
     if (set.tiles[t].glide.size() != 2 * present)
       return bad("tile " + std::to_string(t) + " has " + std::to_string(set.tiles[t].glide.size()) +
                  " glide offsets, its keyframes need " + std::to_string(2 * present));
@@ -252,7 +252,7 @@ Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, st
   if (validate_tileset(set, detail) != Status::kOk) return Status::kInvalidArgument;
   if (set.recipe.size() + set.generator_version.size() + kFixedHeaderBytes > kMaxTilesetHeaderBytes)
     return fail(Status::kInvalidArgument, detail, "recipe text is too long");
-  const std::vector<std::uint8_t> body = serialize_body(set);
+  const std::vector<std::uint8_t> body = serialise_body(set);
   if (body.size() > kMaxTilesetPayloadBytes) return fail(Status::kTooLarge, detail, "tile set is too large");
   std::vector<std::uint8_t> payload(ZSTD_compressBound(body.size()));
   const std::size_t packed = ZSTD_compress(payload.data(), payload.size(), body.data(), body.size(), 19);
@@ -281,11 +281,12 @@ Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, st
   return Status::kOk;
 }
 
-Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std::string* detail) {
-  out = TilesetData{};
+Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& out, std::string* detail) {
+  out = TilesetHeader{};
   const auto* p = static_cast<const std::uint8_t*>(data);
+  if (size > 0 && !p) return fail(Status::kInvalidArgument, detail, "no bytes to read");
   if (size < 8 || std::memcmp(p, kMagic, 8) != 0) {
-    const bool prefix = size < 8 && std::memcmp(p, kMagic, size) == 0;
+    const bool prefix = size < 8 && (size == 0 || std::memcmp(p, kMagic, size) == 0);
     return prefix ? fail(Status::kTruncated, detail, "file ends inside the magic number")
                   : fail(Status::kBadMagic, detail, "file does not start with KDMTILES");
   }
@@ -317,8 +318,26 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   if (colours < 1 || colours > kMaxTileColours || levels < 1 || levels > kMaxTileLevels ||
       tile_count != std::uint64_t(colours) * colours * colours * colours)
     return fail(Status::kInvalidContent, detail, "header counts are inconsistent");
+  out.format_version = version;
+  out.header_bytes = header_size;
+  out.payload_bytes = payload_size, out.decompressed_bytes = body_size;
+  out.payload_crc = get32(p + 32);
+  out.tiles = tile_count, out.colours = colours, out.levels = levels;
+  out.recipe.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes), recipe_size);
+  out.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size),
+                               version_size);
+  return Status::kOk;
+}
+
+Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std::string* detail) {
+  out = TilesetData{};
+  TilesetHeader header;
+  if (const Status s = read_tileset_header(data, size, header, detail); s != Status::kOk) return s;
+  const auto* p = static_cast<const std::uint8_t*>(data);
+  const std::uint32_t version = header.format_version, header_size = header.header_bytes;
+  const std::uint64_t payload_size = header.payload_bytes, body_size = header.decompressed_bytes;
   const std::uint8_t* payload = p + header_size;
-  if (detail::crc32(payload, payload_size) != get32(p + 32))
+  if (detail::crc32(payload, payload_size) != header.payload_crc)
     return fail(Status::kPayloadChecksumMismatch, detail, "payload bytes are damaged");
   const unsigned long long frame = ZSTD_getFrameContentSize(payload, payload_size);
   if (frame == ZSTD_CONTENTSIZE_ERROR || frame == ZSTD_CONTENTSIZE_UNKNOWN || frame != body_size ||
@@ -338,7 +357,7 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   } catch (const std::exception& e) {
     return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
   }
-  if (set.colours != colours || set.levels != levels)
+  if (set.colours != header.colours || set.levels != header.levels)
     return fail(Status::kInvalidContent, detail, "payload disagrees with the header");
   if (const Status s = validate_tileset(set, detail); s != Status::kOk) return s;
   for (std::size_t t = 0; t < glide16.size(); ++t) glide_from_format3(set, glide16[t], set.tiles[t]);
@@ -346,9 +365,8 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
     glide_sums(set, set.tiles[t], glide[t]);
     std::copy(glide[t].begin(), glide[t].end(), set.tiles[t].glide.begin());  // two's complement bytes
   }
-  set.recipe.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes), recipe_size);
-  set.generator_version.assign(reinterpret_cast<const char*>(p + kFixedHeaderBytes + recipe_size),
-                               version_size);
+  set.recipe = std::move(header.recipe);
+  set.generator_version = std::move(header.generator_version);
   out = std::move(set);
   return Status::kOk;
 }

@@ -194,7 +194,7 @@ TEST(Tiling, SeamClassification) {
   // Pairs: across x = 0.5 (seam), inside a tile (interior), across the torus edge x = 0 (seam on the torus).
   const std::vector<double> c = {0.49, 0.30, 0.51, 0.30, 0.20, 0.80, 0.22, 0.80, 0.005, 0.62, 0.995, 0.62};
   std::vector<double> seam, interior;
-  const NearestNeighbors nn = nearest_neighbors(c, 2, true);
+  const NearestNeighbours nn = nearest_neighbours(c, 2, true);
   split_by_seam(c, 2, nn, 0.5, seam, interior);
   EXPECT_EQ(seam.size(), 4u);
   EXPECT_EQ(interior.size(), 2u);

@@ -586,6 +586,10 @@ TEST_F(CliTest, SmallFrictions) {
   ASSERT_EQ(info.status, 0) << info.err;
   EXPECT_NE(info.out.find("  band 0.35\n"), std::string::npos) << info.out;
   EXPECT_NE(info.out.find(" bytes ("), std::string::npos) << info.out;
+  EXPECT_NE(
+      info.out.find("format         version " + std::to_string(kdm::kTilesetFormatVersion) + " (header "),
+      std::string::npos)
+      << info.out;
 }
 
 // The per-band bias table users check their own maps with: a ramp sampled and analysed by the same spec

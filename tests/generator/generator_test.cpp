@@ -43,13 +43,13 @@ VerifyOptions parts(bool statistics, bool direct_check, bool seams) {
   VerifyOptions o;
   o.spectrum_budget = kSpectrumBudget;
   o.statistics = statistics, o.direct_check = direct_check, o.seams = seams;
-  o.keyframes = false;
+  o.glide_track = false;
   return o;
 }
 
 VerifyOptions keyframes_only() {
   VerifyOptions o = parts(false, false, false);
-  o.keyframes = true;
+  o.glide_track = true;
   return o;
 }
 
@@ -89,7 +89,7 @@ TEST(GeneratorTest, TileEdgesAndInBetweenDensitiesLookLikeTheRest) {
 }
 
 TEST(GeneratorTest, GlidingTrackIsBlueAtAndBetweenKeyframesAndMovesLittle) {
-  ASSERT_FALSE(shipped().keyframe_nominal.empty()) << "the shipped set has a gliding track";
+  ASSERT_FALSE(shipped().keyframe_nominal.empty()) << "the shipped set has a glide track";
   VerifyOptions o = keyframes_only();
   o.bars.glide_closest_pair = 0.3;  // the design's aim, which the shipped recipe's glide_separation meets
   const Report report = verify_tileset(shipped(), o);
@@ -105,8 +105,8 @@ TEST(GeneratorTest, VerifierFlagsAJumpInTheGlidingTrack) {
   ASSERT_GT(damaged.keyframe_nominal.size(), 4u);
   Tile& tile = damaged.tiles[5];
   std::size_t at = 0;
-  for (std::size_t g = 0; g < 3; ++g) at += 2 * damaged.glide_count(tile, g);
-  for (std::size_t i = 0; i < 2 * damaged.glide_count(tile, 3); i += 2)
+  for (std::size_t g = 0; g < 3; ++g) at += 2 * damaged.offsets_at_keyframe(tile, g);
+  for (std::size_t i = 0; i < 2 * damaged.offsets_at_keyframe(tile, 3); i += 2)
     tile.glide[at + i] = static_cast<std::int8_t>(std::clamp(tile.glide[at + i] + 40, -127, 127));
   const Report report = verify_tileset(damaged, keyframes_only());
   bool flagged = false;

@@ -1,4 +1,4 @@
-// The gliding track: keyframes from the baker, its paths kept apart, format round trips, and smooth queries
+// The glide track: keyframes from the baker, its paths kept apart, format round trips, and smooth queries
 // (same ids as stable ones, continuous and bounded motion, no close pairs at any density, chunk
 // consistency, better blue noise between levels).
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 #include "bake/glide_paths.h"
 #include "bake/keyframes.h"
 #include "kdm/analysis/common.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/query.h"
@@ -59,22 +59,22 @@ std::map<Key, QueryPoint> query(const Tileset& set, double x0, double y0, double
 
 TEST(GlideTest, KeyframesStepGeometricallyThroughEveryLevel) {
   const std::vector<std::uint32_t> nominal = {32, 128, 512, 2048};
-  const std::vector<std::uint32_t> k = keyframe_counts(nominal, 8);
+  const std::vector<std::uint32_t> k = make_keyframe_nominal(nominal, 8);
   ASSERT_EQ(k.size(), 1 + 3 * 8u);
   for (std::size_t level = 0; level < nominal.size(); ++level) EXPECT_EQ(k[8 * level], nominal[level]);
   for (std::size_t g = 1; g < k.size(); ++g)  // 4^(1/8) = 1.189 per step, up to the rounding to whole points
     EXPECT_NEAR(double(k[g]) / k[g - 1], std::pow(4.0, 1.0 / 8), 0.02) << g;
-  EXPECT_TRUE(keyframe_counts(nominal, 0).empty());
+  EXPECT_TRUE(make_keyframe_nominal(nominal, 0).empty());
 }
 
 TEST(GlideTest, BakedTrackHasAnOffsetPerPointAndKeyframeAndRoundTrips) {
   const TilesetData& d = small_set().data();
-  ASSERT_TRUE(small_set().has_glide());
-  const std::vector<std::uint32_t> expected = keyframe_counts({32, 128}, 16);
+  ASSERT_TRUE(small_set().has_glide_track());
+  const std::vector<std::uint32_t> expected = make_keyframe_nominal({32, 128}, 16);
   EXPECT_EQ(std::vector<std::uint32_t>(d.keyframe_nominal.begin(), d.keyframe_nominal.end()), expected);
   for (const Tile& tile : d.tiles) {
     std::size_t pairs = 0;
-    for (std::size_t g = 0; g < d.keyframe_nominal.size(); ++g) pairs += d.glide_count(tile, g);
+    for (std::size_t g = 0; g < d.keyframe_nominal.size(); ++g) pairs += d.offsets_at_keyframe(tile, g);
     EXPECT_EQ(tile.glide.size(), 2 * pairs);
   }
   // Some points glide, none farther than the offsets' range: 3.97 spacings of the first keyframe.
@@ -141,9 +141,9 @@ TEST(GlideTest, NoPointMovesMoreThanTheCapBetweenKeyframes) {
     std::size_t start = 0;
     for (std::size_t g = 1; g < d.keyframe_nominal.size(); ++g) {
       const std::size_t before = start;
-      start += d.glide_count(tile, g - 1);
+      start += d.offsets_at_keyframe(tile, g - 1);
       const double spacing = analysis::hex_spacing(d.keyframe_nominal[g]);
-      for (std::uint32_t i = 0; i < d.glide_count(tile, g - 1); ++i) {
+      for (std::uint32_t i = 0; i < d.offsets_at_keyframe(tile, g - 1); ++i) {
         double ax, ay, bx, by;
         offset_at(d, tile, before, g - 1, i, ax, ay);
         offset_at(d, tile, start, g, i, bx, by);

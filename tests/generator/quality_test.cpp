@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/generator/sampler.h"
 

@@ -40,7 +40,7 @@
 #include "image_io.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/analysis/tiling.h"
 #include "kdm/runtime/query.h"
@@ -109,14 +109,14 @@ UniformResult measure_uniform(double points_per_tile, bool spectrum) {
   const std::vector<double> coords = normalised(query_all(q), kTiles, kTiles);
   UniformResult r;
   r.n = coords.size() / 2;
-  const analysis::NearestNeighbors nn = analysis::nearest_neighbors(coords, 2, /*torus=*/false);
+  const analysis::NearestNeighbours nn = analysis::nearest_neighbours(coords, 2, /*torus=*/false);
   const double spacing = analysis::hex_spacing(r.n);
   std::vector<double> all, seam, interior;
   for (double d : nn.distance) all.push_back(d / spacing);
   analysis::split_by_seam(coords, 2, nn, 1.0 / kTiles, seam, interior);
-  r.nn = analysis::summarize_nn(all, 1.0);
-  r.seam = analysis::summarize_nn(seam, 1.0);
-  r.interior = analysis::summarize_nn(interior, 1.0);
+  r.nn = analysis::summarise_nn(all, 1.0);
+  r.seam = analysis::summarise_nn(seam, 1.0);
+  r.interior = analysis::summarise_nn(interior, 1.0);
   if (spectrum) {
     const analysis::Periodogram p = analysis::periodogram(coords, 2, kFmax);
     const analysis::SpectrumStats stats = analysis::spectrum_stats(p);

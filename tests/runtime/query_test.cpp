@@ -75,7 +75,7 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
   // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, 2 per gliding position
   // (one per coordinate), 4 per entry of the edge lists, plus small tables.
-  ASSERT_TRUE(t.has_glide());
+  ASSERT_TRUE(t.has_glide_track());
   std::size_t points = 0, glide = 0, listed = 0;
   for (const Tile& tile : t.data().tiles) points += tile.points.size(), glide += tile.glide.size();
   for (std::size_t i = 0; i < t.data().tiles.size(); ++i)

@@ -23,7 +23,7 @@
 namespace kdm {
 namespace {
 
-// A valid random set; with `glide`, a gliding track too (the optional arrays since format 3, filled).
+// A valid random set; with `glide`, a glide track too (the optional arrays since format 3, filled).
 TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, std::uint32_t seed = 1,
                          bool glide = true) {
   std::mt19937 rng(seed);
@@ -56,7 +56,7 @@ TilesetData make_tileset(std::uint32_t colours = 2, std::uint32_t levels = 3, st
     }
     for (Tile& tile : set.tiles)
       for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
-        for (std::uint32_t i = 0; i < 2 * set.glide_count(tile, g); ++i)
+        for (std::uint32_t i = 0; i < 2 * set.offsets_at_keyframe(tile, g); ++i)
           tile.glide.push_back(static_cast<std::int8_t>(rng()));
   }
   return set;
@@ -184,7 +184,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   const TilesetData set = make_tileset(1, 2);  // one colour: a single tile
   const std::vector<std::uint8_t> file = encode(set);
   // An array that claims 2^40 elements: refused before any allocation.
-  // The level table, then an empty keyframe table (no gliding track).
+  // The level table, then an empty keyframe table (no glide track).
   const auto nominal = [](auto& ar) {
     ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(4), std::uint32_t(16));
     ar(cereal::make_size_tag(cereal::size_type(0)));
@@ -237,7 +237,7 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   bad = with_body(file, flat);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   EXPECT_NE(why.find("nominal"), std::string::npos) << "detail: " << why;
-  // Gliding tracks: keyframes that do not increase, that stop short of the top level, and a glide array
+  // Glide tracks: keyframes that do not increase, that stop short of the top level, and a glide array
   // of the wrong size for its keyframes (one point, present at both keyframes: 2 pairs needed).
   const auto one_point = [&](auto& ar, std::uint32_t k0, std::uint32_t k1, std::size_t offsets) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
@@ -398,6 +398,34 @@ TEST(TilesetFormatTest, TheShippedSetCutOrDamagedIsRejected) {
   }
 }
 
+// The header alone says what a file is (kdm info asks this), agrees with the decoded set, and is refused
+// at every length short of the whole file (its size is checked against the header's sizes).
+TEST(TilesetFormatTest, TheHeaderDescribesTheFileAndIsValidatedAlone) {
+  const TilesetData set = make_tileset();
+  const std::vector<std::uint8_t> bytes = encode(set);
+  TilesetHeader h;
+  ASSERT_EQ(read_tileset_header(bytes.data(), bytes.size(), h), Status::kOk);
+  EXPECT_EQ(h.format_version, kTilesetFormatVersion);
+  EXPECT_EQ(h.colours, set.colours);
+  EXPECT_EQ(h.levels, set.levels);
+  EXPECT_EQ(h.tiles, set.tiles.size());
+  EXPECT_EQ(h.recipe, set.recipe);
+  EXPECT_EQ(h.generator_version, set.generator_version);
+  EXPECT_EQ(h.header_bytes + h.payload_bytes, bytes.size());
+  EXPECT_GT(h.decompressed_bytes, h.payload_bytes / 2);
+  const std::size_t header_bytes = h.header_bytes;
+  for (std::size_t len = 0; len < bytes.size(); ++len) {
+    ASSERT_EQ(read_tileset_header(bytes.data(), len, h), Status::kTruncated) << "cut at " << len;
+    EXPECT_EQ(h.format_version, 0u);  // left empty
+  }
+  std::vector<std::uint8_t> damaged = bytes;
+  damaged[header_bytes + 3] ^= 1;  // the payload: the header does not look at it
+  EXPECT_EQ(read_tileset_header(damaged.data(), damaged.size(), h), Status::kOk);
+  damaged[41] ^= 1;  // the colours field
+  EXPECT_EQ(read_tileset_header(damaged.data(), damaged.size(), h), Status::kHeaderChecksumMismatch);
+  EXPECT_EQ(read_tileset_header(nullptr, 0, h), Status::kTruncated);
+}
+
 // An engine's allocator serves every array of a loaded tile set, and gets all of it back, even when
 // other hooks are installed in between.
 struct CountingHeap {
@@ -424,7 +452,7 @@ TEST(TilesetFormatTest, KeyframesCloserThanTheLookupTableStillFindTheirBracket) 
   std::mt19937 rng(5);
   for (Tile& tile : set.tiles)
     for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
-      for (std::uint32_t i = 0; i < 2 * set.glide_count(tile, g); ++i)
+      for (std::uint32_t i = 0; i < 2 * set.offsets_at_keyframe(tile, g); ++i)
         tile.glide.push_back(static_cast<std::int8_t>(rng() % 9) - 4);
   const std::vector<std::uint8_t> bytes = encode(set);
   Tileset t;

@@ -20,6 +20,7 @@
 #include "kdm/analysis/plots.h"
 #include "kdm/analysis/report.h"
 #include "kdm/generator/sampler.h"
+#include "sampler_density.h"
 
 namespace kdm::cli {
 namespace {
@@ -38,30 +39,6 @@ struct AnalyzeArgs {
   int threads = 0;
   std::string output;
 };
-
-// The analysis reads the same density the sampler does (const:V or an image, darkness = density).
-analysis::DensityFunction as_analysis_density(const gen::Density& density) {
-  if (!density.function) return [](double, double) { return 1.0; };
-  return [f = density.function](double x, double y) {
-    const double u[2] = {x, y};
-    return f(u);
-  };
-}
-
-// E/n of each set under the KDM model for its count, domain and density, averaged over the sets.
-double mean_energy_per_point(const std::vector<tools::PointSet>& sets, bool torus,
-                             const gen::Density& density) {
-  double sum = 0;
-  for (const tools::PointSet& set : sets) {
-    gen::SamplerOptions o;
-    o.dim = set.dim;
-    o.domain = torus ? gen::Domain::kTorus : gen::Domain::kBox;
-    std::vector<double> coords = set.coords;
-    for (double& c : coords) c = std::min(c, std::nextafter(1.0, 0.0));  // writers may round up to 1
-    sum += gen::energy_per_point(o, density, coords);
-  }
-  return sum / sets.size();
-}
 
 void save_png(const std::string& path, const tools::RgbImage& image) {
   std::string error;
@@ -85,8 +62,8 @@ void run_analyze(const AnalyzeArgs& args) {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
     gen::Density target = gen::Density::constant();
     if (!args.density.empty()) {
-      target = to_generator_density(parse_density(args.density, args.gamma, args.invert));
-      o.density = as_analysis_density(target);
+      target = cli::to_generator_density(parse_density(args.density, args.gamma, args.invert));
+      o.density = tools::analysis_density(target);
     }
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
@@ -108,7 +85,7 @@ void run_analyze(const AnalyzeArgs& args) {
                          (ec ? ": " + ec.message() : ""));
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (!args.no_energy) {
-      report.energy_per_point = mean_energy_per_point(sets, o.torus, target);
+      report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target);
       report.has_energy = true;
     }
     std::fputs(analysis::format_summary(report).c_str(), stdout);

@@ -9,7 +9,7 @@
 #include "commands.h"
 #include "density_arg.h"
 #include "image_io.h"
-#include "output.h"
+#include "point_output.h"
 #include "runtime_args.h"
 
 namespace kdm::cli {
@@ -30,7 +30,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 /// lines as the region's own; or, with `normalised`, coordinates in [0, 1) of the rectangle.
 std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset& tiles, const double r[4],
                             bool normalised, bool json) {
-  const tools::PointSet unit = normalise_to_rect(points, r);
+  const tools::PointSet unit = tools::normalise_to_rect(points, r);
   std::string out = json ? "{\"rect\": [" : "x,y,tile_x,tile_y,rank,level\n";
   char line[192];
   if (json) {
@@ -79,7 +79,9 @@ void run_query_command(const QueryArgs& a) {
   q.mode = parse_mode(a.mode);
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<QueryPoint> points;
-  query_all(tiles, q, points);  // origin 0: positions are world coordinates, the same bits in any query
+  tools::query_all(
+      tiles, q, points,
+      kCommandLineNames);  // origin 0: positions are world coordinates, the same bits in any query
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   char line[200];
   std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
@@ -93,9 +95,10 @@ void run_query_command(const QueryArgs& a) {
   } else {
     // .txt is the UTK/psa format, [0, 1) by definition; pictures show the rectangle.
     for (QueryPoint& p : points) p.x -= r[0], p.y -= r[1];
-    DrawStyle style;
+    tools::DrawStyle style;
     style.aspect = (r[2] - r[0]) / (r[3] - r[1]);
-    write_points(a.output, normalise_to_rect(points, r), {line, "coordinates normalised to the rect"}, style);
+    tools::write_points(a.output, tools::normalise_to_rect(points, r),
+                        {line, "coordinates normalised to the rect"}, style);
   }
   std::fprintf(stderr, "%s in %.4f s -> %s\n", line, seconds, a.output.c_str());
 }

@@ -10,7 +10,7 @@
 #include "density_arg.h"
 #include "generator_density.h"
 #include "kdm/generator/sampler.h"
-#include "output.h"
+#include "point_output.h"
 #include "progress.h"
 
 namespace kdm::cli {
@@ -75,11 +75,11 @@ void run_sample(const SampleArgs& args) {
                 set.size(), o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
                 r.acceptance_rate());
   std::vector<std::string> header = {line, "density " + args.density + ", domain " + domain};
-  DrawStyle style;
+  tools::DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;
   style.aspect = aspect;
-  write_points(args.output, set, header, style);
+  tools::write_points(args.output, set, header, style);
   std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds, args.output.c_str());
   if (args.timing) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),

@@ -11,9 +11,10 @@
 
 #include "commands.h"
 #include "density_arg.h"
-#include "output.h"
+#include "full_stippler.h"
+#include "point_output.h"
 #include "runtime_args.h"
-#include "stipple_full.h"
+#include "tile_stippler.h"
 
 namespace kdm::cli {
 namespace {
@@ -36,20 +37,6 @@ void parse_region(const std::string& text, double r[4]) {
                        text + "'");
 }
 
-/// The UV rectangle of frame i of k, zooming from the whole image (frame 0) into `region` (frame k-1):
-/// the zoom grows geometrically (the same factor every frame) and each rectangle lies inside the one
-/// before, so the runtime's zoom coherence keeps every dot that stays in view.
-void frame_region(const double region[4], int i, int k, double out[4]) {
-  const double last = std::max(region[2] - region[0], region[3] - region[1]);  // 1 / final zoom
-  const double extent = std::pow(last, k > 1 ? double(i) / (k - 1) : 1.0);     // 1 / this frame's zoom
-  const double s = last < 1 ? (1 - extent) / (1 - last) : 1;                   // 0: whole image, 1: region
-  for (int j = 0; j < 2; ++j) {
-    out[j] = s * region[j];
-    out[j + 2] = 1 + s * (region[j + 2] - 1);
-  }
-  if (i == k - 1) std::copy(region, region + 4, out);  // exactly the region, whatever the rounding
-}
-
 /// OUT.png -> OUT_0007.png (the frame number before the extension).
 std::string frame_path(const std::string& output, int i) {
   const std::size_t slash = output.find_last_of('/'), dot = output.find_last_of('.');
@@ -59,43 +46,6 @@ std::string frame_path(const std::string& output, int i) {
   std::snprintf(number, sizeof number, "_%04d", i);
   return output.substr(0, at) + number + output.substr(at);
 }
-
-/// The runtime (tiles) method: the dots of one UV rectangle of the image, normalised to the rectangle.
-class TileStippler {
- public:
-  TileStippler(const StippleArgs& a, const tools::DensitySpec& spec, double aspect)
-      : tiles_(tileset_for(a.tileset, storage_)), aspect_(aspect), mode_(parse_mode(a.mode)) {
-    density_ = make_runtime_density(spec, 0, 0, aspect, 1);
-    // The scale that gives --points over the whole image (∫ρ dA = mean · aspect).
-    scale_ = a.points > 0 ? a.points / (density_->mean_value * aspect) : a.scale;
-    // Tiles small enough that 4× the image's peak density (a 2× zoom with --region) fits the top level.
-    // The tile size depends on the whole image only, so every region and frame sees the same points.
-    tile_size_ = std::sqrt(tiles_.max_points_per_tile() / (4 * scale_ * density_->max_value));
-  }
-
-  tools::PointSet render(const double uv[4]) const {
-    const double zoom = 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]);
-    if (zoom > 2 + 1e-9) throw CommandError("--region zooms more than 2× (the tile set's density range)");
-    QueryParams q;
-    q.x0 = uv[0] * aspect_, q.y0 = uv[1], q.x1 = uv[2] * aspect_, q.y1 = uv[3];
-    q.origin_x = q.x0, q.origin_y = q.y0;
-    q.tile_size = tile_size_;
-    q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
-    q.density = density_->density;
-    q.mode = mode_;
-    std::vector<QueryPoint> points;
-    query_all(tiles_, q, points);
-    const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
-    return normalise_to_rect(points, rect);
-  }
-
- private:
-  Tileset storage_;
-  const Tileset& tiles_;
-  double aspect_, scale_ = 0, tile_size_ = 1;
-  QueryMode mode_;
-  std::unique_ptr<RuntimeDensity> density_;
-};
 
 void run_stipple(const StippleArgs& a) {
   if (a.points <= 0 && a.scale <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
@@ -116,16 +66,19 @@ void run_stipple(const StippleArgs& a) {
   if (!a.region.empty()) parse_region(a.region, region);
   if (a.method == "full" && !a.region.empty())
     throw CommandError("--region needs --method tiles (the full sampler has no zoom)");
-  if (1 / std::max(region[2] - region[0], region[3] - region[1]) > 2 + 1e-9)  // before writing any frame
-    throw CommandError("--region zooms more than 2× (the tile set's density range)");
-  std::unique_ptr<TileStippler> stippler;
-  if (a.method != "full") stippler = std::make_unique<TileStippler>(a, spec, aspect);
+  if (1 / std::max(region[2] - region[0], region[3] - region[1]) > tools::kMaxStippleZoom + 1e-9)
+    throw CommandError("--region zooms more than 2× (the tile set's density range)");  // before any frame
+  Tileset storage;
+  std::unique_ptr<tools::TileStippler> stippler;
+  if (a.method != "full")
+    stippler = std::make_unique<tools::TileStippler>(spec, tileset_for(a.tileset, storage), double(a.points),
+                                                     a.scale, parse_mode(a.mode));
   const int frames = std::max(1, a.frames);
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
   for (int i = 0; i < frames; ++i) {
     double uv[4];
     if (a.frames > 0)
-      frame_region(region, i, frames, uv);
+      tools::stipple_frame_region(region, i, frames, uv);
     else
       std::copy(region, region + 4, uv);
     const auto t0 = std::chrono::steady_clock::now();
@@ -133,7 +86,8 @@ void run_stipple(const StippleArgs& a) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      set = stipple_full(spec, a.points > 0 ? a.points : std::llround(a.scale * aspect), aspect, a.seed);
+      set =
+          tools::stipple_full(spec, a.points > 0 ? a.points : std::llround(a.scale * aspect), aspect, a.seed);
       how = "full KDM sampler";
     } else {
       set = stippler->render(uv);
@@ -144,7 +98,7 @@ void run_stipple(const StippleArgs& a) {
       const double full = a.points > 0 ? double(a.points) : double(set.size());
       dot_radius = 0.25 * std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, full));
     }
-    DrawStyle style;
+    tools::DrawStyle style;
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
@@ -152,7 +106,7 @@ void run_stipple(const StippleArgs& a) {
     std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(), how.c_str());
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
-    write_points(path, set, {line, "image " + a.image, where}, style);
+    tools::write_points(path, set, {line, "image " + a.image, where}, style);
     std::fprintf(stderr, "%s in %.3f s -> %s\n", line, seconds, path.c_str());
   }
 }

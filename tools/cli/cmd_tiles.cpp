@@ -8,11 +8,11 @@
 #include <iterator>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "commands.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
-#include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
 #include "progress.h"
 
@@ -45,21 +45,25 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
 }
 
 void run_info(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  const long long bytes = in ? static_cast<long long>(in.tellg()) : -1;
-  Tileset loaded;  // as the runtime holds it: the set, and its resident size
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CommandError("cannot open '" + path + "'");
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The runtime answers what the file is: its header, then the set as queries would hold it.
+  TilesetHeader header;
   std::string detail;
-  const Status s = Tileset::load_file(path, loaded, &detail);
+  Status s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+  Tileset loaded;
+  if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), loaded, &detail);
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
   const TilesetData& set = loaded.data();
-  std::printf("file           %s (%lld bytes)\n", path.c_str(), bytes);
+  std::printf("file           %s (%zu bytes)\n", path.c_str(), bytes.size());
   const std::size_t resident = loaded.resident_bytes();
   std::printf("resident       %zu bytes (%.3g MiB) once loaded by the runtime\n", resident,
               double(resident) / (1 << 20));
-  unsigned char header[12] = {};
-  std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(header), sizeof header);  // loaded: ok
-  std::printf("format         version %u\n",
-              header[8] | header[9] << 8 | header[10] << 16 | unsigned(header[11]) << 24);
+  std::printf("format         version %u (header %u bytes, payload %llu bytes, %llu decompressed)\n",
+              header.format_version, header.header_bytes,
+              static_cast<unsigned long long>(header.payload_bytes),
+              static_cast<unsigned long long>(header.decompressed_bytes));
   std::printf("generator      kdm %s\n", set.generator_version.c_str());
   std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
   std::printf("levels         %u\n", set.levels);
@@ -73,10 +77,10 @@ void run_info(const std::string& path) {
   std::printf("density range  1 : %.0f (level 0 to level %u)\n",
               double(set.level_nominal.back()) / set.level_nominal.front(), set.levels - 1);
   if (set.keyframe_nominal.empty())
-    std::printf("gliding track  none (--mode smooth emits stable positions)\n");
+    std::printf("glide track  none (--mode smooth emits stable positions)\n");
   else
     std::printf(
-        "gliding track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
+        "glide track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
         set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
         loaded.glide_reach());
   std::printf("recipe\n");

@@ -1,4 +1,6 @@
-// A parsed --density as the full sampler's density (kdm sample, kdm stipple --method full, kdm analyze).
+// A parsed --density as the full sampler's density (kdm sample, kdm stipple --method full, kdm analyze):
+// tools::to_generator_density (tools/stipple/sampler_density.h, which the Python package shares) with its
+// refusals as CommandError.
 #pragma once
 
 #include "density_spec.h"

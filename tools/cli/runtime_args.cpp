@@ -58,61 +58,12 @@ void parse_rect(const std::string& text, const char* option, double r[4]) {
                        "'");
 }
 
-tools::PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]) {
-  const double w = r[2] - r[0], h = r[3] - r[1], below_one = std::nextafter(1.0, 0.0);
-  tools::PointSet set;
-  set.dim = 2;
-  set.coords.reserve(points.size() * 2);
-  for (const QueryPoint& p : points)
-    set.coords.insert(set.coords.end(), {std::min(p.x / w, below_one), std::min(p.y / h, below_one)});
-  return set;
-}
-
 const Tileset& tileset_for(const std::string& path, Tileset& storage) {
   if (path.empty()) return Tileset::builtin();
   std::string detail;
   const Status s = Tileset::load_file(path, storage, &detail);
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
   return storage;
-}
-
-std::string describe(const QueryProblem& p) {
-  char text[400];
-  switch (p.kind) {
-    case QueryProblem::Kind::kDensityTooHigh:
-      std::snprintf(
-          text, sizeof text,
-          "%s: %.6g points per tile where the tile set holds at most %.0f; use --scale %.6g or less, "
-          "or --tile-size %.6g or less",
-          query_problem_message(p.kind), p.value, p.limit, p.largest_valid, p.largest_tile_size);
-      break;
-    case QueryProblem::Kind::kTooManyTiles:
-      std::snprintf(text, sizeof text,
-                    "%s: %.6g tiles, at most %.0f; use a larger --tile-size or a smaller --rect",
-                    query_problem_message(p.kind), p.value, p.limit);
-      break;
-    default:
-      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
-                    p.value);
-  }
-  return text;
-}
-
-void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out) {
-  out.clear();
-  std::vector<QueryPoint> buffer(1 << 16);
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    QueryProblem problem;
-    const Status s = query_points(tileset, params, buffer.data(), buffer.size(), &written, &cursor, &problem);
-    out.insert(out.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(written));
-    if (out.size() > kMaxCommandLinePoints)  // 1 GiB of points: stop before memory runs out
-      throw CommandError(
-          "the query emits more than 2^25 points; lower --scale or --points, or split the region");
-    if (s == Status::kOk) return;
-    if (s != Status::kBufferFull) throw CommandError("query: " + describe(problem));
-  }
 }
 
 }  // namespace kdm::cli

@@ -9,6 +9,7 @@
 #include "density_spec.h"
 #include "kdm/runtime/query.h"
 #include "point_io.h"
+#include "runtime_query.h"
 
 namespace kdm::cli {
 
@@ -39,18 +40,7 @@ inline QueryMode parse_mode(const std::string& text) {
 /// x0 < x1 and y0 < y1. Throws CommandError.
 void parse_rect(const std::string& text, const char* option, double r[4]);
 
-/// Query points whose origin is the corner (r[0], r[1]) of the rectangle r, as a 2D point set normalised
-/// to it: [0, 1) on both axes.
-tools::PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]);
-
-/// Most points a command-line query collects (2^25, 1 GiB as QueryPoint) before it gives up.
-inline constexpr std::size_t kMaxCommandLinePoints = std::size_t(1) << 25;
-
-/// A refused query's problem in one line for the command line (which option, which limit, what works).
-std::string describe(const QueryProblem& problem);
-
-/// Runs a query to completion into `out` (growing it), throwing CommandError on bad parameters or when
-/// more than kMaxCommandLinePoints points would be emitted.
-void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out);
+/// How refusals name the query's parameters on the command line.
+inline constexpr tools::ParameterNames kCommandLineNames{"--scale", "--tile-size"};
 
 }  // namespace kdm::cli

@@ -27,8 +27,7 @@ namespace kdm::gen {
 namespace {
 
 // Void-and-cluster filter width in units of the current point spacing (progressive_order narrows it as
-// points are added). Measured on a 4-level set: 0.35 gives mid-level δavg .71–.83 but lowP up to .112;
-// 0.7 gives δavg .65–.81 and lowP up to .112; 0.5 gives δavg .69–.82 and lowP at most .099.
+// points are added): half a spacing leaves the least low-frequency power between levels (docs/design.md §3).
 constexpr double kFilterWidth = 0.5;
 
 // The coarsest level's sweeps in the versions that baked the first tile sets (SamplerOptions's default was
@@ -104,7 +103,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "glide_separation") {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
-      r.keyframes = static_cast<std::uint32_t>(whole(0, 32));
+      r.keyframes_per_level = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "glide_sweeps") {
       r.glide_sweeps = static_cast<int>(whole(1, 1000));
     } else if (key == "temperature") {
@@ -115,7 +114,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     }
   }
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
-  if (keyframe_counts(r.nominal_counts(), r.keyframes).size() > kMaxKeyframes)
+  if (make_keyframe_nominal(r.nominal_counts(), r.keyframes_per_level).size() > kMaxKeyframes)
     throw InvalidArgument("recipe: more than " + std::to_string(kMaxKeyframes) + " keyframes in all");
   if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty())
     throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
@@ -139,7 +138,8 @@ std::string BakeRecipe::to_text() const {
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
-  if (keyframes) s << "keyframes " << keyframes << "\nglide_sweeps " << glide_sweeps << "\n";
+  if (keyframes_per_level)
+    s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
   return s.str();
 }
@@ -164,7 +164,8 @@ class Baker {
     if (widths_.empty()) throw InvalidArgument("recipe: the patches of some level are too narrow");
     for (std::uint32_t k = 0; k < recipe.levels; ++k)
       for (const BakeRun& run : runs_) total_work_ += work(k, run);
-    for (std::uint32_t count : keyframe_counts(nominal_, recipe_.keyframes)) total_work_ += glide_work(count);
+    for (std::uint32_t count : make_keyframe_nominal(nominal_, recipe_.keyframes_per_level))
+      total_work_ += glide_work(count);
   }
 
   TilesetData bake() {
@@ -178,18 +179,18 @@ class Baker {
             if (progress_) progress_(done_work_ / total_work_);
           });
     }
-    table_.colours = recipe_.colours;
-    table_.levels = recipe_.levels;
-    table_.level_nominal.assign(nominal_.begin(), nominal_.end());
-    dropped_ = drop_close_pairs(levels_, recipe_.colours, table_, recipe_.separation);
-    const std::vector<std::uint32_t> keyframes = keyframe_counts(nominal_, recipe_.keyframes);
-    table_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
+    shape_.colours = recipe_.colours;
+    shape_.levels = recipe_.levels;
+    shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
+    dropped_ = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
+    const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal_, recipe_.keyframes_per_level);
+    shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
-      relax_keyframe(levels_, runs_, widths_, table_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
+      relax_keyframe(levels_, runs_, widths_, shape_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
-    drop_close_glides(levels_, recipe_.colours, table_, recipe_.glide_separation);
+    drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation);
     return assemble();
   }
 
@@ -237,8 +238,7 @@ class Baker {
     o.coarsest_sweeps = std::max(kFirstCoarsestSweeps, o.sweeps);
     // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
     // resolve a residual density confined to patches between fixed bands, and spread the new points
-    // unevenly between patches (measured: interiors of one run off by up to ±12%, E/n +13%; from two
-    // levels below the finest, ±2% and the full sampler's E/n).
+    // unevenly between patches (docs/design.md §3).
     const double nodes_per_tile = std::sqrt(nominal_[k] * 7.07 / o.peak_density);  // sampler.h, `resolution`
     o.coarsest_grid =
         std::max(o.coarsest_grid, static_cast<int>(nodes_per_tile * std::min(run.w, run.h) / 4));
@@ -341,7 +341,8 @@ class Baker {
 
   /// Every tile (sw, se, ne, nw): its share of the patches around it, level by level, sorted by key.
   TilesetData assemble() const {
-    TilesetData set = table_;
+    TilesetData set;
+    static_cast<TilesetShape&>(set) = shape_;
     set.recipe = recipe_.to_text();
     set.generator_version = version_string();
     const std::size_t count = std::size_t(set.colours) * set.colours * set.colours * set.colours;
@@ -369,7 +370,7 @@ class Baker {
         tile.level_end.push_back(static_cast<std::uint32_t>(tile.points.size()));
       }
       for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
-        for (std::uint32_t c = 0, n = set.glide_count(tile, g); c < n; ++c)
+        for (std::uint32_t c = 0, n = set.offsets_at_keyframe(tile, g); c < n; ++c)
           for (int axis = 0; axis < 2; ++axis) {
             const PatchPointRef& ref = ranked[c];
             KDM_CHECK(ref.patch->frames.size() > g && !ref.patch->frames[g].empty());
@@ -392,7 +393,7 @@ class Baker {
   std::vector<PatchWidths> widths_;
   std::vector<BakeRun> runs_;
   std::vector<LevelPatches> levels_;
-  TilesetData table_;  ///< the level and keyframe counts (no tiles)
+  TilesetShape shape_;  ///< colours, level and keyframe counts: what the tiles fit into
   double total_work_ = 0, done_work_ = 0;
   std::size_t dropped_ = 0;  ///< points drop_close_pairs removed (for a test to read)
 };

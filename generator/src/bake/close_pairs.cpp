@@ -28,7 +28,7 @@ using Victims = std::set<std::tuple<std::size_t, int, std::size_t, std::uint32_t
 
 /// The points of `levels` in the window [x0, x1) × [y0, y1) of the arrangement `col`.
 std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Colouring& col,
-                               const TilesetData& table, double x0, double y0, double x1, double y1) {
+                               const TilesetShape& shape, double x0, double y0, double x1, double y1) {
   constexpr PatchKind kKinds[] = {PatchKind::kCorner, PatchKind::kHorizontalEdge, PatchKind::kVerticalEdge,
                                   PatchKind::kInterior};
   std::vector<Candidate> points;
@@ -43,7 +43,7 @@ std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Co
       const std::vector<Patch>& patches = levels[k].of(kind);
       for (std::size_t i = 0; i < keys.size(); ++i)
         points.push_back({xy[2 * i], xy[2 * i + 1],
-                          table.emission_threshold(static_cast<std::uint32_t>(k), keys[i]),
+                          shape.emission_threshold(static_cast<std::uint32_t>(k), keys[i]),
                           static_cast<int>(kind), k, std::size_t(refs[i].patch - patches.data()),
                           refs[i].index, refs[i].patch, refs[i].anchor_x, refs[i].anchor_y});
     }
@@ -100,13 +100,13 @@ void find_close(const std::vector<Candidate>& points, const std::vector<double>&
   }
 }
 
-/// The gliding track's close pairs among `points` (stable positions in a window): at every sampled density,
+/// The glide track's close pairs among `points` (stable positions in a window): at every sampled density,
 /// the points shown there at their glided positions, those inside [x0, x1) × [y0, y1).
-void find_close_glides(std::vector<Candidate> points, const TilesetData& table, double separation, double x0,
+void find_close_glides(std::vector<Candidate> points, const TilesetShape& shape, double separation, double x0,
                        double y0, double x1, double y1, Victims& victims) {
   std::sort(points.begin(), points.end(),
             [](const Candidate& a, const Candidate& b) { return a.order() < b.order(); });
-  const auto& K = table.keyframe_nominal;
+  const auto& K = shape.keyframe_nominal;
   std::vector<double> at(2 * points.size());
   constexpr int kSteps = 8;
   for (std::size_t g = 0; g < K.size(); ++g)
@@ -114,7 +114,7 @@ void find_close_glides(std::vector<Candidate> points, const TilesetData& table, 
       const double t = double(step) / kSteps;
       const double count = g + 1 < K.size() ? K[g] + t * (double(K[g + 1]) - K[g]) : K[g];
       std::size_t present = 0;
-      while (present < points.size() && TilesetData::emits(points[present].threshold, count)) ++present;
+      while (present < points.size() && TilesetShape::emits(points[present].threshold, count)) ++present;
       for (std::size_t i = 0; i < present; ++i) {
         const Candidate& p = points[i];
         const std::vector<double>& f0 = p.source->frames[g];
@@ -158,17 +158,17 @@ Colouring pair_of_tiles(std::uint32_t colours, bool across, std::vector<std::uin
 }  // namespace
 
 std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                             const TilesetData& table, double separation) {
+                             const TilesetShape& shape, double separation) {
   if (!(separation > 0)) return 0;
   // Densities below the first level are outside the set's range: a pair counts from there on.
-  const double lowest = std::max(1.0, double(table.level_nominal.front()));
+  const double lowest = std::max(1.0, double(shape.level_nominal.front()));
   auto radius = [&](const Candidate& p) {
     return separation * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(p.threshold), lowest)));
   };
   Victims victims;  // (level, kind, patch, index)
   const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
   for (std::size_t t = 0; t < tiles; ++t)
-    find_pairs(collect(levels, Colouring::around_tile(colours, t), table, 0, 0, 1, 1), 1, 1, radius, victims);
+    find_pairs(collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1), 1, 1, radius, victims);
   // Pairs across a tile edge, for every two tiles that can meet there (their shared edge's colours, and
   // two more on each side): a strip as wide as the largest radius on either side of the edge.
   const double reach = separation * std::sqrt(2.0 / (std::sqrt(3.0) * lowest));
@@ -176,9 +176,9 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
   for (std::size_t code = 0; code < std::size_t(tiles) * colours * colours; ++code) {
     std::size_t rest = code;
     for (std::uint32_t& c : v) c = static_cast<std::uint32_t>(rest % colours), rest /= colours;
-    find_pairs(collect(levels, pair_of_tiles(colours, true, v), table, 1 - reach, 0, 1 + reach, 1), 2 * reach,
+    find_pairs(collect(levels, pair_of_tiles(colours, true, v), shape, 1 - reach, 0, 1 + reach, 1), 2 * reach,
                1, radius, victims);
-    find_pairs(collect(levels, pair_of_tiles(colours, false, v), table, 0, 1 - reach, 1, 1 + reach), 1,
+    find_pairs(collect(levels, pair_of_tiles(colours, false, v), shape, 0, 1 - reach, 1, 1 + reach), 1,
                2 * reach, radius, victims);
   }
   remove(levels, victims);
@@ -186,13 +186,13 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
 }
 
 std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                              const TilesetData& table, double separation) {
-  if (!(separation > 0) || table.keyframe_nominal.empty()) return 0;
+                              const TilesetShape& shape, double separation) {
+  if (!(separation > 0) || shape.keyframe_nominal.empty()) return 0;
   const double s = separation + kGlideMargin;
   Victims victims;
   const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
   for (std::size_t t = 0; t < tiles; ++t)
-    find_close_glides(collect(levels, Colouring::around_tile(colours, t), table, 0, 0, 1, 1), table, s, 0, 0,
+    find_close_glides(collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1), shape, s, 0, 0,
                       1, 1, victims);
   // Across a tile edge: points whose stable positions lie within the farthest glide of it, shown within the
   // pair distance of it.
@@ -204,15 +204,15 @@ std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t c
         for (const std::vector<double>& frame : patch.frames)
           for (std::size_t i = 0; i < frame.size(); ++i)
             reach = std::max(reach, std::fabs(frame[i] - patch.xy[i]));
-  const double near = s * std::sqrt(2.0 / (std::sqrt(3.0) * table.keyframe_nominal.front()));
+  const double near = s * std::sqrt(2.0 / (std::sqrt(3.0) * shape.keyframe_nominal.front()));
   std::vector<std::uint32_t> v(6);
   for (std::size_t code = 0; code < std::size_t(tiles) * colours * colours; ++code) {
     std::size_t rest = code;
     for (std::uint32_t& c : v) c = static_cast<std::uint32_t>(rest % colours), rest /= colours;
     const double w = reach + near;
-    find_close_glides(collect(levels, pair_of_tiles(colours, true, v), table, 1 - w, 0, 1 + w, 1), table, s,
+    find_close_glides(collect(levels, pair_of_tiles(colours, true, v), shape, 1 - w, 0, 1 + w, 1), shape, s,
                       w - near, 0, w + near, 1, victims);
-    find_close_glides(collect(levels, pair_of_tiles(colours, false, v), table, 0, 1 - w, 1, 1 + w), table, s,
+    find_close_glides(collect(levels, pair_of_tiles(colours, false, v), shape, 0, 1 - w, 1, 1 + w), shape, s,
                       0, w - near, 1, w + near, victims);
   }
   remove(levels, victims);

@@ -1,4 +1,4 @@
-// Near-coincident points of different runs, and (drop_close_glides) of paths along the gliding track that
+// Near-coincident points of different runs, and (drop_close_glides) of paths along the glide track that
 // the keyframes' relaxation could not keep apart. Each patch is sampled with what its run holds fixed, but a
 // run never sees every patch a tile puts next to it (a vertical edge's run sees its torus's horizontal
 // edges, not those of every tile), so two points of different patches can land almost on top of each
@@ -16,23 +16,23 @@
 
 namespace kdm::gen {
 
-/// Removes from `levels` the point that appears later (higher emission threshold, by `table`'s
+/// Removes from `levels` the point that appears later (higher emission threshold, by `shape`'s
 /// level_nominal) of every pair closer, in some tile of `colours`^4, than `separation` times the hexagonal
 /// spacing at that point's threshold, or at the first level's count if higher (the set's range starts
 /// there): from there on both are present, and at higher densities the pair is farther apart in spacings. The
 /// choice depends on the two points alone, so a shared patch loses the same points in every tile. Call before
-/// the gliding track is relaxed (patches without frames). Returns how many points were removed.
+/// the glide track is relaxed (patches without frames). Returns how many points were removed.
 std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                             const TilesetData& table, double separation);
+                             const TilesetShape& shape, double separation);
 
-/// The same along the gliding track, once it is relaxed: removes the later point of every pair closer than
+/// The same along the glide track, once it is relaxed: removes the later point of every pair closer than
 /// `separation` hexagonal spacings (plus kGlideMargin, for the file's 8-bit offsets) at some density where
 /// both are shown, in some tile or across an edge two tiles can share. Densities are sampled at the
 /// keyframes and at 7 more between each two (the half-way density among them). Paths are pushed apart
 /// while keyframes are relaxed (keyframes.h); this catches the few that bounds keep from moving. Returns
 /// how many points were removed.
 std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                              const TilesetData& table, double separation);
+                              const TilesetShape& shape, double separation);
 
 /// kGlideMargin: offsets are rounded to 1/64 of a keyframe's spacing per axis, which moves a pair's
 /// distance by at most 0.04 hexagonal spacings.

@@ -33,7 +33,7 @@ struct Patch {
   std::vector<double> xy;
   std::vector<std::uint16_t> keys;
   bool done = false;
-  /// Gliding track: frames[g] holds every point's position (relative to the anchor, like xy) at keyframe
+  /// Glide track: frames[g] holds every point's position (relative to the anchor, like xy) at keyframe
   /// g; points not present there keep their stable position. Empty until keyframe g is relaxed.
   std::vector<std::vector<double>> frames;
   std::size_t size() const { return keys.size(); }
@@ -44,7 +44,7 @@ struct Patch {
 };
 
 /// Every patch of one density level. Edge patches are indexed by (first, second) end colour:
-/// first·C + second, left→right or bottom→top; interiors by TilesetData::tile_index(sw, se, ne, nw).
+/// first·C + second, left→right or bottom→top; interiors by TilesetShape::tile_index(sw, se, ne, nw).
 struct LevelPatches {
   std::vector<Patch> corners, horizontal, vertical, interiors;
   explicit LevelPatches(std::uint32_t colours = 1)

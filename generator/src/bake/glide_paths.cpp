@@ -1,4 +1,4 @@
-// Separating the gliding track's paths; see glide_paths.h.
+// Separating the glide track's paths; see glide_paths.h.
 #include "bake/glide_paths.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Keeps the points of the gliding track apart: at a keyframe (separate_points) and on the straight paths
+// Keeps the points of the glide track apart: at a keyframe (separate_points) and on the straight paths
 // between two keyframes (separate_paths).
 //
 // With γ = 1 the energy's pull towards a gap next to a point is as strong as the push of overlapping

@@ -1,4 +1,4 @@
-// Keyframes of the gliding track; see keyframes.h.
+// Keyframes of the glide track; see keyframes.h.
 #include "bake/keyframes.h"
 
 #include <algorithm>
@@ -15,21 +15,19 @@ namespace kdm::gen {
 namespace {
 
 // Distances below are in hexagonal spacings d_hex of the keyframe's count (hex_spacing), the units the
-// generator test and kdm analyze measure in; figures are from 4-level sets of the default recipe
-// (docs/design.md §3).
+// generator test and kdm analyze measure in; why each value, and what it was measured to do:
+// docs/design.md §3 (the glide track).
 
 /// No two points of a keyframe closer than this (separate_points).
 constexpr double kMinDistance = 0.45;
 /// No two paths between keyframes closer than this at any count on the way (separate_paths): the bar is 0.3.
 constexpr double kPathDistance = 0.4;
 /// No point moves farther than this from one keyframe to the next. The descent alone moves a few points
-/// much farther (99th percentile up to 0.76 of the nearest-neighbour distance at 16 keyframes per level);
-/// capped here, the keyframes lose under .005 of δavg.
+/// much farther; the cap costs the keyframes little δavg.
 constexpr double kMaxMove = 0.55;
 /// Interior points stay this far off their tile's edges (keep_in_bounds). The interiors of two
 /// neighbouring tiles are never relaxed together (each meets a stand-in of the other on its own torus):
-/// without this, points of both glide into the thin edge band between them and meet (pairs 0.01 d_hex
-/// apart at 128 points per tile).
+/// without this, points of both glide into the thin edge band between them and meet.
 constexpr double kEdgeMargin = 0.25;
 
 /// Entering points keep off the points of later kinds they meet in other tiles (entry_obstacles) where
@@ -38,21 +36,20 @@ constexpr double kEdgeMargin = 0.25;
 constexpr double kObstacleFraction = 0.25;
 
 /// Each keyframe starts the points this fraction of the way back to their stable positions. Relaxed from
-/// where the last keyframe left them, points drift without bound (a random walk over the keyframes: the
-/// 99th percentile of the offsets grows to several spacings, a third of a tile side on an 8-keyframe
-/// set), and a point whose emission is decided at its stable position then shows far from it: dots outside
-/// a sharp edge of a density image. Pulled back by a quarter, offsets stay within about a spacing (99th
-/// percentile 1.3), and the keyframes measure better than with no pull (δavg +.007).
+/// where the last keyframe left them, points drift without bound (a random walk over the keyframes), and
+/// a point whose emission is decided at its stable position then shows far from it: dots outside a sharp
+/// edge of a density image. Pulled back by a quarter, offsets stay within about a spacing, and the
+/// keyframes measure better than with no pull.
 constexpr double kPull = 0.25;
 
 /// The descent's grid and step. The sampler's default grid (peak density 0.43) resolves the γ = 1 energy
-/// too coarsely for a descent: the keyframes stall at δavg .86–.87 whatever the sweeps. On a grid twice
-/// as fine per axis they reach .87–.89; the shorter step keeps the moves as small.
+/// too coarsely for a descent: the keyframes stall whatever the sweeps. On a grid twice as fine per axis
+/// they do not; the shorter step keeps the moves as small.
 constexpr double kPeakDensity = 0.2;
 constexpr double kStep = 0.2;
 
 /// Offsets stay within this many square-grid spacings (1/√K) along each axis: what the file's 8-bit offsets
-/// hold (kGlideUnitsPerSpacing), less a rounding margin. Rarely binding (the 99th percentile is 1.4).
+/// hold (kGlideUnitsPerSpacing), less a rounding margin. Rarely binding (kPull keeps offsets small).
 constexpr double kMaxOffset = (127 - 2) / kGlideUnitsPerSpacing;
 
 /// d_hex of `count` points per tile, in tile sides.
@@ -80,9 +77,9 @@ struct FrameRun {
 };
 
 /// The level whose nominal range holds keyframe count K: the first with N_L >= K.
-std::uint32_t level_of_count(const TilesetData& table, std::uint32_t count) {
+std::uint32_t level_of_count(const TilesetShape& shape, std::uint32_t count) {
   std::uint32_t level = 0;
-  while (level + 1 < table.level_nominal.size() && table.level_nominal[level] < count) ++level;
+  while (level + 1 < shape.level_nominal.size() && shape.level_nominal[level] < count) ++level;
   return level;
 }
 
@@ -128,7 +125,7 @@ class DriftField {
 /// its ends (half-width `corner`, at its level). A run of vertical edges on a 1×2 torus sees the
 /// horizontal edges of that torus, not those a tile puts at the edge's ends, so two edge points that
 /// slipped into a corner square when the pyramid was sampled met nothing there that kept them apart
-/// (pairs 0.005 d_hex apart from 11,585 points per tile up: the stable set's near-coincident pairs).
+/// (the stable set's near-coincident pairs).
 /// Bounds per axis, so keeping a point in moves it no farther from any point inside, and a capped move
 /// (kMaxMove) stays so.
 void keep_in_bounds(PatchKind kind, double margin, double corner, double* rel) {
@@ -197,16 +194,16 @@ std::vector<LaterNeighbour> later_neighbours(PatchKind kind, std::size_t index, 
 /// points. No run moves them any more, and the runs that sample the patch know them only as stand-ins.
 std::vector<double> entry_obstacles(const std::vector<LevelPatches>& levels, const PatchWidths& w,
                                     std::uint32_t top, PatchKind kind, std::size_t index,
-                                    const TilesetData& table, std::size_t g, double reach) {
+                                    const TilesetShape& shape, std::size_t g, double reach) {
   std::vector<double> out;
-  const double previous = table.keyframe_nominal[g - 1];
-  for (const LaterNeighbour& n : later_neighbours(kind, index, table.colours))
+  const double previous = shape.keyframe_nominal[g - 1];
+  for (const LaterNeighbour& n : later_neighbours(kind, index, shape.colours))
     for (std::uint32_t j = 0; j <= top; ++j) {
       const Patch& patch = levels[j].of(n.kind)[n.index];
       const bool moved = patch.frames.size() > g - 1 && !patch.frames[g - 1].empty();
       const std::vector<double>& at = moved ? patch.frames[g - 1] : patch.xy;
       for (std::size_t i = 0; i < patch.size(); ++i) {
-        if (!TilesetData::emits(table.emission_threshold(j, patch.keys[i]), previous)) continue;
+        if (!TilesetShape::emits(shape.emission_threshold(j, patch.keys[i]), previous)) continue;
         const double x = at[2 * i] + n.dx, y = at[2 * i + 1] + n.dy;
         const bool near = kind == PatchKind::kCorner
                               ? std::fabs(x) < w.corner + reach && std::fabs(y) < w.corner + reach
@@ -228,13 +225,13 @@ void relative(const PatchPointRef& ref, const double* stable, int w, int h, doub
 }
 
 FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
-                   const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                   const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
                    int sweeps, std::uint64_t seed, int threads) {
-  const Colouring col = Colouring::torus(table.colours, run.w, run.h, run.grid);
-  const std::uint32_t count = table.keyframe_nominal[g];
-  const std::uint32_t previous = g ? table.keyframe_nominal[g - 1] : 0;
+  const Colouring col = Colouring::torus(shape.colours, run.w, run.h, run.grid);
+  const std::uint32_t count = shape.keyframe_nominal[g];
+  const std::uint32_t previous = g ? shape.keyframe_nominal[g - 1] : 0;
   const double spacing = hex_spacing(count);
-  const std::uint32_t top = level_of_count(table, count);
+  const std::uint32_t top = level_of_count(shape, count);
   auto wrap = [&](double& x, double& y) {
     x -= run.w * std::floor(x / run.w), y -= run.h * std::floor(y / run.h);
     if (x >= run.w) x = 0;  // rounding of a tiny negative value
@@ -256,9 +253,9 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
       unused.clear(), keys.clear(), refs.clear();
       gather(levels[j], col, kinds, 0, 0, run.w, run.h, unused, &keys, &refs);
       for (std::size_t i = 0; i < refs.size(); ++i) {
-        const float threshold = table.emission_threshold(j, keys[i]);
-        if (!TilesetData::emits(threshold, count)) continue;
-        const bool arrives = !TilesetData::emits(threshold, previous);
+        const float threshold = shape.emission_threshold(j, keys[i]);
+        if (!TilesetShape::emits(threshold, count)) continue;
+        const bool arrives = !TilesetShape::emits(threshold, previous);
         const Patch& patch = *refs[i].patch;
         const std::size_t at = 2 * refs[i].index;
         const double ax = refs[i].anchor_x, ay = refs[i].anchor_y;
@@ -354,7 +351,7 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
       auto [it, fresh] = near.emplace(copy.first, std::vector<double>{});
       if (fresh)
         it->second = entry_obstacles(levels, widths[top], top, kind,
-                                     std::size_t(copy.first - levels[top].of(kind).data()), table, g,
+                                     std::size_t(copy.first - levels[top].of(kind).data()), shape, g,
                                      2 * hex_spacing(previous));
       for (std::size_t k = 0; k < it->second.size(); k += 2) {
         GlidePath o;
@@ -424,8 +421,8 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
 
 }  // namespace
 
-std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal,
-                                           std::uint32_t per_level) {
+std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t>& nominal,
+                                                 std::uint32_t per_level) {
   std::vector<std::uint32_t> counts;
   if (per_level == 0 || nominal.empty()) return counts;
   counts.push_back(nominal[0]);
@@ -441,12 +438,12 @@ std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nom
 }
 
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
-                    const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                    const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
                     int sweeps, std::uint64_t seed, int threads) {
   for_each_run(
       runs, threads,
       [&](std::size_t r, int run_threads) {
-        return relax_run(levels, runs[r], widths, table, g, sweeps,
+        return relax_run(levels, runs[r], widths, shape, g, sweeps,
                          mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)), run_threads);
       },
       [&](std::size_t r, FrameRun& result) {

@@ -1,9 +1,9 @@
-// The gliding track of a tile set (kdm/runtime/tileset_format.h): keyframes between the pyramid's levels, at
+// The glide track of a tile set (kdm/runtime/tileset_format.h): keyframes between the pyramid's levels, at
 // each of which the points present are relaxed as a whole, so that a query in smooth mode shows a good
 // blue-noise set at every density, not only at the levels.
 //
-// Nested sets cannot do that: when no point ever moves, the worst density between two levels ×4 apart has
-// δavg ≈ .70 whatever the ranking (docs/design.md §3). Here the points present at keyframe g (a prefix of
+// Nested sets cannot do that: when no point ever moves, the worst density between two levels ×4 apart is
+// far from it whatever the ranking (docs/design.md §3). Here the points present at keyframe g (a prefix of
 // every tile's ranks, chosen by the same thresholds as the stable emission) start where keyframe g − 1 left
 // them, the new ones at their stable positions, and descend the KDM energy (T = 0) for a few sweeps; each
 // moves at most a bounded step, and pairs are kept apart at the keyframe and on the straight paths between
@@ -27,14 +27,14 @@ namespace kdm::gen {
 
 /// The keyframe counts: N_0, then `per_level` steps per level in geometric progression, each level's last
 /// step its nominal count (rounded to whole points). Empty if per_level is 0.
-std::vector<std::uint32_t> keyframe_counts(const std::vector<std::uint32_t>& nominal,
-                                           std::uint32_t per_level);
+std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t>& nominal,
+                                                 std::uint32_t per_level);
 
-/// Relaxes keyframe g: every patch of the levels up to `table.keyframe_nominal[g]` gets frames[g] (keyframe
-/// g − 1 must be done). `table` supplies the nominal and keyframe counts (its tiles are not read). Descends
+/// Relaxes keyframe g: every patch of the levels up to `shape.keyframe_nominal[g]` gets frames[g] (keyframe
+/// g − 1 must be done). `shape` supplies the colours and the level and keyframe counts. Descends
 /// `sweeps` sweeps; `seed` picks the sweep order.
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
-                    const std::vector<PatchWidths>& widths, const TilesetData& table, std::size_t g,
+                    const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
                     int sweeps, std::uint64_t seed, int threads);
 
 }  // namespace kdm::gen

@@ -1,4 +1,4 @@
-// The bake's schedule of sampler runs, shared by its pyramid levels and its gliding keyframes.
+// The bake's schedule of sampler runs, shared by its pyramid levels and its keyframes.
 //
 // Thread safety: for_each_run calls `sample` from up to `threads` threads at once (for runs of one stage,
 // which read only what earlier stages wrote) and `keep` from the calling thread, in run order.

@@ -1,6 +1,5 @@
 // Transparent huge pages for the sampler's largest buffers. Every first touch of a 4 KiB page is a fault,
-// and on virtual machines a fault is slow: on the machine docs/performance.md's figures come from, faulting
-// in 5 MiB took 17 ms as 4 KiB pages against 3.6 ms as 2 MiB pages. A buffer larger than glibc's largest mmap
+// and on virtual machines a fault is slow (docs/design.md §2.9). A buffer larger than glibc's largest mmap
 // threshold (32 MiB) is mapped afresh, and faulted in again, by every call: the footprint cache from n of
 // about 110,000 up.
 #pragma once
@@ -17,8 +16,8 @@ namespace kdm::gen {
 void advise_huge_pages(void* p, std::size_t bytes) noexcept;
 
 /// A vector of n copies of `value` whose storage, when the vector allocates it, is advised for huge pages
-/// before its first touch. For the grids of ρ and R: at 65,536 points on an image density they are some
-/// 100 MiB, and a one-off `kdm sample` run spent about a tenth of its time faulting them in.
+/// before its first touch. For the grids of ρ and R, the largest buffers of a run on an image density
+/// (docs/design.md §2.9).
 template <class T>
 std::vector<T> vector_on_huge_pages(std::size_t n, const T& value) {
   std::vector<T> v;

@@ -125,9 +125,8 @@ class Chain {
              ChainCounters& counters);
   // The block of R that a cell's updates touch: the cell and a margin of kCellBlockMargin nodes (a
   // footprint's reach at the peak density, its lane padding and a step). sweep() fetches the next cell's
-  // block a slice per update, so a cell does not start by missing the cache on every row it touches first: at
-  // n = 262,144, where R is 17 MB, those misses made the remove pass half as slow again as at n = 16,384, and
-  // fetching the blocks makes the whole run 10% faster.
+  // block a slice per update, so a cell does not start by missing the cache on every row it touches first
+  // (docs/design.md §2.9).
   struct CellBlock {
     std::array<std::int64_t, D> lo{}, hi{}, at{};  // the block, and the row of the next line (at[0] unused)
     std::int64_t lines_per_row = 0, column = 0;    // lines in a row; the next line's place in its row
@@ -152,7 +151,7 @@ class Chain {
       return line;
     }
   };
-  static constexpr int kCellBlockMargin = 8;  // 4 to 9 measured the same
+  static constexpr int kCellBlockMargin = 8;  // not critical (docs/design.md §2.9)
   CellBlock cell_block(int cell, int updates) const;
   KernelTable* table(Scratch& scratch) const {
     scratch.table.isa = isa_;

@@ -56,9 +56,8 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
   // shrinks as r falls: in exact arithmetic a removal never makes another kernel cheaper to remove. A cost
   // worked out before removals that changed R under it, less twice its rounding bound, is therefore a
   // floor for its cost now, and such a stale kernel is worked out again only when its floor is below the
-  // cheapest current cost. Costs no removal touched are current bit for bit. At n = 32,768 in 3D (some
-  // 440 removals among 4,500 kernels) this works out about 4 costs per removal where working out those
-  // of every kernel the removal reached took about 380: the count fixing took 100 ms and now takes 23.
+  // cheapest current cost. Costs no removal touched are current bit for bit. Few stale costs are worked
+  // out again (docs/design.md §2.5).
   const std::vector<float>& R = chain.residual();
   const std::vector<float>& rho = chain.density().rho;
   double max_abs_r = 0;

@@ -172,7 +172,7 @@ void FootprintCache<D>::reserve(std::size_t n) {
   entries_.reset(static_cast<CachedFootprint<D>*>(
       ::operator new (n * sizeof(CachedFootprint<D>), std::align_val_t{alignof(CachedFootprint<D>)})));
   // Faulted in 512 times less often, and, touched by every update in an order unrelated to its layout,
-  // kinder to the TLB: 7-9% of the run time at n = 262,144 (docs/performance.md).
+  // kinder to the TLB (docs/design.md §2.9).
   advise_huge_pages(entries_.get(), n * sizeof(CachedFootprint<D>));
   capacity_ = n;
 }

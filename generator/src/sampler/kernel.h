@@ -74,8 +74,8 @@ void axis_lanes(double x, double sigma, std::int64_t first, int count, std::int6
 
 /// Allocates whole cache lines (64-byte aligned, sizes rounded up to 64 bytes), so a thread's scratch
 /// buffers never share a line with memory another thread writes. With glibc's 16-byte chunks, the small
-/// footprint buffers of the calling thread sat next to other threads' data: at n = 16,384 on two threads,
-/// half the seeds then ran 108–113 ms instead of 80–84, with every update on both threads slower.
+/// footprint buffers of the calling thread sat next to other threads' data, and every update on both
+/// threads was slower (docs/design.md §2.9).
 template <class T>
 struct LineAllocator {
   using value_type = T;
@@ -201,8 +201,8 @@ struct Footprint {
 };
 
 /// A small footprint kept with its particle between sweeps: a particle's next update starts where this
-/// one ended, so its footprint there need not be built again (building is a quarter of an update). Used
-/// only for the exact position, σ and amplitude it was built from, so results do not change.
+/// one ended, so its footprint there need not be built again (docs/design.md §2.9). Used only for the
+/// exact position, σ and amplitude it was built from, so results do not change.
 template <int D>
 struct CachedFootprint {
   static constexpr int kLanes = 12;  ///< the common footprint at the peak density fits in 12 lanes per axis

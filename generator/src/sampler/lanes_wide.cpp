@@ -18,7 +18,7 @@
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define KDM_HAVE_WIDE_PASSES 1
 // GCC 12's AVX-512 casts and inserts start from a deliberately undefined vector, which -Wuninitialized
-// reports from inside immintrin.h (GCC bug 105593, fixed in GCC 13).
+// reports from inside immintrin.h, a false positive that GCC 13 no longer gives.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -84,7 +84,7 @@ KDM_TARGET inline V signed_by(V r, V x) {
 }
 // A row of W = 8, 12 or 16 nodes in the low lanes, the rest zero. Plain 8- and 4-lane loads and stores, not
 // masked ones: this CPU family forwards a store to a later masked load slowly, and the passes read nodes
-// that the previous update has just written (measured: masked rows made the passes 8% slower).
+// that the previous update has just written (docs/design.md §2.9).
 template <int W>
 KDM_TARGET inline V load_row(const float* p) {
   static_assert(W == 8 || W == 12 || W == 16, "rows of 8, 12 or 16 nodes");

@@ -18,7 +18,7 @@ struct NormalZiggurat {
   static constexpr double kLayerArea = 0.00492867323399;    ///< v: the area of every layer
   /// x[i]: layer i's half-width; x[0] is the base layer's equivalent width (area v / f(r)), x[256] = 0.
   std::array<double, kLayers + 1> x{};
-  /// f(x[i]) with f(t) = exp(-t²/2), the unnormalized density.
+  /// f(x[i]) with f(t) = exp(-t²/2), the unnormalised density.
   std::array<double, kLayers + 1> f{};
   /// x[i + 1] / x[i]: |u| below this is inside layer i's sure part.
   std::array<double, kLayers> inner{};

@@ -22,7 +22,7 @@ std::string format_position(const double* u) {
   return s.str();
 }
 
-/// Where normalized coordinate u falls between an image's pixel centres, which sit at (i + 1/2) / pixels,
+/// Where normalised coordinate u falls between an image's pixel centres, which sit at (i + 1/2) / pixels,
 /// clamped at the edges (columns from the left, rows from the bottom).
 struct PixelLerp {
   int lo, hi;

@@ -134,7 +134,7 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
   w.key("sets").value(r.sets).key("points_min").value(r.points_min).key("points_max").value(r.points_max);
   w.key("points_mean").value(r.points_mean);
   w.key("spacing_unit").value(r.dim == 2 ? "d_hex = sqrt(2/(sqrt(3) n))" : "fcc = (sqrt(2)/n)^(1/3)");
-  w.key("nearest_neighbor");
+  w.key("nearest_neighbour");
   write_nn(w, r.nn);
   w.key("dmin_mean_over_sets").value(r.dmin_mean).key("dmin_per_set").value(r.dmin_per_set);
   if (r.has_spectrum) {

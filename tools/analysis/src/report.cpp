@@ -55,7 +55,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
 
   std::vector<double> pooled, seam, interior;
   for (const tools::PointSet& s : sets) {
-    const NearestNeighbors nn = nearest_neighbors(s.coords, s.dim, o.torus, o.threads);
+    const NearestNeighbours nn = nearest_neighbours(s.coords, s.dim, o.torus, o.threads);
     const double spacing = reference_spacing(s.dim, s.size());
     double lo = nn.distance.front();
     for (double d : nn.distance) {
@@ -66,7 +66,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     if (o.tile_size > 0) split_by_seam(s.coords, s.dim, nn, o.tile_size, seam, interior);
     if (o.tile_size > 0 && s.dim == 2) add_edge_bands(s.coords, s.dim, o.tile_size, r.edges);
   }
-  r.nn = summarize_nn(pooled, 1.0);
+  r.nn = summarise_nn(pooled, 1.0);
   r.dmin_mean = 0;
   for (double d : r.dmin_per_set) r.dmin_mean += d / static_cast<double>(r.dmin_per_set.size());
 
@@ -112,8 +112,8 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   if (o.tile_size > 0) {
     r.has_tiling = true;
     r.tile_size = o.tile_size;
-    r.seams.seam = summarize_nn(seam, 1.0);
-    r.seams.interior = summarize_nn(interior, 1.0);
+    r.seams.seam = summarise_nn(seam, 1.0);
+    r.seams.interior = summarise_nn(interior, 1.0);
     r.seams.ks = ks_two_sample(seam, interior);
     if (r.has_spectrum)
       r.periodicity = periodicity_ratio(r.spectrum, r.spectrum_stats, o.tile_size);

@@ -98,7 +98,7 @@ KsResult ks_smaller(std::vector<double> a, std::vector<double> b, double up_to) 
   return r;
 }
 
-void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbors& nn, double tile_size,
+void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbours& nn, double tile_size,
                    std::vector<double>& seam, std::vector<double>& interior) {
   const int t = tiles_per_axis(tile_size);
   const std::size_t n = coords.size() / dim;
@@ -123,12 +123,12 @@ SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, doubl
   tiles_per_axis(tile_size);
   std::vector<double> seam, interior;
   for (const tools::PointSet& s : sets) {
-    const NearestNeighbors nn = nearest_neighbors(s.coords, s.dim, torus, threads);
+    const NearestNeighbours nn = nearest_neighbours(s.coords, s.dim, torus, threads);
     split_by_seam(s.coords, s.dim, nn, tile_size, seam, interior);
   }
   SeamStats out;
-  out.seam = summarize_nn(seam, 1.0);
-  out.interior = summarize_nn(interior, 1.0);
+  out.seam = summarise_nn(seam, 1.0);
+  out.interior = summarise_nn(interior, 1.0);
   out.ks = ks_two_sample(seam, interior);
   return out;
 }

@@ -1,4 +1,4 @@
-// Part 5 of the generator test (verify.h): the gliding track. For every keyframe, over every tile's 2×2
+// Part 5 of the generator test (verify.h): the glide track. For every keyframe, over every tile's 2×2
 // torus, the points at their keyframe positions (δavg, closest pair), the same half-way to the next
 // keyframe (where the points present glide between two relaxed sets), and how far the points move from
 // one keyframe to the next, in mean nearest-neighbour distances of the later one.
@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "kdm/analysis/common.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/generator/bake.h"
 #include "kdm/verify/verify.h"
 #include "tile_torus.h"
@@ -19,7 +19,7 @@ namespace {
 std::vector<std::size_t> glide_starts(const TilesetData& set, const Tile& tile) {
   std::vector<std::size_t> start(set.keyframe_nominal.size() + 1, 0);
   for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
-    start[g + 1] = start[g] + set.glide_count(tile, g);
+    start[g + 1] = start[g] + set.offsets_at_keyframe(tile, g);
   return start;
 }
 
@@ -34,7 +34,7 @@ std::vector<double> glide_torus(const TilesetData& set, std::size_t t, double co
       const std::vector<std::size_t> start = glide_starts(set, tile);
       for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
         for (; i < tile.level_end[k]; ++i) {
-          if (!TilesetData::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
+          if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
           const std::int8_t* o0 = &tile.glide[2 * (start[g0] + i)];
           const std::int8_t* o1 = &tile.glide[2 * (start[g1] + i)];
           const double e0 = set.glide_unit(g0), e1 = set.glide_unit(g1);
@@ -71,14 +71,14 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
         const std::size_t n = coords.size() / 2;
         done(double(n));
         if (n < 2) continue;
-        analysis::NearestNeighbors nn;
+        analysis::NearestNeighbours nn;
         add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
         if (half || g == 0) continue;
         // Motion into this keyframe, of the tile's own points present at the last one (or entering there).
         const Tile& tile = set.tiles[t];
         const std::vector<std::size_t> start = glide_starts(set, tile);
         const double spacing = analysis::hex_spacing(std::size_t(k0));  // tile sides: d_hex at K_g
-        for (std::uint32_t i = 0; i < set.glide_count(tile, g - 1); ++i) {
+        for (std::uint32_t i = 0; i < set.offsets_at_keyframe(tile, g - 1); ++i) {
           const std::int8_t* a = &tile.glide[2 * (start[g - 1] + i)];
           const std::int8_t* c = &tile.glide[2 * (start[g] + i)];
           const double ea = set.glide_unit(g - 1), ec = set.glide_unit(g);

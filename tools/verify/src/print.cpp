@@ -86,9 +86,10 @@ void print_report(const Report& report, std::FILE* out) {
     }
   }
   if (!report.keyframes.empty()) {
-    std::fprintf(out,
-                 "\ngliding track (smooth mode), over every tile's torus; closest pair in d_hex; motion from the "
-                 "keyframe before, in mean nearest-neighbour distances\n");
+    std::fprintf(
+        out,
+        "\nglide track (smooth mode), over every tile's torus; closest pair in d_hex; motion from the "
+        "keyframe before, in mean nearest-neighbour distances\n");
     std::fprintf(out, "%11s %9s %7s %8s %11s %10s  %s\n", "points/tile", "kind", "δavg", "closest",
                  "motion mean", "motion p99", "result");
     for (const KeyframeResult& k : report.keyframes) {

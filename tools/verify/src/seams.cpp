@@ -1,37 +1,12 @@
-// Parts 3 and 4 of the generator test (verify.h): seams and in-between densities.
-//
-// Seams. For each density, over the tori of all tiles: (a) every tile's edge links (NN links crossing a
-// tile edge) have δmin ≥ 0.9 × the δmin of its other links; (b) the pooled NN distances of edge links are
-// not shorter than those of links crossing the lines halfway between tile edges (the same count of lines
-// with the same geometry, so the comparison is neutral: longer links cross any line more often, which
-// makes edge links look better than interior ones in a plain seam/interior split). A seam defect shortens
-// links, so the comparison is one-sided: Kolmogorov–Smirnov D+ (analysis::ks_smaller), the largest excess
-// of edge links over midline links shorter than any length below the midline links' median. Above it the
-// excess says nothing about short links: a set has few distinct edge patches, so link lengths repeat and
-// the CDFs step, and a set whose edge links are all near the median (edges more regular than midlines)
-// showed D+ 0.14 there (4-level set with 1-spacing margins, 104 points per tile: no edge link shorter than
-// 0.80 d, 26% of midline links shorter). A density fails when the excess is both
-// significant (p < 0.001) and large (D+ > 0.1: a visible seam, a tenth of the edge links pushed short).
-// Significance alone is no bar: with 10^4 links per density p falls below 0.001 already at D+ = 0.03, and
-// the default set's top level measures D+ 0.035, p 7e-8, a small real excess of short edge links. Size alone
-// is none either: a set of one tile has a few dozen edge links at its lowest level, where D+ 0.4 is chance (p
-// 0.02). On the default set D+ is at most 0.096. A two-sided test would also flag edge links that are longer
-// than midline links, no defect. Each distinct link counts once: a shared patch shows the same links in
-// every torus that holds it (and a mutual nearest pair is one link seen from both ends), so the pools hold
-// few distinct lengths many times over (a 4-level set at 224 points per tile: 40 distinct edge links in
-// 5,142), and counting repeats as samples would make chance look significant.
-//
-// Between complete levels (what the runtime emits at in-between densities) the tiles stay blue at low
-// frequencies: lowP ≤ 0.105 on every tile's torus once it holds ≥ 1792 points (fewer average too few
-// frequencies for lowP to mean much). The target is 0.1; on the default set the worst of the 16 tiles
-// × 9 densities measures 0.1002 (3/4 of the way from 512 to 2048 points per tile), the rest at most
-// 0.0962.
+// Parts 3 and 4 of the generator test (verify.h): seams and in-between densities. A seam defect shortens
+// links, so edge links are tested against midline links, one-sided, over the short half and counting each
+// distinct link once; why each, and the bars: docs/design.md §5.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "kdm/analysis/common.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/analysis/tiling.h"
 #include "kdm/verify/verify.h"
@@ -70,7 +45,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
       const std::size_t n = coords.size() / 2;
       done(double(n));
       if (n < 2) continue;
-      analysis::NearestNeighbors nn;
+      analysis::NearestNeighbours nn;
       add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
       analysis::add_edge_bands(coords, 2, 0.5, bands);
       std::vector<double> edge, inside;
@@ -92,7 +67,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
       row.worst_low_p = std::isnan(row.worst_low_p) ? low_p : std::max(row.worst_low_p, low_p);
     }
     // Distinct links only, and the short half only: above the midline median the gap measures the shape
-    // of the body, not short links (see the file comment).
+    // of the body, not short links (docs/design.md §5).
     edge_pool = distinct(std::move(edge_pool)), midline_pool = distinct(std::move(midline_pool));
     const double median = midline_pool.empty() ? std::numeric_limits<double>::infinity()
                                                : midline_pool[midline_pool.size() / 2];

@@ -16,7 +16,7 @@ std::vector<double> torus_points(const TilesetData& set, std::size_t t, double c
       const Tile& tile = set.tiles[gen::tile_around(set.colours, t, tx, ty)];
       for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
         for (; i < tile.level_end[k]; ++i) {
-          if (!TilesetData::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
+          if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
           const double x = (tx + tile.points[i].unit_x()) / 2, y = (ty + tile.points[i].unit_y()) / 2;
           all.insert(all.end(), {x, y});
           std::vector<double>* part = (tx == 0 && ty == 0) ? own : others;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "kdm/analysis/common.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
@@ -37,10 +37,10 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
 /// closest_pair (a DensityResult or KeyframeResult).
 template <class Row>
 analysis::NNStats add_torus_nn(const std::vector<double>& coords, std::size_t tiles, int threads,
-                               analysis::NearestNeighbors& nn, Row& row) {
-  nn = analysis::nearest_neighbors(coords, 2, true, threads);
+                               analysis::NearestNeighbours& nn, Row& row) {
+  nn = analysis::nearest_neighbours(coords, 2, true, threads);
   const analysis::NNStats summary =
-      analysis::summarize_nn(nn.distance, analysis::hex_spacing(coords.size() / 2));
+      analysis::summarise_nn(nn.distance, analysis::hex_spacing(coords.size() / 2));
   row.davg += summary.davg / double(tiles);
   row.closest_pair = std::min(row.closest_pair, summary.dmin);
   return summary;

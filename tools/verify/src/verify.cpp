@@ -1,33 +1,11 @@
 // Parts 1 and 2 of the generator test (verify.h): every tile and level against full-sampler runs, and
-// the direct check. Why the bars are what they are (measured on the default set, tilesets/default.recipe):
-//  - Small tiles. The targets are E/n ≤ ref + 5%, lowP ≤ 1.5 × ref and NN1% ≥ 0.85 × ref. Levels whose
-//    tiles are less than 16 point spacings wide (the default set's levels 0 and 1: 5.7 and 11.3) cannot meet
-//    them all: there the corner and edge patches are one to three spacings wide and their boundaries show
-//    as local density errors (measured worst: E/n +12.5%, lowP 2.7 × ref and 2.1 × the largest, NN1% 0.847 ×
-//    ref). They are held to E/n ≤ ref + 20%, lowP ≤ 3 × ref (or 3 × the largest reference where few
-//    frequencies count) and NN1% ≥ 0.8 × ref instead — still far from white noise (lowP 1).
-//    The direct check's energy drop is held to 3% (the target) from 16 spacings on, where the default
-//    set's tiles measure at most 2.1% (1.4% from level 3 on); the smaller levels' patch boundaries relax
-//    measurably (level 1: 2.7%; level 0: up to 3.8%, its E/n being up to 12% above the reference), so
-//    there the bar is 6%. For scale: a full-sampler
-//    set with default options, freed the same way, drops −3% to 5% (it is sampled with 15–30 sweeps per
-//    level, the tiles with 100 or more), which the report prints as the control.
-//  - lowP of one set averages few frequencies when n is small (the torus at level 0 holds ~128 points:
-//    ~25 frequencies, each roughly exponential); there the 1.5× bar is noise, so tori with fewer than 100
-//    frequencies below f = 0.5 must instead stay within (a multiple of) the range of the reference runs.
-//  - RAPS in bands of 0.25 over 0.5 ≤ f < 2: within ±0.1 of the reference, or 4 standard deviations of a
-//    one-set band mean (RAPS / sqrt(values / 2), P(k) = P(−k)) where that is wider. Only for levels of
-//    ≥ 4096 points per tile: smaller levels are baked with 4–64× the default sweeps (BakeRecipe::sweeps_for)
-//    and are measurably more ordered than default runs (a sharper peak).
-//  - The direct check's drift is not "less than 0.1 spacings": at the default temperature every sample of
-//    P diffuses by about 0.16 spacings in 15 sweeps (thermal motion, measured on the full sampler's own
-//    output: the control), so the bar is the control's drift plus 25% for the spread between sets and
-//    levels (controls and tiles measured within ±10% of each other).
+// the direct check. The bars, and why small tiles, few frequencies and small levels' RAPS are judged
+// otherwise: docs/design.md §5 (the shipped set's figures: docs/quality.md).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
@@ -136,6 +114,7 @@ void judge_statistics(const std::vector<double>& coords, const Reference& ref, d
       const auto [tile_band, values] = band_raps(spectrum, lo, lo + 0.25);
       const double ref_band = band_raps(ref.spectrum, lo, lo + 0.25).first;
       if (!(values > 0)) continue;
+      // A one-set band mean of `values` exponentials, P(k) = P(−k): its sd is RAPS / √(values / 2).
       const double tolerance = std::max(b.raps, 4 * ref_band / std::sqrt(values / 2));
       char name[32];
       std::snprintf(name, sizeof name, "|ΔRAPS| f %.2g-%.2g", lo, lo + 0.25);
@@ -214,7 +193,7 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     if (options.direct_check) total += set.tiles.size() * 4 * n;
     if (options.seams) total += set.tiles.size() * 4 * n * (k ? 4 : 1);
   }
-  if (options.keyframes)
+  if (options.glide_track)
     for (std::uint32_t n : set.keyframe_nominal) total += set.tiles.size() * 4 * 2.0 * n;
   const auto done = [&](double units) {
     finished += units;
@@ -235,7 +214,7 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     }
   }
   if (options.seams) judge_densities(set, options, report, done);
-  if (options.keyframes) judge_keyframes(set, options, report, done);
+  if (options.glide_track) judge_keyframes(set, options, report, done);
   if (options.progress) options.progress(1.0);
   return report;
 }

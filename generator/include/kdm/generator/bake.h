@@ -57,13 +57,13 @@ struct BakeRecipe {
   /// apart (bake.cpp says why): 0 (recipes without the key) not at all; 1 ranked together with them; 2
   /// present in proportion, each weighing the fraction of the patch already ranked.
   int rank_context = 0;
-  /// After the gliding track is relaxed, the later of any two points closer than this many hexagonal
+  /// After the glide track is relaxed, the later of any two points closer than this many hexagonal
   /// spacings at some density along it is removed (close_pairs.h, drop_close_glides). 0 (off) in recipes
   /// that do not name it.
   double glide_separation = 0;
-  /// Gliding track (keyframes.h): keyframes per level (0 = none, the set then only serves stable queries),
+  /// Glide track (keyframes.h): keyframes per level (0 = none, the set then only serves stable queries),
   /// and the descent sweeps that relax each keyframe.
-  std::uint32_t keyframes = 0;
+  std::uint32_t keyframes_per_level = 0;  ///< recipe key `keyframes`
   int glide_sweeps = 10;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,

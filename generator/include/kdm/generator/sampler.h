@@ -24,7 +24,7 @@ struct InvalidArgument : std::invalid_argument {
 /// keep their full mass inside the domain and points reach the edge at the target density.
 enum class Domain { kTorus, kBox };
 
-/// Relative target density at normalized position u in [0, 1)^dim. Must return a finite value >= 0.
+/// Relative target density at normalised position u in [0, 1)^dim. Must return a finite value >= 0.
 /// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe.
 using DensityFunction = std::function<double(const double* u)>;
 
@@ -72,7 +72,7 @@ struct SamplerOptions {
   int dim = 2;  ///< 2 or 3
   Domain domain = Domain::kTorus;
   double extent[3] = {1, 1,
-                      1};  ///< relative side lengths (aspect ratio); normalized output is still [0,1)^dim
+                      1};  ///< relative side lengths (aspect ratio); normalised output is still [0,1)^dim
   /// Exact number of points to return (> 0). Set to 0 to use `resolution` instead.
   std::int64_t n = 4096;
   /// Used when n == 0: finest grid nodes along the shortest axis; the count then follows from the
@@ -95,8 +95,8 @@ struct SamplerOptions {
   /// Deterministic descent sweeps (T = 0) right after each refinement, before the MH sweeps: they spread
   /// the crowded children of split kernels. Initialisation only; the MH sweeps then sample P.
   int burn_in_sweeps = 3;
-  /// Δt of eq. 5 (Δt_j = T σ_j Δt / w), model units; 0 = automatic: 0.35 in 2D, 0.1 in 3D (measured to
-  /// give acceptance rates near 0.5–0.6, where the chain relaxes fastest per sweep).
+  /// Δt of eq. 5 (Δt_j = T σ_j Δt / w), model units; 0 = automatic: 0.35 in 2D, 0.1 in 3D, where the chain
+  /// relaxes fastest per sweep (docs/design.md §2.2).
   double step = 0;
   bool metropolis = true;  ///< false = unadjusted Langevin (biased; for experiments only)
   Numerics numerics = Numerics::kFast;
@@ -105,22 +105,22 @@ struct SamplerOptions {
   /// width); lower values are for testing that and for measuring.
   int vector_lanes = 16;
   /// Memory for keeping each point's kernel footprint between sweeps (about 300 bytes per point in 2D):
-  /// a quarter less work per update. Levels with more points than fit skip it. The output does not depend
-  /// on it.
+  /// an update then builds one footprint, not two (docs/design.md §2.9). Levels with more points than fit
+  /// skip it. The output does not depend on it.
   std::size_t footprint_cache_bytes = std::size_t(256) << 20;
   /// Varying densities: before the finest sweeps, move the points so that their counts on coarse grids
-  /// match the density (docs/design.md §2). Without it sparse regions get too few points (−5% at 1:1000,
-  /// more with the range); off only to measure that.
+  /// match the density. Without it sparse regions get too few points, the more so the wider the density's
+  /// range (docs/design.md §2.6); off only to measure that.
   bool count_balance = true;
   double peak_density = 0.43;  ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
   double sigma_max = 4.0;      ///< kernels at least this wide (grid units) are frozen (paper: σmax)
   int coarsest_grid = 32;      ///< nodes along the shortest axis of the coarsest grid (paper: 32)
   std::int64_t max_grid_nodes = std::int64_t(1) << 27;  ///< refuse larger finest grids (memory guard)
-  /// Constrained sampling: points already placed (normalized coordinates, dim per point). Their kernels are
+  /// Constrained sampling: points already placed (normalised coordinates, dim per point). Their kernels are
   /// background that never moves; the chain samples the n new points from P(new | fixed). The result
   /// holds only the new points. The density is scaled for n + fixed count points in all.
   std::vector<double> fixed_points;
-  /// Relaxation instead of sampling: when not empty, the free points start here (normalized coordinates,
+  /// Relaxation instead of sampling: when not empty, the free points start here (normalised coordinates,
   /// dim per point; n is taken as their count) and only `burn_in_sweeps` descent and `sweeps` MH sweeps run
   /// on the finest grid, with no multi-scale. The result keeps their order. For checking that a point set
   /// already is an equilibrium sample (it then neither drifts nor drops in energy).
@@ -165,7 +165,7 @@ struct SampleReport {
 
 struct SampleResult {
   int dim = 2;
-  std::vector<double> points;  ///< n * dim coordinates, normalized to [0, 1) on every axis
+  std::vector<double> points;  ///< n * dim coordinates, normalised to [0, 1) on every axis
   SampleReport report;
   std::size_t size() const { return points.size() / dim; }
 };
@@ -180,7 +180,7 @@ int default_thread_count();
 /// Draws one point set from the KDM model. Throws InvalidArgument on bad options or density.
 SampleResult sample(const SamplerOptions& options, const Density& density = Density::constant());
 
-/// E / n of `points` (normalized coordinates) under the model sample() would use for the same count,
+/// E / n of `points` (normalised coordinates) under the model sample() would use for the same count,
 /// domain and density: the energy of eq. 3 on the finest grid. Lets any point set (tiles, other
 /// samplers) be compared with full-sampler runs on one scale. Throws InvalidArgument on bad input.
 double energy_per_point(const SamplerOptions& options, const Density& density,

@@ -60,7 +60,7 @@ typedef struct kdm_query {
   const kdm_density_image* density_image; /* optional; takes precedence over the callback */
   /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
   int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
-               density, so every density is good blue noise (tile sets with a gliding track) */
+               density, so every density is good blue noise (tile sets with a glide track) */
 } kdm_query;
 
 enum { KDM_MODE_STABLE = 0, KDM_MODE_SMOOTH = 1 };
@@ -104,7 +104,7 @@ typedef struct kdm_tileset_info {
   const char* generator_version; /* the kdm version that baked it; valid while the tile set lives */
   const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
   /* Added in 0.2: */
-  uint32_t keyframes; /* keyframes of its gliding track (0: none; smooth queries emit stable positions) */
+  uint32_t keyframes; /* keyframes of its glide track (0: none; smooth queries emit stable positions) */
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`

@@ -66,7 +66,7 @@ enum class QueryMode : int {
   kStable = 0,
   /// Points glide continuously with the density (never jump), so every density is a good blue-noise set:
   /// for stippling and sample patterns. Ids, emission densities and zoom coherence by id are those of
-  /// stable mode, except that no point shows where the density is zero. A tile set without a gliding
+  /// stable mode, except that no point shows where the density is zero. A tile set without a glide
   /// track emits its stable positions.
   kSmooth = 1,
 };

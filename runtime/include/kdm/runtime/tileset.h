@@ -48,14 +48,14 @@ class KDM_RUNTIME_API Tileset {
   /// Index into data().tiles of the tile shown at tile coordinates (tx, ty). Thread-safe.
   std::size_t tile_index_at(std::int64_t tx, std::int64_t ty) const;
   const Tile& tile_at(std::int64_t tx, std::int64_t ty) const { return set_.tiles[tile_index_at(tx, ty)]; }
-  /// Whether the set has a gliding track (smooth queries then glide; without one they emit stable
+  /// Whether the set has a glide track (smooth queries then glide; without one they emit stable
   /// positions).
-  bool has_glide() const { return !set_.keyframe_nominal.empty(); }
+  bool has_glide_track() const { return !set_.keyframe_nominal.empty(); }
   /// The farthest any point glides from its stable position in smooth mode, per axis, in tile sides (0
-  /// without a gliding track).
+  /// without a glide track).
   double glide_reach() const;
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
-  /// thresholds, gliding tables, recipe text), not counting allocator overhead. The builtin set's decoded
+  /// thresholds, glide tables, recipe text), not counting allocator overhead. The builtin set's decoded
   /// copy is the same size; its compressed bytes in the library's data section are extra. Thread-safe.
   std::size_t resident_bytes() const;
 

@@ -10,33 +10,17 @@
 // (emission_threshold). Points that several tiles share near corners and edges have the same key in all of
 // them, so every tile emits the same subset of them at any density: mid-level densities stay seamless.
 //
-// Gliding (smooth emission): a set may also carry keyframes, expected counts K_0 < … < K_{G-1} = N_top
+// The glide track (smooth mode): a set may also carry keyframes, expected counts K_0 < … < K_{G-1} = N_top
 // per tile (keyframe_nominal). At keyframe g every point emitted there (threshold < K_g) has a position
-// of its own, stored as an 8-bit offset from its stable position in units of a 32nd of that keyframe's
-// spacing 1/√K_g (Tile::glide, TilesetData::glide_unit); between two keyframes a point moves linearly from
-// its position at the one to its position at the next. A point that appears between them has a position
-// at the earlier one too (where it enters), so it glides in from there. Each keyframe was relaxed as a
-// whole, so densities between levels are good blue noise too, and points still appear in rank order.
+// of its own, stored as an 8-bit glide offset from its stable position in units of a 32nd of that
+// keyframe's spacing 1/√K_g (Tile::glide, TilesetShape::glide_unit); between two keyframes a point moves
+// linearly from its position at the one to its position at the next. A point that appears between them has a
+// position at the earlier one too (where it enters), so it glides in from there. Each keyframe was relaxed as
+// a whole, so densities between levels are good blue noise too, and points still appear in rank order.
 //
-// File layout (all integers little-endian):
-//   offset  size  field
-//        0     8  magic "KDMTILES"
-//        8     4  format version (kTilesetFormatVersion)
-//       12     4  header size in bytes (64 + recipe size + generator version size)
-//       16     8  payload size in bytes (zstd frame)
-//       24     8  payload size once decompressed
-//       32     4  CRC-32 of the payload bytes
-//       36     4  tile count (= colours^4)
-//       40     4  colours
-//       44     4  levels
-//       48     4  recipe size;  52: generator version size;  56: reserved (0)
-//       60     4  CRC-32 of the whole header with this field read as zero
-//       64     …  recipe text, then generator version text
-//   header size … payload: zstd-compressed cereal portable-binary archive: colours, levels, tile count,
-//                  level_nominal, keyframe_nominal, then per tile its level_end, x y pairs, keys and
-//                  glide offsets (still read: format 2, no keyframe_nominal and no glide; format 3, glide
-//                  offsets as 16-bit differences in 1/65536 tile sides, converted to 8 bits on reading)
-// The file is exactly header size + payload size bytes long.
+// The file: a 64-byte header with magic, version, sizes and two CRC-32s (TilesetHeader), the recipe and
+// generator version texts, then one zstd frame holding a cereal portable-binary archive of the TilesetData.
+// Every byte is described, once, in docs/tileset-format.md.
 //
 // Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
 #pragma once
@@ -69,11 +53,11 @@ inline constexpr double kGlideUnitsPerSpacing = 32;
 struct TilePoint {
   std::uint16_t x = 0, y = 0;
   /// The point for unit-square coordinates u, v in [0, 1) (floored to the 1/65536 grid, clamped).
-  static TilePoint from_unit(double u, double v) { return {quantize(u), quantize(v)}; }
+  static TilePoint from_unit(double u, double v) { return {quantise(u), quantise(v)}; }
   /// Unit-square position of the grid cell's centre, in [0, 1).
   double unit_x() const { return (x + 0.5) * (1.0 / 65536.0); }
   double unit_y() const { return (y + 0.5) * (1.0 / 65536.0); }
-  static std::uint16_t quantize(double u) {
+  static std::uint16_t quantise(double u) {
     const double t = u * 65536.0;
     return static_cast<std::uint16_t>(t <= 0 ? 0.0 : (t >= 65535.0 ? 65535.0 : t));
   }
@@ -87,10 +71,10 @@ struct Tile {
   TilesetArray<std::uint16_t> keys;
   /// level_end[k] = number of points in levels 0..k; non-decreasing; level_end.back() == points.size().
   TilesetArray<std::uint32_t> level_end;
-  /// Gliding offsets (x, y pairs from the point's stable position, in TilesetData::glide_unit(g) tile
+  /// Glide offsets (x, y pairs from the point's stable position, in TilesetShape::glide_unit(g) tile
   /// sides): keyframe 0's for ranks [0, count_0), then keyframe 1's for [0, count_1), …, where count_g is
-  /// TilesetData::glide_count (the points present at keyframe g or appearing before the next one).
-  /// Empty without keyframes.
+  /// TilesetShape::offsets_at_keyframe (the points present at keyframe g or appearing before the next
+  /// one). Empty without a glide track.
   TilesetArray<std::int8_t> glide;
   /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
   std::uint32_t level_of(std::uint32_t rank) const {
@@ -103,22 +87,19 @@ struct Tile {
   }
 };
 
-struct TilesetData {
-  std::uint32_t colours = 0;  ///< corner colours C; tiles.size() == C^4
+/// What a tile set's tiles fit into: its corner colours, and how many points per tile each level and each
+/// keyframe holds, with the rules that turn a point's level and key into the expected count where it
+/// appears. The baker works with it before any tile exists; TilesetData adds the tiles.
+struct TilesetShape {
+  std::uint32_t colours = 0;  ///< corner colours C; C^4 tiles
   std::uint32_t levels = 0;   ///< pyramid levels per tile
   /// Nominal points per tile in levels 0..k (the count a tile of uniform density has on average);
   /// strictly increasing, positive. Emission thresholds are placed between these.
   TilesetArray<std::uint32_t> level_nominal;
-  /// Keyframes of the gliding track, expected points per tile: strictly increasing, the last one the top
-  /// level's nominal count. Empty: the set has no gliding track (smooth queries then emit stable positions).
+  /// The keyframes of the glide track: nominal points per tile at each, strictly increasing, the last one
+  /// the top level's. Empty: the set has no glide track (smooth queries then emit stable positions).
   TilesetArray<std::uint32_t> keyframe_nominal;
-  TilesetArray<Tile> tiles;       ///< index tile_index(sw, se, ne, nw)
-  std::string recipe;             ///< the recipe text that rebuilds this set exactly
-  std::string generator_version;  ///< the kdm version that baked it
 
-  std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
-    return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
-  }
   /// The expected point count per tile above which a point of `level` with key `key` is emitted, in
   /// the float precision the runtime stores it in (4 bytes per point).
   float emission_threshold(std::uint32_t level, std::uint16_t key) const {
@@ -132,14 +113,8 @@ struct TilesetData {
   double glide_unit(std::size_t g) const {
     return 1.0 / (kGlideUnitsPerSpacing * std::sqrt(double(keyframe_nominal[g])));
   }
-  /// How many of `tile`'s points have a position at keyframe g: those present there or appearing before
-  /// the next keyframe (they glide in from it); every point at the last keyframe. A prefix of its ranks.
-  std::uint32_t glide_count(const Tile& tile, std::size_t g) const {
-    return g + 1 < keyframe_nominal.size() ? keyframe_count(tile, g + 1)
-                                           : static_cast<std::uint32_t>(tile.points.size());
-  }
   /// How many of `tile`'s points are present at keyframe g (threshold < K_g: a prefix of its ranks).
-  std::uint32_t keyframe_count(const Tile& tile, std::size_t g) const {
+  std::uint32_t points_at_keyframe(const Tile& tile, std::size_t g) const {
     std::uint32_t lo = 0, hi = static_cast<std::uint32_t>(tile.points.size());
     while (lo < hi) {  // thresholds grow with rank
       const std::uint32_t mid = lo + (hi - lo) / 2;
@@ -150,12 +125,52 @@ struct TilesetData {
     }
     return lo;
   }
-  friend bool operator==(const TilesetData& a, const TilesetData& b) {
+  /// How many glide offsets `tile` stores at keyframe g: one per point present there or appearing before
+  /// the next keyframe (it glides in from its position here); every point at the last keyframe. A prefix
+  /// of its ranks.
+  std::uint32_t offsets_at_keyframe(const Tile& tile, std::size_t g) const {
+    return g + 1 < keyframe_nominal.size() ? points_at_keyframe(tile, g + 1)
+                                           : static_cast<std::uint32_t>(tile.points.size());
+  }
+  /// The index of the tile with corner colours (sw, se, ne, nw).
+  std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
+    return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
+  }
+  friend bool operator==(const TilesetShape& a, const TilesetShape& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
-           a.keyframe_nominal == b.keyframe_nominal && a.tiles == b.tiles && a.recipe == b.recipe &&
-           a.generator_version == b.generator_version;
+           a.keyframe_nominal == b.keyframe_nominal;
   }
 };
+
+/// A tile set as the file holds it: its shape, its tiles and where it came from.
+struct TilesetData : TilesetShape {
+  TilesetArray<Tile> tiles;       ///< index tile_index(sw, se, ne, nw)
+  std::string recipe;             ///< the recipe text that rebuilds this set exactly
+  std::string generator_version;  ///< the kdm version that baked it
+
+  friend bool operator==(const TilesetData& a, const TilesetData& b) {
+    return static_cast<const TilesetShape&>(a) == static_cast<const TilesetShape&>(b) && a.tiles == b.tiles &&
+           a.recipe == b.recipe && a.generator_version == b.generator_version;
+  }
+};
+
+/// What a tile-set file's header says (its fields in docs/tileset-format.md §1), once validated.
+struct TilesetHeader {
+  std::uint32_t format_version = 0;  ///< kOldestTilesetFormatVersion to kTilesetFormatVersion
+  std::uint32_t header_bytes = 0;    ///< where the payload starts
+  std::uint64_t payload_bytes = 0;   ///< the zstd frame's size in the file
+  std::uint64_t decompressed_bytes = 0;
+  std::uint32_t payload_crc = 0;
+  std::uint32_t tiles = 0, colours = 0, levels = 0;
+  std::string recipe, generator_version;
+};
+
+/// Reads and validates the header of a tile-set file of `size` bytes at `data` (the whole file: its size
+/// is checked against the header's): magic, version, sizes, the header's CRC, the text sizes and the
+/// tile, colour and level counts, before anything else is read. The payload is not decompressed or
+/// checked (decode_tileset does both). On failure `out` is left empty.
+KDM_RUNTIME_API Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& out,
+                                           std::string* detail = nullptr);
 
 /// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
 /// counts, one key per point, keys sorted within each level, keyframes increasing up to the top level,

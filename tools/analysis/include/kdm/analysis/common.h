@@ -46,5 +46,4 @@ inline double axis_delta(double a, double b, bool torus) {
   return d;
 }
 
-
 }  // namespace kdm::analysis

@@ -32,11 +32,10 @@ struct Periodogram {
 };
 
 /// Periodogram of one 2D set up to normalised frequency `fmax` (kmax = ceil(fmax·√n) + 1). `coords`
-/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n · kmax²) flops, memory O(kmax²).
-/// Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the result does
-/// not depend on the thread count (fixed summation order). With threads = 1 the matrix products themselves
-/// may still use Eigen's OpenMP threads. Measured: n = 65,536, fmax = 2.5 (kmax 641):
-/// 13.7 s on 2 idle cores.
+/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n · kmax²) flops, memory
+/// O(kmax²). Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the
+/// result does not depend on the thread count (fixed summation order). With threads = 1 the matrix products
+/// themselves may still use Eigen's OpenMP threads. A time for scale: docs/design.md §6.
 Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0);
 
 /// Mean periodogram of several 2D sets (all on the grid of the mean point count). Throws InvalidInput for an

@@ -10,7 +10,7 @@
 
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/pair_correlation.h"
 #include "kdm/analysis/periodogram.h"
 #include "kdm/analysis/tiling.h"

@@ -6,8 +6,8 @@
 //    edge counts on the torus), else "interior"; δmin/δavg/NN1% per group and a two-sample Kolmogorov–Smirnov
 //    test of the two normalised NN-distance distributions. Caveat: the split is not neutral — a longer link
 //    is more likely to cross an edge, so even an untiled set shows seam δavg slightly above interior δavg
-//    and, with many points, a small KS p-value (Fattal's reference sets at s = 1/8: δavg .876 vs .871,
-//    D = 0.037). Compare against the same statistics of an untiled set of the same kind.
+//    and, with many points, a small KS p-value (docs/design.md §6). Compare against the same statistics
+//    of an untiled set of the same kind.
 //  - edge bands: the point density at each distance from the nearest tile edge, in steps of a quarter of
 //    the hexagonal spacing d_hex up to 2 d_hex, against the set's mean density. Tiles whose edges hold too
 //    few or too many points show as lines in a blurred picture; this measures them.
@@ -17,7 +17,7 @@
 #include <limits>
 #include <vector>
 
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/periodogram.h"
 #include "point_io.h"
 
@@ -66,9 +66,9 @@ struct SeamStats {
 /// gen::default_thread_count().
 SeamStats seam_stats(const std::vector<tools::PointSet>& sets, bool torus, double tile_size, int threads = 0);
 
-/// Seam statistics of one set from precomputed neighbours `nn` (from nearest_neighbors on `coords`).
+/// Seam statistics of one set from precomputed neighbours `nn` (from nearest_neighbours on `coords`).
 /// Appends normalised NN distances to `seam` / `interior`. Thread-safe (pure).
-void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbors& nn, double tile_size,
+void split_by_seam(const std::vector<double>& coords, int dim, const NearestNeighbours& nn, double tile_size,
                    std::vector<double>& seam, std::vector<double>& interior);
 
 /// Density by distance from the nearest tile edge: band b holds the points whose distance to their tile's

@@ -1,7 +1,7 @@
 // Nearest-neighbour distances with a uniform cell list (expanding Chebyshev rings of cells around each
 // point, stopped once no unvisited cell can hold a closer point), and their summary statistics
 // δmin / δavg / NN1% / histogram as defined in docs/design.md §6 (normalised by d_hex or the FCC spacing).
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,13 +14,13 @@
 
 namespace kdm::analysis {
 
-NearestNeighbors nearest_neighbors(const std::vector<double>& coords, int dim, bool torus, int threads) {
+NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads) {
   validate_points(coords, dim);
   const std::size_t n = coords.size() / dim;
   if (n < 2) throw InvalidInput("nearest-neighbour statistics need at least 2 points");
   const detail::CellGrid grid(coords, dim, 2.0, dim == 2 ? 2048 : 160);
   const int g = grid.g;
-  NearestNeighbors out;
+  NearestNeighbours out;
   out.dim = dim;
   out.distance.assign(n, 0.0);
   out.index.assign(n, 0);
@@ -94,7 +94,7 @@ double quantile(std::vector<double> values, double q) {
   return values[rank - 1];
 }
 
-NNStats summarize_nn(const std::vector<double>& distances, double spacing, int bins, double hist_max) {
+NNStats summarise_nn(const std::vector<double>& distances, double spacing, int bins, double hist_max) {
   NNStats s;
   s.count = distances.size();
   s.spacing = spacing;
@@ -125,8 +125,8 @@ NNStats summarize_nn(const std::vector<double>& distances, double spacing, int b
 }
 
 NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads) {
-  const NearestNeighbors nn = nearest_neighbors(coords, dim, torus, threads);
-  return summarize_nn(nn.distance, reference_spacing(dim, nn.distance.size()));
+  const NearestNeighbours nn = nearest_neighbours(coords, dim, torus, threads);
+  return summarise_nn(nn.distance, reference_spacing(dim, nn.distance.size()));
 }
 
 }  // namespace kdm::analysis

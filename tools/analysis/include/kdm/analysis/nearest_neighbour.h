@@ -11,7 +11,7 @@ namespace kdm::analysis {
 /// Per-point nearest neighbours. distance[i] is in unit-domain lengths (not normalised); index[i] is the
 /// neighbour's point index; offset[i*dim + a] is the displacement to that neighbour along axis a (the
 /// minimum image on the torus), so the link can be located (e.g. whether it crosses a tile edge).
-struct NearestNeighbors {
+struct NearestNeighbours {
   int dim = 2;
   std::vector<double> distance;
   std::vector<std::size_t> index;
@@ -20,9 +20,9 @@ struct NearestNeighbors {
 
 /// Finds every point's nearest other point. `coords`: interleaved, `dim` ∈ {2,3}, in [0,1]^dim; `torus`:
 /// periodic distances. Ties go to the lowest index. Needs n ≥ 2 (throws InvalidInput otherwise, and for
-/// invalid coordinates). `threads`: 0 = gen::default_thread_count(). Thread-safe (no shared state); result independent of
-/// the thread count.
-NearestNeighbors nearest_neighbors(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
+/// invalid coordinates). `threads`: 0 = gen::default_thread_count(). Thread-safe (no shared state); result
+/// independent of the thread count.
+NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
 
 /// Summary of NN distances, normalised by the reference spacing.
 struct NNStats {
@@ -38,10 +38,10 @@ struct NNStats {
 
 /// Summarises `distances` (unit-domain lengths) divided by `spacing`. Empty input gives count 0 and NaN
 /// statistics. `bins` histogram bins over [0, hist_max). Thread-safe (pure).
-NNStats summarize_nn(const std::vector<double>& distances, double spacing, int bins = 60,
+NNStats summarise_nn(const std::vector<double>& distances, double spacing, int bins = 60,
                      double hist_max = 1.5);
 
-/// nearest_neighbors + summarize_nn with spacing = reference_spacing(dim, n).
+/// nearest_neighbours + summarise_nn with spacing = reference_spacing(dim, n).
 NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
 
 /// The q-quantile (q in [0,1]) of `values` by the nearest-rank rule (value of rank ceil(q·m), ≥ 1).

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "kdm/analysis/common.h"
-#include "kdm/analysis/nearest_neighbor.h"
+#include "kdm/analysis/nearest_neighbour.h"
 #include "test_sets.h"
 
 namespace kdm::analysis {
@@ -17,7 +17,7 @@ using testing::uniform_set;
 
 void brute_force_check(int dim, bool torus, std::size_t n, unsigned seed) {
   const tools::PointSet s = uniform_set(n, seed, dim);
-  const NearestNeighbors nn = nearest_neighbors(s.coords, dim, torus, 2);
+  const NearestNeighbours nn = nearest_neighbours(s.coords, dim, torus, 2);
   for (std::size_t i = 0; i < n; ++i) {
     double best = std::numeric_limits<double>::infinity();
     std::size_t best_j = 0;
@@ -35,7 +35,7 @@ void brute_force_check(int dim, bool torus, std::size_t n, unsigned seed) {
   }
 }
 
-TEST(NearestNeighbor, CellListMatchesBruteForce) {
+TEST(NearestNeighbour, CellListMatchesBruteForce) {
   brute_force_check(2, true, 700, 1);
   brute_force_check(2, false, 700, 2);
   brute_force_check(3, true, 500, 3);
@@ -44,17 +44,17 @@ TEST(NearestNeighbor, CellListMatchesBruteForce) {
   brute_force_check(3, false, 3, 6);
 }
 
-TEST(NearestNeighbor, TorusWrapsAroundTheEdge) {
+TEST(NearestNeighbour, TorusWrapsAroundTheEdge) {
   const std::vector<double> c = {0.01, 0.5, 0.99, 0.5, 0.5, 0.9};
-  const NearestNeighbors t = nearest_neighbors(c, 2, true);
+  const NearestNeighbours t = nearest_neighbours(c, 2, true);
   EXPECT_NEAR(t.distance[0], 0.02, 1e-12);
   EXPECT_EQ(t.index[0], 1u);
   EXPECT_NEAR(t.offset[0], -0.02, 1e-12);  // the link leaves through x = 0
-  const NearestNeighbors b = nearest_neighbors(c, 2, false);
+  const NearestNeighbours b = nearest_neighbours(c, 2, false);
   EXPECT_NEAR(b.distance[0], std::hypot(0.49, 0.4), 1e-12);
 }
 
-TEST(NearestNeighbor, NearHexTorusLatticeHasExactSpacing) {
+TEST(NearestNeighbour, NearHexTorusLatticeHasExactSpacing) {
   const int cols = 26, rows = 30;  // rows/cols = 1.1538 ≈ 2/√3 = 1.1547
   const tools::PointSet s = torus_hex_lattice(cols, rows);
   const double horizontal = 1.0 / cols, diagonal = std::hypot(0.5 / cols, 1.0 / rows);
@@ -67,7 +67,7 @@ TEST(NearestNeighbor, NearHexTorusLatticeHasExactSpacing) {
   EXPECT_NEAR(expected, 1.0, 0.01);  // and it is close to the hexagonal ideal
 }
 
-TEST(NearestNeighbor, FccLatticeIsOneInFccUnits) {
+TEST(NearestNeighbour, FccLatticeIsOneInFccUnits) {
   const int m = 6;  // m³ cubic cells with 4 points each: NN distance (1/m)/√2 = fcc_spacing(4m³)
   tools::PointSet s;
   s.dim = 3;
@@ -85,7 +85,7 @@ TEST(NearestNeighbor, FccLatticeIsOneInFccUnits) {
   EXPECT_NEAR(st.davg, 1.0, 1e-9);
 }
 
-TEST(NearestNeighbor, PoissonMeanDistance) {
+TEST(NearestNeighbour, PoissonMeanDistance) {
   // Poisson NN distance in 2D has mean 1/(2√λ) and sd sqrt((4 − π)/(4πλ)); in d_hex units the mean is
   // 0.5 / sqrt(2/√3) = 0.4653. With 4·16384 pooled (weakly dependent) values, sd(mean) ≈ 0.0009 in these
   // units.
@@ -100,8 +100,8 @@ TEST(NearestNeighbor, PoissonMeanDistance) {
   EXPECT_NEAR(sum / count, 0.5 / std::sqrt(2.0 / std::sqrt(3.0)), 0.005);
 }
 
-TEST(NearestNeighbor, SummaryAndQuantile) {
-  const NNStats st = summarize_nn({1, 2, 3, 4}, 2.0, 4, 2.0);
+TEST(NearestNeighbour, SummaryAndQuantile) {
+  const NNStats st = summarise_nn({1, 2, 3, 4}, 2.0, 4, 2.0);
   EXPECT_DOUBLE_EQ(st.dmin, 0.5);
   EXPECT_DOUBLE_EQ(st.davg, 1.25);
   EXPECT_DOUBLE_EQ(st.dmax, 2.0);
@@ -113,15 +113,15 @@ TEST(NearestNeighbor, SummaryAndQuantile) {
   for (int i = 0; i < 100; ++i) v[i] = 100 - i;
   EXPECT_DOUBLE_EQ(quantile(v, 0.01), 1.0);
   EXPECT_DOUBLE_EQ(quantile(v, 0.5), 50.0);
-  EXPECT_TRUE(std::isnan(summarize_nn({}, 1.0).davg));
+  EXPECT_TRUE(std::isnan(summarise_nn({}, 1.0).davg));
 }
 
-TEST(NearestNeighbor, RejectsBadInput) {
-  EXPECT_THROW(nearest_neighbors({0.5, 0.5}, 2, true), InvalidInput);            // one point
-  EXPECT_THROW(nearest_neighbors({0.1, 0.2, 0.3}, 2, true), InvalidInput);       // not a multiple of dim
-  EXPECT_THROW(nearest_neighbors({0.1, 0.2, 1.5, 0.3}, 2, true), InvalidInput);  // outside [0,1]
-  EXPECT_THROW(nearest_neighbors({0.1, NAN, 0.5, 0.3}, 2, true), InvalidInput);
-  EXPECT_THROW(nearest_neighbors({0.1, 0.2, 0.5, 0.3}, 4, true), InvalidInput);
+TEST(NearestNeighbour, RejectsBadInput) {
+  EXPECT_THROW(nearest_neighbours({0.5, 0.5}, 2, true), InvalidInput);            // one point
+  EXPECT_THROW(nearest_neighbours({0.1, 0.2, 0.3}, 2, true), InvalidInput);       // not a multiple of dim
+  EXPECT_THROW(nearest_neighbours({0.1, 0.2, 1.5, 0.3}, 2, true), InvalidInput);  // outside [0,1]
+  EXPECT_THROW(nearest_neighbours({0.1, NAN, 0.5, 0.3}, 2, true), InvalidInput);
+  EXPECT_THROW(nearest_neighbours({0.1, 0.2, 0.5, 0.3}, 4, true), InvalidInput);
 }
 
 }  // namespace

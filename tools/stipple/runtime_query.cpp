@@ -1,0 +1,60 @@
+#include "runtime_query.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace kdm::tools {
+
+std::string describe(const QueryProblem& p, const ParameterNames& names) {
+  char text[400];
+  switch (p.kind) {
+    case QueryProblem::Kind::kDensityTooHigh:
+      std::snprintf(text, sizeof text,
+                    "%s: %.6g points per tile where the tile set holds at most %.0f; use %s %.6g or less, or "
+                    "%s %.6g or less",
+                    query_problem_message(p.kind), p.value, p.limit, names.scale, p.largest_valid,
+                    names.tile_size, p.largest_tile_size);
+      break;
+    case QueryProblem::Kind::kTooManyTiles:
+      std::snprintf(text, sizeof text, "%s: %.6g tiles, at most %.0f; use a larger %s or a smaller region",
+                    query_problem_message(p.kind), p.value, p.limit, names.tile_size);
+      break;
+    default:
+      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
+                    p.value);
+  }
+  return text;
+}
+
+void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
+               const ParameterNames& names) {
+  out.clear();
+  QueryCursor cursor;
+  for (;;) {
+    const std::size_t before = out.size();
+    out.resize(before + (std::size_t(1) << 16));
+    std::size_t written = 0;
+    QueryProblem problem;
+    const Status s =
+        query_points(tileset, params, out.data() + before, out.size() - before, &written, &cursor, &problem);
+    out.resize(before + written);
+    if (out.size() > kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
+      throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
+    if (s == Status::kOk) return;
+    if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
+  }
+}
+
+PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]) {
+  const double w = r[2] - r[0], h = r[3] - r[1], below_one = std::nextafter(1.0, 0.0);
+  PointSet set;
+  set.dim = 2;
+  set.coords.reserve(points.size() * 2);
+  for (const QueryPoint& p : points)
+    set.coords.insert(set.coords.end(), {std::min(p.x / w, below_one), std::min(p.y / h, below_one)});
+  return set;
+}
+
+}  // namespace kdm::tools

@@ -1,0 +1,36 @@
+// A runtime query run to completion into a growing array, with refusals as one-line messages: what
+// `kdm query`, `kdm stipple` and the Python package share.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/query.h"
+#include "point_io.h"
+
+namespace kdm::tools {
+
+/// Most points one such query collects (2^25, 1 GiB as QueryPoint) before it gives up.
+inline constexpr std::size_t kMaxCollectedPoints = std::size_t(1) << 25;
+
+/// How a caller names the parameters a refusal suggests changing (`--scale` on the command line,
+/// `scale=` in Python).
+struct ParameterNames {
+  const char* scale = "scale";
+  const char* tile_size = "tile_size";
+};
+
+/// A refused query's problem in one line: which parameter, which limit, what works.
+std::string describe(const QueryProblem& problem, const ParameterNames& names = {});
+
+/// Runs a query to completion into `out` (replaced). Throws std::invalid_argument with describe()'s line
+/// on bad parameters, std::runtime_error when more than kMaxCollectedPoints points would be emitted.
+void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
+               const ParameterNames& names = {});
+
+/// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
+/// point set normalised to it: [0, 1) on both axes.
+PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]);
+
+}  // namespace kdm::tools

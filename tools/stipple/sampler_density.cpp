@@ -1,0 +1,59 @@
+#include "sampler_density.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace kdm::tools {
+
+gen::Density to_generator_density(const DensitySpec& spec) {
+  using Kind = DensitySpec::Kind;
+  switch (spec.kind) {
+    case Kind::kConstant:
+      if (!(spec.constant > 0))
+        throw std::invalid_argument(
+            "--density const:V needs V > 0 for the full sampler (it has nothing to sample)");
+      return gen::Density::constant();
+    case Kind::kRamp:
+    case Kind::kRadial: {
+      gen::Density d;
+      d.function = [spec](const double* u) { return spec.map_at(u[0], u[1]); };
+      d.thread_safe = true;
+      return d;
+    }
+    case Kind::kImage:
+      break;
+  }
+  try {
+    return gen::Density::from_values(spec.width, spec.height, spec.values);
+  } catch (const gen::InvalidArgument& e) {
+    throw std::invalid_argument("image '" + spec.text + "': " + e.what() +
+                                (spec.inverted ? "" : " (an all-white image has no ink)"));
+  }
+}
+
+std::function<double(double, double)> analysis_density(const gen::Density& density) {
+  if (!density.function) return [](double, double) { return 1.0; };
+  return [f = density.function](double x, double y) {
+    const double u[2] = {x, y};
+    return f(u);
+  };
+}
+
+double mean_energy_per_point(const std::vector<PointSet>& sets, bool torus, const gen::Density& density,
+                             int threads) {
+  double sum = 0;
+  for (const PointSet& set : sets) {
+    gen::SamplerOptions o;
+    o.dim = set.dim;
+    o.domain = torus ? gen::Domain::kTorus : gen::Domain::kBox;
+    o.threads = threads;
+    std::vector<double> coords = set.coords;
+    for (double& c : coords) c = std::min(c, std::nextafter(1.0, 0.0));  // writers may round up to 1
+    sum += gen::energy_per_point(o, density, coords);
+  }
+  return sets.empty() ? 0.0 : sum / double(sets.size());
+}
+
+}  // namespace kdm::tools

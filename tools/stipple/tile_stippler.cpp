@@ -1,0 +1,61 @@
+#include "tile_stippler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "runtime_query.h"
+
+namespace kdm::tools {
+
+void stipple_frame_region(const double region[4], int i, int k, double out[4]) {
+  const double last = std::max(region[2] - region[0], region[3] - region[1]);  // 1 / final zoom
+  const double extent = std::pow(last, k > 1 ? double(i) / (k - 1) : 1.0);     // 1 / this frame's zoom
+  const double s = last < 1 ? (1 - extent) / (1 - last) : 1;                   // 0: whole image, 1: region
+  for (int j = 0; j < 2; ++j) {
+    out[j] = s * region[j];
+    out[j + 2] = 1 + s * (region[j + 2] - 1);
+  }
+  if (i == k - 1) std::copy(region, region + 4, out);  // exactly the region, whatever the rounding
+}
+
+TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale,
+                           QueryMode mode)
+    : tiles_(tileset), mode_(mode) {
+  if (spec.kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
+  if (!(spec.max_value() > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
+  if (!(points > 0 || scale > 0)) throw std::invalid_argument("give a number of dots > 0 or a scale > 0");
+  aspect_ = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
+  image_.width = spec.width, image_.height = spec.height;
+  image_.x1 = aspect_, image_.y1 = 1;
+  image_.values = spec.values.data();
+  if (make_density_max_mip(image_, mip_) != Status::kOk)
+    throw std::invalid_argument("density image is invalid");
+  // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
+  scale_ = points > 0 ? points / (spec.mean_value() * aspect_) : scale;
+  // Tiles small enough that the image's peak density, zoomed kMaxStippleZoom times, fits the top level.
+  // The tile size depends on the whole image only, so every region and frame sees the same dots.
+  tile_size_ = std::sqrt(tiles_.max_points_per_tile() /
+                         (kMaxStippleZoom * kMaxStippleZoom * scale_ * spec.max_value()));
+}
+
+PointSet TileStippler::render(const double uv[4]) const {
+  const double zoom = 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]);
+  if (zoom > kMaxStippleZoom + 1e-9)
+    throw std::invalid_argument("the region zooms more than 2× (the tile set's density range)");
+  QueryParams q;
+  q.x0 = uv[0] * aspect_, q.y0 = uv[1], q.x1 = uv[2] * aspect_, q.y1 = uv[3];
+  q.origin_x = q.x0, q.origin_y = q.y0;
+  q.tile_size = tile_size_;
+  q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
+  q.density.kind = QueryDensity::Kind::kImage;
+  q.density.image = &image_;
+  q.mode = mode_;
+  std::vector<QueryPoint> points;
+  query_all(tiles_, q, points);
+  const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
+  return normalise_to_rect(points, rect);
+}
+
+}  // namespace kdm::tools

@@ -1,0 +1,42 @@
+// Stippling an image with the runtime (`kdm stipple`'s default method, kdm.stipple in Python): the dots of
+// a rectangle of the image, at a fixed dot size, so that regions and zoom frames of one image show the
+// same dots. Built apart from the generator: nothing here includes its headers.
+#pragma once
+
+#include <memory>
+
+#include "density_spec.h"
+#include "kdm/runtime/query.h"
+#include "point_io.h"
+
+namespace kdm::tools {
+
+/// The most a region may zoom into an image: the tile size leaves room for 2× more dots per axis.
+inline constexpr double kMaxStippleZoom = 2;
+
+/// The UV rectangle of frame i of k, zooming from the whole image (frame 0) into `region` (frame k − 1):
+/// the zoom grows geometrically and each rectangle lies inside the one before, so zoom coherence keeps
+/// every dot that stays in view.
+void stipple_frame_region(const double region[4], int i, int k, double out[4]);
+
+class TileStippler {
+ public:
+  /// The image `spec` (kImage, with some ink) over the world [0, aspect] × [0, 1], aspect its width /
+  /// height. `points` dots over the whole image (> 0), or, when points is 0, `scale` dots per unit area at
+  /// full darkness. `tileset` must outlive the stippler; so must `spec`. Throws std::invalid_argument.
+  TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode);
+  /// The dots of the UV rectangle `uv` (x0, y0, x1, y1 in [0, 1]², y up), normalised to it: [0, 1)².
+  /// Throws std::invalid_argument when it zooms more than kMaxStippleZoom, std::runtime_error when the
+  /// query would emit more than 2^25 dots.
+  PointSet render(const double uv[4]) const;
+  double aspect() const { return aspect_; }
+
+ private:
+  const Tileset& tiles_;
+  double aspect_ = 1, scale_ = 0, tile_size_ = 1;
+  QueryMode mode_;
+  DensityImageView image_;
+  std::vector<float> mip_;
+};
+
+}  // namespace kdm::tools
