@@ -153,6 +153,19 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
   }
   w.key("pair_correlation").begin_object();
   w.key("r_max").value(r.gr.r_max).key("r").value(r.gr.r).key("g").value(r.gr.g).end_object();
+  if (r.has_empty_circles) {
+    const EmptyCircles& e = r.empty_circles;
+    w.key("empty_circles").begin_object();
+    w.key("triangles").value(e.triangles).key("largest").value(e.largest).key("p999").value(e.p999);
+    w.key("over_085").value(e.over_085).key("over_100").value(e.over_100);
+    w.key("over_085_per_1e5").value(e.over_085_per_1e5()).key("over_100_per_1e5").value(e.over_100_per_1e5());
+    if (r.has_tiling)
+      w.key("over_085_near_tile_edge")
+          .value(e.over_085_near_edge)
+          .key("near_tile_edge_share")
+          .value(e.near_edge_share);
+    w.end_object();
+  }
   if (r.has_density) {
     const DensityAccuracy& d = r.density;
     w.key("density").begin_object();

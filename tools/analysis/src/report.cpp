@@ -76,6 +76,14 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     r.has_spectrum = true;
   }
   r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
+  if (r.dim == 2 && r.points_min >= 3) {
+    EmptyCircleOptions eo;
+    eo.torus = o.torus;
+    eo.density = o.density;
+    eo.tile_size = o.tile_size;
+    r.empty_circles = empty_circles(sets, eo);
+    r.has_empty_circles = true;
+  }
 
   if (o.density && r.dim == 2) {
     DensityOptions dopt;
@@ -148,6 +156,18 @@ std::string format_summary(const AnalysisReport& r) {
       rpeak = r.gr.r[b];
     }
   add("pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  if (r.has_empty_circles) {
+    const EmptyCircles& e = r.empty_circles;
+    add("empty circles      largest %.3f  99.9%% %.3f  > 0.85: %zu (%.1f per 10^5 points)  > 1.0: %zu (%.1f) "
+        " "
+        "(Delaunay, local d_hex%s)\n",
+        e.largest, e.p999, e.over_085, e.over_085_per_1e5(), e.over_100, e.over_100_per_1e5(),
+        r.torus ? "" : ", away from the border");
+    if (r.has_tiling && e.over_085 > 0)
+      add("                   of those > 0.85, %.0f%% within one spacing of a tile edge (%.0f%% of all "
+          "circles)\n",
+          100.0 * e.over_085_near_edge / e.over_085, 100 * e.near_edge_share);
+  }
   if (r.has_density)
     add("density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
         r.density.windows, r.density.mean_expected, r.density.rms_z, r.density.max_abs_z, r.density.bias,

@@ -10,6 +10,7 @@
 
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
+#include "kdm/analysis/empty_circles.h"
 #include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/analysis/pair_correlation.h"
 #include "kdm/analysis/periodogram.h"
@@ -48,6 +49,8 @@ struct AnalysisReport {
   Periodogram spectrum;  ///< set-averaged periodogram
   SpectrumStats spectrum_stats;
   PairCorrelation gr;
+  bool has_empty_circles = false;  ///< 2D sets of at least 3 points
+  EmptyCircles empty_circles;      ///< holes: radii in local d_hex (of the target density, if given)
   bool has_density = false;
   DensityAccuracy density;  ///< pooled: rms/max over all windows of all sets, summed counts
   bool has_tiling = false;

@@ -1,0 +1,101 @@
+// Empty circles (holes) of the Delaunay triangulation: checked against what geometry fixes (a lattice's
+// circumradii, Euler's formula on the torus) and against a brute-force search for the largest empty circle.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "kdm/analysis/common.h"
+#include "kdm/analysis/empty_circles.h"
+#include "test_sets.h"
+
+namespace kdm::analysis {
+namespace {
+
+using testing::torus_hex_lattice;
+using testing::uniform_set;
+
+TEST(EmptyCircles, AHexagonalLatticeHasNoHoleAndAMissingPointIsOne) {
+  const int cols = 26, rows = 30;  // a near-hexagonal lattice on the torus (spacing ≈ d_hex)
+  tools::PointSet s = torus_hex_lattice(cols, rows);
+  const EmptyCircles full = empty_circles({s});
+  EXPECT_EQ(full.triangles, 2 * s.size());  // Euler on the torus: F = 2V
+  EXPECT_EQ(full.over_085, 0u);
+  // Equilateral triangles of side a have circumradius a/√3; a = 1/cols here.
+  EXPECT_NEAR(full.largest, (1.0 / cols) / std::sqrt(3.0) / hex_spacing(s.size()), 0.02);
+  s.coords.erase(s.coords.begin() + 2 * 300, s.coords.begin() + 2 * 301);  // one point gone
+  const EmptyCircles holed = empty_circles({s});
+  EXPECT_GE(holed.over_085, 1u);
+  EXPECT_EQ(holed.over_100, 0u);  // its six neighbours lie at a ≈ 0.99 d_hex
+  EXPECT_GT(holed.largest, 0.95);
+  EXPECT_NEAR(holed.over_085_per_1e5(), holed.over_085 * 1e5 / double(s.size()), 1e-9);
+}
+
+TEST(EmptyCircles, TheLargestMatchesABruteForceSearch) {
+  // The largest empty circle on a torus is the farthest any place is from every point: a fine grid search
+  // finds it to within the grid's half-diagonal from below.
+  const tools::PointSet s = uniform_set(400, 7);
+  const EmptyCircles e = empty_circles({s});
+  EXPECT_EQ(e.triangles, 2 * s.size());
+  constexpr int kGrid = 600;
+  double farthest = 0;
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i) {
+      const double x = (i + 0.5) / kGrid, y = (j + 0.5) / kGrid;
+      double nearest = HUGE_VAL;
+      for (std::size_t p = 0; p < s.size(); ++p)
+        nearest = std::min(nearest, std::hypot(axis_delta(x, s.coords[2 * p], true),
+                                               axis_delta(y, s.coords[2 * p + 1], true)));
+      farthest = std::max(farthest, nearest);
+    }
+  const double d = hex_spacing(s.size()), slack = std::sqrt(0.5) / kGrid;
+  EXPECT_GE(e.largest * d + 1e-12, farthest);
+  EXPECT_LE(e.largest * d, farthest + slack);
+  EXPECT_GE(e.largest, e.p999);
+  EXPECT_GT(e.over_085, 0u);  // white noise is full of holes
+}
+
+TEST(EmptyCircles, BoxSetsJudgeOnlyCirclesAwayFromTheBorder) {
+  const tools::PointSet s = uniform_set(2000, 3);
+  EmptyCircleOptions box;
+  box.torus = false;
+  const EmptyCircles inner = empty_circles({s}, box);
+  box.border = 0;
+  const EmptyCircles all = empty_circles({s}, box);
+  EXPECT_GT(inner.triangles, 0u);
+  EXPECT_LT(inner.triangles, all.triangles);
+  EXPECT_LT(all.triangles, 2 * s.size());  // hull triangles reach outside the window
+}
+
+TEST(EmptyCircles, ADensityScalesTheLocalSpacingAndLocatesTileEdges) {
+  // The same lattice read against a density twice as high on the left: radii there are in spacings √2
+  // smaller, so they grow by √2 relative to the right half's.
+  const tools::PointSet s = torus_hex_lattice(26, 30);
+  EmptyCircleOptions o;
+  o.density = [](double x, double) { return x < 0.5 ? 2.0 : 1.0; };
+  const EmptyCircles e = empty_circles({s}, o);
+  const double base = (1.0 / 26) / std::sqrt(3.0) / hex_spacing(s.size());
+  EXPECT_NEAR(e.largest, base * std::sqrt(2.0 / 1.5), 0.03);  // mean ρ 1.5: left radii × √(2 / 1.5)
+  o.density = [](double, double) { return 0.0; };
+  EXPECT_THROW(empty_circles({s}, o), InvalidInput);
+  EmptyCircleOptions tiles;
+  tiles.tile_size = 0.25;
+  const EmptyCircles t = empty_circles({uniform_set(2000, 9)}, tiles);
+  // Circles within one spacing (d ≈ 0.024) of the lines x, y = k/4: about 1 − (1 − 8d)² ≈ 35% of them.
+  EXPECT_NEAR(t.near_edge_share, 1 - std::pow(1 - 8 * hex_spacing(2000), 2), 0.05);
+  EXPECT_LE(t.over_085_near_edge, t.over_085);
+}
+
+TEST(EmptyCircles, BadInputIsRefused) {
+  tools::PointSet s;
+  s.coords = {0.1, 0.2, 0.3, 0.4};
+  EXPECT_THROW(empty_circles({s}), InvalidInput);  // two points
+  EXPECT_THROW(empty_circles({}), InvalidInput);
+  s.coords = {0.1, 0.2, 0.3, 0.4, 0.5, NAN};
+  EXPECT_THROW(empty_circles({s}), InvalidInput);
+  tools::PointSet cube = uniform_set(50, 1, 3);
+  EXPECT_THROW(empty_circles({cube}), InvalidInput);
+}
+
+}  // namespace
+}  // namespace kdm::analysis

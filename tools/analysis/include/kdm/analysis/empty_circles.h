@@ -1,0 +1,41 @@
+// Holes in a 2D point set: the empty circles of its Delaunay triangulation (each triangle's circumcircle
+// holds no point), their radii in local hexagonal spacings (docs/design.md §6). A good blue-noise set has
+// none larger than about 0.8 d_hex; a missing point leaves one near 1.0, and one tile edge that two
+// patches both avoided leaves a row of them.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "kdm/analysis/density.h"
+#include "point_io.h"
+
+namespace kdm::analysis {
+
+struct EmptyCircleOptions {
+  bool torus =
+      true;  ///< periodic (else a box: circles reaching within `border` spacings of a side are left out)
+  double border = 1;  ///< box sets: spacings between a judged circle and the window's sides
+  /// Target density: radii are divided by the local spacing at each circle's centre (d_hex of the set's
+  /// count, scaled by √(mean ρ / ρ(centre))); circles centred where ρ = 0 are left out. Empty: uniform.
+  DensityFunction density;
+  double tile_size = 0;  ///< > 0: also count the large circles centred within one spacing of a tile edge
+};
+
+struct EmptyCircles {
+  std::size_t points = 0;                  ///< points of the sets, pooled
+  std::size_t triangles = 0;               ///< Delaunay triangles judged
+  double largest = 0;                      ///< largest circumradius / local d_hex
+  double p999 = 0;                         ///< its 99.9th percentile (nearest rank) over the judged triangles
+  std::size_t over_085 = 0, over_100 = 0;  ///< triangles with a radius above 0.85 and 1.0 local d_hex
+  std::size_t over_085_near_edge = 0;      ///< of over_085, centred within one spacing of a tile edge
+  double near_edge_share = 0;  ///< the share of the judged triangles centred there (what even spread gives)
+  double over_085_per_1e5() const { return points ? over_085 * 1e5 / double(points) : 0; }
+  double over_100_per_1e5() const { return points ? over_100 * 1e5 / double(points) : 0; }
+};
+
+/// Empty circles pooled over `sets` (2D, each of at least 3 points, in [0,1]²; each normalised by its own
+/// count). Throws InvalidInput for other input. O(n log n) (Qhull's Delaunay triangulation).
+EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& options = {});
+
+}  // namespace kdm::analysis

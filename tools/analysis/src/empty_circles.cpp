@@ -1,0 +1,151 @@
+// Empty circles of the Delaunay triangulation (empty_circles.h). The triangulation is Qhull's (Barber,
+// Dobkin & Huhdanpaa, "The Quickhull algorithm for convex hulls", ACM TOMS 1996): the lower hull of the
+// points lifted onto a paraboloid. A torus is triangulated with copies of the points near its sides, and
+// each triangle is counted once, in the copy that holds its lowest-numbered point itself.
+#include "kdm/analysis/empty_circles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+extern "C" {
+#include <libqhull_r/qhull_ra.h>
+}
+
+#include "kdm/analysis/common.h"
+
+namespace kdm::analysis {
+namespace {
+
+struct Circle {
+  double x = 0, y = 0, r = 0;
+};
+
+/// The circumcircle of a triangle; r = +inf for a degenerate (flat) one.
+Circle circumcircle(const double* a, const double* b, const double* c) {
+  const double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
+  const double d = 2 * (bx * cy - by * cx);
+  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  if (!(std::fabs(d) > 1e-12 * (b2 + c2))) return {a[0], a[1], HUGE_VAL};
+  const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+  return {a[0] + ux, a[1] + uy, std::hypot(ux, uy)};
+}
+
+/// Calls visit(i, j, k) with the point indices of every Delaunay triangle of `xy` (interleaved x y).
+template <class Visit>
+void delaunay(std::vector<double>& xy, Visit&& visit) {
+  const int n = static_cast<int>(xy.size() / 2);
+  qhT qh_qh;
+  qhT* qh = &qh_qh;
+  qh_zero(qh, stderr);
+  char flags[] = "qhull d Qbb Qc Qz Q12 Qt";
+  const int failed = qh_new_qhull(qh, 2, n, xy.data(), False, flags, nullptr, stderr);
+  if (!failed) {
+    facetT* facet;
+    FORALLfacets {
+      if (facet->upperdelaunay) continue;
+      int id[3], m = 0;
+      vertexT *vertex, **vertexp;
+      FOREACHvertex_(facet->vertices) {
+        if (m < 3) id[m] = qh_pointid(qh, vertex->point);
+        ++m;
+      }
+      if (m == 3) visit(id[0], id[1], id[2]);
+    }
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int curlong = 0, totlong = 0;
+  qh_memfreeshort(qh, &curlong, &totlong);
+  if (failed)
+    throw InvalidInput("the Delaunay triangulation failed (Qhull error " + std::to_string(failed) + ")");
+}
+
+/// Mean of ρ over the unit square on a 256² grid (the scale radii are normalised by).
+double mean_density(const DensityFunction& rho) {
+  constexpr int kGrid = 256;
+  double sum = 0;
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i) sum += std::max(0.0, rho((i + 0.5) / kGrid, (j + 0.5) / kGrid));
+  return sum / (kGrid * kGrid);
+}
+
+}  // namespace
+
+EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& o) {
+  if (sets.empty()) throw InvalidInput("no point sets");
+  EmptyCircles out;
+  std::vector<double> radii;
+  const double mean_rho = o.density ? mean_density(o.density) : 1.0;
+  if (o.density && !(mean_rho > 0)) throw InvalidInput("the target density is zero everywhere");
+  std::size_t near_edge_judged = 0;
+  for (const tools::PointSet& set : sets) {
+    if (set.dim != 2) throw InvalidInput("empty circles are 2D only");
+    validate_points(set.coords, 2);
+    const std::size_t n = set.size();
+    if (n < 3) throw InvalidInput("empty circles need at least 3 points per set");
+    out.points += n;
+    const double spacing = hex_spacing(n);
+    std::vector<double> xy = set.coords;
+    std::vector<std::size_t> original;  // torus: the point each copy stands for
+    if (o.torus) {  // copies within a few spacings of each side, so triangles across the sides are whole
+      const double m = std::min(0.5, 4 * spacing);
+      for (std::size_t i = 0; i < n; ++i) original.push_back(i);
+      for (std::size_t i = 0; i < n; ++i)
+        for (int sx = -1; sx <= 1; ++sx)
+          for (int sy = -1; sy <= 1; ++sy) {
+            if (!sx && !sy) continue;
+            const double x = set.coords[2 * i] + sx, y = set.coords[2 * i + 1] + sy;
+            if (x > -m && x < 1 + m && y > -m && y < 1 + m)
+              xy.insert(xy.end(), {x, y}), original.push_back(i);
+          }
+    }
+    const double edge_band = o.tile_size > 0 ? spacing : 0;
+    delaunay(xy, [&](int i, int j, int k) {
+      const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+      if (!std::isfinite(c.r)) return;
+      if (o.torus) {
+        // A triangle across a side appears once per copy: it counts where its first point (by index)
+        // is the point itself, not a copy.
+        const int v[3] = {i, j, k};
+        const int* first =
+            std::min_element(v, v + 3, [&](int a, int b) { return original[a] < original[b]; });
+        if (std::size_t(*first) >= n) return;
+      } else {
+        const double m = o.border * spacing + c.r;
+        if (!(c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m)) return;
+      }
+      double local = spacing;
+      if (o.density) {
+        const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
+        if (!(rho > 0)) return;
+        local = spacing * std::sqrt(mean_rho / rho);
+      }
+      const double r = c.r / local;
+      radii.push_back(r);
+      bool near_edge = false;
+      if (edge_band > 0) {
+        auto gap = [&](double v) {
+          const double t = v / o.tile_size;
+          return std::fabs(t - std::round(t)) * o.tile_size;
+        };
+        near_edge = std::min(gap(c.x), gap(c.y)) < edge_band;
+        near_edge_judged += near_edge;
+      }
+      if (r > 0.85) out.over_085 += 1, out.over_085_near_edge += near_edge;
+      if (r > 1.0) out.over_100 += 1;
+    });
+  }
+  out.triangles = radii.size();
+  if (!radii.empty()) {
+    out.largest = *std::max_element(radii.begin(), radii.end());
+    const std::size_t rank =
+        std::min(radii.size() - 1, static_cast<std::size_t>(std::ceil(0.999 * radii.size())) - 1);
+    std::nth_element(radii.begin(), radii.begin() + std::ptrdiff_t(rank), radii.end());
+    out.p999 = radii[rank];
+    out.near_edge_share = double(near_edge_judged) / double(radii.size());
+  }
+  return out;
+}
+
+}  // namespace kdm::analysis
