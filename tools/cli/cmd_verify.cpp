@@ -58,6 +58,14 @@ void add_verify_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-seams", args->no_seams, "Skip the seam and in-between-density checks");
   cmd->add_flag("--no-direct", args->no_direct, "Skip the direct check (tiles freed for 15 sweeps)");
+  cmd->add_option("--hole-largest", args->options.bars.hole_largest,
+                  "Fail a complete level or keyframe whose largest empty circle exceeds this many d_hex "
+                  "(0: report only; the design's bar is 1.0)")
+      ->capture_default_str();
+  cmd->add_option("--holes-per-1e5", args->options.bars.holes_per_1e5,
+                  "Fail a complete level or keyframe with more empty circles above 0.85 d_hex per 10^5 "
+                  "points (0: report only; the design's bar is 10)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->options.threads,
                   "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); results do not "
                   "depend on it")

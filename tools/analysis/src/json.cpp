@@ -190,7 +190,9 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
     w.key("periodicity_ratio")
         .value(r.periodicity.ratio)
         .key("lattice_frequencies")
-        .value(r.periodicity.frequencies);
+        .value(r.periodicity.frequencies)
+        .key("lattice_power_ratio")
+        .value(r.periodicity.lattice_ratio);
     w.key("seam");
     write_nn(w, r.seams.seam);
     w.key("interior");

@@ -126,7 +126,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     if (r.has_spectrum)
       r.periodicity = periodicity_ratio(r.spectrum, r.spectrum_stats, o.tile_size);
     else
-      r.periodicity.ratio = std::nan("");
+      r.periodicity.ratio = r.periodicity.lattice_ratio = std::nan("");
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -179,8 +179,9 @@ std::string format_summary(const AnalysisReport& r) {
           1 + b.bias(), b.expected > 0 ? 1 / std::sqrt(b.expected) : 0.0);
   }
   if (r.has_tiling) {
-    add("tiling (s=%g)      periodicity ratio %.2f over %zu frequencies\n", r.tile_size, r.periodicity.ratio,
-        r.periodicity.frequencies);
+    add("tiling (s=%g)      periodicity ratio %.2f over %zu frequencies; lattice power ratio %.2f (up to 2 "
+        "cycles per tile, against their neighbours)\n",
+        r.tile_size, r.periodicity.ratio, r.periodicity.frequencies, r.periodicity.lattice_ratio);
     add("  seams   %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f\n", r.seams.seam.count, r.seams.seam.dmin,
         r.seams.seam.davg, r.seams.seam.nn1);
     add("  inside  %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f   KS D %.4f  p %.3g\n",

@@ -42,6 +42,23 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
   out.mean_power = power / static_cast<double>(out.frequencies);
   out.mean_raps = raps / static_cast<double>(out.frequencies);
   out.ratio = out.mean_power / out.mean_raps;
+  // Whole cycles per tile against their neighbours: the local level of the spectrum, whatever its shape.
+  double on = 0, off = 0;
+  int on_count = 0, off_count = 0;
+  for (int j = -2; j <= 2; ++j)
+    for (int i = -2; i <= 2; ++i) {
+      if (i == 0 && j == 0) continue;
+      const int kx = i * t, ky = j * t;
+      if (std::hypot(std::abs(kx) + 1, std::abs(ky) + 1) > p.kmax) continue;  // neighbours inside the disc
+      on += p.at(kx, ky), ++on_count;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (dx || dy) off += p.at(kx + dx, ky + dy), ++off_count;
+    }
+  if (on_count == 0)
+    out.lattice_ratio = std::nan("");
+  else  // a strictly periodic set has no power off the lattice at all
+    out.lattice_ratio = off > 0 ? (on / on_count) / (off / off_count) : HUGE_VAL;
   return out;
 }
 

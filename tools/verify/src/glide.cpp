@@ -73,6 +73,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
         if (n < 2) continue;
         analysis::NearestNeighbours nn;
         add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
+        if (!half && n >= 3) add_torus_holes(coords, row.holes);
         if (half || g == 0) continue;
         // Motion into this keyframe, of the tile's own points present at the last one (or entering there).
         const Tile& tile = set.tiles[t];
@@ -97,6 +98,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
       row.checks.push_back({"δavg", row.davg, half ? b.glide_between_davg : b.glide_keyframe_davg, false});
       if (b.glide_closest_pair > 0)
         row.checks.push_back({"closest pair", row.closest_pair, b.glide_closest_pair, false});
+      check_holes(row.holes, b, row.checks);
       report.keyframes.push_back(std::move(row));
     }
 }

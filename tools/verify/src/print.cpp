@@ -33,6 +33,13 @@ std::string cell(double value, const char* format, const std::vector<Check>& che
   return s;
 }
 
+// The largest hole and the holes above 0.85 d_hex per 10^5 points, in two columns ("-" where not measured).
+std::string hole_cells(const Holes& holes, const std::vector<Check>& checks) {
+  const double nan = std::nan("");
+  return cell(holes.measured ? holes.largest : nan, "%.3f", checks, "largest hole", 6) + " " +
+         cell(holes.measured ? holes.per_1e5() : nan, "%.1f", checks, "holes per", 7);
+}
+
 void print_failures(const std::vector<Check>& checks, const std::string& what, std::FILE* out) {
   for (const Check& c : checks)
     if (!c.passed())
@@ -71,17 +78,18 @@ void print_report(const Report& report, std::FILE* out) {
   }
   if (!report.densities.empty()) {
     std::fprintf(out, "\nseams and in-between densities, over every tile's torus\n");
-    std::fprintf(out, "%11s %7s %7s %10s %10s %8s %9s %10s %8s %9s  %s\n", "points/tile", "kind", "δavg",
-                 "edge/other", "edge links", "KS D+", "p", "worst lowP", "closest", "edge band", "result");
+    std::fprintf(out, "%11s %7s %7s %10s %10s %8s %9s %10s %8s %9s %6s %7s  %s\n", "points/tile", "kind",
+                 "δavg", "edge/other", "edge links", "KS D+", "p", "worst lowP", "closest", "edge band",
+                 "hole", "/1e5", "result");
     for (const DensityResult& d : report.densities) {
-      std::fprintf(out, "%11.1f %7s %7.4f %s %10zu %s %9.2g %s %s %s  %s\n", d.points_per_tile,
+      std::fprintf(out, "%11.1f %7s %7.4f %s %10zu %s %9.2g %s %s %s %s  %s\n", d.points_per_tile,
                    d.complete_level ? "level" : "between", d.davg,
                    cell(d.worst_edge_ratio, "%.3f", d.checks, "edge δmin", 10).c_str(), d.edge_links,
                    cell(d.ks_d_plus, "%.4f", d.checks, "edge vs midline", 8).c_str(), d.ks_p,
                    cell(d.worst_low_p, "%.4f", d.checks, "lowP", 10).c_str(),
                    cell(d.closest_pair, "%.3f", d.checks, "closest pair", 8).c_str(),
                    cell(100 * (d.edge_band - 1), "%+.1f%%", d.checks, "|edge band", 9).c_str(),
-                   d.passed() ? "pass" : "FAIL");
+                   hole_cells(d.holes, d.checks).c_str(), d.passed() ? "pass" : "FAIL");
       checks += d.checks.size();
     }
   }
@@ -90,13 +98,14 @@ void print_report(const Report& report, std::FILE* out) {
         out,
         "\nglide track (smooth mode), over every tile's torus; closest pair in d_hex; motion from the "
         "keyframe before, in mean nearest-neighbour distances\n");
-    std::fprintf(out, "%11s %9s %7s %8s %11s %10s  %s\n", "points/tile", "kind", "δavg", "closest",
-                 "motion mean", "motion p99", "result");
+    std::fprintf(out, "%11s %9s %7s %8s %11s %10s %6s %7s  %s\n", "points/tile", "kind", "δavg", "closest",
+                 "motion mean", "motion p99", "hole", "/1e5", "result");
     for (const KeyframeResult& k : report.keyframes) {
-      std::fprintf(
-          out, "%11.1f %9s %7.4f %s %11.3f %s  %s\n", k.points_per_tile, k.keyframe ? "keyframe" : "half-way",
-          k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
-          cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(), k.passed() ? "pass" : "FAIL");
+      std::fprintf(out, "%11.1f %9s %7.4f %s %11.3f %s %s  %s\n", k.points_per_tile,
+                   k.keyframe ? "keyframe" : "half-way", k.davg,
+                   cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
+                   cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(),
+                   hole_cells(k.holes, k.checks).c_str(), k.passed() ? "pass" : "FAIL");
       checks += k.checks.size();
     }
   }

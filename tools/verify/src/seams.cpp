@@ -47,6 +47,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
       if (n < 2) continue;
       analysis::NearestNeighbours nn;
       add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
+      if (row.complete_level && n >= 3) add_torus_holes(coords, row.holes);
       analysis::add_edge_bands(coords, 2, 0.5, bands);
       std::vector<double> edge, inside;
       analysis::split_by_seam(coords, 2, nn, 0.5, edge, inside);
@@ -85,6 +86,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
     row.edge_band = bands.first_spacing_ratio();
     if (b.edge_band > 0)
       row.checks.push_back({"|edge band density − 1|", std::fabs(row.edge_band - 1), b.edge_band, true});
+    check_holes(row.holes, b, row.checks);
     report.densities.push_back(std::move(row));
   }
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kdm/analysis/empty_circles.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 
@@ -61,6 +62,22 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
   }
   out.drift /= double(own.size() / 2) * spacing;
   return out;
+}
+
+void add_torus_holes(const std::vector<double>& coords, Holes& holes) {
+  tools::PointSet set;
+  set.dim = 2;
+  set.coords = coords;
+  const analysis::EmptyCircles e = analysis::empty_circles({set});
+  holes.measured = true;
+  holes.largest = std::max(holes.largest, e.largest);
+  holes.over_085 += e.over_085, holes.points += e.points;
+}
+
+void check_holes(const Holes& holes, const Bars& bars, std::vector<Check>& checks) {
+  if (!holes.measured) return;
+  if (bars.hole_largest > 0) checks.push_back({"largest hole", holes.largest, bars.hole_largest, true});
+  if (bars.holes_per_1e5 > 0) checks.push_back({"holes per 1e5", holes.per_1e5(), bars.holes_per_1e5, true});
 }
 
 std::vector<double> densities(const TilesetData& set, const std::vector<std::uint32_t>& levels) {

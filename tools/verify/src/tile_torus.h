@@ -46,6 +46,12 @@ analysis::NNStats add_torus_nn(const std::vector<double>& coords, std::size_t ti
   return summary;
 }
 
+/// Adds the empty circles of a tile's torus (`coords`, normalised, at least 3 points) to `holes`.
+void add_torus_holes(const std::vector<double>& coords, Holes& holes);
+
+/// Appends the hole checks of `bars` (those not off) for `holes` to `checks`.
+void check_holes(const Holes& holes, const Bars& bars, std::vector<Check>& checks);
+
 /// The expected counts per tile judged for `levels`: each complete level and the quarters below it.
 std::vector<double> densities(const TilesetData& set, const std::vector<std::uint32_t>& levels);
 

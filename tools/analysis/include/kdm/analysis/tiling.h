@@ -32,6 +32,11 @@ struct PeriodicityResult {
   double mean_power = 0;        ///< mean P at them
   double mean_raps = 0;         ///< mean RAPS of their rings
   double ratio = 0;             ///< mean_power / mean_raps (NaN when no lattice frequency is in range)
+  /// The tile lattice's own frequencies, up to two whole cycles per tile on either axis (k = (i, j) · tiles
+  /// per axis, 1 ≤ max(|i|, |j|) ≤ 2): mean P there over the mean P of their eight off-lattice neighbours
+  /// (k ± 1). 1: the lattice does not show; a repeated motif raises it by about the number of tiles. NaN
+  /// when they lie outside the periodogram.
+  double lattice_ratio = 0;
 };
 
 /// Periodicity ratio of a (set-averaged) periodogram `p` with radial statistics `stats` for tile side

@@ -67,6 +67,11 @@ struct Bars {
   /// fraction of the mean (every edge shows one of a few shared patches, so an offset there draws the
   /// tile grid on a blurred picture). 0 turns the check off.
   double edge_band = 0;
+  /// Complete levels and keyframes: the largest empty circle (a hole, docs/design.md §6) at most
+  /// `hole_largest` d_hex, and at most `holes_per_1e5` circles above 0.85 d_hex per 10^5 points. 0 turns a
+  /// check off, the default: not every set meets the design's 1.0 and 10 (docs/quality.md); the values
+  /// are printed either way.
+  double hole_largest = 0, holes_per_1e5 = 0;
   /// Glide track: the 99th percentile of how far points move from one keyframe to the next, at most this
   /// fraction of the later keyframe's mean nearest-neighbour distance (its δavg · d_hex).
   double glide_motion = 0.7;
@@ -123,6 +128,14 @@ struct TileResult {
 };
 
 /// One density (expected points per tile): a complete level or a quarter between two.
+/// Empty circles (holes) over the tiles' tori (docs/design.md §6): measured at complete levels and keyframes.
+struct Holes {
+  bool measured = false;
+  double largest = 0;                    ///< the largest empty circle, in d_hex of its torus
+  std::size_t over_085 = 0, points = 0;  ///< circles above 0.85 d_hex, and the points of the tori
+  double per_1e5() const { return points ? over_085 * 1e5 / double(points) : 0; }
+};
+
 struct DensityResult {
   double points_per_tile = 0;
   bool complete_level = false;
@@ -132,6 +145,7 @@ struct DensityResult {
   double closest_pair = 0;      ///< smallest distance between two points of any tile's torus, in d_hex
   double edge_band = 0;         ///< density within one d_hex of tile edges / the mean, pooled
   std::size_t edge_links = 0, midline_links = 0;  ///< distinct links crossing tile edges, midlines
+  Holes holes;                                    ///< complete levels only
   double ks_d_plus = 0, ks_p = 1;                 ///< edge links shorter than midline links?
   std::vector<Check> checks;
   bool passed() const;
@@ -147,6 +161,7 @@ struct KeyframeResult {
   /// of this keyframe; NaN: none).
   double motion_mean = 0;
   double motion_p99 = 0;  ///< its 99th percentile
+  Holes holes;            ///< keyframes only
   std::vector<Check> checks;
   bool passed() const;
 };
