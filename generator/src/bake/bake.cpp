@@ -100,6 +100,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.min_distance = within(0, 0.7);
     } else if (key == "separation") {
       r.separation = within(0, 0.7);
+    } else if (key == "separation_push") {
+      r.separation_push = whole(0, 1) != 0;
     } else if (key == "glide_separation") {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
@@ -138,6 +140,7 @@ std::string BakeRecipe::to_text() const {
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
+  if (separation_push) s << "separation_push 1\n";
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
@@ -182,7 +185,13 @@ class Baker {
     shape_.colours = recipe_.colours;
     shape_.levels = recipe_.levels;
     shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
-    dropped_ = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
+    if (recipe_.separation_push) {
+      const SeparationResult moved =
+          push_close_pairs_apart(levels_, recipe_.colours, shape_, recipe_.separation);
+      dropped_ = moved.removed, pushed_ = moved.moved;
+    } else {
+      dropped_ = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
+    }
     const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal_, recipe_.keyframes_per_level);
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
@@ -395,7 +404,8 @@ class Baker {
   std::vector<LevelPatches> levels_;
   TilesetShape shape_;  ///< colours, level and keyframe counts: what the tiles fit into
   double total_work_ = 0, done_work_ = 0;
-  std::size_t dropped_ = 0;  ///< points drop_close_pairs removed (for a test to read)
+  std::size_t dropped_ = 0;  ///< points the separation pass removed (for a test to read)
+  std::size_t pushed_ = 0;   ///< and points it moved instead
 };
 
 }  // namespace

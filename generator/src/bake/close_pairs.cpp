@@ -2,7 +2,9 @@
 #include "close_pairs.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <set>
 #include <tuple>
 
@@ -50,11 +52,11 @@ std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Co
   return points;
 }
 
-/// Adds to `victims` the later point of every pair of `points` (in a window `width` × `height`) closer
-/// than `radius` of the later one.
-template <class Radius>
+/// Calls on_pair(later, earlier) for every pair of `points` (in a window `width` × `height`) closer than
+/// `radius` of the later one.
+template <class Radius, class OnPair>
 void find_pairs(std::vector<Candidate> points, double width, double height, const Radius& radius,
-                Victims& victims) {
+                OnPair&& on_pair) {
   if (points.empty()) return;
   // Earlier points first; each point looks back for earlier ones within its own radius, on a grid whose
   // cells are the smallest radius wide (the largest radii, at the coarsest levels, are few).
@@ -71,8 +73,7 @@ void find_pairs(std::vector<Candidate> points, double width, double height, cons
     for (int cy = cell_y(p.y - r); cy <= cell_y(p.y + r); ++cy)
       for (int cx = cell_x(p.x - r); cx <= cell_x(p.x + r); ++cx)
         for (std::uint32_t j : grid[std::size_t(cy) * nx + cx])
-          if (std::hypot(points[j].x - p.x, points[j].y - p.y) < r)
-            victims.insert({p.level, p.kind, p.patch, p.index});
+          if (std::hypot(points[j].x - p.x, points[j].y - p.y) < r) on_pair(p, points[j]);
     grid[std::size_t(cell_y(p.y)) * nx + cell_x(p.x)].push_back(i);
   }
 }
@@ -155,34 +156,103 @@ Colouring pair_of_tiles(std::uint32_t colours, bool across, std::vector<std::uin
   return col;
 }
 
-}  // namespace
-
-std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                             const TilesetShape& shape, double separation) {
-  if (!(separation > 0)) return 0;
+/// Calls on_pair(later, earlier) for every pair closer than separation · d_hex of the later point (at its
+/// threshold, or the first level's count if higher), in every tile and across every edge two tiles can
+/// share (their shared edge's colours, and two more on each side: a strip as wide as the largest radius on
+/// either side of the edge).
+template <class OnPair>
+void for_each_close_pair(const std::vector<LevelPatches>& levels, std::uint32_t colours,
+                         const TilesetShape& shape, double separation, OnPair&& on_pair) {
   // Densities below the first level are outside the set's range: a pair counts from there on.
   const double lowest = std::max(1.0, double(shape.level_nominal.front()));
   auto radius = [&](const Candidate& p) {
     return separation * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(p.threshold), lowest)));
   };
-  Victims victims;  // (level, kind, patch, index)
   const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
   for (std::size_t t = 0; t < tiles; ++t)
-    find_pairs(collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1), 1, 1, radius, victims);
-  // Pairs across a tile edge, for every two tiles that can meet there (their shared edge's colours, and
-  // two more on each side): a strip as wide as the largest radius on either side of the edge.
+    find_pairs(collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1), 1, 1, radius, on_pair);
   const double reach = separation * std::sqrt(2.0 / (std::sqrt(3.0) * lowest));
   std::vector<std::uint32_t> v(6);
   for (std::size_t code = 0; code < std::size_t(tiles) * colours * colours; ++code) {
     std::size_t rest = code;
     for (std::uint32_t& c : v) c = static_cast<std::uint32_t>(rest % colours), rest /= colours;
     find_pairs(collect(levels, pair_of_tiles(colours, true, v), shape, 1 - reach, 0, 1 + reach, 1), 2 * reach,
-               1, radius, victims);
+               1, radius, on_pair);
     find_pairs(collect(levels, pair_of_tiles(colours, false, v), shape, 0, 1 - reach, 1, 1 + reach), 1,
-               2 * reach, radius, victims);
+               2 * reach, radius, on_pair);
   }
+}
+
+using PointKey = std::tuple<std::size_t, int, std::size_t, std::uint32_t>;  // (level, kind, patch, index)
+
+PointKey key_of(const Candidate& p) {
+  return {p.level, p.kind, p.patch, p.index};
+}
+
+}  // namespace
+
+std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                             const TilesetShape& shape, double separation) {
+  if (!(separation > 0)) return 0;
+  Victims victims;
+  for_each_close_pair(levels, colours, shape, separation,
+                      [&](const Candidate& later, const Candidate&) { victims.insert(key_of(later)); });
   remove(levels, victims);
   return victims.size();
+}
+
+SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                                        const TilesetShape& shape, double separation) {
+  SeparationResult result;
+  if (!(separation > 0)) return result;
+  // Where each later point of a close pair sits against the earlier points it is too close to, in any
+  // tile: their offsets from it (the same in every window, since a patch moves as a whole).
+  std::map<PointKey, std::vector<std::array<double, 2>>> crowded;
+  std::map<PointKey, double> radius_of;
+  const double lowest = std::max(1.0, double(shape.level_nominal.front()));
+  std::set<PointKey> moved;
+  for (int round = 0; round < kPushRounds; ++round) {
+    crowded.clear();
+    for_each_close_pair(
+        levels, colours, shape, separation, [&](const Candidate& later, const Candidate& earlier) {
+          crowded[key_of(later)].push_back({earlier.x - later.x, earlier.y - later.y});
+          radius_of[key_of(later)] =
+              separation * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(later.threshold), lowest)));
+        });
+    if (crowded.empty()) break;
+    for (const auto& [key, offsets] : crowded) {
+      // The smallest move that clears every earlier neighbour it met: push off each in turn until none is
+      // nearer than the radius (with a margin, so that rounding to the file's grid keeps it clear).
+      const double r = radius_of[key] * kPushMargin;
+      double dx = 0, dy = 0;
+      for (int step = 0; step < 32; ++step) {
+        bool clear = true;
+        for (const auto& o : offsets) {
+          double ex = dx - o[0], ey = dy - o[1];
+          double d = std::hypot(ex, ey);
+          if (d >= r) continue;
+          clear = false;
+          if (d < 1e-12 * r) {  // on top of it: any fixed direction, the same in every tile
+            ex = 1, ey = 0, d = 1;
+          }
+          dx += (r - d) * ex / d, dy += (r - d) * ey / d;
+        }
+        if (clear) break;
+      }
+      const auto& [level, kind, patch_index, index] = key;
+      Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
+      patch.xy[2 * std::size_t(index)] += dx, patch.xy[2 * std::size_t(index) + 1] += dy;
+      moved.insert(key);
+    }
+  }
+  // What the rounds could not clear goes, as drop_close_pairs would take it.
+  Victims victims;
+  for (const auto& entry : crowded) victims.insert(entry.first);
+  remove(levels, victims);
+  result.removed = victims.size();
+  for (const PointKey& key : victims) moved.erase(key);
+  result.moved = moved.size();
+  return result;
 }
 
 std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
