@@ -36,6 +36,7 @@ struct AnalyzeArgs {
   double fmax = 2.5;
   double min_expected = 20;
   int density_bands = 10;
+  double holes_min_density = 0;
   int threads = 0;
   std::string output;
 };
@@ -56,6 +57,9 @@ void run_analyze(const AnalyzeArgs& args) {
   if (args.density_bands < 1 || args.density_bands > 1000)
     throw CommandError("--density-bands must be 1 to 1000, got " + std::to_string(args.density_bands));
   o.density_bands = args.density_bands;
+  if (!(args.holes_min_density >= 0 && args.holes_min_density <= 1))
+    throw CommandError("--holes-min-density must be in [0, 1]");
+  o.holes_min_density = args.holes_min_density;
   o.tile_size = args.tile_size;
   o.threads = args.threads;
   try {
@@ -130,6 +134,10 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_option("--fmax", args->fmax, "Periodogram limit in normalised frequency |k|/sqrt(n)")
       ->capture_default_str();
   cmd->add_option("--min-expected", args->min_expected, "Density windows expect at least this many points")
+      ->capture_default_str();
+  cmd->add_option("--holes-min-density", args->holes_min_density,
+                  "With --density: count empty circles only where the density is at least this fraction of "
+                  "its largest value (0.5: the dark half of a picture)")
       ->capture_default_str();
   cmd->add_option("--density-bands", args->density_bands,
                   "Bands of the per-band bias table: the points where the target density lies in each "

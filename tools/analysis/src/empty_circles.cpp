@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -61,13 +62,16 @@ void delaunay(std::vector<double>& xy, Visit&& visit) {
     throw InvalidInput("the Delaunay triangulation failed (Qhull error " + std::to_string(failed) + ")");
 }
 
-/// Mean of ρ over the unit square on a 256² grid (the scale radii are normalised by).
-double mean_density(const DensityFunction& rho) {
+/// Mean and largest ρ over the unit square on a 256² grid (the scale radii are normalised by).
+std::pair<double, double> density_scale(const DensityFunction& rho) {
   constexpr int kGrid = 256;
-  double sum = 0;
+  double sum = 0, largest = 0;
   for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i) sum += std::max(0.0, rho((i + 0.5) / kGrid, (j + 0.5) / kGrid));
-  return sum / (kGrid * kGrid);
+    for (int i = 0; i < kGrid; ++i) {
+      const double v = std::max(0.0, rho((i + 0.5) / kGrid, (j + 0.5) / kGrid));
+      sum += v, largest = std::max(largest, v);
+    }
+  return {sum / (kGrid * kGrid), largest};
 }
 
 }  // namespace
@@ -76,7 +80,9 @@ EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const Empty
   if (sets.empty()) throw InvalidInput("no point sets");
   EmptyCircles out;
   std::vector<double> radii;
-  const double mean_rho = o.density ? mean_density(o.density) : 1.0;
+  const std::pair<double, double> scale =
+      o.density ? density_scale(o.density) : std::pair<double, double>(1, 1);
+  const double mean_rho = scale.first, max_rho = scale.second;
   if (o.density && !(mean_rho > 0)) throw InvalidInput("the target density is zero everywhere");
   std::size_t near_edge_judged = 0;
   for (const tools::PointSet& set : sets) {
@@ -118,7 +124,7 @@ EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const Empty
       double local = spacing;
       if (o.density) {
         const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
-        if (!(rho > 0)) return;
+        if (!(rho > 0) || rho < o.min_relative_density * max_rho) return;
         local = spacing * std::sqrt(mean_rho / rho);
       }
       const double r = c.r / local;

@@ -20,6 +20,9 @@ struct EmptyCircleOptions {
   /// count, scaled by √(mean ρ / ρ(centre))); circles centred where ρ = 0 are left out. Empty: uniform.
   DensityFunction density;
   double tile_size = 0;  ///< > 0: also count the large circles centred within one spacing of a tile edge
+  /// With a density: judge only circles centred where ρ is at least this fraction of its largest value
+  /// (e.g. 0.5: the dark half of a stippled picture).
+  double min_relative_density = 0;
 };
 
 struct EmptyCircles {

@@ -25,16 +25,17 @@ namespace kdm::analysis {
 std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths);
 
 struct AnalysisOptions {
-  bool torus = true;         ///< periodic distances (else bounded box)
-  double fmax = 2.5;         ///< periodogram limit in normalised frequency f = |k|/√n (2D only)
-  bool spectrum = true;      ///< compute the periodogram (2D)
-  double gr_rmax = 3.0;      ///< g(r) range, units of the reference spacing
-  int gr_bins = 60;          ///< g(r) bins
-  DensityFunction density;   ///< target density for the density test (empty: skip)
-  double min_expected = 20;  ///< density-test windows expect at least this many points
-  int density_bands = 10;    ///< bands of the per-band bias table (equal steps in log ρ)
-  double tile_size = 0;      ///< tile side for the tiling diagnostics (0: skip)
-  int threads = 0;           ///< worker threads, 0 = gen::default_thread_count()
+  bool torus = true;             ///< periodic distances (else bounded box)
+  double fmax = 2.5;             ///< periodogram limit in normalised frequency f = |k|/√n (2D only)
+  bool spectrum = true;          ///< compute the periodogram (2D)
+  double gr_rmax = 3.0;          ///< g(r) range, units of the reference spacing
+  int gr_bins = 60;              ///< g(r) bins
+  DensityFunction density;       ///< target density for the density test (empty: skip)
+  double min_expected = 20;      ///< density-test windows expect at least this many points
+  int density_bands = 10;        ///< bands of the per-band bias table (equal steps in log ρ)
+  double tile_size = 0;          ///< tile side for the tiling diagnostics (0: skip)
+  double holes_min_density = 0;  ///< empty circles: only where ρ ≥ this fraction of its largest value
+  int threads = 0;               ///< worker threads, 0 = gen::default_thread_count()
 };
 
 struct AnalysisReport {
