@@ -70,12 +70,12 @@ void run_query_command(const QueryArgs& a) {
   }
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
-  const auto density = make_runtime_density(spec, dr[0], dr[1], dr[2], dr[3]);
+  const tools::SpecDensity density(spec, dr);
   QueryParams q;
   q.x0 = r[0], q.y0 = r[1], q.x1 = r[2], q.y1 = r[3];
   q.tile_size = a.tile_size;
   q.scale = a.scale;
-  q.density = density->density;
+  q.density = density.density;
   q.mode = parse_mode(a.mode);
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<QueryPoint> points;

@@ -1,3 +1,4 @@
+// --density for the full sampler's commands: the shared conversion, its refusals as CommandError.
 #include "generator_density.h"
 
 #include <stdexcept>

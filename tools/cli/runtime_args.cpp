@@ -9,42 +9,6 @@
 
 namespace kdm::cli {
 
-std::unique_ptr<RuntimeDensity> make_runtime_density(const tools::DensitySpec& spec, double x0, double y0,
-                                                     double x1, double y1) {
-  auto d = std::make_unique<RuntimeDensity>();
-  d->spec = &spec;
-  d->x0 = x0, d->y0 = y0, d->x1 = x1, d->y1 = y1;
-  d->max_value = spec.max_value(), d->mean_value = spec.mean_value();
-  using Kind = tools::DensitySpec::Kind;
-  switch (spec.kind) {
-    case Kind::kConstant:
-      d->density.kind = QueryDensity::Kind::kConstant;
-      d->density.constant = spec.constant;
-      return d;
-    case Kind::kRamp:
-    case Kind::kRadial:
-      d->density.kind = QueryDensity::Kind::kCallback;
-      d->density.callback = [](void* user, double x, double y) {
-        const RuntimeDensity& r = *static_cast<const RuntimeDensity*>(user);
-        const double u = std::clamp((x - r.x0) / (r.x1 - r.x0), 0.0, 1.0);
-        const double v = std::clamp((y - r.y0) / (r.y1 - r.y0), 0.0, 1.0);
-        return r.spec->map_at(u, v);
-      };
-      d->density.user = d.get();
-      d->density.callback_max = 1;
-      return d;
-    case Kind::kImage:
-      break;
-  }
-  d->image.width = spec.width, d->image.height = spec.height;
-  d->image.x0 = x0, d->image.y0 = y0, d->image.x1 = x1, d->image.y1 = y1;
-  d->image.values = spec.values.data();  // row 0 at y0, as DensityImageView has it
-  if (make_density_max_mip(d->image, d->mip) != Status::kOk) throw CommandError("density image is invalid");
-  d->density.kind = QueryDensity::Kind::kImage;
-  d->density.image = &d->image;
-  return d;
-}
-
 void parse_rect(const std::string& text, const char* option, double r[4]) {
   std::istringstream in(text);
   char c[3] = {0, 0, 0};

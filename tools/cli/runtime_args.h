@@ -10,23 +10,9 @@
 #include "kdm/runtime/query.h"
 #include "point_io.h"
 #include "runtime_query.h"
+#include "spec_density.h"
 
 namespace kdm::cli {
-
-/// A runtime density over the world rectangle [x0, x1) × [y0, y1): constant, an image stretched over it
-/// (its texels are the spec's, not a copy), or a test map called back at every candidate.
-struct RuntimeDensity {
-  QueryDensity density;
-  DensityImageView image;
-  std::vector<float> mip;
-  const tools::DensitySpec* spec = nullptr;
-  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;
-  double max_value = 0, mean_value = 0;
-};
-
-/// Builds the runtime density for `spec` over the given world rectangle; `spec` must outlive it.
-std::unique_ptr<RuntimeDensity> make_runtime_density(const tools::DensitySpec& spec, double x0, double y0,
-                                                     double x1, double y1);
 
 /// Loads --tileset or returns the built-in set; throws CommandError naming the problem.
 const Tileset& tileset_for(const std::string& path, Tileset& storage);

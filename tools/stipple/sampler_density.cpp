@@ -1,3 +1,4 @@
+// A DensitySpec as the full sampler's density, and the analysis's view of it (sampler_density.h).
 #include "sampler_density.h"
 
 #include <algorithm>

@@ -27,11 +27,8 @@ TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, doub
   if (!(spec.max_value() > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
   if (!(points > 0 || scale > 0)) throw std::invalid_argument("give a number of dots > 0 or a scale > 0");
   aspect_ = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
-  image_.width = spec.width, image_.height = spec.height;
-  image_.x1 = aspect_, image_.y1 = 1;
-  image_.values = spec.values.data();
-  if (make_density_max_mip(image_, mip_) != Status::kOk)
-    throw std::invalid_argument("density image is invalid");
+  const double world[4] = {0, 0, aspect_, 1};
+  density_ = std::make_unique<SpecDensity>(spec, world);
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
   scale_ = points > 0 ? points / (spec.mean_value() * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kMaxStippleZoom times, fits the top level.
@@ -49,8 +46,7 @@ PointSet TileStippler::render(const double uv[4]) const {
   q.origin_x = q.x0, q.origin_y = q.y0;
   q.tile_size = tile_size_;
   q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
-  q.density.kind = QueryDensity::Kind::kImage;
-  q.density.image = &image_;
+  q.density = density_->density;
   q.mode = mode_;
   std::vector<QueryPoint> points;
   query_all(tiles_, q, points);

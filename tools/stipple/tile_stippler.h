@@ -8,6 +8,7 @@
 #include "density_spec.h"
 #include "kdm/runtime/query.h"
 #include "point_io.h"
+#include "spec_density.h"
 
 namespace kdm::tools {
 
@@ -35,8 +36,7 @@ class TileStippler {
   const Tileset& tiles_;
   double aspect_ = 1, scale_ = 0, tile_size_ = 1;
   QueryMode mode_;
-  DensityImageView image_;
-  std::vector<float> mip_;
+  std::unique_ptr<SpecDensity> density_;  ///< the image over [0, aspect] × [0, 1]
 };
 
 }  // namespace kdm::tools

@@ -101,8 +101,9 @@ Periodogram make_grid(double mean_n, double fmax) {
   Periodogram p;
   p.n = mean_n;
   p.fmax = fmax;
-  p.kmax = static_cast<int>(std::ceil(fmax * std::sqrt(mean_n))) + 1;
-  if (p.kmax > 4096) throw InvalidInput("periodogram grid too large (fmax·sqrt(n) > 4095)");
+  const double kmax = std::ceil(fmax * std::sqrt(mean_n)) + 1;  // checked before it becomes an int
+  if (!(kmax <= 4096)) throw InvalidInput("periodogram grid too large (fmax·sqrt(n) > 4095)");
+  p.kmax = static_cast<int>(kmax);
   p.power.assign(static_cast<std::size_t>(p.side()) * p.side(), 0.0);
   return p;
 }

@@ -1,0 +1,129 @@
+# Type hints of the kdm package (the implementation is kdm/*.py over the compiled kdm._kdm).
+import os
+from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+__all__: list[str]
+
+_Path = Union[str, os.PathLike[str]]
+_Density = Union[None, float, _Path, npt.ArrayLike]
+_Rect = Sequence[float]
+
+def sample(
+    n: int,
+    density: _Density = ...,
+    *,
+    dim: int = ...,
+    domain: Optional[str] = ...,
+    temperature: float = ...,
+    seed: int = ...,
+    threads: int = ...,
+    aspect: Optional[float] = ...,
+    gamma: float = ...,
+    invert: bool = ...,
+) -> npt.NDArray[np.float64]: ...
+
+class QueryResult:
+    xy: npt.NDArray[np.float64]
+    tile: npt.NDArray[np.int64]
+    rank: npt.NDArray[np.uint32]
+    level: npt.NDArray[np.uint32]
+    def __init__(
+        self,
+        xy: npt.NDArray[np.float64],
+        tile: npt.NDArray[np.int64],
+        rank: npt.NDArray[np.uint32],
+        level: npt.NDArray[np.uint32],
+    ) -> None: ...
+    def __len__(self) -> int: ...
+
+class Tileset:
+    def __init__(self, handle: Any) -> None: ...
+    @classmethod
+    def builtin(cls) -> Tileset: ...
+    @classmethod
+    def load(cls, path: _Path) -> Tileset: ...
+    def save(self, path: _Path) -> None: ...
+    @property
+    def info(self) -> Dict[str, Any]: ...
+    def query(
+        self,
+        rect: _Rect,
+        *,
+        scale: float,
+        density: Union[_Density, Callable[[float, float], float]] = ...,
+        density_rect: Optional[_Rect] = ...,
+        density_max: Optional[float] = ...,
+        tile_size: float = ...,
+        mode: str = ...,
+        origin: Sequence[float] = ...,
+        gamma: float = ...,
+        invert: bool = ...,
+        out: Optional[QueryResult] = ...,
+    ) -> QueryResult: ...
+
+def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
+def stipple(
+    image: Union[_Path, npt.ArrayLike],
+    *,
+    points: int = ...,
+    scale: Optional[float] = ...,
+    method: str = ...,
+    mode: str = ...,
+    region: Optional[_Rect] = ...,
+    gamma: float = ...,
+    invert: bool = ...,
+    seed: int = ...,
+    tileset: Optional[Tileset] = ...,
+    output: Optional[_Path] = ...,
+    width: int = ...,
+    dot_size: Optional[float] = ...,
+    threads: int = ...,
+) -> npt.NDArray[np.float64]: ...
+def analyze(
+    points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],
+    *,
+    box: bool = ...,
+    density: _Density = ...,
+    tile_size: Optional[float] = ...,
+    fmax: float = ...,
+    threads: int = ...,
+    energy: bool = ...,
+    gamma: float = ...,
+    invert: bool = ...,
+) -> Dict[str, Any]: ...
+
+class BlueNoise:
+    d: int
+    rng: np.random.Generator
+    rng_seed: Any
+    num_generated: int
+    temperature: float
+    domain: Optional[str]
+    density: _Density
+    threads: int
+    def __init__(
+        self,
+        d: int = ...,
+        *,
+        seed: Union[None, int, np.random.Generator] = ...,
+        temperature: float = ...,
+        domain: Optional[str] = ...,
+        density: _Density = ...,
+        threads: int = ...,
+    ) -> None: ...
+    def random(self, n: int = ..., *, workers: int = ...) -> npt.NDArray[np.float64]: ...
+    def reset(self) -> BlueNoise: ...
+    def fast_forward(self, n: int) -> BlueNoise: ...
+    def integers(
+        self,
+        l_bounds: npt.ArrayLike,
+        *,
+        u_bounds: Optional[npt.ArrayLike] = ...,
+        n: int = ...,
+        endpoint: bool = ...,
+        workers: int = ...,
+    ) -> npt.NDArray[np.int64]: ...

@@ -1,0 +1,79 @@
+"""kdm.analyze: point-set metrics (docs/design.md section 6), the measures `kdm analyze` writes."""
+from __future__ import annotations
+
+import json
+import warnings
+from typing import Any, Dict, Optional
+
+import numpy as np
+
+from . import _checks, _kdm
+
+
+def _arrays(value: Any) -> Any:
+    """metrics.json's lists of numbers as float64 arrays (null, a non-finite value, as NaN)."""
+    if isinstance(value, dict):
+        return {k: _arrays(v) for k, v in value.items()}
+    if isinstance(value, list):
+        if all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in value):
+            return np.array([np.nan if v is None else v for v in value], dtype=np.float64)
+        return [_arrays(v) for v in value]
+    return value
+
+
+def analyze(
+    points: Any,
+    *,
+    box: bool = False,
+    density: Any = None,
+    tile_size: Optional[float] = None,
+    fmax: float = 2.5,
+    threads: int = 0,
+    energy: bool = True,
+    gamma: float = 1.0,
+    invert: bool = False,
+) -> Dict[str, Any]:
+    """Measure point sets as ``kdm analyze`` does, returning what it writes to metrics.json.
+
+    Parameters
+    ----------
+    points : array or list of arrays
+        One (n, 2) or (n, 3) set with coordinates in [0, 1], or a list of such sets of one dimension
+        (statistics are pooled over them, as over the sets of one file).
+    box : bool
+        Bounded-box distances instead of periodic (torus) ones.
+    density : None, float, str or 2-D array
+        The target density, as kdm.sample takes it, for the density accuracy test (default: uniform).
+    tile_size : float or None
+        Tile side in unit-square units (1 / tile_size an integer) for the periodicity and seam
+        statistics.
+    fmax : float
+        The periodogram's limit in normalised frequency |k| / sqrt(n).
+    threads : int
+        Worker threads (0: the default count); the results do not depend on it.
+    energy : bool
+        Compute E/n under the KDM model (``energy_per_point``).
+
+    Returns
+    -------
+    dict
+        metrics.json's keys (inputs, dim, domain, sets, points_*, nearest_neighbour, spectrum,
+        pair_correlation, density, tiling, energy_per_point, seconds: those that apply), with its lists
+        of numbers (spectrum.raps_f, spectrum.raps, pair_correlation.r and .g, ...) as numpy arrays.
+    """
+    several = isinstance(points, (list, tuple)) and len(points) > 0
+    if several and all(isinstance(p, np.ndarray) and p.ndim == 2 for p in points):
+        sets = [_checks.array2d(f"points[{i}]", p) for i, p in enumerate(points)]
+        names = [f"points[{i}]" for i in range(len(sets))]
+    else:
+        sets, names = [_checks.array2d("points", points)], ["points"]
+    box = _checks.flag("box", box)
+    spec = _checks.sampler_density(density, gamma, invert)
+    tile = 0.0 if tile_size is None else _checks.number("tile_size", tile_size, 0.0, strict=True)
+    fmax = _checks.number("fmax", fmax, 0.0, strict=True)
+    threads = _checks.threads(threads)
+    energy = _checks.flag("energy", energy)
+    if sets[0].shape[1] == 3 and (spec is not None or tile_size is not None):
+        warnings.warn("density and tiling diagnostics are 2D only; skipped", stacklevel=2)
+    text = _kdm.analyze(sets, names, box, spec, tile, fmax, threads, energy)
+    return _arrays(json.loads(text))

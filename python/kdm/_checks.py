@@ -1,0 +1,138 @@
+"""Argument checks shared by kdm's functions.
+
+A value of the wrong type raises TypeError and a bad value ValueError, each naming the argument, before
+anything reaches the C++ libraries (which check again, so nothing a caller passes can crash them).
+"""
+from __future__ import annotations
+
+import math
+import numbers
+import os
+from typing import Any, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import _kdm
+
+
+def integer(name: str, value: Any, minimum: Optional[int] = None, maximum: Optional[int] = None) -> int:
+    """`value` as an int (numpy integers too, never bool), within [minimum, maximum]."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__}")
+    value = int(value)
+    if minimum is not None and value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ValueError(f"{name} must be <= {maximum}, got {value}")
+    return value
+
+
+def number(name: str, value: Any, minimum: Optional[float] = None, strict: bool = False) -> float:
+    """`value` as a finite float, at least `minimum` (above it when `strict`)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number, got {type(value).__name__}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value}")
+    if minimum is not None and (value <= minimum if strict else value < minimum):
+        raise ValueError(f"{name} must be {'>' if strict else '>='} {minimum:g}, got {value:g}")
+    return value
+
+
+def threads(value: Any) -> int:
+    """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use)."""
+    return integer("threads", value, 0, 1 << 16)
+
+
+def flag(name: str, value: Any) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {type(value).__name__}")
+    return bool(value)
+
+
+def choice(name: str, value: Any, options: Sequence[str]) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a str, got {type(value).__name__}")
+    if value not in options:
+        raise ValueError(f"{name} must be one of {', '.join(repr(o) for o in options)}, got {value!r}")
+    return value
+
+
+def path(name: str, value: Any) -> str:
+    """A file name: a str or an os.PathLike of one."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a path (str or os.PathLike), got {type(value).__name__}")
+    return value
+
+
+def numbers_tuple(name: str, value: Any, count: int) -> Tuple[float, ...]:
+    """A sequence of `count` finite numbers, as floats."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or not hasattr(value, "__getitem__"):
+        raise TypeError(f"{name} must be a sequence of {count} numbers, got {type(value).__name__}")
+    if len(value) != count:
+        raise ValueError(f"{name} must hold {count} numbers, got {len(value)}")
+    return tuple(number(f"{name}[{i}]", value[i]) for i in range(count))
+
+
+def rect(name: str, value: Any) -> Tuple[float, ...]:
+    """(x0, y0, x1, y1) with x0 < x1 and y0 < y1."""
+    r = numbers_tuple(name, value, 4)
+    if not (r[0] < r[2] and r[1] < r[3]):
+        raise ValueError(f"{name} is empty or inverted (needs x0 < x1 and y0 < y1): {r}")
+    return r
+
+
+def array2d(name: str, value: Any) -> np.ndarray:
+    """A 2-D array of numbers as C-contiguous float64 (copied only when it is not that already)."""
+    try:
+        a = np.asarray(value)
+    except ValueError as e:  # ragged nested lists
+        raise ValueError(f"{name} must be a 2-D array (rows, columns): {e}") from None
+    except Exception as e:  # an object whose __array__ fails
+        raise TypeError(f"{name} must be a 2-D array of numbers: {e}") from None
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if a.ndim != 2:
+        raise ValueError(f"{name} must be a 2-D array (rows, columns), got shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def is_array(value: Any) -> bool:
+    return isinstance(value, (np.ndarray, list, tuple)) or hasattr(value, "__array__")
+
+
+def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str = "density") -> Any:
+    """A density as the C++ side takes it (_kdm.DensitySpec), or None for None.
+
+    A number is a constant (finite, >= 0); a str or path is what `--density` accepts ("const:V", "ramp:R",
+    "radial:R" or an image file, whose darkness to the power `gamma` is the density, or its luminance with
+    `invert`); a 2-D array holds densities with row 0 at the top.
+    """
+    gamma = number("gamma", gamma, 0.0, strict=True)
+    invert = flag("invert", invert)
+    if density is None:
+        return None
+    if isinstance(density, (str, os.PathLike)):
+        return _kdm.DensitySpec.parse(path(name, density), gamma, invert)
+    if gamma != 1.0 or invert:
+        raise ValueError("gamma and invert apply to image files only (an array or a number is the density)")
+    if isinstance(density, numbers.Real) and not isinstance(density, (bool, np.bool_)):
+        return _kdm.DensitySpec.constant(number(name, density, 0.0))
+    if is_array(density):
+        return _kdm.DensitySpec.from_values(array2d(name, density))
+    raise TypeError(
+        f"{name} must be None, a number, a str (const:V, ramp:R, radial:R or an image path) or a 2-D array, "
+        f"got {type(density).__name__}"
+    )
+
+
+def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:
+    """density_spec() for the full sampler, which needs something to sample."""
+    spec = density_spec(density, gamma, invert, name)
+    # Text gets the command line's refusal (from C++); numbers and arrays a message of their own.
+    if spec is not None and spec.text in ("array", "number") and not spec.max_value > 0:
+        what = "an image or array that is zero everywhere" if spec.kind == "image" else "a density of 0"
+        raise ValueError(f"{name}: {what} has nothing to sample (it needs some density > 0)")
+    return spec

@@ -1,0 +1,120 @@
+"""kdm.BlueNoise: the full sampler as a SciPy quasi-Monte Carlo engine (scipy.stats.qmc.QMCEngine).
+
+Code written for ``qmc.PoissonDisk(d=2, seed=rng)`` switches by changing that line to
+``kdm.BlueNoise(d=2, seed=rng)``. Without SciPy the class has the same interface on a small base of its own.
+"""
+from __future__ import annotations
+
+import copy
+import numbers
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _checks, _kdm
+
+
+def _generator(seed: Any) -> Any:
+    """SciPy's check_random_state: an int or None seeds a new Generator, a Generator is used as it is."""
+    if seed is None or isinstance(seed, numbers.Integral):
+        return np.random.default_rng(seed)
+    if isinstance(seed, (np.random.Generator, np.random.RandomState)):
+        return seed
+    raise ValueError(f"{seed!r} cannot be used to seed a numpy.random.Generator instance")
+
+
+class _Engine:
+    """QMCEngine's conventions where SciPy is not installed: d, rng, rng_seed, num_generated, random,
+    reset and fast_forward, with seeds handled as SciPy 1.10 handles them."""
+
+    def __init__(self, d: int, *, seed: Any = None) -> None:
+        if not isinstance(d, numbers.Integral) or d < 0:
+            raise ValueError("d must be a non-negative integer value")
+        self.d = d
+        self.rng = _generator(seed)
+        self.rng_seed = copy.deepcopy(seed)
+        self.num_generated = 0
+
+    def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
+        points = self._random(n, workers=workers)
+        self.num_generated += n
+        return points
+
+    def reset(self) -> "_Engine":
+        self.rng = _generator(copy.deepcopy(self.rng_seed))
+        self.num_generated = 0
+        return self
+
+    def fast_forward(self, n: int) -> "_Engine":
+        self.random(n=n)
+        return self
+
+    def integers(
+        self, l_bounds: Any, *, u_bounds: Any = None, n: int = 1, endpoint: bool = False, workers: int = 1
+    ) -> np.ndarray:
+        if u_bounds is None:
+            u_bounds, l_bounds = l_bounds, 0
+        low, high = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds) + (1 if endpoint else 0)
+        if not (np.issubdtype(low.dtype, np.integer) and np.issubdtype(high.dtype, np.integer)):
+            raise ValueError("'u_bounds' and 'l_bounds' must be integers or array-like of integers")
+        return np.floor(self.random(n=n) * (high - low) + low).astype(np.int64)
+
+
+try:
+    from scipy.stats.qmc import QMCEngine as _Base
+except ImportError:  # SciPy is optional
+    _Base = _Engine
+
+
+class BlueNoise(_Base):  # type: ignore[valid-type, misc]
+    """Blue-noise points from the full KDM sampler, as a SciPy QMC engine.
+
+    Each ``random(n)`` returns `n` fresh points (a whole set drawn with a new seed taken from the engine's
+    generator, so it is blue noise by itself); ``reset()`` replays the same sets; ``fast_forward(n)``
+    draws and drops one set of n. Points lie in [0, 1)^d.
+
+    Parameters
+    ----------
+    d : int
+        2 or 3.
+    seed : None, int or numpy.random.Generator
+        As SciPy's engines take it: an int or None seeds a new ``numpy.random.default_rng``; a Generator
+        is used as it is (and replayed from a copy by reset()).
+    temperature, domain, density, threads
+        As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise);
+        ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
+        draws.
+    """
+
+    def __init__(
+        self,
+        d: int = 2,
+        *,
+        seed: Any = None,
+        temperature: float = 0.5,
+        domain: Optional[str] = None,
+        density: Any = None,
+        threads: int = 0,
+    ) -> None:
+        d = _checks.integer("d", d, 2, 3)
+        seeds = (numbers.Integral, np.random.Generator, np.random.RandomState)
+        if not (seed is None or isinstance(seed, seeds)):
+            raise TypeError(
+                f"seed must be None, an int or a numpy.random.Generator, got {type(seed).__name__}"
+            )
+        super().__init__(d=d, seed=seed)
+        self.temperature = _checks.number("temperature", temperature, 0.0)
+        self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
+        self.density = density
+        self.threads = _checks.threads(threads)
+        self._spec = _checks.sampler_density(density, 1.0, False)  # read once, refused now if bad
+
+    def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
+        n = _checks.integer("n", n, 0, 2**31)
+        if n == 0:
+            return np.empty((0, self.d))
+        if hasattr(self.rng, "integers"):
+            seed = int(self.rng.integers(0, 2**63, dtype=np.int64))
+        else:  # a legacy RandomState
+            seed = int(self.rng.randint(0, 2**63, dtype=np.int64))
+        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, self.threads, None)

@@ -1,0 +1,169 @@
+"""The runtime from Python: tile sets (kdm.Tileset), their queries (kdm.QueryResult) and the baker."""
+from __future__ import annotations
+
+import numbers
+from typing import Any, Callable, Dict, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _checks, _kdm
+
+
+class QueryResult:
+    """The points of a query, in the runtime's order (tiles row by row, ranks ascending).
+
+    Attributes
+    ----------
+    xy : numpy.ndarray
+        (m, 2) float64: world positions minus the query's origin.
+    tile : numpy.ndarray
+        (m, 2) int64: each point's tile (tile_x, tile_y); with `rank`, its stable id.
+    rank : numpy.ndarray
+        (m,) uint32: the point's index in its tile, in emission order.
+    level : numpy.ndarray
+        (m,) uint32: the pyramid level the rank belongs to.
+    """
+
+    __slots__ = ("xy", "tile", "rank", "level", "_storage")
+
+    def __init__(
+        self, xy: np.ndarray, tile: np.ndarray, rank: np.ndarray, level: np.ndarray, storage: Any = None
+    ) -> None:
+        self.xy, self.tile, self.rank, self.level = xy, tile, rank, level
+        self._storage = storage  # the arrays these are the first rows of (query's `out` refills them)
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+    def __repr__(self) -> str:
+        return f"<kdm.QueryResult: {len(self)} points>"
+
+
+class Tileset:
+    """A loaded, immutable tile set: the runtime's source of points for any region and density.
+
+    Get one with Tileset.builtin(), Tileset.load(path) or kdm.bake(recipe). Any number of threads may
+    query one at once.
+    """
+
+    __slots__ = ("_handle",)
+    _builtin: Optional["Tileset"] = None
+
+    def __init__(self, handle: Any) -> None:
+        if not isinstance(handle, _kdm.Tileset):
+            raise TypeError("use Tileset.builtin(), Tileset.load(path) or kdm.bake(recipe)")
+        self._handle = handle
+
+    @classmethod
+    def builtin(cls) -> "Tileset":
+        """The tile set compiled into the library (tilesets/default.kdmt), decoded on the first call."""
+        if cls._builtin is None:
+            cls._builtin = cls(_kdm.Tileset.builtin())
+        return cls._builtin
+
+    @classmethod
+    def load(cls, path: Any) -> "Tileset":
+        """Loads and validates a .kdmt file. Raises OSError (the command line's message) if it cannot."""
+        return cls(_kdm.Tileset.load(_checks.path("path", path)))
+
+    def save(self, path: Any) -> None:
+        """Writes the set as a .kdmt file (atomically). Raises OSError if it cannot."""
+        self._handle.save(_checks.path("path", path))
+
+    @property
+    def info(self) -> Dict[str, Any]:
+        """What the set holds: levels, level_points (nominal points per tile, cumulative), keyframes,
+        max_points_per_tile, colours, tiles, format_version, resident_bytes, recipe, generator_version and
+        glide_reach (tile sides)."""
+        return self._handle.info
+
+    def __repr__(self) -> str:
+        i = self.info
+        return (
+            f"<kdm.Tileset: {i['tiles']} tiles, {i['levels']} levels, "
+            f"up to {i['max_points_per_tile']} points per tile>"
+        )
+
+    def query(
+        self,
+        rect: Sequence[float],
+        *,
+        scale: float,
+        density: Union[float, str, np.ndarray, Callable[[float, float], float], None] = 1.0,
+        density_rect: Optional[Sequence[float]] = None,
+        density_max: Optional[float] = None,
+        tile_size: float = 1.0,
+        mode: str = "stable",
+        origin: Sequence[float] = (0.0, 0.0),
+        gamma: float = 1.0,
+        invert: bool = False,
+        out: Optional["QueryResult"] = None,
+    ) -> QueryResult:
+        """The points of the world rectangle `rect` = (x0, y0, x1, y1), half-open (``kdm query``).
+
+        Parameters
+        ----------
+        scale : float
+            Points per unit area where the density is 1.
+        density : float, str, 2-D array or callable
+            A constant >= 0; a str as ``kdm query --density`` takes it (an image, "const:V", "ramp:R",
+            "radial:R"); a 2-D array of densities (finite, >= 0) with row 0 at the TOP; either of the last
+            two stretched over `density_rect` (default: `rect`; fix it to query parts of one region). Or a
+            callable f(x, y) -> float of world coordinates, called for every candidate point (with the
+            GIL held; an exception it raises is raised here once the query ends), which needs
+            `density_max`, a true upper bound of its values.
+        tile_size : float
+            World units per tile side. A tile expects density * scale * tile_size**2 points, at most
+            info["max_points_per_tile"] where the density is highest, or the query is refused.
+        mode : {"stable", "smooth"}
+            stable: a point never moves once it appears (placing objects); smooth: points glide with the
+            density, so every density is even blue noise (stippling, sample patterns).
+        origin : (float, float)
+            Subtracted from every position (keep it near the region in large worlds).
+        gamma, invert
+            How an image file's pixels become density.
+        out : QueryResult, optional
+            An earlier result whose arrays this query refills, where they are large enough (its arrays
+            are overwritten): a loop of queries then writes into warm memory instead of new arrays.
+
+        Returns
+        -------
+        QueryResult
+            Positions, ids and levels; any partition of a region gives the region's points, and the same
+            arguments give the same bits as ``kdm query ... -o points.csv``.
+        """
+        rect = _checks.rect("rect", rect)
+        scale = _checks.number("scale", scale)
+        tile_size = _checks.number("tile_size", tile_size)
+        mode = _checks.choice("mode", mode, ("stable", "smooth"))
+        origin = _checks.numbers_tuple("origin", origin, 2)
+        if density_rect is not None:
+            density_rect = _checks.rect("density_rect", density_rect)
+        if density_max is not None:
+            density_max = _checks.number("density_max", density_max, 0.0)
+        spec, call = None, None
+        if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
+            call = density
+        else:
+            spec = _checks.density_spec(density, gamma, invert)
+            if spec is None:
+                spec = _kdm.DensitySpec.constant(1.0)
+        if out is not None and not isinstance(out, QueryResult):
+            raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
+        xy, tile, rank, level, storage = _kdm.query(
+            self._handle, rect, scale, spec, call, density_rect, density_max, tile_size, mode, origin,
+            out._storage if out is not None else None,
+        )
+        return QueryResult(xy, tile, rank, level, storage)
+
+
+def bake(recipe_text: str, *, threads: int = 0) -> Tileset:
+    """Bakes a tile set from recipe text ("key value" lines, as ``kdm bake`` reads from a file).
+
+    A recipe gives the same set for any `threads`. Real sets take minutes to hours; a recipe of a few
+    small levels bakes in seconds. Raises ValueError for a bad recipe.
+    """
+    if not isinstance(recipe_text, str):
+        raise TypeError(f"recipe_text must be a str, got {type(recipe_text).__name__}")
+    threads = _checks.threads(threads)
+    return Tileset(_kdm.bake(recipe_text, threads))

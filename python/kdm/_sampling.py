@@ -1,0 +1,67 @@
+"""kdm.sample: the full KDM sampler, as `kdm sample` runs it."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _checks, _kdm
+
+
+def sample(
+    n: int,
+    density: Any = None,
+    *,
+    dim: int = 2,
+    domain: Optional[str] = None,
+    temperature: float = 0.5,
+    seed: int = 1,
+    threads: int = 0,
+    aspect: Optional[float] = None,
+    gamma: float = 1.0,
+    invert: bool = False,
+) -> np.ndarray:
+    """Draw exactly `n` blue-noise points from the KDM model (the full sampler, `kdm sample`).
+
+    Parameters
+    ----------
+    n : int
+        The number of points, 1 to 2**31.
+    density : None, float, str or 2-D array
+        The target density (only its shape matters: the sampler scales it to `n` points). None or a
+        number > 0: uniform. A str: what ``kdm sample --density`` accepts, "const:V", the test maps
+        "ramp:R" and "radial:R", or an image file whose darkness (to the power `gamma`; its luminance with
+        `invert`) is the density. A 2-D array: density values (finite, >= 0, not all zero), stretched over
+        the domain, with row 0 at the TOP, as pictures are stored (and as an image file is read).
+    dim : int
+        2 or 3 (images and arrays are 2-D).
+    domain : {"torus", "box"} or None
+        Periodic or bounded. None: a box for images, arrays and "ramp:R", a torus otherwise.
+    temperature : float
+        >= 0; 0.5 is the paper's look, lower is more ordered, 0 a deterministic descent.
+    seed : int
+        0 to 2**64 - 1. The points depend on the arguments and the seed only, never on `threads`.
+    threads : int
+        Worker threads; 0: OMP_NUM_THREADS if set, else the CPUs this process may use.
+    aspect : float or None
+        Width / height of the domain; None: the image's or array's, else 1. Points are normalised to
+        [0, 1) on every axis whatever the aspect.
+    gamma, invert
+        How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, dim) float64 in [0, 1)^dim: the same bits as ``kdm sample`` with the same arguments.
+    """
+    n = _checks.integer("n", n, 1, 2**31)
+    dim = _checks.integer("dim", dim, 2, 3)
+    if domain is not None:
+        domain = _checks.choice("domain", domain, ("torus", "box"))
+    temperature = _checks.number("temperature", temperature, 0.0)
+    seed = _checks.integer("seed", seed, 0, 2**64 - 1)
+    threads = _checks.threads(threads)
+    if aspect is not None:
+        aspect = _checks.number("aspect", aspect, 0.0, strict=True)
+    spec = _checks.sampler_density(density, gamma, invert)
+    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)

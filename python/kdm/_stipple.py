@@ -1,0 +1,98 @@
+"""kdm.stipple: an image as dots, as `kdm stipple` draws it (one picture; no zoom sequence)."""
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from . import _checks, _kdm
+from ._runtime import Tileset
+
+
+def stipple(
+    image: Any,
+    *,
+    points: int = 20000,
+    scale: Optional[float] = None,
+    method: str = "tiles",
+    mode: str = "smooth",
+    region: Optional[Sequence[float]] = None,
+    gamma: float = 1.0,
+    invert: bool = False,
+    seed: int = 1,
+    tileset: Optional[Tileset] = None,
+    output: Any = None,
+    width: int = 1024,
+    dot_size: Optional[float] = None,
+    threads: int = 0,
+) -> np.ndarray:
+    """Stipple an image: its darkness becomes dot density (``kdm stipple``).
+
+    Parameters
+    ----------
+    image : str, os.PathLike or 2-D array
+        An image file (PNG, JPEG, ...), or luminance in [0, 1] with row 0 at the TOP (as pictures are
+        stored). The image spans [0, width/height] x [0, 1].
+    points : int
+        Dots over the whole image (ignored when `scale` is given).
+    scale : float or None
+        Dots per unit area at full darkness (image height = 1 unit), instead of `points`.
+    method : {"tiles", "full"}
+        tiles: the runtime and a tile set (fast, zoom-coherent); full: the full KDM sampler (best, slow).
+    mode : {"smooth", "stable"}
+        For tiles: dots glide with the tone (smooth) or never move (stable).
+    region : (x0, y0, x1, y1) or None
+        Part of the image's UV square [0, 1]^2 (y up) to render at the whole image's dot size, zooming
+        at most 2x (tiles only). None: the whole image.
+    gamma, invert
+        Darkness ** gamma is the density; invert: luminance instead of darkness.
+    seed : int
+        For method "full".
+    tileset : Tileset or None
+        For method "tiles" (default: the built-in set).
+    output : str, os.PathLike or None
+        Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does.
+    width, dot_size
+        The picture's width in pixels, and the dot radius in pixels (None: a quarter of the whole
+        image's mean dot spacing).
+    threads : int
+        For method "full": worker threads (0: the default count); the dots do not depend on it.
+
+    Returns
+    -------
+    numpy.ndarray
+        (m, 2) float64: the dots normalised to the rendered image or region, [0, 1) on both axes, y up.
+    """
+    gamma = _checks.number("gamma", gamma, 0.0, strict=True)
+    invert = _checks.flag("invert", invert)
+    if isinstance(image, (str, os.PathLike)):
+        label = _checks.path("image", image)
+        spec = _kdm.DensitySpec.parse(label, gamma, invert)
+    elif _checks.is_array(image):
+        label = "array"
+        spec = _kdm.DensitySpec.from_luminance(_checks.array2d("image", image), gamma, invert)
+    else:
+        raise TypeError(f"image must be a path or a 2-D array of luminance, got {type(image).__name__}")
+    if scale is None:
+        points = _checks.integer("points", points, 1, 2**31)
+        scale = 0.0
+    else:
+        scale = _checks.number("scale", scale, 0.0, strict=True)
+        points = 0
+    method = _checks.choice("method", method, ("tiles", "full"))
+    mode = _checks.choice("mode", mode, ("smooth", "stable"))
+    if region is not None:
+        region = _checks.numbers_tuple("region", region, 4)
+    seed = _checks.integer("seed", seed, 0, 2**64 - 1)
+    if tileset is not None and not isinstance(tileset, Tileset):
+        raise TypeError(f"tileset must be a kdm.Tileset or None, got {type(tileset).__name__}")
+    if output is not None:
+        output = _checks.path("output", output)
+    width = _checks.integer("width", width, 1, 65536)
+    dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)
+    threads = _checks.threads(threads)
+    handle = tileset._handle if tileset is not None else None
+    return _kdm.stipple(
+        spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads
+    )

@@ -1,0 +1,56 @@
+// What the sources of the Python module kdm._kdm share: each binds one topic (densities, the sampler, tile
+// sets, queries, stippling, the analysis, C++ timings for the benchmark) through its bind_* function, and
+// they raise the same errors and return numpy arrays the same way.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kdm/runtime/tileset.h"
+
+namespace kdm::python {
+
+namespace py = pybind11;
+
+/// A file that cannot be read or written: raised as OSError (pybind11 would make a std::runtime_error a
+/// RuntimeError). The message is the command line's one line.
+struct FileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A loaded tile set as Python holds it: shared, immutable, so queries run on it with the GIL released.
+struct TilesetHandle {
+  std::shared_ptr<const Tileset> set;
+  std::uint32_t format_version = 0;  ///< of the file it came from (the current one when baked or built in)
+};
+
+/// A numpy array of `shape` that takes over `values` (moved, not copied): the vector is freed when the
+/// last array viewing it is.
+template <class T>
+py::array_t<T> owning_array(std::vector<T>&& values, const std::vector<py::ssize_t>& shape) {
+  auto* owned = new std::vector<T>(std::move(values));
+  py::capsule owner(owned, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, owned->data(), owner);
+}
+
+/// Throws std::invalid_argument("`name` must be ...") unless `value` is finite and at least `min`
+/// (above it when `strict`).
+void check_number(const char* name, double value, double min, bool strict);
+
+void bind_density(py::module_& m);
+void bind_sampler(py::module_& m);
+void bind_tileset(py::module_& m);
+void bind_query(py::module_& m);
+void bind_stipple(py::module_& m);
+void bind_analysis(py::module_& m);
+void bind_timing(py::module_& m);
+
+}  // namespace kdm::python

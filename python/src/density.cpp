@@ -1,0 +1,141 @@
+// kdm._kdm.DensitySpec: a density as `--density` names it (tools::DensitySpec: const:V, ramp:R, radial:R or
+// an image file), or made from a numpy array of densities or of luminances. Arrays arrive with row 0 at
+// the top, as pictures are stored; like the command line, this flips them once, here, to kdm's row 0 at
+// the bottom.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "bindings.h"
+#include "density_spec.h"
+#include "image_io.h"
+
+namespace kdm::python {
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using tools::DensitySpec;
+
+/// The array's size, checked: 2-D, not empty, no larger than the images the command line reads.
+void check_shape(const Array& a, const char* what, int& width, int& height) {
+  if (a.ndim() != 2)
+    throw std::invalid_argument(std::string(what) + " must be a 2-D array (rows, columns), got " +
+                                std::to_string(a.ndim()) + " dimensions");
+  if (a.shape(0) < 1 || a.shape(1) < 1) throw std::invalid_argument(std::string(what) + " is empty");
+  if (std::uint64_t(a.shape(0)) * std::uint64_t(a.shape(1)) > tools::kMaxImagePixels)
+    throw std::invalid_argument(std::string(what) + " has more than 2^26 values (the image size limit)");
+  height = static_cast<int>(a.shape(0)), width = static_cast<int>(a.shape(1));
+}
+
+/// A kImage spec of `a`'s size with row y of the spec taken from row height - 1 - y of `a`, through `f`.
+template <class F>
+DensitySpec flipped(const Array& a, const char* what, F f) {
+  DensitySpec spec;
+  spec.kind = DensitySpec::Kind::kImage;
+  spec.text = "array";
+  check_shape(a, what, spec.width, spec.height);
+  spec.values.resize(std::size_t(spec.width) * spec.height);
+  const double* in = a.data();
+  for (int y = 0; y < spec.height; ++y)
+    for (int x = 0; x < spec.width; ++x)
+      spec.values[std::size_t(y) * spec.width + x] =
+          static_cast<float>(f(in[std::size_t(spec.height - 1 - y) * spec.width + x]));
+  return spec;
+}
+
+DensitySpec from_values(const Array& a) {
+  for (py::ssize_t i = 0; i < a.size(); ++i)
+    if (!(std::isfinite(a.data()[i]) && a.data()[i] >= 0))
+      throw std::invalid_argument("density array values must be finite and >= 0, got " +
+                                  std::to_string(a.data()[i]));
+  return flipped(a, "density array", [](double v) { return v; });
+}
+
+/// As tools::parse_density_spec reads a picture: darkness (or luminance, inverted) to the power gamma.
+DensitySpec from_luminance(const Array& a, double gamma, bool invert) {
+  check_number("gamma", gamma, 0, true);
+  for (py::ssize_t i = 0; i < a.size(); ++i)
+    if (!(a.data()[i] >= 0 && a.data()[i] <= 1))
+      throw std::invalid_argument("image array values must be luminances in [0, 1], got " +
+                                  std::to_string(a.data()[i]));
+  DensitySpec spec = flipped(a, "image array", [gamma, invert](double grey) {
+    const double tone = invert ? grey : 1.0 - grey;
+    return std::pow(std::max(0.0, tone), gamma);
+  });
+  spec.inverted = invert;
+  return spec;
+}
+
+DensitySpec parse(const std::string& text, double gamma, bool invert) {
+  py::gil_scoped_release release;  // an image is read and decoded
+  try {
+    return tools::parse_density_spec(text, gamma, invert);
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // an image that cannot be read
+    throw FileError(e.what());
+  }
+}
+
+/// A picture file as luminance in [0, 1], row 0 at the top (for tests and examples).
+py::array_t<float> load_luminance(const std::string& path) {
+  tools::GreyImage image;
+  std::string error;
+  bool ok;
+  {
+    py::gil_scoped_release release;
+    ok = tools::load_grey_image(path, image, error);
+  }
+  if (!ok) throw FileError(error);
+  return owning_array(std::move(image.pixels), {image.height, image.width});
+}
+
+const char* kind_name(const DensitySpec& s) {
+  switch (s.kind) {
+    case DensitySpec::Kind::kConstant:
+      return "const";
+    case DensitySpec::Kind::kRamp:
+      return "ramp";
+    case DensitySpec::Kind::kRadial:
+      return "radial";
+    case DensitySpec::Kind::kImage:
+      break;
+  }
+  return "image";
+}
+
+}  // namespace
+
+void bind_density(py::module_& m) {
+  py::class_<DensitySpec, std::shared_ptr<DensitySpec>>(
+      m, "DensitySpec", "A density as --density names it (tools::DensitySpec)")
+      .def_static("parse", &parse, py::arg("text"), py::arg("gamma") = 1.0, py::arg("invert") = false,
+                  "const:V, ramp:R, radial:R or an image path (darkness**gamma; invert: luminance)")
+      .def_static(
+          "constant",
+          [](double v) {
+            check_number("density", v, 0, false);
+            DensitySpec spec;
+            spec.constant = v;
+            spec.text = "number";
+            return spec;
+          },
+          py::arg("value"))
+      .def_static("from_values", &from_values, py::arg("values"),
+                  "Densities (finite, >= 0), row 0 at the top")
+      .def_static("from_luminance", &from_luminance, py::arg("values"), py::arg("gamma") = 1.0,
+                  py::arg("invert") = false, "Luminances in [0, 1], row 0 at the top, read as a picture")
+      .def_property_readonly("kind", &kind_name)
+      .def_readonly("width", &DensitySpec::width)
+      .def_readonly("height", &DensitySpec::height)
+      .def_readonly("text", &DensitySpec::text)
+      .def_property_readonly("max_value", &DensitySpec::max_value)
+      .def_property_readonly("mean_value", &DensitySpec::mean_value)
+      .def("__repr__", [](const DensitySpec& s) {
+        return "<DensitySpec " + std::string(kind_name(s)) + " " + s.text + ">";
+      });
+  m.def("load_luminance", &load_luminance, py::arg("path"),
+        "A picture file as luminance in [0, 1] (float32, row 0 at the top)");
+}
+
+}  // namespace kdm::python

@@ -1,0 +1,33 @@
+// A query's density from what Python passes: a DensitySpec (a constant, an image or array stretched over a
+// world rectangle, or a test map: tools::SpecDensity, as `kdm query --density` builds it), or a Python
+// callable.
+#pragma once
+
+#include <atomic>
+#include <optional>
+#include <vector>
+
+#include "bindings.h"
+#include "density_spec.h"
+#include "kdm/runtime/query.h"
+#include "spec_density.h"
+
+namespace kdm::python {
+
+using tools::SpecDensity;  // as `kdm query` builds it (tools/stipple/spec_density.h)
+
+/// A Python callable f(x, y) -> float as a query callback. The query runs with the GIL released; each call
+/// takes it back. The first exception f raises is kept (later calls return 0 at once) for rethrow() to
+/// raise once the query is over, so it reaches the caller as itself.
+struct CallableDensity {
+  CallableDensity(py::object function, double max_value);
+  /// Raises the kept exception, if any. Call with the GIL held.
+  void rethrow();
+
+  QueryDensity density;
+  py::object function;
+  std::atomic<bool> failed{false};
+  std::optional<py::error_already_set> error;
+};
+
+}  // namespace kdm::python

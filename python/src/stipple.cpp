@@ -1,0 +1,101 @@
+// kdm._kdm.stipple: one picture of `kdm stipple` (tools/cli/cmd_stipple.cpp) — the runtime's TileStippler
+// or the full sampler's stipple_full, the same checks, dot size and file header — returning the dots.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "bindings.h"
+#include "full_stippler.h"
+#include "point_output.h"
+#include "tile_stippler.h"
+
+namespace kdm::python {
+namespace {
+
+using tools::DensitySpec;
+using Region = std::array<double, 4>;
+
+py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, std::int64_t points,
+                            double scale, const std::string& method, const std::string& mode,
+                            std::optional<Region> region, std::uint64_t seed, const TilesetHandle* tileset,
+                            std::optional<std::string> output, int width, double dot_size, int threads) {
+  if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
+  if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
+    throw std::invalid_argument("give points > 0 or a finite scale > 0");
+  if (method != "tiles" && method != "full")
+    throw std::invalid_argument("method must be 'tiles' or 'full', got '" + method + "'");
+  if (mode != "stable" && mode != "smooth")
+    throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
+  if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
+  check_number("dot_size", dot_size, 0, false);
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
+  if (spec.kind != DensitySpec::Kind::kImage)
+    throw std::invalid_argument("stipple needs an image; for a constant density use kdm.sample");
+  if (!(spec.max_value() > 0))
+    throw std::invalid_argument("image '" + label + "' has no ink: nothing to stipple" +
+                                (spec.inverted ? "" : " (an all-white image has no ink)"));
+  const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
+  Region uv = {0, 0, 1, 1};
+  if (region) {
+    uv = *region;
+    const bool finite = std::all_of(uv.begin(), uv.end(), [](double v) { return std::isfinite(v); });
+    if (!(finite && uv[0] >= 0 && uv[1] >= 0 && uv[2] <= 1 && uv[3] <= 1 && uv[0] < uv[2] && uv[1] < uv[3]))
+      throw std::invalid_argument(
+          "region must be (x0, y0, x1, y1) with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1");
+    if (method == "full")
+      throw std::invalid_argument("region needs method='tiles' (the full sampler has no zoom)");
+    if (1 / std::max(uv[2] - uv[0], uv[3] - uv[1]) > tools::kMaxStippleZoom + 1e-9)
+      throw std::invalid_argument("region zooms more than 2× (the tile set's density range)");
+  }
+  const QueryMode query_mode = mode == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
+  const Tileset* given = tileset ? tileset->set.get() : nullptr;
+  tools::PointSet set;
+  {
+    py::gil_scoped_release release;
+    const Tileset& tiles = given ? *given : Tileset::builtin();
+    if (method == "full") {
+      set = tools::stipple_full(spec, points > 0 ? points : std::llround(scale * aspect), aspect, seed,
+                                threads);
+    } else {
+      const tools::TileStippler stippler(spec, tiles, double(points), scale, query_mode);
+      set = stippler.render(uv.data());
+    }
+    if (output) {
+      // Dots a quarter of the whole image's mean spacing, as kdm stipple draws them.
+      const double full = points > 0 ? double(points) : double(set.size());
+      tools::DrawStyle style;
+      style.width_px = width;
+      style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
+      style.dot_radius_px =
+          dot_size > 0 ? dot_size : 0.25 * std::sqrt(double(width) * (width / aspect) / std::max(1.0, full));
+      char line[200], where[160];
+      std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(),
+                    method == "full" ? "full KDM sampler" : "runtime tiles");
+      std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
+      try {
+        tools::write_points(*output, set, {line, "image " + label, where}, style);
+      } catch (const std::invalid_argument&) {
+        throw;
+      } catch (const std::runtime_error& e) {
+        throw FileError(e.what());
+      }
+    }
+  }
+  const auto count = static_cast<py::ssize_t>(set.size());
+  return owning_array(std::move(set.coords), {count, py::ssize_t(2)});
+}
+
+}  // namespace
+
+void bind_stipple(py::module_& m) {
+  m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
+        py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
+        py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
+        py::arg("threads"), "One picture of kdm stipple");
+}
+
+}  // namespace kdm::python

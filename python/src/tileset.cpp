@@ -1,0 +1,102 @@
+// kdm._kdm.Tileset: loaded tile sets (the built-in one, a file, or one just baked) and what they hold;
+// kdm._kdm.bake: the tile baker. Queries on them are query.cpp's.
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "kdm/generator/bake.h"
+#include "kdm/runtime/tileset_format.h"
+#include "kdm/runtime/version.h"
+
+namespace kdm::python {
+namespace {
+
+TilesetHandle builtin() {
+  TilesetHandle h;
+  {
+    py::gil_scoped_release release;  // the first call decodes the set (a tenth of a second)
+    h.set = std::shared_ptr<const Tileset>(&Tileset::builtin(), [](const Tileset*) {});
+  }
+  h.format_version = kTilesetFormatVersion;  // compiled in from tilesets/default.kdmt, which CI rebakes
+  return h;
+}
+
+/// The message is `kdm query --tileset`'s.
+TilesetHandle load(const std::string& path) {
+  auto set = std::make_shared<Tileset>();
+  std::string detail;
+  TilesetHeader header;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = Tileset::load_file(path, *set, &detail);
+    if (s == Status::kOk) {  // read again for the header's version, which the loaded set does not keep
+      std::ifstream in(path, std::ios::binary);
+      const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+    }
+  }
+  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  return {std::move(set), header.format_version};
+}
+
+void save(const TilesetHandle& h, const std::string& path) {
+  std::string detail;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = save_tileset(h.set->data(), path, &detail);
+  }
+  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+}
+
+py::dict info(const TilesetHandle& h) {
+  const Tileset& t = *h.set;
+  const TilesetData& d = t.data();
+  py::dict out;
+  out["levels"] = d.levels;
+  out["level_points"] = std::vector<std::uint32_t>(d.level_nominal.begin(), d.level_nominal.end());
+  out["keyframes"] = std::vector<std::uint32_t>(d.keyframe_nominal.begin(), d.keyframe_nominal.end());
+  out["max_points_per_tile"] = t.max_points_per_tile();
+  out["colours"] = d.colours;
+  out["tiles"] = d.tiles.size();
+  out["format_version"] = h.format_version;
+  out["resident_bytes"] = t.resident_bytes();
+  out["recipe"] = d.recipe;
+  out["generator_version"] = d.generator_version;
+  out["glide_reach"] = t.glide_reach();
+  return out;
+}
+
+TilesetHandle bake(const std::string& recipe_text, int threads) {
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
+  const gen::BakeRecipe recipe = gen::BakeRecipe::parse(recipe_text);  // gen::InvalidArgument: ValueError
+  auto set = std::make_shared<Tileset>();
+  std::string detail;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    const TilesetData data = gen::bake_tileset(recipe, threads);
+    std::vector<std::uint8_t> bytes;  // through the file format, as `kdm bake` then a load would go
+    s = encode_tileset(data, bytes, &detail);
+    if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
+  }
+  if (s != Status::kOk)
+    throw std::runtime_error(std::string("baked set: ") + status_message(s) + " (" + detail + ")");
+  return {std::move(set), kTilesetFormatVersion};
+}
+
+}  // namespace
+
+void bind_tileset(py::module_& m) {
+  py::class_<TilesetHandle>(m, "Tileset", "A loaded tile set (kdm::Tileset)")
+      .def_static("builtin", &builtin)
+      .def_static("load", &load, py::arg("path"))
+      .def("save", &save, py::arg("path"))
+      .def_property_readonly("info", &info);
+  m.def("bake", &bake, py::arg("recipe_text"), py::arg("threads"));
+}
+
+}  // namespace kdm::python

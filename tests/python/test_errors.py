@@ -1,0 +1,241 @@
+"""Bad arguments raise TypeError (wrong type), ValueError (bad value) or OSError (a file that cannot be read
+or written), with one clear line, and never crash the interpreter: explicit cases, then random ones."""
+import inspect
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import kdm
+from conftest import SPHERE
+
+TILES = kdm.Tileset.builtin()
+NAN, INF = math.nan, math.inf
+
+
+def raises(kind, match, call, *args, **kwargs):
+    with pytest.raises(kind, match=match) as info:
+        call(*args, **kwargs)
+    assert type(info.value) is kind or kind is OSError, f"{type(info.value).__name__}: {info.value}"
+    assert "\n" not in str(info.value)  # one line
+
+
+@pytest.mark.parametrize("kind,match,kwargs", [
+    (ValueError, "n must be >= 1", dict(n=-5)),
+    (ValueError, "n must be >= 1", dict(n=0)),
+    (ValueError, "n must be <= 2147483648", dict(n=2**40)),
+    (TypeError, "n must be an integer, got float", dict(n=100.0)),
+    (TypeError, "n must be an integer, got str", dict(n="100")),
+    (TypeError, "n must be an integer, got bool", dict(n=True)),
+    (ValueError, "density must be a finite number", dict(n=10, density=NAN)),
+    (ValueError, "density must be >= 0", dict(n=10, density=-1.0)),
+    (ValueError, "a density of 0 has nothing to sample", dict(n=10, density=0)),
+    (TypeError, "density must be None, a number, a str", dict(n=10, density={"a": 1})),
+    (ValueError, "must be a 2-D array", dict(n=10, density=np.ones(5))),
+    (ValueError, "must be a 2-D array", dict(n=10, density=np.ones((2, 2, 2)))),
+    (ValueError, "density array is empty", dict(n=10, density=np.ones((0, 4)))),
+    (ValueError, "finite and >= 0", dict(n=10, density=np.array([[1.0, NAN]]))),
+    (ValueError, "finite and >= 0", dict(n=10, density=np.array([[1.0, -2.0]]))),
+    (ValueError, "finite and >= 0", dict(n=10, density=np.array([[1.0, INF]]))),
+    (ValueError, "zero everywhere has nothing to sample", dict(n=10, density=np.zeros((3, 3)))),
+    (TypeError, "must hold real numbers", dict(n=10, density=np.array([["a", "b"]]))),
+    (TypeError, "must hold real numbers", dict(n=10, density=np.ones((2, 2)) * 1j)),
+    (ValueError, "must be a 2-D array", dict(n=10, density=[[1, 2], [3]])),
+    (ValueError, "gamma and invert apply to image files only", dict(n=10, density=np.ones((2, 2)), gamma=2)),
+    (ValueError, "dim must be <= 3", dict(n=10, dim=4)),
+    (ValueError, "domain must be one of 'torus', 'box'", dict(n=10, domain="sphere")),
+    (ValueError, "temperature must be a finite number", dict(n=10, temperature=NAN)),
+    (ValueError, "temperature must be >= 0", dict(n=10, temperature=-1)),
+    (ValueError, "seed must be >= 0", dict(n=10, seed=-1)),
+    (ValueError, "seed must be <= ", dict(n=10, seed=2**64)),
+    (ValueError, "threads must be >= 0", dict(n=10, threads=-1)),
+    (ValueError, "aspect must be > 0", dict(n=10, aspect=0)),
+    (ValueError, "gamma must be > 0", dict(n=10, density="const:1", gamma=0)),
+    (TypeError, "invert must be True or False", dict(n=10, density="const:1", invert="yes")),
+    (ValueError, "const:V needs a finite V >= 0", dict(n=10, density="const:x")),
+    (ValueError, r"ramp:R needs a dynamic range R in \[1, 1e9\]", dict(n=10, density="ramp:0.5")),
+    (ValueError, "image densities are 2D", dict(n=10, density=np.ones((2, 2)), dim=3)),
+])
+def test_sample_refusals(kind, match, kwargs):
+    raises(kind, match, kdm.sample, **kwargs)
+
+
+def cli_message(cli_path, *args):
+    done = subprocess.run([cli_path, *map(str, args)], capture_output=True, text=True)
+    assert done.returncode == 1
+    line = done.stderr.strip()
+    assert line.startswith("kdm: error: ")
+    return line[len("kdm: error: "):]
+
+
+def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny_tileset):
+    import os
+    kdm_cli = os.environ["KDM_CLI"]
+    missing = tmp_path / "missing.png"
+    not_an_image = tmp_path / "notes.png"
+    not_an_image.write_text("hello")
+    for path in (missing, not_an_image):
+        message = cli_message(kdm_cli, "sample", "--n", 10, "--density", path, "-o", tmp_path / "x.txt")
+        with pytest.raises(OSError) as info:
+            kdm.sample(10, str(path))
+        assert str(info.value) == message
+        with pytest.raises(OSError):
+            kdm.stipple(path)
+        with pytest.raises(OSError):
+            TILES.query((0, 0, 1, 1), scale=10, density=str(path))
+    damaged = tmp_path / "damaged.kdmt"
+    damaged.write_bytes(b"KDMT" + bytes(100))
+    for path in (tmp_path / "missing.kdmt", damaged):
+        message = cli_message(kdm_cli, "query", "--tileset", path, "--rect", "0,0,1,1",
+                              "-o", tmp_path / "x.csv")
+        with pytest.raises(OSError) as info:
+            kdm.Tileset.load(path)
+        assert str(info.value) == message
+    with pytest.raises(OSError, match="cannot|No such|directory"):
+        kdm.stipple(SPHERE, points=100, output=tmp_path / "no" / "such" / "dir" / "x.png")
+    with pytest.raises(OSError):
+        tiny_tileset.save(tmp_path / "no" / "such" / "x.kdmt")  # (the built-in set takes 30 s to encode)
+
+
+@pytest.mark.parametrize("kind,match,kwargs", [
+    (ValueError, "rect is empty or inverted", dict(rect=(0, 0, 0, 1))),
+    (ValueError, "rect is empty or inverted", dict(rect=(2, 0, 1, 1))),
+    (ValueError, r"rect\[1\] must be a finite number", dict(rect=(0, NAN, 1, 1))),
+    (ValueError, "rect must hold 4 numbers", dict(rect=(0, 0, 1))),
+    (TypeError, "rect must be a sequence of 4 numbers", dict(rect="0,0,1,1")),
+    (TypeError, "scale must be a number", dict(scale="10")),
+    (ValueError, "scale must be a finite number", dict(scale=INF)),
+    (ValueError, "must not be negative.*'scale' = -1", dict(scale=-1)),
+    (ValueError, r"more points per tile than .* use scale= 32768 or less", dict(scale=1e300)),
+    (ValueError, "'tile_size' = 0", dict(tile_size=0)),
+    (ValueError, "mode must be one of 'stable', 'smooth'", dict(mode="fast")),
+    (ValueError, "origin must hold 2 numbers", dict(origin=(1, 2, 3))),
+    (ValueError, "density_rect needs an image, an array or a test map", dict(density_rect=(0, 0, 1, 1))),
+    (ValueError, "density_max is for a callable density only", dict(density=0.5, density_max=1)),
+    (ValueError, "a callable density needs density_max", dict(density=lambda x, y: 1.0)),
+    (ValueError, "density_max must be >= 0", dict(density=lambda x, y: 1.0, density_max=-1)),
+    (ValueError, "density must be >= 0", dict(density=-0.5)),
+    (ValueError, "finite and >= 0", dict(density=np.full((3, 3), NAN))),
+    (TypeError, "density must be None, a number", dict(density=object())),
+])
+def test_query_refusals(kind, match, kwargs):
+    args = dict(rect=(0, 0, 1, 1), scale=100)
+    args.update(kwargs)
+    raises(kind, match, TILES.query, args.pop("rect"), **args)
+
+
+@pytest.mark.parametrize("kind,match,call", [
+    (ValueError, "unknown key", lambda: kdm.bake("colours 2\nbogus 1\n")),
+    (TypeError, "recipe_text must be a str", lambda: kdm.bake(b"colours 2")),
+    (TypeError, "use Tileset.builtin", lambda: kdm.Tileset("x")),
+    (TypeError, "path must be a path", lambda: kdm.Tileset.load(5)),
+    (ValueError, "points must be >= 1", lambda: kdm.stipple(SPHERE, points=0)),
+    (ValueError, "scale must be > 0", lambda: kdm.stipple(SPHERE, scale=-1)),
+    (ValueError, "method must be one of", lambda: kdm.stipple(SPHERE, method="fast")),
+    (ValueError, "region must be", lambda: kdm.stipple(SPHERE, region=(0, 0, 2, 1))),
+    (ValueError, "region zooms more than 2", lambda: kdm.stipple(SPHERE, region=(0, 0, 0.1, 0.1))),
+    (ValueError, "needs method='tiles'", lambda: kdm.stipple(SPHERE, method="full", region=(0, 0, 1, 1))),
+    (ValueError, "width must be <= 65536", lambda: kdm.stipple(SPHERE, width=10**6)),
+    (ValueError, "dot_size must be >= 0", lambda: kdm.stipple(SPHERE, dot_size=-1)),
+    (ValueError, "unknown output format", lambda: kdm.stipple(SPHERE, points=100, output="x.gif")),
+    (ValueError, "luminances in", lambda: kdm.stipple(np.full((4, 4), 2.0))),
+    (ValueError, "has no ink", lambda: kdm.stipple(np.ones((4, 4)))),
+    (ValueError, "stipple needs an image", lambda: kdm.stipple("const:1")),
+    (TypeError, "image must be a path or a 2-D array", lambda: kdm.stipple(3)),
+    (TypeError, "tileset must be a kdm.Tileset", lambda: kdm.stipple(SPHERE, tileset="default")),
+    (ValueError, r"points must be an \(n, 2\) or \(n, 3\) array", lambda: kdm.analyze(np.ones((5, 4)))),
+    (ValueError, "must be a 2-D array", lambda: kdm.analyze(np.ones(5))),
+    (ValueError, "outside|inside", lambda: kdm.analyze(np.full((5, 2), 1.5))),
+    (ValueError, "finite|non-finite", lambda: kdm.analyze(np.full((5, 2), NAN))),
+    (ValueError, "at least 2 points", lambda: kdm.analyze(np.full((1, 2), 0.5))),
+    (ValueError, "1 / tile size must be an", lambda: kdm.analyze(np.random.rand(50, 2), tile_size=0.3)),
+    (ValueError, "fmax must be > 0", lambda: kdm.analyze(np.random.rand(50, 2), fmax=0)),
+    (ValueError, "periodogram grid too large", lambda: kdm.analyze(np.random.rand(50, 2), fmax=1e300)),
+    (ValueError, "mix dimensions", lambda: kdm.analyze([np.random.rand(5, 2), np.random.rand(5, 3)])),
+    (ValueError, "d must be >= 2", lambda: kdm.BlueNoise(1)),
+])
+def test_other_refusals(kind, match, call):
+    raises(kind, match, call)
+
+
+# Values no argument of kdm should take, or only in a few places: anything may be passed anywhere.
+GARBAGE = [
+    None, "", "nonsense", "const:-1", "ramp:nan", b"bytes", -1, -(2**70), 2**70, 0, NAN, INF, -INF, 1e308,
+    -0.0, True, 1j, [], [1], [[1, 2], [3]], (NAN, 0, 1, 1), (0, 0, -1, -1), np.array([]), np.zeros((0, 3)),
+    np.full((2, 2), NAN), np.array([["a"]]), np.ones((3, 3, 3)), np.float32(-2), object(), {}, lambda: 0,
+]
+
+
+def cheap_calls():
+    """Each public call with every parameter given, its defaults but for a few that make it quick."""
+    quick = {
+        kdm.sample: dict(n=64, threads=1),
+        TILES.query: dict(rect=(0, 0, 1, 1), scale=50.0),
+        kdm.stipple: dict(image=np.full((8, 8), 0.5), points=100, width=64, threads=1),
+        kdm.analyze: dict(points=np.random.default_rng(1).random((64, 2)), energy=False, threads=1),
+        kdm.BlueNoise: dict(d=2, seed=1, threads=1),
+        kdm.Tileset.load: dict(path="/nonexistent/set.kdmt"),
+    }
+    calls = []
+    for call, given in quick.items():
+        params = inspect.signature(call).parameters.values()
+        kwargs = {p.name: p.default for p in params if p.default is not inspect.Parameter.empty}
+        calls.append((call, {**kwargs, **given}))
+    return calls
+
+
+def test_random_bad_arguments_never_crash():
+    rng = np.random.default_rng(2024)
+    outcomes = {"ok": 0, "refused": 0}
+    for _ in range(600):
+        call, base = cheap_calls()[rng.integers(6)]
+        kwargs = dict(base)
+        for name in rng.choice(list(kwargs), size=min(len(kwargs), rng.integers(1, 3)), replace=False):
+            kwargs[name] = GARBAGE[rng.integers(len(GARBAGE))]
+        if call is TILES.query:
+            rect = kwargs.pop("rect")
+            args = (rect,)
+        else:
+            args = ()
+        try:
+            call(*args, **kwargs)
+            outcomes["ok"] += 1
+        except (TypeError, ValueError, OSError) as e:
+            assert str(e) and "\n" not in str(e), repr(e)
+            outcomes["refused"] += 1
+    assert outcomes["refused"] > 300  # most garbage is refused; the rest happened to be valid
+
+
+def test_the_compiled_layer_checks_too():
+    # kdm._kdm is private, but its own checks keep a caller who skips kdm's from crashing anything.
+    from kdm import _kdm
+    handle = _kdm.Tileset.builtin()
+    spec = _kdm.DensitySpec.constant(1.0)
+    calls = [
+        lambda: _kdm.sample(-1, None, 2, None, 0.5, 1, 0, None),
+        lambda: _kdm.sample(10, None, 5, None, 0.5, 1, 0, None),
+        lambda: _kdm.sample(10, None, 2, "cube", 0.5, 1, 0, None),
+        lambda: _kdm.sample(10, None, 2, None, NAN, 1, 0, None),
+        lambda: _kdm.sample(10, None, 2, None, 0.5, 1, -3, None),
+        lambda: _kdm.sample(10, None, 2, None, 0.5, 1, 0, -2.0),
+        lambda: _kdm.sample(10, _kdm.DensitySpec.constant(0.0), 2, None, 0.5, 1, 0, None),
+        lambda: _kdm.DensitySpec.constant(NAN),
+        lambda: _kdm.DensitySpec.from_values(np.ones((2, 2, 2))),
+        lambda: _kdm.DensitySpec.from_values(np.full((2, 2), -1.0)),
+        lambda: _kdm.DensitySpec.from_luminance(np.ones((2, 2)), 0.0, False),
+        lambda: _kdm.query(handle, (0, 0, NAN, 1), 10, spec, None, None, None, 1, "stable", (0, 0)),
+        lambda: _kdm.query(handle, (0, 0, 1, 1), 10, None, None, None, None, 1, "stable", (0, 0)),
+        lambda: _kdm.query(handle, (0, 0, 1, 1), 10, spec, None, None, None, 1, "wobbly", (0, 0)),
+        lambda: _kdm.query(handle, (0, 0, 1, 1), NAN, spec, None, None, None, 1, "stable", (0, 0)),
+        lambda: _kdm.query(handle, (0, 0, 1, 1), 10, spec, None, None, None, 1, "stable", (INF, 0)),
+        lambda: _kdm.query(handle, (0, 0, 1, 1), 10, None, lambda x, y: 1, None, INF, 1, "stable", (0, 0)),
+        lambda: _kdm.stipple(spec, "x", 10, 0, "tiles", "smooth", None, 1, None, None, 64, 0, 0),
+        lambda: _kdm.stipple(spec, "x", 0, NAN, "tiles", "smooth", None, 1, None, None, 64, 0, 0),
+        lambda: _kdm.analyze([np.ones((4, 2)) * 0.5], ["a"], False, None, NAN, 2.5, 0, False),
+        lambda: _kdm.analyze([], [], False, None, 0, 2.5, 0, False),
+        lambda: _kdm.bake("levels 0\n", 0),
+    ]
+    for call in calls:
+        with pytest.raises((ValueError, TypeError)):
+            call()

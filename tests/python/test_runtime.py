@@ -1,0 +1,195 @@
+"""kdm.Tileset and its queries: the command line's bits, partitions, densities of every kind, loading,
+saving and baking."""
+import math
+
+import numpy as np
+import pytest
+
+import kdm
+from conftest import TINY_RECIPE, read_query_csv
+
+BUILTIN = kdm.Tileset.builtin()
+
+
+def same(a, b):
+    """Whether two query results (or their arrays as tuples) are equal bit for bit."""
+    def fields(r):
+        return (r.xy, r.tile, r.rank, r.level) if isinstance(r, kdm.QueryResult) else r
+    return all(np.array_equal(x, y) for x, y in zip(fields(a), fields(b)))
+
+
+def test_builtin_info():
+    info = BUILTIN.info
+    assert set(info) >= {"levels", "level_points", "keyframes", "max_points_per_tile", "colours", "tiles",
+                         "format_version", "resident_bytes", "recipe", "generator_version"}
+    assert info["levels"] == len(info["level_points"])
+    assert info["max_points_per_tile"] == info["level_points"][-1]
+    assert info["tiles"] == info["colours"] ** 4 and info["keyframes"][-1] == info["max_points_per_tile"]
+    assert "seed" in info["recipe"] and info["resident_bytes"] > 0
+    assert kdm.Tileset.builtin() is BUILTIN
+
+
+@pytest.mark.parametrize("args,kwargs", [
+    ([], {}),
+    (["--mode", "smooth", "--scale", "333.3"], dict(mode="smooth", scale=333.3)),
+    (["--density", "radial:30", "--tile-size", "0.5"], dict(density="radial:30", tile_size=0.5)),
+    (["--density", "const:0.37", "--mode", "smooth"], dict(density=0.37, mode="smooth")),
+])
+def test_same_bits_as_kdm_query(cli, tmp_path, args, kwargs):
+    out = tmp_path / "q.csv"
+    cli("query", "--rect", "-1.5,0.25,2,3", *args, "-o", out)
+    kwargs.setdefault("scale", 1000.0)
+    r = BUILTIN.query((-1.5, 0.25, 2, 3), **kwargs)
+    assert len(r) > 1000
+    assert same(r, read_query_csv(out))
+
+
+def test_same_bits_with_an_image_density(cli, tmp_path, gradient_png):
+    out = tmp_path / "q.csv"
+    cli("query", "--rect", "0,0,3,2", "--density", gradient_png, "--density-rect", "-0.5,0,3,2.5",
+        "--scale", 800, "--mode", "smooth", "--invert", "-o", out)
+    r = BUILTIN.query((0, 0, 3, 2), scale=800, density=str(gradient_png), density_rect=(-0.5, 0, 3, 2.5),
+                      mode="smooth", invert=True)
+    assert same(r, read_query_csv(out))
+    # The image as an array (row 0 at the top, its luminance as density) is the same density.
+    luminance = kdm._kdm.load_luminance(str(gradient_png)).astype(np.float64)
+    a = BUILTIN.query((0, 0, 3, 2), scale=800, density=luminance, density_rect=(-0.5, 0, 3, 2.5),
+                      mode="smooth")
+    assert same(a, r)
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_partitions_concatenate_to_the_whole(mode):
+    density = np.random.default_rng(3).random((16, 16))
+    kw = dict(scale=500, mode=mode, density=density, density_rect=(0, 0, 4, 4))
+    whole = BUILTIN.query((0, 0, 4, 4), **kw)
+    parts = [BUILTIN.query((x0, y0, x1, y1), **kw)
+             for (x0, x1) in ((0, 1.3), (1.3, 4)) for (y0, y1) in ((0, 2.5), (2.5, 4))]
+    def key(xy, tile, rank):
+        return sorted(zip(tile[:, 0], tile[:, 1], rank, xy[:, 0], xy[:, 1]))
+    joined = [np.concatenate([getattr(p, f) for p in parts]) for f in ("xy", "tile", "rank")]
+    assert key(*joined) == key(whole.xy, whole.tile, whole.rank)
+    assert sum(len(p) for p in parts) == len(whole)
+
+
+def test_results_are_deterministic_and_origin_shifts():
+    a = BUILTIN.query((10, 10, 13, 12), scale=300, mode="smooth")
+    again = BUILTIN.query((10, 10, 13, 12), scale=300, mode="smooth")
+    assert same(again, a)
+    b = BUILTIN.query((10, 10, 13, 12), scale=300, mode="smooth", origin=(10, 10))
+    assert np.array_equal(a.tile, b.tile) and np.array_equal(a.rank, b.rank)
+    assert np.allclose(a.xy - 10, b.xy, atol=1e-12) and b.xy.min() < 0.1
+
+
+def test_result_arrays():
+    r = BUILTIN.query((0, 0, 2, 2), scale=2000)
+    assert r.xy.dtype == np.float64 and r.xy.shape == (len(r), 2) and r.xy.flags["C_CONTIGUOUS"]
+    assert r.tile.dtype == np.int64 and r.tile.shape == (len(r), 2)
+    assert r.rank.dtype == np.uint32 and r.level.dtype == np.uint32
+    assert ((r.xy >= 0) & (r.xy < 2)).all()
+    assert np.array_equal(r.tile, np.floor(r.xy).astype(np.int64))  # tile_size 1
+    # Levels follow ranks: level k ends at about level_points[k] points per tile.
+    first = (r.tile == [0, 0]).all(axis=1)
+    assert (np.diff(r.level[first].astype(int)) >= 0).all() and (np.diff(r.rank[first].astype(int)) > 0).all()
+    assert r.level.max() == np.searchsorted(BUILTIN.info["level_points"], 2000)
+    empty = BUILTIN.query((0, 0, 2, 2), scale=0)
+    assert len(empty) == 0 and empty.xy.shape == (0, 2)
+
+
+def test_a_callable_density_equals_the_same_map():
+    # radial:R over the rectangle, computed in Python: the C++ map's formula, so the same points.
+    rect, r = (0.0, 0.0, 3.0, 2.0), 40.0
+    def radial(x, y):
+        u = min(max((x - rect[0]) / (rect[2] - rect[0]), 0.0), 1.0)
+        v = min(max((y - rect[1]) / (rect[3] - rect[1]), 0.0), 1.0)
+        return math.exp(-math.log(r) * min(1.0, 2 * math.sqrt((u - 0.5) ** 2 + (v - 0.5) ** 2)))
+    for mode in ("stable", "smooth"):
+        a = BUILTIN.query(rect, scale=700, density=radial, density_max=1.0, mode=mode)
+        b = BUILTIN.query(rect, scale=700, density=f"radial:{r:g}", mode=mode)
+        assert len(a) > 100 and same(a, b)
+
+
+def test_a_callable_density_gets_numbers_and_may_return_numpy_values():
+    calls = []
+    def f(x, y):
+        calls.append((type(x), type(y)))
+        return np.float32(0.5)
+    r = BUILTIN.query((0, 0, 1, 1), scale=400, density=f, density_max=0.5)
+    assert len(r) > 100 and calls and set(calls) == {(float, float)}
+    assert same(r, (BUILTIN.query((0, 0, 1, 1), scale=400, density=0.5).xy, r.tile, r.rank, r.level))
+
+
+def test_an_exception_in_the_callable_propagates():
+    class Boom(Exception):
+        pass
+    def f(x, y):
+        if x > 0.5:
+            raise Boom("no density here")
+        return 1.0
+    with pytest.raises(Boom, match="no density here"):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=f, density_max=1)
+    with pytest.raises(TypeError):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x, y: "dense", density_max=1)
+    with pytest.raises(TypeError):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x: 1.0, density_max=1)
+    # Still usable afterwards.
+    assert len(BUILTIN.query((0, 0, 1, 1), scale=100)) > 0
+
+
+def test_a_callable_density_may_query_itself():
+    # A query inside the density of another (on the same thread) leaves the outer one's points alone.
+    inner = []
+    def f(x, y):
+        if not inner:
+            inner.append(BUILTIN.query((5, 5, 7, 7), scale=900))
+        return 0.5
+    a = BUILTIN.query((0, 0, 2, 2), scale=800, density=f, density_max=0.5)
+    assert same(a, BUILTIN.query((0, 0, 2, 2), scale=800, density=0.5))
+    assert same(inner[0], BUILTIN.query((5, 5, 7, 7), scale=900))
+
+
+def test_zero_density_and_an_all_white_image_give_no_points():
+    assert len(BUILTIN.query((0, 0, 1, 1), scale=100, density=0.0)) == 0
+    assert len(BUILTIN.query((0, 0, 1, 1), scale=100, density=np.zeros((4, 4)))) == 0
+
+
+def test_refusals_name_the_python_parameter():
+    with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less, or tile_size= [0-9.]+ or less"):
+        BUILTIN.query((0, 0, 1, 1), scale=1e9)
+    with pytest.raises(ValueError, match="larger tile_size= or a smaller region"):
+        BUILTIN.query((0, 0, 1e4, 1e4), scale=1)
+
+
+def test_load_save_and_bake(tmp_path, tiny_tileset):
+    info = tiny_tileset.info
+    assert info["level_points"] == [32, 128] and info["recipe"].startswith("seed 1")
+    path = tmp_path / "tiny.kdmt"
+    tiny_tileset.save(path)
+    loaded = kdm.Tileset.load(path)
+    assert loaded.info == info
+    kw = dict(scale=100, mode="smooth")
+    assert same(loaded.query((0, 0, 3, 3), **kw), tiny_tileset.query((0, 0, 3, 3), **kw))
+    assert kdm.bake(TINY_RECIPE, threads=1).info == info  # any thread count, the same set
+    with pytest.raises(ValueError, match="density too high|points per tile"):
+        loaded.query((0, 0, 1, 1), scale=129)
+
+
+def test_the_shipped_file_loads_as_the_builtin_set():
+    from conftest import SOURCE_DIR
+    shipped = kdm.Tileset.load(SOURCE_DIR / "tilesets" / "default.kdmt")
+    assert shipped.info == BUILTIN.info
+
+
+def test_out_refills_an_earlier_results_arrays():
+    tiles = kdm.Tileset.builtin()
+    big = tiles.query((0, 0, 4, 4), scale=400)
+    small = tiles.query((0, 0, 2, 2), scale=400, out=big)
+    fresh = tiles.query((0, 0, 2, 2), scale=400)
+    for name in ("xy", "tile", "rank", "level"):
+        np.testing.assert_array_equal(getattr(small, name), getattr(fresh, name))
+    assert np.shares_memory(small.xy, big.xy)  # the same memory, refilled
+    larger = tiles.query((0, 0, 6, 6), scale=400, out=small)  # too small to hold it: new arrays
+    assert not np.shares_memory(larger.xy, big.xy)
+    np.testing.assert_array_equal(larger.rank, tiles.query((0, 0, 6, 6), scale=400).rank)
+    with pytest.raises(TypeError):
+        tiles.query((0, 0, 2, 2), scale=400, out=big.xy)

@@ -1,0 +1,110 @@
+"""kdm.sample: the command line's bits, its defaults, determinism and densities."""
+import numpy as np
+import pytest
+
+import kdm
+from conftest import SPHERE, read_txt
+
+
+def test_same_bits_as_kdm_sample(cli, tmp_path):
+    out = tmp_path / "f.txt"
+    cli("sample", "--n", 65536, "--seed", 3, "-o", out)
+    points = kdm.sample(65536, seed=3)
+    assert points.shape == (65536, 2) and points.dtype == np.float64
+    assert np.array_equal(points, read_txt(out))  # the .txt holds 17 significant digits: exact
+
+
+def test_same_bits_with_an_image_density(cli, tmp_path, gradient_png):
+    out = tmp_path / "img.txt"
+    cli("sample", "--n", 3000, "--density", gradient_png, "--gamma", 1.5, "-o", out)
+    assert np.array_equal(kdm.sample(3000, str(gradient_png), gamma=1.5), read_txt(out))
+
+
+@pytest.mark.parametrize("args,kwargs", [
+    (["--density", "ramp:20"], dict(density="ramp:20")),
+    (["--density", "radial:50", "--domain", "box"], dict(density="radial:50", domain="box")),
+    (["--dim", "3", "--temperature", "0.3"], dict(dim=3, temperature=0.3)),
+    (["--aspect", "2"], dict(aspect=2.0)),
+])
+def test_same_bits_for_other_arguments(cli, tmp_path, args, kwargs):
+    out = tmp_path / "p.txt"
+    cli("sample", "--n", 2000, "--seed", 9, *args, "-o", out)
+    assert np.array_equal(kdm.sample(2000, seed=9, **kwargs), read_txt(out))
+
+
+def test_an_array_is_read_as_the_image_is(gradient_png):
+    # The picture's darkness, row 0 at the top as the file stores it: the same density, the same bits.
+    luminance = kdm._kdm.load_luminance(str(gradient_png)).astype(np.float64)
+    assert luminance.shape == (40, 60)
+    darkness = (1.0 - luminance) ** 2
+    from_array = kdm.sample(2500, darkness, seed=4)
+    assert np.array_equal(from_array, kdm.sample(2500, str(gradient_png), gamma=2.0, seed=4))
+    # Flipped rows are another density: the points differ (the sampler is not blind to the row order).
+    assert not np.array_equal(from_array, kdm.sample(2500, darkness[::-1], seed=4))
+
+
+def test_array_dtype_and_layout_do_not_matter():
+    rng = np.random.default_rng(1)
+    d = rng.random((12, 9)) + 0.1
+    expected = kdm.sample(500, d, seed=2)
+    as_float32 = d.astype(np.float32).astype(np.float64)  # what the sampler stores anyway
+    single = kdm.sample(500, as_float32.astype(np.float32), seed=2)
+    assert np.array_equal(single, kdm.sample(500, as_float32, seed=2))
+    fortran = np.asfortranarray(d)
+    strided = np.zeros((12, 18))
+    strided[:, ::2] = d
+    assert np.array_equal(kdm.sample(500, fortran, seed=2), expected)
+    assert np.array_equal(kdm.sample(500, strided[:, ::2], seed=2), expected)
+    assert np.array_equal(kdm.sample(500, d.tolist(), seed=2), expected)
+    ints = np.arange(1, 13 * 5 + 1).reshape(13, 5)
+    assert np.array_equal(kdm.sample(300, ints, seed=2), kdm.sample(300, ints.astype(float), seed=2))
+
+
+def test_defaults_and_domain_rules():
+    p = kdm.sample(1000)
+    assert p.shape == (1000, 2)
+    assert p.min() >= 0 and p.max() < 1
+    assert np.array_equal(p, kdm.sample(1000, seed=1, domain="torus", temperature=0.5, density=1.0))
+    assert np.array_equal(p, kdm.sample(1000, "const:1"))
+    # A constant's value does not matter (the count is exact), as on the command line.
+    assert np.array_equal(p, kdm.sample(1000, 7.5))
+    # A ramp defaults to a box, a radial map to a torus.
+    assert np.array_equal(kdm.sample(800, "ramp:10"), kdm.sample(800, "ramp:10", domain="box"))
+    assert np.array_equal(kdm.sample(800, "radial:10"), kdm.sample(800, "radial:10", domain="torus"))
+    assert not np.array_equal(kdm.sample(800, "radial:10"), kdm.sample(800, "radial:10", domain="box"))
+
+
+def test_image_aspect_is_the_pictures(gradient_png):
+    image = str(gradient_png)  # 60 x 40
+    assert np.array_equal(kdm.sample(900, image), kdm.sample(900, image, aspect=1.5))
+    assert not np.array_equal(kdm.sample(900, image), kdm.sample(900, image, aspect=1.0))
+
+
+def test_determinism_seeds_and_threads():
+    a = kdm.sample(3000, seed=11, threads=1)
+    assert np.array_equal(a, kdm.sample(3000, seed=11, threads=2))
+    assert np.array_equal(a, kdm.sample(3000, seed=11, threads=0))
+    assert not np.array_equal(a, kdm.sample(3000, seed=12))
+    assert kdm.sample(3000, seed=2**64 - 1).shape == (3000, 2)
+
+
+def test_three_dimensions():
+    p = kdm.sample(2000, dim=3, seed=5)
+    assert p.shape == (2000, 3) and p.min() >= 0 and p.max() < 1
+
+
+def test_density_follows_the_image():
+    # sphere.png is white around a dark disc: the corners get no points. (Seeds 1..5: 3,386 to 3,436 of
+    # 4,000 points within 0.3 of the centre, none beyond 0.6.)
+    p = kdm.sample(4000, str(SPHERE), seed=1)
+    r = np.hypot(p[:, 0] - 0.5, p[:, 1] - 0.5)
+    assert (r < 0.3).sum() > 3000 and (r > 0.6).sum() < 20
+
+
+def test_result_owns_its_memory():
+    p = kdm.sample(100)
+    assert p.flags["C_CONTIGUOUS"] and p.flags["WRITEABLE"] and p.flags["ALIGNED"]
+    assert p.base is not None  # a view of the C++ vector, not a copy of it
+    q = p.copy()
+    del p
+    assert q.shape == (100, 2)

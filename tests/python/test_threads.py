@@ -1,0 +1,80 @@
+"""The GIL is released while C++ works: Python threads sample, query, stipple and analyse at once and get
+what one thread gets. (Speed is measured in benchmarks/python_overhead.py, never asserted here.)"""
+import threading
+
+import numpy as np
+
+import kdm
+from conftest import SPHERE
+
+
+def run_together(*jobs):
+    """Runs each job on its own thread, all started together; returns their results in order."""
+    results = [None] * len(jobs)
+    errors = []
+    start = threading.Barrier(len(jobs))
+
+    def work(i, job):
+        try:
+            start.wait()
+            results[i] = job()
+        except BaseException as e:  # re-raised below, on the test's thread
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(i, job)) for i, job in enumerate(jobs)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not any(t.is_alive() for t in threads), "a thread did not finish"
+    if errors:
+        raise errors[0]
+    return results
+
+
+def test_two_samplers_at_once_equal_one_at_a_time():
+    alone = [kdm.sample(20000, seed=s, threads=1) for s in (1, 2)]
+    together = run_together(lambda: kdm.sample(20000, seed=1, threads=1),
+                            lambda: kdm.sample(20000, seed=2, threads=1))
+    assert all(np.array_equal(a, b) for a, b in zip(alone, together))
+
+
+def test_the_gil_is_free_while_sampling():
+    # A counting thread keeps running Python while this one samples. Were the GIL held, it would count
+    # for at most a switch interval (5 ms) around the call; a quarter of its free-running rate over the
+    # whole call separates the two by a factor of 10 or more.
+    import time
+    done = threading.Event()
+    count = [0]
+
+    def counter():
+        while not done.is_set():
+            count[0] += 1
+
+    thread = threading.Thread(target=counter)
+    thread.start()
+    try:
+        c0, t0 = count[0], time.perf_counter()
+        time.sleep(0.1)  # sleeping releases the GIL: the counter's free-running rate
+        rate = (count[0] - c0) / (time.perf_counter() - t0)
+        c0, t0 = count[0], time.perf_counter()
+        kdm.sample(30000, threads=1)
+        during = count[0] - c0
+        elapsed = time.perf_counter() - t0
+    finally:
+        done.set()
+        thread.join()
+    assert elapsed > 0.1 and during > 0.25 * rate * elapsed
+
+
+def test_queries_stipples_and_analyses_at_once():
+    tiles = kdm.Tileset.builtin()
+    jobs = [
+        lambda: tiles.query((0, 0, 6, 6), scale=3000, mode="smooth").xy,
+        lambda: tiles.query((0, 0, 6, 6), scale=3000, density="ramp:8").xy,
+        lambda: kdm.stipple(str(SPHERE), points=5000),
+        lambda: kdm.analyze(kdm.sample(3000, seed=3), energy=False)["nearest_neighbour"]["davg"],
+    ]
+    alone = [job() for job in jobs]
+    together = run_together(*jobs)
+    assert all(np.array_equal(a, b) for a, b in zip(alone, together))

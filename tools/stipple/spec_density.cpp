@@ -1,0 +1,40 @@
+#include "spec_density.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace kdm::tools {
+
+SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
+  std::copy(r, r + 4, rect);
+  using Kind = DensitySpec::Kind;
+  switch (spec.kind) {
+    case Kind::kConstant:
+      density.kind = QueryDensity::Kind::kConstant;
+      density.constant = spec.constant;
+      return;
+    case Kind::kRamp:
+    case Kind::kRadial:
+      density.kind = QueryDensity::Kind::kCallback;
+      density.callback = [](void* user, double x, double y) {
+        const SpecDensity& d = *static_cast<const SpecDensity*>(user);
+        const double u = std::clamp((x - d.rect[0]) / (d.rect[2] - d.rect[0]), 0.0, 1.0);
+        const double v = std::clamp((y - d.rect[1]) / (d.rect[3] - d.rect[1]), 0.0, 1.0);
+        return d.spec.map_at(u, v);
+      };
+      density.user = this;
+      density.callback_max = 1;
+      return;
+    case Kind::kImage:
+      break;
+  }
+  image.width = spec.width, image.height = spec.height;
+  image.x0 = r[0], image.y0 = r[1], image.x1 = r[2], image.y1 = r[3];
+  image.values = spec.values.data();  // row 0 at y0, as DensityImageView has it
+  if (make_density_max_mip(image, mip) != Status::kOk)
+    throw std::invalid_argument("density image is invalid");
+  density.kind = QueryDensity::Kind::kImage;
+  density.image = &image;
+}
+
+}  // namespace kdm::tools

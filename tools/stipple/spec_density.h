@@ -1,0 +1,28 @@
+// A parsed density (tools/common/density_spec.h) as a query's density: what `kdm query --density` and
+// the Python package's queries share, so both give the same points.
+#pragma once
+
+#include <vector>
+
+#include "density_spec.h"
+#include "kdm/runtime/query.h"
+
+namespace kdm::tools {
+
+/// The runtime density for `spec` over the world rectangle r = (x0, y0, x1, y1): constant, the image's
+/// texels stretched over r (the spec's own, not a copy, with their max-mip), or a test map called back at
+/// every candidate. `spec` must outlive it; it does not move (queries keep pointers into it). Throws
+/// std::invalid_argument for an image the runtime refuses.
+struct SpecDensity {
+  SpecDensity(const DensitySpec& spec, const double r[4]);
+  SpecDensity(const SpecDensity&) = delete;
+  SpecDensity& operator=(const SpecDensity&) = delete;
+
+  QueryDensity density;
+  DensityImageView image;
+  std::vector<float> mip;
+  const DensitySpec& spec;
+  double rect[4];
+};
+
+}  // namespace kdm::tools
