@@ -1,7 +1,10 @@
-// kdm._kdm.query: a runtime query run to completion (tools::query_all, as `kdm query` runs it) into numpy
-// arrays: positions, tile ids, ranks and levels, filled in one pass with the GIL released.
+// kdm._kdm.query: a runtime query run to completion (by tools::query_all's rules, as `kdm query` runs it)
+// into numpy arrays: positions, tile ids, ranks and levels, converted chunk by chunk as the query writes
+// them, with the GIL released.
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -29,85 +32,131 @@ QueryMode parse_mode(const std::string& mode) {
   throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
 }
 
-/// Where a query collects its points. Each thread keeps one buffer between calls: fresh memory costs more
-/// than the query (its first touch, page by page), so only a buffer above 2^20 points (40 MiB) is given
-/// back. A query made from inside a callable density, while the thread's buffer is in use, gets its own.
-thread_local std::vector<QueryPoint> kept_points;
-thread_local bool kept_points_in_use = false;
-
-struct ScratchPoints {
-  ScratchPoints() : points(kept_points_in_use ? own : kept_points) { kept_points_in_use = true; }
-  ~ScratchPoints() {
-    if (&points != &kept_points) return;
-    kept_points_in_use = false;
-    if (kept_points.capacity() > (std::size_t(1) << 20)) std::vector<QueryPoint>().swap(kept_points);
-  }
-  ScratchPoints(const ScratchPoints&) = delete;
-  ScratchPoints& operator=(const ScratchPoints&) = delete;
-
-  std::vector<QueryPoint> own;  ///< for a query made from a callable density while the kept one is in use
-  std::vector<QueryPoint>& points;
+/// A result's columns, where the points go: positions, tiles, ranks and levels.
+struct Columns {
+  std::vector<double> xy;
+  std::vector<std::int64_t> tile;
+  std::vector<std::uint32_t> rank, level;
 };
 
-/// Arrays of room for at least m points: those of `storage` (an earlier result's, reused: refilling warm
-/// memory is several times cheaper than first touching fresh memory) when they are large enough and of
-/// the right types, else new ones.
-struct ResultStorage {
+/// What a query writes through: a chunk of points small enough to stay in cache, converted into columns
+/// as it fills, and the columns of the points an `out=` result has no room for (all of them without one).
+/// Each thread keeps its own between calls (refilling warm memory is several times cheaper than first
+/// touching fresh memory); a query made from inside a callable density, while they are in use, gets its
+/// own.
+struct Scratch {
+  std::vector<QueryPoint> chunk;
+  Columns spill;
+};
+thread_local Scratch kept_scratch;
+thread_local bool kept_scratch_in_use = false;
+
+struct ScratchLease {
+  ScratchLease() : scratch(kept_scratch_in_use ? own : kept_scratch) { kept_scratch_in_use = true; }
+  ~ScratchLease() {
+    if (&scratch != &kept_scratch) return;
+    kept_scratch_in_use = false;
+    if (kept_scratch.spill.rank.capacity() > (std::size_t(1) << 20)) kept_scratch.spill = Columns{};
+  }
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+
+  Scratch own;
+  Scratch& scratch;
+};
+
+constexpr std::size_t kChunk = std::size_t(1) << 14;
+
+/// The arrays of an earlier result (`storage`), if they are of the right types and writable: the points
+/// go straight into them while they have room.
+struct Storage {
   py::array_t<double> xy;
   py::array_t<std::int64_t> tile;
   py::array_t<std::uint32_t> rank, level;
-  ResultStorage(py::ssize_t m, const py::object& storage) {
-    if (!storage.is_none() && reuse(m, storage)) return;
-    xy = py::array_t<double>({m, py::ssize_t(2)});
-    tile = py::array_t<std::int64_t>({m, py::ssize_t(2)});
-    rank = py::array_t<std::uint32_t>(m), level = py::array_t<std::uint32_t>(m);
-  }
-
- private:
-  bool reuse(py::ssize_t m, const py::object& storage) {
+  std::size_t capacity = 0;
+  explicit Storage(const py::object& storage) {
+    if (storage.is_none()) return;
     const py::tuple t = storage.cast<py::tuple>();
-    if (t.size() != 4) return false;
-    auto fits = [m](const py::array& a, py::ssize_t columns) {
-      return a.ndim() == (columns > 1 ? 2 : 1) && a.shape(0) >= m &&
-             (columns == 1 || a.shape(1) == columns) && a.writeable() && (a.flags() & py::array::c_style);
-    };
-    if (!py::isinstance<py::array_t<double>>(t[0]) || !py::isinstance<py::array_t<std::int64_t>>(t[1]) ||
+    if (t.size() != 4 || !py::isinstance<py::array_t<double>>(t[0]) ||
+        !py::isinstance<py::array_t<std::int64_t>>(t[1]) ||
         !py::isinstance<py::array_t<std::uint32_t>>(t[2]) ||
         !py::isinstance<py::array_t<std::uint32_t>>(t[3]))
-      return false;
+      return;
     xy = t[0].cast<py::array_t<double>>(), tile = t[1].cast<py::array_t<std::int64_t>>();
     rank = t[2].cast<py::array_t<std::uint32_t>>(), level = t[3].cast<py::array_t<std::uint32_t>>();
-    return fits(xy, 2) && fits(tile, 2) && fits(rank, 1) && fits(level, 1);
+    auto usable = [](const py::array& a, py::ssize_t columns) {
+      return a.ndim() == (columns > 1 ? 2 : 1) && (columns == 1 || a.shape(1) == columns) && a.writeable() &&
+             (a.flags() & py::array::c_style);
+    };
+    if (!(usable(xy, 2) && usable(tile, 2) && usable(rank, 1) && usable(level, 1))) return;
+    capacity =
+        static_cast<std::size_t>(std::min({xy.shape(0), tile.shape(0), rank.shape(0), level.shape(0)}));
   }
 };
 
-/// The query's points as arrays: xy (m×2), tile (m×2), rank and level (m), the first m rows of the
-/// storage returned as the fifth element (for a later query's `storage`).
-py::tuple to_arrays(const Tileset& tiles, const std::vector<QueryPoint>& points, const py::object& storage) {
-  const auto m = static_cast<py::ssize_t>(points.size());
-  ResultStorage out(m, storage);
-  double* out_xy = out.xy.mutable_data();
-  std::int64_t* out_tile = out.tile.mutable_data();
-  std::uint32_t* out_rank = out.rank.mutable_data();
-  std::uint32_t* out_level = out.level.mutable_data();
-  {
-    py::gil_scoped_release release;
-    // Points come tile by tile: look each tile up once.
-    std::int64_t tx = std::numeric_limits<std::int64_t>::min(), ty = tx;
-    const Tile* t = nullptr;
-    for (py::ssize_t i = 0; i < m; ++i) {
-      const QueryPoint& p = points[i];
+/// Runs the query to completion (the rules of tools::query_all), its points into `direct` (room for
+/// `capacity`) and, past that, `spill`. Returns the count. Call without the GIL.
+std::size_t collect(const Tileset& tiles, const QueryParams& q, Scratch& scratch, double* xy,
+                    std::int64_t* tile, std::uint32_t* rank, std::uint32_t* level, std::size_t capacity) {
+  scratch.chunk.resize(kChunk);
+  Columns& spill = scratch.spill;
+  spill.xy.clear(), spill.tile.clear(), spill.rank.clear(), spill.level.clear();
+  QueryCursor cursor;
+  std::size_t m = 0;
+  // Points come tile by tile: look each tile up once.
+  std::int64_t tx = std::numeric_limits<std::int64_t>::min(), ty = tx;
+  const Tile* t = nullptr;
+  for (;;) {
+    std::size_t written = 0;
+    QueryProblem problem;
+    const Status s = query_points(tiles, q, scratch.chunk.data(), kChunk, &written, &cursor, &problem);
+    for (std::size_t i = 0; i < written; ++i, ++m) {
+      const QueryPoint& p = scratch.chunk[i];
       if (!t || p.id.tile_x != tx || p.id.tile_y != ty)
         tx = p.id.tile_x, ty = p.id.tile_y, t = &tiles.tile_at(tx, ty);
-      out_xy[2 * i] = p.x, out_xy[2 * i + 1] = p.y;
-      out_tile[2 * i] = tx, out_tile[2 * i + 1] = ty;
-      out_rank[i] = p.id.rank;
-      out_level[i] = t->level_of(p.id.rank);
+      const std::uint32_t lv = t->level_of(p.id.rank);
+      if (m < capacity) {
+        xy[2 * m] = p.x, xy[2 * m + 1] = p.y, tile[2 * m] = tx, tile[2 * m + 1] = ty;
+        rank[m] = p.id.rank, level[m] = lv;
+      } else {
+        spill.xy.insert(spill.xy.end(), {p.x, p.y}), spill.tile.insert(spill.tile.end(), {tx, ty});
+        spill.rank.push_back(p.id.rank), spill.level.push_back(lv);
+      }
     }
+    if (m > tools::kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
+      throw std::invalid_argument(
+          "the query emits more than 2^25 points; lower the scale or split the region");
+    if (s == Status::kOk) return m;
+    if (s != Status::kBufferFull)
+      throw std::invalid_argument("query: " +
+                                  tools::describe(problem, tools::ParameterNames{"scale=", "tile_size="}));
   }
-  const py::slice first(0, m, 1);
-  return py::make_tuple(out.xy[first], out.tile[first], out.rank[first], out.level[first],
-                        py::make_tuple(out.xy, out.tile, out.rank, out.level));
+}
+
+/// The result's arrays (xy m×2, tile m×2, rank, level), then the storage they are the first rows of (for a
+/// later query's `storage`): `out`'s own when they held every point, else new arrays.
+py::tuple result(std::size_t m, const Storage& out, const Columns& spill) {
+  const auto rows = static_cast<py::ssize_t>(m);
+  const py::slice first(0, rows, 1);
+  if (spill.rank.empty() && out.capacity > 0 && out.capacity >= m)
+    return py::make_tuple(out.xy[first], out.tile[first], out.rank[first], out.level[first],
+                          py::make_tuple(out.xy, out.tile, out.rank, out.level));
+  py::array_t<double> xy({rows, py::ssize_t(2)});
+  py::array_t<std::int64_t> tile({rows, py::ssize_t(2)});
+  py::array_t<std::uint32_t> rank(rows), level(rows);
+  const std::size_t head = std::min(m, out.capacity);  // in `out`; the rest were spilled
+  {
+    py::gil_scoped_release release;
+    auto copy = [head](auto* to, const auto* from, const auto& rest, std::size_t width) {
+      if (head) std::memcpy(to, from, head * width * sizeof(*to));
+      if (!rest.empty()) std::memcpy(to + head * width, rest.data(), rest.size() * sizeof(*to));
+    };
+    copy(xy.mutable_data(), head ? out.xy.data() : nullptr, spill.xy, 2);
+    copy(tile.mutable_data(), head ? out.tile.data() : nullptr, spill.tile, 2);
+    copy(rank.mutable_data(), head ? out.rank.data() : nullptr, spill.rank, 1);
+    copy(level.mutable_data(), head ? out.level.data() : nullptr, spill.level, 1);
+  }
+  return py::make_tuple(xy, tile, rank, level, py::make_tuple(xy, tile, rank, level));
 }
 
 py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
@@ -140,18 +189,19 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
     from_spec = std::make_unique<SpecDensity>(*spec, r.data());
     q.density = from_spec->density;
   }
-  ScratchPoints scratch;
-  std::vector<QueryPoint>& points = scratch.points;
-  try {
+  Storage out(storage);
+  ScratchLease lease;
+  double* xy = out.capacity ? out.xy.mutable_data() : nullptr;
+  std::int64_t* tile = out.capacity ? out.tile.mutable_data() : nullptr;
+  std::uint32_t* rank = out.capacity ? out.rank.mutable_data() : nullptr;
+  std::uint32_t* level = out.capacity ? out.level.mutable_data() : nullptr;
+  std::size_t m = 0;
+  {
     py::gil_scoped_release release;  // a callable density takes it back at each call
-    tools::query_all(*handle.set, q, points, tools::ParameterNames{"scale=", "tile_size="});
-  } catch (const std::invalid_argument&) {
-    throw;
-  } catch (const std::runtime_error& e) {  // more than 2^25 points: too much asked, not a failure
-    throw std::invalid_argument(e.what());
+    m = collect(*handle.set, q, lease.scratch, xy, tile, rank, level, out.capacity);
   }
   if (from_callable) from_callable->rethrow();
-  return to_arrays(*handle.set, points, storage);
+  return result(m, out, lease.scratch.spill);
 }
 
 }  // namespace
