@@ -324,6 +324,10 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   EXPECT_EQ(good.status, 0) << good.out << good.err;
   EXPECT_NE(good.out.find("level 2, 512 points per tile"), std::string::npos) << good.out;
   EXPECT_NE(good.out.find("checks passed"), std::string::npos) << good.out;
+  // --level limits the glide track too: level 2 holds the keyframes in (128, 512] points per tile.
+  EXPECT_NE(good.out.find(" 512.0  keyframe"), std::string::npos) << good.out;
+  EXPECT_EQ(good.out.find(" 128.0  keyframe"), std::string::npos) << good.out;
+  EXPECT_EQ(good.out.find(" 1024.0  keyframe"), std::string::npos) << good.out;
 
   kdm::TilesetData set;
   ASSERT_EQ(kdm::load_tileset(shipped, set), kdm::Status::kOk);

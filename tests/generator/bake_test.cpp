@@ -305,7 +305,7 @@ TEST(BakeTest, SeparationPushKeepsPointsApartWithoutLeavingHoles) {
   BakeRecipe removed = few_sweeps();
   removed.separation = 0.3;
   BakeRecipe pushed = removed;
-  pushed.separation_push = true;
+  pushed.separation_push = 0.55;
   Tileset sets[3];
   const BakeRecipe recipes[3] = {few_sweeps(), removed, pushed};
   std::size_t holes[3];
@@ -365,8 +365,8 @@ TEST(BakeTest, DropClosePairsLooksAcrossTileEdges) {
 }
 
 // Pushed apart instead of removed: the later point of a close pair moves straight away from the earlier one
-// by the least that clears it (the radius times kPushMargin), and every other point stays where it was.
-TEST(BakeTest, PushClosePairsApartMovesTheLaterPointJustClear) {
+// until it is `push` spacings from it, and every other point stays where it was.
+TEST(BakeTest, PushClosePairsApartMovesTheLaterPointOut) {
   std::vector<LevelPatches> levels(2, LevelPatches(1));
   TilesetData table;
   table.level_nominal = {16, 64};
@@ -376,18 +376,18 @@ TEST(BakeTest, PushClosePairsApartMovesTheLaterPointJustClear) {
   levels[1].interiors[0].add(0.99, 0.6, 1000);  // across the tile's right edge from the next one
   levels[1].interiors[0].add(0.005, 0.6, 2000);
   const std::vector<double> before = levels[1].interiors[0].xy;
-  const SeparationResult result = push_close_pairs_apart(levels, 1, table, 0.3);
+  const SeparationResult result = push_close_pairs_apart(levels, 1, table, 0.3, 0.5);
   EXPECT_EQ(result.removed, 0u);
   EXPECT_EQ(result.moved, 2u);
   ASSERT_EQ(levels[1].interiors[0].size(), 4u);
   const std::vector<double>& xy = levels[1].interiors[0].xy;
-  const double radius = 0.3 * std::sqrt(2.0 / (std::sqrt(3.0) * table.emission_threshold(1, 300)));
-  EXPECT_NEAR(xy[0], 0.2 + radius * kPushMargin, 1e-12);  // along +x, away from (0.2, 0.2)
+  const double push = 0.5 * std::sqrt(2.0 / (std::sqrt(3.0) * table.emission_threshold(1, 300)));
+  EXPECT_NEAR(xy[0], 0.2 + push, 1e-12);  // along +x, away from (0.2, 0.2)
   EXPECT_DOUBLE_EQ(xy[1], 0.2);
   for (int i : {2, 3, 4, 5}) EXPECT_EQ(xy[i], before[i]) << i;
   // Across the edge: 0.015 apart in the world, the later one pushed on, further from the edge.
-  const double radius2 = 0.3 * std::sqrt(2.0 / (std::sqrt(3.0) * table.emission_threshold(1, 2000)));
-  EXPECT_NEAR(xy[6], 0.99 + radius2 * kPushMargin - 1, 1e-12);
+  const double push2 = 0.5 * std::sqrt(2.0 / (std::sqrt(3.0) * table.emission_threshold(1, 2000)));
+  EXPECT_NEAR(xy[6], 0.99 + push2 - 1, 1e-12);
   EXPECT_EQ(levels[0].corners[0].xy, (std::vector<double>{0.2, 0.2}));
   // Nothing close is left: the removing pass finds nothing to remove.
   EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 0u);

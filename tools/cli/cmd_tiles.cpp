@@ -77,10 +77,10 @@ void run_info(const std::string& path) {
   std::printf("density range  1 : %.0f (level 0 to level %u)\n",
               double(set.level_nominal.back()) / set.level_nominal.front(), set.levels - 1);
   if (set.keyframe_nominal.empty())
-    std::printf("glide track  none (--mode smooth emits stable positions)\n");
+    std::printf("glide track    none (--mode smooth emits stable positions)\n");
   else
     std::printf(
-        "glide track  %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
+        "glide track    %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
         set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
         loaded.glide_reach());
   std::printf("recipe\n");

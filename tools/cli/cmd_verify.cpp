@@ -15,7 +15,7 @@ namespace {
 struct VerifyArgs {
   std::string path;
   verify::VerifyOptions options;
-  bool no_seams = false, no_direct = false;
+  bool no_seams = false, no_direct = false, no_glide_track = false;
 };
 
 void run_verify(VerifyArgs args) {
@@ -25,6 +25,7 @@ void run_verify(VerifyArgs args) {
   if (s != Status::kOk) throw CommandError("'" + args.path + "': " + status_message(s) + " (" + detail + ")");
   args.options.seams = !args.no_seams;
   args.options.direct_check = !args.no_direct;
+  args.options.glide_track = !args.no_glide_track;
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("verifying");
   args.options.progress = [&bar](double f) { bar.update(f); };
@@ -52,12 +53,14 @@ void add_verify_command(CLI::App& app) {
   cmd->add_option("file", args->path, "Tile-set file")->required();
   cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (>= 2)")
       ->capture_default_str();
-  cmd->add_option("--level", args->options.levels, "Judge only these levels (repeatable; default: all)");
+  cmd->add_option("--level", args->options.levels,
+                  "Judge only these levels and the keyframes within them (repeatable; default: all)");
   cmd->add_option("--spectrum-budget", args->options.spectrum_budget,
                   "Largest tile torus (points) whose spectra (lowP, RAPS) are computed: they cost O(n^2)")
       ->capture_default_str();
   cmd->add_flag("--no-seams", args->no_seams, "Skip the seam and in-between-density checks");
   cmd->add_flag("--no-direct", args->no_direct, "Skip the direct check (tiles freed for 15 sweeps)");
+  cmd->add_flag("--no-glide-track", args->no_glide_track, "Skip the glide track's keyframes (smooth mode)");
   cmd->add_option("--hole-largest", args->options.bars.hole_largest,
                   "Fail a complete level or keyframe whose largest empty circle exceeds this many d_hex "
                   "(0: report only; the design's bar is 1.0)")

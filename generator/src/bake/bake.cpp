@@ -101,7 +101,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "separation") {
       r.separation = within(0, 0.7);
     } else if (key == "separation_push") {
-      r.separation_push = whole(0, 1) != 0;
+      r.separation_push = within(0, 0.9);
     } else if (key == "glide_separation") {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
@@ -140,7 +140,7 @@ std::string BakeRecipe::to_text() const {
   if (min_distance > 0) s << "min_distance " << shortest(min_distance) << "\n";
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
-  if (separation_push) s << "separation_push 1\n";
+  if (separation_push > 0) s << "separation_push " << shortest(separation_push) << "\n";
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
@@ -185,9 +185,9 @@ class Baker {
     shape_.colours = recipe_.colours;
     shape_.levels = recipe_.levels;
     shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
-    if (recipe_.separation_push) {
-      const SeparationResult moved =
-          push_close_pairs_apart(levels_, recipe_.colours, shape_, recipe_.separation);
+    if (recipe_.separation_push > 0) {
+      const SeparationResult moved = push_close_pairs_apart(levels_, recipe_.colours, shape_,
+                                                            recipe_.separation, recipe_.separation_push);
       dropped_ = moved.removed, pushed_ = moved.moved;
     } else {
       dropped_ = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);

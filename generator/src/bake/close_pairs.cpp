@@ -202,28 +202,32 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
 }
 
 SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                                        const TilesetShape& shape, double separation) {
+                                        const TilesetShape& shape, double separation, double push) {
   SeparationResult result;
   if (!(separation > 0)) return result;
-  // Where each later point of a close pair sits against the earlier points it is too close to, in any
-  // tile: their offsets from it (the same in every window, since a patch moves as a whole).
-  std::map<PointKey, std::vector<std::array<double, 2>>> crowded;
+  // Each later point of a close pair, and where the earlier points within `push` spacings of it sit in
+  // any tile: their offsets from it (the same in every window, since a patch moves as a whole).
+  const double reach = std::max(push, separation);
+  std::set<PointKey> crowded;
+  std::map<PointKey, std::vector<std::array<double, 2>>> around;
   std::map<PointKey, double> radius_of;
   const double lowest = std::max(1.0, double(shape.level_nominal.front()));
   std::set<PointKey> moved;
-  for (int round = 0; round < kPushRounds; ++round) {
-    crowded.clear();
-    for_each_close_pair(
-        levels, colours, shape, separation, [&](const Candidate& later, const Candidate& earlier) {
-          crowded[key_of(later)].push_back({earlier.x - later.x, earlier.y - later.y});
-          radius_of[key_of(later)] =
-              separation * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(later.threshold), lowest)));
-        });
-    if (crowded.empty()) break;
-    for (const auto& [key, offsets] : crowded) {
-      // The smallest move that clears every earlier neighbour it met: push off each in turn until none is
-      // nearer than the radius (with a margin, so that rounding to the file's grid keeps it clear).
-      const double r = radius_of[key] * kPushMargin;
+  for (int round = 0;; ++round) {
+    crowded.clear(), around.clear();
+    for_each_close_pair(levels, colours, shape, separation,
+                        [&](const Candidate& later, const Candidate&) { crowded.insert(key_of(later)); });
+    if (crowded.empty() || round == kPushRounds) break;
+    for_each_close_pair(levels, colours, shape, reach, [&](const Candidate& later, const Candidate& earlier) {
+      if (!crowded.count(key_of(later))) return;
+      around[key_of(later)].push_back({earlier.x - later.x, earlier.y - later.y});
+      radius_of[key_of(later)] =
+          reach * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(later.threshold), lowest)));
+    });
+    for (const auto& [key, offsets] : around) {
+      // A small move that takes it `push` spacings from every earlier neighbour: push off each in turn
+      // until none is nearer (or give up; the next round finds it again if it is still too close).
+      const double r = radius_of[key];
       double dx = 0, dy = 0;
       for (int step = 0; step < 32; ++step) {
         bool clear = true;
@@ -245,9 +249,8 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
       moved.insert(key);
     }
   }
-  // What the rounds could not clear goes, as drop_close_pairs would take it.
-  Victims victims;
-  for (const auto& entry : crowded) victims.insert(entry.first);
+  // What the rounds could not part goes, as drop_close_pairs would take it.
+  Victims victims(crowded.begin(), crowded.end());
   remove(levels, victims);
   result.removed = victims.size();
   for (const PointKey& key : victims) moved.erase(key);

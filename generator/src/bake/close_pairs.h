@@ -30,15 +30,15 @@ struct SeparationResult {
   std::size_t moved = 0, removed = 0;
 };
 
-/// Like drop_close_pairs, but the later point of a close pair moves, by the least that clears every
-/// earlier point it is too close to in any tile (plus kPushMargin), instead of going: a point removed
-/// leaves a hole in every tile that shows its patch, and most tiles never met the point it was close to.
-/// The move depends on the pairs alone, so a shared patch moves the same way in every tile. Repeats while
-/// moves make new pairs, at most kPushRounds times; what is still too close then is removed.
+/// Like drop_close_pairs, but the later point of a close pair moves, by the least that takes it `push`
+/// (≥ separation) hexagonal spacings from every earlier point it was too close to in any tile, instead of
+/// going: a point removed leaves a hole in every tile that shows its patch, and most tiles never met the
+/// point it was close to. The move depends on the pairs alone, so a shared patch moves the same way in
+/// every tile. Repeats while moves make new pairs, at most kPushRounds times; what is still too close
+/// then is removed.
 SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                                        const TilesetShape& shape, double separation);
+                                        const TilesetShape& shape, double separation, double push);
 inline constexpr int kPushRounds = 8;
-inline constexpr double kPushMargin = 1.05;
 
 /// The same along the glide track, once it is relaxed: removes the later point of every pair closer than
 /// `separation` hexagonal spacings (plus kGlideMargin, for the file's 8-bit offsets) at some density where

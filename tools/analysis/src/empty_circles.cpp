@@ -15,6 +15,7 @@ extern "C" {
 }
 
 #include "kdm/analysis/common.h"
+#include "parallel.h"
 
 namespace kdm::analysis {
 namespace {
@@ -74,73 +75,100 @@ std::pair<double, double> density_scale(const DensityFunction& rho) {
   return {sum / (kGrid * kGrid), largest};
 }
 
+/// One set's judged circles: their radii in local d_hex and the counts empty_circles pools.
+struct SetCircles {
+  std::vector<double> radii;
+  std::size_t over_085 = 0, over_100 = 0, over_085_near_edge = 0, near_edge_judged = 0;
+};
+
+SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, double mean_rho,
+                     double max_rho) {
+  SetCircles out;
+  const std::size_t n = set.size();
+  const double spacing = hex_spacing(n);
+  std::vector<double> xy = set.coords;
+  std::vector<std::size_t> original;  // torus: the point each copy stands for
+  if (o.torus) {  // copies within a few spacings of each side, so triangles across the sides are whole
+    const double m = std::min(0.5, 4 * spacing);
+    for (std::size_t i = 0; i < n; ++i) original.push_back(i);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int sx = -1; sx <= 1; ++sx)
+        for (int sy = -1; sy <= 1; ++sy) {
+          if (!sx && !sy) continue;
+          const double x = set.coords[2 * i] + sx, y = set.coords[2 * i + 1] + sy;
+          if (x > -m && x < 1 + m && y > -m && y < 1 + m) xy.insert(xy.end(), {x, y}), original.push_back(i);
+        }
+  }
+  const double edge_band = o.tile_size > 0 ? spacing : 0;
+  delaunay(xy, [&](int i, int j, int k) {
+    const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+    if (!std::isfinite(c.r)) return;
+    if (o.torus) {
+      // A triangle across a side appears once per copy: it counts where its first point (by index)
+      // is the point itself, not a copy.
+      const int v[3] = {i, j, k};
+      const int* first = std::min_element(v, v + 3, [&](int a, int b) { return original[a] < original[b]; });
+      if (std::size_t(*first) >= n) return;
+    } else {
+      const double m = o.border * spacing + c.r;
+      if (!(c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m)) return;
+    }
+    double local = spacing;
+    if (o.density) {
+      const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
+      if (!(rho > 0) || rho < o.min_relative_density * max_rho) return;
+      local = spacing * std::sqrt(mean_rho / rho);
+    }
+    const double r = c.r / local;
+    out.radii.push_back(r);
+    bool near_edge = false;
+    if (edge_band > 0) {
+      auto gap = [&](double v) {
+        const double t = v / o.tile_size;
+        return std::fabs(t - std::round(t)) * o.tile_size;
+      };
+      near_edge = std::min(gap(c.x), gap(c.y)) < edge_band;
+      out.near_edge_judged += near_edge;
+    }
+    if (r > 0.85) out.over_085 += 1, out.over_085_near_edge += near_edge;
+    if (r > 1.0) out.over_100 += 1;
+  });
+  return out;
+}
+
 }  // namespace
 
 EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& o) {
   if (sets.empty()) throw InvalidInput("no point sets");
-  EmptyCircles out;
-  std::vector<double> radii;
   const std::pair<double, double> scale =
       o.density ? density_scale(o.density) : std::pair<double, double>(1, 1);
   const double mean_rho = scale.first, max_rho = scale.second;
   if (o.density && !(mean_rho > 0)) throw InvalidInput("the target density is zero everywhere");
-  std::size_t near_edge_judged = 0;
+  EmptyCircles out;
   for (const tools::PointSet& set : sets) {
     if (set.dim != 2) throw InvalidInput("empty circles are 2D only");
     validate_points(set.coords, 2);
-    const std::size_t n = set.size();
-    if (n < 3) throw InvalidInput("empty circles need at least 3 points per set");
-    out.points += n;
-    const double spacing = hex_spacing(n);
-    std::vector<double> xy = set.coords;
-    std::vector<std::size_t> original;  // torus: the point each copy stands for
-    if (o.torus) {  // copies within a few spacings of each side, so triangles across the sides are whole
-      const double m = std::min(0.5, 4 * spacing);
-      for (std::size_t i = 0; i < n; ++i) original.push_back(i);
-      for (std::size_t i = 0; i < n; ++i)
-        for (int sx = -1; sx <= 1; ++sx)
-          for (int sy = -1; sy <= 1; ++sy) {
-            if (!sx && !sy) continue;
-            const double x = set.coords[2 * i] + sx, y = set.coords[2 * i + 1] + sy;
-            if (x > -m && x < 1 + m && y > -m && y < 1 + m)
-              xy.insert(xy.end(), {x, y}), original.push_back(i);
-          }
+    if (set.size() < 3) throw InvalidInput("empty circles need at least 3 points per set");
+    out.points += set.size();
+  }
+  // Sets are triangulated in parallel and pooled in their order, so nothing depends on the thread count.
+  std::vector<SetCircles> per_set(sets.size());
+  std::vector<std::string> failure(sets.size());
+  detail::parallel_for(std::ptrdiff_t(sets.size()), o.threads, [&](std::ptrdiff_t s, int) {
+    try {
+      per_set[s] = judge_set(sets[s], o, mean_rho, max_rho);
+    } catch (const InvalidInput& e) {
+      failure[s] = e.what();
     }
-    const double edge_band = o.tile_size > 0 ? spacing : 0;
-    delaunay(xy, [&](int i, int j, int k) {
-      const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
-      if (!std::isfinite(c.r)) return;
-      if (o.torus) {
-        // A triangle across a side appears once per copy: it counts where its first point (by index)
-        // is the point itself, not a copy.
-        const int v[3] = {i, j, k};
-        const int* first =
-            std::min_element(v, v + 3, [&](int a, int b) { return original[a] < original[b]; });
-        if (std::size_t(*first) >= n) return;
-      } else {
-        const double m = o.border * spacing + c.r;
-        if (!(c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m)) return;
-      }
-      double local = spacing;
-      if (o.density) {
-        const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
-        if (!(rho > 0) || rho < o.min_relative_density * max_rho) return;
-        local = spacing * std::sqrt(mean_rho / rho);
-      }
-      const double r = c.r / local;
-      radii.push_back(r);
-      bool near_edge = false;
-      if (edge_band > 0) {
-        auto gap = [&](double v) {
-          const double t = v / o.tile_size;
-          return std::fabs(t - std::round(t)) * o.tile_size;
-        };
-        near_edge = std::min(gap(c.x), gap(c.y)) < edge_band;
-        near_edge_judged += near_edge;
-      }
-      if (r > 0.85) out.over_085 += 1, out.over_085_near_edge += near_edge;
-      if (r > 1.0) out.over_100 += 1;
-    });
+  });
+  for (const std::string& f : failure)
+    if (!f.empty()) throw InvalidInput(f);
+  std::vector<double> radii;
+  std::size_t near_edge_judged = 0;
+  for (const SetCircles& c : per_set) {
+    radii.insert(radii.end(), c.radii.begin(), c.radii.end());
+    out.over_085 += c.over_085, out.over_100 += c.over_100, out.over_085_near_edge += c.over_085_near_edge;
+    near_edge_judged += c.near_edge_judged;
   }
   out.triangles = radii.size();
   if (!radii.empty()) {

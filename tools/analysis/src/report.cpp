@@ -82,6 +82,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     eo.density = o.density;
     eo.tile_size = o.tile_size;
     eo.min_relative_density = o.holes_min_density;
+    eo.threads = o.threads;
     r.empty_circles = empty_circles(sets, eo);
     r.has_empty_circles = true;
   }

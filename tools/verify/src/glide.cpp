@@ -51,11 +51,18 @@ std::vector<double> glide_torus(const TilesetData& set, std::size_t t, double co
 
 }  // namespace
 
+bool keyframe_judged(const TilesetData& set, const std::vector<std::uint32_t>& levels, std::size_t g) {
+  std::uint32_t level = 0;
+  while (level + 1 < set.levels && set.keyframe_nominal[g] > set.level_nominal[level]) ++level;
+  return std::find(levels.begin(), levels.end(), level) != levels.end();
+}
+
 void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done) {
   const Bars& b = options.bars;
   const std::size_t keyframes = set.keyframe_nominal.size();
-  for (std::size_t g = 0; g < keyframes; ++g)
+  for (std::size_t g = 0; g < keyframes; ++g) {
+    if (!keyframe_judged(set, options.levels, g)) continue;
     for (int half = 0; half < (g + 1 < keyframes ? 2 : 1); ++half) {
       KeyframeResult row;
       const double k0 = set.keyframe_nominal[g], k1 = g + 1 < keyframes ? set.keyframe_nominal[g + 1] : k0;
@@ -63,6 +70,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
       row.keyframe = !half;
       row.closest_pair = std::numeric_limits<double>::infinity();
       std::vector<double> moves;
+      TorusHoles holes;
       for (std::size_t t = 0; t < set.tiles.size(); ++t) {
         std::vector<std::pair<int, std::uint32_t>> ids;
         const std::vector<double> coords = half
@@ -73,7 +81,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
         if (n < 2) continue;
         analysis::NearestNeighbours nn;
         add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
-        if (!half && n >= 3) add_torus_holes(coords, row.holes);
+        if (!half && options.holes) holes.add(coords);
         if (half || g == 0) continue;
         // Motion into this keyframe, of the tile's own points present at the last one (or entering there).
         const Tile& tile = set.tiles[t];
@@ -86,6 +94,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
           moves.push_back(std::hypot(c[0] * ec - a[0] * ea, c[1] * ec - a[1] * ea) / spacing);
         }
       }
+      holes.measure(options.threads, row.holes);
       if (!moves.empty()) {
         double sum = 0;
         for (double& m : moves) sum += (m /= row.davg);  // in mean nearest-neighbour distances
@@ -101,6 +110,7 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
       check_holes(row.holes, b, row.checks);
       report.keyframes.push_back(std::move(row));
     }
+  }
 }
 
 }  // namespace kdm::verify

@@ -40,6 +40,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
     std::vector<double> edge_pool, midline_pool;
     row.closest_pair = std::numeric_limits<double>::infinity();
     analysis::EdgeBands bands;
+    TorusHoles holes;
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {
       const std::vector<double> coords = torus_points(set, t, count);
       const std::size_t n = coords.size() / 2;
@@ -47,7 +48,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
       if (n < 2) continue;
       analysis::NearestNeighbours nn;
       add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
-      if (row.complete_level && n >= 3) add_torus_holes(coords, row.holes);
+      if (row.complete_level && options.holes) holes.add(coords);
       analysis::add_edge_bands(coords, 2, 0.5, bands);
       std::vector<double> edge, inside;
       analysis::split_by_seam(coords, 2, nn, 0.5, edge, inside);
@@ -67,6 +68,7 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
           analysis::spectrum_stats(analysis::periodogram(coords, 2, 0.6, options.threads)).low_p;
       row.worst_low_p = std::isnan(row.worst_low_p) ? low_p : std::max(row.worst_low_p, low_p);
     }
+    holes.measure(options.threads, row.holes);
     // Distinct links only, and the short half only: above the midline median the gap measures the shape
     // of the body, not short links (docs/design.md §5).
     edge_pool = distinct(std::move(edge_pool)), midline_pool = distinct(std::move(midline_pool));

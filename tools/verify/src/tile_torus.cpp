@@ -64,11 +64,15 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
   return out;
 }
 
-void add_torus_holes(const std::vector<double>& coords, Holes& holes) {
-  tools::PointSet set;
-  set.dim = 2;
-  set.coords = coords;
-  const analysis::EmptyCircles e = analysis::empty_circles({set});
+void TorusHoles::add(const std::vector<double>& coords) {
+  if (coords.size() >= 6) tori_.push_back({2, coords});
+}
+
+void TorusHoles::measure(int threads, Holes& holes) const {
+  if (tori_.empty()) return;
+  analysis::EmptyCircleOptions o;
+  o.threads = threads;
+  const analysis::EmptyCircles e = analysis::empty_circles(tori_, o);
   holes.measured = true;
   holes.largest = std::max(holes.largest, e.largest);
   holes.over_085 += e.over_085, holes.points += e.points;

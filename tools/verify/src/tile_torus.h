@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kdm/analysis/common.h"
+#include "kdm/analysis/empty_circles.h"
 #include "kdm/analysis/nearest_neighbour.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset_format.h"
@@ -46,8 +47,18 @@ analysis::NNStats add_torus_nn(const std::vector<double>& coords, std::size_t ti
   return summary;
 }
 
-/// Adds the empty circles of a tile's torus (`coords`, normalised, at least 3 points) to `holes`.
-void add_torus_holes(const std::vector<double>& coords, Holes& holes);
+/// The tiles' tori of one density, gathered so that their empty circles are measured at once.
+class TorusHoles {
+ public:
+  /// Adds a tile's torus (`coords`, normalised); one of fewer than 3 points has no triangles.
+  void add(const std::vector<double>& coords);
+  /// Adds the empty circles of every torus added to `holes` (in parallel on `threads`; the result does
+  /// not depend on it).
+  void measure(int threads, Holes& holes) const;
+
+ private:
+  std::vector<tools::PointSet> tori_;
+};
 
 /// Appends the hole checks of `bars` (those not off) for `holes` to `checks`.
 void check_holes(const Holes& holes, const Bars& bars, std::vector<Check>& checks);
@@ -60,7 +71,12 @@ std::vector<double> densities(const TilesetData& set, const std::vector<std::uin
 void judge_densities(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 
-/// Part 5 (glide.cpp): appends a KeyframeResult per keyframe and half-way density to `report`.
+/// Whether keyframe g (and the density half-way to the next) lies in one of `levels`: level k holds the
+/// counts (N_{k-1}, N_k], the last level every count above too.
+bool keyframe_judged(const TilesetData& set, const std::vector<std::uint32_t>& levels, std::size_t g);
+
+/// Part 5 (glide.cpp): appends a KeyframeResult per keyframe of the judged levels, and the density
+/// half-way to the next, to `report`.
 void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 

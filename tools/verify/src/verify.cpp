@@ -194,7 +194,9 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     if (options.seams) total += set.tiles.size() * 4 * n * (k ? 4 : 1);
   }
   if (options.glide_track)
-    for (std::uint32_t n : set.keyframe_nominal) total += set.tiles.size() * 4 * 2.0 * n;
+    for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g)
+      if (keyframe_judged(set, options.levels, g))
+        total += set.tiles.size() * 4 * 2.0 * set.keyframe_nominal[g];
   const auto done = [&](double units) {
     finished += units;
     if (options.progress) options.progress(std::min(1.0, finished / total));

@@ -53,10 +53,11 @@ struct BakeRecipe {
   /// in recipes that do not name it. It visits every pair of tiles that can meet (C^6 for C colours):
   /// seconds for 2 colours, but C² times the tiles' own work, which grows fast from 5 colours up.
   double separation = 0;
-  /// With `separation`: move the later point of a close pair away from the earlier (by the least that
-  /// clears it, in every tile) instead of removing it, which leaves a hole wherever its patch shows
-  /// (close_pairs.h, push_close_pairs_apart). Off in recipes that do not name it.
-  bool separation_push = false;
+  /// With `separation`: move the later point of a close pair away from the earlier ones it is too close
+  /// to, in every tile alike, until it is this many hexagonal spacings from each, instead of removing it,
+  /// which leaves a hole wherever its patch shows (close_pairs.h, push_close_pairs_apart). 0 (off) in
+  /// recipes that do not name it; at least `separation` otherwise.
+  double separation_push = 0;
   /// How a patch's points are ranked against the run's other new points, stand-ins for the regions ranked
   /// apart (bake.cpp says why): 0 (recipes without the key) not at all; 1 ranked together with them; 2
   /// present in proportion, each weighing the fraction of the patch already ranked.

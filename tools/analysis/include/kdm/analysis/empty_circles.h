@@ -23,6 +23,9 @@ struct EmptyCircleOptions {
   /// With a density: judge only circles centred where ρ is at least this fraction of its largest value
   /// (e.g. 0.5: the dark half of a stippled picture).
   double min_relative_density = 0;
+  /// Sets triangulated at once (0: the default thread count); the result does not depend on it. With
+  /// more than one, `density` is called from several threads.
+  int threads = 1;
 };
 
 struct EmptyCircles {

@@ -85,11 +85,14 @@ struct Bars {
 struct VerifyOptions {
   int reference_runs = 16;              ///< full-sampler runs per level (≥ 2)
   std::size_t spectrum_budget = 40000;  ///< largest torus (points) whose spectra are computed
-  std::vector<std::uint32_t> levels;    ///< levels to judge (statistics, direct check); empty = all
-  bool statistics = true;               ///< run part 1
-  bool direct_check = true;             ///< run part 2
-  bool seams = true;                    ///< run parts 3 and 4 (every density of the judged levels)
-  bool glide_track = true;              ///< run part 5 (sets with a glide track)
+  std::vector<std::uint32_t> levels;  ///< levels to judge (every part; a keyframe by its count); empty = all
+  bool statistics = true;             ///< run part 1
+  bool direct_check = true;           ///< run part 2
+  bool seams = true;                  ///< run parts 3 and 4 (every density of the judged levels)
+  bool glide_track = true;            ///< run part 5 (sets with a glide track)
+  /// Measure empty circles at complete levels and keyframes (a Delaunay triangulation per torus: about
+  /// half of part 5's time). Off, no hole checks are made whatever the bars.
+  bool holes = true;
   int threads = 0;  ///< worker threads, 0 = gen::default_thread_count(); results do not depend on it
   Bars bars;
   std::function<void(double)> progress;  ///< fraction done in [0, 1], from the calling thread (optional)
