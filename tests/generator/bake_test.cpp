@@ -218,15 +218,23 @@ TEST(BakeTest, SpacingGuardTestsTorusDistances) {
   EXPECT_TRUE(off.clear(0.5, 0.5));
 }
 
-// The smallest distance between two points of a world region, in hexagonal spacings of its density.
-double closest_pair(const Tileset& set, double points_per_tile, double side) {
+// The stable points of the world region [0, side)² of unit tiles at `points_per_tile` (out[0..n)).
+std::vector<QueryPoint> region_points(const Tileset& set, double points_per_tile, double side,
+                                      std::size_t& n) {
   QueryParams q;
   q.x1 = q.y1 = side;
   q.scale = points_per_tile;
   std::vector<QueryPoint> out(std::size_t(side * side * points_per_tile * 1.2) + 64);
-  std::size_t n = 0;
+  n = 0;
   QueryCursor cursor;
   EXPECT_EQ(query_points(set, q, out.data(), out.size(), &n, &cursor), Status::kOk);
+  return out;
+}
+
+// The smallest distance between two points of a world region, in hexagonal spacings of its density.
+double closest_pair(const Tileset& set, double points_per_tile, double side) {
+  std::size_t n = 0;
+  std::vector<QueryPoint> out = region_points(set, points_per_tile, side, n);
   // Sort by x and sweep: the closest pair lies within a strip of the best distance so far.
   std::sort(out.begin(), out.begin() + n, [](const QueryPoint& a, const QueryPoint& b) { return a.x < b.x; });
   double best = 1e300;
@@ -280,13 +288,8 @@ TEST(BakeTest, SeparationRemovesNearCoincidentPointsAtEveryDensity) {
 // Large empty circles (holes, in d_hex) of a query of `side`² tiles at `points_per_tile`, at least one
 // d_hex inside the region: a removed point leaves one of about 1.0 d_hex; a well-spread set has none.
 std::size_t holes_over(const Tileset& set, double points_per_tile, int side, double radius) {
-  QueryParams q;
-  q.x1 = q.y1 = side;
-  q.scale = points_per_tile;
-  std::vector<QueryPoint> out(std::size_t(side * side * points_per_tile * 1.2) + 64);
   std::size_t n = 0;
-  QueryCursor cursor;
-  EXPECT_EQ(query_points(set, q, out.data(), out.size(), &n, &cursor), Status::kOk);
+  const std::vector<QueryPoint> out = region_points(set, points_per_tile, side, n);
   tools::PointSet points;
   points.dim = 2;
   for (std::size_t i = 0; i < n; ++i)
