@@ -27,16 +27,19 @@ def sample(
 ) -> npt.NDArray[np.float64]: ...
 
 class QueryResult:
+    points: npt.NDArray[np.void]
     xy: npt.NDArray[np.float64]
     tile: npt.NDArray[np.int64]
     rank: npt.NDArray[np.uint32]
     level: npt.NDArray[np.uint32]
     def __init__(
         self,
+        points: npt.NDArray[np.void],
         xy: npt.NDArray[np.float64],
         tile: npt.NDArray[np.int64],
         rank: npt.NDArray[np.uint32],
         level: npt.NDArray[np.uint32],
+        storage: Any = ...,
     ) -> None: ...
     def __len__(self) -> int: ...
 

@@ -12,8 +12,13 @@ from . import _checks, _kdm
 class QueryResult:
     """The points of a query, in the runtime's order (tiles row by row, ranks ascending).
 
+    `points` holds the runtime's own 40-byte records, as the query wrote them; `xy`, `tile` and `rank`
+    are views of them (strided, not copied: ``np.ascontiguousarray(r.xy)`` makes a packed copy).
+
     Attributes
     ----------
+    points : numpy.ndarray
+        (m,) structured: fields x, y (float64), tile_x, tile_y (int64), rank (uint32).
     xy : numpy.ndarray
         (m, 2) float64: world positions minus the query's origin.
     tile : numpy.ndarray
@@ -24,13 +29,14 @@ class QueryResult:
         (m,) uint32: the pyramid level the rank belongs to.
     """
 
-    __slots__ = ("xy", "tile", "rank", "level", "_storage")
+    __slots__ = ("points", "xy", "tile", "rank", "level", "_storage")
 
     def __init__(
-        self, xy: np.ndarray, tile: np.ndarray, rank: np.ndarray, level: np.ndarray, storage: Any = None
+        self, points: np.ndarray, xy: np.ndarray, tile: np.ndarray, rank: np.ndarray, level: np.ndarray,
+        storage: Any = None,
     ) -> None:
-        self.xy, self.tile, self.rank, self.level = xy, tile, rank, level
-        self._storage = storage  # the arrays these are the first rows of (query's `out` refills them)
+        self.points, self.xy, self.tile, self.rank, self.level = points, xy, tile, rank, level
+        self._storage = storage  # the memory these are the first rows of (query's `out` refills it)
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -123,8 +129,8 @@ class Tileset:
         gamma, invert
             How an image file's pixels become density.
         out : QueryResult, optional
-            An earlier result whose arrays this query refills, where they are large enough (its arrays
-            are overwritten): a loop of queries then writes into warm memory instead of new arrays.
+            An earlier result whose memory this query refills, where it is large enough (its arrays are
+            overwritten): a loop of queries then writes into warm memory instead of new memory.
 
         Returns
         -------
@@ -150,11 +156,10 @@ class Tileset:
                 spec = _kdm.DensitySpec.constant(1.0)
         if out is not None and not isinstance(out, QueryResult):
             raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
-        xy, tile, rank, level, storage = _kdm.query(
+        return QueryResult(*_kdm.query(
             self._handle, rect, scale, spec, call, density_rect, density_max, tile_size, mode, origin,
             out._storage if out is not None else None,
-        )
-        return QueryResult(xy, tile, rank, level, storage)
+        ))
 
 
 def bake(recipe_text: str, *, threads: int = 0) -> Tileset:

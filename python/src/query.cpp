@@ -1,10 +1,13 @@
 // kdm._kdm.query: a runtime query run to completion (by tools::query_all's rules, as `kdm query` runs it)
-// into numpy arrays: positions, tile ids, ranks and levels, converted chunk by chunk as the query writes
-// them, with the GIL released.
+// with the GIL released, into memory numpy then views: the runtime's own point records (positions, tile
+// ids and ranks are strided views of them, nothing is converted) and the points' levels.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -32,97 +35,95 @@ QueryMode parse_mode(const std::string& mode) {
   throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
 }
 
-/// A result's columns, where the points go: positions, tiles, ranks and levels.
-struct Columns {
-  std::vector<double> xy;
-  std::vector<std::int64_t> tile;
-  std::vector<std::uint32_t> rank, level;
-};
+/// Points and their levels in memory numpy arrays view: the runtime's QueryPoint records themselves (no
+/// conversion; `xy`, `tile` and `rank` are strided views of them) and a level per point. Plain malloc
+/// memory, so a buffer no array views yet grows by realloc (pages moved, not copied); once arrays view it,
+/// it never moves (an `out=` result with too little room is copied into a new buffer instead).
+struct Buffer {
+  QueryPoint* points = nullptr;
+  std::uint32_t* levels = nullptr;
+  std::size_t capacity = 0;
+  bool shared = false;  ///< numpy arrays view it: never realloc or free it here
 
-/// What a query writes through: a chunk of points small enough to stay in cache, converted into columns
-/// as it fills, and the columns of the points an `out=` result has no room for (all of them without one).
-/// Each thread keeps its own between calls (refilling warm memory is several times cheaper than first
-/// touching fresh memory); a query made from inside a callable density, while they are in use, gets its
-/// own.
-struct Scratch {
-  std::vector<QueryPoint> chunk;
-  Columns spill;
-};
-thread_local Scratch kept_scratch;
-thread_local bool kept_scratch_in_use = false;
-
-struct ScratchLease {
-  ScratchLease() : scratch(kept_scratch_in_use ? own : kept_scratch) { kept_scratch_in_use = true; }
-  ~ScratchLease() {
-    if (&scratch != &kept_scratch) return;
-    kept_scratch_in_use = false;
-    if (kept_scratch.spill.rank.capacity() > (std::size_t(1) << 20)) kept_scratch.spill = Columns{};
+  Buffer() = default;
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+  ~Buffer() {
+    if (!shared) std::free(points), std::free(levels);
   }
-  ScratchLease(const ScratchLease&) = delete;
-  ScratchLease& operator=(const ScratchLease&) = delete;
 
-  Scratch own;
-  Scratch& scratch;
+  /// Room for at least `wanted` points, keeping the first `kept`. Throws std::bad_alloc.
+  void reserve(std::size_t wanted, std::size_t kept) {
+    if (wanted <= capacity) return;
+    const std::size_t grown = std::max(wanted, 2 * capacity);
+    if (shared) {  // arrays view the old memory: copy what is kept into new memory
+      auto* p = static_cast<QueryPoint*>(std::malloc(grown * sizeof(QueryPoint)));
+      auto* l = static_cast<std::uint32_t*>(std::malloc(grown * sizeof(std::uint32_t)));
+      if (!p || !l) std::free(p), std::free(l), throw std::bad_alloc();
+      if (kept) std::memcpy(p, points, kept * sizeof(QueryPoint)), std::memcpy(l, levels, kept * 4);
+      points = p, levels = l, shared = false;
+    } else {
+      void* p = std::realloc(points, grown * sizeof(QueryPoint));
+      if (!p) throw std::bad_alloc();
+      points = static_cast<QueryPoint*>(p);
+      void* l = std::realloc(levels, grown * sizeof(std::uint32_t));
+      if (!l) throw std::bad_alloc();
+      levels = static_cast<std::uint32_t*>(l);
+    }
+    capacity = grown;
+  }
+};
+
+/// The C++ side of an earlier result's `storage`: the buffer its arrays view, if it is one of ours.
+struct Storage {
+  QueryPoint* points = nullptr;
+  std::uint32_t* levels = nullptr;
+  std::size_t capacity = 0;
+  explicit Storage(const py::object& storage) {
+    if (storage.is_none() || !py::isinstance<py::tuple>(storage)) return;
+    const py::tuple t = storage.cast<py::tuple>();
+    if (t.size() != 2 || !py::isinstance<py::array>(t[0]) || !py::isinstance<py::array_t<std::uint32_t>>(t[1]))
+      return;
+    py::array records = t[0].cast<py::array>();
+    py::array_t<std::uint32_t> levels_array = t[1].cast<py::array_t<std::uint32_t>>();
+    if (records.itemsize() != sizeof(QueryPoint) || records.ndim() != 1 || !records.writeable() ||
+        !levels_array.writeable() || levels_array.ndim() != 1 || levels_array.shape(0) != records.shape(0))
+      return;
+    points = static_cast<QueryPoint*>(records.mutable_data());
+    levels = levels_array.mutable_data();
+    capacity = static_cast<std::size_t>(records.shape(0));
+  }
 };
 
 constexpr std::size_t kChunk = std::size_t(1) << 14;
 
-/// The arrays of an earlier result (`storage`), if they are of the right types and writable: the points
-/// go straight into them while they have room.
-struct Storage {
-  py::array_t<double> xy;
-  py::array_t<std::int64_t> tile;
-  py::array_t<std::uint32_t> rank, level;
-  std::size_t capacity = 0;
-  explicit Storage(const py::object& storage) {
-    if (storage.is_none()) return;
-    const py::tuple t = storage.cast<py::tuple>();
-    if (t.size() != 4 || !py::isinstance<py::array_t<double>>(t[0]) ||
-        !py::isinstance<py::array_t<std::int64_t>>(t[1]) ||
-        !py::isinstance<py::array_t<std::uint32_t>>(t[2]) ||
-        !py::isinstance<py::array_t<std::uint32_t>>(t[3]))
-      return;
-    xy = t[0].cast<py::array_t<double>>(), tile = t[1].cast<py::array_t<std::int64_t>>();
-    rank = t[2].cast<py::array_t<std::uint32_t>>(), level = t[3].cast<py::array_t<std::uint32_t>>();
-    auto usable = [](const py::array& a, py::ssize_t columns) {
-      return a.ndim() == (columns > 1 ? 2 : 1) && (columns == 1 || a.shape(1) == columns) && a.writeable() &&
-             (a.flags() & py::array::c_style);
-    };
-    if (!(usable(xy, 2) && usable(tile, 2) && usable(rank, 1) && usable(level, 1))) return;
-    capacity =
-        static_cast<std::size_t>(std::min({xy.shape(0), tile.shape(0), rank.shape(0), level.shape(0)}));
-  }
-};
-
-/// Runs the query to completion (the rules of tools::query_all), its points into `direct` (room for
-/// `capacity`) and, past that, `spill`. Returns the count. Call without the GIL.
-std::size_t collect(const Tileset& tiles, const QueryParams& q, Scratch& scratch, double* xy,
-                    std::int64_t* tile, std::uint32_t* rank, std::uint32_t* level, std::size_t capacity) {
-  scratch.chunk.resize(kChunk);
-  Columns& spill = scratch.spill;
-  spill.xy.clear(), spill.tile.clear(), spill.rank.clear(), spill.level.clear();
+/// Runs the query to completion (the rules of tools::query_all) into `buffer`, a chunk at a time so that
+/// each chunk's levels are found while its points are still in cache. Returns the count. Call without
+/// the GIL.
+std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) {
   QueryCursor cursor;
   std::size_t m = 0;
-  // Points come tile by tile: look each tile up once.
+  // Points come tile by tile, ranks ascending: look each tile up once and step through its levels.
   std::int64_t tx = std::numeric_limits<std::int64_t>::min(), ty = tx;
   const Tile* t = nullptr;
+  std::uint32_t level = 0, level_end = 0, last_rank = 0;
   for (;;) {
+    if (m == buffer.capacity) buffer.reserve(m + kChunk, m);
     std::size_t written = 0;
     QueryProblem problem;
-    const Status s = query_points(tiles, q, scratch.chunk.data(), kChunk, &written, &cursor, &problem);
-    for (std::size_t i = 0; i < written; ++i, ++m) {
-      const QueryPoint& p = scratch.chunk[i];
-      if (!t || p.id.tile_x != tx || p.id.tile_y != ty)
-        tx = p.id.tile_x, ty = p.id.tile_y, t = &tiles.tile_at(tx, ty);
-      const std::uint32_t lv = t->level_of(p.id.rank);
-      if (m < capacity) {
-        xy[2 * m] = p.x, xy[2 * m + 1] = p.y, tile[2 * m] = tx, tile[2 * m + 1] = ty;
-        rank[m] = p.id.rank, level[m] = lv;
-      } else {
-        spill.xy.insert(spill.xy.end(), {p.x, p.y}), spill.tile.insert(spill.tile.end(), {tx, ty});
-        spill.rank.push_back(p.id.rank), spill.level.push_back(lv);
+    const Status s = query_points(tiles, q, buffer.points + m, std::min(kChunk, buffer.capacity - m), &written,
+                                  &cursor, &problem);
+    for (std::size_t i = m; i < m + written; ++i) {
+      const PointId& id = buffer.points[i].id;
+      if (!t || id.tile_x != tx || id.tile_y != ty || id.rank < last_rank) {
+        if (!t || id.tile_x != tx || id.tile_y != ty) tx = id.tile_x, ty = id.tile_y, t = &tiles.tile_at(tx, ty);
+        level = 0, level_end = t->level_end[0];
       }
+      last_rank = id.rank;
+      while (id.rank >= level_end && level + 1 < t->level_end.size()) level_end = t->level_end[++level];
+      buffer.levels[i] = level;
     }
+    m += written;
     if (m > tools::kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
       throw std::invalid_argument(
           "the query emits more than 2^25 points; lower the scale or split the region");
@@ -133,30 +134,42 @@ std::size_t collect(const Tileset& tiles, const QueryParams& q, Scratch& scratch
   }
 }
 
-/// The result's arrays (xy m×2, tile m×2, rank, level), then the storage they are the first rows of (for a
-/// later query's `storage`): `out`'s own when they held every point, else new arrays.
-py::tuple result(std::size_t m, const Storage& out, const Columns& spill) {
-  const auto rows = static_cast<py::ssize_t>(m);
-  const py::slice first(0, rows, 1);
-  if (spill.rank.empty() && out.capacity > 0 && out.capacity >= m)
-    return py::make_tuple(out.xy[first], out.tile[first], out.rank[first], out.level[first],
-                          py::make_tuple(out.xy, out.tile, out.rank, out.level));
-  py::array_t<double> xy({rows, py::ssize_t(2)});
-  py::array_t<std::int64_t> tile({rows, py::ssize_t(2)});
-  py::array_t<std::uint32_t> rank(rows), level(rows);
-  const std::size_t head = std::min(m, out.capacity);  // in `out`; the rest were spilled
-  {
-    py::gil_scoped_release release;
-    auto copy = [head](auto* to, const auto* from, const auto& rest, std::size_t width) {
-      if (head) std::memcpy(to, from, head * width * sizeof(*to));
-      if (!rest.empty()) std::memcpy(to + head * width, rest.data(), rest.size() * sizeof(*to));
-    };
-    copy(xy.mutable_data(), head ? out.xy.data() : nullptr, spill.xy, 2);
-    copy(tile.mutable_data(), head ? out.tile.data() : nullptr, spill.tile, 2);
-    copy(rank.mutable_data(), head ? out.rank.data() : nullptr, spill.rank, 1);
-    copy(level.mutable_data(), head ? out.level.data() : nullptr, spill.level, 1);
+/// numpy's view of a QueryPoint record (x, y, tile_x, tile_y, rank; 40 bytes with the padding).
+py::dtype record_dtype() {
+  static_assert(offsetof(QueryPoint, y) == 8 && offsetof(QueryPoint, id) == 16 &&
+                    offsetof(PointId, tile_y) == 8 && offsetof(PointId, rank) == 16,
+                "the record layout numpy is told");
+  return py::dtype::from_args(py::dict(py::arg("names") = py::make_tuple("x", "y", "tile_x", "tile_y", "rank"),
+                            py::arg("formats") = py::make_tuple("<f8", "<f8", "<i8", "<i8", "<u4"),
+                            py::arg("offsets") = py::make_tuple(0, 8, 16, 24, 32),
+                            py::arg("itemsize") = sizeof(QueryPoint)));
+}
+
+/// The result: the records (m,), xy (m×2) and tile (m×2) and rank views of them, level (m,), then the
+/// storage they are the first rows of (for a later query's `storage`).
+py::tuple result(std::size_t m, Buffer& buffer, const py::object& storage) {
+  py::tuple full;
+  if (!buffer.shared) {  // new memory: numpy takes it over
+    buffer.shared = true;
+    py::capsule points_owner(buffer.points, [](void* p) { std::free(p); });
+    py::capsule levels_owner(buffer.levels, [](void* p) { std::free(p); });
+    const auto capacity = static_cast<py::ssize_t>(buffer.capacity);
+    full = py::make_tuple(py::array(record_dtype(), {capacity}, {py::ssize_t(sizeof(QueryPoint))},
+                                    buffer.points, points_owner),
+                          py::array_t<std::uint32_t>({capacity}, buffer.levels, levels_owner));
+  } else {
+    full = storage.cast<py::tuple>();
   }
-  return py::make_tuple(xy, tile, rank, level, py::make_tuple(xy, tile, rank, level));
+  const py::array records = full[0].cast<py::array>()[py::slice(0, static_cast<py::ssize_t>(m), 1)];
+  const py::array levels = full[1].cast<py::array>()[py::slice(0, static_cast<py::ssize_t>(m), 1)];
+  const auto rows = static_cast<py::ssize_t>(m), stride = static_cast<py::ssize_t>(sizeof(QueryPoint));
+  auto* base = reinterpret_cast<char*>(buffer.points);
+  py::array_t<double> xy({rows, py::ssize_t(2)}, {stride, py::ssize_t(8)}, reinterpret_cast<double*>(base),
+                         records);
+  py::array_t<std::int64_t> tile({rows, py::ssize_t(2)}, {stride, py::ssize_t(8)},
+                                 reinterpret_cast<std::int64_t*>(base + 16), records);
+  py::array_t<std::uint32_t> rank({rows}, {stride}, reinterpret_cast<std::uint32_t*>(base + 32), records);
+  return py::make_tuple(records, xy, tile, rank, levels, full);
 }
 
 py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
@@ -189,19 +202,17 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
     from_spec = std::make_unique<SpecDensity>(*spec, r.data());
     q.density = from_spec->density;
   }
-  Storage out(storage);
-  ScratchLease lease;
-  double* xy = out.capacity ? out.xy.mutable_data() : nullptr;
-  std::int64_t* tile = out.capacity ? out.tile.mutable_data() : nullptr;
-  std::uint32_t* rank = out.capacity ? out.rank.mutable_data() : nullptr;
-  std::uint32_t* level = out.capacity ? out.level.mutable_data() : nullptr;
+  const Storage out(storage);
+  Buffer buffer;  // an earlier result's memory while it has room, else new memory
+  if (out.capacity) buffer.points = out.points, buffer.levels = out.levels, buffer.capacity = out.capacity;
+  buffer.shared = out.capacity > 0;
   std::size_t m = 0;
   {
     py::gil_scoped_release release;  // a callable density takes it back at each call
-    m = collect(*handle.set, q, lease.scratch, xy, tile, rank, level, out.capacity);
+    m = collect(*handle.set, q, buffer);
   }
   if (from_callable) from_callable->rethrow();
-  return result(m, out, lease.scratch.spill);
+  return result(m, buffer, storage);
 }
 
 }  // namespace

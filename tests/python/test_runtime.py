@@ -83,9 +83,18 @@ def test_results_are_deterministic_and_origin_shifts():
 
 def test_result_arrays():
     r = BUILTIN.query((0, 0, 2, 2), scale=2000)
-    assert r.xy.dtype == np.float64 and r.xy.shape == (len(r), 2) and r.xy.flags["C_CONTIGUOUS"]
+    assert r.xy.dtype == np.float64 and r.xy.shape == (len(r), 2)
     assert r.tile.dtype == np.int64 and r.tile.shape == (len(r), 2)
-    assert r.rank.dtype == np.uint32 and r.level.dtype == np.uint32
+    assert r.rank.dtype == np.uint32 and r.level.dtype == np.uint32 and r.level.shape == (len(r),)
+    # xy, tile and rank view the runtime's records, which `points` holds: nothing is copied.
+    assert r.points.shape == (len(r),) and r.points.dtype.itemsize == 40
+    assert r.points.dtype.names == ("x", "y", "tile_x", "tile_y", "rank")
+    for view in (r.xy, r.tile, r.rank):
+        assert np.shares_memory(view, r.points) and not view.flags["OWNDATA"]
+    assert np.array_equal(r.xy[:, 0], r.points["x"]) and np.array_equal(r.tile[:, 1], r.points["tile_y"])
+    assert np.array_equal(r.rank, r.points["rank"])
+    packed = np.ascontiguousarray(r.xy)
+    assert packed.flags["C_CONTIGUOUS"] and np.array_equal(packed, r.xy)
     assert ((r.xy >= 0) & (r.xy < 2)).all()
     assert np.array_equal(r.tile, np.floor(r.xy).astype(np.int64))  # tile_size 1
     # Levels follow ranks: level k ends at about level_points[k] points per tile.
@@ -187,9 +196,17 @@ def test_out_refills_an_earlier_results_arrays():
     fresh = tiles.query((0, 0, 2, 2), scale=400)
     for name in ("xy", "tile", "rank", "level"):
         np.testing.assert_array_equal(getattr(small, name), getattr(fresh, name))
-    assert np.shares_memory(small.xy, big.xy)  # the same memory, refilled
-    larger = tiles.query((0, 0, 6, 6), scale=400, out=small)  # too small to hold it: new arrays
-    assert not np.shares_memory(larger.xy, big.xy)
-    np.testing.assert_array_equal(larger.rank, tiles.query((0, 0, 6, 6), scale=400).rank)
+    assert np.shares_memory(small.xy, big.xy) and np.shares_memory(small.level, big.level)  # refilled
+    larger = tiles.query((0, 0, 12, 12), scale=400, out=small)  # too small to hold it: new memory
+    assert len(larger) > 2 * len(big) + 16384 and not np.shares_memory(larger.xy, big.xy)
+    whole = tiles.query((0, 0, 12, 12), scale=400)
+    for name in ("xy", "tile", "rank", "level"):
+        np.testing.assert_array_equal(getattr(larger, name), getattr(whole, name))
+    # Queries far larger than a chunk, fresh and refilling: every point's level is found.
+    dense = tiles.query((0, 0, 8, 8), scale=3000, mode="smooth")
+    again = tiles.query((0, 0, 8, 8), scale=3000, mode="smooth", out=dense)
+    assert len(dense) > 150_000 and np.shares_memory(again.xy, dense.xy)
+    levels = np.searchsorted(tiles.info["level_points"], 3000) + 1
+    assert np.array_equal(np.bincount(again.level, minlength=levels) > 0, np.ones(levels, bool))
     with pytest.raises(TypeError):
         tiles.query((0, 0, 2, 2), scale=400, out=big.xy)
