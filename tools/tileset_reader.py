@@ -15,6 +15,7 @@ Every check the document asks of a reader is made; a failure exits with status 1
 """
 import argparse
 import array
+import bisect
 import math
 import struct
 import sys
@@ -49,6 +50,7 @@ class Tile:
         self.ys = ys
         self.keys = keys  # array('H'), emission key of each point
         self.glide = glide  # array('b'), gliding offsets (x, y pairs, Tileset.glide_unit), empty without keyframes
+        self.thresholds = None  # each point's emission threshold, once Tileset.offsets_at_keyframe needs them
 
     def levels_of_points(self):
         """The level of every point: point i is in level k iff level_end[k-1] <= i < level_end[k]."""
@@ -90,8 +92,11 @@ class Tileset:
         (every point at the last keyframe)."""
         if g + 1 == len(self.keyframe_nominal):
             return len(tile.xs)
-        count = self.keyframe_nominal[g + 1]
-        return sum(1 for k, q in zip(tile.levels_of_points(), tile.keys) if self.emits(k, q, count))
+        # Thresholds never decrease along a tile (keys are sorted within a level, _validate, and each level's
+        # thresholds lie above the last's): the points emitted are a prefix.
+        if tile.thresholds is None:
+            tile.thresholds = [self.threshold(k, q) for k, q in zip(tile.levels_of_points(), tile.keys)]
+        return bisect.bisect_left(tile.thresholds, self.keyframe_nominal[g + 1])
 
 
 def _u32(data, offset):

@@ -396,6 +396,26 @@ TEST(BakeTest, PushClosePairsApartMovesTheLaterPointOut) {
   EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 0u);
 }
 
+// A later point next to an earlier one by its tile's top edge, pushed up and to the right: the move stays
+// inside its tile (a point pushed across a tile edge would be shown by another tile), sliding along the
+// edge until it is `push` spacings clear.
+TEST(BakeTest, PushClosePairsApartKeepsPointsInTheirTile) {
+  std::vector<LevelPatches> levels(2, LevelPatches(1));
+  TilesetData table;
+  table.level_nominal = {16, 64};
+  levels[1].interiors[0].add(0.49, 0.975, 100);  // threshold 16.1: earlier
+  levels[1].interiors[0].add(0.5, 0.985, 1000);  // threshold 16.7, 0.014 away
+  const SeparationResult result = push_close_pairs_apart(levels, 1, table, 0.3, 0.5);
+  EXPECT_EQ(result.removed, 0u);
+  EXPECT_EQ(result.moved, 1u);
+  const std::vector<double>& xy = levels[1].interiors[0].xy;
+  EXPECT_DOUBLE_EQ(xy[3], 0.985);  // already closer to the edge than the margin: held, not moved out
+  const double push = 0.5 * std::sqrt(2.0 / (std::sqrt(3.0) * table.emission_threshold(1, 1000)));
+  EXPECT_GE(std::hypot(xy[2] - 0.49, xy[3] - 0.975), push * (1 - 1e-9));
+  EXPECT_GT(xy[2], 0.5);
+  EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 0u);
+}
+
 // Two points far apart at every keyframe whose paths cross half-way between two: the later one goes, with
 // its frames. Paths that do not cross keep both.
 TEST(BakeTest, DropCloseGlidesRemovesPointsWhosePathsMeet) {

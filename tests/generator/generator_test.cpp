@@ -15,6 +15,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "kdm/generator/bake.h"
 #include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
 
@@ -68,6 +69,20 @@ void expect_all_pass(const Report& report) {
     for (const Check& c : k.checks)
       EXPECT_TRUE(c.passed()) << "gliding at " << k.points_per_tile << " points per tile: " << c.name << " "
                               << c.value << (c.at_most ? " > " : " < ") << c.bar;
+}
+
+// Whether the seam part's closest-pair check, at the design's 0.3 d_hex, fails at the complete level
+// `level` of `set`.
+bool closest_pair_flagged(const TilesetData& set, std::uint32_t level) {
+  VerifyOptions o = parts(false, false, true);
+  o.levels = {level};
+  o.bars.closest_pair = 0.3;
+  const Report report = verify_tileset(set, o);
+  bool flagged = false;
+  for (const DensityResult& d : report.densities)
+    for (const Check& c : d.checks)
+      flagged = flagged || (d.complete_level && c.name.find("closest pair") == 0 && !c.passed());
+  return flagged;
 }
 
 TEST(GeneratorTest, EveryTileAndLevelMatchesTheFullSampler) {
@@ -183,16 +198,53 @@ TEST(GeneratorTest, VerifierFlagsNearCoincidentPoints) {
       break;
     }
   ASSERT_GT(moved, 0u);
-  VerifyOptions o = parts(false, false, true);
-  o.levels = {level};
-  o.bars.closest_pair = 0.3;
-  EXPECT_TRUE(verify_tileset(shipped(), o).passed());  // 512 points per tile and below: no close pair
-  const Report report = verify_tileset(damaged, o);
-  bool flagged = false;
-  for (const DensityResult& d : report.densities)
-    for (const Check& c : d.checks)
-      flagged = flagged || (d.complete_level && c.name.find("closest pair") == 0 && !c.passed());
-  EXPECT_TRUE(flagged);
+  EXPECT_FALSE(closest_pair_flagged(shipped(), level));  // 512 points per tile and below: no close pair
+  EXPECT_TRUE(closest_pair_flagged(damaged, level));
+}
+
+// Two tiles that can meet across an edge, though no tile's 2×2 torus puts one above the other: the last
+// point of a level of each moved next to their shared edge, 0.2 spacings apart across it where neither
+// has a point near. Only the check over every pair of tiles that can meet sees the pair.
+TEST(GeneratorTest, VerifierFlagsNearCoincidentPointsOfTilesThatMeetOutsideEveryTorus) {
+  TilesetData damaged = shipped();
+  const std::uint32_t C = damaged.colours, level = 2;
+  auto stacked_in_a_torus = [&](std::size_t below, std::size_t above) {
+    for (std::size_t t = 0; t < damaged.tiles.size(); ++t)
+      for (int tx = 0; tx < 2; ++tx)
+        for (int ty = 0; ty < 2; ++ty)
+          if (gen::tile_around(C, t, tx, ty) == below && gen::tile_around(C, t, tx, 1 - ty) == above)
+            return true;
+    return false;
+  };
+  std::size_t below = 0, above = 0;
+  bool found = false;
+  for (std::size_t t = 0; t < damaged.tiles.size() && !found; ++t)
+    for (std::uint32_t c = 0; c < C * C && !found; ++c) {
+      const std::uint32_t ne = static_cast<std::uint32_t>(t / C % C), nw = static_cast<std::uint32_t>(t % C);
+      below = t, above = damaged.tile_index(nw, ne, c / C, c % C);
+      found = !stacked_in_a_torus(below, above);
+    }
+  ASSERT_TRUE(found) << "every pair of tiles that can meet is stacked in some torus";
+  const double spacing = std::sqrt(2 / (std::sqrt(3.0) * damaged.level_nominal[level]));
+  // Where along the edge no point of either tile is within 0.6 spacings of it.
+  double x = 0;
+  for (double u = 0.3; u < 0.7 && x == 0; u += 0.002) {
+    bool clear = true;
+    for (const std::size_t t : {below, above}) {
+      const Tile& tile = damaged.tiles[t];
+      for (std::uint32_t i = 0; i < tile.level_end[level]; ++i) {
+        const double across = t == below ? 1 - tile.points[i].unit_y() : tile.points[i].unit_y();
+        clear = clear && std::hypot(tile.points[i].unit_x() - u, across) > 0.6 * spacing;
+      }
+    }
+    if (clear) x = u;
+  }
+  ASSERT_GT(x, 0) << "no clear place along the edge";
+  const std::uint32_t last_below = damaged.tiles[below].level_end[level] - 1;
+  const std::uint32_t last_above = damaged.tiles[above].level_end[level] - 1;
+  damaged.tiles[below].points[last_below] = TilePoint::from_unit(x, 1 - 0.1 * spacing);
+  damaged.tiles[above].points[last_above] = TilePoint::from_unit(x, 0.1 * spacing);
+  EXPECT_TRUE(closest_pair_flagged(damaged, level));
 }
 
 TEST(GeneratorTest, VerifierRefusesBadOptions) {

@@ -225,9 +225,24 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
           reach * std::sqrt(2.0 / (std::sqrt(3.0) * std::max(double(later.threshold), lowest)));
     });
     for (const auto& [key, offsets] : around) {
+      const auto& [level, kind, patch_index, index] = key;
+      Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
+      double* at = &patch.xy[2 * std::size_t(index)];
+      // The move keeps the point in the part of the tile grid that its patch is shown from: an interior
+      // point in its tile, an edge point between the vertices of its edge, a quarter spacing in (as the
+      // glide track keeps interiors). Pushed across a tile edge, a point would be shown by whichever tile
+      // the baker's torus put there, not by its own.
+      const double r = radius_of[key], margin = 0.25 * r / reach;
+      double lo[2], hi[2];
+      for (int a = 0; a < 2; ++a) {
+        const bool bounded = kind == static_cast<int>(PatchKind::kInterior) ||
+                             (a == 0 && kind == static_cast<int>(PatchKind::kHorizontalEdge)) ||
+                             (a == 1 && kind == static_cast<int>(PatchKind::kVerticalEdge));
+        lo[a] = bounded ? std::min(at[a], margin) : -1e300,
+        hi[a] = bounded ? std::max(at[a], 1 - margin) : 1e300;
+      }
       // A small move that takes it `push` spacings from every earlier neighbour: push off each in turn
       // until none is nearer (or give up; the next round finds it again if it is still too close).
-      const double r = radius_of[key];
       double dx = 0, dy = 0;
       for (int step = 0; step < 32; ++step) {
         bool clear = true;
@@ -240,12 +255,12 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
             ex = 1, ey = 0, d = 1;
           }
           dx += (r - d) * ex / d, dy += (r - d) * ey / d;
+          dx = std::clamp(at[0] + dx, lo[0], hi[0]) - at[0],
+          dy = std::clamp(at[1] + dy, lo[1], hi[1]) - at[1];
         }
         if (clear) break;
       }
-      const auto& [level, kind, patch_index, index] = key;
-      Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
-      patch.xy[2 * std::size_t(index)] += dx, patch.xy[2 * std::size_t(index) + 1] += dy;
+      at[0] += dx, at[1] += dy;
       moved.insert(key);
     }
   }

@@ -23,28 +23,35 @@ std::vector<std::size_t> glide_starts(const TilesetData& set, const Tile& tile) 
   return start;
 }
 
-/// The 2×2 torus around tile `t` at expected count `count` in smooth mode between keyframes g0 and g1
-/// (fraction s from g0), normalised to the unit square; `ids` (optional) receives (tile slot, rank).
-std::vector<double> glide_torus(const TilesetData& set, std::size_t t, double count, std::size_t g0,
-                                std::size_t g1, double s, std::vector<std::pair<int, std::uint32_t>>* ids) {
+/// Tile `t`'s points at expected count `count` in smooth mode between keyframes g0 and g1 (fraction s
+/// from g0), in its unit coordinates: its first ranks, which are those emitted.
+std::vector<double> glided(const TilesetData& set, std::size_t t, double count, std::size_t g0,
+                           std::size_t g1, double s) {
+  const Tile& tile = set.tiles[t];
+  const std::vector<std::size_t> start = glide_starts(set, tile);
+  const double e0 = set.glide_unit(g0), e1 = set.glide_unit(g1);
+  std::vector<double> out;
+  for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
+    for (; i < tile.level_end[k]; ++i) {
+      if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) return out;
+      const std::int8_t* o0 = &tile.glide[2 * (start[g0] + i)];
+      const std::int8_t* o1 = &tile.glide[2 * (start[g1] + i)];
+      out.insert(out.end(), {tile.points[i].unit_x() + o0[0] * e0 + s * (o1[0] * e1 - o0[0] * e0),
+                             tile.points[i].unit_y() + o0[1] * e0 + s * (o1[1] * e1 - o0[1] * e0)});
+    }
+  return out;
+}
+
+/// The 2×2 torus around tile `t` made of the tiles' points `at`, normalised to the unit square.
+std::vector<double> glide_torus(const TilesetData& set, std::size_t t, const TilePositions& at) {
   std::vector<double> all;
   for (int ty = 0; ty < 2; ++ty)
     for (int tx = 0; tx < 2; ++tx) {
-      const Tile& tile = set.tiles[gen::tile_around(set.colours, t, tx, ty)];
-      const std::vector<std::size_t> start = glide_starts(set, tile);
-      for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
-        for (; i < tile.level_end[k]; ++i) {
-          if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
-          const std::int8_t* o0 = &tile.glide[2 * (start[g0] + i)];
-          const std::int8_t* o1 = &tile.glide[2 * (start[g1] + i)];
-          const double e0 = set.glide_unit(g0), e1 = set.glide_unit(g1);
-          double u = tile.points[i].unit_x() + o0[0] * e0 + s * (o1[0] * e1 - o0[0] * e0);
-          double v = tile.points[i].unit_y() + o0[1] * e0 + s * (o1[1] * e1 - o0[1] * e0);
-          u = (tx + u) / 2, v = (ty + v) / 2;
-          u -= std::floor(u), v -= std::floor(v);
-          all.insert(all.end(), {u, v});
-          if (ids) ids->push_back({2 * ty + tx, i});
-        }
+      const std::vector<double>& p = at[gen::tile_around(set.colours, t, tx, ty)];
+      for (std::size_t i = 0; i < p.size(); i += 2) {
+        const double u = (tx + p[i]) / 2, v = (ty + p[i + 1]) / 2;
+        all.insert(all.end(), {u - std::floor(u), v - std::floor(v)});
+      }
     }
   return all;
 }
@@ -68,14 +75,15 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
       const double k0 = set.keyframe_nominal[g], k1 = g + 1 < keyframes ? set.keyframe_nominal[g + 1] : k0;
       row.points_per_tile = half ? (k0 + k1) / 2 : k0;
       row.keyframe = !half;
-      row.closest_pair = std::numeric_limits<double>::infinity();
       std::vector<double> moves;
       TorusHoles holes;
+      TilePositions at(set.tiles.size());
+      for (std::size_t t = 0; t < set.tiles.size(); ++t)
+        at[t] = glided(set, t, row.points_per_tile, g, half ? g + 1 : g, half ? 0.5 : 0.0);
+      const double row_spacing = analysis::hex_spacing(std::size_t(row.points_per_tile));
+      row.closest_pair = closest_across_edges(set, at, row_spacing) / row_spacing;
       for (std::size_t t = 0; t < set.tiles.size(); ++t) {
-        std::vector<std::pair<int, std::uint32_t>> ids;
-        const std::vector<double> coords = half
-                                               ? glide_torus(set, t, row.points_per_tile, g, g + 1, 0.5, &ids)
-                                               : glide_torus(set, t, row.points_per_tile, g, g, 0, &ids);
+        const std::vector<double> coords = glide_torus(set, t, at);
         const std::size_t n = coords.size() / 2;
         done(double(n));
         if (n < 2) continue;

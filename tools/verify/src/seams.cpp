@@ -38,7 +38,8 @@ void judge_densities(const TilesetData& set, const VerifyOptions& options, Repor
     row.worst_low_p = std::numeric_limits<double>::quiet_NaN();
     row.worst_edge_ratio = std::numeric_limits<double>::infinity();
     std::vector<double> edge_pool, midline_pool;
-    row.closest_pair = std::numeric_limits<double>::infinity();
+    const double spacing = analysis::hex_spacing(std::size_t(count));
+    row.closest_pair = closest_across_edges(set, stable_positions(set, count), spacing) / spacing;
     analysis::EdgeBands bands;
     TorusHoles holes;
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {

@@ -1,6 +1,7 @@
 #include "tile_torus.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "kdm/analysis/empty_circles.h"
@@ -25,6 +26,54 @@ std::vector<double> torus_points(const TilesetData& set, std::size_t t, double c
         }
     }
   return all;
+}
+
+TilePositions stable_positions(const TilesetData& set, double count) {
+  TilePositions at(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const Tile& tile = set.tiles[t];
+    for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
+      for (; i < tile.level_end[k] && TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count);
+           ++i)
+        at[t].insert(at[t].end(), {tile.points[i].unit_x(), tile.points[i].unit_y()});
+  }
+  return at;
+}
+
+double closest_across_edges(const TilesetData& set, const TilePositions& at, double cutoff) {
+  // A pair closer than the cutoff has both points within (largest glide + cutoff) of the edge: each
+  // point's stable position lies on its own side.
+  double glide = 0;
+  for (std::size_t t = 0; t < at.size(); ++t)
+    for (std::size_t i = 0; i < at[t].size(); i += 2) {
+      const TilePoint& p = set.tiles[t].points[i / 2];
+      glide = std::max({glide, std::fabs(at[t][i] - p.unit_x()), std::fabs(at[t][i + 1] - p.unit_y())});
+    }
+  const double band = glide + cutoff;
+  const std::uint32_t C = set.colours;
+  double best = cutoff;
+  std::vector<std::array<double, 2>> low, high;  // (along the edge, across it), across measured from the edge
+  for (std::size_t a = 0; a < set.tiles.size(); ++a) {
+    const auto se = static_cast<std::uint32_t>(a / (C * C) % C), ne = static_cast<std::uint32_t>(a / C % C),
+               nw = static_cast<std::uint32_t>(a % C);
+    for (int axis = 0; axis < 2; ++axis)  // 0: the tile to the right, 1: the tile above
+      for (std::uint32_t c1 = 0; c1 < C; ++c1)
+        for (std::uint32_t c2 = 0; c2 < C; ++c2) {
+          const std::size_t b = axis ? set.tile_index(nw, ne, c1, c2) : set.tile_index(se, c1, c2, ne);
+          low.clear(), high.clear();
+          for (std::size_t i = 0; i < at[a].size(); i += 2)
+            if (at[a][i + axis] > 1 - band) low.push_back({at[a][i + 1 - axis], at[a][i + axis] - 1});
+          for (std::size_t i = 0; i < at[b].size(); i += 2)
+            if (at[b][i + axis] < band) high.push_back({at[b][i + 1 - axis], at[b][i + axis]});
+          std::sort(high.begin(), high.end());
+          for (const auto& p : low) {
+            auto it = std::lower_bound(high.begin(), high.end(), std::array<double, 2>{p[0] - best, -1e300});
+            for (; it != high.end() && (*it)[0] < p[0] + best; ++it)
+              best = std::min(best, std::hypot((*it)[0] - p[0], (*it)[1] - p[1]));
+          }
+        }
+  }
+  return best;
 }
 
 gen::SamplerOptions torus_options(double temperature, double side, int threads) {

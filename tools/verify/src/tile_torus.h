@@ -20,6 +20,19 @@ namespace kdm::verify {
 std::vector<double> torus_points(const TilesetData& set, std::size_t t, double count,
                                  std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
 
+/// Each tile's points at one density, in its own unit coordinates (a glided point may lie outside the
+/// tile): the first n ranks, as (x, y) pairs.
+using TilePositions = std::vector<std::vector<double>>;
+
+/// Every tile's points at expected count `count` per tile in stable mode.
+TilePositions stable_positions(const TilesetData& set, double count);
+
+/// The smallest distance (tile sides) between a point of one tile and a point of a tile that can meet it
+/// across an edge: every tile against each of the C² tiles that can lie right of it and above it. The
+/// tiles' tori hold one such neighbour per edge, so a pair that only some neighbours bring together is
+/// found here alone. Pairs farther apart than `cutoff` are not looked for (the result is then `cutoff`).
+double closest_across_edges(const TilesetData& set, const TilePositions& at, double cutoff);
+
 /// The full sampler's options for a side × side torus (in tiles) at user temperature `temperature`.
 gen::SamplerOptions torus_options(double temperature, double side, int threads);
 

@@ -145,8 +145,10 @@ struct DensityResult {
   double davg = 0;              ///< mean over the tiles' tori
   double worst_low_p = 0;       ///< largest lowP over the tiles (NaN if none measured)
   double worst_edge_ratio = 0;  ///< smallest edge-link δmin / other-link δmin over the tiles
-  double closest_pair = 0;      ///< smallest distance between two points of any tile's torus, in d_hex
-  double edge_band = 0;         ///< density within one d_hex of tile edges / the mean, pooled
+  /// Smallest distance between two points of any tile's torus or of two tiles that can meet across an edge,
+  /// in d_hex.
+  double closest_pair = 0;
+  double edge_band = 0;  ///< density within one d_hex of tile edges / the mean, pooled
   std::size_t edge_links = 0, midline_links = 0;  ///< distinct links crossing tile edges, midlines
   Holes holes;                                    ///< complete levels only
   double ks_d_plus = 0, ks_p = 1;                 ///< edge links shorter than midline links?
@@ -159,7 +161,7 @@ struct KeyframeResult {
   double points_per_tile = 0;
   bool keyframe = true;     ///< false: half-way between two keyframes
   double davg = 0;          ///< mean over the tiles' tori, in smooth mode
-  double closest_pair = 0;  ///< in d_hex, over every tile's torus
+  double closest_pair = 0;  ///< in d_hex, over every tile's torus and every edge two tiles can share
   /// Keyframes: the mean move from the keyframe before, in mean nearest-neighbour distances (δavg · d_hex
   /// of this keyframe; NaN: none).
   double motion_mean = 0;
