@@ -14,6 +14,7 @@
 
 #include "bake/close_pairs.h"
 #include "bake/corner_layout.h"
+#include "bake/hole_finder.h"
 #include "bake/keyframes.h"
 #include "bake/progressive_order.h"
 #include "bake/run_stages.h"
@@ -102,6 +103,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.separation = within(0, 0.7);
     } else if (key == "separation_push") {
       r.separation_push = within(0, 0.9);
+    } else if (key == "fill_holes") {
+      r.fill_holes = within(0.5, 2);
     } else if (key == "glide_separation") {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
@@ -141,6 +144,7 @@ std::string BakeRecipe::to_text() const {
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (separation_push > 0) s << "separation_push " << shortest(separation_push) << "\n";
+  if (fill_holes > 0) s << "fill_holes " << shortest(fill_holes) << "\n";
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
@@ -307,6 +311,33 @@ class Baker {
       guard.add(x, y);
       found[{kind, p.patch}].push_back({x, y});
       relative[{kind, p.patch}].push_back({p.rx, p.ry});
+    }
+    if (recipe_.fill_holes > 0) {
+      // A hole the run froze in a patch it keeps gets a point, deepest first; each changes the holes
+      // around it, so they are found again after each.
+      std::vector<double> all = rank.fixed;
+      all.insert(all.end(), rank.timed.begin(), rank.timed.end());
+      for (std::size_t i = 0; i < result.size(); ++i)
+        all.insert(all.end(), {result.points[2 * i] * run.w, result.points[2 * i + 1] * run.h});
+      HoleFinder holes(run.w, run.h, 0.25 * hex_spacing, 2 * hex_spacing, all);
+      const auto stage_kind = static_cast<PatchKind>(run.stage);
+      for (bool added = true; added;) {
+        added = false;
+        const std::vector<double> centres = holes.centres_beyond(recipe_.fill_holes * hex_spacing);
+        for (std::size_t c = 0; c < centres.size() && !added; c += 2) {
+          Placement p;
+          if (!place_new_point(centres[c], centres[c + 1], stage_kind, widths_[k], col, p) ||
+              level.of(p.kind)[p.patch].done)
+            continue;
+          const std::pair<std::int64_t, std::int64_t> at{(p.anchor_x % run.w + run.w) % run.w,
+                                                         (p.anchor_y % run.h + run.h) % run.h};
+          if (anchors.try_emplace({static_cast<int>(p.kind), p.patch}, at).first->second != at) continue;
+          found[{static_cast<int>(p.kind), p.patch}].push_back({centres[c], centres[c + 1]});
+          relative[{static_cast<int>(p.kind), p.patch}].push_back({p.rx, p.ry});
+          holes.add(centres[c], centres[c + 1]);
+          added = true;
+        }
+      }
     }
     rank.filter_width = kFilterWidth / std::sqrt(k ? nominal_[k - 1] : nominal_[0] / 4.0);
     rank.filter_width_end = kFilterWidth / std::sqrt(double(nominal_[k]));

@@ -58,6 +58,10 @@ struct BakeRecipe {
   /// which leaves a hole wherever its patch shows (close_pairs.h, push_close_pairs_apart). 0 (off) in
   /// recipes that do not name it; at least `separation` otherwise.
   double separation_push = 0;
+  /// After each run is sampled, every empty circle wider than this many hexagonal spacings whose centre
+  /// lies in a patch the run keeps gets a new point there, deepest first (bake/hole_finder.h says why). 0
+  /// (off) in recipes that do not name it.
+  double fill_holes = 0;
   /// How a patch's points are ranked against the run's other new points, stand-ins for the regions ranked
   /// apart (bake.cpp says why): 0 (recipes without the key) not at all; 1 ranked together with them; 2
   /// present in proportion, each weighing the fraction of the patch already ranked.
