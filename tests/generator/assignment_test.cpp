@@ -98,7 +98,8 @@ TEST(AssignmentTest, BeatsGreedyOnASpatialMatchingWithNearestCandidates) {
   for (std::uint32_t r = 0; r < rows; ++r) {
     ASSERT_FALSE(used[row_column[r]]);
     used[row_column[r]] = 1;
-    cost += std::pow(a[2 * r] - b[2 * row_column[r]], 2) + std::pow(a[2 * r + 1] - b[2 * row_column[r] + 1], 2);
+    cost +=
+        std::pow(a[2 * r] - b[2 * row_column[r]], 2) + std::pow(a[2 * r + 1] - b[2 * row_column[r] + 1], 2);
   }
   // Greedy: the globally shortest remaining pair first, any distance.
   std::vector<std::pair<double, std::pair<std::uint32_t, std::uint32_t>>> pairs;
