@@ -18,7 +18,7 @@ namespace kdm {
 struct Subdivision {
   std::uint32_t colours = 1;  ///< corner colours C of the set
   std::uint32_t m = 0;        ///< subtiles per tile side (0: the set has no hand-over)
-  std::uint32_t zone = 0;     ///< half-width of the corner squares and edge bands, in sub-steps; 2·zone + 1 < m
+  std::uint32_t zone = 0;  ///< half-width of the corner squares and edge bands, in sub-steps; 2·zone + 1 < m
 
   /// Where a sub-vertex lies.
   enum class Zone : int { kCorner = 0, kHorizontalEdge = 1, kVerticalEdge = 2, kInterior = 3 };
