@@ -12,6 +12,7 @@
 #include <thread>
 #include <tuple>
 
+#include "bake/bake_internal.h"
 #include "bake/close_pairs.h"
 #include "bake/corner_layout.h"
 #include "bake/hole_finder.h"
@@ -207,6 +208,19 @@ class Baker {
     return assemble();
   }
 
+  /// The hand-over of the set bake() returned (docs/design.md §3, "Unbounded zoom").
+  std::vector<TileHandover> handover(const TilesetData& set, std::uint32_t zone) const {
+    Subdivision sub;
+    sub.colours = set.colours;
+    sub.m = static_cast<std::uint32_t>(
+        std::llround(std::sqrt(double(set.level_nominal.back()) / set.level_nominal[0])));
+    sub.zone = zone;
+    if (sub.m * sub.m * set.level_nominal[0] != set.level_nominal.back() || 2 * zone + 1 >= sub.m)
+      throw InvalidArgument(
+          "hand-over: needs a square number of base tiles per top tile and a zone below half of it");
+    return plan_handover(levels_, set, ranked_, sub);
+  }
+
  private:
   double work(std::uint32_t level, const BakeRun& run) const {
     return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
@@ -380,7 +394,7 @@ class Baker {
   }
 
   /// Every tile (sw, se, ne, nw): its share of the patches around it, level by level, sorted by key.
-  TilesetData assemble() const {
+  TilesetData assemble() {
     TilesetData set;
     static_cast<TilesetShape&>(set) = shape_;
     set.recipe = recipe_.to_text();
@@ -422,6 +436,7 @@ class Baker {
             tile.glide.push_back(static_cast<std::int8_t>(offset));
           }
       set.tiles.push_back(std::move(tile));
+      ranked_.push_back(std::move(ranked));
     }
     return set;
   }
@@ -433,6 +448,7 @@ class Baker {
   std::vector<PatchWidths> widths_;
   std::vector<BakeRun> runs_;
   std::vector<LevelPatches> levels_;
+  std::vector<std::vector<PatchPointRef>> ranked_;  ///< per tile, where each of its points comes from
   TilesetShape shape_;  ///< colours, level and keyframe counts: what the tiles fit into
   double total_work_ = 0, done_work_ = 0;
   std::size_t dropped_ = 0;  ///< points the separation pass removed (for a test to read)
@@ -443,6 +459,14 @@ class Baker {
 
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
   return Baker(recipe, threads, progress).bake();
+}
+
+std::vector<TileHandover> bake_with_handover(const BakeRecipe& recipe, std::uint32_t zone, int threads,
+                                             TilesetData& set) {
+  const std::function<void(double)> no_progress;
+  Baker baker(recipe, threads, no_progress);
+  set = baker.bake();
+  return baker.handover(set, zone);
 }
 
 }  // namespace kdm::gen
