@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 4).
+"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 5).
 
 Written from docs/tileset-format.md alone, not from the C++ sources: the test
 runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
@@ -26,7 +26,7 @@ try:
 except ImportError:  # the reader is useless without it: say what to install
     zstandard = None
 
-FORMAT_VERSION = 4
+FORMAT_VERSION = 5
 OLDEST_FORMAT_VERSION = 2
 MAX_KEYFRAMES = 256
 GLIDE_UNITS_PER_SPACING = 32.0
@@ -44,13 +44,15 @@ class TilesetError(Exception):
 
 
 class Tile:
-    def __init__(self, level_end, xs, ys, keys, glide):
+    def __init__(self, level_end, xs, ys, keys, glide, handover=None, appearing=None):
         self.level_end = level_end  # list of L ints
         self.xs = xs  # array('H'), x of each point in 1/65536 of the tile side
         self.ys = ys
         self.keys = keys  # array('H'), emission key of each point
         self.glide = glide  # array('b'), gliding offsets (x, y pairs, Tileset.glide_unit), empty without keyframes
         self.thresholds = None  # each point's emission threshold, once Tileset.offsets_at_keyframe needs them
+        self.handover = handover if handover is not None else array.array("H")  # doc §7, the hand-over
+        self.appearing = appearing if appearing is not None else array.array(_uint32_typecode())
 
     def levels_of_points(self):
         """The level of every point: point i is in level k iff level_end[k-1] <= i < level_end[k]."""
@@ -68,6 +70,7 @@ class Tileset:
         self.levels = 0
         self.level_nominal = []
         self.keyframe_nominal = []
+        self.handover_zone = 0
         self.tiles = []
         self.recipe = b""
         self.generator_version = b""
@@ -248,10 +251,12 @@ def decode(data):
     if body_tiles != tile_count:
         raise TilesetError(f"body says {body_tiles} tiles, the header {tile_count}")
     ts.level_nominal = list(reader.array(U32, "level_nominal"))
-    gliding = version >= 3
+    gliding, handing_over = version >= 3, version >= 5
     if gliding:
         ts.keyframe_nominal = list(reader.array(U32, "keyframe_nominal"))
-    if body_tiles > reader.remaining() // (32 if gliding else 24):
+    if handing_over:
+        ts.handover_zone = reader.u32("handover_zone")
+    if body_tiles > reader.remaining() // (48 if handing_over else 32 if gliding else 24):
         raise TilesetError(f"tile count {body_tiles} exceeds what {reader.remaining()} body bytes can hold")
     for t in range(body_tiles):
         level_end = list(reader.array(U32, f"tile {t} level_end"))
@@ -260,7 +265,9 @@ def decode(data):
             raise TilesetError(f"tile {t} has an odd number of coordinates ({len(xy)})")
         keys = reader.array("H", f"tile {t} keys")
         glide = reader.array("H" if version == 3 else "B", f"tile {t} glide") if gliding else array.array("b")
-        ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys, glide))
+        handover = reader.array("H", f"tile {t} handover") if handing_over else None
+        appearing = reader.array(U32, f"tile {t} appearing") if handing_over else None
+        ts.tiles.append(Tile(level_end, xy[0::2], xy[1::2], keys, glide, handover, appearing))
     if reader.remaining():
         raise TilesetError(f"body has {reader.remaining()} bytes after the last tile")
 
@@ -316,6 +323,89 @@ def _validate(ts):
         needed = 2 * sum(ts.offsets_at_keyframe(tile, g) for g in range(len(ts.keyframe_nominal)))
         if len(tile.glide) != needed:
             raise TilesetError(f"tile {t} has {len(tile.glide)} glide offsets, its keyframes need {needed}")
+    _validate_handover(ts)
+
+
+def _mix64(z):
+    """Doc §7: SplitMix64's finaliser."""
+    mask = (1 << 64) - 1
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & mask
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & mask
+    return z ^ (z >> 31)
+
+
+def subvertex_colour(ts, m, sw, se, ne, nw, i, j):
+    """Doc §7, the hand-over: the colour of sub-vertex (i, j) of the tile with corners (sw, se, ne, nw)."""
+    z, C, mask = ts.handover_zone, ts.colours, (1 << 64) - 1
+    near_x, near_y = i <= z or i >= m - z, j <= z or j >= m - z
+    di, dj = (i if 2 * i <= m else i - m), (j if 2 * j <= m else j - m)
+    east, north = 2 * i > m, 2 * j > m
+    if near_x and near_y:
+        kind, key, a, b = 0, (ne if east else nw) if north else (se if east else sw), di, dj
+    elif near_y:
+        kind, key, a, b = 1, (nw * C + ne) if north else (sw * C + se), i, dj
+    elif near_x:
+        kind, key, a, b = 2, (se * C + ne) if east else (sw * C + nw), di, j
+    else:
+        kind, key, a, b = 3, ((sw * C + se) * C + ne) * C + nw, i, j
+    h = _mix64(0x53554254494C45 ^ kind)
+    h = _mix64(h ^ key)
+    h = _mix64(h ^ ((a + 0x8000) & mask))
+    return _mix64(h ^ ((b + 0x8000) & mask)) % C
+
+
+def _validate_handover(ts):
+    """Doc §6, invariant 9."""
+    if ts.handover_zone == 0:
+        for t, tile in enumerate(ts.tiles):
+            if len(tile.handover) or len(tile.appearing):
+                raise TilesetError(f"tile {t} has hand-over tables in a set without a hand-over")
+        return
+    C, z = ts.colours, ts.handover_zone
+    if len(ts.keyframe_nominal) < 2:
+        raise TilesetError("a hand-over needs a glide track of at least two keyframes")
+    m = round(math.sqrt(ts.level_nominal[-1] / ts.level_nominal[0]))
+    if m * m * ts.level_nominal[0] != ts.level_nominal[-1] or not 2 <= m <= 256:
+        raise TilesetError("a hand-over needs N_top / N_0 to be the square of an integer m in 2..256")
+    if 2 * z + 1 >= m:
+        raise TilesetError(f"the hand-over zone {z} is too wide")
+    present = []
+    for tile in ts.tiles:
+        ts.offsets_at_keyframe(tile, 0)  # fills tile.thresholds
+        present.append(bisect.bisect_left(tile.thresholds, ts.keyframe_nominal[1]))
+    for t, tile in enumerate(ts.tiles):
+        sw, se, ne, nw = t // C**3, t // C**2 % C, t // C % C, t % C
+        colour = {}
+        for j in range(m + 1):
+            for i in range(m + 1):
+                colour[i, j] = subvertex_colour(ts, m, sw, se, ne, nw, i, j)
+        first, types = [0], []
+        for j in range(m * m):
+            i, k = j % m, j // m
+            types.append(((colour[i, k] * C + colour[i + 1, k]) * C + colour[i + 1, k + 1]) * C + colour[i, k + 1])
+            first.append(first[-1] + present[types[-1]])
+        if len(tile.handover) != len(tile.xs):
+            raise TilesetError(f"tile {t} has {len(tile.handover)} hand-over targets for {len(tile.xs)} points")
+        taken = bytearray(first[-1])
+
+        def take(j, q):
+            if q >= present[types[j]]:
+                raise TilesetError(f"tile {t} names rank {q} of subtile {j}, which has {present[types[j]]} at keyframe 1")
+            if taken[first[j] + q]:
+                raise TilesetError(f"tile {t} takes a sub-point twice")
+            taken[first[j] + q] = 1
+
+        for x, y, v in zip(tile.xs, tile.ys, tile.handover):
+            i, k = ((x * m) >> 16) + v % 25 % 5 - 2, ((y * m) >> 16) + v % 25 // 5 - 2
+            if not (0 <= i < m and 0 <= k < m):
+                raise TilesetError(f"tile {t} sends a point to a subtile outside it")
+            take(k * m + i, v // 25)
+        for w in tile.appearing:
+            if w >> 16 >= m * m:
+                raise TilesetError(f"tile {t} has an appearing sub-point outside its subtiles")
+            take(w >> 16, w & 0xFFFF)
+        if len(tile.handover) + len(tile.appearing) != first[-1]:
+            raise TilesetError(f"tile {t} leaves some of its subtiles' points out of the hand-over")
 
 
 def _round_half_away(v):
@@ -381,6 +471,7 @@ def summary(ts):
         f"tiles {len(ts.tiles)}",
         "level_nominal " + " ".join(str(n) for n in ts.level_nominal),
         "keyframe_nominal" + "".join(f" {n}" for n in ts.keyframe_nominal),
+    ] + ([f"handover_zone {ts.handover_zone}"] if ts.handover_zone else []) + [
         f"recipe_bytes {len(ts.recipe)}",
         f"recipe_crc32 {_crc32(ts.recipe):08x}",
         f"generator_version {_escaped(ts.generator_version)}",
@@ -396,6 +487,12 @@ def summary(ts):
             f" points_crc32 {_crc32(_le_bytes(triples)):08x}"
             f" thresholds_crc32 {_crc32(_le_bytes(thresholds)):08x}"
             f" glide_crc32 {_crc32(_le_bytes(tile.glide)):08x}"
+            + (
+                f" handover_crc32 {_crc32(_le_bytes(tile.handover)):08x}"
+                f" appearing_crc32 {_crc32(_le_bytes(tile.appearing)):08x}"
+                if ts.handover_zone
+                else ""
+            )
         )
     return "".join(line + "\n" for line in lines)
 
@@ -410,7 +507,7 @@ def point_lines(ts, t):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 4).")
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 5).")
     parser.add_argument("file")
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--summary", action="store_true", help="print the canonical summary")

@@ -19,7 +19,7 @@ TilesetHandle builtin() {
     py::gil_scoped_release release;  // the first call decodes the set (a tenth of a second)
     h.set = std::shared_ptr<const Tileset>(&Tileset::builtin(), [](const Tileset*) {});
   }
-  h.format_version = kTilesetFormatVersion;  // compiled in from tilesets/default.kdmt, which CI rebakes
+  h.format_version = tileset_format_version_for(h.set->data());  // as tilesets/default.kdmt has it
   return h;
 }
 
@@ -85,7 +85,8 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
   }
   if (s != Status::kOk)
     throw std::runtime_error(std::string("baked set: ") + status_message(s) + " (" + detail + ")");
-  return {std::move(set), kTilesetFormatVersion};
+  const std::uint32_t version = tileset_format_version_for(set->data());
+  return {std::move(set), version};
 }
 
 }  // namespace

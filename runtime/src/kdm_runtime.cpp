@@ -109,7 +109,7 @@ kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* in
   kdm_tileset_info v;
   if (!tileset || !read_grown(info, kInfoV1, v)) return KDM_INVALID_ARGUMENT;
   const kdm::TilesetData& d = tileset->set->data();
-  v.format_version = kdm::kTilesetFormatVersion;
+  v.format_version = kdm::tileset_format_version_for(d);
   v.colours = d.colours;
   v.tiles = static_cast<uint32_t>(d.tiles.size());
   v.levels = d.levels;

@@ -128,7 +128,8 @@ std::size_t Tileset::resident_bytes() const {
                       set_.generator_version.capacity();
   for (const Tile& t : set_.tiles)
     bytes += t.points.capacity() * sizeof(TilePoint) + t.keys.capacity() * sizeof(std::uint16_t) +
-             t.level_end.capacity() * sizeof(std::uint32_t) + t.glide.capacity() * sizeof(std::int8_t);
+             t.level_end.capacity() * sizeof(std::uint32_t) + t.glide.capacity() * sizeof(std::int8_t) +
+             t.handover.capacity() * sizeof(std::uint16_t) + t.appearing.capacity() * sizeof(std::uint32_t);
   if (tables_) bytes += tables_->resident_bytes();
   return bytes;
 }

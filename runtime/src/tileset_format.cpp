@@ -135,13 +135,19 @@ void glide_from_format3(const TilesetData& set, std::vector<std::uint16_t>& stor
   }
 }
 
+std::uint32_t version_for(const TilesetData& set) {
+  return tileset_format_version_for(set);
+}
+
 std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
   std::ostringstream stream(std::ios::binary);
+  const bool handover = version_for(set) >= 5;
   {
     cereal::PortableBinaryOutputArchive ar(stream);
     ar(set.colours, set.levels, static_cast<std::uint32_t>(set.tiles.size()));
     save_array(ar, set.level_nominal);
     save_array(ar, set.keyframe_nominal);
+    if (handover) ar(set.handover_zone);
     std::vector<std::uint16_t> xy;
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
@@ -152,6 +158,10 @@ std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
       save_array(ar, tile.keys);
       const std::vector<std::uint8_t> offsets(tile.glide.begin(), tile.glide.end());
       save_array(ar, glide_differences(set, tile, offsets));
+      if (handover) {
+        save_array(ar, tile.handover);
+        save_array(ar, tile.appearing);
+      }
     }
   }
   const std::string bytes = stream.str();
@@ -169,10 +179,11 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
   std::uint32_t tile_count = 0;
   ar(set.colours, set.levels, tile_count);
   load_array(ar, buffer, set.level_nominal);
-  const bool gliding = version >= 3;
+  const bool gliding = version >= 3, handover = version >= 5;
   if (gliding) load_array(ar, buffer, set.keyframe_nominal);
+  if (handover) ar(set.handover_zone);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
-  if (tile_count > buffer.remaining() / (gliding ? 32 : 24))
+  if (tile_count > buffer.remaining() / (handover ? 48 : gliding ? 32 : 24))
     throw ContentError("tile count exceeds the payload");
   set.tiles.resize(tile_count);
   std::vector<std::uint16_t> xy;
@@ -192,11 +203,73 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
       load_array(ar, buffer, glide.back());
       tile.glide.resize(glide.back().size());
     }
+    if (handover) {
+      load_array(ar, buffer, tile.handover);
+      load_array(ar, buffer, tile.appearing);
+    }
   }
   if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
 }
 
+/// The first problem of a set's hand-over tables (empty if none): every point of a tile glides onto its own
+/// sub-point of that tile's subtiles at keyframe 1, and those no point takes appear, each once.
+std::string handover_problem(const TilesetData& set) {
+  const std::uint32_t m = set.subtiles_per_side(), zone = set.handover_zone, C = set.colours;
+  if (set.keyframe_nominal.size() < 2) return "a hand-over needs a glide track of at least two keyframes";
+  if (m < 2 || m > 256) return "a hand-over needs N_top / N_0 to be the square of an integer m in 2..256";
+  if (2 * std::uint64_t(zone) + 1 >= m) return "the hand-over zone " + std::to_string(zone) + " is too wide";
+  const Subdivision sub = set.subdivision();
+  std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe 1, per tile
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], 1);
+  std::vector<std::uint32_t> type(std::size_t(m) * m), first(std::size_t(m) * m + 1);
+  std::vector<char> taken;
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const Tile& tile = set.tiles[t];
+    const std::string name = "tile " + std::to_string(t);
+    if (tile.handover.size() != tile.points.size())
+      return name + " has " + std::to_string(tile.handover.size()) + " hand-over targets for " +
+             std::to_string(tile.points.size()) + " points";
+    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
+               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
+    for (std::uint32_t j = 0; j < m * m; ++j) {
+      const std::uint32_t i = j % m, k = j / m;
+      type[j] = std::uint32_t(set.tile_index(
+          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
+          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1)));
+      first[j + 1] = first[j] + present[type[j]];
+    }
+    taken.assign(first.back(), 0);
+    const auto take = [&](std::uint32_t j, std::uint32_t q) -> std::string {
+      if (q >= present[type[j]])
+        return name + " names rank " + std::to_string(q) + " of subtile " + std::to_string(j) +
+               ", which has " + std::to_string(present[type[j]]) + " at keyframe 1";
+      if (taken[first[j] + q]++) return name + " takes a sub-point twice";
+      return {};
+    };
+    for (std::size_t r = 0; r < tile.points.size(); ++r) {
+      const std::uint32_t v = tile.handover[r], d = v % 25;
+      const std::int64_t x =
+          std::int64_t(TilesetShape::subtile_of(tile.points[r].x, m)) + std::int64_t(d % 5) - 2;
+      const std::int64_t y =
+          std::int64_t(TilesetShape::subtile_of(tile.points[r].y, m)) + std::int64_t(d / 5) - 2;
+      if (x < 0 || y < 0 || x >= m || y >= m) return name + " sends a point to a subtile outside it";
+      if (std::string problem = take(std::uint32_t(y * m + x), v / 25); !problem.empty()) return problem;
+    }
+    for (std::uint32_t v : tile.appearing) {
+      if ((v >> 16) >= m * m) return name + " has an appearing sub-point outside its subtiles";
+      if (std::string problem = take(v >> 16, v & 0xFFFF); !problem.empty()) return problem;
+    }
+    if (tile.handover.size() + tile.appearing.size() != first.back())
+      return name + " leaves some of its subtiles' points out of the hand-over";
+  }
+  return {};
+}
+
 }  // namespace
+
+std::uint32_t tileset_format_version_for(const TilesetShape& set) {
+  return set.handover_zone ? kTilesetFormatVersion : 4;  // 4 also rebakes older recipes byte for byte
+}
 
 Status validate_tileset(const TilesetData& set, std::string* detail) {
   auto bad = [&](const std::string& m) { return fail(Status::kInvalidContent, detail, m); };
@@ -245,6 +318,13 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
       return bad("tile " + std::to_string(t) + " has " + std::to_string(set.tiles[t].glide.size()) +
                  " glide offsets, its keyframes need " + std::to_string(2 * present));
   }
+  if (set.handover_zone) {
+    if (const std::string problem = handover_problem(set); !problem.empty()) return bad(problem);
+  } else {
+    for (std::size_t t = 0; t < set.tiles.size(); ++t)
+      if (!set.tiles[t].handover.empty() || !set.tiles[t].appearing.empty())
+        return bad("tile " + std::to_string(t) + " has hand-over tables in a set without a hand-over");
+  }
   return Status::kOk;
 }
 
@@ -263,7 +343,7 @@ Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out, st
   out.assign(header_size + payload.size(), 0);
   std::uint8_t* h = out.data();
   std::memcpy(h, kMagic, 8);
-  put32(h + 8, kTilesetFormatVersion);
+  put32(h + 8, version_for(set));
   put32(h + 12, static_cast<std::uint32_t>(header_size));
   put64(h + 16, payload.size());
   put64(h + 24, body.size());

@@ -1,6 +1,7 @@
 // The hand-over between depths (bake/handover.h) on a small set of three levels (32 … 512 points per tile,
-// 4×4 subtiles per tile): every point gets its own sub-point in its own tile, the sub-points left over
-// appear, nothing else; targets are near; and tiles that share a patch give its points the same targets.
+// 4×4 subtiles per tile), as the file holds it: every point gets its own sub-point in its own tile, the
+// sub-points left over appear, nothing else; targets are near; tiles that share a patch give its points
+// the same targets; the tables survive the file and a damaged one is refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,14 +10,15 @@
 #include <tuple>
 #include <vector>
 
-#include "bake/bake_internal.h"
+#include "kdm/generator/bake.h"
+#include "kdm/generator/sampler.h"
+#include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
 namespace {
 
 struct Baked {
   TilesetData set;
-  std::vector<TileHandover> handover;
   Subdivision sub;
 };
 
@@ -24,12 +26,22 @@ const Baked& small_set() {
   static const Baked baked = [] {
     BakeRecipe r;
     r.levels = 3, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
+    r.handover_zone = 1;
     Baked b;
-    b.handover = bake_with_handover(r, 1, 2, b.set);
-    b.sub.colours = b.set.colours, b.sub.m = 4, b.sub.zone = 1;
+    b.set = bake_tileset(r, 2);
+    b.sub = b.set.subdivision();
     return b;
   }();
   return baked;
+}
+
+/// The sub-point (j << 16 | q) that rank r of tile t glides onto, decoded from the file's encoding.
+std::uint32_t target(const Baked& b, std::size_t t, std::uint32_t r) {
+  const Tile& tile = b.set.tiles[t];
+  const std::uint32_t v = tile.handover[r], d = v % 25, m = b.sub.m;
+  const std::uint32_t x = TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
+  const std::uint32_t y = TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2;
+  return (y * m + x) << 16 | v / 25;
 }
 
 /// Position (tile units) of `rank` of `tile` at keyframe g.
@@ -58,15 +70,19 @@ std::pair<double, double> sub_position(const Baked& b, std::size_t t, std::uint3
 
 TEST(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
   const Baked& b = small_set();
-  ASSERT_EQ(b.handover.size(), b.set.tiles.size());
+  ASSERT_EQ(b.sub.m, 4u);
   for (std::size_t t = 0; t < b.set.tiles.size(); ++t) {
-    const TileHandover& h = b.handover[t];
-    ASSERT_EQ(h.target.size(), b.set.tiles[t].points.size()) << "tile " << t;
+    const Tile& tile = b.set.tiles[t];
+    ASSERT_EQ(tile.handover.size(), tile.points.size()) << "tile " << t;
+    std::vector<std::uint32_t> found_targets;
+    for (std::uint32_t r = 0; r < tile.points.size(); ++r) found_targets.push_back(target(b, t, r));
+    const std::vector<std::uint32_t>& targets = found_targets;
+    const std::vector<std::uint32_t> appearing(tile.appearing.begin(), tile.appearing.end());
     std::set<std::uint32_t> seen;
     std::size_t sub_points = 0;
     for (std::uint32_t j = 0; j < b.sub.m * b.sub.m; ++j)
       sub_points += b.set.points_at_keyframe(b.set.tiles[subtile_type(b, t, j)], 1);
-    for (const std::vector<std::uint32_t>* list : {&h.target, &h.appearing})
+    for (const std::vector<std::uint32_t>* list : {&targets, &appearing})
       for (std::uint32_t packed : *list) {
         const std::uint32_t j = packed >> 16, q = packed & 0xFFFF;
         ASSERT_LT(j, b.sub.m * b.sub.m);
@@ -74,7 +90,7 @@ TEST(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
         EXPECT_TRUE(seen.insert(packed).second) << "tile " << t << " sub-point " << j << "/" << q << " twice";
       }
     EXPECT_EQ(seen.size(), sub_points) << "tile " << t;
-    EXPECT_GT(h.appearing.size(), 0u);
+    EXPECT_GT(appearing.size(), 0u);
   }
 }
 
@@ -89,7 +105,7 @@ TEST(HandoverTest, PointsGlideOnlyAFewSpacings) {
   for (std::size_t t = 0; t < b.set.tiles.size(); ++t)
     for (std::uint32_t r = 0; r < b.set.tiles[t].points.size(); ++r) {
       const auto [x0, y0] = at_keyframe(b.set, b.set.tiles[t], b.set.keyframe_nominal.size() - 1, r);
-      const auto [x1, y1] = sub_position(b, t, b.handover[t].target[r]);
+      const auto [x1, y1] = sub_position(b, t, target(b, t, r));
       const double d = std::hypot(x1 - x0, y1 - y0) / spacing;
       largest = std::max(largest, d), sum += d, ++n;
     }
@@ -114,14 +130,62 @@ TEST(HandoverTest, TilesSharingAnEdgeGiveItsPointsTheSameTargets) {
         if (p.unit_y() > 0.06) continue;
         const auto found = second.find({p.x, p.y});
         if (found == second.end()) continue;
-        const auto [x1, y1] = sub_position(b, t1, b.handover[t1].target[r]);
-        const auto [x2, y2] = sub_position(b, t2, b.handover[t2].target[found->second]);
+        const auto [x1, y1] = sub_position(b, t1, target(b, t1, r));
+        const auto [x2, y2] = sub_position(b, t2, target(b, t2, found->second));
         EXPECT_DOUBLE_EQ(x1, x2);
         EXPECT_DOUBLE_EQ(y1, y2);
         ++compared;
       }
     }
   EXPECT_GT(compared, 100u);  // 738 measured
+}
+
+TEST(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
+  const Baked& b = small_set();
+  std::vector<std::uint8_t> bytes;
+  ASSERT_EQ(encode_tileset(b.set, bytes), Status::kOk);
+  TilesetHeader header;
+  ASSERT_EQ(read_tileset_header(bytes.data(), bytes.size(), header), Status::kOk);
+  EXPECT_EQ(header.format_version, kTilesetFormatVersion);
+  TilesetData back;
+  ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
+  EXPECT_TRUE(back == b.set);
+
+  for (std::size_t n = 0; n < bytes.size(); ++n) {  // every cut is refused, none crashes
+    TilesetData cut;
+    ASSERT_NE(decode_tileset(bytes.data(), n, cut), Status::kOk) << n << " of " << bytes.size() << " bytes";
+  }
+  std::string detail;
+  TilesetData twice = b.set;  // two points onto one sub-point
+  twice.tiles[3].handover[1] = twice.tiles[3].handover[0];
+  twice.tiles[3].points[1] = twice.tiles[3].points[0];
+  EXPECT_EQ(validate_tileset(twice, &detail), Status::kInvalidContent);
+  EXPECT_NE(detail.find("twice"), std::string::npos) << detail;
+  TilesetData short_list = b.set;  // a sub-point left out
+  short_list.tiles[5].appearing.pop_back();
+  EXPECT_EQ(validate_tileset(short_list, &detail), Status::kInvalidContent);
+  EXPECT_NE(detail.find("out of the hand-over"), std::string::npos) << detail;
+  TilesetData outside = b.set;  // a subtile beyond the tile
+  for (std::uint32_t r = 0; r < outside.tiles[0].points.size(); ++r)
+    if (TilesetShape::subtile_of(outside.tiles[0].points[r].x, b.sub.m) == 0) {
+      outside.tiles[0].handover[r] = static_cast<std::uint16_t>(outside.tiles[0].handover[r] / 25 * 25);
+      break;
+    }
+  EXPECT_EQ(validate_tileset(outside, &detail), Status::kInvalidContent);
+  EXPECT_NE(detail.find("outside"), std::string::npos) << detail;
+  TilesetData plain = b.set;  // tables without a hand-over
+  plain.handover_zone = 0;
+  EXPECT_EQ(validate_tileset(plain, &detail), Status::kInvalidContent);
+}
+
+TEST(HandoverTest, RecipesNameTheZonesTheyCanHave) {
+  BakeRecipe r = BakeRecipe::parse("levels 3\nkeyframes 4\nhandover_zone 1\n");
+  EXPECT_EQ(r.handover_zone, 1u);
+  EXPECT_EQ(BakeRecipe::parse(r.to_text()).handover_zone, 1u);
+  EXPECT_THROW(BakeRecipe::parse("levels 3\nkeyframes 4\nhandover_zone 2\n"), InvalidArgument);  // 2·2+1 ≥ 4
+  EXPECT_THROW(BakeRecipe::parse("levels 3\nhandover_zone 1\n"), InvalidArgument);  // no glide track
+  EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 2\n"), InvalidArgument);  // < 2.98
+  EXPECT_EQ(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 3\n").handover_zone, 3u);
 }
 
 }  // namespace

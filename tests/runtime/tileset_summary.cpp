@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
   for (const std::uint32_t n : set.level_nominal) std::printf(" %u", n);
   std::printf("\nkeyframe_nominal");
   for (const std::uint32_t n : set.keyframe_nominal) std::printf(" %u", n);
+  if (set.handover_zone) std::printf("\nhandover_zone %u", set.handover_zone);
   std::printf("\nrecipe_bytes %zu\nrecipe_crc32 %08x\ngenerator_version %s\n", set.recipe.size(),
               crc32({set.recipe.begin(), set.recipe.end()}), escaped(set.generator_version).c_str());
   std::vector<std::uint8_t> triples, thresholds;
@@ -103,8 +104,18 @@ int main(int argc, char** argv) {
     for (const std::uint32_t e : tile.level_end) std::printf(" %u", e);
     std::vector<std::uint8_t> glide;
     for (const std::int8_t v : tile.glide) glide.push_back(static_cast<std::uint8_t>(v));
-    std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x\n", crc32(triples),
+    std::printf(" points_crc32 %08x thresholds_crc32 %08x glide_crc32 %08x", crc32(triples),
                 crc32(thresholds), crc32(glide));
+    if (set.handover_zone) {
+      std::vector<std::uint8_t> handover, appearing;
+      for (const std::uint16_t v : tile.handover) put16(handover, v);
+      for (const std::uint32_t v : tile.appearing) {
+        put16(appearing, static_cast<std::uint16_t>(v));
+        put16(appearing, static_cast<std::uint16_t>(v >> 16));
+      }
+      std::printf(" handover_crc32 %08x appearing_crc32 %08x", crc32(handover), crc32(appearing));
+    }
+    std::printf("\n");
   }
   return 0;
 }

@@ -83,6 +83,10 @@ void run_info(const std::string& path) {
         "glide track    %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
         set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
         loaded.glide_reach());
+  if (set.handover_zone)
+    std::printf(
+        "hand-over      onto %u x %u subtiles past the top level (zones of %u sub-steps; not yet queried)\n",
+        set.subtiles_per_side(), set.subtiles_per_side(), set.handover_zone);
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());
@@ -99,7 +103,7 @@ void add_tile_commands(CLI::App& app) {
   bake->add_option("recipe", *recipe,
                    "Recipe file: 'key value' lines (seed, colours, levels, base_points, "
                    "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
-                   "separation_push, fill_holes, keyframes, glide_sweeps, glide_separation)")
+                   "separation_push, fill_holes, keyframes, glide_sweeps, glide_separation, handover_zone)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   bake->add_option("--threads", *threads,

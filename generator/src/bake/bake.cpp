@@ -12,9 +12,9 @@
 #include <thread>
 #include <tuple>
 
-#include "bake/bake_internal.h"
 #include "bake/close_pairs.h"
 #include "bake/corner_layout.h"
+#include "bake/handover.h"
 #include "bake/hole_finder.h"
 #include "bake/keyframes.h"
 #include "bake/progressive_order.h"
@@ -110,6 +110,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
       r.keyframes_per_level = static_cast<std::uint32_t>(whole(0, 32));
+    } else if (key == "handover_zone") {
+      r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
     } else if (key == "glide_sweeps") {
       r.glide_sweeps = static_cast<int>(whole(1, 1000));
     } else if (key == "temperature") {
@@ -126,6 +128,19 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
                           std::to_string(r.erosion) + " and edge gap " + std::to_string(r.edge_gap) +
                           " leaves some level's edge patches narrower than half a point spacing");
+  if (r.handover_zone) {
+    const std::uint32_t m = 1u << (r.levels - 1);  // √(N_top / N_0)
+    if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
+      throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
+    const double corner = patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).back().corner;
+    const auto least = static_cast<std::uint32_t>(std::ceil(corner * m - 1e-9));
+    if (r.handover_zone < least || 2 * r.handover_zone + 1 >= m)
+      throw InvalidArgument("recipe: handover_zone must be in [" + std::to_string(least) + ", " +
+                            std::to_string((m - 2) / 2) +
+                            "] for these levels and patches (the top level's "
+                            "corner patches reach " +
+                            shortest(corner * m) + " subtile sides)");
+  }
   return r;
 }
 
@@ -149,6 +164,7 @@ std::string BakeRecipe::to_text() const {
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
+  if (handover_zone) s << "handover_zone " << handover_zone << "\n";
   return s.str();
 }
 
@@ -205,20 +221,28 @@ class Baker {
       if (progress_) progress_(done_work_ / total_work_);
     }
     drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation);
-    return assemble();
+    shape_.handover_zone = recipe_.handover_zone;
+    TilesetData set = assemble();
+    if (set.handover_zone) add_handover(set);
+    return set;
   }
 
-  /// The hand-over of the set bake() returned (docs/design.md §3, "Unbounded zoom").
-  std::vector<TileHandover> handover(const TilesetData& set, std::uint32_t zone) const {
-    Subdivision sub;
-    sub.colours = set.colours;
-    sub.m = static_cast<std::uint32_t>(
-        std::llround(std::sqrt(double(set.level_nominal.back()) / set.level_nominal[0])));
-    sub.zone = zone;
-    if (sub.m * sub.m * set.level_nominal[0] != set.level_nominal.back() || 2 * zone + 1 >= sub.m)
-      throw InvalidArgument(
-          "hand-over: needs a square number of base tiles per top tile and a zone below half of it");
-    return plan_handover(levels_, set, ranked_, sub);
+  /// The hand-over tables (docs/design.md §3, "Unbounded zoom"), in the file's encoding.
+  void add_handover(TilesetData& set) const {
+    const Subdivision sub = set.subdivision();
+    const std::vector<TileHandover> plan = plan_handover(levels_, set, ranked_, sub);
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+      Tile& tile = set.tiles[t];
+      for (std::size_t r = 0; r < tile.points.size(); ++r) {
+        const std::uint32_t j = plan[t].target[r] >> 16, q = plan[t].target[r] & 0xFFFF;
+        const std::int64_t dx = std::int64_t(j % sub.m) - TilesetShape::subtile_of(tile.points[r].x, sub.m);
+        const std::int64_t dy = std::int64_t(j / sub.m) - TilesetShape::subtile_of(tile.points[r].y, sub.m);
+        if (std::abs(dx) > 2 || std::abs(dy) > 2 || q >= 2621)
+          throw InvalidArgument("hand-over: a point's sub-point lies more than two subtiles away");
+        tile.handover.push_back(static_cast<std::uint16_t>(q * 25 + (dy + 2) * 5 + (dx + 2)));
+      }
+      tile.appearing.assign(plan[t].appearing.begin(), plan[t].appearing.end());
+    }
   }
 
  private:
@@ -459,14 +483,6 @@ class Baker {
 
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
   return Baker(recipe, threads, progress).bake();
-}
-
-std::vector<TileHandover> bake_with_handover(const BakeRecipe& recipe, std::uint32_t zone, int threads,
-                                             TilesetData& set) {
-  const std::function<void(double)> no_progress;
-  Baker baker(recipe, threads, no_progress);
-  set = baker.bake();
-  return baker.handover(set, zone);
 }
 
 }  // namespace kdm::gen

@@ -74,6 +74,11 @@ struct BakeRecipe {
   /// and the descent sweeps that relax each keyframe.
   std::uint32_t keyframes_per_level = 0;  ///< recipe key `keyframes`
   int glide_sweeps = 10;
+  /// The hand-over between depths (bake/handover.h): the half-width, in subtile sides, of the corner
+  /// squares and edge bands whose sub-vertices take their colours from that corner or edge alone; at
+  /// least the top level's corner patch half-width (an error names the least). 0 (off, recipes that do
+  /// not name it): the set ends at its top level. Needs a glide track.
+  std::uint32_t handover_zone = 0;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).

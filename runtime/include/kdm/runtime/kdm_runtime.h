@@ -96,7 +96,7 @@ typedef struct kdm_query_problem {
 
 typedef struct kdm_tileset_info {
   size_t struct_size;      /* sizeof(kdm_tileset_info) */
-  uint32_t format_version; /* of the file it was loaded from */
+  uint32_t format_version; /* the format version the set is written in (4 without a hand-over) */
   uint32_t colours, tiles, levels;
   uint32_t max_points_per_tile;  /* the densest query: scale * density * tile_size^2 up to this */
   uint32_t level_points[16];     /* nominal points per tile of levels 0 .. levels - 1 */
@@ -118,7 +118,7 @@ KDM_RUNTIME_API void kdm_set_tileset_allocator(void* (*allocate)(size_t bytes, s
 
 /* The library version, "MAJOR.MINOR.PATCH" (static string). */
 KDM_RUNTIME_API const char* kdm_version(void);
-/* The tile-set format version this library reads and writes. */
+/* The newest tile-set format version this library reads and writes (it reads 2 and up). */
 KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 
 /* Loads a tile-set file / memory buffer (untrusted input is validated). *out receives a new handle to

@@ -55,8 +55,9 @@ class KDM_RUNTIME_API Tileset {
   /// without a glide track).
   double glide_reach() const;
   /// Heap bytes this tile set holds once loaded (positions, keys, level tables, per-point emission
-  /// thresholds, glide tables, recipe text), not counting allocator overhead. The builtin set's decoded
-  /// copy is the same size; its compressed bytes in the library's data section are extra. Thread-safe.
+  /// thresholds, glide and hand-over tables, recipe text), not counting allocator overhead. The builtin
+  /// set's decoded copy is the same size; its compressed bytes in the library's data section are extra.
+  /// Thread-safe.
   std::size_t resident_bytes() const;
 
  private:

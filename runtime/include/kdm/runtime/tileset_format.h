@@ -34,6 +34,7 @@
 #include "kdm/runtime/allocator.h"
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/status.h"
+#include "kdm/runtime/subdivision.h"
 #include "kdm/runtime/version.h"
 
 namespace kdm {
@@ -76,6 +77,13 @@ struct Tile {
   /// TilesetShape::offsets_at_keyframe (the points present at keyframe g or appearing before the next
   /// one). Empty without a glide track.
   TilesetArray<std::int8_t> glide;
+  /// The hand-over between depths (sets whose handover_zone is not 0; else empty): per rank, the sub-point
+  /// the point glides onto past the top keyframe, as q · 25 + (dy + 2) · 5 + (dx + 2): rank q of the
+  /// subtile (dx, dy) away from the one holding the point's stable position (TilesetShape::subtile_of).
+  TilesetArray<std::uint16_t> handover;
+  /// The subtiles' points present at their keyframe 1 that no point glides onto, in the order they appear
+  /// during the hand-over: (j << 16) | q, rank q of subtile j = row · m + column (row 0 at the south).
+  TilesetArray<std::uint32_t> appearing;
   /// The level of the point at `rank` (< points.size()): the first k with rank < level_end[k].
   std::uint32_t level_of(std::uint32_t rank) const {
     std::uint32_t k = 0;
@@ -83,7 +91,8 @@ struct Tile {
     return k;
   }
   friend bool operator==(const Tile& a, const Tile& b) {
-    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end && a.glide == b.glide;
+    return a.points == b.points && a.keys == b.keys && a.level_end == b.level_end && a.glide == b.glide &&
+           a.handover == b.handover && a.appearing == b.appearing;
   }
 };
 
@@ -99,6 +108,22 @@ struct TilesetShape {
   /// The keyframes of the glide track: nominal points per tile at each, strictly increasing, the last one
   /// the top level's. Empty: the set has no glide track (smooth queries then emit stable positions).
   TilesetArray<std::uint32_t> keyframe_nominal;
+  /// The hand-over's corner squares and edge bands, in sub-steps (kdm/runtime/subdivision.h); 0: the set
+  /// has no hand-over, and no density beyond its top level.
+  std::uint32_t handover_zone = 0;
+
+  /// Subtiles per tile side in the hand-over: m with m² · N_0 = N_top (0 if there is no such integer).
+  std::uint32_t subtiles_per_side() const {
+    if (level_nominal.empty()) return 0;
+    const auto m =
+        static_cast<std::uint32_t>(std::lround(std::sqrt(double(level_nominal.back()) / level_nominal[0])));
+    return std::uint64_t(m) * m * level_nominal[0] == level_nominal.back() ? m : 0;
+  }
+  Subdivision subdivision() const { return {colours, subtiles_per_side(), handover_zone}; }
+  /// The subtile (column, row) of m per side holding a stable position.
+  static std::uint32_t subtile_of(std::uint16_t coordinate, std::uint32_t m) {
+    return static_cast<std::uint32_t>((std::uint64_t(coordinate) * m) >> 16);
+  }
 
   /// The expected point count per tile above which a point of `level` with key `key` is emitted, in
   /// the float precision the runtime stores it in (4 bytes per point).
@@ -138,7 +163,7 @@ struct TilesetShape {
   }
   friend bool operator==(const TilesetShape& a, const TilesetShape& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
-           a.keyframe_nominal == b.keyframe_nominal;
+           a.keyframe_nominal == b.keyframe_nominal && a.handover_zone == b.handover_zone;
   }
 };
 
@@ -177,6 +202,10 @@ KDM_RUNTIME_API Status read_tileset_header(const void* data, std::size_t size, T
 /// one glide offset pair per point present at each keyframe).
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
 KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
+
+/// The format version encode_tileset writes `set` in: the oldest that holds it (4 for a set without a
+/// hand-over, so that format-4 readers keep reading it; else kTilesetFormatVersion).
+KDM_RUNTIME_API std::uint32_t tileset_format_version_for(const TilesetShape& set);
 
 /// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
 KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out,
