@@ -122,6 +122,8 @@ def recipes():
     write("recipe", "edges.recipe", "  colours\t16 # the format's cap\r\nlevels 1\nbase_points 65536\n"
           "temperature 0\nband 0.49\nerosion 0\nseed 9007199254740992\n")
     write("recipe", "bad.recipe", "levels three\n")
+    write("recipe", "handover.recipe", "levels 3\nbase_points 16\nsweeps 10\nerosion 1\nedge_gap 0.5\nkeyframes 2\n"
+          "glide_sweeps 5\nhandover_zone 1\n")
 
 
 def point_files():
