@@ -121,4 +121,67 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
   }
 }
 
+void judge_handover(const TilesetData& set, const VerifyOptions& options, Report& report,
+                    const std::function<void(double)>& done) {
+  const Bars& b = options.bars;
+  const std::size_t top = set.keyframe_nominal.size() - 1;
+  const Subdivision sub = set.subdivision();
+  const std::uint32_t m = sub.m, C = set.colours;
+  const double n_top = set.level_nominal.back(), n_end = double(m) * m * set.keyframe_nominal[1];
+  TilePositions start(set.tiles.size()), sub_points(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    start[t] = glided(set, t, std::numeric_limits<double>::infinity(), top, top, 0);
+    sub_points[t] = glided(set, t, set.keyframe_nominal[1], 1, 1, 0);
+  }
+  // Each tile's targets and appearing points, in its unit coordinates.
+  TilePositions target(set.tiles.size()), appearing(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
+               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
+    const auto place = [&](std::uint32_t j, std::uint32_t q, std::vector<double>& out) {
+      const std::uint32_t i = j % m, k = j / m;
+      const std::size_t type = set.tile_index(
+          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
+          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1));
+      out.insert(out.end(), {(i + sub_points[type][2 * q]) / m, (k + sub_points[type][2 * q + 1]) / m});
+    };
+    const Tile& tile = set.tiles[t];
+    for (std::size_t r = 0; r < tile.points.size(); ++r) {
+      const std::uint32_t v = tile.handover[r], d = v % 25;
+      place((TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2) * m +
+                TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2,
+            v / 25, target[t]);
+    }
+    for (std::uint32_t w : tile.appearing) place(w >> 16, w & 0xFFFF, appearing[t]);
+  }
+  for (const double s : {0.25, 0.5, 0.75, 1.0}) {
+    KeyframeResult row;
+    row.points_per_tile = n_top + s * (n_end - n_top);
+    row.keyframe = false;
+    row.handover = true;
+    row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
+    TilePositions at(set.tiles.size());
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+      for (std::size_t i = 0; i < start[t].size(); ++i)
+        at[t].push_back(start[t][i] + s * (target[t][i] - start[t][i]));
+      const std::size_t n = appearing[t].size() / 2;
+      for (std::size_t a = 0; a < n; ++a)  // thresholds spread evenly over the hand-over, in table order
+        if (row.points_per_tile > n_top + (double(a) + 0.5) / double(n) * (n_end - n_top))
+          at[t].insert(at[t].end(), {appearing[t][2 * a], appearing[t][2 * a + 1]});
+    }
+    const double row_spacing = analysis::hex_spacing(std::size_t(row.points_per_tile));
+    row.closest_pair = closest_across_edges(set, at, row_spacing) / row_spacing;
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+      const std::vector<double> coords = glide_torus(set, t, at);
+      done(double(coords.size() / 2));
+      analysis::NearestNeighbours nn;
+      add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
+    }
+    row.checks.push_back({"δavg", row.davg, b.glide_between_davg, false});
+    if (b.glide_closest_pair > 0)
+      row.checks.push_back({"closest pair", row.closest_pair, b.glide_closest_pair, false});
+    report.keyframes.push_back(std::move(row));
+  }
+}
+
 }  // namespace kdm::verify

@@ -102,8 +102,10 @@ void print_report(const Report& report, std::FILE* out) {
                  "motion mean", "motion p99", "hole", "/1e5", "result");
     for (const KeyframeResult& k : report.keyframes) {
       std::fprintf(out, "%11.1f %9s %7.4f %s %11.3f %s %s  %s\n", k.points_per_tile,
-                   k.keyframe ? "keyframe" : "half-way", k.davg,
-                   cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
+                   k.handover   ? "hand-over"
+                   : k.keyframe ? "keyframe"
+                                : "half-way",
+                   k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
                    cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(),
                    hole_cells(k.holes, k.checks).c_str(), k.passed() ? "pass" : "FAIL");
       checks += k.checks.size();

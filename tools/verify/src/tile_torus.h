@@ -93,4 +93,10 @@ bool keyframe_judged(const TilesetData& set, const std::vector<std::uint32_t>& l
 void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 
+/// Part 6 (glide.cpp), sets with a hand-over: appends a KeyframeResult (handover set) for a quarter, half,
+/// three quarters and all of the way from the top keyframe to the subtiles' keyframe 1, each point on its
+/// straight path and the appearing points in at evenly spread thresholds.
+void judge_handover(const TilesetData& set, const VerifyOptions& options, Report& report,
+                    const std::function<void(double)>& done);
+
 }  // namespace kdm::verify

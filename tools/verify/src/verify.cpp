@@ -217,6 +217,9 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
   }
   if (options.seams) judge_densities(set, options, report, done);
   if (options.glide_track) judge_keyframes(set, options, report, done);
+  if (options.glide_track && set.handover_zone &&
+      std::find(options.levels.begin(), options.levels.end(), set.levels - 1) != options.levels.end())
+    judge_handover(set, options, report, done);
   if (options.progress) options.progress(1.0);
   return report;
 }

@@ -19,6 +19,8 @@
 //  4. Between levels (rank prefixes): lowP per tile.
 //  5. Sets with a glide track: every keyframe and the density half-way to the next, in smooth mode
 //     (δavg, closest pair), and how far points move from one keyframe to the next.
+//  6. Sets with a hand-over between depths, when the top level is judged: four points along it (δavg,
+//     closest pair; straight paths, appearing points at evenly spread thresholds).
 // Spectra cost O(n · f²): tori above `spectrum_budget` points skip lowP and RAPS (reported as NaN).
 //
 // Thread safety: verify_tileset is reentrant (no shared state); it uses up to `threads` threads.
@@ -160,6 +162,7 @@ struct DensityResult {
 struct KeyframeResult {
   double points_per_tile = 0;
   bool keyframe = true;     ///< false: half-way between two keyframes
+  bool handover = false;    ///< on the hand-over past the top level (part 6)
   double davg = 0;          ///< mean over the tiles' tori, in smooth mode
   double closest_pair = 0;  ///< in d_hex, over every tile's torus and every edge two tiles can share
   /// Keyframes: the mean move from the keyframe before, in mean nearest-neighbour distances (δavg · d_hex
