@@ -230,7 +230,7 @@ class Baker {
   /// The hand-over tables (docs/design.md §3, "Unbounded zoom"), in the file's encoding.
   void add_handover(TilesetData& set) const {
     const Subdivision sub = set.subdivision();
-    const std::vector<TileHandover> plan = plan_handover(levels_, set, ranked_, sub);
+    const std::vector<TileHandover> plan = plan_handover(levels_, set, ranked_, sub, widths_.back());
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {
       Tile& tile = set.tiles[t];
       for (std::size_t r = 0; r < tile.points.size(); ++r) {

@@ -231,6 +231,38 @@ int square_of(double x, double y) {  // parent units on the 2×2 torus
              kParents * wrap(std::int64_t(std::floor(y)), kParents));
 }
 
+/// Which matching a parent point joins, by where its stable position lies and what its patch depends on:
+/// a corner group (a point of the vertex's corner patch within the top level's corner half-width of it),
+/// an edge group (a point of either end's corner patch or of the edge's own patch within the top level's
+/// edge half-width of its line), else the interior of the tile that shows it. Points near a tile edge thus
+/// move the same way in every tile that shows them; those farther in (coarse levels' wide patches) are
+/// matched with their tile's interior, whose neighbourhood they share in every tile anyway. Anchors are
+/// the group's vertex (corner), west or south vertex (edge) or tile corner (interior), parent units.
+ZoneId group_of(PatchKind kind, std::int64_t ax, std::int64_t ay, double rx, double ry, PatchWidths top) {
+  switch (kind) {
+    case PatchKind::kCorner:
+      if (std::max(std::fabs(rx), std::fabs(ry)) < top.corner) return {0, ax, ay};
+      if (std::fabs(ry) < top.edge) return {1, rx > 0 ? ax : ax - 1, ay};
+      if (std::fabs(rx) < top.edge) return {2, ax, ry > 0 ? ay : ay - 1};
+      break;
+    case PatchKind::kHorizontalEdge:
+      if (std::fabs(ry) < top.edge) return {1, ax, ay};
+      break;
+    case PatchKind::kVerticalEdge:
+      if (std::fabs(rx) < top.edge) return {2, ax, ay};
+      break;
+    case PatchKind::kInterior:
+      break;
+  }
+  return {3, std::int64_t(std::floor(double(ax) + rx)), std::int64_t(std::floor(double(ay) + ry))};
+}
+
+/// A parent point to match: which (patch, index; anchor unused) and where (top keyframe, parent tile).
+struct Row {
+  PointKey key;
+  Spot spot;
+};
+
 /// The matching of one patch class: sub-points (anchors relative to the class's anchor vertex) and the
 /// parent points (patch, index; anchor unused) they went to, both ways.
 struct Claims {
@@ -263,8 +295,9 @@ void locate(const std::vector<LevelPatches>& levels, const Patch* p, PatchKind& 
 
 class Planner {
  public:
-  Planner(const std::vector<LevelPatches>& levels, const TilesetData& set, const Subdivision& sub)
-      : levels_(levels), set_(set), sub_(sub), C_(set.colours) {
+  Planner(const std::vector<LevelPatches>& levels, const TilesetData& set, const Subdivision& sub,
+          PatchWidths top_widths)
+      : levels_(levels), set_(set), sub_(sub), C_(set.colours), top_widths_(top_widths) {
     reach_ = 2.5 / std::sqrt(double(set.level_nominal.back()));
     top_ = set.keyframe_nominal.size() - 1;
   }
@@ -276,7 +309,10 @@ class Planner {
       std::vector<SubPoint> columns;
       for (const SubPoint& p : world.points(0, 0, kParents * sub_.m, kParents * sub_.m))
         if (p.zone == ZoneId{0, 0, 0}) columns.push_back(p);
-      corner_[c] = run(PatchKind::kCorner, c, 0, 0, columns, "corner " + std::to_string(c));
+      std::vector<Row> rows;
+      for (const LevelPatches& level : levels_)
+        add_rows(level.corners[c], PatchKind::kCorner, 0, 0, {0, 0, 0}, rows);
+      corner_[c] = run(rows, 0, 0, 0, columns, "corner " + std::to_string(c));
     }
   }
 
@@ -301,8 +337,15 @@ class Planner {
               if (sector(p, p.zone.x, p.zone.y) == ZoneId{kind, 0, 0}) columns.push_back(p);
             }
           }
-          edge_[kind - 1][a * C_ + b] = run(static_cast<PatchKind>(kind), a * C_ + b, 0, 0, columns,
-                                            "edge " + std::to_string(a * C_ + b));
+          std::vector<Row> rows;
+          const ZoneId group{kind, 0, 0};
+          for (const LevelPatches& level : levels_) {
+            const auto edge_kind = static_cast<PatchKind>(kind);
+            add_rows(level.of(edge_kind)[a * C_ + b], edge_kind, 0, 0, group, rows);
+            add_rows(level.corners[a], PatchKind::kCorner, 0, 0, group, rows);
+            add_rows(level.corners[b], PatchKind::kCorner, ex, ey, group, rows);
+          }
+          edge_[kind - 1][a * C_ + b] = run(rows, kind, 0, 0, columns, "edge " + std::to_string(a * C_ + b));
         }
     }
   }
@@ -314,22 +357,35 @@ class Planner {
     std::vector<SubPoint> columns, all = world.points(0, 0, sub_.m, sub_.m);
     for (const SubPoint& p : all)
       if (!claimed(p, parents)) columns.push_back(p);
-    const Claims interior = run(PatchKind::kInterior, t, 0, 0, columns, "interior " + std::to_string(t));
-
-    TileHandover out;
-    std::set<PointKey> taken;  // absolute anchors
+    std::vector<Row> rows;
+    std::vector<ZoneId> groups;
     for (const PatchPointRef& ref : ranked[t]) {
       const auto ax = std::int64_t(std::llround(ref.anchor_x)), ay = std::int64_t(std::llround(ref.anchor_y));
       std::size_t index = 0;
       PatchKind kind = PatchKind::kInterior;
       locate(levels_, ref.patch, kind, index);
-      const Claims& claims = kind == PatchKind::kCorner     ? corner_[index]
-                             : kind == PatchKind::kInterior ? interior
-                                                            : edge_[int(kind) - 1][index];
+      const double rx = ref.patch->xy[2 * ref.index], ry = ref.patch->xy[2 * ref.index + 1];
+      groups.push_back(group_of(kind, ax, ay, rx, ry, top_widths_));
+      if (groups.back().kind == 3) rows.push_back(row(*ref.patch, ref.index, ax, ay));
+    }
+    const Claims interior = run(rows, 3, 0, 0, columns, "interior " + std::to_string(t));
+
+    TileHandover out;
+    std::set<PointKey> taken;  // absolute anchors
+    for (std::size_t r = 0; r < ranked[t].size(); ++r) {
+      const PatchPointRef& ref = ranked[t][r];
+      const ZoneId g = groups[r];
+      const auto colour = [&](std::int64_t x, std::int64_t y) { return parents.at(x, y); };
+      const Claims& claims =
+          g.kind == 0 ? corner_[colour(g.x, g.y)]
+          : g.kind == 3
+              ? interior
+              : edge_[g.kind - 1][colour(g.x, g.y) * C_ + colour(g.x + (g.kind == 1), g.y + (g.kind == 2))];
       const auto found = claims.by_row.find({ref.patch, ref.index, 0, 0});
       KDM_CHECK(found != claims.by_row.end());
-      const PointKey sub_point{found->second.patch, found->second.index, found->second.ax + ax * sub_.m,
-                               found->second.ay + ay * sub_.m};
+      const std::int64_t gx = g.kind == 3 ? 0 : g.x, gy = g.kind == 3 ? 0 : g.y;
+      const PointKey sub_point{found->second.patch, found->second.index, found->second.ax + gx * sub_.m,
+                               found->second.ay + gy * sub_.m};
       taken.insert(sub_point);
       out.target.push_back(pack(sub_point, parents));
     }
@@ -401,28 +457,37 @@ class Planner {
 
   /// Matches the points of every level's patch (kind, index) anchored at parent vertex (vx, vy) to
   /// `columns` (sub-points on the same world); returns the claims keyed relative to that vertex.
-  Claims run(PatchKind kind, std::size_t index, std::int64_t vx, std::int64_t vy,
+  /// Point i of `patch` (anchored at parent vertex (ax, ay)) as a row.
+  Row row(const Patch& patch, std::uint32_t i, std::int64_t ax, std::int64_t ay) const {
+    const auto& frame = patch.frames[top_];
+    KDM_CHECK(frame.size() == 2 * patch.size());
+    return {{&patch, i, 0, 0},
+            {double(ax) + frame[2 * i], double(ay) + frame[2 * i + 1],
+             square_of(double(ax) + patch.xy[2 * i], double(ay) + patch.xy[2 * i + 1])}};
+  }
+
+  /// Appends the points of `patch` (of kind `kind`, anchored at (ax, ay)) that join `group`.
+  void add_rows(const Patch& patch, PatchKind kind, std::int64_t ax, std::int64_t ay, const ZoneId& group,
+                std::vector<Row>& rows) const {
+    for (std::uint32_t i = 0; i < patch.size(); ++i)
+      if (group_of(kind, ax, ay, patch.xy[2 * i], patch.xy[2 * i + 1], top_widths_) == group)
+        rows.push_back(row(patch, i, ax, ay));
+  }
+
+  /// Matches `rows` to `columns` (sub-points on the same world); returns the claims keyed relative to
+  /// the class's vertex (vx, vy) (class kind `kind`: 0 corner, 1, 2 edges, 3 interior).
+  Claims run(const std::vector<Row>& rows, int kind, std::int64_t vx, std::int64_t vy,
              const std::vector<SubPoint>& columns, const std::string& what) const {
-    std::vector<Spot> rows, cols;
-    std::vector<PointKey> row_keys;
-    for (const LevelPatches& level : levels_) {
-      const Patch& patch = level.of(kind)[index];
-      for (std::uint32_t i = 0; i < patch.size(); ++i) {
-        const auto& frame = patch.frames[top_];
-        KDM_CHECK(frame.size() == 2 * patch.size());
-        rows.push_back({double(vx) + frame[2 * i], double(vy) + frame[2 * i + 1],
-                        square_of(double(vx) + patch.xy[2 * i], double(vy) + patch.xy[2 * i + 1])});
-        row_keys.push_back({&patch, i, 0, 0});
-      }
-    }
+    std::vector<Spot> spots, cols;
+    for (const Row& r : rows) spots.push_back(r.spot);
     for (const SubPoint& p : columns)
       cols.push_back({p.x / sub_.m, p.y / sub_.m, square_of(p.sx / sub_.m, p.sy / sub_.m)});
-    const std::vector<std::uint32_t> row_column = match(rows, cols, reach_, what);
+    const std::vector<std::uint32_t> row_column = match(spots, cols, reach_, what);
     Claims claims;
     for (std::size_t r = 0; r < row_column.size(); ++r) {
-      const PointKey sub_point = relative(columns[row_column[r]].key, int(kind), vx, vy);
-      claims.by_sub[sub_point] = row_keys[r];
-      claims.by_row[row_keys[r]] = sub_point;
+      const PointKey sub_point = relative(columns[row_column[r]].key, kind, vx, vy);
+      claims.by_sub[sub_point] = rows[r].key;
+      claims.by_row[rows[r].key] = sub_point;
     }
     return claims;
   }
@@ -449,6 +514,7 @@ class Planner {
   const TilesetData& set_;
   Subdivision sub_;
   std::uint32_t C_;
+  PatchWidths top_widths_;
   double reach_ = 0;
   std::size_t top_ = 0;
   std::vector<Claims> corner_;
@@ -460,10 +526,10 @@ class Planner {
 
 std::vector<TileHandover> plan_handover(const std::vector<LevelPatches>& levels, const TilesetData& set,
                                         const std::vector<std::vector<PatchPointRef>>& ranked,
-                                        const Subdivision& sub) {
+                                        const Subdivision& sub, PatchWidths top_widths) {
   KDM_CHECK(sub.m >= 2 && 2 * sub.zone + 1 < sub.m && sub.colours == set.colours);
   KDM_CHECK(set.keyframe_nominal.size() >= 2 && ranked.size() == set.tiles.size());
-  Planner planner(levels, set, sub);
+  Planner planner(levels, set, sub, top_widths);
   planner.index_ranks(ranked);
   planner.plan_corners();
   planner.plan_edges();

@@ -28,10 +28,11 @@ struct TileHandover {
 /// Plans the hand-over of every tile of `set` (assembled from `levels`, which hold every keyframe's
 /// frames). `ranked[t]` says where each point of tile t comes from, by rank (the refs gather() gives with
 /// the window [0, 1)², anchors relative to the tile). `sub` must have m² = top nominal / base nominal and
-/// the set's colours. Throws std::runtime_error if some patch finds too few sub-points (a zone too narrow
-/// for the patches).
+/// the set's colours; `top_widths` (the top level's patch half-widths) decide which points join a corner
+/// or edge group rather than their tile's interior. Throws std::runtime_error if some patch finds too few
+/// sub-points (a zone too narrow for the patches).
 std::vector<TileHandover> plan_handover(const std::vector<LevelPatches>& levels, const TilesetData& set,
                                         const std::vector<std::vector<PatchPointRef>>& ranked,
-                                        const Subdivision& sub);
+                                        const Subdivision& sub, PatchWidths top_widths);
 
 }  // namespace kdm::gen
