@@ -42,10 +42,10 @@ TilePositions stable_positions(const TilesetData& set, double count) {
 
 double closest_across_edges(const TilesetData& set, const TilePositions& at, double cutoff) {
   // A pair closer than the cutoff has both points within (largest glide + cutoff) of the edge: each
-  // point's stable position lies on its own side.
+  // point's stable position lies on its own side. Points past the ranked ones do not move.
   double glide = 0;
   for (std::size_t t = 0; t < at.size(); ++t)
-    for (std::size_t i = 0; i < at[t].size(); i += 2) {
+    for (std::size_t i = 0; i < std::min(at[t].size(), 2 * set.tiles[t].points.size()); i += 2) {
       const TilePoint& p = set.tiles[t].points[i / 2];
       glide = std::max({glide, std::fabs(at[t][i] - p.unit_x()), std::fabs(at[t][i + 1] - p.unit_y())});
     }

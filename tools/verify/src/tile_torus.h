@@ -21,7 +21,8 @@ std::vector<double> torus_points(const TilesetData& set, std::size_t t, double c
                                  std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
 
 /// Each tile's points at one density, in its own unit coordinates (a glided point may lie outside the
-/// tile): the first n ranks, as (x, y) pairs.
+/// tile): the first n ranks, as (x, y) pairs, then any points without a rank (a hand-over's appearing
+/// points), which lie where they are stored.
 using TilePositions = std::vector<std::vector<double>>;
 
 /// Every tile's points at expected count `count` per tile in stable mode.
