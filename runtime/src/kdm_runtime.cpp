@@ -181,12 +181,13 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
     } else {
       q.density.constant = c.density;
     }
-    kdm::QueryCursor k{cursor->tile_x,       cursor->tile_y,        cursor->rank,
-                       cursor->started != 0, cursor->finished != 0, cursor->fingerprint};
+    kdm::QueryCursor k{cursor->tile_x,        cursor->tile_y,      cursor->rank,  cursor->started != 0,
+                       cursor->finished != 0, cursor->fingerprint, cursor->depth, cursor->path};
     // kdm_point and QueryPoint share their layout (asserted above): write straight into the caller's buffer.
     status = to_c(kdm::query_points(*tileset->set, q, reinterpret_cast<kdm::QueryPoint*>(out), capacity,
                                     written, &k, &why));
-    *cursor = kdm_cursor{k.tile_x, k.tile_y, k.rank, k.started ? 1 : 0, k.finished ? 1 : 0, k.fingerprint};
+    *cursor = kdm_cursor{k.tile_x,           k.tile_y,      k.rank,  k.started ? 1 : 0,
+                         k.finished ? 1 : 0, k.fingerprint, k.depth, k.path};
   }
   if (problem && problem->struct_size >= kProblemV1) {
     kdm_query_problem p;

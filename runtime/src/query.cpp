@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <utility>
 
+#include "descent.h"
 #include "image_sampler.h"
 #include "kdm/runtime/hash.h"
 #include "keyframe_lookup.h"
@@ -14,6 +16,7 @@
 
 namespace kdm {
 
+using detail::density_or_zero;
 using detail::GlideBracket;
 using detail::ImageSampler;
 using detail::keyframe_table;
@@ -25,10 +28,6 @@ namespace {
 bool finite(double v) {
   return std::isfinite(v);
 }
-
-double density_or_zero(double v) {
-  return (v > 0 && v < HUGE_VAL) ? v : 0.0;
-}  // NaN, ±inf, negatives -> 0
 
 /// Every signed byte as a double: a load instead of a conversion with its false dependency.
 struct SignedByteTable {
@@ -276,21 +275,24 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   }
   const double S = q.tile_size, area_scale = S * S * q.scale;
   const ImageSampler sampler(d.kind == QueryDensity::Kind::kImage ? d.image : nullptr);
-  const double top = tileset.max_points_per_tile();
-  if (!(max_density * area_scale <= top + 0.5)) {
-    refuse(Kind::kDensityTooHigh, "scale", max_density * area_scale, top);
-    why.largest_valid = top / (max_density * S * S);
-    why.largest_tile_size = std::sqrt(top / (max_density * q.scale));
+  const double top = tileset.max_points_per_tile(), most = query_density_limit(tileset, q.mode);
+  if (!(max_density * area_scale <= most + 0.5)) {
+    refuse(Kind::kDensityTooHigh, "scale", max_density * area_scale, most);
+    why.largest_valid = most / (max_density * S * S);
+    why.largest_tile_size = std::sqrt(most / (max_density * q.scale));
     return Status::kInvalidArgument;
   }
   // Smooth mode visits the tiles whose points can glide into the region too: as far as any glides at the
   // keyframes a constant density's points sit between, or at any keyframe up to a varying one's maximum.
+  // Past the top level, where tiles hand over to their subtiles, every keyframe's reach bounds the way.
   const bool glide = q.mode == QueryMode::kSmooth && tileset.has_glide_track();
+  const bool descend = glide && tables.subtiles > 0 && max_density * area_scale > top;
   double reach = 0;
   if (glide) {
     const GlideBracket top(keyframe_table(tileset), max_density * area_scale);
     for (std::uint32_t g = d.kind == QueryDensity::Kind::kConstant ? top.g0 : 0; g <= top.g1; ++g)
       reach = std::max(reach, tables.glide_reach[g] * S);
+    if (descend) reach = std::max(reach, tables.glide_reach_from[0] * S) + S * (2.0 / 65536.0);
   }
   const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
   const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);
@@ -304,6 +306,11 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (std::fabs(tx0d) > 9e15 || std::fabs(tx1d) > 9e15)  // tile coordinates must fit an int64 exactly
     return refuse(Kind::kNotFinite, "x0", q.x0);
   if (std::fabs(ty0d) > 9e15 || std::fabs(ty1d) > 9e15) return refuse(Kind::kNotFinite, "y0", q.y0);
+  if (descend) {  // subtile coordinates, m^kMaxQueryDepth times the tile's, must fit an int64 too
+    const double far = std::ldexp(1.0, 62) / std::pow(double(tables.subtiles), kMaxQueryDepth);
+    if (std::fabs(tx0d) > far || std::fabs(tx1d) > far) return refuse(Kind::kNotFinite, "x0", q.x0);
+    if (std::fabs(ty0d) > far || std::fabs(ty1d) > far) return refuse(Kind::kNotFinite, "y0", q.y0);
+  }
   const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
   const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
   if (tx1 <= tx0 || ty1 <= ty0) {  // x1 / S rounded onto x0 / S: no tile column (or row) to visit at all
@@ -311,6 +318,13 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     return Status::kOk;
   }
   if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false, fingerprint};
+  // A cursor inside a tile's subtiles names them by a path of subtile indices: a damaged one is refused.
+  if (cursor->depth > (descend ? kMaxQueryDepth : 0)) return refuse(Kind::kCursorMismatch, "cursor");
+  for (std::uint32_t k = 0; k < cursor->depth; ++k)
+    if ((cursor->path >> (16 * k) & 0xFFFF) >= std::uint64_t(tables.subtiles) * tables.subtiles)
+      return refuse(Kind::kCursorMismatch, "cursor");
+  std::optional<detail::DescentQuery> descent;
+  if (descend) descent.emplace(tileset, q, sampler);
 
   std::size_t n = 0;
   std::uint64_t examined = 0;
@@ -338,7 +352,23 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
                            [](float t, double l) { return TilesetShape::emits(t, l); }) -
           thresholds);
-      const std::uint32_t c = (tx == cursor->tile_x && ty == cursor->tile_y) ? cursor->rank : 0;
+      const bool resumed = tx == cursor->tile_x && ty == cursor->tile_y;
+      if (descend && limit > top) {  // the tile hands over to its subtiles somewhere: descent.h
+        detail::DescentPlace at;
+        if (resumed) at = detail::DescentPlace{cursor->depth, cursor->path, cursor->rank};
+        std::uint64_t budget = kMaxQueryCandidates - examined;
+        const std::uint64_t before = budget;
+        const bool done = detail::emit_descending(*descent, tx, ty, index, out, capacity, n, budget, at);
+        examined += before - budget;
+        if (!done) {
+          *cursor = QueryCursor{tx, ty, at.rank, true, false, fingerprint, at.depth, at.path};
+          *written = n;
+          return Status::kBufferFull;
+        }
+        continue;
+      }
+      if (resumed && cursor->depth != 0) return refuse(Kind::kCursorMismatch, "cursor");
+      const std::uint32_t c = resumed ? cursor->rank : 0;
       if (c >= candidates) continue;
       // Bounded work per call, whatever the region and density.
       const std::uint64_t budget = kMaxQueryCandidates - examined;
@@ -381,6 +411,13 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   cursor->finished = true;
   *written = n;
   return Status::kOk;
+}
+
+double query_density_limit(const Tileset& tileset, QueryMode mode) {
+  const double top = tileset.max_points_per_tile();
+  const std::uint32_t m = tileset.empty() ? 0 : detail::TilesetInternals::tables(tileset).subtiles;
+  if (mode != QueryMode::kSmooth || m == 0) return top;
+  return top * std::pow(double(m), 2.0 * kMaxQueryDepth);
 }
 
 const char* query_problem_message(QueryProblem::Kind kind) {

@@ -67,6 +67,38 @@ QueryTables::QueryTables(const TilesetData& set) {
     span.scale0 = glide_scale[span.g0], span.scale1 = glide_scale[span.g1];
   }
   index_edges(set);
+  index_handover(set);
+}
+
+void QueryTables::index_handover(const TilesetData& set) {
+  const Subdivision sub = set.subdivision();
+  if (set.handover_zone == 0 || sub.m == 0 || set.keyframe_nominal.size() < 2) return;
+  const std::uint32_t m = subtiles = sub.m, C = set.colours, m2 = m * m;
+  child_type.assign(set.tiles.size() * m2, 0);
+  inherited_start.assign(set.tiles.size() * (m2 + 1), 0);
+  inherited.assign(set.tiles.size(), {});
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
+               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
+    std::uint32_t* start = inherited_start.data() + t * (m2 + 1);
+    for (std::uint32_t j = 0; j < m2; ++j) {
+      const std::uint32_t i = j % m, k = j / m;
+      const std::size_t c = set.tile_index(
+          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
+          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1));
+      child_type[t * m2 + j] = static_cast<std::uint32_t>(c);
+      start[j + 1] = start[j] + points_at_keyframe[c][1];
+    }
+    TilesetArray<std::uint32_t>& from = inherited[t];
+    from.assign(start[m2], kAppearing);
+    const Tile& tile = set.tiles[t];
+    for (std::uint32_t r = 0; r < tile.handover.size(); ++r) {  // validated: each sub-point named once
+      const std::uint32_t v = tile.handover[r], d = v % 25;
+      const std::uint32_t j = (TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2) * m +
+                              TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
+      from[start[j] + v / 25] = r;
+    }
+  }
 }
 
 void QueryTables::index_edges(const TilesetData& set) {
@@ -112,7 +144,8 @@ std::size_t QueryTables::resident_bytes() const {
   return sizeof(*this) + nested_bytes(thresholds) + nested_bytes(glide_start) + flat_bytes(glide_reach) +
          flat_bytes(glide_reach_from) + flat_bytes(glide_scale) + nested_bytes(points_at_keyframe) +
          flat_bytes(keyframe_nominal) + flat_bytes(glide_spans) + flat_bytes(keyframe_guess) +
-         nested_bytes(edge_ranks) + flat_bytes(edge_start);
+         nested_bytes(edge_ranks) + flat_bytes(edge_start) + flat_bytes(child_type) +
+         nested_bytes(inherited) + flat_bytes(inherited_start);
 }
 
 std::uint32_t first_keyframe_at_least(const Tileset& set, double expected) {

@@ -55,6 +55,16 @@ struct QueryTables {
   /// scanned through one list, not in full.
   TilesetArray<TilesetArray<std::uint32_t>> edge_ranks;
   TilesetArray<std::uint32_t> edge_start;
+  /// The hand-over between depths (sets with a handover_zone; else empty). Subtiles per side m, and per
+  /// tile t and subtile j = row · m + column, the tile its subtile shows: child_type[t · m² + j].
+  std::uint32_t subtiles = 0;
+  TilesetArray<std::uint32_t> child_type;
+  /// Which point of tile t glides onto rank q of its subtile j: inherited[t][inherited_start[t · (m² + 1)
+  /// + j] + q], a rank of t, or kAppearing for a sub-point that appears on its own. A point emitted by a
+  /// subtile keeps the id of the point it came from.
+  TilesetArray<TilesetArray<std::uint32_t>> inherited;
+  TilesetArray<std::uint32_t> inherited_start;
+  static constexpr std::uint32_t kAppearing = ~0u;
   /// The allocator hooks this object itself came from (Tileset allocates it through them).
   AllocatorHooks hooks;
 
@@ -71,6 +81,7 @@ struct QueryTables {
 
  private:
   void index_edges(const TilesetData& set);
+  void index_handover(const TilesetData& set);
 };
 
 /// A Tileset's tables: what the query loop reads besides its TilesetData.

@@ -44,6 +44,7 @@ typedef struct kdm_point {
   double x, y;            /* world position minus the query origin */
   int64_t tile_x, tile_y; /* stable id: tile coordinates ... */
   uint32_t rank;          /* ... and rank within the tile (its level follows from kdm_tileset_info) */
+  uint32_t depth;         /* past the top level (smooth mode): tiles m^depth times smaller (kdm::PointId) */
 } kdm_point;
 
 typedef struct kdm_query {
@@ -70,7 +71,9 @@ typedef struct kdm_cursor {
   uint32_t rank;
   int started, finished;
   uint64_t fingerprint; /* of the query that started it: a cursor is refused with other parameters */
-} kdm_cursor;           /* zero-initialise before the first call */
+  uint32_t depth;       /* where in the tile's subtiles it stopped (past the top level) */
+  uint64_t path;
+} kdm_cursor; /* zero-initialise before the first call */
 
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {

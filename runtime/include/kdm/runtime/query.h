@@ -30,12 +30,16 @@
 
 namespace kdm {
 
-/// A point's stable identity: its tile and its rank there (the level follows from the rank).
+/// A point's stable identity: its tile and its rank there (the level follows from the rank). Past the
+/// top level (smooth mode, sets with a hand-over) points come from subtiles: at depth d the tile grid is
+/// m^d times finer (m = TilesetShape::subtiles_per_side), so (tile_x, tile_y) index tiles of side
+/// tile_size / m^d; a point that glides from a tile onto a subtile's point keeps the tile's id.
 struct PointId {
   std::int64_t tile_x = 0, tile_y = 0;
   std::uint32_t rank = 0;
+  std::uint32_t depth = 0;  ///< 0 for the tiles of side tile_size; at most kMaxQueryDepth
   friend bool operator==(const PointId& a, const PointId& b) {
-    return a.tile_x == b.tile_x && a.tile_y == b.tile_y && a.rank == b.rank;
+    return a.tile_x == b.tile_x && a.tile_y == b.tile_y && a.rank == b.rank && a.depth == b.depth;
   }
 };
 
@@ -84,6 +88,10 @@ struct QueryParams {
 /// Larger regions are refused (kInvalidArgument); split them.
 inline constexpr std::uint64_t kMaxQueryTiles = std::uint64_t(1) << 24;
 
+/// Deepest subtiles a smooth query descends into past a set's top level: densities up to N_top · m^(2 ·
+/// kMaxQueryDepth) points per tile (query_density_limit), 2^40 times the top for m = 32.
+inline constexpr std::uint32_t kMaxQueryDepth = 4;
+
 /// Most candidate points one call examines (2^24, a few milliseconds): a call that reaches it returns
 /// kBufferFull with the cursor saved, even if the buffer has room, so no call runs unbounded.
 inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
@@ -92,9 +100,11 @@ inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 /// belongs to the parameters of the call that started it (their fingerprint), and is refused with others.
 struct QueryCursor {
   std::int64_t tile_x = 0, tile_y = 0;
-  std::uint32_t rank = 0;
+  std::uint32_t rank = 0;  ///< in the tile or subtile reached; past its ranks, its appearing sub-points
   bool started = false, finished = false;
   std::uint64_t fingerprint = 0;  ///< of the parameters that started it (query_fingerprint)
+  std::uint32_t depth = 0;        ///< how deep into tile (tile_x, tile_y) the query stopped
+  std::uint64_t path = 0;         ///< the subtiles it went through, 16 bits per depth from the lowest
 };
 
 /// Why query_points returned kInvalidArgument: which parameter and, for a limit, the limit and the
@@ -108,7 +118,7 @@ struct QueryProblem {
     kNegative,         ///< `parameter` ("scale", "density.callback_max") must be >= 0; `value` holds it
     kBadDensity,       ///< `parameter` ("density.image", "density.callback") is missing or not prepared
     kTooManyTiles,     ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
-    kDensityTooHigh,   ///< `value` expected points per tile exceed `limit` (max_points_per_tile):
+    kDensityTooHigh,   ///< `value` expected points per tile exceed `limit` (query_density_limit):
                        ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
                        ///< largest tile size that fits this scale
     kCursorMismatch,   ///< the cursor was started by a call with other parameters (or damaged)
@@ -119,6 +129,10 @@ struct QueryProblem {
   double value = 0, limit = 0, largest_valid = 0, largest_tile_size = 0;
 };
 
+/// The most expected points per tile a query in `mode` may ask for: the top level's count, or in smooth
+/// mode with a set that has a hand-over (TilesetShape::handover_zone), that times m^(2 · kMaxQueryDepth).
+KDM_RUNTIME_API double query_density_limit(const Tileset& tileset, QueryMode mode);
+
 /// A short English description of a problem kind (static storage).
 KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 
@@ -127,15 +141,16 @@ KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
-/// ascending); `*written` receives the count, and slots from there to capacity may be overwritten too (a
-/// candidate is written before it is known to be kept). Returns kOk when the region is complete (a finished
-/// cursor called again with the same params gives kOk and no points), kBufferFull when `out` filled up first
-/// or the call examined kMaxQueryCandidates points — call again with the same cursor and params to continue.
-/// Empty or inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional)
-/// saying which parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative
-/// scale, a missing image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the
-/// tile set's top level (scale · max density · tile_size² > max_points_per_tile: use smaller tiles or a
-/// lower scale), or a cursor started with other params. No allocation.
+/// ascending, then past the top level each tile's appearing sub-points and its subtiles, depth first);
+/// `*written` receives the count, and slots from there to capacity may be overwritten too (a candidate is
+/// written before it is known to be kept). Returns kOk when the region is complete (a finished cursor called
+/// again with the same params gives kOk and no points), kBufferFull when `out` filled up first or the call
+/// examined kMaxQueryCandidates points — call again with the same cursor and params to continue. Empty or
+/// inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional) saying which
+/// parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative scale, a missing
+/// image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the density limit (scale ·
+/// max density · tile_size² > query_density_limit: use smaller tiles or a lower scale), or a cursor started
+/// with other params. No allocation.
 KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem = nullptr);

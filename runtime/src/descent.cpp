@@ -1,0 +1,312 @@
+// Smooth queries past a tile set's top level: the hand-over between depths (descent.h; docs/design.md
+// §3, "Unbounded zoom", states the rules this file follows).
+//
+// Every choice about a point is made from canonical quantities (its tile path, its rank, the density at
+// its stable position or at its sub-point's), so partitions of a region stay exact; and a tile and its
+// subtile make the one choice they share, whether a sub-point q is the subtile's, with the same
+// expression: ρ(x_q) · area[d + 1] > K_1, x_q computed as the subtile computes its own points.
+#include "descent.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kdm::detail {
+
+DescentQuery::DescentQuery(const Tileset& tileset, const QueryParams& q, const ImageSampler& s)
+    : set(&tileset.data()),
+      tables(&TilesetInternals::tables(tileset)),
+      keyframes(keyframe_table(tileset)),
+      params(&q),
+      sampler(&s) {
+  const double m = tables->subtiles;
+  side[0] = q.tile_size, area[0] = q.tile_size * q.tile_size * q.scale;
+  for (std::uint32_t d = 1; d <= kMaxQueryDepth; ++d)
+    side[d] = side[d - 1] / m, area[d] = area[d - 1] / (m * m);
+  // Positions past depth 0 are summed relative to the origin's tile, so their precision follows their
+  // distance from the origin, not from the world's.
+  const double ox = std::floor(q.origin_x / q.tile_size), oy = std::floor(q.origin_y / q.tile_size);
+  if (std::fabs(ox) < 9e15 && std::fabs(oy) < 9e15) {
+    origin_tile_x = static_cast<std::int64_t>(ox), origin_tile_y = static_cast<std::int64_t>(oy);
+    origin_frac_x = std::fma(-ox, q.tile_size, q.origin_x),
+    origin_frac_y = std::fma(-oy, q.tile_size, q.origin_y);
+  } else {
+    origin_frac_x = q.origin_x, origin_frac_y = q.origin_y;
+  }
+  reach = tables->glide_reach_from.empty() ? 0 : tables->glide_reach_from[0];
+  top = set->keyframe_nominal.back(), k1 = set->keyframe_nominal[1], handover_end = m * m * k1;
+}
+
+double DescentQuery::density_at(double x, double y) const {
+  const QueryDensity& d = params->density;
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return density_or_zero(d.constant);
+    case QueryDensity::Kind::kImage:
+      return sampler->at(x, y);
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return density_or_zero(d.callback(d.user, x, y));
+}
+
+double DescentQuery::density_bound(double x0, double y0, double x1, double y1) const {
+  const QueryDensity& d = params->density;
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return density_or_zero(d.constant);
+    case QueryDensity::Kind::kImage:
+      return d.image->max_over(x0, y0, x1, y1);
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return d.callback_max;
+}
+
+namespace {
+
+constexpr std::uint32_t kDone = ~0u;
+
+struct Node {
+  std::size_t type = 0;
+  std::uint32_t depth = 0;
+  std::int64_t gx = 0, gy = 0;  ///< its tile coordinates at its depth
+  double wx = 0, wy = 0;        ///< its south-west corner, world units
+  double rx = 0, ry = 0;        ///< the same relative to the query origin
+  double rho_max = 0;           ///< the density bound over it
+  std::uint32_t next_child = 0;
+  bool points_done = false;
+};
+
+/// One depth-0 tile's descent: a stack of the tiles from it down to the one being emitted.
+class Descent {
+ public:
+  Descent(const DescentQuery& q, QueryPoint* out, std::size_t capacity, std::size_t& written,
+          std::uint64_t& budget)
+      : q_(q),
+        set_(*q.set),
+        t_(*q.tables),
+        m_(t_.subtiles),
+        out_(out),
+        capacity_(capacity),
+        n_(written),
+        budget_(budget) {}
+
+  bool run(std::int64_t tx, std::int64_t ty, std::size_t index, DescentPlace& at) {
+    Node& root = stack_[0];
+    root.type = index, root.gx = tx, root.gy = ty;
+    root.wx = double(tx) * q_.side[0], root.wy = double(ty) * q_.side[0];
+    root.rx = double(tx - q_.origin_tile_x) * q_.side[0] - q_.origin_frac_x;
+    root.ry = double(ty - q_.origin_tile_y) * q_.side[0] - q_.origin_frac_y;
+    root.rho_max = q_.density_bound(root.wx, root.wy, root.wx + q_.side[0], root.wy + q_.side[0]);
+    for (std::uint32_t k = 0; k < at.depth; ++k) {  // back down the path a full buffer stopped on
+      const auto j = static_cast<std::uint32_t>(at.path >> (16 * k) & 0xFFFF);
+      stack_[k].points_done = true, stack_[k].next_child = j + 1;
+      stack_[k + 1] = child(stack_[k], j);
+    }
+    int top = static_cast<int>(at.depth);
+    std::uint32_t seq = at.rank;
+    for (;;) {
+      Node& n = stack_[top];
+      if (!n.points_done) {
+        const std::uint32_t stopped = emit(top, seq);
+        if (stopped != kDone) {
+          at = DescentPlace{std::uint32_t(top), 0, stopped};
+          for (int k = 0; k < top; ++k) at.path |= std::uint64_t(stack_[k].next_child - 1) << (16 * k);
+          return false;
+        }
+        n.points_done = true, seq = 0;
+      }
+      bool descended = false;
+      if (descends(n))
+        while (!descended && n.next_child < m_ * m_) {
+          const Node c = child(n, n.next_child++);
+          if (wanted(c)) stack_[++top] = c, descended = true;
+        }
+      if (descended) continue;
+      if (top == 0) return true;
+      --top;
+    }
+  }
+
+ private:
+  /// Whether a tile's subtiles can emit anything: some sub-point's expected count can exceed K_1.
+  bool descends(const Node& n) const {
+    return n.depth < kMaxQueryDepth && n.rho_max * q_.area[n.depth + 1] > q_.k1;
+  }
+  /// Whether the tile's points can glide past its top keyframe (it has a hand-over there).
+  bool hands_over(const Node& n) const { return n.depth < kMaxQueryDepth; }
+
+  Node child(const Node& p, std::uint32_t j) const {
+    Node c;
+    const std::uint32_t cx = j % m_, cy = j / m_, d = p.depth + 1;
+    c.type = t_.child_type[p.type * m_ * m_ + j], c.depth = d;
+    c.gx = p.gx * m_ + cx, c.gy = p.gy * m_ + cy;
+    c.wx = double(c.gx) * q_.side[d], c.wy = double(c.gy) * q_.side[d];
+    c.rx = p.rx + double(cx) * q_.side[d], c.ry = p.ry + double(cy) * q_.side[d];
+    c.rho_max = q_.density_bound(c.wx, c.wy, c.wx + q_.side[d], c.wy + q_.side[d]);
+    return c;
+  }
+
+  /// Whether a subtile can emit a point into the region: it (with its farthest glide) meets the region
+  /// and some of its points can be emitted (every one needs an expected count above K_1).
+  bool wanted(const Node& c) const {
+    const QueryParams& p = *q_.params;
+    const double s = q_.side[c.depth], r = q_.reach * s;
+    return c.wx - r < p.x1 && c.wx + s + r > p.x0 && c.wy - r < p.y1 && c.wy + s + r > p.y0 &&
+           c.rho_max * q_.area[c.depth] > q_.k1;
+  }
+
+  /// A sub-point of tile `n`: its subtile's coordinates and type, its stable position and the expected
+  /// count of its subtile there.
+  struct SubPoint {
+    std::uint32_t cx, cy, rank;
+    std::size_t type;
+    double x, y, expected;
+  };
+  SubPoint sub_point(const Node& n, std::uint32_t cx, std::uint32_t cy, std::uint32_t rank) const {
+    SubPoint s{cx, cy, rank, t_.child_type[n.type * m_ * m_ + cy * m_ + cx], 0, 0, 0};
+    const TilePoint& p = set_.tiles[s.type].points[rank];
+    const std::uint32_t d = n.depth + 1;
+    // As the subtile computes its own points' positions (run, emit): the same bits.
+    const double wx = double(n.gx * m_ + cx) * q_.side[d], wy = double(n.gy * m_ + cy) * q_.side[d];
+    s.x = wx + p.unit_x() * q_.side[d], s.y = wy + p.unit_y() * q_.side[d];
+    s.expected = q_.density_at(s.x, s.y) * q_.area[d];
+    return s;
+  }
+  /// Where sub-point s lies at its subtile's keyframe 1, in its parent's unit coordinates.
+  void keyframe_one(const SubPoint& s, double& ux, double& uy) const {
+    const TilePoint& p = set_.tiles[s.type].points[s.rank];
+    const std::int8_t* o =
+        set_.tiles[s.type].glide.data() + 2 * (std::size_t(t_.glide_start[s.type][1]) + s.rank);
+    const double unit = t_.glide_scale[1] * (1.0 / 65536.0);
+    ux = (s.cx + p.unit_x() + o[0] * unit) / m_, uy = (s.cy + p.unit_y() + o[1] * unit) / m_;
+  }
+
+  /// The id of rank `rank` of stack_[k]: a sub-point a point glided onto keeps that point's id.
+  PointId id_of(int k, std::uint32_t rank) const {
+    while (k > 0 && rank < t_.points_at_keyframe[stack_[k].type][1]) {
+      const Node& p = stack_[k - 1];
+      const std::uint32_t from =
+          t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
+      if (from == QueryTables::kAppearing) break;
+      rank = from, --k;
+    }
+    return PointId{stack_[k].gx, stack_[k].gy, rank, std::uint32_t(k)};
+  }
+
+  /// Writes a point at world (x, y), (rx, ry) from the origin, unless it lies outside the region or where
+  /// the density is 0; false when the buffer is full.
+  bool write(double x, double y, double rx, double ry, const PointId& id) {
+    const QueryParams& p = *q_.params;
+    if (x < p.x0 || x >= p.x1 || y < p.y0 || y >= p.y1) return true;
+    if (p.density.kind != QueryDensity::Kind::kConstant && !(q_.density_at(x, y) > 0)) return true;
+    if (n_ == capacity_) return false;
+    out_[n_++] = QueryPoint{rx, ry, id};
+    return true;
+  }
+  /// The same for a position in tile n's unit coordinates.
+  bool write_unit(const Node& n, double ux, double uy, const PointId& id) {
+    const double s = q_.side[n.depth];
+    const double x = n.wx + ux * s, y = n.wy + uy * s;
+    return n.depth == 0 ? write(x, y, x - q_.params->origin_x, y - q_.params->origin_y, id)
+                        : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
+  }
+
+  /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
+  /// + a): kDone, or where the buffer or the budget ran out.
+  std::uint32_t emit(int k, std::uint32_t seq) {
+    const Node& n = stack_[k];
+    const Tile& tile = set_.tiles[n.type];
+    const float* thresholds = t_.thresholds[n.type].data();
+    const auto count = static_cast<std::uint32_t>(tile.points.size());
+    const double side = q_.side[n.depth], area = q_.area[n.depth], bound = n.rho_max * area;
+    const std::uint32_t candidates = static_cast<std::uint32_t>(
+        std::lower_bound(thresholds, thresholds + count, bound,
+                         [](float t, double l) { return TilesetShape::emits(t, l); }) -
+        thresholds);
+    // A subtile's first points come from its parent: each is the subtile's where its expected count
+    // exceeds K_1, and only there.
+    const std::uint32_t inherited = n.depth > 0 ? t_.points_at_keyframe[n.type][1] : 0;
+    const bool deeper = descends(n);
+    const std::uint32_t top_keyframe = q_.keyframes.n - 1;
+    const std::uint32_t* start = t_.glide_start[n.type].data();
+    for (std::uint32_t r = seq; r < candidates; ++r) {
+      if (budget_ == 0) return r;
+      --budget_;
+      const TilePoint& p = tile.points[r];
+      const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
+      const double expected = q_.density_at(xs, ys) * area;
+      if (r < inherited ? !(expected > q_.k1) : !TilesetShape::emits(thresholds[r], expected)) continue;
+      if (hands_over(n) && (deeper || expected > q_.top)) {
+        const std::uint32_t v = tile.handover[r], code = v % 25;
+        const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
+                                     TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
+        if (s.expected > q_.k1) continue;  // its subtile emits it
+        if (expected > q_.top) {
+          // On the straight line from its top-keyframe position to the sub-point's keyframe-1 position:
+          // a fraction s of the way, linear in the scale, 0 where its own count reaches N_top and 1
+          // where the sub-point's reaches K_1 (both are proportional to the scale).
+          const double a = expected / q_.top, b = s.expected / q_.k1, f = (a - 1) * b / (a - b);
+          const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(start[top_keyframe]) + r);
+          const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
+          const double ax = p.unit_x() + o[0] * unit, ay = p.unit_y() + o[1] * unit;
+          double bx, by;
+          keyframe_one(s, bx, by);
+          if (!write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r))) return r;
+          continue;
+        }
+      }
+      const GlideBracket g(q_.keyframes, expected);
+      const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(start[g.g0]) + r);
+      const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(start[g.g1]) + r);
+      const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
+                   dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
+      bool fits;
+      if (n.depth == 0) {  // the expression of query.cpp's emit_tile, bit for bit
+        const double unit = side * (1.0 / 65536.0), x = xs + dx * unit, y = ys + dy * unit;
+        fits = write(x, y, x - q_.params->origin_x, y - q_.params->origin_y, id_of(k, r));
+      } else {
+        fits =
+            write_unit(n, p.unit_x() + dx * (1.0 / 65536.0), p.unit_y() + dy * (1.0 / 65536.0), id_of(k, r));
+      }
+      if (!fits) return r;
+    }
+    // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].
+    if (!hands_over(n) || !(bound > q_.top)) return kDone;
+    const auto listed = static_cast<std::uint32_t>(tile.appearing.size());
+    for (std::uint32_t a = seq > count ? seq - count : 0; a < listed; ++a) {
+      if (budget_ == 0) return count + a;
+      --budget_;
+      const std::uint32_t w = tile.appearing[a], j = w >> 16;
+      const SubPoint s = sub_point(n, j % m_, j / m_, w & 0xFFFF);
+      if (s.expected > q_.k1) continue;  // its subtile emits it
+      const double threshold = q_.top + (a + 0.5) / listed * (q_.handover_end - q_.top);
+      if (!(q_.density_at(s.x, s.y) * area > threshold)) continue;
+      double ux, uy;
+      keyframe_one(s, ux, uy);
+      const PointId id{n.gx * m_ + s.cx, n.gy * m_ + s.cy, s.rank, n.depth + 1};
+      if (!write_unit(n, ux, uy, id)) return count + a;
+    }
+    return kDone;
+  }
+
+  const DescentQuery& q_;
+  const TilesetData& set_;
+  const QueryTables& t_;
+  const std::uint32_t m_;
+  QueryPoint* out_;
+  std::size_t capacity_;
+  std::size_t& n_;
+  std::uint64_t& budget_;
+  Node stack_[kMaxQueryDepth + 1];
+};
+
+}  // namespace
+
+bool emit_descending(const DescentQuery& q, std::int64_t tx, std::int64_t ty, std::size_t index,
+                     QueryPoint* out, std::size_t capacity, std::size_t& written, std::uint64_t& budget,
+                     DescentPlace& at) {
+  return Descent(q, out, capacity, written, budget).run(tx, ty, index, at);
+}
+
+}  // namespace kdm::detail
