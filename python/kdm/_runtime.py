@@ -18,11 +18,14 @@ class QueryResult:
     Attributes
     ----------
     points : numpy.ndarray
-        (m,) structured: fields x, y (float64), tile_x, tile_y (int64), rank (uint32).
+        (m,) structured: fields x, y (float64), tile_x, tile_y (int64), rank, depth (uint32). Past the
+        tile set's top level (smooth mode) points come from subtiles m**depth times smaller than a tile,
+        and tile_x, tile_y count those.
     xy : numpy.ndarray
         (m, 2) float64: world positions minus the query's origin.
     tile : numpy.ndarray
-        (m, 2) int64: each point's tile (tile_x, tile_y); with `rank`, its stable id.
+        (m, 2) int64: each point's tile (tile_x, tile_y); with `rank` and ``points["depth"]``, its
+        stable id.
     rank : numpy.ndarray
         (m,) uint32: the point's index in its tile, in emission order.
     level : numpy.ndarray
@@ -79,7 +82,9 @@ class Tileset:
     @property
     def info(self) -> Dict[str, Any]:
         """What the set holds: levels, level_points (nominal points per tile, cumulative), keyframes,
-        max_points_per_tile, colours, tiles, format_version, resident_bytes, recipe, generator_version and
+        max_points_per_tile (the stable-mode limit), smooth_limit_per_tile (the smooth-mode limit: with a
+        hand-over to subtiles, max_points_per_tile * subtiles_per_side**8), subtiles_per_side (0 without a
+        hand-over), colours, tiles, format_version, resident_bytes, recipe, generator_version and
         glide_reach (tile sides)."""
         return self._handle.info
 
@@ -120,7 +125,9 @@ class Tileset:
             `density_max`, a true upper bound of its values.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
-            info["max_points_per_tile"] where the density is highest, or the query is refused.
+            info["max_points_per_tile"] where the density is highest in stable mode, or
+            info["smooth_limit_per_tile"] in smooth mode (far more with a set that hands over to subtiles),
+            or the query is refused.
         mode : {"stable", "smooth"}
             stable: a point never moves once it appears (placing objects); smooth: points glide with the
             density, so every density is even blue noise (stippling, sample patterns).

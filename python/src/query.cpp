@@ -7,9 +7,9 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
-#include <new>
 #include <limits>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 
@@ -82,7 +82,8 @@ struct Storage {
   explicit Storage(const py::object& storage) {
     if (storage.is_none() || !py::isinstance<py::tuple>(storage)) return;
     const py::tuple t = storage.cast<py::tuple>();
-    if (t.size() != 2 || !py::isinstance<py::array>(t[0]) || !py::isinstance<py::array_t<std::uint32_t>>(t[1]))
+    if (t.size() != 2 || !py::isinstance<py::array>(t[0]) ||
+        !py::isinstance<py::array_t<std::uint32_t>>(t[1]))
       return;
     py::array records = t[0].cast<py::array>();
     py::array_t<std::uint32_t> levels_array = t[1].cast<py::array_t<std::uint32_t>>();
@@ -106,17 +107,18 @@ std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) 
   // Points come tile by tile, ranks ascending: look each tile up once and step through its levels.
   std::int64_t tx = std::numeric_limits<std::int64_t>::min(), ty = tx;
   const Tile* t = nullptr;
-  std::uint32_t level = 0, level_end = 0, last_rank = 0;
+  std::uint32_t level = 0, level_end = 0, last_rank = 0, depth = 0;
   for (;;) {
     if (m == buffer.capacity) buffer.reserve(m + kChunk, m);
     std::size_t written = 0;
     QueryProblem problem;
-    const Status s = query_points(tiles, q, buffer.points + m, std::min(kChunk, buffer.capacity - m), &written,
-                                  &cursor, &problem);
+    const Status s = query_points(tiles, q, buffer.points + m, std::min(kChunk, buffer.capacity - m),
+                                  &written, &cursor, &problem);
     for (std::size_t i = m; i < m + written; ++i) {
       const PointId& id = buffer.points[i].id;
-      if (!t || id.tile_x != tx || id.tile_y != ty || id.rank < last_rank) {
-        if (!t || id.tile_x != tx || id.tile_y != ty) tx = id.tile_x, ty = id.tile_y, t = &tiles.tile_at(tx, ty);
+      if (!t || id.tile_x != tx || id.tile_y != ty || id.depth != depth || id.rank < last_rank) {
+        if (!t || id.tile_x != tx || id.tile_y != ty || id.depth != depth)
+          tx = id.tile_x, ty = id.tile_y, depth = id.depth, t = tile_of(tiles, id);
         level = 0, level_end = t->level_end[0];
       }
       last_rank = id.rank;
@@ -134,15 +136,16 @@ std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) 
   }
 }
 
-/// numpy's view of a QueryPoint record (x, y, tile_x, tile_y, rank; 40 bytes with the padding).
+/// numpy's view of a QueryPoint record (x, y, tile_x, tile_y, rank, depth; 40 bytes).
 py::dtype record_dtype() {
   static_assert(offsetof(QueryPoint, y) == 8 && offsetof(QueryPoint, id) == 16 &&
-                    offsetof(PointId, tile_y) == 8 && offsetof(PointId, rank) == 16,
+                    offsetof(PointId, tile_y) == 8 && offsetof(PointId, rank) == 16 &&
+                    offsetof(PointId, depth) == 20,
                 "the record layout numpy is told");
-  return py::dtype::from_args(py::dict(py::arg("names") = py::make_tuple("x", "y", "tile_x", "tile_y", "rank"),
-                            py::arg("formats") = py::make_tuple("<f8", "<f8", "<i8", "<i8", "<u4"),
-                            py::arg("offsets") = py::make_tuple(0, 8, 16, 24, 32),
-                            py::arg("itemsize") = sizeof(QueryPoint)));
+  return py::dtype::from_args(py::dict(
+      py::arg("names") = py::make_tuple("x", "y", "tile_x", "tile_y", "rank", "depth"),
+      py::arg("formats") = py::make_tuple("<f8", "<f8", "<i8", "<i8", "<u4", "<u4"),
+      py::arg("offsets") = py::make_tuple(0, 8, 16, 24, 32, 36), py::arg("itemsize") = sizeof(QueryPoint)));
 }
 
 /// The result: the records (m,), xy (m×2) and tile (m×2) and rank views of them, level (m,), then the
@@ -154,9 +157,9 @@ py::tuple result(std::size_t m, Buffer& buffer, const py::object& storage) {
     py::capsule points_owner(buffer.points, [](void* p) { std::free(p); });
     py::capsule levels_owner(buffer.levels, [](void* p) { std::free(p); });
     const auto capacity = static_cast<py::ssize_t>(buffer.capacity);
-    full = py::make_tuple(py::array(record_dtype(), {capacity}, {py::ssize_t(sizeof(QueryPoint))},
-                                    buffer.points, points_owner),
-                          py::array_t<std::uint32_t>({capacity}, buffer.levels, levels_owner));
+    full = py::make_tuple(
+        py::array(record_dtype(), {capacity}, {py::ssize_t(sizeof(QueryPoint))}, buffer.points, points_owner),
+        py::array_t<std::uint32_t>({capacity}, buffer.levels, levels_owner));
   } else {
     full = storage.cast<py::tuple>();
   }

@@ -7,6 +7,7 @@
 
 #include "bindings.h"
 #include "kdm/generator/bake.h"
+#include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset_format.h"
 #include "kdm/runtime/version.h"
 
@@ -60,6 +61,8 @@ py::dict info(const TilesetHandle& h) {
   out["level_points"] = std::vector<std::uint32_t>(d.level_nominal.begin(), d.level_nominal.end());
   out["keyframes"] = std::vector<std::uint32_t>(d.keyframe_nominal.begin(), d.keyframe_nominal.end());
   out["max_points_per_tile"] = t.max_points_per_tile();
+  out["smooth_limit_per_tile"] = query_density_limit(t, QueryMode::kSmooth);
+  out["subtiles_per_side"] = d.handover_zone ? d.subtiles_per_side() : 0u;
   out["colours"] = d.colours;
   out["tiles"] = d.tiles.size();
   out["format_version"] = h.format_version;

@@ -49,17 +49,19 @@ double DescentQuery::density_at(double x, double y) const {
   return density_or_zero(d.callback(d.user, x, y));
 }
 
-double DescentQuery::density_bound(double x0, double y0, double x1, double y1) const {
+void DescentQuery::density_bounds(double x0, double y0, double x1, double y1, double& lo, double& hi) const {
   const QueryDensity& d = params->density;
   switch (d.kind) {
     case QueryDensity::Kind::kConstant:
-      return density_or_zero(d.constant);
+      lo = hi = density_or_zero(d.constant);
+      return;
     case QueryDensity::Kind::kImage:
-      return d.image->max_over(x0, y0, x1, y1);
+      lo = d.image->min_over(x0, y0, x1, y1), hi = d.image->max_over(x0, y0, x1, y1);
+      return;
     case QueryDensity::Kind::kCallback:
       break;
   }
-  return d.callback_max;
+  lo = 0, hi = d.callback_max;
 }
 
 namespace {
@@ -69,10 +71,10 @@ constexpr std::uint32_t kDone = ~0u;
 struct Node {
   std::size_t type = 0;
   std::uint32_t depth = 0;
-  std::int64_t gx = 0, gy = 0;  ///< its tile coordinates at its depth
-  double wx = 0, wy = 0;        ///< its south-west corner, world units
-  double rx = 0, ry = 0;        ///< the same relative to the query origin
-  double rho_max = 0;           ///< the density bound over it
+  std::int64_t gx = 0, gy = 0;      ///< its tile coordinates at its depth
+  double wx = 0, wy = 0;            ///< its south-west corner, world units
+  double rx = 0, ry = 0;            ///< the same relative to the query origin
+  double rho_max = 0, rho_min = 0;  ///< bounds of the density over it
   std::uint32_t next_child = 0;
   bool points_done = false;
 };
@@ -97,7 +99,8 @@ class Descent {
     root.wx = double(tx) * q_.side[0], root.wy = double(ty) * q_.side[0];
     root.rx = double(tx - q_.origin_tile_x) * q_.side[0] - q_.origin_frac_x;
     root.ry = double(ty - q_.origin_tile_y) * q_.side[0] - q_.origin_frac_y;
-    root.rho_max = q_.density_bound(root.wx, root.wy, root.wx + q_.side[0], root.wy + q_.side[0]);
+    q_.density_bounds(root.wx, root.wy, root.wx + q_.side[0], root.wy + q_.side[0], root.rho_min,
+                      root.rho_max);
     for (std::uint32_t k = 0; k < at.depth; ++k) {  // back down the path a full buffer stopped on
       const auto j = static_cast<std::uint32_t>(at.path >> (16 * k) & 0xFFFF);
       stack_[k].points_done = true, stack_[k].next_child = j + 1;
@@ -143,7 +146,7 @@ class Descent {
     c.gx = p.gx * m_ + cx, c.gy = p.gy * m_ + cy;
     c.wx = double(c.gx) * q_.side[d], c.wy = double(c.gy) * q_.side[d];
     c.rx = p.rx + double(cx) * q_.side[d], c.ry = p.ry + double(cy) * q_.side[d];
-    c.rho_max = q_.density_bound(c.wx, c.wy, c.wx + q_.side[d], c.wy + q_.side[d]);
+    q_.density_bounds(c.wx, c.wy, c.wx + q_.side[d], c.wy + q_.side[d], c.rho_min, c.rho_max);
     return c;
   }
 
@@ -216,6 +219,9 @@ class Descent {
   /// + a): kDone, or where the buffer or the budget ran out.
   std::uint32_t emit(int k, std::uint32_t seq) {
     const Node& n = stack_[k];
+    // Every point of a tile has a sub-point: where the density's lower bound puts all of them past K_1,
+    // the subtiles emit them all and the tile nothing.
+    if (n.depth < kMaxQueryDepth && n.rho_min * q_.area[n.depth + 1] > q_.k1) return kDone;
     const Tile& tile = set_.tiles[n.type];
     const float* thresholds = t_.thresholds[n.type].data();
     const auto count = static_cast<std::uint32_t>(tile.points.size());

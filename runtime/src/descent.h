@@ -37,7 +37,8 @@ struct DescentQuery {
   /// Prepares a query that query_points has validated.
   DescentQuery(const Tileset& tileset, const QueryParams& q, const ImageSampler& sampler);
   double density_at(double x, double y) const;
-  double density_bound(double x0, double y0, double x1, double y1) const;
+  /// Lower and upper bounds of the density over a rectangle (the callback's: 0 and callback_max).
+  void density_bounds(double x0, double y0, double x1, double y1, double& lo, double& hi) const;
 };
 
 /// Where a descending tile's emission stopped (QueryCursor's depth, path and rank).

@@ -420,6 +420,25 @@ double query_density_limit(const Tileset& tileset, QueryMode mode) {
   return top * std::pow(double(m), 2.0 * kMaxQueryDepth);
 }
 
+const Tile* tile_of(const Tileset& tileset, const PointId& id) {
+  if (tileset.empty()) return nullptr;
+  if (id.depth == 0) return &tileset.tile_at(id.tile_x, id.tile_y);
+  const QueryTables& tables = detail::TilesetInternals::tables(tileset);
+  const std::int64_t m = tables.subtiles;
+  if (m == 0 || id.depth > kMaxQueryDepth) return nullptr;
+  // The depth-0 tile and the subtile path down from it: the digits of the coordinates in base m.
+  std::int64_t x = id.tile_x, y = id.tile_y, digits[kMaxQueryDepth];
+  for (std::uint32_t d = id.depth; d-- > 0;) {
+    const std::int64_t cx = ((x % m) + m) % m, cy = ((y % m) + m) % m;
+    digits[d] = cy * m + cx;
+    x = (x - cx) / m, y = (y - cy) / m;
+  }
+  std::size_t type = tileset.tile_index_at(x, y);
+  for (std::uint32_t d = 0; d < id.depth; ++d)
+    type = tables.child_type[type * std::size_t(m * m) + std::size_t(digits[d])];
+  return &tileset.data().tiles[type];
+}
+
 const char* query_problem_message(QueryProblem::Kind kind) {
   switch (kind) {
     case QueryProblem::Kind::kNone:

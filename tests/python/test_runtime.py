@@ -25,6 +25,7 @@ def test_builtin_info():
     assert info["levels"] == len(info["level_points"])
     assert info["max_points_per_tile"] == info["level_points"][-1]
     assert info["tiles"] == info["colours"] ** 4 and info["keyframes"][-1] == info["max_points_per_tile"]
+    assert info["smooth_limit_per_tile"] == info["max_points_per_tile"] * max(info["subtiles_per_side"], 1) ** 8
     assert "seed" in info["recipe"] and info["resident_bytes"] > 0
     assert kdm.Tileset.builtin() is BUILTIN
 
@@ -88,7 +89,7 @@ def test_result_arrays():
     assert r.rank.dtype == np.uint32 and r.level.dtype == np.uint32 and r.level.shape == (len(r),)
     # xy, tile and rank view the runtime's records, which `points` holds: nothing is copied.
     assert r.points.shape == (len(r),) and r.points.dtype.itemsize == 40
-    assert r.points.dtype.names == ("x", "y", "tile_x", "tile_y", "rank")
+    assert r.points.dtype.names == ("x", "y", "tile_x", "tile_y", "rank", "depth")
     for view in (r.xy, r.tile, r.rank):
         assert np.shares_memory(view, r.points) and not view.flags["OWNDATA"]
     assert np.array_equal(r.xy[:, 0], r.points["x"]) and np.array_equal(r.tile[:, 1], r.points["tile_y"])
@@ -210,3 +211,25 @@ def test_out_refills_an_earlier_results_arrays():
     assert np.array_equal(np.bincount(again.level, minlength=levels) > 0, np.ones(levels, bool))
     with pytest.raises(TypeError):
         tiles.query((0, 0, 2, 2), scale=400, out=big.xy)
+
+
+@pytest.fixture(scope="module")
+def handover_tileset():
+    # Three levels (32 ... 512 points per tile) handing over to 4 x 4 subtiles: a few seconds to bake.
+    return kdm.bake("colours 2\nlevels 3\nbase_points 32\nsweeps 10\nkeyframes 4\nglide_sweeps 4\n"
+                    "handover_zone 1\n", threads=0)
+
+
+def test_smooth_queries_descend_past_the_top_level(handover_tileset):
+    info = handover_tileset.info
+    assert info["subtiles_per_side"] == 4 and info["max_points_per_tile"] == 512
+    scale = 512 * 16 * 40  # points per tile: past 512 * 16**2, depth-3 sub-points appear
+    r = handover_tileset.query((0, 0, 0.1, 0.1), scale=scale, mode="smooth")
+    assert abs(len(r) / (scale * 0.01) - 1) < 0.05
+    depth = r.points["depth"]
+    assert depth.max() == 3 and (depth == 0).any()
+    ids = set(zip(r.tile[:, 0].tolist(), r.tile[:, 1].tolist(), r.rank.tolist(), depth.tolist()))
+    assert len(ids) == len(r)
+    assert r.level.max() < info["levels"]
+    with pytest.raises(ValueError, match="scale"):
+        handover_tileset.query((0, 0, 0.1, 0.1), scale=scale, mode="stable")

@@ -75,6 +75,9 @@ int main(int argc, char** argv) {
     CHECK(info.colours == 2 && info.tiles == 16 && info.levels == 6);
     CHECK(info.level_points[0] == 32 && info.level_points[5] == 32768 && info.max_points_per_tile == 32768);
     CHECK(info.resident_bytes == kdm_tileset_resident_bytes(builtin));
+    /* Smooth queries reach m^8 times the top level with a hand-over to m x m subtiles, else the top. */
+    CHECK(info.subtiles_per_side == 0 ? info.smooth_limit_per_tile == 32768.0
+                                      : info.smooth_limit_per_tile == 32768.0 * pow(info.subtiles_per_side, 8));
     CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
     CHECK(strchr(kdm_version(), '.') != NULL);
   }

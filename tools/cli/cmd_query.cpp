@@ -42,7 +42,7 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset
   for (std::size_t i = 0; i < points.size(); ++i) {
     const QueryPoint& p = points[i];
     const double x = normalised ? unit.coords[2 * i] : p.x, y = normalised ? unit.coords[2 * i + 1] : p.y;
-    const unsigned level = tiles.tile_at(p.id.tile_x, p.id.tile_y).level_of(p.id.rank);
+    const unsigned level = tile_of(tiles, p.id)->level_of(p.id.rank);
     const long long tx = p.id.tile_x, ty = p.id.tile_y;
     if (json)
       std::snprintf(line, sizeof line,

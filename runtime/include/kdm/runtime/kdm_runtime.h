@@ -108,6 +108,9 @@ typedef struct kdm_tileset_info {
   const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
   /* Added in 0.2: */
   uint32_t keyframes; /* keyframes of its glide track (0: none; smooth queries emit stable positions) */
+  /* Added in 0.3: */
+  uint32_t subtiles_per_side;   /* m of its hand-over to subtiles past the top level (0: none) */
+  double smooth_limit_per_tile; /* the densest smooth query (max_points_per_tile * m^8 with a hand-over) */
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`

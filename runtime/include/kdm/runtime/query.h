@@ -133,6 +133,10 @@ struct QueryProblem {
 /// mode with a set that has a hand-over (TilesetShape::handover_zone), that times m^(2 · kMaxQueryDepth).
 KDM_RUNTIME_API double query_density_limit(const Tileset& tileset, QueryMode mode);
 
+/// The tile (of data().tiles) that point `id` belongs to, at any depth: its rank indexes that tile's
+/// points, so its level is tile_of(…).level_of(id.rank). Null for a depth the set does not have.
+KDM_RUNTIME_API const Tile* tile_of(const Tileset& tileset, const PointId& id);
+
 /// A short English description of a problem kind (static storage).
 KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 
