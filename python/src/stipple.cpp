@@ -48,11 +48,13 @@ py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, s
           "region must be (x0, y0, x1, y1) with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1");
     if (method == "full")
       throw std::invalid_argument("region needs method='tiles' (the full sampler has no zoom)");
-    if (1 / std::max(uv[2] - uv[0], uv[3] - uv[1]) > tools::kMaxStippleZoom + 1e-9)
-      throw std::invalid_argument("region zooms more than 2× (the tile set's density range)");
   }
   const QueryMode query_mode = mode == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
   const Tileset* given = tileset ? tileset->set.get() : nullptr;
+  if (region && 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]) >
+                    tools::max_stipple_zoom(given ? *given : Tileset::builtin(), query_mode) * (1 + 1e-9))
+    throw std::invalid_argument(
+        tools::stipple_zoom_error("region", given ? *given : Tileset::builtin(), query_mode));
   tools::PointSet set;
   {
     py::gil_scoped_release release;

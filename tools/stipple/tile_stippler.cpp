@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <vector>
 
@@ -20,6 +21,17 @@ void stipple_frame_region(const double region[4], int i, int k, double out[4]) {
   if (i == k - 1) std::copy(region, region + 4, out);  // exactly the region, whatever the rounding
 }
 
+double max_stipple_zoom(const Tileset& tileset, QueryMode mode) {
+  return kStippleZoomRoom * std::sqrt(query_density_limit(tileset, mode) / tileset.max_points_per_tile());
+}
+
+std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMode mode) {
+  char text[200];
+  std::snprintf(text, sizeof text, "%s zooms more than %.6g× (the tile set's density range in %s mode)", what,
+                max_stipple_zoom(tileset, mode), mode == QueryMode::kSmooth ? "smooth" : "stable");
+  return text;
+}
+
 TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale,
                            QueryMode mode)
     : tiles_(tileset), mode_(mode) {
@@ -31,16 +43,17 @@ TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, doub
   density_ = std::make_unique<SpecDensity>(spec, world);
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
   scale_ = points > 0 ? points / (spec.mean_value() * aspect_) : scale;
-  // Tiles small enough that the image's peak density, zoomed kMaxStippleZoom times, fits the top level.
-  // The tile size depends on the whole image only, so every region and frame sees the same dots.
+  // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
+  // (past it, smooth mode descends into subtiles). The tile size depends on the whole image only, so
+  // every region and frame sees the same dots.
   tile_size_ = std::sqrt(tiles_.max_points_per_tile() /
-                         (kMaxStippleZoom * kMaxStippleZoom * scale_ * spec.max_value()));
+                         (kStippleZoomRoom * kStippleZoomRoom * scale_ * spec.max_value()));
 }
 
 PointSet TileStippler::render(const double uv[4]) const {
   const double zoom = 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]);
-  if (zoom > kMaxStippleZoom + 1e-9)
-    throw std::invalid_argument("the region zooms more than 2× (the tile set's density range)");
+  if (zoom > max_stipple_zoom(tiles_, mode_) * (1 + 1e-9))
+    throw std::invalid_argument(stipple_zoom_error("the region", tiles_, mode_));
   QueryParams q;
   q.x0 = uv[0] * aspect_, q.y0 = uv[1], q.x1 = uv[2] * aspect_, q.y1 = uv[3];
   q.origin_x = q.x0, q.origin_y = q.y0;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include "density_spec.h"
 #include "kdm/runtime/query.h"
@@ -12,8 +13,15 @@
 
 namespace kdm::tools {
 
-/// The most a region may zoom into an image: the tile size leaves room for 2× more dots per axis.
-inline constexpr double kMaxStippleZoom = 2;
+/// The tile size leaves room for this many times more dots per axis than the whole image shows.
+inline constexpr double kStippleZoomRoom = 2;
+
+/// The most a region may zoom into an image with `tileset` in `mode`: kStippleZoomRoom, times m^4 in
+/// smooth mode with a set that hands over to m×m subtiles past its top level (query_density_limit).
+double max_stipple_zoom(const Tileset& tileset, QueryMode mode);
+
+/// The message for a region that zooms more than max_stipple_zoom.
+std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMode mode);
 
 /// The UV rectangle of frame i of k, zooming from the whole image (frame 0) into `region` (frame k − 1):
 /// the zoom grows geometrically and each rectangle lies inside the one before, so zoom coherence keeps
@@ -27,7 +35,7 @@ class TileStippler {
   /// full darkness. `tileset` must outlive the stippler; so must `spec`. Throws std::invalid_argument.
   TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode);
   /// The dots of the UV rectangle `uv` (x0, y0, x1, y1 in [0, 1]², y up), normalised to it: [0, 1)².
-  /// Throws std::invalid_argument when it zooms more than kMaxStippleZoom, std::runtime_error when the
+  /// Throws std::invalid_argument when it zooms more than max_stipple_zoom, std::runtime_error when the
   /// query would emit more than 2^25 dots.
   PointSet render(const double uv[4]) const;
   double aspect() const { return aspect_; }
