@@ -121,6 +121,23 @@ void BM_QueryDensityCallback(benchmark::State& state) {
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
 
+// Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
+// each (as depth 0's tiles do in BM_QueryConstant), over 8 × 8 of them: the same ~960k points, emitted
+// by tiles 32^d times smaller, with the hand-over's ancestors above them.
+void BM_QuerySmoothAtDepth(benchmark::State& state) {
+  const kdm::Tileset& tiles = kdm::Tileset::builtin();
+  const double m = std::sqrt(kdm::query_density_limit(tiles, kdm::QueryMode::kSmooth) /
+                             tiles.max_points_per_tile());  // m^4
+  if (!(m > 1)) return state.SkipWithError("the built-in set has no hand-over");
+  const double zoom = std::pow(std::sqrt(std::sqrt(m)), double(state.range(0)));  // m^d
+  kdm::QueryParams q = params();
+  q.mode = kdm::QueryMode::kSmooth;
+  q.x1 = q.y1 = kSide / zoom;
+  q.scale = kScale * zoom * zoom;
+  std::vector<kdm::QueryPoint> buffer(1 << 20);
+  run_against_baseline(state, [&] { return run_query(q, buffer); });
+}
+
 void BM_BaselineWriteSamePoints(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   const std::size_t n = run_query(params(), buffer);
@@ -144,6 +161,7 @@ void BM_LoadBuiltinSet(benchmark::State& state) {
 BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityCallback)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -185,6 +185,32 @@ class Descent {
     ux = (s.cx + p.unit_x() + o[0] * unit) / m_, uy = (s.cy + p.unit_y() + o[1] * unit) / m_;
   }
 
+  /// Whose a point is and the count that places it. Rank `rank` of stack_[k], with `expected` the tile's
+  /// count at its stable position: a rank the tile inherits (one of its parent's sub-points) is its own
+  /// once taken over: past K_1 there and, unless it appears on its own, its parent's point gliding onto
+  /// it its parent's own and past the end of its hand-over (m² K_1). Such a point is placed by the smaller
+  /// of its count and its parent point's over m², so that it stands at its keyframe-1 position when taken
+  /// over, however unequal the two counts; every count is proportional to the scale, so no point ever
+  /// jumps. Other ranks are the tile's own, placed by their count (whether it is emitted is the caller's).
+  struct Share {
+    bool own;
+    double count;
+  };
+  Share share(int k, std::uint32_t rank, double expected) const {
+    if (k == 0 || rank >= t_.points_at_keyframe[stack_[k].type][1]) return {true, expected};
+    const Node& p = stack_[k - 1];
+    const std::uint32_t from =
+        t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
+    if (from == QueryTables::kAppearing) return {expected > q_.k1, expected};
+    const TilePoint& point = set_.tiles[p.type].points[from];
+    const double side = q_.side[p.depth];  // as emit computes the parent's own count there
+    const Share parent =
+        share(k - 1, from,
+              q_.density_at(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
+    return {parent.own && expected > q_.k1 && parent.count > q_.handover_end,
+            std::min(expected, parent.count / (double(m_) * m_))};
+  }
+
   /// The id of rank `rank` of stack_[k]: a sub-point a point glided onto keeps that point's id.
   PointId id_of(int k, std::uint32_t rank) const {
     while (k > 0 && rank < t_.points_at_keyframe[stack_[k].type][1]) {
@@ -219,21 +245,21 @@ class Descent {
   /// + a): kDone, or where the buffer or the budget ran out.
   std::uint32_t emit(int k, std::uint32_t seq) {
     const Node& n = stack_[k];
-    // Every point of a tile has a sub-point: where the density's lower bound puts all of them past K_1,
-    // the subtiles emit them all and the tile nothing.
-    if (n.depth < kMaxQueryDepth && n.rho_min * q_.area[n.depth + 1] > q_.k1) return kDone;
     const Tile& tile = set_.tiles[n.type];
     const float* thresholds = t_.thresholds[n.type].data();
     const auto count = static_cast<std::uint32_t>(tile.points.size());
     const double side = q_.side[n.depth], area = q_.area[n.depth], bound = n.rho_max * area;
-    const std::uint32_t candidates = static_cast<std::uint32_t>(
+    std::uint32_t candidates = static_cast<std::uint32_t>(
         std::lower_bound(thresholds, thresholds + count, bound,
                          [](float t, double l) { return TilesetShape::emits(t, l); }) -
         thresholds);
-    // A subtile's first points come from its parent: each is the subtile's where its expected count
-    // exceeds K_1, and only there.
+    // A subtile's first points come from its parent, which emits them until the subtile takes them over.
     const std::uint32_t inherited = n.depth > 0 ? t_.points_at_keyframe[n.type][1] : 0;
-    const bool deeper = descends(n);
+    // Every point has a sub-point: where the density's lower bound puts the tile's own points past the end
+    // of their hand-over and every sub-point past K_1, its subtiles hold all but the inherited ones.
+    const bool handed_over = n.depth < kMaxQueryDepth && n.rho_min * area > q_.handover_end &&
+                             n.rho_min * q_.area[n.depth + 1] > q_.k1;
+    if (handed_over) candidates = std::min(candidates, inherited);
     const std::uint32_t top_keyframe = q_.keyframes.n - 1;
     const std::uint32_t* start = t_.glide_start[n.type].data();
     for (std::uint32_t r = seq; r < candidates; ++r) {
@@ -241,18 +267,21 @@ class Descent {
       --budget_;
       const TilePoint& p = tile.points[r];
       const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
-      const double expected = q_.density_at(xs, ys) * area;
-      if (r < inherited ? !(expected > q_.k1) : !TilesetShape::emits(thresholds[r], expected)) continue;
-      if (hands_over(n) && (deeper || expected > q_.top)) {
+      const Share mine = share(k, r, q_.density_at(xs, ys) * area);
+      if (r < inherited ? !mine.own : !TilesetShape::emits(thresholds[r], mine.count)) continue;
+      const double expected = mine.count;
+      if (hands_over(n) && expected > q_.top) {
         const std::uint32_t v = tile.handover[r], code = v % 25;
         const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
                                      TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
-        if (s.expected > q_.k1) continue;  // its subtile emits it
-        if (expected > q_.top) {
-          // On the straight line from its top-keyframe position to the sub-point's keyframe-1 position:
-          // a fraction s of the way, linear in the scale, 0 where its own count reaches N_top and 1
-          // where the sub-point's reaches K_1 (both are proportional to the scale).
-          const double a = expected / q_.top, b = s.expected / q_.k1, f = (a - 1) * b / (a - b);
+        if (s.expected > q_.k1 && expected > q_.handover_end) continue;  // its subtile took it over
+        {
+          // On the straight line from its top-keyframe position to the sub-point's keyframe-1 position,
+          // a fraction f of the way, linear in the scale: 0 where its own count a · N_top reaches N_top,
+          // 1 where both its own count passes m² K_1 and the sub-point's b · K_1 passes K_1 (a and b are
+          // proportional to the scale), which is where its subtile takes it over.
+          const double a = expected / q_.top, b = s.expected / q_.k1;
+          const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, q_.handover_end / q_.top) - 1);
           const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(start[top_keyframe]) + r);
           const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
           const double ax = p.unit_x() + o[0] * unit, ay = p.unit_y() + o[1] * unit;
@@ -278,14 +307,14 @@ class Descent {
       if (!fits) return r;
     }
     // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].
-    if (!hands_over(n) || !(bound > q_.top)) return kDone;
+    if (!hands_over(n) || !(bound > q_.top) || handed_over) return kDone;
     const auto listed = static_cast<std::uint32_t>(tile.appearing.size());
     for (std::uint32_t a = seq > count ? seq - count : 0; a < listed; ++a) {
       if (budget_ == 0) return count + a;
       --budget_;
       const std::uint32_t w = tile.appearing[a], j = w >> 16;
       const SubPoint s = sub_point(n, j % m_, j / m_, w & 0xFFFF);
-      if (s.expected > q_.k1) continue;  // its subtile emits it
+      if (s.expected > q_.k1) continue;  // its subtile took it over (share: it appears on its own)
       const double threshold = q_.top + (a + 0.5) / listed * (q_.handover_end - q_.top);
       if (!(q_.density_at(s.x, s.y) * area > threshold)) continue;
       double ux, uy;
