@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "kdm/runtime/query.h"
@@ -35,13 +36,18 @@ kdm::QueryParams params(const benchmark::State& state) {
   return q;
 }
 
-std::size_t run_query(const kdm::QueryParams& q, std::vector<kdm::QueryPoint>& buffer) {
+std::size_t run_query(const kdm::Tileset& tiles, const kdm::QueryParams& q,
+                      std::vector<kdm::QueryPoint>& buffer) {
   kdm::QueryCursor cursor;
   std::size_t written = 0, total = 0;
-  while (kdm::query_points(kdm::Tileset::builtin(), q, buffer.data(), buffer.size(), &written, &cursor) ==
+  while (kdm::query_points(tiles, q, buffer.data(), buffer.size(), &written, &cursor) ==
          kdm::Status::kBufferFull)
     total += written;
   return total + written;
+}
+
+std::size_t run_query(const kdm::QueryParams& q, std::vector<kdm::QueryPoint>& buffer) {
+  return run_query(kdm::Tileset::builtin(), q, buffer);
 }
 
 // Writes `n` points into `buffer` the way a query does, with no logic: the practical limit.
@@ -124,8 +130,13 @@ void BM_QueryDensityCallback(benchmark::State& state) {
 // Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
 // each (as depth 0's tiles do in BM_QueryConstant), over 8 × 8 of them: the same ~960k points, emitted
 // by tiles 32^d times smaller, with the hand-over's ancestors above them.
+// KDM_BENCHMARK_TILESET names another set (one with a hand-over) to measure instead of the built-in one.
 void BM_QuerySmoothAtDepth(benchmark::State& state) {
-  const kdm::Tileset& tiles = kdm::Tileset::builtin();
+  static kdm::Tileset loaded;
+  const char* path = std::getenv("KDM_BENCHMARK_TILESET");
+  if (path && loaded.empty() && kdm::Tileset::load_file(path, loaded) != kdm::Status::kOk)
+    return state.SkipWithError("KDM_BENCHMARK_TILESET does not load");
+  const kdm::Tileset& tiles = path ? loaded : kdm::Tileset::builtin();
   const double m = std::sqrt(kdm::query_density_limit(tiles, kdm::QueryMode::kSmooth) /
                              tiles.max_points_per_tile());  // m^4
   if (!(m > 1)) return state.SkipWithError("the built-in set has no hand-over");
@@ -135,7 +146,7 @@ void BM_QuerySmoothAtDepth(benchmark::State& state) {
   q.x1 = q.y1 = kSide / zoom;
   q.scale = kScale * zoom * zoom;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
-  run_against_baseline(state, [&] { return run_query(q, buffer); });
+  run_against_baseline(state, [&] { return run_query(tiles, q, buffer); });
 }
 
 void BM_BaselineWriteSamePoints(benchmark::State& state) {

@@ -96,7 +96,7 @@ void QueryTables::index_handover(const TilesetData& set) {
       const std::uint32_t v = tile.handover[r], d = v % 25;
       const std::uint32_t j = (TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2) * m +
                               TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
-      from[start[j] + v / 25] = r;
+      if (j < m2 && start[j] + v / 25 < start[j + 1]) from[start[j] + v / 25] = r;  // validated: always
     }
   }
 }
