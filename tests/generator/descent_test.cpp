@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <map>
+#include <new>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -14,6 +17,24 @@
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
+
+// Counts heap allocations made by this test binary, to prove deep queries make none (as query_test does
+// at depth 0). The replacement pairs malloc with free on purpose.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace kdm {
 namespace {
@@ -214,6 +235,21 @@ TEST(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
     }
     parts.clear();
   }
+}
+
+TEST(DescentTest, DeepQueriesAllocateNothing) {
+  const Tileset& t = small_set();  // baked and loaded outside the measured window
+  QueryParams p = uniform(0.2, 512.0 * 16 * 40);
+  p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
+  std::vector<QueryPoint> buffer(64);  // small: the cursor resumes inside subtiles
+  const long before = g_allocations.load();
+  std::size_t total = 0, written = 0;
+  QueryCursor cursor;
+  while (query_points(t, p, buffer.data(), buffer.size(), &written, &cursor) == Status::kBufferFull)
+    total += written;
+  total += written;
+  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_GT(total, 2000u);  // about 3,750 points, down to depth 3
 }
 
 TEST(DescentTest, PositionsFarFromTheWorldOriginKeepTheirPrecision) {

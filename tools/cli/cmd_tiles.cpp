@@ -85,7 +85,8 @@ void run_info(const std::string& path) {
         loaded.glide_reach());
   if (set.handover_zone)
     std::printf(
-        "hand-over      onto %u x %u subtiles past the top level (zones of %u sub-steps; not yet queried)\n",
+        "hand-over      onto %u x %u subtiles past the top level (zones of %u sub-steps; smooth queries "
+        "descend)\n",
         set.subtiles_per_side(), set.subtiles_per_side(), set.handover_zone);
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
