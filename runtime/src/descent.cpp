@@ -262,12 +262,19 @@ class Descent {
     if (handed_over) candidates = std::min(candidates, inherited);
     const std::uint32_t top_keyframe = q_.keyframes.n - 1;
     const std::uint32_t* start = t_.glide_start[n.type].data();
+    // A constant density: one count and one bracket for the tile's own points (the same values the
+    // per-point expressions give).
+    const bool constant = q_.params->density.kind == QueryDensity::Kind::kConstant;
+    const double constant_count = constant ? density_or_zero(q_.params->density.constant) * area : 0;
+    const GlideBracket constant_bracket =
+        constant ? GlideBracket(q_.keyframes, constant_count) : GlideBracket();
     for (std::uint32_t r = seq; r < candidates; ++r) {
       if (budget_ == 0) return r;
       --budget_;
       const TilePoint& p = tile.points[r];
       const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
-      const Share mine = share(k, r, q_.density_at(xs, ys) * area);
+      const double count_here = constant ? constant_count : q_.density_at(xs, ys) * area;
+      const Share mine = r < inherited ? share(k, r, count_here) : Share{true, count_here};
       if (r < inherited ? !mine.own : !TilesetShape::emits(thresholds[r], mine.count)) continue;
       const double expected = mine.count;
       if (hands_over(n) && expected > q_.top) {
@@ -291,7 +298,8 @@ class Descent {
           continue;
         }
       }
-      const GlideBracket g(q_.keyframes, expected);
+      const GlideBracket g =
+          constant && r >= inherited ? constant_bracket : GlideBracket(q_.keyframes, expected);
       const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(start[g.g0]) + r);
       const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(start[g.g1]) + r);
       const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,

@@ -237,6 +237,25 @@ TEST(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
   }
 }
 
+TEST(DescentTest, BelowTheTopTheDescentGivesTheOrdinaryPathsBits) {
+  // The same density (a ramp up to 1, 400 points per tile at most, below N_top = 512) with a bound of 1
+  // (every tile takes the ordinary path) and of 50 (every tile takes the descent, which emits the same
+  // points: none is past N_top): the same points, ids and position bits, in the same order.
+  QueryParams p = uniform(0, 400);
+  p.x0 = -1.3, p.y0 = 0.2, p.x1 = 2.1, p.y1 = 1.9, p.origin_x = 0.6, p.origin_y = -0.3;
+  p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
+  const std::vector<QueryPoint> ordinary = query(p);
+  p.density.callback_max = 50;
+  const std::vector<QueryPoint> descended = query(p);
+  ASSERT_EQ(ordinary.size(), descended.size());
+  EXPECT_GT(ordinary.size(), 500u);
+  for (std::size_t i = 0; i < ordinary.size(); ++i) {
+    ASSERT_TRUE(ordinary[i].id == descended[i].id) << i;
+    ASSERT_EQ(ordinary[i].x, descended[i].x) << i;
+    ASSERT_EQ(ordinary[i].y, descended[i].y) << i;
+  }
+}
+
 TEST(DescentTest, DeepQueriesAllocateNothing) {
   const Tileset& t = small_set();  // baked and loaded outside the measured window
   QueryParams p = uniform(0.2, 512.0 * 16 * 40);
