@@ -14,27 +14,10 @@
 #include <tuple>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
-
-// Counts heap allocations made by this test binary, to prove deep queries make none (as query_test does
-// at depth 0). The replacement pairs malloc with free on purpose.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace kdm {
 namespace {
@@ -261,13 +244,13 @@ TEST(DescentTest, DeepQueriesAllocateNothing) {
   QueryParams p = uniform(0.2, 512.0 * 16 * 40);
   p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
   std::vector<QueryPoint> buffer(64);  // small: the cursor resumes inside subtiles
-  const long before = g_allocations.load();
+  const long before = testing::allocations();
   std::size_t total = 0, written = 0;
   QueryCursor cursor;
   while (query_points(t, p, buffer.data(), buffer.size(), &written, &cursor) == Status::kBufferFull)
     total += written;
   total += written;
-  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_EQ(testing::allocations(), before);
   EXPECT_GT(total, 2000u);  // about 3,750 points, down to depth 3
 }
 

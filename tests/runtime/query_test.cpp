@@ -13,28 +13,11 @@
 #include <tuple>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "kdm/analysis/density.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 #include "query_tables.h"
-
-// Counts heap allocations made by this test binary, to prove queries make none. The replacement pairs
-// malloc with free on purpose; GCC's mismatch warning cannot see that both sides are replaced.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-static std::atomic<long> g_allocations{0};
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace kdm {
 namespace {
@@ -509,7 +492,7 @@ TEST(QueryTest, TheCApiSharesTheBuiltinSet) {
 TEST_P(ModeTest, QueriesDoNotAllocate) {
   std::vector<QueryPoint> buffer(4096);
   const Tileset& t = Tileset::builtin();  // decode outside the measured window
-  const long before = g_allocations.load();
+  const long before = testing::allocations();
   std::size_t total = 0;
   for (int i = 0; i < 20; ++i) {
     QueryCursor cursor;
@@ -520,7 +503,7 @@ TEST_P(ModeTest, QueriesDoNotAllocate) {
     total += written;
   }
   EXPECT_GT(total, 0u);
-  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_EQ(testing::allocations(), before);
 }
 
 }  // namespace
