@@ -5,6 +5,7 @@
 // came from, and the same happens one depth further down, to kMaxQueryDepth.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
