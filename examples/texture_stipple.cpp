@@ -8,9 +8,9 @@
 //
 // Per frame it prints the query's point count, the deepest subtile depth, the dot density on screen where
 // the tone is fixed (also relative to its target D × darkness), and the largest motion of a dot over the
-// surface since the previous frame, in spacings 1/√D (near the silhouette apart). With --check it exits
-// non-zero if the relative density of the last frame differs from the first's by more than 10% or a dot
-// away from the silhouette moves half a spacing or more in one frame.
+// surface since the previous frame, in its spacing 1/√(D × darkness) (near the silhouette apart). With
+// --check it exits non-zero if the relative density of the last frame differs from the first's by more than
+// 10% or a dot away from the silhouette moves half a spacing or more in one frame.
 //
 //   texture_stipple [--tileset FILE] [--frames K] [--size PIXELS] [--dots-per-pixel-area D] [--check] -o DIR
 #include <kdm/runtime/query.h>
@@ -147,6 +147,7 @@ struct Dot {  // a point of one frame, kept to follow it into the next
   kdm::PointId id;
   double u, v;
   bool shown;
+  double darkness;  // 1 − tone where it lies: its spacing on screen is 1/√(D · darkness)
 };
 bool id_less(const Dot& a, const Dot& b) {
   return std::tie(a.id.depth, a.id.tile_x, a.id.tile_y, a.id.rank) <
@@ -306,7 +307,7 @@ int main(int argc, char** argv) {
       double sx, sy;
       cam.project(s, sx, sy);
       const bool visible = dot(cam.eye - s, s) > 0 && cam.on_screen(sx, sy);
-      current.push_back({p.id, p.x, p.y, visible});
+      current.push_back({p.id, p.x, p.y, visible, 1 - tone(p.x, p.y, s)});
       depth = std::max(depth, p.id.depth);
       if (!visible) continue;
       ++shown;
@@ -330,7 +331,8 @@ int main(int argc, char** argv) {
     last_density = relative, lowest = std::min(lowest, relative), highest = std::max(highest, relative);
 
     // Dots in both frames, matched by id: how far each moved over the surface, both of its texture
-    // positions seen by this frame's camera (so the camera's own motion is not counted), in spacings.
+    // positions seen by this frame's camera (so the camera's own motion is not counted), in its own
+    // spacing on screen, that of the dots around it.
     std::sort(current.begin(), current.end(), id_less);
     double jump = 0, rim_jump = 0;
     for (std::size_t i = 0, j = 0; k > 0 && i < current.size(); ++i) {
@@ -340,7 +342,7 @@ int main(int argc, char** argv) {
       const Vec a = surface(previous[j].u, previous[j].v), b = surface(current[i].u, current[i].v);
       double ax, ay, bx, by;
       cam.project(a, ax, ay), cam.project(b, bx, by);
-      const double moved = std::hypot(bx - ax, by - ay) / spacing;
+      const double moved = std::hypot(bx - ax, by - ay) * std::sqrt(current[i].darkness) / spacing;
       // Near the silhouette the texture-space density falls to 0 with the foreshortening, so the few points
       // there lie far apart in texture space and glide fast as the silhouette sweeps over them: kept apart.
       const bool rim = std::min(dot(normalized(cam.eye - a), a), dot(normalized(cam.eye - b), b)) < kRim;

@@ -33,7 +33,8 @@ DescentQuery::DescentQuery(const Tileset& tileset, const QueryParams& q, const I
     origin_frac_x = q.origin_x, origin_frac_y = q.origin_y;
   }
   reach = tables->glide_reach_from.empty() ? 0 : tables->glide_reach_from[0];
-  top = set->keyframe_nominal.back(), k1 = set->keyframe_nominal[1], handover_end = m * m * k1;
+  top = set->keyframe_nominal.back(), k1 = set->keyframe_nominal[1];
+  appearing_end = set->appearing_end();
 }
 
 double DescentQuery::density_at(double x, double y) const {
@@ -176,6 +177,20 @@ class Descent {
     s.expected = q_.density_at(s.x, s.y) * q_.area[d];
     return s;
   }
+  /// Where sub-point s lies when its subtile's count at it is `count` (at least K_1), in its parent's unit
+  /// coordinates: as the subtile places it once it owns it.
+  void glided(const SubPoint& s, double count, double& ux, double& uy) const {
+    const TilePoint& p = set_.tiles[s.type].points[s.rank];
+    const std::int8_t* glide = set_.tiles[s.type].glide.data();
+    const std::uint32_t* start = t_.glide_start[s.type].data();
+    const GlideBracket g(q_.keyframes, std::max(count, q_.k1));
+    const std::int8_t *o0 = glide + 2 * (std::size_t(start[g.g0]) + s.rank),
+                      *o1 = glide + 2 * (std::size_t(start[g.g1]) + s.rank);
+    const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
+                 dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
+    ux = (s.cx + p.unit_x() + dx * (1.0 / 65536.0)) / m_,
+    uy = (s.cy + p.unit_y() + dy * (1.0 / 65536.0)) / m_;
+  }
   /// Where sub-point s lies at its subtile's keyframe 1, in its parent's unit coordinates.
   void keyframe_one(const SubPoint& s, double& ux, double& uy) const {
     const TilePoint& p = set_.tiles[s.type].points[s.rank];
@@ -207,7 +222,7 @@ class Descent {
     const Share parent =
         share(k - 1, from,
               q_.density_at(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
-    return {parent.own && expected > q_.k1 && parent.count > q_.handover_end,
+    return {parent.own && expected > q_.k1 && parent.count > t_.handover_end[p.type][from],
             std::min(expected, parent.count / (double(m_) * m_))};
   }
 
@@ -257,7 +272,7 @@ class Descent {
     const std::uint32_t inherited = n.depth > 0 ? t_.points_at_keyframe[n.type][1] : 0;
     // Every point has a sub-point: where the density's lower bound puts the tile's own points past the end
     // of their hand-over and every sub-point past K_1, its subtiles hold all but the inherited ones.
-    const bool handed_over = n.depth < kMaxQueryDepth && n.rho_min * area > q_.handover_end &&
+    const bool handed_over = n.depth < kMaxQueryDepth && n.rho_min * area > t_.handover_end_max[n.type] &&
                              n.rho_min * q_.area[n.depth + 1] > q_.k1;
     if (handed_over) candidates = std::min(candidates, inherited);
     const std::uint32_t top_keyframe = q_.keyframes.n - 1;
@@ -281,19 +296,21 @@ class Descent {
         const std::uint32_t v = tile.handover[r], code = v % 25;
         const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
                                      TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
-        if (s.expected > q_.k1 && expected > q_.handover_end) continue;  // its subtile took it over
+        const double end = t_.handover_end[n.type][r];
+        if (s.expected > q_.k1 && expected > end) continue;  // its subtile took it over
         {
-          // On the straight line from its top-keyframe position to the sub-point's keyframe-1 position,
-          // a fraction f of the way, linear in the scale: 0 where its own count a · N_top reaches N_top,
-          // 1 where both its own count passes m² K_1 and the sub-point's b · K_1 passes K_1 (a and b are
-          // proportional to the scale), which is where its subtile takes it over.
+          // On the straight line from its top-keyframe position to where its subtile will place the
+          // sub-point, a fraction f of the way, linear in the scale: 0 where its own count a · N_top
+          // reaches N_top, 1 where both its own count passes the hand-over's end and the sub-point's
+          // b · K_1 passes K_1 (a and b are proportional to the scale), which is where its subtile takes
+          // it over and places it by the smaller of b · K_1 and its count over m² (share).
           const double a = expected / q_.top, b = s.expected / q_.k1;
-          const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, q_.handover_end / q_.top) - 1);
+          const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, end / q_.top) - 1);
           const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(start[top_keyframe]) + r);
           const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
           const double ax = p.unit_x() + o[0] * unit, ay = p.unit_y() + o[1] * unit;
           double bx, by;
-          keyframe_one(s, bx, by);
+          glided(s, std::min(s.expected, expected / (double(m_) * m_)), bx, by);
           if (!write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r))) return r;
           continue;
         }
@@ -323,7 +340,7 @@ class Descent {
       const std::uint32_t w = tile.appearing[a], j = w >> 16;
       const SubPoint s = sub_point(n, j % m_, j / m_, w & 0xFFFF);
       if (s.expected > q_.k1) continue;  // its subtile took it over (share: it appears on its own)
-      const double threshold = q_.top + (a + 0.5) / listed * (q_.handover_end - q_.top);
+      const double threshold = q_.top + (a + 0.5) / listed * (q_.appearing_end - q_.top);
       if (!(q_.density_at(s.x, s.y) * area > threshold)) continue;
       double ux, uy;
       keyframe_one(s, ux, uy);

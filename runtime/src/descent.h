@@ -33,7 +33,7 @@ struct DescentQuery {
   double origin_frac_x = 0, origin_frac_y = 0;  ///< the origin's place in its depth-0 tile, world units
   std::int64_t origin_tile_x = 0, origin_tile_y = 0;
   double reach = 0;  ///< the farthest a tile's points (and its subtiles') lie outside it, in its sides
-  double top = 0, k1 = 0, handover_end = 0;  ///< N_top, K_1 and m² K_1
+  double top = 0, k1 = 0, appearing_end = 0;  ///< N_top, K_1 and m² K_1
 
   /// Prepares a query that query_points has validated.
   DescentQuery(const Tileset& tileset, const QueryParams& q, const ImageSampler& sampler);

@@ -77,6 +77,9 @@ void QueryTables::index_handover(const TilesetData& set) {
   child_type.assign(set.tiles.size() * m2, 0);
   inherited_start.assign(set.tiles.size() * (m2 + 1), 0);
   inherited.assign(set.tiles.size(), {});
+  handover_end.assign(set.tiles.size(), {});
+  handover_end_max.assign(set.tiles.size(), 0.0);
+  const std::size_t top = set.keyframe_nominal.size() - 1;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
                ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
@@ -97,6 +100,26 @@ void QueryTables::index_handover(const TilesetData& set) {
       const std::uint32_t j = (TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2) * m +
                               TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
       if (j < m2 && start[j] + v / 25 < start[j + 1]) from[start[j] + v / 25] = r;  // validated: always
+    }
+    // Each point's glide, top-keyframe position to sub-point's keyframe-1 position (tile units), in
+    // spacings 1/√N_top; the expressions descent.cpp's positions use.
+    handover_end[t].assign(tile.points.size(), 0.0f);
+    for (std::uint32_t j = 0; j < m2; ++j) {
+      const Tile& child = set.tiles[child_type[t * m2 + j]];
+      for (std::uint32_t q = 0; q < start[j + 1] - start[j]; ++q) {
+        const std::uint32_t r = from[start[j] + q];
+        if (r == kAppearing) continue;
+        const std::int8_t* a = tile.glide.data() + 2 * (std::size_t(glide_start[t][top]) + r);
+        const std::int8_t* b =
+            child.glide.data() + 2 * (std::size_t(glide_start[child_type[t * m2 + j]][1]) + q);
+        const double ax = tile.points[r].unit_x() + a[0] * (glide_scale[top] / 65536.0),
+                     ay = tile.points[r].unit_y() + a[1] * (glide_scale[top] / 65536.0);
+        const double bx = (j % m + child.points[q].unit_x() + b[0] * (glide_scale[1] / 65536.0)) / m,
+                     by = (j / m + child.points[q].unit_y() + b[1] * (glide_scale[1] / 65536.0)) / m;
+        const double glide = std::hypot(bx - ax, by - ay) * std::sqrt(double(set.level_nominal.back()));
+        handover_end[t][r] = static_cast<float>(set.handover_end(glide));
+        handover_end_max[t] = std::max(handover_end_max[t], double(handover_end[t][r]));
+      }
     }
   }
 }
@@ -145,7 +168,8 @@ std::size_t QueryTables::resident_bytes() const {
          flat_bytes(glide_reach_from) + flat_bytes(glide_scale) + nested_bytes(points_at_keyframe) +
          flat_bytes(keyframe_nominal) + flat_bytes(glide_spans) + flat_bytes(keyframe_guess) +
          nested_bytes(edge_ranks) + flat_bytes(edge_start) + flat_bytes(child_type) +
-         nested_bytes(inherited) + flat_bytes(inherited_start);
+         nested_bytes(inherited) + flat_bytes(inherited_start) + nested_bytes(handover_end) +
+         flat_bytes(handover_end_max);
 }
 
 std::uint32_t first_keyframe_at_least(const Tileset& set, double expected) {

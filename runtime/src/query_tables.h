@@ -65,6 +65,11 @@ struct QueryTables {
   TilesetArray<TilesetArray<std::uint32_t>> inherited;
   TilesetArray<std::uint32_t> inherited_start;
   static constexpr std::uint32_t kAppearing = ~0u;
+  /// Per tile and rank, the count where its subtile takes the point over (TilesetShape::handover_end of
+  /// its glide, from its top-keyframe position to its sub-point's keyframe-1 position), and per tile the
+  /// largest of them.
+  TilesetArray<TilesetArray<float>> handover_end;
+  TilesetArray<double> handover_end_max;
   /// The allocator hooks this object itself came from (Tileset allocates it through them).
   AllocatorHooks hooks;
 

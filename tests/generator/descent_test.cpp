@@ -141,9 +141,9 @@ TEST(DescentTest, PointsStayWithTheirIdsAndMoveContinuouslyAsTheScaleGrows) {
       before = std::move(now);
     }
     // A hand-over takes the scale from where a point's count reaches N_top to where it and its
-    // sub-point's pass their ends, at least ×m² K_1 / N_top (×1.41 here): 27 steps or more for a glide of
-    // up to 3 spacings, about 0.1 spacings a step, where a jump would be a spacing or more. Measured:
-    // 0.040 on the ramp, 0.11 across the step.
+    // sub-point's pass their ends, at least ×2.83 here (three keyframe intervals of ×√2): 80 steps or more
+    // for a glide of up to 3 spacings, about 0.04 spacings a step, where a jump would be a spacing or
+    // more. Measured: 0.048 on the ramp, 0.11 across the step.
     EXPECT_LT(largest_step, 0.35) << (density == ramp ? "ramp" : "step");
   }
 }

@@ -180,9 +180,10 @@ TEST(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
 }
 
 TEST(HandoverTest, TheVerifierJudgesTheHandOverAlongItsPaths) {
-  // Part 6 of kdm verify: four rows from just past the top level to the subtiles' own count. Its figures
-  // agree with scripts/handover_check's independent reading of the file (δavg .809, .793, .820 at a quarter,
-  // half and three quarters on this set; the set is baked with few sweeps and keyframes, so the bars fail).
+  // Part 6 of kdm verify: four rows evenly spaced from just past the top level to where 99% of the points
+  // are their subtiles' (each glide ends at TilesetShape::handover_end of its length), the last with the
+  // glides' motion per top keyframe interval. The set is baked with few sweeps and keyframes, so δavg is
+  // low (.77 to .83 measured) and the bars fail.
   const Baked& b = small_set();
   verify::VerifyOptions o;
   o.levels = {b.set.levels - 1};
@@ -193,17 +194,21 @@ TEST(HandoverTest, TheVerifierJudgesTheHandOverAlongItsPaths) {
   for (const verify::KeyframeResult& k : report.keyframes)
     if (k.handover) rows.push_back(&k);
   ASSERT_EQ(rows.size(), 4u);
-  const double n_top = b.set.level_nominal.back(), n_end = b.sub.m * b.sub.m * b.set.keyframe_nominal[1];
+  const double n_top = b.set.level_nominal.back(), last = rows[3]->points_per_tile;
+  EXPECT_GE(last, b.set.appearing_end());    // every sub-point has appeared by then
+  EXPECT_LE(last, b.set.handover_end(3.0));  // no glide is 3 spacings (PointsGlideOnlyAFewSpacings)
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    EXPECT_NEAR(rows[i]->points_per_tile, n_top + (i + 1) / 4.0 * (n_end - n_top), 1e-9);
+    EXPECT_NEAR(rows[i]->points_per_tile, n_top + (i + 1) / 4.0 * (last - n_top), 1e-9);
     EXPECT_GT(rows[i]->davg, 0.7);
     EXPECT_LT(rows[i]->davg, 0.95);
     EXPECT_GT(rows[i]->closest_pair, 0.0);
   }
-  // At the end the points stand on the subtiles' keyframe 1: as even as that relaxed keyframe, better than
-  // half-way, where straight paths cross appearing points.
-  EXPECT_GT(rows[3]->davg, rows[1]->davg + 0.03);
-  EXPECT_GT(rows[3]->closest_pair, rows[1]->closest_pair);
+  // A glide spans as many keyframe intervals as it needs to move no faster than kHandoverSpacingsPerKeyframe
+  // (0.5 spacings 1/√N_top) per interval: about 0.6 mean nearest-neighbour distances at this set's δavg
+  // (0.60 measured), where a glide over the fixed span m² K_1 would move up to 3 spacings in one.
+  EXPECT_GT(rows[3]->motion_p99, 0.0);
+  EXPECT_LT(rows[3]->motion_p99, 0.7);
+  EXPECT_TRUE(std::isnan(rows[0]->motion_p99));
 }
 
 TEST(HandoverTest, RecipesNameTheZonesTheyCanHave) {

@@ -127,47 +127,93 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
   const std::size_t top = set.keyframe_nominal.size() - 1;
   const Subdivision sub = set.subdivision();
   const std::uint32_t m = sub.m, C = set.colours;
-  const double n_top = set.level_nominal.back(), n_end = double(m) * m * set.keyframe_nominal[1];
-  TilePositions start(set.tiles.size()), sub_points(set.tiles.size());
+  const double n_top = set.level_nominal.back(), k1 = set.keyframe_nominal[1];
+  const double appearing_end = set.appearing_end(), top_step = n_top / set.keyframe_nominal[top - 1];
+  TilePositions start(set.tiles.size()), keyframe_one(set.tiles.size());
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     start[t] = glided(set, t, std::numeric_limits<double>::infinity(), top, top, 0);
-    sub_points[t] = glided(set, t, set.keyframe_nominal[1], 1, 1, 0);
+    keyframe_one[t] = glided(set, t, k1, 1, 1, 0);
   }
-  // Each tile's targets and appearing points, in its unit coordinates.
-  TilePositions target(set.tiles.size()), appearing(set.tiles.size());
+  // Each tile's points (rank order) as the sub-point each glides onto (subtile, rank) and the count where
+  // its subtile takes it over, and its appearing sub-points.
+  struct SubRef {
+    std::uint32_t i, k, rank;
+    std::size_t type;
+    double end = 0;
+  };
+  std::vector<std::vector<SubRef>> target(set.tiles.size()), appearing(set.tiles.size());
+  std::vector<std::vector<std::size_t>> subtiles(set.tiles.size());
+  std::vector<double> ends, speeds;  // speeds: glides per top keyframe interval, in d_hex at N_top
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
                ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
-    const auto place = [&](std::uint32_t j, std::uint32_t q, std::vector<double>& out) {
-      const std::uint32_t i = j % m, k = j / m;
-      const std::size_t type = set.tile_index(
-          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1));
-      out.insert(out.end(), {(i + sub_points[type][2 * q]) / m, (k + sub_points[type][2 * q + 1]) / m});
-    };
+    for (std::uint32_t k = 0; k < m; ++k)
+      for (std::uint32_t i = 0; i < m; ++i)
+        subtiles[t].push_back(set.tile_index(
+            sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
+            sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1)));
     const Tile& tile = set.tiles[t];
     for (std::size_t r = 0; r < tile.points.size(); ++r) {
       const std::uint32_t v = tile.handover[r], d = v % 25;
-      place((TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2) * m +
-                TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2,
-            v / 25, target[t]);
+      SubRef q{TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2,
+               TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2, v / 25, 0};
+      q.type = subtiles[t][q.k * m + q.i];
+      const double gx = (q.i + keyframe_one[q.type][2 * q.rank]) / m - start[t][2 * r],
+                   gy = (q.k + keyframe_one[q.type][2 * q.rank + 1]) / m - start[t][2 * r + 1];
+      const double glide = std::hypot(gx, gy) * std::sqrt(n_top);  // as the runtime's tables
+      q.end = set.handover_end(glide);
+      ends.push_back(q.end);
+      speeds.push_back(glide * std::log(top_step) / std::log(q.end / n_top) /
+                       (analysis::hex_spacing(std::size_t(n_top)) * std::sqrt(n_top)));
+      target[t].push_back(q);
     }
-    for (std::uint32_t w : tile.appearing) place(w >> 16, w & 0xFFFF, appearing[t]);
+    for (std::uint32_t w : tile.appearing) {
+      const std::uint32_t j = w >> 16;
+      appearing[t].push_back({j % m, j / m, w & 0xFFFF, subtiles[t][j], 0});
+    }
   }
+  // Judged at a quarter, half, three quarters and all of the way to where 99% of the points are taken over.
+  const double end99 = analysis::quantile(ends, 0.99);
   for (const double s : {0.25, 0.5, 0.75, 1.0}) {
     KeyframeResult row;
-    row.points_per_tile = n_top + s * (n_end - n_top);
+    row.points_per_tile = n_top + s * (end99 - n_top);
     row.keyframe = false;
     row.handover = true;
     row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
+    // The subtiles' points at their count, on their glide track (at keyframe 1 until it passes K_1).
+    const double count = std::max(k1, row.points_per_tile / (double(m) * m));
+    std::size_t g0 = 1;
+    while (g0 + 1 < top && set.keyframe_nominal[g0 + 1] <= count) ++g0;
+    const double w = std::clamp(
+        (count - set.keyframe_nominal[g0]) / (set.keyframe_nominal[g0 + 1] - set.keyframe_nominal[g0]), 0.0,
+        1.0);
+    TilePositions sub_at(set.tiles.size());
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) sub_at[t] = glided(set, t, count, g0, g0 + 1, w);
+    const auto place = [&](const SubRef& q, double& x, double& y) {
+      x = (q.i + sub_at[q.type][2 * q.rank]) / m, y = (q.k + sub_at[q.type][2 * q.rank + 1]) / m;
+    };
     TilePositions at(set.tiles.size());
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {
-      for (std::size_t i = 0; i < start[t].size(); ++i)
-        at[t].push_back(start[t][i] + s * (target[t][i] - start[t][i]));
-      const std::size_t n = appearing[t].size() / 2;
-      for (std::size_t a = 0; a < n; ++a)  // thresholds spread evenly over the hand-over, in table order
-        if (row.points_per_tile > n_top + (double(a) + 0.5) / double(n) * (n_end - n_top))
-          at[t].insert(at[t].end(), {appearing[t][2 * a], appearing[t][2 * a + 1]});
+      double x, y;
+      for (std::size_t i = 0; i < target[t].size(); ++i) {  // each on its straight path, by its own end
+        place(target[t][i], x, y);
+        const double f = std::min(1.0, (row.points_per_tile - n_top) / (target[t][i].end - n_top));
+        at[t].insert(at[t].end(), {start[t][2 * i] + f * (x - start[t][2 * i]),
+                                   start[t][2 * i + 1] + f * (y - start[t][2 * i + 1])});
+      }
+      const std::size_t n = appearing[t].size();
+      for (std::size_t a = 0; a < n; ++a)  // thresholds spread evenly over (N_top, m² K_1], in table order
+        if (row.points_per_tile > n_top + (double(a) + 0.5) / double(n) * (appearing_end - n_top)) {
+          place(appearing[t][a], x, y);
+          at[t].insert(at[t].end(), {x, y});
+        }
+      // The subtiles' own points past keyframe 1, present once their count passes K_1.
+      for (std::uint32_t j = 0; j < m * m; ++j) {
+        const std::size_t type = subtiles[t][j];
+        for (std::size_t q = set.points_at_keyframe(set.tiles[type], 1); 2 * q < sub_at[type].size(); ++q)
+          at[t].insert(at[t].end(),
+                       {(j % m + sub_at[type][2 * q]) / m, (j / m + sub_at[type][2 * q + 1]) / m});
+      }
     }
     const double row_spacing = analysis::hex_spacing(std::size_t(row.points_per_tile));
     row.closest_pair = closest_across_edges(set, at, row_spacing) / row_spacing;
@@ -180,6 +226,13 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
     row.checks.push_back({"δavg", row.davg, b.glide_between_davg, false});
     if (b.glide_closest_pair > 0)
       row.checks.push_back({"closest pair", row.closest_pair, b.glide_closest_pair, false});
+    if (s == 1.0) {  // each glide per top keyframe interval of the scale it spans, as keyframes' motion
+      double sum = 0;
+      for (double& v : speeds) sum += (v /= row.davg);
+      row.motion_mean = sum / double(speeds.size());
+      row.motion_p99 = analysis::quantile(speeds, 0.99);
+      row.checks.push_back({"motion p99", row.motion_p99, b.glide_motion, true});
+    }
     report.keyframes.push_back(std::move(row));
   }
 }

@@ -25,6 +25,7 @@
 // Thread safety: every function here is reentrant; a TilesetData is a plain value (share it read-only).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -120,6 +121,25 @@ struct TilesetShape {
     return std::uint64_t(m) * m * level_nominal[0] == level_nominal.back() ? m : 0;
   }
   Subdivision subdivision() const { return {colours, subtiles_per_side(), handover_zone}; }
+  /// The hand-over past the top level, in points per tile (docs/design.md §3, "Unbounded zoom"): the
+  /// sub-points no point glides onto have appeared by appearing_end() = m² K_1, and a point whose glide
+  /// onto its sub-point is `glide` square-grid spacings (1/√N_top) long is taken over by its subtile at
+  /// handover_end(glide), m² K_1 or later for a long glide.
+  double appearing_end() const {
+    const double m = subtiles_per_side();
+    return keyframe_nominal.size() < 2 ? 0.0 : m * m * keyframe_nominal[1];
+  }
+  /// A glide of `glide` spacings spans at least glide / kHandoverSpacingsPerKeyframe of the top keyframe
+  /// intervals (its ratio of counts), so that no glide moves faster with the scale than the keyframes'
+  /// points (99th percentile about 0.6 of a spacing per interval).
+  static constexpr double kHandoverSpacingsPerKeyframe = 0.5;
+  double handover_end(double glide) const {
+    const std::size_t n = keyframe_nominal.size();
+    if (n < 2) return 0.0;
+    const double top = keyframe_nominal[n - 1];
+    return std::max(appearing_end(),
+                    top * std::pow(top / keyframe_nominal[n - 2], glide / kHandoverSpacingsPerKeyframe));
+  }
   /// The subtile (column, row) of m per side holding a stable position.
   static std::uint32_t subtile_of(std::uint16_t coordinate, std::uint32_t m) {
     return static_cast<std::uint32_t>((std::uint64_t(coordinate) * m) >> 16);
