@@ -256,6 +256,53 @@ class Descent {
                         : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
   }
 
+  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g; kClip:
+  /// only those inside the region. Positions and the region's test as write_unit's, bit for bit. kDone, or
+  /// where the buffer or the budget ran out.
+  template <bool kClip>
+  std::uint32_t emit_own(const Node& n, std::uint32_t from, std::uint32_t end, const GlideBracket& g) {
+    const Tile& tile = set_.tiles[n.type];
+    const std::uint32_t* start = t_.glide_start[n.type].data();
+    const std::int8_t* o0 = tile.glide.data() + 2 * std::size_t(start[g.g0]);
+    const std::int8_t* o1 = tile.glide.data() + 2 * std::size_t(start[g.g1]);
+    const double s = q_.side[n.depth], rx = n.rx, ry = n.ry, wx = n.wx, wy = n.wy, w0 = g.w0, w1 = g.w1;
+    const std::int64_t gx = n.gx, gy = n.gy;
+    const std::uint32_t depth = n.depth;
+    const QueryParams& p = *q_.params;
+    const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
+    // Locals, which the writes into the caller's buffer cannot alias.
+    const TilePoint* points = tile.points.data();
+    QueryPoint* const out = out_;
+    const std::size_t capacity = capacity_;
+    std::size_t written = n_;
+    std::uint64_t budget = budget_;
+    std::uint32_t r = from;
+    for (; r < end; ++r) {
+      if (budget == 0) break;
+      --budget;
+      const TilePoint q = points[r];
+      const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
+                   dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
+      const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
+      // Whether a point lies in the region follows no pattern a branch predictor could learn near its
+      // border: each is written at the next slot, which only one inside keeps.
+      bool kept = true;
+      if (kClip) {
+        const double x = wx + ux * s, y = wy + uy * s;
+        kept = x >= x0 && x < x1 && y >= y0 && y < y1;
+      }
+      if (written == capacity) {
+        if (!kept) continue;
+        ++budget;
+        break;
+      }
+      out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
+      written += kept;
+    }
+    n_ = written, budget_ = budget;
+    return r == end ? kDone : r;
+  }
+
   /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
   /// + a): kDone, or where the buffer or the budget ran out.
   std::uint32_t emit(int k, std::uint32_t seq) {
@@ -283,7 +330,16 @@ class Descent {
     const double constant_count = constant ? density_or_zero(q_.params->density.constant) * area : 0;
     const GlideBracket constant_bracket =
         constant ? GlideBracket(q_.keyframes, constant_count) : GlideBracket();
-    for (std::uint32_t r = seq; r < candidates; ++r) {
+    // A subtile whose own points neither hand over nor meet a varying density: its own ranks are emitted
+    // by a loop of their own (emit_own), the same expressions without the other cases' tests, and without
+    // the region's where the subtile lies inside it.
+    const QueryParams& params = *q_.params;
+    const double margin = (q_.reach + 1e-9) * side;  // a hair more, for rounding
+    const bool direct = constant && n.depth > 0 && !(hands_over(n) && constant_count > q_.top);
+    const bool inside = n.wx - margin >= params.x0 && n.wx + side + margin < params.x1 &&
+                        n.wy - margin >= params.y0 && n.wy + side + margin < params.y1;
+    const std::uint32_t general_end = direct ? std::min(candidates, inherited) : candidates;
+    for (std::uint32_t r = seq; r < general_end; ++r) {
       if (budget_ == 0) return r;
       --budget_;
       const TilePoint& p = tile.points[r];
@@ -330,6 +386,12 @@ class Descent {
             write_unit(n, p.unit_x() + dx * (1.0 / 65536.0), p.unit_y() + dy * (1.0 / 65536.0), id_of(k, r));
       }
       if (!fits) return r;
+    }
+    if (direct && candidates > inherited) {
+      const std::uint32_t from = std::max(seq, inherited);
+      const std::uint32_t stopped = inside ? emit_own<false>(n, from, candidates, constant_bracket)
+                                           : emit_own<true>(n, from, candidates, constant_bracket);
+      if (stopped != kDone) return stopped;
     }
     // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].
     if (!hands_over(n) || !(bound > q_.top) || handed_over) return kDone;

@@ -192,31 +192,36 @@ TEST(DescentTest, OneQueryServesARadialMapOf1To100000) {
 }
 
 TEST(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
-  QueryParams p = uniform(0, 512.0 * 40);
-  p.x0 = 0.3, p.y0 = -0.2, p.x1 = 1.1, p.y1 = 0.45;
-  p.origin_x = 0.25, p.origin_y = 0.125;
-  p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
-  const std::vector<QueryPoint> whole = query(p), chunked = query(p, 7);
-  ASSERT_EQ(whole.size(), chunked.size());
-  for (std::size_t i = 0; i < whole.size(); ++i) {
-    EXPECT_EQ(whole[i].x, chunked[i].x);
-    EXPECT_TRUE(whole[i].id == chunked[i].id);
-  }
-  std::map<Key, std::pair<double, double>> parts;
-  for (const double cut : {0.41, 0.7731}) {
-    QueryParams a = p, b = p;
-    a.x1 = b.x0 = cut;
-    for (const QueryParams& part : {a, b})
-      for (const QueryPoint& q : query(part))
-        EXPECT_TRUE(parts.emplace(key(q.id), std::pair{q.x, q.y}).second);
-    ASSERT_EQ(parts.size(), whole.size());
-    for (const QueryPoint& q : whole) {
-      const auto it = parts.find(key(q.id));
-      ASSERT_NE(it, parts.end());
-      EXPECT_EQ(it->second.first, q.x);
-      EXPECT_EQ(it->second.second, q.y);
+  // A ramp (every point through the general loop) and a constant density (subtiles inside the region emit
+  // their own points through a loop of their own, those cut by a border through the general one).
+  for (const bool constant : {false, true}) {
+    QueryParams p = uniform(0, 512.0 * 40);
+    p.x0 = 0.3, p.y0 = -0.2, p.x1 = 1.1, p.y1 = 0.45;
+    p.origin_x = 0.25, p.origin_y = 0.125;
+    if (!constant)
+      p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
+    const std::vector<QueryPoint> whole = query(p), chunked = query(p, 7);
+    ASSERT_EQ(whole.size(), chunked.size());
+    for (std::size_t i = 0; i < whole.size(); ++i) {
+      EXPECT_EQ(whole[i].x, chunked[i].x);
+      EXPECT_TRUE(whole[i].id == chunked[i].id);
     }
-    parts.clear();
+    std::map<Key, std::pair<double, double>> parts;
+    for (const double cut : {0.41, 0.7731}) {
+      QueryParams a = p, b = p;
+      a.x1 = b.x0 = cut;
+      for (const QueryParams& part : {a, b})
+        for (const QueryPoint& q : query(part))
+          EXPECT_TRUE(parts.emplace(key(q.id), std::pair{q.x, q.y}).second);
+      ASSERT_EQ(parts.size(), whole.size());
+      for (const QueryPoint& q : whole) {
+        const auto it = parts.find(key(q.id));
+        ASSERT_NE(it, parts.end());
+        EXPECT_EQ(it->second.first, q.x);
+        EXPECT_EQ(it->second.second, q.y);
+      }
+      parts.clear();
+    }
   }
 }
 
