@@ -11,7 +11,7 @@ namespace kdm::gen {
 
 HoleFinder::HoleFinder(double width, double height, double step, double reach,
                        const std::vector<double>& points)
-    : width_(width), height_(height), step_(step), reach_(reach) {
+    : height_(height), step_(step), reach_(reach) {
   KDM_CHECK(width > 0 && height > 0 && step > 0 && reach > 0);
   nx_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(width / step)));
   ny_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(height / step)));

@@ -24,7 +24,7 @@ class HoleFinder {
   std::vector<double> centres_beyond(double radius) const;
 
  private:
-  double width_, height_, step_, reach_;
+  double height_, step_, reach_;
   std::size_t nx_, ny_;
   std::vector<float> distance_;  ///< per node, row-major; at most reach
 };
