@@ -8,7 +8,7 @@
 //
 // Per frame it prints the query's point count, the deepest subtile depth, the dot density on screen where
 // the tone is fixed (also relative to its target D × darkness), and the largest motion of a dot over the
-// surface since the previous frame, in its spacing 1/√(D × darkness) (near the silhouette apart). With
+// surface since the previous frame, in its spacing along the way it moved (near the silhouette apart). With
 // --check it exits non-zero if the relative density of the last frame differs from the first's by more than
 // 10% or a dot away from the silhouette moves half a spacing or more in one frame.
 //
@@ -147,7 +147,6 @@ struct Dot {  // a point of one frame, kept to follow it into the next
   kdm::PointId id;
   double u, v;
   bool shown;
-  double darkness;  // 1 − tone where it lies: its spacing on screen is 1/√(D · darkness)
 };
 bool id_less(const Dot& a, const Dot& b) {
   return std::tie(a.id.depth, a.id.tile_x, a.id.tile_y, a.id.rank) <
@@ -307,7 +306,7 @@ int main(int argc, char** argv) {
       double sx, sy;
       cam.project(s, sx, sy);
       const bool visible = dot(cam.eye - s, s) > 0 && cam.on_screen(sx, sy);
-      current.push_back({p.id, p.x, p.y, visible, 1 - tone(p.x, p.y, s)});
+      current.push_back({p.id, p.x, p.y, visible});
       depth = std::max(depth, p.id.depth);
       if (!visible) continue;
       ++shown;
@@ -330,9 +329,10 @@ int main(int argc, char** argv) {
     if (k == 0) first_density = relative;
     last_density = relative, lowest = std::min(lowest, relative), highest = std::max(highest, relative);
 
-    // Dots in both frames, matched by id: how far each moved over the surface, both of its texture
-    // positions seen by this frame's camera (so the camera's own motion is not counted), in its own
-    // spacing on screen, that of the dots around it.
+    // Dots in both frames, matched by id: how far each moved over the surface, in its own spacing along
+    // the way it moved, seen by this frame's camera (so the camera's own motion is not counted). Near a
+    // point the projection is linear, so that ratio is the texture-space step over the texture-space
+    // spacing 1/√density there, whatever the foreshortening stretches on screen.
     std::sort(current.begin(), current.end(), id_less);
     double jump = 0, rim_jump = 0;
     for (std::size_t i = 0, j = 0; k > 0 && i < current.size(); ++i) {
@@ -340,9 +340,8 @@ int main(int argc, char** argv) {
       if (j == previous.size() || id_less(current[i], previous[j]) || !current[i].shown || !previous[j].shown)
         continue;
       const Vec a = surface(previous[j].u, previous[j].v), b = surface(current[i].u, current[i].v);
-      double ax, ay, bx, by;
-      cam.project(a, ax, ay), cam.project(b, bx, by);
-      const double moved = std::hypot(bx - ax, by - ay) * std::sqrt(current[i].darkness) / spacing;
+      const double moved = std::hypot(current[i].u - previous[j].u, current[i].v - previous[j].v) *
+                           std::sqrt(texture_density(&frame, current[i].u, current[i].v));
       // Near the silhouette the texture-space density falls to 0 with the foreshortening, so the few points
       // there lie far apart in texture space and glide fast as the silhouette sweeps over them: kept apart.
       const bool rim = std::min(dot(normalized(cam.eye - a), a), dot(normalized(cam.eye - b), b)) < kRim;
