@@ -300,7 +300,7 @@ class Descent {
       written += kept;
     }
     n_ = written, budget_ = budget;
-    return r == end ? kDone : r;
+    return r >= end ? kDone : r;
   }
 
   /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
