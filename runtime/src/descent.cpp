@@ -334,7 +334,8 @@ class Descent {
     // by a loop of their own (emit_own), the same expressions without the other cases' tests, and without
     // the region's where the subtile lies inside it.
     const QueryParams& params = *q_.params;
-    const double margin = (q_.reach + 1e-9) * side;  // a hair more, for rounding
+    const double reach = std::max(t_.glide_reach[constant_bracket.g0], t_.glide_reach[constant_bracket.g1]);
+    const double margin = (reach + 1e-9) * side;  // the farthest those points glide, and a hair for rounding
     const bool direct = constant && n.depth > 0 && !(hands_over(n) && constant_count > q_.top);
     const bool inside = n.wx - margin >= params.x0 && n.wx + side + margin < params.x1 &&
                         n.wy - margin >= params.y0 && n.wy + side + margin < params.y1;
