@@ -132,14 +132,10 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     const std::uint32_t m = 1u << (r.levels - 1);  // √(N_top / N_0)
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
       throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
-    const double corner = patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).back().corner;
-    const auto least = static_cast<std::uint32_t>(std::ceil(corner * m - 1e-9));
-    if (r.handover_zone < least || 2 * r.handover_zone + 1 >= m)
-      throw InvalidArgument("recipe: handover_zone must be in [" + std::to_string(least) + ", " +
-                            std::to_string((m - 2) / 2) +
-                            "] for these levels and patches (the top level's "
-                            "corner patches reach " +
-                            shortest(corner * m) + " subtile sides)");
+    if (2 * r.handover_zone + 1 >= m)  // Subdivision: corner squares and edge bands must not meet
+      throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) +
+                            "] for " + std::to_string(r.levels) + " levels (" + std::to_string(m) +
+                            " subtiles per side)");
   }
   return r;
 }
@@ -230,7 +226,7 @@ class Baker {
   /// The hand-over tables (docs/design.md §3, "Unbounded zoom"), in the file's encoding.
   void add_handover(TilesetData& set) const {
     const Subdivision sub = set.subdivision();
-    const std::vector<TileHandover> plan = plan_handover(levels_, set, ranked_, sub, widths_.back());
+    const std::vector<TileHandover> plan = plan_handover(set);
     for (std::size_t t = 0; t < set.tiles.size(); ++t) {
       Tile& tile = set.tiles[t];
       for (std::size_t r = 0; r < tile.points.size(); ++r) {
@@ -460,7 +456,6 @@ class Baker {
             tile.glide.push_back(static_cast<std::int8_t>(offset));
           }
       set.tiles.push_back(std::move(tile));
-      ranked_.push_back(std::move(ranked));
     }
     return set;
   }
@@ -472,7 +467,6 @@ class Baker {
   std::vector<PatchWidths> widths_;
   std::vector<BakeRun> runs_;
   std::vector<LevelPatches> levels_;
-  std::vector<std::vector<PatchPointRef>> ranked_;  ///< per tile, where each of its points comes from
   TilesetShape shape_;  ///< colours, level and keyframe counts: what the tiles fit into
   double total_work_ = 0, done_work_ = 0;
   std::size_t dropped_ = 0;  ///< points the separation pass removed (for a test to read)

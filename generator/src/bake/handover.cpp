@@ -2,14 +2,12 @@
 #include "bake/handover.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <map>
-#include <set>
+#include <limits>
 #include <stdexcept>
 #include <string>
-#include <tuple>
 
+#include "bake/glider_field.h"
 #include "bake/min_cost_assignment.h"
 #include "bake/progressive_order.h"
 #include "kdm/runtime/check.h"
@@ -17,524 +15,240 @@
 namespace kdm::gen {
 namespace {
 
-// Worlds here are 2×2 tori of parent tiles (Colouring::around_tile); sub-steps count 1/m of a parent.
-constexpr std::int64_t kParents = 2;
+// Distances in d_hex at N_top. Two glides closer than kGlideSeparation are a close pair; a point appears
+// once every glide is kClearance from it, where the order allows.
+constexpr double kGlideSeparation = 0.35;
+constexpr double kClearance = 0.5;
+// Square-grid spacings 1/√N_top. Glides past kLongGlide cost kLongGlideWeight times more per spacing²
+// beyond it: a long glide is slow (TilesetShape::handover_end) and crosses settled points, so its
+// neighbours are better moved a little each. Swaps that part two glides keep both within kMaxGlide.
+constexpr double kLongGlide = 0.6;
+constexpr double kLongGlideWeight = 10;
+constexpr double kMaxGlide = 1.2;
+// Passes of untangle over the tiles (each sees its neighbours' moves of the pass before).
+constexpr int kPasses = 2;
 
-std::int64_t floor_div(std::int64_t a, std::int64_t b) {
-  return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
-std::int64_t wrap(std::int64_t v, std::int64_t period) {
-  return ((v % period) + period) % period;
-}
-/// v wrapped into [−period/2, period/2).
-std::int64_t centred(std::int64_t v, std::int64_t period) {
-  return wrap(v + period / 2, period) - period / 2;
-}
-double centred(double v, double period) {
-  return v - period * std::floor(v / period + 0.5);
-}
-
-/// A point of some patch, by identity: the patch, its index there and the patch's anchor (sub-steps for
-/// sub-points, relative to a reference the caller chooses).
-struct PointKey {
-  const Patch* patch = nullptr;
-  std::uint32_t index = 0;
-  std::int64_t ax = 0, ay = 0;
-  bool operator<(const PointKey& o) const {
-    return std::tie(patch, index, ax, ay) < std::tie(o.patch, o.index, o.ax, o.ay);
+/// Positions (tile units, x y pairs) of ranks [0, n) of `tile` at keyframe g, as the file holds them.
+std::vector<double> keyframe_positions(const TilesetData& set, const Tile& tile, std::size_t g,
+                                       std::uint32_t n) {
+  std::size_t at = 0;
+  for (std::size_t h = 0; h < g; ++h) at += 2 * set.offsets_at_keyframe(tile, h);
+  KDM_CHECK(n <= set.offsets_at_keyframe(tile, g));
+  const double unit = set.glide_unit(g);
+  std::vector<double> xy(2 * std::size_t(n));
+  for (std::uint32_t r = 0; r < n; ++r) {
+    xy[2 * r] = tile.points[r].unit_x() + tile.glide[at + 2 * r] * unit;
+    xy[2 * r + 1] = tile.points[r].unit_y() + tile.glide[at + 2 * r + 1] * unit;
   }
-};
-
-/// Which class of parent zone decides a sub-point: a corner (anchor: the vertex), a horizontal or vertical
-/// edge (anchor: its west / south vertex) or an interior (anchor: the tile), in parent units mod 2.
-struct ZoneId {
-  int kind = 3;  // PatchKind order: corner, horizontal edge, vertical edge, interior
-  std::int64_t x = 0, y = 0;
-  bool operator<(const ZoneId& o) const { return std::tie(kind, x, y) < std::tie(o.kind, o.x, o.y); }
-  bool operator==(const ZoneId& o) const { return kind == o.kind && x == o.x && y == o.y; }
-};
-
-struct SubPoint {
-  PointKey key;           ///< anchor in sub-steps on the world's torus
-  double sx = 0, sy = 0;  ///< stable position, sub-steps
-  double x = 0, y = 0;    ///< position at keyframe 1, sub-steps
-  ZoneId zone;            ///< the class that decides it
-};
-
-PatchKind kind_of(const LevelPatches& level, const Patch* p, std::size_t& index) {
-  for (int k = 0; k < 4; ++k) {
-    const std::vector<Patch>& v = level.of(static_cast<PatchKind>(k));
-    if (!v.empty() && p >= v.data() && p < v.data() + v.size()) {
-      index = static_cast<std::size_t>(p - v.data());
-      return static_cast<PatchKind>(k);
-    }
-  }
-  return PatchKind::kInterior;  // not reached for a patch of this level
+  return xy;
 }
 
-/// The sub world of a 2×2 torus of parent tiles: sub-vertex colours by the subdivision rule.
-class SubWorld {
- public:
-  SubWorld(const std::vector<LevelPatches>& levels, const TilesetData& set, const Subdivision& sub,
-           const Colouring& parents)
-      : levels_(levels), set_(set), sub_(sub), parents_(parents) {
-    const std::int64_t period = kParents * sub.m;
-    std::vector<std::uint32_t> grid(std::size_t(period * period));
-    for (std::int64_t J = 0; J < period; ++J)
-      for (std::int64_t I = 0; I < period; ++I) {
-        const std::int64_t P = I / sub.m, Q = J / sub.m;
-        grid[std::size_t(J * period + I)] =
-            sub.vertex_colour(parents.at(P, Q), parents.at(P + 1, Q), parents.at(P + 1, Q + 1),
-                              parents.at(P, Q + 1), std::uint32_t(I % sub.m), std::uint32_t(J % sub.m));
-      }
-    sub_colouring_ = Colouring::torus(set.colours, int(period), int(period), std::move(grid));
-  }
+/// The cost of a glide of squared length d2 (tile units), with long glides (past `long_glide`) dearer.
+double glide_cost(double d2, double long_glide) {
+  const double over = std::max(0.0, std::sqrt(d2) - long_glide);
+  return d2 + kLongGlideWeight * over * over;
+}
 
-  const Colouring& colouring() const { return sub_colouring_; }
-
-  /// The parent zone class of a sub-vertex (torus sub-steps).
-  ZoneId zone_of_vertex(std::int64_t I, std::int64_t J) const {
-    const std::int64_t m = sub_.m, period = kParents * m;
-    I = wrap(I, period), J = wrap(J, period);
-    const std::int64_t P = I / m, Q = J / m, i = I % m, j = J % m;
-    const std::int64_t vx = wrap(i * 2 > m ? P + 1 : P, kParents), vy = wrap(j * 2 > m ? Q + 1 : Q, kParents);
-    switch (sub_.zone_of(std::uint32_t(i), std::uint32_t(j))) {
-      case Subdivision::Zone::kCorner:
-        return {0, vx, vy};
-      case Subdivision::Zone::kHorizontalEdge:
-        return {1, P, vy};
-      case Subdivision::Zone::kVerticalEdge:
-        return {2, vx, Q};
-      case Subdivision::Zone::kInterior:
-        break;
-    }
-    return {3, P, Q};
-  }
-
-  /// Every sub-point present at keyframe 1 whose stable position lies in [x0, x1) × [y0, y1) (sub-steps).
-  std::vector<SubPoint> points(double x0, double y0, double x1, double y1) const {
-    std::vector<SubPoint> out;
-    for (std::size_t k = 0; k < levels_.size(); ++k) {
-      if (k > 0 && set_.level_nominal[k - 1] >= set_.keyframe_nominal[1]) break;
-      std::vector<double> xy;
-      std::vector<std::uint16_t> keys;
-      std::vector<PatchPointRef> refs;
-      gather(levels_[k], sub_colouring_, {true, true, true, true}, x0, y0, x1, y1, xy, &keys, &refs);
-      for (std::size_t n = 0; n < refs.size(); ++n) {
-        if (!TilesetShape::emits(set_.emission_threshold(std::uint32_t(k), keys[n]),
-                                 set_.keyframe_nominal[1]))
-          continue;
-        const PatchPointRef& ref = refs[n];
-        const auto ax = static_cast<std::int64_t>(std::llround(ref.anchor_x + x0));
-        const auto ay = static_cast<std::int64_t>(std::llround(ref.anchor_y + y0));
-        KDM_CHECK(ref.patch->frames.size() > 1 && !ref.patch->frames[1].empty());
-        SubPoint p;
-        p.key = {ref.patch, ref.index, ax, ay};
-        p.sx = xy[2 * n] + x0, p.sy = xy[2 * n + 1] + y0;
-        p.x = double(ax) + ref.patch->frames[1][2 * ref.index];
-        p.y = double(ay) + ref.patch->frames[1][2 * ref.index + 1];
-        std::size_t patch_index = 0;
-        const PatchKind kind = kind_of(levels_[k], ref.patch, patch_index);
-        p.zone = class_of(kind, ax, ay, p.sx, p.sy);
-        out.push_back(p);
-      }
-    }
-    return out;
-  }
-
- private:
-  /// The narrowest zone class holding every sub-vertex the patch (kind, anchor) depends on.
-  ZoneId class_of(PatchKind kind, std::int64_t ax, std::int64_t ay, double sx, double sy) const {
-    // The sub-vertices the patch depends on: its vertex, its edge's ends or its subtile's corners.
-    std::array<ZoneId, 4> depends;
-    int n = 0;
-    const std::int64_t wide = kind == PatchKind::kHorizontalEdge || kind == PatchKind::kInterior;
-    const std::int64_t tall = kind == PatchKind::kVerticalEdge || kind == PatchKind::kInterior;
-    for (std::int64_t dy = 0; dy <= tall; ++dy)
-      for (std::int64_t dx = 0; dx <= wide; ++dx)
-        depends[std::size_t(n++)] = zone_of_vertex(ax + dx, ay + dy);
-    const auto zones = [&] { return std::vector<ZoneId>(depends.begin(), depends.begin() + n); }();
-    const ZoneId interior{3, wrap(floor_div(std::int64_t(std::floor(sx)), sub_.m), kParents),
-                          wrap(floor_div(std::int64_t(std::floor(sy)), sub_.m), kParents)};
-    if (std::all_of(zones.begin(), zones.end(),
-                    [&](const ZoneId& z) { return z.kind == 0 && z == zones[0]; }))
-      return zones[0];
-    const ZoneId* edge = nullptr;
-    for (const ZoneId& z : zones) {
-      if (z.kind == 3) return interior;
-      if (z.kind == 0) continue;
-      if (edge && !(*edge == z)) return interior;
-      edge = &z;
-    }
-    if (!edge) return interior;  // corners of two different vertices
-    const ZoneId a{0, edge->x, edge->y},
-        b{0, wrap(edge->x + (edge->kind == 1), kParents), wrap(edge->y + (edge->kind == 2), kParents)};
-    for (const ZoneId& z : zones)
-      if (z.kind == 0 && !(z == a) && !(z == b)) return interior;
-    return *edge;
-  }
-
-  const std::vector<LevelPatches>& levels_;
-  const TilesetData& set_;
-  Subdivision sub_;
-  Colouring parents_;
-  Colouring sub_colouring_;
-};
-
-/// A point to match: position (parent units, on the 2×2 torus) and the parent tile showing it.
-struct Spot {
-  double x = 0, y = 0;
-  int square = 0;
-};
-
-/// Least total squared distance, each row to a column of its square within `reach` (parent units),
-/// widening the reach until every row finds one.
-std::vector<std::uint32_t> match(const std::vector<Spot>& rows, const std::vector<Spot>& columns,
-                                 double reach, const std::string& what) {
+/// Least total glide_cost from each row to a distinct column (x y pairs), each row's candidates the
+/// columns within `reach`, widened until every row finds one.
+std::vector<std::uint32_t> match(const std::vector<double>& rows, const std::vector<double>& columns,
+                                 double reach, double long_glide, std::size_t t) {
+  const auto n_rows = std::uint32_t(rows.size() / 2), n_columns = std::uint32_t(columns.size() / 2);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double v : columns) lo = std::min(lo, v), hi = std::max(hi, v);
   std::vector<std::uint32_t> row_column;
-  if (rows.empty()) return row_column;
-  for (int attempt = 0; attempt < 6; ++attempt, reach *= 1.5) {
-    const auto cells = std::max<std::int64_t>(1, std::int64_t(kParents / reach));
-    const double cell = double(kParents) / double(cells);
+  for (int attempt = 0; attempt < 8; ++attempt, reach *= 1.5) {
+    const auto cells = std::max<std::int64_t>(1, std::int64_t(std::ceil((hi - lo) / reach)));
+    const auto cell_of = [&](double v) {
+      return std::clamp<std::int64_t>(std::int64_t(std::floor((v - lo) / reach)), 0, cells - 1);
+    };
     std::vector<std::vector<std::uint32_t>> grid(std::size_t(cells * cells));
-    const auto cell_of = [&](double v) { return wrap(std::int64_t(std::floor(v / cell)), cells); };
-    for (std::uint32_t c = 0; c < columns.size(); ++c)
-      grid[std::size_t(cell_of(columns[c].y) * cells + cell_of(columns[c].x))].push_back(c);
+    for (std::uint32_t c = 0; c < n_columns; ++c)
+      grid[std::size_t(cell_of(columns[2 * c + 1]) * cells + cell_of(columns[2 * c]))].push_back(c);
     std::vector<AssignmentEdge> edges;
     const double scale = 1.0 / (reach * reach);  // costs of order 1
-    for (std::uint32_t r = 0; r < rows.size(); ++r) {
-      const std::int64_t cx = cell_of(rows[r].x), cy = cell_of(rows[r].y);
-      std::set<std::int64_t> seen;  // small tori: a neighbour cell may repeat
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dx = -1; dx <= 1; ++dx) {
-          const std::int64_t at = wrap(cy + dy, cells) * cells + wrap(cx + dx, cells);
-          if (!seen.insert(at).second) continue;
-          for (std::uint32_t c : grid[std::size_t(at)]) {
-            if (columns[c].square != rows[r].square) continue;
-            const double ex = centred(columns[c].x - rows[r].x, double(kParents));
-            const double ey = centred(columns[c].y - rows[r].y, double(kParents));
+    for (std::uint32_t r = 0; r < n_rows; ++r) {
+      const std::int64_t cx = cell_of(rows[2 * r]), cy = cell_of(rows[2 * r + 1]);
+      for (std::int64_t y = std::max<std::int64_t>(0, cy - 1); y <= std::min(cells - 1, cy + 1); ++y)
+        for (std::int64_t x = std::max<std::int64_t>(0, cx - 1); x <= std::min(cells - 1, cx + 1); ++x)
+          for (std::uint32_t c : grid[std::size_t(y * cells + x)]) {
+            const double ex = columns[2 * c] - rows[2 * r], ey = columns[2 * c + 1] - rows[2 * r + 1];
             const double d2 = ex * ex + ey * ey;
-            if (d2 <= reach * reach) edges.push_back({r, c, d2 * scale});
+            if (d2 <= reach * reach) edges.push_back({r, c, glide_cost(d2, long_glide) * scale});
           }
+    }
+    if (min_cost_assignment(n_rows, n_columns, edges, row_column)) return row_column;
+  }
+  throw std::runtime_error("hand-over: tile " + std::to_string(t) + "'s points find too few sub-points");
+}
+
+/// One tile's sub-points and which of them each of its points glides onto.
+struct Matched {
+  std::vector<double> start;          ///< per rank: the top keyframe's position (x y pairs, tile units)
+  std::vector<double> columns;        ///< the sub-points at their keyframe 1 (x y pairs, tile units)
+  std::vector<std::uint32_t> packed;  ///< the same, packed as TileHandover's
+  std::vector<std::uint32_t> column;  ///< per rank: its sub-point
+};
+
+Matched match_tile(const TilesetData& set, std::size_t t) {
+  const Subdivision sub = set.subdivision();
+  const std::uint32_t m = sub.m, C = set.colours;
+  const double top = set.level_nominal.back();
+  const Tile& tile = set.tiles[t];
+  Matched out;
+  out.start =
+      keyframe_positions(set, tile, set.keyframe_nominal.size() - 1, std::uint32_t(tile.points.size()));
+  const std::uint32_t nw = std::uint32_t(t % C), ne = std::uint32_t(t / C % C),
+                      se = std::uint32_t(t / C / C % C), sw = std::uint32_t(t / C / C / C);
+  for (std::uint32_t k = 0; k < m; ++k)
+    for (std::uint32_t i = 0; i < m; ++i) {
+      const Tile& child = set.tiles[set.tile_index(
+          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
+          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1))];
+      const std::uint32_t present = set.points_at_keyframe(child, 1);
+      const std::vector<double> xy = keyframe_positions(set, child, 1, present);
+      for (std::uint32_t q = 0; q < present; ++q) {
+        out.columns.insert(out.columns.end(), {(i + xy[2 * q]) / m, (k + xy[2 * q + 1]) / m});
+        out.packed.push_back((k * m + i) << 16 | q);
+      }
+    }
+  if (out.columns.size() < out.start.size())
+    throw std::runtime_error("hand-over: tile " + std::to_string(t) + " holds more points than its subtiles");
+  out.column = match(out.start, out.columns, 2.5 / std::sqrt(top), kLongGlide / std::sqrt(top), t);
+  return out;
+}
+
+/// Rank r's glide onto column c.
+Glide glide_to(const TilesetData& set, const Matched& m, std::uint32_t r, std::uint32_t c) {
+  Glide g{m.start[2 * r], m.start[2 * r + 1], m.columns[2 * c], m.columns[2 * c + 1], 0};
+  // As the runtime's tables (QueryTables::handover_end): the length in square-grid spacings 1/√N_top.
+  g.end =
+      set.handover_end(std::hypot(g.bx - g.ax, g.by - g.ay) * std::sqrt(double(set.level_nominal.back())));
+  return g;
+}
+
+/// Parts tile t's glides that come close to another (its own at another pace, or a neighbour tile's):
+/// each such point swaps sub-points with a nearby point of its tile, or takes a sub-point no point has,
+/// where that leaves both clear (some cannot: where a glide crosses its tile's edge, or meets a point
+/// that stays).
+void untangle(const TilesetData& set, std::vector<Matched>& matched, std::vector<std::vector<Glide>>& glides,
+              std::size_t t) {
+  const double top = set.level_nominal.back(), spacing = 1 / std::sqrt(top);
+  const double distance = kGlideSeparation * std::sqrt(2 / (std::sqrt(3.0) * top));
+  Matched& m = matched[t];
+  std::vector<Glide>& own = glides[t];
+  GliderField field(set, glides, t, distance, top);
+  const auto n = static_cast<std::uint32_t>(own.size());
+  // Ranks and free sub-points by cells of 2 spacings, for neighbours.
+  const double cell = 2 * spacing;
+  const auto cells = static_cast<std::int64_t>(std::ceil(1.5 / cell));
+  const auto cell_of = [&](double v) {
+    return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((v + 0.25) / cell)), 0, cells - 1);
+  };
+  std::vector<std::vector<std::uint32_t>> columns_near(std::size_t(cells * cells));
+  for (std::uint32_t c = 0; c < m.packed.size(); ++c)
+    columns_near[std::size_t(cell_of(m.columns[2 * c + 1]) * cells + cell_of(m.columns[2 * c]))].push_back(c);
+  std::vector<std::uint32_t> owner(m.packed.size(), n);
+  for (std::uint32_t r = 0; r < n; ++r) owner[m.column[r]] = r;
+  const double max_length = kMaxGlide * spacing;
+  const auto length = [](const Glide& g) { return std::hypot(g.bx - g.ax, g.by - g.ay); };
+  for (std::uint32_t r = 0; r < n; ++r) {
+    if (!field.meets(own[r], r, r)) continue;
+    // The best move: least added squared length among those that leave every glide it changes clear.
+    double best = std::numeric_limits<double>::infinity();
+    std::uint32_t best_column = 0;
+    Glide best_r, best_other;
+    const std::int64_t cx = cell_of(m.start[2 * r]), cy = cell_of(m.start[2 * r + 1]);
+    const double before = length(own[r]) * length(own[r]);
+    for (std::int64_t y = std::max<std::int64_t>(0, cy - 1); y <= std::min(cells - 1, cy + 1); ++y)
+      for (std::int64_t x = std::max<std::int64_t>(0, cx - 1); x <= std::min(cells - 1, cx + 1); ++x)
+        for (std::uint32_t c : columns_near[std::size_t(y * cells + x)]) {
+          if (c == m.column[r]) continue;
+          const Glide mine = glide_to(set, m, r, c);
+          if (length(mine) > std::max(max_length, length(own[r]))) continue;
+          const std::uint32_t other = owner[c];
+          double added = length(mine) * length(mine) - before;
+          Glide theirs;
+          if (other < n) {
+            theirs = glide_to(set, m, other, m.column[r]);
+            if (length(theirs) > std::max(max_length, length(own[other]))) continue;
+            added += length(theirs) * length(theirs) - length(own[other]) * length(own[other]);
+          }
+          if (added >= best) continue;
+          if (field.meets(mine, r, other < n ? other : r)) continue;
+          if (other < n && (field.meets(theirs, r, other) || field.meet(mine, theirs))) continue;
+          best = added, best_column = c, best_r = mine, best_other = theirs;
         }
-    }
-    if (min_cost_assignment(std::uint32_t(rows.size()), std::uint32_t(columns.size()), edges, row_column))
-      return row_column;
+    if (best == std::numeric_limits<double>::infinity()) continue;
+    const std::uint32_t old = m.column[r], other = owner[best_column];
+    m.column[r] = best_column, owner[best_column] = r, own[r] = best_r;
+    field.replace(r, best_r);
+    owner[old] = other;
+    if (other < n) m.column[other] = old, own[other] = best_other, field.replace(other, best_other);
   }
-  throw std::runtime_error("hand-over: " + what + " finds too few sub-points (" +
-                           std::to_string(rows.size()) + " points, " + std::to_string(columns.size()) +
-                           " sub-points)");
 }
 
-int square_of(double x, double y) {  // parent units on the 2×2 torus
-  return int(wrap(std::int64_t(std::floor(x)), kParents) +
-             kParents * wrap(std::int64_t(std::floor(y)), kParents));
+/// The order tile t's leftover sub-points appear in: a void-and-cluster order among the taken ones, then
+/// each slot (thresholds evenly over (N_top, m² K_1]) takes the first in that order whose place every
+/// glide that can pass near it has cleared.
+std::vector<std::uint32_t> appearing_order(const TilesetData& set, const std::vector<Matched>& matched,
+                                           const std::vector<std::vector<Glide>>& glides, std::size_t t) {
+  const Matched& m = matched[t];
+  const double top = set.level_nominal.back();
+  std::vector<char> taken(m.packed.size(), 0);
+  for (std::uint32_t c : m.column) taken[c] = 1;
+  RankingInput ranking;
+  std::vector<double> spots;
+  std::vector<std::uint32_t> leftover;
+  for (std::size_t c = 0; c < m.packed.size(); ++c) {
+    const double x = m.columns[2 * c], y = m.columns[2 * c + 1];
+    std::vector<double>& into = taken[c] ? ranking.fixed : ranking.candidates;
+    into.insert(into.end(), {x - std::floor(x), y - std::floor(y)});  // on the unit torus
+    if (taken[c]) continue;
+    spots.insert(spots.end(), {x, y});
+    leftover.push_back(m.packed[c]);
+  }
+  ranking.filter_width = 1.5 / std::sqrt(top);
+  const std::vector<std::uint32_t> order = progressive_order(ranking);
+  const double d_hex = std::sqrt(2 / (std::sqrt(3.0) * top));
+  const GliderField field(set, glides, t, kClearance * d_hex, top);
+  const std::vector<double> clear = field.clear_counts(spots, kClearance * d_hex);
+  const std::size_t listed = order.size();
+  std::vector<char> placed(listed, 0);
+  std::vector<std::uint32_t> out;
+  for (std::size_t a = 0; a < listed; ++a) {
+    const double threshold = top + (double(a) + 0.5) / double(listed) * (set.appearing_end() - top);
+    std::size_t pick = listed;
+    for (std::size_t i = 0; i < listed && pick == listed; ++i)
+      if (!placed[order[i]] && clear[order[i]] <= threshold) pick = order[i];
+    if (pick == listed)  // none is clear yet: the one that clears first
+      for (std::size_t i = 0; i < listed; ++i)
+        if (!placed[order[i]] && (pick == listed || clear[order[i]] < clear[pick])) pick = order[i];
+    placed[pick] = 1;
+    out.push_back(leftover[pick]);
+  }
+  return out;
 }
-
-/// Which matching a parent point joins, by where its stable position lies and what its patch depends on:
-/// a corner group (a point of the vertex's corner patch within the top level's corner half-width of it),
-/// an edge group (a point of either end's corner patch or of the edge's own patch within the top level's
-/// edge half-width of its line), else the interior of the tile that shows it. Points near a tile edge thus
-/// move the same way in every tile that shows them; those farther in (coarse levels' wide patches) are
-/// matched with their tile's interior, whose neighbourhood they share in every tile anyway. Anchors are
-/// the group's vertex (corner), west or south vertex (edge) or tile corner (interior), parent units.
-ZoneId group_of(PatchKind kind, std::int64_t ax, std::int64_t ay, double rx, double ry, PatchWidths top) {
-  switch (kind) {
-    case PatchKind::kCorner:
-      if (std::max(std::fabs(rx), std::fabs(ry)) < top.corner) return {0, ax, ay};
-      if (std::fabs(ry) < top.edge) return {1, rx > 0 ? ax : ax - 1, ay};
-      if (std::fabs(rx) < top.edge) return {2, ax, ry > 0 ? ay : ay - 1};
-      break;
-    case PatchKind::kHorizontalEdge:
-      if (std::fabs(ry) < top.edge) return {1, ax, ay};
-      break;
-    case PatchKind::kVerticalEdge:
-      if (std::fabs(rx) < top.edge) return {2, ax, ay};
-      break;
-    case PatchKind::kInterior:
-      break;
-  }
-  return {3, std::int64_t(std::floor(double(ax) + rx)), std::int64_t(std::floor(double(ay) + ry))};
-}
-
-/// A parent point to match: which (patch, index; anchor unused) and where (top keyframe, parent tile).
-struct Row {
-  PointKey key;
-  Spot spot;
-};
-
-/// The matching of one patch class: sub-points (anchors relative to the class's anchor vertex) and the
-/// parent points (patch, index; anchor unused) they went to, both ways.
-struct Claims {
-  std::map<PointKey, PointKey> by_sub, by_row;
-  bool holds(const PointKey& sub_point) const { return by_sub.count(sub_point) > 0; }
-};
-
-/// Where relative anchors are centred for a class kind (sub-steps from its anchor vertex): the vertex for
-/// corners, the edge's middle for edges, the tile's middle for interiors.
-std::int64_t centre_x(int kind, std::int64_t m) {
-  return kind == 1 || kind == 3 ? m / 2 : 0;
-}
-std::int64_t centre_y(int kind, std::int64_t m) {
-  return kind == 2 || kind == 3 ? m / 2 : 0;
-}
-
-/// Finds the patch `p` among the levels' patches: its kind and index there.
-void locate(const std::vector<LevelPatches>& levels, const Patch* p, PatchKind& kind, std::size_t& index) {
-  for (const LevelPatches& level : levels)
-    for (int k = 0; k < 4; ++k) {
-      const std::vector<Patch>& v = level.of(static_cast<PatchKind>(k));
-      if (!v.empty() && p >= v.data() && p < v.data() + v.size()) {
-        kind = static_cast<PatchKind>(k);
-        index = static_cast<std::size_t>(p - v.data());
-        return;
-      }
-    }
-  KDM_CHECK(false);
-}
-
-class Planner {
- public:
-  Planner(const std::vector<LevelPatches>& levels, const TilesetData& set, const Subdivision& sub,
-          PatchWidths top_widths)
-      : levels_(levels), set_(set), sub_(sub), C_(set.colours), top_widths_(top_widths) {
-    reach_ = 2.5 / std::sqrt(double(set.level_nominal.back()));
-    top_ = set.keyframe_nominal.size() - 1;
-  }
-
-  void plan_corners() {
-    corner_.resize(C_);
-    for (std::uint32_t c = 0; c < C_; ++c) {
-      const SubWorld world(levels_, set_, sub_, Colouring::around_tile(C_, tile(c, 0, 0, 0)));
-      std::vector<SubPoint> columns;
-      for (const SubPoint& p : world.points(0, 0, kParents * sub_.m, kParents * sub_.m))
-        if (p.zone == ZoneId{0, 0, 0}) columns.push_back(p);
-      std::vector<Row> rows;
-      for (const LevelPatches& level : levels_)
-        add_rows(level.corners[c], PatchKind::kCorner, 0, 0, {0, 0, 0}, rows);
-      corner_[c] = run(rows, 0, 0, 0, columns, "corner " + std::to_string(c));
-    }
-  }
-
-  void plan_edges() {
-    for (int kind = 1; kind <= 2; ++kind) {
-      edge_[kind - 1].resize(std::size_t(C_) * C_);
-      for (std::uint32_t a = 0; a < C_; ++a)
-        for (std::uint32_t b = 0; b < C_; ++b) {
-          // An edge from vertex (0, 0) east (kind 1: the tile's south edge) or north (kind 2: its west edge).
-          const std::size_t t = kind == 1 ? tile(a, b, 0, 0) : tile(a, 0, 0, b);
-          const SubWorld world(levels_, set_, sub_, Colouring::around_tile(C_, t));
-          const std::int64_t ex = kind == 1, ey = kind == 2;
-          std::vector<SubPoint> columns;
-          for (const SubPoint& p : world.points(0, 0, kParents * sub_.m, kParents * sub_.m)) {
-            if (p.zone == ZoneId{kind, 0, 0}) {
-              columns.push_back(p);
-            } else if (p.zone.kind == 0 &&
-                       ((p.zone.x == 0 && p.zone.y == 0) || (p.zone.x == ex && p.zone.y == ey))) {
-              const bool at_start = p.zone.x == 0 && p.zone.y == 0;
-              const std::uint32_t colour = at_start ? a : b;
-              if (corner_[colour].holds(relative(p.key, 0, p.zone.x, p.zone.y))) continue;
-              if (sector(p, p.zone.x, p.zone.y) == ZoneId{kind, 0, 0}) columns.push_back(p);
-            }
-          }
-          std::vector<Row> rows;
-          const ZoneId group{kind, 0, 0};
-          for (const LevelPatches& level : levels_) {
-            const auto edge_kind = static_cast<PatchKind>(kind);
-            add_rows(level.of(edge_kind)[a * C_ + b], edge_kind, 0, 0, group, rows);
-            add_rows(level.corners[a], PatchKind::kCorner, 0, 0, group, rows);
-            add_rows(level.corners[b], PatchKind::kCorner, ex, ey, group, rows);
-          }
-          edge_[kind - 1][a * C_ + b] = run(rows, kind, 0, 0, columns, "edge " + std::to_string(a * C_ + b));
-        }
-    }
-  }
-
-  /// The interior of tile t, then its tables.
-  TileHandover plan_tile(std::size_t t, const std::vector<std::vector<PatchPointRef>>& ranked) {
-    const Colouring parents = Colouring::around_tile(C_, t);
-    const SubWorld world(levels_, set_, sub_, parents);
-    std::vector<SubPoint> columns, all = world.points(0, 0, sub_.m, sub_.m);
-    for (const SubPoint& p : all)
-      if (!claimed(p, parents)) columns.push_back(p);
-    std::vector<Row> rows;
-    std::vector<ZoneId> groups;
-    for (const PatchPointRef& ref : ranked[t]) {
-      const auto ax = std::int64_t(std::llround(ref.anchor_x)), ay = std::int64_t(std::llround(ref.anchor_y));
-      std::size_t index = 0;
-      PatchKind kind = PatchKind::kInterior;
-      locate(levels_, ref.patch, kind, index);
-      const double rx = ref.patch->xy[2 * ref.index], ry = ref.patch->xy[2 * ref.index + 1];
-      groups.push_back(group_of(kind, ax, ay, rx, ry, top_widths_));
-      if (groups.back().kind == 3) rows.push_back(row(*ref.patch, ref.index, ax, ay));
-    }
-    const Claims interior = run(rows, 3, 0, 0, columns, "interior " + std::to_string(t));
-
-    TileHandover out;
-    std::set<PointKey> taken;  // absolute anchors
-    for (std::size_t r = 0; r < ranked[t].size(); ++r) {
-      const PatchPointRef& ref = ranked[t][r];
-      const ZoneId g = groups[r];
-      const auto colour = [&](std::int64_t x, std::int64_t y) { return parents.at(x, y); };
-      const Claims& claims =
-          g.kind == 0 ? corner_[colour(g.x, g.y)]
-          : g.kind == 3
-              ? interior
-              : edge_[g.kind - 1][colour(g.x, g.y) * C_ + colour(g.x + (g.kind == 1), g.y + (g.kind == 2))];
-      const auto found = claims.by_row.find({ref.patch, ref.index, 0, 0});
-      KDM_CHECK(found != claims.by_row.end());
-      const std::int64_t gx = g.kind == 3 ? 0 : g.x, gy = g.kind == 3 ? 0 : g.y;
-      const PointKey sub_point{found->second.patch, found->second.index, found->second.ax + gx * sub_.m,
-                               found->second.ay + gy * sub_.m};
-      taken.insert(sub_point);
-      out.target.push_back(pack(sub_point, parents));
-    }
-    std::vector<double> fixed, leftovers;
-    std::vector<std::uint32_t> leftover_packed;
-    const auto unit = [&](double v) { return v / sub_.m - std::floor(v / sub_.m); };  // on the unit torus
-    for (const SubPoint& p : all) {
-      if (taken.count(p.key)) {
-        fixed.insert(fixed.end(), {unit(p.x), unit(p.y)});
-      } else {
-        leftovers.insert(leftovers.end(), {unit(p.x), unit(p.y)});
-        leftover_packed.push_back(pack(p.key, parents));
-      }
-    }
-    KDM_CHECK(taken.size() == out.target.size());
-    RankingInput order;
-    order.candidates = leftovers;
-    order.fixed = fixed;
-    order.filter_width = 1.5 / std::sqrt(double(set_.level_nominal.back()));
-    for (std::uint32_t i : progressive_order(order)) out.appearing.push_back(leftover_packed[i]);
-    return out;
-  }
-
-  /// Rank lookups for every tile: (patch, index, anchor relative to the tile) -> rank.
-  void index_ranks(const std::vector<std::vector<PatchPointRef>>& ranked) {
-    rank_of_.resize(ranked.size());
-    for (std::size_t t = 0; t < ranked.size(); ++t)
-      for (std::uint32_t r = 0; r < ranked[t].size(); ++r) {
-        const PatchPointRef& ref = ranked[t][r];
-        rank_of_[t][{ref.patch, ref.index, std::llround(ref.anchor_x), std::llround(ref.anchor_y)}] = r;
-      }
-  }
-
- private:
-  std::size_t tile(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
-    return set_.tile_index(sw, se, ne, nw);
-  }
-
-  /// Key k with its anchor relative to vertex (vx, vy), for a class of kind `kind` (so that the class's
-  /// sub-points all lie within half the torus of its centre).
-  PointKey relative(const PointKey& k, int kind, std::int64_t vx, std::int64_t vy) const {
-    const std::int64_t period = kParents * sub_.m, cx = centre_x(kind, sub_.m), cy = centre_y(kind, sub_.m);
-    return {k.patch, k.index, centred(k.ax - vx * sub_.m - cx, period) + cx,
-            centred(k.ay - vy * sub_.m - cy, period) + cy};
-  }
-
-  /// The edge whose sector around vertex (vx, vy) holds p: east or west (kind 1), north or south (kind 2),
-  /// by its stable position; the edge's anchor is its west / south vertex.
-  ZoneId sector(const SubPoint& p, std::int64_t vx, std::int64_t vy) const {
-    const double dx = centred(p.sx / sub_.m - double(vx), double(kParents));
-    const double dy = centred(p.sy / sub_.m - double(vy), double(kParents));
-    if (std::fabs(dy) < std::fabs(dx)) return {1, wrap(dx > 0 ? vx : vx - 1, kParents), vy};
-    return {2, vx, wrap(dy > 0 ? vy : vy - 1, kParents)};
-  }
-
-  bool claimed(const SubPoint& p, const Colouring& parents) const {
-    const auto edge_claims = [&](const ZoneId& e) -> const Claims& {
-      const std::uint32_t a = parents.at(e.x, e.y), b = parents.at(e.x + (e.kind == 1), e.y + (e.kind == 2));
-      return edge_[e.kind - 1][a * C_ + b];
-    };
-    if (p.zone.kind == 3) return false;
-    if (p.zone.kind == 0) {
-      if (corner_[parents.at(p.zone.x, p.zone.y)].holds(relative(p.key, 0, p.zone.x, p.zone.y))) return true;
-      const ZoneId e = sector(p, p.zone.x, p.zone.y);
-      return edge_claims(e).holds(relative(p.key, e.kind, e.x, e.y));
-    }
-    return edge_claims(p.zone).holds(relative(p.key, p.zone.kind, p.zone.x, p.zone.y));
-  }
-
-  /// Matches the points of every level's patch (kind, index) anchored at parent vertex (vx, vy) to
-  /// `columns` (sub-points on the same world); returns the claims keyed relative to that vertex.
-  /// Point i of `patch` (anchored at parent vertex (ax, ay)) as a row.
-  Row row(const Patch& patch, std::uint32_t i, std::int64_t ax, std::int64_t ay) const {
-    const auto& frame = patch.frames[top_];
-    KDM_CHECK(frame.size() == 2 * patch.size());
-    return {{&patch, i, 0, 0},
-            {double(ax) + frame[2 * i], double(ay) + frame[2 * i + 1],
-             square_of(double(ax) + patch.xy[2 * i], double(ay) + patch.xy[2 * i + 1])}};
-  }
-
-  /// Appends the points of `patch` (of kind `kind`, anchored at (ax, ay)) that join `group`.
-  void add_rows(const Patch& patch, PatchKind kind, std::int64_t ax, std::int64_t ay, const ZoneId& group,
-                std::vector<Row>& rows) const {
-    for (std::uint32_t i = 0; i < patch.size(); ++i)
-      if (group_of(kind, ax, ay, patch.xy[2 * i], patch.xy[2 * i + 1], top_widths_) == group)
-        rows.push_back(row(patch, i, ax, ay));
-  }
-
-  /// Matches `rows` to `columns` (sub-points on the same world); returns the claims keyed relative to
-  /// the class's vertex (vx, vy) (class kind `kind`: 0 corner, 1, 2 edges, 3 interior).
-  Claims run(const std::vector<Row>& rows, int kind, std::int64_t vx, std::int64_t vy,
-             const std::vector<SubPoint>& columns, const std::string& what) const {
-    std::vector<Spot> spots, cols;
-    for (const Row& r : rows) spots.push_back(r.spot);
-    for (const SubPoint& p : columns)
-      cols.push_back({p.x / sub_.m, p.y / sub_.m, square_of(p.sx / sub_.m, p.sy / sub_.m)});
-    const std::vector<std::uint32_t> row_column = match(spots, cols, reach_, what);
-    Claims claims;
-    for (std::size_t r = 0; r < row_column.size(); ++r) {
-      const PointKey sub_point = relative(columns[row_column[r]].key, kind, vx, vy);
-      claims.by_sub[sub_point] = rows[r].key;
-      claims.by_row[rows[r].key] = sub_point;
-    }
-    return claims;
-  }
-
-  /// (j << 16) | q of a sub-point of tile (0, 0) of `parents` (anchor absolute, sub-steps).
-  std::uint32_t pack(const PointKey& key, const Colouring& parents) const {
-    const double sx = double(key.ax) + key.patch->xy[2 * key.index];
-    const double sy = double(key.ay) + key.patch->xy[2 * key.index + 1];
-    const auto si = std::int64_t(std::floor(sx)), sj = std::int64_t(std::floor(sy));
-    KDM_CHECK(si >= 0 && si < sub_.m && sj >= 0 && sj < sub_.m);
-    std::uint32_t corner[4];
-    const std::int64_t I[4] = {si, si + 1, si + 1, si}, J[4] = {sj, sj, sj + 1, sj + 1};
-    for (int v = 0; v < 4; ++v)
-      corner[v] = sub_.vertex_colour(parents.at(0, 0), parents.at(1, 0), parents.at(1, 1), parents.at(0, 1),
-                                     std::uint32_t(I[v]), std::uint32_t(J[v]));
-    const std::size_t type = tile(corner[0], corner[1], corner[2], corner[3]);
-    const auto found = rank_of_[type].find({key.patch, key.index, key.ax - si, key.ay - sj});
-    KDM_CHECK(found != rank_of_[type].end());
-    KDM_CHECK(found->second < 65536 && sj * sub_.m + si < 65536);
-    return std::uint32_t(sj * sub_.m + si) << 16 | found->second;
-  }
-
-  const std::vector<LevelPatches>& levels_;
-  const TilesetData& set_;
-  Subdivision sub_;
-  std::uint32_t C_;
-  PatchWidths top_widths_;
-  double reach_ = 0;
-  std::size_t top_ = 0;
-  std::vector<Claims> corner_;
-  std::vector<Claims> edge_[2];
-  std::vector<std::map<PointKey, std::uint32_t>> rank_of_;
-};
 
 }  // namespace
 
-std::vector<TileHandover> plan_handover(const std::vector<LevelPatches>& levels, const TilesetData& set,
-                                        const std::vector<std::vector<PatchPointRef>>& ranked,
-                                        const Subdivision& sub, PatchWidths top_widths) {
-  KDM_CHECK(sub.m >= 2 && 2 * sub.zone + 1 < sub.m && sub.colours == set.colours);
-  KDM_CHECK(set.keyframe_nominal.size() >= 2 && ranked.size() == set.tiles.size());
-  Planner planner(levels, set, sub, top_widths);
-  planner.index_ranks(ranked);
-  planner.plan_corners();
-  planner.plan_edges();
-  std::vector<TileHandover> out;
-  for (std::size_t t = 0; t < set.tiles.size(); ++t) out.push_back(planner.plan_tile(t, ranked));
+std::vector<TileHandover> plan_handover(const TilesetData& set) {
+  KDM_CHECK(set.subdivision().m >= 2 && set.keyframe_nominal.size() >= 2);
+  std::vector<Matched> matched;
+  std::vector<std::vector<Glide>> glides(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    matched.push_back(match_tile(set, t));
+    for (std::uint32_t r = 0; r < matched[t].column.size(); ++r)
+      glides[t].push_back(glide_to(set, matched[t], r, matched[t].column[r]));
+  }
+  // Tiles in turn, each against its neighbours as they stand: a few passes.
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) untangle(set, matched, glides, t);
+  std::vector<TileHandover> out(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    for (std::uint32_t c : matched[t].column) out[t].target.push_back(matched[t].packed[c]);
+    out[t].appearing = appearing_order(set, matched, glides, t);
+  }
   return out;
 }
 

@@ -1,10 +1,11 @@
 // The hand-over between depths (docs/design.md §3, "Unbounded zoom"): past the top keyframe every point of
 // a tile glides onto a point of one of its m×m subtiles (tiles of the same set at 1/m the size, laid out
 // by kdm/runtime/subdivision.h) as they stand at keyframe 1, the first past their level 0; the sub-points
-// no point takes appear on the way. Each point is matched within the tile that shows it, least total
-// squared distance, patch by patch so that a point's target depends on its patch's colours alone, as its
-// keyframes do: corner patches take sub-points whose every sub-vertex lies in their corner's zone, edge
-// patches those of their band and the ones their corners left in their sector, interiors what is left.
+// no point takes appear on the way. Each tile's points are matched to its own sub-points as one whole,
+// least total squared distance: straight paths of such a matching, travelled in step, never meet (the
+// displacement interpolation of optimal transport), and the tile's whole surplus of sub-points is there
+// for a point wherever it lies. The sub-points left over appear in an order that lets the gliders around
+// each clear its place first.
 //
 // Thread safety: plan_handover is a pure function of its arguments.
 #pragma once
@@ -12,8 +13,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "bake/corner_layout.h"
-#include "kdm/runtime/subdivision.h"
 #include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
@@ -25,14 +24,9 @@ struct TileHandover {
   std::vector<std::uint32_t> appearing;  ///< the sub-points no point takes, in the order they appear
 };
 
-/// Plans the hand-over of every tile of `set` (assembled from `levels`, which hold every keyframe's
-/// frames). `ranked[t]` says where each point of tile t comes from, by rank (the refs gather() gives with
-/// the window [0, 1)², anchors relative to the tile). `sub` must have m² = top nominal / base nominal and
-/// the set's colours; `top_widths` (the top level's patch half-widths) decide which points join a corner
-/// or edge group rather than their tile's interior. Throws std::runtime_error if some patch finds too few
-/// sub-points (a zone too narrow for the patches).
-std::vector<TileHandover> plan_handover(const std::vector<LevelPatches>& levels, const TilesetData& set,
-                                        const std::vector<std::vector<PatchPointRef>>& ranked,
-                                        const Subdivision& sub, PatchWidths top_widths);
+/// Plans the hand-over of every tile of `set`, whose levels, glide track and handover_zone are final (its
+/// hand-over tables are not read). Positions are the file's (quantised), as the runtime shows them.
+/// Throws std::runtime_error if a tile's subtiles hold fewer points at keyframe 1 than the tile holds.
+std::vector<TileHandover> plan_handover(const TilesetData& set);
 
 }  // namespace kdm::gen

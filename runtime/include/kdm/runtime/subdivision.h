@@ -3,7 +3,7 @@
 // set at 1/m the size. For neighbouring tiles to agree, a sub-vertex's colour depends only on the zone of
 // the tile it lies in, as a patch does: within `zone` sub-steps of a corner (both axes) on that corner's
 // colour, within `zone` of an edge on its two end colours, elsewhere on all four; and on its place there.
-// The baker matches points to sub-points with the same rule, and the runtime lays out subtiles with it.
+// The runtime lays out subtiles with it, and the baker matches each tile's points to its own subtiles'.
 //
 // Thread safety: a plain value; every function is pure.
 #pragma once
