@@ -139,7 +139,7 @@ void BM_QuerySmoothAtDepth(benchmark::State& state) {
   const kdm::Tileset& tiles = path ? loaded : kdm::Tileset::builtin();
   const double m = std::sqrt(kdm::query_density_limit(tiles, kdm::QueryMode::kSmooth) /
                              tiles.max_points_per_tile());  // m^4
-  if (!(m > 1)) return state.SkipWithError("the built-in set has no hand-over");
+  if (!(m > 1)) return state.SkipWithError("the tile set has no hand-over");
   const double zoom = std::pow(std::sqrt(std::sqrt(m)), double(state.range(0)));  // m^d
   kdm::QueryParams q = params();
   q.mode = kdm::QueryMode::kSmooth;

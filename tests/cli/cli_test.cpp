@@ -473,7 +473,9 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   expect_error("stipple " + image + " --frames 1 --region 0,0,.5,.5" + out, "--frames");
   expect_error("stipple " + image + " --frames -3 --region 0,0,.5,.5" + out, "--frames");
   expect_error("stipple " + image + " --frames 5" + out, "--region");
-  expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2" + out, "2×");
+  expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2 --mode stable" + out, "2× (");
+  // Smooth mode descends into the built-in set's 32 × 32 subtiles, four depths deep: 2 · 32^4 ×.
+  expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, "2.09715e+06× (");
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
   EXPECT_FALSE(fs::exists(path("z_0000.png")));  // refused before any frame is written
 }

@@ -57,10 +57,14 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_EQ(t.max_points_per_tile(), t.data().level_nominal.back());
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
   // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, 2 per gliding position
-  // (one per coordinate), 4 per entry of the edge lists, plus small tables.
+  // (one per coordinate), 4 per entry of the edge lists; for the hand-over 2 bytes of table, 4 of end and
+  // 4 of inherited id per point and 4 + 4 per appearing sub-point, 8 per subtile; plus small tables.
   ASSERT_TRUE(t.has_glide_track());
-  std::size_t points = 0, glide = 0, listed = 0;
-  for (const Tile& tile : t.data().tiles) points += tile.points.size(), glide += tile.glide.size();
+  std::size_t points = 0, glide = 0, listed = 0, handover = 0, appearing = 0;
+  for (const Tile& tile : t.data().tiles) {
+    points += tile.points.size(), glide += tile.glide.size();
+    handover += tile.handover.size(), appearing += tile.appearing.size();
+  }
   for (std::size_t i = 0; i < t.data().tiles.size(); ++i)
     for (int side = 0; side < 4; ++side) {
       std::uint32_t count = 0;
@@ -68,9 +72,13 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
       listed += count;
     }
   EXPECT_GT(listed, 0u);
-  EXPECT_LT(listed, points);  // a tile's sides list a small share of its points
-  EXPECT_GE(t.resident_bytes(), 10 * points + glide + 4 * listed);
-  EXPECT_LE(t.resident_bytes(), 10 * points + glide + 4 * listed + 64 * 1024);
+  EXPECT_LT(listed, points);    // a tile's sides list a small share of its points
+  ASSERT_EQ(handover, points);  // the built-in set descends into subtiles
+  const std::size_t m = t.data().subtiles_per_side();
+  const std::size_t expected = 10 * points + glide + 4 * listed + 10 * handover + 8 * appearing +
+                               8 * t.data().tiles.size() * (m * m + 1);
+  EXPECT_GE(t.resident_bytes(), expected);
+  EXPECT_LE(t.resident_bytes(), expected + 64 * 1024);
   EXPECT_LT(Tileset{}.resident_bytes(), 1024u);
 }
 

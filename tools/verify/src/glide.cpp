@@ -224,8 +224,8 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
       add_torus_nn(coords, set.tiles.size(), options.threads, nn, row);
     }
     row.checks.push_back({"δavg", row.davg, b.glide_between_davg, false});
-    if (b.glide_closest_pair > 0)
-      row.checks.push_back({"closest pair", row.closest_pair, b.glide_closest_pair, false});
+    if (b.handover_closest_pair > 0)
+      row.checks.push_back({"closest pair", row.closest_pair, b.handover_closest_pair, false});
     if (s == 1.0) {  // each glide per top keyframe interval of the scale it spans, as keyframes' motion
       double sum = 0;
       for (double& v : speeds) sum += (v /= row.davg);
