@@ -1,7 +1,8 @@
 // The hand-over between depths (bake/handover.h) on a small set of three levels (32 … 512 points per tile,
 // 4×4 subtiles per tile), as the file holds it: every point gets its own sub-point in its own tile, the
 // sub-points left over appear, nothing else; targets are near; sub-points appear where the gliders have
-// left; the tables survive the file and a damaged one is refused.
+// left; glides meet only where both are there at once; the tables survive the file and a damaged one is
+// refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <set>
 #include <vector>
 
+#include "bake/glider_field.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset_format.h"
@@ -160,6 +162,29 @@ TEST(HandoverTest, SubPointsAppearWhereTheGlidersHaveLeft) {
   }
   EXPECT_LT(ordered, listed / 40) << ordered << " of " << listed;
   EXPECT_GT(reversed, 3 * ordered) << reversed << " against " << ordered;
+}
+
+TEST(HandoverTest, GlidesMeetOnlyWhereBothAreThereAtOnce) {
+  // Glides in tile 0 of the small set, past a top of 1,000 points per tile, 0.01 tile sides apart at the
+  // least: paths that cross meet only if both reach the crossing at the same count.
+  const Baked& b = small_set();
+  const double top = 1000;
+  std::vector<std::vector<Glide>> glides(b.set.tiles.size());
+  glides[0] = {{0.2, 0.5, 0.8, 0.5, 2000}};  // west to east, at the middle at 1,500
+  const GliderField field(b.set, glides, 0, 0.01, top);
+  const Glide in_step{0.5, 0.2, 0.5, 0.8, 2000};  // south to north, at the middle at 1,500 too
+  const Glide later{0.5, 0.2, 0.5, 0.8, 3000};    // there at 2,000, when the first has arrived
+  const Glide beside{0.5, 0.52, 0.5, 0.8, 2000};  // starts 0.02 north of the first's path
+  EXPECT_TRUE(field.meet(glides[0][0], in_step));
+  EXPECT_FALSE(field.meet(glides[0][0], later));
+  EXPECT_FALSE(field.meet(glides[0][0], beside));
+  EXPECT_TRUE(field.meets(in_step, 1, 1));
+  EXPECT_FALSE(field.meets(in_step, 0, 0));  // the first left out
+  EXPECT_FALSE(field.meets(later, 1, 1));
+  // A spot on the first path is cleared 0.1 past it: at f = 0.5 + 0.1 / 0.6 of the way.
+  const std::vector<double> clear = field.clear_counts({0.5, 0.5, 0.5, 0.9}, 0.1);
+  EXPECT_NEAR(clear[0], top + (0.5 + 0.1 / 0.6) * 1000, 1e-9);
+  EXPECT_EQ(clear[1], top);  // never near it
 }
 
 TEST(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
