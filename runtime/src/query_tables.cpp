@@ -73,7 +73,7 @@ QueryTables::QueryTables(const TilesetData& set) {
 void QueryTables::index_handover(const TilesetData& set) {
   const Subdivision sub = set.subdivision();
   if (set.handover_zone == 0 || sub.m == 0 || set.keyframe_nominal.size() < 2) return;
-  const std::uint32_t m = subtiles = sub.m, C = set.colours, m2 = m * m;
+  const std::uint32_t m = subtiles = sub.m, m2 = m * m;
   child_type.assign(set.tiles.size() * m2, 0);
   inherited_start.assign(set.tiles.size() * (m2 + 1), 0);
   inherited.assign(set.tiles.size(), {});
@@ -81,14 +81,9 @@ void QueryTables::index_handover(const TilesetData& set) {
   handover_end_max.assign(set.tiles.size(), 0.0);
   const std::size_t top = set.keyframe_nominal.size() - 1;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
-    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
-               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
     std::uint32_t* start = inherited_start.data() + t * (m2 + 1);
     for (std::uint32_t j = 0; j < m2; ++j) {
-      const std::uint32_t i = j % m, k = j / m;
-      const std::size_t c = set.tile_index(
-          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1));
+      const std::size_t c = set.subtile_index(t, j % m, j / m);
       child_type[t * m2 + j] = static_cast<std::uint32_t>(c);
       start[j + 1] = start[j] + points_at_keyframe[c][1];
     }

@@ -214,11 +214,10 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
 /// The first problem of a set's hand-over tables (empty if none): every point of a tile glides onto its own
 /// sub-point of that tile's subtiles at keyframe 1, and those no point takes appear, each once.
 std::string handover_problem(const TilesetData& set) {
-  const std::uint32_t m = set.subtiles_per_side(), zone = set.handover_zone, C = set.colours;
+  const std::uint32_t m = set.subtiles_per_side(), zone = set.handover_zone;
   if (set.keyframe_nominal.size() < 2) return "a hand-over needs a glide track of at least two keyframes";
   if (m < 2 || m > 256) return "a hand-over needs N_top / N_0 to be the square of an integer m in 2..256";
   if (2 * std::uint64_t(zone) + 1 >= m) return "the hand-over zone " + std::to_string(zone) + " is too wide";
-  const Subdivision sub = set.subdivision();
   std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe 1, per tile
   for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], 1);
   std::vector<std::uint32_t> type(std::size_t(m) * m), first(std::size_t(m) * m + 1);
@@ -229,13 +228,8 @@ std::string handover_problem(const TilesetData& set) {
     if (tile.handover.size() != tile.points.size())
       return name + " has " + std::to_string(tile.handover.size()) + " hand-over targets for " +
              std::to_string(tile.points.size()) + " points";
-    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
-               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
     for (std::uint32_t j = 0; j < m * m; ++j) {
-      const std::uint32_t i = j % m, k = j / m;
-      type[j] = std::uint32_t(set.tile_index(
-          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1)));
+      type[j] = std::uint32_t(set.subtile_index(t, j % m, j / m));
       first[j + 1] = first[j] + present[type[j]];
     }
     taken.assign(first.back(), 0);

@@ -58,12 +58,7 @@ std::pair<double, double> at_keyframe(const TilesetData& set, const Tile& tile, 
 
 /// The tile shown by subtile j of tile t, and the sub-point's position at keyframe 1 in t's units.
 std::size_t subtile_type(const Baked& b, std::size_t t, std::uint32_t j) {
-  const std::uint32_t C = b.set.colours, m = b.sub.m;
-  const std::uint32_t nw = t % C, ne = t / C % C, se = t / C / C % C, sw = t / C / C / C;
-  const std::uint32_t i = j % m, k = j / m;
-  return b.set.tile_index(
-      b.sub.vertex_colour(sw, se, ne, nw, i, k), b.sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-      b.sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), b.sub.vertex_colour(sw, se, ne, nw, i, k + 1));
+  return b.set.subtile_index(t, j % b.sub.m, j / b.sub.m);
 }
 std::pair<double, double> sub_position(const Baked& b, std::size_t t, std::uint32_t packed) {
   const std::uint32_t j = packed >> 16, q = packed & 0xFFFF;

@@ -92,19 +92,15 @@ struct Matched {
 
 Matched match_tile(const TilesetData& set, std::size_t t) {
   const Subdivision sub = set.subdivision();
-  const std::uint32_t m = sub.m, C = set.colours;
+  const std::uint32_t m = sub.m;
   const double top = set.level_nominal.back();
   const Tile& tile = set.tiles[t];
   Matched out;
   out.start =
       keyframe_positions(set, tile, set.keyframe_nominal.size() - 1, std::uint32_t(tile.points.size()));
-  const std::uint32_t nw = std::uint32_t(t % C), ne = std::uint32_t(t / C % C),
-                      se = std::uint32_t(t / C / C % C), sw = std::uint32_t(t / C / C / C);
   for (std::uint32_t k = 0; k < m; ++k)
     for (std::uint32_t i = 0; i < m; ++i) {
-      const Tile& child = set.tiles[set.tile_index(
-          sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-          sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1))];
+      const Tile& child = set.tiles[set.subtile_index(t, i, k)];
       const std::uint32_t present = set.points_at_keyframe(child, 1);
       const std::vector<double> xy = keyframe_positions(set, child, 1, present);
       for (std::uint32_t q = 0; q < present; ++q) {

@@ -126,7 +126,7 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
   const Bars& b = options.bars;
   const std::size_t top = set.keyframe_nominal.size() - 1;
   const Subdivision sub = set.subdivision();
-  const std::uint32_t m = sub.m, C = set.colours;
+  const std::uint32_t m = sub.m;
   const double n_top = set.level_nominal.back(), k1 = set.keyframe_nominal[1];
   const double appearing_end = set.appearing_end(), top_step = n_top / set.keyframe_nominal[top - 1];
   TilePositions start(set.tiles.size()), keyframe_one(set.tiles.size());
@@ -145,13 +145,8 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
   std::vector<std::vector<std::size_t>> subtiles(set.tiles.size());
   std::vector<double> ends, speeds;  // speeds: glides per top keyframe interval, in d_hex at N_top
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
-    const auto sw = std::uint32_t(t / C / C / C), se = std::uint32_t(t / C / C % C),
-               ne = std::uint32_t(t / C % C), nw = std::uint32_t(t % C);
     for (std::uint32_t k = 0; k < m; ++k)
-      for (std::uint32_t i = 0; i < m; ++i)
-        subtiles[t].push_back(set.tile_index(
-            sub.vertex_colour(sw, se, ne, nw, i, k), sub.vertex_colour(sw, se, ne, nw, i + 1, k),
-            sub.vertex_colour(sw, se, ne, nw, i + 1, k + 1), sub.vertex_colour(sw, se, ne, nw, i, k + 1)));
+      for (std::uint32_t i = 0; i < m; ++i) subtiles[t].push_back(set.subtile_index(t, i, k));
     const Tile& tile = set.tiles[t];
     for (std::size_t r = 0; r < tile.points.size(); ++r) {
       const std::uint32_t v = tile.handover[r], d = v % 25;

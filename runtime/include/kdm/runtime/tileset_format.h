@@ -181,6 +181,17 @@ struct TilesetShape {
   std::size_t tile_index(std::uint32_t sw, std::uint32_t se, std::uint32_t ne, std::uint32_t nw) const {
     return ((std::size_t(sw) * colours + se) * colours + ne) * colours + nw;
   }
+  /// The index of the tile that subtile (i, j) (column, row from the south-west, 0 ≤ i, j < m) of tile
+  /// `tile` shows in the hand-over: its corners' colours by Subdivision::vertex_colour.
+  std::size_t subtile_index(std::size_t tile, std::uint32_t i, std::uint32_t j) const {
+    const Subdivision sub = subdivision();
+    const std::size_t C = colours;
+    const auto sw = std::uint32_t(tile / C / C / C), se = std::uint32_t(tile / C / C % C),
+               ne = std::uint32_t(tile / C % C), nw = std::uint32_t(tile % C);
+    return tile_index(sub.vertex_colour(sw, se, ne, nw, i, j), sub.vertex_colour(sw, se, ne, nw, i + 1, j),
+                      sub.vertex_colour(sw, se, ne, nw, i + 1, j + 1),
+                      sub.vertex_colour(sw, se, ne, nw, i, j + 1));
+  }
   friend bool operator==(const TilesetShape& a, const TilesetShape& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
            a.keyframe_nominal == b.keyframe_nominal && a.handover_zone == b.handover_zone;
