@@ -256,11 +256,38 @@ class Descent {
                         : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
   }
 
-  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g; kClip:
-  /// only those inside the region. Positions and the region's test as write_unit's, bit for bit. kDone, or
-  /// where the buffer or the budget ran out.
-  template <bool kClip>
-  std::uint32_t emit_own(const Node& n, std::uint32_t from, std::uint32_t end, const GlideBracket& g) {
+  /// Which of a subtile's own points emit_own visits when the subtile is not inside the region: those
+  /// whose stable position (1/65536 sides) lies within [lo_x, hi_x) × [lo_y, hi_y), the region widened by
+  /// the farthest they glide and by the rounding of far-off coordinates; and where the region lies beyond
+  /// one of its sides, only that side's edge list (QueryTables::edges_beyond), else listed is null.
+  struct Cull {
+    double lo_x, lo_y, hi_x, hi_y;
+    const std::uint32_t *listed = nullptr, *listed_end = nullptr;
+  };
+  Cull cull(const Node& n, double reach) const {
+    const QueryParams& p = *q_.params;
+    const double s = q_.side[n.depth], scale = 65536.0 / s;
+    // One position unit, and as many more as the rounding of world coordinates this far out can take
+    // (a few ulps of the largest of them), so that the culling is never stricter than write_unit's test.
+    const double slack = 1 + 1e-15 * scale *
+                                 (std::fabs(n.wx) + std::fabs(n.wy) + std::fabs(p.x0) + std::fabs(p.x1) +
+                                  std::fabs(p.y0) + std::fabs(p.y1) + s);
+    Cull c;
+    const double x0 = (p.x0 - n.wx) * scale - slack, x1 = (p.x1 - n.wx) * scale + slack;
+    const double y0 = (p.y0 - n.wy) * scale - slack, y1 = (p.y1 - n.wy) * scale + slack;
+    c.lo_x = x0 - reach * 65536.0, c.hi_x = x1 + reach * 65536.0;
+    c.lo_y = y0 - reach * 65536.0, c.hi_y = y1 + reach * 65536.0;
+    t_.edges_beyond(n.type, x0, y0, x1, y1, c.listed, c.listed_end);
+    return c;
+  }
+
+  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g. kClip:
+  /// only those inside the region, visiting only the ranks `c` lets through; kListed: only c's listed
+  /// ranks. Positions and the region's test as write_unit's, bit for bit. kDone, or where the buffer or
+  /// the budget ran out.
+  template <bool kClip, bool kListed>
+  std::uint32_t emit_own(const Node& n, std::uint32_t from, std::uint32_t end, const GlideBracket& g,
+                         const Cull& c) {
     const Tile& tile = set_.tiles[n.type];
     const std::uint32_t* start = t_.glide_start[n.type].data();
     const std::int8_t* o0 = tile.glide.data() + 2 * std::size_t(start[g.g0]);
@@ -270,34 +297,51 @@ class Descent {
     const std::uint32_t depth = n.depth;
     const QueryParams& p = *q_.params;
     const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
+    const Cull cut = c;
     // Locals, which the writes into the caller's buffer cannot alias.
     const TilePoint* points = tile.points.data();
     QueryPoint* const out = out_;
     const std::size_t capacity = capacity_;
     std::size_t written = n_;
     std::uint64_t budget = budget_;
-    std::uint32_t r = from;
-    for (; r < end; ++r) {
+    const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
+    std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+    while (r < end) {
       if (budget == 0) break;
       --budget;
       const TilePoint q = points[r];
-      const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
-                   dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
-      const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
-      // Whether a point lies in the region follows no pattern a branch predictor could learn near its
-      // border: each is written at the next slot, which only one inside keeps.
-      bool kept = true;
-      if (kClip) {
-        const double x = wx + ux * s, y = wy + uy * s;
-        kept = x >= x0 && x < x1 && y >= y0 && y < y1;
+      bool visit = true;
+      if (kClip) {  // a point that cannot glide into the region is passed over before anything is computed
+        const double sx = q.x + 0.5, sy = q.y + 0.5;
+        visit = sx >= cut.lo_x && sx < cut.hi_x && sy >= cut.lo_y && sy < cut.hi_y;
       }
-      if (written == capacity) {
-        if (!kept) continue;
-        ++budget;
-        break;
+      if (visit) {
+        const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
+                     dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
+        const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
+        // Whether a point lies in the region follows no pattern a branch predictor could learn near its
+        // border: each is written at the next slot, which only one inside keeps.
+        bool kept = true;
+        if (kClip) {
+          const double x = wx + ux * s, y = wy + uy * s;
+          kept = x >= x0 && x < x1 && y >= y0 && y < y1;
+        }
+        if (written == capacity) {
+          if (kept) {
+            ++budget;
+            break;
+          }
+        } else {
+          out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
+          written += kept;
+        }
       }
-      out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
-      written += kept;
+      if (kListed) {
+        ++it;
+        r = it != cut.listed_end ? std::min(*it, end) : end;
+      } else {
+        ++r;
+      }
     }
     n_ = written, budget_ = budget;
     return r >= end ? kDone : r;
@@ -390,8 +434,14 @@ class Descent {
     }
     if (direct && candidates > inherited) {
       const std::uint32_t from = std::max(seq, inherited);
-      const std::uint32_t stopped = inside ? emit_own<false>(n, from, candidates, constant_bracket)
-                                           : emit_own<true>(n, from, candidates, constant_bracket);
+      std::uint32_t stopped;
+      if (inside) {
+        stopped = emit_own<false, false>(n, from, candidates, constant_bracket, Cull{});
+      } else {
+        const Cull c = cull(n, reach);
+        stopped = c.listed ? emit_own<true, true>(n, from, candidates, constant_bracket, c)
+                           : emit_own<true, false>(n, from, candidates, constant_bracket, c);
+      }
       if (stopped != kDone) return stopped;
     }
     // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].

@@ -201,22 +201,6 @@ EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
                 : emit_tile<false, K::kCallback, kInside, false>;
 }
 
-/// Smooth mode: when the region lies beyond one side of the tile (to within a few position units), only the
-/// points that can glide across that side can be emitted: job.listed is set to the shortest such side's
-/// list (QueryTables::edges), whose every other point the culling bounds reject (the list adds
-/// detail::kEdgeSlack units to each reach, the bounds at most one).
-void pick_edge_list(const QueryTables& tables, std::size_t index, TileJob& job) {
-  constexpr double kNear = detail::kEdgeSlack / 2;
-  const bool beyond[4] = {job.cull_x1 <= kNear, job.cull_x0 >= 65536.0 - kNear, job.cull_y1 <= kNear,
-                          job.cull_y0 >= 65536.0 - kNear};
-  std::uint32_t best = ~0u;
-  for (int side = 0; side < 4; ++side) {
-    std::uint32_t count = 0;
-    const std::uint32_t* ranks = tables.edges(index, side, count);
-    if (beyond[side] && count < best) best = count, job.listed = ranks, job.listed_end = ranks + count;
-  }
-}
-
 }  // namespace
 
 Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
@@ -387,8 +371,10 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
           const GlideBracket b(job.keyframes, limit);
           job.reach = std::max(tables.glide_reach[b.g0], tables.glide_reach[b.g1]);
         }
-        job.listed = nullptr;
-        pick_edge_list(tables, index, job);
+        // Beside the region only the points that can glide across the side it lies beyond can be emitted.
+        job.listed = job.listed_end = nullptr;
+        tables.edges_beyond(index, job.cull_x0, job.cull_y0, job.cull_x1, job.cull_y1, job.listed,
+                            job.listed_end);
         job.zero_possible = d.kind == QueryDensity::Kind::kImage &&
                             !(d.image->min_over(wx - reach, wy - reach, wx + S + reach, wy + S + reach) > 0);
       }

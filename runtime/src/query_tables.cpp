@@ -142,6 +142,20 @@ void QueryTables::index_edges(const TilesetData& set) {
   }
 }
 
+bool QueryTables::edges_beyond(std::size_t index, double cull_x0, double cull_y0, double cull_x1,
+                               double cull_y1, const std::uint32_t*& begin, const std::uint32_t*& end) const {
+  constexpr double kNear = kEdgeSlack / 2;
+  const bool beyond[4] = {cull_x1 <= kNear, cull_x0 >= 65536.0 - kNear, cull_y1 <= kNear,
+                          cull_y0 >= 65536.0 - kNear};
+  std::uint32_t best = ~0u;
+  for (int side = 0; side < 4; ++side) {
+    std::uint32_t count = 0;
+    const std::uint32_t* ranks = edges(index, side, count);
+    if (beyond[side] && count < best) best = count, begin = ranks, end = ranks + count;
+  }
+  return best != ~0u;
+}
+
 namespace {
 
 template <class T>

@@ -83,6 +83,12 @@ struct QueryTables {
     count = start[side + 1] - start[side];
     return edge_ranks[index].data() + start[side];
   }
+  /// For a tile beside a region: the region's bounds in the tile's position units (1/65536 sides), widened
+  /// for rounding, and the region lying beyond one of its sides (to within kEdgeSlack / 2 units) give the
+  /// shortest such side's list, whose every other point a culling by those bounds and the points' reach
+  /// would reject. Returns false (begin and end untouched) when the region lies beyond no side.
+  bool edges_beyond(std::size_t index, double cull_x0, double cull_y0, double cull_x1, double cull_y1,
+                    const std::uint32_t*& begin, const std::uint32_t*& end) const;
 
  private:
   void index_edges(const TilesetData& set);

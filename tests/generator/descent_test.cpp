@@ -225,6 +225,27 @@ TEST(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
   }
 }
 
+TEST(DescentTest, PartitionsFarFromTheWorldOriginAtDepthFourKeepEveryPoint) {
+  // Depth 4 at 10^11 world units, where a coordinate's rounding (2^-20 ≈ 1e-6) spans many of a subtile's
+  // position units (1/65536 of its side, 6e-8): the subtiles beside a cut, which pass over the points that
+  // cannot glide into their part, still emit every point of the whole once.
+  const double far = 1e11, per_tile = 512.0 * 65536 * 0.9;
+  QueryParams p = uniform(0, per_tile);
+  p.x0 = p.origin_x = far, p.y0 = p.origin_y = -far;
+  p.x1 = far + 1.0 / 32, p.y1 = -far + 1.0 / 64;
+  const std::vector<QueryPoint> whole = query(p);
+  ASSERT_GT(whole.size(), 5000u);
+  for (const double cut : {1.0 / 77, 1.0 / 43}) {
+    std::set<Key> parts;
+    QueryParams a = p, b = p;
+    a.x1 = b.x0 = far + cut;
+    for (const QueryParams& part : {a, b})
+      for (const QueryPoint& q : query(part)) EXPECT_TRUE(parts.insert(key(q.id)).second);
+    EXPECT_EQ(parts.size(), whole.size());
+    for (const QueryPoint& q : whole) EXPECT_EQ(parts.count(key(q.id)), 1u);
+  }
+}
+
 TEST(DescentTest, BelowTheTopTheDescentGivesTheOrdinaryPathsBits) {
   // The same density (a ramp up to 1, 400 points per tile at most, below N_top = 512) with a bound of 1
   // (every tile takes the ordinary path) and of 50 (every tile takes the descent, which emits the same
