@@ -32,7 +32,7 @@ DescentQuery::DescentQuery(const Tileset& tileset, const QueryParams& q, const I
   } else {
     origin_frac_x = q.origin_x, origin_frac_y = q.origin_y;
   }
-  reach = tables->glide_reach_from.empty() ? 0 : tables->glide_reach_from[0];
+  reach = tables->descent_reach;
   top = set->keyframe_nominal.back(), k1 = set->keyframe_nominal[1];
   appearing_end = set->appearing_end();
 }
@@ -256,38 +256,35 @@ class Descent {
                         : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
   }
 
-  /// Which of a subtile's own points emit_own visits when the subtile is not inside the region: those
-  /// whose stable position (1/65536 sides) lies within [lo_x, hi_x) × [lo_y, hi_y), the region widened by
-  /// the farthest they glide and by the rounding of far-off coordinates; and where the region lies beyond
-  /// one of its sides, only that side's edge list (QueryTables::edges_beyond), else listed is null.
+  /// The region in a subtile's position units (1/65536 sides), widened by one unit and by as many more as
+  /// the rounding of world coordinates this far out can take, so that a culling by it (less the reach of
+  /// the points culled) is never stricter than write_unit's test; and, where the region lies beyond one of
+  /// the subtile's sides, that side's edge list (QueryTables::edges_beyond), else listed is null.
   struct Cull {
-    double lo_x, lo_y, hi_x, hi_y;
+    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     const std::uint32_t *listed = nullptr, *listed_end = nullptr;
   };
-  Cull cull(const Node& n, double reach) const {
+  Cull cull(const Node& n) const {
     const QueryParams& p = *q_.params;
     const double s = q_.side[n.depth], scale = 65536.0 / s;
-    // One position unit, and as many more as the rounding of world coordinates this far out can take
-    // (a few ulps of the largest of them), so that the culling is never stricter than write_unit's test.
+    // A few ulps of the largest coordinate involved, in position units.
     const double slack = 1 + 1e-15 * scale *
                                  (std::fabs(n.wx) + std::fabs(n.wy) + std::fabs(p.x0) + std::fabs(p.x1) +
                                   std::fabs(p.y0) + std::fabs(p.y1) + s);
     Cull c;
-    const double x0 = (p.x0 - n.wx) * scale - slack, x1 = (p.x1 - n.wx) * scale + slack;
-    const double y0 = (p.y0 - n.wy) * scale - slack, y1 = (p.y1 - n.wy) * scale + slack;
-    c.lo_x = x0 - reach * 65536.0, c.hi_x = x1 + reach * 65536.0;
-    c.lo_y = y0 - reach * 65536.0, c.hi_y = y1 + reach * 65536.0;
-    t_.edges_beyond(n.type, x0, y0, x1, y1, c.listed, c.listed_end);
+    c.x0 = (p.x0 - n.wx) * scale - slack, c.x1 = (p.x1 - n.wx) * scale + slack;
+    c.y0 = (p.y0 - n.wy) * scale - slack, c.y1 = (p.y1 - n.wy) * scale + slack;
+    t_.edges_beyond(n.type, c.x0, c.y0, c.x1, c.y1, c.listed, c.listed_end);
     return c;
   }
 
-  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g. kClip:
-  /// only those inside the region, visiting only the ranks `c` lets through; kListed: only c's listed
-  /// ranks. Positions and the region's test as write_unit's, bit for bit. kDone, or where the buffer or
-  /// the budget ran out.
+  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g, none
+  /// farther than `reach` (sides). kClip: only those inside the region, visiting only those whose stable
+  /// position lies within `c` widened by the reach; kListed: only c's listed ranks. Positions and the
+  /// region's test as write_unit's, bit for bit. kDone, or where the buffer or the budget ran out.
   template <bool kClip, bool kListed>
   std::uint32_t emit_own(const Node& n, std::uint32_t from, std::uint32_t end, const GlideBracket& g,
-                         const Cull& c) {
+                         double reach, const Cull& c) {
     const Tile& tile = set_.tiles[n.type];
     const std::uint32_t* start = t_.glide_start[n.type].data();
     const std::int8_t* o0 = tile.glide.data() + 2 * std::size_t(start[g.g0]);
@@ -298,6 +295,8 @@ class Descent {
     const QueryParams& p = *q_.params;
     const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
     const Cull cut = c;
+    const double lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
+    const double lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
     // Locals, which the writes into the caller's buffer cannot alias.
     const TilePoint* points = tile.points.data();
     QueryPoint* const out = out_;
@@ -313,7 +312,7 @@ class Descent {
       bool visit = true;
       if (kClip) {  // a point that cannot glide into the region is passed over before anything is computed
         const double sx = q.x + 0.5, sy = q.y + 0.5;
-        visit = sx >= cut.lo_x && sx < cut.hi_x && sy >= cut.lo_y && sy < cut.hi_y;
+        visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
       }
       if (visit) {
         const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
@@ -345,6 +344,118 @@ class Descent {
     }
     n_ = written, budget_ = budget;
     return r >= end ? kDone : r;
+  }
+
+  /// Emits ranks [from, end) of tile n (depth > 0) under a varying density, none of which hands over:
+  /// each where its count at its stable position passes its threshold, gliding by that count. Emitted
+  /// ranks wait in a batch, as emit_tile's do, so that the chains from a point's density to its position
+  /// overlap instead of restarting after every mispredicted emission test. kClip and kListed as
+  /// emit_own's, each rank culled by the reach from the keyframe it appears after. Positions and tests
+  /// as the general loop's, bit for bit. kDone, or where the buffer or the budget ran out.
+  template <QueryDensity::Kind kKind, bool kClip, bool kListed>
+  std::uint32_t emit_varying(const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
+    static_assert(kKind != QueryDensity::Kind::kConstant);
+    const QueryDensity& density = q_.params->density;
+    const ImageSampler& sampler = *q_.sampler;
+    auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
+      return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y)
+                                                 : density_or_zero(density.callback(density.user, x, y));
+    };
+    const QueryParams& p = *q_.params;
+    const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
+    const Tile& tile = set_.tiles[n.type];
+    const TilePoint* points = tile.points.data();
+    const float* thresholds = t_.thresholds[n.type].data();
+    const std::uint32_t* start = t_.glide_start[n.type].data();
+    const std::uint32_t* present = t_.points_at_keyframe[n.type].data();
+    const std::int8_t* glide = tile.glide.data();
+    const double s = q_.side[n.depth], area = q_.area[n.depth], wx = n.wx, wy = n.wy, rx = n.rx, ry = n.ry;
+    const std::int64_t gx = n.gx, gy = n.gy;
+    const std::uint32_t depth = n.depth, keyframes = q_.keyframes.n;
+    const Cull cut = c;
+    std::uint32_t segment = 0;  // the keyframes whose count the ranks from here on are present at
+    double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+    auto set_reach = [&](double reach) {
+      lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
+      lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
+    };
+    if (kClip) set_reach(t_.glide_reach_from[0]);
+    constexpr int kBatch = 32;
+    std::uint32_t rank[kBatch];
+    double count[kBatch];
+    int pending = 0;
+    auto flush = [&]() -> std::uint32_t {  // kDone, or the rank that did not fit
+      const std::int8_t *o0[kBatch], *o1[kBatch];
+      double w0[kBatch], w1[kBatch];
+      for (int i = 0; i < pending; ++i) {
+        const GlideBracket g(q_.keyframes, count[i]);
+        o0[i] = glide + 2 * (std::size_t(start[g.g0]) + rank[i]);
+        o1[i] = glide + 2 * (std::size_t(start[g.g1]) + rank[i]);
+        w0[i] = g.w0, w1[i] = g.w1;
+      }
+      for (int i = 0; i < pending; ++i) {
+        const TilePoint& p = points[rank[i]];
+        const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
+                     dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
+        const double ux = p.unit_x() + dx * (1.0 / 65536.0), uy = p.unit_y() + dy * (1.0 / 65536.0);
+        // write's tests: in the region, and where the density is not 0.
+        const double x = wx + ux * s, y = wy + uy * s;
+        if (x < x0 || x >= x1 || y < y0 || y >= y1 || !(density_at(x, y) > 0)) continue;
+        if (n_ == capacity_) return pending = 0, rank[i];
+        out_[n_++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
+      }
+      pending = 0;
+      return kDone;
+    };
+    const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
+    std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+    while (r < end) {
+      if (budget_ == 0) {
+        const std::uint32_t stopped = flush();
+        return stopped != kDone ? stopped : r;
+      }
+      --budget_;
+      const TilePoint q = points[r];
+      bool visit = true;
+      if (kClip) {
+        if (segment < keyframes && present[segment] <= r) {
+          while (segment < keyframes && present[segment] <= r) ++segment;
+          set_reach(t_.glide_reach_from[segment - 1]);
+        }
+        const double sx = q.x + 0.5, sy = q.y + 0.5;
+        visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
+      }
+      if (visit) {
+        const double expected = density_at(wx + q.unit_x() * s, wy + q.unit_y() * s) * area;
+        // Queued at the next slot, which only an emitted rank keeps (no branch to mispredict).
+        rank[pending] = r, count[pending] = expected;
+        pending += TilesetShape::emits(thresholds[r], expected);
+        if (pending == kBatch) {
+          const std::uint32_t stopped = flush();
+          if (stopped != kDone) return stopped;
+        }
+      }
+      if (kListed) {
+        ++it;
+        r = it != cut.listed_end ? std::min(*it, end) : end;
+      } else {
+        ++r;
+      }
+    }
+    return flush();
+  }
+
+  /// emit_varying for the query's kind of density.
+  using VaryingEmitter = std::uint32_t (*)(Descent*, const Node&, std::uint32_t, std::uint32_t, const Cull&);
+  template <bool kClip, bool kListed>
+  VaryingEmitter varying_emitter() const {
+    if (q_.params->density.kind == QueryDensity::Kind::kImage)
+      return [](Descent* d, const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
+        return d->emit_varying<QueryDensity::Kind::kImage, kClip, kListed>(n, from, end, c);
+      };
+    return [](Descent* d, const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
+      return d->emit_varying<QueryDensity::Kind::kCallback, kClip, kListed>(n, from, end, c);
+    };
   }
 
   /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
@@ -381,13 +492,38 @@ class Descent {
     const double reach = std::max(t_.glide_reach[constant_bracket.g0], t_.glide_reach[constant_bracket.g1]);
     const double margin = (reach + 1e-9) * side;  // the farthest those points glide, and a hair for rounding
     const bool direct = constant && n.depth > 0 && !(hands_over(n) && constant_count > q_.top);
-    const bool inside = n.wx - margin >= params.x0 && n.wx + side + margin < params.x1 &&
-                        n.wy - margin >= params.y0 && n.wy + side + margin < params.y1;
-    const std::uint32_t general_end = direct ? std::min(candidates, inherited) : candidates;
+    // The same for a varying density whose bound keeps every own point below N_top (emit_varying).
+    const bool varying = !constant && n.depth > 0 && !(hands_over(n) && bound > q_.top);
+    const double margin_all = (t_.glide_reach_from[0] + 1e-9) * side;  // any keyframe's farthest glide
+    const bool inside = direct ? n.wx - margin >= params.x0 && n.wx + side + margin < params.x1 &&
+                                     n.wy - margin >= params.y0 && n.wy + side + margin < params.y1
+                               : n.wx - margin_all >= params.x0 && n.wx + side + margin_all < params.x1 &&
+                                     n.wy - margin_all >= params.y0 && n.wy + side + margin_all < params.y1;
+    const std::uint32_t general_end = direct || varying ? std::min(candidates, inherited) : candidates;
+    // Outside the region widened by the farthest a point glides (from the keyframe before the one it is
+    // present at: it is emitted only past that count) or hands over, a point is passed over before its
+    // density is looked up: an ancestor of a small deep region holds thousands.
+    const double far = (q_.reach + 1e-9) * side;
+    const bool culled = general_end > seq && !(n.wx - far >= params.x0 && n.wx + side + far < params.x1 &&
+                                               n.wy - far >= params.y0 && n.wy + side + far < params.y1);
+    const Cull around = culled ? cull(n) : Cull{};
+    const std::uint32_t* present = t_.points_at_keyframe[n.type].data();
+    std::uint32_t segment = 0;
+    double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
     for (std::uint32_t r = seq; r < general_end; ++r) {
       if (budget_ == 0) return r;
       --budget_;
       const TilePoint& p = tile.points[r];
+      if (culled) {
+        if (r == seq || (segment < q_.keyframes.n && present[segment] <= r)) {
+          while (segment < q_.keyframes.n && present[segment] <= r) ++segment;
+          const double reach =
+              std::max(t_.glide_reach_from[segment ? segment - 1 : 0], hands_over(n) ? t_.handover_reach : 0);
+          lo_x = around.x0 - reach * 65536.0, hi_x = around.x1 + reach * 65536.0;
+          lo_y = around.y0 - reach * 65536.0, hi_y = around.y1 + reach * 65536.0;
+        }
+        if (!(p.x + 0.5 >= lo_x && p.x + 0.5 < hi_x && p.y + 0.5 >= lo_y && p.y + 0.5 < hi_y)) continue;
+      }
       const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
       const double count_here = constant ? constant_count : q_.density_at(xs, ys) * area;
       const Share mine = r < inherited ? share(k, r, count_here) : Share{true, count_here};
@@ -432,15 +568,20 @@ class Descent {
       }
       if (!fits) return r;
     }
-    if (direct && candidates > inherited) {
+    if ((direct || varying) && candidates > inherited) {
       const std::uint32_t from = std::max(seq, inherited);
       std::uint32_t stopped;
       if (inside) {
-        stopped = emit_own<false, false>(n, from, candidates, constant_bracket, Cull{});
+        stopped = direct ? emit_own<false, false>(n, from, candidates, constant_bracket, reach, Cull{})
+                         : varying_emitter<false, false>()(this, n, from, candidates, Cull{});
       } else {
-        const Cull c = cull(n, reach);
-        stopped = c.listed ? emit_own<true, true>(n, from, candidates, constant_bracket, c)
-                           : emit_own<true, false>(n, from, candidates, constant_bracket, c);
+        const Cull c = cull(n);
+        if (direct)
+          stopped = c.listed ? emit_own<true, true>(n, from, candidates, constant_bracket, reach, c)
+                             : emit_own<true, false>(n, from, candidates, constant_bracket, reach, c);
+        else
+          stopped = c.listed ? varying_emitter<true, true>()(this, n, from, candidates, c)
+                             : varying_emitter<true, false>()(this, n, from, candidates, c);
       }
       if (stopped != kDone) return stopped;
     }

@@ -276,7 +276,7 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
     const GlideBracket top(keyframe_table(tileset), max_density * area_scale);
     for (std::uint32_t g = d.kind == QueryDensity::Kind::kConstant ? top.g0 : 0; g <= top.g1; ++g)
       reach = std::max(reach, tables.glide_reach[g] * S);
-    if (descend) reach = std::max(reach, tables.glide_reach_from[0] * S) + S * (2.0 / 65536.0);
+    if (descend) reach = std::max(reach, tables.descent_reach * S) + S * (2.0 / 65536.0);
   }
   const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
   const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);

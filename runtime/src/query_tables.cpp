@@ -114,9 +114,15 @@ void QueryTables::index_handover(const TilesetData& set) {
         const double glide = std::hypot(bx - ax, by - ay) * std::sqrt(double(set.level_nominal.back()));
         handover_end[t][r] = static_cast<float>(set.handover_end(glide));
         handover_end_max[t] = std::max(handover_end_max[t], double(handover_end[t][r]));
+        // The path's far end: the sub-point's stable position, and its glide at any count from K_1 on.
+        const double sub_reach = glide_reach_from[1] / m;
+        const double ex = std::fabs((j % m + child.points[q].unit_x()) / m - tile.points[r].unit_x()),
+                     ey = std::fabs((j / m + child.points[q].unit_y()) / m - tile.points[r].unit_y());
+        handover_reach = std::max({handover_reach, ex + sub_reach, ey + sub_reach});
       }
     }
   }
+  descent_reach = std::max(glide_reach_from[0], handover_reach);
 }
 
 void QueryTables::index_edges(const TilesetData& set) {

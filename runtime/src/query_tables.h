@@ -70,6 +70,11 @@ struct QueryTables {
   /// largest of them.
   TilesetArray<TilesetArray<float>> handover_end;
   TilesetArray<double> handover_end_max;
+  /// The farthest, per axis in tile sides, that a hand-over's straight path (from a point's top-keyframe
+  /// position to its sub-point's glide track from K_1 on) lies from the point's stable position; and the
+  /// farthest any point of a tile or of its subtiles lies from its stable position at any count, the
+  /// larger of that and glide_reach_from[0]: queries past the top level look this far beyond their region.
+  double handover_reach = 0, descent_reach = 0;
   /// The allocator hooks this object itself came from (Tileset allocates it through them).
   AllocatorHooks hooks;
 
