@@ -129,9 +129,15 @@ void BM_QueryDensityCallback(benchmark::State& state) {
 
 // Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
 // each (as depth 0's tiles do in BM_QueryConstant), over 8 × 8 of them: the same ~960k points, emitted
-// by tiles 32^d times smaller, with the hand-over's ancestors above them.
+// by tiles 32^d times smaller, with the hand-over's ancestors above them. BM_QueryRampAtDepth: the same
+// with BM_QueryDensityCallback's ramp over the region (0.2 to 1, ~576k points).
 // KDM_BENCHMARK_TILESET names another set (one with a hand-over) to measure instead of the built-in one.
-void BM_QuerySmoothAtDepth(benchmark::State& state) {
+double ramp_side = kSide;
+double ramp_at_depth(void*, double x, double) {
+  return 0.2 + 0.8 * x / ramp_side;
+}
+
+void query_at_depth(benchmark::State& state, bool ramp) {
   static kdm::Tileset loaded;
   const char* path = std::getenv("KDM_BENCHMARK_TILESET");
   if (path && loaded.empty() && kdm::Tileset::load_file(path, loaded) != kdm::Status::kOk)
@@ -145,8 +151,22 @@ void BM_QuerySmoothAtDepth(benchmark::State& state) {
   q.mode = kdm::QueryMode::kSmooth;
   q.x1 = q.y1 = kSide / zoom;
   q.scale = kScale * zoom * zoom;
+  if (ramp) {
+    ramp_side = q.x1;
+    q.density.kind = kdm::QueryDensity::Kind::kCallback;
+    q.density.callback = ramp_at_depth;
+    q.density.callback_max = 1;
+  }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   run_against_baseline(state, [&] { return run_query(tiles, q, buffer); });
+}
+
+void BM_QuerySmoothAtDepth(benchmark::State& state) {
+  query_at_depth(state, false);
+}
+
+void BM_QueryRampAtDepth(benchmark::State& state) {
+  query_at_depth(state, true);
 }
 
 void BM_BaselineWriteSamePoints(benchmark::State& state) {
@@ -173,6 +193,7 @@ BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityCallback)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
