@@ -1,7 +1,8 @@
 // Smooth queries past the top level (runtime/src/descent.h) on a small set with a hand-over (three levels,
 // 32 … 512 points per tile, 4×4 subtiles per tile): the densities asked for are served to four depths, a
-// point once emitted stays emitted with its id and moves continuously, partitions and resumed calls give
-// the same bits, and positions far from the world origin keep their precision.
+// point once emitted stays emitted with its id and moves continuously, partitions (random grids of cuts),
+// resumed calls and threads give the same bits at depths 0 to 4 and 10^9 units from the origin, the loops
+// for varying and constant densities agree, and positions far from the world origin keep their precision.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +11,9 @@
 #include <cstdlib>
 #include <map>
 #include <new>
+#include <random>
 #include <set>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -271,6 +274,122 @@ TEST(DescentTest, PartitionsFarFromTheWorldOriginAtDepthFourKeepEveryPoint) {
       for (const QueryPoint& q : query(part)) EXPECT_TRUE(parts.insert(key(q.id)).second);
     EXPECT_EQ(parts.size(), whole.size());
     for (const QueryPoint& q : whole) EXPECT_EQ(parts.count(key(q.id)), 1u);
+  }
+}
+
+double wave(void*, double x, double y) {
+  return 0.55 + 0.45 * std::sin(700 * x) * std::cos(500 * y);
+}
+
+/// The three kinds of density over region p (the image covering it), at `per_tile` points per tile at
+/// most; the image's texels live in `texels` and `mip`.
+std::vector<QueryParams> three_densities(QueryParams p, DensityImageView& image, std::vector<float>& texels,
+                                         std::vector<float>& mip) {
+  texels.resize(16 * 16);
+  for (int i = 0; i < 16 * 16; ++i) texels[i] = 0.3f + 0.7f * float((i * 37) % 16) / 15.0f;
+  image.width = image.height = 16;
+  image.x0 = p.x0, image.y0 = p.y0, image.x1 = p.x1, image.y1 = p.y1;
+  image.values = texels.data();
+  EXPECT_EQ(make_density_max_mip(image, mip), Status::kOk);
+  std::vector<QueryParams> out(3, p);
+  out[1].density.kind = QueryDensity::Kind::kCallback, out[1].density.callback = wave;
+  out[1].density.callback_max = 1;
+  out[2].density.kind = QueryDensity::Kind::kImage, out[2].density.image = &image;
+  return out;
+}
+
+using Bits = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t, double, double>;
+std::vector<Bits> sorted_bits(const std::vector<QueryPoint>& points) {
+  std::vector<Bits> out;
+  for (const QueryPoint& q : points)
+    out.emplace_back(q.id.tile_x, q.id.tile_y, q.id.rank, q.id.depth, q.x, q.y);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThree) {
+  // Depths 0, 1 and 3 of the small set (m = 4: depth d's points appear past 512 · 16^(d-1) points per
+  // tile), at the origin and 10^9 units from it, for a constant density, a callback and an image: a random
+  // grid of cuts, the parts queried through a small buffer, gives the whole region's points bit for bit,
+  // and four threads querying at once give a single thread's.
+  std::mt19937 rng(7);
+  for (const double per_tile : {400.0, 512.0 * 9, 512.0 * 256 * 5}) {
+    for (const double offset : {0.0, 1e9}) {
+      const double side = std::sqrt(12000 / per_tile);
+      QueryParams p = uniform(0, per_tile);
+      p.x0 = offset + 0.31 * side, p.y0 = -offset - 0.47 * side, p.x1 = p.x0 + side, p.y1 = p.y0 + side;
+      p.origin_x = offset, p.origin_y = -offset;
+      DensityImageView image;
+      std::vector<float> texels, mip;
+      for (const QueryParams& whole : three_densities(p, image, texels, mip)) {
+        const std::string what = std::to_string(per_tile) + " points per tile, offset " +
+                                 std::to_string(offset) + ", density kind " +
+                                 std::to_string(int(whole.density.kind));
+        const std::vector<QueryPoint> all = query(whole);
+        const std::vector<Bits> expected = sorted_bits(all);
+        ASSERT_GT(expected.size(), 3000u) << what;
+        std::uint32_t deepest = 0;
+        for (const QueryPoint& q : all) deepest = std::max(deepest, q.id.depth);
+        EXPECT_EQ(deepest, per_tile < 512 ? 0u : per_tile < 512 * 16 ? 1u : 3u) << what;
+        std::vector<double> xs = {whole.x0, whole.x1}, ys = {whole.y0, whole.y1};
+        for (int i = 0; i < 3; ++i) {
+          xs.push_back(whole.x0 + side * std::uniform_real_distribution<>(0, 1)(rng));
+          ys.push_back(whole.y0 + side * std::uniform_real_distribution<>(0, 1)(rng));
+        }
+        std::sort(xs.begin(), xs.end());
+        std::sort(ys.begin(), ys.end());
+        std::vector<QueryPoint> parts;
+        for (std::size_t i = 0; i + 1 < xs.size(); ++i)
+          for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
+            QueryParams part = whole;
+            part.x0 = xs[i], part.x1 = xs[i + 1], part.y0 = ys[j], part.y1 = ys[j + 1];
+            const std::vector<QueryPoint> got = query(part, 61);
+            parts.insert(parts.end(), got.begin(), got.end());
+          }
+        EXPECT_TRUE(sorted_bits(parts) == expected) << what;
+        std::vector<std::vector<QueryPoint>> threaded(4);
+        std::vector<std::thread> threads;
+        for (auto& out : threaded) threads.emplace_back([&out, &whole] { out = query(whole, 509); });
+        for (std::thread& t : threads) t.join();
+        for (const auto& out : threaded) {
+          ASSERT_EQ(out.size(), all.size()) << what;
+          for (std::size_t i = 0; i < all.size(); ++i)
+            ASSERT_TRUE(out[i].id == all[i].id && out[i].x == all[i].x && out[i].y == all[i].y) << what;
+        }
+      }
+    }
+  }
+}
+
+TEST(DescentTest, RaisingTheScaleThroughDepthFourKeepsEveryPoint) {
+  // Zoom coherence from depth 3 into depth 4 (whose points appear past 512 · 16^3 points per tile; here
+  // 0.7 to 2.5 times that, ×1.1 a step) on a fixed region, for a constant density and a callback: every
+  // id emitted at one scale at least two spacings inside the region (a point glides less than one per
+  // step) is emitted at the next.
+  const double first = 512.0 * 4096 * 0.7, last = 512.0 * 4096 * 2.5;
+  QueryParams p = uniform(0, first);
+  p.x0 = 0.4, p.y0 = 0.2, p.x1 = p.x0 + std::sqrt(3000 / first), p.y1 = p.y0 + std::sqrt(3000 / first);
+  for (const bool constant : {true, false}) {
+    if (!constant) p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = wave;
+    p.density.callback_max = 1;
+    std::set<Key> before;
+    std::uint32_t deepest = 0;
+    for (double scale = first; scale < last; scale *= 1.1) {
+      p.scale = scale;
+      std::set<Key> now, inner;
+      const double margin = 2 / std::sqrt(0.1 * scale);  // two spacings at density 0.1, the least here
+      for (const QueryPoint& q : query(p)) {
+        now.insert(key(q.id)), deepest = std::max(deepest, q.id.depth);
+        if (q.x > p.x0 + margin && q.x < p.x1 - margin && q.y > p.y0 + margin && q.y < p.y1 - margin)
+          inner.insert(key(q.id));
+      }
+      std::size_t lost = 0;
+      for (const Key& k : before) lost += now.count(k) == 0;
+      EXPECT_EQ(lost, 0u) << "scale " << scale << (constant ? " constant" : " callback");
+      EXPECT_GT(inner.size(), 500u);
+      before = std::move(inner);
+    }
+    EXPECT_EQ(deepest, 4u);
   }
 }
 
