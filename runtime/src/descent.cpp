@@ -355,12 +355,17 @@ class Descent {
   template <QueryDensity::Kind kKind, bool kClip, bool kListed>
   std::uint32_t emit_varying(const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
     static_assert(kKind != QueryDensity::Kind::kConstant);
-    const QueryDensity& density = q_.params->density;
-    const ImageSampler& sampler = *q_.sampler;
+    // Locals, which the writes into the caller's buffer cannot alias.
+    const ImageSampler sampler = *q_.sampler;
+    double (*const callback)(void*, double, double) = q_.params->density.callback;
+    void* const user = q_.params->density.user;
     auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
-      return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y)
-                                                 : density_or_zero(density.callback(density.user, x, y));
+      return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : density_or_zero(callback(user, x, y));
     };
+    QueryPoint* const out = out_;
+    const std::size_t capacity = capacity_;
+    std::size_t written = n_;
+    std::uint64_t budget = budget_;
     const QueryParams& p = *q_.params;
     const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
     const Tile& tile = set_.tiles[n.type];
@@ -398,11 +403,12 @@ class Descent {
         const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
                      dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
         const double ux = p.unit_x() + dx * (1.0 / 65536.0), uy = p.unit_y() + dy * (1.0 / 65536.0);
-        // write's tests: in the region, and where the density is not 0.
+        // write's tests: in the region (a subtile inside it needs none), and where the density is not 0.
         const double x = wx + ux * s, y = wy + uy * s;
-        if (x < x0 || x >= x1 || y < y0 || y >= y1 || !(density_at(x, y) > 0)) continue;
-        if (n_ == capacity_) return pending = 0, rank[i];
-        out_[n_++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
+        if (kClip && (x < x0 || x >= x1 || y < y0 || y >= y1)) continue;
+        if (!(density_at(x, y) > 0)) continue;
+        if (written == capacity) return pending = 0, rank[i];
+        out[written++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
       }
       pending = 0;
       return kDone;
@@ -410,11 +416,12 @@ class Descent {
     const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
     std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
     while (r < end) {
-      if (budget_ == 0) {
+      if (budget == 0) {
         const std::uint32_t stopped = flush();
+        n_ = written, budget_ = budget;
         return stopped != kDone ? stopped : r;
       }
-      --budget_;
+      --budget;
       const TilePoint q = points[r];
       bool visit = true;
       if (kClip) {
@@ -432,7 +439,7 @@ class Descent {
         pending += TilesetShape::emits(thresholds[r], expected);
         if (pending == kBatch) {
           const std::uint32_t stopped = flush();
-          if (stopped != kDone) return stopped;
+          if (stopped != kDone) return n_ = written, budget_ = budget, stopped;
         }
       }
       if (kListed) {
@@ -442,7 +449,9 @@ class Descent {
         ++r;
       }
     }
-    return flush();
+    const std::uint32_t stopped = flush();
+    n_ = written, budget_ = budget;
+    return stopped;
   }
 
   /// emit_varying for the query's kind of density.
