@@ -7,6 +7,8 @@
 // expression: ρ(x_q) · area[d + 1] > K_1, x_q computed as the subtile computes its own points.
 #include "descent.h"
 
+#include "subtile_loops.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -67,18 +69,8 @@ void DescentQuery::density_bounds(double x0, double y0, double x1, double y1, do
 
 namespace {
 
-constexpr std::uint32_t kDone = ~0u;
-
-struct Node {
-  std::size_t type = 0;
-  std::uint32_t depth = 0;
-  std::int64_t gx = 0, gy = 0;      ///< its tile coordinates at its depth
-  double wx = 0, wy = 0;            ///< its south-west corner, world units
-  double rx = 0, ry = 0;            ///< the same relative to the query origin
-  double rho_max = 0, rho_min = 0;  ///< bounds of the density over it
-  std::uint32_t next_child = 0;
-  bool points_done = false;
-};
+constexpr std::uint32_t kDone = kDescentDone;
+using Node = DescentNode;
 
 /// One depth-0 tile's descent: a stack of the tiles from it down to the one being emitted.
 class Descent {
@@ -256,217 +248,6 @@ class Descent {
                         : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
   }
 
-  /// The region in a subtile's position units (1/65536 sides), widened by one unit and by as many more as
-  /// the rounding of world coordinates this far out can take, so that a culling by it (less the reach of
-  /// the points culled) is never stricter than write_unit's test; and, where the region lies beyond one of
-  /// the subtile's sides, that side's edge list (QueryTables::edges_beyond), else listed is null.
-  struct Cull {
-    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    const std::uint32_t *listed = nullptr, *listed_end = nullptr;
-  };
-  Cull cull(const Node& n) const {
-    const QueryParams& p = *q_.params;
-    const double s = q_.side[n.depth], scale = 65536.0 / s;
-    // A few ulps of the largest coordinate involved, in position units.
-    const double slack = 1 + 1e-15 * scale *
-                                 (std::fabs(n.wx) + std::fabs(n.wy) + std::fabs(p.x0) + std::fabs(p.x1) +
-                                  std::fabs(p.y0) + std::fabs(p.y1) + s);
-    Cull c;
-    c.x0 = (p.x0 - n.wx) * scale - slack, c.x1 = (p.x1 - n.wx) * scale + slack;
-    c.y0 = (p.y0 - n.wy) * scale - slack, c.y1 = (p.y1 - n.wy) * scale + slack;
-    t_.edges_beyond(n.type, c.x0, c.y0, c.x1, c.y1, c.listed, c.listed_end);
-    return c;
-  }
-
-  /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g, none
-  /// farther than `reach` (sides). kClip: only those inside the region, visiting only those whose stable
-  /// position lies within `c` widened by the reach; kListed: only c's listed ranks. Positions and the
-  /// region's test as write_unit's, bit for bit. kDone, or where the buffer or the budget ran out.
-  template <bool kClip, bool kListed>
-  std::uint32_t emit_own(const Node& n, std::uint32_t from, std::uint32_t end, const GlideBracket& g,
-                         double reach, const Cull& c) {
-    const Tile& tile = set_.tiles[n.type];
-    const std::uint32_t* start = t_.glide_start[n.type].data();
-    const std::int8_t* o0 = tile.glide.data() + 2 * std::size_t(start[g.g0]);
-    const std::int8_t* o1 = tile.glide.data() + 2 * std::size_t(start[g.g1]);
-    const double s = q_.side[n.depth], rx = n.rx, ry = n.ry, wx = n.wx, wy = n.wy, w0 = g.w0, w1 = g.w1;
-    const std::int64_t gx = n.gx, gy = n.gy;
-    const std::uint32_t depth = n.depth;
-    const QueryParams& p = *q_.params;
-    const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
-    const Cull cut = c;
-    const double lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
-    const double lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
-    // Locals, which the writes into the caller's buffer cannot alias.
-    const TilePoint* points = tile.points.data();
-    QueryPoint* const out = out_;
-    const std::size_t capacity = capacity_;
-    std::size_t written = n_;
-    std::uint64_t budget = budget_;
-    const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
-    std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
-    while (r < end) {
-      if (budget == 0) break;
-      --budget;
-      const TilePoint q = points[r];
-      bool visit = true;
-      if (kClip) {  // a point that cannot glide into the region is passed over before anything is computed
-        const double sx = q.x + 0.5, sy = q.y + 0.5;
-        visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
-      }
-      if (visit) {
-        const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
-                     dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
-        const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
-        // Whether a point lies in the region follows no pattern a branch predictor could learn near its
-        // border: each is written at the next slot, which only one inside keeps.
-        bool kept = true;
-        if (kClip) {
-          const double x = wx + ux * s, y = wy + uy * s;
-          kept = x >= x0 && x < x1 && y >= y0 && y < y1;
-        }
-        if (written == capacity) {
-          if (kept) {
-            ++budget;
-            break;
-          }
-        } else {
-          out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
-          written += kept;
-        }
-      }
-      if (kListed) {
-        ++it;
-        r = it != cut.listed_end ? std::min(*it, end) : end;
-      } else {
-        ++r;
-      }
-    }
-    n_ = written, budget_ = budget;
-    return r >= end ? kDone : r;
-  }
-
-  /// Emits ranks [from, end) of tile n (depth > 0) under a varying density, none of which hands over:
-  /// each where its count at its stable position passes its threshold, gliding by that count. Emitted
-  /// ranks wait in a batch, as emit_tile's do, so that the chains from a point's density to its position
-  /// overlap instead of restarting after every mispredicted emission test. kClip and kListed as
-  /// emit_own's, each rank culled by the reach from the keyframe it appears after. Positions and tests
-  /// as the general loop's, bit for bit. kDone, or where the buffer or the budget ran out.
-  template <QueryDensity::Kind kKind, bool kClip, bool kListed>
-  std::uint32_t emit_varying(const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
-    static_assert(kKind != QueryDensity::Kind::kConstant);
-    // Locals, which the writes into the caller's buffer cannot alias.
-    const ImageSampler sampler = *q_.sampler;
-    double (*const callback)(void*, double, double) = q_.params->density.callback;
-    void* const user = q_.params->density.user;
-    auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
-      return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : density_or_zero(callback(user, x, y));
-    };
-    QueryPoint* const out = out_;
-    const std::size_t capacity = capacity_;
-    std::size_t written = n_;
-    std::uint64_t budget = budget_;
-    const QueryParams& p = *q_.params;
-    const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
-    const Tile& tile = set_.tiles[n.type];
-    const TilePoint* points = tile.points.data();
-    const float* thresholds = t_.thresholds[n.type].data();
-    const std::uint32_t* start = t_.glide_start[n.type].data();
-    const std::uint32_t* present = t_.points_at_keyframe[n.type].data();
-    const std::int8_t* glide = tile.glide.data();
-    const double s = q_.side[n.depth], area = q_.area[n.depth], wx = n.wx, wy = n.wy, rx = n.rx, ry = n.ry;
-    const std::int64_t gx = n.gx, gy = n.gy;
-    const std::uint32_t depth = n.depth, keyframes = q_.keyframes.n;
-    const Cull cut = c;
-    std::uint32_t segment = 0;  // the keyframes whose count the ranks from here on are present at
-    double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
-    auto set_reach = [&](double reach) {
-      lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
-      lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
-    };
-    if (kClip) set_reach(t_.glide_reach_from[0]);
-    constexpr int kBatch = 32;
-    std::uint32_t rank[kBatch];
-    double count[kBatch];
-    int pending = 0;
-    auto flush = [&]() -> std::uint32_t {  // kDone, or the rank that did not fit
-      const std::int8_t *o0[kBatch], *o1[kBatch];
-      double w0[kBatch], w1[kBatch];
-      for (int i = 0; i < pending; ++i) {
-        const GlideBracket g(q_.keyframes, count[i]);
-        o0[i] = glide + 2 * (std::size_t(start[g.g0]) + rank[i]);
-        o1[i] = glide + 2 * (std::size_t(start[g.g1]) + rank[i]);
-        w0[i] = g.w0, w1[i] = g.w1;
-      }
-      for (int i = 0; i < pending; ++i) {
-        const TilePoint& p = points[rank[i]];
-        const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
-                     dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
-        const double ux = p.unit_x() + dx * (1.0 / 65536.0), uy = p.unit_y() + dy * (1.0 / 65536.0);
-        // write's tests: in the region (a subtile inside it needs none), and where the density is not 0.
-        const double x = wx + ux * s, y = wy + uy * s;
-        if (kClip && (x < x0 || x >= x1 || y < y0 || y >= y1)) continue;
-        if (!(density_at(x, y) > 0)) continue;
-        if (written == capacity) return pending = 0, rank[i];
-        out[written++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
-      }
-      pending = 0;
-      return kDone;
-    };
-    const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
-    std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
-    while (r < end) {
-      if (budget == 0) {
-        const std::uint32_t stopped = flush();
-        n_ = written, budget_ = budget;
-        return stopped != kDone ? stopped : r;
-      }
-      --budget;
-      const TilePoint q = points[r];
-      bool visit = true;
-      if (kClip) {
-        if (segment < keyframes && present[segment] <= r) {
-          while (segment < keyframes && present[segment] <= r) ++segment;
-          set_reach(t_.glide_reach_from[segment - 1]);
-        }
-        const double sx = q.x + 0.5, sy = q.y + 0.5;
-        visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
-      }
-      if (visit) {
-        const double expected = density_at(wx + q.unit_x() * s, wy + q.unit_y() * s) * area;
-        // Queued at the next slot, which only an emitted rank keeps (no branch to mispredict).
-        rank[pending] = r, count[pending] = expected;
-        pending += TilesetShape::emits(thresholds[r], expected);
-        if (pending == kBatch) {
-          const std::uint32_t stopped = flush();
-          if (stopped != kDone) return n_ = written, budget_ = budget, stopped;
-        }
-      }
-      if (kListed) {
-        ++it;
-        r = it != cut.listed_end ? std::min(*it, end) : end;
-      } else {
-        ++r;
-      }
-    }
-    const std::uint32_t stopped = flush();
-    n_ = written, budget_ = budget;
-    return stopped;
-  }
-
-  /// emit_varying for the query's kind of density.
-  using VaryingEmitter = std::uint32_t (*)(Descent*, const Node&, std::uint32_t, std::uint32_t, const Cull&);
-  template <bool kClip, bool kListed>
-  VaryingEmitter varying_emitter() const {
-    if (q_.params->density.kind == QueryDensity::Kind::kImage)
-      return [](Descent* d, const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
-        return d->emit_varying<QueryDensity::Kind::kImage, kClip, kListed>(n, from, end, c);
-      };
-    return [](Descent* d, const Node& n, std::uint32_t from, std::uint32_t end, const Cull& c) {
-      return d->emit_varying<QueryDensity::Kind::kCallback, kClip, kListed>(n, from, end, c);
-    };
-  }
-
   /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
   /// + a): kDone, or where the buffer or the budget ran out.
   std::uint32_t emit(int k, std::uint32_t seq) {
@@ -515,7 +296,7 @@ class Descent {
     const double far = (q_.reach + 1e-9) * side;
     const bool culled = general_end > seq && !(n.wx - far >= params.x0 && n.wx + side + far < params.x1 &&
                                                n.wy - far >= params.y0 && n.wy + side + far < params.y1);
-    const Cull around = culled ? cull(n) : Cull{};
+    const SubtileCull around = culled ? subtile_cull(q_, n) : SubtileCull{};
     const std::uint32_t* present = t_.points_at_keyframe[n.type].data();
     std::uint32_t segment = 0;
     double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
@@ -579,18 +360,20 @@ class Descent {
     }
     if ((direct || varying) && candidates > inherited) {
       const std::uint32_t from = std::max(seq, inherited);
+      DescentSink sink{out_, capacity_, n_, budget_};
       std::uint32_t stopped;
       if (inside) {
-        stopped = direct ? emit_own<false, false>(n, from, candidates, constant_bracket, reach, Cull{})
-                         : varying_emitter<false, false>()(this, n, from, candidates, Cull{});
+        stopped = direct ? emit_own<false, false>(q_, n, sink, from, candidates, constant_bracket, reach, {})
+                         : emit_varying_any<false, false>(q_, n, sink, from, candidates, {});
       } else {
-        const Cull c = cull(n);
+        const SubtileCull c = subtile_cull(q_, n);
         if (direct)
-          stopped = c.listed ? emit_own<true, true>(n, from, candidates, constant_bracket, reach, c)
-                             : emit_own<true, false>(n, from, candidates, constant_bracket, reach, c);
+          stopped = c.listed
+                        ? emit_own<true, true>(q_, n, sink, from, candidates, constant_bracket, reach, c)
+                        : emit_own<true, false>(q_, n, sink, from, candidates, constant_bracket, reach, c);
         else
-          stopped = c.listed ? varying_emitter<true, true>()(this, n, from, candidates, c)
-                             : varying_emitter<true, false>()(this, n, from, candidates, c);
+          stopped = c.listed ? emit_varying_any<true, true>(q_, n, sink, from, candidates, c)
+                             : emit_varying_any<true, false>(q_, n, sink, from, candidates, c);
       }
       if (stopped != kDone) return stopped;
     }

@@ -1,0 +1,253 @@
+// Internal: the loops that emit a subtile's own points past the top level (descent.cpp), as query.cpp's
+// emit_tile does at depth 0: a constant density's by one glide bracket (emit_own), a varying one's each by
+// its count, in batches (emit_varying); beside the region both visit only the points that can glide into
+// it (SubtileCull). Positions and tests are Descent::write_unit's, bit for bit.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "descent.h"
+
+namespace kdm::detail {
+
+/// What emit_descending's loops return when a tile's points are all emitted.
+inline constexpr std::uint32_t kDescentDone = ~0u;
+
+/// A tile of a descent: the depth-0 tile or one of its subtiles.
+struct DescentNode {
+  std::size_t type = 0;
+  std::uint32_t depth = 0;
+  std::int64_t gx = 0, gy = 0;      ///< its tile coordinates at its depth
+  double wx = 0, wy = 0;            ///< its south-west corner, world units
+  double rx = 0, ry = 0;            ///< the same relative to the query origin
+  double rho_max = 0, rho_min = 0;  ///< bounds of the density over it
+  std::uint32_t next_child = 0;
+  bool points_done = false;
+};
+
+/// Where the loops write and what they may spend: the caller's buffer, its fill, the candidate budget.
+struct DescentSink {
+  QueryPoint* out;
+  std::size_t capacity;
+  std::size_t& written;
+  std::uint64_t& budget;
+};
+
+/// The region in a subtile's position units (1/65536 sides), widened by one unit and by as many more as
+/// the rounding of world coordinates this far out can take, so that a culling by it (less the reach of
+/// the points culled) is never stricter than write_unit's test; and, where the region lies beyond one of
+/// the subtile's sides, that side's edge list (QueryTables::edges_beyond), else listed is null.
+struct SubtileCull {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  const std::uint32_t *listed = nullptr, *listed_end = nullptr;
+};
+
+/// Node n's SubtileCull for the query.
+inline SubtileCull subtile_cull(const DescentQuery& q, const DescentNode& n) {
+  const QueryParams& p = *q.params;
+  const double s = q.side[n.depth], scale = 65536.0 / s;
+  // A few ulps of the largest coordinate involved, in position units.
+  const double slack = 1 + 1e-15 * scale *
+                               (std::fabs(n.wx) + std::fabs(n.wy) + std::fabs(p.x0) + std::fabs(p.x1) +
+                                std::fabs(p.y0) + std::fabs(p.y1) + s);
+  SubtileCull c;
+  c.x0 = (p.x0 - n.wx) * scale - slack, c.x1 = (p.x1 - n.wx) * scale + slack;
+  c.y0 = (p.y0 - n.wy) * scale - slack, c.y1 = (p.y1 - n.wy) * scale + slack;
+  q.tables->edges_beyond(n.type, c.x0, c.y0, c.x1, c.y1, c.listed, c.listed_end);
+  return c;
+}
+
+/// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g, none
+/// farther than `reach` (sides). kClip: only those inside the region, visiting only those whose stable
+/// position lies within `c` widened by the reach; kListed: only c's listed ranks. Positions and the
+/// region's test as write_unit's, bit for bit. kDescentDone, or where the buffer or the budget ran out.
+template <bool kClip, bool kListed>
+std::uint32_t emit_own(const DescentQuery& q, const DescentNode& n, DescentSink& sink, std::uint32_t from,
+                       std::uint32_t end, const GlideBracket& g, double reach, const SubtileCull& c) {
+  const TilesetData& set = *q.set;
+  const QueryTables& t = *q.tables;
+  const Tile& tile = set.tiles[n.type];
+  const std::uint32_t* start = t.glide_start[n.type].data();
+  const std::int8_t* o0 = tile.glide.data() + 2 * std::size_t(start[g.g0]);
+  const std::int8_t* o1 = tile.glide.data() + 2 * std::size_t(start[g.g1]);
+  const double s = q.side[n.depth], rx = n.rx, ry = n.ry, wx = n.wx, wy = n.wy, w0 = g.w0, w1 = g.w1;
+  const std::int64_t gx = n.gx, gy = n.gy;
+  const std::uint32_t depth = n.depth;
+  const QueryParams& p = *q.params;
+  const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
+  const SubtileCull cut = c;
+  const double lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
+  const double lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
+  // Locals, which the writes into the caller's buffer cannot alias.
+  const TilePoint* points = tile.points.data();
+  QueryPoint* const out = sink.out;
+  const std::size_t capacity = sink.capacity;
+  std::size_t written = sink.written;
+  std::uint64_t budget = sink.budget;
+  const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
+  std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+  while (r < end) {
+    if (budget == 0) break;
+    --budget;
+    const TilePoint q = points[r];
+    bool visit = true;
+    if (kClip) {  // a point that cannot glide into the region is passed over before anything is computed
+      const double sx = q.x + 0.5, sy = q.y + 0.5;
+      visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
+    }
+    if (visit) {
+      const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
+                   dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
+      const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
+      // Whether a point lies in the region follows no pattern a branch predictor could learn near its
+      // border: each is written at the next slot, which only one inside keeps.
+      bool kept = true;
+      if (kClip) {
+        const double x = wx + ux * s, y = wy + uy * s;
+        kept = x >= x0 && x < x1 && y >= y0 && y < y1;
+      }
+      if (written == capacity) {
+        if (kept) {
+          ++budget;
+          break;
+        }
+      } else {
+        out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
+        written += kept;
+      }
+    }
+    if (kListed) {
+      ++it;
+      r = it != cut.listed_end ? std::min(*it, end) : end;
+    } else {
+      ++r;
+    }
+  }
+  sink.written = written, sink.budget = budget;
+  return r >= end ? kDescentDone : r;
+}
+
+/// Emits ranks [from, end) of tile n (depth > 0) under a varying density, none of which hands over:
+/// each where its count at its stable position passes its threshold, gliding by that count. Emitted
+/// ranks wait in a batch, as emit_tile's do, so that the chains from a point's density to its position
+/// overlap instead of restarting after every mispredicted emission test. kClip and kListed as
+/// emit_own's, each rank culled by the reach from the keyframe it appears after. Positions and tests
+/// as the general loop's, bit for bit. kDescentDone, or where the buffer or the budget ran out.
+template <QueryDensity::Kind kKind, bool kClip, bool kListed>
+std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentSink& sink, std::uint32_t from,
+                           std::uint32_t end, const SubtileCull& c) {
+  const TilesetData& set = *q.set;
+  const QueryTables& t = *q.tables;
+  static_assert(kKind != QueryDensity::Kind::kConstant);
+  // Locals, which the writes into the caller's buffer cannot alias.
+  const ImageSampler sampler = *q.sampler;
+  double (*const callback)(void*, double, double) = q.params->density.callback;
+  void* const user = q.params->density.user;
+  auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
+    return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : density_or_zero(callback(user, x, y));
+  };
+  QueryPoint* const out = sink.out;
+  const std::size_t capacity = sink.capacity;
+  std::size_t written = sink.written;
+  std::uint64_t budget = sink.budget;
+  const QueryParams& p = *q.params;
+  const double x0 = p.x0, y0 = p.y0, x1 = p.x1, y1 = p.y1;
+  const Tile& tile = set.tiles[n.type];
+  const TilePoint* points = tile.points.data();
+  const float* thresholds = t.thresholds[n.type].data();
+  const std::uint32_t* start = t.glide_start[n.type].data();
+  const std::uint32_t* present = t.points_at_keyframe[n.type].data();
+  const std::int8_t* glide = tile.glide.data();
+  const double s = q.side[n.depth], area = q.area[n.depth], wx = n.wx, wy = n.wy, rx = n.rx, ry = n.ry;
+  const std::int64_t gx = n.gx, gy = n.gy;
+  const std::uint32_t depth = n.depth, keyframes = q.keyframes.n;
+  const SubtileCull cut = c;
+  std::uint32_t segment = 0;  // the keyframes whose count the ranks from here on are present at
+  double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+  auto set_reach = [&](double reach) {
+    lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
+    lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
+  };
+  if (kClip) set_reach(t.glide_reach_from[0]);
+  constexpr int kBatch = 32;
+  std::uint32_t rank[kBatch];
+  double count[kBatch];
+  int pending = 0;
+  auto flush = [&]() -> std::uint32_t {  // kDescentDone, or the rank that did not fit
+    const std::int8_t *o0[kBatch], *o1[kBatch];
+    double w0[kBatch], w1[kBatch];
+    for (int i = 0; i < pending; ++i) {
+      const GlideBracket g(q.keyframes, count[i]);
+      o0[i] = glide + 2 * (std::size_t(start[g.g0]) + rank[i]);
+      o1[i] = glide + 2 * (std::size_t(start[g.g1]) + rank[i]);
+      w0[i] = g.w0, w1[i] = g.w1;
+    }
+    for (int i = 0; i < pending; ++i) {
+      const TilePoint& p = points[rank[i]];
+      const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
+                   dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
+      const double ux = p.unit_x() + dx * (1.0 / 65536.0), uy = p.unit_y() + dy * (1.0 / 65536.0);
+      // write's tests: in the region (a subtile inside it needs none), and where the density is not 0.
+      const double x = wx + ux * s, y = wy + uy * s;
+      if (kClip && (x < x0 || x >= x1 || y < y0 || y >= y1)) continue;
+      if (!(density_at(x, y) > 0)) continue;
+      if (written == capacity) return pending = 0, rank[i];
+      out[written++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
+    }
+    pending = 0;
+    return kDescentDone;
+  };
+  const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
+  std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+  while (r < end) {
+    if (budget == 0) {
+      const std::uint32_t stopped = flush();
+      sink.written = written, sink.budget = budget;
+      return stopped != kDescentDone ? stopped : r;
+    }
+    --budget;
+    const TilePoint q = points[r];
+    bool visit = true;
+    if (kClip) {
+      if (segment < keyframes && present[segment] <= r) {
+        while (segment < keyframes && present[segment] <= r) ++segment;
+        set_reach(t.glide_reach_from[segment - 1]);
+      }
+      const double sx = q.x + 0.5, sy = q.y + 0.5;
+      visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
+    }
+    if (visit) {
+      const double expected = density_at(wx + q.unit_x() * s, wy + q.unit_y() * s) * area;
+      // Queued at the next slot, which only an emitted rank keeps (no branch to mispredict).
+      rank[pending] = r, count[pending] = expected;
+      pending += TilesetShape::emits(thresholds[r], expected);
+      if (pending == kBatch) {
+        const std::uint32_t stopped = flush();
+        if (stopped != kDescentDone) return sink.written = written, sink.budget = budget, stopped;
+      }
+    }
+    if (kListed) {
+      ++it;
+      r = it != cut.listed_end ? std::min(*it, end) : end;
+    } else {
+      ++r;
+    }
+  }
+  const std::uint32_t stopped = flush();
+  sink.written = written, sink.budget = budget;
+  return stopped;
+}
+
+/// emit_varying for the query's kind of density (not a constant).
+template <bool kClip, bool kListed>
+std::uint32_t emit_varying_any(const DescentQuery& q, const DescentNode& n, DescentSink& sink,
+                               std::uint32_t from, std::uint32_t end, const SubtileCull& c) {
+  return q.params->density.kind == QueryDensity::Kind::kImage
+             ? emit_varying<QueryDensity::Kind::kImage, kClip, kListed>(q, n, sink, from, end, c)
+             : emit_varying<QueryDensity::Kind::kCallback, kClip, kListed>(q, n, sink, from, end, c);
+}
+
+}  // namespace kdm::detail
