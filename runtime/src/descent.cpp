@@ -307,10 +307,10 @@ class Descent {
       if (culled) {
         if (r == seq || (segment < q_.keyframes.n && present[segment] <= r)) {
           while (segment < q_.keyframes.n && present[segment] <= r) ++segment;
-          const double reach =
+          const double rank_reach =
               std::max(t_.glide_reach_from[segment ? segment - 1 : 0], hands_over(n) ? t_.handover_reach : 0);
-          lo_x = around.x0 - reach * 65536.0, hi_x = around.x1 + reach * 65536.0;
-          lo_y = around.y0 - reach * 65536.0, hi_y = around.y1 + reach * 65536.0;
+          lo_x = around.x0 - rank_reach * 65536.0, hi_x = around.x1 + rank_reach * 65536.0;
+          lo_y = around.y0 - rank_reach * 65536.0, hi_y = around.y1 + rank_reach * 65536.0;
         }
         if (!(p.x + 0.5 >= lo_x && p.x + 0.5 < hi_x && p.y + 0.5 >= lo_y && p.y + 0.5 < hi_y)) continue;
       }
