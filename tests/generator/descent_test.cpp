@@ -21,6 +21,7 @@
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
+#include "random_partition.h"
 
 namespace kdm {
 namespace {
@@ -331,21 +332,11 @@ TEST(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThr
         std::uint32_t deepest = 0;
         for (const QueryPoint& q : all) deepest = std::max(deepest, q.id.depth);
         EXPECT_EQ(deepest, per_tile < 512 ? 0u : per_tile < 512 * 16 ? 1u : 3u) << what;
-        std::vector<double> xs = {whole.x0, whole.x1}, ys = {whole.y0, whole.y1};
-        for (int i = 0; i < 3; ++i) {
-          xs.push_back(whole.x0 + side * std::uniform_real_distribution<>(0, 1)(rng));
-          ys.push_back(whole.y0 + side * std::uniform_real_distribution<>(0, 1)(rng));
-        }
-        std::sort(xs.begin(), xs.end());
-        std::sort(ys.begin(), ys.end());
         std::vector<QueryPoint> parts;
-        for (std::size_t i = 0; i + 1 < xs.size(); ++i)
-          for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
-            QueryParams part = whole;
-            part.x0 = xs[i], part.x1 = xs[i + 1], part.y0 = ys[j], part.y1 = ys[j + 1];
-            const std::vector<QueryPoint> got = query(part, 61);
-            parts.insert(parts.end(), got.begin(), got.end());
-          }
+        for (const QueryParams& part : testing::random_grid_parts(whole, 3, rng)) {
+          const std::vector<QueryPoint> got = query(part, 61);
+          parts.insert(parts.end(), got.begin(), got.end());
+        }
         EXPECT_TRUE(sorted_bits(parts) == expected) << what;
         std::vector<std::vector<QueryPoint>> threaded(4);
         std::vector<std::thread> threads;

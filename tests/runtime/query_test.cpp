@@ -18,6 +18,7 @@
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 #include "query_tables.h"
+#include "random_partition.h"
 
 namespace kdm {
 namespace {
@@ -112,22 +113,11 @@ TEST_P(ModeTest, AnyPartitionGivesTheSameUnionBitForBit) {
   ASSERT_GT(expected.size(), 10000u);
   std::mt19937 rng(1);
   for (int trial = 0; trial < 5; ++trial) {
-    // A random grid of cuts (including cuts through tiles and points' neighbourhoods).
-    std::vector<double> xs = {whole.x0, whole.x1}, ys = {whole.y0, whole.y1};
-    for (int i = 0; i < 4; ++i) {
-      xs.push_back(whole.x0 + (whole.x1 - whole.x0) * std::uniform_real_distribution<>(0, 1)(rng));
-      ys.push_back(whole.y0 + (whole.y1 - whole.y0) * std::uniform_real_distribution<>(0, 1)(rng));
-    }
-    std::sort(xs.begin(), xs.end());
-    std::sort(ys.begin(), ys.end());
     std::vector<Key> got;
-    for (std::size_t i = 0; i + 1 < xs.size(); ++i)
-      for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
-        QueryParams part = whole;
-        part.x0 = xs[i], part.x1 = xs[i + 1], part.y0 = ys[j], part.y1 = ys[j + 1];
-        const std::vector<Key> k = run(part);
-        got.insert(got.end(), k.begin(), k.end());
-      }
+    for (const QueryParams& part : testing::random_grid_parts(whole, 4, rng)) {
+      const std::vector<Key> k = run(part);
+      got.insert(got.end(), k.begin(), k.end());
+    }
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, expected) << "trial " << trial;
   }
