@@ -56,6 +56,9 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(r.to_text().find("fill_holes"), std::string::npos);  // off unless named
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("fill_holes 0.8\n").to_text()).fill_holes, 0.8);
   EXPECT_THROW(BakeRecipe::parse("fill_holes 0.3\n"), InvalidArgument);
+  EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
+  EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
+  EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);
   EXPECT_EQ(r.edge_gap, kFirstEdgeGap);
   EXPECT_EQ(r.rank_context, 0);
   const BakeRecipe later = BakeRecipe::parse("edge_gap 1\nrank_context 1\nerosion 2\nband 0.36\n");

@@ -112,6 +112,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.keyframes_per_level = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "handover_zone") {
       r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
+    } else if (key == "glide_consensus") {
+      r.glide_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
     } else if (key == "glide_sweeps") {
       r.glide_sweeps = static_cast<int>(whole(1, 1000));
     } else if (key == "temperature") {
@@ -133,8 +135,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
       throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
     if (2 * r.handover_zone + 1 >= m)  // Subdivision: corner squares and edge bands must not meet
-      throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) +
-                            "] for " + std::to_string(r.levels) + " levels (" + std::to_string(m) +
+      throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) + "] for " +
+                            std::to_string(r.levels) + " levels (" + std::to_string(m) +
                             " subtiles per side)");
   }
   return r;
@@ -160,6 +162,7 @@ std::string BakeRecipe::to_text() const {
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
+  if (glide_consensus) s << "glide_consensus " << glide_consensus << "\n";
   if (handover_zone) s << "handover_zone " << handover_zone << "\n";
   return s.str();
 }
@@ -212,7 +215,8 @@ class Baker {
     const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal_, recipe_.keyframes_per_level);
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
-      relax_keyframe(levels_, runs_, widths_, shape_, g, recipe_.glide_sweeps, recipe_.seed, threads_);
+      relax_keyframe(levels_, runs_, widths_, shape_, g, recipe_.glide_sweeps, recipe_.seed, threads_,
+                     recipe_.glide_consensus);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }

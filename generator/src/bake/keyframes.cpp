@@ -439,45 +439,77 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                    int sweeps, std::uint64_t seed, int threads) {
+                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below) {
+  // The schedule: each stage's own runs, and with consensus the later stages' tori relaxed as that stage
+  // too, so that a shared patch moves by the mean of its moves in every context it meets.
+  const bool consensus = shape.keyframe_nominal[g] <= consensus_below;
+  std::vector<BakeRun> plan;
+  std::vector<std::uint64_t> salts;
+  for (int stage = 0; stage < 4; ++stage)
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      if (runs[r].stage != stage && !(consensus && runs[r].stage > stage)) continue;
+      plan.push_back(runs[r]);
+      plan.back().stage = stage;
+      salts.push_back(runs[r].stage == stage ? r : r + 1024 * (stage + 1));
+    }
+  struct Sum {
+    std::vector<double> b, a;
+    std::vector<int> nb, na;
+  };
+  std::map<Patch*, Sum> sums;
+  std::map<Patch*, std::size_t> first_run;  // without consensus, the one run and copy a patch moves with
   for_each_run(
-      runs, threads,
+      plan, threads,
       [&](std::size_t r, int run_threads) {
-        return relax_run(levels, runs[r], widths, shape, g, sweeps,
-                         mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + r)), run_threads);
+        return relax_run(levels, plan[r], widths, shape, g, sweeps,
+                         mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + salts[r])), run_threads);
       },
       [&](std::size_t r, FrameRun& result) {
-        const BakeRun& run = runs[r];
-        // Each patch of the run's kind not relaxed yet at g takes the moves of one copy on the torus: the
-        // copy of the first point seen of that patch (of any level: a tile's interior can appear twice on
-        // the torus, and its levels must move together).
+        const BakeRun& run = plan[r];
         std::map<std::uint64_t, std::pair<std::int64_t, std::int64_t>> copy_of;
-        std::map<const Patch*, bool> mine;
+        // Each copy of a patch of the run's kind not relaxed yet at g adds its moves (a tile's interior can
+        // appear twice on a torus; its levels move together since every copy counts the same).
         for (std::size_t i = 0; i < result.refs.size(); ++i) {
           if (result.kinds[i] != run.stage) continue;
           const PatchPointRef& ref = result.refs[i];
           auto& patch = const_cast<Patch&>(*ref.patch);  // levels is ours to write; gather hands out const
-          const std::int64_t ax = std::llround(ref.anchor_x), ay = std::llround(ref.anchor_y);
-          const std::pair<std::int64_t, std::int64_t> anchor{(ax % run.w + run.w) % run.w,
-                                                             (ay % run.h + run.h) % run.h};
-          if (copy_of.emplace(result.ids[i], anchor).first->second != anchor) continue;  // the other copy
-          const auto [it, first] = mine.emplace(&patch, false);
-          if (first) {
-            it->second = patch.frames.size() <= g || patch.frames[g].empty();  // else an earlier run's
-            if (it->second) {
-              if (patch.frames.size() <= g) patch.frames.resize(g + 1);
-              patch.frames[g] = g > 0 && !patch.frames[g - 1].empty() ? patch.frames[g - 1] : patch.xy;
-            }
+          if (patch.frames.size() > g && !patch.frames[g].empty() && !sums.count(&patch)) continue;
+          if (!consensus) {
+            const std::int64_t ax = std::llround(ref.anchor_x), ay = std::llround(ref.anchor_y);
+            const std::pair<std::int64_t, std::int64_t> anchor{(ax % run.w + run.w) % run.w,
+                                                               (ay % run.h + run.h) % run.h};
+            if (copy_of.emplace(result.ids[i], anchor).first->second != anchor) continue;  // the other copy
+            if (first_run.emplace(&patch, r).first->second != r) continue;                 // an earlier run's
           }
-          if (!it->second) continue;
+          Sum& sum = sums[&patch];
+          if (sum.b.empty()) {
+            sum.b.assign(patch.xy.size(), 0.0), sum.a.assign(patch.xy.size(), 0.0);
+            sum.nb.assign(patch.size(), 0), sum.na.assign(patch.size(), 0);
+          }
           const double* stable = &patch.xy[2 * ref.index];
           const GlidePath& path = result.paths[i];
-          relative(ref, stable, run.w, run.h, path.bx, path.by, &patch.frames[g][2 * ref.index]);
+          double rel[2];
+          relative(ref, stable, run.w, run.h, path.bx, path.by, rel);
+          sum.b[2 * ref.index] += rel[0], sum.b[2 * ref.index + 1] += rel[1], ++sum.nb[ref.index];
           if (result.arrives[i]) {  // where it enters: its position at keyframe g - 1
-            if (patch.frames[g - 1].empty()) patch.frames[g - 1] = patch.xy;
-            relative(ref, stable, run.w, run.h, path.ax, path.ay, &patch.frames[g - 1][2 * ref.index]);
+            relative(ref, stable, run.w, run.h, path.ax, path.ay, rel);
+            sum.a[2 * ref.index] += rel[0], sum.a[2 * ref.index + 1] += rel[1], ++sum.na[ref.index];
           }
         }
+        if (r + 1 < plan.size() && plan[r + 1].stage == run.stage) return;
+        for (auto& [patch, sum] : sums) {  // the stage is done: its patches take their mean moves
+          if (patch->frames.size() <= g) patch->frames.resize(g + 1);
+          patch->frames[g] = g > 0 && !patch->frames[g - 1].empty() ? patch->frames[g - 1] : patch->xy;
+          for (std::size_t k = 0; k < patch->size(); ++k) {
+            if (sum.nb[k])
+              for (int c = 0; c < 2; ++c) patch->frames[g][2 * k + c] = sum.b[2 * k + c] / sum.nb[k];
+            if (sum.na[k]) {
+              if (patch->frames[g - 1].empty()) patch->frames[g - 1] = patch->xy;
+              for (int c = 0; c < 2; ++c) patch->frames[g - 1][2 * k + c] = sum.a[2 * k + c] / sum.na[k];
+            }
+          }
+        }
+        sums.clear(), first_run.clear();
       });
 }
 

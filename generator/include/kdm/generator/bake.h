@@ -74,6 +74,10 @@ struct BakeRecipe {
   /// and the descent sweeps that relax each keyframe.
   std::uint32_t keyframes_per_level = 0;  ///< recipe key `keyframes`
   int glide_sweeps = 10;
+  /// Keyframes of up to this many points per tile move each shared patch by the mean of its moves on every
+  /// torus of the bake that holds it, not on its own run's alone (keyframes.h says why). 0 (off) in recipes
+  /// that do not name it.
+  std::uint32_t glide_consensus = 0;
   /// The hand-over between depths (bake/handover.h): the half-width, in subtile sides, of the corner
   /// squares and edge bands whose sub-vertices take their colours from that corner or edge alone; at
   /// least the top level's corner patch half-width (an error names the least). 0 (off, recipes that do
