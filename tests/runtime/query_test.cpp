@@ -228,9 +228,9 @@ TEST(QueryTest, TilesBesideASmoothRegionGiveWhatAFullScanGives) {
   // tiles are scanned in full. The small region's points must be the large one's points that lie in it,
   // at low densities (where points glide farthest) and high ones, constant and varying.
   std::ptrdiff_t glided_in = 0;
-  for (double scale : {40.0, 90.0, 700.0, 5000.0})
+  for (double scale : {40.0, 60.0, 90.0, 150.0, 300.0, 700.0, 5000.0})
     for (bool varying : {false, true}) {
-      QueryParams small = region(0.01, 0.02, 0.985, 1.97, scale, QueryMode::kSmooth);
+      QueryParams small = region(0.004, 0.005, 0.996, 1.995, scale, QueryMode::kSmooth);
       if (varying) {
         small.density.kind = QueryDensity::Kind::kCallback;
         small.density.callback = [](void*, double x, double y) {
@@ -253,7 +253,8 @@ TEST(QueryTest, TilesBesideASmoothRegionGiveWhatAFullScanGives) {
         return std::get<0>(k) != 0 || std::get<1>(k) < 0 || std::get<1>(k) > 1;  // not tiles (0, 0), (0, 1)
       });
     }
-  EXPECT_GT(glided_in, 5) << "some points should come from the neighbouring tiles, glided in";
+  // The built-in set glides 89 points in over these 14 queries (0 to 13 each).
+  EXPECT_GT(glided_in, 20) << "some points should come from the neighbouring tiles, glided in";
 }
 
 double step(void*, double x, double) {
@@ -262,7 +263,8 @@ double step(void*, double x, double) {
 
 TEST(QueryTest, SmoothModeShowsNoPointWhereTheDensityIsZero) {
   // A step from density 1 to 0 at x = 1.5. Emission is decided at stable positions, all left of the step;
-  // glided, some would land right of it. None may, in either mode, for a callback or an image.
+  // glided, some would land right of it. None may, in either mode, for a callback or an image. Within half
+  // a spacing of the step the built-in set shows 7 to 86 points per query.
   for (double scale : {60.0, 400.0, 3000.0})
     for (QueryMode mode : kModes) {
       QueryParams q = region(0, 0, 3, 3, scale, mode);
@@ -273,7 +275,7 @@ TEST(QueryTest, SmoothModeShowsNoPointWhereTheDensityIsZero) {
       std::size_t near = 0;
       for (const Key& k : keys) {
         EXPECT_LT(std::get<3>(k), 1.5) << "scale " << scale;
-        near += std::get<3>(k) > 1.5 - spacing / 4;
+        near += std::get<3>(k) > 1.5 - spacing / 2;
       }
       EXPECT_GT(near, 0u) << "points should reach the step, scale " << scale;
       // A step as a 6 × 1 image over [0, 3) × [0, 3): texel centres 0.25 apart, bilinear from 1 at x = 1.25

@@ -224,9 +224,13 @@ void relative(const PatchPointRef& ref, const double* stable, int w, int h, doub
   out[1] = stable[1] + dy - h * std::round(dy / h);
 }
 
+/// Relaxes keyframe g on one run's torus: the points of kinds >= run.stage descend from where keyframe
+/// g - 1 left them, then are kept apart. With `part_only`, the points of kind run.stage are already at g
+/// (their consensus mean) and are only kept apart, from each other and from earlier kinds; later kinds
+/// are left out (their own stages keep them off these).
 FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
                    const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                   int sweeps, std::uint64_t seed, int threads) {
+                   int sweeps, std::uint64_t seed, int threads, bool part_only = false) {
   const Colouring col = Colouring::torus(shape.colours, run.w, run.h, run.grid);
   const std::uint32_t count = shape.keyframe_nominal[g];
   const std::uint32_t previous = g ? shape.keyframe_nominal[g - 1] : 0;
@@ -247,7 +251,7 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
   std::vector<std::uint16_t> keys;
   std::vector<PatchPointRef> refs;
   for (std::uint32_t j = 0; j <= top; ++j)
-    for (int kind = 0; kind < 4; ++kind) {
+    for (int kind = 0; kind < (part_only ? run.stage + 1 : 4); ++kind) {
       std::array<bool, 4> kinds{};
       kinds[kind] = true;
       unused.clear(), keys.clear(), refs.clear();
@@ -282,9 +286,14 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
           fixed_paths.push_back(path);
           continue;
         }
-        // Free points start where the last keyframe left them, pulled back towards their stable spots.
+        // Free points start where the last keyframe left them, pulled back towards their stable spots (or,
+        // parting only, at their mean).
         double x = ax + last[at] + kPull * (patch.xy[at] - last[at]);
         double y = ay + last[at + 1] + kPull * (patch.xy[at + 1] - last[at + 1]);
+        if (part_only) {
+          KDM_CHECK(patch.frames.size() > g && !patch.frames[g].empty());
+          x = ax + patch.frames[g][at], y = ay + patch.frames[g][at + 1];
+        }
         wrap(x, y);
         if (arrives && g > 0) arrivals.push_back(out.refs.size());
         out.refs.push_back(refs[i]);
@@ -328,14 +337,6 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
     confine_point(xy[2 * i], xy[2 * i + 1], i);
   };
 
-  // New points enter where the nested set puts them, moved with their neighbours and kept off them; that
-  // spot is also their position at the last keyframe (their entry), so they glide in from it.
-  for (std::size_t i : arrivals) {
-    double dx, dy;
-    drift.at(start[2 * i], start[2 * i + 1], dx, dy);
-    start[2 * i] += dx, start[2 * i + 1] += dy;
-    wrap(start[2 * i], start[2 * i + 1]);
-  }
   // Obstacles for the entering points of the run's own patches: what they meet in other tiles (each copy
   // on the torus gets its patch's), shown near the start of the way only (later, the runs that move those
   // points keep them apart).
@@ -362,7 +363,16 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
       }
     }
   }
-  {
+  // New points enter where the nested set puts them, moved with their neighbours and kept off them; that
+  // spot is also their position at the last keyframe (their entry), so they glide in from it. Parting
+  // only, their entries are set already (the mean).
+  if (!part_only) {
+    for (std::size_t i : arrivals) {
+      double dx, dy;
+      drift.at(start[2 * i], start[2 * i + 1], dx, dy);
+      start[2 * i] += dx, start[2 * i + 1] += dy;
+      wrap(start[2 * i], start[2 * i + 1]);
+    }
     std::vector<double> others = fixed;
     for (std::size_t i = 0; i < out.refs.size(); ++i)
       if (!out.arrives[i]) others.insert(others.end(), {start[2 * i] / run.w, start[2 * i + 1] / run.h});
@@ -370,8 +380,8 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
     separate_points(
         start, arrivals, others, run.w, run.h, kMinDistance * hex_spacing(previous),
         [&](std::vector<double>& xy, std::size_t i) { confine_point(xy[2 * i], xy[2 * i + 1], i); });
+    for (std::size_t i : arrivals) out.paths[i].ax = start[2 * i], out.paths[i].ay = start[2 * i + 1];
   }
-  for (std::size_t i : arrivals) out.paths[i].ax = start[2 * i], out.paths[i].ay = start[2 * i + 1];
 
   // The descent: T = 0 on the run's torus, earlier kinds fixed at this keyframe.
   SamplerOptions o;
@@ -387,10 +397,12 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
   o.fixed_points = std::move(fixed);
   for (std::size_t i = 0; i < start.size(); i += 2)
     o.initial_points.insert(o.initial_points.end(), {start[i] / run.w, start[i + 1] / run.h});
-  const SampleResult relaxed = sample(o);
-  std::vector<double> end(start.size());
-  for (std::size_t i = 0; i < end.size(); i += 2)
-    end[i] = relaxed.points[i] * run.w, end[i + 1] = relaxed.points[i + 1] * run.h;
+  std::vector<double> end = start;
+  if (!part_only) {
+    const SampleResult relaxed = sample(o);
+    for (std::size_t i = 0; i < end.size(); i += 2)
+      end[i] = relaxed.points[i] * run.w, end[i + 1] = relaxed.points[i + 1] * run.h;
+  }
   std::vector<std::size_t> moving(out.refs.size());
   for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i, confine_end(end, i);
   separate_points(end, moving, o.fixed_points, run.w, run.h, kMinDistance * spacing, confine_end);
@@ -440,77 +452,100 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
                     int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below) {
-  // The schedule: each stage's own runs, and with consensus the later stages' tori relaxed as that stage
-  // too, so that a shared patch moves by the mean of its moves in every context it meets.
   const bool consensus = shape.keyframe_nominal[g] <= consensus_below;
-  std::vector<BakeRun> plan;
-  std::vector<std::uint64_t> salts;
-  for (int stage = 0; stage < 4; ++stage)
+  struct Sum {
+    std::vector<double> b, a;
+    std::vector<int> nb, na;
+  };
+  for (int stage = 0; stage < 4; ++stage) {
+    // The stage's own runs, and with consensus the later stages' tori relaxed as this stage too, so that
+    // a shared patch moves by the mean of its moves in every context it meets.
+    std::vector<BakeRun> plan;
+    std::vector<std::uint64_t> salts;
+    std::vector<std::size_t> own;  // the stage's own runs in the plan
     for (std::size_t r = 0; r < runs.size(); ++r) {
       if (runs[r].stage != stage && !(consensus && runs[r].stage > stage)) continue;
       plan.push_back(runs[r]);
       plan.back().stage = stage;
       salts.push_back(runs[r].stage == stage ? r : r + 1024 * (stage + 1));
+      if (runs[r].stage == stage) own.push_back(plan.size() - 1);
     }
-  struct Sum {
-    std::vector<double> b, a;
-    std::vector<int> nb, na;
-  };
-  std::map<Patch*, Sum> sums;
-  std::map<Patch*, std::size_t> first_run;  // without consensus, the one run and copy a patch moves with
-  for_each_run(
-      plan, threads,
-      [&](std::size_t r, int run_threads) {
-        return relax_run(levels, plan[r], widths, shape, g, sweeps,
-                         mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + salts[r])), run_threads);
-      },
-      [&](std::size_t r, FrameRun& result) {
-        const BakeRun& run = plan[r];
-        std::map<std::uint64_t, std::pair<std::int64_t, std::int64_t>> copy_of;
-        // Each copy of a patch of the run's kind not relaxed yet at g adds its moves (a tile's interior can
-        // appear twice on a torus; its levels move together since every copy counts the same).
-        for (std::size_t i = 0; i < result.refs.size(); ++i) {
-          if (result.kinds[i] != run.stage) continue;
-          const PatchPointRef& ref = result.refs[i];
-          auto& patch = const_cast<Patch&>(*ref.patch);  // levels is ours to write; gather hands out const
-          if (patch.frames.size() > g && !patch.frames[g].empty() && !sums.count(&patch)) continue;
-          if (!consensus) {
-            const std::int64_t ax = std::llround(ref.anchor_x), ay = std::llround(ref.anchor_y);
-            const std::pair<std::int64_t, std::int64_t> anchor{(ax % run.w + run.w) % run.w,
-                                                               (ay % run.h + run.h) % run.h};
-            if (copy_of.emplace(result.ids[i], anchor).first->second != anchor) continue;  // the other copy
-            if (first_run.emplace(&patch, r).first->second != r) continue;                 // an earlier run's
-          }
-          Sum& sum = sums[&patch];
-          if (sum.b.empty()) {
-            sum.b.assign(patch.xy.size(), 0.0), sum.a.assign(patch.xy.size(), 0.0);
-            sum.nb.assign(patch.size(), 0), sum.na.assign(patch.size(), 0);
-          }
-          const double* stable = &patch.xy[2 * ref.index];
-          const GlidePath& path = result.paths[i];
-          double rel[2];
-          relative(ref, stable, run.w, run.h, path.bx, path.by, rel);
-          sum.b[2 * ref.index] += rel[0], sum.b[2 * ref.index + 1] += rel[1], ++sum.nb[ref.index];
-          if (result.arrives[i]) {  // where it enters: its position at keyframe g - 1
-            relative(ref, stable, run.w, run.h, path.ax, path.ay, rel);
-            sum.a[2 * ref.index] += rel[0], sum.a[2 * ref.index + 1] += rel[1], ++sum.na[ref.index];
-          }
+    std::map<Patch*, Sum> sums;
+    std::map<Patch*, std::size_t> first_run;  // the one run and copy a patch moves with, if only one
+    // Each copy of a patch of the stage's kind adds its moves (a tile's interior can appear twice on a
+    // torus; its levels move together since every copy counts the same), or only the first copy seen.
+    auto add_moves = [&](const BakeRun& run, std::size_t r, const FrameRun& result, bool every_copy) {
+      std::map<std::uint64_t, std::pair<std::int64_t, std::int64_t>> copy_of;
+      for (std::size_t i = 0; i < result.refs.size(); ++i) {
+        if (result.kinds[i] != stage) continue;
+        const PatchPointRef& ref = result.refs[i];
+        auto& patch = const_cast<Patch&>(*ref.patch);  // levels is ours to write; gather hands out const
+        if (!every_copy) {
+          const std::int64_t ax = std::llround(ref.anchor_x), ay = std::llround(ref.anchor_y);
+          const std::pair<std::int64_t, std::int64_t> anchor{(ax % run.w + run.w) % run.w,
+                                                             (ay % run.h + run.h) % run.h};
+          if (copy_of.emplace(result.ids[i], anchor).first->second != anchor) continue;  // the other copy
+          if (first_run.emplace(&patch, r).first->second != r) continue;                 // an earlier run's
         }
-        if (r + 1 < plan.size() && plan[r + 1].stage == run.stage) return;
-        for (auto& [patch, sum] : sums) {  // the stage is done: its patches take their mean moves
-          if (patch->frames.size() <= g) patch->frames.resize(g + 1);
+        Sum& sum = sums[&patch];
+        if (sum.b.empty()) {
+          sum.b.assign(patch.xy.size(), 0.0), sum.a.assign(patch.xy.size(), 0.0);
+          sum.nb.assign(patch.size(), 0), sum.na.assign(patch.size(), 0);
+        }
+        const double* stable = &patch.xy[2 * ref.index];
+        const GlidePath& path = result.paths[i];
+        double rel[2];
+        relative(ref, stable, run.w, run.h, path.bx, path.by, rel);
+        sum.b[2 * ref.index] += rel[0], sum.b[2 * ref.index + 1] += rel[1], ++sum.nb[ref.index];
+        if (result.arrives[i]) {  // where it enters: its position at keyframe g - 1
+          relative(ref, stable, run.w, run.h, path.ax, path.ay, rel);
+          sum.a[2 * ref.index] += rel[0], sum.a[2 * ref.index + 1] += rel[1], ++sum.na[ref.index];
+        }
+      }
+    };
+    // The stage is done: its patches take their mean moves.
+    auto commit = [&](bool from_last) {
+      for (auto& [patch, sum] : sums) {
+        if (patch->frames.size() <= g) patch->frames.resize(g + 1);
+        if (from_last)
           patch->frames[g] = g > 0 && !patch->frames[g - 1].empty() ? patch->frames[g - 1] : patch->xy;
-          for (std::size_t k = 0; k < patch->size(); ++k) {
-            if (sum.nb[k])
-              for (int c = 0; c < 2; ++c) patch->frames[g][2 * k + c] = sum.b[2 * k + c] / sum.nb[k];
-            if (sum.na[k]) {
-              if (patch->frames[g - 1].empty()) patch->frames[g - 1] = patch->xy;
-              for (int c = 0; c < 2; ++c) patch->frames[g - 1][2 * k + c] = sum.a[2 * k + c] / sum.na[k];
-            }
+        for (std::size_t k = 0; k < patch->size(); ++k) {
+          if (sum.nb[k])
+            for (int c = 0; c < 2; ++c) patch->frames[g][2 * k + c] = sum.b[2 * k + c] / sum.nb[k];
+          if (sum.na[k]) {
+            if (patch->frames[g - 1].empty()) patch->frames[g - 1] = patch->xy;
+            for (int c = 0; c < 2; ++c) patch->frames[g - 1][2 * k + c] = sum.a[2 * k + c] / sum.na[k];
           }
         }
-        sums.clear(), first_run.clear();
-      });
+      }
+      sums.clear(), first_run.clear();
+    };
+    auto run_seed = [&](std::size_t r) {
+      return mix64(seed ^ mix64(0x474c4944ull + 4096ull * g + salts[r]));
+    };
+    for_each_run(
+        plan, threads,
+        [&](std::size_t r, int run_threads) {
+          return relax_run(levels, plan[r], widths, shape, g, sweeps, run_seed(r), run_threads);
+        },
+        [&](std::size_t r, FrameRun& result) { add_moves(plan[r], r, result, consensus); });
+    commit(true);
+    if (!consensus) continue;
+    // Means of moves that each kept the points apart need not keep them apart: part them on the stage's
+    // own tori (a patch meets the same earlier kinds on every torus, and no other patch of its kind).
+    // Every run reads the means (commit writes after the last), so the result is the same for any thread
+    // count.
+    std::vector<BakeRun> own_runs;
+    for (std::size_t r : own) own_runs.push_back(plan[r]);
+    for_each_run(
+        own_runs, threads,
+        [&](std::size_t r, int run_threads) {
+          return relax_run(levels, own_runs[r], widths, shape, g, sweeps, run_seed(own[r]), run_threads,
+                           true);
+        },
+        [&](std::size_t r, FrameRun& result) { add_moves(own_runs[r], r, result, false); });
+    commit(false);
+  }
 }
 
 }  // namespace kdm::gen

@@ -15,7 +15,8 @@
 // so each point moves once per keyframe, the same way in every tile that holds it. With consensus, every
 // torus of the schedule that holds a patch of kind s is relaxed as a run of stage s too, and the patch
 // takes the mean of its moves on all of them: moved on one torus only, it moves away from neighbours
-// (later kinds' points) that other tiles do not show, and leaves a hole in those tiles.
+// (later kinds' points) that other tiles do not show, and leaves a hole in those tiles. The means are then
+// kept apart on the stage's own tori, as a run's moves are: the mean of two separated layouts need not be.
 //
 // Thread safety: relax_keyframe uses up to `threads` threads of its own; calls must not overlap.
 #pragma once
