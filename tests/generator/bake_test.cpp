@@ -59,6 +59,9 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
   EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
   EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);
+  EXPECT_EQ(r.to_text().find("split_shared"), std::string::npos);  // off unless named
+  EXPECT_TRUE(BakeRecipe::parse(BakeRecipe::parse("split_shared 1\n").to_text()).split_shared);
+  EXPECT_THROW(BakeRecipe::parse("split_shared 2\n"), InvalidArgument);
   EXPECT_EQ(r.edge_gap, kFirstEdgeGap);
   EXPECT_EQ(r.rank_context, 0);
   const BakeRecipe later = BakeRecipe::parse("edge_gap 1\nrank_context 1\nerosion 2\nband 0.36\n");
@@ -308,29 +311,40 @@ std::size_t holes_over(const Tileset& set, double points_per_tile, int side, dou
 }
 
 // Pushed apart instead of removed: the same guarantee (no pair closer than 0.3 d_hex at any density),
-// without the removed points' holes. Over 10 × 10 tiles at the top level (205,000 points), empty circles
-// above 1.0 d_hex (measured: 16 without the pass, 69 removing, 16 pushing): pushing leaves no more than
-// the recipe without the pass plus a third of what removing adds.
+// without the removed points' holes; split per tile first (split_shared), a shared point stays where it
+// is in every tile but the crowded ones. Over 10 × 10 tiles at the top level (205,000 points), empty
+// circles above 1.0 (0.85) d_hex, measured: 16 (157) without the pass, 69 (677) removing, 16 (381)
+// pushing, 16 (217) split and pushed: pushing leaves no more than the recipe without the pass plus a
+// third of what removing adds above 1.0, and splitting takes at least half of what pushing adds above
+// 0.85 (it took 73%).
 TEST(BakeTest, SeparationPushKeepsPointsApartWithoutLeavingHoles) {
   BakeRecipe removed = few_sweeps();
   removed.separation = 0.3;
   BakeRecipe pushed = removed;
   pushed.separation_push = 0.55;
-  Tileset sets[3];
-  const BakeRecipe recipes[3] = {few_sweeps(), removed, pushed};
-  std::size_t holes[3];
-  for (int i = 0; i < 3; ++i) {
+  BakeRecipe split = pushed;
+  split.split_shared = true;
+  Tileset sets[4];
+  const BakeRecipe recipes[4] = {few_sweeps(), removed, pushed, split};
+  std::size_t holes[4], holes85[4];
+  for (int i = 0; i < 4; ++i) {
     const std::vector<std::uint8_t> bytes = encoded(bake_tileset(recipes[i], 0));
     ASSERT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), sets[i]), Status::kOk);
-    holes[i] = holes_over(sets[i], 2048, 10, 1.0);
+    holes[i] = holes_over(sets[i], 2048, 10, 1.0), holes85[i] = holes_over(sets[i], 2048, 10, 0.85);
   }
-  std::printf("holes above 1.0 d_hex at 2048 points per tile: no pass %zu, removing %zu, pushing %zu\n",
-              holes[0], holes[1], holes[2]);
+  std::printf(
+      "holes above 1.0 (0.85) d_hex at 2048 points per tile: no pass %zu (%zu), removing %zu (%zu), "
+      "pushing %zu (%zu), split and pushed %zu (%zu)\n",
+      holes[0], holes85[0], holes[1], holes85[1], holes[2], holes85[2], holes[3], holes85[3]);
   EXPECT_LT(closest_pair(sets[0], 2048, 4), 0.3);  // the control: the pass has pairs to part
-  for (double count : {300.0, 512.0, 768.0, 1024.0, 1536.0, 2048.0})
-    EXPECT_GE(closest_pair(sets[2], count, 4), 0.3) << count << " points per tile";
+  for (int i : {2, 3})
+    for (double count : {300.0, 512.0, 768.0, 1024.0, 1536.0, 2048.0})
+      EXPECT_GE(closest_pair(sets[i], count, 4), 0.3) << count << " points per tile, recipe " << i;
   ASSERT_GE(holes[1], holes[0] + 20);  // removing makes holes: the test could fail
   EXPECT_LE(holes[2], holes[0] + (holes[1] - holes[0]) / 3);
+  EXPECT_LE(holes[3], holes[2]);
+  ASSERT_GE(holes85[2], holes85[0] + 40);  // pushing leaves holes above 0.85 for splitting to save
+  EXPECT_LE(holes85[3], holes85[0] + (holes85[2] - holes85[0]) / 2);
 }
 
 // Runs that end a point short freeze holes at patch borders; filling them in each run removes most.
@@ -466,6 +480,73 @@ TEST(BakeTest, PushClosePairsApartKeepsPointsInTheirTile) {
   EXPECT_EQ(drop_close_pairs(levels, 1, table, 0.3), 0u);
 }
 
+// A corner point too close to a point of one tile's interior: split, it stays, unmoved and with its key, in
+// every other tile that shows it (as a point of that tile's interior), and only the crowded tile goes
+// without it. Moved or removed, it would leave a hole in all seven.
+TEST(BakeTest, SplitSharedKeepsACrowdedPointWhereItIsNotCrowded) {
+  std::vector<LevelPatches> levels(2, LevelPatches(2));
+  TilesetData table;
+  table.colours = 2;
+  table.level_nominal = {16, 64};
+  levels[0].interiors[0].add(0.025, 0.02, 100);  // tile 0 (every corner colour 0): threshold 0.02
+  levels[1].corners[0].add(0.02, 0.02, 1000);    // north-east of every colour-0 vertex: threshold 16.7
+  const SeparationResult result = push_close_pairs_apart(levels, 2, table, 0.3, 0.5, /*split=*/true);
+  EXPECT_EQ(result.split, 1u);
+  EXPECT_EQ(result.moved, 0u);
+  EXPECT_EQ(result.removed, 0u);
+  EXPECT_EQ(levels[1].corners[0].size(), 0u);
+  for (std::size_t t = 0; t < 16; ++t) {
+    const Patch& interior = levels[1].interiors[t];
+    if (t == 0 || t >= 8) {  // the crowded tile, and the tiles whose south-west corner is colour 1
+      EXPECT_EQ(interior.size(), 0u) << t;
+      continue;
+    }
+    ASSERT_EQ(interior.size(), 1u) << t;
+    EXPECT_EQ(interior.xy, (std::vector<double>{0.02, 0.02})) << t;
+    EXPECT_EQ(interior.keys[0], 1000) << t;
+  }
+  EXPECT_EQ(levels[0].interiors[0].size(), 1u);
+  EXPECT_EQ(drop_close_pairs(levels, 2, table, 0.3), 0u);
+}
+
+// Along the glide track a crowded point that its level lets wait is shown later rather than removed: two
+// paths that cross half-way between keyframes 0 and 1 and again between 1 and 2, the later point shown
+// from the density after the last crossing, still within its level, with its frames.
+TEST(BakeTest, SplitSharedShowsACrowdedGliderLater) {
+  TilesetData table;
+  table.level_nominal = {16, 64};
+  table.keyframe_nominal = {16, 32, 64};
+  std::vector<LevelPatches> levels(2, LevelPatches(1));
+  Patch& patch = levels[1].interiors[0];
+  patch.add(0.3, 0.5, 10);  // thresholds 16.01 and 16.02: both shown from keyframe 0
+  patch.add(0.7, 0.5, 20);
+  patch.frames = {{0.3, 0.5, 0.7, 0.5}, {0.7, 0.5, 0.3, 0.5}, {0.3, 0.5, 0.7, 0.5}};
+  const SeparationResult result = drop_close_glides(levels, 1, table, 0.3, /*split=*/true);
+  EXPECT_EQ(result.split, 1u);
+  EXPECT_EQ(result.removed, 0u);
+  ASSERT_EQ(patch.size(), 2u);
+  EXPECT_EQ(patch.keys[0], 10);
+  // They meet at 24 and 48 points per tile (half-way); sampled eight times per keyframe interval, the
+  // next density after 48 is 52.
+  const float threshold = table.emission_threshold(1, patch.keys[1]);
+  EXPECT_GE(threshold, 52.0f);
+  EXPECT_LT(threshold, 52.01f);
+  EXPECT_EQ(patch.xy, (std::vector<double>{0.3, 0.5, 0.7, 0.5}));
+  EXPECT_EQ(patch.frames[1], (std::vector<double>{0.7, 0.5, 0.3, 0.5}));
+  EXPECT_EQ(drop_close_glides(levels, 1, table, 0.3, true).split, 0u);
+  // A level that ends before the last meeting cannot wait: the point goes, as without splitting.
+  std::vector<LevelPatches> short_levels(2, LevelPatches(1));
+  table.keyframe_nominal = {16, 32, 64, 128};
+  table.level_nominal = {16, 64};
+  Patch& early = short_levels[1].interiors[0];
+  early = patch;
+  early.keys = {10, 20};
+  early.frames.push_back({0.7, 0.5, 0.3, 0.5});  // a third crossing, past 64
+  const SeparationResult late = drop_close_glides(short_levels, 1, table, 0.3, true);
+  EXPECT_EQ(late.split, 0u);
+  EXPECT_EQ(late.removed, 1u);
+}
+
 // Two points far apart at every keyframe whose paths cross half-way between two: the later one goes, with
 // its frames. Paths that do not cross keep both.
 TEST(BakeTest, DropCloseGlidesRemovesPointsWhosePathsMeet) {
@@ -483,8 +564,8 @@ TEST(BakeTest, DropCloseGlidesRemovesPointsWhosePathsMeet) {
     const double a1 = cross ? 0.7 : 0.3, b1 = cross ? 0.3 : 0.7;
     patch.frames = {
         {0.3, 0.5, 0.7, 0.5, 0.5, 0.1}, {a1, 0.5, b1, 0.5, 0.5, 0.1}, {0.3, 0.5, 0.7, 0.5, 0.5, 0.1}};
-    EXPECT_EQ(drop_close_glides(levels, 1, table, 0), 0u);
-    EXPECT_EQ(drop_close_glides(levels, 1, table, 0.3), cross ? 1u : 0u);
+    EXPECT_EQ(drop_close_glides(levels, 1, table, 0).removed, 0u);
+    EXPECT_EQ(drop_close_glides(levels, 1, table, 0.3).removed, cross ? 1u : 0u);
     const std::vector<std::uint16_t> kept =
         cross ? std::vector<std::uint16_t>{100, 300} : std::vector<std::uint16_t>{100, 200, 300};
     EXPECT_EQ(patch.keys, kept);

@@ -34,7 +34,9 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   }
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("baking");
-  const TilesetData set = gen::bake_tileset(recipe, threads, [&bar](double f) { bar.update(f); });
+  gen::BakeReport report;
+  const TilesetData set = gen::bake_tileset(
+      recipe, threads, [&bar](double f) { bar.update(f); }, &report);
   bar.finish();
   std::string detail;
   const Status s = save_tileset(set, output, &detail);
@@ -42,6 +44,12 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "kdm bake: %zu tile(s), %u levels, %u points per tile -> %s (%.1f s)\n",
                set.tiles.size(), set.levels, set.level_nominal.back(), output.c_str(), seconds);
+  if (recipe.separation > 0)
+    std::fprintf(stderr, "  close pairs: %zu point(s) moved, %zu split per tile, %zu removed\n", report.moved,
+                 report.split, report.removed);
+  if (recipe.glide_separation > 0)
+    std::fprintf(stderr, "  close glides: %zu point(s) split per tile, %zu removed\n", report.glide_split,
+                 report.glide_removed);
 }
 
 void run_info(const std::string& path) {

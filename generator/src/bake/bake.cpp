@@ -104,6 +104,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.separation = within(0, 0.7);
     } else if (key == "separation_push") {
       r.separation_push = within(0, 0.9);
+    } else if (key == "split_shared") {
+      r.split_shared = whole(0, 1) != 0;
     } else if (key == "fill_holes") {
       r.fill_holes = within(0.5, 2);
     } else if (key == "glide_separation") {
@@ -158,6 +160,7 @@ std::string BakeRecipe::to_text() const {
   if (rank_context) s << "rank_context " << rank_context << "\n";
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (separation_push > 0) s << "separation_push " << shortest(separation_push) << "\n";
+  if (split_shared) s << "split_shared 1\n";
   if (fill_holes > 0) s << "fill_holes " << shortest(fill_holes) << "\n";
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
@@ -177,6 +180,7 @@ namespace {
 
 class Baker {
  public:
+  BakeReport report;  ///< what the separation passes did
   Baker(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress)
       : recipe_(recipe),
         threads_(threads),
@@ -206,11 +210,12 @@ class Baker {
     shape_.levels = recipe_.levels;
     shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
     if (recipe_.separation_push > 0) {
-      const SeparationResult moved = push_close_pairs_apart(levels_, recipe_.colours, shape_,
-                                                            recipe_.separation, recipe_.separation_push);
-      dropped_ = moved.removed, pushed_ = moved.moved;
+      const SeparationResult moved =
+          push_close_pairs_apart(levels_, recipe_.colours, shape_, recipe_.separation,
+                                 recipe_.separation_push, recipe_.split_shared);
+      report.removed = moved.removed, report.moved = moved.moved, report.split = moved.split;
     } else {
-      dropped_ = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
+      report.removed = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
     }
     const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal_, recipe_.keyframes_per_level);
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
@@ -220,7 +225,9 @@ class Baker {
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
-    drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation);
+    const SeparationResult glides =
+        drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation, recipe_.split_shared);
+    report.glide_removed = glides.removed, report.glide_split = glides.split;
     shape_.handover_zone = recipe_.handover_zone;
     TilesetData set = assemble();
     if (set.handover_zone) add_handover(set);
@@ -473,14 +480,16 @@ class Baker {
   std::vector<LevelPatches> levels_;
   TilesetShape shape_;  ///< colours, level and keyframe counts: what the tiles fit into
   double total_work_ = 0, done_work_ = 0;
-  std::size_t dropped_ = 0;  ///< points the separation pass removed (for a test to read)
-  std::size_t pushed_ = 0;   ///< and points it moved instead
 };
 
 }  // namespace
 
-TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress) {
-  return Baker(recipe, threads, progress).bake();
+TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress,
+                         BakeReport* report) {
+  Baker baker(recipe, threads, progress);
+  TilesetData set = baker.bake();
+  if (report) *report = baker.report;
+  return set;
 }
 
 }  // namespace kdm::gen

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <tuple>
@@ -23,10 +24,12 @@ struct Candidate {
   std::uint32_t index;
   const Patch* source;        ///< for its frames
   double anchor_x, anchor_y;  ///< of its patch, in the window
+  std::size_t tile;           ///< the tile its stable position lies in
+  std::uint16_t key;
   auto order() const { return std::tie(threshold, kind, level, patch, index); }
 };
 
-using Victims = std::set<std::tuple<std::size_t, int, std::size_t, std::uint32_t>>;
+using Victims = std::set<PointKey>;
 
 /// The points of `levels` in the window [x0, x1) × [y0, y1) of the arrangement `col`.
 std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Colouring& col,
@@ -43,11 +46,14 @@ std::vector<Candidate> collect(const std::vector<LevelPatches>& levels, const Co
       std::vector<PatchPointRef> refs;
       gather(levels[k], col, only, x0, y0, x1, y1, xy, &keys, &refs);
       const std::vector<Patch>& patches = levels[k].of(kind);
-      for (std::size_t i = 0; i < keys.size(); ++i)
+      for (std::size_t i = 0; i < keys.size(); ++i) {
+        const std::size_t tile = col.tile_at(static_cast<std::int64_t>(std::floor(x0 + xy[2 * i])),
+                                             static_cast<std::int64_t>(std::floor(y0 + xy[2 * i + 1])));
         points.push_back({xy[2 * i], xy[2 * i + 1],
                           shape.emission_threshold(static_cast<std::uint32_t>(k), keys[i]),
                           static_cast<int>(kind), k, std::size_t(refs[i].patch - patches.data()),
-                          refs[i].index, refs[i].patch, refs[i].anchor_x, refs[i].anchor_y});
+                          refs[i].index, refs[i].patch, refs[i].anchor_x, refs[i].anchor_y, tile, keys[i]});
+      }
     }
   return points;
 }
@@ -78,10 +84,11 @@ void find_pairs(std::vector<Candidate> points, double width, double height, cons
   }
 }
 
-/// Adds to `victims` the later of every two points of `at` (positions, in the order of `points`, which is
-/// by Candidate::order) closer than `radius`; only the first `present` points are shown.
+/// Adds to `crowded` the later of every two points of `at` (positions, in the order of `points`, which is
+/// by Candidate::order) closer than `radius`, with its tile and `apart` (the next density sampled, from
+/// which it may be shown there); only the first `present` points are shown.
 void find_close(const std::vector<Candidate>& points, const std::vector<double>& at, std::size_t present,
-                double x0, double y0, double x1, double y1, double radius, Victims& victims) {
+                double x0, double y0, double x1, double y1, double radius, double apart, Crowded& crowded) {
   const int nx = std::max(1, static_cast<int>((x1 - x0) / radius)),
             ny = std::max(1, static_cast<int>((y1 - y0) / radius));
   std::vector<std::vector<std::uint32_t>> grid(std::size_t(nx) * ny);
@@ -95,7 +102,8 @@ void find_close(const std::vector<Candidate>& points, const std::vector<double>&
         for (std::uint32_t j : grid[std::size_t(cy) * nx + cx])
           if (std::hypot(at[2 * j] - x, at[2 * j + 1] - y) < radius) {
             const Candidate& p = points[i];
-            victims.insert({p.level, p.kind, p.patch, p.index});
+            double& from = crowded[{p.level, p.kind, p.patch, p.index}][p.tile];
+            from = std::max(from, apart);
           }
     grid[std::size_t(cell_y(y)) * nx + cell_x(x)].push_back(i);
   }
@@ -104,7 +112,7 @@ void find_close(const std::vector<Candidate>& points, const std::vector<double>&
 /// The glide track's close pairs among `points` (stable positions in a window): at every sampled density,
 /// the points shown there at their glided positions, those inside [x0, x1) × [y0, y1).
 void find_close_glides(std::vector<Candidate> points, const TilesetShape& shape, double separation, double x0,
-                       double y0, double x1, double y1, Victims& victims) {
+                       double y0, double x1, double y1, Crowded& crowded) {
   std::sort(points.begin(), points.end(),
             [](const Candidate& a, const Candidate& b) { return a.order() < b.order(); });
   const auto& K = shape.keyframe_nominal;
@@ -114,6 +122,8 @@ void find_close_glides(std::vector<Candidate> points, const TilesetShape& shape,
     for (int step = 0; step < (g + 1 < K.size() ? kSteps : 1); ++step) {
       const double t = double(step) / kSteps;
       const double count = g + 1 < K.size() ? K[g] + t * (double(K[g + 1]) - K[g]) : K[g];
+      const double next = g + 1 < K.size() ? K[g] + (step + 1.0) / kSteps * (double(K[g + 1]) - K[g])
+                                           : std::numeric_limits<double>::infinity();
       std::size_t present = 0;
       while (present < points.size() && TilesetShape::emits(points[present].threshold, count)) ++present;
       for (std::size_t i = 0; i < present; ++i) {
@@ -125,22 +135,8 @@ void find_close_glides(std::vector<Candidate> points, const TilesetShape& shape,
               (a ? p.anchor_y : p.anchor_x) + (1 - t) * f0[2 * p.index + a] + t * f1[2 * p.index + a];
       }
       const double radius = separation * std::sqrt(2.0 / (std::sqrt(3.0) * count));
-      find_close(points, at, present, x0, y0, x1, y1, radius, victims);
+      find_close(points, at, present, x0, y0, x1, y1, radius, next, crowded);
     }
-}
-
-/// Removes `victims` from their patches (and their frames), highest index first so the others keep theirs.
-void remove(std::vector<LevelPatches>& levels, const Victims& victims) {
-  for (auto it = victims.rbegin(); it != victims.rend(); ++it) {
-    const auto& [level, kind, patch_index, index] = *it;
-    Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
-    KDM_CHECK(index < patch.size());
-    const auto at = 2 * std::ptrdiff_t(index);
-    patch.xy.erase(patch.xy.begin() + at, patch.xy.begin() + at + 2);
-    patch.keys.erase(patch.keys.begin() + index);
-    for (std::vector<double>& frame : patch.frames)
-      if (!frame.empty()) frame.erase(frame.begin() + at, frame.begin() + at + 2);
-  }
 }
 
 /// Two tiles side by side (`across`: left and right, else bottom and top) with the given vertex colours
@@ -183,8 +179,6 @@ void for_each_close_pair(const std::vector<LevelPatches>& levels, std::uint32_t 
   }
 }
 
-using PointKey = std::tuple<std::size_t, int, std::size_t, std::uint32_t>;  // (level, kind, patch, index)
-
 PointKey key_of(const Candidate& p) {
   return {p.level, p.kind, p.patch, p.index};
 }
@@ -197,14 +191,24 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
   Victims victims;
   for_each_close_pair(levels, colours, shape, separation,
                       [&](const Candidate& later, const Candidate&) { victims.insert(key_of(later)); });
-  remove(levels, victims);
+  remove_points(levels, victims);
   return victims.size();
 }
 
 SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                                        const TilesetShape& shape, double separation, double push) {
+                                        const TilesetShape& shape, double separation, double push,
+                                        bool split) {
   SeparationResult result;
   if (!(separation > 0)) return result;
+  if (split) {  // where a tile can keep the point as it is, it does; what is left is pushed
+    Crowded crowded;
+    for_each_close_pair(levels, colours, shape, separation, [&](const Candidate& later, const Candidate&) {
+      crowded[key_of(later)][later.tile] = std::numeric_limits<double>::infinity();
+    });
+    const std::set<PointKey> done = split_crowded_points(levels, colours, shape, crowded);
+    remove_points(levels, done);
+    result.split = done.size();
+  }
   // Each later point of a close pair, and where the earlier points within `push` spacings of it sit in
   // any tile: their offsets from it (the same in every window, since a patch moves as a whole).
   const double reach = std::max(push, separation);
@@ -266,18 +270,19 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
   }
   // What the rounds could not part goes, as drop_close_pairs would take it.
   Victims victims(crowded.begin(), crowded.end());
-  remove(levels, victims);
+  remove_points(levels, victims);
   result.removed = victims.size();
   for (const PointKey& key : victims) moved.erase(key);
   result.moved = moved.size();
   return result;
 }
 
-std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                              const TilesetShape& shape, double separation) {
-  if (!(separation > 0) || shape.keyframe_nominal.empty()) return 0;
+SeparationResult drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                                   const TilesetShape& shape, double separation, bool split) {
+  SeparationResult result;
+  if (!(separation > 0) || shape.keyframe_nominal.empty()) return result;
   const double s = separation + kGlideMargin;
-  Victims victims;
+  Crowded victims;
   const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
   for (std::size_t t = 0; t < tiles; ++t)
     find_close_glides(collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1), shape, s, 0, 0,
@@ -303,8 +308,81 @@ std::size_t drop_close_glides(std::vector<LevelPatches>& levels, std::uint32_t c
     find_close_glides(collect(levels, pair_of_tiles(colours, false, v), shape, 0, 1 - w, 1, 1 + w), shape, s,
                       0, w - near, 1, w + near, victims);
   }
-  remove(levels, victims);
-  return victims.size();
+  std::set<PointKey> gone;
+  if (split) gone = split_crowded_points(levels, colours, shape, victims);
+  result.split = gone.size();
+  for (const auto& entry : victims)
+    if (!gone.count(entry.first)) gone.insert(entry.first), ++result.removed;
+  remove_points(levels, gone);
+  return result;
+}
+
+void remove_points(std::vector<LevelPatches>& levels, const std::set<PointKey>& points) {
+  for (auto it = points.rbegin(); it != points.rend(); ++it) {  // highest index first: the others keep theirs
+    const auto& [level, kind, patch_index, index] = *it;
+    Patch& patch = levels[level].of(static_cast<PatchKind>(kind))[patch_index];
+    KDM_CHECK(index < patch.size());
+    const auto at = 2 * std::ptrdiff_t(index);
+    patch.xy.erase(patch.xy.begin() + at, patch.xy.begin() + at + 2);
+    patch.keys.erase(patch.keys.begin() + index);
+    for (std::vector<double>& frame : patch.frames)
+      if (!frame.empty()) frame.erase(frame.begin() + at, frame.begin() + at + 2);
+  }
+}
+
+std::set<PointKey> split_crowded_points(std::vector<LevelPatches>& levels, std::uint32_t colours,
+                                        const TilesetShape& shape, const Crowded& crowded) {
+  // Every tile's view of each crowded point: where it lies there, and the key it keeps (none: no copy).
+  struct Copy {
+    std::size_t tile;
+    Candidate point;
+    std::uint16_t key;
+  };
+  std::map<PointKey, std::vector<Copy>> copies;
+  const std::size_t tiles = std::size_t(colours) * colours * colours * colours;
+  for (std::size_t t = 0; t < tiles; ++t)
+    for (const Candidate& p : collect(levels, Colouring::around_tile(colours, t), shape, 0, 0, 1, 1)) {
+      const auto it = crowded.find(key_of(p));
+      if (it == crowded.end()) continue;
+      const auto from = it->second.find(t);
+      std::uint16_t key = p.key;
+      if (from != it->second.end()) {  // the lowest key whose threshold is not below `from`
+        const double lo = p.level == 0 ? 0.0 : shape.level_nominal[p.level - 1],
+                     hi = shape.level_nominal[p.level];
+        const double need = std::ceil((from->second - lo) / (hi - lo) * 65536.0 - 0.5);
+        if (!(need <= 65535)) continue;
+        key = static_cast<std::uint16_t>(std::max(need, double(p.key)));
+        if (shape.emission_threshold(static_cast<std::uint32_t>(p.level), key) < from->second) {
+          if (key == 65535) continue;
+          ++key;  // rounding of the float threshold
+        }
+      }
+      copies[key_of(p)].push_back({t, p, key});
+    }
+  std::set<PointKey> split;
+  for (const auto& [point, kept] : copies) {
+    if (kept.empty()) continue;
+    split.insert(point);
+    for (const Copy& c : kept) {
+      // Within its tile's window the point lies at (x, y) from the tile's corner, the interior's anchor.
+      Patch& interior = levels[c.point.level].interiors[c.tile];
+      const Patch& source = *c.point.source;
+      const std::size_t n = interior.size();
+      if (interior.frames.size() < source.frames.size()) interior.frames.resize(source.frames.size());
+      for (std::size_t g = 0; g < interior.frames.size(); ++g) {
+        const bool moved = g < source.frames.size() && !source.frames[g].empty();
+        std::vector<double>& frame = interior.frames[g];
+        if (frame.empty() && !moved) continue;
+        if (frame.empty()) frame = interior.xy;  // points not yet present keep their stable position
+        const std::size_t i = 2 * std::size_t(c.point.index);
+        frame.insert(frame.end(), {moved ? c.point.anchor_x + source.frames[g][i] : c.point.x,
+                                   moved ? c.point.anchor_y + source.frames[g][i + 1] : c.point.y});
+      }
+      interior.add(c.point.x, c.point.y, c.key);
+      KDM_CHECK(interior.size() == n + 1);
+    }
+  }
+  return split;
 }
 
 }  // namespace kdm::gen

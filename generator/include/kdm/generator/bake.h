@@ -58,6 +58,11 @@ struct BakeRecipe {
   /// which leaves a hole wherever its patch shows (close_pairs.h, push_close_pairs_apart). 0 (off) in
   /// recipes that do not name it; at least `separation` otherwise.
   double separation_push = 0;
+  /// With `separation` or `glide_separation`: a point of a shared patch that is too close to another in
+  /// only some of the tiles that show it becomes per-tile copies, left out (along the glide track: shown
+  /// later) only where it is too close, instead of being moved or removed in every tile
+  /// (close_pairs.h, split_crowded_points). Off (false) in recipes that do not name it.
+  bool split_shared = false;
   /// After each run is sampled, every empty circle wider than this many hexagonal spacings whose centre
   /// lies in a patch the run keeps gets a new point there, deepest first (bake/hole_finder.h says why). 0
   /// (off) in recipes that do not name it.
@@ -98,10 +103,17 @@ struct BakeRecipe {
   std::vector<std::uint32_t> nominal_counts() const;
 };
 
-/// Bakes `recipe`. `progress` (optional) receives the fraction done. Throws InvalidArgument on a bad
-/// recipe.
+/// What the passes that keep points apart did (recipe keys separation, separation_push, split_shared and
+/// glide_separation), in points.
+struct BakeReport {
+  std::size_t moved = 0, split = 0, removed = 0;   ///< after the pyramid is sampled
+  std::size_t glide_split = 0, glide_removed = 0;  ///< after the glide track is relaxed
+};
+
+/// Bakes `recipe`. `progress` (optional) receives the fraction done; `report` (optional) what the
+/// separation passes did. Throws InvalidArgument on a bad recipe.
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads = 0,
-                         const std::function<void(double)>& progress = {});
+                         const std::function<void(double)>& progress = {}, BakeReport* report = nullptr);
 
 /// The 2×2 torus of tiles around tile `index` of a set with `colours` corner colours, on which the baker
 /// samples that tile's interior and the generator test judges it: the index of the tile at (tx, ty),
