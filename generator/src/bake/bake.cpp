@@ -106,6 +106,10 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.separation_push = within(0, 0.9);
     } else if (key == "split_shared") {
       r.split_shared = whole(0, 1) != 0;
+    } else if (key == "separation_fill") {
+      r.separation_fill = whole(0, 1) != 0;
+    } else if (key == "separation_per_level") {
+      r.separation_per_level = whole(0, 1) != 0;
     } else if (key == "fill_holes") {
       r.fill_holes = within(0.5, 2);
     } else if (key == "glide_separation") {
@@ -161,6 +165,8 @@ std::string BakeRecipe::to_text() const {
   if (separation > 0) s << "separation " << shortest(separation) << "\n";
   if (separation_push > 0) s << "separation_push " << shortest(separation_push) << "\n";
   if (split_shared) s << "split_shared 1\n";
+  if (separation_fill) s << "separation_fill 1\n";
+  if (separation_per_level) s << "separation_per_level 1\n";
   if (fill_holes > 0) s << "fill_holes " << shortest(fill_holes) << "\n";
   if (keyframes_per_level)
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
@@ -196,6 +202,10 @@ class Baker {
   }
 
   TilesetData bake() {
+    shape_.colours = recipe_.colours;
+    shape_.levels = recipe_.levels;
+    shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
+    const bool push = recipe_.separation_push > 0, per_level = push && recipe_.separation_per_level;
     for (std::uint32_t k = 0; k < recipe_.levels; ++k) {
       levels_.emplace_back(recipe_.colours);
       for_each_run(
@@ -205,18 +215,12 @@ class Baker {
             done_work_ += work(k, runs_[r]);
             if (progress_) progress_(done_work_ / total_work_);
           });
+      if (per_level) separate();  // the levels below were parted already: only level k's points move
     }
-    shape_.colours = recipe_.colours;
-    shape_.levels = recipe_.levels;
-    shape_.level_nominal.assign(nominal_.begin(), nominal_.end());
-    if (recipe_.separation_push > 0) {
-      const SeparationResult moved =
-          push_close_pairs_apart(levels_, recipe_.colours, shape_, recipe_.separation,
-                                 recipe_.separation_push, recipe_.split_shared);
-      report.removed = moved.removed, report.moved = moved.moved, report.split = moved.split;
-    } else {
+    if (push && !per_level)
+      separate();
+    else if (!push)
       report.removed = drop_close_pairs(levels_, recipe_.colours, shape_, recipe_.separation);
-    }
     const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal_, recipe_.keyframes_per_level);
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
@@ -232,6 +236,14 @@ class Baker {
     TilesetData set = assemble();
     if (set.handover_zone) add_handover(set);
     return set;
+  }
+
+  /// Parts the close pairs of the levels sampled so far (push_close_pairs_apart), adding to the report.
+  void separate() {
+    const SeparationResult r =
+        push_close_pairs_apart(levels_, recipe_.colours, shape_, recipe_.separation, recipe_.separation_push,
+                               recipe_.split_shared, recipe_.separation_fill);
+    report.removed += r.removed, report.moved += r.moved, report.split += r.split;
   }
 
   /// The hand-over tables (docs/design.md §3, "Unbounded zoom"), in the file's encoding.

@@ -183,6 +183,27 @@ PointKey key_of(const Candidate& p) {
   return {p.level, p.kind, p.patch, p.index};
 }
 
+/// The move (dx, dy) within kFillReach × `spacing` of `at`, inside [lo, hi], that takes it farthest from
+/// every point of `nearby` (offsets from `at`, each with the spacing of the density where both are shown),
+/// in those spacings; true if that is at least `push` from each (else no move: the caller pushes).
+bool fill_place(const std::vector<std::array<double, 3>>& nearby, double spacing, const double* at,
+                const double* lo, const double* hi, double push, double& dx, double& dy) {
+  const double reach = kFillReach * spacing, step = 0.04 * spacing;
+  const int n = static_cast<int>(reach / step);
+  double best = -1;
+  for (int j = -n; j <= n; ++j)
+    for (int i = -n; i <= n; ++i) {
+      const double x = i * step, y = j * step;
+      if (x * x + y * y > reach * reach || at[0] + x < lo[0] || at[0] + x > hi[0] || at[1] + y < lo[1] ||
+          at[1] + y > hi[1])
+        continue;
+      double worst = std::numeric_limits<double>::infinity();
+      for (const auto& o : nearby) worst = std::min(worst, std::hypot(x - o[0], y - o[1]) / o[2]);
+      if (worst > best) best = worst, dx = x, dy = y;
+    }
+  return best >= push;
+}
+
 }  // namespace
 
 std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t colours,
@@ -196,8 +217,8 @@ std::size_t drop_close_pairs(std::vector<LevelPatches>& levels, std::uint32_t co
 }
 
 SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
-                                        const TilesetShape& shape, double separation, double push,
-                                        bool split) {
+                                        const TilesetShape& shape, double separation, double push, bool split,
+                                        bool fill) {
   SeparationResult result;
   if (!(separation > 0)) return result;
   if (split) {  // where a tile can keep the point as it is, it does; what is left is pushed
@@ -217,11 +238,26 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
   std::map<PointKey, double> radius_of;
   const double lowest = std::max(1.0, double(shape.level_nominal.front()));
   std::set<PointKey> moved;
+  auto spacing = [&](double threshold) {
+    return std::sqrt(2.0 / (std::sqrt(3.0) * std::max(threshold, lowest)));
+  };
+  // With `fill`: every point near each crowded one, in any tile, as (offset, spacing at the density where
+  // both are shown).
+  std::map<PointKey, std::vector<std::array<double, 3>>> nearby;
   for (int round = 0;; ++round) {
-    crowded.clear(), around.clear();
+    crowded.clear(), around.clear(), nearby.clear();
     for_each_close_pair(levels, colours, shape, separation,
                         [&](const Candidate& later, const Candidate&) { crowded.insert(key_of(later)); });
     if (crowded.empty() || round == kPushRounds) break;
+    if (fill)
+      for_each_close_pair(
+          levels, colours, shape, kFillReach + 1, [&](const Candidate& later, const Candidate& earlier) {
+            const double d = spacing(later.threshold);
+            if (crowded.count(key_of(later)))
+              nearby[key_of(later)].push_back({earlier.x - later.x, earlier.y - later.y, d});
+            if (crowded.count(key_of(earlier)))
+              nearby[key_of(earlier)].push_back({later.x - earlier.x, later.y - earlier.y, d});
+          });
     for_each_close_pair(levels, colours, shape, reach, [&](const Candidate& later, const Candidate& earlier) {
       if (!crowded.count(key_of(later))) return;
       around[key_of(later)].push_back({earlier.x - later.x, earlier.y - later.y});
@@ -244,6 +280,14 @@ SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::
                              (a == 1 && kind == static_cast<int>(PatchKind::kVerticalEdge));
         lo[a] = bounded ? std::min(at[a], margin) : -1e300,
         hi[a] = bounded ? std::max(at[a], 1 - margin) : 1e300;
+      }
+      if (fill) {  // the deepest empty place within kFillReach spacings, if it is wide enough
+        double dx = 0, dy = 0;
+        if (fill_place(nearby[key], r / reach, at, lo, hi, push, dx, dy)) {
+          at[0] += dx, at[1] += dy;
+          moved.insert(key);
+          continue;
+        }
       }
       // A small move that takes it `push` spacings from every earlier neighbour: push off each in turn
       // until none is nearer (or give up; the next round finds it again if it is still too close).

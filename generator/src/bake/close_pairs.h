@@ -46,11 +46,16 @@ struct SeparationResult {
 /// point it was close to. The move depends on the pairs alone, so a shared patch moves the same way in
 /// every tile. Repeats while moves make new pairs, at most kPushRounds times; what is still too close
 /// then is removed. With `split`, points of shared patches that some tile can keep are first split
-/// (split_crowded_points: dropped only in the tiles where they are too close) and the rest pushed.
+/// (split_crowded_points: dropped only in the tiles where they are too close) and the rest pushed. With
+/// `fill`, a crowded point moves instead into the deepest empty place within kFillReach spacings of it
+/// (among every point near it in any tile that shows it, each pair judged in the spacing of the density
+/// where both are shown), if that place is at least `push` spacings wide: a close pair is one point too
+/// many here, and usually one too few nearby. Pushed, it leaves part of its place empty.
 SeparationResult push_close_pairs_apart(std::vector<LevelPatches>& levels, std::uint32_t colours,
                                         const TilesetShape& shape, double separation, double push,
-                                        bool split = false);
+                                        bool split = false, bool fill = false);
 inline constexpr int kPushRounds = 8;
+inline constexpr double kFillReach = 1.5;  ///< how far `fill` looks for an empty place, in spacings
 
 /// The same along the glide track, once it is relaxed: removes the later point of every pair closer than
 /// `separation` hexagonal spacings (plus kGlideMargin, for the file's 8-bit offsets) at some density where

@@ -63,6 +63,16 @@ struct BakeRecipe {
   /// later) only where it is too close, instead of being moved or removed in every tile
   /// (close_pairs.h, split_crowded_points). Off (false) in recipes that do not name it.
   bool split_shared = false;
+  /// With `separation_push`: a crowded point moves into the deepest empty place within 1.5 spacings of it
+  /// where no point is nearer than `separation_push` spacings, and is pushed only if there is none
+  /// (close_pairs.h, push_close_pairs_apart). Off (false) in recipes that do not name it.
+  bool separation_fill = false;
+  /// With `separation_push`: part each level's close pairs as soon as the level is sampled, so that the
+  /// finer levels are sampled around where the moved points end up; otherwise the pass runs once over the
+  /// finished pyramid, and a point moved below the top level leaves its place empty at the levels above
+  /// (its partner, within `separation` spacings of its own level, is too far to cover it in theirs). Off
+  /// (false) in recipes that do not name it.
+  bool separation_per_level = false;
   /// After each run is sampled, every empty circle wider than this many hexagonal spacings whose centre
   /// lies in a patch the run keeps gets a new point there, deepest first (bake/hole_finder.h says why). 0
   /// (off) in recipes that do not name it.
