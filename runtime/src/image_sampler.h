@@ -10,8 +10,9 @@
 namespace kdm::detail {
 
 struct ImageSampler {
-  const DensityImageView* image;
+  const DensityImageView* image = nullptr;
   double sx = 0, sy = 0;
+  ImageSampler() = default;
   explicit ImageSampler(const DensityImageView* im) : image(im) {
     if (im) sx = im->width / (im->x1 - im->x0), sy = im->height / (im->y1 - im->y0);
   }

@@ -6,6 +6,7 @@
 #include <new>
 #include <vector>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 
@@ -62,6 +63,75 @@ void write_grown(const T& value, T* out) {
 constexpr std::size_t kQueryV1 = offsetof(kdm_query, mode);
 constexpr std::size_t kProblemV1 = sizeof(kdm_query_problem);
 constexpr std::size_t kInfoV1 = offsetof(kdm_tileset_info, keyframes);
+
+/// Checks a C query's arguments and reads its region, scale and mode into `q`; false with `why` set.
+bool read_query(const kdm_tileset* tileset, const kdm_query* query, const kdm_cursor* cursor, size_t* written,
+                kdm::QueryParams& q, kdm::QueryProblem& why) {
+  if (written) *written = 0;
+  kdm_query c;
+  if (!tileset) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "tileset";
+  } else if (!query) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "query";
+  } else if (!read_grown(query, kQueryV1, c)) {
+    why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = "query.struct_size";
+    why.value = static_cast<double>(query->struct_size), why.limit = static_cast<double>(kQueryV1);
+  } else if (!cursor) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "cursor";
+  } else {
+    q.x0 = c.x0, q.y0 = c.y0, q.x1 = c.x1, q.y1 = c.y1;
+    q.origin_x = c.origin_x, q.origin_y = c.origin_y;
+    q.tile_size = c.tile_size, q.scale = c.scale;
+    q.mode = static_cast<kdm::QueryMode>(c.mode);  // the query refuses values it does not know
+    return true;
+  }
+  return false;
+}
+
+/// A C density (image first, then callback, then the constant) as a QueryDensity.
+kdm::QueryDensity to_density(double constant, double (*callback)(void*, double, double), void* user,
+                             double callback_max, const kdm_density_image* image) {
+  kdm::QueryDensity d;
+  if (image) {
+    d.kind = kdm::QueryDensity::Kind::kImage;
+    d.image = &image->view;
+  } else if (callback) {
+    d.kind = kdm::QueryDensity::Kind::kCallback;
+    d.callback = callback, d.user = user, d.callback_max = callback_max;
+  } else {
+    d.constant = constant;
+  }
+  return d;
+}
+
+/// kdm_point and QueryPoint share their layout: queries write straight into the caller's buffer.
+kdm::QueryPoint* as_points(kdm_point* out) {
+  static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
+  return reinterpret_cast<kdm::QueryPoint*>(out);
+}
+
+/// Runs `query` with the C cursor as a QueryCursor, written back afterwards.
+template <class Query>
+kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
+  kdm::QueryCursor k{cursor->tile_x,        cursor->tile_y,      cursor->rank,  cursor->started != 0,
+                     cursor->finished != 0, cursor->fingerprint, cursor->depth, cursor->path};
+  const kdm::Status status = query(&k);
+  *cursor = kdm_cursor{k.tile_x,           k.tile_y,      k.rank,  k.started ? 1 : 0,
+                       k.finished ? 1 : 0, k.fingerprint, k.depth, k.path};
+  return to_c(status);
+}
+
+/// Writes `why` into the caller's problem struct, if it gave one.
+void report(const kdm::QueryProblem& why, kdm_query_problem* problem) {
+  if (!problem || problem->struct_size < kProblemV1) return;
+  kdm_query_problem p;
+  std::memset(&p, 0, sizeof p);
+  p.kind = static_cast<kdm_problem_kind>(static_cast<int>(why.kind));
+  p.parameter = why.parameter;
+  p.value = why.value, p.limit = why.limit;
+  p.largest_valid = why.largest_valid, p.largest_tile_size = why.largest_tile_size;
+  write_grown(p, problem);
+}
 
 }  // namespace
 
@@ -152,54 +222,44 @@ void kdm_density_image_free(kdm_density_image* image) {
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
                             size_t capacity, size_t* written, kdm_cursor* cursor,
                             kdm_query_problem* problem) {
-  static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
-  if (written) *written = 0;
   kdm::QueryProblem why;
+  kdm::QueryParams q;
   kdm_status status = KDM_INVALID_ARGUMENT;
-  kdm_query c;
-  if (!tileset) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "tileset";
-  } else if (!query) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "query";
-  } else if (!read_grown(query, kQueryV1, c)) {
-    why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = "query.struct_size";
-    why.value = static_cast<double>(query->struct_size), why.limit = static_cast<double>(kQueryV1);
-  } else if (!cursor) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "cursor";
+  if (read_query(tileset, query, cursor, written, q, why)) {
+    q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
+                           query->density_image);
+    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
+      return kdm::query_points(*tileset->set, q, as_points(out), capacity, written, k, &why);
+    });
+  }
+  report(why, problem);
+  return status;
+}
+
+kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,
+                             const kdm_class_density* classes, uint32_t class_count, kdm_point* out,
+                             uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
+                             kdm_query_problem* problem) {
+  kdm::QueryProblem why;
+  kdm::ClassQueryParams q;
+  kdm_status status = KDM_INVALID_ARGUMENT;
+  if (!read_query(tileset, query, cursor, written, q.query, why)) {
+  } else if (!classes) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "classes";
+  } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
+    why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
+    why.value = class_count, why.limit = kdm::kMaxQueryClasses;
   } else {
-    kdm::QueryParams q;
-    q.x0 = c.x0, q.y0 = c.y0, q.x1 = c.x1, q.y1 = c.y1;
-    q.origin_x = c.origin_x, q.origin_y = c.origin_y;
-    q.tile_size = c.tile_size, q.scale = c.scale;
-    q.mode = static_cast<kdm::QueryMode>(c.mode);  // query_points refuses values it does not know
-    if (c.density_image) {
-      q.density.kind = kdm::QueryDensity::Kind::kImage;
-      q.density.image = &c.density_image->view;
-    } else if (c.density_callback) {
-      q.density.kind = kdm::QueryDensity::Kind::kCallback;
-      q.density.callback = c.density_callback;
-      q.density.user = c.user;
-      q.density.callback_max = c.density_max;
-    } else {
-      q.density.constant = c.density;
+    q.class_count = class_count;
+    for (uint32_t k = 0; k < class_count; ++k) {
+      const kdm_class_density& c = classes[k];
+      q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
     }
-    kdm::QueryCursor k{cursor->tile_x,        cursor->tile_y,      cursor->rank,  cursor->started != 0,
-                       cursor->finished != 0, cursor->fingerprint, cursor->depth, cursor->path};
-    // kdm_point and QueryPoint share their layout (asserted above): write straight into the caller's buffer.
-    status = to_c(kdm::query_points(*tileset->set, q, reinterpret_cast<kdm::QueryPoint*>(out), capacity,
-                                    written, &k, &why));
-    *cursor = kdm_cursor{k.tile_x,           k.tile_y,      k.rank,  k.started ? 1 : 0,
-                         k.finished ? 1 : 0, k.fingerprint, k.depth, k.path};
+    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
+      return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity, written, k, &why);
+    });
   }
-  if (problem && problem->struct_size >= kProblemV1) {
-    kdm_query_problem p;
-    std::memset(&p, 0, sizeof p);
-    p.kind = static_cast<kdm_problem_kind>(static_cast<int>(why.kind));
-    p.parameter = why.parameter;
-    p.value = why.value, p.limit = why.limit;
-    p.largest_valid = why.largest_valid, p.largest_tile_size = why.largest_tile_size;
-    write_grown(p, problem);
-  }
+  report(why, problem);
   return status;
 }
 

@@ -447,6 +447,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
       return "the cursor was started by a query with other parameters";
     case QueryProblem::Kind::kBadMode:
       return "the mode is neither stable nor smooth";
+    case QueryProblem::Kind::kBadClassCount:
+      return "a query needs between 1 and 8 classes";
   }
   return "unknown problem";
 }

@@ -71,13 +71,15 @@ int main(int argc, char** argv) {
     info.struct_size = sizeof info;
     CHECK(kdm_tileset_get_info(builtin, &info) == KDM_OK);
     CHECK(info.struct_size == sizeof info);
-    CHECK(info.format_version >= 4 && info.format_version <= kdm_tileset_format_version()); /* 4: no hand-over */
+    CHECK(info.format_version >= 4 &&
+          info.format_version <= kdm_tileset_format_version()); /* 4: no hand-over */
     CHECK(info.colours == 2 && info.tiles == 16 && info.levels == 6);
     CHECK(info.level_points[0] == 32 && info.level_points[5] == 32768 && info.max_points_per_tile == 32768);
     CHECK(info.resident_bytes == kdm_tileset_resident_bytes(builtin));
     /* Smooth queries reach m^8 times the top level with a hand-over to m x m subtiles, else the top. */
-    CHECK(info.subtiles_per_side == 0 ? info.smooth_limit_per_tile == 32768.0
-                                      : info.smooth_limit_per_tile == 32768.0 * pow(info.subtiles_per_side, 8));
+    CHECK(info.subtiles_per_side == 0
+              ? info.smooth_limit_per_tile == 32768.0
+              : info.smooth_limit_per_tile == 32768.0 * pow(info.subtiles_per_side, 8));
     CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
     CHECK(strchr(kdm_version(), '.') != NULL);
   }
@@ -152,6 +154,42 @@ int main(int argc, char** argv) {
     q.x0 = 1, q.x1 = 1.5;
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
+  }
+  /* Several classes: class 0 is the one-class query at its density, the union the one at the sum. */
+  {
+    static kdm_point points[4096], single[4096];
+    static uint8_t classes[4096];
+    kdm_class_density densities[3];
+    kdm_cursor cursor;
+    size_t written = 0, alone = 0, zeros = 0, i;
+    memset(densities, 0, sizeof densities);
+    densities[0].density = 1, densities[1].density = 2, densities[2].density = 4;
+    q = uniform_query();
+    q.scale = 100;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_OK);
+    q.density = 1;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, single, 4096, &alone, &cursor, NULL) == KDM_OK);
+    for (i = 0; i < written; ++i) {
+      CHECK(classes[i] < 3);
+      if (classes[i] == 0) CHECK(memcmp(&points[i], &single[zeros++], sizeof(kdm_point)) == 0);
+    }
+    CHECK(zeros == alone && alone > 300 && written > 6 * alone && written < 8 * alone);
+    q.density = 7;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, single, 4096, &alone, &cursor, NULL) == KDM_OK && alone == written);
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_classes(builtin, &q, densities, 9, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT && problem.value == 9);
+    CHECK(kdm_query_classes(builtin, &q, NULL, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "classes") == 0);
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, NULL, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT);
   }
   {
     kdm_tileset* bad = NULL;

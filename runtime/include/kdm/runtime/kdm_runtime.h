@@ -87,7 +87,8 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_DENSITY_TOO_HIGH = 7, /* `value` points per tile > `limit`; see largest_valid (scale) and
                                        largest_tile_size */
   KDM_PROBLEM_CURSOR_MISMATCH = 8,  /* the cursor was started by a query with other parameters */
-  KDM_PROBLEM_BAD_MODE = 9          /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
+  KDM_PROBLEM_BAD_MODE = 9,         /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
+  KDM_PROBLEM_BAD_CLASS_COUNT = 10  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
@@ -155,6 +156,30 @@ KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);
+
+/* One class's density for kdm_query_classes: as kdm_query's density fields (an image takes precedence
+ * over a callback, a callback over the constant). */
+typedef struct kdm_class_density {
+  double density;
+  double (*density_callback)(void* user, double x, double y);
+  void* user;
+  double density_max;
+  const kdm_density_image* density_image;
+} kdm_class_density;
+
+#define KDM_MAX_CLASSES 8
+
+/* Several classes in one query (kdm/runtime/class_query.h): the points of a query at the sum of the
+ * classes' densities, each with its class (0 ... class_count - 1) in out_classes[i]. `query` gives the
+ * region, scale and mode (its density fields are not read); `classes` the densities, class 0 first. In
+ * stable mode class 0 alone is exactly kdm_query_points at class 0's density, and classes 0 ... k together
+ * at their summed density. Statuses and resumption as kdm_query_points; KDM_INVALID_ARGUMENT also for a
+ * class count of 0 or more than KDM_MAX_CLASSES, a NULL `classes`, or a NULL `out_classes` with room in
+ * `out`. */
+KDM_RUNTIME_API kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,
+                                             const kdm_class_density* classes, uint32_t class_count,
+                                             kdm_point* out, uint8_t* out_classes, size_t capacity,
+                                             size_t* written, kdm_cursor* cursor, kdm_query_problem* problem);
 
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);

@@ -123,6 +123,7 @@ struct QueryProblem {
                        ///< largest tile size that fits this scale
     kCursorMismatch,   ///< the cursor was started by a call with other parameters (or damaged)
     kBadMode,          ///< `parameter` ("mode") is not a QueryMode; `value` holds it
+    kBadClassCount,    ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage

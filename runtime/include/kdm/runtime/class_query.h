@@ -1,0 +1,54 @@
+// Several classes of points in one query: trees, bushes and rocks, or the inks of a colour stipple, each
+// with its own density and all of them keeping their distance from one another (multi-class blue noise,
+// L.-Y. Wei, "Multi-class blue noise sampling", SIGGRAPH 2010, over the one-class query of query.h).
+//
+// The classes' densities ρ_0 … ρ_{K-1} are given in priority order. The query emits the points of a
+// one-class query at their sum, and a point of threshold t (query.h) emitted at its stable position x
+// takes the first class k whose cumulative expected count passes it: (ρ_0 + … + ρ_k)(x) · A · scale > t.
+// So, in stable mode, class 0 is exactly the one-class query at ρ_0, classes 0 … k together exactly the
+// one at ρ_0 + … + ρ_k, and all classes together exactly the one at the sum; each later class fills in
+// around the earlier ones. In smooth mode every point glides on the track of the sum (so the union is
+// exactly the smooth one-class query at the sum and no two points of any classes come closer than its
+// points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions.
+// Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps.
+//
+// Zoom coherence: as densities rise a point keeps its id and can only move to an earlier class (its
+// cumulative counts only grow), never to a later one. Past the top level (smooth mode, depth > 0), a
+// point's class follows its own threshold in the subtile that holds it, so class counts hold there on
+// average rather than exactly. Partitions, determinism and thread safety are those of query_points.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kdm/runtime/export.h"
+#include "kdm/runtime/query.h"
+#include "kdm/runtime/status.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+
+/// Most classes one query may carry.
+inline constexpr std::uint32_t kMaxQueryClasses = 8;
+
+struct ClassQueryParams {
+  QueryParams query;              ///< region, origin, tile size, scale and mode; query.density is not read
+  std::uint32_t class_count = 0;  ///< how many of `classes` are used: 1 … kMaxQueryClasses
+  QueryDensity classes[kMaxQueryClasses];  ///< each class's density, class 0 first (highest priority)
+};
+
+/// A hash of every field of `params` that a query reads: the identity its cursor keeps.
+KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
+
+/// Writes the region's points into `out[0..capacity)` and each one's class (0 … class_count - 1) into
+/// `classes[0..capacity)`, in query_points' order; `*written` receives the count. Returns kOk when the
+/// region is complete, kBufferFull to be called again with the same cursor and params, kInvalidArgument
+/// with `problem` (optional) naming the parameter for: a class count of 0 or more than kMaxQueryClasses
+/// (kBadClassCount), a class's missing image or callback or bad callback_max (parameter
+/// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a null `classes` with room in
+/// `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
+KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
+                                     std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                                     QueryCursor* cursor, QueryProblem* problem = nullptr);
+
+}  // namespace kdm

@@ -1,0 +1,220 @@
+// Several classes in one query (kdm/runtime/class_query.h): the one-class query at the sum of the
+// densities, then each emitted point's class from its threshold and the cumulative densities at its
+// stable position.
+#include "kdm/runtime/class_query.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "descent.h"
+#include "image_sampler.h"
+#include "kdm/runtime/hash.h"
+#include "query_tables.h"
+
+namespace kdm {
+
+using detail::density_or_zero;
+using detail::ImageSampler;
+
+namespace {
+
+// Static names for QueryProblem::parameter, one per class.
+constexpr const char* kImageNames[kMaxQueryClasses] = {
+    "classes[0].image", "classes[1].image", "classes[2].image", "classes[3].image",
+    "classes[4].image", "classes[5].image", "classes[6].image", "classes[7].image"};
+constexpr const char* kCallbackNames[kMaxQueryClasses] = {
+    "classes[0].callback", "classes[1].callback", "classes[2].callback", "classes[3].callback",
+    "classes[4].callback", "classes[5].callback", "classes[6].callback", "classes[7].callback"};
+constexpr const char* kCallbackMaxNames[kMaxQueryClasses] = {
+    "classes[0].callback_max", "classes[1].callback_max", "classes[2].callback_max",
+    "classes[3].callback_max", "classes[4].callback_max", "classes[5].callback_max",
+    "classes[6].callback_max", "classes[7].callback_max"};
+
+/// The classes' densities, read as query_points reads a one-class density, so that a class's values and
+/// their running sums are the very numbers the one-class queries compare.
+struct ClassDensities {
+  const ClassQueryParams* params = nullptr;
+  ImageSampler samplers[kMaxQueryClasses];
+  bool all_constant = true;
+
+  double at(std::uint32_t k, double x, double y) const {
+    const QueryDensity& d = params->classes[k];
+    switch (d.kind) {
+      case QueryDensity::Kind::kConstant:
+        return density_or_zero(d.constant);
+      case QueryDensity::Kind::kImage:
+        return samplers[k].at(x, y);
+      case QueryDensity::Kind::kCallback:
+        break;
+    }
+    return density_or_zero(d.callback(d.user, x, y));
+  }
+  /// The first class whose cumulative expected count (densities times `area`) passes `threshold`; the
+  /// last class if none does (past the top level, where a point's own threshold only approximates the
+  /// rule that emitted it).
+  std::uint8_t class_of(float threshold, double x, double y, double area) const {
+    const std::uint32_t last = params->class_count - 1;
+    double sum = 0;
+    for (std::uint32_t k = 0; k < last; ++k) {
+      sum += at(k, x, y);
+      if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
+    }
+    return static_cast<std::uint8_t>(last);
+  }
+};
+
+double sum_of_densities(void* user, double x, double y) {
+  const auto& c = *static_cast<const ClassDensities*>(user);
+  double sum = 0;
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) sum += c.at(k, x, y);
+  return sum;
+}
+
+/// An upper bound of class `d`'s density wherever a point that can show in the region is decided: the
+/// region, or in smooth mode (whose points glide in from outside it) the whole image.
+double density_bound(const QueryDensity& d, const QueryParams& q) {
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return density_or_zero(d.constant);
+    case QueryDensity::Kind::kImage:
+      if (q.mode == QueryMode::kSmooth)
+        return d.image->max_over(d.image->x0, d.image->y0, d.image->x1, d.image->y1);
+      return d.image->max_over(q.x0, q.y0, q.x1, q.y1);
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return d.callback_max;
+}
+
+}  // namespace
+
+std::uint64_t query_fingerprint(const ClassQueryParams& p) {
+  QueryParams q = p.query;
+  q.density = QueryDensity{};
+  std::uint64_t h = mix64(query_fingerprint(q) ^ 0x636c6173736573ull);  // "classes"
+  auto add = [&](std::uint64_t v) { h = mix64(h ^ v); };
+  auto add_double = [&](double v) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    add(bits);
+  };
+  add(p.class_count);
+  for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
+    const QueryDensity& d = p.classes[k];
+    add(static_cast<std::uint64_t>(d.kind));
+    add_double(d.constant), add_double(d.callback_max);
+    add(reinterpret_cast<std::uintptr_t>(d.image));
+    add(reinterpret_cast<std::uintptr_t>(d.callback));
+    add(reinterpret_cast<std::uintptr_t>(d.user));
+  }
+  return h;
+}
+
+Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
+                     std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                     QueryProblem* problem) {
+  QueryProblem unused;
+  QueryProblem& why = problem ? *problem : unused;
+  why = QueryProblem{};
+  auto refuse = [&](QueryProblem::Kind kind, const char* parameter, double value = 0, double limit = 0) {
+    why.kind = kind, why.parameter = parameter, why.value = value, why.limit = limit;
+    return Status::kInvalidArgument;
+  };
+  using Kind = QueryProblem::Kind;
+  if (written) *written = 0;
+  if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
+    return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
+  if (capacity > 0 && !classes) return refuse(Kind::kMissingArgument, "classes");
+  ClassDensities densities;
+  densities.params = &p;
+  for (std::uint32_t k = 0; k < p.class_count; ++k) {
+    const QueryDensity& d = p.classes[k];
+    switch (d.kind) {
+      case QueryDensity::Kind::kConstant:
+        continue;
+      case QueryDensity::Kind::kImage:
+        if (!d.image || !d.image->values || !d.image->max_mip)
+          return refuse(Kind::kBadDensity, kImageNames[k]);
+        densities.samplers[k] = ImageSampler(d.image);
+        break;
+      case QueryDensity::Kind::kCallback:
+        if (!d.callback) return refuse(Kind::kBadDensity, kCallbackNames[k]);
+        if (!std::isfinite(d.callback_max))
+          return refuse(Kind::kNotFinite, kCallbackMaxNames[k], d.callback_max);
+        if (d.callback_max < 0) return refuse(Kind::kNegative, kCallbackMaxNames[k], d.callback_max);
+        break;
+      default:
+        return refuse(Kind::kBadDensity, kCallbackNames[k], static_cast<double>(static_cast<int>(d.kind)));
+    }
+    densities.all_constant = false;
+  }
+
+  // The union: a constant when every class is one (query_points' fastest path), else their sum by callback.
+  QueryParams q = p.query;
+  q.density = QueryDensity{};
+  if (densities.all_constant) {
+    q.density.constant = 0;  // not QueryDensity's default of 1
+    for (std::uint32_t k = 0; k < p.class_count; ++k)
+      q.density.constant += density_or_zero(p.classes[k].constant);
+  } else {
+    q.density.kind = QueryDensity::Kind::kCallback;
+    q.density.callback = sum_of_densities;
+    q.density.user = &densities;
+    q.density.callback_max = 0;
+    for (std::uint32_t k = 0; k < p.class_count; ++k)
+      q.density.callback_max += density_bound(p.classes[k], q);
+  }
+  // The cursor carries this query's fingerprint; the inner one's (which hashes `densities`' address) only
+  // while query_points runs.
+  const std::uint64_t fingerprint = query_fingerprint(p);
+  if (cursor && cursor->started) {
+    if (cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
+    cursor->fingerprint = query_fingerprint(q);
+  }
+  const Status status = query_points(tileset, q, out, capacity, written, cursor, &why);
+  if (cursor && cursor->started) cursor->fingerprint = fingerprint;
+  if (status == Status::kInvalidArgument) return status;
+
+  // Each point's class, from its tile's threshold at its rank and its stable position (query.h).
+  const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
+  const TilesetData& set = tileset.data();
+  const double S = q.tile_size;
+  const double m = tables.subtiles;
+  PointId cached{0, 0, 0, ~0u};
+  std::size_t index = 0;
+  double cumulative_area[kMaxQueryClasses] = {};  // constants: the cumulative counts at depth `cached`
+  for (std::size_t i = 0; i < *written; ++i) {
+    const PointId& id = out[i].id;
+    if (id.tile_x != cached.tile_x || id.tile_y != cached.tile_y || id.depth != cached.depth) {
+      cached = id;
+      index = id.depth == 0 ? tileset.tile_index_at(id.tile_x, id.tile_y)
+                            : static_cast<std::size_t>(tile_of(tileset, id) - set.tiles.data());
+      const double side = id.depth == 0 ? S : S / std::pow(m, double(id.depth));
+      const double area = side * side * q.scale;
+      double sum = 0;
+      for (std::uint32_t k = 0; k < p.class_count; ++k)
+        sum += density_or_zero(p.classes[k].constant), cumulative_area[k] = sum * area;
+    }
+    const auto& thresholds = tables.thresholds[index];
+    if (id.rank >= thresholds.size()) {  // not a point of its tile: the least class (never for a valid set)
+      classes[i] = static_cast<std::uint8_t>(p.class_count - 1);
+      continue;
+    }
+    const float t = thresholds[id.rank];
+    if (densities.all_constant) {
+      std::uint32_t k = 0;
+      while (k + 1 < p.class_count && !TilesetShape::emits(t, cumulative_area[k])) ++k;
+      classes[i] = static_cast<std::uint8_t>(k);
+      continue;
+    }
+    // The stable position, computed as query_points computes it (depth 0) so the densities read are its.
+    const TilePoint& point = set.tiles[index].points[id.rank];
+    const double side = id.depth == 0 ? S : S / std::pow(m, double(id.depth));
+    const double wx = double(id.tile_x) * side, wy = double(id.tile_y) * side;
+    const double x = wx + point.unit_x() * side, y = wy + point.unit_y() * side;
+    classes[i] = densities.class_of(t, x, y, side * side * q.scale);
+  }
+  return status;
+}
+
+}  // namespace kdm

@@ -1,0 +1,329 @@
+// Several classes in one query: in stable mode class 0, classes 0 … k and the union are exactly the
+// one-class queries at their densities; smooth mode's union is the smooth query at the sum; class counts
+// follow the densities; partitions, resumption, zoom coherence (a class can only be promoted), refusals and
+// no allocation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "allocation_counter.h"
+#include "kdm/runtime/class_query.h"
+#include "random_partition.h"
+
+namespace kdm {
+namespace {
+
+using Id = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
+struct Emitted {
+  double x, y;
+  int cls;
+};
+using Points = std::map<Id, Emitted>;
+
+Id id_of(const QueryPoint& p) {
+  return {p.id.tile_x, p.id.tile_y, p.id.rank, p.id.depth};
+}
+
+Points run_classes(const ClassQueryParams& q, std::size_t capacity = 1 << 14) {
+  std::vector<QueryPoint> out(capacity);
+  std::vector<std::uint8_t> classes(capacity);
+  Points points;
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s =
+        query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
+    for (std::size_t i = 0; i < written; ++i) {
+      EXPECT_LT(classes[i], q.class_count);
+      EXPECT_TRUE(points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, classes[i]}).second)
+          << "a point emitted twice";
+    }
+    if (s != Status::kBufferFull) break;
+  }
+  return points;
+}
+
+Points run_one(const QueryParams& q) {
+  std::vector<QueryPoint> out(1 << 14);
+  Points points;
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
+    for (std::size_t i = 0; i < written; ++i) points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, 0});
+    if (s != Status::kBufferFull) break;
+  }
+  return points;
+}
+
+/// The points of `all` whose class is at most `last`.
+Points up_to_class(const Points& all, int last) {
+  Points some;
+  for (const auto& [id, p] : all)
+    if (p.cls <= last) some.emplace(id, p);
+  return some;
+}
+
+/// Whether two point sets hold the same ids at the same positions (bit for bit).
+void expect_same(const Points& a, const Points& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  auto j = b.begin();
+  for (auto i = a.begin(); i != a.end(); ++i, ++j) {
+    ASSERT_TRUE(i->first == j->first) << what;
+    ASSERT_EQ(i->second.x, j->second.x) << what;
+    ASSERT_EQ(i->second.y, j->second.y) << what;
+  }
+}
+
+ClassQueryParams three_constants(double x0, double y0, double x1, double y1, double scale, QueryMode mode) {
+  ClassQueryParams q;
+  q.query.x0 = x0, q.query.y0 = y0, q.query.x1 = x1, q.query.y1 = y1;
+  q.query.scale = scale, q.query.mode = mode;
+  q.class_count = 3;
+  for (int k = 0; k < 3; ++k) q.classes[k].constant = double(1 << k);  // 1 : 2 : 4
+  return q;
+}
+
+/// Three images over [0, 4)²: a ramp in x, a ramp in y and a bump, each with its max-mip.
+struct ThreeImages {
+  std::vector<float> values[3], mips[3];
+  DensityImageView views[3];
+  ThreeImages() {
+    for (int k = 0; k < 3; ++k) {
+      values[k].resize(32 * 32);
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+          values[k][y * 32 + x] =
+              static_cast<float>(k == 0   ? u
+                                 : k == 1 ? 0.2 + v
+                                          : std::exp(-8 * ((u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5))));
+        }
+      DensityImageView& view = views[k];
+      view.width = view.height = 32;
+      view.x1 = view.y1 = 4;
+      view.values = values[k].data();
+      EXPECT_EQ(make_density_max_mip(view, mips[k]), Status::kOk);
+    }
+  }
+};
+
+double sum_of_images(void* user, double x, double y) {
+  const auto& images = *static_cast<const ThreeImages*>(user);
+  double sum = 0;
+  for (const DensityImageView& v : images.views) sum += v.at(x, y);
+  return sum;
+}
+
+TEST(ClassQueryTest, StableClassesAreTheOneClassQueriesAtTheirCumulativeDensities) {
+  // Constants 1 : 2 : 4 at a mid-level density (neither a level nor a keyframe) over 6×6 tiles.
+  const ClassQueryParams q = three_constants(0.3, 0.2, 6.3, 6.2, 300, QueryMode::kStable);
+  const Points all = run_classes(q);
+  double cumulative = 0;
+  for (int k = 0; k < 3; ++k) {
+    cumulative += q.classes[k].constant;
+    QueryParams one = q.query;
+    one.density.constant = cumulative;
+    expect_same(up_to_class(all, k), run_one(one), "constant classes");
+  }
+  // Three images, and one class of each kind: class 0 is the query at its own image, the union the query
+  // at the sum (a callback adding the images' values as the classes' sum does).
+  ThreeImages images;
+  ClassQueryParams qi = q;
+  qi.query.x0 = 0, qi.query.y0 = 0, qi.query.x1 = 4, qi.query.y1 = 4, qi.query.scale = 1500;
+  for (int k = 0; k < 3; ++k) {
+    qi.classes[k].kind = QueryDensity::Kind::kImage;
+    qi.classes[k].image = &images.views[k];
+  }
+  const Points all_images = run_classes(qi);
+  QueryParams one = qi.query;
+  one.density.kind = QueryDensity::Kind::kImage;
+  one.density.image = &images.views[0];
+  expect_same(up_to_class(all_images, 0), run_one(one), "image class 0");
+  one.density.kind = QueryDensity::Kind::kCallback;
+  one.density.callback = sum_of_images;
+  one.density.user = &images;
+  one.density.callback_max = 1 + 1.2 + 1;
+  expect_same(all_images, run_one(one), "union of the images");
+  // Mixed kinds: a constant first, then an image, then a callback.
+  ClassQueryParams qm = qi;
+  qm.classes[0] = QueryDensity{};
+  qm.classes[0].constant = 0.5;
+  qm.classes[2].kind = QueryDensity::Kind::kCallback;
+  qm.classes[2].callback = [](void*, double x, double) { return x / 4; };
+  qm.classes[2].callback_max = 1;
+  const Points mixed = run_classes(qm);
+  one = qm.query;
+  one.density.constant = 0.5;
+  expect_same(up_to_class(mixed, 0), run_one(one), "mixed class 0");
+  std::printf("constants: %zu points; images: %zu; mixed: %zu\n", all.size(), all_images.size(),
+              mixed.size());
+}
+
+TEST(ClassQueryTest, SmoothUnionIsTheSmoothQueryAtTheSum) {
+  const ClassQueryParams q = three_constants(0.3, 0.2, 6.3, 6.2, 300, QueryMode::kSmooth);
+  const Points all = run_classes(q);
+  QueryParams one = q.query;
+  one.density.constant = 7;
+  expect_same(all, run_one(one), "smooth union");
+  // The ids of class 0 are stable mode's class 0 (the positions are the union's glided ones).
+  ClassQueryParams stable = q;
+  stable.query.mode = QueryMode::kStable;
+  const Points stable_all = run_classes(stable);
+  std::set<Id> smooth0, stable0;
+  for (const auto& [id, p] : all)
+    if (p.cls == 0) smooth0.insert(id);
+  for (const auto& [id, p] : stable_all)
+    if (p.cls == 0) stable0.insert(id);
+  // Stable class 0 holds its region's stable positions; smooth class 0 those that glided into it: the same
+  // ids but for a few along the region's border.
+  std::size_t shared = 0;
+  for (const Id& id : smooth0) shared += stable0.count(id);
+  std::printf("class 0: %zu stable, %zu smooth, %zu shared\n", stable0.size(), smooth0.size(), shared);
+  EXPECT_GE(double(shared), 0.97 * double(stable0.size()));
+  EXPECT_GE(double(shared), 0.97 * double(smooth0.size()));
+}
+
+TEST(ClassQueryTest, ClassCountsFollowTheirDensities) {
+  // 20×20 tiles at 7 × 150 points per tile: expected 60,000 / 120,000 / 240,000. The counts of a rank
+  // prefix vary far less than Poisson counts (a few points per tile edge band): measured within 0.4%.
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    const ClassQueryParams q = three_constants(0, 0, 20, 20, 150, mode);
+    const Points all = run_classes(q);
+    std::size_t counts[3] = {};
+    for (const auto& [id, p] : all) ++counts[p.cls];
+    for (int k = 0; k < 3; ++k) {
+      const double expected = q.classes[k].constant * 150 * 400;
+      std::printf("mode %d class %d: %zu points, expected %.0f\n", int(mode), k, counts[k], expected);
+      EXPECT_NEAR(double(counts[k]) / expected, 1.0, 0.01);
+    }
+  }
+}
+
+TEST(ClassQueryTest, PartsOfARegionGiveItsPointsAndClasses) {
+  std::mt19937 rng(7);
+  ThreeImages images;
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    ClassQueryParams whole = three_constants(0, 0, 4, 4, 900, mode);
+    whole.classes[1].kind = QueryDensity::Kind::kImage;
+    whole.classes[1].image = &images.views[2];
+    const Points all = run_classes(whole, 1000);  // resumed many times
+    Points joined;
+    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
+      ClassQueryParams p = whole;
+      p.query = part;
+      for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
+    }
+    expect_same(all, joined, "parts");
+    for (const auto& [id, e] : all) ASSERT_EQ(e.cls, joined.at(id).cls);
+  }
+}
+
+TEST(ClassQueryTest, RaisingTheDensitiesOnlyPromotesAPointsClass) {
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    Points before = run_classes(three_constants(0, 0, 5, 5, 100, mode));
+    for (double scale : {130.0, 170.0, 400.0, 1100.0}) {
+      const Points after = run_classes(three_constants(0, 0, 5, 5, scale, mode));
+      std::size_t promoted = 0;
+      for (const auto& [id, p] : before) {
+        // Smooth points near the border glide in and out of the region as the density changes.
+        const double margin = mode == QueryMode::kSmooth ? 1.5 * Tileset::builtin().glide_reach() : 0;
+        if (p.x < margin || p.x >= 5 - margin || p.y < margin || p.y >= 5 - margin) continue;
+        const auto it = after.find(id);
+        ASSERT_NE(it, after.end()) << "a point disappeared as the density rose";
+        ASSERT_LE(it->second.cls, p.cls) << "a point moved to a later class";
+        promoted += it->second.cls < p.cls;
+      }
+      EXPECT_GT(promoted, 0u);
+      before = after;
+    }
+  }
+}
+
+TEST(ClassQueryTest, PastTheTopLevelClassCountsStillFollowTheirDensities) {
+  // Smooth mode descends into subtiles past the top level (32,768 points per tile): 3 × the top over a
+  // quarter tile. A point's class follows its own subtile's threshold there: measured within 1.9%.
+  ClassQueryParams q = three_constants(0, 0, 0.5, 0.5, 3 * 32768.0 / 7, QueryMode::kSmooth);
+  const Points all = run_classes(q);
+  std::size_t counts[3] = {}, deep = 0;
+  for (const auto& [id, p] : all) ++counts[p.cls], deep += std::get<3>(id) > 0;
+  EXPECT_GT(deep, 0u);
+  std::printf("%zu points (%zu from subtiles): %zu / %zu / %zu\n", all.size(), deep, counts[0], counts[1],
+              counts[2]);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(double(counts[k]) / (q.classes[k].constant / 7 * double(all.size())), 1.0, 0.03);
+}
+
+TEST(ClassQueryTest, BadInputIsRefusedByName) {
+  QueryPoint out[4];
+  std::uint8_t classes[4];
+  std::size_t written = 0;
+  auto refusal = [&](const ClassQueryParams& q, std::uint8_t* cls = nullptr) {
+    QueryCursor cursor;
+    QueryProblem why;
+    const Status s =
+        query_classes(Tileset::builtin(), q, out, cls ? cls : classes, 4, &written, &cursor, &why);
+    EXPECT_EQ(s, Status::kInvalidArgument);
+    return why;
+  };
+  ClassQueryParams q = three_constants(0, 0, 1, 1, 10, QueryMode::kStable);
+  q.class_count = 0;
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kBadClassCount);
+  q.class_count = 9;
+  EXPECT_EQ(refusal(q).value, 9);
+  q.class_count = 3;
+  q.classes[1].kind = QueryDensity::Kind::kImage;
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].image");
+  q.classes[1].kind = QueryDensity::Kind::kCallback;
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].callback");
+  q.classes[1].callback = [](void*, double, double) { return 1.0; };
+  q.classes[1].callback_max = -1;
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);
+  q.classes[1].callback_max = NAN;
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].callback_max");
+  q.classes[1] = QueryDensity{};
+  std::uint8_t* none = nullptr;
+  QueryCursor cursor;
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out, none, 4, &written, &cursor), Status::kInvalidArgument);
+  // A cursor started by other classes is refused.
+  cursor = QueryCursor{};
+  ASSERT_EQ(query_classes(Tileset::builtin(), q, out, classes, 4, &written, &cursor), Status::kBufferFull);
+  q.classes[2].constant = 5;
+  QueryProblem why;
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out, classes, 4, &written, &cursor, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kCursorMismatch);
+  // Too dense for the set: the sum is judged.
+  q.query.scale = 32768.0 / 7 * 1.01;
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kDensityTooHigh);
+}
+
+TEST(ClassQueryTest, QueriesAllocateNothing) {
+  ThreeImages images;
+  ClassQueryParams q = three_constants(0, 0, 4, 4, 500, QueryMode::kSmooth);
+  q.classes[2].kind = QueryDensity::Kind::kImage;
+  q.classes[2].image = &images.views[0];
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  (void)Tileset::builtin();
+  const long before = testing::allocations();
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    q.query.mode = mode;
+    QueryCursor cursor;
+    std::size_t written = 0;
+    EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    EXPECT_GT(written, 10000u);
+  }
+  EXPECT_EQ(testing::allocations(), before);
+}
+
+}  // namespace
+}  // namespace kdm
