@@ -583,6 +583,42 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
   expect_error("sample --n 100 --density const:0 -o '" + path("z.txt") + "'", "> 0");
 }
 
+// --class, repeated: one query, each row with its class; class 0's rows are the one-class query's at its
+// density, the rows of every class together the one-class query's at the sum.
+TEST_F(CliTest, QueryClassesWriteAClassColumnAndOneGroupPerClass) {
+  const std::string common = " --rect 0,0,3,2 --scale 150 -o '";
+  ASSERT_EQ(kdm("query --class const:1 --class const:2 --class ramp:4" + common + path("c.csv") + "'").status,
+            0);
+  ASSERT_EQ(kdm("query --density const:1" + common + path("one.csv") + "'").status, 0);
+  std::istringstream in(slurp(path("c.csv")));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,y,tile_x,tile_y,rank,level,class");
+  std::vector<std::string> zero;
+  std::size_t counts[3] = {};
+  while (std::getline(in, line)) {
+    const std::size_t comma = line.rfind(',');
+    const int cls = std::atoi(line.c_str() + comma + 1);
+    ASSERT_TRUE(cls >= 0 && cls < 3) << line;
+    ++counts[cls];
+    if (cls == 0) zero.push_back(line.substr(0, comma));
+  }
+  std::sort(zero.begin(), zero.end());
+  EXPECT_EQ(zero, sorted_rows(slurp(path("one.csv"))));
+  EXPECT_NEAR(double(counts[1]) / double(counts[0]), 2.0, 0.05);  // rank prefixes: counts within a few points
+  ASSERT_EQ(kdm("query --class const:1 --class const:2" + common + path("c.svg") + "'").status, 0);
+  const std::string svg = slurp(path("c.svg"));
+  EXPECT_NE(svg.find("<g id=\"class-0\""), std::string::npos);
+  EXPECT_NE(svg.find("<g id=\"class-1\""), std::string::npos);
+  ASSERT_EQ(kdm("query --class const:1 --class const:2" + common + path("c.json") + "'").status, 0);
+  EXPECT_NE(slurp(path("c.json")).find("\"level\": 0, \"class\": 0}"), std::string::npos);
+  expect_error("query --density const:1 --class const:1" + common + path("z.csv") + "'", "not both");
+  std::string nine;
+  for (int k = 0; k < 9; ++k) nine += " --class const:1";
+  expect_error("query" + nine + common + path("z.csv") + "'", "at most 8 classes");
+  expect_error("query --class const:1 --class const:-1" + common + path("z.csv") + "'", ">= 0");
+}
+
 TEST_F(CliTest, SmallFrictions) {
   expect_error("analyze '" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt' -o '" +
                    path("metrics.json") + "'",

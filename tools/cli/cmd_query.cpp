@@ -2,6 +2,7 @@
 // units with their stable ids (.csv, .json), or normalised to the rectangle (.txt, pictures).
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -17,6 +18,7 @@ namespace {
 
 struct QueryArgs {
   std::string tileset, rect, density_rect, density = "const:1", output, mode = "stable";
+  std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
   double scale = 1000, tile_size = 1, gamma = 1;
   bool invert = false, normalised = false;
 };
@@ -25,13 +27,16 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-/// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level. Positions
-/// are world coordinates printed exactly (%.17g), so the points of any partition of a region are the same
-/// lines as the region's own; or, with `normalised`, coordinates in [0, 1) of the rectangle.
-std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset& tiles, const double r[4],
-                            bool normalised, bool json) {
+/// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level, and its
+/// class when `classes` is given. Positions are world coordinates printed exactly (%.17g), so the points of
+/// any partition of a region are the same lines as the region's own; or, with `normalised`, coordinates in
+/// [0, 1) of the rectangle.
+std::string points_with_ids(const std::vector<QueryPoint>& points, const std::vector<std::uint8_t>* classes,
+                            const Tileset& tiles, const double r[4], bool normalised, bool json) {
   const tools::PointSet unit = tools::normalise_to_rect(points, r);
-  std::string out = json ? "{\"rect\": [" : "x,y,tile_x,tile_y,rank,level\n";
+  std::string out = json      ? "{\"rect\": ["
+                    : classes ? "x,y,tile_x,tile_y,rank,level,class\n"
+                              : "x,y,tile_x,tile_y,rank,level\n";
   char line[192];
   if (json) {
     std::snprintf(line, sizeof line, "%.17g, %.17g, %.17g, %.17g], \"normalised\": %s, \"points\": [", r[0],
@@ -47,21 +52,34 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const Tileset
     if (json)
       std::snprintf(line, sizeof line,
                     "%s\n  {\"x\": %.17g, \"y\": %.17g, \"tile_x\": %lld, \"tile_y\": %lld, \"rank\": %u, "
-                    "\"level\": %u}",
+                    "\"level\": %u",
                     i ? "," : "", x, y, tx, ty, p.id.rank, level);
     else
-      std::snprintf(line, sizeof line, "%.17g,%.17g,%lld,%lld,%u,%u\n", x, y, tx, ty, p.id.rank, level);
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%lld,%lld,%u,%u", x, y, tx, ty, p.id.rank, level);
     out += line;
+    if (classes) out += (json ? ", \"class\": " : ",") + std::to_string((*classes)[i]);
+    out += json ? "}" : "\n";
   }
   if (json) out += "\n]}\n";
   return out;
 }
 
-void run_query_command(const QueryArgs& a) {
+void run_query_command(const QueryArgs& a, bool density_given) {
   double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
-  const tools::DensitySpec spec = parse_density(a.density, a.gamma, a.invert);
-  if (!a.density_rect.empty() && spec.kind == tools::DensitySpec::Kind::kConstant)
+  if (density_given && !a.classes.empty())
+    throw CommandError("give either --density or --class (one per class), not both");
+  if (a.classes.size() > kMaxQueryClasses)
+    throw CommandError("--class given " + std::to_string(a.classes.size()) + " times; at most " +
+                       std::to_string(kMaxQueryClasses) + " classes");
+  // One density per class (--density alone is one class); specs and densities stay put (queries point in).
+  std::vector<std::unique_ptr<tools::DensitySpec>> specs;
+  for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes)
+    specs.push_back(std::make_unique<tools::DensitySpec>(parse_density(text, a.gamma, a.invert)));
+  const bool any_map = std::any_of(specs.begin(), specs.end(), [](const auto& s) {
+    return s->kind != tools::DensitySpec::Kind::kConstant;
+  });
+  if (!a.density_rect.empty() && !any_map)
     throw CommandError("--density-rect needs an image or a test map --density");
   if (a.density_rect.empty()) {
     std::copy(r, r + 4, dr);  // the image stretched over the rectangle queried
@@ -70,18 +88,28 @@ void run_query_command(const QueryArgs& a) {
   }
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
-  const tools::SpecDensity density(spec, dr);
+  std::vector<std::unique_ptr<tools::SpecDensity>> densities;
+  for (const auto& spec : specs) densities.push_back(std::make_unique<tools::SpecDensity>(*spec, dr));
   QueryParams q;
   q.x0 = r[0], q.y0 = r[1], q.x1 = r[2], q.y1 = r[3];
   q.tile_size = a.tile_size;
   q.scale = a.scale;
-  q.density = density.density;
+  q.density = densities[0]->density;
   q.mode = parse_mode(a.mode);
   const auto t0 = std::chrono::steady_clock::now();
+  // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;
-  tools::query_all(
-      tiles, q, points,
-      kCommandLineNames);  // origin 0: positions are world coordinates, the same bits in any query
+  std::vector<std::uint8_t> classes;
+  const bool classed = !a.classes.empty();
+  if (classed) {
+    ClassQueryParams cq;
+    cq.query = q;
+    cq.class_count = static_cast<std::uint32_t>(densities.size());
+    for (std::size_t k = 0; k < densities.size(); ++k) cq.classes[k] = densities[k]->density;
+    tools::query_all(tiles, cq, points, classes, kCommandLineNames);
+  } else {
+    tools::query_all(tiles, q, points, kCommandLineNames);
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   char line[200];
   std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
@@ -89,14 +117,16 @@ void run_query_command(const QueryArgs& a) {
   const bool csv = ends_with(a.output, ".csv"), json = ends_with(a.output, ".json");
   if (csv || json) {
     std::string error;
-    if (!tools::write_text_file_atomic(a.output, points_with_ids(points, tiles, r, a.normalised, json),
-                                       error))
+    if (!tools::write_text_file_atomic(
+            a.output, points_with_ids(points, classed ? &classes : nullptr, tiles, r, a.normalised, json),
+            error))
       throw CommandError(error);
   } else {
     // .txt is the UTK/psa format, [0, 1) by definition; pictures show the rectangle.
     for (QueryPoint& p : points) p.x -= r[0], p.y -= r[1];
     tools::DrawStyle style;
     style.aspect = (r[2] - r[0]) / (r[3] - r[1]);
+    if (classed) style.classes = &classes, style.inks = tools::class_inks(densities.size());
     tools::write_points(a.output, tools::normalise_to_rect(points, r),
                         {line, "coordinates normalised to the rect"}, style);
   }
@@ -110,11 +140,19 @@ void add_query_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("query", "Points of a world rectangle from a tile set (the runtime)");
   cmd->add_option("--tileset", a->tileset, "Tile-set file (default: the built-in set)");
   cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 in world units (half-open)")->required();
+  CLI::Option* density =
+      cmd->add_option(
+             "--density", a->density,
+             "const:V (V >= 0), an image (dark = dense), or a test map ramp:R or radial:R (dynamic range "
+             "R), stretched over --density-rect")
+          ->capture_default_str();
   cmd->add_option(
-         "--density", a->density,
-         "const:V (V >= 0), an image (dark = dense), or a test map ramp:R or radial:R (dynamic range "
-         "R), stretched over --density-rect")
-      ->capture_default_str();
+         "--class", a->classes,
+         "Several classes in one query (instead of --density): repeat it, one density each, the "
+         "first given first place (largest objects first), up to 8; every point gets a class "
+         "(a class column in .csv/.json, a colour in pictures, a group per class in .svg); by default "
+         "one class, --density")
+      ->take_all();
   cmd->add_option(
       "--density-rect", a->density_rect,
       "World rectangle x0,y0,x1,y1 the image or test map covers (default: --rect); fix it to query parts of "
@@ -130,11 +168,12 @@ void add_query_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--normalised", a->normalised,
                 ".csv/.json coordinates in [0, 1) of --rect instead of world units");
-  cmd->add_option("-o,--output", a->output,
-                  "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level), .txt (UTK format, "
-                  "normalised to the rect), .svg or .png")
+  cmd->add_option(
+         "-o,--output", a->output,
+         "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level[, class]), .txt (UTK format, "
+         "normalised to the rect), .svg or .png")
       ->required();
-  cmd->callback([a] { run_query_command(*a); });
+  cmd->callback([a, density] { run_query_command(*a, density->count() > 0); });
 }
 
 }  // namespace kdm::cli

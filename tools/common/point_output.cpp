@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <string>
 
@@ -21,7 +22,25 @@ double auto_radius(const PointSet& points, double width_px, double height_px) {
   return std::max(0.5, 0.25 * spacing);
 }
 
+std::string hex(const Ink& ink) {
+  char text[8];
+  std::snprintf(text, sizeof text, "#%02x%02x%02x", ink.rgb[0], ink.rgb[1], ink.rgb[2]);
+  return text;
+}
+
 }  // namespace
+
+std::vector<Ink> class_inks(std::size_t count) {
+  static constexpr std::uint8_t kColours[8][3] = {{0, 0, 0},     {214, 39, 40},  {31, 119, 180},
+                                                  {44, 160, 44}, {255, 127, 14}, {148, 103, 189},
+                                                  {140, 86, 75}, {227, 119, 194}};
+  std::vector<Ink> inks(std::min<std::size_t>(count, 8));
+  for (std::size_t k = 0; k < inks.size(); ++k) {
+    std::copy(kColours[k], kColours[k] + 3, inks[k].rgb);
+    inks[k].name = "class-" + std::to_string(k);
+  }
+  return inks;
+}
 
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
                   const DrawStyle& style) {
@@ -41,11 +60,18 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     throw std::invalid_argument("a picture of " + std::to_string(w) + "x" + std::to_string(h) +
                                 " pixels is too large (limit 2^28 pixels); lower the width");
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
+  const bool classed = style.classes != nullptr;
+  if (classed && style.classes->size() != points.size())
+    throw std::invalid_argument("a picture's classes do not match its points");
+  std::vector<Ink> inks = style.inks.empty() ? class_inks(1) : style.inks;
+  if (classed)
+    for (std::uint8_t c : *style.classes)
+      if (c >= inks.size()) throw std::invalid_argument("a point's class has no ink");
   if (png) {
     RgbImage image(w, h, 255);
-    const std::uint8_t ink[3] = {0, 0, 0};
     for (std::size_t i = 0; i < points.size(); ++i)
-      draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, r, ink);
+      draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, r,
+                inks[classed ? (*style.classes)[i] : 0].rgb);
     if (!write_png(path, image, error)) throw std::runtime_error(error);
     return;
   }
@@ -53,12 +79,17 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
       << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
   for (const std::string& line : header) out << "<!-- " << line << " -->\n";
-  out << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<g fill=\"black\">\n";
+  out << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   out.precision(6);
-  for (std::size_t i = 0; i < points.size(); ++i)
-    out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h
-        << "\" r=\"" << r << "\"/>\n";
-  out << "</g>\n</svg>\n";
+  for (std::size_t k = 0; k < (classed ? inks.size() : 1); ++k) {
+    out << "<g id=\"" << (classed ? inks[k].name : "points") << "\" fill=\"" << hex(inks[k]) << "\">\n";
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (!classed || (*style.classes)[i] == k)
+        out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h
+            << "\" r=\"" << r << "\"/>\n";
+    out << "</g>\n";
+  }
+  out << "</svg>\n";
   if (!write_text_file_atomic(path, out.str(), error)) throw std::runtime_error(error);
 }
 

@@ -1,6 +1,7 @@
 // Writing point sets in the formats kdm offers: .txt (UTK/psa), .csv, .svg and .png.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -8,10 +9,23 @@
 
 namespace kdm::tools {
 
+/// A class's colour in pictures, and its name (an SVG group's id: one layer per pen on a plotter).
+struct Ink {
+  std::uint8_t rgb[3] = {0, 0, 0};
+  std::string name;
+};
+
+/// Distinct inks for `count` classes (at most 8), named class-0, class-1, …: black first, then colours.
+std::vector<Ink> class_inks(std::size_t count);
+
 struct DrawStyle {
   int width_px = 1024;       ///< PNG width; height follows the aspect ratio
   double dot_radius_px = 0;  ///< 0 = automatic from the point count
   double aspect = 1;         ///< width / height of the domain
+  /// Optional: every point's class, drawn in inks[class] (SVG: a group per class, in class order); null
+  /// draws every point black.
+  const std::vector<std::uint8_t>* classes = nullptr;
+  std::vector<Ink> inks;
 };
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.

@@ -28,8 +28,11 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
   return text;
 }
 
-void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
-               const ParameterNames& names) {
+namespace {
+
+/// Runs `step` (one call of a query into out[from, from + room)) until the region is complete.
+template <class Step>
+void collect(std::vector<QueryPoint>& out, const ParameterNames& names, Step&& step) {
   out.clear();
   QueryCursor cursor;
   for (;;) {
@@ -37,14 +40,38 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
     out.resize(before + (std::size_t(1) << 16));
     std::size_t written = 0;
     QueryProblem problem;
-    const Status s =
-        query_points(tileset, params, out.data() + before, out.size() - before, &written, &cursor, &problem);
+    const Status s = step(before, out.size() - before, &written, &cursor, &problem);
     out.resize(before + written);
     if (out.size() > kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
       throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
     if (s == Status::kOk) return;
     if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
   }
+}
+
+}  // namespace
+
+void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
+               const ParameterNames& names) {
+  collect(out, names,
+          [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+              QueryProblem* problem) {
+            return query_points(tileset, params, out.data() + from, room, written, cursor, problem);
+          });
+}
+
+void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
+               std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+  classes.clear();
+  collect(out, names,
+          [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+              QueryProblem* problem) {
+            classes.resize(from + room);
+            const Status s = query_classes(tileset, params, out.data() + from, classes.data() + from, room,
+                                           written, cursor, problem);
+            classes.resize(from + *written);
+            return s;
+          });
 }
 
 PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]) {

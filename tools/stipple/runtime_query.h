@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
 #include "point_io.h"
 
@@ -28,6 +30,9 @@ std::string describe(const QueryProblem& problem, const ParameterNames& names = 
 /// on bad parameters, std::runtime_error when more than kMaxCollectedPoints points would be emitted.
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names = {});
+/// The same for several classes: `classes` (replaced) receives each point's class.
+void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
+               std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
 
 /// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
 /// point set normalised to it: [0, 1) on both axes.
