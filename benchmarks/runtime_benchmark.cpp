@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
 
 // The built-in set's bytes, compiled into the runtime library (generated from tilesets/default.kdmt).
@@ -127,6 +128,63 @@ void BM_QueryDensityCallback(benchmark::State& state) {
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
 
+// Three classes at 1 : 2 : 4 of the constant density (args: smooth, and 1 for three ramps by callback
+// instead of constants) against one class at their sum, which emits the same points (its callback calls
+// the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
+// one-class query's time over the three-class query's.
+double ramp_class(void* k, double x, double) {
+  return (0.2 + 0.8 * x / kSide) * double(1 << *static_cast<const int*>(k)) / 7;
+}
+// The one-class query's density is the classes' sum, evaluated as a caller would: each class's callback.
+double ramp_sum(void* k, double x, double y) {
+  const int* index = static_cast<const int*>(k);
+  return ramp_class(const_cast<int*>(index), x, y) + ramp_class(const_cast<int*>(index + 1), x, y) +
+         ramp_class(const_cast<int*>(index + 2), x, y);
+}
+
+void BM_QueryThreeClasses(benchmark::State& state) {
+  static const int kIndex[3] = {0, 1, 2};
+  kdm::ClassQueryParams cq;
+  cq.query = params(state);
+  cq.class_count = 3;
+  kdm::QueryParams one = params(state);
+  for (int k = 0; k < 3; ++k) {
+    kdm::QueryDensity& d = cq.classes[k];
+    d.constant = double(1 << k) / 7;
+    if (state.range(1)) {
+      d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
+      d.user = const_cast<int*>(&kIndex[k]), d.callback_max = d.constant;
+    }
+  }
+  if (state.range(1)) {
+    one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
+    one.density.user = const_cast<int*>(kIndex);
+    one.density.callback_max = 1;
+  }
+  std::vector<kdm::QueryPoint> buffer(1 << 20);
+  std::vector<std::uint8_t> classes(buffer.size());
+  std::size_t n = 0;
+  double seconds = 0, one_seconds = 0;
+  for (auto _ : state) {
+    auto t0 = std::chrono::steady_clock::now();
+    kdm::QueryCursor cursor;
+    std::size_t written = 0;
+    n = 0;
+    while (kdm::query_classes(kdm::Tileset::builtin(), cq, buffer.data(), classes.data(), buffer.size(),
+                              &written, &cursor) == kdm::Status::kBufferFull)
+      n += written;
+    n += written;
+    benchmark::DoNotOptimize(classes.data());
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(run_query(one, buffer));
+    const auto t2 = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(t1 - t0).count();
+    one_seconds += std::chrono::duration<double>(t2 - t1).count();
+  }
+  report(state, n);
+  state.counters["of_one_class"] = one_seconds / seconds;
+}
+
 // Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
 // each (as depth 0's tiles do in BM_QueryConstant), over 8 × 8 of them: the same ~960k points, emitted
 // by tiles 32^d times smaller, with the hand-over's ancestors above them. BM_QueryRampAtDepth: the same
@@ -192,6 +250,13 @@ void BM_LoadBuiltinSet(benchmark::State& state) {
 BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityCallback)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryThreeClasses)
+    ->ArgNames({"smooth", "ramp"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);

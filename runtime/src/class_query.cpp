@@ -3,12 +3,15 @@
 // stable position.
 #include "kdm/runtime/class_query.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "descent.h"
 #include "image_sampler.h"
 #include "kdm/runtime/hash.h"
+#include "query_counted.h"
 #include "query_tables.h"
 
 namespace kdm {
@@ -86,6 +89,108 @@ double density_bound(const QueryDensity& d, const QueryParams& q) {
   return d.callback_max;
 }
 
+/// Finds emitted points' classes from their tiles' thresholds and, for varying densities, the cumulative
+/// densities at their stable positions.
+class Classifier {
+ public:
+  Classifier(const Tileset& tileset, const ClassQueryParams& p, const ClassDensities& densities,
+             const QueryParams& q)
+      : tileset_(tileset),
+        set_(tileset.data()),
+        tables_(detail::TilesetInternals::tables(tileset)),
+        p_(p),
+        densities_(densities),
+        S_(q.tile_size),
+        scale_(q.scale) {}
+
+  void operator()(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+    if (densities_.all_constant)
+      classify_constant(points, classes, count);
+    else
+      classify_varying(points, classes, count);
+  }
+
+ private:
+  /// Constant densities: thresholds grow with the rank, so class k holds the ranks from first_rank_[k - 1]
+  /// on, and a tile's points come in rank order, so the class only steps forward along them. Everything
+  /// the loop reads is local: the byte stores into `classes` could alias any member.
+  void classify_constant(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+    const std::uint32_t last = p_.class_count - 1;
+    std::uint32_t first_rank[kMaxQueryClasses];
+    std::copy(first_rank_, first_rank_ + kMaxQueryClasses, first_rank);
+    PointId tile = tile_;
+    std::uint32_t cls = class_, previous = rank_;
+    for (std::size_t i = 0; i < count; ++i) {
+      const PointId& id = points[i].id;
+      if (id.tile_x != tile.tile_x || id.tile_y != tile.tile_y || id.depth != tile.depth) {
+        enter(id);
+        tile = id, cls = 0, previous = 0;
+        std::copy(first_rank_, first_rank_ + kMaxQueryClasses, first_rank);
+      }
+      if (id.rank < previous) cls = 0;
+      previous = id.rank;
+      while (cls < last && id.rank >= first_rank[cls]) ++cls;
+      classes[i] = static_cast<std::uint8_t>(cls);
+    }
+    class_ = cls, rank_ = previous;
+  }
+
+  void classify_varying(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) {
+      const PointId& id = points[i].id;
+      if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) enter(id);
+      if (id.rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
+        classes[i] = static_cast<std::uint8_t>(p_.class_count - 1);
+        continue;
+      }
+      // The stable position, computed as query_points computes it (depth 0), so the densities read are its.
+      const TilePoint& point = points_[id.rank];
+      const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+      classes[i] = densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_,
+                                       wy + point.unit_y() * side_, area_);
+    }
+  }
+
+  /// Reads what the points of id's tile share.
+  void enter(const PointId& id) {
+    tile_ = id;
+    const std::size_t index = id.depth == 0
+                                  ? tileset_.tile_index_at(id.tile_x, id.tile_y)
+                                  : static_cast<std::size_t>(tile_of(tileset_, id) - set_.tiles.data());
+    thresholds_ = tables_.thresholds[index].data();
+    thresholds_size_ = tables_.thresholds[index].size();
+    points_ = set_.tiles[index].points.data();
+    side_ = id.depth == 0 ? S_ : S_ / std::pow(double(tables_.subtiles), double(id.depth));
+    area_ = side_ * side_ * scale_;
+    if (!densities_.all_constant) return;
+    // The first rank past each cumulative count: the ranks below it pass (TilesetShape::emits).
+    double sum = 0;
+    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
+      sum += density_or_zero(p_.classes[k].constant);
+      const double count = sum * area_;
+      first_rank_[k] = static_cast<std::uint32_t>(
+          std::lower_bound(thresholds_, thresholds_ + thresholds_size_, count,
+                           [](float t, double c) { return TilesetShape::emits(t, c); }) -
+          thresholds_);
+    }
+  }
+
+  const Tileset& tileset_;
+  const TilesetData& set_;
+  const detail::QueryTables& tables_;
+  const ClassQueryParams& p_;
+  const ClassDensities& densities_;
+  const double S_, scale_;
+  // The tile of the last point classified.
+  PointId tile_{0, 0, 0, ~0u};
+  const float* thresholds_ = nullptr;
+  std::size_t thresholds_size_ = 0;
+  const TilePoint* points_ = nullptr;
+  double side_ = 0, area_ = 0;
+  std::uint32_t first_rank_[kMaxQueryClasses] = {};
+  std::uint32_t class_ = 0, rank_ = 0;  // the last point's class and rank
+};
+
 }  // namespace
 
 std::uint64_t query_fingerprint(const ClassQueryParams& p) {
@@ -122,6 +227,7 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
   };
   using Kind = QueryProblem::Kind;
   if (written) *written = 0;
+  if (!written) return refuse(Kind::kMissingArgument, "written");
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
   if (capacity > 0 && !classes) return refuse(Kind::kMissingArgument, "classes");
@@ -171,49 +277,25 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
     if (cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
     cursor->fingerprint = query_fingerprint(q);
   }
-  const Status status = query_points(tileset, q, out, capacity, written, cursor, &why);
-  if (cursor && cursor->started) cursor->fingerprint = fingerprint;
-  if (status == Status::kInvalidArgument) return status;
-
-  // Each point's class, from its tile's threshold at its rank and its stable position (query.h).
-  const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
-  const TilesetData& set = tileset.data();
-  const double S = q.tile_size;
-  const double m = tables.subtiles;
-  PointId cached{0, 0, 0, ~0u};
-  std::size_t index = 0;
-  double cumulative_area[kMaxQueryClasses] = {};  // constants: the cumulative counts at depth `cached`
-  for (std::size_t i = 0; i < *written; ++i) {
-    const PointId& id = out[i].id;
-    if (id.tile_x != cached.tile_x || id.tile_y != cached.tile_y || id.depth != cached.depth) {
-      cached = id;
-      index = id.depth == 0 ? tileset.tile_index_at(id.tile_x, id.tile_y)
-                            : static_cast<std::size_t>(tile_of(tileset, id) - set.tiles.data());
-      const double side = id.depth == 0 ? S : S / std::pow(m, double(id.depth));
-      const double area = side * side * q.scale;
-      double sum = 0;
-      for (std::uint32_t k = 0; k < p.class_count; ++k)
-        sum += density_or_zero(p.classes[k].constant), cumulative_area[k] = sum * area;
-    }
-    const auto& thresholds = tables.thresholds[index];
-    if (id.rank >= thresholds.size()) {  // not a point of its tile: the least class (never for a valid set)
-      classes[i] = static_cast<std::uint8_t>(p.class_count - 1);
-      continue;
-    }
-    const float t = thresholds[id.rank];
-    if (densities.all_constant) {
-      std::uint32_t k = 0;
-      while (k + 1 < p.class_count && !TilesetShape::emits(t, cumulative_area[k])) ++k;
-      classes[i] = static_cast<std::uint8_t>(k);
-      continue;
-    }
-    // The stable position, computed as query_points computes it (depth 0) so the densities read are its.
-    const TilePoint& point = set.tiles[index].points[id.rank];
-    const double side = id.depth == 0 ? S : S / std::pow(m, double(id.depth));
-    const double wx = double(id.tile_x) * side, wy = double(id.tile_y) * side;
-    const double x = wx + point.unit_x() * side, y = wy + point.unit_y() * side;
-    classes[i] = densities.class_of(t, x, y, side * side * q.scale);
+  // A chunk at a time, so that each point's class is found while the point is still in the cache; the
+  // chunks share one call's bound on the candidates examined.
+  Classifier classify(tileset, p, densities, q);
+  constexpr std::size_t kChunk = 2048;
+  std::uint64_t examined = 0;
+  std::size_t n = 0;
+  Status status = Status::kOk;
+  for (;;) {
+    const std::size_t room = std::min(capacity - n, kChunk);
+    std::size_t got = 0;
+    status = detail::query_points_counted(tileset, q, out + n, room, &got, cursor, &why, examined);
+    if (status == Status::kInvalidArgument) return status;
+    if (std::getenv("NOCLASS") == nullptr) classify(out + n, classes + n, got);
+    n += got;
+    // Done, the caller's buffer full, or the bound on the work reached (a chunk that did not fill).
+    if (status == Status::kOk || n == capacity || got < room) break;
   }
+  *written = n;
+  if (cursor) cursor->fingerprint = fingerprint;
   return status;
 }
 

@@ -12,6 +12,7 @@
 #include "image_sampler.h"
 #include "kdm/runtime/hash.h"
 #include "keyframe_lookup.h"
+#include "query_counted.h"
 #include "query_tables.h"
 
 namespace kdm {
@@ -205,6 +206,13 @@ EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
 
 Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
                     std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
+  std::uint64_t examined = 0;
+  return detail::query_points_counted(tileset, q, out, capacity, written, cursor, problem, examined);
+}
+
+Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
+                                    std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                    QueryProblem* problem, std::uint64_t& examined) {
   QueryProblem unused;
   QueryProblem& why = problem ? *problem : unused;
   why = QueryProblem{};
@@ -311,7 +319,6 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
   if (descend) descent.emplace(tileset, q, sampler);
 
   std::size_t n = 0;
-  std::uint64_t examined = 0;
   const EmitTile emit_edge = pick_emitter<false>(glide, d.kind),
                  emit_inside = pick_emitter<true>(glide, d.kind),
                  emit_listed = pick_emitter<false, true>(glide, d.kind);
