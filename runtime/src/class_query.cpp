@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 
 #include "descent.h"
@@ -289,7 +288,7 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
     std::size_t got = 0;
     status = detail::query_points_counted(tileset, q, out + n, room, &got, cursor, &why, examined);
     if (status == Status::kInvalidArgument) return status;
-    if (std::getenv("NOCLASS") == nullptr) classify(out + n, classes + n, got);
+    classify(out + n, classes + n, got);
     n += got;
     // Done, the caller's buffer full, or the bound on the work reached (a chunk that did not fill).
     if (status == Status::kOk || n == capacity || got < room) break;
