@@ -32,6 +32,7 @@ class QueryResult:
     tile: npt.NDArray[np.int64]
     rank: npt.NDArray[np.uint32]
     level: npt.NDArray[np.uint32]
+    classes: Optional[npt.NDArray[np.uint8]]
     def __init__(
         self,
         points: npt.NDArray[np.void],
@@ -40,6 +41,7 @@ class QueryResult:
         rank: npt.NDArray[np.uint32],
         level: npt.NDArray[np.uint32],
         storage: Any = ...,
+        classes: Optional[npt.NDArray[np.uint8]] = ...,
     ) -> None: ...
     def __len__(self) -> int: ...
 
@@ -58,6 +60,7 @@ class Tileset:
         *,
         scale: float,
         density: Union[_Density, Callable[[float, float], float]] = ...,
+        classes: Optional[Sequence[_Density]] = ...,
         density_rect: Optional[_Rect] = ...,
         density_max: Optional[float] = ...,
         tile_size: float = ...,

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numbers
+import os
 from typing import Any, Callable, Dict, Optional, Sequence, Union
 
 import numpy as np
@@ -30,15 +31,18 @@ class QueryResult:
         (m,) uint32: the point's index in its tile, in emission order.
     level : numpy.ndarray
         (m,) uint32: the pyramid level the rank belongs to.
+    classes : numpy.ndarray or None
+        (m,) uint8: each point's class, for a query with `classes` (None otherwise).
     """
 
-    __slots__ = ("points", "xy", "tile", "rank", "level", "_storage")
+    __slots__ = ("points", "xy", "tile", "rank", "level", "classes", "_storage")
 
     def __init__(
         self, points: np.ndarray, xy: np.ndarray, tile: np.ndarray, rank: np.ndarray, level: np.ndarray,
-        storage: Any = None,
+        storage: Any = None, classes: Optional[np.ndarray] = None,
     ) -> None:
         self.points, self.xy, self.tile, self.rank, self.level = points, xy, tile, rank, level
+        self.classes = classes
         self._storage = storage  # the memory these are the first rows of (query's `out` refills it)
 
     def __len__(self) -> int:
@@ -100,7 +104,8 @@ class Tileset:
         rect: Sequence[float],
         *,
         scale: float,
-        density: Union[float, str, np.ndarray, Callable[[float, float], float], None] = 1.0,
+        density: Union[float, str, np.ndarray, Callable[[float, float], float], None] = None,
+        classes: Optional[Sequence[Union[float, str, np.ndarray]]] = None,
         density_rect: Optional[Sequence[float]] = None,
         density_max: Optional[float] = None,
         tile_size: float = 1.0,
@@ -122,7 +127,13 @@ class Tileset:
             two stretched over `density_rect` (default: `rect`; fix it to query parts of one region). Or a
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
             GIL held; an exception it raises is raised here once the query ends), which needs
-            `density_max`, a true upper bound of its values.
+            `density_max`, a true upper bound of its values. Default: 1.
+        classes : sequence of densities, optional
+            Several kinds of points in one query, instead of `density`: 1 to 8 densities (numbers, str or
+            2-D arrays as `density` takes them, not callables), highest priority first (largest objects
+            first). Every point gets a class (`classes` of the result). All classes together are the
+            points of one query at the summed density; in stable mode class 0 alone is exactly the query
+            at its own density. ``kdm query --class``.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
             info["max_points_per_tile"] where the density is highest in stable mode, or
@@ -154,6 +165,9 @@ class Tileset:
             density_rect = _checks.rect("density_rect", density_rect)
         if density_max is not None:
             density_max = _checks.number("density_max", density_max, 0.0)
+        if classes is not None:
+            return self._query_classes(rect, scale, density, classes, density_rect, density_max, tile_size,
+                                       mode, origin, gamma, invert, out)
         spec, call = None, None
         if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
             call = density
@@ -167,6 +181,32 @@ class Tileset:
             self._handle, rect, scale, spec, call, density_rect, density_max, tile_size, mode, origin,
             out._storage if out is not None else None,
         ))
+
+
+    def _query_classes(
+        self, rect: Any, scale: float, density: Any, classes: Any, density_rect: Any, density_max: Any,
+        tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any, out: Any,
+    ) -> QueryResult:
+        if density is not None:
+            raise ValueError("give either density or classes, not both")
+        if density_max is not None or out is not None:
+            raise ValueError("density_max and out do not apply to a query with classes")
+        if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
+            raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
+        if not 1 <= len(classes) <= 8:
+            raise ValueError(f"classes must hold 1 to 8 densities, got {len(classes)}")
+        specs = []
+        for k, d in enumerate(classes):
+            name = f"classes[{k}]"
+            if callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
+                raise TypeError(f"{name}: a class's density cannot be a callable")
+            if d is None:
+                raise TypeError(f"{name} must be a number, a str or a 2-D array, got None")
+            image = isinstance(d, (str, os.PathLike))
+            specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
+        *fields, labels = _kdm.query_classes(
+            self._handle, rect, scale, specs, density_rect, tile_size, mode, origin)
+        return QueryResult(*fields, classes=labels)
 
 
 def bake(recipe_text: str, *, threads: int = 0) -> Tileset:

@@ -12,8 +12,10 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bindings.h"
+#include "kdm/runtime/class_query.h"
 #include "query_density.h"
 #include "runtime_query.h"
 
@@ -218,9 +220,53 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
   return result(m, buffer, storage);
 }
 
+/// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
+/// query() returns them, then each point's class. New memory every call (no `storage`).
+py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
+                        const std::vector<const tools::DensitySpec*>& specs, std::optional<Rect> density_rect,
+                        double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+  check_rect("rect", rect);
+  if (specs.empty() || specs.size() > kMaxQueryClasses)
+    throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
+                                " densities, got " + std::to_string(specs.size()));
+  if (density_rect) check_rect("density_rect", *density_rect);
+  const Rect r = density_rect ? *density_rect : rect;
+  ClassQueryParams q;
+  q.query.x0 = rect[0], q.query.y0 = rect[1], q.query.x1 = rect[2], q.query.y1 = rect[3];
+  q.query.origin_x = origin[0], q.query.origin_y = origin[1];
+  q.query.tile_size = tile_size;
+  q.query.scale = scale;
+  q.query.mode = parse_mode(mode);
+  q.class_count = static_cast<std::uint32_t>(specs.size());
+  std::vector<std::unique_ptr<SpecDensity>> densities;
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    if (!specs[k]) throw std::invalid_argument("classes[" + std::to_string(k) + "] is not a density");
+    densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
+    q.classes[k] = densities.back()->density;
+  }
+  std::vector<QueryPoint> points;
+  std::vector<std::uint8_t> classes;
+  Buffer buffer;
+  {
+    py::gil_scoped_release release;
+    tools::query_all(*handle.set, q, points, classes, tools::ParameterNames{"scale=", "tile_size="});
+    buffer.reserve(std::max<std::size_t>(points.size(), 1), 0);
+    std::copy(points.begin(), points.end(), buffer.points);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      buffer.levels[i] = tile_of(*handle.set, points[i].id)->level_of(points[i].id.rank);
+  }
+  py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(classes.size()));
+  std::copy(classes.begin(), classes.end(), labels.mutable_data());
+  const py::tuple base = result(points.size(), buffer, py::none());
+  return py::make_tuple(base[0], base[1], base[2], base[3], base[4], base[5], labels);
+}
+
 }  // namespace
 
 void bind_query(py::module_& m) {
+  m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("specs"),
+        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        "several classes in one query: query()'s tuple and each point's class");
   m.def(
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
       py::arg("callable").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),

@@ -233,3 +233,41 @@ def test_smooth_queries_descend_past_the_top_level(handover_tileset):
     assert r.level.max() < info["levels"]
     with pytest.raises(ValueError, match="scale"):
         handover_tileset.query((0, 0, 0.1, 0.1), scale=scale, mode="stable")
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_classes_in_one_query(cli, tmp_path, mode):
+    # The same bits and classes as `kdm query --class`; the union is the one-class query at the sum, and
+    # in stable mode class 0 is the one-class query at its own density.
+    rect = (0.0, 0.0, 3.0, 2.0)
+    r = BUILTIN.query(rect, scale=150, classes=[1.0, 2.0, "ramp:4"], mode=mode)
+    assert r.classes.dtype == np.uint8 and len(r.classes) == len(r) > 1000
+    assert set(np.unique(r.classes)) == {0, 1, 2}
+    out = tmp_path / "c.csv"
+    cli("query", "--rect", "0,0,3,2", "--scale", 150, "--mode", mode, "--class", "const:1", "--class",
+        "const:2", "--class", "ramp:4", "-o", out)
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.array_equal(rows[:, :2], r.xy) and np.array_equal(rows[:, 6], r.classes)
+    constants = BUILTIN.query(rect, scale=150, classes=[1.0, 2.0, 4.0], mode=mode)
+    assert same(constants, BUILTIN.query(rect, scale=150, density=7.0, mode=mode))
+    if mode == "stable":
+        zero = constants.classes == 0
+        alone = BUILTIN.query(rect, scale=150, density=1.0)
+        assert same((constants.xy[zero], constants.tile[zero], constants.rank[zero]),
+                    (alone.xy, alone.tile, alone.rank))
+
+
+def test_classes_refuse_bad_input():
+    rect = (0.0, 0.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="1 to 8"):
+        BUILTIN.query(rect, scale=10, classes=[])
+    with pytest.raises(ValueError, match="1 to 8"):
+        BUILTIN.query(rect, scale=10, classes=[1.0] * 9)
+    with pytest.raises(ValueError, match="not both"):
+        BUILTIN.query(rect, scale=10, density=1.0, classes=[1.0])
+    with pytest.raises(TypeError, match="callable"):
+        BUILTIN.query(rect, scale=10, classes=[1.0, lambda x, y: 1.0])
+    with pytest.raises(ValueError, match=r"classes\[1\]"):
+        BUILTIN.query(rect, scale=10, classes=[1.0, -2.0])
+    with pytest.raises(ValueError, match="scale="):
+        BUILTIN.query(rect, scale=1e9, classes=[1.0, 1.0])
