@@ -56,6 +56,37 @@ TEST(PointFiles, CsvRoundTrip) {
 
 // Coordinates are written as printf's %.17g, so they read back exactly and the files stay byte for byte
 // what earlier versions wrote.
+// Labelled points: "x,y,class" CSV round trips, kdm query's CSV reads as x, y (and class), and bad classes
+// are refused by line.
+TEST(PointFiles, LabelledPointsRoundTripAndQueryCsvReads) {
+  tools::PointSet set = testing::uniform_set(50, 3);
+  for (std::size_t i = 0; i < set.size(); ++i) set.classes.push_back(static_cast<std::uint8_t>(i % 3));
+  const std::string path = ::testing::TempDir() + "kdm_analysis_labelled.csv";
+  std::string error;
+  ASSERT_TRUE(tools::write_point_set(path, set, {}, error)) << error;
+  std::vector<tools::PointSet> sets;
+  ASSERT_TRUE(tools::read_point_sets(path, sets, error)) << error;
+  ASSERT_EQ(sets.size(), 1u);
+  EXPECT_EQ(sets[0].coords, set.coords);
+  EXPECT_EQ(sets[0].classes, set.classes);
+  EXPECT_FALSE(tools::write_point_set(::testing::TempDir() + "kdm_analysis_labelled.txt", set, {}, error));
+  EXPECT_NE(error.find(".csv"), std::string::npos);
+  ASSERT_TRUE(tools::read_point_sets(
+      write_temp("query.csv",
+                 "x,y,tile_x,tile_y,rank,level,class\n0.25,0.5,0,0,3,0,2\n0.75,0.125,1,0,0,0,0\n"),
+      sets, error))
+      << error;
+  EXPECT_EQ(sets[0].coords, (std::vector<double>{0.25, 0.5, 0.75, 0.125}));
+  EXPECT_EQ(sets[0].classes, (std::vector<std::uint8_t>{2, 0}));
+  ASSERT_TRUE(tools::read_point_sets(
+      write_temp("query1.csv", "x,y,tile_x,tile_y,rank,level\n0.25,0.5,0,0,3,0\n"), sets, error));
+  EXPECT_TRUE(sets[0].classes.empty());
+  EXPECT_NE(read_error("x,y,class\n0.1,0.2,1.5\n", "half.csv").find(":2: a class must be an integer"),
+            std::string::npos);
+  EXPECT_NE(read_error("x,y,class\n0.1,0.2,256\n", "big.csv").find("0 to 255"), std::string::npos);
+  EXPECT_NE(read_error("x,y,class\n0.1,0.2\n", "short.csv").find("expected 3 columns"), std::string::npos);
+}
+
 TEST(PointFiles, WritesSeventeenSignificantDigits) {
   tools::PointSet s;
   s.dim = 2;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "kdm/analysis/classes.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/nearest_neighbour.h"
 #include "test_sets.h"
@@ -42,6 +43,32 @@ TEST(NearestNeighbour, CellListMatchesBruteForce) {
   brute_force_check(3, false, 500, 4);
   brute_force_check(2, true, 5, 5);  // grid of one cell: wrap-around visits it repeatedly
   brute_force_check(3, false, 3, 6);
+}
+
+// The closest pair of different classes, against brute force, on the torus and in the box, with classes
+// of very different sizes (one class of 5 points among 2,000).
+TEST(NearestNeighbour, CrossClassClosestPairMatchesBruteForce) {
+  for (bool torus : {false, true})
+    for (int rare : {0, 1}) {
+      tools::PointSet s = uniform_set(2000, 11 + rare);
+      for (std::size_t i = 0; i < s.size(); ++i)
+        s.classes.push_back(static_cast<std::uint8_t>(rare ? (i % 400 == 0) : i % 3));
+      double best = HUGE_VAL;
+      for (std::size_t i = 0; i < s.size(); ++i)
+        for (std::size_t j = i + 1; j < s.size(); ++j) {
+          if (s.classes[i] == s.classes[j]) continue;
+          double dx = std::fabs(s.coords[2 * i] - s.coords[2 * j]),
+                 dy = std::fabs(s.coords[2 * i + 1] - s.coords[2 * j + 1]);
+          if (torus) dx = std::min(dx, 1 - dx), dy = std::min(dy, 1 - dy);
+          best = std::min(best, std::hypot(dx, dy));
+        }
+      EXPECT_DOUBLE_EQ(cross_class_closest(s, torus), best / hex_spacing(s.size())) << torus << rare;
+    }
+  tools::PointSet one = uniform_set(10, 1);
+  one.classes.assign(10, 4);
+  EXPECT_TRUE(std::isnan(cross_class_closest(one, true)));
+  one.classes.clear();
+  EXPECT_THROW(cross_class_closest(one, true), InvalidInput);
 }
 
 TEST(NearestNeighbour, TorusWrapsAroundTheEdge) {

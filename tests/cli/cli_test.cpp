@@ -617,6 +617,20 @@ TEST_F(CliTest, QueryClassesWriteAClassColumnAndOneGroupPerClass) {
   for (int k = 0; k < 9; ++k) nine += " --class const:1";
   expect_error("query" + nine + common + path("z.csv") + "'", "at most 8 classes");
   expect_error("query --class const:1 --class const:-1" + common + path("z.csv") + "'", ">= 0");
+  // kdm analyze reads the labelled .csv (normalised): each class alone, and the cross-class closest pair,
+  // which the union's spacing bounds from below (no two points of the built-in set come within 0.3 d_hex).
+  ASSERT_EQ(kdm("query --class const:1 --class const:2 --rect 0,0,3,3 --scale 150 --normalised -o '" +
+                path("n.csv") + "'")
+                .status,
+            0);
+  const Outcome analyzed = kdm("analyze '" + path("n.csv") + "' --no-energy -o '" + path("a") + "'");
+  ASSERT_EQ(analyzed.status, 0) << analyzed.err;
+  EXPECT_NE(analyzed.out.find("class 1 alone"), std::string::npos) << analyzed.out;
+  const std::string json = slurp(path("a") + "/classes.json");
+  const std::size_t at = json.find("\"cross_class_closest\": ");
+  ASSERT_NE(at, std::string::npos) << json.substr(0, 200);
+  EXPECT_GT(std::atof(json.c_str() + at + 23), 0.3);
+  EXPECT_NE(json.find("{\"class\": 1, \"metrics\": {"), std::string::npos);
 }
 
 TEST_F(CliTest, SmallFrictions) {

@@ -15,6 +15,7 @@
 #include "density_arg.h"
 #include "generator_density.h"
 #include "image_io.h"
+#include "kdm/analysis/classes.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/plots.h"
@@ -44,6 +45,47 @@ struct AnalyzeArgs {
 void save_png(const std::string& path, const tools::RgbImage& image) {
   std::string error;
   if (!tools::write_png(path, image, error)) throw CommandError(error);
+}
+
+/// Labelled points (several classes): each class alone, as the whole set was analysed (printed, and in
+/// DIR/classes.json with the closest pair of points of different classes).
+void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
+                     const gen::Density& target, const AnalyzeArgs& args, const std::filesystem::path& dir) {
+  double closest = HUGE_VAL;
+  std::vector<std::uint8_t> present;
+  for (const tools::PointSet& set : sets) {
+    if (set.classes.size() != set.size())
+      throw CommandError("every set of a labelled file needs its classes");
+    closest = std::min(closest, analysis::cross_class_closest(set, o.torus));
+    for (std::uint8_t k : analysis::classes_present(set))
+      if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
+  }
+  std::sort(present.begin(), present.end());
+  std::printf("\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n", present.size(),
+              closest);
+  analysis::JsonWriter number;
+  number.value(closest);  // null when no two classes meet
+  std::string json = "{\"cross_class_closest\": " + number.str() + ", \"classes\": [";
+  for (std::size_t c = 0; c < present.size(); ++c) {
+    std::vector<tools::PointSet> subsets;
+    for (const tools::PointSet& set : sets) {
+      subsets.push_back(analysis::class_subset(set, present[c]));
+      if (subsets.back().size() < 2) subsets.pop_back();
+    }
+    if (subsets.empty()) continue;
+    analysis::AnalysisReport report = analysis::analyze(subsets, o);
+    if (!args.no_energy) {
+      report.energy_per_point = tools::mean_energy_per_point(subsets, o.torus, target);
+      report.has_energy = true;
+    }
+    std::printf("\nclass %u alone:\n", unsigned(present[c]));
+    std::fputs(analysis::format_summary(report).c_str(), stdout);
+    json += std::string(c ? ", " : "") + "{\"class\": " + std::to_string(present[c]) +
+            ", \"metrics\": " + analysis::metrics_json(report, args.files) + "}";
+  }
+  json += "]}\n";
+  std::string error;
+  if (!tools::write_text_file_atomic((dir / "classes.json").string(), json, error)) throw CommandError(error);
 }
 
 void run_analyze(const AnalyzeArgs& args) {
@@ -98,6 +140,7 @@ void run_analyze(const AnalyzeArgs& args) {
     if (!tools::write_text_file_atomic((dir / "metrics.json").string(),
                                        analysis::metrics_json(report, args.files), error))
       throw CommandError(error);
+    if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
     save_png((dir / "points.png").string(), analysis::plot_points(sets.front()));
     if (report.has_spectrum) {
       save_png((dir / "spectrum.png").string(), analysis::plot_spectrum(report.spectrum));

@@ -32,9 +32,11 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
   int file_dim = 0;
   std::string line;
   int line_no = 0;
+  // Columns of a labelled CSV: which hold x, y and the class, and how many a line has.
+  int columns = 0, class_column = -1;
   auto finish_set = [&] {
     if (!current.coords.empty()) sets.push_back(current);
-    current.coords.clear();
+    current.coords.clear(), current.classes.clear();
   };
   while (std::getline(in, line)) {
     ++line_no;
@@ -49,6 +51,14 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
       std::string head = line.substr(first);
       while (!head.empty() && (head.back() == '\r' || head.back() == ' ')) head.pop_back();
       if (head == "x,y" || head == "x,y,z") continue;
+      if (head == "x,y,class") {
+        columns = 3, class_column = 2;
+        continue;
+      }
+      if (head == "x,y,tile_x,tile_y,rank,level" || head == "x,y,tile_x,tile_y,rank,level,class") {
+        columns = head.back() == 's' ? 7 : 6, class_column = columns == 7 ? 6 : -1;
+        continue;
+      }
     }
     std::vector<double> values;
     // To the line's end, not its first NUL: a NUL byte is malformed, not the end of the line.
@@ -68,6 +78,22 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
       values.push_back(v);
       p = end;
       while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') ++p;
+    }
+    if (columns) {  // a labelled or query CSV: x, y and the class
+      if (static_cast<int>(values.size()) != columns) {
+        error = path + ":" + std::to_string(line_no) + ": expected " + std::to_string(columns) +
+                " columns, found " + std::to_string(values.size());
+        return false;
+      }
+      if (class_column >= 0) {
+        const double c = values[class_column];
+        if (!(c >= 0 && c <= 255 && c == std::floor(c))) {
+          error = path + ":" + std::to_string(line_no) + ": a class must be an integer 0 to 255";
+          return false;
+        }
+        current.classes.push_back(static_cast<std::uint8_t>(c));
+      }
+      values.resize(2);
     }
     const int dim = static_cast<int>(values.size());
     if (dim != 2 && dim != 3) {
@@ -95,13 +121,18 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
                      std::string& error) {
   const bool csv = ends_with(path, ".csv");
+  const bool labelled = !set.classes.empty();
+  if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
+    error = "'" + path + "': points with classes are written as .csv (x,y,class)";
+    return false;
+  }
   // One string grown once, numbers by to_chars (printf's %.17g, as `ostream << double` at precision 17
   // wrote them): at 262,144 points a string stream doubling its buffer took a third of the page faults of
   // a whole `kdm sample` run on our VM.
   std::string out;
   out.reserve(64 + header.size() * 80 + set.coords.size() * 25);
   if (csv) {
-    out += set.dim == 3 ? "x,y,z\n" : "x,y\n";
+    out += set.dim == 3 ? "x,y,z\n" : labelled ? "x,y,class\n" : "x,y\n";
   } else {
     for (const std::string& h : header) out += "# " + h + '\n';
   }
@@ -114,6 +145,7 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
                                          std::chars_format::general, 17);
       out.append(number, written.ptr);
     }
+    if (labelled) out += ',' + std::to_string(set.classes[i]);
     out += '\n';
   }
   return write_text_file_atomic(path, out, error);

@@ -1,19 +1,24 @@
 // Point-set text files as UTK and psa read and write them: '#' lines are comments, and a '#' line that
 // follows points separates one set from the next; every other line holds D coordinates in [0, 1)
 // (separated by blanks or commas; a first line "x,y" or "x,y,z" — the CSV header we write — is skipped).
+// Labelled points (several classes) are CSV files whose header is "x,y,class", or `kdm query`'s CSV
+// ("x,y,tile_x,tile_y,rank,level", with ",class" for several classes), of which x, y and class are read.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <istream>
 #include <string>
 #include <vector>
 
 namespace kdm::tools {
 
-/// One point set: `dim` coordinates per point, interleaved (x0 y0 x1 y1 ...).
+/// One point set: `dim` coordinates per point, interleaved (x0 y0 x1 y1 ...), and for labelled 2D points
+/// (several classes) each point's class.
 struct PointSet {
   int dim = 2;
   std::vector<double> coords;
+  std::vector<std::uint8_t> classes;  ///< empty, or one class (0 … 255) per point
   std::size_t size() const { return dim > 0 ? coords.size() / dim : 0; }
 };
 
@@ -26,7 +31,8 @@ bool read_point_sets(std::istream& in, const std::string& name, std::vector<Poin
                      std::string& error);
 
 /// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
-/// or as CSV when `path` ends in ".csv". Atomic (temporary file, then rename).
+/// or as CSV when `path` ends in ".csv" (with a class column for labelled points, which only CSV carries:
+/// false with `error` for a labelled set and another format). Atomic (temporary file, then rename).
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
                      std::string& error);
 

@@ -1,0 +1,74 @@
+#include "kdm/analysis/classes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "kdm/analysis/common.h"
+
+namespace kdm::analysis {
+
+std::vector<std::uint8_t> classes_present(const tools::PointSet& set) {
+  std::vector<std::uint8_t> present(set.classes);
+  std::sort(present.begin(), present.end());
+  present.erase(std::unique(present.begin(), present.end()), present.end());
+  return present;
+}
+
+tools::PointSet class_subset(const tools::PointSet& set, std::uint8_t k) {
+  tools::PointSet subset;
+  subset.dim = set.dim;
+  for (std::size_t i = 0; i < set.classes.size(); ++i)
+    if (set.classes[i] == k)
+      subset.coords.insert(subset.coords.end(), set.coords.begin() + i * set.dim,
+                           set.coords.begin() + (i + 1) * set.dim);
+  return subset;
+}
+
+double cross_class_closest(const tools::PointSet& set, bool torus) {
+  const std::size_t n = set.size();
+  if (set.dim != 2 || set.classes.size() != n)
+    throw InvalidInput("the cross-class closest pair needs 2D points with a class each");
+  if (classes_present(set).size() < 2) return std::numeric_limits<double>::quiet_NaN();
+  // Cells about two spacings wide; each point looks through rings of cells around its own until the ring
+  // lies farther than the closest pair found so far.
+  const double spacing = hex_spacing(n);
+  const int cells = std::clamp(static_cast<int>(1 / (2 * spacing)), 1, 4096);
+  const double h = 1.0 / cells;
+  auto cell_of = [&](double v) { return std::min(cells - 1, std::max(0, static_cast<int>(v * cells))); };
+  std::vector<std::size_t> start(std::size_t(cells) * cells + 1, 0), order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    ++start[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i]) + 1];
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    order[fill[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i])]++] = i;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = set.coords[2 * i], y = set.coords[2 * i + 1];
+    const int cx = cell_of(x), cy = cell_of(y);
+    for (int ring = 0; ring <= cells && (ring - 1) * h < best; ++ring)
+      for (int dy = -ring; dy <= ring; ++dy)
+        for (int dx = -ring; dx <= ring; ++dx) {
+          if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
+          int gx = cx + dx, gy = cy + dy;
+          if (torus) {
+            if (ring > cells / 2) continue;  // every cell is already within reach on the torus
+            gx = (gx % cells + cells) % cells, gy = (gy % cells + cells) % cells;
+          } else if (gx < 0 || gy < 0 || gx >= cells || gy >= cells) {
+            continue;
+          }
+          const std::size_t c = std::size_t(gy) * cells + gx;
+          for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
+            const std::size_t j = order[k];
+            if (set.classes[j] == set.classes[i]) continue;
+            double ddx = std::fabs(set.coords[2 * j] - x), ddy = std::fabs(set.coords[2 * j + 1] - y);
+            if (torus) ddx = std::min(ddx, 1 - ddx), ddy = std::min(ddy, 1 - ddy);
+            best = std::min(best, std::hypot(ddx, ddy));
+          }
+        }
+  }
+  return best / spacing;
+}
+
+}  // namespace kdm::analysis
