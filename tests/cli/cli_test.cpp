@@ -633,6 +633,42 @@ TEST_F(CliTest, QueryClassesWriteAClassColumnAndOneGroupPerClass) {
   EXPECT_NE(json.find("{\"class\": 1, \"metrics\": {"), std::string::npos);
 }
 
+// kdm stipple --colours: one class per ink, an SVG group per ink, a class column in .csv; a grey picture
+// needs black alone; bad schemes and formats that cannot carry inks are refused.
+TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
+  const std::string coffee = "'" + std::string(KDM_SOURCE_DIR) + "/examples/coffee.png'";
+  const std::string sphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  ASSERT_EQ(kdm("stipple " + coffee + " --colours cmyk --points 8000 -o '" + path("c.svg") + "'").status, 0);
+  const std::string svg = slurp(path("c.svg"));
+  for (const char* ink : {"black", "cyan", "magenta", "yellow"})
+    EXPECT_NE(svg.find("<g id=\"" + std::string(ink) + "\""), std::string::npos) << ink;
+  ASSERT_EQ(kdm("stipple " + sphere + " --colours cmyk -o '" + path("s.svg") + "'").status, 0);
+  const std::string grey = slurp(path("s.svg"));
+  EXPECT_NE(grey.find("<g id=\"black\""), std::string::npos);
+  EXPECT_EQ(grey.find("<g id=\"cyan\""), std::string::npos);  // a grey picture has no colour to separate
+  ASSERT_EQ(kdm("stipple " + coffee + " --colours 3 --points 8000 -o '" + path("c.csv") + "'").status, 0);
+  std::istringstream in(slurp(path("c.csv")));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,y,class");
+  std::size_t counts[3] = {}, rows = 0;
+  while (std::getline(in, line)) {
+    const int k = std::atoi(line.c_str() + line.rfind(',') + 1);
+    ASSERT_TRUE(k >= 0 && k < 3) << line;
+    ++counts[k], ++rows;
+  }
+  EXPECT_NEAR(double(rows), 8000, 80);  // the dots of all inks together
+  for (std::size_t c : counts) EXPECT_GT(c, 100u);
+  ASSERT_EQ(kdm("stipple " + coffee + " --colours rgb --points 2000 -o '" + path("rgb.svg") + "'").status, 0);
+  EXPECT_NE(slurp(path("rgb.svg")).find("fill=\"#000000\"/>"), std::string::npos);  // black paper
+  expect_error("stipple " + coffee + " --colours 9 -o '" + path("x.png") + "'", "from 2 to 8");
+  expect_error("stipple " + coffee + " --colours cmy -o '" + path("x.png") + "'", "cmyk, rgb");
+  expect_error("stipple " + coffee + " --colours cmyk -o '" + path("x.txt") + "'", ".csv");
+  expect_error("stipple " + coffee + " --colours cmyk --method full -o '" + path("x.png") + "'",
+               "--method tiles");
+  expect_error("stipple " + coffee + " --colours cmyk --invert -o '" + path("x.png") + "'", "--invert");
+}
+
 TEST_F(CliTest, SmallFrictions) {
   expect_error("analyze '" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt' -o '" +
                    path("metrics.json") + "'",

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "colour_separation.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "full_stippler.h"
@@ -20,7 +21,7 @@ namespace kdm::cli {
 namespace {
 
 struct StippleArgs {
-  std::string image, output, method = "tiles", region, tileset, mode = "smooth";
+  std::string image, output, method = "tiles", region, tileset, mode = "smooth", colours;
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0;
   bool invert = false;
@@ -55,12 +56,30 @@ void run_stipple(const StippleArgs& a) {
   if (a.frames > 0 && a.region.empty()) throw CommandError("--frames needs --region (where the zoom ends)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
-  const tools::DensitySpec spec = parse_density(a.image, a.gamma, a.invert);
+  // One ink (the image's darkness), or with --colours the image separated into several.
+  tools::ColourSeparation inks;
+  if (a.colours.empty()) {
+    inks.channels.push_back(parse_density(a.image, a.gamma, a.invert));
+    inks.inks = tools::class_inks(1);
+  } else {
+    if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
+    tools::ColourImage image;
+    std::string error;
+    if (!tools::load_colour_image(a.image, image, error)) throw CommandError(error);
+    try {
+      inks = tools::separate_colours(image, a.colours, a.gamma);
+    } catch (const std::invalid_argument& e) {
+      throw CommandError(e.what());
+    }
+  }
+  const tools::DensitySpec& spec = inks.channels.front();
   if (spec.kind != tools::DensitySpec::Kind::kImage)
     throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
-  if (!(spec.max_value() > 0))
+  if (!(spec.max_value() > 0) && a.colours.empty())
     throw CommandError("image '" + a.image + "' has no ink: nothing to stipple" +
                        (a.invert ? "" : " (an all-white image has no ink)"));
+  const bool coloured = !a.colours.empty();
+  if (coloured && a.method == "full") throw CommandError("--colours needs --method tiles");
   const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
@@ -73,9 +92,12 @@ void run_stipple(const StippleArgs& a) {
           tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
-  if (a.method != "full")
+  if (a.method != "full") {
+    std::vector<const tools::DensitySpec*> specs;
+    for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
     stippler =
-        std::make_unique<tools::TileStippler>(spec, tiles, double(a.points), a.scale, parse_mode(a.mode));
+        std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale, parse_mode(a.mode));
+  }
   const int frames = std::max(1, a.frames);
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
   for (int i = 0; i < frames; ++i) {
@@ -105,8 +127,15 @@ void run_stipple(const StippleArgs& a) {
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
+    if (coloured) {
+      if (set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left: a one-class query
+      style.classes = &set.classes, style.inks = inks.inks;
+      std::copy(inks.background, inks.background + 3, style.background);
+      style.blend = inks.blend;
+    }
     char line[200], where[160];
-    std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(), how.c_str());
+    std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s%s%s)", set.size(), how.c_str(),
+                  coloured ? ", inks " : "", coloured ? a.colours.c_str() : "");
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     tools::write_points(path, set, {line, "image " + a.image, where}, style);
@@ -147,6 +176,11 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
+  cmd->add_option("--colours", a->colours,
+                  "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
+                  "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
+                  "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
+                  "(a layer per pen), .csv an ink column (default: black dots of the image's darkness)");
   cmd->add_option("--seed", a->seed, "Random seed for --method full")->capture_default_str();
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
   cmd->add_option("--mode", a->mode,

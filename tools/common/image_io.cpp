@@ -244,10 +244,39 @@ void to_luminance(const Sample* data, int channels, float full, std::vector<floa
   }
 }
 
+// Red, green and blue in [0, 1] composited on white paper (grey images give three equal values).
+template <class Sample>
+void to_rgb(const Sample* data, int channels, float full, std::vector<float>& pixels) {
+  for (std::size_t i = 0; i < pixels.size() / 3; ++i) {
+    float p[4] = {0, 0, 0, 1};
+    for (int c = 0; c < channels; ++c) p[c] = static_cast<float>(data[i * channels + c]) / full;
+    const bool grey = channels < 3;
+    const float alpha = channels == 2 ? p[1] : channels == 4 ? p[3] : 1.0f;
+    for (int c = 0; c < 3; ++c)
+      pixels[3 * i + c] = std::clamp((grey ? p[0] : p[c]) * alpha + (1.0f - alpha), 0.0f, 1.0f);
+  }
+}
+
+template <class Sample>
+void convert(const Sample* data, int channels, float full, GreyImage& image) {
+  to_luminance(data, channels, full, image.pixels);
+}
+template <class Sample>
+void convert(const Sample* data, int channels, float full, ColourImage& image) {
+  to_rgb(data, channels, full, image.pixels);
+}
+constexpr std::size_t channels_of(const GreyImage&) {
+  return 1;
+}
+constexpr std::size_t channels_of(const ColourImage&) {
+  return 3;
+}
+
 // Both loaders end here, with the image file's bytes: the known faults of stb refused, then the header
 // read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
-bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& name, std::uint64_t max_pixels,
-               GreyImage& out, std::string& error) {
+template <class Image>
+bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& name,
+                std::uint64_t max_pixels, Image& out, std::string& error) {
   if (size == 0) {
     error = "cannot read image '" + name + "': the file is empty";
     return false;
@@ -279,7 +308,7 @@ bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& n
     return false;
   }
   int lw = 0, lh = 0, channels = 0;
-  GreyImage image;
+  Image image;
   // The decoder must return the header's size, so that the limit holds for what is kept.
   auto decoded = [&](const void* data) {
     if (!data) {
@@ -290,7 +319,7 @@ bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& n
       error = "cannot read image '" + name + "': its header and its pixels disagree";
       return false;
     }
-    image.pixels.resize(pixels);
+    image.pixels.resize(pixels * channels_of(image));
     return true;
   };
   if (stbi_is_16_bit_from_memory(bytes, length)) {
@@ -303,12 +332,12 @@ bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& n
       for (std::size_t i = 0; i < pixels * channels; ++i)
         data.get()[i] =
             static_cast<stbi_us>(bytes[pnm.pixels_at + 2 * i] << 8 | bytes[pnm.pixels_at + 2 * i + 1]);
-    to_luminance(data.get(), channels, 65535.0f, image.pixels);
+    convert(data.get(), channels, 65535.0f, image);
   } else {
     std::unique_ptr<stbi_uc, void (*)(void*)> data(
         stbi_load_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
-    to_luminance(data.get(), channels, 255.0f, image.pixels);
+    convert(data.get(), channels, 255.0f, image);
   }
   image.width = w;
   image.height = h;
@@ -318,7 +347,10 @@ bool load_grey(const std::uint8_t* bytes, std::size_t size, const std::string& n
 
 }  // namespace
 
-bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels) {
+namespace {
+
+template <class Image>
+bool load_image_file(const std::string& path, Image& out, std::string& error, std::uint64_t max_pixels) {
   // Read whole, once: the checks and the decoder see the same bytes, whatever happens to the file.
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) {
@@ -346,12 +378,23 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
-  return load_grey(bytes.data(), bytes.size(), path, max_pixels, out, error);
+  return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error);
+}
+
+}  // namespace
+
+bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels) {
+  return load_image_file(path, out, error, max_pixels);
+}
+
+bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
+                       std::uint64_t max_pixels) {
+  return load_image_file(path, out, error, max_pixels);
 }
 
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
                             const std::string& name, std::uint64_t max_pixels) {
-  return load_grey(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error);
+  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error);
 }
 
 bool write_png(const std::string& path, const RgbImage& image, std::string& error) {
@@ -368,7 +411,7 @@ bool write_png(const std::string& path, const RgbImage& image, std::string& erro
   return commit_temp(tmp, path, error);
 }
 
-void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3]) {
+void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode) {
   // Coverage by distance to the edge, one pixel of antialiasing ramp.
   const int x0 = std::max(0, static_cast<int>(std::floor(cx - r - 1)));
   const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(cx + r + 1)));
@@ -380,8 +423,13 @@ void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8
       const double coverage = std::clamp(r + 0.5 - d, 0.0, 1.0);
       if (coverage <= 0) continue;
       std::uint8_t* p = &image.pixels[(static_cast<std::size_t>(y) * image.width + x) * 3];
-      for (int c = 0; c < 3; ++c)
-        p[c] = static_cast<std::uint8_t>(std::lround(p[c] + (rgb[c] - p[c]) * coverage));
+      for (int c = 0; c < 3; ++c) {
+        const double under = p[c];
+        const double ink = mode == 1   ? under * rgb[c] / 255.0
+                           : mode == 2 ? std::min(255.0, under + rgb[c])
+                                       : rgb[c];
+        p[c] = static_cast<std::uint8_t>(std::lround(under + (ink - under) * coverage));
+      }
     }
   }
 }

@@ -17,6 +17,13 @@ struct GreyImage {
   float at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
+/// A colour image: red, green and blue in [0, 1] per pixel (3 floats), row-major, row 0 at the top.
+struct ColourImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> pixels;
+};
+
 /// An 8-bit RGB image, row-major, row 0 at the top.
 struct RgbImage {
   int width = 0;
@@ -42,7 +49,11 @@ inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
 bool load_grey_image(const std::string& path, GreyImage& out, std::string& error,
                      std::uint64_t max_pixels = kMaxImagePixels);
 
-/// The same for an image file's bytes in memory; `name` stands for the file in error messages.
+/// The same as red, green and blue (alpha composited on white; a grey image gives three equal channels).
+bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
+                       std::uint64_t max_pixels = kMaxImagePixels);
+/// The same as load_grey_image for an image file's bytes in memory; `name` stands for the file in error
+/// messages.
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
                             const std::string& name = "image in memory",
                             std::uint64_t max_pixels = kMaxImagePixels);
@@ -50,8 +61,9 @@ bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, 
 /// Writes `image` as PNG atomically (temporary file, then rename). Returns false with `error` set on failure.
 bool write_png(const std::string& path, const RgbImage& image, std::string& error);
 
-/// Draws an antialiased filled disc of radius `r` pixels centred at (cx, cy) (pixel units, y down).
-void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3]);
+/// Draws an antialiased filled disc of radius `r` pixels centred at (cx, cy) (pixel units, y down): painted
+/// over what is there, or with `mode` 1 multiplied into it (inks on paper), 2 added to it (light).
+void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode = 0);
 
 /// Writes `text` to `path` atomically (temporary file, then rename).
 bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error);

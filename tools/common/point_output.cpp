@@ -69,9 +69,10 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
       if (c >= inks.size()) throw std::invalid_argument("a point's class has no ink");
   if (png) {
     RgbImage image(w, h, 255);
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = style.background[i % 3];
     for (std::size_t i = 0; i < points.size(); ++i)
       draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, r,
-                inks[classed ? (*style.classes)[i] : 0].rgb);
+                inks[classed ? (*style.classes)[i] : 0].rgb, static_cast<int>(style.blend));
     if (!write_png(path, image, error)) throw std::runtime_error(error);
     return;
   }
@@ -79,10 +80,16 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
       << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
   for (const std::string& line : header) out << "<!-- " << line << " -->\n";
-  out << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  Ink paper;
+  std::copy(style.background, style.background + 3, paper.rgb);
+  out << "<rect width=\"100%\" height=\"100%\" fill=\"" << hex(paper) << "\"/>\n";
   out.precision(6);
   for (std::size_t k = 0; k < (classed ? inks.size() : 1); ++k) {
-    out << "<g id=\"" << (classed ? inks[k].name : "points") << "\" fill=\"" << hex(inks[k]) << "\">\n";
+    const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
+                        : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
+                                                        : "";
+    out << "<g id=\"" << (classed ? inks[k].name : "points") << "\" fill=\"" << hex(inks[k]) << "\"" << blend
+        << ">\n";
     for (std::size_t i = 0; i < points.size(); ++i)
       if (!classed || (*style.classes)[i] == k)
         out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h

@@ -18,6 +18,10 @@ struct Ink {
 /// Distinct inks for `count` classes (at most 8), named class-0, class-1, …: black first, then colours.
 std::vector<Ink> class_inks(std::size_t count);
 
+/// How a dot's ink meets what is under it: painted over, multiplied (inks on paper: overlapping cyan and
+/// yellow make green) or added (light on black).
+enum class Blend { kOver, kMultiply, kAdd };
+
 struct DrawStyle {
   int width_px = 1024;       ///< PNG width; height follows the aspect ratio
   double dot_radius_px = 0;  ///< 0 = automatic from the point count
@@ -26,6 +30,8 @@ struct DrawStyle {
   /// draws every point black.
   const std::vector<std::uint8_t>* classes = nullptr;
   std::vector<Ink> inks;
+  std::uint8_t background[3] = {255, 255, 255};  ///< the paper
+  Blend blend = Blend::kOver;
 };
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.

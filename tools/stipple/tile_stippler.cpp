@@ -34,20 +34,36 @@ std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMo
 
 TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale,
                            QueryMode mode)
+    : TileStippler(std::vector<const DensitySpec*>{&spec}, tileset, points, scale, mode) {}
+
+TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
+                           double scale, QueryMode mode)
     : tiles_(tileset), mode_(mode) {
-  if (spec.kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
-  if (!(spec.max_value() > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
+  if (inks.empty() || inks.size() > kMaxQueryClasses)
+    throw std::invalid_argument("stippling takes 1 to 8 inks, got " + std::to_string(inks.size()));
+  const DensitySpec& first = *inks.front();
+  double mean = 0;
+  std::vector<double> sum(first.values.size(), 0.0);  // the inks' summed density per pixel
+  for (const DensitySpec* spec : inks) {
+    if (spec->kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
+    if (spec->width != first.width || spec->height != first.height)
+      throw std::invalid_argument("the inks' images differ in size");
+    mean += spec->mean_value();
+    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += spec->values[i];
+  }
+  const double peak = sum.empty() ? 0.0 : *std::max_element(sum.begin(), sum.end());
+  if (!(peak > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
   if (!(points > 0 || scale > 0)) throw std::invalid_argument("give a number of dots > 0 or a scale > 0");
-  aspect_ = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
+  aspect_ = double(first.width) / first.height;  // world: [0, aspect] × [0, 1]
   const double world[4] = {0, 0, aspect_, 1};
-  density_ = std::make_unique<SpecDensity>(spec, world);
+  for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
-  scale_ = points > 0 ? points / (spec.mean_value() * aspect_) : scale;
+  scale_ = points > 0 ? points / (mean * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
   // (past it, smooth mode descends into subtiles). The tile size depends on the whole image only, so
   // every region and frame sees the same dots.
-  tile_size_ = std::sqrt(tiles_.max_points_per_tile() /
-                         (kStippleZoomRoom * kStippleZoomRoom * scale_ * spec.max_value()));
+  tile_size_ =
+      std::sqrt(tiles_.max_points_per_tile() / (kStippleZoomRoom * kStippleZoomRoom * scale_ * peak));
 }
 
 PointSet TileStippler::render(const double uv[4]) const {
@@ -59,12 +75,23 @@ PointSet TileStippler::render(const double uv[4]) const {
   q.origin_x = q.x0, q.origin_y = q.y0;
   q.tile_size = tile_size_;
   q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
-  q.density = density_->density;
+  q.density = densities_.front()->density;
   q.mode = mode_;
   std::vector<QueryPoint> points;
-  query_all(tiles_, q, points);
+  std::vector<std::uint8_t> classes;
+  if (densities_.size() == 1) {
+    query_all(tiles_, q, points);
+  } else {
+    ClassQueryParams cq;
+    cq.query = q;
+    cq.class_count = static_cast<std::uint32_t>(densities_.size());
+    for (std::size_t k = 0; k < densities_.size(); ++k) cq.classes[k] = densities_[k]->density;
+    query_all(tiles_, cq, points, classes);
+  }
   const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
-  return normalise_to_rect(points, rect);
+  PointSet set = normalise_to_rect(points, rect);
+  set.classes = std::move(classes);
+  return set;
 }
 
 }  // namespace kdm::tools

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "density_spec.h"
 #include "kdm/runtime/query.h"
@@ -34,6 +35,10 @@ class TileStippler {
   /// height. `points` dots over the whole image (> 0), or, when points is 0, `scale` dots per unit area at
   /// full darkness. `tileset` must outlive the stippler; so must `spec`. Throws std::invalid_argument.
   TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode);
+  /// Several inks (1 … kMaxQueryClasses images of one size, highest priority first): `points` and `scale`
+  /// count the dots of all of them, and render() gives each dot its ink's class.
+  TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
+               double scale, QueryMode mode);
   /// The dots of the UV rectangle `uv` (x0, y0, x1, y1 in [0, 1]², y up), normalised to it: [0, 1)².
   /// Throws std::invalid_argument when it zooms more than max_stipple_zoom, std::runtime_error when the
   /// query would emit more than 2^25 dots.
@@ -44,7 +49,7 @@ class TileStippler {
   const Tileset& tiles_;
   double aspect_ = 1, scale_ = 0, tile_size_ = 1;
   QueryMode mode_;
-  std::unique_ptr<SpecDensity> density_;  ///< the image over [0, aspect] × [0, 1]
+  std::vector<std::unique_ptr<SpecDensity>> densities_;  ///< each image over [0, aspect] × [0, 1]
 };
 
 }  // namespace kdm::tools

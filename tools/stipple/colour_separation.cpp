@@ -1,0 +1,157 @@
+#include "colour_separation.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace kdm::tools {
+namespace {
+
+/// An image-sized density with row 0 at the bottom (DensitySpec's order), filled by `value(pixel)`.
+template <class Value>
+DensitySpec channel(const ColourImage& image, double gamma, const std::string& name, Value&& value) {
+  DensitySpec spec;
+  spec.kind = DensitySpec::Kind::kImage;
+  spec.width = image.width, spec.height = image.height;
+  spec.text = name;
+  spec.values.resize(std::size_t(image.width) * image.height);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const float* rgb = &image.pixels[(std::size_t(y) * image.width + x) * 3];
+      // Below 1e-6 is rounding (the chromatic parts of a grey pixel), not ink.
+      const double raw = value(rgb), v = raw < 1e-6 ? 0.0 : std::min(raw, 1.0);
+      spec.values[std::size_t(image.height - 1 - y) * image.width + x] =
+          static_cast<float>(std::pow(v, gamma));
+    }
+  return spec;
+}
+
+Ink ink(std::uint8_t r, std::uint8_t g, std::uint8_t b, const std::string& name) {
+  Ink i;
+  i.rgb[0] = r, i.rgb[1] = g, i.rgb[2] = b;
+  i.name = name;
+  return i;
+}
+
+double luminance(const float* rgb) {
+  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+/// N colours of the image by k-means (Lloyd's iterations from a farthest-point start on a subsample, so
+/// the result depends on the image alone).
+std::vector<std::array<double, 3>> cluster_colours(const ColourImage& image, int n) {
+  const std::size_t pixels = std::size_t(image.width) * image.height;
+  const std::size_t step = std::max<std::size_t>(1, pixels / 65536);
+  std::vector<std::array<double, 3>> samples;
+  for (std::size_t i = 0; i < pixels; i += step)
+    samples.push_back({image.pixels[3 * i], image.pixels[3 * i + 1], image.pixels[3 * i + 2]});
+  auto distance = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+  };
+  // Start from the darkest sample, then each next centre the sample farthest from those chosen.
+  std::vector<std::array<double, 3>> centres = {*std::min_element(
+      samples.begin(), samples.end(),
+      [](const auto& a, const auto& b) { return a[0] + a[1] + a[2] < b[0] + b[1] + b[2]; })};
+  std::vector<double> nearest(samples.size(), HUGE_VAL);
+  while (int(centres.size()) < n) {
+    std::size_t far = 0;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      nearest[i] = std::min(nearest[i], distance(samples[i], centres.back()));
+      if (nearest[i] > nearest[far]) far = i;
+    }
+    centres.push_back(samples[far]);
+  }
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    std::vector<std::array<double, 4>> sums(centres.size(), {0, 0, 0, 0});
+    for (const auto& s : samples) {
+      std::size_t best = 0;
+      for (std::size_t c = 1; c < centres.size(); ++c)
+        if (distance(s, centres[c]) < distance(s, centres[best])) best = c;
+      for (int k = 0; k < 3; ++k) sums[best][k] += s[k];
+      sums[best][3] += 1;
+    }
+    for (std::size_t c = 0; c < centres.size(); ++c)
+      if (sums[c][3] > 0)
+        for (int k = 0; k < 3; ++k) centres[c][k] = sums[c][k] / sums[c][3];
+  }
+  // Darkest first: the inks that show most get the best-spread dots.
+  std::sort(centres.begin(), centres.end(),
+            [](const auto& a, const auto& b) { return a[0] + a[1] + a[2] < b[0] + b[1] + b[2]; });
+  return centres;
+}
+
+}  // namespace
+
+ColourSeparation separate_colours(const ColourImage& image, const std::string& scheme, double gamma) {
+  if (!(gamma > 0) || !std::isfinite(gamma)) throw std::invalid_argument("gamma must be a finite number > 0");
+  ColourSeparation s;
+  if (scheme == "cmyk") {
+    auto black = [](const float* p) { return 1.0 - std::max({double(p[0]), double(p[1]), double(p[2])}); };
+    auto part = [&](int c) {
+      return [c, black](const float* p) {
+        const double k = black(p);
+        return k >= 1 ? 0.0 : (1 - p[c] - k) / (1 - k);
+      };
+    };
+    s.channels = {channel(image, gamma, "black", black), channel(image, gamma, "cyan", part(0)),
+                  channel(image, gamma, "magenta", part(1)), channel(image, gamma, "yellow", part(2))};
+    s.inks = {ink(0, 0, 0, "black"), ink(0, 174, 239, "cyan"), ink(236, 0, 140, "magenta"),
+              ink(255, 242, 0, "yellow")};
+  } else if (scheme == "rgb") {
+    for (int c = 0; c < 3; ++c) {
+      const char* names[3] = {"red", "green", "blue"};
+      s.channels.push_back(channel(image, gamma, names[c], [c](const float* p) { return double(p[c]); }));
+    }
+    s.inks = {ink(255, 0, 0, "red"), ink(0, 255, 0, "green"), ink(0, 0, 255, "blue")};
+    std::fill(s.background, s.background + 3, 0);
+    s.blend = Blend::kAdd;
+  } else {
+    char* end = nullptr;
+    const long n = std::strtol(scheme.c_str(), &end, 10);
+    if (scheme.empty() || *end != '\0' || n < 2 || n > 8)
+      throw std::invalid_argument("--colours must be cmyk, rgb or a number of inks from 2 to 8, got '" +
+                                  scheme + "'");
+    const auto centres = cluster_colours(image, int(n));
+    for (std::size_t c = 0; c < centres.size(); ++c) {
+      s.channels.push_back(channel(image, gamma, "ink-" + std::to_string(c), [&, c](const float* p) {
+        std::size_t best = 0;
+        auto d = [&](std::size_t k) {
+          return std::pow(p[0] - centres[k][0], 2) + std::pow(p[1] - centres[k][1], 2) +
+                 std::pow(p[2] - centres[k][2], 2);
+        };
+        for (std::size_t k = 1; k < centres.size(); ++k)
+          if (d(k) < d(best)) best = k;
+        return best == c ? 1 - luminance(p) : 0.0;
+      }));
+      const auto byte = [](double v) {
+        return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
+      };
+      s.inks.push_back(
+          ink(byte(centres[c][0]), byte(centres[c][1]), byte(centres[c][2]), "ink-" + std::to_string(c)));
+    }
+  }
+  // Inks that no pixel uses would only waste a class: keep those with some coverage.
+  for (std::size_t c = s.channels.size(); c-- > 0;)
+    if (!(s.channels[c].max_value() > 0))
+      s.channels.erase(s.channels.begin() + c), s.inks.erase(s.inks.begin() + c);
+  if (s.channels.empty())
+    throw std::invalid_argument("the image has no ink in any colour: nothing to stipple");
+  // The ink that covers most of the image first: a sparse class early in the order takes the union's
+  // lowest thresholds, which repeat a motif along tile edges, and shows the tile grid as coloured lines
+  // (docs/design.md, "Several classes").
+  std::vector<std::size_t> order(s.channels.size());
+  for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return s.channels[a].mean_value() > s.channels[b].mean_value();
+  });
+  ColourSeparation sorted;
+  std::copy(s.background, s.background + 3, sorted.background);
+  sorted.blend = s.blend;
+  for (std::size_t c : order)
+    sorted.channels.push_back(std::move(s.channels[c])), sorted.inks.push_back(s.inks[c]);
+  return sorted;
+}
+
+}  // namespace kdm::tools

@@ -1,0 +1,35 @@
+// Colour stippling: an image separated into inks, each ink's coverage the density of one class of dots
+// (kdm/runtime/class_query.h), so that the dots of all inks together are one blue-noise set and each ink's
+// dots follow its channel.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "density_spec.h"
+#include "image_io.h"
+#include "point_output.h"
+
+namespace kdm::tools {
+
+/// An image separated into inks: per ink, its density (a DensitySpec of kind kImage, row 0 at the bottom)
+/// and its colour in pictures; `background` is the paper.
+struct ColourSeparation {
+  std::vector<DensitySpec> channels;
+  std::vector<Ink> inks;
+  std::uint8_t background[3] = {255, 255, 255};
+  Blend blend = Blend::kMultiply;  ///< inks on paper multiply; light on black adds
+};
+
+/// Separates `image` by `scheme`:
+/// - "cmyk": cyan, magenta, yellow and black on white paper, black by full under-colour removal
+///   (K = 1 − max(R, G, B), C = (1 − R − K) / (1 − K), …), black first (highest priority);
+/// - "rgb": red, green and blue dots on black paper, each channel's intensity its density;
+/// - "N" (2 … 8): N inks on white paper, the image's colours clustered into N (k-means, deterministic),
+///   each pixel's darkness the density of its nearest ink.
+/// Each density is the coverage raised to `gamma` (> 0); the inks come in order of decreasing mean coverage
+/// (class 0 the ink that covers most). Throws std::invalid_argument naming the problem
+/// for another scheme or an image with no ink.
+ColourSeparation separate_colours(const ColourImage& image, const std::string& scheme, double gamma);
+
+}  // namespace kdm::tools
