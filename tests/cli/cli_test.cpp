@@ -664,9 +664,40 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   expect_error("stipple " + coffee + " --colours 9 -o '" + path("x.png") + "'", "from 2 to 8");
   expect_error("stipple " + coffee + " --colours cmy -o '" + path("x.png") + "'", "cmyk, rgb");
   expect_error("stipple " + coffee + " --colours cmyk -o '" + path("x.txt") + "'", ".csv");
-  expect_error("stipple " + coffee + " --colours cmyk --method full -o '" + path("x.png") + "'",
-               "--method tiles");
+  // The full sampler's inks: every dot with its ink's class, all of them the count asked for.
+  ASSERT_EQ(
+      kdm("stipple " + coffee + " --colours cmyk --method full --points 3000 -o '" + path("f.csv") + "'")
+          .status,
+      0);
+  std::istringstream full(slurp(path("f.csv")));
+  std::getline(full, line);
+  EXPECT_EQ(line, "x,y,class");
+  std::size_t full_rows = 0, inks_seen[4] = {};
+  while (std::getline(full, line))
+    ++full_rows, ++inks_seen[std::atoi(line.c_str() + line.rfind(',') + 1) & 3];
+  EXPECT_EQ(full_rows, 3000u);
+  EXPECT_GT(inks_seen[0], inks_seen[2]);  // the ink that covers most comes first
+  EXPECT_GT(inks_seen[2], 0u);
   expect_error("stipple " + coffee + " --colours cmyk --invert -o '" + path("x.png") + "'", "--invert");
+}
+
+// kdm sample --class: exact counts per class by the densities' integrals, a class column in .csv.
+TEST_F(CliTest, SampleClassesSplitTheCountByTheDensities) {
+  ASSERT_EQ(
+      kdm("sample --n 700 --class const:1 --class const:2 --class const:4 -o '" + path("c.csv") + "'").status,
+      0);
+  std::istringstream in(slurp(path("c.csv")));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,y,class");
+  std::size_t counts[3] = {};
+  while (std::getline(in, line)) ++counts[std::atoi(line.c_str() + line.rfind(',') + 1) % 3];
+  EXPECT_EQ(counts[0], 100u);
+  EXPECT_EQ(counts[1], 200u);
+  EXPECT_EQ(counts[2], 400u);
+  expect_error("sample --n 100 --density const:1 --class const:1 -o '" + path("z.csv") + "'", "not both");
+  expect_error("sample --n 0 --resolution 64 --class const:1 -o '" + path("z.csv") + "'", "--n > 0");
+  expect_error("sample --n 100 --class const:1 -o '" + path("z.txt") + "'", ".csv");
 }
 
 TEST_F(CliTest, SmallFrictions) {

@@ -5,10 +5,12 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "density_arg.h"
 #include "generator_density.h"
+#include "kdm/generator/multiclass.h"
 #include "kdm/generator/sampler.h"
 #include "point_output.h"
 #include "progress.h"
@@ -19,7 +21,8 @@ namespace {
 struct SampleArgs {
   gen::SamplerOptions options;
   std::string density = "const:1";
-  std::string domain;  // empty: box for images and ramps, torus otherwise
+  std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
+  std::string domain;                // empty: box for images and ramps, torus otherwise
   std::string output;
   double aspect = 0;  // 0: from the image, or 1
   double gamma = 1;
@@ -30,7 +33,20 @@ struct SampleArgs {
   double dot_radius = 0;
 };
 
-void run_sample(const SampleArgs& args) {
+/// A class's density for the full sampler: as --density gives it, but a constant keeps its value (a
+/// class's share of the points follows it), as a one-texel image.
+gen::Density class_density(const tools::DensitySpec& spec) {
+  if (spec.kind != tools::DensitySpec::Kind::kConstant) return to_generator_density(spec);
+  if (spec.constant == 0) {  // a class with no points
+    gen::Density none;
+    none.function = [](const double*) { return 0.0; };
+    none.thread_safe = true;
+    return none;
+  }
+  return gen::Density::from_values(1, 1, {static_cast<float>(spec.constant)});
+}
+
+void run_sample(const SampleArgs& args, bool density_given) {
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
   if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
   if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");
@@ -39,17 +55,37 @@ void run_sample(const SampleArgs& args) {
     throw CommandError("--width must be 1 to 65536 pixels");
   if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
     throw CommandError("--dot-size must be >= 0");
-  const tools::DensitySpec spec = parse_density(args.density, args.gamma, args.invert);
-  const bool image = spec.kind == tools::DensitySpec::Kind::kImage;
+  if (density_given && !args.classes.empty())
+    throw CommandError("give either --density or --class (one per class), not both");
+  if (args.classes.size() > 8)
+    throw CommandError("--class given " + std::to_string(args.classes.size()) + " times; at most 8 classes");
+  const bool classed = !args.classes.empty();
+  if (classed && args.options.n <= 0) throw CommandError("--class needs --n > 0 (the points of all classes)");
+  std::vector<tools::DensitySpec> specs;
+  for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density})
+    specs.push_back(parse_density(text, args.gamma, args.invert));
+  bool image = false, edged = false;
+  for (const tools::DensitySpec& s : specs) {
+    image = image || s.kind == tools::DensitySpec::Kind::kImage;
+    // A ramp or a picture has edges that do not meet: a box, unless asked otherwise.
+    edged = edged || s.kind == tools::DensitySpec::Kind::kImage || s.kind == tools::DensitySpec::Kind::kRamp;
+  }
   gen::SamplerOptions o = args.options;
-  // A ramp or a picture has edges that do not meet: a box, unless asked otherwise.
-  const bool edged = image || spec.kind == tools::DensitySpec::Kind::kRamp;
   const std::string domain = args.domain.empty() ? (edged ? "box" : "torus") : args.domain;
   o.domain = domain == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
   double aspect = args.aspect;
-  if (aspect <= 0) aspect = image ? double(spec.width) / spec.height : 1.0;
+  if (aspect <= 0) {
+    aspect = 1;
+    for (const tools::DensitySpec& s : specs)
+      if (s.kind == tools::DensitySpec::Kind::kImage) {
+        aspect = double(s.width) / s.height;
+        break;
+      }
+  }
   if (image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
-  const gen::Density density = to_generator_density(spec);
+  std::vector<gen::Density> densities;
+  for (const tools::DensitySpec& s : specs)
+    densities.push_back(classed ? class_density(s) : to_generator_density(s));
   o.extent[0] = aspect;
   o.extent[1] = 1;
   o.metropolis = !args.unadjusted;
@@ -58,13 +94,25 @@ void run_sample(const SampleArgs& args) {
   ProgressBar bar("sampling");
   o.progress = [&bar](double f) { bar.update(f); };
   gen::SampleResult result;
+  tools::PointSet set;
   try {
-    result = gen::sample(o, density);
+    if (classed) {
+      gen::ClassSample labelled = gen::sample_classes(o, densities);
+      set.classes = std::move(labelled.classes);
+      result.dim = labelled.dim, result.points = std::move(labelled.points);
+      // One report for the file's header: the classes' runs summed (their acceptance and time).
+      for (const gen::SampleReport& r : labelled.reports) {
+        result.report.proposals += r.proposals, result.report.accepted += r.accepted;
+        result.report.seconds += r.seconds;
+        result.report.model_temperature = r.model_temperature, result.report.threads = r.threads;
+      }
+    } else {
+      result = gen::sample(o, densities.front());
+    }
   } catch (const gen::InvalidArgument& e) {
     throw CommandError(e.what());
   }
   bar.finish();
-  tools::PointSet set;
   set.dim = result.dim;
   set.coords = std::move(result.points);
   const gen::SampleReport& r = result.report;
@@ -74,11 +122,17 @@ void run_sample(const SampleArgs& args) {
   std::snprintf(line, sizeof line, "kdm sample: %zu points, T=%g (model %.4g), seed %llu, acceptance %.3f",
                 set.size(), o.temperature, r.model_temperature, static_cast<unsigned long long>(o.seed),
                 r.acceptance_rate());
-  std::vector<std::string> header = {line, "density " + args.density + ", domain " + domain};
+  std::string what = "density " + args.density;
+  if (classed) {
+    what = "classes";
+    for (const std::string& c : args.classes) what += " " + c;
+  }
+  std::vector<std::string> header = {line, what + ", domain " + domain};
   tools::DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;
   style.aspect = aspect;
+  if (classed) style.classes = &set.classes, style.inks = tools::class_inks(specs.size());
   tools::write_points(args.output, set, header, style);
   std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds, args.output.c_str());
   if (args.timing) {
@@ -123,6 +177,11 @@ void add_sample_command(CLI::App& app) {
                   "const:V, an image whose darkness is the density, or a test map: ramp:R (R^-x, dynamic "
                   "range R) or radial:R (R^-(2r) around the centre)")
       ->capture_default_str();
+  cmd->add_option("--class", args->classes,
+                  "Several classes (instead of --density): repeat it, one density each, highest priority "
+                  "first, up to 8; --n counts all of them, split by each density's integral; class k is "
+                  "sampled around classes 0 … k-1 at their summed density (a class column in .csv, a colour "
+                  "in pictures); by default one class, --density");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   cmd->add_option("--threads", o.threads,
@@ -148,9 +207,9 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({4, 8, 16}))
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
-                  "Output file: .txt (UTK/psa points in [0,1)), .csv, .svg or .png")
+                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,class]), .svg or .png")
       ->required();
-  cmd->callback([args] { run_sample(*args); });
+  cmd->callback([args, cmd] { run_sample(*args, cmd->get_option("--density")->count() > 0); });
 }
 
 }  // namespace kdm::cli

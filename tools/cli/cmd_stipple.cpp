@@ -79,7 +79,6 @@ void run_stipple(const StippleArgs& a) {
     throw CommandError("image '" + a.image + "' has no ink: nothing to stipple" +
                        (a.invert ? "" : " (an all-white image has no ink)"));
   const bool coloured = !a.colours.empty();
-  if (coloured && a.method == "full") throw CommandError("--colours needs --method tiles");
   const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
@@ -111,8 +110,14 @@ void run_stipple(const StippleArgs& a) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      set =
-          tools::stipple_full(spec, a.points > 0 ? a.points : std::llround(a.scale * aspect), aspect, a.seed);
+      const std::int64_t count = a.points > 0 ? a.points : std::llround(a.scale * aspect);
+      if (coloured) {
+        std::vector<const tools::DensitySpec*> specs;
+        for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
+        set = tools::stipple_full(specs, count, aspect, a.seed);
+      } else {
+        set = tools::stipple_full(spec, count, aspect, a.seed);
+      }
       how = "full KDM sampler";
     } else {
       set = stippler->render(uv);

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "kdm/generator/multiclass.h"
 #include "kdm/generator/sampler.h"
 
 namespace kdm::tools {
@@ -18,6 +19,38 @@ PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspec
   PointSet set;
   set.dim = 2;
   set.coords = gen::sample(o, gen::Density::from_values(spec.width, spec.height, spec.values)).points;
+  return set;
+}
+
+PointSet stipple_full(const std::vector<const DensitySpec*>& inks, std::int64_t points, double aspect,
+                      std::uint64_t seed, int threads) {
+  if (inks.size() == 1) {
+    PointSet set = stipple_full(*inks.front(), points, aspect, seed, threads);
+    set.classes.assign(set.size(), 0);
+    return set;
+  }
+  std::vector<gen::Density> densities;
+  for (const DensitySpec* spec : inks) {
+    if (spec->kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
+    if (spec->max_value() > 0) {
+      densities.push_back(gen::Density::from_values(spec->width, spec->height, spec->values));
+    } else {  // an ink no pixel uses: a class without points
+      densities.emplace_back();
+      densities.back().function = [](const double*) { return 0.0; };
+      densities.back().thread_safe = true;
+    }
+  }
+  gen::SamplerOptions o;
+  o.n = points;
+  o.domain = gen::Domain::kBox;
+  o.extent[0] = aspect;
+  o.seed = seed;
+  o.threads = threads;
+  gen::ClassSample sample = gen::sample_classes(o, densities);
+  PointSet set;
+  set.dim = 2;
+  set.coords = std::move(sample.points);
+  set.classes = std::move(sample.classes);
   return set;
 }
 

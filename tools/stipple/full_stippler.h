@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "density_spec.h"
 #include "point_io.h"
@@ -14,5 +15,10 @@ namespace kdm::tools {
 /// std::invalid_argument (gen::InvalidArgument) for an image with no ink or a count out of range.
 PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspect, std::uint64_t seed,
                       int threads = 0);
+
+/// The same for several inks (images of one size, highest priority first): `points` dots of all of them,
+/// each with its ink's class (gen::sample_classes).
+PointSet stipple_full(const std::vector<const DensitySpec*>& inks, std::int64_t points, double aspect,
+                      std::uint64_t seed, int threads = 0);
 
 }  // namespace kdm::tools

@@ -1,0 +1,137 @@
+// Several classes by constrained KDM sampling, one class at a time; see kdm/generator/multiclass.h.
+#include "kdm/generator/multiclass.h"
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace kdm::gen {
+namespace {
+
+/// The mean of `density` over the unit domain: an image's mean value, a function's mean over a grid of
+/// 256² (2D) or 64³ (3D) midpoints, 1 for a constant.
+double mean_of(const Density& density, int dim) {
+  if (density.image) {
+    double sum = 0;
+    for (float v : density.image->values) sum += v;
+    return sum / double(density.image->values.size());
+  }
+  if (!density.function) return 1;
+  const int side = dim == 2 ? 256 : 64;
+  double sum = 0, u[3] = {0, 0, 0};
+  std::int64_t count = 0;
+  for (int z = 0; z < (dim == 3 ? side : 1); ++z)
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x) {
+        u[0] = (x + 0.5) / side, u[1] = (y + 0.5) / side, u[2] = (z + 0.5) / side;
+        const double v = density.function(u);
+        if (!std::isfinite(v) || v < 0) throw InvalidArgument("a class's density is negative or not finite");
+        sum += v, ++count;
+      }
+  return sum / double(count);
+}
+
+std::uint64_t class_seed(std::uint64_t seed, std::size_t k) {
+  // SplitMix64 of the pair: the class runs' random streams are unrelated, and class 0 keeps `seed`.
+  if (k == 0) return seed;
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (k + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std::vector<Density>& densities,
+                                       std::int64_t n) {
+  std::vector<double> cumulative;
+  double total = 0;
+  for (const Density& d : densities) cumulative.push_back(total += mean_of(d, options.dim));
+  if (!(total > 0)) throw InvalidArgument("every class's density is zero: nothing to sample");
+  std::vector<std::int64_t> counts;
+  std::int64_t before = 0;
+  for (double c : cumulative) {
+    const auto upto = static_cast<std::int64_t>(std::llround(double(n) * c / total));
+    counts.push_back(upto - before);
+    before = upto;
+  }
+  return counts;
+}
+
+Density sum_of_densities(const std::vector<Density>& densities) {
+  bool all_constant = true, images = true;
+  int width = 0, height = 0;
+  for (const Density& d : densities) {
+    if (!d.function) continue;
+    all_constant = false;
+    if (!d.image || (width && (d.image->width != width || d.image->height != height))) images = false;
+    if (d.image) width = d.image->width, height = d.image->height;
+  }
+  if (all_constant) return Density::constant();
+  if (images) {  // one image: the sampler reads its values itself
+    std::vector<float> sum(std::size_t(width) * height, 0.0f);
+    for (const Density& d : densities)
+      for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += d.function ? d.image->values[i] : 1.0f;
+    return Density::from_values(width, height, std::move(sum));
+  }
+  Density sum;
+  sum.thread_safe = true;
+  for (const Density& d : densities) {
+    sum.thread_safe = sum.thread_safe && (d.thread_safe || !d.function);
+    for (int a = 0; a < 3; ++a)
+      sum.native_resolution[a] = std::max(sum.native_resolution[a], d.native_resolution[a]);
+  }
+  auto parts = std::make_shared<std::vector<Density>>(densities);
+  sum.function = [parts](const double* u) {
+    double s = 0;
+    for (const Density& d : *parts) s += d.function ? d.function(u) : 1.0;
+    return s;
+  };
+  return sum;
+}
+
+ClassSample sample_classes(const SamplerOptions& options, const std::vector<Density>& densities,
+                           int union_sweeps) {
+  if (union_sweeps < 0) throw InvalidArgument("union sweeps must be >= 0");
+  if (densities.empty() || densities.size() > 8)
+    throw InvalidArgument("a sample takes 1 to 8 classes, got " + std::to_string(densities.size()));
+  if (options.n <= 0) throw InvalidArgument("a sample with classes needs a point count n > 0");
+  if (!options.fixed_points.empty() || !options.initial_points.empty())
+    throw InvalidArgument("a sample with classes takes no fixed or initial points");
+  ClassSample result;
+  result.dim = options.dim;
+  result.counts = class_counts(options, densities, options.n);
+  std::vector<Density> prefix;
+  for (std::size_t k = 0; k < densities.size(); ++k) {
+    prefix.push_back(densities[k]);
+    const std::int64_t count = result.counts[k];
+    if (count == 0) continue;
+    SamplerOptions o = options;
+    o.n = count;
+    o.seed = class_seed(options.seed, k);
+    o.fixed_points = result.points;  // the earlier classes, which this one fills in around
+    if (options.progress)
+      o.progress = [&options, k, total = densities.size()](double f) {
+        options.progress((double(k) + f) / double(total));
+      };
+    SampleResult r = sample(o, prefix.size() == 1 ? prefix.front() : sum_of_densities(prefix));
+    result.points.insert(result.points.end(), r.points.begin(), r.points.end());
+    result.classes.insert(result.classes.end(), r.size(), static_cast<std::uint8_t>(k));
+    result.reports.push_back(std::move(r.report));
+  }
+  if (union_sweeps > 0 && densities.size() > 1) {  // all classes together, in their order
+    SamplerOptions o = options;
+    o.n = 0;
+    o.seed = class_seed(options.seed, densities.size());
+    o.initial_points = result.points;
+    o.sweeps = union_sweeps;
+    o.burn_in_sweeps = 0;
+    o.progress = nullptr;
+    SampleResult r = sample(o, sum_of_densities(densities));
+    result.points = std::move(r.points);
+    result.reports.push_back(std::move(r.report));
+  }
+  return result;
+}
+
+}  // namespace kdm::gen
