@@ -217,13 +217,8 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
 Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
                      std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                      QueryProblem* problem) {
-  QueryProblem unused;
-  QueryProblem& why = problem ? *problem : unused;
-  why = QueryProblem{};
-  auto refuse = [&](QueryProblem::Kind kind, const char* parameter, double value = 0, double limit = 0) {
-    why.kind = kind, why.parameter = parameter, why.value = value, why.limit = limit;
-    return Status::kInvalidArgument;
-  };
+  detail::Refusal refuse(problem);
+  QueryProblem& why = refuse.problem();
   using Kind = QueryProblem::Kind;
   if (written) *written = 0;
   if (!written) return refuse(Kind::kMissingArgument, "written");

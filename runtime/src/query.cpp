@@ -213,13 +213,8 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
 Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem, std::uint64_t& examined) {
-  QueryProblem unused;
-  QueryProblem& why = problem ? *problem : unused;
-  why = QueryProblem{};
-  auto refuse = [&](QueryProblem::Kind kind, const char* parameter, double value = 0, double limit = 0) {
-    why.kind = kind, why.parameter = parameter, why.value = value, why.limit = limit;
-    return Status::kInvalidArgument;
-  };
+  detail::Refusal refuse(problem);
+  QueryProblem& why = refuse.problem();
   using Kind = QueryProblem::Kind;
   if (written) *written = 0;
   if (!written) return refuse(Kind::kMissingArgument, "written");

@@ -9,6 +9,24 @@
 
 namespace kdm::detail {
 
+/// A query's refusals: the caller's optional QueryProblem, reset on entry and filled by a refusal.
+class Refusal {
+ public:
+  explicit Refusal(QueryProblem* problem) : why_(problem ? *problem : unused_) { why_ = QueryProblem{}; }
+  Refusal(const Refusal&) = delete;
+  Refusal& operator=(const Refusal&) = delete;
+  /// Records the problem; returns kInvalidArgument.
+  Status operator()(QueryProblem::Kind kind, const char* parameter, double value = 0, double limit = 0) {
+    why_.kind = kind, why_.parameter = parameter, why_.value = value, why_.limit = limit;
+    return Status::kInvalidArgument;
+  }
+  QueryProblem& problem() { return why_; }
+
+ private:
+  QueryProblem unused_;  // where a caller without a QueryProblem gets its answer
+  QueryProblem& why_;
+};
+
 /// query_points, counting into `examined` (on entry, what this call of the caller has examined so far):
 /// it returns kBufferFull once `examined` reaches kMaxQueryCandidates.
 Status query_points_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,

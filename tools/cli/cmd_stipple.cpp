@@ -126,7 +126,9 @@ void run_stipple(const StippleArgs& a) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (dot_radius <= 0) {
       const double full = a.points > 0 ? double(a.points) : double(set.size());
-      dot_radius = 0.25 * std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, full));
+      // Colour dots larger (0.7 of the mean spacing): inks then cover their share of the paper.
+      dot_radius = (coloured ? 0.7 : 0.25) *
+                   std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, full));
     }
     tools::DrawStyle style;
     style.width_px = a.width_px;
@@ -176,8 +178,10 @@ void add_stipple_command(CLI::App& app) {
                   "zoom, zoom-coherent; needs --method tiles; 0: one picture)")
       ->capture_default_str();
   cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
-  cmd->add_option("--dot-size", a->dot_size,
-                  "Dot radius in pixels (default: a quarter of the whole image's mean dot spacing)");
+  cmd->add_option(
+      "--dot-size", a->dot_size,
+      "Dot radius in pixels (default: a quarter of the whole image's mean dot spacing, 0.7 of it with "
+      "--colours)");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");

@@ -6,16 +6,25 @@
 #include "kdm/generator/sampler.h"
 
 namespace kdm::tools {
+namespace {
 
-PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspect, std::uint64_t seed,
-                      int threads) {
-  if (spec.kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
+/// The sampler's options for `points` dots of an image over [0, aspect] × [0, 1] in a box.
+gen::SamplerOptions stipple_options(std::int64_t points, double aspect, std::uint64_t seed, int threads) {
   gen::SamplerOptions o;
   o.n = points;
   o.domain = gen::Domain::kBox;
   o.extent[0] = aspect;
   o.seed = seed;
   o.threads = threads;
+  return o;
+}
+
+}  // namespace
+
+PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspect, std::uint64_t seed,
+                      int threads) {
+  if (spec.kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
+  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads);
   PointSet set;
   set.dim = 2;
   set.coords = gen::sample(o, gen::Density::from_values(spec.width, spec.height, spec.values)).points;
@@ -40,12 +49,7 @@ PointSet stipple_full(const std::vector<const DensitySpec*>& inks, std::int64_t 
       densities.back().thread_safe = true;
     }
   }
-  gen::SamplerOptions o;
-  o.n = points;
-  o.domain = gen::Domain::kBox;
-  o.extent[0] = aspect;
-  o.seed = seed;
-  o.threads = threads;
+  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads);
   gen::ClassSample sample = gen::sample_classes(o, densities);
   PointSet set;
   set.dim = 2;
