@@ -8,7 +8,8 @@
 //  - collecting with a buffer of 1-8 points, resuming from the cursor, gives exactly the points of one
 //    call with a large buffer, in the same order; kBufferFull only with a full buffer; a finished cursor
 //    gives no more points;
-//  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B)).
+//  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
+//  - query_classes with the density and an empty class (two halves of a constant) gives the same points.
 // A failed check aborts.
 #include <algorithm>
 #include <cfloat>
@@ -20,6 +21,7 @@
 #include <tuple>
 #include <vector>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
 
 namespace {
@@ -212,6 +214,29 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (kdm::query_points(kdm::Tileset::builtin(), q, small, capacity, &written, &cursor) != kdm::Status::kOk ||
       written != 0)
     fail();
+
+  // Two classes: the density and nothing (a constant density: two halves) give the same points, each
+  // with a class that exists.
+  {
+    kdm::ClassQueryParams cq;
+    cq.query = q;
+    cq.class_count = 2;
+    cq.classes[0] = q.density;
+    cq.classes[1].constant = 0;
+    if (kind == 0 && value / 2 + value / 2 == value)  // exact halves
+      cq.classes[0].constant = cq.classes[1].constant = value / 2;
+    static Points classed;
+    static std::uint8_t classes[kBigCapacity];
+    kdm::QueryCursor class_cursor;
+    classed.status = kdm::query_classes(kdm::Tileset::builtin(), cq, classed.data, classes, kBigCapacity,
+                                        &classed.size, &class_cursor);
+    if (classed.status == kdm::Status::kInvalidArgument) fail();  // the one-class query accepted these
+    if (classed.status == kdm::Status::kOk) {
+      if (classed.size != all.size) fail();
+      for (std::size_t i = 0; i < all.size; ++i)
+        if (!same(classed[i], all[i]) || classes[i] > (kind == 0 ? 1 : 0)) fail();
+    }
+  }
 
   // Split at x = xm: both halves are accepted (their density bounds are no higher), and together they
   // hold exactly the region's points.
