@@ -264,9 +264,9 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
 }  // namespace
 
 void bind_query(py::module_& m) {
-  m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("specs"),
-        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-        "several classes in one query: query()'s tuple and each point's class");
+  m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
+        py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
+        py::arg("origin"), "several classes in one query: query()'s tuple and each point's class");
   m.def(
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
       py::arg("callable").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),
