@@ -234,6 +234,35 @@ void BM_BaselineWriteSamePoints(benchmark::State& state) {
   report(state, n);
 }
 
+// The same count written as 16-byte records (float position, 64-bit id) into a reused 65,536-record
+// buffer, and BM_QueryConstant's stable query into a reused 65,536-point one: the bound of a compact
+// output, against the query as callers that keep no points use it.
+struct CompactRecord {
+  float x, y;
+  std::uint64_t id;
+};
+
+void BM_BaselineWriteCompact(benchmark::State& state) {
+  std::vector<kdm::QueryPoint> points(1 << 20);
+  const std::size_t n = run_query(params(), points);
+  std::vector<CompactRecord> buffer(1 << 16);
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < n; ++i) {
+      CompactRecord& r = buffer[i & (buffer.size() - 1)];
+      r.x = float(i), r.y = float(i), r.id = i;
+    }
+    benchmark::ClobberMemory();
+  }
+  report(state, n);
+}
+
+void BM_QueryConstantReusedBuffer(benchmark::State& state) {
+  std::vector<kdm::QueryPoint> buffer(1 << 16);
+  std::size_t n = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(n = run_query(params(), buffer));
+  report(state, n);
+}
+
 // What the first Tileset::builtin() costs: decoding the built-in set's bytes (checksums, zstd, parsing,
 // validation, emission thresholds). Each iteration loads them afresh.
 void BM_LoadBuiltinSet(benchmark::State& state) {
@@ -260,5 +289,7 @@ BENCHMARK(BM_QueryThreeClasses)
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BaselineWriteCompact)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryConstantReusedBuffer)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
