@@ -130,6 +130,8 @@ def point_files():
     write("point_file", "two_sets.txt", "# kdm sample\n0.1 0.2\n0.3 0.4\n#\n0.5 0.6\n\n0.7,0.8\r\n")
     write("point_file", "header.csv", "x,y,z\n0.25,0.5,0.75\n1e-3,0x1p-2,.5\n")
     write("point_file", "bad.txt", "0.1 0.2\n0.3\n")
+    write("point_file", "classes.csv", "x,y,class\n0.1,0.2,0\n0.3,0.4,2\n")
+    write("point_file", "query.csv", "x,y,tile_x,tile_y,rank,level,class\n0.5,0.25,0,0,3,0,1\n")
 
 
 def crashes():
