@@ -88,7 +88,8 @@ def stipple(
     width: int = ...,
     dot_size: Optional[float] = ...,
     threads: int = ...,
-) -> npt.NDArray[np.float64]: ...
+    colours: Union[str, int, None] = ...,
+) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],
     *,

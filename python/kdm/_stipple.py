@@ -1,6 +1,7 @@
 """kdm.stipple: an image as dots, as `kdm stipple` draws it (one picture; no zoom sequence)."""
 from __future__ import annotations
 
+import numbers
 import os
 from typing import Any, Optional, Sequence
 
@@ -26,7 +27,8 @@ def stipple(
     width: int = 1024,
     dot_size: Optional[float] = None,
     threads: int = 0,
-) -> np.ndarray:
+    colours: Any = None,
+) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
     Parameters
@@ -59,11 +61,17 @@ def stipple(
         image's mean dot spacing).
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
+    colours : {"cmyk", "rgb"}, int or None
+        A colour stipple of an image file (``kdm stipple --colours``): "cmyk" (black by under-colour
+        removal), "rgb" (light on black) or a number of inks, 2 to 8, clustered from the image; one class
+        of dots per ink, all of them one blue-noise set.
 
     Returns
     -------
-    numpy.ndarray
-        (m, 2) float64: the dots normalised to the rendered image or region, [0, 1) on both axes, y up.
+    numpy.ndarray, or with `colours` a tuple (dots, classes, inks)
+        dots: (m, 2) float64, normalised to the rendered image or region, [0, 1) on both axes, y up;
+        classes: (m,) uint8, each dot's ink; inks: the inks' names, in class order (the ink that covers
+        most first).
     """
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     invert = _checks.flag("invert", invert)
@@ -93,7 +101,17 @@ def stipple(
     width = _checks.integer("width", width, 1, 65536)
     dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)
     threads = _checks.threads(threads)
+    if colours is not None:
+        if label == "array":
+            raise ValueError("colours needs an image file (an array holds luminance only)")
+        if invert:
+            raise ValueError("invert does not apply to colours (each ink has its own channel)")
+        if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
+            colours = str(int(colours))
+        if not isinstance(colours, str):
+            raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
-        spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads
+        spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
+        colours, gamma,
     )

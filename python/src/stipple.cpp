@@ -7,9 +7,12 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bindings.h"
+#include "colour_separation.h"
 #include "full_stippler.h"
+#include "image_io.h"
 #include "point_output.h"
 #include "tile_stippler.h"
 
@@ -19,10 +22,11 @@ namespace {
 using tools::DensitySpec;
 using Region = std::array<double, 4>;
 
-py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, std::int64_t points,
-                            double scale, const std::string& method, const std::string& mode,
-                            std::optional<Region> region, std::uint64_t seed, const TilesetHandle* tileset,
-                            std::optional<std::string> output, int width, double dot_size, int threads) {
+py::object stipple(const DensitySpec& spec, const std::string& label, std::int64_t points, double scale,
+                   const std::string& method, const std::string& mode, std::optional<Region> region,
+                   std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
+                   int width, double dot_size, int threads, std::optional<std::string> colours,
+                   double gamma) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -38,6 +42,17 @@ py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, s
   if (!(spec.max_value() > 0))
     throw std::invalid_argument("image '" + label + "' has no ink: nothing to stipple" +
                                 (spec.inverted ? "" : " (an all-white image has no ink)"));
+  // With `colours`, the image file separated into inks, one class of dots each (kdm stipple --colours).
+  tools::ColourSeparation inks;
+  std::vector<const DensitySpec*> specs = {&spec};
+  if (colours) {
+    tools::ColourImage image;
+    std::string error;
+    if (!tools::load_colour_image(label, image, error)) throw FileError(error);
+    inks = tools::separate_colours(image, *colours, gamma);
+    specs.clear();
+    for (const DensitySpec& channel : inks.channels) specs.push_back(&channel);
+  }
   const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
   Region uv = {0, 0, 1, 1};
   if (region) {
@@ -59,21 +74,29 @@ py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, s
   {
     py::gil_scoped_release release;
     const Tileset& tiles = given ? *given : Tileset::builtin();
+    const std::int64_t count = points > 0 ? points : std::llround(scale * aspect);
     if (method == "full") {
-      set = tools::stipple_full(spec, points > 0 ? points : std::llround(scale * aspect), aspect, seed,
-                                threads);
+      set = colours ? tools::stipple_full(specs, count, aspect, seed, threads)
+                    : tools::stipple_full(spec, count, aspect, seed, threads);
     } else {
-      const tools::TileStippler stippler(spec, tiles, double(points), scale, query_mode);
+      const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode);
       set = stippler.render(uv.data());
     }
+    if (colours && set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left
     if (output) {
-      // Dots a quarter of the whole image's mean spacing, as kdm stipple draws them.
+      // Dots a quarter of the whole image's mean spacing (0.7 in colour), as kdm stipple draws them.
       const double full = points > 0 ? double(points) : double(set.size());
       tools::DrawStyle style;
       style.width_px = width;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px =
-          dot_size > 0 ? dot_size : 0.25 * std::sqrt(double(width) * (width / aspect) / std::max(1.0, full));
+          dot_size > 0
+              ? dot_size
+              : (colours ? 0.7 : 0.25) * std::sqrt(double(width) * (width / aspect) / std::max(1.0, full));
+      if (colours) {
+        style.classes = &set.classes, style.inks = inks.inks, style.blend = inks.blend;
+        std::copy(inks.background, inks.background + 3, style.background);
+      }
       char line[200], where[160];
       std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(),
                     method == "full" ? "full KDM sampler" : "runtime tiles");
@@ -88,7 +111,11 @@ py::array_t<double> stipple(const DensitySpec& spec, const std::string& label, s
     }
   }
   const auto count = static_cast<py::ssize_t>(set.size());
-  return owning_array(std::move(set.coords), {count, py::ssize_t(2)});
+  py::array_t<double> dots = owning_array(std::move(set.coords), {count, py::ssize_t(2)});
+  if (!colours) return std::move(dots);
+  py::list names;
+  for (const tools::Ink& ink : inks.inks) names.append(ink.name);
+  return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names);
 }
 
 }  // namespace
@@ -97,7 +124,8 @@ void bind_stipple(py::module_& m) {
   m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
         py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
-        py::arg("threads"), "One picture of kdm stipple");
+        py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"),
+        "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 
 }  // namespace kdm::python

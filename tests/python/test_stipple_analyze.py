@@ -2,6 +2,7 @@
 import json
 
 import numpy as np
+import pytest
 
 import kdm
 from conftest import SPHERE, read_txt
@@ -99,3 +100,22 @@ def test_analyze_options_and_several_sets(gradient_png):
     rng = np.random.default_rng(0)
     assert kdm.analyze(rng.random((2000, 2)), energy=False)["nearest_neighbour"]["dmin"] < 0.2
     assert kdm.analyze(kdm.sample(2000), energy=False)["nearest_neighbour"]["dmin"] > 0.4
+
+
+def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
+    # The same dots and inks as `kdm stipple --colours cmyk`, each ink a class, all of them the dots asked.
+    coffee = SPHERE.parent / "coffee.png"
+    cli("stipple", coffee, "--colours", "cmyk", "--points", 5000, "-o", tmp_path / "cli.csv")
+    dots, classes, inks = kdm.stipple(str(coffee), points=5000, colours="cmyk", output=tmp_path / "py.svg")
+    rows = np.loadtxt(tmp_path / "cli.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(rows[:, :2], dots) and np.array_equal(rows[:, 2], classes)
+    assert classes.dtype == np.uint8 and len(inks) == 4 and set(inks) == {"cyan", "magenta", "yellow", "black"}
+    assert '<g id="%s"' % inks[0] in (tmp_path / "py.svg").read_text()
+    full = kdm.stipple(str(coffee), points=2000, colours=3, method="full", threads=1)
+    assert len(full[0]) == 2000 and set(np.unique(full[1])) <= {0, 1, 2}
+    with pytest.raises(ValueError, match="cmyk, rgb"):
+        kdm.stipple(str(coffee), colours="cmy")
+    with pytest.raises(ValueError, match="invert"):
+        kdm.stipple(str(coffee), colours="rgb", invert=True)
+    with pytest.raises(ValueError, match="image file"):
+        kdm.stipple(np.ones((4, 4)) * 0.5, colours="cmyk")
