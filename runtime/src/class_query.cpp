@@ -73,15 +73,13 @@ double sum_of_densities(void* user, double x, double y) {
 }
 
 /// An upper bound of class `d`'s density wherever a point that can show in the region is decided: the
-/// region, or in smooth mode (whose points glide in from outside it) the whole image.
-double density_bound(const QueryDensity& d, const QueryParams& q) {
+/// region widened by `reach` (world units; in smooth mode points glide in from outside it).
+double density_bound(const QueryDensity& d, const QueryParams& q, double reach) {
   switch (d.kind) {
     case QueryDensity::Kind::kConstant:
       return density_or_zero(d.constant);
     case QueryDensity::Kind::kImage:
-      if (q.mode == QueryMode::kSmooth)
-        return d.image->max_over(d.image->x0, d.image->y0, d.image->x1, d.image->y1);
-      return d.image->max_over(q.x0, q.y0, q.x1, q.y1);
+      return d.image->max_over(q.x0 - reach, q.y0 - reach, q.x1 + reach, q.y1 + reach);
     case QueryDensity::Kind::kCallback:
       break;
   }
@@ -260,9 +258,20 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
     q.density.kind = QueryDensity::Kind::kCallback;
     q.density.callback = sum_of_densities;
     q.density.user = &densities;
+    // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
+    double reach = 0;
+    if (q.mode == QueryMode::kSmooth && tileset.has_glide_track()) {
+      const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
+      for (std::size_t g = 0; g < tables.glide_reach.size(); ++g)
+        reach = std::max(reach, tables.glide_reach[g]);
+      reach = (std::max(reach, tables.descent_reach) + 2.0 / 65536.0) * q.tile_size;
+    }
     q.density.callback_max = 0;
-    for (std::uint32_t k = 0; k < p.class_count; ++k)
-      q.density.callback_max += density_bound(p.classes[k], q);
+    // Bounds of a region query_points will accept (it refuses the others, with their names, below).
+    const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
+                        std::isfinite(q.y1) && std::isfinite(reach);
+    for (std::uint32_t k = 0; k < p.class_count && finite; ++k)
+      q.density.callback_max += density_bound(p.classes[k], q, reach);
   }
   // The cursor carries this query's fingerprint; the inner one's (which hashes `densities`' address) only
   // while query_points runs.

@@ -300,6 +300,14 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_EQ(query_classes(Tileset::builtin(), q, out, classes, 4, &written, &cursor, &why),
             Status::kInvalidArgument);
   EXPECT_EQ(why.kind, QueryProblem::Kind::kCursorMismatch);
+  // A region that is not finite, with an image class (whose bound is not computed for it): refused by name.
+  ThreeImages images;
+  ClassQueryParams qn = three_constants(0, 0, 1, 1, 10, QueryMode::kSmooth);
+  qn.classes[1].kind = QueryDensity::Kind::kImage, qn.classes[1].image = &images.views[0];
+  qn.query.x0 = NAN;
+  EXPECT_STREQ(refusal(qn).parameter, "x0");
+  qn.query.x0 = 0, qn.query.tile_size = HUGE_VAL;
+  EXPECT_STREQ(refusal(qn).parameter, "tile_size");
   // Too dense for the set: the sum is judged.
   q.query.scale = 32768.0 / 7 * 1.01;
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kDensityTooHigh);
