@@ -42,33 +42,34 @@ TEST(PointFiles, ReadsSeveralSets) {
   EXPECT_EQ(all.size(), 4u);
 }
 
+/// `set` written to the temporary file `name` and read back: the one set it must hold.
+tools::PointSet round_trip(const tools::PointSet& set, const std::string& name) {
+  std::string error;
+  EXPECT_TRUE(tools::write_point_set(::testing::TempDir() + name, set, {}, error)) << error;
+  std::vector<tools::PointSet> sets;
+  EXPECT_TRUE(tools::read_point_sets(::testing::TempDir() + name, sets, error)) << error;
+  EXPECT_EQ(sets.size(), 1u);
+  return sets.empty() ? tools::PointSet{} : sets.front();
+}
+
 TEST(PointFiles, CsvRoundTrip) {
   tools::PointSet s = testing::uniform_set(10, 31);
-  const std::string path = ::testing::TempDir() + "kdm_analysis_round.csv";
-  std::string error;
-  ASSERT_TRUE(tools::write_point_set(path, s, {}, error)) << error;
+  EXPECT_EQ(round_trip(s, "kdm_analysis_round.csv").coords, s.coords);  // 17 significant digits: exact
   std::vector<tools::PointSet> sets;
-  ASSERT_TRUE(tools::read_point_sets(path, sets, error)) << error;
-  ASSERT_EQ(sets.size(), 1u);
-  EXPECT_EQ(sets[0].coords, s.coords);  // 17 significant digits: exact
+  std::string error;
   EXPECT_FALSE(tools::read_point_sets(write_temp("late_header.csv", "0.1,0.2\nx,y\n"), sets, error));
 }
 
-// Coordinates are written as printf's %.17g, so they read back exactly and the files stay byte for byte
-// what earlier versions wrote.
 // Labelled points: "x,y,class" CSV round trips, kdm query's CSV reads as x, y (and class), and bad classes
 // are refused by line.
 TEST(PointFiles, LabelledPointsRoundTripAndQueryCsvReads) {
   tools::PointSet set = testing::uniform_set(50, 3);
   for (std::size_t i = 0; i < set.size(); ++i) set.classes.push_back(static_cast<std::uint8_t>(i % 3));
-  const std::string path = ::testing::TempDir() + "kdm_analysis_labelled.csv";
+  const tools::PointSet back = round_trip(set, "kdm_analysis_labelled.csv");
+  EXPECT_EQ(back.coords, set.coords);
+  EXPECT_EQ(back.classes, set.classes);
   std::string error;
-  ASSERT_TRUE(tools::write_point_set(path, set, {}, error)) << error;
   std::vector<tools::PointSet> sets;
-  ASSERT_TRUE(tools::read_point_sets(path, sets, error)) << error;
-  ASSERT_EQ(sets.size(), 1u);
-  EXPECT_EQ(sets[0].coords, set.coords);
-  EXPECT_EQ(sets[0].classes, set.classes);
   EXPECT_FALSE(tools::write_point_set(::testing::TempDir() + "kdm_analysis_labelled.txt", set, {}, error));
   EXPECT_NE(error.find(".csv"), std::string::npos);
   ASSERT_TRUE(tools::read_point_sets(
@@ -87,6 +88,8 @@ TEST(PointFiles, LabelledPointsRoundTripAndQueryCsvReads) {
   EXPECT_NE(read_error("x,y,class\n0.1,0.2\n", "short.csv").find("expected 3 columns"), std::string::npos);
 }
 
+// Coordinates are written as printf's %.17g, so they read back exactly and the files stay byte for byte
+// what earlier versions wrote.
 TEST(PointFiles, WritesSeventeenSignificantDigits) {
   tools::PointSet s;
   s.dim = 2;
