@@ -9,9 +9,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 
 // The built-in set's bytes, compiled into the runtime library (generated from tilesets/default.kdmt).
@@ -234,26 +236,52 @@ void BM_BaselineWriteSamePoints(benchmark::State& state) {
   report(state, n);
 }
 
-// The same count written as 16-byte records (float position, 64-bit id) into a reused 65,536-record
-// buffer, and BM_QueryConstant's stable query into a reused 65,536-point one: the bound of a compact
-// output, against the query as callers that keep no points use it.
-struct CompactRecord {
-  float x, y;
-  std::uint64_t id;
-};
-
-void BM_BaselineWriteCompact(benchmark::State& state) {
-  std::vector<kdm::QueryPoint> points(1 << 20);
-  const std::size_t n = run_query(params(), points);
-  std::vector<CompactRecord> buffer(1 << 16);
-  for (auto _ : state) {
-    for (std::size_t i = 0; i < n; ++i) {
-      CompactRecord& r = buffer[i & (buffer.size() - 1)];
-      r.x = float(i), r.y = float(i), r.id = i;
-    }
+// The compact output (compact_query.h) into reused 65,536-point arrays (args: smooth; keys, 1 to write
+// them too; ramp, 1 for BM_QueryDensityCallback's ramp instead of the constant density), in rounds that
+// alternate with a plain copy of as many points into the same arrays (memcpy): `of_plain_copy` is the
+// copy's time over the query's. BM_QueryConstantReusedBuffer: QueryPoint records into a reused 65,536-point
+// buffer. Copies n points into `out` from arrays of as many (`from`, 65,536 points), 65,536 at a time, as
+// memcpy does: the bytes the query writes, with no logic.
+void plain_copy(const kdm::CompactPoints& from, const kdm::CompactPoints& out, std::size_t n) {
+  for (std::size_t done = 0; done < n; done += 1 << 16) {
+    const std::size_t count = std::min<std::size_t>(n - done, 1 << 16);
+    std::memcpy(out.xy, from.xy, count * 2 * sizeof(float));
+    if (out.keys) std::memcpy(out.keys, from.keys, count * sizeof(std::uint64_t));
     benchmark::ClobberMemory();
   }
+}
+
+void BM_QueryCompact(benchmark::State& state) {
+  kdm::QueryParams q = params(state);
+  if (state.range(2)) {
+    q.density.kind = kdm::QueryDensity::Kind::kCallback;
+    q.density.callback = ramp;
+    q.density.callback_max = 1;
+  }
+  std::vector<float> xy(2 << 16), source_xy(2 << 16, 1.0f);
+  std::vector<std::uint64_t> keys(1 << 16), source_keys(1 << 16, 1);
+  const kdm::CompactPoints out{xy.data(), state.range(1) ? keys.data() : nullptr};
+  const kdm::CompactPoints source{source_xy.data(), source_keys.data()};
+  std::size_t n = 0;
+  double seconds = 0, copy_seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    kdm::QueryCursor cursor;
+    std::size_t written = 0;
+    n = 0;
+    while (kdm::query_points_compact(kdm::Tileset::builtin(), q, out, keys.size(), &written, &cursor) ==
+           kdm::Status::kBufferFull)
+      n += written;
+    n += written;
+    benchmark::ClobberMemory();
+    const auto t1 = std::chrono::steady_clock::now();
+    plain_copy(source, out, n);
+    const auto t2 = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(t1 - t0).count();
+    copy_seconds += std::chrono::duration<double>(t2 - t1).count();
+  }
   report(state, n);
+  state.counters["of_plain_copy"] = copy_seconds / seconds;
 }
 
 void BM_QueryConstantReusedBuffer(benchmark::State& state) {
@@ -289,7 +317,15 @@ BENCHMARK(BM_QueryThreeClasses)
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_BaselineWriteCompact)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryCompact)
+    ->ArgNames({"smooth", "keys", "ramp"})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 1, 1})
+    ->Args({1, 1, 1})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryConstantReusedBuffer)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

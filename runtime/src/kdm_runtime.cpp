@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 
@@ -230,6 +231,24 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
                            query->density_image);
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
       return kdm::query_points(*tileset->set, q, as_points(out), capacity, written, k, &why);
+    });
+  }
+  report(why, problem);
+  return status;
+}
+
+kdm_status kdm_query_compact(const kdm_tileset* tileset, const kdm_query* query, float* xy, uint64_t* keys,
+                             size_t capacity, size_t* written, kdm_cursor* cursor,
+                             kdm_query_problem* problem) {
+  kdm::QueryProblem why;
+  kdm::QueryParams q;
+  kdm_status status = KDM_INVALID_ARGUMENT;
+  if (read_query(tileset, query, cursor, written, q, why)) {
+    q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
+                           query->density_image);
+    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
+      return kdm::query_points_compact(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity, written, k,
+                                       &why);
     });
   }
   report(why, problem);

@@ -9,7 +9,9 @@
 #include <utility>
 
 #include "descent.h"
+#include "emit_tile.h"
 #include "image_sampler.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/hash.h"
 #include "keyframe_lookup.h"
 #include "query_counted.h"
@@ -26,200 +28,51 @@ using detail::QueryTables;
 
 namespace {
 
+using detail::CompactSink;
+using detail::PointSink;
+
 bool finite(double v) {
   return std::isfinite(v);
 }
 
-/// Every signed byte as a double: a load instead of a conversion with its false dependency.
-struct SignedByteTable {
-  double value[256];
-  constexpr SignedByteTable() : value() {
-    for (int i = 0; i < 256; ++i) value[i] = i - 128;
-  }
-};
-constexpr SignedByteTable kSignedByte;
-
-/// What the per-point loop of one tile reads, copied out of the caller's structures: the output buffer
-/// could alias them, and the compiler would reload each after every point written.
-struct TileJob {
-  const QueryTables* tables;
-  KeyframeTable keyframes;
-  const TilePoint* points;
-  const float* thresholds;
-  const std::int8_t* glide;     ///< smooth mode: the tile's offsets
-  const std::uint32_t* starts;  ///< smooth mode: where each keyframe's begin
-  std::int64_t tx, ty;
-  double wx, wy, S;
-  double x0, y0, x1, y1, origin_x, origin_y;
-  /// Smooth mode: the stable positions (1/65536 tile sides) that can glide into the region, for points
-  /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
-  double cull_x0, cull_y0, cull_x1, cull_y1, reach;
-  const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::points_at_keyframe
-  /// Smooth mode, a tile beside the region: the only ranks that can glide into it (QueryTables::edges).
-  const std::uint32_t *listed, *listed_end;
-  double area_scale, limit;
-  const QueryDensity* density;
-  const ImageSampler* sampler;
-  /// Smooth mode with an image: whether the density can be 0 where the tile's points glide (min-mip).
-  bool zero_possible;
-};
-
-/// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
-/// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
-/// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
-/// job.listed are visited (the others are culled, as the full scan would).
-template <bool kSmooth, QueryDensity::Kind kKind, bool kInside, bool kListed>
-std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, QueryPoint* out,
-                        std::size_t capacity, std::size_t& written) {
-  const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
-  std::size_t n = written;
-  constexpr bool kConstant = kKind == QueryDensity::Kind::kConstant;
-  const GlideBracket constant = kSmooth && kConstant ? GlideBracket(j.keyframes, j.limit) : GlideBracket();
-  const std::int8_t* c0 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g0]) : nullptr;
-  const std::int8_t* c1 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g1]) : nullptr;
-  // Culling bounds; with a varying density they narrow with the rank: a point whose threshold is at least
-  // K_g is emitted only above it, where it glides no farther than any point does from keyframe g on.
-  const std::size_t keyframes = kSmooth ? j.keyframes.n : 0;
-  std::size_t segment = 0;  // varying: the keyframes whose count the thresholds from rank c on reach
-  double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
-  auto set_reach = [&](double reach) {
-    lo_x = j.cull_x0 - reach * 65536.0, hi_x = j.cull_x1 + reach * 65536.0;
-    lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
-  };
-  if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.tables->glide_reach_from[0]);
-  // Places candidate c, emitted at `expected`: false when the buffer is full.
-  // Places candidate c at its stable position (x, y) plus, in smooth mode, its offsets o0 and o1 weighted
-  // by w0 and w1 (GlideBracket): false when the buffer is full.
-  const double unit = j.S * (1.0 / 65536.0);  // world units per position unit
-  auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
-                   double w0, double w1) -> bool {
-    if (kSmooth) {
-      const double* v = kSignedByte.value + 128;
-      x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
-      if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
-      // A point never shows where there is no density: one decided at its stable position could glide up
-      // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
-      if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
-      if (kKind == QueryDensity::Kind::kCallback &&
-          !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
-        return true;
-    }
-    if (n == capacity) return false;
-    out[n++] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
-    return true;
-  };
-  // Smooth mode with a varying density: the emitted candidates wait in a batch, so that the long chain from
-  // a point's density to its glided position overlaps between points instead of restarting after every
-  // mispredicted emission test.
-  constexpr bool kBatched = kSmooth && !kConstant;
-  constexpr std::uint32_t kNone = ~0u;
-  constexpr int kBatch = kBatched ? 32 : 1;
-  std::uint32_t pending_rank[kBatch];
-  double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
-  int pending = 0;
-  auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
-    // Two passes, each short enough for the processor to overlap many points' latency chains.
-    const std::int8_t *o0[kBatch], *o1[kBatch];
-    double w0[kBatch], w1[kBatch];
-    for (int i = 0; i < pending; ++i) {
-      const GlideBracket b(j.keyframes, pending_expected[i]);
-      o0[i] = j.glide + 2 * (std::size_t(j.starts[b.g0]) + pending_rank[i]);
-      o1[i] = j.glide + 2 * (std::size_t(j.starts[b.g1]) + pending_rank[i]);
-      w0[i] = b.w0, w1[i] = b.w1;
-    }
-    for (int i = 0; i < pending; ++i)
-      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i]))
-        return pending = 0, pending_rank[i];
-    pending = 0;
-    return kNone;
-  };
-  // One candidate: the rank that did not fit, or kNone. Positions: the stable one (for ρ and in stable
-  // mode), then the glide added to it.
-  auto visit = [&](std::uint32_t c) -> std::uint32_t {
-    const TilePoint p = j.points[c];
-    if (kSmooth && !kInside) {
-      if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
-        while (segment < keyframes && j.ranks[segment] <= c) ++segment;
-        set_reach(j.tables->glide_reach_from[segment - 1]);
-      }
-      const double sx = p.x + 0.5, sy = p.y + 0.5;
-      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) return kNone;
-    }
-    const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
-    if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
-    if (kConstant)
-      return place(c, x, y, kSmooth ? c0 + 2 * std::size_t(c) : nullptr,
-                   kSmooth ? c1 + 2 * std::size_t(c) : nullptr, constant.w0, constant.w1)
-                 ? kNone
-                 : c;
-    const double rho = kKind == QueryDensity::Kind::kImage
-                           ? j.sampler->at(x, y)
-                           : density_or_zero(j.density->callback(j.density->user, x, y));
-    const double expected = rho * j.area_scale;
-    // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
-    // written (or queued) at the next slot, which only an emitted one then keeps.
-    const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
-    if (!kBatched) {
-      if (n == capacity) return emitted ? c : kNone;
-      out[n] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}};
-      n += emitted;
-      return kNone;
-    }
-    pending_rank[pending] = c, pending_expected[pending] = expected;
-    pending_x[pending] = x, pending_y[pending] = y;
-    pending += emitted;
-    return pending == kBatch ? flush() : kNone;
-  };
-  std::uint32_t stopped = kNone;
-  if constexpr (kListed) {
-    const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
-    for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
-  } else {
-    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
-  }
-  if (kBatched && stopped == kNone) stopped = flush();
-  written = n;
-  return stopped == kNone ? end : stopped;
+/// Tile (tx, ty), set tile `index`, and its subtiles from `at` on into `out` (descent.h's
+/// emit_descending); false when the buffer filled or the budget ran out first, with `at` where to resume.
+bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, std::int64_t ty,
+                          std::size_t index, PointSink out, std::size_t capacity, std::size_t& n,
+                          std::uint64_t& budget, detail::DescentPlace& at) {
+  return detail::emit_descending(descent, tx, ty, index, out.points, capacity, n, budget, at);
 }
 
-using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t, QueryPoint*, std::size_t,
-                                   std::size_t&);
-
-template <bool kInside, bool kListed = false>
-EmitTile pick_emitter(bool smooth, QueryDensity::Kind kind) {
-  using K = QueryDensity::Kind;
-  switch (kind) {
-    case K::kConstant:
-      return smooth ? emit_tile<true, K::kConstant, kInside, kListed>
-                    : emit_tile<false, K::kConstant, kInside, false>;
-    case K::kImage:
-      return smooth ? emit_tile<true, K::kImage, kInside, kListed>
-                    : emit_tile<false, K::kImage, kInside, false>;
-    case K::kCallback:
-      break;
+/// The same for a compact output, through QueryPoint records on the stack: the descent's own loops write
+/// those, and past the top level the glide, not the writing, sets the speed.
+template <bool kKeys>
+bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, std::int64_t ty,
+                          std::size_t index, CompactSink<kKeys> out, std::size_t capacity, std::size_t& n,
+                          std::uint64_t& budget, detail::DescentPlace& at) {
+  constexpr std::size_t kStage = 256;
+  QueryPoint stage[kStage];
+  for (;;) {
+    const std::size_t room = std::min(kStage, capacity - n);
+    std::size_t staged = 0;
+    const bool done = detail::emit_descending(descent, tx, ty, index, stage, room, staged, budget, at);
+    for (std::size_t i = 0; i < staged; ++i) out.put(n + i, stage[i].x, stage[i].y, stage[i].id);
+    n += staged;
+    if (done) return true;
+    if (staged < room || n == capacity) return false;  // the budget ran out, or the caller's buffer is full
   }
-  return smooth ? emit_tile<true, K::kCallback, kInside, kListed>
-                : emit_tile<false, K::kCallback, kInside, false>;
 }
 
-}  // namespace
-
-Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
-                    std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
-  std::uint64_t examined = 0;
-  return detail::query_points_counted(tileset, q, out, capacity, written, cursor, problem, examined);
-}
-
-Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
-                                    std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                    QueryProblem* problem, std::uint64_t& examined) {
-  detail::Refusal refuse(problem);
+/// query_points into any sink (emit_tile.h); `has_room` is false for a null output with room in it.
+template <class Sink>
+Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool has_room, const char* out_name,
+                  std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
+                  std::uint64_t& examined) {
   QueryProblem& why = refuse.problem();
   using Kind = QueryProblem::Kind;
   if (written) *written = 0;
   if (!written) return refuse(Kind::kMissingArgument, "written");
   if (!cursor) return refuse(Kind::kMissingArgument, "cursor");
-  if (capacity > 0 && !out) return refuse(Kind::kMissingArgument, "out");
+  if (capacity > 0 && !has_room) return refuse(Kind::kMissingArgument, out_name);
   if (tileset.empty()) return refuse(Kind::kMissingArgument, "tileset");
   const QueryTables& tables = detail::TilesetInternals::tables(tileset);
   const std::pair<const char*, double> numbers[] = {{"x0", q.x0},
@@ -314,10 +167,10 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
   if (descend) descent.emplace(tileset, q, sampler);
 
   std::size_t n = 0;
-  const EmitTile emit_edge = pick_emitter<false>(glide, d.kind),
-                 emit_inside = pick_emitter<true>(glide, d.kind),
-                 emit_listed = pick_emitter<false, true>(glide, d.kind);
-  TileJob job{};
+  const detail::EmitTile<Sink> emit_edge = detail::pick_emitter<Sink, false>(glide, d.kind),
+                               emit_inside = detail::pick_emitter<Sink, true>(glide, d.kind),
+                               emit_listed = detail::pick_emitter<Sink, false, true>(glide, d.kind);
+  detail::TileJob job{};
   job.tables = &tables;
   job.keyframes = keyframe_table(tileset);
   job.S = S, job.x0 = q.x0, job.y0 = q.y0, job.x1 = q.x1, job.y1 = q.y1;
@@ -344,7 +197,7 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
         if (resumed) at = detail::DescentPlace{cursor->depth, cursor->path, cursor->rank};
         std::uint64_t budget = kMaxQueryCandidates - examined;
         const std::uint64_t before = budget;
-        const bool done = detail::emit_descending(*descent, tx, ty, index, out, capacity, n, budget, at);
+        const bool done = emit_descending_into(*descent, tx, ty, index, out, capacity, n, budget, at);
         examined += before - budget;
         if (!done) {
           *cursor = QueryCursor{tx, ty, at.rank, true, false, fingerprint, at.depth, at.path};
@@ -361,6 +214,9 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
       const std::uint32_t end = candidates - c > budget ? static_cast<std::uint32_t>(c + budget) : candidates;
       job.points = tile.points.data(), job.thresholds = thresholds, job.tx = tx, job.ty = ty;
       job.wx = wx, job.wy = wy, job.limit = limit;
+      job.rel_unit = static_cast<float>(S / 65536.0);
+      job.rel_x = static_cast<float>((wx - q.origin_x) + S * (0.5 / 65536.0));
+      job.rel_y = static_cast<float>((wy - q.origin_y) + S * (0.5 / 65536.0));
       if (glide) {
         job.glide = tile.glide.data(), job.starts = tables.glide_start[index].data();
         job.ranks = tables.points_at_keyframe[index].data();
@@ -382,11 +238,15 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
       }
       // Inside: the tile widened by the farthest any of its points can glide (and two position units, for
       // rounding) lies in the region. Such tiles skip every test, and the positions are computed as
-      // elsewhere.
+      // elsewhere. Without a glide the test is exact: a position rounds monotonically in its grid cell, so
+      // the tile's first and last cells bound every point (a region of whole tiles has no edge tiles).
       const double margin = reach + S * (2.0 / 65536.0);
-      const bool inside =
-          wx - margin >= q.x0 && wx + S + margin < q.x1 && wy - margin >= q.y0 && wy + S + margin < q.y1;
-      const EmitTile emit = inside ? emit_inside : job.listed ? emit_listed : emit_edge;
+      const TilePoint first{0, 0}, last{65535, 65535};
+      const bool inside = glide ? wx - margin >= q.x0 && wx + S + margin < q.x1 && wy - margin >= q.y0 &&
+                                      wy + S + margin < q.y1
+                                : wx + first.unit_x() * S >= q.x0 && wx + last.unit_x() * S < q.x1 &&
+                                      wy + first.unit_y() * S >= q.y0 && wy + last.unit_y() * S < q.y1;
+      const detail::EmitTile<Sink> emit = inside ? emit_inside : job.listed ? emit_listed : emit_edge;
       const std::uint32_t stopped = emit(job, c, end, out, capacity, n);
       examined += stopped - c;
       if (stopped < candidates) {  // the buffer is full, or the budget spent
@@ -399,6 +259,42 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
   cursor->finished = true;
   *written = n;
   return Status::kOk;
+}
+
+}  // namespace
+
+Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
+                    std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
+  std::uint64_t examined = 0;
+  return detail::query_points_counted(tileset, q, out, capacity, written, cursor, problem, examined);
+}
+
+Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
+                                    std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                    QueryProblem* problem, std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  return query_into(tileset, q, PointSink{out}, out != nullptr, "out", capacity, written, cursor, refuse,
+                    examined);
+}
+
+Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,
+                            std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                            QueryProblem* problem) {
+  detail::Refusal refuse(problem);
+  std::uint64_t examined = 0;
+  if (!out.keys)
+    return query_into(tileset, q, CompactSink<false>{out.xy, nullptr}, out.xy != nullptr, "out.xy", capacity,
+                      written, cursor, refuse, examined);
+  if (!tileset.empty()) {
+    const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
+    if (most > (std::uint64_t(1) << kKeyRankBits)) {
+      if (written) *written = 0;
+      return refuse(QueryProblem::Kind::kKeysUnsupported, "out.keys", double(most),
+                    double(std::uint64_t(1) << kKeyRankBits));
+    }
+  }
+  return query_into(tileset, q, CompactSink<true>{out.xy, out.keys}, out.xy != nullptr, "out.xy", capacity,
+                    written, cursor, refuse, examined);
 }
 
 double query_density_limit(const Tileset& tileset, QueryMode mode) {
@@ -451,6 +347,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
       return "the mode is neither stable nor smooth";
     case QueryProblem::Kind::kBadClassCount:
       return "a query needs between 1 and 8 classes";
+    case QueryProblem::Kind::kKeysUnsupported:
+      return "the tile set's tiles hold more points than a 64-bit point key can number";
   }
   return "unknown problem";
 }

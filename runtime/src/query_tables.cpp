@@ -20,8 +20,10 @@ QueryTables::QueryTables(const TilesetData& set) {
       for (; i < tile.level_end[k]; ++i) out[i] = set.emission_threshold(k, tile.keys[i]);
   }
   min_threshold = HUGE_VAL;
-  for (const TilesetArray<float>& t : thresholds)
+  for (const TilesetArray<float>& t : thresholds) {
     if (!t.empty()) min_threshold = std::min(min_threshold, double(t.front()));
+    most_points = std::max(most_points, std::uint64_t(t.size()));
+  }
   // Where each keyframe's offsets start in every tile, their units, and how far any point glides.
   const std::size_t keyframes = set.keyframe_nominal.size();
   glide_start.assign(set.tiles.size(), {});

@@ -28,6 +28,8 @@ struct QueryTables {
   TilesetArray<TilesetArray<float>> thresholds;
   /// The lowest threshold of any point: below it no tile emits anything.
   double min_threshold = 0;
+  /// The most points any tile holds (a rank is always below it).
+  std::uint64_t most_points = 0;
   /// Per tile, where each keyframe's offsets start in Tile::glide, in offset pairs (keyframes + 1 entries:
   /// keyframe g's pairs are [start[g], start[g + 1]), one per rank below TilesetShape::offsets_at_keyframe).
   TilesetArray<TilesetArray<std::uint32_t>> glide_start;

@@ -191,6 +191,38 @@ int main(int argc, char** argv) {
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT);
   }
+  /* The compact output: the same points as floats and keys, through a small buffer with resumes. */
+  {
+    static kdm_point points[4096];
+    static float xy[2 * 100];
+    static uint64_t keys[100];
+    kdm_cursor cursor;
+    size_t written = 0, all = 0, total = 0, i;
+    kdm_status s;
+    q = uniform_query();
+    q.origin_x = 0.5, q.mode = KDM_MODE_SMOOTH;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, points, 4096, &all, &cursor, NULL) == KDM_OK && all > 1000);
+    memset(&cursor, 0, sizeof cursor);
+    do {
+      s = kdm_query_compact(builtin, &q, xy, keys, 100, &written, &cursor, &problem);
+      CHECK(total + written <= all);
+      for (i = 0; i < written; ++i) {
+        const kdm_point* p = &points[total + i];
+        CHECK(xy[2 * i] == (float)p->x && xy[2 * i + 1] == (float)p->y);
+        CHECK((keys[i] & 0x1FFFFF) == ((uint64_t)p->tile_x & 0x1FFFFF) &&
+              (keys[i] >> 42 & 0x7FFFF) == p->rank);
+      }
+      total += written;
+    } while (s == KDM_BUFFER_FULL);
+    CHECK(s == KDM_OK && total == all);
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_compact(builtin, &q, NULL, keys, 100, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out.xy") == 0);
+    CHECK(kdm_query_compact(builtin, &q, xy, NULL, 100, &written, &cursor, NULL) == KDM_BUFFER_FULL);
+    CHECK(written == 100);
+  }
   {
     kdm_tileset* bad = NULL;
     CHECK(kdm_tileset_load_memory("not a tile set", 14, &bad) == KDM_BAD_MAGIC && bad == NULL);

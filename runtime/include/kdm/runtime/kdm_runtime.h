@@ -88,7 +88,9 @@ typedef enum kdm_problem_kind {
                                        largest_tile_size */
   KDM_PROBLEM_CURSOR_MISMATCH = 8,  /* the cursor was started by a query with other parameters */
   KDM_PROBLEM_BAD_MODE = 9,         /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
-  KDM_PROBLEM_BAD_CLASS_COUNT = 10  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
+  KDM_PROBLEM_BAD_CLASS_COUNT = 10, /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
+  KDM_PROBLEM_KEYS_UNSUPPORTED = 11 /* kdm_query_compact: keys asked of a set whose tiles hold `value`
+                                       points, more than a key's ranks (`limit`) */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
@@ -156,6 +158,16 @@ KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);
+
+/* kdm_query_points into a compact output (kdm/runtime/compact_query.h): the same points in the same order,
+ * point i at xy[2i], xy[2i + 1] (floats, relative to the query's origin: keep it near the region) and, if
+ * `keys` is not NULL, keys[i] = its 64-bit point key (tile x and y modulo 2^21, rank, depth; unique within
+ * any region less than 2^21 tiles across). Statuses and resumption as kdm_query_points (a cursor serves
+ * both); KDM_INVALID_ARGUMENT also for a NULL `xy` with room in it, and for keys asked of a set whose tiles
+ * hold more than 2^19 points (KDM_PROBLEM_KEYS_UNSUPPORTED). */
+KDM_RUNTIME_API kdm_status kdm_query_compact(const kdm_tileset* tileset, const kdm_query* query, float* xy,
+                                             uint64_t* keys, size_t capacity, size_t* written,
+                                             kdm_cursor* cursor, kdm_query_problem* problem);
 
 /* One class's density for kdm_query_classes: as kdm_query's density fields (an image takes precedence
  * over a callback, a callback over the constant). */

@@ -124,6 +124,8 @@ struct QueryProblem {
     kCursorMismatch,   ///< the cursor was started by a call with other parameters (or damaged)
     kBadMode,          ///< `parameter` ("mode") is not a QueryMode; `value` holds it
     kBadClassCount,    ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
+    kKeysUnsupported,  ///< query_points_compact: keys asked of a set whose tiles hold `value` points,
+                       ///< more than a key's ranks (`limit`, 2^19)
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage

@@ -1,0 +1,55 @@
+// The query of query.h written compactly: positions as float32 pairs and, if asked for, a 64-bit key per
+// point, in separate arrays (structure of arrays), so a caller that needs only positions writes only
+// positions: 8 bytes a point, or 16 with keys, instead of QueryPoint's 40. The points, their order, the
+// statuses, the cursor and every guarantee are query_points' own; only the output's form differs.
+//
+// Float positions are relative to the query origin (QueryParams::origin_x, origin_y): keep the origin
+// near the region (a chunk's corner, the camera), as float32 carries about 7 significant digits.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kdm/runtime/export.h"
+#include "kdm/runtime/query.h"
+#include "kdm/runtime/status.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+
+/// Bits of a point key: the low bits of the tile coordinates, the rank, the depth (from the lowest bit).
+inline constexpr int kKeyTileBits = 21, kKeyRankBits = 19, kKeyDepthBits = 3;
+
+/// A point's id in 64 bits: tile_x and tile_y modulo 2^21, the rank (below 2^19) and the depth. Two
+/// points have the same key only if their tiles, at their depth, lie a multiple of 2^21 tiles apart: keys
+/// are unique within any region less than 2,097,152 tiles (of the points' depth) across, and the same in
+/// every query, so a caller can follow a point across frames or seed its own randomness from it.
+constexpr std::uint64_t point_key(const PointId& id) {
+  constexpr std::uint64_t tile_mask = (std::uint64_t(1) << kKeyTileBits) - 1;
+  return (std::uint64_t(id.tile_x) & tile_mask) | (std::uint64_t(id.tile_y) & tile_mask) << kKeyTileBits |
+         std::uint64_t(id.rank) << (2 * kKeyTileBits) |
+         std::uint64_t(id.depth) << (2 * kKeyTileBits + kKeyRankBits);
+}
+
+/// Where query_points_compact writes, caller-owned: `xy` is required (room for 2 · capacity floats), `keys`
+/// optional (null: no keys are written; else room for capacity keys).
+struct CompactPoints {
+  float* xy = nullptr;            ///< x, y of each point, world position minus the query origin
+  std::uint64_t* keys = nullptr;  ///< point_key of each point's id
+};
+
+/// query_points into a compact output: the same points in the same order, point i's position as floats
+/// at xy[2i], xy[2i + 1] and, if keys is not null, keys[i] = point_key(its id). In smooth mode a position
+/// is the double query_points writes, rounded to float; in stable mode it is computed in float from its
+/// tile's corner relative to the origin (whole tiles then convert as fast as a copy), within 2^-22 ·
+/// (|position| + tile_size) of that double. Either way it depends only on the point and the parameters, so
+/// partitions of a region give the same bits. Slots from *written to capacity may be overwritten. Statuses,
+/// resumption (a cursor serves query_points and this function alike) and refusals as query_points', with
+/// parameter "out.xy" for a null xy with room in it, and kKeysUnsupported when keys are asked of a set
+/// whose tiles hold more than 2^19 points (ranks would not fit a key). No allocation.
+KDM_RUNTIME_API Status query_points_compact(const Tileset& tileset, const QueryParams& params,
+                                            const CompactPoints& out, std::size_t capacity,
+                                            std::size_t* written, QueryCursor* cursor,
+                                            QueryProblem* problem = nullptr);
+
+}  // namespace kdm

@@ -1,0 +1,248 @@
+// Internal: the loop that emits one depth-0 tile's candidates (query.cpp's driver calls it per tile), for
+// each mode, kind of density and output form (query.h's QueryPoint records or compact_query.h's arrays).
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+#include "image_sampler.h"
+#include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/query.h"
+#include "keyframe_lookup.h"
+#include "query_tables.h"
+
+namespace kdm::detail {
+
+/// Every signed byte as a double: a load instead of a conversion with its false dependency.
+struct SignedByteTable {
+  double value[256];
+  constexpr SignedByteTable() : value() {
+    for (int i = 0; i < 256; ++i) value[i] = i - 128;
+  }
+};
+constexpr SignedByteTable kSignedByte;
+
+/// What the per-point loop of one tile reads, copied out of the caller's structures: the output buffer
+/// could alias them, and the compiler would reload each after every point written.
+struct TileJob {
+  const QueryTables* tables;
+  KeyframeTable keyframes;
+  const TilePoint* points;
+  const float* thresholds;
+  const std::int8_t* glide;     ///< smooth mode: the tile's offsets
+  const std::uint32_t* starts;  ///< smooth mode: where each keyframe's begin
+  std::int64_t tx, ty;
+  double wx, wy, S;
+  double x0, y0, x1, y1, origin_x, origin_y;
+  /// Smooth mode: the stable positions (1/65536 tile sides) that can glide into the region, for points
+  /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
+  double cull_x0, cull_y0, cull_x1, cull_y1, reach;
+  const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::points_at_keyframe
+  /// Smooth mode, a tile beside the region: the only ranks that can glide into it (QueryTables::edges).
+  const std::uint32_t *listed, *listed_end;
+  double area_scale, limit;
+  const QueryDensity* density;
+  const ImageSampler* sampler;
+  /// Smooth mode with an image: whether the density can be 0 where the tile's points glide (min-mip).
+  bool zero_possible;
+  /// Compact output in stable mode: the centre of the tile's first grid cell relative to the query origin
+  /// and the grid's step, world units in float (CompactSink::put_stable).
+  float rel_x, rel_y, rel_unit;
+};
+
+/// Output into QueryPoint records. put: a position relative to the query origin; put_stable: point p of
+/// the tile at its stable position, computed as the query's tests compute it.
+struct PointSink {
+  QueryPoint* points;
+  void put(std::size_t i, double x, double y, const PointId& id) const { points[i] = QueryPoint{x, y, id}; }
+  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+    const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+    points[i] = QueryPoint{x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, rank}};
+  }
+  /// Ranks [c, c + count) into slots from i on.
+  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
+    for (std::uint32_t k = 0; k < count; ++k) put_stable(i + k, j, j.points[c + k], c + k);
+  }
+};
+
+/// Compact output (compact_query.h): float positions and, with kKeys, point keys. A stable position is
+/// computed in float from the tile's corner (TileJob::rel_x …), so whole tiles convert as fast as a copy.
+template <bool kKeys>
+struct CompactSink {
+  float* xy;
+  std::uint64_t* keys;
+  void put(std::size_t i, double x, double y, const PointId& id) const {
+    xy[2 * i] = static_cast<float>(x), xy[2 * i + 1] = static_cast<float>(y);
+    if (kKeys) keys[i] = point_key(id);
+  }
+  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+    xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit, xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit;
+    if (kKeys) keys[i] = point_key(PointId{j.tx, j.ty, rank});
+  }
+  /// Ranks [c, c + count) into slots from i on, in loops the compiler vectorises (no wrapping indices).
+  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
+    const TilePoint* from = j.points + c;
+    float* to = xy + 2 * i;
+    const float rx = j.rel_x, ry = j.rel_y, unit = j.rel_unit;
+    for (std::size_t k = 0; k < count; ++k)
+      to[2 * k] = rx + float(from[k].x) * unit, to[2 * k + 1] = ry + float(from[k].y) * unit;
+    if (kKeys) {
+      const std::uint64_t first = point_key(PointId{j.tx, j.ty, c}), step = point_key(PointId{0, 0, 1});
+      std::uint64_t* key = keys + i;
+      for (std::size_t k = 0; k < count; ++k) key[k] = first + k * step;
+    }
+  }
+};
+
+/// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
+/// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
+/// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
+/// job.listed are visited (the others are culled, as the full scan would).
+template <class Sink, bool kSmooth, QueryDensity::Kind kKind, bool kInside, bool kListed>
+std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, const Sink out,
+                        std::size_t capacity, std::size_t& written) {
+  const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
+  std::size_t n = written;
+  constexpr bool kConstant = kKind == QueryDensity::Kind::kConstant;
+  if constexpr (kConstant && kInside && !kSmooth) {
+    // Every candidate is emitted where it stands: a plain loop the compiler can vectorise.
+    const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(end - c, capacity - n));
+    out.put_stable_run(n, j, c, count);
+    written = n + count;
+    return c + count;
+  }
+  const GlideBracket constant = kSmooth && kConstant ? GlideBracket(j.keyframes, j.limit) : GlideBracket();
+  const std::int8_t* c0 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g0]) : nullptr;
+  const std::int8_t* c1 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g1]) : nullptr;
+  // Culling bounds; with a varying density they narrow with the rank: a point whose threshold is at least
+  // K_g is emitted only above it, where it glides no farther than any point does from keyframe g on.
+  const std::size_t keyframes = kSmooth ? j.keyframes.n : 0;
+  std::size_t segment = 0;  // varying: the keyframes whose count the thresholds from rank c on reach
+  double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+  auto set_reach = [&](double reach) {
+    lo_x = j.cull_x0 - reach * 65536.0, hi_x = j.cull_x1 + reach * 65536.0;
+    lo_y = j.cull_y0 - reach * 65536.0, hi_y = j.cull_y1 + reach * 65536.0;
+  };
+  if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.tables->glide_reach_from[0]);
+  // Smooth mode: places candidate c at its stable position (x, y) plus its offsets o0 and o1 weighted by
+  // w0 and w1 (GlideBracket): false when the buffer is full.
+  const double unit = j.S * (1.0 / 65536.0);  // world units per position unit
+  auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
+                   double w0, double w1) -> bool {
+    const double* v = kSignedByte.value + 128;
+    x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
+    if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
+    // A point never shows where there is no density: one decided at its stable position could glide up
+    // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
+    if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
+    if (kKind == QueryDensity::Kind::kCallback &&
+        !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
+      return true;
+    if (n == capacity) return false;
+    out.put(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
+    return true;
+  };
+  // Smooth mode with a varying density: the emitted candidates wait in a batch, so that the long chain from
+  // a point's density to its glided position overlaps between points instead of restarting after every
+  // mispredicted emission test.
+  constexpr bool kBatched = kSmooth && !kConstant;
+  constexpr std::uint32_t kNone = ~0u;
+  constexpr int kBatch = kBatched ? 32 : 1;
+  std::uint32_t pending_rank[kBatch];
+  double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
+  int pending = 0;
+  auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
+    // Two passes, each short enough for the processor to overlap many points' latency chains.
+    const std::int8_t *o0[kBatch], *o1[kBatch];
+    double w0[kBatch], w1[kBatch];
+    for (int i = 0; i < pending; ++i) {
+      const GlideBracket b(j.keyframes, pending_expected[i]);
+      o0[i] = j.glide + 2 * (std::size_t(j.starts[b.g0]) + pending_rank[i]);
+      o1[i] = j.glide + 2 * (std::size_t(j.starts[b.g1]) + pending_rank[i]);
+      w0[i] = b.w0, w1[i] = b.w1;
+    }
+    for (int i = 0; i < pending; ++i)
+      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i]))
+        return pending = 0, pending_rank[i];
+    pending = 0;
+    return kNone;
+  };
+  // One candidate: the rank that did not fit, or kNone. Positions: the stable one (for ρ and in stable
+  // mode), then the glide added to it.
+  auto visit = [&](std::uint32_t c) -> std::uint32_t {
+    const TilePoint p = j.points[c];
+    if (kSmooth && !kInside) {
+      if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
+        while (segment < keyframes && j.ranks[segment] <= c) ++segment;
+        set_reach(j.tables->glide_reach_from[segment - 1]);
+      }
+      const double sx = p.x + 0.5, sy = p.y + 0.5;
+      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) return kNone;
+    }
+    const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+    if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
+    if (kConstant && !kSmooth) {
+      if (n == capacity) return c;
+      out.put_stable(n++, j, p, c);
+      return kNone;
+    }
+    if (kConstant)
+      return place(c, x, y, kSmooth ? c0 + 2 * std::size_t(c) : nullptr,
+                   kSmooth ? c1 + 2 * std::size_t(c) : nullptr, constant.w0, constant.w1)
+                 ? kNone
+                 : c;
+    const double rho = kKind == QueryDensity::Kind::kImage
+                           ? j.sampler->at(x, y)
+                           : density_or_zero(j.density->callback(j.density->user, x, y));
+    const double expected = rho * j.area_scale;
+    // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
+    // written (or queued) at the next slot, which only an emitted one then keeps.
+    const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
+    if (!kBatched) {
+      if (n == capacity) return emitted ? c : kNone;
+      out.put_stable(n, j, p, c);
+      n += emitted;
+      return kNone;
+    }
+    pending_rank[pending] = c, pending_expected[pending] = expected;
+    pending_x[pending] = x, pending_y[pending] = y;
+    pending += emitted;
+    return pending == kBatch ? flush() : kNone;
+  };
+  std::uint32_t stopped = kNone;
+  if constexpr (kListed) {
+    const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
+    for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
+  } else {
+    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
+  }
+  if (kBatched && stopped == kNone) stopped = flush();
+  written = n;
+  return stopped == kNone ? end : stopped;
+}
+
+template <class Sink>
+using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t, Sink, std::size_t,
+                                   std::size_t&);
+
+/// The emitter for a mode and kind of density: beside the region (kInside false), inside it, or through
+/// an edge list (kListed).
+template <class Sink, bool kInside, bool kListed = false>
+EmitTile<Sink> pick_emitter(bool smooth, QueryDensity::Kind kind) {
+  using K = QueryDensity::Kind;
+  switch (kind) {
+    case K::kConstant:
+      return smooth ? emit_tile<Sink, true, K::kConstant, kInside, kListed>
+                    : emit_tile<Sink, false, K::kConstant, kInside, false>;
+    case K::kImage:
+      return smooth ? emit_tile<Sink, true, K::kImage, kInside, kListed>
+                    : emit_tile<Sink, false, K::kImage, kInside, false>;
+    case K::kCallback:
+      break;
+  }
+  return smooth ? emit_tile<Sink, true, K::kCallback, kInside, kListed>
+                : emit_tile<Sink, false, K::kCallback, kInside, false>;
+}
+
+}  // namespace kdm::detail
