@@ -46,9 +46,23 @@ struct TileJob {
   const ImageSampler* sampler;
   /// Smooth mode with an image: whether the density can be 0 where the tile's points glide (min-mip).
   bool zero_possible;
+  /// Smooth mode, constant density: the grid cells whose points land inside the region however far they
+  /// glide (by `reach`, with room for rounding), which skip its test: safe_x ≤ x < safe_x + safe_w (as
+  /// unsigned differences; safe_w = 0 for none), the same in y.
+  std::int32_t safe_x, safe_y;
+  std::uint32_t safe_w, safe_h;
   /// Compact output in stable mode: the centre of the tile's first grid cell relative to the query origin
   /// and the grid's step, world units in float (CompactSink::put_stable).
   float rel_x, rel_y, rel_unit;
+};
+
+/// Smooth mode with a constant density: a tile's offsets at the two keyframes around its count (ranks
+/// index pairs from o0 and o1), their weights (GlideBracket's) and, for float output, the weights times
+/// the world units per position unit.
+struct ConstantGlide {
+  const std::int8_t *o0, *o1;
+  double w0, w1;
+  float w0f, w1f;
 };
 
 /// Output into QueryPoint records. put: a position relative to the query origin; put_stable: point p of
@@ -64,6 +78,13 @@ struct PointSink {
   void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
     for (std::uint32_t k = 0; k < count; ++k) put_stable(i + k, j, j.points[c + k], c + k);
   }
+  /// Point c, glided by a constant density (as emit_tile's place glides it).
+  void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c) const {
+    put_glided_run(i, j, g, c, 1);
+  }
+  /// Ranks [c, c + count) of a tile inside the region, glided by a constant density, as place does.
+  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
+                      std::uint32_t count) const;
 };
 
 /// Compact output (compact_query.h): float positions and, with kKeys, point keys. A stable position is
@@ -93,7 +114,46 @@ struct CompactSink {
       for (std::size_t k = 0; k < count; ++k) key[k] = first + k * step;
     }
   }
+  /// A glided point, also in float from the tile's corner and its offsets (put_glided_run's formula, so a
+  /// point is written alike by every emitter).
+  [[gnu::always_inline]] void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g,
+                                         std::uint32_t c) const {
+    const TilePoint p = j.points[c];
+    const std::int8_t *o0 = g.o0 + 2 * std::size_t(c), *o1 = g.o1 + 2 * std::size_t(c);
+    xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit + (float(o0[0]) * g.w0f + float(o1[0]) * g.w1f);
+    xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit + (float(o0[1]) * g.w0f + float(o1[1]) * g.w1f);
+    if (kKeys) keys[i] = point_key(PointId{j.tx, j.ty, c});
+  }
+  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
+                      std::uint32_t count) const {
+    const TilePoint* from = j.points + c;
+    const std::int8_t *o0 = g.o0 + 2 * std::size_t(c), *o1 = g.o1 + 2 * std::size_t(c);
+    float* to = xy + 2 * i;
+    const float rx = j.rel_x, ry = j.rel_y, unit = j.rel_unit, w0 = g.w0f, w1 = g.w1f;
+    for (std::size_t k = 0; k < count; ++k) {
+      to[2 * k] = rx + float(from[k].x) * unit + (float(o0[2 * k]) * w0 + float(o1[2 * k]) * w1);
+      to[2 * k + 1] = ry + float(from[k].y) * unit + (float(o0[2 * k + 1]) * w0 + float(o1[2 * k + 1]) * w1);
+    }
+    if (kKeys) {
+      const std::uint64_t first = point_key(PointId{j.tx, j.ty, c}), step = point_key(PointId{0, 0, 1});
+      std::uint64_t* key = keys + i;
+      for (std::size_t k = 0; k < count; ++k) key[k] = first + k * step;
+    }
+  }
 };
+
+inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g,
+                                      std::uint32_t c, std::uint32_t count) const {
+  const double* v = kSignedByte.value + 128;
+  const double unit = j.S * (1.0 / 65536.0);
+  for (std::uint32_t k = c; k < c + count; ++k) {
+    const TilePoint p = j.points[k];
+    const std::int8_t *o0 = g.o0 + 2 * std::size_t(k), *o1 = g.o1 + 2 * std::size_t(k);
+    double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+    x += (v[o0[0]] * g.w0 + v[o1[0]] * g.w1) * unit, y += (v[o0[1]] * g.w0 + v[o1[1]] * g.w1) * unit;
+    put(i + (k - c), x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, k});
+  }
+}
 
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
@@ -113,8 +173,20 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     return c + count;
   }
   const GlideBracket constant = kSmooth && kConstant ? GlideBracket(j.keyframes, j.limit) : GlideBracket();
-  const std::int8_t* c0 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g0]) : nullptr;
-  const std::int8_t* c1 = kSmooth ? j.glide + 2 * std::size_t(j.starts[constant.g1]) : nullptr;
+  const double unit = j.S * (1.0 / 65536.0);  // world units per position unit
+  ConstantGlide glide{};
+  if (kSmooth) {
+    glide.o0 = j.glide + 2 * std::size_t(j.starts[constant.g0]);
+    glide.o1 = j.glide + 2 * std::size_t(j.starts[constant.g1]);
+    glide.w0 = constant.w0, glide.w1 = constant.w1;
+    glide.w0f = static_cast<float>(constant.w0 * unit), glide.w1f = static_cast<float>(constant.w1 * unit);
+  }
+  if constexpr (kConstant && kInside && kSmooth) {  // the same, glided by the tile's two keyframes
+    const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(end - c, capacity - n));
+    out.put_glided_run(n, j, glide, c, count);
+    written = n + count;
+    return c + count;
+  }
   // Culling bounds; with a varying density they narrow with the rank: a point whose threshold is at least
   // K_g is emitted only above it, where it glides no farther than any point does from keyframe g on.
   const std::size_t keyframes = kSmooth ? j.keyframes.n : 0;
@@ -127,7 +199,6 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.tables->glide_reach_from[0]);
   // Smooth mode: places candidate c at its stable position (x, y) plus its offsets o0 and o1 weighted by
   // w0 and w1 (GlideBracket): false when the buffer is full.
-  const double unit = j.S * (1.0 / 65536.0);  // world units per position unit
   auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
                    double w0, double w1) -> bool {
     const double* v = kSignedByte.value + 128;
@@ -140,7 +211,10 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
         !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
       return true;
     if (n == capacity) return false;
-    out.put(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
+    if (kConstant)
+      out.put_glided(n++, j, glide, c);
+    else
+      out.put(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
     return true;
   };
   // Smooth mode with a varying density: the emitted candidates wait in a batch, so that the long chain from
@@ -188,8 +262,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       return kNone;
     }
     if (kConstant)
-      return place(c, x, y, kSmooth ? c0 + 2 * std::size_t(c) : nullptr,
-                   kSmooth ? c1 + 2 * std::size_t(c) : nullptr, constant.w0, constant.w1)
+      return place(c, x, y, glide.o0 + 2 * std::size_t(c), glide.o1 + 2 * std::size_t(c), glide.w0, glide.w1)
                  ? kNone
                  : c;
     const double rho = kKind == QueryDensity::Kind::kImage
@@ -214,6 +287,25 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   if constexpr (kListed) {
     const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
     for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
+  } else if constexpr (kSmooth && kConstant && !kInside) {
+    // Beside the region, most points land inside it however they glide: runs of such points skip the test
+    // and are written as whole tiles inside are.
+    auto safe = [&](std::uint32_t r) {
+      const TilePoint p = j.points[r];
+      return std::uint32_t(p.x - j.safe_x) < j.safe_w && std::uint32_t(p.y - j.safe_y) < j.safe_h;
+    };
+    while (c < end && stopped == kNone) {
+      std::uint32_t run = c;
+      while (run < end && safe(run)) ++run;
+      if (run == c) {
+        stopped = visit(c++);
+        continue;
+      }
+      const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(run - c, capacity - n));
+      out.put_glided_run(n, j, glide, c, count);
+      n += count, c += count;
+      if (c < run) stopped = c;
+    }
   } else {
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   }

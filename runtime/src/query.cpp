@@ -228,6 +228,18 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
         if (d.kind == QueryDensity::Kind::kConstant) {
           const GlideBracket b(job.keyframes, limit);
           job.reach = std::max(tables.glide_reach[b.g0], tables.glide_reach[b.g1]);
+          // Rounding of world coordinates, in position units: two, and a few ulps of the largest involved.
+          const double units = 65536.0 / S;
+          const double slack = 2 + 1e-15 * units *
+                                       (std::fabs(wx) + std::fabs(wy) + std::fabs(q.x0) + std::fabs(q.x1) +
+                                        std::fabs(q.y0) + std::fabs(q.y1) + S);
+          const double r = job.reach * 65536.0 + slack + 0.5;  // a cell's centre is half a unit in
+          auto cells = [&](double lo, double hi, std::int32_t& first, std::uint32_t& count) {
+            lo = std::max(std::ceil(lo + r), 0.0), hi = std::min(std::floor(hi - r), 65536.0);
+            first = hi > lo ? std::int32_t(lo) : 0, count = hi > lo ? std::uint32_t(hi - lo) : 0;
+          };
+          cells((q.x0 - wx) * units, (q.x1 - wx) * units, job.safe_x, job.safe_w);
+          cells((q.y0 - wy) * units, (q.y1 - wy) * units, job.safe_y, job.safe_h);
         }
         // Beside the region only the points that can glide across the side it lies beyond can be emitted.
         job.listed = job.listed_end = nullptr;

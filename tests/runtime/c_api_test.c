@@ -209,7 +209,8 @@ int main(int argc, char** argv) {
       CHECK(total + written <= all);
       for (i = 0; i < written; ++i) {
         const kdm_point* p = &points[total + i];
-        CHECK(xy[2 * i] == (float)p->x && xy[2 * i + 1] == (float)p->y);
+        CHECK(fabs(xy[2 * i] - p->x) <= ldexp(fabs(p->x) + 1, -21) &&
+              fabs(xy[2 * i + 1] - p->y) <= ldexp(fabs(p->y) + 1, -21));
         CHECK((keys[i] & 0x1FFFFF) == ((uint64_t)p->tile_x & 0x1FFFFF) &&
               (keys[i] >> 42 & 0x7FFFF) == p->rank);
       }

@@ -65,23 +65,19 @@ QueryParams region(QueryMode mode) {
   return q;
 }
 
-// The compact points are the full query's: in smooth mode its doubles rounded to float, in stable mode
-// within the documented 2^-22 · (|position| + tile size) (computed in float from the tile's corner).
-void expect_same(const std::vector<QueryPoint>& full, const Compact& compact, bool keys, QueryMode mode,
+// The compact points are the full query's, their positions within the documented 2^-21 · (|position| +
+// tile size) of its doubles (computed in float from the tile's corner and offsets where the density is
+// constant, else its doubles rounded to float).
+void expect_same(const std::vector<QueryPoint>& full, const Compact& compact, bool keys,
                  double tile_size = 1) {
   ASSERT_EQ(compact.xy.size(), 2 * full.size());
   if (keys) {
     ASSERT_EQ(compact.keys.size(), full.size());
   }
   for (std::size_t i = 0; i < full.size(); ++i) {
-    if (mode == QueryMode::kSmooth) {
-      ASSERT_EQ(compact.xy[2 * i], static_cast<float>(full[i].x)) << i;
-      ASSERT_EQ(compact.xy[2 * i + 1], static_cast<float>(full[i].y)) << i;
-    } else {
-      ASSERT_LE(std::fabs(compact.xy[2 * i] - full[i].x), std::ldexp(std::fabs(full[i].x) + tile_size, -22));
-      ASSERT_LE(std::fabs(compact.xy[2 * i + 1] - full[i].y),
-                std::ldexp(std::fabs(full[i].y) + tile_size, -22));
-    }
+    ASSERT_LE(std::fabs(compact.xy[2 * i] - full[i].x), std::ldexp(std::fabs(full[i].x) + tile_size, -21));
+    ASSERT_LE(std::fabs(compact.xy[2 * i + 1] - full[i].y),
+              std::ldexp(std::fabs(full[i].y) + tile_size, -21));
     if (keys) {
       ASSERT_EQ(compact.keys[i], point_key(full[i].id)) << i;
     }
@@ -110,7 +106,7 @@ TEST(CompactQueryTest, WritesTheFullQuerysPointsInItsOrder) {
       ASSERT_GT(full.size(), 5000u);
       for (bool keys : {false, true})
         for (std::size_t capacity : {std::size_t(1), std::size_t(997), std::size_t(1) << 16})
-          expect_same(full, run_compact(q, capacity, keys), keys, mode);
+          expect_same(full, run_compact(q, capacity, keys), keys);
     }
   }
 }
@@ -126,7 +122,7 @@ TEST(CompactQueryTest, WritesTheSubtilesPointsPastTheTopLevel) {
   for (const QueryPoint& p : full) deep = deep || p.id.depth > 0;
   ASSERT_TRUE(deep);
   for (std::size_t capacity : {std::size_t(300), std::size_t(1) << 16})
-    expect_same(full, run_compact(q, capacity, true), true, q.mode);
+    expect_same(full, run_compact(q, capacity, true), true);
 }
 
 TEST(CompactQueryTest, PartsOfARegionGiveItsPointsBitForBit) {
@@ -173,7 +169,7 @@ TEST(CompactQueryTest, ACursorServesTheFullAndTheCompactQueryAlike) {
     }
     if (s != Status::kBufferFull) break;
   }
-  expect_same(full, mixed, true, q.mode);
+  expect_same(full, mixed, true);
 }
 
 TEST(CompactQueryTest, KeysAreUniqueAndNameTheirPoint) {

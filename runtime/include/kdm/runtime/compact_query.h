@@ -39,11 +39,11 @@ struct CompactPoints {
 };
 
 /// query_points into a compact output: the same points in the same order, point i's position as floats
-/// at xy[2i], xy[2i + 1] and, if keys is not null, keys[i] = point_key(its id). In smooth mode a position
-/// is the double query_points writes, rounded to float; in stable mode it is computed in float from its
-/// tile's corner relative to the origin (whole tiles then convert as fast as a copy), within 2^-22 ·
-/// (|position| + tile_size) of that double. Either way it depends only on the point and the parameters, so
-/// partitions of a region give the same bits. Slots from *written to capacity may be overwritten. Statuses,
+/// at xy[2i], xy[2i + 1] and, if keys is not null, keys[i] = point_key(its id). A position lies within
+/// 2^-21 · (|position| + tile_size) of the double query_points writes: with a constant density it is
+/// computed in float from the tile's corner relative to the origin (and the point's glide offsets), so that
+/// whole tiles convert as fast as a copy; with a varying one it is that double rounded to float. Either way
+/// it depends only on the point and the parameters, so partitions of a region give the same bits. Slots from *written to capacity may be overwritten. Statuses,
 /// resumption (a cursor serves query_points and this function alike) and refusals as query_points', with
 /// parameter "out.xy" for a null xy with room in it, and kKeysUnsupported when keys are asked of a set
 /// whose tiles hold more than 2^19 points (ranks would not fit a key). No allocation.
