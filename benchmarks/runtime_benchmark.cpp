@@ -14,6 +14,7 @@
 
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/parallel_query.h"
 #include "kdm/runtime/query.h"
 
 // The built-in set's bytes, compiled into the runtime library (generated from tilesets/default.kdmt).
@@ -284,6 +285,57 @@ void BM_QueryCompact(benchmark::State& state) {
   state.counters["of_plain_copy"] = copy_seconds / seconds;
 }
 
+// One query of about 4 million points (16 × 16 tiles at 15,000 points each, BM_QueryConstant's density)
+// filled at once by ParallelQuery (args: smooth; compact, 1 for float positions and keys instead of
+// QueryPoint records; ramp, 1 for BM_QueryDensityCallback's ramp), on two workers in rounds alternating
+// with one worker: `speedup` is one worker's time over two's. Every round checks the two give the same bits.
+void BM_QueryParallel(benchmark::State& state) {
+  kdm::QueryParams q = params(state);
+  q.x1 = q.y1 = 2 * kSide;
+  if (state.range(2)) {
+    q.density.kind = kdm::QueryDensity::Kind::kCallback;
+    q.density.callback = ramp;
+    q.density.callback_max = 1;
+  }
+  const bool compact = state.range(1) != 0;
+  kdm::ParallelQuery one, two;
+  one.init(1), two.init(2);
+  const std::size_t capacity = std::size_t(1) << 22;
+  std::vector<kdm::QueryPoint> points[2];
+  std::vector<float> xy[2];
+  std::vector<std::uint64_t> keys[2];
+  for (int k = 0; k < 2; ++k) {
+    if (compact)
+      xy[k].resize(2 * capacity), keys[k].resize(capacity);
+    else
+      points[k].resize(capacity);
+  }
+  const kdm::TaskRunner threads = kdm::std_thread_runner();
+  std::size_t n[2] = {0, 0};
+  double seconds[2] = {0, 0};
+  auto run = [&](kdm::ParallelQuery& pq, int k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const kdm::Status s =
+        compact ? pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), keys[k].data()},
+                         capacity, &n[k], threads)
+                : pq.run(kdm::Tileset::builtin(), q, points[k].data(), capacity, &n[k], threads);
+    seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return s == kdm::Status::kOk;
+  };
+  for (auto _ : state) {
+    if (!run(one, 0) || !run(two, 1)) return state.SkipWithError("the query did not fit");
+    const bool same =
+        n[0] == n[1] &&
+        (compact ? std::memcmp(xy[0].data(), xy[1].data(), 2 * n[0] * sizeof(float)) == 0 &&
+                       std::memcmp(keys[0].data(), keys[1].data(), n[0] * 8) == 0
+                 : std::memcmp(points[0].data(), points[1].data(), n[0] * sizeof(kdm::QueryPoint)) == 0);
+    if (!same) return state.SkipWithError("one and two workers gave different bits");
+  }
+  report(state, n[1]);
+  state.counters["speedup"] = seconds[0] / seconds[1];
+  state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
+}
+
 void BM_QueryConstantReusedBuffer(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 16);
   std::size_t n = 0;
@@ -319,6 +371,15 @@ BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchma
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryCompact)
     ->ArgNames({"smooth", "keys", "ramp"})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 1, 1})
+    ->Args({1, 1, 1})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryParallel)
+    ->ArgNames({"smooth", "compact", "ramp"})
     ->Args({0, 0, 0})
     ->Args({1, 0, 0})
     ->Args({0, 1, 0})

@@ -60,6 +60,25 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
           });
 }
 
+void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
+                  const ParameterNames& names) {
+  xy.clear();
+  QueryCursor cursor;
+  for (std::size_t m = 0;;) {
+    xy.resize(2 * (m + (std::size_t(1) << 16)));
+    std::size_t written = 0;
+    QueryProblem problem;
+    const Status s = query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * m, nullptr},
+                                          xy.size() / 2 - m, &written, &cursor, &problem);
+    m += written;
+    xy.resize(2 * m);
+    if (m > kMaxCollectedPoints)
+      throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
+    if (s == Status::kOk) return;
+    if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
+  }
+}
+
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const ParameterNames& names) {
   classes.clear();
@@ -81,6 +100,19 @@ PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r
   set.coords.reserve(points.size() * 2);
   for (const QueryPoint& p : points)
     set.coords.insert(set.coords.end(), {std::min(p.x / w, below_one), std::min(p.y / h, below_one)});
+  return set;
+}
+
+PointSet normalise_to_rect(const std::vector<float>& xy, const double r[4]) {
+  const double w = r[2] - r[0], h = r[3] - r[1], below_one = std::nextafter(1.0, 0.0);
+  PointSet set;
+  set.dim = 2;
+  set.coords.resize(xy.size());
+  // A float position just below the region's far side may round onto it; clamp as for doubles, and at 0.
+  for (std::size_t i = 0; i < xy.size(); i += 2) {
+    set.coords[i] = std::clamp(xy[i] / w, 0.0, below_one);
+    set.coords[i + 1] = std::clamp(xy[i + 1] / h, 0.0, below_one);
+  }
   return set;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 #include "point_io.h"
 
@@ -30,6 +31,10 @@ std::string describe(const QueryProblem& problem, const ParameterNames& names = 
 /// on bad parameters, std::runtime_error when more than kMaxCollectedPoints points would be emitted.
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names = {});
+/// The same into the compact output (compact_query.h): positions only, `xy` (replaced) holding x, y
+/// pairs relative to the query origin, as fast as the runtime writes them.
+void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
+                  const ParameterNames& names = {});
 /// The same for several classes: `classes` (replaced) receives each point's class.
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
@@ -37,5 +42,7 @@ void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vect
 /// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
 /// point set normalised to it: [0, 1) on both axes.
 PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]);
+/// The same for x, y pairs (query_all_xy's).
+PointSet normalise_to_rect(const std::vector<float>& xy, const double r[4]);
 
 }  // namespace kdm::tools

@@ -1,0 +1,90 @@
+// One large query split over several threads, for callers that fill a large region at once: the region is
+// cut into units (runs of tiles, or parts of a tile where a tile holds many points), fixed by the
+// parameters alone; workers take units in order, query each into their own scratch, learn where it goes
+// once the unit before it has counted its points, and copy it there. The result is the units' points in
+// unit order: the same bits for any number of threads or any task system, and the same points as
+// query_points (in stable mode also in its order where no tile is cut into parts, as units then follow
+// its tile order; in smooth mode the points that glide across a unit's side come with that unit).
+//
+// The runtime library starts no threads: the caller gives a task system (TaskRunner), or the inline
+// std::thread one below.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+#include "kdm/runtime/allocator.h"
+#include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/export.h"
+#include "kdm/runtime/query.h"
+#include "kdm/runtime/status.h"
+#include "kdm/runtime/tileset.h"
+
+namespace kdm {
+
+/// A caller's task system: run(context, task, task_context, count) calls task(task_context, i) once for
+/// every i in [0, count), on as many threads as it has, and returns when all have returned. The tasks
+/// wait for one another (each for the unit before its own), so they must run concurrently, not one after
+/// another on one thread unless that thread runs them all in turn (as a sequential runner does).
+struct TaskRunner {
+  void (*run)(void* context, void (*task)(void* task_context, std::size_t index), void* task_context,
+              std::size_t count) = nullptr;
+  void* context = nullptr;
+};
+
+/// A TaskRunner over std::thread: count - 1 new threads and the caller's. Inline, so only a program that
+/// uses it links threads.
+inline TaskRunner std_thread_runner() {
+  TaskRunner r;
+  r.run = [](void*, void (*task)(void*, std::size_t), void* task_context, std::size_t count) {
+    std::vector<std::thread> threads;
+    for (std::size_t i = 1; i < count; ++i) threads.emplace_back(task, task_context, i);
+    if (count > 0) task(task_context, 0);
+    for (std::thread& t : threads) t.join();
+  };
+  return r;
+}
+
+/// Most workers one ParallelQuery serves.
+inline constexpr std::uint32_t kMaxParallelWorkers = 64;
+
+/// Points a worker's scratch holds: a unit is sized to expect at most this many.
+inline constexpr std::size_t kParallelUnitPoints = std::size_t(1) << 15;
+
+/// The per-worker scratch of parallel queries, allocated once by init (through the tile-set allocator
+/// hooks, allocator.h); run then allocates nothing. One ParallelQuery serves one run at a time.
+class KDM_RUNTIME_API ParallelQuery {
+ public:
+  /// Scratch for `workers` workers (1 … kMaxParallelWorkers; about 1.8 MB each). kInvalidArgument for a
+  /// count out of range.
+  Status init(std::uint32_t workers);
+  std::uint32_t workers() const { return workers_; }
+
+  /// The region's points into out[0 .. capacity) in unit order, `*written` the count, with `workers()`
+  /// tasks on `runner`. kOk when all fit; kBufferFull when there were more (out holds the first
+  /// `capacity`, `*needed` the full count if not null: call again with room for it). kInvalidArgument with
+  /// `problem` as query_points refuses the parameters, or for a ParallelQuery not initialised or a runner
+  /// without a run function.
+  Status run(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
+             std::size_t* written, const TaskRunner& runner, std::size_t* needed = nullptr,
+             QueryProblem* problem = nullptr);
+  /// The same into a compact output (compact_query.h).
+  Status run(const Tileset& tileset, const QueryParams& params, const CompactPoints& out,
+             std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+             std::size_t* needed = nullptr, QueryProblem* problem = nullptr);
+
+ private:
+  template <class Output>
+  Status run_into(const Tileset& tileset, const QueryParams& params, const Output& out, std::size_t capacity,
+                  std::size_t* written, const TaskRunner& runner, std::size_t* needed, QueryProblem* problem);
+
+  std::uint32_t workers_ = 0;
+  TilesetArray<QueryPoint> points_;   ///< workers × kParallelUnitPoints
+  TilesetArray<float> xy_;            ///< workers × 2 · kParallelUnitPoints
+  TilesetArray<std::uint64_t> keys_;  ///< workers × kParallelUnitPoints
+};
+
+}  // namespace kdm

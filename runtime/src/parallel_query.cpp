@@ -1,0 +1,220 @@
+// One query over several threads; see kdm/runtime/parallel_query.h.
+#include "kdm/runtime/parallel_query.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include "kdm/runtime/check.h"
+
+namespace kdm {
+namespace {
+
+/// The units of a region: a grid of cells (tiles, or g × g parts of each where a tile expects more than a
+/// unit's points), rows bottom to top, each row cut into runs of `per_unit` cells. Every boundary is
+/// computed from its integer cell index alone, so neighbouring units share it bit for bit.
+struct UnitGrid {
+  double cell = 1;
+  std::int64_t cx0 = 0, cy0 = 0;  ///< the first cell's index
+  std::int64_t columns = 0, rows = 0, per_unit = 1;
+
+  std::size_t units() const { return static_cast<std::size_t>(rows * ((columns + per_unit - 1) / per_unit)); }
+  /// Unit u's query: `whole` over its cells, clipped to the whole region.
+  QueryParams unit(const QueryParams& whole, std::size_t u) const {
+    const std::int64_t per_row = (columns + per_unit - 1) / per_unit;
+    const std::int64_t row = static_cast<std::int64_t>(u) / per_row,
+                       run = static_cast<std::int64_t>(u) % per_row;
+    const std::int64_t c0 = run * per_unit, c1 = std::min(columns, c0 + per_unit);
+    QueryParams q = whole;
+    q.x0 = std::max(whole.x0, double(cx0 + c0) * cell), q.x1 = std::min(whole.x1, double(cx0 + c1) * cell);
+    q.y0 = std::max(whole.y0, double(cy0 + row) * cell),
+    q.y1 = std::min(whole.y1, double(cy0 + row + 1) * cell);
+    if (c0 == 0) q.x0 = whole.x0;  // the region's own sides, not a rounding of them
+    if (c1 == columns) q.x1 = whole.x1;
+    if (row == 0) q.y0 = whole.y0;
+    if (row + 1 == rows) q.y1 = whole.y1;
+    return q;
+  }
+};
+
+/// Most cells a tile is cut into per side: units of a denser tile hold more than a unit's points.
+constexpr std::int64_t kMaxCellsPerTileSide = 1024;
+
+UnitGrid plan_units(const QueryParams& q) {
+  double rho = 0;  // an upper bound of the density (the query has accepted it)
+  switch (q.density.kind) {
+    case QueryDensity::Kind::kConstant:
+      rho = q.density.constant;
+      break;
+    case QueryDensity::Kind::kImage:
+      rho = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
+      break;
+    case QueryDensity::Kind::kCallback:
+      rho = q.density.callback_max;
+      break;
+  }
+  const double per_tile = std::max(rho, 0.0) * q.tile_size * q.tile_size * q.scale;
+  const double target = double(kParallelUnitPoints) / 2;  // room for a loose bound and the glide's margin
+  UnitGrid g;
+  std::int64_t split = 1;
+  if (per_tile > target)
+    split =
+        std::min<std::int64_t>(kMaxCellsPerTileSide, std::int64_t(std::ceil(std::sqrt(per_tile / target))));
+  g.cell = q.tile_size / double(split);
+  g.cx0 = std::int64_t(std::floor(q.x0 / q.tile_size)) * split;
+  g.cy0 = std::int64_t(std::floor(q.y0 / q.tile_size)) * split;
+  g.columns = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.x1 / g.cell)) - g.cx0);
+  g.rows = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.y1 / g.cell)) - g.cy0);
+  const double per_cell = per_tile / double(split * split);
+  g.per_unit = per_cell > 0 ? std::max<std::int64_t>(1, std::int64_t(target / per_cell)) : g.columns;
+  return g;
+}
+
+/// Where a worker's unit goes and what it reads: QueryPoint records or compact arrays.
+struct PointOutput {
+  QueryPoint* out;
+  QueryPoint* scratch;  // of this worker
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
+    return query_points(t, q, scratch, kParallelUnitPoints, w, c);
+  }
+  bool has_output() const { return out != nullptr; }
+  void copy(std::size_t to, std::size_t count) const { std::memcpy(out + to, scratch, count * sizeof *out); }
+};
+
+struct CompactOutput {
+  CompactPoints out, scratch;
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
+    return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c);
+  }
+  bool has_output() const { return out.xy != nullptr; }
+  void copy(std::size_t to, std::size_t count) const {
+    std::memcpy(out.xy + 2 * to, scratch.xy, 2 * count * sizeof(float));
+    if (out.keys) std::memcpy(out.keys + to, scratch.keys, count * sizeof(std::uint64_t));
+  }
+};
+
+/// What the workers share: the units, the next unit to take, and the end of the last unit counted.
+template <class Output>
+struct Job {
+  const Tileset* tileset;
+  const QueryParams* params;
+  UnitGrid grid;
+  std::size_t units, capacity;
+  const Output* outputs;  // one per worker
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> counted{0};  // units [0, counted) have their places; `end` follows the last
+  std::atomic<std::size_t> end{0};
+
+  /// Unit u's first slot, once every unit before it has counted its points.
+  std::size_t place_of(std::size_t u) {
+    while (counted.load(std::memory_order_acquire) != u) std::this_thread::yield();
+    return end.load(std::memory_order_relaxed);
+  }
+
+  void work(std::size_t worker) {
+    const Output& o = outputs[worker];
+    for (;;) {
+      const std::size_t u = next.fetch_add(1, std::memory_order_relaxed);
+      if (u >= units) return;
+      const QueryParams part = grid.unit(*params, u);
+      QueryCursor cursor;
+      constexpr std::size_t kUnplaced = std::numeric_limits<std::size_t>::max();
+      std::size_t base = kUnplaced, count = 0;
+      for (;;) {
+        std::size_t w = 0;
+        const Status s = o.query(*tileset, part, &w, &cursor);
+        KDM_CHECK(s == Status::kOk || s == Status::kBufferFull);  // the whole query was accepted
+        const bool last = s == Status::kOk;
+        // A unit waits for its place before its first copy and, once counted, publishes its end before
+        // copying, so the next unit waits for this one's count, not for its copy.
+        if (base == kUnplaced) base = place_of(u);
+        if (last) {
+          end.store(base + count + w, std::memory_order_relaxed);
+          counted.store(u + 1, std::memory_order_release);
+        }
+        if (base + count < capacity) o.copy(base + count, std::min(w, capacity - base - count));
+        count += w;
+        if (last) break;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+Status ParallelQuery::init(std::uint32_t workers) {
+  if (workers < 1 || workers > kMaxParallelWorkers) return Status::kInvalidArgument;
+  workers_ = workers;
+  points_.assign(std::size_t(workers) * kParallelUnitPoints, QueryPoint{});
+  xy_.assign(std::size_t(workers) * 2 * kParallelUnitPoints, 0.0f);
+  keys_.assign(std::size_t(workers) * kParallelUnitPoints, 0);
+  return Status::kOk;
+}
+
+template <class Output>
+Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, const Output& out,
+                               std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+                               std::size_t* needed, QueryProblem* problem) {
+  // The whole query's refusals, from a call with no room (it stops at the first point).
+  QueryCursor probe;
+  std::size_t none = 0;
+  Status s;
+  if constexpr (std::is_same_v<Output, CompactOutput>)
+    s = query_points_compact(tileset, q, CompactPoints{out.out.xy, out.out.keys}, 0, &none, &probe, problem);
+  else
+    s = query_points(tileset, q, out.out, 0, &none, &probe, problem);
+  if (written) *written = 0;
+  if (needed) *needed = 0;
+  if (s == Status::kInvalidArgument) return s;
+  QueryProblem why;
+  QueryProblem& p = problem ? *problem : why;
+  auto refuse = [&](QueryProblem::Kind kind, const char* parameter) {
+    p = QueryProblem{};
+    p.kind = kind, p.parameter = parameter;
+    return Status::kInvalidArgument;
+  };
+  if (workers_ == 0) return refuse(QueryProblem::Kind::kMissingArgument, "ParallelQuery::init");
+  if (!runner.run) return refuse(QueryProblem::Kind::kMissingArgument, "runner.run");
+  if (capacity > 0 && !out.has_output()) return refuse(QueryProblem::Kind::kMissingArgument, "out");
+  if (s == Status::kOk) return Status::kOk;  // no point at all
+
+  Job<Output> job;
+  job.tileset = &tileset, job.params = &q;
+  job.grid = plan_units(q);
+  job.units = job.grid.units(), job.capacity = capacity;
+  Output outputs[kMaxParallelWorkers];
+  for (std::uint32_t w = 0; w < workers_; ++w) {
+    outputs[w] = out;
+    if constexpr (std::is_same_v<Output, CompactOutput>)
+      outputs[w].scratch =
+          CompactPoints{xy_.data() + std::size_t(w) * 2 * kParallelUnitPoints,
+                        out.out.keys ? keys_.data() + std::size_t(w) * kParallelUnitPoints : nullptr};
+    else
+      outputs[w].scratch = points_.data() + std::size_t(w) * kParallelUnitPoints;
+  }
+  job.outputs = outputs;
+  runner.run(
+      runner.context, [](void* j, std::size_t worker) { static_cast<Job<Output>*>(j)->work(worker); }, &job,
+      workers_);
+  const std::size_t total = job.end.load();
+  if (written) *written = std::min(total, capacity);
+  if (needed) *needed = total;
+  return total <= capacity ? Status::kOk : Status::kBufferFull;
+}
+
+Status ParallelQuery::run(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
+                          std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+                          std::size_t* needed, QueryProblem* problem) {
+  return run_into(tileset, params, PointOutput{out, nullptr}, capacity, written, runner, needed, problem);
+}
+
+Status ParallelQuery::run(const Tileset& tileset, const QueryParams& params, const CompactPoints& out,
+                          std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+                          std::size_t* needed, QueryProblem* problem) {
+  return run_into(tileset, params, CompactOutput{out, {}}, capacity, written, runner, needed, problem);
+}
+
+}  // namespace kdm

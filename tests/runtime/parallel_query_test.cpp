@@ -1,0 +1,187 @@
+// One query over several threads: the same bits for any worker count and task system, the same points as
+// query_points (in stable mode in its order too), dense tiles cut into parts, a short buffer, refusals, no
+// allocation in a run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "allocation_counter.h"
+#include "kdm/runtime/parallel_query.h"
+
+namespace kdm {
+namespace {
+
+TaskRunner sequential_runner() {
+  TaskRunner r;
+  r.run = [](void*, void (*task)(void*, std::size_t), void* context, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) task(context, i);
+  };
+  return r;
+}
+
+std::vector<QueryPoint> run_whole(const QueryParams& q) {
+  std::vector<QueryPoint> all, out(1 << 16);
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull);
+    all.insert(all.end(), out.begin(), out.begin() + written);
+    if (s != Status::kBufferFull) return all;
+  }
+}
+
+std::vector<QueryPoint> run_parallel(const QueryParams& q, std::uint32_t workers, const TaskRunner& runner) {
+  ParallelQuery pq;
+  EXPECT_EQ(pq.init(workers), Status::kOk);
+  std::vector<QueryPoint> out(1 << 21);
+  std::size_t written = 0, needed = 0;
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, runner, &needed), Status::kOk);
+  EXPECT_EQ(written, needed);
+  out.resize(written);
+  return out;
+}
+
+bool same_bits(const std::vector<QueryPoint>& a, const std::vector<QueryPoint>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(QueryPoint)) == 0;
+}
+
+using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
+std::map<Key, std::pair<double, double>> by_id(const std::vector<QueryPoint>& points) {
+  std::map<Key, std::pair<double, double>> m;
+  for (const QueryPoint& p : points)
+    EXPECT_TRUE(
+        m.emplace(Key{p.id.tile_x, p.id.tile_y, p.id.rank, p.id.depth}, std::make_pair(p.x, p.y)).second);
+  return m;
+}
+
+double ramp(void*, double x, double) {
+  return 0.2 + 0.1 * x;
+}
+
+QueryParams region(QueryMode mode, int kind) {
+  QueryParams q;
+  q.x0 = -2.3, q.y0 = 0.6, q.x1 = 4.2, q.y1 = 5.1;
+  q.origin_x = 1, q.origin_y = 2;
+  q.scale = 20000;  // units of two tiles' runs: many units
+  q.mode = mode;
+  if (kind == 1) {
+    q.density.kind = QueryDensity::Kind::kCallback;
+    q.density.callback = ramp, q.density.callback_max = 0.7;
+  }
+  return q;
+}
+
+TEST(ParallelQueryTest, GivesTheSameBitsForAnyWorkerCountAndTheWholeQuerysPoints) {
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    for (int kind = 0; kind < 2; ++kind) {
+      SCOPED_TRACE(::testing::Message() << "mode " << int(mode) << " kind " << kind);
+      const QueryParams q = region(mode, kind);
+      const std::vector<QueryPoint> whole = run_whole(q);
+      const std::vector<QueryPoint> one = run_parallel(q, 1, sequential_runner());
+      ASSERT_GT(one.size(), 100000u);
+      EXPECT_TRUE(same_bits(one, run_parallel(q, 2, std_thread_runner())));
+      EXPECT_TRUE(same_bits(one, run_parallel(q, 3, std_thread_runner())));
+      EXPECT_TRUE(same_bits(one, run_parallel(q, 2, sequential_runner())));
+      EXPECT_TRUE(by_id(one) == by_id(whole));
+    }
+  }
+}
+
+TEST(ParallelQueryTest, KeepsTheWholeQuerysOrderInStableModeWhereTilesAreWhole) {
+  QueryParams q = region(QueryMode::kStable, 1);
+  q.scale = 3000;  // runs of several tiles, none cut
+  const std::vector<QueryPoint> whole = run_whole(q);
+  ASSERT_GT(whole.size(), 20000u);
+  EXPECT_TRUE(same_bits(run_parallel(q, 2, std_thread_runner()), whole));
+}
+
+TEST(ParallelQueryTest, CutsDenseTilesAndWritesCompactOutput) {
+  QueryParams q;
+  q.x0 = 0.1, q.y0 = 0.2, q.x1 = 1.3, q.y1 = 1.1;
+  q.mode = QueryMode::kSmooth;
+  q.scale = 2 * Tileset::builtin().max_points_per_tile();  // past the top: tiles cut into parts
+  const std::vector<QueryPoint> whole = run_whole(q);
+  ASSERT_GT(whole.size(), 60000u);
+  const std::vector<QueryPoint> two = run_parallel(q, 2, std_thread_runner());
+  EXPECT_TRUE(by_id(two) == by_id(whole));
+  // The compact form: the records' points, in their order, as floats and keys.
+  ParallelQuery pq;
+  ASSERT_EQ(pq.init(2), Status::kOk);
+  std::vector<float> xy(2 * two.size());
+  std::vector<std::uint64_t> keys(two.size());
+  std::size_t written = 0;
+  ASSERT_EQ(pq.run(Tileset::builtin(), q, CompactPoints{xy.data(), keys.data()}, keys.size(), &written,
+                   std_thread_runner()),
+            Status::kOk);
+  ASSERT_EQ(written, two.size());
+  for (std::size_t i = 0; i < written; ++i) {
+    ASSERT_EQ(keys[i], point_key(two[i].id)) << i;
+    ASSERT_LE(std::fabs(xy[2 * i] - two[i].x), std::ldexp(std::fabs(two[i].x) + 1, -21));
+  }
+}
+
+TEST(ParallelQueryTest, AShortBufferHoldsThePrefixAndTellsTheCount) {
+  const QueryParams q = region(QueryMode::kSmooth, 0);
+  const std::vector<QueryPoint> all = run_parallel(q, 2, std_thread_runner());
+  ParallelQuery pq;
+  ASSERT_EQ(pq.init(2), Status::kOk);
+  std::vector<QueryPoint> out(all.size() / 3);
+  std::size_t written = 0, needed = 0;
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, std_thread_runner(), &needed),
+            Status::kBufferFull);
+  EXPECT_EQ(written, out.size());
+  EXPECT_EQ(needed, all.size());
+  EXPECT_EQ(std::memcmp(out.data(), all.data(), out.size() * sizeof(QueryPoint)), 0);
+}
+
+TEST(ParallelQueryTest, RefusesByName) {
+  ParallelQuery pq;
+  std::vector<QueryPoint> out(16);
+  std::size_t written = 0;
+  QueryProblem why;
+  QueryParams q = region(QueryMode::kStable, 0);
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, sequential_runner(), nullptr, &why),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "ParallelQuery::init");
+  EXPECT_EQ(pq.init(0), Status::kInvalidArgument);
+  EXPECT_EQ(pq.init(kMaxParallelWorkers + 1), Status::kInvalidArgument);
+  ASSERT_EQ(pq.init(2), Status::kOk);
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, TaskRunner{}, nullptr, &why),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "runner.run");
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, static_cast<QueryPoint*>(nullptr), 16, &written,
+                   sequential_runner(), nullptr, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kMissingArgument);
+  q.scale = -1;  // refused as query_points refuses it
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, sequential_runner(), nullptr, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kNegative);
+  EXPECT_STREQ(why.parameter, "scale");
+  q = region(QueryMode::kStable, 0);
+  q.x1 = q.x0;  // empty: no point, kOk
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, sequential_runner()), Status::kOk);
+  EXPECT_EQ(written, 0u);
+}
+
+TEST(ParallelQueryTest, ARunAllocatesNothing) {
+  const QueryParams q = region(QueryMode::kSmooth, 1);
+  ParallelQuery pq;
+  ASSERT_EQ(pq.init(2), Status::kOk);
+  std::vector<QueryPoint> out(1 << 21);
+  (void)Tileset::builtin();
+  std::size_t written = 0;
+  const long before = testing::allocations();
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, sequential_runner()),
+            Status::kOk);
+  EXPECT_EQ(testing::allocations(), before);
+  EXPECT_GT(written, 100000u);
+}
+
+}  // namespace
+}  // namespace kdm
