@@ -43,10 +43,11 @@ struct CompactPoints {
 /// 2^-21 · (|position| + tile_size) of the double query_points writes: with a constant density it is
 /// computed in float from the tile's corner relative to the origin (and the point's glide offsets), so that
 /// whole tiles convert as fast as a copy; with a varying one it is that double rounded to float. Either way
-/// it depends only on the point and the parameters, so partitions of a region give the same bits. Slots from *written to capacity may be overwritten. Statuses,
-/// resumption (a cursor serves query_points and this function alike) and refusals as query_points', with
-/// parameter "out.xy" for a null xy with room in it, and kKeysUnsupported when keys are asked of a set
-/// whose tiles hold more than 2^19 points (ranks would not fit a key). No allocation.
+/// it depends only on the point and the parameters, so partitions of a region give the same bits. Slots from
+/// *written to capacity may be overwritten. Statuses, resumption (a cursor serves query_points and this
+/// function alike) and refusals as query_points', with parameter "out.xy" for a null xy with room in it, and
+/// kKeysUnsupported when keys are asked of a set whose tiles hold more than 2^19 points (ranks would not fit
+/// a key). No allocation.
 KDM_RUNTIME_API Status query_points_compact(const Tileset& tileset, const QueryParams& params,
                                             const CompactPoints& out, std::size_t capacity,
                                             std::size_t* written, QueryCursor* cursor,
