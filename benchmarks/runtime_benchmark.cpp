@@ -288,7 +288,8 @@ void BM_QueryCompact(benchmark::State& state) {
 // One query of about 4 million points (16 × 16 tiles at 15,000 points each, BM_QueryConstant's density)
 // filled at once by ParallelQuery (args: smooth; compact, 1 for float positions and keys instead of
 // QueryPoint records; ramp, 1 for BM_QueryDensityCallback's ramp), on two workers in rounds alternating
-// with one worker: `speedup` is one worker's time over two's. Every round checks the two give the same bits.
+// with one worker and with one plain query into the same memory: `speedup` is one worker's time over two's,
+// `of_one_query` the plain query's over two workers'. Every round checks one and two workers' bits agree.
 void BM_QueryParallel(benchmark::State& state) {
   kdm::QueryParams q = params(state);
   q.x1 = q.y1 = 2 * kSide;
@@ -322,7 +323,25 @@ void BM_QueryParallel(benchmark::State& state) {
     seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return s == kdm::Status::kOk;
   };
+  double plain_seconds = 0;  // query_points / query_points_compact into the same memory, one thread
+  auto run_plain = [&]() {
+    const auto t0 = std::chrono::steady_clock::now();
+    kdm::QueryCursor cursor;
+    std::size_t written = 0, total = 0;
+    kdm::Status s;
+    do {
+      s = compact ? kdm::query_points_compact(
+                        kdm::Tileset::builtin(), q,
+                        kdm::CompactPoints{xy[0].data() + 2 * total, keys[0].data() + total},
+                        capacity - total, &written, &cursor)
+                  : kdm::query_points(kdm::Tileset::builtin(), q, points[0].data() + total, capacity - total,
+                                      &written, &cursor);
+      total += written;
+    } while (s == kdm::Status::kBufferFull && total < capacity);
+    plain_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   for (auto _ : state) {
+    run_plain();
     if (!run(one, 0) || !run(two, 1)) return state.SkipWithError("the query did not fit");
     const bool same =
         n[0] == n[1] &&
@@ -333,6 +352,7 @@ void BM_QueryParallel(benchmark::State& state) {
   }
   report(state, n[1]);
   state.counters["speedup"] = seconds[0] / seconds[1];
+  state.counters["of_one_query"] = plain_seconds / seconds[1];
   state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
 }
 

@@ -155,6 +155,16 @@ inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const Con
   }
 }
 
+/// Counts without writing (detail::count_points).
+struct CountSink {
+  void put(std::size_t, double, double, const PointId&) const {}
+  void put_stable(std::size_t, const TileJob&, TilePoint, std::uint32_t) const {}
+  void put_stable_run(std::size_t, const TileJob&, std::uint32_t, std::uint32_t) const {}
+  void put_glided(std::size_t, const TileJob&, const ConstantGlide&, std::uint32_t) const {}
+  void put_glided_run(std::size_t, const TileJob&, const ConstantGlide&, std::uint32_t, std::uint32_t) const {
+  }
+};
+
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
 /// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of

@@ -9,41 +9,48 @@
 #include <thread>
 
 #include "kdm/runtime/check.h"
+#include "query_counted.h"
 
 namespace kdm {
 namespace {
 
 /// The units of a region: a grid of cells (tiles, or g × g parts of each where a tile expects more than a
-/// unit's points), rows bottom to top, each row cut into runs of `per_unit` cells. Every boundary is
-/// computed from its integer cell index alone, so neighbouring units share it bit for bit.
+/// unit's points) cut into blocks of `across` × `down` cells, in rows of blocks bottom to top. Every
+/// boundary is computed from its integer cell index alone, so neighbouring units share it bit for bit.
 struct UnitGrid {
   double cell = 1;
   std::int64_t cx0 = 0, cy0 = 0;  ///< the first cell's index
-  std::int64_t columns = 0, rows = 0, per_unit = 1;
+  std::int64_t columns = 0, rows = 0, across = 1, down = 1;
 
-  std::size_t units() const { return static_cast<std::size_t>(rows * ((columns + per_unit - 1) / per_unit)); }
+  std::int64_t per_row() const { return (columns + across - 1) / across; }
+  std::size_t units() const { return static_cast<std::size_t>(per_row() * ((rows + down - 1) / down)); }
   /// Unit u's query: `whole` over its cells, clipped to the whole region.
   QueryParams unit(const QueryParams& whole, std::size_t u) const {
-    const std::int64_t per_row = (columns + per_unit - 1) / per_unit;
-    const std::int64_t row = static_cast<std::int64_t>(u) / per_row,
-                       run = static_cast<std::int64_t>(u) % per_row;
-    const std::int64_t c0 = run * per_unit, c1 = std::min(columns, c0 + per_unit);
+    const std::int64_t block_row = static_cast<std::int64_t>(u) / per_row();
+    const std::int64_t c0 = static_cast<std::int64_t>(u) % per_row() * across,
+                       c1 = std::min(columns, c0 + across);
+    const std::int64_t r0 = block_row * down, r1 = std::min(rows, r0 + down);
     QueryParams q = whole;
     q.x0 = std::max(whole.x0, double(cx0 + c0) * cell), q.x1 = std::min(whole.x1, double(cx0 + c1) * cell);
-    q.y0 = std::max(whole.y0, double(cy0 + row) * cell),
-    q.y1 = std::min(whole.y1, double(cy0 + row + 1) * cell);
+    q.y0 = std::max(whole.y0, double(cy0 + r0) * cell), q.y1 = std::min(whole.y1, double(cy0 + r1) * cell);
     if (c0 == 0) q.x0 = whole.x0;  // the region's own sides, not a rounding of them
     if (c1 == columns) q.x1 = whole.x1;
-    if (row == 0) q.y0 = whole.y0;
-    if (row + 1 == rows) q.y1 = whole.y1;
+    if (r0 == 0) q.y0 = whole.y0;
+    if (r1 == rows) q.y1 = whole.y1;
     return q;
   }
 };
 
+/// Points a unit aims at when it is counted first and written in place (a constant density): large units,
+/// as only their count waits for the unit before.
+constexpr double kDirectUnitPoints = double(std::size_t(1) << 20);
+
 /// Most cells a tile is cut into per side: units of a denser tile hold more than a unit's points.
 constexpr std::int64_t kMaxCellsPerTileSide = 1024;
 
-UnitGrid plan_units(const QueryParams& q) {
+/// Units that expect about `target` points: runs along a row in stable mode (units then follow the whole
+/// query's tile order), square blocks in smooth mode (fewer tiles beside a unit whose points glide in).
+UnitGrid plan_units(const QueryParams& q, double target) {
   double rho = 0;  // an upper bound of the density (the query has accepted it)
   switch (q.density.kind) {
     case QueryDensity::Kind::kConstant:
@@ -57,7 +64,6 @@ UnitGrid plan_units(const QueryParams& q) {
       break;
   }
   const double per_tile = std::max(rho, 0.0) * q.tile_size * q.tile_size * q.scale;
-  const double target = double(kParallelUnitPoints) / 2;  // room for a loose bound and the glide's margin
   UnitGrid g;
   std::int64_t split = 1;
   if (per_tile > target)
@@ -69,7 +75,11 @@ UnitGrid plan_units(const QueryParams& q) {
   g.columns = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.x1 / g.cell)) - g.cx0);
   g.rows = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.y1 / g.cell)) - g.cy0);
   const double per_cell = per_tile / double(split * split);
-  g.per_unit = per_cell > 0 ? std::max<std::int64_t>(1, std::int64_t(target / per_cell)) : g.columns;
+  const double cells = per_cell > 0 ? std::min(target / per_cell, 1e12) : 1e12;
+  if (q.mode == QueryMode::kSmooth && split == 1)
+    g.across = g.down = std::max<std::int64_t>(1, std::int64_t(std::sqrt(cells)));
+  else
+    g.across = std::max<std::int64_t>(1, std::int64_t(cells)), g.down = 1;
   return g;
 }
 
@@ -80,6 +90,10 @@ struct PointOutput {
   Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
     return query_points(t, q, scratch, kParallelUnitPoints, w, c);
   }
+  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
+                        std::size_t* w, QueryCursor* c) const {
+    return query_points(t, q, out + at, room, w, c);
+  }
   bool has_output() const { return out != nullptr; }
   void copy(std::size_t to, std::size_t count) const { std::memcpy(out + to, scratch, count * sizeof *out); }
 };
@@ -88,6 +102,11 @@ struct CompactOutput {
   CompactPoints out, scratch;
   Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
     return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c);
+  }
+  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
+                        std::size_t* w, QueryCursor* c) const {
+    return query_points_compact(t, q, CompactPoints{out.xy + 2 * at, out.keys ? out.keys + at : nullptr},
+                                room, w, c);
   }
   bool has_output() const { return out.xy != nullptr; }
   void copy(std::size_t to, std::size_t count) const {
@@ -103,6 +122,7 @@ struct Job {
   const QueryParams* params;
   UnitGrid grid;
   std::size_t units, capacity;
+  bool direct;            // count_and_write, else through each worker's scratch
   const Output* outputs;  // one per worker
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> counted{0};  // units [0, counted) have their places; `end` follows the last
@@ -114,12 +134,41 @@ struct Job {
     return end.load(std::memory_order_relaxed);
   }
 
+  /// Counts unit u, takes its place, then writes it there: no copy (a constant density, whose count costs
+  /// little beside its writing).
+  void count_and_write(const Output& o, std::size_t u, const QueryParams& part) {
+    QueryCursor cursor;
+    std::size_t count = 0;
+    for (;;) {
+      std::size_t c = 0;
+      const Status s = detail::count_points(*tileset, part, &c, &cursor);
+      KDM_CHECK(s == Status::kOk || s == Status::kBufferFull);
+      count += c;
+      if (s == Status::kOk) break;
+    }
+    const std::size_t base = place_of(u);
+    end.store(base + count, std::memory_order_relaxed);
+    counted.store(u + 1, std::memory_order_release);
+    const std::size_t room = base < capacity ? std::min(count, capacity - base) : 0;
+    cursor = QueryCursor{};
+    for (std::size_t done = 0; done < room;) {
+      std::size_t w = 0;
+      const Status s = o.query_in_place(*tileset, part, base + done, room - done, &w, &cursor);
+      done += w;
+      if (s != Status::kBufferFull) break;
+    }
+  }
+
   void work(std::size_t worker) {
     const Output& o = outputs[worker];
     for (;;) {
       const std::size_t u = next.fetch_add(1, std::memory_order_relaxed);
       if (u >= units) return;
       const QueryParams part = grid.unit(*params, u);
+      if (direct) {
+        count_and_write(o, u, part);
+        continue;
+      }
       QueryCursor cursor;
       constexpr std::size_t kUnplaced = std::numeric_limits<std::size_t>::max();
       std::size_t base = kUnplaced, count = 0;
@@ -183,7 +232,10 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
 
   Job<Output> job;
   job.tileset = &tileset, job.params = &q;
-  job.grid = plan_units(q);
+  // A constant density's units are counted, then written in place; a varying one's, whose count costs
+  // as much as the query, go through the scratch (room for a loose bound and the glide's margin).
+  job.direct = q.density.kind == QueryDensity::Kind::kConstant;
+  job.grid = plan_units(q, job.direct ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
   job.units = job.grid.units(), job.capacity = capacity;
   Output outputs[kMaxParallelWorkers];
   for (std::uint32_t w = 0; w < workers_; ++w) {

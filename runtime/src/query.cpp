@@ -43,11 +43,11 @@ bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, 
   return detail::emit_descending(descent, tx, ty, index, out.points, capacity, n, budget, at);
 }
 
-/// The same for a compact output, through QueryPoint records on the stack: the descent's own loops write
+/// The same for another sink, through QueryPoint records on the stack: the descent's own loops write
 /// those, and past the top level the glide, not the writing, sets the speed.
-template <bool kKeys>
+template <class Sink>
 bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, std::int64_t ty,
-                          std::size_t index, CompactSink<kKeys> out, std::size_t capacity, std::size_t& n,
+                          std::size_t index, Sink out, std::size_t capacity, std::size_t& n,
                           std::uint64_t& budget, detail::DescentPlace& at) {
   constexpr std::size_t kStage = 256;
   QueryPoint stage[kStage];
@@ -287,6 +287,14 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
   detail::Refusal refuse(problem);
   return query_into(tileset, q, PointSink{out}, out != nullptr, "out", capacity, written, cursor, refuse,
                     examined);
+}
+
+Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::size_t* count,
+                            QueryCursor* cursor) {
+  detail::Refusal refuse(nullptr);
+  std::uint64_t examined = 0;
+  return query_into(tileset, q, detail::CountSink{}, true, "out", std::numeric_limits<std::size_t>::max(),
+                    count, cursor, refuse, examined);
 }
 
 Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,

@@ -33,4 +33,11 @@ Status query_points_counted(const Tileset& tileset, const QueryParams& params, Q
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                             QueryProblem* problem, std::uint64_t& examined);
 
+/// How many points query_points would write for `params` from `cursor` on, into `*count`, without
+/// writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing to count). Returns
+/// kOk, kBufferFull after kMaxQueryCandidates candidates (call again with the cursor and add), or
+/// kInvalidArgument as query_points refuses.
+Status count_points(const Tileset& tileset, const QueryParams& params, std::size_t* count,
+                    QueryCursor* cursor);
+
 }  // namespace kdm::detail

@@ -93,11 +93,13 @@ TEST(ParallelQueryTest, GivesTheSameBitsForAnyWorkerCountAndTheWholeQuerysPoints
 }
 
 TEST(ParallelQueryTest, KeepsTheWholeQuerysOrderInStableModeWhereTilesAreWhole) {
-  QueryParams q = region(QueryMode::kStable, 1);
-  q.scale = 3000;  // runs of several tiles, none cut
-  const std::vector<QueryPoint> whole = run_whole(q);
-  ASSERT_GT(whole.size(), 20000u);
-  EXPECT_TRUE(same_bits(run_parallel(q, 2, std_thread_runner()), whole));
+  for (int kind = 0; kind < 2; ++kind) {  // counted and written in place, and through the scratch
+    QueryParams q = region(QueryMode::kStable, kind);
+    q.scale = 3000;  // runs of several tiles, none cut
+    const std::vector<QueryPoint> whole = run_whole(q);
+    ASSERT_GT(whole.size(), 20000u);
+    EXPECT_TRUE(same_bits(run_parallel(q, 2, std_thread_runner()), whole)) << "density kind " << kind;
+  }
 }
 
 TEST(ParallelQueryTest, CutsDenseTilesAndWritesCompactOutput) {
@@ -170,17 +172,19 @@ TEST(ParallelQueryTest, RefusesByName) {
 }
 
 TEST(ParallelQueryTest, ARunAllocatesNothing) {
-  const QueryParams q = region(QueryMode::kSmooth, 1);
   ParallelQuery pq;
   ASSERT_EQ(pq.init(2), Status::kOk);
   std::vector<QueryPoint> out(1 << 21);
   (void)Tileset::builtin();
-  std::size_t written = 0;
-  const long before = testing::allocations();
-  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, sequential_runner()),
-            Status::kOk);
-  EXPECT_EQ(testing::allocations(), before);
-  EXPECT_GT(written, 100000u);
+  for (int kind = 0; kind < 2; ++kind) {  // counted and written in place, and through the scratch
+    const QueryParams q = region(QueryMode::kSmooth, kind);
+    std::size_t written = 0;
+    const long before = testing::allocations();
+    EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, sequential_runner()),
+              Status::kOk);
+    EXPECT_EQ(testing::allocations(), before);
+    EXPECT_GT(written, 100000u);
+  }
 }
 
 }  // namespace

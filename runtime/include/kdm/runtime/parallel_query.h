@@ -1,10 +1,12 @@
-// One large query split over several threads, for callers that fill a large region at once: the region is
-// cut into units (runs of tiles, or parts of a tile where a tile holds many points), fixed by the
-// parameters alone; workers take units in order, query each into their own scratch, learn where it goes
-// once the unit before it has counted its points, and copy it there. The result is the units' points in
-// unit order: the same bits for any number of threads or any task system, and the same points as
-// query_points (in stable mode also in its order where no tile is cut into parts, as units then follow
-// its tile order; in smooth mode the points that glide across a unit's side come with that unit).
+// One large query split over several threads, for callers that fill a large region at once. The region is
+// cut into units (runs or blocks of tiles, or parts of a tile where a tile holds many points), fixed by
+// the parameters alone; workers take units in order. With a constant density a worker counts its unit
+// (whole tiles cost nothing to count), takes its place once the unit before it has counted, and writes it
+// there; with a varying density, whose count costs as much as the query, it queries the unit into its
+// own scratch and copies it into place. The result is the units' points in unit order: the same bits for
+// any number of threads or any task system, and the same points as query_points (in stable mode also in
+// its order where no tile is cut into parts, as units then follow its tile order; in smooth mode the
+// points that glide across a unit's side come with that unit).
 //
 // The runtime library starts no threads: the caller gives a task system (TaskRunner), or the inline
 // std::thread one below.
@@ -51,7 +53,7 @@ inline TaskRunner std_thread_runner() {
 /// Most workers one ParallelQuery serves.
 inline constexpr std::uint32_t kMaxParallelWorkers = 64;
 
-/// Points a worker's scratch holds: a unit is sized to expect at most this many.
+/// Points a worker's scratch holds: a unit of a varying density is sized to expect at most half as many.
 inline constexpr std::size_t kParallelUnitPoints = std::size_t(1) << 15;
 
 /// The per-worker scratch of parallel queries, allocated once by init (through the tile-set allocator
