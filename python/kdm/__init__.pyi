@@ -70,6 +70,22 @@ class Tileset:
         invert: bool = ...,
         out: Optional[QueryResult] = ...,
     ) -> QueryResult: ...
+    def positions(
+        self,
+        rect: _Rect,
+        *,
+        scale: float,
+        density: Union[_Density, Callable[[float, float], float]] = ...,
+        density_rect: Optional[_Rect] = ...,
+        density_max: Optional[float] = ...,
+        tile_size: float = ...,
+        mode: str = ...,
+        origin: Sequence[float] = ...,
+        gamma: float = ...,
+        invert: bool = ...,
+        keys: bool = ...,
+        threads: Optional[int] = ...,
+    ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[np.float32], npt.NDArray[np.uint64]]]: ...
 
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
 def stipple(

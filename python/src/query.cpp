@@ -16,6 +16,8 @@
 
 #include "bindings.h"
 #include "kdm/runtime/class_query.h"
+#include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/parallel_query.h"
 #include "query_density.h"
 #include "runtime_query.h"
 
@@ -177,12 +179,18 @@ py::tuple result(std::size_t m, Buffer& buffer, const py::object& storage) {
   return py::make_tuple(records, xy, tile, rank, levels, full);
 }
 
-py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
-                py::object callable, std::optional<Rect> density_rect, std::optional<double> density_max,
-                double tile_size, const std::string& mode, const std::array<double, 2>& origin,
-                const py::object& storage) {
-  check_rect("rect", rect);
+/// A query's parameters and the density objects they point at (kept alive with them).
+struct PreparedQuery {
   QueryParams q;
+  std::unique_ptr<SpecDensity> from_spec;
+  std::unique_ptr<CallableDensity> from_callable;
+};
+
+void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::DensitySpec* spec,
+             py::object callable, std::optional<Rect> density_rect, std::optional<double> density_max,
+             double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+  check_rect("rect", rect);
+  QueryParams& q = p.q;
   q.x0 = rect[0], q.y0 = rect[1], q.x1 = rect[2], q.y1 = rect[3];
   q.origin_x = origin[0], q.origin_y = origin[1];
   q.tile_size = tile_size;
@@ -194,19 +202,28 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
     throw std::invalid_argument("density_rect needs an image, an array or a test map density");
   if (density_max && !call) throw std::invalid_argument("density_max is for a callable density only");
   if (density_rect) check_rect("density_rect", *density_rect);
-  std::unique_ptr<SpecDensity> from_spec;
-  std::unique_ptr<CallableDensity> from_callable;
   if (call) {
     if (!density_max)
       throw std::invalid_argument("a callable density needs density_max, an upper bound of its values");
     check_number("density_max", *density_max, 0, false);
-    from_callable = std::make_unique<CallableDensity>(std::move(callable), *density_max);
-    q.density = from_callable->density;
+    p.from_callable = std::make_unique<CallableDensity>(std::move(callable), *density_max);
+    q.density = p.from_callable->density;
   } else {
     const Rect r = density_rect ? *density_rect : rect;  // by default the image covers the rectangle queried
-    from_spec = std::make_unique<SpecDensity>(*spec, r.data());
-    q.density = from_spec->density;
+    p.from_spec = std::make_unique<SpecDensity>(*spec, r.data());
+    q.density = p.from_spec->density;
   }
+}
+
+py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
+                py::object callable, std::optional<Rect> density_rect, std::optional<double> density_max,
+                double tile_size, const std::string& mode, const std::array<double, 2>& origin,
+                const py::object& storage) {
+  PreparedQuery prepared;
+  prepare(prepared, rect, scale, spec, std::move(callable), density_rect, density_max, tile_size, mode,
+          origin);
+  const QueryParams& q = prepared.q;
+  const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
   const Storage out(storage);
   Buffer buffer;  // an earlier result's memory while it has room, else new memory
   if (out.capacity) buffer.points = out.points, buffer.levels = out.levels, buffer.capacity = out.capacity;
@@ -218,6 +235,111 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
   }
   if (from_callable) from_callable->rethrow();
   return result(m, buffer, storage);
+}
+
+/// Arrays of malloc'd memory that numpy takes over once filled: positions and, if asked, keys.
+struct CompactBuffer {
+  float* xy = nullptr;
+  std::uint64_t* keys = nullptr;
+  std::size_t capacity = 0;
+  bool with_keys = false;
+  CompactBuffer() = default;
+  CompactBuffer(const CompactBuffer&) = delete;
+  CompactBuffer& operator=(const CompactBuffer&) = delete;
+  ~CompactBuffer() { std::free(xy), std::free(keys); }
+  void reserve(std::size_t wanted) {  // keeps the contents; throws std::bad_alloc
+    if (wanted <= capacity) return;
+    const std::size_t grown = std::max(wanted, 2 * capacity);
+    auto* x = static_cast<float*>(std::realloc(xy, std::max<std::size_t>(grown, 1) * 2 * sizeof(float)));
+    if (!x) throw std::bad_alloc();
+    xy = x;
+    if (with_keys) {
+      auto* k =
+          static_cast<std::uint64_t*>(std::realloc(keys, std::max<std::size_t>(grown, 1) * sizeof *keys));
+      if (!k) throw std::bad_alloc();
+      keys = k;
+    }
+    capacity = grown;
+  }
+  CompactPoints at(std::size_t i) const { return CompactPoints{xy + 2 * i, with_keys ? keys + i : nullptr}; }
+};
+
+[[noreturn]] void refused(const QueryProblem& problem) {
+  throw std::invalid_argument("query: " +
+                              tools::describe(problem, tools::ParameterNames{"scale=", "tile_size="}));
+}
+
+void check_collected(std::size_t m) {
+  if (m > tools::kMaxCollectedPoints)
+    throw std::invalid_argument("the query emits more than 2^25 points; lower the scale or split the region");
+}
+
+/// The compact query (kdm/runtime/compact_query.h) into new arrays, with the GIL released: positions
+/// (m × 2 float32, relative to the origin) and, with `keys`, each point's 64-bit key (else None). `threads`
+/// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
+/// order: the same bits for any count).
+py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
+                    const tools::DensitySpec* spec, py::object callable, std::optional<Rect> density_rect,
+                    std::optional<double> density_max, double tile_size, const std::string& mode,
+                    const std::array<double, 2>& origin, bool keys, int threads) {
+  if (threads < 0 || threads > int(kMaxParallelWorkers))
+    throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
+                                std::to_string(threads));
+  PreparedQuery prepared;
+  prepare(prepared, rect, scale, spec, std::move(callable), density_rect, density_max, tile_size, mode,
+          origin);
+  const QueryParams& q = prepared.q;
+  CompactBuffer buffer;
+  buffer.with_keys = keys;
+  std::size_t m = 0;
+  {
+    py::gil_scoped_release release;  // a callable density takes it back at each call
+    QueryProblem problem;
+    if (threads == 0) {
+      QueryCursor cursor;
+      for (;;) {
+        buffer.reserve(m + kChunk);
+        std::size_t written = 0;
+        const Status s = query_points_compact(*handle.set, q, buffer.at(m), buffer.capacity - m, &written,
+                                              &cursor, &problem);
+        m += written;
+        check_collected(m);
+        if (s == Status::kOk) break;
+        if (s != Status::kBufferFull) refused(problem);
+      }
+    } else {
+      ParallelQuery parallel;
+      parallel.init(static_cast<std::uint32_t>(threads));
+      // Room for the density's bound over the rectangle, then exactly what it needs if that was short.
+      double rho = q.density.constant;
+      if (q.density.kind == QueryDensity::Kind::kImage)
+        rho = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
+      if (q.density.kind == QueryDensity::Kind::kCallback) rho = q.density.callback_max;
+      const double bound = std::max(rho, 0.0) * (q.x1 - q.x0) * (q.y1 - q.y0) * q.scale * 1.05 + 4096;
+      std::size_t wanted = std::size_t(std::min(bound, double(tools::kMaxCollectedPoints) + 1));
+      for (;;) {
+        buffer.reserve(wanted);
+        std::size_t needed = 0;
+        const Status s = parallel.run(*handle.set, q, buffer.at(0), buffer.capacity, &m, std_thread_runner(),
+                                      &needed, &problem);
+        check_collected(needed);
+        if (s == Status::kOk) break;
+        if (s != Status::kBufferFull) refused(problem);
+        wanted = needed;
+      }
+    }
+  }
+  if (prepared.from_callable) prepared.from_callable->rethrow();
+  // numpy takes the memory over (shrunk to the points).
+  const auto rows = static_cast<py::ssize_t>(m);
+  float* xy = buffer.xy;
+  std::uint64_t* key = buffer.keys;
+  buffer.xy = nullptr, buffer.keys = nullptr;
+  py::capsule xy_owner(xy, [](void* p) { std::free(p); });
+  py::array_t<float> xy_array({rows, py::ssize_t(2)}, xy, xy_owner);
+  if (!keys) return py::make_tuple(xy_array, py::none());
+  py::capsule keys_owner(key, [](void* p) { std::free(p); });
+  return py::make_tuple(xy_array, py::array_t<std::uint64_t>({rows}, key, keys_owner));
 }
 
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
@@ -267,6 +389,11 @@ void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
         py::arg("origin"), "several classes in one query: query()'s tuple and each point's class");
+  m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
+        py::arg("spec").none(true), py::arg("callable").none(true), py::arg("density_rect").none(true),
+        py::arg("density_max").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        py::arg("keys"), py::arg("threads"),
+        "the compact query into new arrays: float32 positions and, if asked, 64-bit keys");
   m.def(
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
       py::arg("callable").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),

@@ -271,3 +271,49 @@ def test_classes_refuse_bad_input():
         BUILTIN.query(rect, scale=10, classes=[1.0, -2.0])
     with pytest.raises(ValueError, match="scale="):
         BUILTIN.query(rect, scale=1e9, classes=[1.0, 1.0])
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_positions_are_the_querys_points_as_float32(mode):
+    rect, origin = (-1.3, 0.4, 2.7, 3.1), (-1.0, 0.0)
+    for density in (0.8, "radial:20", lambda x, y: 0.2 + 0.1 * x):
+        kwargs = dict(scale=900, mode=mode, origin=origin)
+        if callable(density):
+            kwargs["density_max"] = 0.5
+        full = BUILTIN.query(rect, density=density, **kwargs)
+        xy, keys = BUILTIN.positions(rect, density=density, keys=True, **kwargs)
+        assert xy.dtype == np.float32 and xy.shape == (len(full), 2) and len(full) > 1000
+        # Within the documented 2**-21 * (|position| + tile_size) of the doubles.
+        assert np.all(np.abs(xy - full.xy) <= np.ldexp(np.abs(full.xy) + 1.0, -21))
+        tile = full.tile.astype(np.uint64) & np.uint64(2**21 - 1)
+        expected = tile[:, 0] | tile[:, 1] << np.uint64(21) | full.rank.astype(np.uint64) << np.uint64(42)
+        assert keys.dtype == np.uint64 and np.array_equal(keys, expected)
+        # Positions alone are the same numbers.
+        assert np.array_equal(BUILTIN.positions(rect, density=density, **kwargs), xy)
+
+
+def test_positions_over_threads_give_the_same_bits_for_any_count():
+    rect = (0.0, 0.0, 6.0, 5.0)
+    for mode in ("stable", "smooth"):
+        one, one_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True, threads=1)
+        two, two_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True, threads=2)
+        assert len(one) > 100000 and np.array_equal(one, two) and np.array_equal(one_keys, two_keys)
+        # The same points as one query, in an order of their own.
+        plain_xy, plain_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True)
+        assert np.array_equal(np.sort(plain_keys), np.sort(one_keys))
+
+
+def test_positions_refuse_bad_arguments():
+    with pytest.raises(ValueError, match="threads must be 1 to 64"):
+        BUILTIN.positions((0, 0, 1, 1), scale=10, threads=0)
+    with pytest.raises(TypeError, match="threads must be an int"):
+        BUILTIN.positions((0, 0, 1, 1), scale=10, threads=1.5)
+    with pytest.raises(TypeError, match="keys must be a bool"):
+        BUILTIN.positions((0, 0, 1, 1), scale=10, keys=1)
+    with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less"):
+        BUILTIN.positions((0, 0, 1, 1), scale=1e9)
+    with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less"):
+        BUILTIN.positions((0, 0, 1, 1), scale=1e9, threads=2)
+    with pytest.raises(ValueError, match="density_max"):
+        BUILTIN.positions((0, 0, 1, 1), scale=10, density=lambda x, y: 1.0)
+    assert BUILTIN.positions((0, 0, 1, 1), scale=100, density=0.0).shape == (0, 2)
