@@ -122,11 +122,18 @@ double ramp(void*, double x, double) {
   return 0.2 + 0.8 * x / kSide;
 }
 
+// The ramp's bounds over a rectangle (QueryDensity::bounds).
+void ramp_bounds(void*, double x0, double, double x1, double, double* lo, double* hi) {
+  *lo = ramp(nullptr, std::max(x0, 0.0), 0), *hi = ramp(nullptr, std::min(x1, kSide), 0);
+}
+
+// Args: smooth; bounds, 1 to give the callback's bounds too.
 void BM_QueryDensityCallback(benchmark::State& state) {
   kdm::QueryParams q = params(state);
   q.density.kind = kdm::QueryDensity::Kind::kCallback;
   q.density.callback = ramp;
   q.density.callback_max = 1;
+  if (state.range(1)) q.density.bounds = ramp_bounds;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
@@ -238,11 +245,11 @@ void BM_BaselineWriteSamePoints(benchmark::State& state) {
 }
 
 // The compact output (compact_query.h) into reused 65,536-point arrays (args: smooth; keys, 1 to write
-// them too; ramp, 1 for BM_QueryDensityCallback's ramp instead of the constant density), in rounds that
-// alternate with a plain copy of as many points into the same arrays (memcpy): `of_plain_copy` is the
-// copy's time over the query's. BM_QueryConstantReusedBuffer: QueryPoint records into a reused 65,536-point
-// buffer. Copies n points into `out` from arrays of as many (`from`, 65,536 points), 65,536 at a time, as
-// memcpy does: the bytes the query writes, with no logic.
+// them too; ramp, 1 for BM_QueryDensityCallback's ramp instead of the constant density, 2 with its bounds),
+// in rounds that alternate with a plain copy of as many points into the same arrays (memcpy): `of_plain_copy`
+// is the copy's time over the query's. BM_QueryConstantReusedBuffer: QueryPoint records into a reused
+// 65,536-point buffer. Copies n points into `out` from arrays of as many (`from`, 65,536 points), 65,536 at a
+// time, as memcpy does: the bytes the query writes, with no logic.
 void plain_copy(const kdm::CompactPoints& from, const kdm::CompactPoints& out, std::size_t n) {
   for (std::size_t done = 0; done < n; done += 1 << 16) {
     const std::size_t count = std::min<std::size_t>(n - done, 1 << 16);
@@ -258,6 +265,7 @@ void BM_QueryCompact(benchmark::State& state) {
     q.density.kind = kdm::QueryDensity::Kind::kCallback;
     q.density.callback = ramp;
     q.density.callback_max = 1;
+    if (state.range(2) == 2) q.density.bounds = ramp_bounds;
   }
   std::vector<float> xy(2 << 16), source_xy(2 << 16, 1.0f);
   std::vector<std::uint64_t> keys(1 << 16), source_keys(1 << 16, 1);
@@ -378,7 +386,13 @@ void BM_LoadBuiltinSet(benchmark::State& state) {
 
 BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_QueryDensityCallback)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryDensityCallback)
+    ->ArgNames({"smooth", "bounds"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp"})
     ->Args({0, 0})
@@ -397,6 +411,8 @@ BENCHMARK(BM_QueryCompact)
     ->Args({1, 1, 0})
     ->Args({0, 1, 1})
     ->Args({1, 1, 1})
+    ->Args({0, 1, 2})
+    ->Args({1, 1, 2})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryParallel)
     ->ArgNames({"smooth", "compact", "ramp"})

@@ -44,8 +44,11 @@ struct TileJob {
   double area_scale, limit;
   const QueryDensity* density;
   const ImageSampler* sampler;
-  /// Smooth mode with an image: whether the density can be 0 where the tile's points glide (min-mip).
+  /// Smooth mode with a varying density: whether it can be 0 where the tile's points glide (its bounds).
   bool zero_possible;
+  /// Stable mode with a varying density: ranks below this are emitted wherever they lie in the tile (their
+  /// thresholds lie below the density's lower bound there), without reading the density.
+  std::uint32_t sure;
   /// Smooth mode, constant density: the grid cells whose points land inside the region however far they
   /// glide (by `reach`, with room for rounding), which skip its test: safe_x ≤ x < safe_x + safe_w (as
   /// unsigned differences; safe_w = 0 for none), the same in y.
@@ -175,6 +178,18 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   const TileJob j = job;  // a local copy, which the writes into `out` cannot alias
   std::size_t n = written;
   constexpr bool kConstant = kKind == QueryDensity::Kind::kConstant;
+  if constexpr (!kConstant && kInside && !kSmooth) {  // the ranks sure to be emitted, as a constant's
+    if (c < j.sure) {
+      const std::uint32_t count =
+          static_cast<std::uint32_t>(std::min<std::size_t>(std::min(end, j.sure) - c, capacity - n));
+      out.put_stable_run(n, j, c, count);
+      n += count, c += count;
+      if (c < std::min(end, j.sure) || c == end) {
+        written = n;
+        return c;
+      }
+    }
+  }
   if constexpr (kConstant && kInside && !kSmooth) {
     // Every candidate is emitted where it stands: a plain loop the compiler can vectorise.
     const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(end - c, capacity - n));
@@ -217,7 +232,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     // A point never shows where there is no density: one decided at its stable position could glide up
     // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
     if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
-    if (kKind == QueryDensity::Kind::kCallback &&
+    if (kKind == QueryDensity::Kind::kCallback && j.zero_possible &&
         !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
       return true;
     if (n == capacity) return false;
@@ -266,7 +281,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     }
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
     if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
-    if (kConstant && !kSmooth) {
+    if (!kSmooth && (kConstant || c < j.sure)) {
       if (n == capacity) return c;
       out.put_stable(n++, j, p, c);
       return kNone;

@@ -229,6 +229,8 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
   if (read_query(tileset, query, cursor, written, q, why)) {
     q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
                            query->density_image);
+    if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
+      q.density.bounds = query->density_bounds;
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
       return kdm::query_points(*tileset->set, q, as_points(out), capacity, written, k, &why);
     });
@@ -246,6 +248,8 @@ kdm_status kdm_query_compact(const kdm_tileset* tileset, const kdm_query* query,
   if (read_query(tileset, query, cursor, written, q, why)) {
     q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
                            query->density_image);
+    if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
+      q.density.bounds = query->density_bounds;
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
       return kdm::query_points_compact(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity, written, k,
                                        &why);

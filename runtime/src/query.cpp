@@ -183,8 +183,20 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       const Tile& tile = tileset.data().tiles[index];
       const float* thresholds = tables.thresholds[index].data();
       const double wx = double(tx) * S;
-      double bound = max_density;
-      if (d.kind == QueryDensity::Kind::kImage) bound = d.image->max_over(wx, wy, wx + S, wy + S);
+      // Bounds of the density over the tile (in smooth mode widened by the glide, where a point's density
+      // is read a second time): below lo a point is emitted wherever it lies, above the bound never.
+      double bound = max_density, lo = 0;
+      if (d.kind == QueryDensity::Kind::kImage) {
+        bound = d.image->max_over(wx, wy, wx + S, wy + S);
+        lo = glide ? d.image->min_over(wx - reach, wy - reach, wx + S + reach, wy + S + reach)
+                   : d.image->min_over(wx, wy, wx + S, wy + S);
+      } else if (d.kind == QueryDensity::Kind::kCallback && d.bounds) {
+        const double r = glide ? reach : 0;
+        double l = std::nan(""), h = std::nan("");
+        d.bounds(d.user, wx - r, wy - r, wx + S + r, wy + S + r, &l, &h);
+        if (h >= 0 && h < bound) bound = h;  // NaN bounds fail both tests
+        if (l > 0) lo = std::min(l, bound);
+      }
       // Thresholds are sorted: the points below bound · A · scale are a prefix; none beyond can be emitted.
       const double limit = bound * area_scale;
       const std::uint32_t candidates = static_cast<std::uint32_t>(
@@ -214,6 +226,14 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       const std::uint32_t end = candidates - c > budget ? static_cast<std::uint32_t>(c + budget) : candidates;
       job.points = tile.points.data(), job.thresholds = thresholds, job.tx = tx, job.ty = ty;
       job.wx = wx, job.wy = wy, job.limit = limit;
+      // Stable mode: the ranks emitted wherever they lie, less a margin for a bilinear or callback value
+      // that equals lo rounding below it.
+      job.sure = 0;
+      if (!glide && lo > 0)
+        job.sure = static_cast<std::uint32_t>(
+            std::lower_bound(thresholds, thresholds + candidates, lo * area_scale * (1 - 1e-9),
+                             [](float t, double l) { return TilesetShape::emits(t, l); }) -
+            thresholds);
       job.rel_unit = static_cast<float>(S / 65536.0);
       job.rel_x = static_cast<float>((wx - q.origin_x) + S * (0.5 / 65536.0));
       job.rel_y = static_cast<float>((wy - q.origin_y) + S * (0.5 / 65536.0));
@@ -245,8 +265,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
         job.listed = job.listed_end = nullptr;
         tables.edges_beyond(index, job.cull_x0, job.cull_y0, job.cull_x1, job.cull_y1, job.listed,
                             job.listed_end);
-        job.zero_possible = d.kind == QueryDensity::Kind::kImage &&
-                            !(d.image->min_over(wx - reach, wy - reach, wx + S + reach, wy + S + reach) > 0);
+        job.zero_possible = !(lo > 0);
       }
       // Inside: the tile widened by the farthest any of its points can glide (and two position units, for
       // rounding) lies in the region. Such tiles skip every test, and the positions are computed as
@@ -389,6 +408,7 @@ std::uint64_t query_fingerprint(const QueryParams& q) {
   add(reinterpret_cast<std::uintptr_t>(q.density.image));
   add(reinterpret_cast<std::uintptr_t>(q.density.callback));
   add(reinterpret_cast<std::uintptr_t>(q.density.user));
+  add(reinterpret_cast<std::uintptr_t>(q.density.bounds));
   return h;
 }
 

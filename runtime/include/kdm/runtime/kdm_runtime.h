@@ -62,6 +62,10 @@ typedef struct kdm_query {
   /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
   int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
                density, so every density is good blue noise (tile sets with a glide track) */
+  /* Added in 0.4: optional bounds of the callback's density over a world rectangle (*lo <= density <= *hi
+   * there), asked once per tile so that the callback is called only where emission is in doubt
+   * (kdm::QueryDensity::bounds). */
+  void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
 } kdm_query;
 
 enum { KDM_MODE_STABLE = 0, KDM_MODE_SMOOTH = 1 };

@@ -60,6 +60,14 @@ struct QueryDensity {
   void* user = nullptr;
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
   double callback_max = 1;
+  /// For callbacks, optional: bounds of the density over a world rectangle, *lo ≤ ρ ≤ *hi everywhere in
+  /// [x0, x1] × [y0, y1] (must be thread-safe, like the callback). A query asks once per tile and then
+  /// calls `callback` only where a point's emission is in doubt: in stable mode the points whose threshold
+  /// lies between lo and hi (those below lo are emitted, those above hi skipped, unseen), in smooth mode
+  /// the points below hi, without the second call at a glided position where lo > 0. Bounds that are not
+  /// true bounds make points appear or vanish as if the density were lo or hi there; NaN bounds are
+  /// ignored (0 and callback_max serve).
+  void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
 };
 
 /// How emitted points move as the density changes.
