@@ -9,7 +9,8 @@
 //    call with a large buffer, in the same order; kBufferFull only with a full buffer; a finished cursor
 //    gives no more points;
 //  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
-//  - query_classes with the density and an empty class (two halves of a constant) gives the same points.
+//  - query_classes with the density and an empty class (two halves of a constant) gives the same points;
+//  - query_points_compact gives the same points as floats, with their keys.
 // A failed check aborts.
 #include <algorithm>
 #include <cfloat>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 
 namespace {
@@ -238,6 +240,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (classed.size != all.size) fail();
       for (std::size_t i = 0; i < all.size; ++i)
         if (!same(classed[i], all[i]) || classes[i] > (kind == 0 ? 1 : 0)) fail();
+    }
+  }
+
+  // The compact output: the same points, as floats within 2^-21 · (|position| + tile size), with their keys.
+  {
+    static float xy[2 * kBigCapacity];
+    static std::uint64_t keys[kBigCapacity];
+    kdm::QueryCursor compact_cursor;
+    std::size_t size = 0;
+    const kdm::Status status = kdm::query_points_compact(
+        kdm::Tileset::builtin(), q, kdm::CompactPoints{xy, keys}, kBigCapacity, &size, &compact_cursor);
+    if (status != all.status || size != all.size) fail();
+    for (std::size_t i = 0; i < size; ++i) {
+      const kdm::QueryPoint& p = all[i];
+      if (keys[i] != kdm::point_key(p.id)) fail();
+      if (!(std::fabs(xy[2 * i] - p.x) <= std::ldexp(std::fabs(p.x) + q.tile_size, -21))) fail();
+      if (!(std::fabs(xy[2 * i + 1] - p.y) <= std::ldexp(std::fabs(p.y) + q.tile_size, -21))) fail();
     }
   }
 
