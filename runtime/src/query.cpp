@@ -321,6 +321,17 @@ Status query_points_compact(const Tileset& tileset, const QueryParams& q, const 
                             QueryProblem* problem) {
   detail::Refusal refuse(problem);
   std::uint64_t examined = 0;
+  // Positions relative to the origin must fit a float (3.4e38); a margin for the region's own width.
+  const double far_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x));
+  const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
+  if (far_x > 1e38) {
+    if (written) *written = 0;
+    return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x);
+  }
+  if (far_y > 1e38) {
+    if (written) *written = 0;
+    return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y);
+  }
   if (!out.keys)
     return query_into(tileset, q, CompactSink<false>{out.xy, nullptr}, out.xy != nullptr, "out.xy", capacity,
                       written, cursor, refuse, examined);

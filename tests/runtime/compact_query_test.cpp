@@ -234,6 +234,13 @@ TEST(CompactQueryTest, RefusesMissingOutputByName) {
   EXPECT_EQ(query_points_compact(Tileset::builtin(), q, {xy, nullptr}, 4, nullptr, &cursor, &why),
             Status::kInvalidArgument);
   EXPECT_STREQ(why.parameter, "written");
+  QueryParams far = q;  // positions relative to the origin beyond a float
+  far.origin_y = -5e69;
+  QueryCursor fresh;
+  EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_STREQ(why.parameter, "origin_y");
 }
 
 TEST(CompactQueryTest, RefusesKeysForTilesTooLargeToNumber) {
