@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
@@ -403,25 +404,20 @@ BENCHMARK(BM_QueryThreeClasses)
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BaselineWriteSamePoints)->Unit(benchmark::kMillisecond);
+// Both modes of: the second argument off and on at a constant density, then on with the ramp.
+void modes_output_density(benchmark::internal::Benchmark* b) {
+  for (const auto& [output, ramp] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}})
+    for (int smooth : {0, 1}) b->Args({smooth, output, ramp});
+}
 BENCHMARK(BM_QueryCompact)
     ->ArgNames({"smooth", "keys", "ramp"})
-    ->Args({0, 0, 0})
-    ->Args({1, 0, 0})
-    ->Args({0, 1, 0})
-    ->Args({1, 1, 0})
-    ->Args({0, 1, 1})
-    ->Args({1, 1, 1})
+    ->Apply(modes_output_density)
     ->Args({0, 1, 2})
     ->Args({1, 1, 2})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryParallel)
     ->ArgNames({"smooth", "compact", "ramp"})
-    ->Args({0, 0, 0})
-    ->Args({1, 0, 0})
-    ->Args({0, 1, 0})
-    ->Args({1, 1, 0})
-    ->Args({0, 1, 1})
-    ->Args({1, 1, 1})
+    ->Apply(modes_output_density)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryConstantReusedBuffer)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadBuiltinSet)->Unit(benchmark::kMillisecond);

@@ -156,25 +156,12 @@ class Tileset:
             Positions, ids and levels; any partition of a region gives the region's points, and the same
             arguments give the same bits as ``kdm query ... -o points.csv``.
         """
-        rect = _checks.rect("rect", rect)
-        scale = _checks.number("scale", scale)
-        tile_size = _checks.number("tile_size", tile_size)
-        mode = _checks.choice("mode", mode, ("stable", "smooth"))
-        origin = _checks.numbers_tuple("origin", origin, 2)
-        if density_rect is not None:
-            density_rect = _checks.rect("density_rect", density_rect)
-        if density_max is not None:
-            density_max = _checks.number("density_max", density_max, 0.0)
+        rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
+            rect, scale, tile_size, mode, origin, density_rect, density_max)
         if classes is not None:
             return self._query_classes(rect, scale, density, classes, density_rect, density_max, tile_size,
                                        mode, origin, gamma, invert, out)
-        spec, call = None, None
-        if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
-            call = density
-        else:
-            spec = _checks.density_spec(density, gamma, invert)
-            if spec is None:
-                spec = _kdm.DensitySpec.constant(1.0)
+        spec, call = _density_arg(density, gamma, invert)
         if out is not None and not isinstance(out, QueryResult):
             raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
         return QueryResult(*_kdm.query(
@@ -209,15 +196,8 @@ class Tileset:
         region in a fixed order: the same bits for any N, in an order of its own); the default runs one
         query, in query()'s order.
         """
-        rect = _checks.rect("rect", rect)
-        scale = _checks.number("scale", scale)
-        tile_size = _checks.number("tile_size", tile_size)
-        mode = _checks.choice("mode", mode, ("stable", "smooth"))
-        origin = _checks.numbers_tuple("origin", origin, 2)
-        if density_rect is not None:
-            density_rect = _checks.rect("density_rect", density_rect)
-        if density_max is not None:
-            density_max = _checks.number("density_max", density_max, 0.0)
+        rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
+            rect, scale, tile_size, mode, origin, density_rect, density_max)
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
         workers = 0
@@ -227,13 +207,7 @@ class Tileset:
             if not 1 <= threads <= 64:
                 raise ValueError(f"threads must be 1 to 64, got {threads}")
             workers = int(threads)
-        spec, call = None, None
-        if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
-            call = density
-        else:
-            spec = _checks.density_spec(density, gamma, invert)
-            if spec is None:
-                spec = _kdm.DensitySpec.constant(1.0)
+        spec, call = _density_arg(density, gamma, invert)
         xy, key = _kdm.positions(self._handle, rect, scale, spec, call, density_rect, density_max, tile_size,
                                  mode, origin, keys, workers)
         return (xy, key) if keys else xy
@@ -262,6 +236,29 @@ class Tileset:
         *fields, labels = _kdm.query_classes(
             self._handle, rect, scale, specs, density_rect, tile_size, mode, origin)
         return QueryResult(*fields, classes=labels)
+
+
+def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, density_rect: Any,
+                density_max: Any) -> Tuple[Any, ...]:
+    """A query's common arguments, checked (ValueError, TypeError) and normalised."""
+    rect = _checks.rect("rect", rect)
+    scale = _checks.number("scale", scale)
+    tile_size = _checks.number("tile_size", tile_size)
+    mode = _checks.choice("mode", mode, ("stable", "smooth"))
+    origin = _checks.numbers_tuple("origin", origin, 2)
+    if density_rect is not None:
+        density_rect = _checks.rect("density_rect", density_rect)
+    if density_max is not None:
+        density_max = _checks.number("density_max", density_max, 0.0)
+    return rect, scale, tile_size, mode, origin, density_rect, density_max
+
+
+def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:
+    """A query's density as (spec, callable): one of them None; no density is the constant 1."""
+    if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
+        return None, density
+    spec = _checks.density_spec(density, gamma, invert)
+    return (spec if spec is not None else _kdm.DensitySpec.constant(1.0)), None
 
 
 def bake(recipe_text: str, *, threads: int = 0) -> Tileset:

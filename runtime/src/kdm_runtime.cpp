@@ -134,6 +134,25 @@ void report(const kdm::QueryProblem& why, kdm_query_problem* problem) {
   write_grown(p, problem);
 }
 
+/// A one-density query of the C API: reads its parameters and density, runs `query` (params, cursor,
+/// problem) with the C cursor, and reports its problem.
+template <class Query>
+kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t* written, kdm_cursor* cursor,
+                     kdm_query_problem* problem, Query&& run) {
+  kdm::QueryProblem why;
+  kdm::QueryParams q;
+  kdm_status status = KDM_INVALID_ARGUMENT;
+  if (read_query(tileset, query, cursor, written, q, why)) {
+    q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
+                           query->density_image);
+    if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
+      q.density.bounds = query->density_bounds;
+    status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
+  }
+  report(why, problem);
+  return status;
+}
+
 }  // namespace
 
 extern "C" {
@@ -223,40 +242,20 @@ void kdm_density_image_free(kdm_density_image* image) {
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
                             size_t capacity, size_t* written, kdm_cursor* cursor,
                             kdm_query_problem* problem) {
-  kdm::QueryProblem why;
-  kdm::QueryParams q;
-  kdm_status status = KDM_INVALID_ARGUMENT;
-  if (read_query(tileset, query, cursor, written, q, why)) {
-    q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
-                           query->density_image);
-    if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
-      q.density.bounds = query->density_bounds;
-    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
-      return kdm::query_points(*tileset->set, q, as_points(out), capacity, written, k, &why);
-    });
-  }
-  report(why, problem);
-  return status;
+  return run_query(tileset, query, written, cursor, problem,
+                   [&](const kdm::QueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                     return kdm::query_points(*tileset->set, q, as_points(out), capacity, written, k, why);
+                   });
 }
 
 kdm_status kdm_query_compact(const kdm_tileset* tileset, const kdm_query* query, float* xy, uint64_t* keys,
                              size_t capacity, size_t* written, kdm_cursor* cursor,
                              kdm_query_problem* problem) {
-  kdm::QueryProblem why;
-  kdm::QueryParams q;
-  kdm_status status = KDM_INVALID_ARGUMENT;
-  if (read_query(tileset, query, cursor, written, q, why)) {
-    q.density = to_density(query->density, query->density_callback, query->user, query->density_max,
-                           query->density_image);
-    if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
-      q.density.bounds = query->density_bounds;
-    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
-      return kdm::query_points_compact(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity, written, k,
-                                       &why);
-    });
-  }
-  report(why, problem);
-  return status;
+  return run_query(tileset, query, written, cursor, problem,
+                   [&](const kdm::QueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                     return kdm::query_points_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                      capacity, written, k, why);
+                   });
 }
 
 kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,

@@ -13,6 +13,7 @@
 #include "allocation_counter.h"
 #include "kdm/runtime/compact_query.h"
 #include "random_partition.h"
+#include "run_query.h"
 
 namespace kdm {
 namespace {
@@ -23,15 +24,7 @@ struct Compact {
 };
 
 std::vector<QueryPoint> run_full(const QueryParams& q) {
-  std::vector<QueryPoint> all, out(4096);
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    all.insert(all.end(), out.begin(), out.begin() + written);
-    if (s != Status::kBufferFull) return all;
-  }
+  return testing::run_query(q, 4096);
 }
 
 // Through a buffer of `capacity` points, keys if asked.

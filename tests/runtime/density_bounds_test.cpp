@@ -10,24 +10,15 @@
 #include <vector>
 
 #include "kdm/runtime/query.h"
+#include "run_query.h"
 
 namespace kdm {
 namespace {
 
-std::vector<QueryPoint> run(const QueryParams& q) {
-  std::vector<QueryPoint> all, out(1 << 14);
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    all.insert(all.end(), out.begin(), out.begin() + written);
-    if (s != Status::kBufferFull) return all;
-  }
-}
+using testing::same_bits;
 
-bool same_bits(const std::vector<QueryPoint>& a, const std::vector<QueryPoint>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(QueryPoint)) == 0;
+std::vector<QueryPoint> run(const QueryParams& q) {
+  return testing::run_query(q);
 }
 
 // A ramp in x, 0.1 at x = -2 to 0.9 at x = 6, with a zero strip below x = -1.5 (where smooth mode's check

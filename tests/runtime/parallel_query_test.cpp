@@ -11,6 +11,7 @@
 
 #include "allocation_counter.h"
 #include "kdm/runtime/parallel_query.h"
+#include "run_query.h"
 
 namespace kdm {
 namespace {
@@ -24,15 +25,7 @@ TaskRunner sequential_runner() {
 }
 
 std::vector<QueryPoint> run_whole(const QueryParams& q) {
-  std::vector<QueryPoint> all, out(1 << 16);
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull);
-    all.insert(all.end(), out.begin(), out.begin() + written);
-    if (s != Status::kBufferFull) return all;
-  }
+  return testing::run_query(q, 1 << 16);
 }
 
 std::vector<QueryPoint> run_parallel(const QueryParams& q, std::uint32_t workers, const TaskRunner& runner) {
@@ -46,9 +39,7 @@ std::vector<QueryPoint> run_parallel(const QueryParams& q, std::uint32_t workers
   return out;
 }
 
-bool same_bits(const std::vector<QueryPoint>& a, const std::vector<QueryPoint>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(QueryPoint)) == 0;
-}
+using testing::same_bits;
 
 using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
 std::map<Key, std::pair<double, double>> by_id(const std::vector<QueryPoint>& points) {
