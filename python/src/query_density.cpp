@@ -1,11 +1,13 @@
 // A Python callable as a query's density (query_density.h).
 #include "query_density.h"
 
+#include <limits>
 #include <stdexcept>
 
 namespace kdm::python {
 
-CallableDensity::CallableDensity(py::object f, double max_value) : function(std::move(f)) {
+CallableDensity::CallableDensity(py::object f, double max_value, py::object bounds)
+    : function(std::move(f)), bounds_function(std::move(bounds)) {
   density.kind = QueryDensity::Kind::kCallback;
   density.callback_max = max_value;
   density.user = this;
@@ -26,6 +28,25 @@ CallableDensity::CallableDensity(py::object f, double max_value) : function(std:
     }
     d.failed.store(true, std::memory_order_relaxed);
     return 0;
+  };
+  if (bounds_function.is_none()) return;
+  density.bounds = [](void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+    CallableDensity& d = *static_cast<CallableDensity*>(user);
+    *lo = *hi = std::numeric_limits<double>::quiet_NaN();  // no bounds, unless the call gives them
+    if (d.failed.load(std::memory_order_relaxed)) return;
+    py::gil_scoped_acquire gil;
+    try {
+      const py::sequence pair = d.bounds_function(x0, y0, x1, y1).cast<py::sequence>();
+      if (pair.size() != 2) throw std::invalid_argument("density_bounds must return (lo, hi)");
+      *lo = pair[0].cast<double>(), *hi = pair[1].cast<double>();
+      return;
+    } catch (py::error_already_set& e) {
+      d.error.emplace(std::move(e));
+    } catch (const std::exception& e) {  // a failed cast, or not a pair
+      PyErr_SetString(PyExc_ValueError, e.what());
+      d.error.emplace();
+    }
+    d.failed.store(true, std::memory_order_relaxed);
   };
 }
 

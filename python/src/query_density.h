@@ -18,14 +18,15 @@ using tools::SpecDensity;  // as `kdm query` builds it (tools/stipple/spec_densi
 
 /// A Python callable f(x, y) -> float as a query callback. The query runs with the GIL released; each call
 /// takes it back. The first exception f raises is kept (later calls return 0 at once) for rethrow() to
-/// raise once the query is over, so it reaches the caller as itself.
+/// raise once the query is over, so it reaches the caller as itself. `bounds`, if not None, is a callable
+/// (x0, y0, x1, y1) -> (lo, hi) bounding the density over a rectangle (QueryDensity::bounds).
 struct CallableDensity {
-  CallableDensity(py::object function, double max_value);
+  CallableDensity(py::object function, double max_value, py::object bounds);
   /// Raises the kept exception, if any. Call with the GIL held.
   void rethrow();
 
   QueryDensity density;
-  py::object function;
+  py::object function, bounds_function;
   std::atomic<bool> failed{false};
   std::optional<py::error_already_set> error;
 };
