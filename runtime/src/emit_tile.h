@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "float_runs.h"
 #include "image_sampler.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
@@ -104,18 +105,10 @@ struct CompactSink {
     xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit, xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit;
     if (kKeys) keys[i] = point_key(PointId{j.tx, j.ty, rank});
   }
-  /// Ranks [c, c + count) into slots from i on, in loops the compiler vectorises (no wrapping indices).
+  /// Ranks [c, c + count) into slots from i on (float_runs.h: put_stable's formula, vectorised).
   void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
-    const TilePoint* from = j.points + c;
-    float* to = xy + 2 * i;
-    const float rx = j.rel_x, ry = j.rel_y, unit = j.rel_unit;
-    for (std::size_t k = 0; k < count; ++k)
-      to[2 * k] = rx + float(from[k].x) * unit, to[2 * k + 1] = ry + float(from[k].y) * unit;
-    if (kKeys) {
-      const std::uint64_t first = point_key(PointId{j.tx, j.ty, c}), step = point_key(PointId{0, 0, 1});
-      std::uint64_t* key = keys + i;
-      for (std::size_t k = 0; k < count; ++k) key[k] = first + k * step;
-    }
+    stable_run_xy(j.points + c, count, j.rel_x, j.rel_y, j.rel_unit, xy + 2 * i);
+    if (kKeys) key_run(keys + i, count, point_key(PointId{j.tx, j.ty, c}), point_key(PointId{0, 0, 1}));
   }
   /// A glided point, also in float from the tile's corner and its offsets (put_glided_run's formula, so a
   /// point is written alike by every emitter).
@@ -129,19 +122,9 @@ struct CompactSink {
   }
   void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
                       std::uint32_t count) const {
-    const TilePoint* from = j.points + c;
-    const std::int8_t *o0 = g.o0 + 2 * std::size_t(c), *o1 = g.o1 + 2 * std::size_t(c);
-    float* to = xy + 2 * i;
-    const float rx = j.rel_x, ry = j.rel_y, unit = j.rel_unit, w0 = g.w0f, w1 = g.w1f;
-    for (std::size_t k = 0; k < count; ++k) {
-      to[2 * k] = rx + float(from[k].x) * unit + (float(o0[2 * k]) * w0 + float(o1[2 * k]) * w1);
-      to[2 * k + 1] = ry + float(from[k].y) * unit + (float(o0[2 * k + 1]) * w0 + float(o1[2 * k + 1]) * w1);
-    }
-    if (kKeys) {
-      const std::uint64_t first = point_key(PointId{j.tx, j.ty, c}), step = point_key(PointId{0, 0, 1});
-      std::uint64_t* key = keys + i;
-      for (std::size_t k = 0; k < count; ++k) key[k] = first + k * step;
-    }
+    glided_run_xy(j.points + c, g.o0 + 2 * std::size_t(c), g.o1 + 2 * std::size_t(c), count, j.rel_x, j.rel_y,
+                  j.rel_unit, g.w0f, g.w1f, xy + 2 * i);
+    if (kKeys) key_run(keys + i, count, point_key(PointId{j.tx, j.ty, c}), point_key(PointId{0, 0, 1}));
   }
 };
 

@@ -1,0 +1,32 @@
+// The compact output's runs of points; see float_runs.h.
+#include "float_runs.h"
+
+// Clones for AVX2 and the baseline, picked once by the loader (GCC on x86-64; elsewhere the baseline).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define KDM_RUN_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define KDM_RUN_CLONES
+#endif
+
+namespace kdm::detail {
+
+KDM_RUN_CLONES void stable_run_xy(const TilePoint* from, std::size_t count, float rx, float ry, float unit,
+                                  float* to) {
+  for (std::size_t k = 0; k < count; ++k)
+    to[2 * k] = rx + float(from[k].x) * unit, to[2 * k + 1] = ry + float(from[k].y) * unit;
+}
+
+KDM_RUN_CLONES void glided_run_xy(const TilePoint* from, const std::int8_t* o0, const std::int8_t* o1,
+                                  std::size_t count, float rx, float ry, float unit, float w0, float w1,
+                                  float* to) {
+  for (std::size_t k = 0; k < count; ++k) {
+    to[2 * k] = rx + float(from[k].x) * unit + (float(o0[2 * k]) * w0 + float(o1[2 * k]) * w1);
+    to[2 * k + 1] = ry + float(from[k].y) * unit + (float(o0[2 * k + 1]) * w0 + float(o1[2 * k + 1]) * w1);
+  }
+}
+
+KDM_RUN_CLONES void key_run(std::uint64_t* to, std::size_t count, std::uint64_t first, std::uint64_t step) {
+  for (std::size_t k = 0; k < count; ++k) to[k] = first + k * step;
+}
+
+}  // namespace kdm::detail

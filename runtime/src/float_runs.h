@@ -1,0 +1,24 @@
+// Internal: the compact output's whole runs of points (compact_query.h, emit_tile.h's CompactSink), the
+// loops that bound its speed, compiled for AVX2 as well as the baseline and chosen at run time (x86-64
+// with GCC). Both compute the same operations in the same order (the runtime builds with
+// -ffp-contract=off: no fused multiply-add), so every CPU writes the same bits.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kdm/runtime/tileset_format.h"
+
+namespace kdm::detail {
+
+/// to[2k], to[2k + 1] = rx + from[k].x · unit, ry + from[k].y · unit, for k < count.
+void stable_run_xy(const TilePoint* from, std::size_t count, float rx, float ry, float unit, float* to);
+
+/// The same plus the glide: o0[2k] · w0 + o1[2k] · w1 in x (and o0[2k + 1], o1[2k + 1] in y).
+void glided_run_xy(const TilePoint* from, const std::int8_t* o0, const std::int8_t* o1, std::size_t count,
+                   float rx, float ry, float unit, float w0, float w1, float* to);
+
+/// to[k] = first + k · step, for k < count.
+void key_run(std::uint64_t* to, std::size_t count, std::uint64_t first, std::uint64_t step);
+
+}  // namespace kdm::detail
