@@ -130,6 +130,12 @@ TEST(ParallelQueryTest, AShortBufferHoldsThePrefixAndTellsTheCount) {
   EXPECT_EQ(written, out.size());
   EXPECT_EQ(needed, all.size());
   EXPECT_EQ(std::memcmp(out.data(), all.data(), out.size() * sizeof(QueryPoint)), 0);
+  // No room: a count alone.
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, static_cast<QueryPoint*>(nullptr), 0, &written, std_thread_runner(),
+                   &needed),
+            Status::kBufferFull);
+  EXPECT_EQ(written, 0u);
+  EXPECT_EQ(needed, all.size());
 }
 
 TEST(ParallelQueryTest, RefusesByName) {
