@@ -389,17 +389,11 @@ BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityCallback)
     ->ArgNames({"smooth", "bounds"})
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({0, 1})
-    ->Args({1, 1})
+    ->ArgsProduct({{0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp"})
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({0, 1})
-    ->Args({1, 1})
+    ->ArgsProduct({{0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

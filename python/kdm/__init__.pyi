@@ -11,6 +11,8 @@ __all__: list[str]
 _Path = Union[str, os.PathLike[str]]
 _Density = Union[None, float, _Path, npt.ArrayLike]
 _Rect = Sequence[float]
+_Bounds = Callable[[float, float, float, float], Tuple[float, float]]
+_Function = Callable[[float, float], float]
 
 def sample(
     n: int,
@@ -59,11 +61,11 @@ class Tileset:
         rect: _Rect,
         *,
         scale: float,
-        density: Union[_Density, Callable[[float, float], float]] = ...,
+        density: Union[_Density, _Function] = ...,
         classes: Optional[Sequence[_Density]] = ...,
         density_rect: Optional[_Rect] = ...,
         density_max: Optional[float] = ...,
-        density_bounds: Optional[Callable[[float, float, float, float], Tuple[float, float]]] = ...,
+        density_bounds: Optional[_Bounds] = ...,
         tile_size: float = ...,
         mode: str = ...,
         origin: Sequence[float] = ...,
@@ -76,10 +78,10 @@ class Tileset:
         rect: _Rect,
         *,
         scale: float,
-        density: Union[_Density, Callable[[float, float], float]] = ...,
+        density: Union[_Density, _Function] = ...,
         density_rect: Optional[_Rect] = ...,
         density_max: Optional[float] = ...,
-        density_bounds: Optional[Callable[[float, float, float, float], Tuple[float, float]]] = ...,
+        density_bounds: Optional[_Bounds] = ...,
         tile_size: float = ...,
         mode: str = ...,
         origin: Sequence[float] = ...,

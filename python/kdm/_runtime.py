@@ -9,6 +9,11 @@ import numpy as np
 
 from . import _checks, _kdm
 
+# The argument types query() and positions() share.
+_Rect = Sequence[float]
+_Density = Union[float, str, np.ndarray, Callable[[float, float], float], None]
+_Bounds = Callable[[float, float, float, float], Tuple[float, float]]
+
 
 class QueryResult:
     """The points of a query, in the runtime's order (tiles row by row, ranks ascending).
@@ -101,14 +106,14 @@ class Tileset:
 
     def query(
         self,
-        rect: Sequence[float],
+        rect: _Rect,
         *,
         scale: float,
-        density: Union[float, str, np.ndarray, Callable[[float, float], float], None] = None,
+        density: _Density = None,
         classes: Optional[Sequence[Union[float, str, np.ndarray]]] = None,
-        density_rect: Optional[Sequence[float]] = None,
+        density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
-        density_bounds: Optional[Callable[[float, float, float, float], Tuple[float, float]]] = None,
+        density_bounds: Optional[_Bounds] = None,
         tile_size: float = 1.0,
         mode: str = "stable",
         origin: Sequence[float] = (0.0, 0.0),
@@ -182,13 +187,13 @@ class Tileset:
 
     def positions(
         self,
-        rect: Sequence[float],
+        rect: _Rect,
         *,
         scale: float,
-        density: Union[float, str, np.ndarray, Callable[[float, float], float], None] = None,
-        density_rect: Optional[Sequence[float]] = None,
+        density: _Density = None,
+        density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
-        density_bounds: Optional[Callable[[float, float, float, float], Tuple[float, float]]] = None,
+        density_bounds: Optional[_Bounds] = None,
         tile_size: float = 1.0,
         mode: str = "stable",
         origin: Sequence[float] = (0.0, 0.0),
