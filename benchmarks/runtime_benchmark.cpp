@@ -139,8 +139,9 @@ void BM_QueryDensityCallback(benchmark::State& state) {
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
 
-// Three classes at 1 : 2 : 4 of the constant density (args: smooth, and 1 for three ramps by callback
-// instead of constants) against one class at their sum, which emits the same points (its callback calls
+// Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp, 1 for three ramps by callback
+// instead of constants; compact, 1 for both queries into float positions) against one class at their
+// sum, which emits the same points (its callback calls
 // the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
 // one-class query's time over the three-class query's.
 double ramp_class(void* k, double x, double) {
@@ -174,20 +175,34 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::vector<std::uint8_t> classes(buffer.size());
+  std::vector<float> xy(2 * buffer.size());
+  const kdm::CompactPoints compact{xy.data(), nullptr};
+  const bool is_compact = state.range(2) != 0;
+  // Runs the query to its end (resumed while the buffer fills); the points emitted.
+  auto run = [&](auto&& call) {
+    kdm::QueryCursor cursor;
+    std::size_t written = 0, total = 0;
+    while (call(&written, &cursor) == kdm::Status::kBufferFull) total += written;
+    return total + written;
+  };
   std::size_t n = 0;
   double seconds = 0, one_seconds = 0;
   for (auto _ : state) {
     auto t0 = std::chrono::steady_clock::now();
-    kdm::QueryCursor cursor;
-    std::size_t written = 0;
-    n = 0;
-    while (kdm::query_classes(kdm::Tileset::builtin(), cq, buffer.data(), classes.data(), buffer.size(),
-                              &written, &cursor) == kdm::Status::kBufferFull)
-      n += written;
-    n += written;
+    n = run([&](std::size_t* written, kdm::QueryCursor* cursor) {
+      return is_compact ? kdm::query_classes_compact(kdm::Tileset::builtin(), cq, compact, classes.data(),
+                                                     buffer.size(), written, cursor)
+                        : kdm::query_classes(kdm::Tileset::builtin(), cq, buffer.data(), classes.data(),
+                                             buffer.size(), written, cursor);
+    });
     benchmark::DoNotOptimize(classes.data());
     const auto t1 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(run_query(one, buffer));
+    benchmark::DoNotOptimize(run([&](std::size_t* written, kdm::QueryCursor* cursor) {
+      return is_compact ? kdm::query_points_compact(kdm::Tileset::builtin(), one, compact, buffer.size(),
+                                                    written, cursor)
+                        : kdm::query_points(kdm::Tileset::builtin(), one, buffer.data(), buffer.size(),
+                                            written, cursor);
+    }));
     const auto t2 = std::chrono::steady_clock::now();
     seconds += std::chrono::duration<double>(t1 - t0).count();
     one_seconds += std::chrono::duration<double>(t2 - t1).count();
@@ -392,8 +407,8 @@ BENCHMARK(BM_QueryDensityCallback)
     ->ArgsProduct({{0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
-    ->ArgNames({"smooth", "ramp"})
-    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgNames({"smooth", "ramp", "compact"})
+    ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

@@ -89,7 +89,8 @@ class Tileset:
         invert: bool = ...,
         keys: bool = ...,
         threads: Optional[int] = ...,
-    ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[np.float32], npt.NDArray[np.uint64]]]: ...
+        classes: Optional[Sequence[_Density]] = ...,
+    ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[Any], ...]]: ...
 
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
 def stipple(

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -201,7 +201,8 @@ class Tileset:
         invert: bool = False,
         keys: bool = False,
         threads: Optional[int] = None,
-    ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
+        classes: Optional[Sequence[_Density]] = None,
+    ) -> Union[np.ndarray, Tuple[np.ndarray, ...]]:
         """The points of `rect` as positions only: the fast path for callers that need no ids.
 
         The arguments are query()'s. Returns an (n, 2) float32 array of positions relative to `origin`
@@ -210,12 +211,22 @@ class Tileset:
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
         region in a fixed order: the same bits for any N, in an order of its own); the default runs one
-        query, in query()'s order.
+        query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; one thread)
+        appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         """
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
             rect, scale, tile_size, mode, origin, density_rect, density_max)
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
+        if classes is not None:
+            if density is not None or density_max is not None or density_bounds is not None:
+                raise ValueError("density, density_max and density_bounds do not apply to a query with classes")
+            if threads is not None:
+                raise ValueError("threads does not apply to a query with classes")
+            specs = _class_specs(classes, gamma, invert)
+            xy, key, labels = _kdm.class_positions(self._handle, rect, scale, specs, density_rect, tile_size,
+                                                   mode, origin, keys)
+            return (xy, key, labels) if keys else (xy, labels)
         workers = 0
         if threads is not None:
             if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
@@ -238,19 +249,7 @@ class Tileset:
             raise ValueError("give either density or classes, not both")
         if density_max is not None or out is not None:
             raise ValueError("density_max and out do not apply to a query with classes")
-        if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
-            raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
-        if not 1 <= len(classes) <= 8:
-            raise ValueError(f"classes must hold 1 to 8 densities, got {len(classes)}")
-        specs = []
-        for k, d in enumerate(classes):
-            name = f"classes[{k}]"
-            if callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
-                raise TypeError(f"{name}: a class's density cannot be a callable")
-            if d is None:
-                raise TypeError(f"{name} must be a number, a str or a 2-D array, got None")
-            image = isinstance(d, (str, os.PathLike))
-            specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
+        specs = _class_specs(classes, gamma, invert)
         *fields, labels = _kdm.query_classes(
             self._handle, rect, scale, specs, density_rect, tile_size, mode, origin)
         return QueryResult(*fields, classes=labels)
@@ -269,6 +268,24 @@ def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, d
     if density_max is not None:
         density_max = _checks.number("density_max", density_max, 0.0)
     return rect, scale, tile_size, mode, origin, density_rect, density_max
+
+
+def _class_specs(classes: Any, gamma: Any, invert: Any) -> List[Any]:
+    """The density specs of a query's classes, checked (TypeError, ValueError)."""
+    if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
+        raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
+    if not 1 <= len(classes) <= 8:
+        raise ValueError(f"classes must hold 1 to 8 densities, got {len(classes)}")
+    specs = []
+    for k, d in enumerate(classes):
+        name = f"classes[{k}]"
+        if callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
+            raise TypeError(f"{name}: a class's density cannot be a callable")
+        if d is None:
+            raise TypeError(f"{name} must be a number, a str or a 2-D array, got None")
+        image = isinstance(d, (str, os.PathLike))
+        specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
+    return specs
 
 
 def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:

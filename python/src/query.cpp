@@ -277,6 +277,20 @@ void check_collected(std::size_t m) {
     throw std::invalid_argument("the query emits more than 2^25 points; lower the scale or split the region");
 }
 
+/// numpy takes over `buffer`'s first m positions and keys: (m × 2 float32, m uint64 or None).
+py::tuple take_compact(CompactBuffer& buffer, std::size_t m) {
+  const auto rows = static_cast<py::ssize_t>(m);
+  float* xy = buffer.xy;
+  std::uint64_t* key = buffer.keys;
+  const bool keys = buffer.with_keys;
+  buffer.xy = nullptr, buffer.keys = nullptr;
+  py::capsule xy_owner(xy, [](void* p) { std::free(p); });
+  py::array_t<float> xy_array({rows, py::ssize_t(2)}, xy, xy_owner);
+  if (!keys) return py::make_tuple(xy_array, py::none());
+  py::capsule keys_owner(key, [](void* p) { std::free(p); });
+  return py::make_tuple(xy_array, py::array_t<std::uint64_t>({rows}, key, keys_owner));
+}
+
 /// The compact query (kdm/runtime/compact_query.h) into new arrays, with the GIL released: positions
 /// (m × 2 float32, relative to the origin) and, with `keys`, each point's 64-bit key (else None). `threads`
 /// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
@@ -333,16 +347,36 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
     }
   }
   if (prepared.from_callable) prepared.from_callable->rethrow();
-  // numpy takes the memory over (shrunk to the points).
-  const auto rows = static_cast<py::ssize_t>(m);
-  float* xy = buffer.xy;
-  std::uint64_t* key = buffer.keys;
-  buffer.xy = nullptr, buffer.keys = nullptr;
-  py::capsule xy_owner(xy, [](void* p) { std::free(p); });
-  py::array_t<float> xy_array({rows, py::ssize_t(2)}, xy, xy_owner);
-  if (!keys) return py::make_tuple(xy_array, py::none());
-  py::capsule keys_owner(key, [](void* p) { std::free(p); });
-  return py::make_tuple(xy_array, py::array_t<std::uint64_t>({rows}, key, keys_owner));
+  return take_compact(buffer, m);
+}
+
+/// A class query's parameters from Python's arguments, with the densities they point into.
+struct PreparedClasses {
+  ClassQueryParams q;
+  std::vector<std::unique_ptr<SpecDensity>> densities;
+};
+
+void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
+                     const std::vector<const tools::DensitySpec*>& specs, std::optional<Rect> density_rect,
+                     double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+  check_rect("rect", rect);
+  if (specs.empty() || specs.size() > kMaxQueryClasses)
+    throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
+                                " densities, got " + std::to_string(specs.size()));
+  if (density_rect) check_rect("density_rect", *density_rect);
+  const Rect r = density_rect ? *density_rect : rect;
+  ClassQueryParams& q = prepared.q;
+  q.query.x0 = rect[0], q.query.y0 = rect[1], q.query.x1 = rect[2], q.query.y1 = rect[3];
+  q.query.origin_x = origin[0], q.query.origin_y = origin[1];
+  q.query.tile_size = tile_size;
+  q.query.scale = scale;
+  q.query.mode = parse_mode(mode);
+  q.class_count = static_cast<std::uint32_t>(specs.size());
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    if (!specs[k]) throw std::invalid_argument("classes[" + std::to_string(k) + "] is not a density");
+    prepared.densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
+    q.classes[k] = prepared.densities.back()->density;
+  }
 }
 
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
@@ -350,31 +384,14 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
                         const std::vector<const tools::DensitySpec*>& specs, std::optional<Rect> density_rect,
                         double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
-  check_rect("rect", rect);
-  if (specs.empty() || specs.size() > kMaxQueryClasses)
-    throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
-                                " densities, got " + std::to_string(specs.size()));
-  if (density_rect) check_rect("density_rect", *density_rect);
-  const Rect r = density_rect ? *density_rect : rect;
-  ClassQueryParams q;
-  q.query.x0 = rect[0], q.query.y0 = rect[1], q.query.x1 = rect[2], q.query.y1 = rect[3];
-  q.query.origin_x = origin[0], q.query.origin_y = origin[1];
-  q.query.tile_size = tile_size;
-  q.query.scale = scale;
-  q.query.mode = parse_mode(mode);
-  q.class_count = static_cast<std::uint32_t>(specs.size());
-  std::vector<std::unique_ptr<SpecDensity>> densities;
-  for (std::size_t k = 0; k < specs.size(); ++k) {
-    if (!specs[k]) throw std::invalid_argument("classes[" + std::to_string(k) + "] is not a density");
-    densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
-    q.classes[k] = densities.back()->density;
-  }
+  PreparedClasses prepared;
+  prepare_classes(prepared, rect, scale, specs, density_rect, tile_size, mode, origin);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
   {
     py::gil_scoped_release release;
-    tools::query_all(*handle.set, q, points, classes, tools::ParameterNames{"scale=", "tile_size="});
+    tools::query_all(*handle.set, prepared.q, points, classes, tools::ParameterNames{"scale=", "tile_size="});
     buffer.reserve(std::max<std::size_t>(points.size(), 1), 0);
     std::copy(points.begin(), points.end(), buffer.points);
     for (std::size_t i = 0; i < points.size(); ++i)
@@ -386,12 +403,50 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
   return py::make_tuple(base[0], base[1], base[2], base[3], base[4], base[5], labels);
 }
 
+/// Several classes into the compact output (query_classes_compact), with the GIL released: positions
+/// (m × 2 float32), each point's key if asked (else None), and each point's class.
+py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double scale,
+                          const std::vector<const tools::DensitySpec*>& specs,
+                          std::optional<Rect> density_rect, double tile_size, const std::string& mode,
+                          const std::array<double, 2>& origin, bool keys) {
+  PreparedClasses prepared;
+  prepare_classes(prepared, rect, scale, specs, density_rect, tile_size, mode, origin);
+  CompactBuffer buffer;
+  buffer.with_keys = keys;
+  std::vector<std::uint8_t> classes;
+  std::size_t m = 0;
+  {
+    py::gil_scoped_release release;
+    QueryProblem problem;
+    QueryCursor cursor;
+    for (;;) {
+      buffer.reserve(m + kChunk);
+      classes.resize(buffer.capacity);
+      std::size_t written = 0;
+      const Status s = query_classes_compact(*handle.set, prepared.q, buffer.at(m), classes.data() + m,
+                                             buffer.capacity - m, &written, &cursor, &problem);
+      m += written;
+      check_collected(m);
+      if (s == Status::kOk) break;
+      if (s != Status::kBufferFull) refused(problem);
+    }
+  }
+  py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(m));
+  std::copy(classes.begin(), classes.begin() + m, labels.mutable_data());
+  const py::tuple arrays = take_compact(buffer, m);
+  return py::make_tuple(arrays[0], arrays[1], labels);
+}
+
 }  // namespace
 
 void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
         py::arg("origin"), "several classes in one query: query()'s tuple and each point's class");
+  m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
+        py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
+        py::arg("origin"), py::arg("keys"),
+        "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("spec").none(true), py::arg("callable").none(true), py::arg("bounds").none(true),
         py::arg("density_rect").none(true), py::arg("density_max").none(true), py::arg("tile_size"),

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "descent.h"
+#include "emit_tile.h"
 #include "image_sampler.h"
 #include "kdm/runtime/hash.h"
 #include "query_counted.h"
@@ -19,6 +20,10 @@ using detail::density_or_zero;
 using detail::ImageSampler;
 
 namespace {
+
+/// Points the union's query writes between two classings (varying densities): they are classed while
+/// still in cache; the compact output keeps their ids on the stack (24 bytes each).
+constexpr std::size_t kClassChunk = 1024;
 
 // Static names for QueryProblem::parameter, one per class.
 constexpr const char* kImageNames[kMaxQueryClasses] = {
@@ -100,25 +105,35 @@ class Classifier {
         S_(q.tile_size),
         scale_(q.scale) {}
 
-  void operator()(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+  /// detail::ConstantClasses::class_of_id over a Classifier (`user`): one point's class.
+  static std::uint8_t class_of_id(void* user, const PointId& id) {
+    std::uint8_t c = 0;
+    (*static_cast<Classifier*>(user))([&](std::size_t) -> const PointId& { return id; }, &c, 1);
+    return c;
+  }
+
+  /// Classes ids(0) … ids(count - 1) into classes[0..count).
+  template <class Ids>
+  void operator()(Ids ids, std::uint8_t* classes, std::size_t count) {
     if (densities_.all_constant)
-      classify_constant(points, classes, count);
+      classify_constant(ids, classes, count);
     else
-      classify_varying(points, classes, count);
+      classify_varying(ids, classes, count);
   }
 
  private:
   /// Constant densities: thresholds grow with the rank, so class k holds the ranks from first_rank_[k - 1]
   /// on, and a tile's points come in rank order, so the class only steps forward along them. Everything
   /// the loop reads is local: the byte stores into `classes` could alias any member.
-  void classify_constant(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+  template <class Ids>
+  void classify_constant(Ids ids, std::uint8_t* classes, std::size_t count) {
     const std::uint32_t last = p_.class_count - 1;
     std::uint32_t first_rank[kMaxQueryClasses];
     std::copy(first_rank_, first_rank_ + kMaxQueryClasses, first_rank);
     PointId tile = tile_;
     std::uint32_t cls = class_, previous = rank_;
     for (std::size_t i = 0; i < count; ++i) {
-      const PointId& id = points[i].id;
+      const PointId& id = ids(i);
       if (id.tile_x != tile.tile_x || id.tile_y != tile.tile_y || id.depth != tile.depth) {
         enter(id);
         tile = id, cls = 0, previous = 0;
@@ -132,9 +147,10 @@ class Classifier {
     class_ = cls, rank_ = previous;
   }
 
-  void classify_varying(const QueryPoint* points, std::uint8_t* classes, std::size_t count) {
+  template <class Ids>
+  void classify_varying(Ids ids, std::uint8_t* classes, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) {
-      const PointId& id = points[i].id;
+      const PointId& id = ids(i);
       if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) enter(id);
       if (id.rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
         classes[i] = static_cast<std::uint8_t>(p_.class_count - 1);
@@ -212,18 +228,15 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
   return h;
 }
 
-Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
-                     std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                     QueryProblem* problem) {
-  detail::Refusal refuse(problem);
-  QueryProblem& why = refuse.problem();
+namespace {
+
+/// Checks `p` and sets up what both outputs share: the classes' densities and the one-class query at their
+/// sum (`q`). Fills `fingerprint` with the class query's own. kOk, or kInvalidArgument by `refuse`.
+Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, ClassDensities& densities,
+                     QueryParams& q, detail::Refusal& refuse) {
   using Kind = QueryProblem::Kind;
-  if (written) *written = 0;
-  if (!written) return refuse(Kind::kMissingArgument, "written");
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
-  if (capacity > 0 && !classes) return refuse(Kind::kMissingArgument, "classes");
-  ClassDensities densities;
   densities.params = &p;
   for (std::uint32_t k = 0; k < p.class_count; ++k) {
     const QueryDensity& d = p.classes[k];
@@ -248,51 +261,64 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
   }
 
   // The union: a constant when every class is one (query_points' fastest path), else their sum by callback.
-  QueryParams q = p.query;
+  q = p.query;
   q.density = QueryDensity{};
   if (densities.all_constant) {
     q.density.constant = 0;  // not QueryDensity's default of 1
     for (std::uint32_t k = 0; k < p.class_count; ++k)
       q.density.constant += density_or_zero(p.classes[k].constant);
-  } else {
-    q.density.kind = QueryDensity::Kind::kCallback;
-    q.density.callback = sum_of_densities;
-    q.density.user = &densities;
-    // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
-    double reach = 0;
-    if (q.mode == QueryMode::kSmooth && tileset.has_glide_track()) {
-      const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
-      for (std::size_t g = 0; g < tables.glide_reach.size(); ++g)
-        reach = std::max(reach, tables.glide_reach[g]);
-      reach = (std::max(reach, tables.descent_reach) + 2.0 / 65536.0) * q.tile_size;
-    }
-    q.density.callback_max = 0;
-    // Bounds of a region query_points will accept (it refuses the others, with their names, below).
-    const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
-                        std::isfinite(q.y1) && std::isfinite(reach);
-    for (std::uint32_t k = 0; k < p.class_count && finite; ++k)
-      q.density.callback_max += density_bound(p.classes[k], q, reach);
+    return Status::kOk;
   }
-  // The cursor carries this query's fingerprint; the inner one's (which hashes `densities`' address) only
-  // while query_points runs.
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = sum_of_densities;
+  q.density.user = &densities;
+  // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
+  double reach = 0;
+  if (q.mode == QueryMode::kSmooth && tileset.has_glide_track()) {
+    const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
+    for (std::size_t g = 0; g < tables.glide_reach.size(); ++g)
+      reach = std::max(reach, tables.glide_reach[g]);
+    reach = (std::max(reach, tables.descent_reach) + 2.0 / 65536.0) * q.tile_size;
+  }
+  q.density.callback_max = 0;
+  // Bounds of a region query_points will accept (it refuses the others, with their names, later).
+  const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
+                      std::isfinite(q.y1) && std::isfinite(reach);
+  for (std::uint32_t k = 0; k < p.class_count && finite; ++k)
+    q.density.callback_max += density_bound(p.classes[k], q, reach);
+  return Status::kOk;
+}
+
+/// Constant classes: their cumulative expected counts per depth-0 tile, as Classifier::enter computes them.
+void constant_counts(const ClassQueryParams& p, const QueryParams& q, double counts[kMaxQueryClasses]) {
+  const double area = q.tile_size * q.tile_size * q.scale;
+  double sum = 0;
+  for (std::uint32_t k = 0; k + 1 < p.class_count; ++k)
+    counts[k] = (sum += density_or_zero(p.classes[k].constant)) * area;
+}
+
+/// Runs `chunk(n, room, &got, inner_problem, examined)` (the union's query into the outputs from slot n on,
+/// at most `chunk_size` points, classing what it wrote) until the region is done, the caller's room is used
+/// or the bound on the work is reached: the chunks share one call's candidate bound, and each point is
+/// classed while still in cache. The cursor carries the class query's fingerprint between calls and the
+/// union's while the chunks run.
+template <class Chunk>
+Status run_chunks(const ClassQueryParams& p, const QueryParams& q, std::size_t chunk_size,
+                  std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
+                  Chunk chunk) {
   const std::uint64_t fingerprint = query_fingerprint(p);
   if (cursor && cursor->started) {
-    if (cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
+    if (cursor->fingerprint != fingerprint) return refuse(QueryProblem::Kind::kCursorMismatch, "cursor");
     cursor->fingerprint = query_fingerprint(q);
   }
-  // A chunk at a time, so that each point's class is found while the point is still in the cache; the
-  // chunks share one call's bound on the candidates examined.
-  Classifier classify(tileset, p, densities, q);
-  constexpr std::size_t kChunk = 2048;
   std::uint64_t examined = 0;
   std::size_t n = 0;
   Status status = Status::kOk;
   for (;;) {
-    const std::size_t room = std::min(capacity - n, kChunk);
+    const std::size_t room = std::min(capacity - n, chunk_size);
     std::size_t got = 0;
-    status = detail::query_points_counted(tileset, q, out + n, room, &got, cursor, &why, examined);
+    status = chunk(n, room, &got, &refuse.problem(), examined);
     if (status == Status::kInvalidArgument) return status;
-    classify(out + n, classes + n, got);
     n += got;
     // Done, the caller's buffer full, or the bound on the work reached (a chunk that did not fill).
     if (status == Status::kOk || n == capacity || got < room) break;
@@ -300,6 +326,80 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
   *written = n;
   if (cursor) cursor->fingerprint = fingerprint;
   return status;
+}
+
+}  // namespace
+
+Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
+                     std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                     QueryProblem* problem) {
+  detail::Refusal refuse(problem);
+  if (written) *written = 0;
+  if (!written) return refuse(QueryProblem::Kind::kMissingArgument, "written");
+  ClassDensities densities;
+  QueryParams q;
+  if (prepare_union(tileset, p, densities, q, refuse) != Status::kOk) return Status::kInvalidArgument;
+  if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
+  Classifier classify(tileset, p, densities, q);
+  if (densities.all_constant) {  // classed as they are written, in one piece
+    double counts[kMaxQueryClasses];
+    constant_counts(p, q, counts);
+    return run_chunks(
+        p, q, capacity, capacity, written, cursor, refuse,
+        [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
+          const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
+                                          &classify};
+          return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
+        });
+  }
+  return run_chunks(
+      p, q, 2 * kClassChunk, capacity, written, cursor, refuse,
+      [&](std::size_t n, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
+        const Status status =
+            detail::query_points_counted(tileset, q, out + n, room, got, cursor, why, examined);
+        if (status != Status::kInvalidArgument)
+          classify([&](std::size_t i) -> const PointId& { return out[n + i].id; }, classes + n, *got);
+        return status;
+      });
+}
+
+Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, const CompactPoints& out,
+                             std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                             QueryCursor* cursor, QueryProblem* problem) {
+  detail::Refusal refuse(problem);
+  if (written) *written = 0;
+  if (!written) return refuse(QueryProblem::Kind::kMissingArgument, "written");
+  ClassDensities densities;
+  QueryParams q;
+  if (prepare_union(tileset, p, densities, q, refuse) != Status::kOk) return Status::kInvalidArgument;
+  if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
+  if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
+  if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
+  Classifier classify(tileset, p, densities, q);
+  if (densities.all_constant) {  // classed as they are written, in one piece
+    double counts[kMaxQueryClasses];
+    constant_counts(p, q, counts);
+    return run_chunks(
+        p, q, capacity, capacity, written, cursor, refuse,
+        [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
+          const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
+                                          &classify};
+          return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
+        });
+  }
+  PointId ids[kClassChunk];  // the chunk's ids, for its classes and keys
+  return run_chunks(
+      p, q, kClassChunk, capacity, written, cursor, refuse,
+      [&](std::size_t n, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
+        const Status status = detail::query_compact_ids_counted(tileset, q, out.xy + 2 * n, ids, room, got,
+                                                                cursor, why, examined);
+        if (status == Status::kInvalidArgument) return status;
+        classify([&](std::size_t i) -> const PointId& { return ids[i]; }, classes + n, *got);
+        if (out.keys)
+          for (std::size_t i = 0; i < *got; ++i) out.keys[n + i] = point_key(ids[i]);
+        return status;
+      });
 }
 
 }  // namespace kdm

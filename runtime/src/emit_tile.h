@@ -128,6 +128,87 @@ struct CompactSink {
   }
 };
 
+/// Compact positions as CompactSink<false> writes them, and each point's id beside them (the class query
+/// classes points by id, then writes keys if asked).
+struct CompactIdSink {
+  CompactSink<false> xy;
+  PointId* ids;
+  void put(std::size_t i, double x, double y, const PointId& id) const {
+    xy.put(i, x, y, id);
+    ids[i] = id;
+  }
+  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+    xy.put_stable(i, j, p, rank);
+    ids[i] = PointId{j.tx, j.ty, rank};
+  }
+  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
+    xy.put_stable_run(i, j, c, count);
+    for (std::uint32_t k = 0; k < count; ++k) ids[i + k] = PointId{j.tx, j.ty, c + k};
+  }
+  void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c) const {
+    xy.put_glided(i, j, g, c);
+    ids[i] = PointId{j.tx, j.ty, c};
+  }
+  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
+                      std::uint32_t count) const {
+    xy.put_glided_run(i, j, g, c, count);
+    for (std::uint32_t k = 0; k < count; ++k) ids[i + k] = PointId{j.tx, j.ty, c + k};
+  }
+};
+
+/// Any output (Base: PointSink or CompactSink) with each point's class, for classes of constant densities
+/// (class_query.h): thresholds grow with the rank, so a depth-0 tile's classes are rank ranges, found once
+/// per run by binary search. Class k holds the ranks that `counts[k]` (the first k + 1 classes' expected
+/// count per tile) emits and `counts[k - 1]` does not. A point written by put (past the top level) is
+/// classed by `class_of_id`.
+template <class Base>
+struct ClassSink {
+  Base base;
+  std::uint8_t* classes;
+  const double* counts;  ///< cumulative expected counts per tile, classes 0 … last - 1
+  std::uint32_t last;    ///< the last class, which takes every rank the others leave
+  std::uint8_t (*class_of_id)(void* user, const PointId& id);
+  void* user;
+  void put(std::size_t i, double x, double y, const PointId& id) const {
+    base.put(i, x, y, id);
+    classes[i] = class_of_id(user, id);
+  }
+  std::uint8_t class_of(float threshold) const {
+    std::uint32_t k = 0;
+    while (k < last && !TilesetShape::emits(threshold, counts[k])) ++k;
+    return static_cast<std::uint8_t>(k);
+  }
+  /// Ranks [c, c + count) of tile j into slots from i on.
+  void class_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
+    const float *first = j.thresholds + c, *end = first + count;
+    for (std::uint32_t k = 0; k <= last && first < end; ++k) {
+      const float* upto = k == last ? end : std::lower_bound(first, end, counts[k], [](float t, double e) {
+        return TilesetShape::emits(t, e);
+      });
+      std::fill(classes + i + (first - j.thresholds - c), classes + i + (upto - j.thresholds - c),
+                static_cast<std::uint8_t>(k));
+      first = upto;
+    }
+  }
+  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+    base.put_stable(i, j, p, rank);
+    classes[i] = class_of(j.thresholds[rank]);
+  }
+  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
+    base.put_stable_run(i, j, c, count);
+    class_run(i, j, c, count);
+  }
+  void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c) const {
+    base.put_glided(i, j, g, c);
+    classes[i] = class_of(j.thresholds[c]);
+  }
+  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
+                      std::uint32_t count) const {
+    base.put_glided_run(i, j, g, c, count);
+    class_run(i, j, c, count);
+  }
+};
+
 inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g,
                                       std::uint32_t c, std::uint32_t count) const {
   const double* v = kSignedByte.value + 128;

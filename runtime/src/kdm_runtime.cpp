@@ -153,6 +153,32 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
   return status;
 }
 
+/// Reads the class densities into `q` and runs `run(q, cursor, why)` (a class query) with the C cursor.
+template <class Run>
+kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
+                           const kdm_class_density* classes, uint32_t class_count, size_t* written,
+                           kdm_cursor* cursor, kdm_query_problem* problem, Run run) {
+  kdm::QueryProblem why;
+  kdm::ClassQueryParams q;
+  kdm_status status = KDM_INVALID_ARGUMENT;
+  if (!read_query(tileset, query, cursor, written, q.query, why)) {
+  } else if (!classes) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "classes";
+  } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
+    why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
+    why.value = class_count, why.limit = kdm::kMaxQueryClasses;
+  } else {
+    q.class_count = class_count;
+    for (uint32_t k = 0; k < class_count; ++k) {
+      const kdm_class_density& c = classes[k];
+      q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
+    }
+    status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
+  }
+  report(why, problem);
+  return status;
+}
+
 }  // namespace
 
 extern "C" {
@@ -262,27 +288,22 @@ kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,
                              const kdm_class_density* classes, uint32_t class_count, kdm_point* out,
                              uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
                              kdm_query_problem* problem) {
-  kdm::QueryProblem why;
-  kdm::ClassQueryParams q;
-  kdm_status status = KDM_INVALID_ARGUMENT;
-  if (!read_query(tileset, query, cursor, written, q.query, why)) {
-  } else if (!classes) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "classes";
-  } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
-    why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
-    why.value = class_count, why.limit = kdm::kMaxQueryClasses;
-  } else {
-    q.class_count = class_count;
-    for (uint32_t k = 0; k < class_count; ++k) {
-      const kdm_class_density& c = classes[k];
-      q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
-    }
-    status = with_cursor(cursor, [&](kdm::QueryCursor* k) {
-      return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity, written, k, &why);
-    });
-  }
-  report(why, problem);
-  return status;
+  return run_class_query(tileset, query, classes, class_count, written, cursor, problem,
+                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                           return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity,
+                                                     written, k, why);
+                         });
+}
+
+kdm_status kdm_query_classes_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                     const kdm_class_density* classes, uint32_t class_count, float* xy,
+                                     uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written,
+                                     kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_class_query(tileset, query, classes, class_count, written, cursor, problem,
+                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                           return kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                             out_classes, capacity, written, k, why);
+                         });
 }
 
 const char* kdm_status_message(kdm_status status) {

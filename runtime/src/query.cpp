@@ -316,33 +316,77 @@ Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::s
                     count, cursor, refuse, examined);
 }
 
+Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, bool keys, Refusal& refuse) {
+  // Positions relative to the origin must fit a float (3.4e38); a margin for the region's own width.
+  const double far_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x));
+  const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
+  if (far_x > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x);
+  if (far_y > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y);
+  if (keys && !tileset.empty()) {
+    const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
+    if (most > (std::uint64_t(1) << kKeyRankBits))
+      return refuse(QueryProblem::Kind::kKeysUnsupported, "out.keys", double(most),
+                    double(std::uint64_t(1) << kKeyRankBits));
+  }
+  return Status::kOk;
+}
+
+Status detail::query_compact_ids_counted(const Tileset& tileset, const QueryParams& q, float* xy,
+                                         PointId* ids, std::size_t capacity, std::size_t* written,
+                                         QueryCursor* cursor, QueryProblem* problem,
+                                         std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  if (written) *written = 0;
+  if (compact_refusal(tileset, q, false, refuse) != Status::kOk) return Status::kInvalidArgument;
+  return query_into(tileset, q, detail::CompactIdSink{CompactSink<false>{xy, nullptr}, ids},
+                    xy != nullptr && ids != nullptr, "out.xy", capacity, written, cursor, refuse, examined);
+}
+
+namespace {
+
+template <class Base>
+detail::ClassSink<Base> class_sink(Base base, const detail::ConstantClasses& c) {
+  return detail::ClassSink<Base>{base, c.classes, c.counts, c.last, c.class_of_id, c.user};
+}
+
+}  // namespace
+
+Status detail::query_constant_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
+                                              const ConstantClasses& classes, std::size_t capacity,
+                                              std::size_t* written, QueryCursor* cursor,
+                                              QueryProblem* problem, std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  return query_into(tileset, q, class_sink(PointSink{out}, classes), out && classes.classes, "out", capacity,
+                    written, cursor, refuse, examined);
+}
+
+Status detail::query_constant_classes_counted(const Tileset& tileset, const QueryParams& q,
+                                              const CompactPoints& compact, const ConstantClasses& classes,
+                                              std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                              QueryProblem* problem, std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  if (written) *written = 0;
+  if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
+  const bool room = compact.xy && classes.classes;
+  if (compact.keys)
+    return query_into(tileset, q, class_sink(CompactSink<true>{compact.xy, compact.keys}, classes), room,
+                      "out.xy", capacity, written, cursor, refuse, examined);
+  return query_into(tileset, q, class_sink(CompactSink<false>{compact.xy, nullptr}, classes), room, "out.xy",
+                    capacity, written, cursor, refuse, examined);
+}
+
 Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                             QueryProblem* problem) {
   detail::Refusal refuse(problem);
   std::uint64_t examined = 0;
-  // Positions relative to the origin must fit a float (3.4e38); a margin for the region's own width.
-  const double far_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x));
-  const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
-  if (far_x > 1e38) {
-    if (written) *written = 0;
-    return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x);
-  }
-  if (far_y > 1e38) {
-    if (written) *written = 0;
-    return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y);
-  }
+  if (written) *written = 0;
+  if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
   if (!out.keys)
     return query_into(tileset, q, CompactSink<false>{out.xy, nullptr}, out.xy != nullptr, "out.xy", capacity,
                       written, cursor, refuse, examined);
-  if (!tileset.empty()) {
-    const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
-    if (most > (std::uint64_t(1) << kKeyRankBits)) {
-      if (written) *written = 0;
-      return refuse(QueryProblem::Kind::kKeysUnsupported, "out.keys", double(most),
-                    double(std::uint64_t(1) << kKeyRankBits));
-    }
-  }
   return query_into(tileset, q, CompactSink<true>{out.xy, out.keys}, out.xy != nullptr, "out.xy", capacity,
                     written, cursor, refuse, examined);
 }

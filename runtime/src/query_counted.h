@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 
 namespace kdm::detail {
@@ -32,6 +33,37 @@ class Refusal {
 Status query_points_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                             QueryProblem* problem, std::uint64_t& examined);
+
+/// The compact output's own refusals, before query_points': a region more than 1e38 from the origin
+/// (beyond a float), and `keys` asked of a set whose tiles hold more points than a key's ranks. kOk when
+/// none applies, else kInvalidArgument with `refuse`'s problem filled.
+Status compact_refusal(const Tileset& tileset, const QueryParams& params, bool keys, Refusal& refuse);
+
+/// query_points_compact's positions (no keys) with each point's id into `ids[0..capacity)`, counting into
+/// `examined` as query_points_counted does; a null xy or ids with room is refused as "out.xy".
+Status query_compact_ids_counted(const Tileset& tileset, const QueryParams& params, float* xy, PointId* ids,
+                                 std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                 QueryProblem* problem, std::uint64_t& examined);
+
+/// Classes of constant densities (class_query.h), classed as they are written (emit_tile.h's ClassSink:
+/// `counts` the classes' cumulative expected counts per depth-0 tile, `last` the last class, class_of_id
+/// for points past the top level): query_points into `out`, or query_points_compact into `compact`, with
+/// each point's class into `classes`, counting into `examined` as query_points_counted does.
+struct ConstantClasses {
+  std::uint8_t* classes;
+  const double* counts;
+  std::uint32_t last;
+  std::uint8_t (*class_of_id)(void* user, const PointId& id);
+  void* user;
+};
+Status query_constant_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
+                                      const ConstantClasses& classes, std::size_t capacity,
+                                      std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
+                                      std::uint64_t& examined);
+Status query_constant_classes_counted(const Tileset& tileset, const QueryParams& params,
+                                      const CompactPoints& compact, const ConstantClasses& classes,
+                                      std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                      QueryProblem* problem, std::uint64_t& examined);
 
 /// How many points query_points would write for `params` from `cursor` on, into `*count`, without
 /// writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing to count). Returns

@@ -292,6 +292,29 @@ def test_positions_are_the_querys_points_as_float32(mode):
         assert np.array_equal(BUILTIN.positions(rect, density=density, **kwargs), xy)
 
 
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_positions_with_classes_are_the_class_querys_points(mode):
+    rect, origin = (0.2, 0.1, 3.0, 2.0), (0.0, 0.0)
+    classes = [1.0, "ramp:4", 2.0]
+    full = BUILTIN.query(rect, scale=150, classes=classes, mode=mode, origin=origin)
+    xy, keys, labels = BUILTIN.positions(rect, scale=150, classes=classes, mode=mode, origin=origin, keys=True)
+    assert len(full) > 1000 and xy.shape == (len(full), 2) and xy.dtype == np.float32
+    assert labels.dtype == np.uint8 and np.array_equal(labels, full.classes)
+    # A varying union writes the double rounded to float.
+    assert np.array_equal(xy, full.xy.astype(np.float32))
+    assert np.array_equal(keys >> np.uint64(42) & np.uint64(2**19 - 1), full.rank.astype(np.uint64))
+    # Constant classes: the one-class positions at the sum, bit for bit.
+    xy_c, labels_c = BUILTIN.positions(rect, scale=150, classes=[1.0, 2.0], mode=mode)
+    assert np.array_equal(xy_c, BUILTIN.positions(rect, scale=150, density=3.0, mode=mode))
+    assert set(np.unique(labels_c)) == {0, 1}
+    with pytest.raises(ValueError, match="threads"):
+        BUILTIN.positions(rect, scale=150, classes=classes, threads=2)
+    with pytest.raises(ValueError, match="do not apply"):
+        BUILTIN.positions(rect, scale=150, classes=classes, density=1.0)
+    with pytest.raises(ValueError, match="1 to 8"):
+        BUILTIN.positions(rect, scale=150, classes=[])
+
+
 def test_positions_over_threads_give_the_same_bits_for_any_count():
     rect = (0.0, 0.0, 6.0, 5.0)
     for mode in ("stable", "smooth"):

@@ -202,6 +202,37 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_classes(builtin, &q, densities, 3, points, NULL, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT);
+    /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
+    {
+      static float xy[2 * 4096], sum_xy[2 * 4096];
+      static uint64_t keys[4096];
+      static uint8_t compact_classes[4096];
+      size_t compact = 0;
+      q.density = 1;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, NULL) ==
+            KDM_OK);
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_classes_compact(builtin, &q, densities, 3, xy, keys, compact_classes, 4096, &compact,
+                                      &cursor, &problem) == KDM_OK);
+      CHECK(compact == written);
+      q.density = 7;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_compact(builtin, &q, sum_xy, NULL, 4096, &alone, &cursor, NULL) == KDM_OK &&
+            alone == written);
+      CHECK(memcmp(xy, sum_xy, 2 * written * sizeof(float)) == 0);
+      for (i = 0; i < written; ++i) {
+        CHECK(compact_classes[i] == classes[i]);
+        CHECK((keys[i] >> 42 & 0x7FFFF) == points[i].rank);
+        CHECK(fabs(xy[2 * i] - points[i].x) < 1e-5 && fabs(xy[2 * i + 1] - points[i].y) < 1e-5);
+      }
+      CHECK(kdm_query_classes_compact(builtin, &q, densities, 3, NULL, keys, compact_classes, 4096, &compact,
+                                      &cursor, &problem) == KDM_INVALID_ARGUMENT);
+      CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out.xy") == 0);
+      CHECK(kdm_query_classes_compact(builtin, &q, densities, 0, xy, keys, compact_classes, 4096, &compact,
+                                      &cursor, &problem) == KDM_INVALID_ARGUMENT);
+      CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT);
+    }
   }
   /* A callback's bounds: the same points, far fewer calls. */
   {

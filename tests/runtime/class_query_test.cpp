@@ -1,7 +1,7 @@
 // Several classes in one query: in stable mode class 0, classes 0 … k and the union are exactly the
 // one-class queries at their densities; smooth mode's union is the smooth query at the sum; class counts
-// follow the densities; partitions, resumption, zoom coherence (a class can only be promoted), refusals and
-// no allocation.
+// follow the densities; partitions, resumption, zoom coherence (a class can only be promoted), refusals,
+// no allocation, and the compact output's same points and classes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -308,9 +308,110 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(refusal(qn).parameter, "x0");
   qn.query.x0 = 0, qn.query.tile_size = HUGE_VAL;
   EXPECT_STREQ(refusal(qn).parameter, "tile_size");
+  // The compact output's own: no positions, a region beyond a float of the origin.
+  float xy[8];
+  ClassQueryParams qc = three_constants(0, 0, 1, 1, 10, QueryMode::kStable);
+  cursor = QueryCursor{};
+  EXPECT_EQ(
+      query_classes_compact(Tileset::builtin(), qc, CompactPoints{}, classes, 4, &written, &cursor, &why),
+      Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "out.xy");
+  EXPECT_EQ(query_classes_compact(Tileset::builtin(), qc, CompactPoints{xy, nullptr}, none, 4, &written,
+                                  &cursor, &why),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "classes");
+  qc.query.origin_x = 1e39;
+  EXPECT_EQ(query_classes_compact(Tileset::builtin(), qc, CompactPoints{xy, nullptr}, classes, 4, &written,
+                                  &cursor, &why),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "origin_x");
   // Too dense for the set: the sum is judged.
   q.query.scale = 32768.0 / 7 * 1.01;
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kDensityTooHigh);
+}
+
+/// query_classes_compact over `q` with keys, resumed through buffers of `capacity`: positions, keys and
+/// classes in output order.
+struct CompactRun {
+  std::vector<float> xy;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::uint8_t> classes;
+};
+CompactRun run_compact(const ClassQueryParams& q, std::size_t capacity) {
+  CompactRun run;
+  std::vector<float> xy(2 * capacity);
+  std::vector<std::uint64_t> keys(capacity);
+  std::vector<std::uint8_t> classes(capacity);
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), keys.data()},
+                                           classes.data(), capacity, &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
+    run.xy.insert(run.xy.end(), xy.begin(), xy.begin() + 2 * written);
+    run.keys.insert(run.keys.end(), keys.begin(), keys.begin() + written);
+    run.classes.insert(run.classes.end(), classes.begin(), classes.begin() + written);
+    if (s != Status::kBufferFull) break;
+  }
+  return run;
+}
+
+TEST(ClassQueryTest, CompactOutputHoldsTheSamePointsAndClasses) {
+  ThreeImages images;
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth})
+    for (bool mixed : {false, true}) {
+      ClassQueryParams q = three_constants(0.3, 0.2, 3.1, 2.7, 700, mode);
+      q.query.origin_x = 1, q.query.origin_y = 2;
+      if (mixed) q.classes[1].kind = QueryDensity::Kind::kImage, q.classes[1].image = &images.views[2];
+      const CompactRun compact = run_compact(q, 777);  // resumed across chunks and calls
+
+      // The records' query: the same points, order and classes; keys from their ids.
+      std::vector<QueryPoint> out(compact.keys.size() + 1);
+      std::vector<std::uint8_t> classes(out.size());
+      QueryCursor cursor;
+      std::size_t written = 0;
+      ASSERT_EQ(
+          query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor),
+          Status::kOk);
+      ASSERT_EQ(written, compact.keys.size());
+      ASSERT_GT(written, 5000u);
+      for (std::size_t i = 0; i < written; ++i) {
+        ASSERT_EQ(compact.keys[i], point_key(out[i].id)) << i;
+        ASSERT_EQ(compact.classes[i], classes[i]) << i;
+        if (mixed) {  // a varying density writes the double rounded to float
+          ASSERT_EQ(compact.xy[2 * i], static_cast<float>(out[i].x)) << i;
+          ASSERT_EQ(compact.xy[2 * i + 1], static_cast<float>(out[i].y)) << i;
+        }
+      }
+      if (mixed) continue;
+      // Constant densities: the one-class compact query at the sum, bit for bit.
+      QueryParams sum = q.query;
+      sum.density.constant = 7;
+      std::vector<float> xy(2 * out.size());
+      cursor = QueryCursor{};
+      ASSERT_EQ(query_points_compact(Tileset::builtin(), sum, CompactPoints{xy.data(), nullptr}, out.size(),
+                                     &written, &cursor),
+                Status::kOk);
+      ASSERT_EQ(written, compact.keys.size());
+      for (std::size_t i = 0; i < 2 * written; ++i) ASSERT_EQ(compact.xy[i], xy[i]) << i;
+    }
+  // Past the top level, where constant classes are not rank ranges of a depth-0 tile.
+  const ClassQueryParams deep = three_constants(0, 0, 0.25, 0.25, 3 * 32768.0 / 7, QueryMode::kSmooth);
+  const CompactRun compact = run_compact(deep, 1000);
+  std::vector<QueryPoint> out(compact.keys.size() + 1);
+  std::vector<std::uint8_t> classes(out.size());
+  QueryCursor cursor;
+  std::size_t written = 0, below = 0;
+  ASSERT_EQ(
+      query_classes(Tileset::builtin(), deep, out.data(), classes.data(), out.size(), &written, &cursor),
+      Status::kOk);
+  ASSERT_EQ(written, compact.keys.size());
+  for (std::size_t i = 0; i < written; ++i) {
+    ASSERT_EQ(compact.keys[i], point_key(out[i].id)) << i;
+    ASSERT_EQ(compact.classes[i], classes[i]) << i;
+    below += out[i].id.depth > 0;
+  }
+  EXPECT_GT(below, written / 4);
 }
 
 TEST(ClassQueryTest, QueriesAllocateNothing) {
@@ -320,6 +421,8 @@ TEST(ClassQueryTest, QueriesAllocateNothing) {
   q.classes[2].image = &images.views[0];
   std::vector<QueryPoint> out(1 << 16);
   std::vector<std::uint8_t> classes(out.size());
+  std::vector<float> xy(2 * out.size());
+  std::vector<std::uint64_t> keys(out.size());
   (void)Tileset::builtin();
   const long before = testing::allocations();
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
@@ -327,6 +430,11 @@ TEST(ClassQueryTest, QueriesAllocateNothing) {
     QueryCursor cursor;
     std::size_t written = 0;
     EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    EXPECT_GT(written, 10000u);
+    cursor = QueryCursor{};
+    EXPECT_EQ(query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), keys.data()},
+                                    classes.data(), out.size(), &written, &cursor),
               Status::kOk);
     EXPECT_GT(written, 10000u);
   }

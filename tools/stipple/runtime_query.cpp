@@ -60,16 +60,19 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
           });
 }
 
-void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
-                  const ParameterNames& names) {
+namespace {
+
+/// collect's loop for compact output: `step` writes x, y pairs into xy[2 · from ..) and what else it keeps.
+template <class Step>
+void collect_xy(std::vector<float>& xy, const ParameterNames& names, Step&& step) {
   xy.clear();
   QueryCursor cursor;
   for (std::size_t m = 0;;) {
-    xy.resize(2 * (m + (std::size_t(1) << 16)));
+    const std::size_t room = std::size_t(1) << 16;
+    xy.resize(2 * (m + room));
     std::size_t written = 0;
     QueryProblem problem;
-    const Status s = query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * m, nullptr},
-                                          xy.size() / 2 - m, &written, &cursor, &problem);
+    const Status s = step(m, room, &written, &cursor, &problem);
     m += written;
     xy.resize(2 * m);
     if (m > kMaxCollectedPoints)
@@ -77,6 +80,33 @@ void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector
     if (s == Status::kOk) return;
     if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
   }
+}
+
+}  // namespace
+
+void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
+                  const ParameterNames& names) {
+  collect_xy(xy, names,
+             [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+                 QueryProblem* problem) {
+               return query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr},
+                                           room, written, cursor, problem);
+             });
+}
+
+void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
+                  std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+  classes.clear();
+  collect_xy(xy, names,
+             [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+                 QueryProblem* problem) {
+               classes.resize(from + room);
+               const Status s =
+                   query_classes_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr},
+                                         classes.data() + from, room, written, cursor, problem);
+               classes.resize(from + *written);
+               return s;
+             });
 }
 
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,

@@ -38,6 +38,9 @@ void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector
 /// The same for several classes: `classes` (replaced) receives each point's class.
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
+/// The same into the compact output: x, y pairs and each point's class.
+void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
+                  std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
 
 /// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
 /// point set normalised to it: [0, 1) on both axes.

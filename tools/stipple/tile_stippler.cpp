@@ -78,8 +78,8 @@ PointSet TileStippler::render(const double uv[4]) const {
   q.density = densities_.front()->density;
   q.mode = mode_;
   const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
-  if (densities_.size() == 1) {  // positions only: the compact output
-    std::vector<float> xy;
+  std::vector<float> xy;  // positions only: the compact output
+  if (densities_.size() == 1) {
     query_all_xy(tiles_, q, xy);
     return normalise_to_rect(xy, rect);
   }
@@ -87,10 +87,9 @@ PointSet TileStippler::render(const double uv[4]) const {
   cq.query = q;
   cq.class_count = static_cast<std::uint32_t>(densities_.size());
   for (std::size_t k = 0; k < densities_.size(); ++k) cq.classes[k] = densities_[k]->density;
-  std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
-  query_all(tiles_, cq, points, classes);
-  PointSet set = normalise_to_rect(points, rect);
+  query_all_xy(tiles_, cq, xy, classes);
+  PointSet set = normalise_to_rect(xy, rect);
   set.classes = std::move(classes);
   return set;
 }

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/status.h"
@@ -50,5 +51,15 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
 KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
                                      std::uint8_t* classes, std::size_t capacity, std::size_t* written,
                                      QueryCursor* cursor, QueryProblem* problem = nullptr);
+
+/// query_classes into a compact output (compact_query.h): the same points, order, classes, statuses and
+/// cursor, each point's position as floats at out.xy[2i], out.xy[2i + 1] (bit for bit those
+/// query_points_compact writes for the one-class query at the sum of the densities) and, if out.keys is not
+/// null, its point_key at out.keys[i]. Refusals as query_classes', and query_points_compact's for the output
+/// ("out.xy", a region beyond a float of the origin, kKeysUnsupported). No allocation; 24 KB of stack.
+KDM_RUNTIME_API Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& params,
+                                             const CompactPoints& out, std::uint8_t* classes,
+                                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                             QueryProblem* problem = nullptr);
 
 }  // namespace kdm

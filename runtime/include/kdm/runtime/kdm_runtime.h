@@ -197,6 +197,16 @@ KDM_RUNTIME_API kdm_status kdm_query_classes(const kdm_tileset* tileset, const k
                                              kdm_point* out, uint8_t* out_classes, size_t capacity,
                                              size_t* written, kdm_cursor* cursor, kdm_query_problem* problem);
 
+/* kdm_query_classes into a compact output, as kdm_query_compact writes one: the same points, order and
+ * classes, positions as float pairs in xy[2i], xy[2i + 1] (those kdm_query_compact writes at the sum of
+ * the densities), keys in keys[i] when `keys` is not NULL, classes in out_classes[i]. Statuses, resumption
+ * and refusals as kdm_query_classes' and kdm_query_compact's. */
+KDM_RUNTIME_API kdm_status kdm_query_classes_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                                     const kdm_class_density* classes, uint32_t class_count,
+                                                     float* xy, uint64_t* keys, uint8_t* out_classes,
+                                                     size_t capacity, size_t* written, kdm_cursor* cursor,
+                                                     kdm_query_problem* problem);
+
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
