@@ -140,10 +140,10 @@ void BM_QueryDensityCallback(benchmark::State& state) {
 }
 
 // Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp, 1 for three ramps by callback
-// instead of constants; compact, 1 for both queries into float positions) against one class at their
-// sum, which emits the same points (its callback calls
-// the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
-// one-class query's time over the three-class query's.
+// instead of constants, 2 for the same with their bounds (and the sum's); compact, 1 for both queries into
+// float positions) against one class at their sum, which emits the same points (its callback calls the three
+// ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the one-class
+// query's time over the three-class query's.
 double ramp_class(void* k, double x, double) {
   return (0.2 + 0.8 * x / kSide) * double(1 << *static_cast<const int*>(k)) / 7;
 }
@@ -152,6 +152,13 @@ double ramp_sum(void* k, double x, double y) {
   const int* index = static_cast<const int*>(k);
   return ramp_class(const_cast<int*>(index), x, y) + ramp_class(const_cast<int*>(index + 1), x, y) +
          ramp_class(const_cast<int*>(index + 2), x, y);
+}
+
+void ramp_class_bounds(void* k, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  *lo = ramp_class(k, x0, y0), *hi = ramp_class(k, x1, y1);
+}
+void ramp_sum_bounds(void* k, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  *lo = ramp_sum(k, x0, y0), *hi = ramp_sum(k, x1, y1);
 }
 
 void BM_QueryThreeClasses(benchmark::State& state) {
@@ -166,12 +173,14 @@ void BM_QueryThreeClasses(benchmark::State& state) {
     if (state.range(1)) {
       d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
       d.user = const_cast<int*>(&kIndex[k]), d.callback_max = d.constant;
+      if (state.range(1) == 2) d.bounds = ramp_class_bounds;
     }
   }
   if (state.range(1)) {
     one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
     one.density.user = const_cast<int*>(kIndex);
     one.density.callback_max = 1;
+    if (state.range(1) == 2) one.density.bounds = ramp_sum_bounds;
   }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::vector<std::uint8_t> classes(buffer.size());
@@ -408,7 +417,7 @@ BENCHMARK(BM_QueryDensityCallback)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
-    ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

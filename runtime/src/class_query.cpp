@@ -56,6 +56,25 @@ struct ClassDensities {
     }
     return density_or_zero(d.callback(d.user, x, y));
   }
+  /// Bounds of class k's density over [x0, x1] × [y0, y1]: a constant's value, an image's min- and max-mip,
+  /// a callback's own bounds (else 0 and callback_max), as query_points takes them.
+  void bounds(std::uint32_t k, double x0, double y0, double x1, double y1, double& lo, double& hi) const {
+    const QueryDensity& d = params->classes[k];
+    switch (d.kind) {
+      case QueryDensity::Kind::kConstant:
+        lo = hi = density_or_zero(d.constant);
+        return;
+      case QueryDensity::Kind::kImage:
+        lo = d.image->min_over(x0, y0, x1, y1), hi = d.image->max_over(x0, y0, x1, y1);
+        return;
+      case QueryDensity::Kind::kCallback:
+        break;
+    }
+    double l = std::nan(""), h = std::nan("");
+    if (d.bounds) d.bounds(d.user, x0, y0, x1, y1, &l, &h);
+    hi = h >= 0 && h < d.callback_max ? h : d.callback_max;  // NaN bounds fail both tests
+    lo = l > 0 ? std::min(l, hi) : 0;
+  }
   /// The first class whose cumulative expected count (densities times `area`) passes `threshold`; the
   /// last class if none does (past the top level, where a point's own threshold only approximates the
   /// rule that emitted it).
@@ -75,6 +94,17 @@ double sum_of_densities(void* user, double x, double y) {
   double sum = 0;
   for (std::uint32_t k = 0; k < c.params->class_count; ++k) sum += c.at(k, x, y);
   return sum;
+}
+
+/// The union's bounds (QueryDensity::bounds): the sum of the classes'.
+void sum_of_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  const auto& c = *static_cast<const ClassDensities*>(user);
+  *lo = *hi = 0;
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) {
+    double l, h;
+    c.bounds(k, x0, y0, x1, y1, l, h);
+    *lo += l, *hi += h;
+  }
 }
 
 /// An upper bound of class `d`'s density wherever a point that can show in the region is decided: the
@@ -156,6 +186,13 @@ class Classifier {
         classes[i] = static_cast<std::uint8_t>(p_.class_count - 1);
         continue;
       }
+      // Ranks whose class the tile's bounds settle need no density read.
+      std::uint32_t k = 0;
+      while (k < p_.class_count && !(id.rank >= sure_from_[k] && id.rank < sure_to_[k])) ++k;
+      if (k < p_.class_count) {
+        classes[i] = static_cast<std::uint8_t>(k);
+        continue;
+      }
       // The stable position, computed as query_points computes it (depth 0), so the densities read are its.
       const TilePoint& point = points_[id.rank];
       const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
@@ -175,7 +212,10 @@ class Classifier {
     points_ = set_.tiles[index].points.data();
     side_ = id.depth == 0 ? S_ : S_ / std::pow(double(tables_.subtiles), double(id.depth));
     area_ = side_ * side_ * scale_;
-    if (!densities_.all_constant) return;
+    if (!densities_.all_constant) {
+      enter_bounds(id);
+      return;
+    }
     // The first rank past each cumulative count: the ranks below it pass (TilesetShape::emits).
     double sum = 0;
     for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
@@ -185,6 +225,28 @@ class Classifier {
           std::lower_bound(thresholds_, thresholds_ + thresholds_size_, count,
                            [](float t, double c) { return TilesetShape::emits(t, c); }) -
           thresholds_);
+    }
+  }
+
+  /// Varying densities: the ranks [sure_from_[k], sure_to_[k]) of the tile that are of class k wherever they
+  /// lie in it. Class k holds a point when the first k classes' count at it does not pass its threshold
+  /// and the first k + 1 classes' does; the tile's bounds of those counts, widened by 10^-9 for rounding
+  /// (query.cpp's margin), settle both for a range of thresholds, and thresholds are sorted.
+  void enter_bounds(const PointId& id) {
+    const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+    auto first_not_emitted = [&](double count) {
+      return static_cast<std::uint32_t>(
+          std::lower_bound(thresholds_, thresholds_ + thresholds_size_, count,
+                           [](float t, double c) { return TilesetShape::emits(t, c); }) -
+          thresholds_);
+    };
+    double lo = 0, hi = 0;
+    for (std::uint32_t k = 0; k < p_.class_count; ++k) {
+      sure_from_[k] = k == 0 ? 0 : first_not_emitted(hi * area_ * (1 + 1e-9));
+      double l, h;
+      densities_.bounds(k, wx, wy, wx + side_, wy + side_, l, h);
+      lo += l, hi += h;
+      sure_to_[k] = k + 1 == p_.class_count ? ~0u : first_not_emitted(lo * area_ * (1 - 1e-9));
     }
   }
 
@@ -201,6 +263,7 @@ class Classifier {
   const TilePoint* points_ = nullptr;
   double side_ = 0, area_ = 0;
   std::uint32_t first_rank_[kMaxQueryClasses] = {};
+  std::uint32_t sure_from_[kMaxQueryClasses] = {}, sure_to_[kMaxQueryClasses] = {};
   std::uint32_t class_ = 0, rank_ = 0;  // the last point's class and rank
 };
 
@@ -271,6 +334,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, ClassDen
   }
   q.density.kind = QueryDensity::Kind::kCallback;
   q.density.callback = sum_of_densities;
+  q.density.bounds = sum_of_bounds;
   q.density.user = &densities;
   // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
   double reach = 0;

@@ -330,6 +330,46 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kDensityTooHigh);
 }
 
+double image_value(void* view, double x, double y) {
+  return static_cast<const DensityImageView*>(view)->at(x, y);
+}
+void image_bounds(void* view, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  const auto& v = *static_cast<const DensityImageView*>(view);
+  *lo = v.min_over(x0, y0, x1, y1), *hi = v.max_over(x0, y0, x1, y1);
+}
+
+TEST(ClassQueryTest, BoundsSettleClassesWithoutChangingThem) {
+  // Images (their mips bound each tile), callbacks reading them with bounds, and without: the classes the
+  // bounds settle are the ones the densities' values give.
+  ThreeImages images;
+  std::vector<float> mins[3];
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(make_density_max_mip(images.views[k], mins[k]), Status::kOk);
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    ClassQueryParams as_images = three_constants(0, 0, 4, 4, 800, mode), with_bounds = as_images,
+                     without = as_images;
+    for (int k = 0; k < 3; ++k) {
+      as_images.classes[k].kind = QueryDensity::Kind::kImage, as_images.classes[k].image = &images.views[k];
+      QueryDensity& d = with_bounds.classes[k];
+      d.kind = QueryDensity::Kind::kCallback, d.callback = image_value;
+      d.user = &images.views[k], d.callback_max = 1.2, d.bounds = image_bounds;
+      without.classes[k] = d, without.classes[k].bounds = nullptr;
+    }
+    const Points a = run_classes(as_images), b = run_classes(with_bounds), c = run_classes(without);
+    ASSERT_GT(a.size(), 10000u);
+    expect_same(a, c, "images against callbacks");
+    expect_same(b, c, "callbacks with bounds against without");
+    std::size_t counts[3] = {};
+    for (const auto& [id, e] : c) {
+      ASSERT_EQ(a.at(id).cls, e.cls);
+      ASSERT_EQ(b.at(id).cls, e.cls);
+      ++counts[e.cls];
+    }
+    EXPECT_GT(counts[0], 1000u);
+    EXPECT_GT(counts[1], 1000u);
+    EXPECT_GT(counts[2], 1000u);
+  }
+}
+
 /// query_classes_compact over `q` with keys, resumed through buffers of `capacity`: positions, keys and
 /// classes in output order.
 struct CompactRun {
