@@ -56,24 +56,9 @@ struct ClassDensities {
     }
     return density_or_zero(d.callback(d.user, x, y));
   }
-  /// Bounds of class k's density over [x0, x1] × [y0, y1]: a constant's value, an image's min- and max-mip,
-  /// a callback's own bounds (else 0 and callback_max), as query_points takes them.
+  /// Bounds of class k's density over [x0, x1] × [y0, y1], as query_points takes them.
   void bounds(std::uint32_t k, double x0, double y0, double x1, double y1, double& lo, double& hi) const {
-    const QueryDensity& d = params->classes[k];
-    switch (d.kind) {
-      case QueryDensity::Kind::kConstant:
-        lo = hi = density_or_zero(d.constant);
-        return;
-      case QueryDensity::Kind::kImage:
-        lo = d.image->min_over(x0, y0, x1, y1), hi = d.image->max_over(x0, y0, x1, y1);
-        return;
-      case QueryDensity::Kind::kCallback:
-        break;
-    }
-    double l = std::nan(""), h = std::nan("");
-    if (d.bounds) d.bounds(d.user, x0, y0, x1, y1, &l, &h);
-    hi = h >= 0 && h < d.callback_max ? h : d.callback_max;  // NaN bounds fail both tests
-    lo = l > 0 ? std::min(l, hi) : 0;
+    detail::density_bounds(params->classes[k], x0, y0, x1, y1, lo, hi);
   }
   /// The first class whose cumulative expected count (densities times `area`) passes `threshold`; the
   /// last class if none does (past the top level, where a point's own threshold only approximates the

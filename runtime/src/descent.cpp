@@ -53,18 +53,7 @@ double DescentQuery::density_at(double x, double y) const {
 }
 
 void DescentQuery::density_bounds(double x0, double y0, double x1, double y1, double& lo, double& hi) const {
-  const QueryDensity& d = params->density;
-  switch (d.kind) {
-    case QueryDensity::Kind::kConstant:
-      lo = hi = density_or_zero(d.constant);
-      return;
-    case QueryDensity::Kind::kImage:
-      lo = d.image->min_over(x0, y0, x1, y1), hi = d.image->max_over(x0, y0, x1, y1);
-      return;
-    case QueryDensity::Kind::kCallback:
-      break;
-  }
-  lo = 0, hi = d.callback_max;
+  detail::density_bounds(params->density, x0, y0, x1, y1, lo, hi);
 }
 
 namespace {

@@ -67,6 +67,20 @@ TEST(DensityBoundsTest, ACallbacksBoundsKeepItsPointsAndSaveItsCalls) {
   }
 }
 
+TEST(DensityBoundsTest, PastTheTopLevelBoundsKeepThePoints) {
+  // Smooth mode descends into subtiles past the top level (32,768 points per tile), where the bounds of a
+  // subtile decide which of its points are visited: about 3 times the top here.
+  Ramp ramp;
+  QueryParams q = ramp_query(ramp, QueryMode::kSmooth);
+  q.x0 = 0.1, q.y0 = 0.2, q.x1 = 0.4, q.y1 = 0.45, q.scale = 3 * 32768 / 0.3;
+  const std::vector<QueryPoint> read_everywhere = run(q);
+  std::size_t deep = 0;
+  for (const QueryPoint& p : read_everywhere) deep += p.id.depth > 0;
+  ASSERT_GT(deep, 1000u);
+  q.density.bounds = Ramp::bounds;
+  EXPECT_TRUE(same_bits(run(q), read_everywhere));
+}
+
 TEST(DensityBoundsTest, AnImagesPointsAreThoseOfReadingItEverywhere) {
   // The image query (bounded by its mips) against a callback reading the same image with no bounds.
   std::vector<float> values(40 * 30), mip;
