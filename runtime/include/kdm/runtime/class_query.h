@@ -11,6 +11,8 @@
 // exactly the smooth one-class query at the sum and no two points of any classes come closer than its
 // points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions.
 // Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps.
+// Give a callback class its bounds (QueryDensity::bounds): the union's are their sum, and a tile's bounds
+// settle most of its points' classes without reading any density.
 //
 // Zoom coherence: as densities rise a point keeps its id and can only move to an earlier class (its
 // cumulative counts only grow), never to a later one. Past the top level (smooth mode, depth > 0), a
