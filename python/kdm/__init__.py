@@ -4,8 +4,8 @@
 - ``kdm.BlueNoise(d, seed=...)``: the same as a SciPy QMC engine (``scipy.stats.qmc.QMCEngine``).
 - ``kdm.Tileset.builtin().query(rect, scale=...)``: the runtime, points of any region in real time
   (``kdm query``); ``kdm.bake(recipe)`` bakes tile sets.
-- ``kdm.stipple(image)``: an image as dots (``kdm stipple``); ``kdm.analyze(points)``: point-set metrics
-  (``kdm analyze``).
+- ``kdm.stipple(image)``: an image as dots (``kdm stipple``), ``kdm.separate(image)`` its inks;
+  ``kdm.analyze(points)``: point-set metrics (``kdm analyze``).
 
 Arrays in are converted to float64 as needed; 2-D density and image arrays have row 0 at the top, as
 pictures are stored. Wrong types raise TypeError, bad values ValueError, unreadable files OSError. The
@@ -17,11 +17,11 @@ from . import _kdm
 from ._analysis import analyze
 from ._runtime import QueryResult, Tileset, bake
 from ._sampling import sample
-from ._stipple import stipple
+from ._stipple import separate, stipple
 
 __version__: str = _kdm.__version__
 
-__all__ = ["BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "stipple", "__version__"]
+__all__ = ["BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "__version__"]
 
 
 def __getattr__(name: str) -> Any:

@@ -1,6 +1,6 @@
 # Type hints of the kdm package (the implementation is kdm/*.py over the compiled kdm._kdm).
 import os
-from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -93,6 +93,9 @@ class Tileset:
     ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[Any], ...]]: ...
 
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
+def separate(
+    image: _Path, *, colours: Union[str, int] = ..., gamma: float = ...
+) -> Tuple[npt.NDArray[np.float32], List[str]]: ...
 def stipple(
     image: Union[_Path, npt.ArrayLike],
     *,

@@ -1,9 +1,9 @@
-"""kdm.stipple: an image as dots, as `kdm stipple` draws it (one picture; no zoom sequence)."""
+"""kdm.stipple: an image as dots, as `kdm stipple` draws it (one picture; no zoom sequence); kdm.separate: its inks."""
 from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Optional, Sequence
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -70,8 +70,7 @@ def stipple(
     -------
     numpy.ndarray, or with `colours` a tuple (dots, classes, inks)
         dots: (m, 2) float64, normalised to the rendered image or region, [0, 1) on both axes, y up;
-        classes: (m,) uint8, each dot's ink; inks: the inks' names, in class order (the ink that covers
-        most first).
+        classes: (m,) uint8, each dot's ink; inks: the inks' names, in class order (separate()'s).
     """
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     invert = _checks.flag("invert", invert)
@@ -115,3 +114,21 @@ def stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
         colours, gamma,
     )
+
+
+def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[np.ndarray, List[str]]:
+    """The inks of an image file as ``stipple(image, colours=...)`` separates them, to preview or measure.
+
+    Returns ``(channels, inks)``: channels a (k, height, width) float32 array, each ink's density in [0, 1]
+    (its coverage raised to `gamma`), row 0 at the top as in the picture; inks the inks' names, in class
+    order: the inks of least coverage first (a later class's tone carries the earlier classes' count
+    errors, the more the smaller its share), except that inks under a tenth of the total coverage come last.
+    """
+    label = _checks.path("image", image)
+    gamma = _checks.number("gamma", gamma, 0.0, strict=True)
+    if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
+        colours = str(int(colours))
+    if not isinstance(colours, str):
+        raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
+    channels, inks = _kdm.separate(label, colours, gamma)
+    return channels, list(inks)

@@ -118,9 +118,31 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names);
 }
 
+/// The inks of an image file as kdm stipple --colours separates them: (k, height, width) float32 densities,
+/// row 0 at the top as in the picture, and the inks' names, in class order.
+py::tuple separate(const std::string& path, const std::string& colours, double gamma) {
+  check_number("gamma", gamma, 0, true);
+  tools::ColourImage image;
+  std::string error;
+  if (!tools::load_colour_image(path, image, error)) throw FileError(error);
+  const tools::ColourSeparation inks = tools::separate_colours(image, colours, gamma);
+  const auto k = static_cast<py::ssize_t>(inks.channels.size());
+  py::array_t<float> channels({k, py::ssize_t(image.height), py::ssize_t(image.width)});
+  float* out = channels.mutable_data();
+  const std::size_t w = std::size_t(image.width), h = std::size_t(image.height);
+  for (std::size_t c = 0; c < inks.channels.size(); ++c)
+    for (std::size_t y = 0; y < h; ++y)  // DensitySpec's rows run from the bottom
+      std::copy_n(inks.channels[c].values.data() + (h - 1 - y) * w, w, out + (c * h + y) * w);
+  py::list names;
+  for (const tools::Ink& ink : inks.inks) names.append(ink.name);
+  return py::make_tuple(channels, names);
+}
+
 }  // namespace
 
 void bind_stipple(py::module_& m) {
+  m.def("separate", &separate, py::arg("path"), py::arg("colours"), py::arg("gamma"),
+        "The inks of an image file as kdm stipple --colours separates them (channels, names)");
   m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
         py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),

@@ -138,13 +138,20 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
       s.channels.erase(s.channels.begin() + c), s.inks.erase(s.inks.begin() + c);
   if (s.channels.empty())
     throw std::invalid_argument("the image has no ink in any colour: nothing to stipple");
-  // The ink that covers most of the image first: a sparse class early in the order takes the union's
-  // lowest thresholds, which repeat a motif along tile edges, and shows the tile grid as coloured lines
-  // (docs/design.md, "Several classes").
+  // A later class's dots are those its cumulative density adds to the earlier classes', so its tone carries
+  // their count errors too, the more the smaller its share: inks of least coverage first. But an ink of
+  // very little coverage first takes the union's lowest thresholds, which repeat a motif along tile edges:
+  // inks under a tenth of the total coverage go last, most covering first (docs/design.md, "Several
+  // classes in colour").
+  double total = 0;
+  for (const DensitySpec& c : s.channels) total += c.mean_value();
+  auto minor = [&](std::size_t c) { return s.channels[c].mean_value() < 0.1 * total; };
   std::vector<std::size_t> order(s.channels.size());
   for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return s.channels[a].mean_value() > s.channels[b].mean_value();
+    if (minor(a) != minor(b)) return minor(b);
+    const double ca = s.channels[a].mean_value(), cb = s.channels[b].mean_value();
+    return minor(a) ? ca > cb : ca < cb;
   });
   ColourSeparation sorted;
   std::copy(s.background, s.background + 3, sorted.background);

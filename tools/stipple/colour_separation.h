@@ -23,13 +23,15 @@ struct ColourSeparation {
 
 /// Separates `image` by `scheme`:
 /// - "cmyk": cyan, magenta, yellow and black on white paper, black by full under-colour removal
-///   (K = 1 − max(R, G, B), C = (1 − R − K) / (1 − K), …), black first (highest priority);
+///   (K = 1 − max(R, G, B), C = (1 − R − K) / (1 − K), …);
 /// - "rgb": red, green and blue dots on black paper, each channel's intensity its density;
 /// - "N" (2 … 8): N inks on white paper, the image's colours clustered into N (k-means, deterministic),
 ///   each pixel's darkness the density of its nearest ink.
-/// Each density is the coverage raised to `gamma` (> 0); the inks come in order of decreasing mean coverage
-/// (class 0 the ink that covers most). Throws std::invalid_argument naming the problem
-/// for another scheme or an image with no ink.
+/// Each density is the coverage raised to `gamma` (> 0). The inks come in order of increasing mean coverage
+/// (a later class's tone carries the earlier classes' count errors, the more the smaller its share), except
+/// that inks under a tenth of the total coverage come last, most covering first (a sparse class early in
+/// the order shows the tile edges). Throws std::invalid_argument naming the problem for another scheme or
+/// an image with no ink.
 ColourSeparation separate_colours(const ColourImage& image, const std::string& scheme, double gamma);
 
 }  // namespace kdm::tools
