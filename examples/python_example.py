@@ -27,9 +27,17 @@ density = lambda x, y: 0.2 + 0.8 * x / 200  # noqa: E731
 rocks = tiles.query((0, 0, 200, 200), scale=2, tile_size=32, density=density, density_max=1.0)
 print(f"query: {len(rocks)} points, ids like tile {tuple(rocks.tile[0])} rank {rocks.rank[0]}")
 
-# 3. Stippling a picture to PNG, with the runtime's tiles (fast) and with the full sampler (slow, best).
+# Several kinds at once, as float32 positions (the fast path): trees first (the largest), then rocks.
+xy, kinds = tiles.positions((0, 0, 200, 200), scale=2, tile_size=32, classes=[0.1, 0.4])
+print(f"positions: {len(xy)} points, {np.count_nonzero(kinds == 0)} trees")
+
+# 3. Stippling a picture to PNG with the runtime's tiles, in grey and in colour (an ink per class).
 dots = kdm.stipple(str(here / "sphere.png"), points=10000, output=out / "sphere-dots.png")
 print(f"stipple: {len(dots)} dots -> {out / 'sphere-dots.png'}")
+channels, inks = kdm.separate(here / "coffee.png", colours="cmyk")
+dots, ink_of_dot, _ = kdm.stipple(str(here / "coffee.png"), points=20000, colours="cmyk",
+                                  output=out / "coffee-dots.png")
+print(f"stipple: inks {inks}, mean coverage {np.round(channels.mean(axis=(1, 2)), 2)} -> {out / 'coffee-dots.png'}")
 
 # 4. The measures `kdm analyze` reports; the radially averaged power spectrum of blue noise is low at low
 # frequencies, then a peak near the mean spacing's frequency.
