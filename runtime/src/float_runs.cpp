@@ -1,9 +1,10 @@
 // The compact output's runs of points; see float_runs.h.
 #include "float_runs.h"
 
-// Clones for AVX2 and the baseline, picked once by the loader (GCC on x86-64; elsewhere the baseline).
+// Clones for AVX-512 (x86-64-v4), AVX2 and the baseline, picked once by the loader (GCC on x86-64;
+// elsewhere the baseline).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define KDM_RUN_CLONES __attribute__((target_clones("avx2", "default")))
+#define KDM_RUN_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #else
 #define KDM_RUN_CLONES
 #endif
