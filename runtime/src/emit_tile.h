@@ -12,17 +12,9 @@
 #include "kdm/runtime/query.h"
 #include "keyframe_lookup.h"
 #include "query_tables.h"
+#include "signed_byte_table.h"
 
 namespace kdm::detail {
-
-/// Every signed byte as a double: a load instead of a conversion with its false dependency.
-struct SignedByteTable {
-  double value[256];
-  constexpr SignedByteTable() : value() {
-    for (int i = 0; i < 256; ++i) value[i] = i - 128;
-  }
-};
-constexpr SignedByteTable kSignedByte;
 
 /// What the per-point loop of one tile reads, copied out of the caller's structures: the output buffer
 /// could alias them, and the compiler would reload each after every point written.

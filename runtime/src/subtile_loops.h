@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "descent.h"
+#include "signed_byte_table.h"
 
 namespace kdm::detail {
 
@@ -43,6 +44,9 @@ struct DescentSink {
 struct SubtileCull {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   const std::uint32_t *listed = nullptr, *listed_end = nullptr;
+  /// The region narrowed by the same rounding: a position at least in_x0 and below in_x1 (and so in y)
+  /// passes write_unit's test.
+  double in_x0 = 0, in_y0 = 0, in_x1 = 0, in_y1 = 0;
 };
 
 /// Node n's SubtileCull for the query.
@@ -56,8 +60,27 @@ inline SubtileCull subtile_cull(const DescentQuery& q, const DescentNode& n) {
   SubtileCull c;
   c.x0 = (p.x0 - n.wx) * scale - slack, c.x1 = (p.x1 - n.wx) * scale + slack;
   c.y0 = (p.y0 - n.wy) * scale - slack, c.y1 = (p.y1 - n.wy) * scale + slack;
+  c.in_x0 = c.x0 + 2 * slack, c.in_x1 = c.x1 - 2 * slack;
+  c.in_y0 = c.y0 + 2 * slack, c.in_y1 = c.y1 - 2 * slack;
   q.tables->edges_beyond(n.type, c.x0, c.y0, c.x1, c.y1, c.listed, c.listed_end);
   return c;
+}
+
+/// Points from[0 .. count) of a subtile (ranks from id.rank on) glided by offsets a and b weighted w0 and
+/// w1, as QueryPoint records relative to the origin (rx, ry: the subtile's corner; s: its side) into
+/// to[0 .. count): emit_own's expressions, bit for bit. Its own function, so that every caller runs the
+/// same compiled loop (offsets read as doubles from a table: the values of conversions, without their
+/// false dependency).
+[[gnu::noinline]] inline void glided_records(QueryPoint* to, const TilePoint* from, const std::int8_t* a,
+                                             const std::int8_t* b, std::uint32_t count, double w0, double w1,
+                                             double rx, double ry, double s, PointId id) {
+  const double* v = kSignedByte.value + 128;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const TilePoint q = from[k];
+    const double dx = v[a[2 * k]] * w0 + v[b[2 * k]] * w1, dy = v[a[2 * k + 1]] * w0 + v[b[2 * k + 1]] * w1;
+    const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
+    to[k] = QueryPoint{rx + ux * s, ry + uy * s, PointId{id.tile_x, id.tile_y, id.rank + k, id.depth}};
+  }
 }
 
 /// Emits ranks [from, end) of tile n (depth > 0), every one emitted and gliding by bracket g, none
@@ -81,15 +104,53 @@ std::uint32_t emit_own(const DescentQuery& q, const DescentNode& n, DescentSink&
   const SubtileCull cut = c;
   const double lo_x = cut.x0 - reach * 65536.0, hi_x = cut.x1 + reach * 65536.0;
   const double lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
+  // Stable positions this far inside the narrowed region land in it however far they glide (2 units for
+  // the offsets' blend): runs of them are written with no test, as inside subtiles' points are. As cells:
+  // x + 0.5 in [lo, hi) is x in [ceil(lo − 0.5), ceil(hi − 0.5)), an unsigned range test.
+  auto cells = [](double lo, double hi, std::uint32_t& first, std::uint32_t& width) {
+    const double a = std::clamp(std::ceil(lo - 0.5), 0.0, 65536.0),
+                 b = std::clamp(std::ceil(hi - 0.5), 0.0, 65536.0);
+    first = static_cast<std::uint32_t>(a), width = b > a ? static_cast<std::uint32_t>(b - a) : 0;
+  };
+  std::uint32_t safe_x, safe_w, safe_y, safe_h;
+  cells(cut.in_x0 + reach * 65536.0 + 2, cut.in_x1 - reach * 65536.0 - 2, safe_x, safe_w);
+  cells(cut.in_y0 + reach * 65536.0 + 2, cut.in_y1 - reach * 65536.0 - 2, safe_y, safe_h);
   // Locals, which the writes into the caller's buffer cannot alias.
   const TilePoint* points = tile.points.data();
   QueryPoint* const out = sink.out;
   const std::size_t capacity = sink.capacity;
   std::size_t written = sink.written;
   std::uint64_t budget = sink.budget;
+  // Ranks [r, r + count) into out[written ..), every one kept: one plain loop.
+  // Ranks [r, r + count) into out[written ..), every one kept.
+  auto run = [&](std::uint32_t r, std::uint32_t count) {
+    glided_records(out + written, points + r, o0 + 2 * std::size_t(r), o1 + 2 * std::size_t(r), count, w0, w1,
+                   rx, ry, s, PointId{gx, gy, r, depth});
+    written += count, budget -= count;
+  };
+  if constexpr (!kClip && !kListed) {  // inside the region: as many as the buffer and the budget allow
+    const auto count = static_cast<std::uint32_t>(
+        std::min<std::uint64_t>({std::uint64_t(end - from), std::uint64_t(capacity - written), budget}));
+    run(from, count);
+    sink.written = written, sink.budget = budget;
+    return from + count >= end ? kDescentDone : from + count;
+  }
+  auto safe = [&](std::uint32_t r) {
+    return std::uint32_t(points[r].x - safe_x) < safe_w && std::uint32_t(points[r].y - safe_y) < safe_h;
+  };
   const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
   std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
   while (r < end) {
+    if (kClip && !kListed && safe(r)) {
+      std::uint32_t stop = r + 1;
+      while (stop < end && safe(stop)) ++stop;
+      const auto count = static_cast<std::uint32_t>(
+          std::min<std::uint64_t>({std::uint64_t(stop - r), std::uint64_t(capacity - written), budget}));
+      run(r, count);
+      r += count;
+      if (r < stop) break;  // the buffer or the budget ran out
+      continue;
+    }
     if (budget == 0) break;
     --budget;
     const TilePoint q = points[r];
