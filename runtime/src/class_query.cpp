@@ -377,6 +377,23 @@ Status run_chunks(const ClassQueryParams& p, const QueryParams& q, std::size_t c
   return status;
 }
 
+/// Constant classes, classed as they are written, in one piece: into `out`, QueryPoint records or a
+/// CompactPoints, and `classes`.
+template <class Output>
+Status run_constant(const Tileset& tileset, const ClassQueryParams& p, const QueryParams& q,
+                    Classifier& classify, Output out, std::uint8_t* classes, std::size_t capacity,
+                    std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse) {
+  double counts[kMaxQueryClasses];
+  constant_counts(p, q, counts);
+  return run_chunks(
+      p, q, capacity, capacity, written, cursor, refuse,
+      [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
+        const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
+                                        &classify};
+        return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
+      });
+}
+
 }  // namespace
 
 Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
@@ -390,17 +407,8 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
   if (prepare_union(tileset, p, densities, q, refuse) != Status::kOk) return Status::kInvalidArgument;
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  if (densities.all_constant) {  // classed as they are written, in one piece
-    double counts[kMaxQueryClasses];
-    constant_counts(p, q, counts);
-    return run_chunks(
-        p, q, capacity, capacity, written, cursor, refuse,
-        [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
-          const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
-                                          &classify};
-          return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
-        });
-  }
+  if (densities.all_constant)
+    return run_constant(tileset, p, q, classify, out, classes, capacity, written, cursor, refuse);
   return run_chunks(
       p, q, 2 * kClassChunk, capacity, written, cursor, refuse,
       [&](std::size_t n, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
@@ -426,17 +434,8 @@ Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, 
   if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  if (densities.all_constant) {  // classed as they are written, in one piece
-    double counts[kMaxQueryClasses];
-    constant_counts(p, q, counts);
-    return run_chunks(
-        p, q, capacity, capacity, written, cursor, refuse,
-        [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
-          const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
-                                          &classify};
-          return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
-        });
-  }
+  if (densities.all_constant)
+    return run_constant(tileset, p, q, classify, out, classes, capacity, written, cursor, refuse);
   PointId ids[kClassChunk];  // the chunk's ids, for its classes and keys
   return run_chunks(
       p, q, kClassChunk, capacity, written, cursor, refuse,
