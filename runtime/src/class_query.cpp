@@ -278,11 +278,13 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
 
 namespace {
 
-/// Checks `p` and sets up what both outputs share: the classes' densities and the one-class query at their
-/// sum (`q`). Fills `fingerprint` with the class query's own. kOk, or kInvalidArgument by `refuse`.
-Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, ClassDensities& densities,
-                     QueryParams& q, detail::Refusal& refuse) {
+/// Checks `p` and `written` (set to 0) and sets up what both outputs share: the classes' densities and the
+/// one-class query at their sum (`q`). kOk, or kInvalidArgument by `refuse`.
+Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::size_t* written,
+                     ClassDensities& densities, QueryParams& q, detail::Refusal& refuse) {
   using Kind = QueryProblem::Kind;
+  if (written) *written = 0;
+  if (!written) return refuse(Kind::kMissingArgument, "written");
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
   densities.params = &p;
@@ -400,11 +402,10 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
                      std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                      QueryProblem* problem) {
   detail::Refusal refuse(problem);
-  if (written) *written = 0;
-  if (!written) return refuse(QueryProblem::Kind::kMissingArgument, "written");
   ClassDensities densities;
   QueryParams q;
-  if (prepare_union(tileset, p, densities, q, refuse) != Status::kOk) return Status::kInvalidArgument;
+  if (prepare_union(tileset, p, written, densities, q, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
   if (densities.all_constant)
@@ -424,11 +425,10 @@ Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, 
                              std::uint8_t* classes, std::size_t capacity, std::size_t* written,
                              QueryCursor* cursor, QueryProblem* problem) {
   detail::Refusal refuse(problem);
-  if (written) *written = 0;
-  if (!written) return refuse(QueryProblem::Kind::kMissingArgument, "written");
   ClassDensities densities;
   QueryParams q;
-  if (prepare_union(tileset, p, densities, q, refuse) != Status::kOk) return Status::kInvalidArgument;
+  if (prepare_union(tileset, p, written, densities, q, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
   if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
     return Status::kInvalidArgument;
   if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
