@@ -172,6 +172,7 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
     for (uint32_t k = 0; k < class_count; ++k) {
       const kdm_class_density& c = classes[k];
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
+      q.classes[k].bounds = c.density_bounds;
     }
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }

@@ -250,6 +250,26 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
     CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
     CHECK(g_ramp_calls < calls_without / 3); /* measured: about an eighth */
+    /* Classes of callback densities: their bounds keep the points and classes and save calls. */
+    {
+      static uint8_t with_classes[8192], without_classes[8192];
+      kdm_class_density ramps[2];
+      memset(ramps, 0, sizeof ramps);
+      ramps[0].density_callback = ramps[1].density_callback = ramp;
+      ramps[0].density_max = ramps[1].density_max = 1;
+      q.scale = 400, q.density_bounds = NULL;
+      g_ramp_calls = 0;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_classes(builtin, &q, ramps, 2, without, without_classes, 8192, &a, &cursor, NULL) ==
+            KDM_OK);
+      calls_without = g_ramp_calls, g_ramp_calls = 0;
+      ramps[0].density_bounds = ramps[1].density_bounds = ramp_bounds;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_classes(builtin, &q, ramps, 2, with, with_classes, 8192, &b, &cursor, NULL) == KDM_OK);
+      CHECK(a == b && a > 2000 && memcmp(with, without, a * sizeof(kdm_point)) == 0);
+      CHECK(memcmp(with_classes, without_classes, a) == 0);
+      CHECK(g_ramp_calls < calls_without / 3); /* measured: about a tenth */
+    }
   }
   /* The compact output: the same points as floats and keys, through a small buffer with resumes. */
   {

@@ -174,13 +174,17 @@ KDM_RUNTIME_API kdm_status kdm_query_compact(const kdm_tileset* tileset, const k
                                              kdm_cursor* cursor, kdm_query_problem* problem);
 
 /* One class's density for kdm_query_classes: as kdm_query's density fields (an image takes precedence
- * over a callback, a callback over the constant). */
+ * over a callback, a callback over the constant). Zero the struct before filling it. */
 typedef struct kdm_class_density {
   double density;
   double (*density_callback)(void* user, double x, double y);
   void* user;
   double density_max;
   const kdm_density_image* density_image;
+  /* Added in 0.4 (the struct grew: rebuild callers; arrays of it have a new stride): optional bounds of
+   * the callback's density, as kdm_query's density_bounds; the union takes their sum, and a tile's
+   * bounds settle most points' classes without a call. */
+  void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
 } kdm_class_density;
 
 #define KDM_MAX_CLASSES 8
