@@ -164,17 +164,21 @@ class Classifier {
 
   template <class Ids>
   void classify_varying(Ids ids, std::uint8_t* classes, std::size_t count) {
+    // The sure ranges follow one another in rank order, and a tile's points come in rank order: the range
+    // a rank may lie in only steps forward (back to the first where the ranks fall, past the top level).
+    std::uint32_t k = class_, previous = rank_;
     for (std::size_t i = 0; i < count; ++i) {
       const PointId& id = ids(i);
-      if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) enter(id);
+      if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) enter(id), k = 0;
+      if (id.rank < previous) k = 0;
+      previous = id.rank;
       if (id.rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
         classes[i] = static_cast<std::uint8_t>(p_.class_count - 1);
         continue;
       }
       // Ranks whose class the tile's bounds settle need no density read.
-      std::uint32_t k = 0;
-      while (k < p_.class_count && !(id.rank >= sure_from_[k] && id.rank < sure_to_[k])) ++k;
-      if (k < p_.class_count) {
+      while (id.rank >= sure_to_[k]) ++k;  // the last class's range has no end
+      if (id.rank >= sure_from_[k]) {
         classes[i] = static_cast<std::uint8_t>(k);
         continue;
       }
@@ -184,6 +188,7 @@ class Classifier {
       classes[i] = densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_,
                                        wy + point.unit_y() * side_, area_);
     }
+    class_ = k, rank_ = previous;
   }
 
   /// Reads what the points of id's tile share.
