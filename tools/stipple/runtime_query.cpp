@@ -30,97 +30,85 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
 
 namespace {
 
-/// Runs `step` (one call of a query into out[from, from + room)) until the region is complete.
-template <class Step>
-void collect(std::vector<QueryPoint>& out, const ParameterNames& names, Step&& step) {
+/// Runs `step` (one call of a query writing points [from, from + room) into `out`, `per_point` elements
+/// each, and returning its status) until the region is complete; `out` ends holding exactly the points.
+/// The one rule of every collecting query: chunks of 2^16 points, at most kMaxCollectedPoints, refusals
+/// as describe()'s line.
+template <class T, class Step>
+void collect(std::vector<T>& out, std::size_t per_point, const ParameterNames& names, Step&& step) {
   out.clear();
   QueryCursor cursor;
-  for (;;) {
-    const std::size_t before = out.size();
-    out.resize(before + (std::size_t(1) << 16));
+  for (std::size_t m = 0;;) {
+    const std::size_t room = std::size_t(1) << 16;
+    out.resize(per_point * (m + room));
     std::size_t written = 0;
     QueryProblem problem;
-    const Status s = step(before, out.size() - before, &written, &cursor, &problem);
-    out.resize(before + written);
-    if (out.size() > kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
+    const Status s = step(m, room, &written, &cursor, &problem);
+    m += written;
+    out.resize(per_point * m);
+    if (m > kMaxCollectedPoints)  // 1 GiB of QueryPoint records: stop before memory runs out
       throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
     if (s == Status::kOk) return;
     if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
   }
+}
+
+/// collect for a class query: `step` also takes where the chunk's classes go, and `classes` ends holding
+/// one per point.
+template <class T, class Step>
+void collect_classes(std::vector<T>& out, std::size_t per_point, std::vector<std::uint8_t>& classes,
+                     const ParameterNames& names, Step&& step) {
+  classes.clear();
+  collect(out, per_point, names,
+          [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+              QueryProblem* problem) {
+            classes.resize(from + room);
+            const Status s = step(from, room, classes.data() + from, written, cursor, problem);
+            classes.resize(from + *written);
+            return s;
+          });
 }
 
 }  // namespace
 
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names) {
-  collect(out, names,
+  collect(out, 1, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
               QueryProblem* problem) {
             return query_points(tileset, params, out.data() + from, room, written, cursor, problem);
           });
 }
 
-namespace {
-
-/// collect's loop for compact output: `step` writes x, y pairs into xy[2 · from ..) and what else it keeps.
-template <class Step>
-void collect_xy(std::vector<float>& xy, const ParameterNames& names, Step&& step) {
-  xy.clear();
-  QueryCursor cursor;
-  for (std::size_t m = 0;;) {
-    const std::size_t room = std::size_t(1) << 16;
-    xy.resize(2 * (m + room));
-    std::size_t written = 0;
-    QueryProblem problem;
-    const Status s = step(m, room, &written, &cursor, &problem);
-    m += written;
-    xy.resize(2 * m);
-    if (m > kMaxCollectedPoints)
-      throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
-    if (s == Status::kOk) return;
-    if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
-  }
-}
-
-}  // namespace
-
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
                   const ParameterNames& names) {
-  collect_xy(xy, names,
-             [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
-                 QueryProblem* problem) {
-               return query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr},
-                                           room, written, cursor, problem);
-             });
+  collect(xy, 2, names,
+          [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
+              QueryProblem* problem) {
+            return query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr}, room,
+                                        written, cursor, problem);
+          });
 }
 
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
                   std::vector<std::uint8_t>& classes, const ParameterNames& names) {
-  classes.clear();
-  collect_xy(xy, names,
-             [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
-                 QueryProblem* problem) {
-               classes.resize(from + room);
-               const Status s =
-                   query_classes_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr},
-                                         classes.data() + from, room, written, cursor, problem);
-               classes.resize(from + *written);
-               return s;
-             });
+  collect_classes(xy, 2, classes, names,
+                  [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
+                      QueryCursor* cursor, QueryProblem* problem) {
+                    return query_classes_compact(tileset, params,
+                                                 CompactPoints{xy.data() + 2 * from, nullptr}, to, room,
+                                                 written, cursor, problem);
+                  });
 }
 
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const ParameterNames& names) {
-  classes.clear();
-  collect(out, names,
-          [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
-              QueryProblem* problem) {
-            classes.resize(from + room);
-            const Status s = query_classes(tileset, params, out.data() + from, classes.data() + from, room,
-                                           written, cursor, problem);
-            classes.resize(from + *written);
-            return s;
-          });
+  collect_classes(out, 1, classes, names,
+                  [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
+                      QueryCursor* cursor, QueryProblem* problem) {
+                    return query_classes(tileset, params, out.data() + from, to, room, written, cursor,
+                                         problem);
+                  });
 }
 
 PointSet normalise_to_rect(const std::vector<QueryPoint>& points, const double r[4]) {
