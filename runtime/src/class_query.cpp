@@ -21,10 +21,6 @@ using detail::ImageSampler;
 
 namespace {
 
-/// Points the union's query writes between two classings (varying densities): they are classed while
-/// still in cache; the compact output keeps their ids on the stack (24 bytes each).
-constexpr std::size_t kClassChunk = 1024;
-
 // Static names for QueryProblem::parameter, one per class.
 constexpr const char* kImageNames[kMaxQueryClasses] = {
     "classes[0].image", "classes[1].image", "classes[2].image", "classes[3].image",
@@ -43,6 +39,9 @@ struct ClassDensities {
   const ClassQueryParams* params = nullptr;
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
+  /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
+  /// VaryingClassSink classes the candidate just read from it).
+  mutable detail::ClassScratch scratch;
 
   double at(std::uint32_t k, double x, double y) const {
     const QueryDensity& d = params->classes[k];
@@ -77,7 +76,8 @@ struct ClassDensities {
 double sum_of_densities(void* user, double x, double y) {
   const auto& c = *static_cast<const ClassDensities*>(user);
   double sum = 0;
-  for (std::uint32_t k = 0; k < c.params->class_count; ++k) sum += c.at(k, x, y);
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) c.scratch.cumulative[k] = sum += c.at(k, x, y);
+  c.scratch.x = x, c.scratch.y = y;
   return sum;
 }
 
@@ -125,6 +125,13 @@ class Classifier {
     std::uint8_t c = 0;
     (*static_cast<Classifier*>(user))([&](std::size_t) -> const PointId& { return id; }, &c, 1);
     return c;
+  }
+
+  /// detail::VaryingClasses::class_ranks over a Classifier (`user`): ranks [first, first + count) of
+  /// depth-0 tile (tx, ty).
+  static void class_ranks(void* user, std::int64_t tx, std::int64_t ty, std::uint32_t first,
+                          std::uint32_t count, std::uint8_t* out) {
+    static_cast<Classifier*>(user)->classify_run(PointId{tx, ty, first}, count, out);
   }
 
   /// Classes ids(0) … ids(count - 1) into classes[0..count).
@@ -182,13 +189,51 @@ class Classifier {
         classes[i] = static_cast<std::uint8_t>(k);
         continue;
       }
-      // The stable position, computed as query_points computes it (depth 0), so the densities read are its.
-      const TilePoint& point = points_[id.rank];
-      const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
-      classes[i] = densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_,
-                                       wy + point.unit_y() * side_, area_);
+      classes[i] = read_class(id);
     }
     class_ = k, rank_ = previous;
+  }
+
+  /// Varying densities: ranks [first.rank, first.rank + count) of first's tile into classes[0..count), a
+  /// settled range at a time.
+  void classify_run(const PointId& first, std::uint32_t count, std::uint8_t* classes) {
+    const std::uint32_t end = first.rank + count;
+    if (densities_.all_constant || end > thresholds_size_ || first.tile_x != tile_.tile_x ||
+        first.tile_y != tile_.tile_y || first.depth != tile_.depth) {
+      enter(first);
+      if (densities_.all_constant || end > thresholds_size_) {
+        (*this)(
+            [&](std::size_t i) {
+              return PointId{first.tile_x, first.tile_y, first.rank + std::uint32_t(i)};
+            },
+            classes, count);
+        return;
+      }
+      class_ = 0, rank_ = 0;
+    }
+    std::uint32_t k = first.rank < rank_ ? 0 : class_;
+    PointId id = first;
+    while (id.rank < end) {
+      while (id.rank >= sure_to_[k]) ++k;
+      const bool settled = id.rank >= sure_from_[k];
+      const std::uint32_t upto = std::min(end, settled ? sure_to_[k] : sure_from_[k]);
+      if (settled)
+        std::fill(classes + (id.rank - first.rank), classes + (upto - first.rank),
+                  static_cast<std::uint8_t>(k));
+      else
+        for (; id.rank < upto; ++id.rank) classes[id.rank - first.rank] = read_class(id);
+      id.rank = upto;
+    }
+    class_ = k, rank_ = end - 1;
+  }
+
+  /// A point of the current tile whose class its tile's bounds leave open: the classes' densities at its
+  /// stable position, computed as query_points computes it (depth 0), so the densities read are its.
+  std::uint8_t read_class(const PointId& id) const {
+    const TilePoint& point = points_[id.rank];
+    const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+    return densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_, wy + point.unit_y() * side_,
+                               area_);
   }
 
   /// Reads what the points of id's tile share.
@@ -353,52 +398,36 @@ void constant_counts(const ClassQueryParams& p, const QueryParams& q, double cou
     counts[k] = (sum += density_or_zero(p.classes[k].constant)) * area;
 }
 
-/// Runs `chunk(n, room, &got, inner_problem, examined)` (the union's query into the outputs from slot n on,
-/// at most `chunk_size` points, classing what it wrote) until the region is done, the caller's room is used
-/// or the bound on the work is reached: the chunks share one call's candidate bound, and each point is
-/// classed while still in cache. The cursor carries the class query's fingerprint between calls and the
-/// union's while the chunks run.
-template <class Chunk>
-Status run_chunks(const ClassQueryParams& p, const QueryParams& q, std::size_t chunk_size,
-                  std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
-                  Chunk chunk) {
+/// The union's query into `out` (QueryPoint records or a CompactPoints) with each point's class into
+/// `classes`, classed as it is written, in one piece. The cursor carries the class query's fingerprint
+/// between calls and the union's while it runs.
+template <class Output>
+Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const QueryParams& q,
+                   const ClassDensities& densities, Classifier& classify, Output out, std::uint8_t* classes,
+                   std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse) {
   const std::uint64_t fingerprint = query_fingerprint(p);
   if (cursor && cursor->started) {
     if (cursor->fingerprint != fingerprint) return refuse(QueryProblem::Kind::kCursorMismatch, "cursor");
     cursor->fingerprint = query_fingerprint(q);
   }
   std::uint64_t examined = 0;
-  std::size_t n = 0;
-  Status status = Status::kOk;
-  for (;;) {
-    const std::size_t room = std::min(capacity - n, chunk_size);
-    std::size_t got = 0;
-    status = chunk(n, room, &got, &refuse.problem(), examined);
-    if (status == Status::kInvalidArgument) return status;
-    n += got;
-    // Done, the caller's buffer full, or the bound on the work reached (a chunk that did not fill).
-    if (status == Status::kOk || n == capacity || got < room) break;
+  Status status;
+  if (densities.all_constant) {
+    double counts[kMaxQueryClasses];
+    constant_counts(p, q, counts);
+    const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id, &classify};
+    status = detail::query_constant_classes_counted(tileset, q, out, c, capacity, written, cursor,
+                                                    &refuse.problem(), examined);
+  } else {
+    const detail::VaryingClasses c{
+        classes,           &densities.scratch,      q.tile_size * q.tile_size * q.scale,
+        p.class_count - 1, Classifier::class_ranks, Classifier::class_of_id,
+        &classify};
+    status = detail::query_varying_classes_counted(tileset, q, out, c, capacity, written, cursor,
+                                                   &refuse.problem(), examined);
   }
-  *written = n;
-  if (cursor) cursor->fingerprint = fingerprint;
+  if (status != Status::kInvalidArgument && cursor) cursor->fingerprint = fingerprint;
   return status;
-}
-
-/// Constant classes, classed as they are written, in one piece: into `out`, QueryPoint records or a
-/// CompactPoints, and `classes`.
-template <class Output>
-Status run_constant(const Tileset& tileset, const ClassQueryParams& p, const QueryParams& q,
-                    Classifier& classify, Output out, std::uint8_t* classes, std::size_t capacity,
-                    std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse) {
-  double counts[kMaxQueryClasses];
-  constant_counts(p, q, counts);
-  return run_chunks(
-      p, q, capacity, capacity, written, cursor, refuse,
-      [&](std::size_t, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
-        const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id,
-                                        &classify};
-        return detail::query_constant_classes_counted(tileset, q, out, c, room, got, cursor, why, examined);
-      });
 }
 
 }  // namespace
@@ -413,17 +442,7 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
     return Status::kInvalidArgument;
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  if (densities.all_constant)
-    return run_constant(tileset, p, q, classify, out, classes, capacity, written, cursor, refuse);
-  return run_chunks(
-      p, q, 2 * kClassChunk, capacity, written, cursor, refuse,
-      [&](std::size_t n, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
-        const Status status =
-            detail::query_points_counted(tileset, q, out + n, room, got, cursor, why, examined);
-        if (status != Status::kInvalidArgument)
-          classify([&](std::size_t i) -> const PointId& { return out[n + i].id; }, classes + n, *got);
-        return status;
-      });
+  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse);
 }
 
 Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, const CompactPoints& out,
@@ -439,20 +458,7 @@ Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, 
   if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  if (densities.all_constant)
-    return run_constant(tileset, p, q, classify, out, classes, capacity, written, cursor, refuse);
-  PointId ids[kClassChunk];  // the chunk's ids, for its classes and keys
-  return run_chunks(
-      p, q, kClassChunk, capacity, written, cursor, refuse,
-      [&](std::size_t n, std::size_t room, std::size_t* got, QueryProblem* why, std::uint64_t& examined) {
-        const Status status = detail::query_compact_ids_counted(tileset, q, out.xy + 2 * n, ids, room, got,
-                                                                cursor, why, examined);
-        if (status == Status::kInvalidArgument) return status;
-        classify([&](std::size_t i) -> const PointId& { return ids[i]; }, classes + n, *got);
-        if (out.keys)
-          for (std::size_t i = 0; i < *got; ++i) out.keys[n + i] = point_key(ids[i]);
-        return status;
-      });
+  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse);
 }
 
 }  // namespace kdm

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "float_runs.h"
 #include "image_sampler.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 #include "keyframe_lookup.h"
+#include "query_counted.h"
 #include "query_tables.h"
 #include "signed_byte_table.h"
 
@@ -120,34 +122,6 @@ struct CompactSink {
   }
 };
 
-/// Compact positions as CompactSink<false> writes them, and each point's id beside them (the class query
-/// classes points by id, then writes keys if asked).
-struct CompactIdSink {
-  CompactSink<false> xy;
-  PointId* ids;
-  void put(std::size_t i, double x, double y, const PointId& id) const {
-    xy.put(i, x, y, id);
-    ids[i] = id;
-  }
-  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
-    xy.put_stable(i, j, p, rank);
-    ids[i] = PointId{j.tx, j.ty, rank};
-  }
-  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t c, std::uint32_t count) const {
-    xy.put_stable_run(i, j, c, count);
-    for (std::uint32_t k = 0; k < count; ++k) ids[i + k] = PointId{j.tx, j.ty, c + k};
-  }
-  void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c) const {
-    xy.put_glided(i, j, g, c);
-    ids[i] = PointId{j.tx, j.ty, c};
-  }
-  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t c,
-                      std::uint32_t count) const {
-    xy.put_glided_run(i, j, g, c, count);
-    for (std::uint32_t k = 0; k < count; ++k) ids[i + k] = PointId{j.tx, j.ty, c + k};
-  }
-};
-
 /// Any output (Base: PointSink or CompactSink) with each point's class, for classes of constant densities
 /// (class_query.h): thresholds grow with the rank, so a depth-0 tile's classes are rank ranges, found once
 /// per run by binary search. Class k holds the ranks that `counts[k]` (the first k + 1 classes' expected
@@ -201,6 +175,56 @@ struct ClassSink {
   }
 };
 
+/// Any output (Base) with each point's class, for classes of varying densities (query_counted.h's
+/// VaryingClasses): a candidate whose union density the loop has just read is classed from the classes'
+/// running sums at its stable position, which that read left in the scratch, so no class density is read
+/// twice; every other point by the classifier. Points are classed as they are written, in every path (a
+/// stable-mode candidate is written before its emission is known, and an unkept one is overwritten).
+template <class Base>
+struct VaryingClassSink {
+  Base base;
+  const VaryingClasses* c;
+  void put(std::size_t i, double x, double y, const PointId& id) const {
+    base.put(i, x, y, id);
+    c->classes[i] = c->class_of_id(c->user, id);
+  }
+  /// Candidate `rank` of tile j at its stable position (x, y), as the loop computes it: its class, from the
+  /// scratch where the loop has just read the density there.
+  std::uint8_t class_at(const TileJob& j, std::uint32_t rank, double x, double y) const {
+    const ClassScratch& s = *c->scratch;
+    if (s.x == x && s.y == y) {
+      const float t = j.thresholds[rank];
+      std::uint32_t k = 0;
+      while (k < c->last && !TilesetShape::emits(t, s.cumulative[k] * c->area)) ++k;
+      return static_cast<std::uint8_t>(k);
+    }
+    std::uint8_t k;
+    c->class_ranks(c->user, j.tx, j.ty, rank, 1, &k);
+    return k;
+  }
+  /// A point whose class class_at gave (smooth mode: found before the glide, written after it).
+  void put_classed(std::size_t i, double x, double y, const PointId& id, std::uint8_t k) const {
+    base.put(i, x, y, id);
+    c->classes[i] = k;
+  }
+  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+    base.put_stable(i, j, p, rank);
+    c->classes[i] = class_at(j, rank, j.wx + p.unit_x() * j.S, j.wy + p.unit_y() * j.S);
+  }
+  void put_stable_run(std::size_t i, const TileJob& j, std::uint32_t first, std::uint32_t count) const {
+    base.put_stable_run(i, j, first, count);
+    c->class_ranks(c->user, j.tx, j.ty, first, count, c->classes + i);
+  }
+  void put_glided(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t rank) const {
+    put_glided_run(i, j, g, rank, 1);
+  }
+  void put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g, std::uint32_t first,
+                      std::uint32_t count) const {
+    base.put_glided_run(i, j, g, first, count);
+    c->class_ranks(c->user, j.tx, j.ty, first, count, c->classes + i);
+  }
+};
+
 inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const ConstantGlide& g,
                                       std::uint32_t c, std::uint32_t count) const {
   const double* v = kSignedByte.value + 128;
@@ -223,6 +247,13 @@ struct CountSink {
   void put_glided_run(std::size_t, const TileJob&, const ConstantGlide&, std::uint32_t, std::uint32_t) const {
   }
 };
+
+/// Whether a sink classes a candidate when its density is read (VaryingClassSink::class_at), before
+/// smooth mode's batch glides and writes it (put_classed).
+template <class Sink, class = void>
+constexpr bool kClassesAtDensity = false;
+template <class Sink>
+constexpr bool kClassesAtDensity<Sink, std::void_t<decltype(&Sink::put_classed)>> = true;
 
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
@@ -281,7 +312,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   // Smooth mode: places candidate c at its stable position (x, y) plus its offsets o0 and o1 weighted by
   // w0 and w1 (GlideBracket): false when the buffer is full.
   auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
-                   double w0, double w1) -> bool {
+                   double w0, double w1, std::uint8_t cls) -> bool {
     const double* v = kSignedByte.value + 128;
     x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
     if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
@@ -292,8 +323,10 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
         !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
       return true;
     if (n == capacity) return false;
-    if (kConstant)
+    if constexpr (kConstant)
       out.put_glided(n++, j, glide, c);
+    else if constexpr (kClassesAtDensity<Sink>)
+      out.put_classed(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}, cls);
     else
       out.put(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
     return true;
@@ -306,6 +339,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   constexpr int kBatch = kBatched ? 32 : 1;
   std::uint32_t pending_rank[kBatch];
   double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
+  std::uint8_t pending_class[kBatch];
   int pending = 0;
   auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
     // Two passes, each short enough for the processor to overlap many points' latency chains.
@@ -318,7 +352,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       w0[i] = b.w0, w1[i] = b.w1;
     }
     for (int i = 0; i < pending; ++i)
-      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i]))
+      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i], pending_class[i]))
         return pending = 0, pending_rank[i];
     pending = 0;
     return kNone;
@@ -343,7 +377,8 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       return kNone;
     }
     if (kConstant)
-      return place(c, x, y, glide.o0 + 2 * std::size_t(c), glide.o1 + 2 * std::size_t(c), glide.w0, glide.w1)
+      return place(c, x, y, glide.o0 + 2 * std::size_t(c), glide.o1 + 2 * std::size_t(c), glide.w0, glide.w1,
+                   0)
                  ? kNone
                  : c;
     const double rho = kKind == QueryDensity::Kind::kImage
@@ -361,6 +396,9 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     }
     pending_rank[pending] = c, pending_expected[pending] = expected;
     pending_x[pending] = x, pending_y[pending] = y;
+    if constexpr (kClassesAtDensity<Sink>) {
+      if (emitted) pending_class[pending] = out.class_at(j, c, x, y);
+    }
     pending += emitted;
     return pending == kBatch ? flush() : kNone;
   };

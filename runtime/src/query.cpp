@@ -331,17 +331,6 @@ Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, boo
   return Status::kOk;
 }
 
-Status detail::query_compact_ids_counted(const Tileset& tileset, const QueryParams& q, float* xy,
-                                         PointId* ids, std::size_t capacity, std::size_t* written,
-                                         QueryCursor* cursor, QueryProblem* problem,
-                                         std::uint64_t& examined) {
-  detail::Refusal refuse(problem);
-  if (written) *written = 0;
-  if (compact_refusal(tileset, q, false, refuse) != Status::kOk) return Status::kInvalidArgument;
-  return query_into(tileset, q, detail::CompactIdSink{CompactSink<false>{xy, nullptr}, ids},
-                    xy != nullptr && ids != nullptr, "out.xy", capacity, written, cursor, refuse, examined);
-}
-
 namespace {
 
 template <class Base>
@@ -374,6 +363,32 @@ Status detail::query_constant_classes_counted(const Tileset& tileset, const Quer
                       "out.xy", capacity, written, cursor, refuse, examined);
   return query_into(tileset, q, class_sink(CompactSink<false>{compact.xy, nullptr}, classes), room, "out.xy",
                     capacity, written, cursor, refuse, examined);
+}
+
+Status detail::query_varying_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
+                                             const VaryingClasses& classes, std::size_t capacity,
+                                             std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
+                                             std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  return query_into(tileset, q, detail::VaryingClassSink<PointSink>{PointSink{out}, &classes},
+                    out && classes.classes, "out", capacity, written, cursor, refuse, examined);
+}
+
+Status detail::query_varying_classes_counted(const Tileset& tileset, const QueryParams& q,
+                                             const CompactPoints& compact, const VaryingClasses& classes,
+                                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                             QueryProblem* problem, std::uint64_t& examined) {
+  detail::Refusal refuse(problem);
+  if (written) *written = 0;
+  if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
+    return Status::kInvalidArgument;
+  const bool room = compact.xy && classes.classes;
+  if (compact.keys)
+    return query_into(tileset, q,
+                      detail::VaryingClassSink<CompactSink<true>>{{compact.xy, compact.keys}, &classes}, room,
+                      "out.xy", capacity, written, cursor, refuse, examined);
+  return query_into(tileset, q, detail::VaryingClassSink<CompactSink<false>>{{compact.xy, nullptr}, &classes},
+                    room, "out.xy", capacity, written, cursor, refuse, examined);
 }
 
 Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,

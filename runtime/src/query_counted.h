@@ -4,7 +4,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 
@@ -39,12 +41,6 @@ Status query_points_counted(const Tileset& tileset, const QueryParams& params, Q
 /// none applies, else kInvalidArgument with `refuse`'s problem filled.
 Status compact_refusal(const Tileset& tileset, const QueryParams& params, bool keys, Refusal& refuse);
 
-/// query_points_compact's positions (no keys) with each point's id into `ids[0..capacity)`, counting into
-/// `examined` as query_points_counted does; a null xy or ids with room is refused as "out.xy".
-Status query_compact_ids_counted(const Tileset& tileset, const QueryParams& params, float* xy, PointId* ids,
-                                 std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                 QueryProblem* problem, std::uint64_t& examined);
-
 /// Classes of constant densities (class_query.h), classed as they are written (emit_tile.h's ClassSink:
 /// `counts` the classes' cumulative expected counts per depth-0 tile, `last` the last class, class_of_id
 /// for points past the top level): query_points into `out`, or query_points_compact into `compact`, with
@@ -64,6 +60,38 @@ Status query_constant_classes_counted(const Tileset& tileset, const QueryParams&
                                       const CompactPoints& compact, const ConstantClasses& classes,
                                       std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                       QueryProblem* problem, std::uint64_t& examined);
+
+/// The union's density at the last position it was read (class_query.cpp's sum of the classes' densities
+/// writes it): the position and the running sums of the classes' densities there, class 0 first. NaN
+/// until the first read, so that no position matches it.
+struct ClassScratch {
+  double x = std::numeric_limits<double>::quiet_NaN(), y = x;
+  double cumulative[kMaxQueryClasses] = {};
+};
+
+/// Classes of varying densities, classed as they are written (emit_tile.h's VaryingClassSink). A candidate
+/// whose union density was just read at its stable position (`scratch` holds that position) is classed from
+/// the running sums there, without reading a density again; other points by `class_ranks` (ranks
+/// [first, first + count) of depth-0 tile (tx, ty) into out[0..count)) or, past the top level,
+/// `class_of_id`. `area` is a depth-0 tile's area times the scale, as the classifier multiplies it.
+struct VaryingClasses {
+  std::uint8_t* classes;
+  const ClassScratch* scratch;
+  double area;
+  std::uint32_t last;
+  void (*class_ranks)(void* user, std::int64_t tx, std::int64_t ty, std::uint32_t first, std::uint32_t count,
+                      std::uint8_t* out);
+  std::uint8_t (*class_of_id)(void* user, const PointId& id);
+  void* user;
+};
+Status query_varying_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
+                                     const VaryingClasses& classes, std::size_t capacity,
+                                     std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
+                                     std::uint64_t& examined);
+Status query_varying_classes_counted(const Tileset& tileset, const QueryParams& params,
+                                     const CompactPoints& compact, const VaryingClasses& classes,
+                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                     QueryProblem* problem, std::uint64_t& examined);
 
 /// How many points query_points would write for `params` from `cursor` on, into `*count`, without
 /// writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing to count). Returns

@@ -121,6 +121,10 @@ double sum_of_images(void* user, double x, double y) {
   for (const DensityImageView& v : images.views) sum += v.at(x, y);
   return sum;
 }
+double sum_of_first_two_images(void* user, double x, double y) {
+  const auto& images = *static_cast<const ThreeImages*>(user);
+  return images.views[0].at(x, y) + images.views[1].at(x, y);
+}
 
 TEST(ClassQueryTest, StableClassesAreTheOneClassQueriesAtTheirCumulativeDensities) {
   // Constants 1 : 2 : 4 at a mid-level density (neither a level nor a keyframe) over 6×6 tiles.
@@ -152,6 +156,8 @@ TEST(ClassQueryTest, StableClassesAreTheOneClassQueriesAtTheirCumulativeDensitie
   one.density.user = &images;
   one.density.callback_max = 1 + 1.2 + 1;
   expect_same(all_images, run_one(one), "union of the images");
+  one.density.callback = sum_of_first_two_images;
+  expect_same(up_to_class(all_images, 1), run_one(one), "image classes 0 and 1");
   // Mixed kinds: a constant first, then an image, then a callback.
   ClassQueryParams qm = qi;
   qm.classes[0] = QueryDensity{};
@@ -344,6 +350,7 @@ TEST(ClassQueryTest, BoundsSettleClassesWithoutChangingThem) {
   ThreeImages images;
   std::vector<float> mins[3];
   for (int k = 0; k < 3; ++k) ASSERT_EQ(make_density_max_mip(images.views[k], mins[k]), Status::kOk);
+  Points stable;
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     ClassQueryParams as_images = three_constants(0, 0, 4, 4, 800, mode), with_bounds = as_images,
                      without = as_images;
@@ -367,6 +374,20 @@ TEST(ClassQueryTest, BoundsSettleClassesWithoutChangingThem) {
     EXPECT_GT(counts[0], 1000u);
     EXPECT_GT(counts[1], 1000u);
     EXPECT_GT(counts[2], 1000u);
+    if (mode == QueryMode::kStable) {
+      stable = c;
+      continue;
+    }
+    // A class is decided at the point's stable position, whichever way it then glides: smooth mode gives
+    // each point stable mode's class (all but those that glide across the region's border are in both).
+    std::size_t shared = 0;
+    for (const auto& [id, e] : c) {
+      const auto it = stable.find(id);
+      if (it == stable.end()) continue;
+      ++shared;
+      ASSERT_EQ(it->second.cls, e.cls);
+    }
+    EXPECT_GE(double(shared), 0.97 * double(c.size()));
   }
 }
 
