@@ -139,30 +139,66 @@ void BM_QueryDensityCallback(benchmark::State& state) {
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
 
-// Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp, 1 for three ramps by callback
-// instead of constants, 2 for the same with their bounds (and the sum's); compact, 1 for both queries into
-// float positions) against one class at their sum, which emits the same points (its callback calls the three
-// ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the one-class
-// query's time over the three-class query's.
-double ramp_class(void* k, double x, double) {
-  return (0.2 + 0.8 * x / kSide) * double(1 << *static_cast<const int*>(k)) / 7;
+// Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp: 0 constants, 1 three ramps by
+// callback, 2 the same with their bounds (and the sum's), 3 the ramps and bounds from one joint call
+// (ClassQueryParams::joint), 4 and 5 as 2 and 3 with a texture over the ramps; compact, 1 for both queries
+// into float positions) against one class at their sum, which emits the same points (its callback computes
+// the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
+// one-class query's time over the three-class query's.
+struct RampClass {
+  int k;          // the class: its ramp is (0.2 … 1) · 2^k / 7
+  bool textured;  // times texture()
+};
+// Eight octaves of sines, a factor in [0.95, 1.05]: about as costly as a lookup in a caller's biome map,
+// which a joint density computes once for all classes.
+double texture(double x, double y) {
+  double t = 0;
+  for (int i = 0; i < 8; ++i) t += std::sin(x * double(1 << i) * 1.7 + y * (i + 1));
+  return 1 + 0.05 * t / 8;
 }
-// The one-class query's density is the classes' sum, evaluated as a caller would: each class's callback.
-double ramp_sum(void* k, double x, double y) {
-  const int* index = static_cast<const int*>(k);
-  return ramp_class(const_cast<int*>(index), x, y) + ramp_class(const_cast<int*>(index + 1), x, y) +
-         ramp_class(const_cast<int*>(index + 2), x, y);
+std::uint64_t ramp_class_reads = 0;  // how many times a class's ramp was evaluated, by either query
+double plain_ramp(int k, double x) {
+  ++ramp_class_reads;
+  return (0.2 + 0.8 * x / kSide) * double(1 << k) / 7;
 }
-
-void ramp_class_bounds(void* k, double x0, double y0, double x1, double y1, double* lo, double* hi) {
-  *lo = ramp_class(k, x0, y0), *hi = ramp_class(k, x1, y1);
+double ramp_class(void* user, double x, double y) {
+  const auto& c = *static_cast<const RampClass*>(user);
+  return c.textured ? plain_ramp(c.k, x) * texture(x, y) : plain_ramp(c.k, x);
 }
-void ramp_sum_bounds(void* k, double x0, double y0, double x1, double y1, double* lo, double* hi) {
-  *lo = ramp_sum(k, x0, y0), *hi = ramp_sum(k, x1, y1);
+// The one-class query's density is the classes' sum, evaluated as a caller would: the texture once, then
+// each class's value (the same products, added in the same order, as the class query's).
+double ramp_sum(void* user, double x, double y) {
+  const auto* c = static_cast<const RampClass*>(user);
+  const double t = c->textured ? texture(x, y) : 1;
+  return plain_ramp(0, x) * t + plain_ramp(1, x) * t + plain_ramp(2, x) * t;
+}
+void ramp_class_bounds(void* user, double x0, double, double x1, double, double* lo, double* hi) {
+  const auto& c = *static_cast<const RampClass*>(user);
+  *lo = plain_ramp(c.k, x0) * (c.textured ? 0.95 : 1), *hi = plain_ramp(c.k, x1) * (c.textured ? 1.05 : 1);
+}
+void ramp_sum_bounds(void* user, double x0, double, double x1, double, double* lo, double* hi) {
+  const auto* c = static_cast<const RampClass*>(user);
+  *lo = (plain_ramp(0, x0) + plain_ramp(1, x0) + plain_ramp(2, x0)) * (c->textured ? 0.95 : 1);
+  *hi = (plain_ramp(0, x1) + plain_ramp(1, x1) + plain_ramp(2, x1)) * (c->textured ? 1.05 : 1);
+}
+// The three ramps from one call (ClassQueryParams::joint), the texture once, and their bounds.
+void ramp_classes(void* user, double x, double y, double* values) {
+  const auto* c = static_cast<const RampClass*>(user);
+  const double t = c->textured ? texture(x, y) : 1;
+  for (int k = 0; k < 3; ++k) values[k] = plain_ramp(k, x) * t;
+}
+void ramp_classes_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  const auto* c = static_cast<const RampClass*>(user);
+  for (int k = 0; k < 3; ++k)
+    ramp_class_bounds(const_cast<RampClass*>(c + k), x0, y0, x1, y1, lo + k, hi + k);
 }
 
 void BM_QueryThreeClasses(benchmark::State& state) {
-  static const int kIndex[3] = {0, 1, 2};
+  static const RampClass kPlain[3] = {{0, false}, {1, false}, {2, false}},
+                         kTextured[3] = {{0, true}, {1, true}, {2, true}};
+  const int ramp = static_cast<int>(state.range(1));
+  const RampClass* user = ramp >= 4 ? kTextured : kPlain;
+  const double most = ramp >= 4 ? 1.05 : 1;  // the ramp's maximum, times the texture's
   kdm::ClassQueryParams cq;
   cq.query = params(state);
   cq.class_count = 3;
@@ -170,17 +206,22 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   for (int k = 0; k < 3; ++k) {
     kdm::QueryDensity& d = cq.classes[k];
     d.constant = double(1 << k) / 7;
-    if (state.range(1)) {
+    if (ramp) {
       d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
-      d.user = const_cast<int*>(&kIndex[k]), d.callback_max = d.constant;
-      if (state.range(1) == 2) d.bounds = ramp_class_bounds;
+      d.user = const_cast<RampClass*>(user + k), d.callback_max = d.constant * most;
+      if (ramp >= 2) d.bounds = ramp_class_bounds;
     }
   }
-  if (state.range(1)) {
+  if (ramp == 3 || ramp == 5) {
+    cq.joint.densities = ramp_classes, cq.joint.bounds = ramp_classes_bounds;
+    cq.joint.user = const_cast<RampClass*>(user);
+    for (int k = 0; k < 3; ++k) cq.joint.max[k] = cq.classes[k].callback_max;
+  }
+  if (ramp) {
     one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
-    one.density.user = const_cast<int*>(kIndex);
-    one.density.callback_max = 1;
-    if (state.range(1) == 2) one.density.bounds = ramp_sum_bounds;
+    one.density.user = const_cast<RampClass*>(user);
+    one.density.callback_max = most;
+    if (ramp >= 2) one.density.bounds = ramp_sum_bounds;
   }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::vector<std::uint8_t> classes(buffer.size());
@@ -196,7 +237,9 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   };
   std::size_t n = 0;
   double seconds = 0, one_seconds = 0;
+  std::uint64_t reads = 0, one_reads = 0;
   for (auto _ : state) {
+    const std::uint64_t r0 = ramp_class_reads;
     auto t0 = std::chrono::steady_clock::now();
     n = run([&](std::size_t* written, kdm::QueryCursor* cursor) {
       return is_compact ? kdm::query_classes_compact(kdm::Tileset::builtin(), cq, compact, classes.data(),
@@ -206,6 +249,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
     });
     benchmark::DoNotOptimize(classes.data());
     const auto t1 = std::chrono::steady_clock::now();
+    const std::uint64_t r1 = ramp_class_reads;
     benchmark::DoNotOptimize(run([&](std::size_t* written, kdm::QueryCursor* cursor) {
       return is_compact ? kdm::query_points_compact(kdm::Tileset::builtin(), one, compact, buffer.size(),
                                                     written, cursor)
@@ -215,9 +259,16 @@ void BM_QueryThreeClasses(benchmark::State& state) {
     const auto t2 = std::chrono::steady_clock::now();
     seconds += std::chrono::duration<double>(t1 - t0).count();
     one_seconds += std::chrono::duration<double>(t2 - t1).count();
+    reads += r1 - r0, one_reads += ramp_class_reads - r1;
   }
   report(state, n);
   state.counters["of_one_class"] = one_seconds / seconds;
+  // Class densities read per point emitted (ramps only), by the class query and by the one-class query.
+  if (state.range(1)) {
+    const double points = double(n) * double(state.iterations());
+    state.counters["reads_per_point"] = double(reads) / points;
+    state.counters["one_class_reads_per_point"] = double(one_reads) / points;
+  }
 }
 
 // Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
@@ -417,7 +468,7 @@ BENCHMARK(BM_QueryDensityCallback)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
-    ->ArgsProduct({{0, 1}, {0, 1, 2}, {0, 1}})
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

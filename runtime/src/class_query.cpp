@@ -32,6 +32,9 @@ constexpr const char* kCallbackMaxNames[kMaxQueryClasses] = {
     "classes[0].callback_max", "classes[1].callback_max", "classes[2].callback_max",
     "classes[3].callback_max", "classes[4].callback_max", "classes[5].callback_max",
     "classes[6].callback_max", "classes[7].callback_max"};
+constexpr const char* kJointMaxNames[kMaxQueryClasses] = {"joint.max[0]", "joint.max[1]", "joint.max[2]",
+                                                          "joint.max[3]", "joint.max[4]", "joint.max[5]",
+                                                          "joint.max[6]", "joint.max[7]"};
 
 /// The classes' densities, read as query_points reads a one-class density, so that a class's values and
 /// their running sums are the very numbers the one-class queries compare.
@@ -55,24 +58,45 @@ struct ClassDensities {
     }
     return density_or_zero(d.callback(d.user, x, y));
   }
-  /// Bounds of class k's density over [x0, x1] × [y0, y1], as query_points takes them.
-  void bounds(std::uint32_t k, double x0, double y0, double x1, double y1, double& lo, double& hi) const {
-    detail::density_bounds(params->classes[k], x0, y0, x1, y1, lo, hi);
+  /// The joint density's values at (x, y) into v[0 … class_count), as query_points reads one value.
+  void joint_at(double x, double y, double* v) const {
+    const JointClassDensity& j = params->joint;
+    j.densities(j.user, x, y, v);
+    for (std::uint32_t k = 0; k < params->class_count; ++k) v[k] = density_or_zero(v[k]);
+  }
+  /// Bounds of every class's density over [x0, x1] × [y0, y1] into lo[k], hi[k], as query_points takes
+  /// one density's.
+  void bounds(double x0, double y0, double x1, double y1, double* lo, double* hi) const {
+    const JointClassDensity& j = params->joint;
+    if (!j.densities) {
+      for (std::uint32_t k = 0; k < params->class_count; ++k)
+        detail::density_bounds(params->classes[k], x0, y0, x1, y1, lo[k], hi[k]);
+      return;
+    }
+    double l[kMaxQueryClasses], h[kMaxQueryClasses];
+    std::fill(l, l + kMaxQueryClasses, std::nan("")), std::fill(h, h + kMaxQueryClasses, std::nan(""));
+    if (j.bounds) j.bounds(j.user, x0, y0, x1, y1, l, h);
+    for (std::uint32_t k = 0; k < params->class_count; ++k)
+      detail::trusted_bounds(l[k], h[k], j.max[k], lo[k], hi[k]);
   }
   /// The first class whose cumulative expected count (densities times `area`) passes `threshold`; the
   /// last class if none does (past the top level, where a point's own threshold only approximates the
-  /// rule that emitted it).
+  /// rule that emitted it). Separate densities are read only up to the class found.
   std::uint8_t class_of(float threshold, double x, double y, double area) const {
     const std::uint32_t last = params->class_count - 1;
+    double v[kMaxQueryClasses];
+    if (params->joint.densities) joint_at(x, y, v);
     double sum = 0;
     for (std::uint32_t k = 0; k < last; ++k) {
-      sum += at(k, x, y);
+      sum += params->joint.densities ? v[k] : at(k, x, y);
       if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
     }
     return static_cast<std::uint8_t>(last);
   }
 };
 
+// The union's density (QueryDensity::callback) from separate densities and from a joint one: the classes'
+// running sums, left in the scratch for the sink to class the candidate.
 double sum_of_densities(void* user, double x, double y) {
   const auto& c = *static_cast<const ClassDensities*>(user);
   double sum = 0;
@@ -80,16 +104,22 @@ double sum_of_densities(void* user, double x, double y) {
   c.scratch.x = x, c.scratch.y = y;
   return sum;
 }
+double sum_of_joint(void* user, double x, double y) {
+  const auto& c = *static_cast<const ClassDensities*>(user);
+  double v[kMaxQueryClasses], sum = 0;
+  c.joint_at(x, y, v);
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) c.scratch.cumulative[k] = sum += v[k];
+  c.scratch.x = x, c.scratch.y = y;
+  return sum;
+}
 
 /// The union's bounds (QueryDensity::bounds): the sum of the classes'.
 void sum_of_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
   const auto& c = *static_cast<const ClassDensities*>(user);
+  double l[kMaxQueryClasses], h[kMaxQueryClasses];
+  c.bounds(x0, y0, x1, y1, l, h);
   *lo = *hi = 0;
-  for (std::uint32_t k = 0; k < c.params->class_count; ++k) {
-    double l, h;
-    c.bounds(k, x0, y0, x1, y1, l, h);
-    *lo += l, *hi += h;
-  }
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) *lo += l[k], *hi += h[k];
 }
 
 /// An upper bound of class `d`'s density wherever a point that can show in the region is decided: the
@@ -275,12 +305,12 @@ class Classifier {
                            [](float t, double c) { return TilesetShape::emits(t, c); }) -
           thresholds_);
     };
+    double l[kMaxQueryClasses], h[kMaxQueryClasses];
+    densities_.bounds(wx, wy, wx + side_, wy + side_, l, h);
     double lo = 0, hi = 0;
     for (std::uint32_t k = 0; k < p_.class_count; ++k) {
       sure_from_[k] = k == 0 ? 0 : first_not_emitted(hi * area_ * (1 + 1e-9));
-      double l, h;
-      densities_.bounds(k, wx, wy, wx + side_, wy + side_, l, h);
-      lo += l, hi += h;
+      lo += l[k], hi += h[k];
       sure_to_[k] = k + 1 == p_.class_count ? ~0u : first_not_emitted(lo * area_ * (1 - 1e-9));
     }
   }
@@ -315,6 +345,9 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
     add(bits);
   };
   add(p.class_count);
+  add(reinterpret_cast<std::uintptr_t>(p.joint.densities));
+  add(reinterpret_cast<std::uintptr_t>(p.joint.user));
+  for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) add_double(p.joint.max[k]);
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
     const QueryDensity& d = p.classes[k];
     add(static_cast<std::uint64_t>(d.kind));
@@ -338,7 +371,13 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
   densities.params = &p;
-  for (std::uint32_t k = 0; k < p.class_count; ++k) {
+  const bool joint = p.joint.densities != nullptr;
+  for (std::uint32_t k = 0; k < p.class_count && joint; ++k) {
+    if (!std::isfinite(p.joint.max[k])) return refuse(Kind::kNotFinite, kJointMaxNames[k], p.joint.max[k]);
+    if (p.joint.max[k] < 0) return refuse(Kind::kNegative, kJointMaxNames[k], p.joint.max[k]);
+    densities.all_constant = false;
+  }
+  for (std::uint32_t k = 0; k < p.class_count && !joint; ++k) {
     const QueryDensity& d = p.classes[k];
     switch (d.kind) {
       case QueryDensity::Kind::kConstant:
@@ -370,7 +409,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     return Status::kOk;
   }
   q.density.kind = QueryDensity::Kind::kCallback;
-  q.density.callback = sum_of_densities;
+  q.density.callback = joint ? sum_of_joint : sum_of_densities;
   q.density.bounds = sum_of_bounds;
   q.density.user = &densities;
   // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
@@ -386,7 +425,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
                       std::isfinite(q.y1) && std::isfinite(reach);
   for (std::uint32_t k = 0; k < p.class_count && finite; ++k)
-    q.density.callback_max += density_bound(p.classes[k], q, reach);
+    q.density.callback_max += joint ? p.joint.max[k] : density_bound(p.classes[k], q, reach);
   return Status::kOk;
 }
 

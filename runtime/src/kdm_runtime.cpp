@@ -153,31 +153,60 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
   return status;
 }
 
-/// Reads the class densities into `q` and runs `run(q, cursor, why)` (a class query) with the C cursor.
+/// Reads the class densities (`classes`, or `joint` when `is_joint`) into `q` and runs
+/// `run(q, cursor, why)` (a class query) with the C cursor.
 template <class Run>
 kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
-                           const kdm_class_density* classes, uint32_t class_count, size_t* written,
-                           kdm_cursor* cursor, kdm_query_problem* problem, Run run) {
+                           const kdm_class_density* classes, const kdm_joint_class_density* joint,
+                           bool is_joint, uint32_t class_count, size_t* written, kdm_cursor* cursor,
+                           kdm_query_problem* problem, Run run) {
   kdm::QueryProblem why;
   kdm::ClassQueryParams q;
   kdm_status status = KDM_INVALID_ARGUMENT;
   if (!read_query(tileset, query, cursor, written, q.query, why)) {
-  } else if (!classes) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = "classes";
+  } else if (is_joint ? !(joint && joint->densities) : !classes) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = is_joint ? "joint" : "classes";
   } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
     why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
     why.value = class_count, why.limit = kdm::kMaxQueryClasses;
   } else {
     q.class_count = class_count;
-    for (uint32_t k = 0; k < class_count; ++k) {
+    for (uint32_t k = 0; k < class_count && !is_joint; ++k) {
       const kdm_class_density& c = classes[k];
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
       q.classes[k].bounds = c.density_bounds;
+    }
+    if (is_joint) {
+      q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,
+      q.joint.user = joint->user;
+      std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
     }
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);
   return status;
+}
+
+/// The class queries into records and into the compact output, for either kind of densities.
+kdm_status class_records(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
+                         const kdm_joint_class_density* joint, bool is_joint, uint32_t class_count,
+                         kdm_point* out, uint8_t* out_classes, size_t capacity, size_t* written,
+                         kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                           return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity,
+                                                     written, k, why);
+                         });
+}
+kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
+                         const kdm_joint_class_density* joint, bool is_joint, uint32_t class_count, float* xy,
+                         uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written,
+                         kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                           return kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                             out_classes, capacity, written, k, why);
+                         });
 }
 
 }  // namespace
@@ -289,22 +318,32 @@ kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,
                              const kdm_class_density* classes, uint32_t class_count, kdm_point* out,
                              uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
                              kdm_query_problem* problem) {
-  return run_class_query(tileset, query, classes, class_count, written, cursor, problem,
-                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
-                           return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity,
-                                                     written, k, why);
-                         });
+  return class_records(tileset, query, classes, nullptr, false, class_count, out, out_classes, capacity,
+                       written, cursor, problem);
 }
 
 kdm_status kdm_query_classes_compact(const kdm_tileset* tileset, const kdm_query* query,
                                      const kdm_class_density* classes, uint32_t class_count, float* xy,
                                      uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written,
                                      kdm_cursor* cursor, kdm_query_problem* problem) {
-  return run_class_query(tileset, query, classes, class_count, written, cursor, problem,
-                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
-                           return kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
-                                                             out_classes, capacity, written, k, why);
-                         });
+  return class_compact(tileset, query, classes, nullptr, false, class_count, xy, keys, out_classes, capacity,
+                       written, cursor, problem);
+}
+
+kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
+                                   const kdm_joint_class_density* joint, uint32_t class_count, kdm_point* out,
+                                   uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
+                                   kdm_query_problem* problem) {
+  return class_records(tileset, query, nullptr, joint, true, class_count, out, out_classes, capacity, written,
+                       cursor, problem);
+}
+
+kdm_status kdm_query_classes_joint_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                           const kdm_joint_class_density* joint, uint32_t class_count,
+                                           float* xy, uint64_t* keys, uint8_t* out_classes, size_t capacity,
+                                           size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
+  return class_compact(tileset, query, nullptr, joint, true, class_count, xy, keys, out_classes, capacity,
+                       written, cursor, problem);
 }
 
 const char* kdm_status_message(kdm_status status) {

@@ -51,6 +51,14 @@ static void ramp_bounds(void* user, double x0, double y0, double x1, double y1, 
   (void)user, (void)y0, (void)y1;
   *lo = 0.2 + 0.1 * x0, *hi = 0.2 + 0.1 * x1;
 }
+/* Two classes from one call: the ramp's value for each, and their bounds. */
+static void two_ramps(void* user, double x, double y, double* values) {
+  values[0] = values[1] = ramp(user, x, y);
+}
+static void two_ramp_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  ramp_bounds(user, x0, y0, x1, y1, lo, hi);
+  lo[1] = lo[0], hi[1] = hi[0];
+}
 
 static kdm_query uniform_query(void) {
   kdm_query q;
@@ -269,6 +277,40 @@ int main(int argc, char** argv) {
       CHECK(a == b && a > 2000 && memcmp(with, without, a * sizeof(kdm_point)) == 0);
       CHECK(memcmp(with_classes, without_classes, a) == 0);
       CHECK(g_ramp_calls < calls_without / 3); /* measured: about a tenth */
+      /* The same two classes from one joint call: the same points and classes, a call per candidate. */
+      {
+        static float xy[2 * 8192];
+        static uint8_t compact_classes[8192];
+        kdm_joint_class_density joint;
+        size_t c = 0;
+        memset(&joint, 0, sizeof joint);
+        joint.densities = two_ramps;
+        joint.density_max[0] = joint.density_max[1] = 1;
+        g_ramp_calls = 0;
+        memset(&cursor, 0, sizeof cursor);
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor, NULL) ==
+              KDM_OK);
+        CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
+        CHECK(memcmp(with_classes, without_classes, a) == 0);
+        CHECK(g_ramp_calls <
+              calls_without * 2 / 3); /* two ramps a call; separately, two a candidate and more */
+        joint.density_bounds = two_ramp_bounds;
+        memset(&cursor, 0, sizeof cursor);
+        CHECK(kdm_query_classes_joint_compact(builtin, &q, &joint, 2, xy, NULL, compact_classes, 8192, &c,
+                                              &cursor, NULL) == KDM_OK);
+        CHECK(c == a && memcmp(compact_classes, without_classes, a) == 0);
+        for (c = 0; c < a; ++c) /* floats within 2^-21 of the tile-relative double (region 8 wide) */
+          CHECK(fabs(xy[2 * c] - without[c].x) < 1e-5 && fabs(xy[2 * c + 1] - without[c].y) < 1e-5);
+        /* Refused by name: no joint density, a bad maximum. */
+        memset(&cursor, 0, sizeof cursor);
+        CHECK(kdm_query_classes_joint(builtin, &q, NULL, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              strcmp(problem.parameter, "joint") == 0);
+        joint.density_max[1] = -1;
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              strcmp(problem.parameter, "joint.max[1]") == 0);
+      }
     }
   }
   /* The compact output: the same points as floats and keys, through a small buffer with resumes. */

@@ -295,6 +295,14 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   q.classes[1].callback_max = NAN;
   EXPECT_STREQ(refusal(q).parameter, "classes[1].callback_max");
   q.classes[1] = QueryDensity{};
+  // A joint density's maxima.
+  ClassQueryParams qj = q;
+  qj.joint.densities = [](void*, double, double, double* v) { v[0] = v[1] = v[2] = 1; };
+  qj.joint.max[0] = qj.joint.max[1] = 1, qj.joint.max[2] = -1;
+  EXPECT_EQ(refusal(qj).kind, QueryProblem::Kind::kNegative);
+  EXPECT_STREQ(refusal(qj).parameter, "joint.max[2]");
+  qj.joint.max[2] = INFINITY;
+  EXPECT_EQ(refusal(qj).kind, QueryProblem::Kind::kNotFinite);
   std::uint8_t* none = nullptr;
   QueryCursor cursor;
   EXPECT_EQ(query_classes(Tileset::builtin(), q, out, none, 4, &written, &cursor), Status::kInvalidArgument);
@@ -389,6 +397,61 @@ TEST(ClassQueryTest, BoundsSettleClassesWithoutChangingThem) {
     }
     EXPECT_GE(double(shared), 0.97 * double(c.size()));
   }
+}
+
+/// The three images' values from one call (JointClassDensity), counting the calls.
+struct JointImages {
+  const ThreeImages* images;
+  std::size_t calls = 0;
+};
+void joint_values(void* user, double x, double y, double* v) {
+  auto& j = *static_cast<JointImages*>(user);
+  ++j.calls;
+  for (int k = 0; k < 3; ++k) v[k] = j.images->views[k].at(x, y);
+}
+void joint_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  const auto& j = *static_cast<JointImages*>(user);
+  for (int k = 0; k < 3; ++k)
+    image_bounds(const_cast<DensityImageView*>(&j.images->views[k]), x0, y0, x1, y1, lo + k, hi + k);
+}
+std::size_t separate_calls = 0;
+double counted_image_value(void* view, double x, double y) {
+  ++separate_calls;
+  return image_value(view, x, y);
+}
+
+TEST(ClassQueryTest, AJointDensityGivesTheSeparateClassesPoints) {
+  // The images as separate callbacks and as one joint callback, with bounds and without: the same points
+  // and classes, and the joint one called once where the separate ones are called up to three times.
+  ThreeImages images;
+  std::vector<float> mins[3];
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(make_density_max_mip(images.views[k], mins[k]), Status::kOk);
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth})
+    for (bool bounds : {false, true}) {
+      ClassQueryParams separate = three_constants(0, 0, 4, 4, 800, mode), joint = separate;
+      JointImages j{&images};
+      for (int k = 0; k < 3; ++k) {
+        QueryDensity& d = separate.classes[k];
+        d.kind = QueryDensity::Kind::kCallback, d.callback = counted_image_value;
+        d.user = &images.views[k], d.callback_max = 1.2;
+        if (bounds) d.bounds = image_bounds;
+        joint.joint.max[k] = 1.2;
+      }
+      joint.classes[0].constant = -5;  // not read
+      joint.joint.densities = joint_values, joint.joint.user = &j;
+      if (bounds) joint.joint.bounds = joint_bounds;
+      separate_calls = 0;
+      const Points a = run_classes(separate), b = run_classes(joint);
+      ASSERT_GT(a.size(), 10000u);
+      expect_same(a, b, "a joint density against separate ones");
+      for (const auto& [id, e] : a) ASSERT_EQ(b.at(id).cls, e.cls);
+      std::printf("%s, %s bounds: %zu points, %zu separate calls, %zu joint\n",
+                  mode == QueryMode::kStable ? "stable" : "smooth", bounds ? "with" : "without", a.size(),
+                  separate_calls, j.calls);
+      // Each joint call stands for three separate ones (the union's reads) or fewer (a class's reads).
+      EXPECT_LT(double(j.calls), 0.5 * double(separate_calls));
+      EXPECT_GT(j.calls, 0u);
+    }
 }
 
 /// query_classes_compact over `q` with keys, resumed through buffers of `capacity`: positions, keys and

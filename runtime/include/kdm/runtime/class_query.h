@@ -12,7 +12,9 @@
 // points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions.
 // Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps.
 // Give a callback class its bounds (QueryDensity::bounds): the union's are their sum, and a tile's bounds
-// settle most of its points' classes without reading any density.
+// settle most of its points' classes without reading any density. Classes whose densities come from one
+// computation are best given by one function (ClassQueryParams::joint): the query then makes one call per
+// candidate instead of one per class.
 //
 // Zoom coherence: as densities rise a point keeps its id and can only move to an earlier class (its
 // cumulative counts only grow), never to a later one. Past the top level (smooth mode, depth > 0), a
@@ -34,10 +36,28 @@ namespace kdm {
 /// Most classes one query may carry.
 inline constexpr std::uint32_t kMaxQueryClasses = 8;
 
+/// Every class's density from one call, for classes that share their inputs (a biome map that gives the
+/// densities of trees, bushes and rocks at once): one call where separate callbacks would take one each,
+/// at every candidate the bounds leave open.
+struct JointClassDensity {
+  /// Writes the class_count densities at world position (x, y), points per unit area at scale 1, class 0
+  /// first, into values[0 … class_count). NaN, negative and infinite values count as 0. Called from the
+  /// querying thread only; it must give the same values for the same position.
+  void (*densities)(void* user, double x, double y, double* values) = nullptr;
+  /// Optional: bounds of each class's density over [x0, x1] × [y0, y1] into lo[k] ≤ ρ_k ≤ hi[k], as
+  /// QueryDensity::bounds gives one density's (values that are not numbers fall back to 0 and max[k]).
+  void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
+  void* user = nullptr;  ///< passed to both
+  /// An upper bound of each class's density wherever it is read (finite, ≥ 0), as QueryDensity::callback_max.
+  double max[kMaxQueryClasses] = {};
+};
+
 struct ClassQueryParams {
   QueryParams query;              ///< region, origin, tile size, scale and mode; query.density is not read
   std::uint32_t class_count = 0;  ///< how many of `classes` are used: 1 … kMaxQueryClasses
   QueryDensity classes[kMaxQueryClasses];  ///< each class's density, class 0 first (highest priority)
+  /// Optional: when joint.densities is set, it gives every class's density and `classes` is not read.
+  JointClassDensity joint;
 };
 
 /// A hash of every field of `params` that a query reads: the identity its cursor keeps.
@@ -48,7 +68,8 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
 /// region is complete, kBufferFull to be called again with the same cursor and params, kInvalidArgument
 /// with `problem` (optional) naming the parameter for: a class count of 0 or more than kMaxQueryClasses
 /// (kBadClassCount), a class's missing image or callback or bad callback_max (parameter
-/// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a null `classes` with room in
+/// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a bad joint maximum
+/// ("joint.max[k]"), a null `classes` with room in
 /// `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
 KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
                                      std::uint8_t* classes, std::size_t capacity, std::size_t* written,
@@ -58,7 +79,7 @@ KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryPar
 /// cursor, each point's position as floats at out.xy[2i], out.xy[2i + 1] (bit for bit those
 /// query_points_compact writes for the one-class query at the sum of the densities) and, if out.keys is not
 /// null, its point_key at out.keys[i]. Refusals as query_classes', and query_points_compact's for the output
-/// ("out.xy", a region beyond a float of the origin, kKeysUnsupported). No allocation; 24 KB of stack.
+/// ("out.xy", a region beyond a float of the origin, kKeysUnsupported). No allocation.
 KDM_RUNTIME_API Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& params,
                                              const CompactPoints& out, std::uint8_t* classes,
                                              std::size_t capacity, std::size_t* written, QueryCursor* cursor,

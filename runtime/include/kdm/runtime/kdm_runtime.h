@@ -211,6 +211,33 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_compact(const kdm_tileset* tileset,
                                                      size_t capacity, size_t* written, kdm_cursor* cursor,
                                                      kdm_query_problem* problem);
 
+/* Every class's density from one call (kdm::JointClassDensity), for classes that share their inputs:
+ * `densities` writes the class_count densities at (x, y), class 0 first, into values[0 ... class_count);
+ * `density_bounds` (optional) each class's bounds over the rectangle into lo[k], hi[k]; density_max[k] an
+ * upper bound of class k's density (finite, >= 0). Zero the struct before filling it. */
+typedef struct kdm_joint_class_density {
+  void (*densities)(void* user, double x, double y, double* values);
+  void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
+  void* user;
+  double density_max[KDM_MAX_CLASSES];
+} kdm_joint_class_density;
+
+/* kdm_query_classes and kdm_query_classes_compact with the classes' densities from one call: the same
+ * points and classes as separate callbacks giving the same values, one call per candidate instead of one
+ * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` or joint->densities ("joint") and a bad
+ * density_max ("joint.max[k]"). Added in 0.4. */
+KDM_RUNTIME_API kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
+                                                   const kdm_joint_class_density* joint, uint32_t class_count,
+                                                   kdm_point* out, uint8_t* out_classes, size_t capacity,
+                                                   size_t* written, kdm_cursor* cursor,
+                                                   kdm_query_problem* problem);
+KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                                           const kdm_joint_class_density* joint,
+                                                           uint32_t class_count, float* xy, uint64_t* keys,
+                                                           uint8_t* out_classes, size_t capacity,
+                                                           size_t* written, kdm_cursor* cursor,
+                                                           kdm_query_problem* problem);
+
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
