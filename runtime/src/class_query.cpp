@@ -58,11 +58,12 @@ struct ClassDensities {
     }
     return density_or_zero(d.callback(d.user, x, y));
   }
-  /// The joint density's values at (x, y) into v[0 … class_count), as query_points reads one value.
+  /// The joint density's values at (x, y) into v[0 … class_count), each to be read as query_points reads
+  /// one value (density_or_zero) where it is added: a separate pass would load pairs of values just
+  /// stored one by one, which the processor cannot forward.
   void joint_at(double x, double y, double* v) const {
     const JointClassDensity& j = params->joint;
     j.densities(j.user, x, y, v);
-    for (std::uint32_t k = 0; k < params->class_count; ++k) v[k] = density_or_zero(v[k]);
   }
   /// Bounds of every class's density over [x0, x1] × [y0, y1] into lo[k], hi[k], as query_points takes
   /// one density's.
@@ -88,7 +89,7 @@ struct ClassDensities {
     if (params->joint.densities) joint_at(x, y, v);
     double sum = 0;
     for (std::uint32_t k = 0; k < last; ++k) {
-      sum += params->joint.densities ? v[k] : at(k, x, y);
+      sum += params->joint.densities ? density_or_zero(v[k]) : at(k, x, y);
       if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
     }
     return static_cast<std::uint8_t>(last);
@@ -108,7 +109,8 @@ double sum_of_joint(void* user, double x, double y) {
   const auto& c = *static_cast<const ClassDensities*>(user);
   double v[kMaxQueryClasses], sum = 0;
   c.joint_at(x, y, v);
-  for (std::uint32_t k = 0; k < c.params->class_count; ++k) c.scratch.cumulative[k] = sum += v[k];
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k)
+    c.scratch.cumulative[k] = sum += density_or_zero(v[k]);
   c.scratch.x = x, c.scratch.y = y;
   return sum;
 }
@@ -257,18 +259,48 @@ class Classifier {
     class_ = k, rank_ = end - 1;
   }
 
-  /// A point of the current tile whose class its tile's bounds leave open: the classes' densities at its
-  /// stable position, computed as query_points computes it (depth 0), so the densities read are its.
-  std::uint8_t read_class(const PointId& id) const {
+  /// A point of the current tile whose class its tile's bounds leave open: settled by the bounds of the
+  /// cell of the tile it lies in where they can, else by the classes' densities at its stable position,
+  /// computed as query_points computes it (depth 0), so the densities read are its.
+  std::uint8_t read_class(const PointId& id) {
     const TilePoint& point = points_[id.rank];
+    const float t = thresholds_[id.rank];
+    const std::uint32_t cx = point.x >> (16 - kCellBits), cy = point.y >> (16 - kCellBits);
+    const std::uint32_t cell = cy << kCellBits | cx;
+    if (!(cells_read_ >> cell & 1)) read_cell(cx, cy, cell);
+    const std::uint32_t last = p_.class_count - 1;
+    std::uint32_t k = 0;
+    for (; k < last; ++k) {
+      if (!TilesetShape::emits(t, cell_hi_[cell][k])) continue;  // classes 0 … k fall short everywhere there
+      if (TilesetShape::emits(t, cell_lo_[cell][k])) return static_cast<std::uint8_t>(k);
+      break;  // open: read
+    }
+    if (k == last) return static_cast<std::uint8_t>(last);
     const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
-    return densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_, wy + point.unit_y() * side_,
-                               area_);
+    return densities_.class_of(t, wx + point.unit_x() * side_, wy + point.unit_y() * side_, area_);
+  }
+
+  /// The classes' cumulative expected counts' bounds over cell (cx, cy) of the current tile, widened by
+  /// 10^-9 as the tile's. The cell's sides are computed as positions are (corner plus a fraction times the
+  /// side), and rounding is monotonic, so every point of the cell lies in the rectangle bounded.
+  void read_cell(std::uint32_t cx, std::uint32_t cy, std::uint32_t cell) {
+    constexpr double kStep = 1.0 / (1 << kCellBits);
+    const double wx = double(tile_.tile_x) * side_, wy = double(tile_.tile_y) * side_;
+    double l[kMaxQueryClasses], h[kMaxQueryClasses];
+    densities_.bounds(wx + (cx * kStep) * side_, wy + (cy * kStep) * side_, wx + ((cx + 1) * kStep) * side_,
+                      wy + ((cy + 1) * kStep) * side_, l, h);
+    double lo = 0, hi = 0;
+    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
+      lo += l[k], hi += h[k];
+      cell_lo_[cell][k] = lo * area_ * (1 - 1e-9), cell_hi_[cell][k] = hi * area_ * (1 + 1e-9);
+    }
+    cells_read_ |= 1u << cell;
   }
 
   /// Reads what the points of id's tile share.
   void enter(const PointId& id) {
     tile_ = id;
+    cells_read_ = 0;
     const std::size_t index = id.depth == 0
                                   ? tileset_.tile_index_at(id.tile_x, id.tile_y)
                                   : static_cast<std::size_t>(tile_of(tileset_, id) - set_.tiles.data());
@@ -330,6 +362,13 @@ class Classifier {
   std::uint32_t first_rank_[kMaxQueryClasses] = {};
   std::uint32_t sure_from_[kMaxQueryClasses] = {}, sure_to_[kMaxQueryClasses] = {};
   std::uint32_t class_ = 0, rank_ = 0;  // the last point's class and rank
+  // Varying densities: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds read_class reads for the
+  // points its tile's bounds leave open (cell c's when bit c of cells_read_ is set): narrower bands, fewer
+  // densities read.
+  static constexpr std::uint32_t kCellBits = 3;
+  std::uint32_t cells_read_ = 0;
+  double cell_lo_[1 << (2 * kCellBits)][kMaxQueryClasses] = {},
+                            cell_hi_[1 << (2 * kCellBits)][kMaxQueryClasses] = {};
 };
 
 }  // namespace
