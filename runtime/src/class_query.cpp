@@ -294,7 +294,7 @@ class Classifier {
       lo += l[k], hi += h[k];
       cell_lo_[cell][k] = lo * area_ * (1 - 1e-9), cell_hi_[cell][k] = hi * area_ * (1 + 1e-9);
     }
-    cells_read_ |= 1u << cell;
+    cells_read_ |= std::uint64_t(1) << cell;
   }
 
   /// Reads what the points of id's tile share.
@@ -365,8 +365,8 @@ class Classifier {
   // Varying densities: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds read_class reads for the
   // points its tile's bounds leave open (cell c's when bit c of cells_read_ is set): narrower bands, fewer
   // densities read.
-  static constexpr std::uint32_t kCellBits = 3;
-  std::uint32_t cells_read_ = 0;
+  static constexpr std::uint32_t kCellBits = 3;  // at most 3: cells_read_ has a bit per cell
+  std::uint64_t cells_read_ = 0;
   double cell_lo_[1 << (2 * kCellBits)][kMaxQueryClasses] = {},
                             cell_hi_[1 << (2 * kCellBits)][kMaxQueryClasses] = {};
 };
