@@ -365,7 +365,7 @@ class Classifier {
   // Varying densities: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds read_class reads for the
   // points its tile's bounds leave open (cell c's when bit c of cells_read_ is set): narrower bands, fewer
   // densities read.
-  static constexpr std::uint32_t kCellBits = 3;  // at most 3: cells_read_ has a bit per cell
+  static constexpr std::uint32_t kCellBits = 2;  // at most 3: cells_read_ has a bit per cell
   std::uint64_t cells_read_ = 0;
   double cell_lo_[1 << (2 * kCellBits)][kMaxQueryClasses] = {},
                             cell_hi_[1 << (2 * kCellBits)][kMaxQueryClasses] = {};
