@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "density_bounds.h"
 #include "float_runs.h"
 #include "image_sampler.h"
 #include "kdm/runtime/compact_query.h"
@@ -44,6 +45,9 @@ struct TileJob {
   /// Stable mode with a varying density: ranks below this are emitted wherever they lie in the tile (their
   /// thresholds lie below the density's lower bound there), without reading the density.
   std::uint32_t sure;
+  /// Stable mode with a callback density that has bounds: a candidate above `sure` is first held to the
+  /// bounds of the cell of the tile it lies in (kCellBits), which settle it without a call where they can.
+  bool cells;
   /// Smooth mode, constant density: the grid cells whose points land inside the region however far they
   /// glide (by `reach`, with room for rounding), which skip its test: safe_x ≤ x < safe_x + safe_w (as
   /// unsigned differences; safe_w = 0 for none), the same in y.
@@ -255,6 +259,10 @@ constexpr bool kClassesAtDensity = false;
 template <class Sink>
 constexpr bool kClassesAtDensity<Sink, std::void_t<decltype(&Sink::put_classed)>> = true;
 
+/// Stable mode with a varying density: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds settle a
+/// candidate between the tile's bounds without reading the density where they can.
+constexpr std::uint32_t kCellBits = 2;
+
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
 /// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
@@ -357,6 +365,27 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     pending = 0;
     return kNone;
   };
+  // Stable mode, a density with bounds: each cell's expected counts' bounds (widened by 10^-9 for rounding,
+  // as the tile's), read when a candidate first lies in it. The cell's sides are computed as positions are
+  // (corner plus a fraction times the side) and rounding is monotonic, so its points lie in its rectangle.
+  constexpr bool kCells = !kSmooth && !kConstant;
+  constexpr std::uint32_t kCellCount = kCells ? 1u << (2 * kCellBits) : 1;
+  static_assert(kCellCount <= 32, "a bit per cell in cells_read");
+  double cell_lo[kCellCount], cell_hi[kCellCount];
+  std::uint32_t cells_read = 0;
+  auto cell_of = [&](TilePoint p) {
+    const std::uint32_t cx = p.x >> (16 - kCellBits), cy = p.y >> (16 - kCellBits);
+    const std::uint32_t cell = kCells ? cy << kCellBits | cx : 0;
+    if (!(cells_read >> cell & 1)) {
+      constexpr double kStep = 1.0 / (1 << kCellBits);
+      double lo, hi;
+      density_bounds(*j.density, j.wx + (cx * kStep) * j.S, j.wy + (cy * kStep) * j.S,
+                     j.wx + ((cx + 1) * kStep) * j.S, j.wy + ((cy + 1) * kStep) * j.S, lo, hi);
+      cell_lo[cell] = lo * j.area_scale * (1 - 1e-9), cell_hi[cell] = hi * j.area_scale * (1 + 1e-9);
+      cells_read |= 1u << cell;
+    }
+    return cell;
+  };
   // One candidate: the rank that did not fit, or kNone. Positions: the stable one (for ρ and in stable
   // mode), then the glide added to it.
   auto visit = [&](std::uint32_t c) -> std::uint32_t {
@@ -381,6 +410,15 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
                    0)
                  ? kNone
                  : c;
+    if (kCells && j.cells) {
+      const std::uint32_t cell = cell_of(p);
+      if (!TilesetShape::emits(j.thresholds[c], cell_hi[cell])) return kNone;  // not even at its cell's most
+      if (TilesetShape::emits(j.thresholds[c], cell_lo[cell])) {
+        if (n == capacity) return c;
+        out.put_stable(n++, j, p, c);
+        return kNone;
+      }
+    }
     const double rho = kKind == QueryDensity::Kind::kImage
                            ? j.sampler->at(x, y)
                            : density_or_zero(j.density->callback(j.density->user, x, y));

@@ -229,6 +229,8 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       // Stable mode: the ranks emitted wherever they lie, less a margin for a bilinear or callback value
       // that equals lo rounding below it.
       job.sure = 0;
+      // A callback's cells (emit_tile.h): an image's texel is read faster than its cell tested.
+      job.cells = !glide && d.kind == QueryDensity::Kind::kCallback && d.bounds;
       if (!glide && lo > 0)
         job.sure = static_cast<std::uint32_t>(
             std::lower_bound(thresholds, thresholds + candidates, lo * area_scale * (1 - 1e-9),

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -57,9 +58,11 @@ TEST(DensityBoundsTest, ACallbacksBoundsKeepItsPointsAndSaveItsCalls) {
     q.density.bounds = Ramp::bounds;
     EXPECT_TRUE(same_bits(run(q), read_everywhere)) << "mode " << int(mode);
     const long calls_bounded = ramp.calls.exchange(0);
-    // Stable mode reads the density only between a tile's bounds (a tenth of the ramp per tile here:
-    // measured 0.125 of the calls); smooth mode below its upper bound, once per point (measured 0.433).
-    EXPECT_LT(calls_bounded, (mode == QueryMode::kStable ? 0.25 : 0.65) * calls_everywhere)
+    std::printf("mode %d: %ld of %ld calls\n", int(mode), calls_bounded, calls_everywhere);
+    // Stable mode reads the density only between the bounds of the quarter-by-quarter cell of its tile a
+    // point lies in (a tenth of the ramp per tile here: 0.125 of the calls with the tile's bounds alone,
+    // measured 0.037 with its cells'); smooth mode below its upper bound, once per point (measured 0.433).
+    EXPECT_LT(calls_bounded, (mode == QueryMode::kStable ? 0.06 : 0.65) * calls_everywhere)
         << "mode " << int(mode);
     q.density.bounds = Ramp::no_bounds;  // NaN bounds are no bounds
     EXPECT_TRUE(same_bits(run(q), read_everywhere)) << "mode " << int(mode);
