@@ -192,10 +192,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
                    : d.image->min_over(wx, wy, wx + S, wy + S);
       } else if (d.kind == QueryDensity::Kind::kCallback && d.bounds) {
         const double r = glide ? reach : 0;
-        double l = std::nan(""), h = std::nan("");
-        d.bounds(d.user, wx - r, wy - r, wx + S + r, wy + S + r, &l, &h);
-        if (h >= 0 && h < bound) bound = h;  // NaN bounds fail both tests
-        if (l > 0) lo = std::min(l, bound);
+        detail::density_bounds(d, wx - r, wy - r, wx + S + r, wy + S + r, lo, bound);
       }
       // Thresholds are sorted: the points below bound · A · scale are a prefix; none beyond can be emitted.
       const double limit = bound * area_scale;
