@@ -108,26 +108,41 @@ constexpr std::size_t kChunk = std::size_t(1) << 14;
 std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) {
   QueryCursor cursor;
   std::size_t m = 0;
-  // Points come tile by tile, ranks ascending: look each tile up once and step through its levels.
-  std::int64_t tx = std::numeric_limits<std::int64_t>::min(), ty = tx;
+  // Points come tile by tile, ranks ascending: a run of one tile's points takes its levels a level at a
+  // time, the run's end at each level found by binary search (ranks ascend) and the levels filled.
   const Tile* t = nullptr;
-  std::uint32_t level = 0, level_end = 0, last_rank = 0, depth = 0;
+  PointId tile{std::numeric_limits<std::int64_t>::min(), 0, 0, 0};
   for (;;) {
     if (m == buffer.capacity) buffer.reserve(m + kChunk, m);
     std::size_t written = 0;
     QueryProblem problem;
     const Status s = query_points(tiles, q, buffer.points + m, std::min(kChunk, buffer.capacity - m),
                                   &written, &cursor, &problem);
-    for (std::size_t i = m; i < m + written; ++i) {
-      const PointId& id = buffer.points[i].id;
-      if (!t || id.tile_x != tx || id.tile_y != ty || id.depth != depth || id.rank < last_rank) {
-        if (!t || id.tile_x != tx || id.tile_y != ty || id.depth != depth)
-          tx = id.tile_x, ty = id.tile_y, depth = id.depth, t = tile_of(tiles, id);
-        level = 0, level_end = t->level_end[0];
+    const QueryPoint* points = buffer.points;
+    for (std::size_t i = m, end = m + written; i < end;) {
+      const PointId& id = points[i].id;
+      if (!t || id.tile_x != tile.tile_x || id.tile_y != tile.tile_y || id.depth != tile.depth)
+        tile = id, t = tile_of(tiles, id);
+      std::size_t run = i + 1;
+      for (std::uint32_t last = id.rank; run < end; last = points[run++].id.rank) {
+        const PointId& next = points[run].id;
+        if (next.tile_x != tile.tile_x || next.tile_y != tile.tile_y || next.depth != tile.depth ||
+            next.rank <= last)
+          break;
       }
-      last_rank = id.rank;
-      while (id.rank >= level_end && level + 1 < t->level_end.size()) level_end = t->level_end[++level];
-      buffer.levels[i] = level;
+      for (std::uint32_t level = t->level_of(id.rank); i < run; ++level) {
+        const bool last_level = level + 1 >= t->level_end.size();
+        const std::size_t upto =
+            last_level
+                ? run
+                : static_cast<std::size_t>(std::partition_point(points + i, points + run,
+                                                                [&](const QueryPoint& p) {
+                                                                  return p.id.rank < t->level_end[level];
+                                                                }) -
+                                           points);
+        std::fill(buffer.levels + i, buffer.levels + upto, level);
+        i = upto;
+      }
     }
     m += written;
     if (m > tools::kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
