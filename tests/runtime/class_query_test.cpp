@@ -265,6 +265,30 @@ TEST(ClassQueryTest, PastTheTopLevelClassCountsStillFollowTheirDensities) {
               counts[2]);
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(double(counts[k]) / (q.classes[k].constant / 7 * double(all.size())), 1.0, 0.03);
+  // The same densities by callbacks, with bounds (the classes' cells) and without: a point's class is
+  // decided by the same rule from its threshold, whichever path classes it.
+  for (bool bounds : {false, true}) {
+    ClassQueryParams qc = q;
+    for (int k = 0; k < 3; ++k) {
+      QueryDensity& d = qc.classes[k];
+      d.kind = QueryDensity::Kind::kCallback, d.user = &q.classes[k].constant, d.callback_max = d.constant;
+      d.callback = [](void* v, double, double) { return *static_cast<const double*>(v); };
+      if (bounds)
+        d.bounds = [](void* v, double, double, double, double, double* lo, double* hi) {
+          *lo = *hi = *static_cast<const double*>(v);
+        };
+    }
+    const Points by_callback = run_classes(qc);
+    std::size_t shared = 0, deep_shared = 0;
+    for (const auto& [id, p] : by_callback) {
+      const auto it = all.find(id);
+      if (it == all.end()) continue;
+      ++shared, deep_shared += std::get<3>(id) > 0;
+      ASSERT_EQ(it->second.cls, p.cls);
+    }
+    EXPECT_GE(double(shared), 0.97 * double(all.size()));
+    EXPECT_GT(deep_shared, 0u);
+  }
 }
 
 TEST(ClassQueryTest, BadInputIsRefusedByName) {
