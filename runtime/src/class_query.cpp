@@ -494,15 +494,15 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
     double counts[kMaxQueryClasses];
     constant_counts(p, q, counts);
     const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id, &classify};
-    status = detail::query_constant_classes_counted(tileset, q, out, c, capacity, written, cursor,
-                                                    &refuse.problem(), examined);
+    status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
+                                           examined);
   } else {
     const detail::VaryingClasses c{
         classes,           &densities.scratch,      q.tile_size * q.tile_size * q.scale,
         p.class_count - 1, Classifier::class_ranks, Classifier::class_of_id,
         &classify};
-    status = detail::query_varying_classes_counted(tileset, q, out, c, capacity, written, cursor,
-                                                   &refuse.problem(), examined);
+    status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
+                                           examined);
   }
   if (status != Status::kInvalidArgument && cursor) cursor->fingerprint = fingerprint;
   return status;

@@ -332,26 +332,32 @@ Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, boo
 
 namespace {
 
+/// The sink that classes points into `c.classes` as it writes them into `base`.
 template <class Base>
 detail::ClassSink<Base> class_sink(Base base, const detail::ConstantClasses& c) {
   return detail::ClassSink<Base>{base, c.classes, c.counts, c.last, c.class_of_id, c.user};
 }
+template <class Base>
+detail::VaryingClassSink<Base> class_sink(Base base, const detail::VaryingClasses& c) {
+  return detail::VaryingClassSink<Base>{base, &c};
+}
 
 }  // namespace
 
-Status detail::query_constant_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
-                                              const ConstantClasses& classes, std::size_t capacity,
-                                              std::size_t* written, QueryCursor* cursor,
-                                              QueryProblem* problem, std::uint64_t& examined) {
+template <class Classes>
+Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
+                                     const Classes& classes, std::size_t capacity, std::size_t* written,
+                                     QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined) {
   detail::Refusal refuse(problem);
   return query_into(tileset, q, class_sink(PointSink{out}, classes), out && classes.classes, "out", capacity,
                     written, cursor, refuse, examined);
 }
 
-Status detail::query_constant_classes_counted(const Tileset& tileset, const QueryParams& q,
-                                              const CompactPoints& compact, const ConstantClasses& classes,
-                                              std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                              QueryProblem* problem, std::uint64_t& examined) {
+template <class Classes>
+Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& q,
+                                     const CompactPoints& compact, const Classes& classes,
+                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                     QueryProblem* problem, std::uint64_t& examined) {
   detail::Refusal refuse(problem);
   if (written) *written = 0;
   if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
@@ -364,31 +370,19 @@ Status detail::query_constant_classes_counted(const Tileset& tileset, const Quer
                     capacity, written, cursor, refuse, examined);
 }
 
-Status detail::query_varying_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
-                                             const VaryingClasses& classes, std::size_t capacity,
-                                             std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
-                                             std::uint64_t& examined) {
-  detail::Refusal refuse(problem);
-  return query_into(tileset, q, detail::VaryingClassSink<PointSink>{PointSink{out}, &classes},
-                    out && classes.classes, "out", capacity, written, cursor, refuse, examined);
-}
-
-Status detail::query_varying_classes_counted(const Tileset& tileset, const QueryParams& q,
-                                             const CompactPoints& compact, const VaryingClasses& classes,
-                                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                             QueryProblem* problem, std::uint64_t& examined) {
-  detail::Refusal refuse(problem);
-  if (written) *written = 0;
-  if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
-    return Status::kInvalidArgument;
-  const bool room = compact.xy && classes.classes;
-  if (compact.keys)
-    return query_into(tileset, q,
-                      detail::VaryingClassSink<CompactSink<true>>{{compact.xy, compact.keys}, &classes}, room,
-                      "out.xy", capacity, written, cursor, refuse, examined);
-  return query_into(tileset, q, detail::VaryingClassSink<CompactSink<false>>{{compact.xy, nullptr}, &classes},
-                    room, "out.xy", capacity, written, cursor, refuse, examined);
-}
+// The two kinds of classes class_query.cpp runs.
+template Status detail::query_classes_counted(const Tileset&, const QueryParams&, QueryPoint*,
+                                              const ConstantClasses&, std::size_t, std::size_t*, QueryCursor*,
+                                              QueryProblem*, std::uint64_t&);
+template Status detail::query_classes_counted(const Tileset&, const QueryParams&, const CompactPoints&,
+                                              const ConstantClasses&, std::size_t, std::size_t*, QueryCursor*,
+                                              QueryProblem*, std::uint64_t&);
+template Status detail::query_classes_counted(const Tileset&, const QueryParams&, QueryPoint*,
+                                              const VaryingClasses&, std::size_t, std::size_t*, QueryCursor*,
+                                              QueryProblem*, std::uint64_t&);
+template Status detail::query_classes_counted(const Tileset&, const QueryParams&, const CompactPoints&,
+                                              const VaryingClasses&, std::size_t, std::size_t*, QueryCursor*,
+                                              QueryProblem*, std::uint64_t&);
 
 Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,

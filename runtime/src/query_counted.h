@@ -43,8 +43,7 @@ Status compact_refusal(const Tileset& tileset, const QueryParams& params, bool k
 
 /// Classes of constant densities (class_query.h), classed as they are written (emit_tile.h's ClassSink:
 /// `counts` the classes' cumulative expected counts per depth-0 tile, `last` the last class, class_of_id
-/// for points past the top level): query_points into `out`, or query_points_compact into `compact`, with
-/// each point's class into `classes`, counting into `examined` as query_points_counted does.
+/// for points past the top level).
 struct ConstantClasses {
   std::uint8_t* classes;
   const double* counts;
@@ -52,14 +51,6 @@ struct ConstantClasses {
   std::uint8_t (*class_of_id)(void* user, const PointId& id);
   void* user;
 };
-Status query_constant_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
-                                      const ConstantClasses& classes, std::size_t capacity,
-                                      std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
-                                      std::uint64_t& examined);
-Status query_constant_classes_counted(const Tileset& tileset, const QueryParams& params,
-                                      const CompactPoints& compact, const ConstantClasses& classes,
-                                      std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                      QueryProblem* problem, std::uint64_t& examined);
 
 /// The union's density at the last position it was read (class_query.cpp's sum of the classes' densities
 /// writes it): the position and the running sums of the classes' densities there, class 0 first. NaN
@@ -84,14 +75,18 @@ struct VaryingClasses {
   std::uint8_t (*class_of_id)(void* user, const PointId& id);
   void* user;
 };
-Status query_varying_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
-                                     const VaryingClasses& classes, std::size_t capacity,
-                                     std::size_t* written, QueryCursor* cursor, QueryProblem* problem,
-                                     std::uint64_t& examined);
-Status query_varying_classes_counted(const Tileset& tileset, const QueryParams& params,
-                                     const CompactPoints& compact, const VaryingClasses& classes,
-                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                     QueryProblem* problem, std::uint64_t& examined);
+
+/// query_points into `out`, or query_points_compact into `compact`, with each point's class into
+/// `classes.classes` (Classes: ConstantClasses or VaryingClasses), counting into `examined` as
+/// query_points_counted does.
+template <class Classes>
+Status query_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
+                             const Classes& classes, std::size_t capacity, std::size_t* written,
+                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined);
+template <class Classes>
+Status query_classes_counted(const Tileset& tileset, const QueryParams& params, const CompactPoints& compact,
+                             const Classes& classes, std::size_t capacity, std::size_t* written,
+                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined);
 
 /// How many points query_points would write for `params` from `cursor` on, into `*count`, without
 /// writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing to count). Returns
