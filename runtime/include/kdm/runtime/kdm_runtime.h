@@ -63,8 +63,8 @@ typedef struct kdm_query {
   int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
                density, so every density is good blue noise (tile sets with a glide track) */
   /* Added in 0.4: optional bounds of the callback's density over a world rectangle (*lo <= density <= *hi
-   * there), asked once per tile so that the callback is called only where emission is in doubt
-   * (kdm::QueryDensity::bounds). */
+   * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
+   * called only where emission is in doubt (kdm::QueryDensity::bounds). */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
 } kdm_query;
 

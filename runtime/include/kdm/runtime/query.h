@@ -63,7 +63,9 @@ struct QueryDensity {
   /// For callbacks, optional: bounds of the density over a world rectangle, *lo ≤ ρ ≤ *hi everywhere in
   /// [x0, x1] × [y0, y1] (must be thread-safe, like the callback). A query asks once per tile and then
   /// calls `callback` only where a point's emission is in doubt: in stable mode the points whose threshold
-  /// lies between lo and hi (those below lo are emitted, those above hi skipped, unseen), in smooth mode
+  /// lies between lo and hi (those below lo are emitted, those above hi skipped, unseen), and of those
+  /// only the ones the bounds over their quarter-by-quarter cell of the tile leave in doubt too (asked
+  /// when a point first lies in the cell: up to 16 more calls a tile); in smooth mode
   /// the points below hi, without the second call at a glided position where lo > 0. Bounds that are not
   /// true bounds make points appear or vanish as if the density were lo or hi there; NaN bounds are
   /// ignored (0 and callback_max serve).
