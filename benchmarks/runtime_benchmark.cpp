@@ -141,7 +141,8 @@ void BM_QueryDensityCallback(benchmark::State& state) {
 
 // Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp: 0 constants, 1 three ramps by
 // callback, 2 the same with their bounds (and the sum's), 3 the ramps and bounds from one joint call
-// (ClassQueryParams::joint), 4 and 5 as 2 and 3 with a texture over the ramps; compact, 1 for both queries
+// (ClassQueryParams::joint), 4 and 5 as 2 and 3 with a texture over the ramps, 6 the ramps as images against
+// an image of their sum; compact, 1 for both queries
 // into float positions) against one class at their sum, which emits the same points (its callback computes
 // the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
 // one-class query's time over the three-class query's.
@@ -206,7 +207,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   for (int k = 0; k < 3; ++k) {
     kdm::QueryDensity& d = cq.classes[k];
     d.constant = double(1 << k) / 7;
-    if (ramp) {
+    if (ramp >= 1 && ramp <= 5) {
       d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
       d.user = const_cast<RampClass*>(user + k), d.callback_max = d.constant * most;
       if (ramp >= 2) d.bounds = ramp_class_bounds;
@@ -217,7 +218,25 @@ void BM_QueryThreeClasses(benchmark::State& state) {
     cq.joint.user = const_cast<RampClass*>(user);
     for (int k = 0; k < 3; ++k) cq.joint.max[k] = cq.classes[k].callback_max;
   }
-  if (ramp) {
+  // ramp 6: each class the ramp as a 256² image, against one image of their sum.
+  std::vector<float> values[4], mips[4];
+  kdm::DensityImageView images[4];
+  if (ramp == 6) {
+    for (int k = 0; k < 4; ++k) {
+      values[k].resize(256 * 256);
+      for (int x = 0; x < 256; ++x) {
+        const double r = 0.2 + 0.8 * (x + 0.5) / 256;
+        for (int y = 0; y < 256; ++y)
+          values[k][y * 256 + x] = static_cast<float>(k < 3 ? r * (1 << k) / 7 : r);
+      }
+      images[k].width = images[k].height = 256, images[k].x1 = images[k].y1 = kSide;
+      images[k].values = values[k].data();
+      kdm::make_density_max_mip(images[k], mips[k]);
+      kdm::QueryDensity& d = k < 3 ? cq.classes[k] : one.density;
+      d.kind = kdm::QueryDensity::Kind::kImage, d.image = &images[k];
+    }
+  }
+  if (ramp >= 1 && ramp <= 5) {
     one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
     one.density.user = const_cast<RampClass*>(user);
     one.density.callback_max = most;
@@ -264,7 +283,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   report(state, n);
   state.counters["of_one_class"] = one_seconds / seconds;
   // Class densities read per point emitted (ramps only), by the class query and by the one-class query.
-  if (state.range(1)) {
+  if (ramp >= 1 && ramp <= 5) {
     const double points = double(n) * double(state.iterations());
     state.counters["reads_per_point"] = double(reads) / points;
     state.counters["one_class_reads_per_point"] = double(one_reads) / points;
@@ -468,7 +487,7 @@ BENCHMARK(BM_QueryDensityCallback)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5}, {0, 1}})
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryRampAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
