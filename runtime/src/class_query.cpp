@@ -42,6 +42,7 @@ struct ClassDensities {
   const ClassQueryParams* params = nullptr;
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
+  bool one_grid = false;  ///< every class an image on class 0's texels (sum_of_images)
   /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
   /// VaryingClassSink classes the candidate just read from it).
   mutable detail::ClassScratch scratch;
@@ -87,9 +88,13 @@ struct ClassDensities {
     const std::uint32_t last = params->class_count - 1;
     double v[kMaxQueryClasses];
     if (params->joint.densities) joint_at(x, y, v);
+    ImageSampler::Texels t{};
+    if (one_grid) t = samplers[0].texels(x, y);
     double sum = 0;
     for (std::uint32_t k = 0; k < last; ++k) {
-      sum += params->joint.densities ? density_or_zero(v[k]) : at(k, x, y);
+      sum += params->joint.densities ? density_or_zero(v[k])
+             : one_grid              ? ImageSampler::blend(params->classes[k].image->values, t)
+                                     : at(k, x, y);
       if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
     }
     return static_cast<std::uint8_t>(last);
@@ -102,6 +107,16 @@ double sum_of_densities(void* user, double x, double y) {
   const auto& c = *static_cast<const ClassDensities*>(user);
   double sum = 0;
   for (std::uint32_t k = 0; k < c.params->class_count; ++k) c.scratch.cumulative[k] = sum += c.at(k, x, y);
+  c.scratch.x = x, c.scratch.y = y;
+  return sum;
+}
+/// Classes that are all images on one grid of texels: where a position falls among them is found once.
+double sum_of_images(void* user, double x, double y) {
+  const auto& c = *static_cast<const ClassDensities*>(user);
+  const ImageSampler::Texels t = c.samplers[0].texels(x, y);
+  double sum = 0;
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k)
+    c.scratch.cumulative[k] = sum += ImageSampler::blend(c.params->classes[k].image->values, t);
   c.scratch.x = x, c.scratch.y = y;
   return sum;
 }
@@ -448,7 +463,11 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     return Status::kOk;
   }
   q.density.kind = QueryDensity::Kind::kCallback;
-  q.density.callback = joint ? sum_of_joint : sum_of_densities;
+  bool& one_grid = densities.one_grid = !joint;
+  for (std::uint32_t k = 0; k < p.class_count && one_grid; ++k)
+    one_grid = p.classes[k].kind == QueryDensity::Kind::kImage &&
+               densities.samplers[0].same_grid(*p.classes[k].image);
+  q.density.callback = joint ? sum_of_joint : one_grid ? sum_of_images : sum_of_densities;
   q.density.bounds = sum_of_bounds;
   q.density.user = &densities;
   // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.

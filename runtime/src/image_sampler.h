@@ -16,16 +16,38 @@ struct ImageSampler {
   explicit ImageSampler(const DensityImageView* im) : image(im) {
     if (im) sx = im->width / (im->x1 - im->x0), sy = im->height / (im->y1 - im->y0);
   }
-  double at(double x, double y) const {
+  /// Where a world position falls among the texels: the four texels around it (rows r0, r1 from the
+  /// image's values, columns ix, jx) and the weights of the second ones.
+  struct Texels {
+    std::size_t r0, r1;
+    int ix, jx;
+    double ax, ay;
+  };
+  Texels texels(double x, double y) const {
     const DensityImageView& im = *image;
     const double fx = std::clamp((x - im.x0) * sx - 0.5, 0.0, im.width - 1.0);
     const double fy = std::clamp((y - im.y0) * sy - 0.5, 0.0, im.height - 1.0);
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
     const int jx = std::min(ix + 1, im.width - 1), jy = std::min(iy + 1, im.height - 1);
-    const double ax = fx - ix, ay = fy - iy;
-    const float* r0 = im.values + static_cast<std::size_t>(iy) * im.width;
-    const float* r1 = im.values + static_cast<std::size_t>(jy) * im.width;
-    return (1 - ay) * ((1 - ax) * r0[ix] + ax * r0[jx]) + ay * ((1 - ax) * r1[ix] + ax * r1[jx]);
+    return Texels{static_cast<std::size_t>(iy) * im.width,
+                  static_cast<std::size_t>(jy) * im.width,
+                  ix,
+                  jx,
+                  fx - ix,
+                  fy - iy};
+  }
+  /// The bilinear value at `t` of `values`, an image of this one's size.
+  static double blend(const float* values, const Texels& t) {
+    const float *r0 = values + t.r0, *r1 = values + t.r1;
+    return (1 - t.ay) * ((1 - t.ax) * r0[t.ix] + t.ax * r0[t.jx]) +
+           t.ay * ((1 - t.ax) * r1[t.ix] + t.ax * r1[t.jx]);
+  }
+  double at(double x, double y) const { return blend(image->values, texels(x, y)); }
+  /// Whether `other` lies on the same texels as this image: then texels() serves both.
+  bool same_grid(const DensityImageView& other) const {
+    const DensityImageView& im = *image;
+    return im.width == other.width && im.height == other.height && im.x0 == other.x0 && im.y0 == other.y0 &&
+           im.x1 == other.x1 && im.y1 == other.y1;
   }
 };
 
