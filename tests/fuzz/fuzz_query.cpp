@@ -9,7 +9,8 @@
 //    call with a large buffer, in the same order; kBufferFull only with a full buffer; a finished cursor
 //    gives no more points;
 //  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
-//  - query_classes with the density and an empty class (two halves of a constant) gives the same points;
+//  - query_classes with the density and an empty class (two halves of a constant) gives the same points,
+//    and a callback's two classes from one joint callback the same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys.
 // A failed check aborts.
 #include <algorithm>
@@ -64,6 +65,11 @@ double coordinate(std::uint8_t b) {
 double callback(void* user, double x, double y) {
   const double v = *static_cast<const double*>(user);
   return v * (x - y);  // any value, hostile ones included
+}
+
+// Two classes from one call (ClassQueryParams::joint): the callback's value and nothing.
+void joint_callback(void* user, double x, double y, double* values) {
+  values[0] = callback(user, x, y), values[1] = 0;
 }
 
 [[noreturn]] void fail() {
@@ -240,6 +246,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (classed.size != all.size) fail();
       for (std::size_t i = 0; i < all.size; ++i)
         if (!same(classed[i], all[i]) || classes[i] > (kind == 0 ? 1 : 0)) fail();
+    }
+    // The same two classes from one joint callback: the same status, points and classes.
+    if (kind == 2) {
+      cq.joint.densities = joint_callback, cq.joint.user = &value;
+      cq.joint.max[0] = callback_max, cq.joint.max[1] = 0;
+      static Points joint;
+      static std::uint8_t joint_classes[kBigCapacity];
+      kdm::QueryCursor joint_cursor;
+      joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes, kBigCapacity,
+                                        &joint.size, &joint_cursor);
+      if (joint.status != classed.status || joint.size != classed.size) fail();
+      for (std::size_t i = 0; i < joint.size; ++i)
+        if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
     }
   }
 
