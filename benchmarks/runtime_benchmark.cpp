@@ -356,6 +356,7 @@ void plain_copy(const kdm::CompactPoints& from, const kdm::CompactPoints& out, s
 
 void BM_QueryCompact(benchmark::State& state) {
   kdm::QueryParams q = params(state);
+  q.x1 = q.y1 = double(state.range(3));  // tile_size 1: the region's side in tiles
   if (state.range(2)) {
     q.density.kind = kdm::QueryDensity::Kind::kCallback;
     q.density.callback = ramp;
@@ -497,11 +498,16 @@ void modes_output_density(benchmark::internal::Benchmark* b) {
   for (const auto& [output, ramp] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}})
     for (int smooth : {0, 1}) b->Args({smooth, output, ramp});
 }
+void compact_cases(benchmark::internal::Benchmark* b) {
+  for (const auto& [keys, ramp] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}, std::pair{1, 2}})
+    for (int smooth : {0, 1}) b->Args({smooth, keys, ramp, std::int64_t(kSide)});
+  // Four times the side: an eighth of the tiles where a sixteenth lie on the border, where smooth mode's
+  // points are tested one by one (the inside's speed, nearly).
+  for (int smooth : {0, 1}) b->Args({smooth, 0, 0, 4 * std::int64_t(kSide)});
+}
 BENCHMARK(BM_QueryCompact)
-    ->ArgNames({"smooth", "keys", "ramp"})
-    ->Apply(modes_output_density)
-    ->Args({0, 1, 2})
-    ->Args({1, 1, 2})
+    ->ArgNames({"smooth", "keys", "ramp", "tiles"})
+    ->Apply(compact_cases)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryParallel)
     ->ArgNames({"smooth", "compact", "ramp"})

@@ -70,6 +70,8 @@ struct ConstantGlide {
 /// Output into QueryPoint records. put: a position relative to the query origin; put_stable: point p of
 /// the tile at its stable position, computed as the query's tests compute it.
 struct PointSink {
+  /// Whether put_glided_run is a vector loop (emit_tile: how it writes beside the region).
+  static constexpr bool kVectorRuns = false;
   QueryPoint* points;
   void put(std::size_t i, double x, double y, const PointId& id) const { points[i] = QueryPoint{x, y, id}; }
   void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
@@ -93,11 +95,17 @@ struct PointSink {
 /// computed in float from the tile's corner (TileJob::rel_x …), so whole tiles convert as fast as a copy.
 template <bool kKeys>
 struct CompactSink {
+  static constexpr bool kVectorRuns = true;
   float* xy;
   std::uint64_t* keys;
   void put(std::size_t i, double x, double y, const PointId& id) const {
     xy[2 * i] = static_cast<float>(x), xy[2 * i + 1] = static_cast<float>(y);
     if (kKeys) keys[i] = point_key(id);
+  }
+  /// Slot `from`'s point into slot `to` (to ≤ from), closing up over points not kept.
+  void move(std::size_t to, std::size_t from) const {
+    xy[2 * to] = xy[2 * from], xy[2 * to + 1] = xy[2 * from + 1];
+    if (kKeys) keys[to] = keys[from];
   }
   void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
     xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit, xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit;
@@ -133,6 +141,7 @@ struct CompactSink {
 /// classed by `class_of_id`.
 template <class Base>
 struct ClassSink {
+  static constexpr bool kVectorRuns = Base::kVectorRuns;
   Base base;
   std::uint8_t* classes;
   const double* counts;  ///< cumulative expected counts per tile, classes 0 … last - 1
@@ -143,6 +152,7 @@ struct ClassSink {
     base.put(i, x, y, id);
     classes[i] = class_of_id(user, id);
   }
+  void move(std::size_t to, std::size_t from) const { base.move(to, from), classes[to] = classes[from]; }
   std::uint8_t class_of(float threshold) const {
     std::uint32_t k = 0;
     while (k < last && !TilesetShape::emits(threshold, counts[k])) ++k;
@@ -186,11 +196,15 @@ struct ClassSink {
 /// stable-mode candidate is written before its emission is known, and an unkept one is overwritten).
 template <class Base>
 struct VaryingClassSink {
+  static constexpr bool kVectorRuns = Base::kVectorRuns;
   Base base;
   const VaryingClasses* c;
   void put(std::size_t i, double x, double y, const PointId& id) const {
     base.put(i, x, y, id);
     c->classes[i] = c->class_of_id(c->user, id);
+  }
+  void move(std::size_t to, std::size_t from) const {
+    base.move(to, from), c->classes[to] = c->classes[from];
   }
   /// Candidate `rank` of tile j at its stable position (x, y), as the loop computes it: its class, from the
   /// scratch where the loop has just read the density there.
@@ -244,6 +258,7 @@ inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const Con
 
 /// Counts without writing (detail::count_points).
 struct CountSink {
+  static constexpr bool kVectorRuns = false;
   void put(std::size_t, double, double, const PointId&) const {}
   void put_stable(std::size_t, const TileJob&, TilePoint, std::uint32_t) const {}
   void put_stable_run(std::size_t, const TileJob&, std::uint32_t, std::uint32_t) const {}
@@ -319,11 +334,16 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   if (kSmooth && !kInside) set_reach(kConstant ? j.reach : j.tables->glide_reach_from[0]);
   // Smooth mode: places candidate c at its stable position (x, y) plus its offsets o0 and o1 weighted by
   // w0 and w1 (GlideBracket): false when the buffer is full.
-  auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
-                   double w0, double w1, std::uint8_t cls) -> bool {
+  auto glide_by = [&](double& x, double& y, const std::int8_t* o0, const std::int8_t* o1, double w0,
+                      double w1) {
     const double* v = kSignedByte.value + 128;
     x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
-    if (!kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return true;
+  };
+  auto outside = [&](double x, double y) { return x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1; };
+  auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
+                   double w0, double w1, std::uint8_t cls) -> bool {
+    glide_by(x, y, o0, o1, w0, w1);
+    if (!kInside && outside(x, y)) return true;
     // A point never shows where there is no density: one decided at its stable position could glide up
     // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
     if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
@@ -388,6 +408,10 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   };
   // One candidate: the rank that did not fit, or kNone. Positions: the stable one (for ρ and in stable
   // mode), then the glide added to it.
+  auto culled = [&](TilePoint p) {
+    const double sx = p.x + 0.5, sy = p.y + 0.5;
+    return sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y;
+  };
   auto visit = [&](std::uint32_t c) -> std::uint32_t {
     const TilePoint p = j.points[c];
     if (kSmooth && !kInside) {
@@ -395,8 +419,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
         set_reach(j.tables->glide_reach_from[segment - 1]);
       }
-      const double sx = p.x + 0.5, sy = p.y + 0.5;
-      if (sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y) return kNone;
+      if (culled(p)) return kNone;
     }
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
     if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
@@ -445,24 +468,52 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
     for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
   } else if constexpr (kSmooth && kConstant && !kInside) {
-    // Beside the region, most points land inside it however they glide: runs of such points skip the test
-    // and are written as whole tiles inside are.
+    // Beside the region most points land inside it however they glide (those in the safe cells).
     auto safe = [&](std::uint32_t r) {
       const TilePoint p = j.points[r];
       return std::uint32_t(p.x - j.safe_x) < j.safe_w && std::uint32_t(p.y - j.safe_y) < j.safe_h;
     };
-    while (c < end && stopped == kNone) {
-      std::uint32_t run = c;
-      while (run < end && safe(run)) ++run;
-      if (run == c) {
-        stopped = visit(c++);
-        continue;
+    if constexpr (Sink::kVectorRuns) {
+      // Candidates are written a chunk at a time as whole tiles inside are, then the unsafe ones tested as
+      // visit tests them and the kept ones closed up over the rest: runs cut at every point to test would
+      // leave most points to the scalar ends of the vector loop.
+      constexpr std::size_t kChunk = 2048;  // written, then read back, while in the first-level cache
+      auto kept = [&](std::uint32_t r) {
+        if (safe(r)) return true;
+        const TilePoint p = j.points[r];
+        if (culled(p)) return false;
+        double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+        glide_by(x, y, glide.o0 + 2 * std::size_t(r), glide.o1 + 2 * std::size_t(r), glide.w0, glide.w1);
+        return !outside(x, y);
+      };
+      while (c < end && n < capacity && j.safe_w != 0 && j.safe_h != 0) {  // else few if any are kept
+        const auto count = static_cast<std::uint32_t>(std::min<std::size_t>({end - c, capacity - n, kChunk}));
+        out.put_glided_run(n, j, glide, c, count);
+        std::uint32_t i = 0;
+        while (i < count && kept(c + i)) ++i;
+        std::size_t to = n + i;
+        for (; i < count; ++i) {
+          const bool keep = kept(c + i);
+          out.move(to, n + i);
+          to += keep;
+        }
+        n = to, c += count;
       }
-      const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(run - c, capacity - n));
-      out.put_glided_run(n, j, glide, c, count);
-      n += count, c += count;
-      if (c < run) stopped = c;
+    } else {  // runs of safe points skip the test and are written as whole tiles inside are
+      while (c < end && n < capacity) {
+        std::uint32_t run = c;
+        while (run < end && safe(run)) ++run;
+        if (run == c) {
+          if ((stopped = visit(c++)) != kNone) break;
+          continue;
+        }
+        const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(run - c, capacity - n));
+        out.put_glided_run(n, j, glide, c, count);
+        n += count, c += count;
+      }
     }
+    // The rest one by one (a full buffer: so that the call stops at the first point that does not fit).
+    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   } else {
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   }
