@@ -3,8 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include "density_bounds.h"
@@ -102,10 +104,13 @@ struct CompactSink {
     xy[2 * i] = static_cast<float>(x), xy[2 * i + 1] = static_cast<float>(y);
     if (kKeys) keys[i] = point_key(id);
   }
-  /// Slot `from`'s point into slot `to` (to ≤ from), closing up over points not kept.
-  void move(std::size_t to, std::size_t from) const {
-    xy[2 * to] = xy[2 * from], xy[2 * to + 1] = xy[2 * from + 1];
-    if (kKeys) keys[to] = keys[from];
+  /// The positions written from slot i on.
+  const float* positions(std::size_t i) const { return xy + 2 * i; }
+  /// Slots [from, from + count) into slots from `to` ≤ from on, closing up over points left out.
+  void move_run(std::size_t to, std::size_t from, std::size_t count) const {
+    if (to == from) return;
+    std::memmove(xy + 2 * to, xy + 2 * from, count * 2 * sizeof(float));
+    if (kKeys) std::memmove(keys + to, keys + from, count * sizeof(std::uint64_t));
   }
   void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
     xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit, xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit;
@@ -152,7 +157,11 @@ struct ClassSink {
     base.put(i, x, y, id);
     classes[i] = class_of_id(user, id);
   }
-  void move(std::size_t to, std::size_t from) const { base.move(to, from), classes[to] = classes[from]; }
+  const float* positions(std::size_t i) const { return base.positions(i); }
+  void move_run(std::size_t to, std::size_t from, std::size_t count) const {
+    base.move_run(to, from, count);
+    if (to != from) std::memmove(classes + to, classes + from, count);
+  }
   std::uint8_t class_of(float threshold) const {
     std::uint32_t k = 0;
     while (k < last && !TilesetShape::emits(threshold, counts[k])) ++k;
@@ -203,8 +212,10 @@ struct VaryingClassSink {
     base.put(i, x, y, id);
     c->classes[i] = c->class_of_id(c->user, id);
   }
-  void move(std::size_t to, std::size_t from) const {
-    base.move(to, from), c->classes[to] = c->classes[from];
+  const float* positions(std::size_t i) const { return base.positions(i); }
+  void move_run(std::size_t to, std::size_t from, std::size_t count) const {
+    base.move_run(to, from, count);
+    if (to != from) std::memmove(c->classes + to, c->classes + from, count);
   }
   /// Candidate `rank` of tile j at its stable position (x, y), as the loop computes it: its class, from the
   /// scratch where the loop has just read the density there.
@@ -273,6 +284,32 @@ template <class Sink, class = void>
 constexpr bool kClassesAtDensity = false;
 template <class Sink>
 constexpr bool kClassesAtDensity<Sink, std::void_t<decltype(&Sink::put_classed)>> = true;
+
+/// Smooth mode, compact output beside the region: rectangles in float relative to the origin such that a
+/// glided point whose float position lies inside `sure` lies inside the region by the query's test in double,
+/// and one outside `may` outside it. Their margin is far beyond the float formula's error (within
+/// 2^-21 · (|p| + S), CompactSink) and a double's rounding at the world's magnitudes.
+struct RegionFlagBoxes {
+  FloatBox sure, may;
+};
+inline RegionFlagBoxes region_flag_boxes(const TileJob& j) {
+  const double x0 = j.x0 - j.origin_x, x1 = j.x1 - j.origin_x, y0 = j.y0 - j.origin_y, y1 = j.y1 - j.origin_y;
+  const double far = std::max({std::fabs(x0), std::fabs(x1), std::fabs(y0), std::fabs(y1)}) + 2 * j.S;
+  const double world = std::fabs(j.wx) + std::fabs(j.wy) + std::fabs(j.x0) + std::fabs(j.x1) +
+                       std::fabs(j.y0) + std::fabs(j.y1) + std::fabs(j.origin_x) + std::fabs(j.origin_y) +
+                       j.S;
+  const double m = std::ldexp(far, -18) + 1e-14 * world;
+  auto up = [](double v) {  // the least float ≥ v
+    const float f = static_cast<float>(v);
+    return double(f) < v ? std::nextafter(f, HUGE_VALF) : f;
+  };
+  auto down = [](double v) {  // the greatest float ≤ v
+    const float f = static_cast<float>(v);
+    return double(f) > v ? std::nextafter(f, -HUGE_VALF) : f;
+  };
+  return {{up(x0 + m), up(y0 + m), down(x1 - m), down(y1 - m)},
+          {down(x0 - m), down(y0 - m), up(x1 + m), up(y1 + m)}};
+}
 
 /// Stable mode with a varying density: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds settle a
 /// candidate between the tile's bounds without reading the density where they can.
@@ -468,38 +505,42 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
     for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
   } else if constexpr (kSmooth && kConstant && !kInside) {
-    // Beside the region most points land inside it however they glide (those in the safe cells).
-    auto safe = [&](std::uint32_t r) {
-      const TilePoint p = j.points[r];
-      return std::uint32_t(p.x - j.safe_x) < j.safe_w && std::uint32_t(p.y - j.safe_y) < j.safe_h;
-    };
+    // Beside the region most points land inside it however they glide.
     if constexpr (Sink::kVectorRuns) {
-      // Candidates are written a chunk at a time as whole tiles inside are, then the unsafe ones tested as
-      // visit tests them and the kept ones closed up over the rest: runs cut at every point to test would
-      // leave most points to the scalar ends of the vector loop.
+      // Candidates are written a chunk at a time as whole tiles inside are; then their float positions,
+      // held to the region in one vector pass, settle all but those within rounding of its sides, which
+      // are tested as visit tests them, and the kept ones are closed up over the few left out. Runs cut
+      // at every point near a side instead left most points to the scalar ends of the vector loop.
       constexpr std::size_t kChunk = 2048;  // written, then read back, while in the first-level cache
-      auto kept = [&](std::uint32_t r) {
-        if (safe(r)) return true;
+      std::uint8_t flags[kChunk];
+      const RegionFlagBoxes boxes = region_flag_boxes(j);
+      auto lands_inside = [&](std::uint32_t r) {
         const TilePoint p = j.points[r];
         if (culled(p)) return false;
         double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
         glide_by(x, y, glide.o0 + 2 * std::size_t(r), glide.o1 + 2 * std::size_t(r), glide.w0, glide.w1);
         return !outside(x, y);
       };
-      while (c < end && n < capacity && j.safe_w != 0 && j.safe_h != 0) {  // else few if any are kept
+      while (c < end && n < capacity) {
         const auto count = static_cast<std::uint32_t>(std::min<std::size_t>({end - c, capacity - n, kChunk}));
         out.put_glided_run(n, j, glide, c, count);
-        std::uint32_t i = 0;
-        while (i < count && kept(c + i)) ++i;
-        std::size_t to = n + i;
-        for (; i < count; ++i) {
-          const bool keep = kept(c + i);
-          out.move(to, n + i);
-          to += keep;
+        box_flags(out.positions(n), count, boxes.sure, boxes.may, flags);
+        std::size_t to = n;
+        std::uint32_t from = 0;  // the first kept point not yet closed up
+        for (std::uint32_t i = next_unsettled(flags, 0, count); i < count;
+             i = next_unsettled(flags, i + 1, count)) {
+          if (flags[i] == kBoxUnsure && lands_inside(c + i)) continue;
+          out.move_run(to, n + from, i - from);
+          to += i - from, from = i + 1;
         }
-        n = to, c += count;
+        out.move_run(to, n + from, count - from);
+        n = to + (count - from), c += count;
       }
-    } else {  // runs of safe points skip the test and are written as whole tiles inside are
+    } else {  // runs of points in the safe cells skip the test and are written as whole tiles inside are
+      auto safe = [&](std::uint32_t r) {
+        const TilePoint p = j.points[r];
+        return std::uint32_t(p.x - j.safe_x) < j.safe_w && std::uint32_t(p.y - j.safe_y) < j.safe_h;
+      };
       while (c < end && n < capacity) {
         std::uint32_t run = c;
         while (run < end && safe(run)) ++run;

@@ -118,6 +118,22 @@ TEST(CompactQueryTest, WritesTheSubtilesPointsPastTheTopLevel) {
     expect_same(full, run_compact(q, capacity, true), true);
 }
 
+TEST(CompactQueryTest, KeepsTheFullQuerysPointsFarFromTheOrigin) {
+  // Smooth mode settles a border tile's points by their float positions where these are far enough from
+  // the region's sides, and by the full query's test in double where they are not: far from the origin a
+  // float's step (2.4e-4 at 3,000, 0.06 at 10^6) leaves more, or nearly all, points to the test.
+  for (double at : {3000.0, 1e6}) {
+    QueryParams q = region(QueryMode::kSmooth);
+    q.x0 += at, q.x1 += at, q.y0 -= at, q.y1 -= at;
+    q.origin_x = q.origin_y = 0;
+    SCOPED_TRACE(::testing::Message() << "region at " << at);
+    const std::vector<QueryPoint> full = run_full(q);
+    ASSERT_GT(full.size(), 30000u);
+    for (std::size_t capacity : {std::size_t(997), std::size_t(1) << 16})
+      expect_same(full, run_compact(q, capacity, true), true);
+  }
+}
+
 TEST(CompactQueryTest, PartsOfARegionGiveItsPointsBitForBit) {
   // Whole tiles (converted by the straight loop) and cut ones (tested point by point) write a point alike.
   std::mt19937 rng(5);
