@@ -112,6 +112,10 @@ struct CompactSink {
     std::memmove(xy + 2 * to, xy + 2 * from, count * 2 * sizeof(float));
     if (kKeys) std::memmove(keys + to, keys + from, count * sizeof(std::uint64_t));
   }
+  void move(std::size_t to, std::size_t from) const {
+    std::memcpy(xy + 2 * to, xy + 2 * from, 2 * sizeof(float));  // to == from at times: one 8-byte copy
+    if (kKeys) keys[to] = keys[from];
+  }
   void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
     xy[2 * i] = j.rel_x + float(p.x) * j.rel_unit, xy[2 * i + 1] = j.rel_y + float(p.y) * j.rel_unit;
     if (kKeys) keys[i] = point_key(PointId{j.tx, j.ty, rank});
@@ -162,6 +166,7 @@ struct ClassSink {
     base.move_run(to, from, count);
     if (to != from) std::memmove(classes + to, classes + from, count);
   }
+  void move(std::size_t to, std::size_t from) const { base.move(to, from), classes[to] = classes[from]; }
   std::uint8_t class_of(float threshold) const {
     std::uint32_t k = 0;
     while (k < last && !TilesetShape::emits(threshold, counts[k])) ++k;
@@ -216,6 +221,9 @@ struct VaryingClassSink {
   void move_run(std::size_t to, std::size_t from, std::size_t count) const {
     base.move_run(to, from, count);
     if (to != from) std::memmove(c->classes + to, c->classes + from, count);
+  }
+  void move(std::size_t to, std::size_t from) const {
+    base.move(to, from), c->classes[to] = c->classes[from];
   }
   /// Candidate `rank` of tile j at its stable position (x, y), as the loop computes it: its class, from the
   /// scratch where the loop has just read the density there.
@@ -309,6 +317,31 @@ inline RegionFlagBoxes region_flag_boxes(const TileJob& j) {
   };
   return {{up(x0 + m), up(y0 + m), down(x1 - m), down(y1 - m)},
           {down(x0 - m), down(y0 - m), up(x1 + m), up(y1 + m)}};
+}
+
+/// Closes up slots [n, n + count) of `out` over those whose flag is 0 (flags 0 or 1); returns the slot after
+/// the last one kept. A few left out: the runs between them move; many: every slot, with no branch.
+template <class Sink>
+std::size_t close_up(const Sink& out, std::size_t n, const std::uint8_t* flags, std::uint32_t count) {
+  std::uint32_t kept = 0;
+  for (std::uint32_t i = 0; i < count; ++i) kept += flags[i];
+  if (kept == count) return n + count;
+  std::size_t to = n;
+  if (count - kept <= count / 32) {
+    std::uint32_t from = 0;  // the first kept point not yet moved
+    for (std::uint32_t i = next_unsettled(flags, 0, count); i < count;
+         i = next_unsettled(flags, i + 1, count)) {
+      out.move_run(to, n + from, i - from);
+      to += i - from, from = i + 1;
+    }
+    out.move_run(to, n + from, count - from);
+    return to + (count - from);
+  }
+  for (std::uint32_t i = 0; i < count; ++i) {
+    out.move(to, n + i);
+    to += flags[i];
+  }
+  return to;
 }
 
 /// Stable mode with a varying density: a tile's 2^kCellBits × 2^kCellBits cells, whose bounds settle a
@@ -459,11 +492,15 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       if (culled(p)) return kNone;
     }
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
-    if (!kSmooth && !kInside && (x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1)) return kNone;
-    if (!kSmooth && (kConstant || c < j.sure)) {
-      if (n == capacity) return c;
-      out.put_stable(n++, j, p, c);
-      return kNone;
+    if constexpr (!kSmooth) {
+      const bool in = kInside || ((x >= j.x0) & (x < j.x1) & (y >= j.y0) & (y < j.y1));
+      if (kConstant || c < j.sure) {  // emitted if inside: written at the next slot, which only then it keeps
+        if (n == capacity) return in ? c : kNone;
+        out.put_stable(n, j, p, c);
+        n += in;
+        return kNone;
+      }
+      if (!in) return kNone;
     }
     if (kConstant)
       return place(c, x, y, glide.o0 + 2 * std::size_t(c), glide.o1 + 2 * std::size_t(c), glide.w0, glide.w1,
@@ -504,56 +541,50 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   if constexpr (kListed) {
     const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
     for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
-  } else if constexpr (kSmooth && kConstant && !kInside) {
-    // Beside the region most points land inside it however they glide.
-    if constexpr (Sink::kVectorRuns) {
-      // Candidates are written a chunk at a time as whole tiles inside are; then their float positions,
-      // held to the region in one vector pass, settle all but those within rounding of its sides, which
-      // are tested as visit tests them, and the kept ones are closed up over the few left out. Runs cut
-      // at every point near a side instead left most points to the scalar ends of the vector loop.
-      constexpr std::size_t kChunk = 2048;  // written, then read back, while in the first-level cache
-      std::uint8_t flags[kChunk];
-      const RegionFlagBoxes boxes = region_flag_boxes(j);
-      auto lands_inside = [&](std::uint32_t r) {
-        const TilePoint p = j.points[r];
-        if (culled(p)) return false;
-        double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+  } else if constexpr (kConstant && !kInside && Sink::kVectorRuns) {
+    // Beside the region, compact output: candidates are written a chunk at a time as whole tiles inside
+    // are; their float positions, held to the region in one vector pass, settle all but those within
+    // rounding of its sides, which are tested as visit tests them; the kept ones are then closed up over
+    // the rest. Point by point, whether a point lies inside is a branch the predictor misses where the
+    // region cuts the tile, and runs cut at every point near a side leave the vector loop's scalar ends.
+    constexpr std::size_t kChunk = 2048;  // written, then read back, while in the first-level cache
+    std::uint8_t flags[kChunk];
+    const RegionFlagBoxes boxes = region_flag_boxes(j);
+    auto lands_inside = [&](std::uint32_t r) {
+      const TilePoint p = j.points[r];
+      if (kSmooth && culled(p)) return false;
+      double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+      if (kSmooth)
         glide_by(x, y, glide.o0 + 2 * std::size_t(r), glide.o1 + 2 * std::size_t(r), glide.w0, glide.w1);
-        return !outside(x, y);
-      };
-      while (c < end && n < capacity) {
-        const auto count = static_cast<std::uint32_t>(std::min<std::size_t>({end - c, capacity - n, kChunk}));
+      return !outside(x, y);
+    };
+    while (c < end && n < capacity) {
+      const auto count = static_cast<std::uint32_t>(std::min<std::size_t>({end - c, capacity - n, kChunk}));
+      if constexpr (kSmooth)
         out.put_glided_run(n, j, glide, c, count);
-        box_flags(out.positions(n), count, boxes.sure, boxes.may, flags);
-        std::size_t to = n;
-        std::uint32_t from = 0;  // the first kept point not yet closed up
-        for (std::uint32_t i = next_unsettled(flags, 0, count); i < count;
-             i = next_unsettled(flags, i + 1, count)) {
-          if (flags[i] == kBoxUnsure && lands_inside(c + i)) continue;
-          out.move_run(to, n + from, i - from);
-          to += i - from, from = i + 1;
-        }
-        out.move_run(to, n + from, count - from);
-        n = to + (count - from), c += count;
-      }
-    } else {  // runs of points in the safe cells skip the test and are written as whole tiles inside are
-      auto safe = [&](std::uint32_t r) {
-        const TilePoint p = j.points[r];
-        return std::uint32_t(p.x - j.safe_x) < j.safe_w && std::uint32_t(p.y - j.safe_y) < j.safe_h;
-      };
-      while (c < end && n < capacity) {
-        std::uint32_t run = c;
-        while (run < end && safe(run)) ++run;
-        if (run == c) {
-          if ((stopped = visit(c++)) != kNone) break;
-          continue;
-        }
-        const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::size_t>(run - c, capacity - n));
-        out.put_glided_run(n, j, glide, c, count);
-        n += count, c += count;
-      }
+      else
+        out.put_stable_run(n, j, c, count);
+      box_flags(out.positions(n), count, boxes.sure, boxes.may, flags);
+      for (std::uint32_t i = next_unsure(flags, 0, count); i < count; i = next_unsure(flags, i + 1, count))
+        flags[i] = lands_inside(c + i);
+      n = close_up(out, n, flags, count), c += count;
     }
     // The rest one by one (a full buffer: so that the call stops at the first point that does not fit).
+    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
+  } else if constexpr (kSmooth && kConstant && !kInside) {
+    // Beside the region, QueryPoint records: where the tile reaches well into the region (it has safe
+    // cells), each candidate is glided, written at the next slot and kept if inside, with no branch a
+    // predictor would miss where the region cuts the tile; elsewhere most are culled, predictably.
+    if (j.safe_w != 0 && j.safe_h != 0) {
+      for (; c < end && n < capacity; ++c) {
+        const TilePoint p = j.points[c];
+        double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+        glide_by(x, y, glide.o0 + 2 * std::size_t(c), glide.o1 + 2 * std::size_t(c), glide.w0, glide.w1);
+        const bool in = (x >= j.x0) & (x < j.x1) & (y >= j.y0) & (y < j.y1);
+        out.put_glided(n, j, glide, c);
+        n += in;
+      }
+    }
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   } else {
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);

@@ -30,6 +30,15 @@ constexpr std::uint8_t kBoxOut = 0, kBoxIn = 1, kBoxUnsure = 2;
 /// flags[k] for the position xy[2k], xy[2k + 1], k < count.
 void box_flags(const float* xy, std::size_t count, FloatBox sure, FloatBox may, std::uint8_t* flags);
 
+/// The first k in [i, count) whose flag is kBoxUnsure, else count.
+inline std::uint32_t next_unsure(const std::uint8_t* flags, std::uint32_t i, std::uint32_t count) {
+  constexpr std::uint64_t kAnyUnsure = 0x0202020202020202u;  // eight at a time: few are unsure
+  for (std::uint64_t w; i + 8 <= count; i += 8)
+    if (std::memcpy(&w, flags + i, 8), (w & kAnyUnsure) != 0) break;
+  while (i < count && flags[i] != kBoxUnsure) ++i;
+  return i;
+}
+
 /// The first k in [i, count) whose flag is not kBoxIn, else count.
 inline std::uint32_t next_unsettled(const std::uint8_t* flags, std::uint32_t i, std::uint32_t count) {
   constexpr std::uint64_t kAllIn = 0x0101010101010101u;  // eight at a time: nearly all are in
