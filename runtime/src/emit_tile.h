@@ -413,20 +413,26 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
                    double w0, double w1, std::uint8_t cls) -> bool {
     glide_by(x, y, o0, o1, w0, w1);
-    if (!kInside && outside(x, y)) return true;
+    // Where the region cuts the tile, whether a point lies inside follows no pattern: it is written at the
+    // next slot, which only then it keeps.
+    const bool in = kInside || ((x >= j.x0) & (x < j.x1) & (y >= j.y0) & (y < j.y1));
     // A point never shows where there is no density: one decided at its stable position could glide up
     // to a spacing past a sharp edge of the density (stray dots outside a stippled shape).
-    if (kKind == QueryDensity::Kind::kImage && j.zero_possible && !(j.sampler->at(x, y) > 0)) return true;
-    if (kKind == QueryDensity::Kind::kCallback && j.zero_possible &&
-        !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
-      return true;
-    if (n == capacity) return false;
+    if (!kConstant && j.zero_possible) {
+      if (!in) return true;
+      if (kKind == QueryDensity::Kind::kImage && !(j.sampler->at(x, y) > 0)) return true;
+      if (kKind == QueryDensity::Kind::kCallback &&
+          !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
+        return true;
+    }
+    if (n == capacity) return !in;
     if constexpr (kConstant)
-      out.put_glided(n++, j, glide, c);
+      out.put_glided(n, j, glide, c);
     else if constexpr (kClassesAtDensity<Sink>)
-      out.put_classed(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}, cls);
+      out.put_classed(n, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c}, cls);
     else
-      out.put(n++, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
+      out.put(n, x - j.origin_x, y - j.origin_y, PointId{j.tx, j.ty, c});
+    n += in;
     return true;
   };
   // Smooth mode with a varying density: the emitted candidates wait in a batch, so that the long chain from
