@@ -140,6 +140,21 @@ std::uint32_t emit_own(const DescentQuery& q, const DescentNode& n, DescentSink&
   };
   const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
   std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+  const double safe_share = double(safe_w) * double(safe_h) / (65536.0 * 65536.0);
+  if (kClip && !kListed && safe_share > 0 && safe_share < 0.9) {
+    // The region's side cuts the subtile: every candidate is glided and written, kept if inside, with no
+    // branch on where it lies, which follows no pattern. Below, runs where nearly all are safe (the region's
+    // side near the subtile's) and culling where none is (most of the subtile lies outside).
+    for (; r < end && written < capacity && budget != 0; ++r, --budget) {
+      const TilePoint q = points[r];
+      const double dx = double(o0[2 * r]) * w0 + double(o1[2 * r]) * w1,
+                   dy = double(o0[2 * r + 1]) * w0 + double(o1[2 * r + 1]) * w1;
+      const double ux = q.unit_x() + dx * (1.0 / 65536.0), uy = q.unit_y() + dy * (1.0 / 65536.0);
+      const double x = wx + ux * s, y = wy + uy * s;
+      out[written] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, r, depth}};
+      written += (x >= x0) & (x < x1) & (y >= y0) & (y < y1);
+    }
+  }
   while (r < end) {
     if (kClip && !kListed && safe(r)) {
       std::uint32_t stop = r + 1;
