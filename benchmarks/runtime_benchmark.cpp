@@ -502,6 +502,39 @@ void BM_QueryUnaligned(benchmark::State& state) {
   state.counters["of_aligned"] = aligned_seconds / seconds;
 }
 
+// The benchmark's 8 × 8-tile region queried as a grid of square chunks (args: smooth; chunk, the chunk's side
+// in hundredths of a tile), from a corner 0.3 tiles off the tiling, into a reused 65,536-point buffer, as an
+// engine streams chunks that ignore the tiles; chunks of 0.1 tile cover 8 × 8 tiles' worth of area at 32 × 32
+// chunks. `of_one_query`: one query over the chunks' whole area, timed in the same rounds, over the chunks'.
+void BM_QueryChunks(benchmark::State& state) {
+  const double side = double(state.range(1)) / 100;
+  const int per_side = std::min(32, int(std::lround(kSide / side)));
+  kdm::QueryParams whole = params(state);
+  whole.x0 = whole.y0 = 0.3, whole.x1 = whole.y1 = 0.3 + per_side * side;
+  std::vector<kdm::QueryPoint> buffer(1 << 16);
+  std::size_t n = 0;
+  double one_seconds = 0, seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    n = 0;
+    for (int cy = 0; cy < per_side; ++cy)
+      for (int cx = 0; cx < per_side; ++cx) {
+        kdm::QueryParams q = whole;
+        q.x0 = whole.x0 + cx * side, q.x1 = q.x0 + side, q.y0 = whole.y0 + cy * side, q.y1 = q.y0 + side;
+        n += run_query(q, buffer);
+      }
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(run_query(whole, buffer));
+    const auto t2 = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(t1 - t0).count();
+    one_seconds += std::chrono::duration<double>(t2 - t1).count();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  report(state, n);
+  state.counters["chunks"] = double(per_side) * per_side;
+  state.counters["of_one_query"] = one_seconds / seconds;
+}
+
 void BM_QueryConstantReusedBuffer(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 16);
   std::size_t n = 0;
@@ -556,6 +589,11 @@ BENCHMARK(BM_QueryCompact)
 BENCHMARK(BM_QueryParallel)
     ->ArgNames({"smooth", "compact", "ramp"})
     ->Apply(modes_output_density)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryChunks)
+    ->ArgNames({"smooth", "chunk"})
+    ->ArgsProduct({{0, 1}, {100, 25, 10}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryUnaligned)

@@ -605,22 +605,22 @@ using EmitTile = std::uint32_t (*)(const TileJob&, std::uint32_t, std::uint32_t,
                                    std::size_t&);
 
 /// The emitter for a mode and kind of density: beside the region (kInside false), inside it, or through
-/// an edge list (kListed).
+/// a list of ranks (kListed: an edge list, or the points of the cells the region meets).
 template <class Sink, bool kInside, bool kListed = false>
 EmitTile<Sink> pick_emitter(bool smooth, QueryDensity::Kind kind) {
   using K = QueryDensity::Kind;
   switch (kind) {
     case K::kConstant:
       return smooth ? emit_tile<Sink, true, K::kConstant, kInside, kListed>
-                    : emit_tile<Sink, false, K::kConstant, kInside, false>;
+                    : emit_tile<Sink, false, K::kConstant, kInside, kListed>;
     case K::kImage:
       return smooth ? emit_tile<Sink, true, K::kImage, kInside, kListed>
-                    : emit_tile<Sink, false, K::kImage, kInside, false>;
+                    : emit_tile<Sink, false, K::kImage, kInside, kListed>;
     case K::kCallback:
       break;
   }
   return smooth ? emit_tile<Sink, true, K::kCallback, kInside, kListed>
-                : emit_tile<Sink, false, K::kCallback, kInside, false>;
+                : emit_tile<Sink, false, K::kCallback, kInside, kListed>;
 }
 
 }  // namespace kdm::detail

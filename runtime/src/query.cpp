@@ -8,6 +8,7 @@
 #include <optional>
 #include <utility>
 
+#include "cell_index.h"
 #include "descent.h"
 #include "emit_tile.h"
 #include "image_sampler.h"
@@ -276,8 +277,28 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
                                       wy + S + margin < q.y1
                                 : wx + first.unit_x() * S >= q.x0 && wx + last.unit_x() * S < q.x1 &&
                                       wy + first.unit_y() * S >= q.y0 && wy + last.unit_y() * S < q.y1;
-      const detail::EmitTile<Sink> emit = inside ? emit_inside : job.listed ? emit_listed : emit_edge;
-      const std::uint32_t stopped = emit(job, c, end, out, capacity, n);
+      // A region meeting few of a tile's cells (QueryTables::cell_ranks) visits only their points: those
+      // whose stable position lies within the glide's reach (and rounding) of it.
+      detail::CellSpan span{0, detail::kIndexCells - 1, 0, detail::kIndexCells - 1};
+      if (!inside && !job.listed && !tables.cell_ranks.empty()) {
+        const double units = 65536.0 / S;
+        const double r =
+            (glide ? (d.kind == QueryDensity::Kind::kConstant ? job.reach : tables.glide_reach_from[0]) : 0) *
+                65536.0 +
+            2 +
+            1e-15 * units *
+                (std::fabs(wx) + std::fabs(wy) + std::fabs(q.x0) + std::fabs(q.x1) + std::fabs(q.y0) +
+                 std::fabs(q.y1) + S);
+        span = detail::cells_met((q.x0 - wx) * units - r, (q.y0 - wy) * units - r, (q.x1 - wx) * units + r,
+                                 (q.y1 - wy) * units + r);
+      }
+      std::uint32_t stopped;
+      if (2 * span.count() <= detail::kIndexCells * detail::kIndexCells)
+        stopped = detail::emit_cells(tables, index, span, job, c, end, emit_listed, out, capacity, n);
+      else
+        stopped = (inside       ? emit_inside
+                   : job.listed ? emit_listed
+                                : emit_edge)(job, c, end, out, capacity, n);
       examined += stopped - c;
       if (stopped < candidates) {  // the buffer is full, or the budget spent
         *cursor = QueryCursor{tx, ty, stopped, true, false, fingerprint};

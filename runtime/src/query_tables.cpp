@@ -69,7 +69,28 @@ QueryTables::QueryTables(const TilesetData& set) {
     span.scale0 = glide_scale[span.g0], span.scale1 = glide_scale[span.g1];
   }
   index_edges(set);
+  index_cells(set);
   index_handover(set);
+}
+
+void QueryTables::index_cells(const TilesetData& set) {
+  if (most_points > 65536) return;
+  constexpr std::uint32_t kCells = kIndexCells * kIndexCells, kShift = 16 - kIndexCellBits;
+  cell_start.assign((kCells + 1) * set.tiles.size(), 0);
+  cell_ranks.assign(set.tiles.size(), {});
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const TilesetArray<TilePoint>& points = set.tiles[t].points;
+    std::uint32_t* start = cell_start.data() + (kCells + 1) * t;
+    auto cell = [&](const TilePoint& p) { return (p.y >> kShift) * kIndexCells + (p.x >> kShift); };
+    for (const TilePoint& p : points) ++start[cell(p) + 1];
+    for (std::uint32_t k = 0; k < kCells; ++k) start[k + 1] += start[k];
+    TilesetArray<std::uint16_t>& ranks = cell_ranks[t];
+    ranks.resize(points.size());
+    std::uint32_t next[kCells];
+    std::copy(start, start + kCells, next);
+    for (std::uint32_t r = 0; r < points.size(); ++r)
+      ranks[next[cell(points[r])]++] = static_cast<std::uint16_t>(r);
+  }
 }
 
 void QueryTables::index_handover(const TilesetData& set) {
@@ -184,9 +205,9 @@ std::size_t QueryTables::resident_bytes() const {
   return sizeof(*this) + nested_bytes(thresholds) + nested_bytes(glide_start) + flat_bytes(glide_reach) +
          flat_bytes(glide_reach_from) + flat_bytes(glide_scale) + nested_bytes(points_at_keyframe) +
          flat_bytes(keyframe_nominal) + flat_bytes(glide_spans) + flat_bytes(keyframe_guess) +
-         nested_bytes(edge_ranks) + flat_bytes(edge_start) + flat_bytes(child_type) +
-         nested_bytes(inherited) + flat_bytes(inherited_start) + nested_bytes(handover_end) +
-         flat_bytes(handover_end_max);
+         nested_bytes(edge_ranks) + flat_bytes(edge_start) + nested_bytes(cell_ranks) +
+         flat_bytes(cell_start) + flat_bytes(child_type) + nested_bytes(inherited) +
+         flat_bytes(inherited_start) + nested_bytes(handover_end) + flat_bytes(handover_end_max);
 }
 
 std::uint32_t first_keyframe_at_least(const Tileset& set, double expected) {

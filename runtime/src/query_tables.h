@@ -23,6 +23,9 @@ struct GlideSpan {
 /// Position units (1/65536 tile side) the edge lists add to each point's reach, for rounding.
 inline constexpr double kEdgeSlack = 8;
 
+/// QueryTables::cell_ranks cuts a tile into 2^kIndexCellBits × 2^kIndexCellBits cells.
+inline constexpr std::uint32_t kIndexCellBits = 4, kIndexCells = 1u << kIndexCellBits;
+
 struct QueryTables {
   /// Per tile, its points' emission thresholds (TilesetShape::emission_threshold), non-decreasing.
   TilesetArray<TilesetArray<float>> thresholds;
@@ -57,6 +60,12 @@ struct QueryTables {
   /// scanned through one list, not in full.
   TilesetArray<TilesetArray<std::uint32_t>> edge_ranks;
   TilesetArray<std::uint32_t> edge_start;
+  /// Per tile, the ranks of its points in each of its kIndexCells² cells (point p lies in cell
+  /// (p.y >> (16 − kIndexCellBits)) · kIndexCells + (p.x >> (16 − kIndexCellBits))), ascending, the cells in
+  /// turn; cell_start holds kIndexCells² + 1 offsets per tile. A query whose region meets a few cells of a
+  /// tile visits only their points. Empty when a tile holds more than 65,536 points.
+  TilesetArray<TilesetArray<std::uint16_t>> cell_ranks;
+  TilesetArray<std::uint32_t> cell_start;
   /// The hand-over between depths (sets with a handover_zone; else empty). Subtiles per side m, and per
   /// tile t and subtile j = row · m + column, the tile its subtile shows: child_type[t · m² + j].
   std::uint32_t subtiles = 0;
@@ -99,6 +108,7 @@ struct QueryTables {
 
  private:
   void index_edges(const TilesetData& set);
+  void index_cells(const TilesetData& set);
   void index_handover(const TilesetData& set);
 };
 

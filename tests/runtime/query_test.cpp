@@ -57,9 +57,9 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_FALSE(t.empty());
   EXPECT_EQ(t.max_points_per_tile(), t.data().level_nominal.back());
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
-  // Resident size: 4 bytes of position, 2 of key and 4 of threshold per point, 2 per gliding position
-  // (one per coordinate), 4 per entry of the edge lists; for the hand-over 2 bytes of table, 4 of end and
-  // 4 of inherited id per point and 4 + 4 per appearing sub-point, 8 per subtile; plus small tables.
+  // Resident size: 4 bytes of position, 2 of key, 4 of threshold and 2 of cell list per point, 2 per gliding
+  // position (one per coordinate), 4 per entry of the edge lists; for the hand-over 2 bytes of table, 4 of
+  // end and 4 of inherited id per point and 4 + 4 per appearing sub-point, 8 per subtile; plus small tables.
   ASSERT_TRUE(t.has_glide_track());
   std::size_t points = 0, glide = 0, listed = 0, handover = 0, appearing = 0;
   for (const Tile& tile : t.data().tiles) {
@@ -76,7 +76,7 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_LT(listed, points);    // a tile's sides list a small share of its points
   ASSERT_EQ(handover, points);  // the built-in set descends into subtiles
   const std::size_t m = t.data().subtiles_per_side();
-  const std::size_t expected = 10 * points + glide + 4 * listed + 10 * handover + 8 * appearing +
+  const std::size_t expected = 12 * points + glide + 4 * listed + 10 * handover + 8 * appearing +
                                8 * t.data().tiles.size() * (m * m + 1);
   EXPECT_GE(t.resident_bytes(), expected);
   EXPECT_LE(t.resident_bytes(), expected + 64 * 1024);
@@ -255,6 +255,64 @@ TEST(QueryTest, TilesBesideASmoothRegionGiveWhatAFullScanGives) {
     }
   // The built-in set glides 89 points in over these 14 queries (0 to 13 each).
   EXPECT_GT(glided_in, 20) << "some points should come from the neighbouring tiles, glided in";
+}
+
+TEST(QueryTest, CellListsHoldEachPointOnceInItsCell) {
+  // A query whose region meets few cells of a tile visits only the points these lists name.
+  const Tileset& t = Tileset::builtin();
+  const detail::QueryTables& tables = detail::TilesetInternals::tables(t);
+  constexpr std::uint32_t kCells = detail::kIndexCells * detail::kIndexCells,
+                          kShift = 16 - detail::kIndexCellBits;
+  ASSERT_EQ(tables.cell_ranks.size(), t.data().tiles.size());
+  for (std::size_t i = 0; i < t.data().tiles.size(); ++i) {
+    const auto& points = t.data().tiles[i].points;
+    const std::uint32_t* start = tables.cell_start.data() + (kCells + 1) * i;
+    ASSERT_EQ(start[kCells], points.size());
+    std::vector<int> seen(points.size(), 0);
+    for (std::uint32_t k = 0; k < kCells; ++k) {
+      const std::uint16_t* ranks = tables.cell_ranks[i].data();
+      ASSERT_TRUE(std::is_sorted(ranks + start[k], ranks + start[k + 1]));
+      for (std::uint32_t j = start[k]; j < start[k + 1]; ++j) {
+        const TilePoint p = points[ranks[j]];
+        EXPECT_EQ((p.y >> kShift) * detail::kIndexCells + (p.x >> kShift), k) << i << " " << ranks[j];
+        ++seen[ranks[j]];
+      }
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), std::ptrdiff_t(points.size())) << i;
+  }
+}
+
+TEST(QueryTest, ChunksSmallerThanATileGiveTheRegionsPoints) {
+  // Chunks a tenth to a third of a tile meet few cells of each tile and visit only theirs (emit_cells);
+  // together they must give the region's points, at low densities (where points glide farthest) and high
+  // ones, constant and varying, and one chunk resumed through a small buffer its own.
+  std::mt19937 rng(7);
+  for (QueryMode mode : kModes)
+    for (double scale : {60.0, 900.0, 20000.0})
+      for (bool varying : {false, true}) {
+        QueryParams whole = region(-0.61, 0.27, 1.43, 1.9, scale, mode);
+        if (varying) {
+          whole.density.kind = QueryDensity::Kind::kCallback;
+          whole.density.callback = [](void*, double x, double y) {
+            return 0.2 + 0.8 * std::fabs(std::sin(3 * x + y));
+          };
+          whole.density.callback_max = 1;
+        }
+        SCOPED_TRACE(::testing::Message()
+                     << "mode " << int(mode) << " scale " << scale << (varying ? " varying" : " constant"));
+        std::vector<Key> expected = run(whole), got;
+        std::sort(expected.begin(), expected.end());
+        const std::vector<QueryParams> parts = testing::random_grid_parts(whole, 8, rng);
+        for (const QueryParams& part : parts) {
+          const std::vector<Key> k = run(part);
+          got.insert(got.end(), k.begin(), k.end());
+        }
+        std::sort(got.begin(), got.end());
+        ASSERT_GT(got.size(), 60u);
+        EXPECT_EQ(got, expected);
+        const QueryParams& part = parts[parts.size() / 2];
+        EXPECT_EQ(run(part, 7), run(part));
+      }
 }
 
 double step(void*, double x, double) {
