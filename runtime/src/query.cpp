@@ -278,9 +278,10 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
                                 : wx + first.unit_x() * S >= q.x0 && wx + last.unit_x() * S < q.x1 &&
                                       wy + first.unit_y() * S >= q.y0 && wy + last.unit_y() * S < q.y1;
       // A region meeting few of a tile's cells (QueryTables::cell_ranks) visits only their points: those
-      // whose stable position lies within the glide's reach (and rounding) of it.
+      // whose stable position lies within the glide's reach (and rounding) of it; beside the region, where
+      // they are fewer than the edge list's (a region shorter than the tile's side).
       detail::CellSpan span{0, detail::kIndexCells - 1, 0, detail::kIndexCells - 1};
-      if (!inside && !job.listed && !tables.cell_ranks.empty()) {
+      if (!inside && !tables.cell_ranks.empty()) {
         const double units = 65536.0 / S;
         const double r =
             (glide ? (d.kind == QueryDensity::Kind::kConstant ? job.reach : tables.glide_reach_from[0]) : 0) *
@@ -292,8 +293,11 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
         span = detail::cells_met((q.x0 - wx) * units - r, (q.y0 - wy) * units - r, (q.x1 - wx) * units + r,
                                  (q.y1 - wy) * units + r);
       }
+      constexpr double kCells = detail::kIndexCells * detail::kIndexCells;
+      const double share = span.count() / kCells;  // of the tile's points the cells hold, about
       std::uint32_t stopped;
-      if (2 * span.count() <= detail::kIndexCells * detail::kIndexCells)
+      if (share <= 0.5 &&
+          (!job.listed || share * double(tile.points.size()) < double(job.listed_end - job.listed)))
         stopped = detail::emit_cells(tables, index, span, job, c, end, emit_listed, out, capacity, n);
       else
         stopped = (inside       ? emit_inside
