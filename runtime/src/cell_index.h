@@ -59,6 +59,11 @@ std::uint32_t emit_cells(const QueryTables& tables, std::size_t index, const Cel
   std::uint32_t listed[kWindow];
   std::uint64_t bits[kWindow / 64];
   for (std::uint32_t w = c; w < end;) {
+    std::uint32_t next = end;  // no window starts before the cells' next rank
+    for (std::uint32_t k = 0; k < cells; ++k)
+      if (at[k] < stop[k]) next = std::min<std::uint32_t>(next, ranks[at[k]]);
+    if (next >= end) break;
+    w = std::max(w, next);
     const std::uint32_t w_end = end - w > kWindow ? w + kWindow : end;
     std::fill(bits, bits + kWindow / 64, 0);
     for (std::uint32_t k = 0; k < cells; ++k) {
