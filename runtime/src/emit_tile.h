@@ -194,7 +194,9 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
         set_reach(j.tables->glide_reach_from[segment - 1]);
       }
-      if (culled(p)) return kNone;
+      // A listed constant-density candidate is glided and tested without a branch (place): its list has
+      // already left out most of those the culling would, and whether it is culled follows no pattern.
+      if (!(kConstant && kListed) && culled(p)) return kNone;
     }
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
     if constexpr (!kSmooth) {
