@@ -17,9 +17,9 @@
 
 namespace kdm::detail {
 
-/// Smooth mode, compact output beside the region: rectangles in float relative to the origin such that a
-/// glided point whose float position lies inside `sure` lies inside the region by the query's test in double,
-/// and one outside `may` outside it. Their margin is far beyond the float formula's error (within
+/// Compact output beside the region, either mode: rectangles in float relative to the origin such that a
+/// point whose float position lies inside `sure` lies inside the region by the query's test in double, and
+/// one outside `may` outside it. Their margin is far beyond the float formula's error (within
 /// 2^-21 · (|p| + S), CompactSink) and a double's rounding at the world's magnitudes.
 struct RegionFlagBoxes {
   FloatBox sure, may;
