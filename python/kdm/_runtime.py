@@ -16,7 +16,8 @@ _Bounds = Callable[[float, float, float, float], Tuple[float, float]]
 
 
 class QueryResult:
-    """The points of a query, in the runtime's order (tiles row by row, ranks ascending).
+    """The points of a query, in the runtime's order (tiles row by row, ranks ascending; cell by cell in
+    a tile the region meets only a small part of).
 
     `points` holds the runtime's own 40-byte records, as the query wrote them; `xy`, `tile` and `rank`
     are views of them (strided, not copied: ``np.ascontiguousarray(r.xy)`` makes a packed copy).

@@ -1,4 +1,4 @@
-// Internal: a tile's points in the cells a region meets (QueryTables::cell_ranks), visited in rank order
+// Internal: a tile's points in the cells a region meets (QueryTables::cell_ranks), visited cell by cell
 // through emit_tile's listed emitter, so that a region covering a small part of a tile (a chunk smaller
 // than the tiles, or a tile the region's side cuts near a corner) costs its cells' points, not the tile's.
 #pragma once
@@ -28,61 +28,64 @@ inline CellSpan cells_met(double lo_u, double lo_v, double hi_u, double hi_v) {
   return CellSpan{column(lo_u), column(hi_u), column(lo_v), column(hi_v)};
 }
 
-inline int lowest_set_bit(std::uint64_t w) {
-#if defined(__GNUC__) || defined(__clang__)
-  return __builtin_ctzll(w);
-#else
-  int k = 0;
-  for (; !(w & 1); w >>= 1) ++k;
-  return k;
-#endif
-}
+/// Where a tile visited through its cells stopped: the cell (its place in the span, row by row) and the
+/// rank in it to go on from (QueryCursor's path, less one, and rank).
+struct CellPlace {
+  std::uint32_t cell = 0, rank = 0;
+};
 
-/// Emits the ranks [c, end) of tile `index` that lie in the cells `span`, in rank order, through `emit`
-/// (a listed emitter, which tests each as the full scan would): the rank it stopped at, or end.
+/// Emits the points of tile `index` that lie in the cells `span` and rank below `end`, cell by cell from
+/// `at` on, each cell's in rank order, through `emit` (a listed emitter, which tests each as the full scan
+/// would), visiting at most `budget` of them (reduced by those visited). Returns true when the tile is
+/// done, false with `at` where it stopped (the buffer full or the budget spent).
 template <class Sink>
-std::uint32_t emit_cells(const QueryTables& tables, std::size_t index, const CellSpan& span, TileJob& job,
-                         std::uint32_t c, std::uint32_t end, EmitTile<Sink> emit, const Sink& out,
-                         std::size_t capacity, std::size_t& written) {
-  constexpr std::uint32_t kCells = kIndexCells * kIndexCells;
-  constexpr std::uint32_t kWindow = 2048;  // ranks per pass: a bitmap and a list of them on the stack
-  const std::uint32_t* start = tables.cell_start.data() + (kCells + 1) * index;
+bool emit_cells(const QueryTables& tables, std::size_t index, const CellSpan& span, TileJob& job,
+                CellPlace& at, std::uint32_t end, std::uint64_t& budget, EmitTile<Sink> emit, const Sink& out,
+                std::size_t capacity, std::size_t& written) {
+  // Several cells' ranks go to the emitter in one list (it takes them in list order), so that a call's
+  // cost is shared by cells of a few points each.
+  constexpr std::uint32_t kBatch = 2048;
+  const std::uint32_t* start = tables.cell_start.data() + (kIndexCells * kIndexCells + 1) * index;
   const std::uint16_t* ranks = tables.cell_ranks[index].data();
-  std::uint32_t at[kCells], stop[kCells], cells = 0;
-  for (std::uint32_t y = span.y0; y <= span.y1; ++y)
-    for (std::uint32_t x = span.x0; x <= span.x1; ++x, ++cells) {
-      const std::uint32_t k = y * kIndexCells + x;
-      at[cells] =
-          static_cast<std::uint32_t>(std::lower_bound(ranks + start[k], ranks + start[k + 1], c) - ranks);
-      stop[cells] = start[k + 1];
+  const std::uint32_t columns = span.x1 - span.x0 + 1, cells = span.count();
+  std::uint32_t listed[kBatch];
+  std::uint32_t cell_of[kIndexCells * kIndexCells + 1], first_of[kIndexCells * kIndexCells + 1];
+  const std::uint16_t* p = nullptr;  // the next rank of cell at.cell, once found
+  while (at.cell < cells) {
+    // A batch: the cells' ranks from at on, while they fit and the budget lasts.
+    std::uint32_t m = 0, batched = 0;
+    const std::uint64_t most = std::min<std::uint64_t>(kBatch, budget);
+    for (; at.cell < cells; ++at.cell, at.rank = 0, p = nullptr) {
+      const std::uint32_t k = (span.y0 + at.cell / columns) * kIndexCells + span.x0 + at.cell % columns;
+      const std::uint16_t* const stop = ranks + start[k + 1];
+      if (!p) p = std::lower_bound(ranks + start[k], stop, at.rank);
+      cell_of[batched] = at.cell, first_of[batched++] = m;
+      for (; m < most && p != stop && *p < end; ++p) listed[m++] = *p;
+      if (m == most && p != stop && *p < end) {  // the cell goes on in the next batch
+        at.rank = *p;
+        break;
+      }
     }
-  std::uint32_t listed[kWindow];
-  std::uint64_t bits[kWindow / 64];
-  for (std::uint32_t w = c; w < end;) {
-    std::uint32_t next = end;  // no window starts before the cells' next rank
-    for (std::uint32_t k = 0; k < cells; ++k)
-      if (at[k] < stop[k]) next = std::min<std::uint32_t>(next, ranks[at[k]]);
-    if (next >= end) break;
-    w = std::max(w, next);
-    const std::uint32_t w_end = end - w > kWindow ? w + kWindow : end;
-    std::fill(bits, bits + kWindow / 64, 0);
-    for (std::uint32_t k = 0; k < cells; ++k) {
-      std::uint32_t i = at[k];
-      for (; i < stop[k] && ranks[i] < w_end; ++i)
-        bits[(ranks[i] - w) >> 6] |= std::uint64_t(1) << ((ranks[i] - w) & 63);
-      at[k] = i;
+    if (m == 0) {
+      if (at.cell == cells) break;
+      return false;  // the budget is spent
     }
-    std::uint32_t m = 0;
-    for (std::uint32_t b = 0; b < (w_end - w + 63) / 64; ++b)
-      for (std::uint64_t word = bits[b]; word != 0; word &= word - 1)
-        listed[m++] = w + 64 * b + lowest_set_bit(word);
     job.listed = listed, job.listed_end = listed + m;
-    const std::uint32_t stopped = emit(job, w, w_end, out, capacity, written);
+    const std::uint32_t stopped = emit(job, 0, ~0u, out, capacity, written);
     job.listed = job.listed_end = nullptr;
-    if (stopped < w_end) return stopped;
-    w = w_end;
+    if (stopped == ~0u) {
+      budget -= m;
+      continue;
+    }
+    // The buffer is full at rank `stopped`: its place in the list, and the cell it came from.
+    const auto i = static_cast<std::uint32_t>(std::find(listed, listed + m, stopped) - listed);
+    budget -= i;
+    std::uint32_t b = batched - 1;
+    while (first_of[b] > i) --b;
+    at = CellPlace{cell_of[b], stopped};
+    return false;
   }
-  return end;
+  return true;
 }
 
 }  // namespace kdm::detail

@@ -50,7 +50,7 @@ constexpr std::uint32_t kCellBits = 2;
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
 /// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
-/// job.listed are visited (the others are culled, as the full scan would).
+/// job.listed are visited, in their order (the others are culled, as the full scan would).
 template <class Sink, bool kSmooth, QueryDensity::Kind kKind, bool kInside, bool kListed>
 std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, const Sink out,
                         std::size_t capacity, std::size_t& written) {
@@ -190,6 +190,10 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   auto visit = [&](std::uint32_t c) -> std::uint32_t {
     const TilePoint p = j.points[c];
     if (kSmooth && !kInside) {
+      if (!kConstant && kListed && segment > 0 && c < j.ranks[segment - 1]) {  // cells' lists, one by one
+        segment = 0;
+        set_reach(j.tables->glide_reach_from[0]);
+      }
       if (!kConstant && segment < keyframes && j.ranks[segment] <= c) {
         while (segment < keyframes && j.ranks[segment] <= c) ++segment;
         set_reach(j.tables->glide_reach_from[segment - 1]);

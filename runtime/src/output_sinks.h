@@ -36,8 +36,9 @@ struct TileJob {
   /// gliding up to `reach` (tile sides): cull_x0 - reach · 65536 ≤ x < cull_x1 + reach · 65536.
   double cull_x0, cull_y0, cull_x1, cull_y1, reach;
   const std::uint32_t* ranks;  ///< smooth mode, varying density: QueryTables::points_at_keyframe
-  /// The only ranks that can land in the region, ascending, when listed: a smooth tile's edge list beside
-  /// it (QueryTables::edges), or the ranks of the cells it meets (cell_index.h); else null.
+  /// The only ranks that can land in the region, when listed: a smooth tile's edge list beside it
+  /// (QueryTables::edges), ascending, or the ranks of the cells it meets (cell_index.h), ascending in each
+  /// cell, the cells in turn; else null.
   const std::uint32_t *listed, *listed_end;
   double area_scale, limit;
   const QueryDensity* density;

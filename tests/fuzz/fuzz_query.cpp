@@ -199,7 +199,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         !in_tile(p.y, q.origin_y, p.id.tile_y, q.tile_size))
       fail();
     if (p.id.rank >= kdm::Tileset::builtin().tile_at(p.id.tile_x, p.id.tile_y).points.size()) fail();
-    if (i > 0 && !(order_key(all[i - 1]) < order_key(p))) fail();  // documented order, so ids are unique
+    // Documented order: tiles row by row (within a tile, ranks ascending or cell by cell).
+    if (i > 0 &&
+        std::make_pair(p.id.tile_y, p.id.tile_x) < std::make_pair(all[i - 1].id.tile_y, all[i - 1].id.tile_x))
+      fail();
+  }
+  {  // every id once
+    static std::tuple<std::int64_t, std::int64_t, std::uint32_t> ids[kBigCapacity];
+    for (std::size_t i = 0; i < all.size; ++i) ids[i] = order_key(all[i]);
+    std::sort(ids, ids + all.size);
+    if (std::adjacent_find(ids, ids + all.size) != ids + all.size) fail();
   }
 
   // Resumed with a small buffer: the same points in the same order.
@@ -290,6 +299,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   qa.x1 = xm, qb.x0 = xm;
   if (!a.query(qa) || a.status != kdm::Status::kOk || !b.query(qb) || b.status != kdm::Status::kOk) fail();
   if (a.size + b.size != all.size) fail();
+  auto by_id = [](Points& p) {  // in id order (a tile a part meets only in part comes cell by cell)
+    std::sort(p.data, p.data + p.size,
+              [](const kdm::QueryPoint& u, const kdm::QueryPoint& v) { return order_key(u) < order_key(v); });
+  };
+  by_id(all), by_id(a), by_id(b);
   std::size_t ia = 0, ib = 0;
   for (std::size_t i = 0; i < all.size; ++i) {
     const bool from_a = ia < a.size && (ib == b.size || order_key(a[ia]) < order_key(b[ib]));

@@ -76,8 +76,8 @@ typedef struct kdm_cursor {
   int started, finished;
   uint64_t fingerprint; /* of the query that started it: a cursor is refused with other parameters */
   uint32_t depth;       /* where in the tile's subtiles it stopped (past the top level) */
-  uint64_t path;
-} kdm_cursor; /* zero-initialise before the first call */
+  uint64_t path;        /* the subtiles it went through; at depth 0, the tile's cell it stopped in + 1 */
+} kdm_cursor;           /* zero-initialise before the first call */
 
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {

@@ -114,7 +114,9 @@ struct QueryCursor {
   bool started = false, finished = false;
   std::uint64_t fingerprint = 0;  ///< of the parameters that started it (query_fingerprint)
   std::uint32_t depth = 0;        ///< how deep into tile (tile_x, tile_y) the query stopped
-  std::uint64_t path = 0;         ///< the subtiles it went through, 16 bits per depth from the lowest
+  /// The subtiles it went through, 16 bits per depth from the lowest; at depth 0 in a tile visited cell by
+  /// cell (query_points), the cell it stopped in plus one.
+  std::uint64_t path = 0;
 };
 
 /// Why query_points returned kInvalidArgument: which parameter and, for a limit, the limit and the
@@ -158,7 +160,9 @@ KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
-/// ascending, then past the top level each tile's appearing sub-points and its subtiles, depth first);
+/// ascending, then past the top level each tile's appearing sub-points and its subtiles, depth first; a
+/// tile of which the region, widened by the glide's reach, meets at most half gives its points cell by
+/// cell instead, cells of a 16 × 16 grid row by row, ranks ascending in each);
 /// `*written` receives the count, and slots from there to capacity may be overwritten too (a candidate is
 /// written before it is known to be kept). Returns kOk when the region is complete (a finished cursor called
 /// again with the same params gives kOk and no points), kBufferFull when `out` filled up first or the call
