@@ -535,6 +535,21 @@ void BM_QueryChunks(benchmark::State& state) {
   state.counters["of_one_query"] = one_seconds / seconds;
 }
 
+// What one call costs on its own (args: smooth; side, the region's side in hundredths of a tile, 0 for a
+// point-sized region): calls over 35 places inside the first tiles, off the tiling, into a reused buffer.
+void BM_QueryPerCall(benchmark::State& state) {
+  const double side = state.range(1) ? double(state.range(1)) / 100 : 1e-6;
+  kdm::QueryParams q = params(state);
+  std::vector<kdm::QueryPoint> buffer(1 << 12);
+  std::size_t n = 0, calls = 0;
+  for (auto _ : state) {
+    q.x0 = 0.3 + double(calls % 7) * 0.11, q.y0 = 0.35 + double(calls % 5) * 0.13;
+    q.x1 = q.x0 + side, q.y1 = q.y0 + side;
+    n += run_query(q, buffer), ++calls;
+  }
+  state.counters["points_per_call"] = double(n) / double(calls);
+}
+
 void BM_QueryConstantReusedBuffer(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 16);
   std::size_t n = 0;
@@ -596,6 +611,10 @@ BENCHMARK(BM_QueryChunks)
     ->ArgsProduct({{0, 1}, {100, 25, 10}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryPerCall)
+    ->ArgNames({"smooth", "side"})
+    ->ArgsProduct({{0, 1}, {0, 10}})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QueryUnaligned)
     ->ArgNames({"smooth", "compact"})
     ->ArgsProduct({{0, 1}, {0, 1}})
