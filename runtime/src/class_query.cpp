@@ -178,7 +178,9 @@ class Classifier {
   /// depth-0 tile (tx, ty).
   static void class_ranks(void* user, std::int64_t tx, std::int64_t ty, std::uint32_t first,
                           std::uint32_t count, std::uint8_t* out) {
-    static_cast<Classifier*>(user)->classify_run(PointId{tx, ty, first}, count, out);
+    auto& c = *static_cast<Classifier*>(user);
+    if (count == 1 && c.classify_one(tx, ty, first, *out)) return;
+    c.classify_run(PointId{tx, ty, first}, count, out);
   }
 
   /// Classes ids(0) … ids(count - 1) into classes[0..count).
@@ -241,6 +243,19 @@ class Classifier {
     class_ = k, rank_ = previous;
   }
 
+  /// Varying densities, one rank of the current tile at or past the last one classified (a candidate the
+  /// loop settled by its cell's bounds): its class into `out`; false for any other point.
+  bool classify_one(std::int64_t tx, std::int64_t ty, std::uint32_t rank, std::uint8_t& out) {
+    if (densities_.all_constant || tx != tile_.tile_x || ty != tile_.tile_y || tile_.depth != 0 ||
+        rank < rank_ || rank >= thresholds_size_)
+      return false;
+    std::uint32_t k = class_;
+    while (rank >= sure_to_[k]) ++k;
+    class_ = k, rank_ = rank;
+    out = rank >= sure_from_[k] ? static_cast<std::uint8_t>(k) : read_class(PointId{tx, ty, rank});
+    return true;
+  }
+
   /// Varying densities: ranks [first.rank, first.rank + count) of first's tile into classes[0..count), a
   /// settled range at a time.
   void classify_run(const PointId& first, std::uint32_t count, std::uint8_t* classes) {
@@ -277,20 +292,22 @@ class Classifier {
   /// A point of the current tile whose class its tile's bounds leave open: settled by the bounds of the
   /// cell of the tile it lies in where they can, else by the classes' densities at its stable position,
   /// computed as query_points computes it (depth 0), so the densities read are its.
-  std::uint8_t read_class(const PointId& id) {
+  [[gnu::always_inline]] std::uint8_t read_class(const PointId& id) {
     const TilePoint& point = points_[id.rank];
     const float t = thresholds_[id.rank];
     const std::uint32_t cx = point.x >> (16 - kCellBits), cy = point.y >> (16 - kCellBits);
     const std::uint32_t cell = cy << kCellBits | cx;
     if (!(cells_read_ >> cell & 1)) read_cell(cx, cy, cell);
+    // The cumulative bounds rise with the class (every class's bounds are finite and ≥ 0), so the classes
+    // whose count falls short of t everywhere in the cell are a prefix, as are those whose count may: the
+    // point is settled where the two end, counted without a branch the class's changes would mispredict.
     const std::uint32_t last = p_.class_count - 1;
-    std::uint32_t k = 0;
-    for (; k < last; ++k) {
-      if (!TilesetShape::emits(t, cell_hi_[cell][k])) continue;  // classes 0 … k fall short everywhere there
-      if (TilesetShape::emits(t, cell_lo_[cell][k])) return static_cast<std::uint8_t>(k);
-      break;  // open: read
+    std::uint32_t short_everywhere = 0, short_somewhere = 0;
+    for (std::uint32_t k = 0; k < last; ++k) {
+      short_everywhere += !TilesetShape::emits(t, cell_hi_[cell][k]);
+      short_somewhere += !TilesetShape::emits(t, cell_lo_[cell][k]);
     }
-    if (k == last) return static_cast<std::uint8_t>(last);
+    if (short_everywhere == short_somewhere) return static_cast<std::uint8_t>(short_everywhere);
     const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
     return densities_.class_of(t, wx + point.unit_x() * side_, wy + point.unit_y() * side_, area_);
   }

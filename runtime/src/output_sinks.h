@@ -228,7 +228,8 @@ struct VaryingClassSink {
   }
   /// Candidate `rank` of tile j at its stable position (x, y), as the loop computes it: its class, from the
   /// scratch where the loop has just read the density there.
-  std::uint8_t class_at(const TileJob& j, std::uint32_t rank, double x, double y) const {
+  [[gnu::always_inline]] std::uint8_t class_at(const TileJob& j, std::uint32_t rank, double x,
+                                               double y) const {
     const ClassScratch& s = *c->scratch;
     if (s.x == x && s.y == y) {
       const float t = j.thresholds[rank];
@@ -245,7 +246,8 @@ struct VaryingClassSink {
     base.put(i, x, y, id);
     c->classes[i] = k;
   }
-  void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
+  [[gnu::always_inline]] void put_stable(std::size_t i, const TileJob& j, TilePoint p,
+                                         std::uint32_t rank) const {
     base.put_stable(i, j, p, rank);
     c->classes[i] = class_at(j, rank, j.wx + p.unit_x() * j.S, j.wy + p.unit_y() * j.S);
   }
