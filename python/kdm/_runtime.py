@@ -133,13 +133,14 @@ class Tileset:
             "radial:R"); a 2-D array of densities (finite, >= 0) with row 0 at the TOP; either of the last
             two stretched over `density_rect` (default: `rect`; fix it to query parts of one region). Or a
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
-            GIL held; an exception it raises is raised here once the query ends), which needs
-            `density_max`, a true upper bound of its values. Default: 1.
+            GIL held; an exception it raises is raised here once the query ends, and a value that is
+            not finite and >= 0 raises ValueError), which needs `density_max`, a true upper bound of
+            its values. Default: 1.
         density_bounds : callable, optional
             For a callable density: f(x0, y0, x1, y1) -> (lo, hi), bounds of the density over a world
-            rectangle. Asked once per tile, it lets the query call the density only where a point's
-            emission is in doubt (several times fewer calls in stable mode), giving the same points as
-            long as the bounds hold.
+            rectangle, 0 <= lo <= hi (else ValueError). Asked once per tile, it lets the query call the
+            density only where a point's emission is in doubt (several times fewer calls in stable mode),
+            giving the same points as long as the bounds hold.
         classes : sequence of densities, optional
             Several kinds of points in one query, instead of `density`: 1 to 8 densities (numbers, str or
             2-D arrays as `density` takes them, not callables), highest priority first (largest objects

@@ -32,12 +32,10 @@ TilesetHandle load(const std::string& path) {
   Status s;
   {
     py::gil_scoped_release release;
-    s = Tileset::load_file(path, *set, &detail);
-    if (s == Status::kOk) {  // read again for the header's version, which the loaded set does not keep
-      std::ifstream in(path, std::ios::binary);
-      const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
-    }
+    std::vector<char> bytes;  // the header's version too, which the loaded set does not keep
+    s = read_tileset_file(path, bytes, &detail);
+    if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+    if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
   if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
   return {std::move(set), header.format_version};

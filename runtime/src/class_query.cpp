@@ -22,6 +22,9 @@ using detail::ImageSampler;
 namespace {
 
 // Static names for QueryProblem::parameter, one per class.
+constexpr const char* kConstantNames[kMaxQueryClasses] = {
+    "classes[0].constant", "classes[1].constant", "classes[2].constant", "classes[3].constant",
+    "classes[4].constant", "classes[5].constant", "classes[6].constant", "classes[7].constant"};
 constexpr const char* kImageNames[kMaxQueryClasses] = {
     "classes[0].image", "classes[1].image", "classes[2].image", "classes[3].image",
     "classes[4].image", "classes[5].image", "classes[6].image", "classes[7].image"};
@@ -452,6 +455,8 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     const QueryDensity& d = p.classes[k];
     switch (d.kind) {
       case QueryDensity::Kind::kConstant:
+        if (!std::isfinite(d.constant)) return refuse(Kind::kNotFinite, kConstantNames[k], d.constant);
+        if (d.constant < 0) return refuse(Kind::kNegative, kConstantNames[k], d.constant);
         continue;
       case QueryDensity::Kind::kImage:
         if (!d.image || !d.image->values || !d.image->max_mip)

@@ -2,7 +2,9 @@
 // -fno-exceptions); allocations that fail return KDM_OUT_OF_MEMORY where the library checks them.
 #include <algorithm>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <vector>
 
@@ -18,7 +20,10 @@ struct kdm_tileset {
 
 struct kdm_density_image {
   kdm::DensityImageView view;
-  std::vector<float> values, mip;
+  // malloc'd: a caller's size may not fit in memory, or even in what operator new[] accepts, and that is
+  // a status here, not an exception.
+  std::unique_ptr<float, decltype(&std::free)> values{nullptr, std::free};
+  std::vector<float> mip;
 };
 
 namespace {
@@ -227,11 +232,13 @@ uint32_t kdm_tileset_format_version(void) {
 }
 
 kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out) {
+  if (out) *out = nullptr;
   if (!path) return KDM_INVALID_ARGUMENT;
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t); });
 }
 
 kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out) {
+  if (out) *out = nullptr;
   if (!data && size) return KDM_INVALID_ARGUMENT;
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_memory(data, size, t); });
 }
@@ -276,12 +283,18 @@ kdm_status kdm_density_image_create(int width, int height, const float* values, 
   if (!out) return KDM_INVALID_ARGUMENT;
   *out = nullptr;
   if (!values || width <= 0 || height <= 0) return KDM_INVALID_ARGUMENT;
+  const std::size_t texels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   auto* image = new (std::nothrow) kdm_density_image;
   if (!image) return KDM_OUT_OF_MEMORY;
-  image->values.assign(values, values + static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  image->values.reset(static_cast<float*>(std::malloc(texels * sizeof(float))));  // ≤ 2^62 · 4 bytes
+  if (!image->values) {
+    delete image;
+    return KDM_OUT_OF_MEMORY;
+  }
+  std::copy(values, values + texels, image->values.get());
   kdm::DensityImageView& v = image->view;
   v.width = width, v.height = height, v.x0 = x0, v.y0 = y0, v.x1 = x1, v.y1 = y1;
-  v.values = image->values.data();
+  v.values = image->values.get();
   const kdm::Status s = kdm::make_density_max_mip(v, image->mip);
   if (s != kdm::Status::kOk) {
     delete image;

@@ -90,6 +90,11 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   if (q.scale < 0) return refuse(Kind::kNegative, "scale", q.scale);
   if (q.mode != QueryMode::kStable && q.mode != QueryMode::kSmooth)
     return refuse(Kind::kBadMode, "mode", static_cast<double>(static_cast<int>(q.mode)));
+  // A constant is the caller's number, not a value read at a point: one that is no density is refused.
+  if (q.density.kind == QueryDensity::Kind::kConstant && !finite(q.density.constant))
+    return refuse(Kind::kNotFinite, "density.constant", q.density.constant);
+  if (q.density.kind == QueryDensity::Kind::kConstant && q.density.constant < 0)
+    return refuse(Kind::kNegative, "density.constant", q.density.constant);
   const std::uint64_t fingerprint = query_fingerprint(q);
   if (cursor->started && cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
   if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {

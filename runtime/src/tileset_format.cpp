@@ -14,6 +14,9 @@
 #include <memory>
 #include <sstream>
 #include <streambuf>
+#include <vector>
+
+#include <sys/stat.h>
 
 #include "crc32.h"
 #include "kdm/runtime/tileset_format.h"
@@ -445,12 +448,33 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   return Status::kOk;
 }
 
+Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std::string* detail) {
+  bytes.clear();
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+  if (!file) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
+  struct stat info;
+  if (fstat(fileno(file.get()), &info) == 0 && S_ISDIR(info.st_mode))
+    return fail(Status::kIoError, detail, "'" + path + "' is a directory, not a tile set file");
+  bytes.resize(kFixedHeaderBytes);
+  std::size_t n = std::fread(bytes.data(), 1, bytes.size(), file.get());
+  if (n == kFixedHeaderBytes && std::memcmp(bytes.data(), kMagic, 8) == 0) {
+    const auto* h = reinterpret_cast<const std::uint8_t*>(bytes.data());
+    const std::uint64_t header_size = get32(h + 12), payload_size = get64(h + 16);
+    if (header_size >= kFixedHeaderBytes && header_size <= kMaxTilesetHeaderBytes &&
+        payload_size <= ZSTD_compressBound(kMaxTilesetPayloadBytes)) {
+      bytes.resize(static_cast<std::size_t>(header_size + payload_size + 1));
+      n += std::fread(bytes.data() + n, 1, bytes.size() - n, file.get());
+    }
+  }
+  bytes.resize(n);
+  if (std::ferror(file.get())) return fail(Status::kIoError, detail, "cannot read '" + path + "'");
+  return Status::kOk;
+}
+
 Status load_tileset(const std::string& path, TilesetData& out, std::string* detail) {
   out = TilesetData{};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return fail(Status::kIoError, detail, "cannot read '" + path + "'");
+  std::vector<char> bytes;
+  if (const Status s = read_tileset_file(path, bytes, detail); s != Status::kOk) return s;
   return decode_tileset(bytes.data(), bytes.size(), out, detail);
 }
 

@@ -86,7 +86,7 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
             TILES.query((0, 0, 1, 1), scale=10, density=str(path))
     damaged = tmp_path / "damaged.kdmt"
     damaged.write_bytes(b"KDMT" + bytes(100))
-    for path in (tmp_path / "missing.kdmt", damaged):
+    for path in (tmp_path / "missing.kdmt", damaged, tmp_path):  # a directory too
         message = cli_message(kdm_cli, "query", "--tileset", path, "--rect", "0,0,1,1",
                               "-o", tmp_path / "x.csv")
         with pytest.raises(OSError) as info:

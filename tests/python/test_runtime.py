@@ -146,6 +146,24 @@ def test_an_exception_in_the_callable_propagates():
     assert len(BUILTIN.query((0, 0, 1, 1), scale=100)) > 0
 
 
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -0.5])
+def test_a_callable_density_that_returns_no_density_is_an_error(bad):
+    # Counted as 0 by the C++ query, such a value from Python is a bug in the callable: said where.
+    def f(x, y):
+        return bad if x > 1.0 else 1.0
+    with pytest.raises(ValueError, match=r"density callable returned .* at \(1\.\d+, .*finite and >= 0"):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=f, density_max=1)
+    with pytest.raises(ValueError, match="density callable returned"):
+        BUILTIN.positions((0, 0, 2, 2), scale=100, density=f, density_max=1)
+
+
+@pytest.mark.parametrize("bounds", [(math.nan, 1.0), (2.0, 1.0), (-1.0, 1.0), (0.0, math.nan)])
+def test_density_bounds_that_are_no_bounds_are_an_error(bounds):
+    with pytest.raises(ValueError, match=r"density_bounds returned .*0 <= lo <= hi"):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x, y: 1.0, density_max=1.0,
+                      density_bounds=lambda *r: bounds)
+
+
 def test_a_callable_density_may_query_itself():
     # A query inside the density of another (on the same thread) leaves the outer one's points alone.
     inner = []

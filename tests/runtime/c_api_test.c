@@ -1,6 +1,7 @@
 /* The C interface from C: load, query into a small buffer with resumes, density images, tile-set info,
  * bad input with its detail, cursor misuse, status codes. */
 #include <kdm/runtime/kdm_runtime.h>
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -115,6 +116,9 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_image_create(2, 2, bad, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT && image == NULL);
     CHECK(kdm_density_image_create(0, 2, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 0, 2, &image) == KDM_INVALID_ARGUMENT);
+    /* 16 EiB of texels: no memory holds their copy, which is said, not thrown. */
+    CHECK(kdm_density_image_create(INT_MAX, INT_MAX, values, 0, 0, 2, 2, &image) == KDM_OUT_OF_MEMORY &&
+          image == NULL);
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 2, 2, &image) == KDM_OK && image != NULL);
     q.density_image = image;
     memset(&cursor, 0, sizeof cursor);
@@ -145,6 +149,13 @@ int main(int argc, char** argv) {
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(strcmp(problem.parameter, "query.struct_size") == 0);
+    q = uniform_query();
+    q.density = -1; /* a constant density that is none */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "density.constant") == 0);
+    q.density = 0.0 / 0.0;
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_FINITE && strcmp(problem.parameter, "density.constant") == 0);
     q = uniform_query();
     q.mode = 7;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
@@ -350,6 +361,9 @@ int main(int argc, char** argv) {
     kdm_tileset* bad = NULL;
     CHECK(kdm_tileset_load_memory("not a tile set", 14, &bad) == KDM_BAD_MAGIC && bad == NULL);
     CHECK(kdm_tileset_load_file("/nonexistent.kdmt", &bad) == KDM_IO_ERROR && bad == NULL);
+    CHECK(kdm_tileset_load_file(".", &bad) == KDM_IO_ERROR && bad == NULL); /* a directory */
+    bad = (kdm_tileset*)&q; /* set to NULL on every failure, a missing path too */
+    CHECK(kdm_tileset_load_file(NULL, &bad) == KDM_INVALID_ARGUMENT && bad == NULL);
   }
   CHECK(strlen(kdm_status_message(KDM_TRUNCATED)) > 0);
   kdm_tileset_free(loaded);

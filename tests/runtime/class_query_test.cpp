@@ -309,6 +309,12 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   q.class_count = 9;
   EXPECT_EQ(refusal(q).value, 9);
   q.class_count = 3;
+  q.classes[2].constant = NAN;
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_STREQ(refusal(q).parameter, "classes[2].constant");
+  q.classes[2].constant = -5;
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);
+  q.classes[2].constant = 0.5;
   q.classes[1].kind = QueryDensity::Kind::kImage;
   EXPECT_STREQ(refusal(q).parameter, "classes[1].image");
   q.classes[1].kind = QueryDensity::Kind::kCallback;

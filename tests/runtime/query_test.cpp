@@ -480,6 +480,18 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   p = problem_of(region(0, 0, 1, 1, -1));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kNegative);
   EXPECT_STREQ(p.parameter, "scale");
+  // A constant density is the caller's number, refused even for a region that holds no point.
+  for (const double region_side : {1.0, 0.0}) {
+    q = region(0, 0, region_side, 1, 100);
+    q.density.constant = std::nan("");
+    p = problem_of(q);
+    EXPECT_EQ(p.kind, QueryProblem::Kind::kNotFinite);
+    EXPECT_STREQ(p.parameter, "density.constant");
+    q.density.constant = -1;
+    p = problem_of(q);
+    EXPECT_EQ(p.kind, QueryProblem::Kind::kNegative);
+    EXPECT_STREQ(p.parameter, "density.constant");
+  }
   q = region(0, 0, 1, 1, 100);
   q.density.kind = QueryDensity::Kind::kImage;
   p = problem_of(q);

@@ -510,5 +510,38 @@ TEST(TilesetAllocatorTest, TheTileSetsArraysGoThroughTheHook) {
   EXPECT_EQ(heap.allocations, heap.frees);
 }
 
+// A path that holds no tile set fails at once with a reason: a directory, an endless device, a file cut
+// short or with bytes after its payload. The loader reads no more than the header says the file holds.
+TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
+  TilesetData loaded;
+  std::string detail;
+  EXPECT_EQ(load_tileset(testing::TempDir(), loaded, &detail), Status::kIoError);
+  EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
+  Tileset handle;
+  EXPECT_EQ(Tileset::load_file(testing::TempDir(), handle), Status::kIoError);
+  if (std::ifstream("/dev/zero").good()) {
+    EXPECT_EQ(load_tileset("/dev/zero", loaded), Status::kBadMagic);
+  }
+
+  std::vector<std::uint8_t> bytes;
+  ASSERT_EQ(encode_tileset(make_tileset(), bytes), Status::kOk);
+  const std::string path = testing::TempDir() + "/cut.kdmt";
+  auto load_bytes = [&](std::size_t size, const std::string& tail) {
+    {
+      std::ofstream f(path, std::ios::binary | std::ios::trunc);
+      f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(size));
+      f << tail;
+    }
+    return load_tileset(path, loaded);
+  };
+  EXPECT_EQ(load_bytes(bytes.size(), ""), Status::kOk);
+  EXPECT_EQ(load_bytes(bytes.size(), "x"), Status::kTrailingBytes);
+  EXPECT_EQ(load_bytes(bytes.size(), std::string(1 << 16, 'x')), Status::kTrailingBytes);
+  for (const std::size_t size :
+       {std::size_t(0), std::size_t(5), std::size_t(63), std::size_t(64), bytes.size() / 2, bytes.size() - 1})
+    EXPECT_EQ(load_bytes(size, ""), Status::kTruncated) << size;
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace kdm

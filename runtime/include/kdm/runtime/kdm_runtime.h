@@ -49,11 +49,11 @@ typedef struct kdm_point {
 
 typedef struct kdm_query {
   size_t struct_size;        /* sizeof(kdm_query) */
-  double x0, y0, x1, y1;     /* half-open world region [x0, x1) x [y0, y1) */
+  double x0, y0, x1, y1;     /* half-open world region [x0, x1) x [y0, y1): no points if x1 <= x0 */
   double origin_x, origin_y; /* subtracted from every output position */
   double tile_size;          /* world units per tile side (> 0) */
   double scale;              /* points per unit area at density 1 (>= 0) */
-  double density;            /* constant density, used when neither an image nor a callback is given */
+  double density;            /* constant density (finite, >= 0), used without an image or a callback */
   /* Optional: density at world (x, y); NaN, negative and infinite values count as 0. */
   double (*density_callback)(void* user, double x, double y);
   void* user;
@@ -151,7 +151,8 @@ KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_
 /* A density image over the world rectangle [x0, x1) x [y0, y1): `width` x `height` values, row-major,
  * row 0 at y0, bilinear between texel centres and clamped at the edges. The values are copied and an
  * 8x8 max-mip is built, so queries skip what cannot be emitted. KDM_INVALID_ARGUMENT for an empty image,
- * a NULL or negative or non-finite value, or an empty rectangle. Free with kdm_density_image_free. */
+ * a NULL or negative or non-finite value, or an empty rectangle; KDM_OUT_OF_MEMORY when its copy does
+ * not fit in memory. Free with kdm_density_image_free. */
 KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const float* values, double x0,
                                                     double y0, double x1, double y1, kdm_density_image** out);
 KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);

@@ -54,7 +54,7 @@ struct QueryPoint {
 /// from a callback are treated as 0 (documented: a bad value never emits points or crashes).
 struct QueryDensity {
   enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;
-  double constant = 1;
+  double constant = 1;  ///< kConstant: finite and >= 0, or the query is refused
   const DensityImageView* image = nullptr;
   double (*callback)(void* user, double x, double y) = nullptr;
   void* user = nullptr;
@@ -86,7 +86,7 @@ enum class QueryMode : int {
 };
 
 struct QueryParams {
-  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< half-open world region [x0, x1) × [y0, y1)
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< half-open world region [x0, x1) × [y0, y1); none if x1 ≤ x0
   double origin_x = 0, origin_y = 0;      ///< subtracted from every output position
   double tile_size = 1;                   ///< world units per tile side
   double scale = 1;                       ///< points per unit area at density 1
@@ -127,7 +127,8 @@ struct QueryProblem {
     kMissingArgument,  ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
     kNotFinite,        ///< `parameter` is NaN or infinite; `value` holds it
     kNotPositive,      ///< `parameter` ("tile_size") must be > 0; `value` holds it
-    kNegative,         ///< `parameter` ("scale", "density.callback_max") must be >= 0; `value` holds it
+    kNegative,         ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
+                       ///< >= 0; `value` holds it
     kBadDensity,       ///< `parameter` ("density.image", "density.callback") is missing or not prepared
     kTooManyTiles,     ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
     kDensityTooHigh,   ///< `value` expected points per tile exceed `limit` (query_density_limit):

@@ -247,7 +247,14 @@ KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::u
 KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, TilesetData& out,
                                       std::string* detail = nullptr);
 
-/// Reads and decodes the file at `path`.
+/// Reads the bytes of the tile-set file at `path` into `bytes`, for read_tileset_header and decode_tileset
+/// to judge: its fixed header, then no more than that header says the file holds, and one byte past it
+/// (an endless or huge input stops at its header). kIoError, with `detail`, when the path cannot be
+/// opened or read or is a directory; else kOk, whatever the bytes are.
+KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<char>& bytes,
+                                         std::string* detail = nullptr);
+
+/// Reads (read_tileset_file) and decodes the file at `path`.
 KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
