@@ -359,9 +359,139 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   expect_error("sample --n 10", "--output");
   expect_error("sample --n 10 --aspect -1" + out, "--aspect");
   expect_error("sample --n 10 --width 0 -o '" + path("x.png") + "'", "--width");
-  expect_error("sample --n 10 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
+  expect_error("sample --n 2000 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
   expect_error("stipple --frames 2x a.png" + out, "--frames");
   expect_error("query --rect 0,0,1" + out, "--rect");
+}
+
+// --threads has one limit in every command that takes it, checked before any work: negative counts and
+// counts that would exhaust memory (std::bad_alloc) or time (a bake of 10^6 threads took 43 s) are refused.
+TEST_F(CliTest, ThreadsAreBoundedInEveryCommand) {
+  std::ofstream(path("r.recipe")) << "levels 1\nbase_points 32\ncolours 1\nkeyframes 0\nsweeps 1\n";
+  ASSERT_EQ(kdm("bake '" + path("r.recipe") + "' --threads 256 -o '" + path("r.kdmt") + "'").status, 0);
+  write_bytes(path("pts.txt"), {'0', '.', '5', ' ', '0', '.', '5', '\n'});
+  for (const std::string& command : {"sample -n 10 -o '" + path("s.txt") + "'",
+                                     "bake '" + path("r.recipe") + "' -o '" + path("x.kdmt") + "'",
+                                     "verify '" + path("r.kdmt") + "' --runs 2",
+                                     "analyze '" + path("pts.txt") + "' -o '" + path("a") + "'"})
+    for (const char* threads : {"-5", "257", "1000000", "99999999999999999999"}) {
+      SCOPED_TRACE(command + " --threads " + threads);
+      expect_error(command + " --threads " + threads, "--threads: must be 0 (automatic) or 1 to 256");
+    }
+  EXPECT_FALSE(fs::exists(path("x.kdmt")) || fs::exists(path("a")));
+}
+
+// A PNG that cannot be written whole (here a file size limit, with SIGXFSZ ignored so the write fails with
+// EFBIG) is an error and leaves no file, as .csv and .svg already did; it was a truncated PNG and exit 0.
+TEST_F(CliTest, TruncatedPngWritesAreErrors) {
+  write_bytes(path("grey.png"), grey_png(2, 2, 8, {0, 64, 128, 192}));
+  const std::string limit = "trap '' XFSZ; ulimit -f 4;";  // 4 KiB: each picture below is larger
+  for (const std::string& command : {"sample -n 2000 -o '" + path("s.png") + "'",
+                                     "stipple '" + path("grey.png") + "' -o '" + path("s.png") + "'",
+                                     "query --rect 0,0,1,1 --scale 2000 -o '" + path("s.png") + "'"}) {
+    SCOPED_TRACE(command);
+    const Outcome r = kdm(command, limit);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("kdm: error: cannot write '" + path("s.png") + "': File too large", 0), 0u)
+        << r.err;
+    EXPECT_FALSE(fs::exists(path("s.png")));
+    EXPECT_FALSE(fs::exists(path("s.png.tmp~")));
+  }
+  const Outcome whole = kdm("sample -n 2000 -o '" + path("s.png") + "'");  // without the limit: a PNG
+  ASSERT_EQ(whole.status, 0) << whole.err;
+  kdm::tools::GreyImage image;
+  std::string error;
+  EXPECT_TRUE(kdm::tools::load_grey_image(path("s.png"), image, error)) << error;
+  EXPECT_EQ(image.width, 1024);
+}
+
+// The full sampler cannot place points across a domain too narrow for their count (a short side of one
+// grid node): every one of them ended up in its left half. Such aspect ratios, from --aspect or from an
+// image's shape, are refused by name; --aspect 0 is no aspect ratio.
+TEST_F(CliTest, AspectRatiosTheSamplerCannotFillAreRefused) {
+  const std::string out = " -o '" + path("s.csv") + "'";
+  for (const char* aspect : {"5000", "0.0002", "1e300", "1e-300"}) {
+    SCOPED_TRACE(aspect);
+    expect_error(std::string("sample -n 300 --aspect ") + aspect + out, "too narrow for 300 points");
+  }
+  expect_error("sample -n 100 --aspect 0" + out, "--aspect must be a number > 0");
+  std::vector<std::uint16_t> row(4000, 100);
+  write_bytes(path("wide.png"), grey_png(4000, 1, 8, row));
+  expect_error("sample -n 300 --density '" + path("wide.png") + "'" + out, "at aspect ratio 4000");
+  expect_error("stipple '" + path("wide.png") + "' --method full --points 300" + out, "at aspect ratio 4000");
+  EXPECT_FALSE(fs::exists(path("s.csv")));
+}
+
+// -n 0 needs --resolution, and a resolution so coarse that the model puts no point on it is refused too
+// (it wrote an empty file and exit 0).
+TEST_F(CliTest, ResolutionsThatHoldNoPointAreRefused) {
+  const std::string out = " -o '" + path("s.txt") + "'";
+  expect_error("sample -n 0 --resolution 1" + out, "resolution must be at least 2");
+  expect_error("sample -n 0 --resolution 2" + out, "--resolution 2 is too coarse");
+  EXPECT_FALSE(fs::exists(path("s.txt")));
+  const Outcome three = kdm("sample -n 0 --resolution 3" + out);
+  ASSERT_EQ(three.status, 0) << three.err;
+  EXPECT_NE(three.err.find("kdm sample: 1 points"), std::string::npos) << three.err;
+}
+
+// stipple --scale, when given, must be a usable dot density: it used to fall back to --points silently.
+TEST_F(CliTest, StippleScaleIsChecked) {
+  write_bytes(path("grey.png"), grey_png(2, 2, 8, {0, 64, 128, 192}));
+  const std::string stipple = "stipple '" + path("grey.png") + "' -o '" + path("s.txt") + "' --scale ";
+  for (const char* scale : {"-1", "nan", "0", "inf"}) {
+    SCOPED_TRACE(scale);
+    expect_error(stipple + scale, "--scale must be a number > 0");
+  }
+  expect_error(stipple + "1e300 --method full", "--scale 1e+300 asks for");
+  EXPECT_FALSE(fs::exists(path("s.txt")));
+  ASSERT_EQ(kdm(stipple + "500 --method full").status, 0);
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
+  EXPECT_EQ(sets.at(0).size(), 500u);  // --scale decides, not --points' default
+}
+
+// --class images cover one domain: images of different sizes (each stretched its own way) are refused;
+// images of one size are fine.
+TEST_F(CliTest, ClassImagesMustShareOneSize) {
+  write_bytes(path("a.png"), grey_png(32, 32, 8, std::vector<std::uint16_t>(32 * 32, 100)));
+  write_bytes(path("b.png"), grey_png(32, 16, 8, std::vector<std::uint16_t>(32 * 16, 100)));
+  const std::string a = " --class '" + path("a.png") + "'", b = " --class '" + path("b.png") + "'";
+  expect_error("sample -n 100" + a + b + " -o '" + path("s.csv") + "'", "b.png' is 32x16");
+  expect_error("query --rect 0,0,1,1" + b + a + " -o '" + path("q.csv") + "'", "a.png' is 32x32");
+  EXPECT_FALSE(fs::exists(path("s.csv")) || fs::exists(path("q.csv")));
+  EXPECT_EQ(kdm("sample -n 100" + a + a + " -o '" + path("s.csv") + "'").status, 0);
+  EXPECT_EQ(kdm("query --rect 0,0,1,1" + a + a + " -o '" + path("q.csv") + "'").status, 0);
+}
+
+// Smaller refusals that named the wrong thing or nothing: verify's bars below 0 or NaN (silently off), a
+// directory as an image ("larger than 2 GiB"), a hand-over zone 2 levels cannot hold ("in [1, 0]"), and
+// points with no triangulation (pages of Qhull's internals).
+TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
+  const std::string shipped = "'" + std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt'";
+  expect_error("verify " + shipped + " --hole-largest -1", "--hole-largest must be a number >= 0");
+  expect_error("verify " + shipped + " --hole-largest nan", "--hole-largest must be a number >= 0");
+  expect_error("verify " + shipped + " --holes-per-1e5 -1", "--holes-per-1e5 must be a number >= 0");
+  fs::create_directories(path("dir.png"));
+  expect_error("sample -n 10 --density '" + path("dir.png") + "' -o '" + path("s.txt") + "'",
+               "dir.png': it is a directory");
+  std::ofstream(path("h.recipe")) << "levels 2\nbase_points 32\nkeyframes 2\nhandover_zone 1\n";
+  expect_error("bake '" + path("h.recipe") + "' -o '" + path("h.kdmt") + "'",
+               "handover_zone needs at least 3 levels");
+  for (const char* points :
+       {"0.5 0.5\n0.5 0.5\n0.5 0.5\n0.5 0.5\n", "0.1 0.5\n0.2 0.5\n0.3 0.5\n0.9 0.5\n"}) {
+    std::ofstream(path("flat.txt")) << points;
+    expect_error("analyze '" + path("flat.txt") + "' -o '" + path("a") + "'", "degenerate");
+  }
+  // A directory or an endless device where a tile set or a recipe belongs fails at once, saying so.
+  expect_error("info '" + path("dir.png") + "'", "is a directory, not a tile set file");
+  expect_error("query --tileset '" + path("dir.png") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
+               "is a directory");
+  expect_error("bake '" + path("dir.png") + "' -o '" + path("d.kdmt") + "'", "cannot read recipe");
+  if (fs::exists("/dev/zero")) {
+    expect_error("info /dev/zero", "bad magic");
+    expect_error("bake /dev/zero -o '" + path("z.kdmt") + "'", "not a recipe");
+  }
 }
 
 TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {

@@ -1,6 +1,7 @@
 // The full sampler (Algorithm 2) end to end: exact counts, determinism, density accuracy, bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -301,6 +302,43 @@ TEST(SamplerTest, MoreThanTheGridCanHoldIsRefusedByName) {
   }
   o.n = std::int64_t(1) << 32;
   EXPECT_THROW(sample(o), InvalidArgument);  // beyond the 2^31 point cap
+}
+
+// A domain whose short side would be one grid node wide is refused (its points bunched up: 300 at aspect
+// 5000 all in the left half); one just inside the limit (two nodes) covers both of its sides. An extreme
+// aspect ratio is refused before its grid's size overflows an int.
+TEST(SamplerTest, TooNarrowADomainIsRefusedAndANarrowOneCovered) {
+  for (double aspect : {5000.0, 1 / 5000.0, 1e300, 1e-300}) {
+    SamplerOptions o = options_for(300, Domain::kTorus);
+    o.extent[0] = aspect;
+    try {
+      sample(o);
+      ADD_FAILURE() << "aspect " << aspect << ": no error";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("too narrow"), std::string::npos) << e.what();
+    }
+  }
+  SamplerOptions resolution = options_for(0, Domain::kTorus);
+  resolution.resolution = 1;
+  EXPECT_THROW(sample(resolution), InvalidArgument);
+  for (double aspect : {2500.0, 1 / 2500.0}) {
+    SamplerOptions o = options_for(300, Domain::kTorus);
+    o.extent[0] = aspect;
+    const SampleResult r = sample(o);
+    ASSERT_EQ(r.size(), 300u);
+    const int long_axis = aspect > 1 ? 0 : 1;
+    double lo[2] = {1, 1}, hi[2] = {0, 0}, low_half = 0;
+    for (std::size_t j = 0; j < r.size(); ++j)
+      for (int k = 0; k < 2; ++k) {
+        const double u = r.points[2 * j + k];
+        lo[k] = std::min(lo[k], u), hi[k] = std::max(hi[k], u);
+        if (k == long_axis) low_half += u < 0.5;
+      }
+    EXPECT_LT(lo[long_axis], 0.02) << aspect;
+    EXPECT_GT(hi[long_axis], 0.98) << aspect;
+    EXPECT_NEAR(low_half / 300, 0.5, 0.1) << aspect;
+    EXPECT_GT(hi[1 - long_axis] - lo[1 - long_axis], 0.5) << aspect;  // across the short side too
+  }
 }
 
 // Window counts against a density that varies along x only: square windows, as small as possible while

@@ -22,6 +22,7 @@
 #include "kdm/analysis/report.h"
 #include "kdm/generator/sampler.h"
 #include "sampler_density.h"
+#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {
@@ -186,10 +187,7 @@ void add_analyze_command(CLI::App& app) {
                   "Bands of the per-band bias table: the points where the target density lies in each "
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
-  cmd->add_option("--threads", args->threads,
-                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); results do not "
-                  "depend on it")
-      ->capture_default_str();
+  add_threads_option(cmd, args->threads, "results do not depend on it");
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->callback([args] { run_analyze(*args); });
 }

@@ -76,6 +76,9 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   std::vector<std::unique_ptr<tools::DensitySpec>> specs;
   for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes)
     specs.push_back(std::make_unique<tools::DensitySpec>(parse_density(text, a.gamma, a.invert)));
+  std::vector<const tools::DensitySpec*> class_specs;
+  for (const auto& spec : specs) class_specs.push_back(spec.get());
+  check_class_images(class_specs);
   const bool any_map = std::any_of(specs.begin(), specs.end(), [](const auto& s) {
     return s->kind != tools::DensitySpec::Kind::kConstant;
   });

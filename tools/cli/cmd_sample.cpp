@@ -14,6 +14,7 @@
 #include "kdm/generator/sampler.h"
 #include "point_output.h"
 #include "progress.h"
+#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {
@@ -46,11 +47,12 @@ gen::Density class_density(const tools::DensitySpec& spec) {
   return gen::Density::from_values(1, 1, {static_cast<float>(spec.constant)});
 }
 
-void run_sample(const SampleArgs& args, bool density_given) {
+void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
   if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
   if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");
-  if (!(args.aspect >= 0 && std::isfinite(args.aspect))) throw CommandError("--aspect must be a number > 0");
+  if (aspect_given && !(args.aspect > 0 && std::isfinite(args.aspect)))
+    throw CommandError("--aspect must be a number > 0");
   if (!(args.width_px >= 1 && args.width_px <= 65536))
     throw CommandError("--width must be 1 to 65536 pixels");
   if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
@@ -64,6 +66,9 @@ void run_sample(const SampleArgs& args, bool density_given) {
   std::vector<tools::DensitySpec> specs;
   for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density})
     specs.push_back(parse_density(text, args.gamma, args.invert));
+  std::vector<const tools::DensitySpec*> class_specs;
+  for (const tools::DensitySpec& s : specs) class_specs.push_back(&s);
+  check_class_images(class_specs);
   bool image = false, edged = false;
   for (const tools::DensitySpec& s : specs) {
     image = image || s.kind == tools::DensitySpec::Kind::kImage;
@@ -74,7 +79,7 @@ void run_sample(const SampleArgs& args, bool density_given) {
   const std::string domain = args.domain.empty() ? (edged ? "box" : "torus") : args.domain;
   o.domain = domain == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
   double aspect = args.aspect;
-  if (aspect <= 0) {
+  if (!aspect_given) {
     aspect = 1;
     for (const tools::DensitySpec& s : specs)
       if (s.kind == tools::DensitySpec::Kind::kImage) {
@@ -113,6 +118,10 @@ void run_sample(const SampleArgs& args, bool density_given) {
     throw CommandError(e.what());
   }
   bar.finish();
+  // --resolution sets the grid and the model the count: too coarse a grid holds no point at all.
+  if (result.points.empty())
+    throw CommandError("--resolution " + std::to_string(o.resolution) +
+                       " is too coarse: the model puts no points on that grid (raise it, or give --n)");
   set.dim = result.dim;
   set.coords = std::move(result.points);
   const gen::SampleReport& r = result.report;
@@ -184,10 +193,7 @@ void add_sample_command(CLI::App& app) {
                   "in pictures); by default one class, --density");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
-  cmd->add_option("--threads", o.threads,
-                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); output does not "
-                  "depend on it")
-      ->capture_default_str();
+  add_threads_option(cmd, o.threads, "output does not depend on it");
   cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points on the finest level")
       ->capture_default_str();
   cmd->add_option("--coarse-sweeps", o.coarse_sweeps,
@@ -209,7 +215,9 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output,
                   "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,class]), .svg or .png")
       ->required();
-  cmd->callback([args, cmd] { run_sample(*args, cmd->get_option("--density")->count() > 0); });
+  cmd->callback([args, cmd] {
+    run_sample(*args, cmd->get_option("--density")->count() > 0, cmd->get_option("--aspect")->count() > 0);
+  });
 }
 
 }  // namespace kdm::cli

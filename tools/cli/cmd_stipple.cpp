@@ -48,8 +48,10 @@ std::string frame_path(const std::string& output, int i) {
   return output.substr(0, at) + number + output.substr(at);
 }
 
-void run_stipple(const StippleArgs& a) {
-  if (a.points <= 0 && a.scale <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
+void run_stipple(const StippleArgs& a, bool scale_given) {
+  if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
+    throw CommandError("--scale must be a number > 0 (dots per unit area at full darkness)");
+  if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
   if (a.frames < 0 || a.frames == 1 || a.frames > 10000)
     throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
                        std::to_string(a.frames));
@@ -110,7 +112,14 @@ void run_stipple(const StippleArgs& a) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      const std::int64_t count = a.points > 0 ? a.points : std::llround(a.scale * aspect);
+      const double dots = a.points > 0 ? double(a.points) : a.scale * aspect;
+      if (!(dots <= double(std::int64_t(1) << 31))) {  // the full sampler's limit, before llround overflows
+        char message[160];
+        std::snprintf(message, sizeof message,
+                      "--scale %g asks for %.3g dots, more than the full sampler's 2^31", a.scale, dots);
+        throw CommandError(message);
+      }
+      const std::int64_t count = std::llround(dots);
       if (coloured) {
         std::vector<const tools::DensitySpec*> specs;
         for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
@@ -197,9 +206,10 @@ void add_stipple_command(CLI::App& app) {
                   "stable (dots never move as the density or zoom changes)")
       ->check(CLI::IsMember({"stable", "smooth"}))
       ->capture_default_str();
-  cmd->callback([a] {
-    if (a->scale > 0) a->points = 0;
-    run_stipple(*a);
+  cmd->callback([a, cmd] {
+    const bool scale_given = cmd->get_option("--scale")->count() > 0;
+    if (scale_given) a->points = 0;
+    run_stipple(*a, scale_given);
   });
 }
 

@@ -15,6 +15,7 @@
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
 #include "progress.h"
+#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {
@@ -22,7 +23,16 @@ namespace {
 std::string read_text(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw CommandError("cannot open recipe '" + path + "'");
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  // A recipe is a few lines: reading stops past the header's cap for it, so an endless input (a device, a
+  // pipe) or a directory fails instead of filling memory.
+  std::string text(kMaxTilesetHeaderBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw CommandError("cannot read recipe '" + path + "'");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxTilesetHeaderBytes)
+    throw CommandError("recipe '" + path + "' is longer than " + std::to_string(kMaxTilesetHeaderBytes) +
+                       " bytes: not a recipe");
+  return text;
 }
 
 void run_bake(const std::string& recipe_path, const std::string& output, int threads) {
@@ -53,13 +63,12 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
 }
 
 void run_info(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw CommandError("cannot open '" + path + "'");
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   // The runtime answers what the file is: its header, then the set as queries would hold it.
+  std::vector<char> bytes;
   TilesetHeader header;
   std::string detail;
-  Status s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+  Status s = read_tileset_file(path, bytes, &detail);
+  if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
   Tileset loaded;
   if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), loaded, &detail);
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
@@ -116,10 +125,7 @@ void add_tile_commands(CLI::App& app) {
                    "keyframes, glide_sweeps, glide_separation, glide_consensus, handover_zone)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
-  bake->add_option("--threads", *threads,
-                   "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); the file does "
-                   "not depend on it")
-      ->capture_default_str();
+  add_threads_option(bake, *threads, "the file does not depend on it");
   bake->callback([=] { run_bake(*recipe, *output, *threads); });
 
   auto info_path = std::make_shared<std::string>();

@@ -2,12 +2,14 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "commands.h"
 #include "kdm/verify/verify.h"
 #include "progress.h"
+#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {
@@ -19,6 +21,11 @@ struct VerifyArgs {
 };
 
 void run_verify(VerifyArgs args) {
+  // 0 turns a bar off; a negative or NaN bar would too, silently.
+  if (!(args.options.bars.hole_largest >= 0 && std::isfinite(args.options.bars.hole_largest)))
+    throw CommandError("--hole-largest must be a number >= 0 (0: report only)");
+  if (!(args.options.bars.holes_per_1e5 >= 0 && std::isfinite(args.options.bars.holes_per_1e5)))
+    throw CommandError("--holes-per-1e5 must be a number >= 0 (0: report only)");
   TilesetData set;
   std::string detail;
   const Status s = load_tileset(args.path, set, &detail);
@@ -69,10 +76,7 @@ void add_verify_command(CLI::App& app) {
                   "Fail a complete level or keyframe with more empty circles above 0.85 d_hex per 10^5 "
                   "points (0: report only; the design's bar is 10)")
       ->capture_default_str();
-  cmd->add_option("--threads", args->options.threads,
-                  "Worker threads (0: OMP_NUM_THREADS, else the CPUs this process may use); results do not "
-                  "depend on it")
-      ->capture_default_str();
+  add_threads_option(cmd, args->options.threads, "results do not depend on it");
   cmd->callback([args] { run_verify(*args); });
 }
 

@@ -14,4 +14,19 @@ tools::DensitySpec parse_density(const std::string& text, double gamma, bool inv
   }
 }
 
+void check_class_images(const std::vector<const tools::DensitySpec*>& classes) {
+  const tools::DensitySpec* first = nullptr;
+  for (const tools::DensitySpec* s : classes) {
+    if (s->kind != tools::DensitySpec::Kind::kImage) continue;
+    if (!first) {
+      first = s;
+    } else if (s->width != first->width || s->height != first->height) {
+      auto size = [](const tools::DensitySpec& i) {
+        return "'" + i.text + "' is " + std::to_string(i.width) + "x" + std::to_string(i.height);
+      };
+      throw CommandError("--class images must all have one size: " + size(*first) + ", " + size(*s));
+    }
+  }
+}
+
 }  // namespace kdm::cli

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "density_spec.h"
 
@@ -11,5 +12,9 @@ namespace kdm::cli {
 
 /// Parses --density (see tools::parse_density_spec). Throws CommandError naming the problem.
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert);
+
+/// The --class densities share one domain, each image stretched over all of it: images of different sizes
+/// would each be stretched differently. Throws CommandError naming two that differ.
+void check_class_images(const std::vector<const tools::DensitySpec*>& classes);
 
 }  // namespace kdm::cli

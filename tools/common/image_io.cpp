@@ -6,10 +6,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <utility>
+
+#include <sys/stat.h>
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
@@ -357,6 +358,11 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
+  struct stat info;  // a directory opens, and then reads as an error or as a huge size
+  if (fstat(fileno(file.get()), &info) == 0 && S_ISDIR(info.st_mode)) {
+    error = "cannot read image '" + path + "': it is a directory";
+    return false;
+  }
   const auto too_large = [&] {
     error = "cannot read image '" + path + "': larger than 2 GiB";
     return false;
@@ -402,13 +408,19 @@ bool write_png(const std::string& path, const RgbImage& image, std::string& erro
     error = "cannot write an empty image to '" + path + "'";
     return false;
   }
-  const std::string tmp = temp_path_for(path);
-  if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.pixels.data(), image.width * 3)) {
-    error = "cannot write '" + path + "': " + std::strerror(errno);
-    std::remove(tmp.c_str());
+  // Encoded in memory, then written with checked writes: stbi_write_png ignores fwrite and fclose errors
+  // (a full disk or a file size limit would leave a truncated PNG reported as written).
+  std::string png;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<std::size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.pixels.data(),
+                              image.width * 3)) {
+    error = "cannot write '" + path + "': PNG encoding failed";
     return false;
   }
-  return commit_temp(tmp, path, error);
+  return write_text_file_atomic(path, png, error);
 }
 
 void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode) {
@@ -436,13 +448,18 @@ void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8
 
 bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error) {
   const std::string tmp = temp_path_for(path);
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f || !(f << text) || !f.flush()) {
-      error = "cannot write '" + path + "': " + std::strerror(errno);
-      std::remove(tmp.c_str());
-      return false;
-    }
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) {
+    error = "cannot write '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  // fclose too can fail (delayed write errors); either failure leaves no file behind.
+  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  const int write_errno = errno;
+  if (std::fclose(f) != 0 || !written) {
+    error = "cannot write '" + path + "': " + std::strerror(written ? errno : write_errno);
+    std::remove(tmp.c_str());
+    return false;
   }
   return commit_temp(tmp, path, error);
 }

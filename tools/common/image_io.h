@@ -65,7 +65,7 @@ bool write_png(const std::string& path, const RgbImage& image, std::string& erro
 /// over what is there, or with `mode` 1 multiplied into it (inks on paper), 2 added to it (light).
 void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode = 0);
 
-/// Writes `text` to `path` atomically (temporary file, then rename).
+/// Writes `text` (any bytes) to `path` atomically (temporary file, then rename), every write checked.
 bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error);
 
 }  // namespace kdm::tools

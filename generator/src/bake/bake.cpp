@@ -140,7 +140,13 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     const std::uint32_t m = 1u << (r.levels - 1);  // √(N_top / N_0)
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
       throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
-    if (2 * r.handover_zone + 1 >= m)  // Subdivision: corner squares and edge bands must not meet
+    // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side), which
+    // 2 levels' 2 subtiles per side cannot give for any zone.
+    if (m < 4)
+      throw InvalidArgument("recipe: handover_zone needs at least 3 levels: " + std::to_string(r.levels) +
+                            " levels give " + std::to_string(m) +
+                            " subtiles per side, too few for a zone of 1 (2 * zone + 1 must be below it)");
+    if (2 * r.handover_zone + 1 >= m)
       throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) + "] for " +
                             std::to_string(r.levels) + " levels (" + std::to_string(m) +
                             " subtiles per side)");

@@ -146,6 +146,20 @@ std::vector<float> sample_density(const Grid<D>& grid, const Density& density, i
   return sample_function<D>(grid, density, threads);
 }
 
+/// The refusal of a domain whose finest grid is one node wide across its short side. That leaves the chain
+/// no room across it: measured with a uniform density, the points then bunch up (300 at aspect ratio
+/// 5000: all in the left half), while two nodes sample it evenly.
+InvalidArgument too_narrow(const SamplerOptions& o) {
+  double min_extent = o.extent[0], max_extent = o.extent[0];
+  for (int k = 1; k < o.dim; ++k)
+    min_extent = std::min(min_extent, o.extent[k]), max_extent = std::max(max_extent, o.extent[k]);
+  std::ostringstream s;
+  s << "the domain is too narrow for " << o.n << " points: at aspect ratio " << max_extent / min_extent
+    << " its short side would be one grid node wide, and the sampler needs two (an aspect ratio, or its "
+       "inverse, of at most about 10 times the point count); ask for more points or a squarer domain";
+  return InvalidArgument(s.str());
+}
+
 template <int D>
 Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
   double min_extent = o.extent[0];
@@ -153,20 +167,21 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
   levels = 1;
   while (shortest / std::ldexp(1.0, levels) >= o.coarsest_grid) ++levels;
   const double unit = std::ldexp(1.0, levels - 1);
-  Grid<D> g;
-  g.torus = o.domain == Domain::kTorus;
-  double nodes = 1;
+  double dims[D], nodes = 1, fewest = 0;  // in double first: an extreme aspect ratio overflows an int
   for (int k = 0; k < D; ++k) {
-    g.dims[k] =
-        static_cast<int>(unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit)));
-    nodes *= g.dims[k];
+    dims[k] = unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit));
+    nodes *= dims[k], fewest = k ? std::min(fewest, dims[k]) : dims[k];
   }
-  if (nodes > double(o.max_grid_nodes)) {
+  if (!(nodes <= double(o.max_grid_nodes))) {
+    if (fewest < 2) throw too_narrow(o);  // refining the grid only makes it larger: say what is wrong
     std::ostringstream s;
     s << "the density needs a computational grid of " << nodes << " nodes, more than the limit of "
-      << o.max_grid_nodes << " (ask for fewer points or a smaller dynamic range)";
+      << o.max_grid_nodes << " (ask for fewer points, a smaller dynamic range or a squarer domain)";
     throw InvalidArgument(s.str());
   }
+  Grid<D> g;
+  g.torus = o.domain == Domain::kTorus;
+  for (int k = 0; k < D; ++k) g.dims[k] = static_cast<int>(dims[k]);
   return g;
 }
 
@@ -243,7 +258,9 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       }
       shortest *= std::pow(peak / o.peak_density, 1.0 / D) * 1.01;
     }
+    if (*std::min_element(grid.dims.begin(), grid.dims.end()) < 2) throw too_narrow(o);
   } else {
+    if (o.resolution < 2) throw InvalidArgument("grid resolution must be at least 2 nodes");
     grid = make_grid<D>(o, o.resolution, levels);
     rho = sample_density<D>(grid, density, threads);
     const double mx = *std::max_element(rho.begin(), rho.end());

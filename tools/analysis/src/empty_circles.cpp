@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -38,11 +39,26 @@ Circle circumcircle(const double* a, const double* b, const double* c) {
 template <class Visit>
 void delaunay(std::vector<double>& xy, Visit&& visit) {
   const int n = static_cast<int>(xy.size() / 2);
+  // Points that span no area have no triangulation: Qhull fails on them after pages of its internals.
+  bool flat = true;
+  for (int i = 1, far = 0; i < n && flat; ++i) {  // far: the point farthest from the first yet
+    const double fx = xy[2 * far] - xy[0], fy = xy[2 * far + 1] - xy[1];
+    const double dx = xy[2 * i] - xy[0], dy = xy[2 * i + 1] - xy[1];
+    flat = std::fabs(fx * dy - fy * dx) <= 1e-12 * (fx * fx + fy * fy + dx * dx + dy * dy);
+    if (dx * dx + dy * dy > fx * fx + fy * fy) far = i;
+  }
+  if (flat)
+    throw InvalidInput(
+        "the points are degenerate (all coincident or on one line): they have no Delaunay "
+        "triangulation");
+  // Qhull's own report of any other failure goes to a scratch file: the error below says it in one line.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> sink(std::tmpfile(), std::fclose);
+  std::FILE* err = sink ? sink.get() : stderr;
   qhT qh_qh;
   qhT* qh = &qh_qh;
-  qh_zero(qh, stderr);
+  qh_zero(qh, err);
   char flags[] = "qhull d Qbb Qc Qz Q12 Qt";
-  const int failed = qh_new_qhull(qh, 2, n, xy.data(), False, flags, nullptr, stderr);
+  const int failed = qh_new_qhull(qh, 2, n, xy.data(), False, flags, nullptr, err);
   if (!failed) {
     facetT* facet;
     FORALLfacets {
