@@ -82,6 +82,21 @@ class Tileset:
         value = lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo)  # IEEE double, this order
         return struct.unpack("<f", struct.pack("<f", value))[0]
 
+    def coarsest_level_thresholds(self):
+        """Doc §7: every tile's level-0 thresholds as queries compare them, spread over the tiles."""
+        pooled = []  # (threshold, tie, tile, rank): tie counts the tile's earlier ranks of equal threshold
+        for t, tile in enumerate(self.tiles):
+            for i in range(tile.level_end[0]):
+                value = self.threshold(0, tile.keys[i])
+                tie = pooled[-1][1] + 1 if i > 0 and pooled[-1][0] == value else 0
+                pooled.append((value, tie, t, i))
+        pooled.sort(key=lambda p: (p[0], p[1], p[2]))
+        out = [[0.0] * tile.level_end[0] for tile in self.tiles]
+        step = self.level_nominal[0] / len(pooled)  # IEEE double
+        for i, (_, _, t, rank) in enumerate(pooled):
+            out[t][rank] = struct.unpack("<f", struct.pack("<f", (i + 0.5) * step))[0]
+        return out
+
     def emits(self, level, key, expected):
         """Doc §7: emitted iff the tile's expected point count exceeds the threshold."""
         return expected > self.threshold(level, key)
@@ -476,12 +491,14 @@ def summary(ts):
         f"recipe_crc32 {_crc32(ts.recipe):08x}",
         f"generator_version {_escaped(ts.generator_version)}",
     ]
+    coarsest = ts.coarsest_level_thresholds()
     for t, tile in enumerate(ts.tiles):
         # (x, y, key) as three little-endian u16 per point; each point's float32 threshold as its bits.
         triples = array.array("H", bytes(6 * len(tile.xs)))
         triples[0::3], triples[1::3], triples[2::3] = tile.xs, tile.ys, tile.keys
         levels = tile.levels_of_points()
-        thresholds = array.array("f", [ts.threshold(k, q) for k, q in zip(levels, tile.keys)])
+        thresholds = array.array("f", coarsest[t] + [ts.threshold(k, q) for k, q in zip(levels, tile.keys)
+                                                     if k > 0])
         lines.append(
             f"tile {t} points {len(tile.xs)} level_end {' '.join(str(e) for e in tile.level_end)}"
             f" points_crc32 {_crc32(_le_bytes(triples)):08x}"

@@ -11,12 +11,14 @@ namespace kdm::detail {
 
 QueryTables::QueryTables(const TilesetData& set) {
   // Thresholds once per load, so the query loop compares instead of interpolating.
+  const std::vector<std::vector<float>> coarsest = coarsest_level_thresholds(set);
   thresholds.assign(set.tiles.size(), {});
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
     TilesetArray<float>& out = thresholds[t];
+    out.assign(coarsest[t].begin(), coarsest[t].end());
     out.resize(tile.points.size());
-    for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
+    for (std::uint32_t k = 1, i = tile.level_end[0]; k < set.levels; ++k)
       for (; i < tile.level_end[k]; ++i) out[i] = set.emission_threshold(k, tile.keys[i]);
   }
   min_threshold = HUGE_VAL;

@@ -4,6 +4,7 @@
 // and validates the structure it built.
 #include <zstd.h>
 
+#include <algorithm>
 #include <cereal/archives/portable_binary.hpp>
 #include <cerrno>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <sstream>
 #include <streambuf>
+#include <tuple>
 #include <vector>
 
 #include <sys/stat.h>
@@ -266,6 +268,33 @@ std::string handover_problem(const TilesetData& set) {
 
 std::uint32_t tileset_format_version_for(const TilesetShape& set) {
   return set.handover_zone ? kTilesetFormatVersion : 4;  // 4 also rebakes older recipes byte for byte
+}
+
+std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set) {
+  std::vector<std::vector<float>> out(set.tiles.size());
+  struct Coarsest {
+    float threshold;
+    std::uint32_t tie;  // how many earlier ranks of its tile have the same threshold
+    std::uint32_t tile, rank;
+  };
+  std::vector<Coarsest> coarsest;
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    const Tile& tile = set.tiles[t];
+    out[t].resize(tile.level_end.empty() ? 0 : tile.level_end[0]);
+    for (std::uint32_t i = 0; i < out[t].size(); ++i) {
+      const float threshold = set.emission_threshold(0, tile.keys[i]);
+      const bool tied = i > 0 && coarsest.back().threshold == threshold;
+      coarsest.push_back({threshold, tied ? coarsest.back().tie + 1 : 0, static_cast<std::uint32_t>(t), i});
+    }
+  }
+  std::sort(coarsest.begin(), coarsest.end(), [](const Coarsest& a, const Coarsest& b) {
+    return std::tie(a.threshold, a.tie, a.tile) < std::tie(b.threshold, b.tie, b.tile);
+  });
+  // Spread over (0, N_0) as the keys are, so the level is complete where it was.
+  const double step = double(set.level_nominal[0]) / double(coarsest.size());
+  for (std::size_t i = 0; i < coarsest.size(); ++i)
+    out[coarsest[i].tile][coarsest[i].rank] = static_cast<float>((double(i) + 0.5) * step);
+  return out;
 }
 
 Status validate_tileset(const TilesetData& set, std::string* detail) {

@@ -367,6 +367,19 @@ TEST(QueryTest, FollowsADensityRamp) {
   EXPECT_LE(std::fabs(acc.bias), 0.005);
 }
 
+// Below the coarsest level's count, a tile emits on average its share of the expected count (the level
+// spread over the tiles: coarsest_level_thresholds). Over 64 × 64 tiles, measured at 1 to 24 points per
+// tile and six places: within 1.2% of the expected count, 0.4% apart between places; the thresholds as
+// keyed gave 50% at 1, 78% at 4, 93% at 8 and 16. Both modes emit the same count.
+TEST(QueryTest, TheSparseEndEmitsItsShareOfEveryCount) {
+  for (const QueryMode mode : kModes)
+    for (const double count : {1.0, 2.0, 4.0, 6.0, 8.0, 16.0, 24.0}) {
+      const double x0 = 1000.5 * count;
+      const std::size_t n = run(region(x0, 0, x0 + 64, 64, count, mode)).size();
+      EXPECT_NEAR(double(n) / (count * 64 * 64), 1.0, 0.02) << count << " points per tile";
+    }
+}
+
 TEST(QueryTest, FollowsADensityImage) {
   // A 64×64 image over the 4×4 region: a 1:1000 radial falloff, bilinear between texels.
   std::vector<float> values(64 * 64), mip;

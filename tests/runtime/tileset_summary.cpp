@@ -81,6 +81,7 @@ int main(int argc, char** argv) {
   std::printf("\nrecipe_bytes %zu\nrecipe_crc32 %08x\ngenerator_version %s\n", set.recipe.size(),
               crc32({set.recipe.begin(), set.recipe.end()}), escaped(set.generator_version).c_str());
   std::vector<std::uint8_t> triples, thresholds;
+  const std::vector<std::vector<float>> coarsest = kdm::coarsest_level_thresholds(set);
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const kdm::Tile& tile = set.tiles[t];
     // (x, y, key) as three little-endian u16 per point, and each point's float32 emission threshold as
@@ -93,7 +94,7 @@ int main(int argc, char** argv) {
       put16(triples, tile.points[i].y);
       put16(triples, tile.keys[i]);
       while (i >= tile.level_end[level]) ++level;
-      const float threshold = set.emission_threshold(level, tile.keys[i]);
+      const float threshold = level == 0 ? coarsest[t][i] : set.emission_threshold(level, tile.keys[i]);
       std::uint32_t bits = 0;
       static_assert(sizeof bits == sizeof threshold);
       std::memcpy(&bits, &threshold, sizeof bits);

@@ -31,9 +31,11 @@ std::vector<double> glided(const TilesetData& set, std::size_t t, double count, 
   const std::vector<std::size_t> start = glide_starts(set, tile);
   const double e0 = set.glide_unit(g0), e1 = set.glide_unit(g1);
   std::vector<double> out;
+  const std::vector<float> coarsest = coarsest_level_thresholds(set)[t];
   for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
     for (; i < tile.level_end[k]; ++i) {
-      if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) return out;
+      if (!TilesetShape::emits(k == 0 ? coarsest[i] : set.emission_threshold(k, tile.keys[i]), count))
+        return out;
       const std::int8_t* o0 = &tile.glide[2 * (start[g0] + i)];
       const std::int8_t* o1 = &tile.glide[2 * (start[g1] + i)];
       out.insert(out.end(), {tile.points[i].unit_x() + o0[0] * e0 + s * (o1[0] * e1 - o0[0] * e0),

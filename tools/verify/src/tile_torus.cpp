@@ -13,12 +13,15 @@ namespace kdm::verify {
 std::vector<double> torus_points(const TilesetData& set, std::size_t t, double count,
                                  std::vector<double>* own, std::vector<double>* others) {
   std::vector<double> all;
+  const std::vector<std::vector<float>> coarsest = coarsest_level_thresholds(set);
   for (int ty = 0; ty < 2; ++ty)
     for (int tx = 0; tx < 2; ++tx) {
-      const Tile& tile = set.tiles[gen::tile_around(set.colours, t, tx, ty)];
+      const std::size_t index = gen::tile_around(set.colours, t, tx, ty);
+      const Tile& tile = set.tiles[index];
       for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
         for (; i < tile.level_end[k]; ++i) {
-          if (!TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count)) continue;
+          const float threshold = k == 0 ? coarsest[index][i] : set.emission_threshold(k, tile.keys[i]);
+          if (!TilesetShape::emits(threshold, count)) continue;
           const double x = (tx + tile.points[i].unit_x()) / 2, y = (ty + tile.points[i].unit_y()) / 2;
           all.insert(all.end(), {x, y});
           std::vector<double>* part = (tx == 0 && ty == 0) ? own : others;
@@ -30,10 +33,12 @@ std::vector<double> torus_points(const TilesetData& set, std::size_t t, double c
 
 TilePositions stable_positions(const TilesetData& set, double count) {
   TilePositions at(set.tiles.size());
+  const std::vector<std::vector<float>> coarsest = coarsest_level_thresholds(set);
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
     for (std::uint32_t k = 0, i = 0; k < set.levels; ++k)
-      for (; i < tile.level_end[k] && TilesetShape::emits(set.emission_threshold(k, tile.keys[i]), count);
+      for (; i < tile.level_end[k] &&
+             TilesetShape::emits(k == 0 ? coarsest[t][i] : set.emission_threshold(k, tile.keys[i]), count);
            ++i)
         at[t].insert(at[t].end(), {tile.points[i].unit_x(), tile.points[i].unit_y()});
   }
