@@ -127,6 +127,9 @@ kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
   return to_c(status);
 }
 
+static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN,
+              "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
+
 /// Writes `why` into the caller's problem struct, if it gave one.
 void report(const kdm::QueryProblem& why, kdm_query_problem* problem) {
   if (!problem || problem->struct_size < kProblemV1) return;

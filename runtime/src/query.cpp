@@ -163,6 +163,15 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
+  // Depth-0 positions are summed in world units and a point's place in the region is decided in them: a
+  // double's step there (at most 2^-52 of the distance) must stay below a 16th of the spacing at depth 0
+  // and a quarter of the region's side, or positions fall together and regions lose their points.
+  const double far = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
+  const double spacing = S / std::sqrt(std::min(max_density * area_scale, top));
+  const double farthest = std::ldexp(std::min(spacing / 16, std::min(q.x1 - q.x0, q.y1 - q.y0) / 4), 52);
+  if (far > farthest)
+    return refuse(Kind::kTooFarFromOrigin, far == std::fabs(q.x0) || far == std::fabs(q.x1) ? "x0" : "y0",
+                  far, farthest);
   if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false, fingerprint};
   // A cursor inside a tile's subtiles names them by a path of subtile indices: a damaged one is refused.
   if (cursor->depth > (descend ? kMaxQueryDepth : 0)) return refuse(Kind::kCursorMismatch, "cursor");
@@ -498,6 +507,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
       return "a query needs between 1 and 8 classes";
     case QueryProblem::Kind::kKeysUnsupported:
       return "the tile set's tiles hold more points than a 64-bit point key can number";
+    case QueryProblem::Kind::kTooFarFromOrigin:
+      return "the region lies too far from the world origin for doubles to place its points";
   }
   return "unknown problem";
 }

@@ -109,6 +109,8 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
     (ValueError, "must not be negative.*'scale' = -1", dict(scale=-1)),
     (ValueError, r"more points per tile than .* use scale= 32768 or less", dict(scale=1e300)),
     (ValueError, "'tile_size' = 0", dict(tile_size=0)),
+    (ValueError, "too far from the world origin.*move the origin",
+     dict(rect=(1e15, 0, 1e15 + 1, 1), scale=1000)),
     (ValueError, "mode must be one of 'stable', 'smooth'", dict(mode="fast")),
     (ValueError, "origin must hold 2 numbers", dict(origin=(1, 2, 3))),
     (ValueError, "density_rect needs an image, an array or a test map", dict(density_rect=(0, 0, 1, 1))),

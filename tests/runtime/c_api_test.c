@@ -150,6 +150,10 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(strcmp(problem.parameter, "query.struct_size") == 0);
     q = uniform_query();
+    q.x0 = 1e15, q.x1 = 1e15 + 1; /* a double's step there is 1/8: points would fall together */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN && problem.limit < 1e15);
+    q = uniform_query();
     q.density = -1; /* a constant density that is none */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "density.constant") == 0);

@@ -9,6 +9,7 @@
 #include <map>
 #include <new>
 #include <random>
+#include <set>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -514,6 +515,22 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
   EXPECT_EQ(p.limit, double(kMaxQueryTiles));
   EXPECT_EQ(p.value, 8192.0 * 4097.0);
+  // 10^15 units out a double's step is 1/8, more than the spacing of 1,000 points per unit area: positions
+  // would fall together. 10^10 out, a region 2·10^-6 wide is one step wide, however deep smooth mode goes.
+  p = problem_of(region(1e15, 0, 1e15 + 1, 1, 1000));
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(p.parameter, "x0");
+  EXPECT_NEAR(p.value, 1e15, 1.0);  // |x1|, the farthest side
+  EXPECT_LT(p.limit, 1e15);
+  EXPECT_GT(p.limit, 1e12);  // 2^52 · spacing / 16 ≈ 8.9 · 10^12
+  p = problem_of(region(0, -1e10, 2e-6, -1e10 + 2e-6, 1e16, QueryMode::kSmooth));
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(p.parameter, "y0");
+  std::set<std::pair<double, double>> distinct;  // 10^12 out (a step of 1/8192) points stay apart
+  const std::vector<Key> far_points = run(region(1e12, 0, 1e12 + 1, 1, 1000));
+  for (const Key& k : far_points) distinct.insert({std::get<3>(k), std::get<4>(k)});
+  EXPECT_GT(far_points.size(), 900u);
+  EXPECT_EQ(distinct.size(), far_points.size());
   // 100,000 points per unit area at density 0.5 on tiles of side 2: 200,000 per tile, past the top level.
   q = region(0, 0, 4, 4, 100000);
   q.tile_size = 2, q.density.constant = 0.5;

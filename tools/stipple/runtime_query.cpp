@@ -21,6 +21,12 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
       std::snprintf(text, sizeof text, "%s: %.6g tiles, at most %.0f; use a larger %s or a smaller region",
                     query_problem_message(p.kind), p.value, p.limit, names.tile_size);
       break;
+    case QueryProblem::Kind::kTooFarFromOrigin:
+      std::snprintf(text, sizeof text,
+                    "%s: %.6g from it, at most %.6g for this density and region; keep the world's "
+                    "coordinates nearer its origin (move the origin), or ask for fewer points per unit area",
+                    query_problem_message(p.kind), p.value, p.limit);
+      break;
     default:
       std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
                     p.value);

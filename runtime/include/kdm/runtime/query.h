@@ -123,22 +123,26 @@ struct QueryCursor {
 /// largest value that passes (Detour-style detail, in plain values: nothing is allocated).
 struct QueryProblem {
   enum class Kind : int {
-    kNone = 0,         ///< no problem
-    kMissingArgument,  ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
-    kNotFinite,        ///< `parameter` is NaN or infinite; `value` holds it
-    kNotPositive,      ///< `parameter` ("tile_size") must be > 0; `value` holds it
-    kNegative,         ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
-                       ///< >= 0; `value` holds it
-    kBadDensity,       ///< `parameter` ("density.image", "density.callback") is missing or not prepared
-    kTooManyTiles,     ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
-    kDensityTooHigh,   ///< `value` expected points per tile exceed `limit` (query_density_limit):
-                       ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
-                       ///< largest tile size that fits this scale
-    kCursorMismatch,   ///< the cursor was started by a call with other parameters (or damaged)
-    kBadMode,          ///< `parameter` ("mode") is not a QueryMode; `value` holds it
-    kBadClassCount,    ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
-    kKeysUnsupported,  ///< query_points_compact: keys asked of a set whose tiles hold `value` points,
-                       ///< more than a key's ranks (`limit`, 2^19)
+    kNone = 0,          ///< no problem
+    kMissingArgument,   ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
+    kNotFinite,         ///< `parameter` is NaN or infinite; `value` holds it
+    kNotPositive,       ///< `parameter` ("tile_size") must be > 0; `value` holds it
+    kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
+                        ///< >= 0; `value` holds it
+    kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared
+    kTooManyTiles,      ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
+    kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
+                        ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
+                        ///< largest tile size that fits this scale
+    kCursorMismatch,    ///< the cursor was started by a call with other parameters (or damaged)
+    kBadMode,           ///< `parameter` ("mode") is not a QueryMode; `value` holds it
+    kBadClassCount,     ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
+    kKeysUnsupported,   ///< query_points_compact: keys asked of a set whose tiles hold `value` points,
+                        ///< more than a key's ranks (`limit`, 2^19)
+    kTooFarFromOrigin,  ///< the region lies `value` world units from the world origin, farther than
+                        ///< `limit`, where a double's step is over a 16th of the points' spacing (or a
+                        ///< quarter of the region's side): move the world's origin nearer, or query a
+                        ///< larger region at a lower density
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage
