@@ -49,6 +49,13 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_DOUBLE_EQ(guarded.min_distance, 0.35);
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(guarded.to_text()).min_distance, 0.35);
   EXPECT_THROW(BakeRecipe::parse("min_distance 0.8\n"), InvalidArgument);
+  try {  // a key given twice: which value was meant is not known
+    BakeRecipe::parse("levels 3\ncolours 2\nlevels 4\n");
+    ADD_FAILURE() << "a repeated key was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3: levels was already given on line 1"), std::string::npos)
+        << e.what();
+  }
   EXPECT_EQ(r.separation, 0.0);  // off unless named, and then not written
   EXPECT_EQ(r.to_text().find("separation"), std::string::npos);
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("separation 0.3\n").to_text()).separation, 0.3);

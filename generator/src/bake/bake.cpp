@@ -56,6 +56,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
   std::istringstream in(text);
   std::string line;
   int line_no = 0;
+  std::map<std::string, int> seen;  // key -> the line that gave it
   while (std::getline(in, line)) {
     ++line_no;
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
@@ -64,6 +65,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     if (!(fields >> key)) continue;
     const std::string where = "recipe line " + std::to_string(line_no) + ": ";
     if (!(fields >> value) || (fields >> extra)) throw InvalidArgument(where + "expected 'key value'");
+    // A second value would silently win over the first: which one the author meant is not known.
+    if (const auto [it, first] = seen.emplace(key, line_no); !first)
+      throw InvalidArgument(where + key + " was already given on line " + std::to_string(it->second));
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
     if (*end != '\0' || !std::isfinite(v)) throw InvalidArgument(where + "'" + value + "' is not a number");
