@@ -29,8 +29,9 @@ gen::Density to_generator_density(const DensitySpec& spec) {
   try {
     return gen::Density::from_values(spec.width, spec.height, spec.values);
   } catch (const gen::InvalidArgument& e) {
+    const bool blank = std::string(e.what()).find("zero everywhere") != std::string::npos;
     throw std::invalid_argument("image '" + spec.text + "': " + e.what() +
-                                (spec.inverted ? "" : " (an all-white image has no ink)"));
+                                (blank && !spec.inverted ? " (an all-white image has no ink)" : ""));
   }
 }
 
