@@ -209,6 +209,26 @@ TEST(ImageLimit, PathAndMemoryLoadersAgreeOnTheSeeds) {
   EXPECT_TRUE(contains(error, "'empty.png'")) << error;
 }
 
+// A PGM's samples are fractions of its maxval, whatever it is (stb reads them as they are); maxval 0 is
+// refused, not read as black.
+TEST(ImageLimit, PgmSamplesAreFractionsOfTheirMaxval) {
+  GreyImage image;
+  std::string error;
+  const std::string eight = std::string("P5 2 1 100\n") + char(100) + char(25);
+  ASSERT_TRUE(kdm::tools::load_grey_image_memory(eight.data(), eight.size(), image, error)) << error;
+  EXPECT_FLOAT_EQ(image.at(0, 0), 1.0f);
+  EXPECT_FLOAT_EQ(image.at(1, 0), 0.25f);
+  const std::string sixteen = std::string("P5 1 1 1000\n") + char(1) + char(244);  // 500 of 1000
+  ASSERT_TRUE(kdm::tools::load_grey_image_memory(sixteen.data(), sixteen.size(), image, error)) << error;
+  EXPECT_FLOAT_EQ(image.at(0, 0), 0.5f);
+  const std::string zero = std::string("P5 2 1 0\n") + char(0) + char(0);
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(zero.data(), zero.size(), image, error));
+  EXPECT_TRUE(contains(error, "maxval of 0")) << error;
+  const std::string above = std::string("P5 2 1 100\n") + char(100) + char(101);
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(above.data(), above.size(), image, error));
+  EXPECT_TRUE(contains(error, "a sample above its maxval of 100")) << error;
+}
+
 // A NUL byte inside a line is malformed, not the line's end (the reader used to stop there silently).
 TEST(PointFileInput, NulBytesAreMalformed) {
   std::vector<kdm::tools::PointSet> sets;

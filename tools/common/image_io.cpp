@@ -273,6 +273,19 @@ constexpr std::size_t channels_of(const ColourImage&) {
   return 3;
 }
 
+/// Whether every PGM/PPM sample is at most the file's maxval (else `error`: the file is corrupt).
+template <class Sample>
+bool samples_within(const Sample* data, std::size_t count, std::int64_t max_value, const std::string& name,
+                    std::string& error) {
+  for (std::size_t i = 0; i < count; ++i)
+    if (data[i] > max_value) {
+      error = "cannot read image '" + name + "': corrupt PGM/PPM (a sample above its maxval of " +
+              std::to_string(max_value) + ")";
+      return false;
+    }
+  return true;
+}
+
 // Both loaders end here, with the image file's bytes: the known faults of stb refused, then the header
 // read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
 template <class Image>
@@ -288,6 +301,12 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   }
   if (const char* fault = stb_fault(bytes, size)) {
     error = "cannot read image '" + name + "': " + fault;
+    return false;
+  }
+  // stb reads PGM/PPM samples as they are, whatever the file's maxval: full scale is the maxval here.
+  const PnmHeader pnm = pnm_header(bytes, size);
+  if (pnm.pnm && pnm.max_value == 0) {
+    error = "cannot read image '" + name + "': corrupt PGM/PPM (a maxval of 0)";
     return false;
   }
   const int length = static_cast<int>(size);
@@ -328,17 +347,18 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
         stbi_load_16_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
     // stb 2.27 copies 16-bit PGM/PPM samples in host byte order; Netpbm stores them big-endian.
-    if (const PnmHeader pnm = pnm_header(bytes, size);
-        pnm.pnm && pnm.max_value > 255 && pnm.channels == channels)
+    if (pnm.pnm && pnm.max_value > 255 && pnm.channels == channels)
       for (std::size_t i = 0; i < pixels * channels; ++i)
         data.get()[i] =
             static_cast<stbi_us>(bytes[pnm.pixels_at + 2 * i] << 8 | bytes[pnm.pixels_at + 2 * i + 1]);
-    convert(data.get(), channels, 65535.0f, image);
+    if (pnm.pnm && !samples_within(data.get(), pixels * channels, pnm.max_value, name, error)) return false;
+    convert(data.get(), channels, pnm.pnm ? float(pnm.max_value) : 65535.0f, image);
   } else {
     std::unique_ptr<stbi_uc, void (*)(void*)> data(
         stbi_load_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
-    convert(data.get(), channels, 255.0f, image);
+    if (pnm.pnm && !samples_within(data.get(), pixels * channels, pnm.max_value, name, error)) return false;
+    convert(data.get(), channels, pnm.pnm ? float(pnm.max_value) : 255.0f, image);
   }
   image.width = w;
   image.height = h;
