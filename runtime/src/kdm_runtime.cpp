@@ -195,6 +195,14 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
   return status;
 }
 
+/// The C name of a class query's refused argument: C++'s output `classes` is `out_classes` here, where
+/// `classes` names the densities.
+kdm::Status with_c_names(kdm::Status status, kdm::QueryProblem* why) {
+  if (why->kind == kdm::QueryProblem::Kind::kMissingArgument && std::strcmp(why->parameter, "classes") == 0)
+    why->parameter = "out_classes";
+  return status;
+}
+
 /// The class queries into records and into the compact output, for either kind of densities.
 kdm_status class_records(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
                          const kdm_joint_class_density* joint, bool is_joint, uint32_t class_count,
@@ -202,8 +210,9 @@ kdm_status class_records(const kdm_tileset* tileset, const kdm_query* query, con
                          kdm_cursor* cursor, kdm_query_problem* problem) {
   return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
                          [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
-                           return kdm::query_classes(*tileset->set, q, as_points(out), out_classes, capacity,
-                                                     written, k, why);
+                           return with_c_names(kdm::query_classes(*tileset->set, q, as_points(out),
+                                                                  out_classes, capacity, written, k, why),
+                                               why);
                          });
 }
 kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
@@ -212,8 +221,10 @@ kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, con
                          kdm_cursor* cursor, kdm_query_problem* problem) {
   return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
                          [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
-                           return kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
-                                                             out_classes, capacity, written, k, why);
+                           return with_c_names(
+                               kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                          out_classes, capacity, written, k, why),
+                               why);
                          });
 }
 

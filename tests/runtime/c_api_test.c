@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
     CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "classes") == 0);
     CHECK(kdm_query_classes(builtin, &q, densities, 3, points, NULL, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out_classes") == 0);
     /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
     {
       static float xy[2 * 4096], sum_xy[2 * 4096];
