@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "commands.h"
@@ -37,6 +38,10 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const kdm::cli::CommandError& e) {
     std::fprintf(stderr, "kdm: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr,
+                 "kdm: error: out of memory (fewer --threads, fewer points or a smaller image may fit)\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "kdm: error: %s\n", e.what());

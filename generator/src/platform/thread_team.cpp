@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <system_error>
+#include <utility>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -71,15 +72,29 @@ void ThreadTeam::run(int threads, const std::function<void(int, int)>& body) {
   const int team = std::min(threads, static_cast<int>(workers_.size()) + 1);
   if (team <= 1) return body(0, 1);
   body_ = &body;
+  error_ = nullptr;
   running_.store(team - 1);
   publish(static_cast<std::uint64_t>(team));
-  body(0, team);
+  call(0, team);
   auto finished = [&] { return running_.load() == 0; };
-  if (spin_until(finished)) return;
-  std::unique_lock<std::mutex> lock(mutex_);
-  ++sleepers_;
-  done_.wait(lock, finished);
-  --sleepers_;
+  if (!spin_until(finished)) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ++sleepers_;
+    done_.wait(lock, finished);
+    --sleepers_;
+  }
+  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+}
+
+void ThreadTeam::call(int index, int team) noexcept {
+  // An exception must not leave a worker's thread (that ends the process) nor the caller before the
+  // workers are done with `body`.
+  try {
+    (*body_)(index, team);
+  } catch (...) {
+    std::lock_guard<std::mutex> lock(error_mutex_);
+    if (!error_) error_ = std::current_exception();
+  }
 }
 
 void ThreadTeam::work(int index, std::uint64_t seen) {
@@ -96,7 +111,7 @@ void ThreadTeam::work(int index, std::uint64_t seen) {
     const int team = static_cast<int>(seen & kTeamMask);
     if (team == 0) return;
     if (index >= team) continue;
-    (*body_)(index, team);
+    call(index, team);
     if (--running_ == 0) notify(done_);
   }
 }

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -36,11 +37,13 @@ class ThreadTeam {
 
   /// Runs body(thread, threads) for thread = 0 .. threads - 1, thread 0 on the caller, and returns when all
   /// have returned. `threads` <= 1 calls body(0, 1) directly. If a worker cannot be started, the team is
-  /// smaller (body sees the actual size). The body must not throw.
+  /// smaller (body sees the actual size). If bodies throw (a worker out of memory), the others still run
+  /// to their end, and the first exception caught is rethrown here once all have returned.
   void run(int threads, const std::function<void(int, int)>& body);
 
  private:
   void work(int index, std::uint64_t seen);
+  void call(int index, int team) noexcept;
   void publish(std::uint64_t team);
   void notify(std::condition_variable& cv);
 
@@ -53,6 +56,8 @@ class ThreadTeam {
   std::atomic<int> running_{0};   // workers still in the current body
   std::atomic<int> sleepers_{0};  // threads asleep, or about to be, on wake_ or done_
   const std::function<void(int, int)>* body_ = nullptr;
+  std::mutex error_mutex_;
+  std::exception_ptr error_;  // the first exception a body threw in the current run
 };
 
 }  // namespace kdm::gen

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <exception>
+#include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -25,7 +28,9 @@ inline int worker_count(int threads, std::ptrdiff_t count) {
   return t;
 }
 
-/// Calls body(i, w) for every i in [0, count); w is the worker slot. Dynamic scheduling, blocking.
+/// Calls body(i, w) for every i in [0, count); w is the worker slot. Dynamic scheduling, blocking. If bodies
+/// throw (out of memory), the rest still run and the first exception is rethrown here: one must not leave a
+/// worker (that ends the process).
 template <class Body>
 void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
   const int workers = worker_count(threads, count);
@@ -33,18 +38,34 @@ void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
     for (std::ptrdiff_t i = 0; i < count; ++i) body(i, 0);
     return;
   }
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  auto guarded = [&](std::ptrdiff_t i, int w) noexcept {
+    try {
+      body(i, w);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+    }
+  };
 #ifdef _OPENMP
 #pragma omp parallel for schedule(dynamic, 1) num_threads(workers)
-  for (std::ptrdiff_t i = 0; i < count; ++i) body(i, omp_get_thread_num());
+  for (std::ptrdiff_t i = 0; i < count; ++i) guarded(i, omp_get_thread_num());
 #else
   std::atomic<std::ptrdiff_t> next{0};
   std::vector<std::thread> pool;
-  for (int w = 0; w < workers; ++w)
-    pool.emplace_back([&, w] {
-      for (std::ptrdiff_t i; (i = next.fetch_add(1)) < count;) body(i, w);
-    });
+  auto work = [&](int w) {
+    for (std::ptrdiff_t i; (i = next.fetch_add(1)) < count;) guarded(i, w);
+  };
+  try {
+    for (int w = 1; w < workers; ++w) pool.emplace_back(work, w);
+  } catch (const std::system_error&) {
+    // no more threads to be had: the started ones and this one share the work
+  }
+  work(0);
   for (std::thread& t : pool) t.join();
 #endif
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace kdm::analysis::detail
