@@ -187,8 +187,28 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const double sx = p.x + 0.5, sy = p.y + 0.5;
     return sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y;
   };
-  auto visit = [&](std::uint32_t c) -> std::uint32_t {
-    const TilePoint p = j.points[c];
+  // A candidate whose density `rho` is read at its stable position (x, y): written or queued, as visit says.
+  auto decide = [&](std::uint32_t c, TilePoint p, double x, double y, double rho) -> std::uint32_t {
+    const double expected = rho * j.area_scale;
+    // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
+    // written (or queued) at the next slot, which only an emitted one then keeps.
+    const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
+    if (!kBatched) {
+      if (n == capacity) return emitted ? c : kNone;
+      out.put_stable(n, j, p, c);
+      n += emitted;
+      return kNone;
+    }
+    pending_rank[pending] = c, pending_expected[pending] = expected;
+    pending_x[pending] = x, pending_y[pending] = y;
+    if constexpr (kClassesAtDensity<Sink>) {
+      if (emitted) pending_class[pending] = out.class_at(j, c, x, y);
+    }
+    pending += emitted;
+    return pending == kBatch ? flush() : kNone;
+  };
+  // Smooth mode beside the region: whether candidate c (at p) cannot glide into it.
+  auto beyond_reach = [&](std::uint32_t c, TilePoint p) {
     if (kSmooth && !kInside) {
       if (!kConstant && kListed && segment > 0 && c < j.ranks[segment - 1]) {  // cells' lists, one by one
         segment = 0;
@@ -200,8 +220,13 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       }
       // A listed constant-density candidate is glided and tested without a branch (place): its list has
       // already left out most of those the culling would, and whether it is culled follows no pattern.
-      if (!(kConstant && kListed) && culled(p)) return kNone;
+      if (!(kConstant && kListed) && culled(p)) return true;
     }
+    return false;
+  };
+  auto visit = [&](std::uint32_t c) -> std::uint32_t {
+    const TilePoint p = j.points[c];
+    if (beyond_reach(c, p)) return kNone;
     const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
     if constexpr (!kSmooth) {
       const bool in = kInside || ((x >= j.x0) & (x < j.x1) & (y >= j.y0) & (y < j.y1));
@@ -230,23 +255,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const double rho = kKind == QueryDensity::Kind::kImage
                            ? j.sampler->at(x, y)
                            : density_or_zero(j.density->callback(j.density->user, x, y));
-    const double expected = rho * j.area_scale;
-    // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
-    // written (or queued) at the next slot, which only an emitted one then keeps.
-    const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
-    if (!kBatched) {
-      if (n == capacity) return emitted ? c : kNone;
-      out.put_stable(n, j, p, c);
-      n += emitted;
-      return kNone;
-    }
-    pending_rank[pending] = c, pending_expected[pending] = expected;
-    pending_x[pending] = x, pending_y[pending] = y;
-    if constexpr (kClassesAtDensity<Sink>) {
-      if (emitted) pending_class[pending] = out.class_at(j, c, x, y);
-    }
-    pending += emitted;
-    return pending == kBatch ? flush() : kNone;
+    return decide(c, p, x, y, rho);
   };
   std::uint32_t stopped = kNone;
   if constexpr (kListed) {
@@ -297,6 +306,20 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       }
     }
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
+  } else if constexpr (kKind == QueryDensity::Kind::kImage && (kSmooth || kInside)) {
+    // Nearly every candidate's density is read (a tile in the region, or at its side): a block of them at
+    // once, in a loop the compiler vectorises.
+    constexpr std::uint32_t kBlock = 64;
+    double bx[kBlock], by[kBlock], rho[kBlock];
+    if (!image_run_fits(*j.sampler->image))
+      for (; c < end && stopped == kNone; ++c) stopped = visit(c);
+    while (c < end && stopped == kNone) {
+      const std::uint32_t count = std::min(end - c, kBlock);
+      image_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler->image, j.sampler->sx, j.sampler->sy, bx, by,
+                rho);
+      for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
+        if (!beyond_reach(c, j.points[c])) stopped = decide(c, j.points[c], bx[i], by[i], rho[i]);
+    }
   } else {
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   }
