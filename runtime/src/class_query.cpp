@@ -538,10 +538,17 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
                                            examined);
   } else {
-    const detail::VaryingClasses c{
-        classes,           &densities.scratch,      q.tile_size * q.tile_size * q.scale,
-        p.class_count - 1, Classifier::class_ranks, Classifier::class_of_id,
-        &classify};
+    detail::ClassImages images{&densities.samplers[0], {}, p.class_count};
+    for (std::uint32_t k = 0; k < p.class_count && densities.one_grid; ++k)
+      images.values[k] = p.classes[k].image->values;
+    const detail::VaryingClasses c{classes,
+                                   &densities.scratch,
+                                   q.tile_size * q.tile_size * q.scale,
+                                   p.class_count - 1,
+                                   Classifier::class_ranks,
+                                   Classifier::class_of_id,
+                                   &classify,
+                                   densities.one_grid ? &images : nullptr};
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
                                            examined);
   }

@@ -9,6 +9,7 @@
 
 #include "density_bounds.h"
 #include "float_runs.h"
+#include "image_runs.h"
 #include "image_sampler.h"
 #include "keyframe_lookup.h"
 #include "output_sinks.h"
@@ -309,17 +310,34 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   } else if constexpr (kKind == QueryDensity::Kind::kImage && (kSmooth || kInside)) {
     // Nearly every candidate's density is read (a tile in the region, or at its side): a block of them at
     // once, in a loop the compiler vectorises.
-    constexpr std::uint32_t kBlock = 64;
-    double bx[kBlock], by[kBlock], rho[kBlock];
-    if (!image_run_fits(*j.sampler->image))
+    double bx[kImageBlock], by[kImageBlock], rho[kImageBlock];
+    if (!image_runs_fit(*j.sampler->image))
       for (; c < end && stopped == kNone; ++c) stopped = visit(c);
     while (c < end && stopped == kNone) {
-      const std::uint32_t count = std::min(end - c, kBlock);
-      image_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler->image, j.sampler->sx, j.sampler->sy, bx, by,
-                rho);
+      const std::uint32_t count = std::min(end - c, kImageBlock);
+      image_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler, bx, by, rho);
       for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
         if (!beyond_reach(c, j.points[c])) stopped = decide(c, j.points[c], bx[i], by[i], rho[i]);
     }
+  } else if constexpr (kKind == QueryDensity::Kind::kCallback && kClassesAtDensity<Sink> &&
+                       (kSmooth || kInside)) {
+    // Classes that are all images on one grid: their running sums a block at a time, as above.
+    const ClassImages* images = out.images();
+    if (images && image_runs_fit(*images->grid->image)) {
+      double bx[kImageBlock], by[kImageBlock], sums[kImageBlock * kMaxQueryClasses];
+      const double* total = sums + (images->count - 1) * std::size_t(kImageBlock);
+      while (c < end && stopped == kNone) {
+        const std::uint32_t count = std::min(end - c, kImageBlock);
+        image_sums_run(j.points + c, count, j.wx, j.wy, j.S, *images->grid, images->values, images->count, bx,
+                       by, sums);
+        for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
+          if (!beyond_reach(c, j.points[c])) {
+            out.hold_sums(bx[i], by[i], sums + i, kImageBlock);
+            stopped = decide(c, j.points[c], bx[i], by[i], density_or_zero(total[i]));
+          }
+      }
+    }
+    for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   } else {
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);
   }

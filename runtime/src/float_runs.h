@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstring>
 
-#include "kdm/runtime/density_image.h"
 #include "kdm/runtime/tileset_format.h"
 
 namespace kdm::detail {
@@ -51,15 +50,5 @@ inline std::uint32_t next_unsettled(const std::uint8_t* flags, std::uint32_t i, 
 
 /// to[k] = first + k · step, for k < count.
 void key_run(std::uint64_t* to, std::size_t count, std::uint64_t first, std::uint64_t step);
-
-/// The bilinear density at candidates from[0 … count) of a tile at (wx, wy) of side S, read from `image`
-/// with scales sx, sy (ImageSampler): their stable world positions into x[k], y[k] and the density into
-/// rho[k], bit for bit as ImageSampler::at(x[k], y[k]) reads it. The image holds fewer than 2^31 texels
-/// (image_run_fits).
-void image_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
-               const DensityImageView& image, double sx, double sy, double* x, double* y, double* rho);
-inline bool image_run_fits(const DensityImageView& image) {
-  return std::uint64_t(image.width) * std::uint64_t(image.height) < (std::uint64_t(1) << 31);
-}
 
 }  // namespace kdm::detail

@@ -241,6 +241,15 @@ struct VaryingClassSink {
     c->class_ranks(c->user, j.tx, j.ty, rank, 1, &k);
     return k;
   }
+  /// Classes all images on one grid (ClassImages), else null.
+  const ClassImages* images() const { return c->images; }
+  /// The running sums read at stable position (x, y), sums[0], sums[stride], …: as the union's callback
+  /// leaves them, for class_at.
+  [[gnu::always_inline]] void hold_sums(double x, double y, const double* sums, std::size_t stride) const {
+    ClassScratch& s = *c->scratch;
+    for (std::uint32_t k = 0; k <= c->last; ++k) s.cumulative[k] = sums[k * stride];
+    s.x = x, s.y = y;
+  }
   /// A point whose class class_at gave (smooth mode: found before the glide, written after it).
   void put_classed(std::size_t i, double x, double y, const PointId& id, std::uint8_t k) const {
     base.put(i, x, y, id);

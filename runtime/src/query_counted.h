@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "image_sampler.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
@@ -65,15 +66,26 @@ struct ClassScratch {
 /// the running sums there, without reading a density again; other points by `class_ranks` (ranks
 /// [first, first + count) of depth-0 tile (tx, ty) into out[0..count)) or, past the top level,
 /// `class_of_id`. `area` is a depth-0 tile's area times the scale, as the classifier multiplies it.
+/// Classes that are all images on one grid of texels (class_query.cpp): `grid` reads class 0's, values[k]
+/// are class k's texels, k < count.
+struct ClassImages {
+  const ImageSampler* grid;
+  const float* values[kMaxQueryClasses];
+  std::uint32_t count;
+};
+
 struct VaryingClasses {
   std::uint8_t* classes;
-  const ClassScratch* scratch;
+  ClassScratch* scratch;
   double area;
   std::uint32_t last;
   void (*class_ranks)(void* user, std::int64_t tx, std::int64_t ty, std::uint32_t first, std::uint32_t count,
                       std::uint8_t* out);
   std::uint8_t (*class_of_id)(void* user, const PointId& id);
   void* user;
+  /// Classes all images on one grid, else null: the union's density is then read a block of candidates
+  /// at a time (emit_tile.h, image_sums_run) instead of through its callback.
+  const ClassImages* images = nullptr;
 };
 
 /// query_points into `out`, or query_points_compact into `compact`, with each point's class into

@@ -1,0 +1,70 @@
+// Image densities at blocks of candidates; see image_runs.h.
+#include "image_runs.h"
+
+#include <algorithm>
+
+#include "run_clones.h"
+
+namespace kdm::detail {
+namespace {
+
+/// Where the candidates fall among the texels (ImageSampler::texels, with 32-bit indices): the four
+/// texels' indices and the weights of the second ones.
+struct BlockTexels {
+  int i00[kImageBlock], i01[kImageBlock], i10[kImageBlock], i11[kImageBlock];
+  double ax[kImageBlock], ay[kImageBlock];
+};
+
+[[gnu::always_inline]] inline void block_texels(const TilePoint* __restrict from, std::size_t count,
+                                                double wx, double wy, double S, const ImageSampler& sampler,
+                                                double* __restrict x, double* __restrict y,
+                                                BlockTexels& __restrict t) {
+  const DensityImageView& image = *sampler.image;
+  const double x0 = image.x0, y0 = image.y0, sx = sampler.sx, sy = sampler.sy;
+  const double last_x = image.width - 1.0, last_y = image.height - 1.0;
+  const int w = image.width, wmax = image.width - 1, hmax = image.height - 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double px = wx + ((from[k].x + 0.5) * (1.0 / 65536.0)) * S;  // TilePoint::unit_x
+    const double py = wy + ((from[k].y + 0.5) * (1.0 / 65536.0)) * S;
+    double fx = (px - x0) * sx - 0.5, fy = (py - y0) * sy - 0.5;
+    fx = std::min(std::max(fx, 0.0), last_x), fy = std::min(std::max(fy, 0.0), last_y);  // std::clamp's
+    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+    const int jx = std::min(ix + 1, wmax), jy = std::min(iy + 1, hmax);
+    x[k] = px, y[k] = py;
+    t.i00[k] = iy * w + ix, t.i01[k] = iy * w + jx, t.i10[k] = jy * w + ix, t.i11[k] = jy * w + jx;
+    t.ax[k] = fx - ix, t.ay[k] = fy - iy;
+  }
+}
+
+/// ImageSampler::blend of `values` at the block's texels, k < count.
+[[gnu::always_inline]] inline double blend(const float* __restrict values, const BlockTexels& t,
+                                           std::size_t k) {
+  const double ax = t.ax[k], ay = t.ay[k];
+  return (1 - ay) * ((1 - ax) * values[t.i00[k]] + ax * values[t.i01[k]]) +
+         ay * ((1 - ax) * values[t.i10[k]] + ax * values[t.i11[k]]);
+}
+
+}  // namespace
+
+KDM_RUN_CLONES void image_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                              const ImageSampler& sampler, double* x, double* y, double* rho) {
+  BlockTexels t;
+  block_texels(from, count, wx, wy, S, sampler, x, y, t);
+  const float* values = sampler.image->values;
+  for (std::size_t k = 0; k < count; ++k) rho[k] = blend(values, t, k);
+}
+
+KDM_RUN_CLONES void image_sums_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                                   const ImageSampler& sampler, const float* const* values,
+                                   std::uint32_t images, double* x, double* y, double* sums) {
+  BlockTexels t;
+  block_texels(from, count, wx, wy, S, sampler, x, y, t);
+  for (std::size_t k = 0; k < count; ++k) sums[k] = 0.0 + blend(values[0], t, k);
+  for (std::uint32_t i = 1; i < images; ++i) {
+    double* __restrict to = sums + i * kImageBlock;
+    const double* __restrict from_sums = to - kImageBlock;
+    for (std::size_t k = 0; k < count; ++k) to[k] = from_sums[k] + blend(values[i], t, k);
+  }
+}
+
+}  // namespace kdm::detail

@@ -1,0 +1,35 @@
+// Internal: bilinear image densities at a block of a tile's candidates at once (emit_tile.h), in loops the
+// compiler vectorises (run_clones.h), bit for bit as ImageSampler reads one position.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "image_sampler.h"
+#include "kdm/runtime/tileset_format.h"
+
+namespace kdm::detail {
+
+/// Most candidates one call reads.
+inline constexpr std::uint32_t kImageBlock = 64;
+
+/// Whether the runs below can read `image`: fewer than 2^31 texels (their indices are 32-bit, which the
+/// vector gathers take).
+inline bool image_runs_fit(const DensityImageView& image) {
+  return std::uint64_t(image.width) * std::uint64_t(image.height) < (std::uint64_t(1) << 31);
+}
+
+/// Candidates from[0 … count) (count ≤ kImageBlock) of a tile at (wx, wy) of side S: their stable world
+/// positions into x[k], y[k] and the density of `sampler`'s image there into rho[k], as
+/// sampler.at(x[k], y[k]) reads it.
+void image_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+               const ImageSampler& sampler, double* x, double* y, double* rho);
+
+/// The same for `images` images on `sampler`'s grid of texels (ImageSampler::same_grid), values[i] the
+/// i-th one's: their running sums into sums[i · kImageBlock + k] (image 0's value, then plus image 1's,
+/// …), as sampler.texels and ImageSampler::blend add them up one by one.
+void image_sums_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                    const ImageSampler& sampler, const float* const* values, std::uint32_t images, double* x,
+                    double* y, double* sums);
+
+}  // namespace kdm::detail
