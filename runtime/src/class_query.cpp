@@ -9,6 +9,7 @@
 
 #include "descent.h"
 #include "emit_tile.h"
+#include "image_runs.h"
 #include "image_sampler.h"
 #include "kdm/runtime/hash.h"
 #include "query_counted.h"
@@ -45,7 +46,8 @@ struct ClassDensities {
   const ClassQueryParams* params = nullptr;
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
-  bool one_grid = false;  ///< every class an image on class 0's texels (sum_of_images)
+  bool one_grid = false;         ///< every class an image on class 0's texels (sum_of_images)
+  detail::ClassImages images{};  ///< when one_grid: the images, read a block of points at a time
   /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
   /// VaryingClassSink classes the candidate just read from it).
   mutable detail::ClassScratch scratch;
@@ -285,11 +287,37 @@ class Classifier {
       if (settled)
         std::fill(classes + (id.rank - first.rank), classes + (upto - first.rank),
                   static_cast<std::uint8_t>(k));
+      else if (densities_.one_grid && detail::image_runs_fit(*densities_.images.grid->image))
+        classify_by_sums(id, upto, classes + (id.rank - first.rank));
       else
         for (; id.rank < upto; ++id.rank) classes[id.rank - first.rank] = read_class(id);
       id.rank = upto;
     }
     class_ = k, rank_ = end - 1;
+  }
+
+  /// Classes that are all images on one grid: ranks [first.rank, end) of the current tile into out[0 ..),
+  /// from the images' running sums a block at a time, every point read (texels are read faster than
+  /// cells are tested). The sums rise with the class, so the classes whose count does not pass a point's
+  /// threshold are a prefix (read_class's rule).
+  void classify_by_sums(const PointId& first, std::uint32_t end, std::uint8_t* out) {
+    const double wx = double(first.tile_x) * side_, wy = double(first.tile_y) * side_;
+    const detail::ClassImages& images = densities_.images;
+    const std::uint32_t last = p_.class_count - 1;
+    double x[detail::kImageBlock], y[detail::kImageBlock], sums[detail::kImageBlock * kMaxQueryClasses];
+    for (std::uint32_t r = first.rank; r < end;) {
+      const std::uint32_t count = std::min(end - r, detail::kImageBlock);
+      detail::image_sums_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, images.count, x,
+                             y, sums);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const float t = thresholds_[r + i];
+        std::uint32_t cls = 0;
+        for (std::uint32_t k = 0; k < last; ++k)
+          cls += !TilesetShape::emits(t, sums[k * detail::kImageBlock + i] * area_);
+        out[r + i - first.rank] = static_cast<std::uint8_t>(cls);
+      }
+      r += count;
+    }
   }
 
   /// A point of the current tile whose class its tile's bounds leave open: settled by the bounds of the
@@ -490,6 +518,10 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     one_grid = p.classes[k].kind == QueryDensity::Kind::kImage &&
                densities.samplers[0].same_grid(*p.classes[k].image);
   q.density.callback = joint ? sum_of_joint : one_grid ? sum_of_images : sum_of_densities;
+  if (one_grid) {
+    densities.images.grid = &densities.samplers[0], densities.images.count = p.class_count;
+    for (std::uint32_t k = 0; k < p.class_count; ++k) densities.images.values[k] = p.classes[k].image->values;
+  }
   q.density.bounds = sum_of_bounds;
   q.density.user = &densities;
   // Smooth mode: as far as any point of the set glides, or lies past its tile down its subtiles.
@@ -538,9 +570,6 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
                                            examined);
   } else {
-    detail::ClassImages images{&densities.samplers[0], {}, p.class_count};
-    for (std::uint32_t k = 0; k < p.class_count && densities.one_grid; ++k)
-      images.values[k] = p.classes[k].image->values;
     const detail::VaryingClasses c{classes,
                                    &densities.scratch,
                                    q.tile_size * q.tile_size * q.scale,
@@ -548,7 +577,7 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
                                    Classifier::class_ranks,
                                    Classifier::class_of_id,
                                    &classify,
-                                   densities.one_grid ? &images : nullptr};
+                                   densities.one_grid ? &densities.images : nullptr};
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
                                            examined);
   }

@@ -189,21 +189,30 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     return sx < lo_x || sx >= hi_x || sy < lo_y || sy >= hi_y;
   };
   // A candidate whose density `rho` is read at its stable position (x, y): written or queued, as visit says.
-  auto decide = [&](std::uint32_t c, TilePoint p, double x, double y, double rho) -> std::uint32_t {
+  // `cls`: its class where the caller found it (a class query), else null.
+  auto decide = [&](std::uint32_t c, TilePoint p, double x, double y, double rho,
+                    const std::uint8_t* cls = nullptr) -> std::uint32_t {
     const double expected = rho * j.area_scale;
     // Whether a point is emitted follows no pattern a branch predictor could learn: each candidate is
     // written (or queued) at the next slot, which only an emitted one then keeps.
     const bool emitted = TilesetShape::emits(j.thresholds[c], expected);
     if (!kBatched) {
       if (n == capacity) return emitted ? c : kNone;
-      out.put_stable(n, j, p, c);
+      if constexpr (kClassesAtDensity<Sink>) {
+        if (cls)
+          out.put_stable_classed(n, j, p, c, *cls);
+        else
+          out.put_stable(n, j, p, c);
+      } else {
+        out.put_stable(n, j, p, c);
+      }
       n += emitted;
       return kNone;
     }
     pending_rank[pending] = c, pending_expected[pending] = expected;
     pending_x[pending] = x, pending_y[pending] = y;
     if constexpr (kClassesAtDensity<Sink>) {
-      if (emitted) pending_class[pending] = out.class_at(j, c, x, y);
+      if (emitted) pending_class[pending] = cls ? *cls : out.class_at(j, c, x, y);
     }
     pending += emitted;
     return pending == kBatch ? flush() : kNone;
@@ -325,16 +334,16 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     const ClassImages* images = out.images();
     if (images && image_runs_fit(*images->grid->image)) {
       double bx[kImageBlock], by[kImageBlock], sums[kImageBlock * kMaxQueryClasses];
+      std::uint8_t cls[kImageBlock];
       const double* total = sums + (images->count - 1) * std::size_t(kImageBlock);
       while (c < end && stopped == kNone) {
         const std::uint32_t count = std::min(end - c, kImageBlock);
         image_sums_run(j.points + c, count, j.wx, j.wy, j.S, *images->grid, images->values, images->count, bx,
                        by, sums);
+        out.classes_of_sums(j, c, count, sums, kImageBlock, cls);
         for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
-          if (!beyond_reach(c, j.points[c])) {
-            out.hold_sums(bx[i], by[i], sums + i, kImageBlock);
-            stopped = decide(c, j.points[c], bx[i], by[i], density_or_zero(total[i]));
-          }
+          if (!beyond_reach(c, j.points[c]))
+            stopped = decide(c, j.points[c], bx[i], by[i], density_or_zero(total[i]), cls + i);
       }
     }
     for (; c < end && stopped == kNone; ++c) stopped = visit(c);

@@ -243,12 +243,25 @@ struct VaryingClassSink {
   }
   /// Classes all images on one grid (ClassImages), else null.
   const ClassImages* images() const { return c->images; }
-  /// The running sums read at stable position (x, y), sums[0], sums[stride], …: as the union's callback
-  /// leaves them, for class_at.
-  [[gnu::always_inline]] void hold_sums(double x, double y, const double* sums, std::size_t stride) const {
-    ClassScratch& s = *c->scratch;
-    for (std::uint32_t k = 0; k <= c->last; ++k) s.cumulative[k] = sums[k * stride];
-    s.x = x, s.y = y;
+  /// Ranks [first, first + count) of tile j from their classes' running sums at their stable positions
+  /// (sums[k · stride + i] for rank first + i, image_sums_run's), into out[0 … count): class_at's rule, in a
+  /// loop the compiler vectorises.
+  void classes_of_sums(const TileJob& j, std::uint32_t first, std::uint32_t count, const double* sums,
+                       std::size_t stride, std::uint8_t* out) const {
+    const float* t = j.thresholds + first;
+    const double area = c->area;
+    for (std::uint32_t i = 0; i < count; ++i) {
+      std::uint32_t k = 0;
+      for (std::uint32_t m = 0; m < c->last; ++m)
+        k += !TilesetShape::emits(t[i], sums[m * stride + i] * area);
+      out[i] = static_cast<std::uint8_t>(k);
+    }
+  }
+  /// put_stable of a point whose class is known.
+  [[gnu::always_inline]] void put_stable_classed(std::size_t i, const TileJob& j, TilePoint p,
+                                                 std::uint32_t rank, std::uint8_t k) const {
+    base.put_stable(i, j, p, rank);
+    c->classes[i] = k;
   }
   /// A point whose class class_at gave (smooth mode: found before the glide, written after it).
   void put_classed(std::size_t i, double x, double y, const PointId& id, std::uint8_t k) const {
