@@ -1,7 +1,5 @@
 // Internal: the compact output's whole runs of points (compact_query.h, emit_tile.h's CompactSink), the
-// loops that bound its speed, compiled for AVX-512 and AVX2 as well as the baseline and chosen at run time
-// (x86-64 with GCC). All compute the same operations in the same order (the runtime builds with
-// -ffp-contract=off: no fused multiply-add), so every CPU writes the same bits.
+// loops that bound its speed, compiled for several instruction sets with the same bits (run_clones.h).
 #pragma once
 
 #include <cstddef>
