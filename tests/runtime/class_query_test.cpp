@@ -232,6 +232,33 @@ TEST(ClassQueryTest, PartsOfARegionGiveItsPointsAndClasses) {
   }
 }
 
+TEST(ClassQueryTest, PartsOfARegionOfImagesOnOneGridGiveItsPointsAndClasses) {
+  // Images on one grid are read a block at a time in whole tiles and by the classifier, one by one in cut
+  // tiles: parts of a region give its points and classes, in both modes.
+  std::mt19937 rng(11);
+  ThreeImages images;
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    ClassQueryParams whole = three_constants(-0.4, 0.3, 4.3, 4.6, 900, mode);
+    for (int k = 0; k < 3; ++k)
+      whole.classes[k].kind = QueryDensity::Kind::kImage, whole.classes[k].image = &images.views[k];
+    const Points all = run_classes(whole, 1000);  // resumed many times
+    ASSERT_GT(all.size(), 10000u);
+    Points joined;
+    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
+      ClassQueryParams p = whole;
+      p.query = part;
+      for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
+    }
+    expect_same(all, joined, "parts");
+    std::size_t counts[3] = {};
+    for (const auto& [id, e] : all) {
+      ASSERT_EQ(e.cls, joined.at(id).cls);
+      ++counts[e.cls];
+    }
+    for (std::size_t c : counts) EXPECT_GT(c, 1000u) << "mode " << int(mode);
+  }
+}
+
 TEST(ClassQueryTest, RaisingTheDensitiesOnlyPromotesAPointsClass) {
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     Points before = run_classes(three_constants(0, 0, 5, 5, 100, mode));
