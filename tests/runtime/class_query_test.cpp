@@ -213,6 +213,25 @@ TEST(ClassQueryTest, ClassCountsFollowTheirDensities) {
   }
 }
 
+/// Parts of `whole` (a random grid of them) give its points and classes, the whole resumed many times;
+/// returns the whole's count per class.
+std::vector<std::size_t> expect_parts_give_the_whole(const ClassQueryParams& whole, std::mt19937& rng) {
+  const Points all = run_classes(whole, 1000);
+  Points joined;
+  for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
+    ClassQueryParams p = whole;
+    p.query = part;
+    for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
+  }
+  expect_same(all, joined, "parts");
+  std::vector<std::size_t> counts(whole.class_count);
+  for (const auto& [id, e] : all) {
+    EXPECT_EQ(e.cls, joined.at(id).cls);
+    ++counts.at(e.cls);
+  }
+  return counts;
+}
+
 TEST(ClassQueryTest, PartsOfARegionGiveItsPointsAndClasses) {
   std::mt19937 rng(7);
   ThreeImages images;
@@ -220,15 +239,7 @@ TEST(ClassQueryTest, PartsOfARegionGiveItsPointsAndClasses) {
     ClassQueryParams whole = three_constants(0, 0, 4, 4, 900, mode);
     whole.classes[1].kind = QueryDensity::Kind::kImage;
     whole.classes[1].image = &images.views[2];
-    const Points all = run_classes(whole, 1000);  // resumed many times
-    Points joined;
-    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
-      ClassQueryParams p = whole;
-      p.query = part;
-      for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
-    }
-    expect_same(all, joined, "parts");
-    for (const auto& [id, e] : all) ASSERT_EQ(e.cls, joined.at(id).cls);
+    expect_parts_give_the_whole(whole, rng);
   }
 }
 
@@ -241,21 +252,7 @@ TEST(ClassQueryTest, PartsOfARegionOfImagesOnOneGridGiveItsPointsAndClasses) {
     ClassQueryParams whole = three_constants(-0.4, 0.3, 4.3, 4.6, 900, mode);
     for (int k = 0; k < 3; ++k)
       whole.classes[k].kind = QueryDensity::Kind::kImage, whole.classes[k].image = &images.views[k];
-    const Points all = run_classes(whole, 1000);  // resumed many times
-    ASSERT_GT(all.size(), 10000u);
-    Points joined;
-    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
-      ClassQueryParams p = whole;
-      p.query = part;
-      for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
-    }
-    expect_same(all, joined, "parts");
-    std::size_t counts[3] = {};
-    for (const auto& [id, e] : all) {
-      ASSERT_EQ(e.cls, joined.at(id).cls);
-      ++counts[e.cls];
-    }
-    for (std::size_t c : counts) EXPECT_GT(c, 1000u) << "mode " << int(mode);
+    for (std::size_t c : expect_parts_give_the_whole(whole, rng)) EXPECT_GT(c, 1000u) << "mode " << int(mode);
   }
 }
 

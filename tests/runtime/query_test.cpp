@@ -107,21 +107,27 @@ INSTANTIATE_TEST_SUITE_P(QueryTest, ModeTest, ::testing::ValuesIn(kModes), [](co
   return std::string(info.param == QueryMode::kStable ? "Stable" : "Smooth");
 });
 
-TEST_P(ModeTest, AnyPartitionGivesTheSameUnionBitForBit) {
-  const QueryParams whole = region(-3.3, -2.1, 4.7, 5.9, 900, GetParam());
+/// Random grids of parts of `whole`, each queried through a buffer of `capacity` points, give its points
+/// bit for bit, `trials` times.
+void expect_partitions_give_the_whole(const QueryParams& whole, int trials, int parts, std::size_t capacity,
+                                      std::mt19937& rng) {
   std::vector<Key> expected = run(whole);
   std::sort(expected.begin(), expected.end());
   ASSERT_GT(expected.size(), 10000u);
-  std::mt19937 rng(1);
-  for (int trial = 0; trial < 5; ++trial) {
+  for (int trial = 0; trial < trials; ++trial) {
     std::vector<Key> got;
-    for (const QueryParams& part : testing::random_grid_parts(whole, 4, rng)) {
-      const std::vector<Key> k = run(part);
+    for (const QueryParams& part : testing::random_grid_parts(whole, parts, rng)) {
+      const std::vector<Key> k = run(part, capacity);
       got.insert(got.end(), k.begin(), k.end());
     }
     std::sort(got.begin(), got.end());
     EXPECT_EQ(got, expected) << "trial " << trial;
   }
+}
+
+TEST_P(ModeTest, AnyPartitionGivesTheSameUnionBitForBit) {
+  std::mt19937 rng(1);
+  expect_partitions_give_the_whole(region(-3.3, -2.1, 4.7, 5.9, 900, GetParam()), 5, 4, 1 << 16, rng);
 }
 
 TEST_P(ModeTest, AnImagesPartitionsGiveTheSameUnionBitForBit) {
@@ -138,19 +144,8 @@ TEST_P(ModeTest, AnImagesPartitionsGiveTheSameUnionBitForBit) {
   ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
   QueryParams whole = region(-3.3, -2.1, 4.7, 5.9, 2000, GetParam());
   whole.density.kind = QueryDensity::Kind::kImage, whole.density.image = &image;
-  std::vector<Key> expected = run(whole);
-  std::sort(expected.begin(), expected.end());
-  ASSERT_GT(expected.size(), 20000u);
   std::mt19937 rng(4);
-  for (int trial = 0; trial < 3; ++trial) {
-    std::vector<Key> got;
-    for (const QueryParams& part : testing::random_grid_parts(whole, 3, rng)) {
-      const std::vector<Key> k = run(part, 1000);  // resumed within blocks too
-      got.insert(got.end(), k.begin(), k.end());
-    }
-    std::sort(got.begin(), got.end());
-    EXPECT_EQ(got, expected) << "trial " << trial;
-  }
+  expect_partitions_give_the_whole(whole, 3, 3, 1000, rng);  // resumed within blocks too
 }
 
 TEST(QueryTest, EdgeListsHoldEveryPointThatCanGlideAcrossASide) {
