@@ -487,7 +487,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
         if (d.constant < 0) return refuse(Kind::kNegative, kConstantNames[k], d.constant);
         continue;
       case QueryDensity::Kind::kImage:
-        if (!d.image || !d.image->values || !d.image->max_mip)
+        if (!d.image || !d.image->values || !d.image->max_mip || !detail::image_rect_usable(*d.image))
           return refuse(Kind::kBadDensity, kImageNames[k]);
         densities.samplers[k] = ImageSampler(d.image);
         break;

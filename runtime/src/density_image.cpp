@@ -11,6 +11,7 @@
 namespace kdm {
 
 double DensityImageView::at(double x, double y) const {
+  if (!values || !detail::image_rect_usable(*this)) return 0;  // an image no query takes: nothing there
   return detail::ImageSampler(this).at(x, y);
 }
 
@@ -49,9 +50,7 @@ double DensityImageView::min_over(double qx0, double qy0, double qx1, double qy1
 
 Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
   if (image.width <= 0 || image.height <= 0 || !image.values) return Status::kInvalidArgument;
-  if (!(std::isfinite(image.x0) && std::isfinite(image.x1) && std::isfinite(image.y0) &&
-        std::isfinite(image.y1) && image.x1 > image.x0 && image.y1 > image.y0))
-    return Status::kInvalidArgument;
+  if (!detail::image_rect_usable(image)) return Status::kInvalidArgument;
   const std::size_t count = static_cast<std::size_t>(image.width) * image.height;
   for (std::size_t i = 0; i < count; ++i)
     if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;

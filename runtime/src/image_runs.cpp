@@ -27,7 +27,7 @@ struct BlockTexels {
     const double px = wx + ((from[k].x + 0.5) * (1.0 / 65536.0)) * S;  // TilePoint::unit_x
     const double py = wy + ((from[k].y + 0.5) * (1.0 / 65536.0)) * S;
     double fx = (px - x0) * sx - 0.5, fy = (py - y0) * sy - 0.5;
-    fx = std::min(std::max(fx, 0.0), last_x), fy = std::min(std::max(fy, 0.0), last_y);  // std::clamp's
+    fx = std::min(std::max(0.0, fx), last_x), fy = std::min(std::max(0.0, fy), last_y);  // ImageSampler's
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
     const int jx = std::min(ix + 1, wmax), jy = std::min(iy + 1, hmax);
     x[k] = px, y[k] = py;

@@ -3,11 +3,22 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 #include "kdm/runtime/density_image.h"
 
 namespace kdm::detail {
+
+/// Whether world positions map to texels as numbers: a finite rectangle of positive size whose texels per
+/// world unit are finite (a rectangle hundreds of orders of magnitude smaller than its texels is not, nor one
+/// whose size overflows), so that no position gives NaN (0 · ∞) where the texels are found.
+inline bool image_rect_usable(const DensityImageView& im) {
+  if (!(im.width > 0 && im.height > 0)) return false;
+  const double sx = im.width / (im.x1 - im.x0), sy = im.height / (im.y1 - im.y0);
+  return std::isfinite(im.x0) && std::isfinite(im.y0) && sx > 0 && sy > 0 && std::isfinite(sx) &&
+         std::isfinite(sy) && std::isfinite(im.x1 - im.x0) && std::isfinite(im.y1 - im.y0);
+}
 
 struct ImageSampler {
   const DensityImageView* image = nullptr;
@@ -25,8 +36,9 @@ struct ImageSampler {
   };
   Texels texels(double x, double y) const {
     const DensityImageView& im = *image;
-    const double fx = std::clamp((x - im.x0) * sx - 0.5, 0.0, im.width - 1.0);
-    const double fy = std::clamp((y - im.y0) * sy - 0.5, 0.0, im.height - 1.0);
+    // Clamped to the texels, NaN (a NaN position) to the first.
+    const double fx = std::min(std::max(0.0, (x - im.x0) * sx - 0.5), im.width - 1.0);
+    const double fy = std::min(std::max(0.0, (y - im.y0) * sy - 0.5), im.height - 1.0);
     const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
     const int jx = std::min(ix + 1, im.width - 1), jy = std::min(iy + 1, im.height - 1);
     return Texels{static_cast<std::size_t>(iy) * im.width,

@@ -434,6 +434,28 @@ TEST(QueryTest, FollowsADensityImage) {
   EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
   values[5] = std::nanf("");
   EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
+  // So is a rectangle whose texels per world unit are not finite numbers (one 10^-323 wide, or one whose
+  // width overflows a double), where a position would map to texel NaN: by the mips, and by a query whose
+  // image was changed after them.
+  values[5] = 0.5f;
+  ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
+  for (const auto& [x0, x1] : {std::pair{0.0, 5e-324}, std::pair{-1e308, 1e308}}) {
+    DensityImageView bad = image;
+    bad.x0 = x0, bad.x1 = x1;
+    std::vector<float> bad_mip;
+    EXPECT_EQ(make_density_max_mip(bad, bad_mip), Status::kInvalidArgument) << x0 << " " << x1;
+    bad.max_mip = image.max_mip, bad.min_mip = image.min_mip;
+    QueryParams b = region(-1, -1, 1, 1, 1000);
+    b.density.kind = QueryDensity::Kind::kImage, b.density.image = &bad;
+    std::vector<QueryPoint> out(16);
+    std::size_t written = 0;
+    QueryCursor cursor;
+    QueryProblem problem;
+    EXPECT_EQ(query_points(Tileset::builtin(), b, out.data(), out.size(), &written, &cursor, &problem),
+              Status::kInvalidArgument);
+    EXPECT_EQ(problem.kind, QueryProblem::Kind::kBadDensity);
+    EXPECT_STREQ(problem.parameter, "density.image");
+  }
 }
 
 TEST(QueryTest, MipsBoundAnImageFromAboveAndBelow) {

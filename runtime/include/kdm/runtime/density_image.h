@@ -18,7 +18,8 @@ struct KDM_RUNTIME_API DensityImageView {
   const float* max_mip = nullptr;         ///< per 8×8 texel block maximum (see make_density_max_mip)
   const float* min_mip = nullptr;         ///< per 8×8 texel block minimum (optional: null means 0)
   int mip_width = 0, mip_height = 0;
-  /// The density at world position (x, y).
+  /// The density at world position (x, y): bilinear, clamped at the edges (a NaN position reads the first
+  /// texel); 0 for an image without values or with a rectangle make_density_max_mip refuses.
   double at(double x, double y) const;
   /// Upper bound of the density over a world rectangle (from the max-mip; exact bound, maybe loose).
   double max_over(double x0, double y0, double x1, double y1) const;
@@ -28,8 +29,10 @@ struct KDM_RUNTIME_API DensityImageView {
 
 /// Fills `mip` (resized to 2·ceil(w/8)·ceil(h/8)) with the 8×8 block maxima of `image.values`, then their
 /// minima, each block widened by one texel so they bound bilinear values too, and points the image's
-/// max_mip and min_mip at them. Returns kInvalidArgument for empty images or values that are negative or
-/// not finite.
+/// max_mip and min_mip at them. Returns kInvalidArgument for empty images, values that are negative or
+/// not finite, and a world rectangle that is not finite and of positive size, or whose texels per world
+/// unit overflow (a rectangle narrower than about 10^-300 of a unit per texel). Queries refuse such an
+/// image too ("density.image"), should its rectangle change after this call.
 KDM_RUNTIME_API Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
 
 }  // namespace kdm
