@@ -1,6 +1,8 @@
 #include "spec_density.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace kdm::tools {
@@ -31,8 +33,21 @@ SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
   image.width = spec.width, image.height = spec.height;
   image.x0 = r[0], image.y0 = r[1], image.x1 = r[2], image.y1 = r[3];
   image.values = spec.values.data();  // row 0 at y0, as DensityImageView has it
-  if (make_density_max_mip(image, mip) != Status::kOk)
-    throw std::invalid_argument("density image is invalid");
+  if (make_density_max_mip(image, mip) != Status::kOk) {
+    const bool values_ok = std::all_of(spec.values.begin(), spec.values.end(),
+                                       [](float v) { return v >= 0 && std::isfinite(v); });
+    char message[256];
+    if (!values_ok || image.width <= 0 || image.height <= 0)
+      std::snprintf(message, sizeof message,
+                    "density image of %d x %d values: values must be finite and >= 0", image.width,
+                    image.height);
+    else
+      std::snprintf(message, sizeof message,
+                    "density image rectangle (%.17g, %.17g, %.17g, %.17g) must be finite, of positive width "
+                    "and height, and wide enough for its texels per unit to be finite",
+                    r[0], r[1], r[2], r[3]);
+    throw std::invalid_argument(message);
+  }
   density.kind = QueryDensity::Kind::kImage;
   density.image = &image;
 }
