@@ -22,7 +22,7 @@ template <class Pick>
 double fold_blocks(const DensityImageView& im, const float* mip, double qx0, double qy0, double qx1,
                    double qy1, float start, Pick pick) {
   auto block = [](double v, double lo, double hi, int n, int blocks) {
-    const double t = std::clamp((v - lo) / (hi - lo) * n, 0.0, double(n - 1));
+    const double t = std::min(std::max(0.0, (v - lo) / (hi - lo) * n), double(n - 1));  // NaN to 0
     return std::min(blocks - 1, static_cast<int>(t) / 8);
   };
   const int bx0 = block(qx0, im.x0, im.x1, im.width, im.mip_width),
