@@ -62,7 +62,7 @@ struct ClassDensities {
       case QueryDensity::Kind::kCallback:
         break;
     }
-    return density_or_zero(d.callback(d.user, x, y));
+    return detail::callback_value(d, x, y);
   }
   /// The joint density's values at (x, y) into v[0 … class_count), each to be read as query_points reads
   /// one value (density_or_zero) where it is added: a separate pass would load pairs of values just
@@ -456,6 +456,7 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
     add_double(d.constant), add_double(d.callback_max);
     add(reinterpret_cast<std::uintptr_t>(d.image));
     add(reinterpret_cast<std::uintptr_t>(d.callback));
+    add(reinterpret_cast<std::uintptr_t>(d.batch_callback));
     add(reinterpret_cast<std::uintptr_t>(d.user));
   }
   return h;
@@ -492,7 +493,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
         densities.samplers[k] = ImageSampler(d.image);
         break;
       case QueryDensity::Kind::kCallback:
-        if (!d.callback) return refuse(Kind::kBadDensity, kCallbackNames[k]);
+        if (!d.callback == !d.batch_callback) return refuse(Kind::kBadDensity, kCallbackNames[k]);
         if (!std::isfinite(d.callback_max))
           return refuse(Kind::kNotFinite, kCallbackMaxNames[k], d.callback_max);
         if (d.callback_max < 0) return refuse(Kind::kNegative, kCallbackMaxNames[k], d.callback_max);

@@ -15,6 +15,14 @@ inline double density_or_zero(double v) {
   return (v > 0 && v < HUGE_VAL) ? v : 0.0;
 }
 
+/// A callback density's value at (x, y), through whichever of its two functions the caller set.
+inline double callback_value(const QueryDensity& d, double x, double y) {
+  if (d.callback) return density_or_zero(d.callback(d.user, x, y));
+  double v;
+  d.batch_callback(d.user, 1, &x, &y, &v);
+  return density_or_zero(v);
+}
+
 /// A caller's bounds l ≤ ρ ≤ h of a density whose maximum is `max`, as queries use them: an upper bound
 /// that is not a number in [0, max) is max, a lower one that is not positive is 0.
 inline void trusted_bounds(double l, double h, double max, double& lo, double& hi) {

@@ -49,7 +49,7 @@ double DescentQuery::density_at(double x, double y) const {
     case QueryDensity::Kind::kCallback:
       break;
   }
-  return density_or_zero(d.callback(d.user, x, y));
+  return callback_value(d, x, y);
 }
 
 void DescentQuery::density_bounds(double x0, double y0, double x1, double y1, double& lo, double& hi) const {

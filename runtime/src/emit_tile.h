@@ -110,8 +110,9 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     x += (v[o0[0]] * w0 + v[o1[0]] * w1) * unit, y += (v[o0[1]] * w0 + v[o1[1]] * w1) * unit;
   };
   auto outside = [&](double x, double y) { return x < j.x0 || x >= j.x1 || y < j.y0 || y >= j.y1; };
+  // `glided`: a batch callback's value at the glided position, read with the batch's (else read here).
   auto place = [&](std::uint32_t c, double x, double y, const std::int8_t* o0, const std::int8_t* o1,
-                   double w0, double w1, std::uint8_t cls) -> bool {
+                   double w0, double w1, std::uint8_t cls, const double* glided = nullptr) -> bool {
     glide_by(x, y, o0, o1, w0, w1);
     // Where the region cuts the tile, whether a point lies inside follows no pattern: it is written at the
     // next slot, which only then it keeps.
@@ -122,7 +123,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       if (!in) return true;
       if (kKind == QueryDensity::Kind::kImage && !(j.sampler->at(x, y) > 0)) return true;
       if (kKind == QueryDensity::Kind::kCallback &&
-          !(density_or_zero(j.density->callback(j.density->user, x, y)) > 0))
+          !((glided ? density_or_zero(*glided) : callback_value(*j.density, x, y)) > 0))
         return true;
     }
     if (n == capacity) return !in;
@@ -140,8 +141,15 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   // mispredicted emission test.
   constexpr bool kBatched = kSmooth && !kConstant;
   constexpr std::uint32_t kNone = ~0u;
-  constexpr int kBatch = kBatched ? 32 : 1;
+  // A batch callback's reads (BatchCallback below): each tile's, kDensityBatch at a time; the second
+  // reads at glided positions go with the emitted points' batch, which then holds as many.
+  constexpr bool kMayBatchReads = kKind == QueryDensity::Kind::kCallback && !kClassesAtDensity<Sink>;
+  const bool batch_reads = kMayBatchReads && j.density->batch_callback;
+  constexpr int kBatch = kBatched ? (kMayBatchReads ? int(kDensityBatch) : 32) : 1;
+  const int batch_size = batch_reads ? kBatch : std::min(kBatch, 32);
   std::uint32_t pending_rank[kBatch];
+  constexpr std::size_t kGather = kMayBatchReads ? kDensityBatch : 1;  // of a batch callback's reads
+  double glided[kGather], gx[kGather], gy[kGather];
   double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
   std::uint8_t pending_class[kBatch];
   int pending = 0;
@@ -155,8 +163,17 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       o1[i] = j.glide + 2 * (std::size_t(j.starts[b.g1]) + pending_rank[i]);
       w0[i] = b.w0, w1[i] = b.w1;
     }
+    const bool read_glided = batch_reads && j.zero_possible && pending > 0;
+    if (read_glided) {  // the densities at the glided positions, in one call
+      for (int i = 0; i < pending; ++i) {
+        gx[i] = pending_x[i], gy[i] = pending_y[i];
+        glide_by(gx[i], gy[i], o0[i], o1[i], w0[i], w1[i]);
+      }
+      j.density->batch_callback(j.density->user, std::size_t(pending), gx, gy, glided);
+    }
     for (int i = 0; i < pending; ++i)
-      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i], pending_class[i]))
+      if (!place(pending_rank[i], pending_x[i], pending_y[i], o0[i], o1[i], w0[i], w1[i], pending_class[i],
+                 read_glided ? glided + i : nullptr))
         return pending = 0, pending_rank[i];
     pending = 0;
     return kNone;
@@ -215,7 +232,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       if (emitted) pending_class[pending] = cls ? *cls : out.class_at(j, c, x, y);
     }
     pending += emitted;
-    return pending == kBatch ? flush() : kNone;
+    return pending == batch_size ? flush() : kNone;
   };
   // Smooth mode beside the region: whether candidate c (at p) cannot glide into it.
   auto beyond_reach = [&](std::uint32_t c, TilePoint p) {
@@ -267,8 +284,64 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
                            : density_or_zero(j.density->callback(j.density->user, x, y));
     return decide(c, p, x, y, rho);
   };
+  // A batch callback: the candidates visit would read wait, in order and with those it settles unread,
+  // until kDensityBatch of them are gathered; one call then reads them all and each is decided as visit
+  // decides it. `next` gives the ranks to visit, kNone past the last.
+  std::uint32_t rank[kGather];
+  bool read[kGather];
+  double bx[kGather], by[kGather], rho[kGather];
+  auto visit_in_batches = [&](auto next) -> std::uint32_t {
+    for (bool more = true; more;) {
+      std::size_t gathered = 0, reads = 0;
+      while (gathered < kGather) {
+        const std::uint32_t r = next();
+        if (r == kNone) {
+          more = false;
+          break;
+        }
+        const TilePoint p = j.points[r];
+        if (beyond_reach(r, p)) continue;
+        const double x = j.wx + p.unit_x() * j.S, y = j.wy + p.unit_y() * j.S;
+        bool unread_emitted = false;  // stable mode: emitted without a read, as visit emits it
+        if constexpr (!kSmooth) {
+          if (!(kInside || ((x >= j.x0) & (x < j.x1) & (y >= j.y0) & (y < j.y1)))) continue;
+          if (r < j.sure) {
+            unread_emitted = true;
+          } else if (kCells && j.cells) {
+            const std::uint32_t cell = cell_of(p);
+            if (!TilesetShape::emits(j.thresholds[r], cell_hi[cell])) continue;
+            unread_emitted = TilesetShape::emits(j.thresholds[r], cell_lo[cell]);
+          }
+        }
+        rank[gathered] = r, read[gathered++] = !unread_emitted;
+        if (!unread_emitted) bx[reads] = x, by[reads++] = y;
+      }
+      if (reads > 0) j.density->batch_callback(j.density->user, reads, bx, by, rho);
+      for (std::size_t i = 0, k = 0; i < gathered; ++i) {
+        const std::uint32_t r = rank[i];
+        std::uint32_t stop = kNone;
+        if (read[i]) {
+          stop = decide(r, j.points[r], bx[k], by[k], density_or_zero(rho[k]));
+          ++k;
+        } else if (n == capacity) {
+          stop = r;
+        } else {
+          out.put_stable(n++, j, j.points[r], r);
+        }
+        if (stop != kNone) return stop;
+      }
+    }
+    return kNone;
+  };
   std::uint32_t stopped = kNone;
-  if constexpr (kListed) {
+  if (batch_reads) {
+    if constexpr (kListed) {
+      const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
+      stopped = visit_in_batches([&] { return it != j.listed_end && *it < end ? *it++ : kNone; });
+    } else {
+      stopped = visit_in_batches([&] { return c < end ? c++ : kNone; });
+    }
+  } else if constexpr (kListed) {
     const std::uint32_t* it = std::lower_bound(j.listed, j.listed_end, c);
     for (; it != j.listed_end && *it < end && stopped == kNone; ++it) stopped = visit(*it);
   } else if constexpr (kConstant && !kInside && Sink::kVectorRuns) {

@@ -113,7 +113,8 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
       break;
     case QueryDensity::Kind::kCallback:
-      if (!d.callback) return refuse(Kind::kBadDensity, "density.callback");
+      if (!d.callback == !d.batch_callback)  // neither or both: which one is meant is unclear
+        return refuse(Kind::kBadDensity, d.callback ? "density.batch_callback" : "density.callback");
       if (!finite(d.callback_max)) return refuse(Kind::kNotFinite, "density.callback_max", d.callback_max);
       if (d.callback_max < 0) return refuse(Kind::kNegative, "density.callback_max", d.callback_max);
       max_density = d.callback_max;
@@ -494,7 +495,7 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kNegative:
       return "a parameter must not be negative";
     case QueryProblem::Kind::kBadDensity:
-      return "the density's image (with its max-mip) or callback is missing";
+      return "the density's image (with its max-mip) or callback is missing (or both callbacks are set)";
     case QueryProblem::Kind::kTooManyTiles:
       return "the region covers more tiles than one query may (split it)";
     case QueryProblem::Kind::kDensityTooHigh:
@@ -528,6 +529,7 @@ std::uint64_t query_fingerprint(const QueryParams& q) {
   add(static_cast<std::uint64_t>(q.mode));
   add(reinterpret_cast<std::uintptr_t>(q.density.image));
   add(reinterpret_cast<std::uintptr_t>(q.density.callback));
+  add(reinterpret_cast<std::uintptr_t>(q.density.batch_callback));
   add(reinterpret_cast<std::uintptr_t>(q.density.user));
   add(reinterpret_cast<std::uintptr_t>(q.density.bounds));
   return h;

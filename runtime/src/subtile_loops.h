@@ -220,10 +220,9 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
   static_assert(kKind != QueryDensity::Kind::kConstant);
   // Locals, which the writes into the caller's buffer cannot alias.
   const ImageSampler sampler = *q.sampler;
-  double (*const callback)(void*, double, double) = q.params->density.callback;
-  void* const user = q.params->density.user;
+  const QueryDensity density = q.params->density;
   auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
-    return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : density_or_zero(callback(user, x, y));
+    return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : callback_value(density, x, y);
   };
   QueryPoint* const out = sink.out;
   const std::size_t capacity = sink.capacity;

@@ -57,6 +57,12 @@ struct QueryDensity {
   double constant = 1;  ///< kConstant: finite and >= 0, or the query is refused
   const DensityImageView* image = nullptr;
   double (*callback)(void* user, double x, double y) = nullptr;
+  /// For callbacks, instead of `callback` (set one of the two): the densities at n positions at once,
+  /// out[i] at (x[i], y[i]), 1 ≤ n ≤ kDensityBatch, with callback's rules (thread-safe, values that are
+  /// not finite and ≥ 0 count as 0). Below the top level a query gathers each tile's reads into such
+  /// batches, so a vectorised function (SIMD, numpy) pays one call per batch; past it (smooth mode's
+  /// subtiles) it asks one position at a time. The points are those of `callback` giving the same values.
+  void (*batch_callback)(void* user, std::size_t n, const double* x, const double* y, double* out) = nullptr;
   void* user = nullptr;
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
   double callback_max = 1;
@@ -71,6 +77,9 @@ struct QueryDensity {
   /// ignored (0 and callback_max serve).
   void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
 };
+
+/// Most positions one QueryDensity::batch_callback call is asked for.
+inline constexpr std::size_t kDensityBatch = 128;
 
 /// How emitted points move as the density changes.
 enum class QueryMode : int {
@@ -129,7 +138,8 @@ struct QueryProblem {
     kNotPositive,       ///< `parameter` ("tile_size") must be > 0; `value` holds it
     kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
                         ///< >= 0; `value` holds it
-    kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared
+    kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared,
+                        ///< or both callbacks are set
     kTooManyTiles,      ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
     kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
                         ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
@@ -174,9 +184,9 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// examined kMaxQueryCandidates points — call again with the same cursor and params to continue. Empty or
 /// inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional) saying which
 /// parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative scale, a missing
-/// image or callback, a region of more than kMaxQueryTiles tiles, a density beyond the density limit (scale ·
-/// max density · tile_size² > query_density_limit: use smaller tiles or a lower scale), or a cursor started
-/// with other params. No allocation.
+/// image or callback (or both callbacks set), a region of more than kMaxQueryTiles tiles, a density beyond
+/// the density limit (scale · max density · tile_size² > query_density_limit: use smaller tiles or a lower
+/// scale), or a cursor started with other params. No allocation.
 KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem = nullptr);
