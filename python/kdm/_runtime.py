@@ -115,6 +115,7 @@ class Tileset:
         density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
         density_bounds: Optional[_Bounds] = None,
+        vectorized: bool = False,
         tile_size: float = 1.0,
         mode: str = "stable",
         origin: Sequence[float] = (0.0, 0.0),
@@ -136,6 +137,12 @@ class Tileset:
             GIL held; an exception it raises is raised here once the query ends, and a value that is
             not finite and >= 0 raises ValueError), which needs `density_max`, a true upper bound of
             its values. Default: 1.
+        vectorized : bool
+            For a callable density: True if f takes arrays, f(x, y) -> array of the same length (x and y
+            float64 arrays of up to 128 positions, a tile's candidates at a time; scipy's `vectorized`).
+            One call then serves many points: for a numpy expression about ten times faster than
+            calling it point by point. The same points as the scalar callable. Past the top level
+            (smooth mode) the arrays hold one position.
         density_bounds : callable, optional
             For a callable density: f(x0, y0, x1, y1) -> (lo, hi), bounds of the density over a world
             rectangle, 0 <= lo <= hi (else ValueError). Asked once per tile, it lets the query call the
@@ -174,6 +181,8 @@ class Tileset:
         if classes is not None:
             if density_bounds is not None:
                 raise ValueError("density_bounds does not apply to a query with classes")
+            if vectorized:
+                raise ValueError("vectorized does not apply to a query with classes")
             return self._query_classes(rect, scale, density, classes, density_rect, density_max, tile_size,
                                        mode, origin, gamma, invert, out)
         spec, call = _density_arg(density, gamma, invert)
@@ -182,8 +191,8 @@ class Tileset:
         if density_bounds is not None and not callable(density_bounds):
             raise TypeError(f"density_bounds must be callable, got {type(density_bounds).__name__}")
         return QueryResult(*_kdm.query(
-            self._handle, rect, scale, spec, call, density_bounds, density_rect, density_max, tile_size, mode,
-            origin, out._storage if out is not None else None,
+            self._handle, rect, scale, spec, call, _checks.flag("vectorized", vectorized), density_bounds,
+            density_rect, density_max, tile_size, mode, origin, out._storage if out is not None else None,
         ))
 
 
@@ -196,6 +205,7 @@ class Tileset:
         density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
         density_bounds: Optional[_Bounds] = None,
+        vectorized: bool = False,
         tile_size: float = 1.0,
         mode: str = "stable",
         origin: Sequence[float] = (0.0, 0.0),
@@ -221,8 +231,9 @@ class Tileset:
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
         if classes is not None:
-            if density is not None or density_max is not None or density_bounds is not None:
-                raise ValueError("density, density_max and density_bounds do not apply to a query with classes")
+            if density is not None or density_max is not None or density_bounds is not None or vectorized:
+                raise ValueError(
+                    "density, density_max, density_bounds and vectorized do not apply to a query with classes")
             if threads is not None:
                 raise ValueError("threads does not apply to a query with classes")
             specs = _class_specs(classes, gamma, invert)
@@ -239,8 +250,8 @@ class Tileset:
         spec, call = _density_arg(density, gamma, invert)
         if density_bounds is not None and not callable(density_bounds):
             raise TypeError(f"density_bounds must be callable, got {type(density_bounds).__name__}")
-        xy, key = _kdm.positions(self._handle, rect, scale, spec, call, density_bounds, density_rect, density_max, tile_size,
-                                 mode, origin, keys, workers)
+        xy, key = _kdm.positions(self._handle, rect, scale, spec, call, _checks.flag("vectorized", vectorized),
+                                 density_bounds, density_rect, density_max, tile_size, mode, origin, keys, workers)
         return (xy, key) if keys else xy
 
     def _query_classes(

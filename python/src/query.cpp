@@ -202,7 +202,7 @@ struct PreparedQuery {
 };
 
 void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::DensitySpec* spec,
-             py::object callable, py::object bounds, std::optional<Rect> density_rect,
+             py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
              std::optional<double> density_max, double tile_size, const std::string& mode,
              const std::array<double, 2>& origin) {
   check_rect("rect", rect);
@@ -217,6 +217,7 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
   if (density_rect && (call || spec->kind == tools::DensitySpec::Kind::kConstant))
     throw std::invalid_argument("density_rect needs an image, an array or a test map density");
   if (density_max && !call) throw std::invalid_argument("density_max is for a callable density only");
+  if (vectorized && !call) throw std::invalid_argument("vectorized is for a callable density only");
   if (!bounds.is_none() && !call)
     throw std::invalid_argument("density_bounds is for a callable density only");
   if (density_rect) check_rect("density_rect", *density_rect);
@@ -224,7 +225,8 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
     if (!density_max)
       throw std::invalid_argument("a callable density needs density_max, an upper bound of its values");
     check_number("density_max", *density_max, 0, false);
-    p.from_callable = std::make_unique<CallableDensity>(std::move(callable), *density_max, std::move(bounds));
+    p.from_callable =
+        std::make_unique<CallableDensity>(std::move(callable), *density_max, std::move(bounds), vectorized);
     q.density = p.from_callable->density;
   } else {
     const Rect r = density_rect ? *density_rect : rect;  // by default the image covers the rectangle queried
@@ -234,12 +236,12 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
 }
 
 py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
-                py::object callable, py::object bounds, std::optional<Rect> density_rect,
+                py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
                 std::optional<double> density_max, double tile_size, const std::string& mode,
                 const std::array<double, 2>& origin, const py::object& storage) {
   PreparedQuery prepared;
-  prepare(prepared, rect, scale, spec, std::move(callable), std::move(bounds), density_rect, density_max,
-          tile_size, mode, origin);
+  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
+          density_max, tile_size, mode, origin);
   const QueryParams& q = prepared.q;
   const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
   const Storage out(storage);
@@ -311,15 +313,15 @@ py::tuple take_compact(CompactBuffer& buffer, std::size_t m) {
 /// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
 /// order: the same bits for any count).
 py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
-                    const tools::DensitySpec* spec, py::object callable, py::object bounds,
+                    const tools::DensitySpec* spec, py::object callable, bool vectorized, py::object bounds,
                     std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
                     const std::string& mode, const std::array<double, 2>& origin, bool keys, int threads) {
   if (threads < 0 || threads > int(kMaxParallelWorkers))
     throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
                                 std::to_string(threads));
   PreparedQuery prepared;
-  prepare(prepared, rect, scale, spec, std::move(callable), std::move(bounds), density_rect, density_max,
-          tile_size, mode, origin);
+  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
+          density_max, tile_size, mode, origin);
   const QueryParams& q = prepared.q;
   CompactBuffer buffer;
   buffer.with_keys = keys;
@@ -463,15 +465,15 @@ void bind_query(py::module_& m) {
         py::arg("origin"), py::arg("keys"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("spec").none(true), py::arg("callable").none(true), py::arg("bounds").none(true),
-        py::arg("density_rect").none(true), py::arg("density_max").none(true), py::arg("tile_size"),
-        py::arg("mode"), py::arg("origin"), py::arg("keys"), py::arg("threads"),
+        py::arg("spec").none(true), py::arg("callable").none(true), py::arg("vectorized"),
+        py::arg("bounds").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),
+        py::arg("tile_size"), py::arg("mode"), py::arg("origin"), py::arg("keys"), py::arg("threads"),
         "the compact query into new arrays: float32 positions and, if asked, 64-bit keys");
   m.def(
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
-      py::arg("callable").none(true), py::arg("bounds").none(true), py::arg("density_rect").none(true),
-      py::arg("density_max").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-      py::arg("storage").none(true),
+      py::arg("callable").none(true), py::arg("vectorized"), py::arg("bounds").none(true),
+      py::arg("density_rect").none(true), py::arg("density_max").none(true), py::arg("tile_size"),
+      py::arg("mode"), py::arg("origin"), py::arg("storage").none(true),
       "tools::query_all into numpy arrays (reusing `storage`, an earlier result's, when it is large enough)");
 }
 

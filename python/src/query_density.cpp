@@ -1,6 +1,7 @@
 // A Python callable as a query's density (query_density.h).
 #include "query_density.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -15,61 +16,108 @@ std::string number(double v) {
   return text;
 }
 
+/// A density value from Python: the C++ query counts a bad one as 0; from Python it is a bug in the
+/// callable, said so.
+double checked_value(double v, double x, double y) {
+  if (!(v >= 0 && v < std::numeric_limits<double>::infinity()))
+    throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
+                            number(y) + "): a density must be finite and >= 0");
+  return v;
+}
+
+/// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all.
+void read_values(const py::object& value, std::size_t n, const double* x, const double* y, double* out) {
+  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  const Array v = Array::ensure(value);
+  if (!v) throw std::invalid_argument("a vectorized density callable must return an array of numbers");
+  const bool one = v.ndim() == 0 || (v.ndim() == 1 && v.shape(0) == 1);
+  if (!one && !(v.ndim() == 1 && std::size_t(v.shape(0)) == n)) {
+    std::string shape;
+    for (py::ssize_t k = 0; k < v.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(v.shape(k));
+    throw std::invalid_argument("vectorized density callable returned shape (" + shape + ") for " +
+                                std::to_string(n) + " positions: it must return one value per position");
+  }
+  const double* values = v.data();
+  for (std::size_t i = 0; i < n; ++i) out[i] = checked_value(values[one ? 0 : i], x[i], y[i]);
+}
+
+/// Runs `call` (which talks to Python) with the GIL held, unless an earlier call failed: true if it
+/// returned. Its first exception is kept in `d` for rethrow(), as itself or as a ValueError (a bad value,
+/// shape or pair) or RuntimeError (a failed conversion inside pybind11), and later calls are skipped.
+template <class Call>
+bool guarded(CallableDensity& d, Call&& call) {
+  if (d.failed.load(std::memory_order_relaxed)) return false;
+  py::gil_scoped_acquire gil;
+  try {
+    call();
+    return true;
+  } catch (py::error_already_set& e) {
+    d.error.emplace(std::move(e));
+  } catch (const std::domain_error& e) {
+    PyErr_SetString(PyExc_ValueError, e.what());
+    d.error.emplace();
+  } catch (const std::invalid_argument& e) {
+    PyErr_SetString(PyExc_ValueError, e.what());
+    d.error.emplace();
+  } catch (const std::exception& e) {
+    PyErr_SetString(PyExc_RuntimeError, e.what());
+    d.error.emplace();
+  }
+  d.failed.store(true, std::memory_order_relaxed);
+  return false;
+}
+
 }  // namespace
 
-CallableDensity::CallableDensity(py::object f, double max_value, py::object bounds)
+CallableDensity::CallableDensity(py::object f, double max_value, py::object bounds, bool vectorized)
     : function(std::move(f)), bounds_function(std::move(bounds)) {
   density.kind = QueryDensity::Kind::kCallback;
   density.callback_max = max_value;
   density.user = this;
-  density.callback = [](void* user, double x, double y) -> double {
-    CallableDensity& d = *static_cast<CallableDensity*>(user);
-    if (d.failed.load(std::memory_order_relaxed)) return 0;
-    py::gil_scoped_acquire gil;
-    try {
-      const py::object value = d.function(x, y);
-      const double v = PyFloat_AsDouble(value.ptr());  // any number, numpy's too
-      if (v == -1 && PyErr_Occurred()) throw py::error_already_set();
-      // The C++ query counts such a value as 0; from Python it is a bug in the callable, said so.
-      if (!(v >= 0 && v < std::numeric_limits<double>::infinity()))
-        throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
-                                number(y) + "): a density must be finite and >= 0");
+  if (vectorized) {
+    density.batch_callback = [](void* user, std::size_t n, const double* x, const double* y, double* out) {
+      CallableDensity& d = *static_cast<CallableDensity*>(user);
+      const bool read = guarded(d, [&] {
+        const py::array_t<double> xs(py::ssize_t(n), x),
+            ys(py::ssize_t(n), y);  // copies the callable may keep
+        read_values(d.function(xs, ys), n, x, y, out);
+      });
+      if (!read) std::fill(out, out + n, 0.0);
+    };
+  } else {
+    density.callback = [](void* user, double x, double y) -> double {
+      CallableDensity& d = *static_cast<CallableDensity*>(user);
+      double v = 0;
+      guarded(d, [&] {
+        const py::object value = d.function(x, y);
+        const double got = PyFloat_AsDouble(value.ptr());  // any number, numpy's too
+        if (got == -1 && PyErr_Occurred()) throw py::error_already_set();
+        v = checked_value(got, x, y);
+      });
       return v;
-    } catch (const std::domain_error& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-      d.error.emplace();
-    } catch (py::error_already_set& e) {
-      d.error.emplace(std::move(e));
-    } catch (const std::exception& e) {  // a failed conversion inside pybind11
-      PyErr_SetString(PyExc_RuntimeError, e.what());
-      d.error.emplace();
-    }
-    d.failed.store(true, std::memory_order_relaxed);
-    return 0;
-  };
+    };
+  }
   if (bounds_function.is_none()) return;
   density.bounds = [](void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
     CallableDensity& d = *static_cast<CallableDensity*>(user);
     *lo = *hi = std::numeric_limits<double>::quiet_NaN();  // no bounds, unless the call gives them
-    if (d.failed.load(std::memory_order_relaxed)) return;
-    py::gil_scoped_acquire gil;
-    try {
-      const py::sequence pair = d.bounds_function(x0, y0, x1, y1).cast<py::sequence>();
-      if (pair.size() != 2) throw std::invalid_argument("density_bounds must return (lo, hi)");
-      const double l = pair[0].cast<double>(), h = pair[1].cast<double>();
+    guarded(d, [&] {
+      const py::object got = d.bounds_function(x0, y0, x1, y1);
+      if (!py::isinstance<py::sequence>(got) || py::len(got) != 2)
+        throw std::invalid_argument("density_bounds must return (lo, hi)");
+      const py::sequence pair = got.cast<py::sequence>();
+      double l, h;
+      try {
+        l = pair[0].cast<double>(), h = pair[1].cast<double>();
+      } catch (const py::cast_error&) {
+        throw std::invalid_argument("density_bounds must return two numbers (lo, hi)");
+      }
       if (!(l >= 0 && l <= h))
         throw std::invalid_argument("density_bounds returned (" + number(l) + ", " + number(h) + ") for (" +
                                     number(x0) + ", " + number(y0) + ", " + number(x1) + ", " + number(y1) +
                                     "): bounds must satisfy 0 <= lo <= hi");
       *lo = l, *hi = h;
-      return;
-    } catch (py::error_already_set& e) {
-      d.error.emplace(std::move(e));
-    } catch (const std::exception& e) {  // a failed cast, or not a pair
-      PyErr_SetString(PyExc_ValueError, e.what());
-      d.error.emplace();
-    }
-    d.failed.store(true, std::memory_order_relaxed);
+    });
   };
 }
 

@@ -16,12 +16,14 @@ namespace kdm::python {
 
 using tools::SpecDensity;  // as `kdm query` builds it (tools/stipple/spec_density.h)
 
-/// A Python callable f(x, y) -> float as a query callback. The query runs with the GIL released; each call
-/// takes it back. The first exception f raises is kept (later calls return 0 at once) for rethrow() to
-/// raise once the query is over, so it reaches the caller as itself. `bounds`, if not None, is a callable
-/// (x0, y0, x1, y1) -> (lo, hi) bounding the density over a rectangle (QueryDensity::bounds).
+/// A Python callable f(x, y) -> float as a query callback or, `vectorized`, f(x, y) -> array of float64
+/// arrays x and y of the same length (QueryDensity::batch_callback: up to kDensityBatch positions a call).
+/// The query runs with the GIL released; each call takes it back. The first exception f raises is kept (later
+/// calls return 0 at once) for rethrow() to raise once the query is over, so it reaches the caller as itself.
+/// `bounds`, if not None, is a callable (x0, y0, x1, y1) -> (lo, hi) bounding the density over a rectangle
+/// (QueryDensity::bounds).
 struct CallableDensity {
-  CallableDensity(py::object function, double max_value, py::object bounds);
+  CallableDensity(py::object function, double max_value, py::object bounds, bool vectorized);
   /// Raises the kept exception, if any. Call with the GIL held.
   void rethrow();
 

@@ -127,6 +127,7 @@ kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
   return to_c(status);
 }
 
+static_assert(KDM_DENSITY_BATCH == kdm::kDensityBatch, "the C and C++ batch sizes agree");
 static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN,
               "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
 
@@ -155,6 +156,13 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
                            query->density_image);
     if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
       q.density.bounds = query->density_bounds;
+    if (query->struct_size >=
+            offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback &&
+        query->density_batch_callback && !query->density_image) {
+      q.density.kind = kdm::QueryDensity::Kind::kCallback;
+      q.density.batch_callback = query->density_batch_callback;
+      q.density.user = query->user, q.density.callback_max = query->density_max;
+    }
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);

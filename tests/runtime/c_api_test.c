@@ -52,6 +52,14 @@ static void ramp_bounds(void* user, double x0, double y0, double x1, double y1, 
   (void)user, (void)y0, (void)y1;
   *lo = 0.2 + 0.1 * x0, *hi = 0.2 + 0.1 * x1;
 }
+/* The ramp at n positions (density_batch_callback), counting its calls and values. */
+static long g_batch_calls = 0, g_batch_values = 0;
+static void ramp_batch(void* user, size_t n, const double* x, const double* y, double* out) {
+  size_t i;
+  (void)user, (void)y;
+  ++g_batch_calls, g_batch_values += (long)n;
+  for (i = 0; i < n; ++i) out[i] = 0.2 + 0.1 * x[i];
+}
 /* Two classes from one call: the ramp's value for each, and their bounds. */
 static void two_ramps(void* user, double x, double y, double* values) {
   values[0] = values[1] = ramp(user, x, y);
@@ -273,6 +281,23 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
     CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
     CHECK(g_ramp_calls < calls_without / 10); /* measured: a fortieth (tile and cell bounds) */
+    /* The ramp as a batch callback: the same points, the same values read, many a call. */
+    {
+      kdm_query_problem problem;
+      memset(&problem, 0, sizeof problem);
+      problem.struct_size = sizeof problem;
+      q.density_bounds = NULL, q.density_batch_callback = ramp_batch;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+      CHECK(problem.kind == KDM_PROBLEM_BAD_DENSITY &&
+            strcmp(problem.parameter, "density.batch_callback") == 0);
+      q.density_callback = NULL;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
+      CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
+      CHECK(g_batch_values == calls_without && g_batch_calls * 20 < g_batch_values);
+      q.density_callback = ramp, q.density_batch_callback = NULL;
+    }
     /* Classes of callback densities: their bounds keep the points and classes and save calls. */
     {
       static uint8_t with_classes[8192], without_classes[8192];

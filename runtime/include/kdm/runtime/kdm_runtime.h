@@ -66,7 +66,14 @@ typedef struct kdm_query {
    * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
    * called only where emission is in doubt (kdm::QueryDensity::bounds). */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
+  /* Added in 0.4: instead of density_callback (set one of the two), the density at n positions at once,
+   * out[i] at (x[i], y[i]), 1 <= n <= KDM_DENSITY_BATCH, for vectorised functions: a query gathers each
+   * tile's reads into such calls (kdm::QueryDensity::batch_callback). The same points as density_callback
+   * giving the same values. */
+  void (*density_batch_callback)(void* user, size_t n, const double* x, const double* y, double* out);
 } kdm_query;
+
+#define KDM_DENSITY_BATCH 128 /* kdm::kDensityBatch */
 
 enum { KDM_MODE_STABLE = 0, KDM_MODE_SMOOTH = 1 };
 
