@@ -123,7 +123,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
       if (!in) return true;
       if (kKind == QueryDensity::Kind::kImage && !(j.sampler->at(x, y) > 0)) return true;
       if (kKind == QueryDensity::Kind::kCallback &&
-          !((glided ? density_or_zero(*glided) : callback_value(*j.density, x, y)) > 0))
+          !(density_or_zero(glided ? *glided : j.density->callback(j.density->user, x, y)) > 0))
         return true;
     }
     if (n == capacity) return !in;

@@ -212,7 +212,7 @@ std::uint32_t emit_own(const DescentQuery& q, const DescentNode& n, DescentSink&
 /// overlap instead of restarting after every mispredicted emission test. kClip and kListed as
 /// emit_own's, each rank culled by the reach from the keyframe it appears after. Positions and tests
 /// as the general loop's, bit for bit. kDescentDone, or where the buffer or the budget ran out.
-template <QueryDensity::Kind kKind, bool kClip, bool kListed>
+template <QueryDensity::Kind kKind, bool kClip, bool kListed, bool kBatchReads = false>
 std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentSink& sink, std::uint32_t from,
                            std::uint32_t end, const SubtileCull& c) {
   const TilesetData& set = *q.set;
@@ -220,9 +220,14 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
   static_assert(kKind != QueryDensity::Kind::kConstant);
   // Locals, which the writes into the caller's buffer cannot alias.
   const ImageSampler sampler = *q.sampler;
-  const QueryDensity density = q.params->density;
+  double (*const callback)(void*, double, double) = q.params->density.callback;  // set unless kBatchReads
+  void* const user = q.params->density.user;
+  // A batch callback reads n positions at once (set if kBatchReads).
+  auto read_many = [&](std::size_t n, const double* x, const double* y, double* rho) {
+    q.params->density.batch_callback(user, n, x, y, rho);
+  };
   auto density_at = [&](double x, double y) {  // DescentQuery::density_at, its kind known
-    return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : callback_value(density, x, y);
+    return kKind == QueryDensity::Kind::kImage ? sampler.at(x, y) : density_or_zero(callback(user, x, y));
   };
   QueryPoint* const out = sink.out;
   const std::size_t capacity = sink.capacity;
@@ -247,7 +252,14 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
     lo_y = cut.y0 - reach * 65536.0, hi_y = cut.y1 + reach * 65536.0;
   };
   if (kClip) set_reach(t.glide_reach_from[0]);
-  constexpr int kBatch = 32;
+  // A batch callback reads up to kDensityBatch positions a call: the visited ranks' stable positions
+  // (gathered below), and the emitted ones' glided positions (a batch of as many).
+  static_assert(!kBatchReads || kKind == QueryDensity::Kind::kCallback);
+  constexpr int kBatch = kBatchReads ? int(kDensityBatch) : 32;
+  constexpr std::size_t kGather = kBatchReads ? kDensityBatch : 1;
+  double read_x[kGather], read_y[kGather];  // the gathered ranks' stable positions
+  std::uint32_t read_at[kGather];           // and the ranks
+  double glided_x[kGather], glided_y[kGather], glided_rho[kGather];
   std::uint32_t rank[kBatch];
   double count[kBatch];
   int pending = 0;
@@ -260,7 +272,19 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
       o1[i] = glide + 2 * (std::size_t(start[g.g1]) + rank[i]);
       w0[i] = g.w0, w1[i] = g.w1;
     }
-    for (int i = 0; i < pending; ++i) {
+    if constexpr (kBatchReads) {  // the glided positions in the region, read in one call
+      std::size_t reads = 0;
+      for (int i = 0; i < pending; ++i) {
+        const TilePoint& p = points[rank[i]];
+        const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
+                     dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
+        const double x = wx + (p.unit_x() + dx * (1.0 / 65536.0)) * s,
+                     y = wy + (p.unit_y() + dy * (1.0 / 65536.0)) * s;
+        if (!(kClip && (x < x0 || x >= x1 || y < y0 || y >= y1))) glided_x[reads] = x, glided_y[reads++] = y;
+      }
+      if (reads > 0) read_many(reads, glided_x, glided_y, glided_rho);
+    }
+    for (int i = 0, k = 0; i < pending; ++i) {
       const TilePoint& p = points[rank[i]];
       const double dx = double(o0[i][0]) * w0[i] + double(o1[i][0]) * w1[i],
                    dy = double(o0[i][1]) * w0[i] + double(o1[i][1]) * w1[i];
@@ -268,18 +292,40 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
       // write's tests: in the region (a subtile inside it needs none), and where the density is not 0.
       const double x = wx + ux * s, y = wy + uy * s;
       if (kClip && (x < x0 || x >= x1 || y < y0 || y >= y1)) continue;
-      if (!(density_at(x, y) > 0)) continue;
+      if (!((kBatchReads ? density_or_zero(glided_rho[k++]) : density_at(x, y)) > 0)) continue;
       if (written == capacity) return pending = 0, rank[i];
       out[written++] = QueryPoint{rx + ux * s, ry + uy * s, PointId{gx, gy, rank[i], depth}};
     }
     pending = 0;
     return kDescentDone;
   };
+  // A gathered rank r, emitted by its count at its stable position: queued as the loop below queues one.
+  // kDescentDone, or the rank that did not fit.
+  auto decide = [&](std::uint32_t r, double rho) -> std::uint32_t {
+    const double expected = rho * area;
+    rank[pending] = r, count[pending] = expected;
+    pending += TilesetShape::emits(thresholds[r], expected);
+    return pending == kBatch ? flush() : kDescentDone;
+  };
   const std::uint32_t* it = kListed ? std::lower_bound(cut.listed, cut.listed_end, from) : nullptr;
   std::uint32_t r = kListed ? (it != cut.listed_end ? std::min(*it, end) : end) : from;
+  // A batch callback's visited ranks wait in read_at with their positions until kGather are gathered.
+  std::size_t gathered = 0;
+  double visited_rho[kGather];
+  auto decide_gathered = [&]() -> std::uint32_t {
+    read_many(gathered, read_x, read_y, visited_rho);
+    const std::size_t m = gathered;
+    gathered = 0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::uint32_t stopped = decide(read_at[i], density_or_zero(visited_rho[i]));
+      if (stopped != kDescentDone) return stopped;
+    }
+    return kDescentDone;
+  };
   while (r < end) {
     if (budget == 0) {
-      const std::uint32_t stopped = flush();
+      std::uint32_t stopped = kBatchReads && gathered > 0 ? decide_gathered() : kDescentDone;
+      if (stopped == kDescentDone) stopped = flush();
       sink.written = written, sink.budget = budget;
       return stopped != kDescentDone ? stopped : r;
     }
@@ -295,13 +341,18 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
       visit = sx >= lo_x && sx < hi_x && sy >= lo_y && sy < hi_y;
     }
     if (visit) {
-      const double expected = density_at(wx + q.unit_x() * s, wy + q.unit_y() * s) * area;
-      // Queued at the next slot, which only an emitted rank keeps (no branch to mispredict).
-      rank[pending] = r, count[pending] = expected;
-      pending += TilesetShape::emits(thresholds[r], expected);
-      if (pending == kBatch) {
-        const std::uint32_t stopped = flush();
-        if (stopped != kDescentDone) return sink.written = written, sink.budget = budget, stopped;
+      const double x = wx + q.unit_x() * s, y = wy + q.unit_y() * s;
+      if constexpr (kBatchReads) {
+        read_x[gathered] = x, read_y[gathered] = y, read_at[gathered++] = r;
+      } else {
+        const double expected = density_at(x, y) * area;
+        // Queued at the next slot, which only an emitted rank keeps (no branch to mispredict).
+        rank[pending] = r, count[pending] = expected;
+        pending += TilesetShape::emits(thresholds[r], expected);
+        if (pending == kBatch) {
+          const std::uint32_t stopped = flush();
+          if (stopped != kDescentDone) return sink.written = written, sink.budget = budget, stopped;
+        }
       }
     }
     if (kListed) {
@@ -310,6 +361,14 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
     } else {
       ++r;
     }
+    if (kBatchReads && (gathered == kGather || (gathered > 0 && r >= end))) {
+      const std::uint32_t stopped = decide_gathered();
+      if (stopped != kDescentDone) return sink.written = written, sink.budget = budget, stopped;
+    }
+  }
+  if (kBatchReads && gathered > 0) {
+    const std::uint32_t stopped = decide_gathered();
+    if (stopped != kDescentDone) return sink.written = written, sink.budget = budget, stopped;
   }
   const std::uint32_t stopped = flush();
   sink.written = written, sink.budget = budget;
@@ -320,9 +379,12 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
 template <bool kClip, bool kListed>
 std::uint32_t emit_varying_any(const DescentQuery& q, const DescentNode& n, DescentSink& sink,
                                std::uint32_t from, std::uint32_t end, const SubtileCull& c) {
-  return q.params->density.kind == QueryDensity::Kind::kImage
-             ? emit_varying<QueryDensity::Kind::kImage, kClip, kListed>(q, n, sink, from, end, c)
-             : emit_varying<QueryDensity::Kind::kCallback, kClip, kListed>(q, n, sink, from, end, c);
+  using K = QueryDensity::Kind;
+  if (q.params->density.kind == K::kImage)
+    return emit_varying<K::kImage, kClip, kListed>(q, n, sink, from, end, c);
+  return q.params->density.batch_callback
+             ? emit_varying<K::kCallback, kClip, kListed, true>(q, n, sink, from, end, c)
+             : emit_varying<K::kCallback, kClip, kListed>(q, n, sink, from, end, c);
 }
 
 }  // namespace kdm::detail

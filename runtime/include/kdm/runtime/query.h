@@ -59,9 +59,10 @@ struct QueryDensity {
   double (*callback)(void* user, double x, double y) = nullptr;
   /// For callbacks, instead of `callback` (set one of the two): the densities at n positions at once,
   /// out[i] at (x[i], y[i]), 1 ≤ n ≤ kDensityBatch, with callback's rules (thread-safe, values that are
-  /// not finite and ≥ 0 count as 0). Below the top level a query gathers each tile's reads into such
-  /// batches, so a vectorised function (SIMD, numpy) pays one call per batch; past it (smooth mode's
-  /// subtiles) it asks one position at a time. The points are those of `callback` giving the same values.
+  /// not finite and ≥ 0 count as 0). A query gathers each tile's (and past the top level each
+  /// subtile's) reads into such batches, so a vectorised function (SIMD, numpy) pays one call per batch;
+  /// past the top level the points the subtiles' ancestors hold are still read one at a time (n = 1).
+  /// The points are those of `callback` giving the same values.
   void (*batch_callback)(void* user, std::size_t n, const double* x, const double* y, double* out) = nullptr;
   void* user = nullptr;
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
