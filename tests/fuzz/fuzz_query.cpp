@@ -11,7 +11,8 @@
 //  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
 //  - query_classes with the density and an empty class (two halves of a constant) gives the same points,
 //    and a callback's two classes from one joint callback the same points and classes;
-//  - query_points_compact gives the same points as floats, with their keys.
+//  - query_points_compact gives the same points as floats, with their keys;
+//  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch.
 // A failed check aborts.
 #include <algorithm>
 #include <cfloat>
@@ -65,6 +66,12 @@ double coordinate(std::uint8_t b) {
 double callback(void* user, double x, double y) {
   const double v = *static_cast<const double*>(user);
   return v * (x - y);  // any value, hostile ones included
+}
+
+// The callback at n positions (QueryDensity::batch_callback); a batch out of its bounds fails.
+void batch_callback(void* user, std::size_t n, const double* x, const double* y, double* out) {
+  if (n < 1 || n > kdm::kDensityBatch) std::abort();
+  for (std::size_t i = 0; i < n; ++i) out[i] = callback(user, x[i], y[i]);
 }
 
 // Two classes from one call (ClassQueryParams::joint): the callback's value and nothing.
@@ -231,6 +238,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (kdm::query_points(kdm::Tileset::builtin(), q, small, capacity, &written, &cursor) != kdm::Status::kOk ||
       written != 0)
     fail();
+
+  // The callback read in batches: the same points in the same order.
+  if (kind == 2) {
+    kdm::QueryParams batched = q;
+    batched.density.callback = nullptr, batched.density.batch_callback = batch_callback;
+    static Points through_batches;
+    if (!through_batches.query(batched) || through_batches.status != all.status ||
+        through_batches.size != all.size)
+      fail();
+    for (std::size_t i = 0; i < all.size; ++i)
+      if (!same(through_batches[i], all[i])) fail();
+  }
 
   // Two classes: the density and nothing (a constant density: two halves) give the same points, each
   // with a class that exists.

@@ -20,6 +20,7 @@
 #include "kdm/runtime/query.h"
 #include "query_tables.h"
 #include "random_partition.h"
+#include "run_query.h"
 
 namespace kdm {
 namespace {
@@ -447,12 +448,7 @@ TEST(QueryTest, FollowsADensityImage) {
     bad.max_mip = image.max_mip, bad.min_mip = image.min_mip;
     QueryParams b = region(-1, -1, 1, 1, 1000);
     b.density.kind = QueryDensity::Kind::kImage, b.density.image = &bad;
-    std::vector<QueryPoint> out(16);
-    std::size_t written = 0;
-    QueryCursor cursor;
-    QueryProblem problem;
-    EXPECT_EQ(query_points(Tileset::builtin(), b, out.data(), out.size(), &written, &cursor, &problem),
-              Status::kInvalidArgument);
+    const QueryProblem problem = testing::refusal(b);
     EXPECT_EQ(problem.kind, QueryProblem::Kind::kBadDensity);
     EXPECT_STREQ(problem.parameter, "density.image");
   }

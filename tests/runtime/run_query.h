@@ -23,6 +23,17 @@ inline std::vector<QueryPoint> run_query(const QueryParams& q, std::size_t chunk
   }
 }
 
+/// Why query_points refuses `q` (a failure if it does not).
+inline QueryProblem refusal(const QueryParams& q) {
+  std::vector<QueryPoint> out(16);
+  std::size_t written = 0;
+  QueryCursor cursor;
+  QueryProblem problem;
+  EXPECT_EQ(query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor, &problem),
+            Status::kInvalidArgument);
+  return problem;
+}
+
 /// Whether two results are the same points in the same order, bit for bit.
 inline bool same_bits(const std::vector<QueryPoint>& a, const std::vector<QueryPoint>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(QueryPoint)) == 0;
