@@ -344,6 +344,9 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   q.classes[1].kind = QueryDensity::Kind::kCallback;
   EXPECT_STREQ(refusal(q).parameter, "classes[1].callback");
   q.classes[1].callback = [](void*, double, double) { return 1.0; };
+  q.classes[1].batch_callback = [](void*, std::size_t, const double*, const double*, double*) {};
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].callback");  // both: which one is meant is unclear
+  q.classes[1].batch_callback = nullptr;
   q.classes[1].callback_max = -1;
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);
   q.classes[1].callback_max = NAN;
@@ -406,27 +409,37 @@ void image_bounds(void* view, double x0, double y0, double x1, double y1, double
   *lo = v.min_over(x0, y0, x1, y1), *hi = v.max_over(x0, y0, x1, y1);
 }
 
+// An image's values at n positions (QueryDensity::batch_callback).
+void image_values(void* view, std::size_t n, const double* x, const double* y, double* out) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = image_value(view, x[i], y[i]);
+}
+
 TEST(ClassQueryTest, BoundsSettleClassesWithoutChangingThem) {
-  // Images (their mips bound each tile), callbacks reading them with bounds, and without: the classes the
-  // bounds settle are the ones the densities' values give.
+  // Images (their mips bound each tile), callbacks reading them with bounds, and without, and batch
+  // callbacks: the classes the bounds settle are the ones the densities' values give.
   ThreeImages images;
   std::vector<float> mins[3];
   for (int k = 0; k < 3; ++k) ASSERT_EQ(make_density_max_mip(images.views[k], mins[k]), Status::kOk);
   Points stable;
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     ClassQueryParams as_images = three_constants(0, 0, 4, 4, 800, mode), with_bounds = as_images,
-                     without = as_images;
+                     without = as_images, batched = as_images;
     for (int k = 0; k < 3; ++k) {
       as_images.classes[k].kind = QueryDensity::Kind::kImage, as_images.classes[k].image = &images.views[k];
       QueryDensity& d = with_bounds.classes[k];
       d.kind = QueryDensity::Kind::kCallback, d.callback = image_value;
       d.user = &images.views[k], d.callback_max = 1.2, d.bounds = image_bounds;
       without.classes[k] = d, without.classes[k].bounds = nullptr;
+      batched.classes[k] = d, batched.classes[k].callback = nullptr,
+      batched.classes[k].batch_callback = image_values;
     }
     const Points a = run_classes(as_images), b = run_classes(with_bounds), c = run_classes(without);
     ASSERT_GT(a.size(), 10000u);
     expect_same(a, c, "images against callbacks");
     expect_same(b, c, "callbacks with bounds against without");
+    const Points batches = run_classes(batched);
+    expect_same(batches, b, "batch callbacks against callbacks");
+    for (const auto& [id, e] : b) ASSERT_EQ(batches.at(id).cls, e.cls);
     std::size_t counts[3] = {};
     for (const auto& [id, e] : c) {
       ASSERT_EQ(a.at(id).cls, e.cls);

@@ -89,19 +89,19 @@ typedef struct kdm_cursor {
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {
   KDM_PROBLEM_NONE = 0,
-  KDM_PROBLEM_MISSING_ARGUMENT = 1,    /* `parameter` is NULL (or the tile set is empty) */
-  KDM_PROBLEM_NOT_FINITE = 2,          /* `parameter` is NaN or infinite; `value` holds it */
-  KDM_PROBLEM_NOT_POSITIVE = 3,        /* `parameter` must be > 0 */
-  KDM_PROBLEM_NEGATIVE = 4,            /* `parameter` must be >= 0 */
-  KDM_PROBLEM_BAD_DENSITY = 5,         /* the density image or callback is missing */
-  KDM_PROBLEM_TOO_MANY_TILES = 6,      /* `value` tiles, more than `limit`: split the region */
-  KDM_PROBLEM_DENSITY_TOO_HIGH = 7,    /* `value` points per tile > `limit`; see largest_valid (scale) and
-                                          largest_tile_size */
-  KDM_PROBLEM_CURSOR_MISMATCH = 8,     /* the cursor was started by a query with other parameters */
-  KDM_PROBLEM_BAD_MODE = 9,            /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
-  KDM_PROBLEM_BAD_CLASS_COUNT = 10,    /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
-  KDM_PROBLEM_KEYS_UNSUPPORTED = 11,   /* kdm_query_compact: keys asked of a set whose tiles hold `value`
-                                          points, more than a key's ranks (`limit`) */
+  KDM_PROBLEM_MISSING_ARGUMENT = 1,  /* `parameter` is NULL (or the tile set is empty) */
+  KDM_PROBLEM_NOT_FINITE = 2,        /* `parameter` is NaN or infinite; `value` holds it */
+  KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 */
+  KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
+  KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing, or both callbacks are set */
+  KDM_PROBLEM_TOO_MANY_TILES = 6,    /* `value` tiles, more than `limit`: split the region */
+  KDM_PROBLEM_DENSITY_TOO_HIGH = 7,  /* `value` points per tile > `limit`; see largest_valid (scale) and
+                                        largest_tile_size */
+  KDM_PROBLEM_CURSOR_MISMATCH = 8,   /* the cursor was started by a query with other parameters */
+  KDM_PROBLEM_BAD_MODE = 9,          /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
+  KDM_PROBLEM_BAD_CLASS_COUNT = 10,  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
+  KDM_PROBLEM_KEYS_UNSUPPORTED = 11, /* kdm_query_compact: keys asked of a set whose tiles hold `value`
+                                        points, more than a key's ranks (`limit`) */
   KDM_PROBLEM_TOO_FAR_FROM_ORIGIN = 12 /* the region lies `value` from the world origin, farther than
                                           `limit`, where doubles cannot place its points */
 } kdm_problem_kind;
