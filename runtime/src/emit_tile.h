@@ -313,6 +313,11 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
             unread_emitted = TilesetShape::emits(j.thresholds[r], cell_lo[cell]);
           }
         }
+        if (unread_emitted && gathered == 0) {  // nothing waits before it: written at once
+          if (n == capacity) return r;
+          out.put_stable(n++, j, p, r);
+          continue;
+        }
         rank[gathered] = r, read[gathered++] = !unread_emitted;
         if (!unread_emitted) bx[reads] = x, by[reads++] = y;
       }
