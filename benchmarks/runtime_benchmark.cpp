@@ -135,14 +135,11 @@ void ramp_batch(void*, std::size_t n, const double* x, const double*, double* ou
   for (std::size_t i = 0; i < n; ++i) out[i] = 0.2 + 0.8 * x[i] / kSide;
 }
 
-// Args: smooth; bounds, 1 to give the callback's bounds too; batch, 1 to read it through batch_callback.
+// Args: smooth; bounds, 1 to give the callback's bounds too.
 void BM_QueryDensityCallback(benchmark::State& state) {
   kdm::QueryParams q = params(state);
   q.density.kind = kdm::QueryDensity::Kind::kCallback;
-  if (state.range(2))
-    q.density.batch_callback = ramp_batch;
-  else
-    q.density.callback = ramp;
+  q.density.callback = ramp;
   q.density.callback_max = 1;
   if (state.range(1)) q.density.bounds = ramp_bounds;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
@@ -520,6 +517,33 @@ void BM_QueryUnaligned(benchmark::State& state) {
   state.counters["of_aligned"] = aligned_seconds / seconds;
 }
 
+// The ramp read through batch_callback (args: smooth; bounds), in rounds alternating with the same query
+// through callback; `of_scalar`: the scalar query's time over the batch query's (the same points).
+void BM_QueryBatchCallback(benchmark::State& state) {
+  kdm::QueryParams scalar = params(state);
+  scalar.density.kind = kdm::QueryDensity::Kind::kCallback;
+  scalar.density.callback = ramp;
+  scalar.density.callback_max = 1;
+  if (state.range(1)) scalar.density.bounds = ramp_bounds;
+  kdm::QueryParams batch = scalar;
+  batch.density.callback = nullptr, batch.density.batch_callback = ramp_batch;
+  std::vector<kdm::QueryPoint> buffer(1 << 20);
+  std::size_t n = 0;
+  double seconds = 0, scalar_seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(n = run_query(batch, buffer));
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(run_query(scalar, buffer));
+    const auto t2 = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(t1 - t0).count();
+    scalar_seconds += std::chrono::duration<double>(t2 - t1).count();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  report(state, n);
+  state.counters["of_scalar"] = scalar_seconds / seconds;
+}
+
 // The benchmark's 8 × 8-tile region queried as a grid of square chunks (args: smooth; chunk, the chunk's side
 // in hundredths of a tile), from a corner 0.3 tiles off the tiling, into a reused 65,536-point buffer, as an
 // engine streams chunks that ignore the tiles; chunks of 0.1 tile cover 8 × 8 tiles' worth of area at 32 × 32
@@ -591,8 +615,8 @@ void BM_LoadBuiltinSet(benchmark::State& state) {
 BENCHMARK(BM_QueryConstant)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryDensityCallback)
-    ->ArgNames({"smooth", "bounds", "batch"})
-    ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})
+    ->ArgNames({"smooth", "bounds"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
@@ -635,6 +659,11 @@ BENCHMARK(BM_QueryPerCall)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QueryUnaligned)
     ->ArgNames({"smooth", "compact"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryBatchCallback)
+    ->ArgNames({"smooth", "bounds"})
     ->ArgsProduct({{0, 1}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
