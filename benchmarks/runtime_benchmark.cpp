@@ -98,6 +98,24 @@ void run_against_baseline(benchmark::State& state, Query&& query) {
   state.counters["of_baseline"] = baseline_seconds(n) / (seconds / double(state.iterations()));
 }
 
+// Rounds of `timed` (returning its point count, which `n` receives; its time is the benchmark's) alternating
+// with `reference`: the reference's time over the timed query's.
+template <class Timed, class Reference>
+double alternate(benchmark::State& state, std::size_t& n, Timed&& timed, Reference&& reference) {
+  double seconds = 0, reference_seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(n = timed());
+    const auto t1 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(reference());
+    const auto t2 = std::chrono::steady_clock::now();
+    seconds += std::chrono::duration<double>(t1 - t0).count();
+    reference_seconds += std::chrono::duration<double>(t2 - t1).count();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  return reference_seconds / seconds;
+}
+
 void BM_QueryConstant(benchmark::State& state) {
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   run_against_baseline(state, [&] { return run_query(params(state), buffer); });
@@ -135,13 +153,19 @@ void ramp_batch(void*, std::size_t n, const double* x, const double*, double* ou
   for (std::size_t i = 0; i < n; ++i) out[i] = 0.2 + 0.8 * x[i] / kSide;
 }
 
-// Args: smooth; bounds, 1 to give the callback's bounds too.
-void BM_QueryDensityCallback(benchmark::State& state) {
+// The benchmark's query with the ramp by callback (args: smooth; bounds, 1 to give its bounds too).
+kdm::QueryParams ramp_params(benchmark::State& state) {
   kdm::QueryParams q = params(state);
   q.density.kind = kdm::QueryDensity::Kind::kCallback;
   q.density.callback = ramp;
   q.density.callback_max = 1;
   if (state.range(1)) q.density.bounds = ramp_bounds;
+  return q;
+}
+
+// Args: smooth; bounds.
+void BM_QueryDensityCallback(benchmark::State& state) {
+  const kdm::QueryParams q = ramp_params(state);
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
@@ -502,46 +526,24 @@ void BM_QueryUnaligned(benchmark::State& state) {
     return total + written;
   };
   std::size_t n = 0;
-  double seconds = 0, aligned_seconds = 0;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(n = run(moved));
-    const auto t1 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(run(aligned));
-    const auto t2 = std::chrono::steady_clock::now();
-    seconds += std::chrono::duration<double>(t1 - t0).count();
-    aligned_seconds += std::chrono::duration<double>(t2 - t1).count();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
-  }
+  const double of_aligned = alternate(
+      state, n, [&] { return run(moved); }, [&] { return run(aligned); });
   report(state, n);
-  state.counters["of_aligned"] = aligned_seconds / seconds;
+  state.counters["of_aligned"] = of_aligned;
 }
 
 // The ramp read through batch_callback (args: smooth; bounds), in rounds alternating with the same query
 // through callback; `of_scalar`: the scalar query's time over the batch query's (the same points).
 void BM_QueryBatchCallback(benchmark::State& state) {
-  kdm::QueryParams scalar = params(state);
-  scalar.density.kind = kdm::QueryDensity::Kind::kCallback;
-  scalar.density.callback = ramp;
-  scalar.density.callback_max = 1;
-  if (state.range(1)) scalar.density.bounds = ramp_bounds;
+  const kdm::QueryParams scalar = ramp_params(state);
   kdm::QueryParams batch = scalar;
   batch.density.callback = nullptr, batch.density.batch_callback = ramp_batch;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::size_t n = 0;
-  double seconds = 0, scalar_seconds = 0;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(n = run_query(batch, buffer));
-    const auto t1 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(run_query(scalar, buffer));
-    const auto t2 = std::chrono::steady_clock::now();
-    seconds += std::chrono::duration<double>(t1 - t0).count();
-    scalar_seconds += std::chrono::duration<double>(t2 - t1).count();
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
-  }
+  const double of_scalar = alternate(
+      state, n, [&] { return run_query(batch, buffer); }, [&] { return run_query(scalar, buffer); });
   report(state, n);
-  state.counters["of_scalar"] = scalar_seconds / seconds;
+  state.counters["of_scalar"] = of_scalar;
 }
 
 // The benchmark's 8 × 8-tile region queried as a grid of square chunks (args: smooth; chunk, the chunk's side
