@@ -110,6 +110,15 @@ kdm::QueryDensity to_density(double constant, double (*callback)(void*, double, 
   return d;
 }
 
+/// A C batch callback (if not NULL and no image takes precedence) into `d`, made by to_density.
+void with_batch_callback(kdm::QueryDensity& d,
+                         void (*batch)(void*, size_t, const double*, const double*, double*), void* user,
+                         double callback_max, const kdm_density_image* image) {
+  if (!batch || image) return;
+  d.kind = kdm::QueryDensity::Kind::kCallback;
+  d.batch_callback = batch, d.user = user, d.callback_max = callback_max;
+}
+
 /// kdm_point and QueryPoint share their layout: queries write straight into the caller's buffer.
 kdm::QueryPoint* as_points(kdm_point* out) {
   static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
@@ -157,12 +166,9 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
     if (query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds)
       q.density.bounds = query->density_bounds;
     if (query->struct_size >=
-            offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback &&
-        query->density_batch_callback && !query->density_image) {
-      q.density.kind = kdm::QueryDensity::Kind::kCallback;
-      q.density.batch_callback = query->density_batch_callback;
-      q.density.user = query->user, q.density.callback_max = query->density_max;
-    }
+        offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback)
+      with_batch_callback(q.density, query->density_batch_callback, query->user, query->density_max,
+                          query->density_image);
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);
@@ -191,6 +197,7 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
       const kdm_class_density& c = classes[k];
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
       q.classes[k].bounds = c.density_bounds;
+      with_batch_callback(q.classes[k], c.density_batch_callback, c.user, c.density_max, c.density_image);
     }
     if (is_joint) {
       q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,

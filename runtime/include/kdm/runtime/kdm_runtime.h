@@ -196,6 +196,9 @@ typedef struct kdm_class_density {
    * the callback's density, as kdm_query's density_bounds; the union takes their sum, and a tile's
    * bounds settle most points' classes without a call. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
+  /* Added in 0.4: instead of density_callback, the density at n positions at once, as kdm_query's
+   * density_batch_callback (a class query reads its classes one position at a time through it). */
+  void (*density_batch_callback)(void* user, size_t n, const double* x, const double* y, double* out);
 } kdm_class_density;
 
 #define KDM_MAX_CLASSES 8
