@@ -110,10 +110,11 @@ struct Points {
   kdm::QueryPoint data[kBigCapacity];
   std::size_t size = 0;
   kdm::Status status = kdm::Status::kOk;
+  kdm::QueryProblem problem;
   // False if they do not fit (the input is then over budget).
   bool query(const kdm::QueryParams& q) {
     kdm::QueryCursor cursor;
-    status = kdm::query_points(kdm::Tileset::builtin(), q, data, kBigCapacity, &size, &cursor);
+    status = kdm::query_points(kdm::Tileset::builtin(), q, data, kBigCapacity, &size, &cursor, &problem);
     return status != kdm::Status::kBufferFull;
   }
   const kdm::QueryPoint& operator[](std::size_t i) const { return data[i]; }
@@ -310,13 +311,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
 
-  // Split at x = xm: both halves are accepted (their density bounds are no higher), and together they
-  // hold exactly the region's points.
+  // Split at x = xm: both halves are accepted (their density bounds are no higher), unless a half is too
+  // narrow for its distance from the world origin (refused by name), and together they hold exactly the
+  // region's points.
   const double xm = q.x0 + split * (q.x1 - q.x0);
   if (!(xm > q.x0 && xm < q.x1)) return 0;
   kdm::QueryParams qa = q, qb = q;
   qa.x1 = xm, qb.x0 = xm;
-  if (!a.query(qa) || a.status != kdm::Status::kOk || !b.query(qb) || b.status != kdm::Status::kOk) fail();
+  const bool a_fits = a.query(qa), b_fits = b.query(qb);
+  for (const Points* half : {&a, &b})
+    if (half->status == kdm::Status::kInvalidArgument &&
+        half->problem.kind == kdm::QueryProblem::Kind::kTooFarFromOrigin)
+      return 0;
+  if (!a_fits || a.status != kdm::Status::kOk || !b_fits || b.status != kdm::Status::kOk) fail();
   if (a.size + b.size != all.size) fail();
   auto by_id = [](Points& p) {  // in id order (a tile a part meets only in part comes cell by cell)
     std::sort(p.data, p.data + p.size,
