@@ -341,18 +341,23 @@ double ramp_side = kSide;
 double ramp_at_depth(void*, double x, double) {
   return 0.2 + 0.8 * x / ramp_side;
 }
+void ramp_batch_at_depth(void*, std::size_t n, const double* x, const double*, double* out) {
+  for (std::size_t i = 0; i < n; ++i) out[i] = 0.2 + 0.8 * x[i] / ramp_side;
+}
 
-void query_at_depth(benchmark::State& state, bool ramp) {
+// The query at depth state.range(0) into `q`, from `tiles`; false (the state told) if the set has no
+// hand-over.
+bool at_depth(benchmark::State& state, bool ramp, const kdm::Tileset*& tiles, kdm::QueryParams& q) {
   static kdm::Tileset loaded;
   const char* path = std::getenv("KDM_BENCHMARK_TILESET");
   if (path && loaded.empty() && kdm::Tileset::load_file(path, loaded) != kdm::Status::kOk)
-    return state.SkipWithError("KDM_BENCHMARK_TILESET does not load");
-  const kdm::Tileset& tiles = path ? loaded : kdm::Tileset::builtin();
-  const double m = std::sqrt(kdm::query_density_limit(tiles, kdm::QueryMode::kSmooth) /
-                             tiles.max_points_per_tile());  // m^4
-  if (!(m > 1)) return state.SkipWithError("the tile set has no hand-over");
+    return state.SkipWithError("KDM_BENCHMARK_TILESET does not load"), false;
+  tiles = path ? &loaded : &kdm::Tileset::builtin();
+  const double m = std::sqrt(kdm::query_density_limit(*tiles, kdm::QueryMode::kSmooth) /
+                             tiles->max_points_per_tile());  // m^4
+  if (!(m > 1)) return state.SkipWithError("the tile set has no hand-over"), false;
   const double zoom = std::pow(std::sqrt(std::sqrt(m)), double(state.range(0)));  // m^d
-  kdm::QueryParams q = params();
+  q = params();
   q.mode = kdm::QueryMode::kSmooth;
   q.x1 = q.y1 = kSide / zoom;
   q.scale = kScale * zoom * zoom;
@@ -362,8 +367,15 @@ void query_at_depth(benchmark::State& state, bool ramp) {
     q.density.callback = ramp_at_depth;
     q.density.callback_max = 1;
   }
+  return true;
+}
+
+void query_at_depth(benchmark::State& state, bool ramp) {
+  const kdm::Tileset* tiles = nullptr;
+  kdm::QueryParams q;
+  if (!at_depth(state, ramp, tiles, q)) return;
   std::vector<kdm::QueryPoint> buffer(1 << 20);
-  run_against_baseline(state, [&] { return run_query(tiles, q, buffer); });
+  run_against_baseline(state, [&] { return run_query(*tiles, q, buffer); });
 }
 
 void BM_QuerySmoothAtDepth(benchmark::State& state) {
@@ -372,6 +384,23 @@ void BM_QuerySmoothAtDepth(benchmark::State& state) {
 
 void BM_QueryRampAtDepth(benchmark::State& state) {
   query_at_depth(state, true);
+}
+
+// BM_QueryRampAtDepth's ramp read through batch_callback, in rounds alternating with the scalar callback;
+// `of_scalar` as BM_QueryBatchCallback's.
+void BM_QueryBatchRampAtDepth(benchmark::State& state) {
+  const kdm::Tileset* tiles = nullptr;
+  kdm::QueryParams scalar;
+  if (!at_depth(state, true, tiles, scalar)) return;
+  kdm::QueryParams batch = scalar;
+  batch.density.callback = nullptr, batch.density.batch_callback = ramp_batch_at_depth;
+  std::vector<kdm::QueryPoint> buffer(1 << 20);
+  std::size_t n = 0;
+  const double of_scalar = alternate(
+      state, n, [&] { return run_query(*tiles, batch, buffer); },
+      [&] { return run_query(*tiles, scalar, buffer); });
+  report(state, n);
+  state.counters["of_scalar"] = of_scalar;
 }
 
 void BM_BaselineWriteSamePoints(benchmark::State& state) {
@@ -667,6 +696,11 @@ BENCHMARK(BM_QueryUnaligned)
 BENCHMARK(BM_QueryBatchCallback)
     ->ArgNames({"smooth", "bounds"})
     ->ArgsProduct({{0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryBatchRampAtDepth)
+    ->ArgName("depth")
+    ->DenseRange(1, 2)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryConstantReusedBuffer)->Unit(benchmark::kMillisecond);

@@ -7,6 +7,7 @@
 // expression: ρ(x_q) · area[d + 1] > K_1, x_q computed as the subtile computes its own points.
 #include "descent.h"
 
+#include "read_ahead.h"
 #include "subtile_loops.h"
 
 #include <algorithm>
@@ -65,7 +66,7 @@ using Node = DescentNode;
 class Descent {
  public:
   Descent(const DescentQuery& q, QueryPoint* out, std::size_t capacity, std::size_t& written,
-          std::uint64_t& budget)
+          std::uint64_t& budget, ReadAhead* ahead)
       : q_(q),
         set_(*q.set),
         t_(*q.tables),
@@ -73,7 +74,8 @@ class Descent {
         out_(out),
         capacity_(capacity),
         n_(written),
-        budget_(budget) {}
+        budget_(budget),
+        ahead_(ahead) {}
 
   bool run(std::int64_t tx, std::int64_t ty, std::size_t index, DescentPlace& at) {
     Node& root = stack_[0];
@@ -148,14 +150,14 @@ class Descent {
     std::size_t type;
     double x, y, expected;
   };
-  SubPoint sub_point(const Node& n, std::uint32_t cx, std::uint32_t cy, std::uint32_t rank) const {
+  SubPoint sub_point(const Node& n, std::uint32_t cx, std::uint32_t cy, std::uint32_t rank) {
     SubPoint s{cx, cy, rank, t_.child_type[n.type * m_ * m_ + cy * m_ + cx], 0, 0, 0};
     const TilePoint& p = set_.tiles[s.type].points[rank];
     const std::uint32_t d = n.depth + 1;
     // As the subtile computes its own points' positions (run, emit): the same bits.
     const double wx = double(n.gx * m_ + cx) * q_.side[d], wy = double(n.gy * m_ + cy) * q_.side[d];
     s.x = wx + p.unit_x() * q_.side[d], s.y = wy + p.unit_y() * q_.side[d];
-    s.expected = q_.density_at(s.x, s.y) * q_.area[d];
+    s.expected = read(s.x, s.y) * q_.area[d];
     return s;
   }
   /// Where sub-point s lies when its subtile's count at it is `count` (at least K_1), in its parent's unit
@@ -192,7 +194,7 @@ class Descent {
     bool own;
     double count;
   };
-  Share share(int k, std::uint32_t rank, double expected) const {
+  Share share(int k, std::uint32_t rank, double expected) {
     if (k == 0 || rank >= t_.points_at_keyframe[stack_[k].type][1]) return {true, expected};
     const Node& p = stack_[k - 1];
     const std::uint32_t from =
@@ -200,9 +202,8 @@ class Descent {
     if (from == QueryTables::kAppearing) return {expected > q_.k1, expected};
     const TilePoint& point = set_.tiles[p.type].points[from];
     const double side = q_.side[p.depth];  // as emit computes the parent's own count there
-    const Share parent =
-        share(k - 1, from,
-              q_.density_at(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
+    const Share parent = share(
+        k - 1, from, read(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
     return {parent.own && expected > q_.k1 && parent.count > t_.handover_end[p.type][from],
             std::min(expected, parent.count / (double(m_) * m_))};
   }
@@ -219,12 +220,24 @@ class Descent {
     return PointId{stack_[k].gx, stack_[k].gy, rank, std::uint32_t(k)};
   }
 
+  /// The density at (x, y). With a batch callback, read ahead when it can be (ReadAhead); in a dry run a
+  /// value not yet read is asked for and the candidate stops there: its later reads give 0 unasked.
+  double read(double x, double y) { return ahead_ ? read_through_ahead(x, y) : q_.density_at(x, y); }
+  [[gnu::noinline]] double read_through_ahead(double x, double y) {
+    double value;
+    if (ahead_->find(x, y, value)) return value;
+    if (!dry_) return q_.density_at(x, y);
+    if (!missed_) missed_ = true, ahead_->want(x, y);
+    return 0;
+  }
+
   /// Writes a point at world (x, y), (rx, ry) from the origin, unless it lies outside the region or where
   /// the density is 0; false when the buffer is full.
   bool write(double x, double y, double rx, double ry, const PointId& id) {
     const QueryParams& p = *q_.params;
     if (x < p.x0 || x >= p.x1 || y < p.y0 || y >= p.y1) return true;
-    if (p.density.kind != QueryDensity::Kind::kConstant && !(q_.density_at(x, y) > 0)) return true;
+    if (p.density.kind != QueryDensity::Kind::kConstant && !(read(x, y) > 0)) return true;
+    if (dry_) return true;
     if (n_ == capacity_) return false;
     out_[n_++] = QueryPoint{rx, ry, id};
     return true;
@@ -235,6 +248,97 @@ class Descent {
     const double x = n.wx + ux * s, y = n.wy + uy * s;
     return n.depth == 0 ? write(x, y, x - q_.params->origin_x, y - q_.params->origin_y, id)
                         : write(x, y, n.rx + ux * s, n.ry + uy * s, id);
+  }
+
+  /// What emit's loop over a tile's ranks uses, fixed for the tile, and the window a culled tile's ranks
+  /// must lie in (it widens as the ranks pass keyframes).
+  struct RankLoop {
+    const Node* n;
+    const Tile* tile;
+    const float* thresholds;
+    const std::uint32_t* start;
+    const std::uint32_t* present;
+    double side, area, constant_count;
+    std::uint32_t seq, inherited;
+    bool constant, culled;
+    GlideBracket constant_bracket;
+    SubtileCull around;
+    std::uint32_t segment = 0;
+    double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+  };
+
+  /// Rank r of stack_[k], in emit's loop over the ranks that may hand over or be inherited: written if
+  /// emitted; false when the buffer is full.
+  [[gnu::always_inline]] bool visit(int k, RankLoop& L, std::uint32_t r) {
+    const Node& n = *L.n;
+    const Tile& tile = *L.tile;
+    const double side = L.side, area = L.area;
+    const std::uint32_t inherited = L.inherited, top_keyframe = q_.keyframes.n - 1;
+    const TilePoint& p = tile.points[r];
+    if (L.culled) {
+      if (r == L.seq || (L.segment < q_.keyframes.n && L.present[L.segment] <= r)) {
+        while (L.segment < q_.keyframes.n && L.present[L.segment] <= r) ++L.segment;
+        const double rank_reach = std::max(t_.glide_reach_from[L.segment ? L.segment - 1 : 0],
+                                           hands_over(n) ? t_.handover_reach : 0);
+        L.lo_x = L.around.x0 - rank_reach * 65536.0, L.hi_x = L.around.x1 + rank_reach * 65536.0;
+        L.lo_y = L.around.y0 - rank_reach * 65536.0, L.hi_y = L.around.y1 + rank_reach * 65536.0;
+      }
+      if (!(p.x + 0.5 >= L.lo_x && p.x + 0.5 < L.hi_x && p.y + 0.5 >= L.lo_y && p.y + 0.5 < L.hi_y))
+        return true;
+    }
+    const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
+    const double count_here = L.constant ? L.constant_count : read(xs, ys) * area;
+    const Share mine = r < inherited ? share(k, r, count_here) : Share{true, count_here};
+    if (r < inherited ? !mine.own : !TilesetShape::emits(L.thresholds[r], mine.count)) return true;
+    const double expected = mine.count;
+    if (hands_over(n) && expected > q_.top) {
+      const std::uint32_t v = tile.handover[r], code = v % 25;
+      const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
+                                   TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
+      const double end = t_.handover_end[n.type][r];
+      if (s.expected > q_.k1 && expected > end) return true;  // its subtile took it over
+      // On the straight line from its top-keyframe position to where its subtile will place the sub-point,
+      // a fraction f of the way, linear in the scale: 0 where its own count a · N_top reaches N_top, 1
+      // where both its own count passes the hand-over's end and the sub-point's b · K_1 passes K_1 (a and
+      // b are proportional to the scale), which is where its subtile takes it over and places it by the
+      // smaller of b · K_1 and its count over m² (share).
+      const double a = expected / q_.top, b = s.expected / q_.k1;
+      const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, end / q_.top) - 1);
+      const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(L.start[top_keyframe]) + r);
+      const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
+      const double ax = p.unit_x() + o[0] * unit, ay = p.unit_y() + o[1] * unit;
+      double bx, by;
+      glided(s, std::min(s.expected, expected / (double(m_) * m_)), bx, by);
+      return write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r));
+    }
+    const GlideBracket g =
+        L.constant && r >= inherited ? L.constant_bracket : GlideBracket(q_.keyframes, expected);
+    const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(L.start[g.g0]) + r);
+    const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(L.start[g.g1]) + r);
+    const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
+                 dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
+    if (n.depth == 0) {  // the expression of query.cpp's emit_tile, bit for bit
+      const double unit = side * (1.0 / 65536.0), x = xs + dx * unit, y = ys + dy * unit;
+      return write(x, y, x - q_.params->origin_x, y - q_.params->origin_y, id_of(k, r));
+    }
+    return write_unit(n, p.unit_x() + dx * (1.0 / 65536.0), p.unit_y() + dy * (1.0 / 65536.0), id_of(k, r));
+  }
+
+  /// Reads ahead the values that items [from, …) of a loop will read, by dry runs of `pass(from, to)`,
+  /// which visits them (ReadAhead); `reads` bounds the values an item reads. Returns the end of the items
+  /// read for.
+  template <class Pass>
+  std::uint32_t read_ahead(std::uint32_t from, std::uint32_t end, std::uint32_t reads, Pass pass) {
+    const std::uint32_t block = std::max<std::uint32_t>(1, std::uint32_t(ReadAhead::kCapacity) / reads);
+    const std::uint32_t to = end - from > block ? from + block : end;
+    ahead_->clear();
+    dry_ = true;
+    do {
+      pass(from, to);
+      ahead_->read();
+    } while (ahead_->take_added() > 0);
+    dry_ = false;
+    return to;
   }
 
   /// Emits stack_[k]'s points from `seq` on (ranks, then its appearing sub-points at index point count
@@ -256,7 +360,6 @@ class Descent {
     const bool handed_over = n.depth < kMaxQueryDepth && n.rho_min * area > t_.handover_end_max[n.type] &&
                              n.rho_min * q_.area[n.depth + 1] > q_.k1;
     if (handed_over) candidates = std::min(candidates, inherited);
-    const std::uint32_t top_keyframe = q_.keyframes.n - 1;
     const std::uint32_t* start = t_.glide_start[n.type].data();
     // A constant density: one count and one bracket for the tile's own points (the same values the
     // per-point expressions give).
@@ -286,66 +389,20 @@ class Descent {
     const bool culled = general_end > seq && !(n.wx - far >= params.x0 && n.wx + side + far < params.x1 &&
                                                n.wy - far >= params.y0 && n.wy + side + far < params.y1);
     const SubtileCull around = culled ? subtile_cull(q_, n) : SubtileCull{};
-    const std::uint32_t* present = t_.points_at_keyframe[n.type].data();
-    std::uint32_t segment = 0;
-    double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+    RankLoop loop{&n,       &tile,  thresholds,       start, t_.points_at_keyframe[n.type].data(),
+                  side,     area,   constant_count,   seq,   inherited,
+                  constant, culled, constant_bracket, around};
+    std::uint32_t read_to = seq;  // the ranks whose values are read ahead (a batch callback's)
     for (std::uint32_t r = seq; r < general_end; ++r) {
       if (budget_ == 0) return r;
       --budget_;
-      const TilePoint& p = tile.points[r];
-      if (culled) {
-        if (r == seq || (segment < q_.keyframes.n && present[segment] <= r)) {
-          while (segment < q_.keyframes.n && present[segment] <= r) ++segment;
-          const double rank_reach =
-              std::max(t_.glide_reach_from[segment ? segment - 1 : 0], hands_over(n) ? t_.handover_reach : 0);
-          lo_x = around.x0 - rank_reach * 65536.0, hi_x = around.x1 + rank_reach * 65536.0;
-          lo_y = around.y0 - rank_reach * 65536.0, hi_y = around.y1 + rank_reach * 65536.0;
-        }
-        if (!(p.x + 0.5 >= lo_x && p.x + 0.5 < hi_x && p.y + 0.5 >= lo_y && p.y + 0.5 < hi_y)) continue;
-      }
-      const double xs = n.wx + p.unit_x() * side, ys = n.wy + p.unit_y() * side;
-      const double count_here = constant ? constant_count : q_.density_at(xs, ys) * area;
-      const Share mine = r < inherited ? share(k, r, count_here) : Share{true, count_here};
-      if (r < inherited ? !mine.own : !TilesetShape::emits(thresholds[r], mine.count)) continue;
-      const double expected = mine.count;
-      if (hands_over(n) && expected > q_.top) {
-        const std::uint32_t v = tile.handover[r], code = v % 25;
-        const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
-                                     TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
-        const double end = t_.handover_end[n.type][r];
-        if (s.expected > q_.k1 && expected > end) continue;  // its subtile took it over
-        {
-          // On the straight line from its top-keyframe position to where its subtile will place the
-          // sub-point, a fraction f of the way, linear in the scale: 0 where its own count a · N_top
-          // reaches N_top, 1 where both its own count passes the hand-over's end and the sub-point's
-          // b · K_1 passes K_1 (a and b are proportional to the scale), which is where its subtile takes
-          // it over and places it by the smaller of b · K_1 and its count over m² (share).
-          const double a = expected / q_.top, b = s.expected / q_.k1;
-          const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, end / q_.top) - 1);
-          const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(start[top_keyframe]) + r);
-          const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
-          const double ax = p.unit_x() + o[0] * unit, ay = p.unit_y() + o[1] * unit;
-          double bx, by;
-          glided(s, std::min(s.expected, expected / (double(m_) * m_)), bx, by);
-          if (!write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r))) return r;
-          continue;
-        }
-      }
-      const GlideBracket g =
-          constant && r >= inherited ? constant_bracket : GlideBracket(q_.keyframes, expected);
-      const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(start[g.g0]) + r);
-      const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(start[g.g1]) + r);
-      const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
-                   dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
-      bool fits;
-      if (n.depth == 0) {  // the expression of query.cpp's emit_tile, bit for bit
-        const double unit = side * (1.0 / 65536.0), x = xs + dx * unit, y = ys + dy * unit;
-        fits = write(x, y, x - q_.params->origin_x, y - q_.params->origin_y, id_of(k, r));
-      } else {
-        fits =
-            write_unit(n, p.unit_x() + dx * (1.0 / 65536.0), p.unit_y() + dy * (1.0 / 65536.0), id_of(k, r));
-      }
-      if (!fits) return r;
+      // A rank reads at most its count, its k ancestors', its sub-point's and its glided position's.
+      if (ahead_ && r == read_to)
+        read_to = read_ahead(r, general_end, std::uint32_t(k) + 3, [&](std::uint32_t from, std::uint32_t to) {
+          RankLoop dry = loop;
+          for (std::uint32_t i = from; i < to; ++i) missed_ = false, visit(k, dry, i);
+        });
+      if (!visit(k, loop, r)) return r;
     }
     if ((direct || varying) && candidates > inherited) {
       const std::uint32_t from = std::max(seq, inherited);
@@ -369,18 +426,25 @@ class Descent {
     // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].
     if (!hands_over(n) || !(bound > q_.top) || handed_over) return kDone;
     const auto listed = static_cast<std::uint32_t>(tile.appearing.size());
-    for (std::uint32_t a = seq > count ? seq - count : 0; a < listed; ++a) {
-      if (budget_ == 0) return count + a;
-      --budget_;
+    const auto appear = [&](std::uint32_t a) {  // false when the buffer is full
       const std::uint32_t w = tile.appearing[a], j = w >> 16;
       const SubPoint s = sub_point(n, j % m_, j / m_, w & 0xFFFF);
-      if (s.expected > q_.k1) continue;  // its subtile took it over (share: it appears on its own)
+      if (s.expected > q_.k1) return true;  // its subtile took it over (share: it appears on its own)
       const double threshold = q_.top + (a + 0.5) / listed * (q_.appearing_end - q_.top);
-      if (!(q_.density_at(s.x, s.y) * area > threshold)) continue;
+      if (!(read(s.x, s.y) * area > threshold)) return true;
       double ux, uy;
       keyframe_one(s, ux, uy);
-      const PointId id{n.gx * m_ + s.cx, n.gy * m_ + s.cy, s.rank, n.depth + 1};
-      if (!write_unit(n, ux, uy, id)) return count + a;
+      return write_unit(n, ux, uy, PointId{n.gx * m_ + s.cx, n.gy * m_ + s.cy, s.rank, n.depth + 1});
+    };
+    read_to = seq > count ? seq - count : 0;
+    for (std::uint32_t a = read_to; a < listed; ++a) {
+      if (budget_ == 0) return count + a;
+      --budget_;
+      if (ahead_ && a == read_to)  // two values: at the sub-point and where it appears
+        read_to = read_ahead(a, listed, 2, [&](std::uint32_t from, std::uint32_t to) {
+          for (std::uint32_t i = from; i < to; ++i) missed_ = false, appear(i);
+        });
+      if (!appear(a)) return count + a;
     }
     return kDone;
   }
@@ -393,6 +457,9 @@ class Descent {
   std::size_t capacity_;
   std::size_t& n_;
   std::uint64_t& budget_;
+  ReadAhead* const ahead_;  // set for a batch callback
+  bool dry_ = false;        // a run that only finds the values to read ahead
+  bool missed_ = false;     // the candidate a dry run is at stopped at a value not yet read
   Node stack_[kMaxQueryDepth + 1];
 };
 
@@ -401,7 +468,12 @@ class Descent {
 bool emit_descending(const DescentQuery& q, std::int64_t tx, std::int64_t ty, std::size_t index,
                      QueryPoint* out, std::size_t capacity, std::size_t& written, std::uint64_t& budget,
                      DescentPlace& at) {
-  return Descent(q, out, capacity, written, budget).run(tx, ty, index, at);
+  const QueryDensity& d = q.params->density;
+  if (d.kind == QueryDensity::Kind::kCallback && d.batch_callback) {
+    ReadAhead ahead(d);
+    return Descent(q, out, capacity, written, budget, &ahead).run(tx, ty, index, at);
+  }
+  return Descent(q, out, capacity, written, budget, nullptr).run(tx, ty, index, at);
 }
 
 }  // namespace kdm::detail
