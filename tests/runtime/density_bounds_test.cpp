@@ -177,6 +177,34 @@ TEST(DensityBoundsTest, ABatchCallbackServesPastTheTopLevel) {
   }
 }
 
+// A density that varies over a few hundred spacings at four million times the top level, read one value or
+// many a call.
+struct Wave {
+  static double at(double x, double y) { return 0.5 + 0.4 * std::sin(3000 * x) * std::cos(2000 * y); }
+  static double density(void*, double x, double y) { return at(x, y); }
+  static void batch(void*, std::size_t n, const double* x, const double* y, double* out) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = at(x[i], y[i]);
+  }
+};
+
+TEST(DensityBoundsTest, ABatchCallbackServesDeepFarFromTheOrigin) {
+  // Four million times the top level (depth 3 of subtiles 32 times smaller a side), 10^6 units out.
+  QueryParams q;
+  q.x0 = 1e6 + 0.1, q.y0 = -1e6 + 0.2, q.x1 = q.x0 + 2e-4, q.y1 = q.y0 + 1.5e-4;
+  q.origin_x = 1e6, q.origin_y = -1e6;
+  q.scale = 4e6 * 32768, q.mode = QueryMode::kSmooth;
+  q.density.kind = QueryDensity::Kind::kCallback, q.density.callback_max = 0.9;
+  q.density.callback = Wave::density;
+  const std::vector<QueryPoint> one_by_one = testing::run_query(q, 1 << 16);
+  std::uint32_t deepest = 0;
+  for (const QueryPoint& p : one_by_one) deepest = std::max(deepest, p.id.depth);
+  ASSERT_GT(one_by_one.size(), 1000u);
+  ASSERT_GE(deepest, 3u);
+  q.density.callback = nullptr, q.density.batch_callback = Wave::batch;
+  EXPECT_TRUE(same_bits(testing::run_query(q, 1 << 16), one_by_one));
+  EXPECT_TRUE(same_bits(testing::run_query(q, 5), one_by_one));
+}
+
 TEST(DensityBoundsTest, ACallbackDensityNeedsExactlyOneOfItsFunctions) {
   Ramp ramp;
   QueryParams q = ramp_query(ramp, QueryMode::kStable);
