@@ -62,9 +62,9 @@ class Tileset:
         *,
         scale: float,
         density: Union[_Density, _Function] = ...,
-        classes: Optional[Sequence[_Density]] = ...,
+        classes: Optional[Sequence[Union[_Density, _Function]]] = ...,
         density_rect: Optional[_Rect] = ...,
-        density_max: Optional[float] = ...,
+        density_max: Union[float, Sequence[Optional[float]], None] = ...,
         density_bounds: Optional[_Bounds] = ...,
         vectorized: bool = ...,
         tile_size: float = ...,
@@ -81,7 +81,7 @@ class Tileset:
         scale: float,
         density: Union[_Density, _Function] = ...,
         density_rect: Optional[_Rect] = ...,
-        density_max: Optional[float] = ...,
+        density_max: Union[float, Sequence[Optional[float]], None] = ...,
         density_bounds: Optional[_Bounds] = ...,
         vectorized: bool = ...,
         tile_size: float = ...,
@@ -91,7 +91,7 @@ class Tileset:
         invert: bool = ...,
         keys: bool = ...,
         threads: Optional[int] = ...,
-        classes: Optional[Sequence[_Density]] = ...,
+        classes: Optional[Sequence[Union[_Density, _Function]]] = ...,
     ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[Any], ...]]: ...
 
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...

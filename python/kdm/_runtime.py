@@ -149,11 +149,13 @@ class Tileset:
             density only where a point's emission is in doubt (several times fewer calls in stable mode),
             giving the same points as long as the bounds hold.
         classes : sequence of densities, optional
-            Several kinds of points in one query, instead of `density`: 1 to 8 densities (numbers, str or
-            2-D arrays as `density` takes them, not callables), highest priority first (largest objects
-            first). Every point gets a class (`classes` of the result). All classes together are the
-            points of one query at the summed density; in stable mode class 0 alone is exactly the query
-            at its own density. ``kdm query --class``.
+            Several kinds of points in one query, instead of `density`: 1 to 8 densities (numbers, str,
+            2-D arrays or callables f(x, y) -> float as `density` takes them), highest priority first
+            (largest objects first). Every point gets a class (`classes` of the result). All classes
+            together are the points of one query at the summed density; in stable mode class 0 alone is
+            exactly the query at its own density. Callable classes need `density_max`: one bound for
+            all of them, or a sequence with one entry per class (None for the others); they are called
+            point by point (not `vectorized`), without `density_bounds`. ``kdm query --class``.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
             info["max_points_per_tile"] where the density is highest in stable mode, or
@@ -176,14 +178,15 @@ class Tileset:
             Positions, ids and levels; any partition of a region gives the region's points, and the same
             arguments give the same bits as ``kdm query ... -o points.csv``.
         """
+        class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
-            rect, scale, tile_size, mode, origin, density_rect, density_max)
+            rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max)
         if classes is not None:
             if density_bounds is not None:
                 raise ValueError("density_bounds does not apply to a query with classes")
             if vectorized:
                 raise ValueError("vectorized does not apply to a query with classes")
-            return self._query_classes(rect, scale, density, classes, density_rect, density_max, tile_size,
+            return self._query_classes(rect, scale, density, classes, density_rect, class_max, tile_size,
                                        mode, origin, gamma, invert, out)
         spec, call = _density_arg(density, gamma, invert)
         if out is not None and not isinstance(out, QueryResult):
@@ -226,19 +229,19 @@ class Tileset:
         query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; one thread)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         """
+        class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
-            rect, scale, tile_size, mode, origin, density_rect, density_max)
+            rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max)
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
         if classes is not None:
-            if density is not None or density_max is not None or density_bounds is not None or vectorized:
-                raise ValueError(
-                    "density, density_max, density_bounds and vectorized do not apply to a query with classes")
+            if density is not None or density_bounds is not None or vectorized:
+                raise ValueError("density, density_bounds and vectorized do not apply to a query with classes")
             if threads is not None:
                 raise ValueError("threads does not apply to a query with classes")
-            specs = _class_specs(classes, gamma, invert)
-            xy, key, labels = _kdm.class_positions(self._handle, rect, scale, specs, density_rect, tile_size,
-                                                   mode, origin, keys)
+            specs, callables, maxima = _class_args(classes, gamma, invert, class_max)
+            xy, key, labels = _kdm.class_positions(self._handle, rect, scale, specs, callables, maxima,
+                                                   density_rect, tile_size, mode, origin, keys)
             return (xy, key, labels) if keys else (xy, labels)
         workers = 0
         if threads is not None:
@@ -260,11 +263,11 @@ class Tileset:
     ) -> QueryResult:
         if density is not None:
             raise ValueError("give either density or classes, not both")
-        if density_max is not None or out is not None:
-            raise ValueError("density_max and out do not apply to a query with classes")
-        specs = _class_specs(classes, gamma, invert)
+        if out is not None:
+            raise ValueError("out does not apply to a query with classes")
+        specs, callables, maxima = _class_args(classes, gamma, invert, density_max)
         *fields, labels = _kdm.query_classes(
-            self._handle, rect, scale, specs, density_rect, tile_size, mode, origin)
+            self._handle, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin)
         return QueryResult(*fields, classes=labels)
 
 
@@ -283,27 +286,48 @@ def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, d
     return rect, scale, tile_size, mode, origin, density_rect, density_max
 
 
-def _class_specs(classes: Any, gamma: Any, invert: Any) -> List[Any]:
-    """The density specs of a query's classes, checked (TypeError, ValueError)."""
+def _is_callable(density: Any) -> bool:
+    return callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str))
+
+
+def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any) -> Tuple[List[Any], List[Any], List[float]]:
+    """A query's classes as (specs, callables, maxima), one each per class, checked (TypeError, ValueError):
+    a class is its spec, or its callable (not None) bounded by its maximum, from `density_max` (one number
+    for every callable class, or one entry per class)."""
     if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
         raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
     if not 1 <= len(classes) <= 8:
         raise ValueError(f"classes must hold 1 to 8 densities, got {len(classes)}")
-    specs = []
+    per_class = density_max is not None and not isinstance(density_max, numbers.Real)
+    if per_class and (isinstance(density_max, (str, bytes)) or not hasattr(density_max, "__len__")):
+        raise TypeError(f"density_max must be a number or a sequence, got {type(density_max).__name__}")
+    if per_class and len(density_max) != len(classes):
+        raise ValueError(f"density_max must hold one entry per class ({len(classes)}), got {len(density_max)}")
+    if density_max is not None and not any(_is_callable(d) for d in classes):
+        raise ValueError("density_max applies to callable classes only")
+    specs, callables, maxima = [], [], []
     for k, d in enumerate(classes):
         name = f"classes[{k}]"
-        if callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
-            raise TypeError(f"{name}: a class's density cannot be a callable")
+        if _is_callable(d):
+            bound = density_max[k] if per_class else density_max
+            if bound is None:
+                raise ValueError(f"{name} is a callable: density_max must give an upper bound of its values")
+            specs.append(_kdm.DensitySpec.constant(0.0))
+            callables.append(d)
+            maxima.append(_checks.number(f"density_max[{k}]" if per_class else "density_max", bound, 0.0))
+            continue
         if d is None:
-            raise TypeError(f"{name} must be a number, a str or a 2-D array, got None")
+            raise TypeError(f"{name} must be a number, a str, a 2-D array or a callable, got None")
         image = isinstance(d, (str, os.PathLike))
         specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
-    return specs
+        callables.append(None)
+        maxima.append(0.0)
+    return specs, callables, maxima
 
 
 def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:
     """A query's density as (spec, callable): one of them None; no density is the constant 1."""
-    if callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str)):
+    if _is_callable(density):
         return None, density
     spec = _checks.density_spec(density, gamma, invert)
     return (spec if spec is not None else _kdm.DensitySpec.constant(1.0)), None

@@ -371,15 +371,25 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
 struct PreparedClasses {
   ClassQueryParams q;
   std::vector<std::unique_ptr<SpecDensity>> densities;
+  std::vector<std::unique_ptr<CallableDensity>> callables;
+  /// Raises the first exception a class's callable raised, in class order. Call with the GIL held.
+  void rethrow() {
+    for (const std::unique_ptr<CallableDensity>& c : callables) c->rethrow();
+  }
 };
 
+/// A class's density is specs[k], or callables[k] where that is not None (bounded by maxima[k]).
 void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
-                     const std::vector<const tools::DensitySpec*>& specs, std::optional<Rect> density_rect,
-                     double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+                     const std::vector<const tools::DensitySpec*>& specs,
+                     const std::vector<py::object>& callables, const std::vector<double>& maxima,
+                     std::optional<Rect> density_rect, double tile_size, const std::string& mode,
+                     const std::array<double, 2>& origin) {
   check_rect("rect", rect);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
                                 " densities, got " + std::to_string(specs.size()));
+  if (callables.size() != specs.size() || maxima.size() != specs.size())
+    throw std::invalid_argument("classes: one callable (or None) and one maximum per class");
   if (density_rect) check_rect("density_rect", *density_rect);
   const Rect r = density_rect ? *density_rect : rect;
   ClassQueryParams& q = prepared.q;
@@ -390,7 +400,16 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
   q.query.mode = parse_mode(mode);
   q.class_count = static_cast<std::uint32_t>(specs.size());
   for (std::size_t k = 0; k < specs.size(); ++k) {
-    if (!specs[k]) throw std::invalid_argument("classes[" + std::to_string(k) + "] is not a density");
+    const std::string name = "classes[" + std::to_string(k) + "]";
+    if (!callables[k].is_none()) {
+      if (!(maxima[k] >= 0 && maxima[k] < std::numeric_limits<double>::infinity()))
+        throw std::invalid_argument(name + ": a callable's density_max must be finite and >= 0");
+      prepared.callables.push_back(
+          std::make_unique<CallableDensity>(callables[k], maxima[k], py::none(), false));
+      q.classes[k] = prepared.callables.back()->density;
+      continue;
+    }
+    if (!specs[k]) throw std::invalid_argument(name + " is not a density");
     prepared.densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
     q.classes[k] = prepared.densities.back()->density;
   }
@@ -399,21 +418,24 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
 /// query() returns them, then each point's class. New memory every call (no `storage`).
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
-                        const std::vector<const tools::DensitySpec*>& specs, std::optional<Rect> density_rect,
-                        double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+                        const std::vector<const tools::DensitySpec*>& specs,
+                        const std::vector<py::object>& callables, const std::vector<double>& maxima,
+                        std::optional<Rect> density_rect, double tile_size, const std::string& mode,
+                        const std::array<double, 2>& origin) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, density_rect, tile_size, mode, origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
   {
-    py::gil_scoped_release release;
+    py::gil_scoped_release release;  // a callable class takes it back at each call
     tools::query_all(*handle.set, prepared.q, points, classes, tools::ParameterNames{"scale=", "tile_size="});
     buffer.reserve(std::max<std::size_t>(points.size(), 1), 0);
     std::copy(points.begin(), points.end(), buffer.points);
     for (std::size_t i = 0; i < points.size(); ++i)
       buffer.levels[i] = tile_of(*handle.set, points[i].id)->level_of(points[i].id.rank);
   }
+  prepared.rethrow();
   py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(classes.size()));
   std::copy(classes.begin(), classes.end(), labels.mutable_data());
   const py::tuple base = result(points.size(), buffer, py::none());
@@ -424,10 +446,11 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
 /// (m × 2 float32), each point's key if asked (else None), and each point's class.
 py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double scale,
                           const std::vector<const tools::DensitySpec*>& specs,
+                          const std::vector<py::object>& callables, const std::vector<double>& maxima,
                           std::optional<Rect> density_rect, double tile_size, const std::string& mode,
                           const std::array<double, 2>& origin, bool keys) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, density_rect, tile_size, mode, origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;
@@ -448,6 +471,7 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
       if (s != Status::kBufferFull) refused(problem);
     }
   }
+  prepared.rethrow();
   py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(m));
   std::copy(classes.begin(), classes.begin() + m, labels.mutable_data());
   const py::tuple arrays = take_compact(buffer, m);
@@ -458,11 +482,12 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
 
 void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
-        py::arg("origin"), "several classes in one query: query()'s tuple and each point's class");
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("density_rect").none(true),
+        py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        "several classes in one query: query()'s tuple and each point's class");
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
-        py::arg("origin"), py::arg("keys"),
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("density_rect").none(true),
+        py::arg("tile_size"), py::arg("mode"), py::arg("origin"), py::arg("keys"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("spec").none(true), py::arg("callable").none(true), py::arg("vectorized"),

@@ -363,12 +363,60 @@ def test_classes_refuse_bad_input():
         BUILTIN.query(rect, scale=10, classes=[1.0] * 9)
     with pytest.raises(ValueError, match="not both"):
         BUILTIN.query(rect, scale=10, density=1.0, classes=[1.0])
-    with pytest.raises(TypeError, match="callable"):
+    with pytest.raises(ValueError, match=r"classes\[1\] is a callable: density_max"):
         BUILTIN.query(rect, scale=10, classes=[1.0, lambda x, y: 1.0])
     with pytest.raises(ValueError, match=r"classes\[1\]"):
         BUILTIN.query(rect, scale=10, classes=[1.0, -2.0])
     with pytest.raises(ValueError, match="scale="):
         BUILTIN.query(rect, scale=1e9, classes=[1.0, 1.0])
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_callable_classes(mode):
+    # A callable class among a constant and an array: the union is the one-class query at the sum (the
+    # same values added in class order), in stable mode class 0 alone the one-class query at its own
+    # density; a callable of constant value classes the points as the constant does.
+    rect = (0.0, 0.0, 3.0, 2.0)
+    def ramp(x, y):
+        return 0.5 + 0.5 * x
+    image = np.full((4, 6), 0.75)
+    r = BUILTIN.query(rect, scale=150, classes=[ramp, 1.0, image], density_max=[2.0, None, None], mode=mode)
+    assert len(r) > 1000 and set(np.unique(r.classes)) == {0, 1, 2}
+    union = BUILTIN.query(rect, scale=150, density=lambda x, y: ramp(x, y) + 1.0 + 0.75, density_max=3.75,
+                          mode=mode)
+    assert same(r, union)
+    if mode == "stable":
+        zero = r.classes == 0
+        alone = BUILTIN.query(rect, scale=150, density=ramp, density_max=2.0)
+        assert same((r.xy[zero], r.tile[zero], r.rank[zero]), (alone.xy, alone.tile, alone.rank))
+    constants = BUILTIN.query(rect, scale=150, classes=[1.0, 2.0], mode=mode)
+    called = BUILTIN.query(rect, scale=150, classes=[lambda x, y: 1.0, 2.0], density_max=1.0, mode=mode)
+    assert same(called, constants) and np.array_equal(called.classes, constants.classes)
+    xy, labels = BUILTIN.positions(rect, scale=150, classes=[ramp, 1.0, image], density_max=2.0, mode=mode)
+    assert np.array_equal(labels, r.classes) and np.array_equal(xy, r.xy.astype(np.float32))
+
+
+def test_callable_classes_refuse_bad_input():
+    rect = (0.0, 0.0, 1.0, 1.0)
+    f = lambda x, y: 0.5  # noqa: E731
+    with pytest.raises(ValueError, match=r"one entry per class \(2\), got 3"):
+        BUILTIN.query(rect, scale=10, classes=[f, 1.0], density_max=[1.0, None, None])
+    with pytest.raises(ValueError, match=r"classes\[1\] is a callable"):
+        BUILTIN.query(rect, scale=10, classes=[f, f], density_max=[1.0, None])
+    with pytest.raises(ValueError, match="callable classes only"):
+        BUILTIN.positions(rect, scale=10, classes=[1.0, 2.0], density_max=1.0)
+    with pytest.raises(ValueError, match=r"density_max\[0\] must be >= 0"):
+        BUILTIN.query(rect, scale=10, classes=[f], density_max=[-1.0])
+    with pytest.raises(TypeError, match="density_max must be a number or a sequence"):
+        BUILTIN.query(rect, scale=10, classes=[f], density_max="1")
+    with pytest.raises(ValueError, match=r"returned nan at \("):
+        BUILTIN.query(rect, scale=100, classes=[1.0, lambda x, y: math.nan], density_max=1.0)
+    class Boom(Exception):
+        pass
+    def boom(x, y):
+        raise Boom()
+    with pytest.raises(Boom):
+        BUILTIN.positions(rect, scale=100, classes=[boom, 1.0], density_max=1.0)
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
