@@ -1,10 +1,13 @@
 // Fuzz target: query_points on the built-in tile set, with every parameter taken from the input: per
 // parameter a selector bit picks a raw double (NaN, infinities and extremes included) or a small value
-// from one byte; the density is a constant, a 4×4 image (raw or byte texels) or a callback. The work per
-// input is bounded: when the region would hold more than kBudget candidate points it is cut to a few
-// tiles and then the scale lowered (huge regions and scales are the unit tests' business). Checks:
-//  - every point, origin added back, lies in [x0, x1) × [y0, y1) and in the tile its id names;
-//  - points come in the documented order (tiles row by row, ranks ascending), so ids are unique;
+// from one byte; the density is a constant, a 4×4 image (raw or byte texels) or a callback; the mode
+// stable or smooth (past the top level smooth queries descend into subtiles). The work per input is
+// bounded: when the region would hold more than kBudget candidate points it is cut to a few tiles and
+// then the scale lowered, or past the top level the region shrunk (huge regions and scales are the unit
+// tests' business). Checks:
+//  - every point, origin added back, lies in [x0, x1) × [y0, y1) and in the tile its id names (in smooth
+//    mode within a side of that tile, at the id's depth: points glide);
+//  - points come in the documented order (depth-0 tiles row by row), and ids are unique;
 //  - collecting with a buffer of 1-8 points, resuming from the cursor, gives exactly the points of one
 //    call with a large buffer, in the same order; kBufferFull only with a full buffer; a finished cursor
 //    gives no more points;
@@ -91,14 +94,28 @@ bool inside(double out, double origin, double lo, double hi) {
   return w >= lo - tol && w < hi + tol;
 }
 
-bool in_tile(double out, double origin, std::int64_t t, double size) {
-  const double w = out + origin, lo = double(t) * size, hi = double(t + 1) * size;
+// Within `margin` tile sides of tile t (of side `size`).
+bool in_tile(double out, double origin, std::int64_t t, double size, double margin) {
+  const double w = out + origin, lo = (double(t) - margin) * size, hi = (double(t + 1) + margin) * size;
   const double tol = 4 * DBL_EPSILON * (std::fabs(out) + std::fabs(origin) + std::fabs(lo) + std::fabs(hi));
   return w >= lo - tol && w <= hi + tol;
 }
 
+// Subtiles per side of the built-in set's tiles past the top level: limit / top = m^(2 · kMaxQueryDepth).
+const double kSubtiles =
+    std::round(std::pow(kdm::query_density_limit(kdm::Tileset::builtin(), kdm::QueryMode::kSmooth) /
+                            kdm::Tileset::builtin().max_points_per_tile(),
+                        1.0 / (2 * kdm::kMaxQueryDepth)));
+
+// Tile coordinate t at `depth` as a depth-0 tile's (floor division by m, depth times).
+std::int64_t at_depth_zero(std::int64_t t, std::uint32_t depth) {
+  const auto m = static_cast<std::int64_t>(kSubtiles);
+  for (std::uint32_t d = 0; d < depth; ++d) t = t >= 0 ? t / m : -((-t + m - 1) / m);
+  return t;
+}
+
 auto order_key(const kdm::QueryPoint& p) {
-  return std::make_tuple(p.id.tile_y, p.id.tile_x, p.id.rank);
+  return std::make_tuple(p.id.depth, p.id.tile_y, p.id.tile_x, p.id.rank);
 }
 
 bool same(const kdm::QueryPoint& a, const kdm::QueryPoint& b) {
@@ -120,23 +137,32 @@ struct Points {
   const kdm::QueryPoint& operator[](std::size_t i) const { return data[i]; }
 };
 
+// Whether a query descends past the top level (smooth mode over the top level's count).
+bool descends(const kdm::QueryParams& q, double peak) {
+  return q.mode == kdm::QueryMode::kSmooth &&
+         peak * q.tile_size * q.tile_size * q.scale > kdm::Tileset::builtin().max_points_per_tile();
+}
+
 // Expected candidate points of a query, about: per tile, the overhead and every rank whose threshold
-// (~ c + ½) is below the tile's density bound, at most `peak` (the density's maximum anywhere). 0 when
-// the query is refused or empty before any work (with a margin: the rounding may differ from the query's).
+// (~ c + ½) is below the tile's density bound, at most `peak` (the density's maximum anywhere); past the
+// top level the points the region holds (the ancestors' ranks outside it are passed over, cheaply). 0
+// when the query is refused or empty before any work (with a margin: the rounding may differ from the
+// query's).
 double work(const kdm::QueryParams& q, double peak) {
-  const double S = q.tile_size, top = kdm::Tileset::builtin().max_points_per_tile();
+  const double S = q.tile_size, limit = kdm::query_density_limit(kdm::Tileset::builtin(), q.mode);
   if (!(std::isfinite(q.x0) && std::isfinite(q.x1) && std::isfinite(q.y0) && std::isfinite(q.y1) &&
         std::isfinite(S) && std::isfinite(q.scale) && S > 0 && q.scale > 0 && q.x1 > q.x0 && q.y1 > q.y0))
     return 0;
-  double density = peak;  // the bound the query checks against the top level
+  double density = peak;  // the bound the query checks against its limit
   if (q.density.kind == kdm::QueryDensity::Kind::kImage)
     density = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
   const double area_scale = S * S * q.scale;
-  if (!(density * area_scale <= top * 1.000001 + 1)) return 0;  // refused: density too high
+  if (!(density * area_scale <= limit * 1.000001 + 1)) return 0;  // refused: density too high
   const double tiles =
       (std::ceil(q.x1 / S) - std::floor(q.x0 / S)) * (std::ceil(q.y1 / S) - std::floor(q.y0 / S));
   if (!(tiles <= double(kdm::kMaxQueryTiles) * 1.000001)) return 0;  // refused: too many tiles
-  return tiles * (8 + std::min(peak * area_scale, top));
+  if (descends(q, peak)) return tiles * 8 + (q.x1 - q.x0) * (q.y1 - q.y0) * peak * q.scale;
+  return tiles * (8 + std::min(peak * area_scale, limit));
 }
 
 }  // namespace
@@ -145,8 +171,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 3) return 0;
   const int kind = data[0] % 3;
   const std::size_t capacity = 1 + (data[0] >> 2) % 8;
+  const bool smooth = (data[0] >> 5) & 1;
   Reader r{data + 3, size - 3, std::uint32_t(data[1]) | std::uint32_t(data[2]) << 8};
   kdm::QueryParams q;
+  q.mode = smooth ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable;
   q.x0 = r.next(coordinate), q.y0 = r.next(coordinate), q.x1 = r.next(coordinate), q.y1 = r.next(coordinate);
   q.origin_x = r.next(coordinate), q.origin_y = r.next(coordinate);
   q.tile_size = r.next([](std::uint8_t b) { return b / 64.0; });
@@ -189,11 +217,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       q.density.callback_max = peak = callback_max;
   }
 
-  // Bound the work: a few tiles at most, then a lower scale.
+  // Bound the work: a few tiles at most, then a lower scale (past the top level a smaller region).
   if (work(q, peak) > kBudget) {
     q.x1 = std::min(q.x1, q.x0 + 2 * q.tile_size);
     q.y1 = std::min(q.y1, q.y0 + 2 * q.tile_size);
-    if (const double w = work(q, peak); w > kBudget) q.scale *= kBudget / w;
+    if (const double w = work(q, peak); w > kBudget) {
+      if (descends(q, peak)) {
+        const double f = std::sqrt(kBudget / w);
+        q.x1 = q.x0 + (q.x1 - q.x0) * f, q.y1 = q.y0 + (q.y1 - q.y0) * f;
+      } else {
+        q.scale *= kBudget / w;
+      }
+    }
     if (work(q, peak) > kBudget) return 0;
   }
 
@@ -203,17 +238,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::size_t i = 0; i < all.size; ++i) {
     const kdm::QueryPoint& p = all[i];
     if (!inside(p.x, q.origin_x, q.x0, q.x1) || !inside(p.y, q.origin_y, q.y0, q.y1)) fail();
-    if (!in_tile(p.x, q.origin_x, p.id.tile_x, q.tile_size) ||
-        !in_tile(p.y, q.origin_y, p.id.tile_y, q.tile_size))
+    if (p.id.depth > (smooth ? kdm::kMaxQueryDepth : 0)) fail();
+    const double side = q.tile_size / std::pow(kSubtiles, double(p.id.depth)), margin = smooth ? 1 : 0;
+    if (!in_tile(p.x, q.origin_x, p.id.tile_x, side, margin) ||
+        !in_tile(p.y, q.origin_y, p.id.tile_y, side, margin))
       fail();
-    if (p.id.rank >= kdm::Tileset::builtin().tile_at(p.id.tile_x, p.id.tile_y).points.size()) fail();
-    // Documented order: tiles row by row (within a tile, ranks ascending or cell by cell).
-    if (i > 0 &&
-        std::make_pair(p.id.tile_y, p.id.tile_x) < std::make_pair(all[i - 1].id.tile_y, all[i - 1].id.tile_x))
-      fail();
+    const kdm::Tile* tile = kdm::tile_of(kdm::Tileset::builtin(), p.id);
+    if (!tile || p.id.rank >= tile->points.size()) fail();
+    // Documented order: depth-0 tiles row by row (within a tile, ranks ascending or cell by cell, and
+    // past the top level subtile by subtile).
+    const auto tile_row = [](const kdm::PointId& id) {
+      return std::make_pair(at_depth_zero(id.tile_y, id.depth), at_depth_zero(id.tile_x, id.depth));
+    };
+    if (i > 0 && tile_row(p.id) < tile_row(all[i - 1].id)) fail();
   }
   {  // every id once
-    static std::tuple<std::int64_t, std::int64_t, std::uint32_t> ids[kBigCapacity];
+    static std::tuple<std::uint32_t, std::int64_t, std::int64_t, std::uint32_t> ids[kBigCapacity];
     for (std::size_t i = 0; i < all.size; ++i) ids[i] = order_key(all[i]);
     std::sort(ids, ids + all.size);
     if (std::adjacent_find(ids, ids + all.size) != ids + all.size) fail();

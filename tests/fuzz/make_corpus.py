@@ -89,9 +89,9 @@ def images():
 # image's x0 y0 x1 y1 (one byte each unless raw), the split byte, 16 texels (bytes unless bit 14 is set).
 # Byte values: coordinates int8/8, tile_size b/64, scale 2^((b-128)/8), value int8/16, callback_max b/16.
 
-def query(kind, capacity, raw=0, values=None, split=128, texels=None):
+def query(kind, capacity, raw=0, values=None, split=128, texels=None, smooth=False):
     fields = values or [0, 0, 16, 16, 0, 0, 64, 160, 16, 16, 0, 0, 16, 16]
-    out = bytes([kind + ((capacity - 1) << 2), raw & 0xFF, raw >> 8])
+    out = bytes([kind + ((capacity - 1) << 2) + (32 if smooth else 0), raw & 0xFF, raw >> 8])
     for i, v in enumerate(fields):
         out += struct.pack("<d", v) if (raw >> i) & 1 else bytes([v])
     out += bytes([split])
@@ -106,6 +106,13 @@ def queries():
     write("query", "constant", query(0, 8))
     write("query", "image", query(1, 3))
     write("query", "callback", query(2, 1))
+    write("query", "smooth_image", query(1, 6, smooth=True))
+    write("query", "smooth_callback", query(2, 2, smooth=True))
+    # 10^8 points per unit area on tiles of side 1: three thousand times the top level, two depths down.
+    write("query", "smooth_past_top", query(0, 8, raw=1 << 7, values=[0, 0, 1, 1, 0, 0, 64, 1e8, 16, 16,
+                                                                      0, 0, 16, 16], smooth=True))
+    write("query", "smooth_past_top_callback", query(2, 3, raw=1 << 7, values=[8, 8, 9, 9, 0, 0, 64, 3e8, 16,
+                                                                               16, 0, 0, 16, 16], smooth=True))
     write("query", "nan_region", query(0, 4, raw=1 << 2, values=[0, 0, float("nan"), 16, 0, 0, 64, 160, 16, 16,
                                                                   0, 0, 16, 16]))
     write("query", "huge_scale", query(0, 8, raw=1 << 7, values=[0, 0, 16, 16, 0, 0, 64, 1e12, 16, 16,
