@@ -142,7 +142,7 @@ class Tileset:
             float64 arrays of up to 128 positions, a tile's candidates at a time; scipy's `vectorized`).
             One call then serves many points: for a numpy expression about ten times faster than
             calling it point by point. The same points as the scalar callable. Past the top level
-            (smooth mode) the arrays are shorter (about 30 positions).
+            (smooth mode) the arrays are shorter (about 50 positions).
         density_bounds : callable, optional
             For a callable density: f(x0, y0, x1, y1) -> (lo, hi), bounds of the density over a world
             rectangle, 0 <= lo <= hi (else ValueError). Asked once per tile, it lets the query call the

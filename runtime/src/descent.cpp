@@ -227,7 +227,8 @@ class Descent {
     double value;
     if (ahead_->find(x, y, value)) return value;
     if (!dry_) return q_.density_at(x, y);
-    if (!missed_) missed_ = true, ahead_->want(x, y);
+    if (!missed_ && (missed_ = true, !ahead_->want(x, y)))
+      overflow_item_ = std::min(overflow_item_, dry_item_);
     return 0;
   }
 
@@ -325,19 +326,29 @@ class Descent {
   }
 
   /// Reads ahead the values that items [from, …) of a loop will read, by dry runs of `pass(from, to)`,
-  /// which visits them (ReadAhead); `reads` bounds the values an item reads. Returns the end of the items
-  /// read for.
+  /// which visits them (ReadAhead), setting dry_item_ to the item it is at; `reads` bounds the values an
+  /// item reads. Returns the end of the items read for. Most items read far fewer (culled, not emitted,
+  /// taken over): a block that left the table less than half full makes the next one twice as long, and
+  /// one that fills it ends before the first item the table refused, and makes the next half as long.
   template <class Pass>
   std::uint32_t read_ahead(std::uint32_t from, std::uint32_t end, std::uint32_t reads, Pass pass) {
-    const std::uint32_t block = std::max<std::uint32_t>(1, std::uint32_t(ReadAhead::kCapacity) / reads);
-    const std::uint32_t to = end - from > block ? from + block : end;
+    const std::uint32_t block =
+        std::max<std::uint32_t>(1, std::uint32_t(ReadAhead::kCapacity) * ahead_widen_ / reads);
+    std::uint32_t to = end - from > block ? from + block : end;
+    const std::uint32_t asked = to;
     ahead_->clear();
     dry_ = true;
     do {
+      overflow_item_ = to;
       pass(from, to);
       ahead_->read();
+      if (overflow_item_ < to) to = std::max(overflow_item_, from + 1);
     } while (ahead_->take_added() > 0);
     dry_ = false;
+    if (to < asked)
+      ahead_widen_ = std::max<std::uint32_t>(1, ahead_widen_ / 2);
+    else if (2 * ahead_->size() < ReadAhead::kCapacity && to - from == block && ahead_widen_ < 64)
+      ahead_widen_ *= 2;
     return to;
   }
 
@@ -400,7 +411,7 @@ class Descent {
       if (ahead_ && r == read_to)
         read_to = read_ahead(r, general_end, std::uint32_t(k) + 3, [&](std::uint32_t from, std::uint32_t to) {
           RankLoop dry = loop;
-          for (std::uint32_t i = from; i < to; ++i) missed_ = false, visit(k, dry, i);
+          for (std::uint32_t i = from; i < to; ++i) dry_item_ = i, missed_ = false, visit(k, dry, i);
         });
       if (!visit(k, loop, r)) return r;
     }
@@ -442,7 +453,7 @@ class Descent {
       --budget_;
       if (ahead_ && a == read_to)  // two values: at the sub-point and where it appears
         read_to = read_ahead(a, listed, 2, [&](std::uint32_t from, std::uint32_t to) {
-          for (std::uint32_t i = from; i < to; ++i) missed_ = false, appear(i);
+          for (std::uint32_t i = from; i < to; ++i) dry_item_ = i, missed_ = false, appear(i);
         });
       if (!appear(a)) return count + a;
     }
@@ -460,6 +471,8 @@ class Descent {
   ReadAhead* const ahead_;  // set for a batch callback
   bool dry_ = false;        // a run that only finds the values to read ahead
   bool missed_ = false;     // the candidate a dry run is at stopped at a value not yet read
+  std::uint32_t dry_item_ = 0, overflow_item_ = 0;  // the item a dry run is at; the first the table refused
+  std::uint32_t ahead_widen_ = 1;  // a block's items, in units of the table's room over an item's reads
   Node stack_[kMaxQueryDepth + 1];
 };
 

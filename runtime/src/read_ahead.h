@@ -64,6 +64,9 @@ class ReadAhead {
     return added;
   }
 
+  /// Values read since clear().
+  std::size_t size() const { return size_; }
+
   /// Values added since the last call (how a dry run knows it found something to read).
   std::size_t take_added() {
     const std::size_t a = added_;

@@ -196,7 +196,7 @@ def test_a_vectorized_density_gives_the_points_of_the_scalar_one(mode):
 
 def test_a_vectorized_density_serves_past_the_top_level():
     # Smooth mode at three times the top level, where tiles hand over to their subtiles: the ancestors'
-    # points are read a block ahead, in calls of about 30 (measured 29 on average here).
+    # points are read a block ahead, in calls of about 40 (measured 41 on average here).
     def bump(x, y):
         return 0.3 + 0.7 * np.exp(-((x - 0.3) ** 2 + (y - 0.3) ** 2) / 0.02)
     sizes = []
@@ -208,7 +208,7 @@ def test_a_vectorized_density_serves_past_the_top_level():
     batched = BUILTIN.query(rect, scale=scale, density=vectorized, density_max=1.0, mode="smooth",
                             vectorized=True)
     assert len(scalar) > 5000 and same(scalar, batched)
-    assert max(sizes) <= 128 and sum(sizes) > 15 * len(sizes)
+    assert max(sizes) <= 128 and sum(sizes) > 25 * len(sizes)
 
 
 def test_a_vectorized_density_may_return_one_value_for_all():

@@ -163,8 +163,8 @@ TEST(DensityBoundsTest, ABatchCallbackServesPastTheTopLevel) {
     batch.calls = batch.values = batch.singles = 0;
     EXPECT_TRUE(same_bits(testing::run_query(q, 1 << 20), one_by_one)) << bounded;
     // The subtiles' own points are read a batch at a time, their ancestors' points, hand-overs and
-    // appearing points a block of ranks at a time (read ahead): measured 33 and 40 values a call of more
-    // than one, without and with bounds, and 13 and 6 calls of one value (of 46,886 and 19,802 values),
+    // appearing points a block of ranks at a time (read ahead): measured 63 and 40 values a call of more
+    // than one, without and with bounds, and 11 and 6 calls of one value (of 46,886 and 19,802 values),
     // where every value not read in a batch was a call of its own.
     const long batched_values = batch.values - batch.singles, batched_calls = batch.calls - batch.singles;
     std::printf("bounds %d: %ld values in %ld calls of more than one, %ld of one; %ld scalar calls\n",

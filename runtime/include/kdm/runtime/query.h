@@ -62,7 +62,7 @@ struct QueryDensity {
   /// not finite and ≥ 0 count as 0). A query gathers each tile's (and past the top level each
   /// subtile's) reads into such batches, so a vectorised function (SIMD, numpy) pays one call per batch;
   /// past the top level, where one value decides which the next is, the points the subtiles' ancestors
-  /// hold are read a block of ranks ahead, in several smaller batches (about 30 positions a call). The
+  /// hold are read a block of ranks ahead, in several smaller batches (about 50 positions a call). The
   /// points are those of `callback` giving the same values (18 KiB more stack past the top level).
   void (*batch_callback)(void* user, std::size_t n, const double* x, const double* y, double* out) = nullptr;
   void* user = nullptr;
