@@ -142,7 +142,8 @@ class Tileset:
             float64 arrays of up to 128 positions, a tile's candidates at a time; scipy's `vectorized`).
             One call then serves many points: for a numpy expression about ten times faster than
             calling it point by point. The same points as the scalar callable. Past the top level
-            (smooth mode) the arrays are shorter (about 50 positions).
+            (smooth mode) the arrays are shorter (about 50 positions). With `classes`: every callable
+            class is vectorized.
         density_bounds : callable, optional
             For a callable density: f(x0, y0, x1, y1) -> (lo, hi), bounds of the density over a world
             rectangle, 0 <= lo <= hi (else ValueError). Asked once per tile, it lets the query call the
@@ -155,7 +156,8 @@ class Tileset:
             together are the points of one query at the summed density; in stable mode class 0 alone is
             exactly the query at its own density. Callable classes need `density_max`: one bound for
             all of them, or a sequence with one entry per class (None for the others); they are called
-            point by point (not `vectorized`), without `density_bounds`. ``kdm query --class``.
+            point by point, or on arrays with `vectorized`, without `density_bounds`.
+            ``kdm query --class``.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
             info["max_points_per_tile"] where the density is highest in stable mode, or
@@ -184,10 +186,8 @@ class Tileset:
         if classes is not None:
             if density_bounds is not None:
                 raise ValueError("density_bounds does not apply to a query with classes")
-            if vectorized:
-                raise ValueError("vectorized does not apply to a query with classes")
-            return self._query_classes(rect, scale, density, classes, density_rect, class_max, tile_size,
-                                       mode, origin, gamma, invert, out)
+            return self._query_classes(rect, scale, density, classes, density_rect, class_max, vectorized,
+                                       tile_size, mode, origin, gamma, invert, out)
         spec, call = _density_arg(density, gamma, invert)
         if out is not None and not isinstance(out, QueryResult):
             raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
@@ -235,13 +235,14 @@ class Tileset:
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
         if classes is not None:
-            if density is not None or density_bounds is not None or vectorized:
-                raise ValueError("density, density_bounds and vectorized do not apply to a query with classes")
+            if density is not None or density_bounds is not None:
+                raise ValueError("density and density_bounds do not apply to a query with classes")
             if threads is not None:
                 raise ValueError("threads does not apply to a query with classes")
             specs, callables, maxima = _class_args(classes, gamma, invert, class_max)
-            xy, key, labels = _kdm.class_positions(self._handle, rect, scale, specs, callables, maxima,
-                                                   density_rect, tile_size, mode, origin, keys)
+            xy, key, labels = _kdm.class_positions(
+                self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
+                density_rect, tile_size, mode, origin, keys)
             return (xy, key, labels) if keys else (xy, labels)
         workers = 0
         if threads is not None:
@@ -259,7 +260,7 @@ class Tileset:
 
     def _query_classes(
         self, rect: Any, scale: float, density: Any, classes: Any, density_rect: Any, density_max: Any,
-        tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any, out: Any,
+        vectorized: Any, tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any, out: Any,
     ) -> QueryResult:
         if density is not None:
             raise ValueError("give either density or classes, not both")
@@ -267,7 +268,8 @@ class Tileset:
             raise ValueError("out does not apply to a query with classes")
         specs, callables, maxima = _class_args(classes, gamma, invert, density_max)
         *fields, labels = _kdm.query_classes(
-            self._handle, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin)
+            self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
+            density_rect, tile_size, mode, origin)
         return QueryResult(*fields, classes=labels)
 
 

@@ -382,8 +382,8 @@ struct PreparedClasses {
 void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<const tools::DensitySpec*>& specs,
                      const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                     std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                     const std::array<double, 2>& origin) {
+                     bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                     const std::string& mode, const std::array<double, 2>& origin) {
   check_rect("rect", rect);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
@@ -399,13 +399,16 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
   q.query.scale = scale;
   q.query.mode = parse_mode(mode);
   q.class_count = static_cast<std::uint32_t>(specs.size());
+  if (vectorized &&
+      std::all_of(callables.begin(), callables.end(), [](const py::object& f) { return f.is_none(); }))
+    throw std::invalid_argument("vectorized is for callable classes only");
   for (std::size_t k = 0; k < specs.size(); ++k) {
     const std::string name = "classes[" + std::to_string(k) + "]";
     if (!callables[k].is_none()) {
       if (!(maxima[k] >= 0 && maxima[k] < std::numeric_limits<double>::infinity()))
         throw std::invalid_argument(name + ": a callable's density_max must be finite and >= 0");
       prepared.callables.push_back(
-          std::make_unique<CallableDensity>(callables[k], maxima[k], py::none(), false));
+          std::make_unique<CallableDensity>(callables[k], maxima[k], py::none(), vectorized));
       q.classes[k] = prepared.callables.back()->density;
       continue;
     }
@@ -420,10 +423,11 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
                         const std::vector<const tools::DensitySpec*>& specs,
                         const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                        std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                        const std::array<double, 2>& origin) {
+                        bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                        const std::string& mode, const std::array<double, 2>& origin) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, vectorized, density_rect, tile_size, mode,
+                  origin);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
@@ -447,10 +451,11 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
 py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double scale,
                           const std::vector<const tools::DensitySpec*>& specs,
                           const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                          std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                          const std::array<double, 2>& origin, bool keys) {
+                          bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                          const std::string& mode, const std::array<double, 2>& origin, bool keys) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, density_rect, tile_size, mode, origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, vectorized, density_rect, tile_size, mode,
+                  origin);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;
@@ -482,12 +487,13 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
 
 void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("density_rect").none(true),
-        py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("vectorized"),
+        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
         "several classes in one query: query()'s tuple and each point's class");
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("density_rect").none(true),
-        py::arg("tile_size"), py::arg("mode"), py::arg("origin"), py::arg("keys"),
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("vectorized"),
+        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        py::arg("keys"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("spec").none(true), py::arg("callable").none(true), py::arg("vectorized"),

@@ -47,6 +47,7 @@ struct ClassDensities {
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
   bool one_grid = false;         ///< every class an image on class 0's texels (sum_of_images)
+  bool batch = false;            ///< a class read in batches (sum_of_densities_batch)
   detail::ClassImages images{};  ///< when one_grid: the images, read a block of points at a time
   /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
   /// VaryingClassSink classes the candidate just read from it).
@@ -70,6 +71,16 @@ struct ClassDensities {
   void joint_at(double x, double y, double* v) const {
     const JointClassDensity& j = params->joint;
     j.densities(j.user, x, y, v);
+  }
+  /// Class k's values at n positions into v[0 … n), as at() reads each: a batch callback's in one call.
+  void values_of(std::uint32_t k, std::size_t n, const double* x, const double* y, double* v) const {
+    const QueryDensity& d = params->classes[k];
+    if (d.kind != QueryDensity::Kind::kCallback || !d.batch_callback) {
+      for (std::size_t i = 0; i < n; ++i) v[i] = at(k, x[i], y[i]);
+      return;
+    }
+    d.batch_callback(d.user, n, x, y, v);
+    for (std::size_t i = 0; i < n; ++i) v[i] = density_or_zero(v[i]);
   }
   /// Bounds of every class's density over [x0, x1] × [y0, y1] into lo[k], hi[k], as query_points takes
   /// one density's.
@@ -114,6 +125,29 @@ double sum_of_densities(void* user, double x, double y) {
   for (std::uint32_t k = 0; k < c.params->class_count; ++k) c.scratch.cumulative[k] = sum += c.at(k, x, y);
   c.scratch.x = x, c.scratch.y = y;
   return sum;
+}
+/// The union's density (QueryDensity::batch_callback) when a class is read in batches: each such class's
+/// values for all n positions in one call, the others' position by position, and the running sums left in
+/// the scratch's batch for the sink to class the positions read. Sums as sum_of_densities adds them.
+void sum_of_densities_batch(void* user, std::size_t n, const double* x, const double* y, double* out) {
+  const auto& c = *static_cast<const ClassDensities*>(user);
+  detail::ClassScratch& s = c.scratch;
+  std::fill(out, out + n, 0.0);
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) {
+    const QueryDensity& d = c.params->classes[k];
+    double* sums = s.batch_cumulative[k];
+    if (d.kind == QueryDensity::Kind::kCallback && d.batch_callback) {
+      d.batch_callback(d.user, n, x, y, sums);
+      for (std::size_t i = 0; i < n; ++i) sums[i] = out[i] += density_or_zero(sums[i]);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) sums[i] = out[i] += c.at(k, x[i], y[i]);
+    }
+  }
+  std::copy(x, x + n, s.batch_x), std::copy(y, y + n, s.batch_y);
+  s.batch_count = n;
+  if (n != 1) return;
+  for (std::uint32_t k = 0; k < c.params->class_count; ++k) s.cumulative[k] = s.batch_cumulative[k][0];
+  s.x = x[0], s.y = y[0];  // a single read, as sum_of_densities leaves it (VaryingClassSink::class_at)
 }
 /// Classes that are all images on one grid of texels: where a position falls among them is found once.
 double sum_of_images(void* user, double x, double y) {
@@ -186,6 +220,22 @@ class Classifier {
     auto& c = *static_cast<Classifier*>(user);
     if (count == 1 && c.classify_one(tx, ty, first, *out)) return;
     c.classify_run(PointId{tx, ty, first}, count, out);
+  }
+
+  /// detail::VaryingClasses::class_points over a Classifier (`user`).
+  static void class_points(void* user, std::int64_t tx, std::int64_t ty, const std::uint32_t* ranks,
+                           std::size_t n, const double* x, const double* y, std::uint8_t* out) {
+    static_cast<Classifier*>(user)->classify_points(tx, ty, ranks, n, x, y, out);
+  }
+
+  /// detail::VaryingClasses::class_records over a Classifier (`user`).
+  static void class_records(void* user, const QueryPoint* p, std::size_t n, std::uint8_t* out) {
+    auto& c = *static_cast<Classifier*>(user);
+    if (!c.densities_.batch) {
+      c([&](std::size_t i) -> const PointId& { return p[i].id; }, out, n);
+      return;
+    }
+    c.classify_records(p, n, out);
   }
 
   /// Classes ids(0) … ids(count - 1) into classes[0..count).
@@ -289,6 +339,8 @@ class Classifier {
                   static_cast<std::uint8_t>(k));
       else if (densities_.one_grid && detail::image_runs_fit(*densities_.images.grid->image))
         classify_by_sums(id, upto, classes + (id.rank - first.rank));
+      else if (densities_.batch)
+        classify_in_batches(id, upto, classes + (id.rank - first.rank));
       else
         for (; id.rank < upto; ++id.rank) classes[id.rank - first.rank] = read_class(id);
       id.rank = upto;
@@ -320,12 +372,117 @@ class Classifier {
     }
   }
 
-  /// A point of the current tile whose class its tile's bounds leave open: settled by the bounds of the
-  /// cell of the tile it lies in where they can, else by the classes' densities at its stable position,
-  /// computed as query_points computes it (depth 0), so the densities read are its.
-  [[gnu::always_inline]] std::uint8_t read_class(const PointId& id) {
-    const TilePoint& point = points_[id.rank];
-    const float t = thresholds_[id.rank];
+  /// Classes read in batches: ranks [first.rank, end) of the current tile (depth 0) into out[0 ..),
+  /// kDensityBatch at a time (classify_points).
+  void classify_in_batches(const PointId& first, std::uint32_t end, std::uint8_t* out) {
+    const double wx = double(first.tile_x) * side_, wy = double(first.tile_y) * side_;
+    std::uint32_t ranks[kDensityBatch];
+    double x[kDensityBatch], y[kDensityBatch];
+    for (std::uint32_t r = first.rank; r < end;) {
+      const std::uint32_t count = std::min<std::uint32_t>(end - r, kDensityBatch);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const TilePoint& point = points_[r + i];
+        ranks[i] = r + i, x[i] = wx + point.unit_x() * side_, y[i] = wy + point.unit_y() * side_;
+      }
+      classify_points(first.tile_x, first.tile_y, ranks, count, x, y, out + (r - first.rank));
+      r += count;
+    }
+  }
+
+  /// Ranks ranks[0 … n) of depth-0 tile (tx, ty) at their stable positions (x[i], y[i]) into out[0 … n):
+  /// those the bounds leave open are read together, each class's values in one batch (read_class's rule).
+  void classify_points(std::int64_t tx, std::int64_t ty, const std::uint32_t* ranks, std::size_t n,
+                       const double* x, const double* y, std::uint8_t* out) {
+    if (!densities_.batch) {
+      for (std::size_t i = 0; i < n; ++i) class_ranks(this, tx, ty, ranks[i], 1, out + i);
+      return;
+    }
+    if (tx != tile_.tile_x || ty != tile_.tile_y || tile_.depth != 0) {
+      enter(PointId{tx, ty, ranks[0]});
+      class_ = 0, rank_ = 0;
+    }
+    std::uint32_t open[kDensityBatch];  // the points the bounds leave open
+    double ox[kDensityBatch], oy[kDensityBatch];
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t rank = ranks[i];
+      if (rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
+        out[i] = static_cast<std::uint8_t>(p_.class_count - 1);
+        continue;
+      }
+      std::uint32_t k = 0;
+      while (rank >= sure_to_[k]) ++k;
+      if (rank >= sure_from_[k]) {
+        out[i] = static_cast<std::uint8_t>(k);
+        continue;
+      }
+      if (settled_by_cell(rank, out[i])) continue;
+      open[m] = std::uint32_t(i), ox[m] = x[i], oy[m++] = y[i];
+    }
+    if (m == 0) return;
+    // The running sums' counts against each threshold: the classes short of it are a prefix.
+    double sum[kDensityBatch] = {}, v[kDensityBatch];
+    std::uint8_t short_of[kDensityBatch] = {};
+    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
+      densities_.values_of(k, m, ox, oy, v);
+      for (std::size_t i = 0; i < m; ++i) {
+        sum[i] += v[i];
+        short_of[i] += !TilesetShape::emits(thresholds_[ranks[open[i]]], sum[i] * area_);
+      }
+    }
+    for (std::size_t i = 0; i < m; ++i) out[open[i]] = short_of[i];
+  }
+
+  /// Points of any depths (classes read in batches): each by read_class's rule, those the bounds leave
+  /// open gathered, kDensityBatch at a time, and each class's values read for them in one batch.
+  void classify_records(const QueryPoint* p, std::size_t n, std::uint8_t* out) {
+    std::uint32_t open[kDensityBatch];
+    float t[kDensityBatch];
+    double x[kDensityBatch], y[kDensityBatch], area[kDensityBatch];
+    std::size_t m = 0;
+    auto read_open = [&] {
+      double sum[kDensityBatch] = {}, v[kDensityBatch];
+      std::uint8_t short_of[kDensityBatch] = {};
+      for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
+        densities_.values_of(k, m, x, y, v);
+        for (std::size_t i = 0; i < m; ++i) {
+          sum[i] += v[i];
+          short_of[i] += !TilesetShape::emits(t[i], sum[i] * area[i]);
+        }
+      }
+      for (std::size_t i = 0; i < m; ++i) out[open[i]] = short_of[i];
+      m = 0;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const PointId& id = p[i].id;
+      if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) {
+        enter(id);
+        class_ = 0, rank_ = 0;
+      }
+      if (id.rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
+        out[i] = static_cast<std::uint8_t>(p_.class_count - 1);
+        continue;
+      }
+      std::uint32_t k = 0;
+      while (id.rank >= sure_to_[k]) ++k;
+      if (id.rank >= sure_from_[k]) {
+        out[i] = static_cast<std::uint8_t>(k);
+        continue;
+      }
+      if (settled_by_cell(id.rank, out[i])) continue;
+      const TilePoint& point = points_[id.rank];
+      const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+      open[m] = std::uint32_t(i), t[m] = thresholds_[id.rank], area[m] = area_;
+      x[m] = wx + point.unit_x() * side_, y[m++] = wy + point.unit_y() * side_;
+      if (m == kDensityBatch) read_open();
+    }
+    if (m > 0) read_open();
+  }
+
+  /// The class of rank `rank` of the current tile if the bounds of the cell it lies in settle it (read_cell).
+  bool settled_by_cell(std::uint32_t rank, std::uint8_t& out) {
+    const TilePoint& point = points_[rank];
+    const float t = thresholds_[rank];
     const std::uint32_t cx = point.x >> (16 - kCellBits), cy = point.y >> (16 - kCellBits);
     const std::uint32_t cell = cy << kCellBits | cx;
     if (!(cells_read_ >> cell & 1)) read_cell(cx, cy, cell);
@@ -338,9 +495,20 @@ class Classifier {
       short_everywhere += !TilesetShape::emits(t, cell_hi_[cell][k]);
       short_somewhere += !TilesetShape::emits(t, cell_lo_[cell][k]);
     }
-    if (short_everywhere == short_somewhere) return static_cast<std::uint8_t>(short_everywhere);
+    out = static_cast<std::uint8_t>(short_everywhere);
+    return short_everywhere == short_somewhere;
+  }
+
+  /// A point of the current tile whose class its tile's bounds leave open: settled by the bounds of the
+  /// cell of the tile it lies in where they can, else by the classes' densities at its stable position,
+  /// computed as query_points computes it (depth 0), so the densities read are its.
+  [[gnu::always_inline]] std::uint8_t read_class(const PointId& id) {
+    std::uint8_t k;
+    if (settled_by_cell(id.rank, k)) return k;
+    const TilePoint& point = points_[id.rank];
     const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
-    return densities_.class_of(t, wx + point.unit_x() * side_, wy + point.unit_y() * side_, area_);
+    return densities_.class_of(thresholds_[id.rank], wx + point.unit_x() * side_, wy + point.unit_y() * side_,
+                               area_);
   }
 
   /// The classes' cumulative expected counts' bounds over cell (cx, cy) of the current tile, widened by
@@ -518,7 +686,13 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   for (std::uint32_t k = 0; k < p.class_count && one_grid; ++k)
     one_grid = p.classes[k].kind == QueryDensity::Kind::kImage &&
                densities.samplers[0].same_grid(*p.classes[k].image);
-  q.density.callback = joint ? sum_of_joint : one_grid ? sum_of_images : sum_of_densities;
+  bool& batch = densities.batch;  // a class read in batches: the union too
+  for (std::uint32_t k = 0; k < p.class_count && !joint && !one_grid; ++k)
+    batch |= p.classes[k].kind == QueryDensity::Kind::kCallback && p.classes[k].batch_callback;
+  if (batch)
+    q.density.batch_callback = sum_of_densities_batch;
+  else
+    q.density.callback = joint ? sum_of_joint : one_grid ? sum_of_images : sum_of_densities;
   if (one_grid) {
     densities.images.grid = &densities.samplers[0], densities.images.count = p.class_count;
     for (std::uint32_t k = 0; k < p.class_count; ++k) densities.images.values[k] = p.classes[k].image->values;
@@ -577,6 +751,8 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
                                    p.class_count - 1,
                                    Classifier::class_ranks,
                                    Classifier::class_of_id,
+                                   Classifier::class_points,
+                                   Classifier::class_records,
                                    &classify,
                                    densities.one_grid ? &densities.images : nullptr};
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),

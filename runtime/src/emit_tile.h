@@ -143,7 +143,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   constexpr std::uint32_t kNone = ~0u;
   // A batch callback's reads (BatchCallback below): each tile's, kDensityBatch at a time; the second
   // reads at glided positions go with the emitted points' batch, which then holds as many.
-  constexpr bool kMayBatchReads = kKind == QueryDensity::Kind::kCallback && !kClassesAtDensity<Sink>;
+  constexpr bool kMayBatchReads = kKind == QueryDensity::Kind::kCallback;
   const bool batch_reads = kMayBatchReads && j.density->batch_callback;
   constexpr int kBatch = kBatched ? (kMayBatchReads ? int(kDensityBatch) : 32) : 1;
   const int batch_size = batch_reads ? kBatch : std::min(kBatch, 32);
@@ -287,12 +287,20 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   // A batch callback: the candidates visit would read wait, in order and with those it settles unread,
   // until kDensityBatch of them are gathered; one call then reads them all and each is decided as visit
   // decides it. `next` gives the ranks to visit, kNone past the last.
-  std::uint32_t rank[kGather];
+  std::uint32_t rank[kGather], read_rank[kGather];
   bool read[kGather];
   double bx[kGather], by[kGather], rho[kGather];
+  // A class query's: the classes of the ranks read, and the ranks emitted unread, classed together after.
+  // Smooth mode reads every candidate it visits.
+  constexpr bool kClassUnread = kClassesAtDensity<Sink> && !kSmooth;
+  constexpr std::size_t kClassed = kClassesAtDensity<Sink> ? kGather : 1,
+                        kUnread = kClassUnread ? kGather : 1;
+  std::uint8_t read_class[kClassed], unread_class[kUnread];
+  std::uint32_t unread_rank[kUnread];
+  double ux[kUnread], uy[kUnread];
   auto visit_in_batches = [&](auto next) -> std::uint32_t {
     for (bool more = true; more;) {
-      std::size_t gathered = 0, reads = 0;
+      std::size_t gathered = 0, reads = 0, unread = 0;
       while (gathered < kGather) {
         const std::uint32_t r = next();
         if (r == kNone) {
@@ -313,23 +321,35 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
             unread_emitted = TilesetShape::emits(j.thresholds[r], cell_lo[cell]);
           }
         }
-        if (unread_emitted && gathered == 0) {  // nothing waits before it: written at once
+        if (unread_emitted && gathered == 0 && !kClassUnread) {  // nothing waits: written at once
           if (n == capacity) return r;
           out.put_stable(n++, j, p, r);
           continue;
         }
         rank[gathered] = r, read[gathered++] = !unread_emitted;
-        if (!unread_emitted) bx[reads] = x, by[reads++] = y;
+        if (!unread_emitted)
+          read_rank[reads] = r, bx[reads] = x, by[reads++] = y;
+        else if constexpr (kClassUnread)
+          unread_rank[unread] = r, ux[unread] = x, uy[unread++] = y;
       }
-      if (reads > 0) j.density->batch_callback(j.density->user, reads, bx, by, rho);
-      for (std::size_t i = 0, k = 0; i < gathered; ++i) {
+      if (reads > 0) {
+        j.density->batch_callback(j.density->user, reads, bx, by, rho);
+        if constexpr (kClassesAtDensity<Sink>) out.classes_of_reads(j, read_rank, reads, bx, by, read_class);
+      }
+      if constexpr (kClassUnread) {
+        if (unread > 0) out.classes_of_unread(j, unread_rank, unread, ux, uy, unread_class);
+      }
+      for (std::size_t i = 0, k = 0, u = 0; i < gathered; ++i) {
         const std::uint32_t r = rank[i];
         std::uint32_t stop = kNone;
         if (read[i]) {
-          stop = decide(r, j.points[r], bx[k], by[k], density_or_zero(rho[k]));
+          stop = decide(r, j.points[r], bx[k], by[k], density_or_zero(rho[k]),
+                        kClassesAtDensity<Sink> ? read_class + k : nullptr);
           ++k;
         } else if (n == capacity) {
           stop = r;
+        } else if constexpr (kClassUnread) {
+          out.put_stable_classed(n++, j, j.points[r], r, unread_class[u++]);
         } else {
           out.put_stable(n++, j, j.points[r], r);
         }

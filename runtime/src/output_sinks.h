@@ -241,6 +241,37 @@ struct VaryingClassSink {
     c->class_ranks(c->user, j.tx, j.ty, rank, 1, &k);
     return k;
   }
+  /// Candidates ranks[0 … n) of tile j at their stable positions (x[i], y[i]), whose densities one batch
+  /// read has just given: their classes into out[0 … n), from the running sums that read left in the
+  /// scratch (class_at's rule; class_at itself for a position the scratch does not hold).
+  void classes_of_reads(const TileJob& j, const std::uint32_t* ranks, std::size_t n, const double* x,
+                        const double* y, std::uint8_t* out) const {
+    const ClassScratch& s = *c->scratch;
+    const double area = c->area;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (s.batch_count != n || s.batch_x[i] != x[i] || s.batch_y[i] != y[i]) {
+        out[i] = class_at(j, ranks[i], x[i], y[i]);
+        continue;
+      }
+      const float t = j.thresholds[ranks[i]];
+      std::uint32_t k = 0;
+      for (std::uint32_t m = 0; m < c->last; ++m)
+        k += !TilesetShape::emits(t, s.batch_cumulative[m][i] * area);
+      out[i] = static_cast<std::uint8_t>(k);
+    }
+  }
+  /// Candidates ranks[0 … n) of tile j at their stable positions, emitted without their densities
+  /// read: their classes into out[0 … n), the classes' densities read in batches where the bounds leave
+  /// a class open.
+  void classes_of_unread(const TileJob& j, const std::uint32_t* ranks, std::size_t n, const double* x,
+                         const double* y, std::uint8_t* out) const {
+    c->class_points(c->user, j.tx, j.ty, ranks, n, x, y, out);
+  }
+  /// Records p[0 … count) into slots i … i + count - 1, classed together (past the top level).
+  void put_records(std::size_t i, const QueryPoint* p, std::size_t count) const {
+    for (std::size_t k = 0; k < count; ++k) base.put(i + k, p[k].x, p[k].y, p[k].id);
+    c->class_records(c->user, p, count, c->classes + i);
+  }
   /// Classes all images on one grid (ClassImages), else null.
   const ClassImages* images() const { return c->images; }
   /// Ranks [first, first + count) of tile j from their classes' running sums at their stable positions
@@ -317,6 +348,12 @@ template <class Sink, class = void>
 constexpr bool kClassesAtDensity = false;
 template <class Sink>
 constexpr bool kClassesAtDensity<Sink, std::void_t<decltype(&Sink::put_classed)>> = true;
+
+/// Whether a sink takes a run of QueryPoint records at once (VaryingClassSink::put_records).
+template <class Sink, class = void>
+constexpr bool kPutsRecords = false;
+template <class Sink>
+constexpr bool kPutsRecords<Sink, std::void_t<decltype(&Sink::put_records)>> = true;
 
 /// Closes up slots [n, n + count) of `out` over those whose flag is 0 (flags 0 or 1); returns the slot after
 /// the last one kept. A few left out: the runs between them move; many: every slot, with no branch.

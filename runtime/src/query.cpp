@@ -56,7 +56,10 @@ bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, 
     const std::size_t room = std::min(kStage, capacity - n);
     std::size_t staged = 0;
     const bool done = detail::emit_descending(descent, tx, ty, index, stage, room, staged, budget, at);
-    for (std::size_t i = 0; i < staged; ++i) out.put(n + i, stage[i].x, stage[i].y, stage[i].id);
+    if constexpr (detail::kPutsRecords<Sink>)
+      out.put_records(n, stage, staged);
+    else
+      for (std::size_t i = 0; i < staged; ++i) out.put(n + i, stage[i].x, stage[i].y, stage[i].id);
     n += staged;
     if (done) return true;
     if (staged < room || n == capacity) return false;  // the budget ran out, or the caller's buffer is full

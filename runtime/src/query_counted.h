@@ -59,6 +59,11 @@ struct ConstantClasses {
 struct ClassScratch {
   double x = std::numeric_limits<double>::quiet_NaN(), y = x;
   double cumulative[kMaxQueryClasses] = {};
+  /// The union's last batch read (classes read in batches): its `batch_count` positions and the running
+  /// sums there, batch_cumulative[k][i] at position i.
+  std::size_t batch_count = 0;
+  double batch_x[kDensityBatch], batch_y[kDensityBatch];
+  double batch_cumulative[kMaxQueryClasses][kDensityBatch];
 };
 
 /// Classes of varying densities, classed as they are written (emit_tile.h's VaryingClassSink). A candidate
@@ -82,6 +87,12 @@ struct VaryingClasses {
   void (*class_ranks)(void* user, std::int64_t tx, std::int64_t ty, std::uint32_t first, std::uint32_t count,
                       std::uint8_t* out);
   std::uint8_t (*class_of_id)(void* user, const PointId& id);
+  /// Ranks ranks[0 … n) of depth-0 tile (tx, ty) at their stable positions (x[i], y[i]), n at most
+  /// kDensityBatch, into out[0 … n), the densities read in batches where any class is.
+  void (*class_points)(void* user, std::int64_t tx, std::int64_t ty, const std::uint32_t* ranks,
+                       std::size_t n, const double* x, const double* y, std::uint8_t* out);
+  /// The points p[0 … n) of any depths into out[0 … n), the densities read in batches where any class is.
+  void (*class_records)(void* user, const QueryPoint* p, std::size_t n, std::uint8_t* out);
   void* user;
   /// Classes all images on one grid, else null: the union's density is then read a block of candidates
   /// at a time (emit_tile.h, image_sums_run) instead of through its callback.
