@@ -13,7 +13,7 @@
 //    gives no more points;
 //  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
 //  - query_classes with the density and an empty class (two halves of a constant) gives the same points,
-//    and a callback's two classes from one joint callback the same points and classes;
+//    and a callback's two classes read in batches or from one joint callback the same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys;
 //  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch.
 // A failed check aborts.
@@ -315,6 +315,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (classed.size != all.size) fail();
       for (std::size_t i = 0; i < all.size; ++i)
         if (!same(classed[i], all[i]) || classes[i] > (kind == 0 ? 1 : 0)) fail();
+    }
+    // The same two classes, the callback read in batches: the same status, points and classes.
+    if (kind == 2) {
+      kdm::ClassQueryParams batched = cq;
+      batched.classes[0].callback = nullptr, batched.classes[0].batch_callback = batch_callback;
+      static Points through_batches;
+      static std::uint8_t batch_classes[kBigCapacity];
+      kdm::QueryCursor batch_cursor;
+      through_batches.status = kdm::query_classes(kdm::Tileset::builtin(), batched, through_batches.data,
+                                                  batch_classes, kBigCapacity, &through_batches.size,
+                                                  &batch_cursor);
+      if (through_batches.status != classed.status || through_batches.size != classed.size) fail();
+      for (std::size_t i = 0; i < classed.size; ++i)
+        if (!same(through_batches[i], classed[i]) || batch_classes[i] != classes[i]) fail();
     }
     // The same two classes from one joint callback: the same status, points and classes.
     if (kind == 2) {

@@ -15,6 +15,8 @@
 // settle most of its points' classes without reading any density. Classes whose densities come from one
 // computation are best given by one function (ClassQueryParams::joint): the query then makes one call per
 // candidate instead of one per class.
+// A class given by a batch callback (QueryDensity::batch_callback) is read as a one-class query reads one:
+// up to kDensityBatch positions a call, its classes found from the same values.
 //
 // Zoom coherence: as densities rise a point keeps its id and can only move to an earlier class (its
 // cumulative counts only grow), never to a later one. Past the top level (smooth mode, depth > 0), a

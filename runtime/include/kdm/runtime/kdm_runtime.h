@@ -197,7 +197,8 @@ typedef struct kdm_class_density {
    * bounds settle most points' classes without a call. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback, the density at n positions at once, as kdm_query's
-   * density_batch_callback (a class query reads its classes one position at a time through it). */
+   * density_batch_callback: a class query reads the classes where it would read their sum, up to
+   * KDM_DENSITY_BATCH positions a call. */
   void (*density_batch_callback)(void* user, size_t n, const double* x, const double* y, double* out);
 } kdm_class_density;
 
