@@ -173,8 +173,8 @@ void BM_QueryDensityCallback(benchmark::State& state) {
 // Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp: 0 constants, 1 three ramps by
 // callback, 2 the same with their bounds (and the sum's), 3 the ramps and bounds from one joint call
 // (ClassQueryParams::joint), 4 and 5 as 2 and 3 with a texture over the ramps, 6 the ramps as images against
-// an image of their sum, 7 as 4 by batch callbacks against a batch callback of the sum; compact, 1 for both
-// queries
+// an image of their sum, 7 and 8 as 4 and 5 by batch functions against a batch callback of the sum;
+// compact, 1 for both queries
 // into float positions) against one class at their sum, which emits the same points (its callback computes
 // the three ramps, as a caller's sum would): rounds alternate between the two, and `of_one_class` is the
 // one-class query's time over the three-class query's.
@@ -230,6 +230,13 @@ void ramp_classes(void* user, double x, double y, double* values) {
   const double t = c->textured ? texture(x, y) : 1;
   for (int k = 0; k < 3; ++k) values[k] = plain_ramp(k, x) * t;
 }
+void ramp_classes_batch(void* user, std::size_t n, const double* x, const double* y, double* values) {
+  double v[3];
+  for (std::size_t i = 0; i < n; ++i) {
+    ramp_classes(user, x[i], y[i], v);
+    for (int k = 0; k < 3; ++k) values[k * n + i] = v[k];
+  }
+}
 void ramp_classes_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
   const auto* c = static_cast<const RampClass*>(user);
   for (int k = 0; k < 3; ++k)
@@ -249,15 +256,16 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   for (int k = 0; k < 3; ++k) {
     kdm::QueryDensity& d = cq.classes[k];
     d.constant = double(1 << k) / 7;
-    if ((ramp >= 1 && ramp <= 5) || ramp == 7) {
+    if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
       d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
       d.user = const_cast<RampClass*>(user + k), d.callback_max = d.constant * most;
       if (ramp >= 2) d.bounds = ramp_class_bounds;
       if (ramp == 7) d.callback = nullptr, d.batch_callback = ramp_class_batch;
     }
   }
-  if (ramp == 3 || ramp == 5) {
+  if (ramp == 3 || ramp == 5 || ramp == 8) {
     cq.joint.densities = ramp_classes, cq.joint.bounds = ramp_classes_bounds;
+    if (ramp == 8) cq.joint.densities = nullptr, cq.joint.batch_densities = ramp_classes_batch;
     cq.joint.user = const_cast<RampClass*>(user);
     for (int k = 0; k < 3; ++k) cq.joint.max[k] = cq.classes[k].callback_max;
   }
@@ -279,12 +287,12 @@ void BM_QueryThreeClasses(benchmark::State& state) {
       d.kind = kdm::QueryDensity::Kind::kImage, d.image = &images[k];
     }
   }
-  if ((ramp >= 1 && ramp <= 5) || ramp == 7) {
+  if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
     one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
     one.density.user = const_cast<RampClass*>(user);
     one.density.callback_max = most;
     if (ramp >= 2) one.density.bounds = ramp_sum_bounds;
-    if (ramp == 7) one.density.callback = nullptr, one.density.batch_callback = ramp_sum_batch;
+    if (ramp >= 7) one.density.callback = nullptr, one.density.batch_callback = ramp_sum_batch;
   }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::vector<std::uint8_t> classes(buffer.size());
@@ -335,7 +343,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   report(state, n);
   state.counters["of_one_class"] = one_seconds / seconds;
   // Class densities read per point emitted (ramps only), by the class query and by the one-class query.
-  if ((ramp >= 1 && ramp <= 5) || ramp == 7) {
+  if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
     state.counters["reads_per_point"] = double(reads) / double(n);
     state.counters["one_class_reads_per_point"] = double(one_reads) / double(n);
   }
@@ -660,7 +668,7 @@ BENCHMARK(BM_QueryDensityCallback)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

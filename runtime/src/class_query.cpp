@@ -47,7 +47,8 @@ struct ClassDensities {
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
   bool one_grid = false;         ///< every class an image on class 0's texels (sum_of_images)
-  bool batch = false;            ///< a class read in batches (sum_of_densities_batch)
+  bool batch = false;            ///< a class read in batches (sum_of_batches), or the joint density
+  bool joint = false;            ///< the joint density gives every class's (ClassQueryParams::joint)
   detail::ClassImages images{};  ///< when one_grid: the images, read a block of points at a time
   /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
   /// VaryingClassSink classes the candidate just read from it).
@@ -70,7 +71,10 @@ struct ClassDensities {
   /// stored one by one, which the processor cannot forward.
   void joint_at(double x, double y, double* v) const {
     const JointClassDensity& j = params->joint;
-    j.densities(j.user, x, y, v);
+    if (j.densities)
+      j.densities(j.user, x, y, v);
+    else
+      j.batch_densities(j.user, 1, &x, &y, v);  // class k's value at v[k · 1 + 0]
   }
   /// Class k's values at n positions into v[0 … n), as at() reads each: a batch callback's in one call.
   void values_of(std::uint32_t k, std::size_t n, const double* x, const double* y, double* v) const {
@@ -82,11 +86,38 @@ struct ClassDensities {
     d.batch_callback(d.user, n, x, y, v);
     for (std::size_t i = 0; i < n; ++i) v[i] = density_or_zero(v[i]);
   }
+  /// The running sums of classes 0 … count - 1 at n ≤ kDensityBatch positions into sums[k][i], added as
+  /// sum_of_densities adds them: a batch callback's values in one call, a joint batch's all in one.
+  void sums_at(std::size_t n, const double* x, const double* y, std::uint32_t count,
+               double (*sums)[kDensityBatch]) const {
+    if (!joint) {
+      for (std::uint32_t k = 0; k < count; ++k) {
+        values_of(k, n, x, y, sums[k]);
+        if (k > 0)
+          for (std::size_t i = 0; i < n; ++i) sums[k][i] += sums[k - 1][i];
+      }
+      return;
+    }
+    double v[kMaxQueryClasses * kDensityBatch];  // class k's value at position i in v[k · n + i]
+    const JointClassDensity& j = params->joint;
+    if (j.batch_densities) {
+      j.batch_densities(j.user, n, x, y, v);
+    } else {
+      double one[kMaxQueryClasses];
+      for (std::size_t i = 0; i < n; ++i) {
+        j.densities(j.user, x[i], y[i], one);
+        for (std::uint32_t k = 0; k < count; ++k) v[k * n + i] = one[k];
+      }
+    }
+    for (std::uint32_t k = 0; k < count; ++k)
+      for (std::size_t i = 0; i < n; ++i)
+        sums[k][i] = (k > 0 ? sums[k - 1][i] : 0.0) + density_or_zero(v[k * n + i]);
+  }
   /// Bounds of every class's density over [x0, x1] × [y0, y1] into lo[k], hi[k], as query_points takes
   /// one density's.
   void bounds(double x0, double y0, double x1, double y1, double* lo, double* hi) const {
     const JointClassDensity& j = params->joint;
-    if (!j.densities) {
+    if (!joint) {
       for (std::uint32_t k = 0; k < params->class_count; ++k)
         detail::density_bounds(params->classes[k], x0, y0, x1, y1, lo[k], hi[k]);
       return;
@@ -103,14 +134,14 @@ struct ClassDensities {
   std::uint8_t class_of(float threshold, double x, double y, double area) const {
     const std::uint32_t last = params->class_count - 1;
     double v[kMaxQueryClasses];
-    if (params->joint.densities) joint_at(x, y, v);
+    if (joint) joint_at(x, y, v);
     ImageSampler::Texels t{};
     if (one_grid) t = samplers[0].texels(x, y);
     double sum = 0;
     for (std::uint32_t k = 0; k < last; ++k) {
-      sum += params->joint.densities ? density_or_zero(v[k])
-             : one_grid              ? ImageSampler::blend(params->classes[k].image->values, t)
-                                     : at(k, x, y);
+      sum += joint      ? density_or_zero(v[k])
+             : one_grid ? ImageSampler::blend(params->classes[k].image->values, t)
+                        : at(k, x, y);
       if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
     }
     return static_cast<std::uint8_t>(last);
@@ -126,27 +157,19 @@ double sum_of_densities(void* user, double x, double y) {
   c.scratch.x = x, c.scratch.y = y;
   return sum;
 }
-/// The union's density (QueryDensity::batch_callback) when a class is read in batches: each such class's
-/// values for all n positions in one call, the others' position by position, and the running sums left in
-/// the scratch's batch for the sink to class the positions read. Sums as sum_of_densities adds them.
-void sum_of_densities_batch(void* user, std::size_t n, const double* x, const double* y, double* out) {
+/// The union's density (QueryDensity::batch_callback) when a class, or the joint density, is read in
+/// batches: the classes' running sums at the n positions (ClassDensities::sums_at), left in the scratch's
+/// batch for the sink to class the positions read.
+void sum_of_batches(void* user, std::size_t n, const double* x, const double* y, double* out) {
   const auto& c = *static_cast<const ClassDensities*>(user);
   detail::ClassScratch& s = c.scratch;
-  std::fill(out, out + n, 0.0);
-  for (std::uint32_t k = 0; k < c.params->class_count; ++k) {
-    const QueryDensity& d = c.params->classes[k];
-    double* sums = s.batch_cumulative[k];
-    if (d.kind == QueryDensity::Kind::kCallback && d.batch_callback) {
-      d.batch_callback(d.user, n, x, y, sums);
-      for (std::size_t i = 0; i < n; ++i) sums[i] = out[i] += density_or_zero(sums[i]);
-    } else {
-      for (std::size_t i = 0; i < n; ++i) sums[i] = out[i] += c.at(k, x[i], y[i]);
-    }
-  }
+  const std::uint32_t count = c.params->class_count;
+  c.sums_at(n, x, y, count, s.batch_cumulative);
+  std::copy(s.batch_cumulative[count - 1], s.batch_cumulative[count - 1] + n, out);
   std::copy(x, x + n, s.batch_x), std::copy(y, y + n, s.batch_y);
   s.batch_count = n;
   if (n != 1) return;
-  for (std::uint32_t k = 0; k < c.params->class_count; ++k) s.cumulative[k] = s.batch_cumulative[k][0];
+  for (std::uint32_t k = 0; k < count; ++k) s.cumulative[k] = s.batch_cumulative[k][0];
   s.x = x[0], s.y = y[0];  // a single read, as sum_of_densities leaves it (VaryingClassSink::class_at)
 }
 /// Classes that are all images on one grid of texels: where a position falls among them is found once.
@@ -420,17 +443,24 @@ class Classifier {
       open[m] = std::uint32_t(i), ox[m] = x[i], oy[m++] = y[i];
     }
     if (m == 0) return;
-    // The running sums' counts against each threshold: the classes short of it are a prefix.
-    double sum[kDensityBatch] = {}, v[kDensityBatch];
-    std::uint8_t short_of[kDensityBatch] = {};
-    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
-      densities_.values_of(k, m, ox, oy, v);
-      for (std::size_t i = 0; i < m; ++i) {
-        sum[i] += v[i];
-        short_of[i] += !TilesetShape::emits(thresholds_[ranks[open[i]]], sum[i] * area_);
-      }
+    float t[kDensityBatch];
+    double area[kDensityBatch];
+    for (std::size_t i = 0; i < m; ++i) t[i] = thresholds_[ranks[open[i]]], area[i] = area_;
+    classes_of_open(m, open, t, area, ox, oy, out);
+  }
+
+  /// Points out[open[i]] (i < m) of thresholds t[i] at (x[i], y[i]), expected counts density times
+  /// area[i]: their classes from the running sums there. The classes short of a threshold are a prefix.
+  void classes_of_open(std::size_t m, const std::uint32_t* open, const float* t, const double* area,
+                       const double* x, const double* y, std::uint8_t* out) const {
+    const std::uint32_t last = p_.class_count - 1;
+    double sums[kMaxQueryClasses][kDensityBatch];
+    densities_.sums_at(m, x, y, last, sums);
+    for (std::size_t i = 0; i < m; ++i) {
+      std::uint32_t k = 0;
+      for (std::uint32_t c = 0; c < last; ++c) k += !TilesetShape::emits(t[i], sums[c][i] * area[i]);
+      out[open[i]] = static_cast<std::uint8_t>(k);
     }
-    for (std::size_t i = 0; i < m; ++i) out[open[i]] = short_of[i];
   }
 
   /// Points of any depths (classes read in batches): each by read_class's rule, those the bounds leave
@@ -441,16 +471,7 @@ class Classifier {
     double x[kDensityBatch], y[kDensityBatch], area[kDensityBatch];
     std::size_t m = 0;
     auto read_open = [&] {
-      double sum[kDensityBatch] = {}, v[kDensityBatch];
-      std::uint8_t short_of[kDensityBatch] = {};
-      for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
-        densities_.values_of(k, m, x, y, v);
-        for (std::size_t i = 0; i < m; ++i) {
-          sum[i] += v[i];
-          short_of[i] += !TilesetShape::emits(t[i], sum[i] * area[i]);
-        }
-      }
-      for (std::size_t i = 0; i < m; ++i) out[open[i]] = short_of[i];
+      classes_of_open(m, open, t, area, x, y, out);
       m = 0;
     };
     for (std::size_t i = 0; i < n; ++i) {
@@ -616,6 +637,7 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
   };
   add(p.class_count);
   add(reinterpret_cast<std::uintptr_t>(p.joint.densities));
+  add(reinterpret_cast<std::uintptr_t>(p.joint.batch_densities));
   add(reinterpret_cast<std::uintptr_t>(p.joint.user));
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) add_double(p.joint.max[k]);
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
@@ -642,7 +664,9 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
   densities.params = &p;
-  const bool joint = p.joint.densities != nullptr;
+  const bool joint = densities.joint = p.joint.densities || p.joint.batch_densities;
+  if (p.joint.densities && p.joint.batch_densities)  // which one is meant is unclear
+    return refuse(Kind::kBadDensity, "joint.batch_densities");
   for (std::uint32_t k = 0; k < p.class_count && joint; ++k) {
     if (!std::isfinite(p.joint.max[k])) return refuse(Kind::kNotFinite, kJointMaxNames[k], p.joint.max[k]);
     if (p.joint.max[k] < 0) return refuse(Kind::kNegative, kJointMaxNames[k], p.joint.max[k]);
@@ -686,11 +710,11 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   for (std::uint32_t k = 0; k < p.class_count && one_grid; ++k)
     one_grid = p.classes[k].kind == QueryDensity::Kind::kImage &&
                densities.samplers[0].same_grid(*p.classes[k].image);
-  bool& batch = densities.batch;  // a class read in batches: the union too
+  bool& batch = densities.batch = p.joint.batch_densities != nullptr;  // read in batches: the union too
   for (std::uint32_t k = 0; k < p.class_count && !joint && !one_grid; ++k)
     batch |= p.classes[k].kind == QueryDensity::Kind::kCallback && p.classes[k].batch_callback;
   if (batch)
-    q.density.batch_callback = sum_of_densities_batch;
+    q.density.batch_callback = sum_of_batches;
   else
     q.density.callback = joint ? sum_of_joint : one_grid ? sum_of_images : sum_of_densities;
   if (one_grid) {

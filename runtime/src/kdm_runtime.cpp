@@ -186,7 +186,7 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
   kdm::ClassQueryParams q;
   kdm_status status = KDM_INVALID_ARGUMENT;
   if (!read_query(tileset, query, cursor, written, q.query, why)) {
-  } else if (is_joint ? !(joint && joint->densities) : !classes) {
+  } else if (is_joint ? !(joint && (joint->densities || joint->batch_densities)) : !classes) {
     why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = is_joint ? "joint" : "classes";
   } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
     why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
@@ -201,7 +201,7 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
     }
     if (is_joint) {
       q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,
-      q.joint.user = joint->user;
+      q.joint.user = joint->user, q.joint.batch_densities = joint->batch_densities;
       std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
     }
     status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });

@@ -13,7 +13,8 @@
 //    gives no more points;
 //  - splitting the region at some x gives the same points (query(A ∪ B) = query(A) ⊎ query(B));
 //  - query_classes with the density and an empty class (two halves of a constant) gives the same points,
-//    and a callback's two classes read in batches or from one joint callback the same points and classes;
+//    and a callback's two classes read in batches or from one joint function (of one position or many) the
+//    same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys;
 //  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch.
 // A failed check aborts.
@@ -80,6 +81,12 @@ void batch_callback(void* user, std::size_t n, const double* x, const double* y,
 // Two classes from one call (ClassQueryParams::joint): the callback's value and nothing.
 void joint_callback(void* user, double x, double y, double* values) {
   values[0] = callback(user, x, y), values[1] = 0;
+}
+
+// The same at n positions (JointClassDensity::batch_densities); a batch out of its bounds fails.
+void joint_batch_callback(void* user, std::size_t n, const double* x, const double* y, double* values) {
+  if (n < 1 || n > kdm::kDensityBatch) std::abort();
+  for (std::size_t i = 0; i < n; ++i) values[i] = callback(user, x[i], y[i]), values[n + i] = 0;
 }
 
 [[noreturn]] void fail() {
@@ -323,9 +330,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       static Points through_batches;
       static std::uint8_t batch_classes[kBigCapacity];
       kdm::QueryCursor batch_cursor;
-      through_batches.status = kdm::query_classes(kdm::Tileset::builtin(), batched, through_batches.data,
-                                                  batch_classes, kBigCapacity, &through_batches.size,
-                                                  &batch_cursor);
+      through_batches.status =
+          kdm::query_classes(kdm::Tileset::builtin(), batched, through_batches.data, batch_classes,
+                             kBigCapacity, &through_batches.size, &batch_cursor);
       if (through_batches.status != classed.status || through_batches.size != classed.size) fail();
       for (std::size_t i = 0; i < classed.size; ++i)
         if (!same(through_batches[i], classed[i]) || batch_classes[i] != classes[i]) fail();
@@ -339,6 +346,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       kdm::QueryCursor joint_cursor;
       joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes, kBigCapacity,
                                         &joint.size, &joint_cursor);
+      if (joint.status != classed.status || joint.size != classed.size) fail();
+      for (std::size_t i = 0; i < joint.size; ++i)
+        if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
+      // And from one joint function of many positions.
+      cq.joint.densities = nullptr, cq.joint.batch_densities = joint_batch_callback;
+      kdm::QueryCursor joint_batch_cursor;
+      joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes, kBigCapacity,
+                                        &joint.size, &joint_batch_cursor);
       if (joint.status != classed.status || joint.size != classed.size) fail();
       for (std::size_t i = 0; i < joint.size; ++i)
         if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();

@@ -60,7 +60,14 @@ static void ramp_batch(void* user, size_t n, const double* x, const double* y, d
   ++g_batch_calls, g_batch_values += (long)n;
   for (i = 0; i < n; ++i) out[i] = 0.2 + 0.1 * x[i];
 }
-/* Two classes from one call: the ramp's value for each, and their bounds. */
+/* Two classes from one call: the ramp's value for each (at n positions: class k's value i at
+ * values[k * n + i]), and their bounds. */
+static void two_ramps_batch(void* user, size_t n, const double* x, const double* y, double* values) {
+  size_t i;
+  (void)user, (void)y;
+  ++g_batch_calls, g_batch_values += (long)n;
+  for (i = 0; i < n; ++i) values[i] = values[n + i] = 0.2 + 0.1 * x[i];
+}
 static void two_ramps(void* user, double x, double y, double* values) {
   values[0] = values[1] = ramp(user, x, y);
 }
@@ -352,6 +359,21 @@ int main(int argc, char** argv) {
         CHECK(c == a && memcmp(compact_classes, without_classes, a) == 0);
         for (c = 0; c < a; ++c) /* floats within 2^-21 of the tile-relative double (region 8 wide) */
           CHECK(fabs(xy[2 * c] - without[c].x) < 1e-5 && fabs(xy[2 * c + 1] - without[c].y) < 1e-5);
+        /* The joint densities at many positions a call: the same points and classes. */
+        joint.densities = NULL, joint.batch_densities = two_ramps_batch;
+        g_batch_calls = g_batch_values = 0;
+        memset(&cursor, 0, sizeof cursor);
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor, NULL) ==
+              KDM_OK);
+        CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
+        CHECK(memcmp(with_classes, without_classes, a) == 0 && g_batch_calls * 8 < g_batch_values);
+        /* Both functions: which one is meant is unclear. */
+        joint.densities = two_ramps;
+        memset(&cursor, 0, sizeof cursor);
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              strcmp(problem.parameter, "joint.batch_densities") == 0);
+        joint.batch_densities = NULL;
         /* Refused by name: no joint density, a bad maximum. */
         memset(&cursor, 0, sizeof cursor);
         CHECK(kdm_query_classes_joint(builtin, &q, NULL, 2, with, with_classes, 8192, &b, &cursor,

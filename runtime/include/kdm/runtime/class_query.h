@@ -15,8 +15,9 @@
 // settle most of its points' classes without reading any density. Classes whose densities come from one
 // computation are best given by one function (ClassQueryParams::joint): the query then makes one call per
 // candidate instead of one per class.
-// A class given by a batch callback (QueryDensity::batch_callback) is read as a one-class query reads one:
-// up to kDensityBatch positions a call, its classes found from the same values.
+// A class given by a batch callback (QueryDensity::batch_callback), or every class by a joint batch function
+// (JointClassDensity::batch_densities), is read as a one-class query reads a batch callback: up to
+// kDensityBatch positions a call, the classes found from the same values.
 //
 // Zoom coherence: as densities rise a point keeps its id and can only move to an earlier class (its
 // cumulative counts only grow), never to a later one. Past the top level (smooth mode, depth > 0), a
@@ -49,16 +50,22 @@ struct JointClassDensity {
   /// Optional: bounds of each class's density over [x0, x1] × [y0, y1] into lo[k] ≤ ρ_k ≤ hi[k], as
   /// QueryDensity::bounds gives one density's (values that are not numbers fall back to 0 and max[k]).
   void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
-  void* user = nullptr;  ///< passed to both
+  void* user = nullptr;  ///< passed to all three
   /// An upper bound of each class's density wherever it is read (finite, ≥ 0), as QueryDensity::callback_max.
   double max[kMaxQueryClasses] = {};
+  /// Instead of `densities` (set one of the two): the densities at n positions (x[i], y[i]) at once, class
+  /// k's at position i into values[k · n + i], n ≤ kDensityBatch, for a vectorised function. The query
+  /// gathers its reads as a one-class query gathers a batch callback's; the same points and classes.
+  void (*batch_densities)(void* user, std::size_t n, const double* x, const double* y,
+                          double* values) = nullptr;
 };
 
 struct ClassQueryParams {
   QueryParams query;              ///< region, origin, tile size, scale and mode; query.density is not read
   std::uint32_t class_count = 0;  ///< how many of `classes` are used: 1 … kMaxQueryClasses
   QueryDensity classes[kMaxQueryClasses];  ///< each class's density, class 0 first (highest priority)
-  /// Optional: when joint.densities is set, it gives every class's density and `classes` is not read.
+  /// Optional: when joint.densities or joint.batch_densities is set, it gives every class's density and
+  /// `classes` is not read.
   JointClassDensity joint;
 };
 
@@ -71,7 +78,7 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
 /// with `problem` (optional) naming the parameter for: a class count of 0 or more than kMaxQueryClasses
 /// (kBadClassCount), a class's missing image or callback or bad callback_max (parameter
 /// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a bad joint maximum
-/// ("joint.max[k]"), a null `classes` with room in
+/// ("joint.max[k]"), both joint functions ("joint.batch_densities"), a null `classes` with room in
 /// `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
 KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
                                      std::uint8_t* classes, std::size_t capacity, std::size_t* written,

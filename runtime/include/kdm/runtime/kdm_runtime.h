@@ -235,12 +235,16 @@ typedef struct kdm_joint_class_density {
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   void* user;
   double density_max[KDM_MAX_CLASSES];
+  /* Added in 0.4: instead of `densities` (set one of the two), the densities at n positions at once,
+   * class k's at (x[i], y[i]) into values[k * n + i], n <= KDM_DENSITY_BATCH, read as a class query reads
+   * a density_batch_callback. */
+  void (*batch_densities)(void* user, size_t n, const double* x, const double* y, double* values);
 } kdm_joint_class_density;
 
 /* kdm_query_classes and kdm_query_classes_compact with the classes' densities from one call: the same
  * points and classes as separate callbacks giving the same values, one call per candidate instead of one
- * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` or joint->densities ("joint") and a bad
- * density_max ("joint.max[k]"). Added in 0.4. */
+ * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` or neither of its two density functions
+ * ("joint"), both of them ("joint.batch_densities") and a bad density_max ("joint.max[k]"). Added in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
                                                    const kdm_joint_class_density* joint, uint32_t class_count,
                                                    kdm_point* out, uint8_t* out_classes, size_t capacity,
