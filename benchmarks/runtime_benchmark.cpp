@@ -551,6 +551,67 @@ void BM_QueryParallel(benchmark::State& state) {
   state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
 }
 
+// BM_QueryParallel's region as three classes at 1 : 2 : 4 of its density (args: smooth; ramp, 1 for the
+// plain ramps by callback with their bounds, as BM_QueryThreeClasses' ramp 2), into the compact output with
+// each point's class: two workers in rounds alternating with one worker and with one query_classes_compact.
+void BM_QueryParallelClasses(benchmark::State& state) {
+  static const RampClass kPlain[3] = {{0, false}, {1, false}, {2, false}};
+  kdm::ClassQueryParams q;
+  q.query = params(state);
+  q.query.x1 = q.query.y1 = 2 * kSide;
+  q.class_count = 3;
+  for (int k = 0; k < 3; ++k) {
+    kdm::QueryDensity& d = q.classes[k];
+    d.constant = double(1 << k) / 7;
+    if (state.range(1)) {
+      d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class, d.bounds = ramp_class_bounds;
+      d.user = const_cast<RampClass*>(kPlain + k), d.callback_max = d.constant;
+    }
+  }
+  kdm::ParallelQuery one, two;
+  one.init(1), two.init(2);
+  const std::size_t capacity = std::size_t(1) << 22;
+  std::vector<float> xy[2] = {std::vector<float>(2 * capacity), std::vector<float>(2 * capacity)};
+  std::vector<std::uint8_t> classes[2] = {std::vector<std::uint8_t>(capacity),
+                                          std::vector<std::uint8_t>(capacity)};
+  const kdm::TaskRunner threads = kdm::std_thread_runner();
+  std::size_t n[2] = {0, 0};
+  double seconds[2] = {0, 0}, plain_seconds = 0;
+  auto run = [&](kdm::ParallelQuery& pq, int k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const kdm::Status s = pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), nullptr},
+                                 classes[k].data(), capacity, &n[k], threads);
+    seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return s == kdm::Status::kOk;
+  };
+  auto run_plain = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    kdm::QueryCursor cursor;
+    std::size_t written = 0, total = 0;
+    kdm::Status s;
+    do {
+      s = kdm::query_classes_compact(kdm::Tileset::builtin(), q,
+                                     kdm::CompactPoints{xy[0].data() + 2 * total, nullptr},
+                                     classes[0].data() + total, capacity - total, &written, &cursor);
+      total += written;
+    } while (s == kdm::Status::kBufferFull && total < capacity);
+    plain_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  for (auto _ : state) {
+    run_plain();
+    const double before = seconds[1];
+    if (!run(one, 0) || !run(two, 1)) return state.SkipWithError("the query did not fit");
+    state.SetIterationTime(seconds[1] - before);  // two workers' time
+    if (n[0] != n[1] || std::memcmp(xy[0].data(), xy[1].data(), 2 * n[0] * sizeof(float)) != 0 ||
+        std::memcmp(classes[0].data(), classes[1].data(), n[0]) != 0)
+      return state.SkipWithError("one and two workers gave different bits");
+  }
+  report(state, n[1]);
+  state.counters["speedup"] = seconds[0] / seconds[1];
+  state.counters["of_one_query"] = plain_seconds / seconds[1];
+  state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
+}
+
 // The benchmark's region moved by half a tile in x and y, so that its sides cut 32 of the 81 tiles it meets,
 // as a view or a chunk that ignores the tiling does (args: smooth; compact, 1 for float positions instead of
 // QueryPoint records), both into reused 65,536-point buffers, in rounds alternating with the aligned region:
@@ -694,6 +755,11 @@ BENCHMARK(BM_QueryCompact)
 BENCHMARK(BM_QueryParallel)
     ->ArgNames({"smooth", "compact", "ramp"})
     ->Apply(modes_output_density)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryParallelClasses)
+    ->ArgNames({"smooth", "ramp"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryChunks)

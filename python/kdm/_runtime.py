@@ -226,7 +226,7 @@ class Tileset:
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
         region in a fixed order: the same bits for any N, in an order of its own); the default runs one
-        query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; one thread)
+        query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         """
         class_max = density_max  # a number or one entry per class, checked with the classes
@@ -234,16 +234,6 @@ class Tileset:
             rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max)
         if not isinstance(keys, bool):
             raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
-        if classes is not None:
-            if density is not None or density_bounds is not None:
-                raise ValueError("density and density_bounds do not apply to a query with classes")
-            if threads is not None:
-                raise ValueError("threads does not apply to a query with classes")
-            specs, callables, maxima = _class_args(classes, gamma, invert, class_max)
-            xy, key, labels = _kdm.class_positions(
-                self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
-                density_rect, tile_size, mode, origin, keys)
-            return (xy, key, labels) if keys else (xy, labels)
         workers = 0
         if threads is not None:
             if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
@@ -251,6 +241,14 @@ class Tileset:
             if not 1 <= threads <= 64:
                 raise ValueError(f"threads must be 1 to 64, got {threads}")
             workers = int(threads)
+        if classes is not None:
+            if density is not None or density_bounds is not None:
+                raise ValueError("density and density_bounds do not apply to a query with classes")
+            specs, callables, maxima = _class_args(classes, gamma, invert, class_max)
+            xy, key, labels = _kdm.class_positions(
+                self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
+                density_rect, tile_size, mode, origin, keys, workers)
+            return (xy, key, labels) if keys else (xy, labels)
         spec, call = _density_arg(density, gamma, invert)
         if density_bounds is not None and not callable(density_bounds):
             raise TypeError(f"density_bounds must be callable, got {type(density_bounds).__name__}")

@@ -308,6 +308,33 @@ py::tuple take_compact(CompactBuffer& buffer, std::size_t m) {
   return py::make_tuple(xy_array, py::array_t<std::uint64_t>({rows}, key, keys_owner));
 }
 
+/// `threads` as positions() takes it: 0 (one query) or 1 … kMaxParallelWorkers.
+void check_threads(int threads) {
+  if (threads < 0 || threads > int(kMaxParallelWorkers))
+    throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
+                                std::to_string(threads));
+}
+
+/// An upper bound of density `d` over the query's rectangle.
+double density_bound(const QueryDensity& d, const QueryParams& q) {
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return std::max(d.constant, 0.0);
+    case QueryDensity::Kind::kImage:
+      return d.image->max_over(q.x0, q.y0, q.x1, q.y1);
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return d.callback_max;
+}
+
+/// Room for a parallel query's points at density `rho` (a bound), with a margin for smooth mode's glide;
+/// ParallelQuery then says exactly what it needs if that was short.
+std::size_t room_for(double rho, const QueryParams& q) {
+  const double bound = std::max(rho, 0.0) * (q.x1 - q.x0) * (q.y1 - q.y0) * q.scale * 1.05 + 4096;
+  return std::size_t(std::min(bound, double(tools::kMaxCollectedPoints) + 1));
+}
+
 /// The compact query (kdm/runtime/compact_query.h) into new arrays, with the GIL released: positions
 /// (m × 2 float32, relative to the origin) and, with `keys`, each point's 64-bit key (else None). `threads`
 /// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
@@ -316,9 +343,7 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
                     const tools::DensitySpec* spec, py::object callable, bool vectorized, py::object bounds,
                     std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
                     const std::string& mode, const std::array<double, 2>& origin, bool keys, int threads) {
-  if (threads < 0 || threads > int(kMaxParallelWorkers))
-    throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
-                                std::to_string(threads));
+  check_threads(threads);
   PreparedQuery prepared;
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
           density_max, tile_size, mode, origin);
@@ -344,13 +369,7 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
     } else {
       ParallelQuery parallel;
       parallel.init(static_cast<std::uint32_t>(threads));
-      // Room for the density's bound over the rectangle, then exactly what it needs if that was short.
-      double rho = q.density.constant;
-      if (q.density.kind == QueryDensity::Kind::kImage)
-        rho = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
-      if (q.density.kind == QueryDensity::Kind::kCallback) rho = q.density.callback_max;
-      const double bound = std::max(rho, 0.0) * (q.x1 - q.x0) * (q.y1 - q.y0) * q.scale * 1.05 + 4096;
-      std::size_t wanted = std::size_t(std::min(bound, double(tools::kMaxCollectedPoints) + 1));
+      std::size_t wanted = room_for(density_bound(q.density, q), q);
       for (;;) {
         buffer.reserve(wanted);
         std::size_t needed = 0;
@@ -452,28 +471,50 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
                           const std::vector<const tools::DensitySpec*>& specs,
                           const std::vector<py::object>& callables, const std::vector<double>& maxima,
                           bool vectorized, std::optional<Rect> density_rect, double tile_size,
-                          const std::string& mode, const std::array<double, 2>& origin, bool keys) {
+                          const std::string& mode, const std::array<double, 2>& origin, bool keys,
+                          int threads) {
+  check_threads(threads);
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, callables, maxima, vectorized, density_rect, tile_size, mode,
                   origin);
+  const ClassQueryParams& q = prepared.q;
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;
   std::size_t m = 0;
   {
-    py::gil_scoped_release release;
+    py::gil_scoped_release release;  // a callable class takes it back at each call
     QueryProblem problem;
-    QueryCursor cursor;
-    for (;;) {
-      buffer.reserve(m + kChunk);
-      classes.resize(buffer.capacity);
-      std::size_t written = 0;
-      const Status s = query_classes_compact(*handle.set, prepared.q, buffer.at(m), classes.data() + m,
-                                             buffer.capacity - m, &written, &cursor, &problem);
-      m += written;
-      check_collected(m);
-      if (s == Status::kOk) break;
-      if (s != Status::kBufferFull) refused(problem);
+    if (threads == 0) {
+      QueryCursor cursor;
+      for (;;) {
+        buffer.reserve(m + kChunk);
+        classes.resize(buffer.capacity);
+        std::size_t written = 0;
+        const Status s = query_classes_compact(*handle.set, q, buffer.at(m), classes.data() + m,
+                                               buffer.capacity - m, &written, &cursor, &problem);
+        m += written;
+        check_collected(m);
+        if (s == Status::kOk) break;
+        if (s != Status::kBufferFull) refused(problem);
+      }
+    } else {
+      ParallelQuery parallel;
+      parallel.init(static_cast<std::uint32_t>(threads));
+      double rho = 0;
+      for (std::uint32_t k = 0; k < q.class_count; ++k) rho += density_bound(q.classes[k], q.query);
+      std::size_t wanted = room_for(rho, q.query);
+      for (;;) {
+        buffer.reserve(wanted);
+        classes.resize(buffer.capacity);
+        std::size_t needed = 0;
+        const Status s = parallel.run(*handle.set, q, buffer.at(0), classes.data(), buffer.capacity, &m,
+                                      std_thread_runner(), &needed, &problem);
+        check_collected(needed);
+        if (s == Status::kOk) break;
+        if (s != Status::kBufferFull) refused(problem);
+        wanted = needed;
+      }
     }
   }
   prepared.rethrow();
@@ -493,7 +534,7 @@ void bind_query(py::module_& m) {
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("vectorized"),
         py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-        py::arg("keys"),
+        py::arg("keys"), py::arg("threads"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("spec").none(true), py::arg("callable").none(true), py::arg("vectorized"),

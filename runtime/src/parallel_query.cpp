@@ -8,6 +8,7 @@
 #include <limits>
 #include <thread>
 
+#include "density_bounds.h"
 #include "kdm/runtime/check.h"
 #include "query_counted.h"
 
@@ -83,10 +84,53 @@ UnitGrid plan_units(const QueryParams& q, double target) {
   return g;
 }
 
+/// The classes' union as units are planned and counted: their constant sum (the very number the class
+/// query adds up), else a callback density bounded by the sum of the classes' bounds over the region
+/// (never called: only plan_units reads its bound). For classes the class query has accepted.
+QueryParams union_plan(const ClassQueryParams& p) {
+  QueryParams q = p.query;
+  q.density = QueryDensity{};
+  const bool joint = p.joint.densities || p.joint.batch_densities;
+  bool constant = !joint;
+  double sum = 0;
+  for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
+    const QueryDensity& d = p.classes[k];
+    if (joint) {
+      sum += p.joint.max[k];
+    } else if (d.kind == QueryDensity::Kind::kConstant) {
+      sum += detail::density_or_zero(d.constant);
+    } else {
+      constant = false;
+      sum +=
+          d.kind == QueryDensity::Kind::kImage ? d.image->max_over(q.x0, q.y0, q.x1, q.y1) : d.callback_max;
+    }
+  }
+  if (constant) {
+    q.density.constant = sum;
+  } else {
+    q.density.kind = QueryDensity::Kind::kCallback;
+    q.density.callback_max = sum;
+  }
+  return q;
+}
+
+/// A worker's scratch (ParallelQuery's arrays at its offset), which an output takes what it uses of.
+struct Scratch {
+  QueryPoint* points;
+  float* xy;
+  std::uint64_t* keys;
+  std::uint8_t* classes;
+};
+
 /// Where a worker's unit goes and what it reads: QueryPoint records or compact arrays.
 struct PointOutput {
   QueryPoint* out;
   QueryPoint* scratch;  // of this worker
+  Status probe(const Tileset& t, const QueryParams& q, QueryCursor* c, QueryProblem* problem) const {
+    std::size_t none = 0;
+    return query_points(t, q, out, 0, &none, c, problem);
+  }
+  void take(const Scratch& s) { scratch = s.points; }
   Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
     return query_points(t, q, scratch, kParallelUnitPoints, w, c);
   }
@@ -100,6 +144,11 @@ struct PointOutput {
 
 struct CompactOutput {
   CompactPoints out, scratch;
+  Status probe(const Tileset& t, const QueryParams& q, QueryCursor* c, QueryProblem* problem) const {
+    std::size_t none = 0;
+    return query_points_compact(t, q, out, 0, &none, c, problem);
+  }
+  void take(const Scratch& s) { scratch = CompactPoints{s.xy, out.keys ? s.keys : nullptr}; }
   Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
     return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c);
   }
@@ -112,6 +161,55 @@ struct CompactOutput {
   void copy(std::size_t to, std::size_t count) const {
     std::memcpy(out.xy + 2 * to, scratch.xy, 2 * count * sizeof(float));
     if (out.keys) std::memcpy(out.keys + to, scratch.keys, count * sizeof(std::uint64_t));
+  }
+};
+
+/// Either output with each point's class (query_classes, query_classes_compact over a unit): the caller's
+/// `classes` beside `base.out`, this worker's `class_scratch` beside its scratch.
+template <class Base>
+struct ClassOutput {
+  Base base;
+  const ClassQueryParams* params;
+  std::uint8_t* classes;
+  std::uint8_t* class_scratch = nullptr;
+
+  /// The class query over unit `q` (its region; the rest is params').
+  ClassQueryParams over(const QueryParams& q) const {
+    ClassQueryParams p = *params;
+    p.query.x0 = q.x0, p.query.y0 = q.y0, p.query.x1 = q.x1, p.query.y1 = q.y1;
+    return p;
+  }
+  static Status query_into(const Tileset& t, const ClassQueryParams& p, QueryPoint* out, std::uint8_t* cls,
+                           std::size_t room, std::size_t* w, QueryCursor* c,
+                           QueryProblem* problem = nullptr) {
+    return query_classes(t, p, out, cls, room, w, c, problem);
+  }
+  static Status query_into(const Tileset& t, const ClassQueryParams& p, const CompactPoints& out,
+                           std::uint8_t* cls, std::size_t room, std::size_t* w, QueryCursor* c,
+                           QueryProblem* problem = nullptr) {
+    return query_classes_compact(t, p, out, cls, room, w, c, problem);
+  }
+  Status probe(const Tileset& t, const QueryParams&, QueryCursor* c, QueryProblem* problem) const {
+    std::size_t none = 0;
+    return query_into(t, *params, base.out, classes, 0, &none, c, problem);
+  }
+  void take(const Scratch& s) { base.take(s), class_scratch = s.classes; }
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
+    return query_into(t, over(q), base.scratch, class_scratch, kParallelUnitPoints, w, c);
+  }
+  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
+                        std::size_t* w, QueryCursor* c) const {
+    if constexpr (std::is_same_v<Base, CompactOutput>)
+      return query_into(t, over(q),
+                        CompactPoints{base.out.xy + 2 * at, base.out.keys ? base.out.keys + at : nullptr},
+                        classes + at, room, w, c);
+    else
+      return query_into(t, over(q), base.out + at, classes + at, room, w, c);
+  }
+  bool has_output() const { return base.has_output() && classes != nullptr; }
+  void copy(std::size_t to, std::size_t count) const {
+    base.copy(to, count);
+    std::memcpy(classes + to, class_scratch, count);
   }
 };
 
@@ -200,6 +298,7 @@ Status ParallelQuery::init(std::uint32_t workers) {
   points_.assign(std::size_t(workers) * kParallelUnitPoints, QueryPoint{});
   xy_.assign(std::size_t(workers) * 2 * kParallelUnitPoints, 0.0f);
   keys_.assign(std::size_t(workers) * kParallelUnitPoints, 0);
+  classes_.assign(std::size_t(workers) * kParallelUnitPoints, 0);
   return Status::kOk;
 }
 
@@ -209,12 +308,7 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
                                std::size_t* needed, QueryProblem* problem) {
   // The whole query's refusals, from a call with no room (it stops at the first point).
   QueryCursor probe;
-  std::size_t none = 0;
-  Status s;
-  if constexpr (std::is_same_v<Output, CompactOutput>)
-    s = query_points_compact(tileset, q, CompactPoints{out.out.xy, out.out.keys}, 0, &none, &probe, problem);
-  else
-    s = query_points(tileset, q, out.out, 0, &none, &probe, problem);
+  const Status s = out.probe(tileset, q, &probe, problem);
   if (written) *written = 0;
   if (needed) *needed = 0;
   if (s == Status::kInvalidArgument) return s;
@@ -230,22 +324,23 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
   if (capacity > 0 && !out.has_output()) return refuse(QueryProblem::Kind::kMissingArgument, "out");
   if (s == Status::kOk) return Status::kOk;  // no point at all
 
+  // Classes: units planned and counted over their union.
+  QueryParams plan = q;
+  if constexpr (!std::is_same_v<Output, PointOutput> && !std::is_same_v<Output, CompactOutput>)
+    plan = union_plan(*out.params);
   Job<Output> job;
-  job.tileset = &tileset, job.params = &q;
+  job.tileset = &tileset, job.params = &plan;
   // A constant density's units are counted, then written in place; a varying one's, whose count costs
   // as much as the query, go through the scratch (room for a loose bound and the glide's margin).
-  job.direct = q.density.kind == QueryDensity::Kind::kConstant;
-  job.grid = plan_units(q, job.direct ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
+  job.direct = plan.density.kind == QueryDensity::Kind::kConstant;
+  job.grid = plan_units(plan, job.direct ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
   job.units = job.grid.units(), job.capacity = capacity;
   Output outputs[kMaxParallelWorkers];
   for (std::uint32_t w = 0; w < workers_; ++w) {
+    const std::size_t at = std::size_t(w) * kParallelUnitPoints;
     outputs[w] = out;
-    if constexpr (std::is_same_v<Output, CompactOutput>)
-      outputs[w].scratch =
-          CompactPoints{xy_.data() + std::size_t(w) * 2 * kParallelUnitPoints,
-                        out.out.keys ? keys_.data() + std::size_t(w) * kParallelUnitPoints : nullptr};
-    else
-      outputs[w].scratch = points_.data() + std::size_t(w) * kParallelUnitPoints;
+    outputs[w].take(
+        Scratch{points_.data() + at, xy_.data() + 2 * at, keys_.data() + at, classes_.data() + at});
   }
   job.outputs = outputs;
   runner.run(
@@ -267,6 +362,21 @@ Status ParallelQuery::run(const Tileset& tileset, const QueryParams& params, con
                           std::size_t capacity, std::size_t* written, const TaskRunner& runner,
                           std::size_t* needed, QueryProblem* problem) {
   return run_into(tileset, params, CompactOutput{out, {}}, capacity, written, runner, needed, problem);
+}
+
+Status ParallelQuery::run(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
+                          std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                          const TaskRunner& runner, std::size_t* needed, QueryProblem* problem) {
+  return run_into(tileset, params.query,
+                  ClassOutput<PointOutput>{PointOutput{out, nullptr}, &params, classes}, capacity, written,
+                  runner, needed, problem);
+}
+
+Status ParallelQuery::run(const Tileset& tileset, const ClassQueryParams& params, const CompactPoints& out,
+                          std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                          const TaskRunner& runner, std::size_t* needed, QueryProblem* problem) {
+  return run_into(tileset, params.query, ClassOutput<CompactOutput>{CompactOutput{out, {}}, &params, classes},
+                  capacity, written, runner, needed, problem);
 }
 
 }  // namespace kdm

@@ -426,6 +426,10 @@ def test_vectorized_classes(mode):
         assert max(sizes) <= 128 and sum(sizes) > 30 * len(sizes)
         xy, labels = BUILTIN.positions(rect, classes=[ramp, 0.5, bump], vectorized=True, **kwargs)
         assert np.array_equal(labels, scalar.classes) and np.array_equal(xy, scalar.xy.astype(np.float32))
+        # The functions called from two threads: the same points and classes, in the units' order.
+        xy_2, labels_2 = BUILTIN.positions(rect, classes=[ramp, 0.5, bump], vectorized=True, threads=2, **kwargs)
+        order, order_2 = np.lexsort(xy.T), np.lexsort(xy_2.T)
+        assert np.array_equal(xy[order], xy_2[order_2]) and np.array_equal(labels[order], labels_2[order_2])
 
 
 def test_callable_classes_refuse_bad_input():
@@ -485,8 +489,15 @@ def test_positions_with_classes_are_the_class_querys_points(mode):
     xy_c, labels_c = BUILTIN.positions(rect, scale=150, classes=[1.0, 2.0], mode=mode)
     assert np.array_equal(xy_c, BUILTIN.positions(rect, scale=150, density=3.0, mode=mode))
     assert set(np.unique(labels_c)) == {0, 1}
-    with pytest.raises(ValueError, match="threads"):
-        BUILTIN.positions(rect, scale=150, classes=classes, threads=2)
+    # On threads: the same points and classes (in an order of the units'), the same bits for any count.
+    xy_2, labels_2 = BUILTIN.positions(rect, scale=150, classes=classes, mode=mode, origin=origin, threads=2)
+    xy_3, labels_3 = BUILTIN.positions(rect, scale=150, classes=classes, mode=mode, origin=origin, threads=3)
+    assert np.array_equal(xy_2, xy_3) and np.array_equal(labels_2, labels_3)
+    order = np.lexsort((xy[:, 1], xy[:, 0]))
+    order_2 = np.lexsort((xy_2[:, 1], xy_2[:, 0]))
+    assert np.array_equal(xy[order], xy_2[order_2]) and np.array_equal(labels[order], labels_2[order_2])
+    with pytest.raises(ValueError, match="threads must be 1 to 64"):
+        BUILTIN.positions(rect, scale=150, classes=classes, threads=0)
     with pytest.raises(ValueError, match="do not apply"):
         BUILTIN.positions(rect, scale=150, classes=classes, density=1.0)
     with pytest.raises(ValueError, match="1 to 8"):

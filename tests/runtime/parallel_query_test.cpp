@@ -1,9 +1,10 @@
 // One query over several threads: the same bits for any worker count and task system, the same points as
 // query_points (in stable mode in its order too), dense tiles cut into parts, a short buffer, refusals, no
-// allocation in a run.
+// allocation in a run; and the same for several classes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <tuple>
@@ -168,6 +169,140 @@ TEST(ParallelQueryTest, RefusesByName) {
   EXPECT_EQ(written, 0u);
 }
 
+/// Three classes over region(mode, 0): constants 1 : 2 : 4 of a seventh of the density (kind 0), or a
+/// constant, the ramp by callback and the ramp by batch callback (kind 1).
+ClassQueryParams three_classes(QueryMode mode, int kind) {
+  ClassQueryParams c;
+  c.query = region(mode, 0);
+  c.class_count = 3;
+  for (int k = 0; k < 3; ++k) c.classes[k].constant = double(1 << k) / 7;
+  if (kind == 1) {
+    QueryDensity& ramp_class = c.classes[1];
+    ramp_class.kind = QueryDensity::Kind::kCallback;
+    ramp_class.callback = ramp, ramp_class.callback_max = 0.7;
+    c.classes[2] = ramp_class;
+    c.classes[2].callback = nullptr;
+    c.classes[2].batch_callback = [](void*, std::size_t n, const double* x, const double*, double* out) {
+      for (std::size_t i = 0; i < n; ++i) out[i] = 0.1 + 0.05 * x[i];
+    };
+    c.classes[2].callback_max = 0.35;
+  }
+  return c;
+}
+
+/// A class query's points and classes, whole (resumed through a buffer) or in parallel.
+struct Classed {
+  std::vector<QueryPoint> points;
+  std::vector<std::uint8_t> classes;
+};
+Classed run_classes_whole(const ClassQueryParams& q) {
+  Classed r;
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s =
+        query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull);
+    r.points.insert(r.points.end(), out.begin(), out.begin() + written);
+    r.classes.insert(r.classes.end(), classes.begin(), classes.begin() + written);
+    if (s != Status::kBufferFull) return r;
+  }
+}
+Classed run_classes_parallel(const ClassQueryParams& q, std::uint32_t workers, const TaskRunner& runner) {
+  ParallelQuery pq;
+  EXPECT_EQ(pq.init(workers), Status::kOk);
+  Classed r;
+  r.points.resize(1 << 21), r.classes.resize(1 << 21);
+  std::size_t written = 0, needed = 0;
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, r.points.data(), r.classes.data(), r.points.size(), &written,
+                   runner, &needed),
+            Status::kOk);
+  EXPECT_EQ(written, needed);
+  r.points.resize(written), r.classes.resize(written);
+  return r;
+}
+
+TEST(ParallelQueryTest, ClassesGiveTheSameBitsForAnyWorkerCountAndTheWholeQuerysPointsAndClasses) {
+  // Constant classes are counted and written in place, varying ones go through the scratch.
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    for (int kind = 0; kind < 2; ++kind) {
+      SCOPED_TRACE(::testing::Message() << "mode " << int(mode) << " kind " << kind);
+      const ClassQueryParams q = three_classes(mode, kind);
+      const Classed whole = run_classes_whole(q), one = run_classes_parallel(q, 1, sequential_runner());
+      ASSERT_GT(one.points.size(), 100000u);
+      for (const Classed& other : {run_classes_parallel(q, 2, std_thread_runner()),
+                                   run_classes_parallel(q, 3, std_thread_runner())}) {
+        EXPECT_TRUE(same_bits(one.points, other.points));
+        EXPECT_TRUE(one.classes == other.classes);
+      }
+      // The whole query's points, each with its class.
+      std::map<Key, std::uint8_t> class_of;
+      for (std::size_t i = 0; i < whole.points.size(); ++i) {
+        const PointId& id = whole.points[i].id;
+        class_of[Key{id.tile_x, id.tile_y, id.rank, id.depth}] = whole.classes[i];
+      }
+      EXPECT_TRUE(by_id(one.points) == by_id(whole.points));
+      std::size_t counts[3] = {};
+      for (std::size_t i = 0; i < one.points.size(); ++i) {
+        const PointId& id = one.points[i].id;
+        ASSERT_EQ(one.classes[i], class_of.at(Key{id.tile_x, id.tile_y, id.rank, id.depth}));
+        ++counts[one.classes[i]];
+      }
+      for (std::size_t c : counts) EXPECT_GT(c, 10000u);
+      // Into the compact output: the records' points, in their order, with the same classes.
+      ParallelQuery pq;
+      ASSERT_EQ(pq.init(2), Status::kOk);
+      std::vector<float> xy(2 * one.points.size());
+      std::vector<std::uint8_t> classes(one.points.size());
+      std::size_t written = 0;
+      ASSERT_EQ(pq.run(Tileset::builtin(), q, CompactPoints{xy.data(), nullptr}, classes.data(),
+                       classes.size(), &written, std_thread_runner()),
+                Status::kOk);
+      ASSERT_EQ(written, one.points.size());
+      EXPECT_TRUE(classes == one.classes);
+      for (std::size_t i = 0; i < written; ++i)
+        ASSERT_LE(std::fabs(xy[2 * i] - one.points[i].x), std::ldexp(std::fabs(one.points[i].x) + 1, -21));
+    }
+  }
+}
+
+TEST(ParallelQueryTest, ClassesAreRefusedByName) {
+  ParallelQuery pq;
+  ASSERT_EQ(pq.init(2), Status::kOk);
+  std::vector<QueryPoint> out(16);
+  std::uint8_t classes[16];
+  std::size_t written = 0;
+  QueryProblem why;
+  ClassQueryParams q = three_classes(QueryMode::kStable, 1);
+  q.class_count = 0;
+  EXPECT_EQ(
+      pq.run(Tileset::builtin(), q, out.data(), classes, 16, &written, sequential_runner(), nullptr, &why),
+      Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kBadClassCount);
+  q.class_count = 3;
+  q.classes[1].callback_max = -1;
+  EXPECT_EQ(
+      pq.run(Tileset::builtin(), q, out.data(), classes, 16, &written, sequential_runner(), nullptr, &why),
+      Status::kInvalidArgument);
+  EXPECT_STREQ(why.parameter, "classes[1].callback_max");
+  q.classes[1].callback_max = 0.7;
+  EXPECT_EQ(
+      pq.run(Tileset::builtin(), q, out.data(), nullptr, 16, &written, sequential_runner(), nullptr, &why),
+      Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kMissingArgument);
+  // A short buffer: its prefix, and the count.
+  const Classed all = run_classes_parallel(q, 2, std_thread_runner());
+  std::size_t needed = 0;
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), classes, 16, &written, std_thread_runner(), &needed),
+            Status::kBufferFull);
+  EXPECT_EQ(written, 16u);
+  EXPECT_EQ(needed, all.points.size());
+  EXPECT_TRUE(same_bits(out, std::vector<QueryPoint>(all.points.begin(), all.points.begin() + 16)));
+  EXPECT_EQ(std::memcmp(classes, all.classes.data(), 16), 0);
+}
+
 TEST(ParallelQueryTest, ARunAllocatesNothing) {
   ParallelQuery pq;
   ASSERT_EQ(pq.init(2), Status::kOk);
@@ -179,6 +314,17 @@ TEST(ParallelQueryTest, ARunAllocatesNothing) {
     const long before = testing::allocations();
     EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, sequential_runner()),
               Status::kOk);
+    EXPECT_EQ(testing::allocations(), before);
+    EXPECT_GT(written, 100000u);
+  }
+  std::vector<std::uint8_t> classes(out.size());
+  for (int kind = 0; kind < 2; ++kind) {
+    const ClassQueryParams q = three_classes(QueryMode::kSmooth, kind);
+    std::size_t written = 0;
+    const long before = testing::allocations();
+    EXPECT_EQ(
+        pq.run(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, sequential_runner()),
+        Status::kOk);
     EXPECT_EQ(testing::allocations(), before);
     EXPECT_GT(written, 100000u);
   }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "kdm/runtime/allocator.h"
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/query.h"
@@ -60,7 +61,7 @@ inline constexpr std::size_t kParallelUnitPoints = std::size_t(1) << 15;
 /// hooks, allocator.h); run then allocates nothing. One ParallelQuery serves one run at a time.
 class KDM_RUNTIME_API ParallelQuery {
  public:
-  /// Scratch for `workers` workers (1 … kMaxParallelWorkers; about 1.8 MB each). kInvalidArgument for a
+  /// Scratch for `workers` workers (1 … kMaxParallelWorkers; about 1.9 MB each). kInvalidArgument for a
   /// count out of range.
   Status init(std::uint32_t workers);
   std::uint32_t workers() const { return workers_; }
@@ -78,6 +79,18 @@ class KDM_RUNTIME_API ParallelQuery {
   Status run(const Tileset& tileset, const QueryParams& params, const CompactPoints& out,
              std::size_t capacity, std::size_t* written, const TaskRunner& runner,
              std::size_t* needed = nullptr, QueryProblem* problem = nullptr);
+  /// Several classes (class_query.h): query_classes' points and classes, each point's class into
+  /// classes[0 .. capacity), split into units as the one-class query at the classes' sum is. The classes'
+  /// callbacks are called from the runner's threads at once, so they must be safe to call concurrently.
+  /// Statuses and refusals as the one-class run's, and query_classes' for the classes (a null `classes`
+  /// with room: "out").
+  Status run(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out, std::uint8_t* classes,
+             std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+             std::size_t* needed = nullptr, QueryProblem* problem = nullptr);
+  /// The same into a compact output.
+  Status run(const Tileset& tileset, const ClassQueryParams& params, const CompactPoints& out,
+             std::uint8_t* classes, std::size_t capacity, std::size_t* written, const TaskRunner& runner,
+             std::size_t* needed = nullptr, QueryProblem* problem = nullptr);
 
  private:
   template <class Output>
@@ -85,9 +98,10 @@ class KDM_RUNTIME_API ParallelQuery {
                   std::size_t* written, const TaskRunner& runner, std::size_t* needed, QueryProblem* problem);
 
   std::uint32_t workers_ = 0;
-  TilesetArray<QueryPoint> points_;   ///< workers × kParallelUnitPoints
-  TilesetArray<float> xy_;            ///< workers × 2 · kParallelUnitPoints
-  TilesetArray<std::uint64_t> keys_;  ///< workers × kParallelUnitPoints
+  TilesetArray<QueryPoint> points_;     ///< workers × kParallelUnitPoints
+  TilesetArray<float> xy_;              ///< workers × 2 · kParallelUnitPoints
+  TilesetArray<std::uint64_t> keys_;    ///< workers × kParallelUnitPoints
+  TilesetArray<std::uint8_t> classes_;  ///< workers × kParallelUnitPoints
 };
 
 }  // namespace kdm
