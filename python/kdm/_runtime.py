@@ -114,7 +114,7 @@ class Tileset:
         classes: Optional[Sequence[Union[float, str, np.ndarray]]] = None,
         density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
-        density_bounds: Optional[_Bounds] = None,
+        density_bounds: Optional[Union[_Bounds, Sequence[Optional[_Bounds]]]] = None,
         vectorized: bool = False,
         tile_size: float = 1.0,
         mode: str = "stable",
@@ -156,8 +156,8 @@ class Tileset:
             together are the points of one query at the summed density; in stable mode class 0 alone is
             exactly the query at its own density. Callable classes need `density_max`: one bound for
             all of them, or a sequence with one entry per class (None for the others); they are called
-            point by point, or on arrays with `vectorized`, without `density_bounds`.
-            ``kdm query --class``.
+            point by point, or on arrays with `vectorized`; `density_bounds` then holds one bounds
+            function (or None) per class. ``kdm query --class``.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
             info["max_points_per_tile"] where the density is highest in stable mode, or
@@ -184,10 +184,8 @@ class Tileset:
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
             rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max)
         if classes is not None:
-            if density_bounds is not None:
-                raise ValueError("density_bounds does not apply to a query with classes")
-            return self._query_classes(rect, scale, density, classes, density_rect, class_max, vectorized,
-                                       tile_size, mode, origin, gamma, invert, out)
+            return self._query_classes(rect, scale, density, classes, density_rect, class_max, density_bounds,
+                                       vectorized, tile_size, mode, origin, gamma, invert, out)
         spec, call = _density_arg(density, gamma, invert)
         if out is not None and not isinstance(out, QueryResult):
             raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
@@ -207,7 +205,7 @@ class Tileset:
         density: _Density = None,
         density_rect: Optional[_Rect] = None,
         density_max: Optional[float] = None,
-        density_bounds: Optional[_Bounds] = None,
+        density_bounds: Optional[Union[_Bounds, Sequence[Optional[_Bounds]]]] = None,
         vectorized: bool = False,
         tile_size: float = 1.0,
         mode: str = "stable",
@@ -242,11 +240,11 @@ class Tileset:
                 raise ValueError(f"threads must be 1 to 64, got {threads}")
             workers = int(threads)
         if classes is not None:
-            if density is not None or density_bounds is not None:
-                raise ValueError("density and density_bounds do not apply to a query with classes")
-            specs, callables, maxima = _class_args(classes, gamma, invert, class_max)
+            if density is not None:
+                raise ValueError("give either density or classes, not both")
+            specs, callables, maxima, bounds = _class_args(classes, gamma, invert, class_max, density_bounds)
             xy, key, labels = _kdm.class_positions(
-                self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
+                self._handle, rect, scale, specs, callables, maxima, bounds, _checks.flag("vectorized", vectorized),
                 density_rect, tile_size, mode, origin, keys, workers)
             return (xy, key, labels) if keys else (xy, labels)
         spec, call = _density_arg(density, gamma, invert)
@@ -258,15 +256,16 @@ class Tileset:
 
     def _query_classes(
         self, rect: Any, scale: float, density: Any, classes: Any, density_rect: Any, density_max: Any,
-        vectorized: Any, tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any, out: Any,
+        density_bounds: Any, vectorized: Any, tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any,
+        out: Any,
     ) -> QueryResult:
         if density is not None:
             raise ValueError("give either density or classes, not both")
         if out is not None:
             raise ValueError("out does not apply to a query with classes")
-        specs, callables, maxima = _class_args(classes, gamma, invert, density_max)
+        specs, callables, maxima, bounds = _class_args(classes, gamma, invert, density_max, density_bounds)
         *fields, labels = _kdm.query_classes(
-            self._handle, rect, scale, specs, callables, maxima, _checks.flag("vectorized", vectorized),
+            self._handle, rect, scale, specs, callables, maxima, bounds, _checks.flag("vectorized", vectorized),
             density_rect, tile_size, mode, origin)
         return QueryResult(*fields, classes=labels)
 
@@ -290,10 +289,12 @@ def _is_callable(density: Any) -> bool:
     return callable(density) and not isinstance(density, (np.ndarray, numbers.Real, str))
 
 
-def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any) -> Tuple[List[Any], List[Any], List[float]]:
-    """A query's classes as (specs, callables, maxima), one each per class, checked (TypeError, ValueError):
-    a class is its spec, or its callable (not None) bounded by its maximum, from `density_max` (one number
-    for every callable class, or one entry per class)."""
+def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
+                density_bounds: Any = None) -> Tuple[List[Any], List[Any], List[float], List[Any]]:
+    """A query's classes as (specs, callables, maxima, bounds), one each per class, checked (TypeError,
+    ValueError): a class is its spec, or its callable (not None) bounded by its maximum, from `density_max`
+    (one number for every callable class, or one entry per class), with its bounds function if
+    `density_bounds` (one entry per class) gives one."""
     if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
         raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
     if not 1 <= len(classes) <= 8:
@@ -305,9 +306,21 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any) -> Tupl
         raise ValueError(f"density_max must hold one entry per class ({len(classes)}), got {len(density_max)}")
     if density_max is not None and not any(_is_callable(d) for d in classes):
         raise ValueError("density_max applies to callable classes only")
-    specs, callables, maxima = [], [], []
+    if density_bounds is not None:
+        if callable(density_bounds) or isinstance(density_bounds, (str, bytes)) or not hasattr(
+                density_bounds, "__len__"):
+            raise TypeError("density_bounds with classes must be a sequence of one callable or None per class, "
+                            f"got {type(density_bounds).__name__}")
+        if len(density_bounds) != len(classes):
+            raise ValueError(f"density_bounds must hold one entry per class ({len(classes)}), "
+                             f"got {len(density_bounds)}")
+    specs, callables, maxima, bounds = [], [], [], []
     for k, d in enumerate(classes):
         name = f"classes[{k}]"
+        b = density_bounds[k] if density_bounds is not None else None
+        if b is not None and not callable(b):
+            raise TypeError(f"density_bounds[{k}] must be callable or None, got {type(b).__name__}")
+        bounds.append(b)
         if _is_callable(d):
             bound = density_max[k] if per_class else density_max
             if bound is None:
@@ -316,13 +329,15 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any) -> Tupl
             callables.append(d)
             maxima.append(_checks.number(f"density_max[{k}]" if per_class else "density_max", bound, 0.0))
             continue
+        if b is not None:
+            raise ValueError(f"density_bounds[{k}] is given but {name} is not a callable")
         if d is None:
             raise TypeError(f"{name} must be a number, a str, a 2-D array or a callable, got None")
         image = isinstance(d, (str, os.PathLike))
         specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
         callables.append(None)
         maxima.append(0.0)
-    return specs, callables, maxima
+    return specs, callables, maxima, bounds
 
 
 def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:

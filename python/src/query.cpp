@@ -401,14 +401,15 @@ struct PreparedClasses {
 void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<const tools::DensitySpec*>& specs,
                      const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                     bool vectorized, std::optional<Rect> density_rect, double tile_size,
-                     const std::string& mode, const std::array<double, 2>& origin) {
+                     const std::vector<py::object>& bounds, bool vectorized, std::optional<Rect> density_rect,
+                     double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
   check_rect("rect", rect);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
                                 " densities, got " + std::to_string(specs.size()));
-  if (callables.size() != specs.size() || maxima.size() != specs.size())
-    throw std::invalid_argument("classes: one callable (or None) and one maximum per class");
+  if (callables.size() != specs.size() || maxima.size() != specs.size() || bounds.size() != specs.size())
+    throw std::invalid_argument(
+        "classes: one callable (or None), one maximum and one bounds (or None) per class");
   if (density_rect) check_rect("density_rect", *density_rect);
   const Rect r = density_rect ? *density_rect : rect;
   ClassQueryParams& q = prepared.q;
@@ -427,7 +428,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
       if (!(maxima[k] >= 0 && maxima[k] < std::numeric_limits<double>::infinity()))
         throw std::invalid_argument(name + ": a callable's density_max must be finite and >= 0");
       prepared.callables.push_back(
-          std::make_unique<CallableDensity>(callables[k], maxima[k], py::none(), vectorized));
+          std::make_unique<CallableDensity>(callables[k], maxima[k], bounds[k], vectorized));
       q.classes[k] = prepared.callables.back()->density;
       continue;
     }
@@ -442,11 +443,12 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
                         const std::vector<const tools::DensitySpec*>& specs,
                         const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                        bool vectorized, std::optional<Rect> density_rect, double tile_size,
-                        const std::string& mode, const std::array<double, 2>& origin) {
+                        const std::vector<py::object>& bounds, bool vectorized,
+                        std::optional<Rect> density_rect, double tile_size, const std::string& mode,
+                        const std::array<double, 2>& origin) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, vectorized, density_rect, tile_size, mode,
-                  origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
+                  tile_size, mode, origin);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
@@ -470,13 +472,13 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
 py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double scale,
                           const std::vector<const tools::DensitySpec*>& specs,
                           const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                          bool vectorized, std::optional<Rect> density_rect, double tile_size,
-                          const std::string& mode, const std::array<double, 2>& origin, bool keys,
-                          int threads) {
+                          const std::vector<py::object>& bounds, bool vectorized,
+                          std::optional<Rect> density_rect, double tile_size, const std::string& mode,
+                          const std::array<double, 2>& origin, bool keys, int threads) {
   check_threads(threads);
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, vectorized, density_rect, tile_size, mode,
-                  origin);
+  prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
+                  tile_size, mode, origin);
   const ClassQueryParams& q = prepared.q;
   CompactBuffer buffer;
   buffer.with_keys = keys;
@@ -528,11 +530,11 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
 
 void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("vectorized"),
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
         py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
         "several classes in one query: query()'s tuple and each point's class");
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("vectorized"),
+        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
         py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
         py::arg("keys"), py::arg("threads"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
