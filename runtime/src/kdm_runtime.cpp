@@ -11,6 +11,7 @@
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/kdm_runtime.h"
+#include "kdm/runtime/parallel_query.h"
 #include "kdm/runtime/query.h"
 
 struct kdm_tileset {
@@ -24,6 +25,10 @@ struct kdm_density_image {
   // a status here, not an exception.
   std::unique_ptr<float, decltype(&std::free)> values{nullptr, std::free};
   std::vector<float> mip;
+};
+
+struct kdm_parallel_query {
+  kdm::ParallelQuery parallel;
 };
 
 namespace {
@@ -243,9 +248,93 @@ kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, con
                          });
 }
 
+/// A parallel query's own arguments, checked: the parallel query and the runner, as `task_runner`.
+bool read_parallel(const kdm_parallel_query* parallel, const kdm_task_runner* runner,
+                   kdm::TaskRunner& task_runner, size_t* written, kdm_query_problem* problem) {
+  if (written) *written = 0;
+  kdm::QueryProblem why;
+  why.kind = kdm::QueryProblem::Kind::kMissingArgument;
+  if (!parallel)
+    why.parameter = "parallel";
+  else if (!runner || !runner->run)
+    why.parameter = "runner.run";
+  else
+    return task_runner = kdm::TaskRunner{runner->run, runner->context}, true;
+  report(why, problem);
+  return false;
+}
+
 }  // namespace
 
 extern "C" {
+
+kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out) {
+  if (!out) return KDM_INVALID_ARGUMENT;
+  *out = nullptr;
+  if (workers < 1 || workers > kdm::kMaxParallelWorkers) return KDM_INVALID_ARGUMENT;
+  auto* handle = new (std::nothrow) kdm_parallel_query;
+  if (!handle) return KDM_OUT_OF_MEMORY;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+    handle->parallel.init(workers);
+  } catch (const std::bad_alloc&) {
+    delete handle;
+    return KDM_OUT_OF_MEMORY;
+  }
+#else
+  handle->parallel.init(workers);  // a refused allocation ends the program (allocator.h)
+#endif
+  *out = handle;
+  return KDM_OK;
+}
+
+void kdm_parallel_query_free(kdm_parallel_query* parallel) {
+  delete parallel;
+}
+
+kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel, const kdm_task_runner* runner,
+                                     const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
+                                     size_t capacity, size_t* written, size_t* needed,
+                                     kdm_query_problem* problem) {
+  kdm::TaskRunner r;
+  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
+  kdm_cursor unused{};
+  return run_query(tileset, query, written, &unused, problem,
+                   [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                     return parallel->parallel.run(*tileset->set, q, as_points(out), capacity, written, r,
+                                                   needed, why);
+                   });
+}
+
+kdm_status kdm_parallel_query_compact(kdm_parallel_query* parallel, const kdm_task_runner* runner,
+                                      const kdm_tileset* tileset, const kdm_query* query, float* xy,
+                                      uint64_t* keys, size_t capacity, size_t* written, size_t* needed,
+                                      kdm_query_problem* problem) {
+  kdm::TaskRunner r;
+  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
+  kdm_cursor unused{};
+  return run_query(tileset, query, written, &unused, problem,
+                   [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                     return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity,
+                                                   written, r, needed, why);
+                   });
+}
+
+kdm_status kdm_parallel_query_classes_compact(kdm_parallel_query* parallel, const kdm_task_runner* runner,
+                                              const kdm_tileset* tileset, const kdm_query* query,
+                                              const kdm_class_density* classes, uint32_t class_count,
+                                              float* xy, uint64_t* keys, uint8_t* out_classes,
+                                              size_t capacity, size_t* written, size_t* needed,
+                                              kdm_query_problem* problem) {
+  kdm::TaskRunner r;
+  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
+  kdm_cursor unused{};
+  return run_class_query(tileset, query, classes, nullptr, false, class_count, written, &unused, problem,
+                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                           return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                         out_classes, capacity, written, r, needed, why);
+                         });
+}
 
 void kdm_set_tileset_allocator(void* (*allocate)(size_t, size_t, void*),
                                void (*deallocate)(void*, size_t, size_t, void*), void* user) {

@@ -257,6 +257,49 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
                                                            size_t* written, kdm_cursor* cursor,
                                                            kdm_query_problem* problem);
 
+/* One query over several threads (kdm::ParallelQuery, kdm/runtime/parallel_query.h), for callers that fill
+ * a large region at once: the region is cut into units fixed by the parameters, so any number of workers
+ * gives the same bits, the region's points in the units' order. The library starts no threads: runner->run
+ * (context, task, task_context, count) must call task(task_context, i) once for every i in [0, count),
+ * concurrently (the tasks wait for one another; a single thread may run them all in turn), and return when
+ * all have returned. Density callbacks are then called from those threads at once. Added in 0.4. */
+typedef struct kdm_task_runner {
+  void (*run)(void* context, void (*task)(void* task_context, size_t index), void* task_context,
+              size_t count);
+  void* context;
+} kdm_task_runner;
+
+typedef struct kdm_parallel_query kdm_parallel_query; /* per-worker scratch, allocated once */
+
+/* Scratch for `workers` workers (1 ... 64; about 1.9 MB each) into *out: KDM_OK, KDM_INVALID_ARGUMENT for
+ * a count out of range or a NULL `out`, KDM_OUT_OF_MEMORY. One kdm_parallel_query serves one run at a time.
+ */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out);
+KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
+
+/* The region's points into out[0 ... capacity) (kdm_query_points' points, in the units' order), *written
+ * the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first `capacity`,
+ * *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out only
+ * count); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
+ * ("parallel") or runner or runner->run ("runner.run"). Allocates nothing. */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel,
+                                                     const kdm_task_runner* runner,
+                                                     const kdm_tileset* tileset, const kdm_query* query,
+                                                     kdm_point* out, size_t capacity, size_t* written,
+                                                     size_t* needed, kdm_query_problem* problem);
+/* The same into the compact output (kdm_query_compact's xy and optional keys). */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_compact(kdm_parallel_query* parallel,
+                                                      const kdm_task_runner* runner,
+                                                      const kdm_tileset* tileset, const kdm_query* query,
+                                                      float* xy, uint64_t* keys, size_t capacity,
+                                                      size_t* written, size_t* needed,
+                                                      kdm_query_problem* problem);
+/* Several classes (kdm_query_classes_compact's points and classes) the same way. */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_classes_compact(
+    kdm_parallel_query* parallel, const kdm_task_runner* runner, const kdm_tileset* tileset,
+    const kdm_query* query, const kdm_class_density* classes, uint32_t class_count, float* xy, uint64_t* keys,
+    uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
+
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
