@@ -9,6 +9,7 @@
 
 #include "density_bounds.h"
 #include "image_sampler.h"
+#include "kdm/runtime/check.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/tileset.h"
 #include "query_counted.h"
@@ -136,6 +137,7 @@ inline double sum_of_densities(void* user, double x, double y) {
 /// batches: the classes' running sums at the n positions (ClassDensities::sums_at), left in the scratch's
 /// batch for the sink to class the positions read.
 inline void sum_of_batches(void* user, std::size_t n, const double* x, const double* y, double* out) {
+  KDM_CHECK(n >= 1 && n <= kDensityBatch);  // the scratch holds one batch
   const auto& c = *static_cast<const ClassDensities*>(user);
   detail::ClassScratch& s = c.scratch;
   const std::uint32_t count = c.params->class_count;
