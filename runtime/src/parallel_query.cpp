@@ -81,6 +81,20 @@ UnitGrid plan_units(const QueryParams& q, double target) {
     g.across = g.down = std::max<std::int64_t>(1, std::int64_t(std::sqrt(cells)));
   else
     g.across = std::max<std::int64_t>(1, std::int64_t(cells)), g.down = 1;
+  // A query refuses a region too narrow for its distance from the world origin (kTooFarFromOrigin: its
+  // side under about 2^-50 of that distance) that the whole region may not be. A first or last row or
+  // column the region cuts that thin is merged into its neighbour; and as far out as even a whole cell
+  // could be refused (2^46 cells, where only a density below a point in 16 cells is accepted), the region
+  // is one unit.
+  const double far = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
+  const double thin = std::ldexp(far, -40);
+  auto merge_slivers = [&](double lo, double hi, std::int64_t& first, std::int64_t& count) {
+    if (count > 1 && double(first + 1) * g.cell - lo < thin) ++first, --count;
+    if (count > 1 && hi - double(first + count - 1) * g.cell < thin) --count;
+  };
+  merge_slivers(q.x0, q.x1, g.cx0, g.columns);
+  merge_slivers(q.y0, q.y1, g.cy0, g.rows);
+  if (far > std::ldexp(g.cell, 46)) g.across = g.columns, g.down = g.rows;
   return g;
 }
 
@@ -131,8 +145,9 @@ struct PointOutput {
     return query_points(t, q, out, 0, &none, c, problem);
   }
   void take(const Scratch& s) { scratch = s.points; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
-    return query_points(t, q, scratch, kParallelUnitPoints, w, c);
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
+               QueryProblem* p) const {
+    return query_points(t, q, scratch, kParallelUnitPoints, w, c, p);
   }
   Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
                         std::size_t* w, QueryCursor* c) const {
@@ -149,8 +164,9 @@ struct CompactOutput {
     return query_points_compact(t, q, out, 0, &none, c, problem);
   }
   void take(const Scratch& s) { scratch = CompactPoints{s.xy, out.keys ? s.keys : nullptr}; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
-    return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c);
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
+               QueryProblem* p) const {
+    return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c, p);
   }
   Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
                         std::size_t* w, QueryCursor* c) const {
@@ -194,8 +210,9 @@ struct ClassOutput {
     return query_into(t, *params, base.out, classes, 0, &none, c, problem);
   }
   void take(const Scratch& s) { base.take(s), class_scratch = s.classes; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c) const {
-    return query_into(t, over(q), base.scratch, class_scratch, kParallelUnitPoints, w, c);
+  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
+               QueryProblem* p) const {
+    return query_into(t, over(q), base.scratch, class_scratch, kParallelUnitPoints, w, c, p);
   }
   Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
                         std::size_t* w, QueryCursor* c) const {
@@ -225,6 +242,8 @@ struct Job {
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> counted{0};  // units [0, counted) have their places; `end` follows the last
   std::atomic<std::size_t> end{0};
+  std::atomic<bool> refused{false};  // a unit was refused where the whole query was not (a bug): `why`
+  QueryProblem why;
 
   /// Unit u's first slot, once every unit before it has counted its points.
   std::size_t place_of(std::size_t u) {
@@ -242,7 +261,13 @@ struct Job {
       const Status s = detail::count_points(*tileset, part, &c, &cursor);
       KDM_CHECK(s == Status::kOk || s == Status::kBufferFull);
       count += c;
-      if (s == Status::kOk) break;
+      if (s == Status::kInvalidArgument &&
+          !refused.exchange(true)) {  // the refusal, from a call with no room
+        QueryCursor probe;
+        std::size_t none = 0;
+        query_points(*tileset, part, nullptr, 0, &none, &probe, &why);
+      }
+      if (s != Status::kBufferFull) break;
     }
     const std::size_t base = place_of(u);
     end.store(base + count, std::memory_order_relaxed);
@@ -272,9 +297,11 @@ struct Job {
       std::size_t base = kUnplaced, count = 0;
       for (;;) {
         std::size_t w = 0;
-        const Status s = o.query(*tileset, part, &w, &cursor);
+        QueryProblem problem;
+        const Status s = o.query(*tileset, part, &w, &cursor, &problem);
         KDM_CHECK(s == Status::kOk || s == Status::kBufferFull);  // the whole query was accepted
-        const bool last = s == Status::kOk;
+        if (s == Status::kInvalidArgument && !refused.exchange(true)) why = problem;
+        const bool last = s != Status::kBufferFull;  // a refused unit ends too: no worker waits forever
         // A unit waits for its place before its first copy and, once counted, publishes its end before
         // copying, so the next unit waits for this one's count, not for its copy.
         if (base == kUnplaced) base = place_of(u);
@@ -346,6 +373,10 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
   runner.run(
       runner.context, [](void* j, std::size_t worker) { static_cast<Job<Output>*>(j)->work(worker); }, &job,
       workers_);
+  if (job.refused.load()) {  // KDM_CHECK'd in the workers: units are planned to be accepted
+    p = job.why;
+    return Status::kInvalidArgument;
+  }
   const std::size_t total = job.end.load();
   if (written) *written = std::min(total, capacity);
   if (needed) *needed = total;

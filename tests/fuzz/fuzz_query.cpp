@@ -16,7 +16,8 @@
 //    and a callback's two classes read in batches or from one joint function (of one position or many) the
 //    same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys;
-//  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch.
+//  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch;
+//  - ParallelQuery (two workers run in turn) gives the same points.
 // A failed check aborts.
 #include <algorithm>
 #include <cfloat>
@@ -30,6 +31,7 @@
 
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/parallel_query.h"
 #include "kdm/runtime/query.h"
 
 namespace {
@@ -378,6 +380,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!(std::fabs(xy[2 * i] - p.x) <= std::ldexp(std::fabs(p.x) + q.tile_size, -21))) fail();
       if (!(std::fabs(xy[2 * i + 1] - p.y) <= std::ldexp(std::fabs(p.y) + q.tile_size, -21))) fail();
     }
+  }
+
+  // Over two workers run in turn (ParallelQuery, its units planned from the parameters): the region's
+  // points, in the units' order, and the whole count.
+  {
+    static kdm::ParallelQuery parallel;
+    static const kdm::Status ready = parallel.init(2);
+    if (ready != kdm::Status::kOk) fail();
+    kdm::TaskRunner in_turn;
+    in_turn.run = [](void*, void (*task)(void*, std::size_t), void* context, std::size_t count) {
+      for (std::size_t i = 0; i < count; ++i) task(context, i);
+    };
+    static Points units;
+    static kdm::QueryPoint sorted[kBigCapacity];
+    std::size_t needed = 0;
+    units.status = parallel.run(kdm::Tileset::builtin(), q, units.data, kBigCapacity, &units.size, in_turn,
+                                &needed, &units.problem);
+    if (units.status != kdm::Status::kOk || units.size != all.size || needed != all.size) fail();
+    auto id_order = [](const kdm::QueryPoint& u, const kdm::QueryPoint& v) {
+      return order_key(u) < order_key(v);
+    };
+    std::copy(all.data, all.data + all.size, sorted);
+    std::sort(sorted, sorted + all.size, id_order);
+    std::sort(units.data, units.data + units.size, id_order);
+    for (std::size_t i = 0; i < all.size; ++i)
+      if (!same(units[i], sorted[i])) fail();
   }
 
   // Split at x = xm: both halves are accepted (their density bounds are no higher), unless a half is too

@@ -170,6 +170,11 @@ def crashes():
     # for its distance from the world origin (kTooFarFromOrigin), which the split check took for a failure.
     write("query", "split_half_too_narrow_for_its_distance",
           bytes.fromhex("040c00000025000000000000" "00ffffffffffff100010101080000e0a1c143c1b2229"), root)
+    # ParallelQuery never returned (runtime/src/parallel_query.cpp): a region from y = -6 to 3e-322 on tiles of
+    # side 2.95 leaves a last row of units 3e-322 high, which the query refuses as too narrow for its
+    # distance from the origin (kTooFarFromOrigin); the worker waited for a last call that never came.
+    write("query", "parallel_unit_too_narrow_for_its_distance", bytes.fromhex(
+        "040c0000d04b6202f0550000404000000000000000b89fbd" "5df2ffffbf4000000000ffffffffffffffff00ff0f1000"), root)
 
 
 if __name__ == "__main__":

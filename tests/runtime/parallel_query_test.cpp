@@ -139,6 +139,23 @@ TEST(ParallelQueryTest, AShortBufferHoldsThePrefixAndTellsTheCount) {
   EXPECT_EQ(needed, all.size());
 }
 
+TEST(ParallelQueryTest, ARegionEndingASliverPastATileSideIsServedWhole) {
+  // The region's last row of tiles is 3e-322 high: a unit that thin would be refused as too narrow for its
+  // distance from the origin, where the whole region is not (a fuzzer found the run never returned).
+  for (int kind = 0; kind < 2; ++kind) {  // counted and written in place, and through the scratch
+    QueryParams q = region(QueryMode::kStable, kind);
+    q.x0 = 0, q.x1 = 2.0001639128425146, q.y0 = -6, q.y1 = 3.1620201333839779e-322;
+    q.origin_x = -9, q.origin_y = -12.125, q.tile_size = 2.953125, q.scale = 3000;
+    for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+      q.mode = mode;
+      const std::vector<QueryPoint> whole = run_whole(q);
+      ASSERT_GT(whole.size(), 1000u);
+      EXPECT_TRUE(by_id(run_parallel(q, 2, sequential_runner())) == by_id(whole))
+          << "kind " << kind << " mode " << int(mode);
+    }
+  }
+}
+
 TEST(ParallelQueryTest, RefusesByName) {
   ParallelQuery pq;
   std::vector<QueryPoint> out(16);
