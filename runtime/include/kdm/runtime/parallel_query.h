@@ -5,8 +5,10 @@
 // there; with a varying density, whose count costs as much as the query, it queries the unit into its
 // own scratch and copies it into place. The result is the units' points in unit order: the same bits for
 // any number of threads or any task system, and the same points as query_points (in stable mode also in
-// its order where no tile is cut into parts, as units then follow its tile order; in smooth mode the
-// points that glide across a unit's side come with that unit).
+// its order where no tile is cut into parts, as units then follow its tile order, unless a side of the
+// region lies past a tile's side by less than 2^-40 of its distance from the world origin, a sliver that
+// joins the row or column beside it; in smooth mode the points that glide across a unit's side come with
+// that unit).
 //
 // The runtime library starts no threads: the caller gives a task system (TaskRunner), or the inline
 // std::thread one below.
