@@ -17,7 +17,7 @@
 //    same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys;
 //  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch;
-//  - ParallelQuery (two workers run in turn) gives the same points.
+//  - ParallelQuery (two workers run in turn) gives the same points, and the same classes.
 // A failed check aborts.
 #include <algorithm>
 #include <cfloat>
@@ -27,6 +27,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
@@ -93,6 +94,21 @@ void joint_batch_callback(void* user, std::size_t n, const double* x, const doub
 
 [[noreturn]] void fail() {
   std::abort();
+}
+
+// A ParallelQuery of two workers, which in_turn() runs one after the other on this thread.
+kdm::ParallelQuery& two_workers() {
+  static kdm::ParallelQuery parallel;
+  static const kdm::Status ready = parallel.init(2);
+  if (ready != kdm::Status::kOk) fail();
+  return parallel;
+}
+kdm::TaskRunner in_turn() {
+  kdm::TaskRunner r;
+  r.run = [](void*, void (*task)(void*, std::size_t), void* context, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) task(context, i);
+  };
+  return r;
 }
 
 // `out` (a query output) plus `origin` lies in [lo, hi): exact when there is no origin, else up to the
@@ -325,6 +341,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       for (std::size_t i = 0; i < all.size; ++i)
         if (!same(classed[i], all[i]) || classes[i] > (kind == 0 ? 1 : 0)) fail();
     }
+    // Over two workers: the same points (in the units' order) with the same classes.
+    if (classed.status == kdm::Status::kOk) {
+      static kdm::QueryPoint units[kBigCapacity];
+      static std::uint8_t unit_classes[kBigCapacity];
+      static std::pair<std::tuple<std::uint32_t, std::int64_t, std::int64_t, std::uint32_t>, std::uint8_t>
+          expected[kBigCapacity], got[kBigCapacity];
+      std::size_t n = 0;
+      if (two_workers().run(kdm::Tileset::builtin(), cq, units, unit_classes, kBigCapacity, &n, in_turn()) !=
+              kdm::Status::kOk ||
+          n != classed.size)
+        fail();
+      for (std::size_t i = 0; i < n; ++i)
+        expected[i] = {order_key(classed[i]), classes[i]}, got[i] = {order_key(units[i]), unit_classes[i]};
+      std::sort(expected, expected + n), std::sort(got, got + n);
+      if (!std::equal(expected, expected + n, got)) fail();
+    }
     // The same two classes, the callback read in batches: the same status, points and classes.
     if (kind == 2) {
       kdm::ClassQueryParams batched = cq;
@@ -385,18 +417,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Over two workers run in turn (ParallelQuery, its units planned from the parameters): the region's
   // points, in the units' order, and the whole count.
   {
-    static kdm::ParallelQuery parallel;
-    static const kdm::Status ready = parallel.init(2);
-    if (ready != kdm::Status::kOk) fail();
-    kdm::TaskRunner in_turn;
-    in_turn.run = [](void*, void (*task)(void*, std::size_t), void* context, std::size_t count) {
-      for (std::size_t i = 0; i < count; ++i) task(context, i);
-    };
     static Points units;
     static kdm::QueryPoint sorted[kBigCapacity];
     std::size_t needed = 0;
-    units.status = parallel.run(kdm::Tileset::builtin(), q, units.data, kBigCapacity, &units.size, in_turn,
-                                &needed, &units.problem);
+    units.status = two_workers().run(kdm::Tileset::builtin(), q, units.data, kBigCapacity, &units.size,
+                                     in_turn(), &needed, &units.problem);
     if (units.status != kdm::Status::kOk || units.size != all.size || needed != all.size) fail();
     auto id_order = [](const kdm::QueryPoint& u, const kdm::QueryPoint& v) {
       return order_key(u) < order_key(v);
