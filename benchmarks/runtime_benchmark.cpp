@@ -478,6 +478,37 @@ void BM_QueryCompact(benchmark::State& state) {
   state.counters["of_plain_copy"] = copy_seconds / seconds;
 }
 
+// BM_QueryParallel's rounds: plain(), one query on this thread into output 0, then run(query, k, &n[k]) with
+// one worker into output 0 and two into output 1 (false if the query did not fit), and same(n) comparing
+// the two outputs' n points. Two workers' time is the iteration's; `speedup` is one worker's time over
+// two's, `of_one_query` the plain query's over two workers'.
+template <class Plain, class Run, class Same>
+void parallel_rounds(benchmark::State& state, Plain&& plain, Run&& run, Same&& same) {
+  kdm::ParallelQuery workers[2];
+  workers[0].init(1), workers[1].init(2);
+  std::size_t n[2] = {0, 0};
+  double seconds[2] = {0, 0}, plain_seconds = 0;
+  auto timed = [](double& total, auto&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool ok = f();
+    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return ok;
+  };
+  for (auto _ : state) {
+    timed(plain_seconds, [&] { return plain(), true; });
+    const double before = seconds[1];
+    for (int k = 0; k < 2; ++k)
+      if (!timed(seconds[k], [&] { return run(workers[k], k, &n[k]); }))
+        return state.SkipWithError("the query did not fit");
+    state.SetIterationTime(seconds[1] - before);
+    if (n[0] != n[1] || !same(n[0])) return state.SkipWithError("one and two workers gave different bits");
+  }
+  report(state, n[1]);
+  state.counters["speedup"] = seconds[0] / seconds[1];
+  state.counters["of_one_query"] = plain_seconds / seconds[1];
+  state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
+}
+
 // One query of about 4 million points (16 × 16 tiles at 15,000 points each, BM_QueryConstant's density)
 // filled at once by ParallelQuery (args: smooth; compact, 1 for float positions and keys instead of
 // QueryPoint records; ramp, 1 for BM_QueryDensityCallback's ramp), on two workers in rounds alternating
@@ -492,8 +523,6 @@ void BM_QueryParallel(benchmark::State& state) {
     q.density.callback_max = 1;
   }
   const bool compact = state.range(1) != 0;
-  kdm::ParallelQuery one, two;
-  one.init(1), two.init(2);
   const std::size_t capacity = std::size_t(1) << 22;
   std::vector<kdm::QueryPoint> points[2];
   std::vector<float> xy[2];
@@ -504,21 +533,7 @@ void BM_QueryParallel(benchmark::State& state) {
     else
       points[k].resize(capacity);
   }
-  const kdm::TaskRunner threads = kdm::std_thread_runner();
-  std::size_t n[2] = {0, 0};
-  double seconds[2] = {0, 0};
-  auto run = [&](kdm::ParallelQuery& pq, int k) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const kdm::Status s =
-        compact ? pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), keys[k].data()},
-                         capacity, &n[k], threads)
-                : pq.run(kdm::Tileset::builtin(), q, points[k].data(), capacity, &n[k], threads);
-    seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return s == kdm::Status::kOk;
-  };
-  double plain_seconds = 0;  // query_points / query_points_compact into the same memory, one thread
-  auto run_plain = [&]() {
-    const auto t0 = std::chrono::steady_clock::now();
+  auto plain = [&] {  // query_points / query_points_compact into the same memory
     kdm::QueryCursor cursor;
     std::size_t written = 0, total = 0;
     kdm::Status s;
@@ -531,24 +546,20 @@ void BM_QueryParallel(benchmark::State& state) {
                                       &written, &cursor);
       total += written;
     } while (s == kdm::Status::kBufferFull && total < capacity);
-    plain_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  for (auto _ : state) {
-    run_plain();
-    const double before = seconds[1];
-    if (!run(one, 0) || !run(two, 1)) return state.SkipWithError("the query did not fit");
-    state.SetIterationTime(seconds[1] - before);  // two workers' time
-    const bool same =
-        n[0] == n[1] &&
-        (compact ? std::memcmp(xy[0].data(), xy[1].data(), 2 * n[0] * sizeof(float)) == 0 &&
-                       std::memcmp(keys[0].data(), keys[1].data(), n[0] * 8) == 0
-                 : std::memcmp(points[0].data(), points[1].data(), n[0] * sizeof(kdm::QueryPoint)) == 0);
-    if (!same) return state.SkipWithError("one and two workers gave different bits");
-  }
-  report(state, n[1]);
-  state.counters["speedup"] = seconds[0] / seconds[1];
-  state.counters["of_one_query"] = plain_seconds / seconds[1];
-  state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
+  auto run = [&](kdm::ParallelQuery& pq, int k, std::size_t* n) {
+    const kdm::TaskRunner threads = kdm::std_thread_runner();
+    return (compact ? pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), keys[k].data()},
+                             capacity, n, threads)
+                    : pq.run(kdm::Tileset::builtin(), q, points[k].data(), capacity, n, threads)) ==
+           kdm::Status::kOk;
+  };
+  auto same = [&](std::size_t n) {
+    return compact ? std::memcmp(xy[0].data(), xy[1].data(), 2 * n * sizeof(float)) == 0 &&
+                         std::memcmp(keys[0].data(), keys[1].data(), n * 8) == 0
+                   : std::memcmp(points[0].data(), points[1].data(), n * sizeof(kdm::QueryPoint)) == 0;
+  };
+  parallel_rounds(state, plain, run, same);
 }
 
 // BM_QueryParallel's region as three classes at 1 : 2 : 4 of its density (args: smooth; ramp, 1 for the
@@ -568,24 +579,11 @@ void BM_QueryParallelClasses(benchmark::State& state) {
       d.user = const_cast<RampClass*>(kPlain + k), d.callback_max = d.constant;
     }
   }
-  kdm::ParallelQuery one, two;
-  one.init(1), two.init(2);
   const std::size_t capacity = std::size_t(1) << 22;
   std::vector<float> xy[2] = {std::vector<float>(2 * capacity), std::vector<float>(2 * capacity)};
   std::vector<std::uint8_t> classes[2] = {std::vector<std::uint8_t>(capacity),
                                           std::vector<std::uint8_t>(capacity)};
-  const kdm::TaskRunner threads = kdm::std_thread_runner();
-  std::size_t n[2] = {0, 0};
-  double seconds[2] = {0, 0}, plain_seconds = 0;
-  auto run = [&](kdm::ParallelQuery& pq, int k) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const kdm::Status s = pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), nullptr},
-                                 classes[k].data(), capacity, &n[k], threads);
-    seconds[k] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return s == kdm::Status::kOk;
-  };
-  auto run_plain = [&] {
-    const auto t0 = std::chrono::steady_clock::now();
+  auto plain = [&] {  // query_classes_compact into the same memory
     kdm::QueryCursor cursor;
     std::size_t written = 0, total = 0;
     kdm::Status s;
@@ -595,21 +593,16 @@ void BM_QueryParallelClasses(benchmark::State& state) {
                                      classes[0].data() + total, capacity - total, &written, &cursor);
       total += written;
     } while (s == kdm::Status::kBufferFull && total < capacity);
-    plain_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  for (auto _ : state) {
-    run_plain();
-    const double before = seconds[1];
-    if (!run(one, 0) || !run(two, 1)) return state.SkipWithError("the query did not fit");
-    state.SetIterationTime(seconds[1] - before);  // two workers' time
-    if (n[0] != n[1] || std::memcmp(xy[0].data(), xy[1].data(), 2 * n[0] * sizeof(float)) != 0 ||
-        std::memcmp(classes[0].data(), classes[1].data(), n[0]) != 0)
-      return state.SkipWithError("one and two workers gave different bits");
-  }
-  report(state, n[1]);
-  state.counters["speedup"] = seconds[0] / seconds[1];
-  state.counters["of_one_query"] = plain_seconds / seconds[1];
-  state.counters["two_workers_Mps"] = double(n[1]) * double(state.iterations()) / seconds[1] / 1e6;
+  auto run = [&](kdm::ParallelQuery& pq, int k, std::size_t* n) {
+    return pq.run(kdm::Tileset::builtin(), q, kdm::CompactPoints{xy[k].data(), nullptr}, classes[k].data(),
+                  capacity, n, kdm::std_thread_runner()) == kdm::Status::kOk;
+  };
+  auto same = [&](std::size_t n) {
+    return std::memcmp(xy[0].data(), xy[1].data(), 2 * n * sizeof(float)) == 0 &&
+           std::memcmp(classes[0].data(), classes[1].data(), n) == 0;
+  };
+  parallel_rounds(state, plain, run, same);
 }
 
 // The benchmark's region moved by half a tile in x and y, so that its sides cut 32 of the 81 tiles it meets,

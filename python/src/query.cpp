@@ -335,6 +335,44 @@ std::size_t room_for(double rho, const QueryParams& q) {
   return std::size_t(std::min(bound, double(tools::kMaxCollectedPoints) + 1));
 }
 
+/// Fills `buffer` with a compact query's points, the GIL released (a callable density takes it back at each
+/// call), and returns their count: with `threads` 0 by serial(at, written, cursor, problem), which writes
+/// from slot `at` on, resumed until done; else by parallel(query, written, needed, problem) on a
+/// ParallelQuery of `threads` workers, with room first for `wanted` points, then for what it needed.
+/// `grow(capacity)` sizes what is kept beside the points (classes). A refusal raises ValueError.
+template <class Serial, class Parallel, class Grow>
+std::size_t fill_compact(CompactBuffer& buffer, int threads, std::size_t wanted, Serial&& serial,
+                         Parallel&& parallel, Grow&& grow) {
+  py::gil_scoped_release release;
+  QueryProblem problem;
+  std::size_t m = 0;
+  if (threads == 0) {
+    QueryCursor cursor;
+    for (;;) {
+      buffer.reserve(m + kChunk);
+      grow(buffer.capacity);
+      std::size_t written = 0;
+      const Status s = serial(m, &written, &cursor, &problem);
+      m += written;
+      check_collected(m);
+      if (s == Status::kOk) return m;
+      if (s != Status::kBufferFull) refused(problem);
+    }
+  }
+  ParallelQuery query;
+  query.init(static_cast<std::uint32_t>(threads));
+  for (;;) {
+    buffer.reserve(wanted);
+    grow(buffer.capacity);
+    std::size_t needed = 0;
+    const Status s = parallel(query, &m, &needed, &problem);
+    check_collected(needed);
+    if (s == Status::kOk) return m;
+    if (s != Status::kBufferFull) refused(problem);
+    wanted = needed;
+  }
+}
+
 /// The compact query (kdm/runtime/compact_query.h) into new arrays, with the GIL released: positions
 /// (m × 2 float32, relative to the origin) and, with `keys`, each point's 64-bit key (else None). `threads`
 /// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
@@ -350,38 +388,17 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
   const QueryParams& q = prepared.q;
   CompactBuffer buffer;
   buffer.with_keys = keys;
-  std::size_t m = 0;
-  {
-    py::gil_scoped_release release;  // a callable density takes it back at each call
-    QueryProblem problem;
-    if (threads == 0) {
-      QueryCursor cursor;
-      for (;;) {
-        buffer.reserve(m + kChunk);
-        std::size_t written = 0;
-        const Status s = query_points_compact(*handle.set, q, buffer.at(m), buffer.capacity - m, &written,
-                                              &cursor, &problem);
-        m += written;
-        check_collected(m);
-        if (s == Status::kOk) break;
-        if (s != Status::kBufferFull) refused(problem);
-      }
-    } else {
-      ParallelQuery parallel;
-      parallel.init(static_cast<std::uint32_t>(threads));
-      std::size_t wanted = room_for(density_bound(q.density, q), q);
-      for (;;) {
-        buffer.reserve(wanted);
-        std::size_t needed = 0;
-        const Status s = parallel.run(*handle.set, q, buffer.at(0), buffer.capacity, &m, std_thread_runner(),
-                                      &needed, &problem);
-        check_collected(needed);
-        if (s == Status::kOk) break;
-        if (s != Status::kBufferFull) refused(problem);
-        wanted = needed;
-      }
-    }
-  }
+  const std::size_t m = fill_compact(
+      buffer, threads, room_for(density_bound(q.density, q), q),
+      [&](std::size_t at, std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
+        return query_points_compact(*handle.set, q, buffer.at(at), buffer.capacity - at, written, cursor,
+                                    problem);
+      },
+      [&](ParallelQuery& parallel, std::size_t* written, std::size_t* needed, QueryProblem* problem) {
+        return parallel.run(*handle.set, q, buffer.at(0), buffer.capacity, written, std_thread_runner(),
+                            needed, problem);
+      },
+      [](std::size_t) {});
   if (prepared.from_callable) prepared.from_callable->rethrow();
   return take_compact(buffer, m);
 }
@@ -483,42 +500,19 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;
-  std::size_t m = 0;
-  {
-    py::gil_scoped_release release;  // a callable class takes it back at each call
-    QueryProblem problem;
-    if (threads == 0) {
-      QueryCursor cursor;
-      for (;;) {
-        buffer.reserve(m + kChunk);
-        classes.resize(buffer.capacity);
-        std::size_t written = 0;
-        const Status s = query_classes_compact(*handle.set, q, buffer.at(m), classes.data() + m,
-                                               buffer.capacity - m, &written, &cursor, &problem);
-        m += written;
-        check_collected(m);
-        if (s == Status::kOk) break;
-        if (s != Status::kBufferFull) refused(problem);
-      }
-    } else {
-      ParallelQuery parallel;
-      parallel.init(static_cast<std::uint32_t>(threads));
-      double rho = 0;
-      for (std::uint32_t k = 0; k < q.class_count; ++k) rho += density_bound(q.classes[k], q.query);
-      std::size_t wanted = room_for(rho, q.query);
-      for (;;) {
-        buffer.reserve(wanted);
-        classes.resize(buffer.capacity);
-        std::size_t needed = 0;
-        const Status s = parallel.run(*handle.set, q, buffer.at(0), classes.data(), buffer.capacity, &m,
-                                      std_thread_runner(), &needed, &problem);
-        check_collected(needed);
-        if (s == Status::kOk) break;
-        if (s != Status::kBufferFull) refused(problem);
-        wanted = needed;
-      }
-    }
-  }
+  double rho = 0;  // a bound of the classes' sum
+  for (std::uint32_t k = 0; k < q.class_count; ++k) rho += density_bound(q.classes[k], q.query);
+  const std::size_t m = fill_compact(
+      buffer, threads, room_for(rho, q.query),
+      [&](std::size_t at, std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
+        return query_classes_compact(*handle.set, q, buffer.at(at), classes.data() + at, buffer.capacity - at,
+                                     written, cursor, problem);
+      },
+      [&](ParallelQuery& parallel, std::size_t* written, std::size_t* needed, QueryProblem* problem) {
+        return parallel.run(*handle.set, q, buffer.at(0), classes.data(), buffer.capacity, written,
+                            std_thread_runner(), needed, problem);
+      },
+      [&](std::size_t capacity) { classes.resize(capacity); });
   prepared.rethrow();
   py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(m));
   std::copy(classes.begin(), classes.begin() + m, labels.mutable_data());

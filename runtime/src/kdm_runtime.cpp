@@ -248,20 +248,24 @@ kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, con
                          });
 }
 
-/// A parallel query's own arguments, checked: the parallel query and the runner, as `task_runner`.
-bool read_parallel(const kdm_parallel_query* parallel, const kdm_task_runner* runner,
-                   kdm::TaskRunner& task_runner, size_t* written, kdm_query_problem* problem) {
+/// A parallel query of the C API: checks the parallel query and the runner, then returns run(task_runner,
+/// cursor), whose cursor only satisfies the query readers (a run has none).
+template <class Run>
+kdm_status run_parallel(const kdm_parallel_query* parallel, const kdm_task_runner* runner, size_t* written,
+                        kdm_query_problem* problem, Run&& run) {
   if (written) *written = 0;
   kdm::QueryProblem why;
   why.kind = kdm::QueryProblem::Kind::kMissingArgument;
-  if (!parallel)
+  if (!parallel) {
     why.parameter = "parallel";
-  else if (!runner || !runner->run)
+  } else if (!runner || !runner->run) {
     why.parameter = "runner.run";
-  else
-    return task_runner = kdm::TaskRunner{runner->run, runner->context}, true;
+  } else {
+    kdm_cursor unused{};
+    return run(kdm::TaskRunner{runner->run, runner->context}, &unused);
+  }
   report(why, problem);
-  return false;
+  return KDM_INVALID_ARGUMENT;
 }
 
 }  // namespace
@@ -296,28 +300,26 @@ kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel, const kdm_tas
                                      const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,
                                      size_t capacity, size_t* written, size_t* needed,
                                      kdm_query_problem* problem) {
-  kdm::TaskRunner r;
-  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
-  kdm_cursor unused{};
-  return run_query(tileset, query, written, &unused, problem,
-                   [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
-                     return parallel->parallel.run(*tileset->set, q, as_points(out), capacity, written, r,
-                                                   needed, why);
-                   });
+  return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
+    return run_query(tileset, query, written, cursor, problem,
+                     [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                       return parallel->parallel.run(*tileset->set, q, as_points(out), capacity, written, r,
+                                                     needed, why);
+                     });
+  });
 }
 
 kdm_status kdm_parallel_query_compact(kdm_parallel_query* parallel, const kdm_task_runner* runner,
                                       const kdm_tileset* tileset, const kdm_query* query, float* xy,
                                       uint64_t* keys, size_t capacity, size_t* written, size_t* needed,
                                       kdm_query_problem* problem) {
-  kdm::TaskRunner r;
-  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
-  kdm_cursor unused{};
-  return run_query(tileset, query, written, &unused, problem,
-                   [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
-                     return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity,
-                                                   written, r, needed, why);
-                   });
+  return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
+    return run_query(tileset, query, written, cursor, problem,
+                     [&](const kdm::QueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                       return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys}, capacity,
+                                                     written, r, needed, why);
+                     });
+  });
 }
 
 kdm_status kdm_parallel_query_classes_compact(kdm_parallel_query* parallel, const kdm_task_runner* runner,
@@ -326,14 +328,13 @@ kdm_status kdm_parallel_query_classes_compact(kdm_parallel_query* parallel, cons
                                               float* xy, uint64_t* keys, uint8_t* out_classes,
                                               size_t capacity, size_t* written, size_t* needed,
                                               kdm_query_problem* problem) {
-  kdm::TaskRunner r;
-  if (!read_parallel(parallel, runner, r, written, problem)) return KDM_INVALID_ARGUMENT;
-  kdm_cursor unused{};
-  return run_class_query(tileset, query, classes, nullptr, false, class_count, written, &unused, problem,
-                         [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
-                           return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
-                                                         out_classes, capacity, written, r, needed, why);
-                         });
+  return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
+    return run_class_query(tileset, query, classes, nullptr, false, class_count, written, cursor, problem,
+                           [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                             return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                           out_classes, capacity, written, r, needed, why);
+                           });
+  });
 }
 
 void kdm_set_tileset_allocator(void* (*allocate)(size_t, size_t, void*),

@@ -7,13 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CHECK(cond)                                                            \
-  do {                                                                         \
-    if (!(cond)) {                                                             \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-      return 1;                                                                \
-    }                                                                          \
-  } while (0)
+#include "c_check.h"
 
 /* Every task in turn on the calling thread. */
 static void run_in_turn(void* context, void (*task)(void*, size_t), void* task_context, size_t count) {
