@@ -432,15 +432,21 @@ def test_vectorized_classes(mode):
         assert np.array_equal(xy[order], xy_2[order_2]) and np.array_equal(labels[order], labels_2[order_2])
 
 
-def test_callable_classes_with_bounds():
-    # Bounds for the callable classes (None for the others): the same points and classes with fewer calls
-    # in stable mode (measured a fifth of them), in both outputs.
+def counted_ramp(slope):
+    """The density 0.2 + slope * x counting its calls in calls[0], and its bounds over a rectangle."""
     calls = [0]
     def ramp(x, y):
         calls[0] += 1
-        return 0.2 + 0.2 * x
-    def ramp_bounds(x0, y0, x1, y1):
-        return 0.2 + 0.2 * x0, 0.2 + 0.2 * x1
+        return 0.2 + slope * x
+    def bounds(x0, y0, x1, y1):
+        return 0.2 + slope * x0, 0.2 + slope * x1
+    return ramp, bounds, calls
+
+
+def test_callable_classes_with_bounds():
+    # Bounds for the callable classes (None for the others): the same points and classes with fewer calls
+    # in stable mode (measured a fifth of them), in both outputs.
+    ramp, ramp_bounds, calls = counted_ramp(0.2)
     rect, kwargs = (0.0, 0.0, 3.0, 2.0), dict(scale=600, density_max=[0.8, None])
     plain = BUILTIN.query(rect, classes=[ramp, 0.5], **kwargs)
     without = calls[0]
@@ -563,12 +569,7 @@ def test_positions_refuse_bad_arguments():
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
 def test_density_bounds_keep_the_points_and_save_calls(mode):
-    calls = [0]
-    def ramp(x, y):
-        calls[0] += 1
-        return 0.2 + 0.1 * x
-    def bounds(x0, y0, x1, y1):
-        return 0.2 + 0.1 * x0, 0.2 + 0.1 * x1
+    ramp, bounds, calls = counted_ramp(0.1)
     rect = (0.0, 0.0, 8.0, 1.0)
     plain = BUILTIN.query(rect, scale=600, density=ramp, density_max=1.0, mode=mode)
     everywhere, calls[0] = calls[0], 0
