@@ -268,6 +268,22 @@ kdm_status run_parallel(const kdm_parallel_query* parallel, const kdm_task_runne
   return KDM_INVALID_ARGUMENT;
 }
 
+/// The parallel class queries, for either kind of densities (run_class_query's `is_joint`).
+kdm_status parallel_classes(kdm_parallel_query* parallel, const kdm_task_runner* runner,
+                            const kdm_tileset* tileset, const kdm_query* query,
+                            const kdm_class_density* classes, const kdm_joint_class_density* joint,
+                            bool is_joint, uint32_t class_count, float* xy, uint64_t* keys,
+                            uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed,
+                            kdm_query_problem* problem) {
+  return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
+    return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+                           [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
+                             return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                           out_classes, capacity, written, r, needed, why);
+                           });
+  });
+}
+
 }  // namespace
 
 extern "C" {
@@ -328,13 +344,19 @@ kdm_status kdm_parallel_query_classes_compact(kdm_parallel_query* parallel, cons
                                               float* xy, uint64_t* keys, uint8_t* out_classes,
                                               size_t capacity, size_t* written, size_t* needed,
                                               kdm_query_problem* problem) {
-  return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
-    return run_class_query(tileset, query, classes, nullptr, false, class_count, written, cursor, problem,
-                           [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
-                             return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
-                                                           out_classes, capacity, written, r, needed, why);
-                           });
-  });
+  return parallel_classes(parallel, runner, tileset, query, classes, nullptr, false, class_count, xy, keys,
+                          out_classes, capacity, written, needed, problem);
+}
+
+kdm_status kdm_parallel_query_classes_joint_compact(kdm_parallel_query* parallel,
+                                                    const kdm_task_runner* runner, const kdm_tileset* tileset,
+                                                    const kdm_query* query,
+                                                    const kdm_joint_class_density* joint,
+                                                    uint32_t class_count, float* xy, uint64_t* keys,
+                                                    uint8_t* out_classes, size_t capacity, size_t* written,
+                                                    size_t* needed, kdm_query_problem* problem) {
+  return parallel_classes(parallel, runner, tileset, query, nullptr, joint, true, class_count, xy, keys,
+                          out_classes, capacity, written, needed, problem);
 }
 
 void kdm_set_tileset_allocator(void* (*allocate)(size_t, size_t, void*),

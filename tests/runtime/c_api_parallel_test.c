@@ -1,6 +1,6 @@
 /* The C interface's parallel queries from C: the same bits on one thread run in turn and on two POSIX
- * threads, kdm_query_compact's points and kdm_query_classes_compact's classes, a short buffer's prefix and
- * count, refusals by name. */
+ * threads, kdm_query_compact's points and kdm_query_classes_compact's classes (separate densities or one
+ * joint function), a short buffer's prefix and count, refusals by name. */
 #include <kdm/runtime/kdm_runtime.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -43,6 +43,11 @@ static void run_on_threads(void* context, void (*task)(void*, size_t), void* tas
 static double ramp(void* user, double x, double y) {
   (void)user, (void)y;
   return 0.2 + 0.1 * x;
+}
+
+/* The three classes of main's `three` from one call. */
+static void three_joint(void* user, double x, double y, double* values) {
+  values[0] = 1.0 / 7, values[1] = ramp(user, x, y), values[2] = 4.0 / 7;
 }
 
 enum { kCapacity = 1 << 20 };
@@ -100,6 +105,18 @@ int main(void) {
     CHECK(kdm_parallel_query_classes_compact(parallel, &on_threads, builtin, &q, three, 3, xy[1], keys[1],
                                              classes[1], kCapacity, &n[1], NULL, NULL) == KDM_OK);
     CHECK(n[0] == n[1] && n[0] == one && memcmp(classes[0], classes[1], n[0]) == 0);
+    {
+      /* The same three classes from one joint function: the same points and classes. */
+      kdm_joint_class_density joint;
+      memset(&joint, 0, sizeof joint);
+      joint.densities = three_joint;
+      joint.density_max[0] = 1.0 / 7, joint.density_max[1] = 0.9, joint.density_max[2] = 4.0 / 7;
+      CHECK(kdm_parallel_query_classes_joint_compact(parallel, &on_threads, builtin, &q, &joint, 3, xy[1],
+                                                     keys[1], classes[1], kCapacity, &n[1], NULL,
+                                                     NULL) == KDM_OK);
+      CHECK(n[1] == n[0] && memcmp(xy[0], xy[1], 2 * n[0] * sizeof(float)) == 0 &&
+            memcmp(classes[0], classes[1], n[0]) == 0);
+    }
     {
       size_t counts[2][3] = {{0, 0, 0}, {0, 0, 0}};
       for (i = 0; i < one; ++i) ++counts[0][one_classes[i]], ++counts[1][classes[0][i]];

@@ -299,6 +299,13 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_classes_compact(
     kdm_parallel_query* parallel, const kdm_task_runner* runner, const kdm_tileset* tileset,
     const kdm_query* query, const kdm_class_density* classes, uint32_t class_count, float* xy, uint64_t* keys,
     uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
+/* Several classes from one joint density (kdm_query_classes_joint_compact's points and classes) the same
+ * way. */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_classes_joint_compact(
+    kdm_parallel_query* parallel, const kdm_task_runner* runner, const kdm_tileset* tileset,
+    const kdm_query* query, const kdm_joint_class_density* joint, uint32_t class_count, float* xy,
+    uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed,
+    kdm_query_problem* problem);
 
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
