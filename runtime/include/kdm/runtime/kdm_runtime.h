@@ -271,9 +271,10 @@ typedef struct kdm_task_runner {
 
 typedef struct kdm_parallel_query kdm_parallel_query; /* per-worker scratch, allocated once */
 
-/* Scratch for `workers` workers (1 ... 64; about 1.9 MB each) into *out: KDM_OK, KDM_INVALID_ARGUMENT for
- * a count out of range or a NULL `out`, KDM_OUT_OF_MEMORY. One kdm_parallel_query serves one run at a time.
- */
+/* Scratch for `workers` workers (1 ... 64; about 1.9 MB each, through kdm_set_tileset_allocator's hooks)
+ * into *out: KDM_OK, KDM_INVALID_ARGUMENT for a count out of range or a NULL `out`, KDM_OUT_OF_MEMORY (a
+ * library built without exceptions ends the program instead). One kdm_parallel_query serves one run at a
+ * time. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out);
 KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
 
