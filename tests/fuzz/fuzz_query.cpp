@@ -377,20 +377,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       cq.joint.max[0] = callback_max, cq.joint.max[1] = 0;
       static Points joint;
       static std::uint8_t joint_classes[kBigCapacity];
-      kdm::QueryCursor joint_cursor;
-      joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes, kBigCapacity,
-                                        &joint.size, &joint_cursor);
-      if (joint.status != classed.status || joint.size != classed.size) fail();
-      for (std::size_t i = 0; i < joint.size; ++i)
-        if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
-      // And from one joint function of many positions.
-      cq.joint.densities = nullptr, cq.joint.batch_densities = joint_batch_callback;
-      kdm::QueryCursor joint_batch_cursor;
-      joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes, kBigCapacity,
-                                        &joint.size, &joint_batch_cursor);
-      if (joint.status != classed.status || joint.size != classed.size) fail();
-      for (std::size_t i = 0; i < joint.size; ++i)
-        if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
+      for (const bool batch : {false, true}) {  // then from one joint function of many positions
+        if (batch) cq.joint.densities = nullptr, cq.joint.batch_densities = joint_batch_callback;
+        kdm::QueryCursor joint_cursor;
+        joint.status = kdm::query_classes(kdm::Tileset::builtin(), cq, joint.data, joint_classes,
+                                          kBigCapacity, &joint.size, &joint_cursor);
+        if (joint.status != classed.status || joint.size != classed.size) fail();
+        for (std::size_t i = 0; i < joint.size; ++i)
+          if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
+      }
     }
   }
 
