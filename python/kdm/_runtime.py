@@ -223,8 +223,8 @@ class Tileset:
         2**-21 * (|position| + tile_size); with ``keys=True`` also an (n,) uint64 array of point keys
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
-        region in a fixed order: the same bits for any N, in an order of its own); the default runs one
-        query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
+        region in a fixed order: the same bits for any N, in query()'s order unless a tile holds more
+        points than a unit); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         """
         class_max = density_max  # a number or one entry per class, checked with the classes

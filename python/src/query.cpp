@@ -375,8 +375,8 @@ std::size_t fill_compact(CompactBuffer& buffer, int threads, std::size_t wanted,
 
 /// The compact query (kdm/runtime/compact_query.h) into new arrays, with the GIL released: positions
 /// (m × 2 float32, relative to the origin) and, with `keys`, each point's 64-bit key (else None). `threads`
-/// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (its unit
-/// order: the same bits for any count).
+/// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (the same
+/// bits for any count, in query_points' order where no tile is cut into units).
 py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
                     const tools::DensitySpec* spec, py::object callable, bool vectorized, py::object bounds,
                     std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,

@@ -181,13 +181,14 @@ void constant_counts(const ClassQueryParams& p, const QueryParams& q, double cou
     counts[k] = (sum += density_or_zero(p.classes[k].constant)) * area;
 }
 
-/// The union's query into `out` (QueryPoint records or a CompactPoints) with each point's class into
-/// `classes`, classed as it is written, in one piece. The cursor carries the class query's fingerprint
-/// between calls and the union's while it runs.
+/// The union's query over the tiles of `run` into `out` (QueryPoint records or a CompactPoints) with each
+/// point's class into `classes`, classed as it is written, in one piece. The cursor carries the class
+/// query's fingerprint between calls and the union's while it runs.
 template <class Output>
 Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const QueryParams& q,
                    const ClassDensities& densities, Classifier& classify, Output out, std::uint8_t* classes,
-                   std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse) {
+                   std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
+                   const detail::TileRun& run) {
   const std::uint64_t fingerprint = query_fingerprint(p);
   if (cursor && cursor->started) {
     if (cursor->fingerprint != fingerprint) return refuse(QueryProblem::Kind::kCursorMismatch, "cursor");
@@ -200,7 +201,7 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
     constant_counts(p, q, counts);
     const detail::ConstantClasses c{classes, counts, p.class_count - 1, Classifier::class_of_id, &classify};
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
-                                           examined);
+                                           examined, run);
   } else {
     const detail::VaryingClasses c{classes,
                                    &densities.scratch,
@@ -213,7 +214,7 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
                                    &classify,
                                    densities.one_grid ? &densities.images : nullptr};
     status = detail::query_classes_counted(tileset, q, out, c, capacity, written, cursor, &refuse.problem(),
-                                           examined);
+                                           examined, run);
   }
   if (status != Status::kInvalidArgument && cursor) cursor->fingerprint = fingerprint;
   return status;
@@ -224,6 +225,18 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
 Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
                      std::uint8_t* classes, std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                      QueryProblem* problem) {
+  return detail::query_classes_run(tileset, p, out, classes, capacity, written, cursor, problem, {});
+}
+
+Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, const CompactPoints& out,
+                             std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                             QueryCursor* cursor, QueryProblem* problem) {
+  return detail::query_classes_run(tileset, p, out, classes, capacity, written, cursor, problem, {});
+}
+
+Status detail::query_classes_run(const Tileset& tileset, const ClassQueryParams& p, QueryPoint* out,
+                                 std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                                 QueryCursor* cursor, QueryProblem* problem, const TileRun& run) {
   detail::Refusal refuse(problem);
   ClassDensities densities;
   QueryParams q;
@@ -231,12 +244,13 @@ Status query_classes(const Tileset& tileset, const ClassQueryParams& p, QueryPoi
     return Status::kInvalidArgument;
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse);
+  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse,
+                     run);
 }
 
-Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, const CompactPoints& out,
-                             std::uint8_t* classes, std::size_t capacity, std::size_t* written,
-                             QueryCursor* cursor, QueryProblem* problem) {
+Status detail::query_classes_run(const Tileset& tileset, const ClassQueryParams& p, const CompactPoints& out,
+                                 std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                                 QueryCursor* cursor, QueryProblem* problem, const TileRun& run) {
   detail::Refusal refuse(problem);
   ClassDensities densities;
   QueryParams q;
@@ -247,7 +261,8 @@ Status query_classes_compact(const Tileset& tileset, const ClassQueryParams& p, 
   if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");
   Classifier classify(tileset, p, densities, q);
-  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse);
+  return run_classed(tileset, p, q, densities, classify, out, classes, capacity, written, cursor, refuse,
+                     run);
 }
 
 }  // namespace kdm

@@ -11,47 +11,66 @@
 #include "density_bounds.h"
 #include "kdm/runtime/check.h"
 #include "query_counted.h"
+#include "query_tables.h"
 
 namespace kdm {
 namespace {
 
-/// The units of a region: a grid of cells (tiles, or g × g parts of each where a tile expects more than a
-/// unit's points) cut into blocks of `across` × `down` cells, in rows of blocks bottom to top. Every
-/// boundary is computed from its integer cell index alone, so neighbouring units share it bit for bit.
+/// A unit: the query over `part` (the whole region, or a part of it) and the tiles of `run`.
+struct Unit {
+  QueryParams part;
+  detail::TileRun run;
+};
+
+/// The units of a region. Where tiles are whole: runs of `per_run` tiles in the query's own order over the
+/// tiles it visits (the region widened by the farthest glide, rows bottom to top), each querying the whole
+/// region, so that the units' points in unit order are the query's, in its order, in both modes (a point
+/// that glides into the region comes with the tile it belongs to). Where a tile expects more than a
+/// unit's points: a grid of cells (g × g parts of each tile) cut into runs of `across` cells along a row,
+/// each querying its part of the region. Every boundary is computed from integer indices alone, so
+/// neighbouring units share it bit for bit.
 struct UnitGrid {
-  double cell = 1;
-  std::int64_t cx0 = 0, cy0 = 0;  ///< the first cell's index
-  std::int64_t columns = 0, rows = 0, across = 1, down = 1;
+  bool runs = true;
+  std::int64_t tx0 = 0, ty0 = 0, width = 1, tiles = 1, per_run = 1;  // runs
+  double cell = 1;                                                   // cells
+  std::int64_t cx0 = 0, cy0 = 0;                                     ///< the first cell's index
+  std::int64_t columns = 0, rows = 0, across = 1;
 
   std::int64_t per_row() const { return (columns + across - 1) / across; }
-  std::size_t units() const { return static_cast<std::size_t>(per_row() * ((rows + down - 1) / down)); }
-  /// Unit u's query: `whole` over its cells, clipped to the whole region.
-  QueryParams unit(const QueryParams& whole, std::size_t u) const {
-    const std::int64_t block_row = static_cast<std::int64_t>(u) / per_row();
+  std::size_t units() const {
+    return static_cast<std::size_t>(runs ? (tiles + per_run - 1) / per_run : per_row() * rows);
+  }
+  Unit unit(const QueryParams& whole, std::size_t u) const {
+    Unit unit{whole, {}};
+    if (runs) {  // the first run from the lowest tile and the last to the highest: all tiles are served
+      const std::int64_t first = static_cast<std::int64_t>(u) * per_run, next = first + per_run;
+      if (u > 0) unit.run.from_x = tx0 + first % width, unit.run.from_y = ty0 + first / width;
+      if (next < tiles) unit.run.to_x = tx0 + next % width, unit.run.to_y = ty0 + next / width;
+      return unit;
+    }
+    const std::int64_t r0 = static_cast<std::int64_t>(u) / per_row(), r1 = r0 + 1;
     const std::int64_t c0 = static_cast<std::int64_t>(u) % per_row() * across,
                        c1 = std::min(columns, c0 + across);
-    const std::int64_t r0 = block_row * down, r1 = std::min(rows, r0 + down);
-    QueryParams q = whole;
+    QueryParams& q = unit.part;
     q.x0 = std::max(whole.x0, double(cx0 + c0) * cell), q.x1 = std::min(whole.x1, double(cx0 + c1) * cell);
     q.y0 = std::max(whole.y0, double(cy0 + r0) * cell), q.y1 = std::min(whole.y1, double(cy0 + r1) * cell);
     if (c0 == 0) q.x0 = whole.x0;  // the region's own sides, not a rounding of them
     if (c1 == columns) q.x1 = whole.x1;
     if (r0 == 0) q.y0 = whole.y0;
     if (r1 == rows) q.y1 = whole.y1;
-    return q;
+    return unit;
   }
 };
 
-/// Points a unit aims at when it is counted first and written in place (a constant density): large units,
-/// as only their count waits for the unit before.
-constexpr double kDirectUnitPoints = double(std::size_t(1) << 20);
+/// Points a unit aims at when it is counted first and written in place (a constant density): only its
+/// count waits for the unit before, but units many times the workers' count keep the last ones even.
+constexpr double kDirectUnitPoints = double(std::size_t(1) << 18);
 
 /// Most cells a tile is cut into per side: units of a denser tile hold more than a unit's points.
 constexpr std::int64_t kMaxCellsPerTileSide = 1024;
 
-/// Units that expect about `target` points: runs along a row in stable mode (units then follow the whole
-/// query's tile order), square blocks in smooth mode (fewer tiles beside a unit whose points glide in).
-UnitGrid plan_units(const QueryParams& q, double target) {
+/// Units that expect about `target` points.
+UnitGrid plan_units(const Tileset& tileset, const QueryParams& q, double target) {
   double rho = 0;  // an upper bound of the density (the query has accepted it)
   switch (q.density.kind) {
     case QueryDensity::Kind::kConstant:
@@ -64,23 +83,36 @@ UnitGrid plan_units(const QueryParams& q, double target) {
       rho = q.density.callback_max;
       break;
   }
-  const double per_tile = std::max(rho, 0.0) * q.tile_size * q.tile_size * q.scale;
+  const double S = q.tile_size, per_tile = std::max(rho, 0.0) * S * S * q.scale;
   UnitGrid g;
-  std::int64_t split = 1;
-  if (per_tile > target)
-    split =
-        std::min<std::int64_t>(kMaxCellsPerTileSide, std::int64_t(std::ceil(std::sqrt(per_tile / target))));
-  g.cell = q.tile_size / double(split);
-  g.cx0 = std::int64_t(std::floor(q.x0 / q.tile_size)) * split;
-  g.cy0 = std::int64_t(std::floor(q.y0 / q.tile_size)) * split;
+  if (!(per_tile > target)) {
+    // The tiles the query visits, about: widened by as far as any point glides (the query's own reach is
+    // no farther), clamped where it refuses tile indices.
+    double reach = 0;
+    if (q.mode == QueryMode::kSmooth && tileset.has_glide_track()) {
+      const detail::QueryTables& tables = detail::TilesetInternals::tables(tileset);
+      reach = tables.descent_reach;
+      for (double r : tables.glide_reach) reach = std::max(reach, r);
+      reach *= S;
+    }
+    auto index = [](double t) { return std::int64_t(std::clamp(t, -9e15, 9e15)); };
+    g.tx0 = index(std::floor((q.x0 - reach) / S)), g.ty0 = index(std::floor((q.y0 - reach) / S));
+    g.width = std::max<std::int64_t>(1, index(std::ceil((q.x1 + reach) / S)) - g.tx0);
+    const std::int64_t height = std::max<std::int64_t>(1, index(std::ceil((q.y1 + reach) / S)) - g.ty0);
+    g.tiles = g.width * height;  // at most about kMaxQueryTiles, which the query has accepted
+    g.per_run = per_tile > 0 ? std::int64_t(std::clamp(target / per_tile, 1.0, double(g.tiles))) : g.tiles;
+    return g;
+  }
+  g.runs = false;
+  const std::int64_t split =
+      std::min<std::int64_t>(kMaxCellsPerTileSide, std::int64_t(std::ceil(std::sqrt(per_tile / target))));
+  g.cell = S / double(split);
+  g.cx0 = std::int64_t(std::floor(q.x0 / S)) * split;
+  g.cy0 = std::int64_t(std::floor(q.y0 / S)) * split;
   g.columns = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.x1 / g.cell)) - g.cx0);
   g.rows = std::max<std::int64_t>(1, std::int64_t(std::ceil(q.y1 / g.cell)) - g.cy0);
   const double per_cell = per_tile / double(split * split);
-  const double cells = per_cell > 0 ? std::min(target / per_cell, 1e12) : 1e12;
-  if (q.mode == QueryMode::kSmooth && split == 1)
-    g.across = g.down = std::max<std::int64_t>(1, std::int64_t(std::sqrt(cells)));
-  else
-    g.across = std::max<std::int64_t>(1, std::int64_t(cells)), g.down = 1;
+  g.across = std::max<std::int64_t>(1, std::int64_t(std::min(target / per_cell, 1e12)));
   // A query refuses a region too narrow for its distance from the world origin (kTooFarFromOrigin: its
   // side under about 2^-50 of that distance) that the whole region may not be. A first or last row or
   // column the region cuts that thin is merged into its neighbour; and as far out as even a whole cell
@@ -94,7 +126,7 @@ UnitGrid plan_units(const QueryParams& q, double target) {
   };
   merge_slivers(q.x0, q.x1, g.cx0, g.columns);
   merge_slivers(q.y0, q.y1, g.cy0, g.rows);
-  if (far > std::ldexp(g.cell, 46)) g.across = g.columns, g.down = g.rows;
+  if (far > std::ldexp(g.cell, 46)) g.runs = true, g.tiles = g.per_run = 1;
   return g;
 }
 
@@ -145,13 +177,14 @@ struct PointOutput {
     return query_points(t, q, out, 0, &none, c, problem);
   }
   void take(const Scratch& s) { scratch = s.points; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
-               QueryProblem* p) const {
-    return query_points(t, q, scratch, kParallelUnitPoints, w, c, p);
+  Status query(const Tileset& t, const Unit& u, std::size_t* w, QueryCursor* c, QueryProblem* p) const {
+    std::uint64_t examined = 0;
+    return detail::query_points_counted(t, u.part, scratch, kParallelUnitPoints, w, c, p, examined, u.run);
   }
-  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
-                        std::size_t* w, QueryCursor* c) const {
-    return query_points(t, q, out + at, room, w, c);
+  Status query_in_place(const Tileset& t, const Unit& u, std::size_t at, std::size_t room, std::size_t* w,
+                        QueryCursor* c) const {
+    std::uint64_t examined = 0;
+    return detail::query_points_counted(t, u.part, out + at, room, w, c, nullptr, examined, u.run);
   }
   bool has_output() const { return out != nullptr; }
   void copy(std::size_t to, std::size_t count) const { std::memcpy(out + to, scratch, count * sizeof *out); }
@@ -164,14 +197,14 @@ struct CompactOutput {
     return query_points_compact(t, q, out, 0, &none, c, problem);
   }
   void take(const Scratch& s) { scratch = CompactPoints{s.xy, out.keys ? s.keys : nullptr}; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
-               QueryProblem* p) const {
-    return query_points_compact(t, q, scratch, kParallelUnitPoints, w, c, p);
+  Status query(const Tileset& t, const Unit& u, std::size_t* w, QueryCursor* c, QueryProblem* p) const {
+    return detail::query_compact_run(t, u.part, scratch, kParallelUnitPoints, w, c, p, u.run);
   }
-  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
-                        std::size_t* w, QueryCursor* c) const {
-    return query_points_compact(t, q, CompactPoints{out.xy + 2 * at, out.keys ? out.keys + at : nullptr},
-                                room, w, c);
+  Status query_in_place(const Tileset& t, const Unit& u, std::size_t at, std::size_t room, std::size_t* w,
+                        QueryCursor* c) const {
+    return detail::query_compact_run(t, u.part,
+                                     CompactPoints{out.xy + 2 * at, out.keys ? out.keys + at : nullptr}, room,
+                                     w, c, nullptr, u.run);
   }
   bool has_output() const { return out.xy != nullptr; }
   void copy(std::size_t to, std::size_t count) const {
@@ -195,33 +228,24 @@ struct ClassOutput {
     p.query.x0 = q.x0, p.query.y0 = q.y0, p.query.x1 = q.x1, p.query.y1 = q.y1;
     return p;
   }
-  static Status query_into(const Tileset& t, const ClassQueryParams& p, QueryPoint* out, std::uint8_t* cls,
-                           std::size_t room, std::size_t* w, QueryCursor* c,
-                           QueryProblem* problem = nullptr) {
-    return query_classes(t, p, out, cls, room, w, c, problem);
-  }
-  static Status query_into(const Tileset& t, const ClassQueryParams& p, const CompactPoints& out,
-                           std::uint8_t* cls, std::size_t room, std::size_t* w, QueryCursor* c,
-                           QueryProblem* problem = nullptr) {
-    return query_classes_compact(t, p, out, cls, room, w, c, problem);
-  }
   Status probe(const Tileset& t, const QueryParams&, QueryCursor* c, QueryProblem* problem) const {
     std::size_t none = 0;
-    return query_into(t, *params, base.out, classes, 0, &none, c, problem);
+    return detail::query_classes_run(t, *params, base.out, classes, 0, &none, c, problem, {});
   }
   void take(const Scratch& s) { base.take(s), class_scratch = s.classes; }
-  Status query(const Tileset& t, const QueryParams& q, std::size_t* w, QueryCursor* c,
-               QueryProblem* p) const {
-    return query_into(t, over(q), base.scratch, class_scratch, kParallelUnitPoints, w, c, p);
+  Status query(const Tileset& t, const Unit& u, std::size_t* w, QueryCursor* c, QueryProblem* p) const {
+    return detail::query_classes_run(t, over(u.part), base.scratch, class_scratch, kParallelUnitPoints, w, c,
+                                     p, u.run);
   }
-  Status query_in_place(const Tileset& t, const QueryParams& q, std::size_t at, std::size_t room,
-                        std::size_t* w, QueryCursor* c) const {
+  Status query_in_place(const Tileset& t, const Unit& u, std::size_t at, std::size_t room, std::size_t* w,
+                        QueryCursor* c) const {
     if constexpr (std::is_same_v<Base, CompactOutput>)
-      return query_into(t, over(q),
-                        CompactPoints{base.out.xy + 2 * at, base.out.keys ? base.out.keys + at : nullptr},
-                        classes + at, room, w, c);
+      return detail::query_classes_run(
+          t, over(u.part), CompactPoints{base.out.xy + 2 * at, base.out.keys ? base.out.keys + at : nullptr},
+          classes + at, room, w, c, nullptr, u.run);
     else
-      return query_into(t, over(q), base.out + at, classes + at, room, w, c);
+      return detail::query_classes_run(t, over(u.part), base.out + at, classes + at, room, w, c, nullptr,
+                                       u.run);
   }
   bool has_output() const { return base.has_output() && classes != nullptr; }
   void copy(std::size_t to, std::size_t count) const {
@@ -253,19 +277,19 @@ struct Job {
 
   /// Counts unit u, takes its place, then writes it there: no copy (a constant density, whose count costs
   /// little beside its writing).
-  void count_and_write(const Output& o, std::size_t u, const QueryParams& part) {
+  void count_and_write(const Output& o, std::size_t u, const Unit& part) {
     QueryCursor cursor;
     std::size_t count = 0;
     for (;;) {
       std::size_t c = 0;
-      const Status s = detail::count_points(*tileset, part, &c, &cursor);
+      const Status s = detail::count_points(*tileset, part.part, &c, &cursor, part.run);
       KDM_CHECK(s == Status::kOk || s == Status::kBufferFull);
       count += c;
       if (s == Status::kInvalidArgument &&
           !refused.exchange(true)) {  // the refusal, from a call with no room
         QueryCursor probe;
         std::size_t none = 0;
-        query_points(*tileset, part, nullptr, 0, &none, &probe, &why);
+        query_points(*tileset, part.part, nullptr, 0, &none, &probe, &why);
       }
       if (s != Status::kBufferFull) break;
     }
@@ -287,7 +311,7 @@ struct Job {
     for (;;) {
       const std::size_t u = next.fetch_add(1, std::memory_order_relaxed);
       if (u >= units) return;
-      const QueryParams part = grid.unit(*params, u);
+      const Unit part = grid.unit(*params, u);
       if (direct) {
         count_and_write(o, u, part);
         continue;
@@ -360,7 +384,7 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
   // A constant density's units are counted, then written in place; a varying one's, whose count costs
   // as much as the query, go through the scratch (room for a loose bound and the glide's margin).
   job.direct = plan.density.kind == QueryDensity::Kind::kConstant;
-  job.grid = plan_units(plan, job.direct ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
+  job.grid = plan_units(tileset, plan, job.direct ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
   job.units = job.grid.units(), job.capacity = capacity;
   Output outputs[kMaxParallelWorkers];
   for (std::uint32_t w = 0; w < workers_; ++w) {

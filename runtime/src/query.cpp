@@ -66,11 +66,12 @@ bool emit_descending_into(const detail::DescentQuery& descent, std::int64_t tx, 
   }
 }
 
-/// query_points into any sink (emit_tile.h); `has_room` is false for a null output with room in it.
+/// query_points over the tiles of `run` into any sink (emit_tile.h); `has_room` is false for a null output
+/// with room in it.
 template <class Sink>
 Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool has_room, const char* out_name,
                   std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
-                  std::uint64_t& examined) {
+                  std::uint64_t& examined, const detail::TileRun& run) {
   QueryProblem& why = refuse.problem();
   using Kind = QueryProblem::Kind;
   if (written) *written = 0;
@@ -176,7 +177,14 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   if (far > farthest)
     return refuse(Kind::kTooFarFromOrigin, far == std::fabs(q.x0) || far == std::fabs(q.x1) ? "x0" : "y0",
                   far, farthest);
-  if (!cursor->started) *cursor = QueryCursor{tx0, ty0, 0, true, false, fingerprint};
+  if (!cursor->started) {  // at the first tile of the run the query visits
+    std::int64_t sx = tx0, sy = ty0;
+    if (run.from_y > ty0 || (run.from_y == ty0 && run.from_x > tx0)) {
+      sy = run.from_y, sx = std::max(run.from_x, tx0);
+      if (sx >= tx1) ++sy, sx = tx0;
+    }
+    *cursor = QueryCursor{sx, sy, 0, true, false, fingerprint};
+  }
   // A cursor inside a tile's subtiles names them by a path of subtile indices: a damaged one is refused.
   if (cursor->depth > (descend ? kMaxQueryDepth : 0)) return refuse(Kind::kCursorMismatch, "cursor");
   for (std::uint32_t k = 0; k < cursor->depth; ++k)
@@ -195,9 +203,10 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   job.S = S, job.x0 = q.x0, job.y0 = q.y0, job.x1 = q.x1, job.y1 = q.y1;
   job.origin_x = q.origin_x, job.origin_y = q.origin_y, job.area_scale = area_scale;
   job.density = &d, job.sampler = &sampler;
-  for (std::int64_t ty = cursor->tile_y; ty < ty1; ++ty) {
+  for (std::int64_t ty = cursor->tile_y; ty < ty1 && ty <= run.to_y; ++ty) {
     const double wy = double(ty) * S;
-    for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < tx1; ++tx) {
+    const std::int64_t row_end = ty == run.to_y ? std::min(tx1, run.to_x) : tx1;
+    for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < row_end; ++tx) {
       const std::size_t index = tileset.tile_index_at(tx, ty);
       const Tile& tile = tileset.data().tiles[index];
       const float* thresholds = tables.thresholds[index].data();
@@ -361,18 +370,19 @@ Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* ou
 
 Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                    QueryProblem* problem, std::uint64_t& examined) {
+                                    QueryProblem* problem, std::uint64_t& examined,
+                                    const detail::TileRun& run) {
   detail::Refusal refuse(problem);
   return query_into(tileset, q, PointSink{out}, out != nullptr, "out", capacity, written, cursor, refuse,
-                    examined);
+                    examined, run);
 }
 
 Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::size_t* count,
-                            QueryCursor* cursor) {
+                            QueryCursor* cursor, const TileRun& run) {
   detail::Refusal refuse(nullptr);
   std::uint64_t examined = 0;
   return query_into(tileset, q, detail::CountSink{}, true, "out", std::numeric_limits<std::size_t>::max(),
-                    count, cursor, refuse, examined);
+                    count, cursor, refuse, examined, run);
 }
 
 Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, bool keys, Refusal& refuse) {
@@ -407,17 +417,18 @@ detail::VaryingClassSink<Base> class_sink(Base base, const detail::VaryingClasse
 template <class Classes>
 Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& q, QueryPoint* out,
                                      const Classes& classes, std::size_t capacity, std::size_t* written,
-                                     QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined) {
+                                     QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined,
+                                     const TileRun& run) {
   detail::Refusal refuse(problem);
   return query_into(tileset, q, class_sink(PointSink{out}, classes), out && classes.classes, "out", capacity,
-                    written, cursor, refuse, examined);
+                    written, cursor, refuse, examined, run);
 }
 
 template <class Classes>
 Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& q,
                                      const CompactPoints& compact, const Classes& classes,
                                      std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                                     QueryProblem* problem, std::uint64_t& examined) {
+                                     QueryProblem* problem, std::uint64_t& examined, const TileRun& run) {
   detail::Refusal refuse(problem);
   if (written) *written = 0;
   if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
@@ -425,28 +436,34 @@ Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& 
   const bool room = compact.xy && classes.classes;
   if (compact.keys)
     return query_into(tileset, q, class_sink(CompactSink<true>{compact.xy, compact.keys}, classes), room,
-                      "out.xy", capacity, written, cursor, refuse, examined);
+                      "out.xy", capacity, written, cursor, refuse, examined, run);
   return query_into(tileset, q, class_sink(CompactSink<false>{compact.xy, nullptr}, classes), room, "out.xy",
-                    capacity, written, cursor, refuse, examined);
+                    capacity, written, cursor, refuse, examined, run);
 }
 
 // The two kinds of classes class_query.cpp runs.
 template Status detail::query_classes_counted(const Tileset&, const QueryParams&, QueryPoint*,
                                               const ConstantClasses&, std::size_t, std::size_t*, QueryCursor*,
-                                              QueryProblem*, std::uint64_t&);
+                                              QueryProblem*, std::uint64_t&, const TileRun&);
 template Status detail::query_classes_counted(const Tileset&, const QueryParams&, const CompactPoints&,
                                               const ConstantClasses&, std::size_t, std::size_t*, QueryCursor*,
-                                              QueryProblem*, std::uint64_t&);
+                                              QueryProblem*, std::uint64_t&, const TileRun&);
 template Status detail::query_classes_counted(const Tileset&, const QueryParams&, QueryPoint*,
                                               const VaryingClasses&, std::size_t, std::size_t*, QueryCursor*,
-                                              QueryProblem*, std::uint64_t&);
+                                              QueryProblem*, std::uint64_t&, const TileRun&);
 template Status detail::query_classes_counted(const Tileset&, const QueryParams&, const CompactPoints&,
                                               const VaryingClasses&, std::size_t, std::size_t*, QueryCursor*,
-                                              QueryProblem*, std::uint64_t&);
+                                              QueryProblem*, std::uint64_t&, const TileRun&);
 
 Status query_points_compact(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                             QueryProblem* problem) {
+  return detail::query_compact_run(tileset, q, out, capacity, written, cursor, problem, {});
+}
+
+Status detail::query_compact_run(const Tileset& tileset, const QueryParams& q, const CompactPoints& out,
+                                 std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                                 QueryProblem* problem, const TileRun& run) {
   detail::Refusal refuse(problem);
   std::uint64_t examined = 0;
   if (written) *written = 0;
@@ -454,9 +471,9 @@ Status query_points_compact(const Tileset& tileset, const QueryParams& q, const 
     return Status::kInvalidArgument;
   if (!out.keys)
     return query_into(tileset, q, CompactSink<false>{out.xy, nullptr}, out.xy != nullptr, "out.xy", capacity,
-                      written, cursor, refuse, examined);
+                      written, cursor, refuse, examined, run);
   return query_into(tileset, q, CompactSink<true>{out.xy, out.keys}, out.xy != nullptr, "out.xy", capacity,
-                    written, cursor, refuse, examined);
+                    written, cursor, refuse, examined, run);
 }
 
 double query_density_limit(const Tileset& tileset, QueryMode mode) {

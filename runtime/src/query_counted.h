@@ -31,11 +31,26 @@ class Refusal {
   QueryProblem& why_;
 };
 
-/// query_points, counting into `examined` (on entry, what this call of the caller has examined so far):
-/// it returns kBufferFull once `examined` reaches kMaxQueryCandidates.
+/// A run of a query's depth-0 tiles in the order it visits them (rows bottom to top, each left to right):
+/// the tiles (tx, ty) with (from_y, from_x) <= (ty, tx) < (to_y, to_x), row first. Consecutive runs, the
+/// first from the lowest tile and the last to the highest, share out whatever tiles a query visits, each
+/// with the points it emits (in smooth mode, those that glide in from beside the region too): ParallelQuery's
+/// units. The default run is every tile.
+struct TileRun {
+  std::int64_t from_x = std::numeric_limits<std::int64_t>::min(), from_y = from_x;
+  std::int64_t to_x = std::numeric_limits<std::int64_t>::max(), to_y = to_x;
+};
+
+/// query_points over the tiles of `run`, counting into `examined` (on entry, what this call of the caller
+/// has examined so far): it returns kBufferFull once `examined` reaches kMaxQueryCandidates.
 Status query_points_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                             std::size_t capacity, std::size_t* written, QueryCursor* cursor,
-                            QueryProblem* problem, std::uint64_t& examined);
+                            QueryProblem* problem, std::uint64_t& examined, const TileRun& run = {});
+
+/// query_points_compact over the tiles of `run`.
+Status query_compact_run(const Tileset& tileset, const QueryParams& params, const CompactPoints& out,
+                         std::size_t capacity, std::size_t* written, QueryCursor* cursor,
+                         QueryProblem* problem, const TileRun& run);
 
 /// The compact output's own refusals, before query_points': a region more than 1e38 from the origin
 /// (beyond a float), and `keys` asked of a set whose tiles hold more points than a key's ranks. kOk when
@@ -100,22 +115,32 @@ struct VaryingClasses {
 };
 
 /// query_points into `out`, or query_points_compact into `compact`, with each point's class into
-/// `classes.classes` (Classes: ConstantClasses or VaryingClasses), counting into `examined` as
-/// query_points_counted does.
+/// `classes.classes` (Classes: ConstantClasses or VaryingClasses), over the tiles of `run`, counting into
+/// `examined` as query_points_counted does.
 template <class Classes>
 Status query_classes_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                              const Classes& classes, std::size_t capacity, std::size_t* written,
-                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined);
+                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined,
+                             const TileRun& run);
 template <class Classes>
 Status query_classes_counted(const Tileset& tileset, const QueryParams& params, const CompactPoints& compact,
                              const Classes& classes, std::size_t capacity, std::size_t* written,
-                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined);
+                             QueryCursor* cursor, QueryProblem* problem, std::uint64_t& examined,
+                             const TileRun& run);
 
-/// How many points query_points would write for `params` from `cursor` on, into `*count`, without
-/// writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing to count). Returns
-/// kOk, kBufferFull after kMaxQueryCandidates candidates (call again with the cursor and add), or
-/// kInvalidArgument as query_points refuses.
+/// query_classes and query_classes_compact over the tiles of `run`.
+Status query_classes_run(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
+                         std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                         QueryCursor* cursor, QueryProblem* problem, const TileRun& run);
+Status query_classes_run(const Tileset& tileset, const ClassQueryParams& params, const CompactPoints& out,
+                         std::uint8_t* classes, std::size_t capacity, std::size_t* written,
+                         QueryCursor* cursor, QueryProblem* problem, const TileRun& run);
+
+/// How many points query_points would write for `params` over the tiles of `run` from `cursor` on, into
+/// `*count`, without writing them (the loops run with a sink that keeps nothing: whole tiles cost nothing
+/// to count). Returns kOk, kBufferFull after kMaxQueryCandidates candidates (call again with the cursor
+/// and add), or kInvalidArgument as query_points refuses.
 Status count_points(const Tileset& tileset, const QueryParams& params, std::size_t* count,
-                    QueryCursor* cursor);
+                    QueryCursor* cursor, const TileRun& run = {});
 
 }  // namespace kdm::detail

@@ -1,6 +1,6 @@
 // One query over several threads: the same bits for any worker count and task system, the same points as
-// query_points (in stable mode in its order too), dense tiles cut into parts, a short buffer, refusals, no
-// allocation in a run; and the same for several classes.
+// query_points (in its order too where no tile is cut into parts), dense tiles cut into parts, a short
+// buffer, refusals, no allocation in a run; and the same for several classes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -84,13 +84,18 @@ TEST(ParallelQueryTest, GivesTheSameBitsForAnyWorkerCountAndTheWholeQuerysPoints
   }
 }
 
-TEST(ParallelQueryTest, KeepsTheWholeQuerysOrderInStableModeWhereTilesAreWhole) {
-  for (int kind = 0; kind < 2; ++kind) {  // counted and written in place, and through the scratch
-    QueryParams q = region(QueryMode::kStable, kind);
-    q.scale = 3000;  // runs of several tiles, none cut
-    const std::vector<QueryPoint> whole = run_whole(q);
-    ASSERT_GT(whole.size(), 20000u);
-    EXPECT_TRUE(same_bits(run_parallel(q, 2, std_thread_runner()), whole)) << "density kind " << kind;
+TEST(ParallelQueryTest, KeepsTheWholeQuerysOrderWhereTilesAreWhole) {
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    for (int kind = 0; kind < 2; ++kind) {      // counted and written in place, and through the scratch
+      for (double scale : {3000.0, 15000.0}) {  // runs of several tiles, and of one, none cut
+        QueryParams q = region(mode, kind);
+        q.scale = scale;
+        const std::vector<QueryPoint> whole = run_whole(q);
+        ASSERT_GT(whole.size(), 20000u);
+        EXPECT_TRUE(same_bits(run_parallel(q, 2, std_thread_runner()), whole))
+            << "mode " << int(mode) << " density kind " << kind << " scale " << scale;
+      }
+    }
   }
 }
 
@@ -281,6 +286,19 @@ TEST(ParallelQueryTest, ClassesGiveTheSameBitsForAnyWorkerCountAndTheWholeQuerys
       EXPECT_TRUE(classes == one.classes);
       for (std::size_t i = 0; i < written; ++i)
         ASSERT_LE(std::fabs(xy[2 * i] - one.points[i].x), std::ldexp(std::fabs(one.points[i].x) + 1, -21));
+    }
+  }
+}
+
+TEST(ParallelQueryTest, ClassesKeepTheWholeQuerysOrderWhereTilesAreWhole) {
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    for (int kind = 0; kind < 2; ++kind) {
+      ClassQueryParams q = three_classes(mode, kind);
+      q.query.scale = 6000;  // runs of one tile (varying classes) or of many (constant ones), none cut
+      const Classed whole = run_classes_whole(q), two = run_classes_parallel(q, 2, std_thread_runner());
+      ASSERT_GT(whole.points.size(), 20000u);
+      EXPECT_TRUE(same_bits(two.points, whole.points)) << "mode " << int(mode) << " kind " << kind;
+      EXPECT_TRUE(two.classes == whole.classes) << "mode " << int(mode) << " kind " << kind;
     }
   }
 }

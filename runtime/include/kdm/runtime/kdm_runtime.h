@@ -259,7 +259,8 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
 
 /* One query over several threads (kdm::ParallelQuery, kdm/runtime/parallel_query.h), for callers that fill
  * a large region at once: the region is cut into units fixed by the parameters, so any number of workers
- * gives the same bits, the region's points in the units' order. The library starts no threads: runner->run
+ * gives the same bits, the region's points in kdm_query_points' order (in the units' order where a tile
+ * holds more points than a unit, 16,384 with a varying density, 262,144 with a constant). The library starts no threads: runner->run
  * (context, task, task_context, count) must call task(task_context, i) once for every i in [0, count),
  * concurrently (the tasks wait for one another; a single thread may run them all in turn), and return when
  * all have returned. Density callbacks are then called from those threads at once. Added in 0.4. */
@@ -278,7 +279,7 @@ typedef struct kdm_parallel_query kdm_parallel_query; /* per-worker scratch, all
 KDM_RUNTIME_API kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out);
 KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
 
-/* The region's points into out[0 ... capacity) (kdm_query_points' points, in the units' order), *written
+/* The region's points into out[0 ... capacity) (kdm_query_points' points, in the order above), *written
  * the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first `capacity`,
  * *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out only
  * count); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query

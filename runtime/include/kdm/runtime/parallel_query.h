@@ -1,14 +1,12 @@
-// One large query split over several threads, for callers that fill a large region at once. The region is
-// cut into units (runs or blocks of tiles, or parts of a tile where a tile holds many points), fixed by
-// the parameters alone; workers take units in order. With a constant density a worker counts its unit
-// (whole tiles cost nothing to count), takes its place once the unit before it has counted, and writes it
-// there; with a varying density, whose count costs as much as the query, it queries the unit into its
-// own scratch and copies it into place. The result is the units' points in unit order: the same bits for
-// any number of threads or any task system, and the same points as query_points (in stable mode also in
-// its order where no tile is cut into parts, as units then follow its tile order, unless a side of the
-// region lies past a tile's side by less than 2^-40 of its distance from the world origin, a sliver that
-// joins the row or column beside it; in smooth mode the points that glide across a unit's side come with
-// that unit).
+// One large query split over several threads, for callers that fill a large region at once. The query is
+// cut into units, fixed by the parameters alone: runs of the tiles it visits, in its own order, or, where a
+// tile holds many points, parts of each tile; workers take units in order. With a constant density a worker
+// counts its unit (whole tiles cost nothing to count), takes its place once the unit before it has counted,
+// and writes it there; with a varying density, whose count costs as much as the query, it queries the unit
+// into its own scratch and copies it into place. The result is the units' points in unit order: the same
+// bits for any number of threads or any task system, and the same points as query_points, in its order
+// where no tile is cut into parts (in smooth mode a point that glides into the region comes with the tile
+// it belongs to).
 //
 // The runtime library starts no threads: the caller gives a task system (TaskRunner), or the inline
 // std::thread one below.
