@@ -114,15 +114,15 @@ UnitGrid plan_units(const Tileset& tileset, const QueryParams& q, double target)
   const double per_cell = per_tile / double(split * split);
   g.across = std::max<std::int64_t>(1, std::int64_t(std::min(target / per_cell, 1e12)));
   // A query refuses a region too narrow for its distance from the world origin (kTooFarFromOrigin: its
-  // side under about 2^-50 of that distance) that the whole region may not be. A first or last row or
-  // column the region cuts that thin is merged into its neighbour; and as far out as even a whole cell
-  // could be refused (2^46 cells, where only a density below a point in 16 cells is accepted), the region
-  // is one unit.
+  // side under about 2^-50 of that distance) that the whole region may not be. The first and last rows
+  // and columns the region cuts that thin, or misses (the grid starts at a tile's side), are merged into
+  // their neighbours; and as far out as even a whole cell could be refused (2^46 cells, where only a
+  // density below a point in 16 cells is accepted), the region is one unit.
   const double far = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
   const double thin = std::ldexp(far, -40);
   auto merge_slivers = [&](double lo, double hi, std::int64_t& first, std::int64_t& count) {
-    if (count > 1 && double(first + 1) * g.cell - lo < thin) ++first, --count;
-    if (count > 1 && hi - double(first + count - 1) * g.cell < thin) --count;
+    while (count > 1 && double(first + 1) * g.cell - lo < thin) ++first, --count;  // at most `split`
+    while (count > 1 && hi - double(first + count - 1) * g.cell < thin) --count;
   };
   merge_slivers(q.x0, q.x1, g.cx0, g.columns);
   merge_slivers(q.y0, q.y1, g.cy0, g.rows);

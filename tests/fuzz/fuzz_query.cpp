@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <tuple>
@@ -92,9 +93,12 @@ void joint_batch_callback(void* user, std::size_t n, const double* x, const doub
   for (std::size_t i = 0; i < n; ++i) values[i] = callback(user, x[i], y[i]), values[n + i] = 0;
 }
 
-[[noreturn]] void fail() {
+// The check that failed, by its line: a crash input then says which guarantee it breaks.
+[[noreturn]] void fail_at(int line) {
+  std::fprintf(stderr, "fuzz_query: the check at fuzz_query.cpp:%d failed\n", line);
   std::abort();
 }
+#define fail() fail_at(__LINE__)
 
 // A ParallelQuery of two workers, which in_turn() runs one after the other on this thread.
 kdm::ParallelQuery& two_workers() {

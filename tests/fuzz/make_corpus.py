@@ -175,6 +175,13 @@ def crashes():
     # distance from the origin (kTooFarFromOrigin); the worker waited for a last call that never came.
     write("query", "parallel_unit_too_narrow_for_its_distance", bytes.fromhex(
         "040c0000d04b6202f0550000404000000000000000b89fbd" "5df2ffffbf4000000000ffffffffffffffff00ff0f1000"), root)
+    # ParallelQuery refused an accepted query (runtime/src/parallel_query.cpp): a region from x = -1.7e-154
+    # to 3.7e-4 on tiles of side 3.36 cut into half-tile cells starts a column of cells past the region
+    # (cells are counted from the tile's side) and has a column -1.7e-154 to 0, too narrow for its
+    # distance from the origin; merging only the first column kept the sliver.
+    write("query", "parallel_sliver_after_an_empty_column", bytes.fromhex(
+        "25270000000010100002a0100002a0102dc310002525401c23383f060d141b101020000000d7d7d7d7d701005617a520d0"
+        "ffffffffffffffffffffffffffffffffffd8d7d710002525230d3f401c3414061b101022ffffffff29"), root)
 
 
 if __name__ == "__main__":

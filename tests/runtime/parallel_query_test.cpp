@@ -161,6 +161,19 @@ TEST(ParallelQueryTest, ARegionEndingASliverPastATileSideIsServedWhole) {
   }
 }
 
+TEST(ParallelQueryTest, ARegionStartingASliverPastATileSideIsServedWhole) {
+  // Dense enough to cut tiles into halves of a unit each: the grid of halves starts at the tile's side, a
+  // column wholly before the region, then one from x0 = -1.7e-154 to 0, a unit too narrow for its
+  // distance from the origin; both join the column after them.
+  QueryParams q = region(QueryMode::kSmooth, 1);
+  q.x0 = -1.6781495144799912e-154, q.x1 = 0.6, q.y0 = 6.3240035215958458e-228, q.y1 = 0.75;
+  q.origin_x = 1.625, q.origin_y = 0, q.tile_size = 3.359375, q.scale = 1878.0242804831666;
+  q.density.callback_max = 2;  // 42,000 points per tile: halves of more than half a unit's
+  const std::vector<QueryPoint> whole = run_whole(q);
+  ASSERT_GT(whole.size(), 100u);
+  EXPECT_TRUE(by_id(run_parallel(q, 2, sequential_runner())) == by_id(whole));
+}
+
 TEST(ParallelQueryTest, RefusesByName) {
   ParallelQuery pq;
   std::vector<QueryPoint> out(16);
