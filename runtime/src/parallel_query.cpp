@@ -119,14 +119,17 @@ UnitGrid plan_units(const Tileset& tileset, const QueryParams& q, double target)
   // their neighbours; and as far out as even a whole cell could be refused (2^46 cells, where only a
   // density below a point in 16 cells is accepted), the region is one unit.
   const double far = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
-  const double thin = std::ldexp(far, -40);
+  if (far > std::ldexp(g.cell, 46)) {
+    g.runs = true, g.tiles = g.per_run = 1;
+    return g;
+  }
+  const double thin = std::ldexp(far, -40);  // under 64 cells: each loop below runs at most split + 64 times
   auto merge_slivers = [&](double lo, double hi, std::int64_t& first, std::int64_t& count) {
-    while (count > 1 && double(first + 1) * g.cell - lo < thin) ++first, --count;  // at most `split`
+    while (count > 1 && double(first + 1) * g.cell - lo < thin) ++first, --count;
     while (count > 1 && hi - double(first + count - 1) * g.cell < thin) --count;
   };
   merge_slivers(q.x0, q.x1, g.cx0, g.columns);
   merge_slivers(q.y0, q.y1, g.cy0, g.rows);
-  if (far > std::ldexp(g.cell, 46)) g.runs = true, g.tiles = g.per_run = 1;
   return g;
 }
 
