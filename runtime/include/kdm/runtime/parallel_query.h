@@ -2,11 +2,11 @@
 // cut into units, fixed by the parameters alone: runs of the tiles it visits, in its own order, or, where a
 // tile holds many points, parts of each tile; workers take units in order. With a constant density a worker
 // counts its unit (whole tiles cost nothing to count), takes its place once the unit before it has counted,
-// and writes it there; with a varying density, whose count costs as much as the query, it queries the unit
-// into its own scratch and copies it into place. The result is the units' points in unit order: the same
-// bits for any number of threads or any task system, and the same points as query_points, in its order
-// where no tile is cut into parts (in smooth mode a point that glides into the region comes with the tile
-// it belongs to).
+// and writes it there; with a varying density, whose count costs as much as the query, and in smooth mode
+// into compact arrays, it queries the unit into its own scratch and copies it into place. The result is the
+// units' points in unit order: the same bits for any number of threads or any task system, and the same
+// points as query_points, in its order where no tile is cut into parts (in smooth mode a point that glides
+// into the region comes with the tile it belongs to).
 //
 // The runtime library starts no threads: the caller gives a task system (TaskRunner), or the inline
 // std::thread one below.
