@@ -260,10 +260,11 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
 /* One query over several threads (kdm::ParallelQuery, kdm/runtime/parallel_query.h), for callers that fill
  * a large region at once: the region is cut into units fixed by the parameters, so any number of workers
  * gives the same bits, the region's points in kdm_query_points' order (in the units' order where a tile
- * holds more points than a unit: 262,144 at a constant density in stable mode, else 16,384). The library starts no threads: runner->run
- * (context, task, task_context, count) must call task(task_context, i) once for every i in [0, count),
- * concurrently (the tasks wait for one another; a single thread may run them all in turn), and return when
- * all have returned. Density callbacks are then called from those threads at once. Added in 0.4. */
+ * holds more points than a unit: 262,144 at a constant density in stable mode, else 16,384). The library
+ * starts no threads: runner->run(context, task, task_context, count) must call task(task_context, i) once
+ * for every i in [0, count), concurrently (the tasks wait for one another; a single thread may run them all
+ * in turn), and return when all have returned. Density callbacks are then called from those threads at
+ * once. Added in 0.4. */
 typedef struct kdm_task_runner {
   void (*run)(void* context, void (*task)(void* task_context, size_t index), void* task_context,
               size_t count);
