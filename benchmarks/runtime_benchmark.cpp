@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/parallel_query.h"
@@ -247,8 +248,9 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   static const RampClass kPlain[3] = {{0, false}, {1, false}, {2, false}},
                          kTextured[3] = {{0, true}, {1, true}, {2, true}};
   const int ramp = static_cast<int>(state.range(1));
+  const bool by_callback = (ramp >= 1 && ramp <= 5) || ramp == 7 || ramp == 8;
   const RampClass* user = ramp >= 4 ? kTextured : kPlain;
-  const double most = ramp >= 4 ? 1.05 : 1;  // the ramp's maximum, times the texture's
+  const double most = by_callback && ramp >= 4 ? 1.05 : 1;  // the ramp's maximum, times the texture's
   kdm::ClassQueryParams cq;
   cq.query = params(state);
   cq.class_count = 3;
@@ -256,7 +258,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   for (int k = 0; k < 3; ++k) {
     kdm::QueryDensity& d = cq.classes[k];
     d.constant = double(1 << k) / 7;
-    if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
+    if (by_callback) {
       d.kind = kdm::QueryDensity::Kind::kCallback, d.callback = ramp_class;
       d.user = const_cast<RampClass*>(user + k), d.callback_max = d.constant * most;
       if (ramp >= 2) d.bounds = ramp_class_bounds;
@@ -269,10 +271,12 @@ void BM_QueryThreeClasses(benchmark::State& state) {
     cq.joint.user = const_cast<RampClass*>(user);
     for (int k = 0; k < 3; ++k) cq.joint.max[k] = cq.classes[k].callback_max;
   }
-  // ramp 6: each class the ramp as a 256² image, against one image of their sum.
+  // ramp 6: each class the ramp as a 256² image, against one image of their sum; 9 the same images by
+  // their running sums (ClassImageSums).
   std::vector<float> values[4], mips[4];
   kdm::DensityImageView images[4];
-  if (ramp == 6) {
+  kdm::ClassImageSums sums;
+  if (ramp == 6 || ramp == 9) {
     for (int k = 0; k < 4; ++k) {
       values[k].resize(256 * 256);
       for (int x = 0; x < 256; ++x) {
@@ -286,13 +290,15 @@ void BM_QueryThreeClasses(benchmark::State& state) {
       kdm::QueryDensity& d = k < 3 ? cq.classes[k] : one.density;
       d.kind = kdm::QueryDensity::Kind::kImage, d.image = &images[k];
     }
+    const kdm::DensityImageView* classes[3] = {&images[0], &images[1], &images[2]};
+    if (ramp == 9 && sums.build(classes, 3) == kdm::Status::kOk) cq.image_sums = &sums;
   }
-  if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
+  if (by_callback) {
     one.density.kind = kdm::QueryDensity::Kind::kCallback, one.density.callback = ramp_sum;
     one.density.user = const_cast<RampClass*>(user);
     one.density.callback_max = most;
     if (ramp >= 2) one.density.bounds = ramp_sum_bounds;
-    if (ramp >= 7) one.density.callback = nullptr, one.density.batch_callback = ramp_sum_batch;
+    if (ramp == 7 || ramp == 8) one.density.callback = nullptr, one.density.batch_callback = ramp_sum_batch;
   }
   std::vector<kdm::QueryPoint> buffer(1 << 20);
   std::vector<std::uint8_t> classes(buffer.size());
@@ -343,7 +349,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
   report(state, n);
   state.counters["of_one_class"] = one_seconds / seconds;
   // Class densities read per point emitted (ramps only), by the class query and by the one-class query.
-  if ((ramp >= 1 && ramp <= 5) || ramp >= 7) {
+  if (by_callback) {
     state.counters["reads_per_point"] = double(reads) / double(n);
     state.counters["one_class_reads_per_point"] = double(one_reads) / double(n);
   }
@@ -722,7 +728,7 @@ BENCHMARK(BM_QueryDensityCallback)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7, 8}, {0, 1}})
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QuerySmoothAtDepth)->ArgName("depth")->DenseRange(0, 4)->Unit(benchmark::kMillisecond);

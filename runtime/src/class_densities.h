@@ -10,6 +10,7 @@
 #include "density_bounds.h"
 #include "image_sampler.h"
 #include "kdm/runtime/check.h"
+#include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/tileset.h"
 #include "query_counted.h"
@@ -22,9 +23,12 @@ struct ClassDensities {
   const ClassQueryParams* params = nullptr;
   ImageSampler samplers[kMaxQueryClasses];
   bool all_constant = true;
-  bool one_grid = false;         ///< every class an image on class 0's texels (sum_of_images)
-  bool batch = false;            ///< a class read in batches (sum_of_batches), or the joint density
-  bool joint = false;            ///< the joint density gives every class's (ClassQueryParams::joint)
+  bool one_grid = false;  ///< every class an image on class 0's texels (sum_of_images)
+  bool batch = false;     ///< a class read in batches (sum_of_batches), or the joint density
+  bool joint = false;     ///< the joint density gives every class's (ClassQueryParams::joint)
+  /// The images of the classes' running sums (ClassQueryParams::image_sums), else null: then one_grid,
+  /// samplers[0] reads them and the union's density is the last sum's image.
+  const ClassImageSums* sums = nullptr;
   detail::ClassImages images{};  ///< when one_grid: the images, read a block of points at a time
   /// Where sum_of_densities last read the classes, and their running sums there (emit_tile.h's
   /// VaryingClassSink classes the candidate just read from it).
@@ -115,12 +119,28 @@ struct ClassDensities {
     if (one_grid) t = samplers[0].texels(x, y);
     double sum = 0;
     for (std::uint32_t k = 0; k < last; ++k) {
-      sum += joint      ? density_or_zero(v[k])
-             : one_grid ? ImageSampler::blend(params->classes[k].image->values, t)
-                        : at(k, x, y);
+      if (sums)
+        sum = ImageSampler::blend(images.values[k], t);
+      else
+        sum += joint      ? density_or_zero(v[k])
+               : one_grid ? ImageSampler::blend(images.values[k], t)
+                          : at(k, x, y);
       if (TilesetShape::emits(threshold, sum * area)) return static_cast<std::uint8_t>(k);
     }
     return static_cast<std::uint8_t>(last);
+  }
+  /// Bounds of the classes' running sums over [x0, x1] × [y0, y1] into lo[k], hi[k] (classes 0 … k's
+  /// summed density): the sums of bounds(), or the sums' own images' bounds.
+  void cumulative_bounds(double x0, double y0, double x1, double y1, double* lo, double* hi) const {
+    if (sums) {
+      for (std::uint32_t k = 0; k < params->class_count; ++k) {
+        const DensityImageView& im = sums->sum(k);
+        lo[k] = im.min_over(x0, y0, x1, y1), hi[k] = im.max_over(x0, y0, x1, y1);
+      }
+      return;
+    }
+    bounds(x0, y0, x1, y1, lo, hi);
+    for (std::uint32_t k = 1; k < params->class_count; ++k) lo[k] += lo[k - 1], hi[k] += hi[k - 1];
   }
 };
 

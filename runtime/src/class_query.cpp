@@ -9,6 +9,7 @@
 
 #include "class_densities.h"
 #include "classifier.h"
+#include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/hash.h"
 #include "query_counted.h"
 #include "query_tables.h"
@@ -71,6 +72,9 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
   add(reinterpret_cast<std::uintptr_t>(p.joint.batch_densities));
   add(reinterpret_cast<std::uintptr_t>(p.joint.user));
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) add_double(p.joint.max[k]);
+  add(reinterpret_cast<std::uintptr_t>(p.image_sums));
+  for (std::uint32_t k = 0; p.image_sums && k < p.image_sums->count(); ++k)
+    add(reinterpret_cast<std::uintptr_t>(p.image_sums->sum(k).values));
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
     const QueryDensity& d = p.classes[k];
     add(static_cast<std::uint64_t>(d.kind));
@@ -85,6 +89,35 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
 
 namespace {
 
+/// prepare_union for classes by their running sums' images (ClassQueryParams::image_sums): the union is the
+/// one-class query at the last sum's image.
+Status prepare_sums(const ClassQueryParams& p, ClassDensities& densities, QueryParams& q,
+                    detail::Refusal& refuse) {
+  using Kind = QueryProblem::Kind;
+  const ClassImageSums& sums = *p.image_sums;
+  if (sums.count() != p.class_count || p.joint.densities || p.joint.batch_densities)
+    return refuse(Kind::kBadDensity, "image_sums");
+  for (std::uint32_t k = 0; k < p.class_count; ++k) {
+    const DensityImageView& im = sums.sum(k);
+    if (!im.values || !im.max_mip || !detail::image_rect_usable(im) ||
+        !ImageSampler(&sums.sum(0)).same_grid(im))
+      return refuse(Kind::kBadDensity, "image_sums");
+  }
+  densities.all_constant = false;
+  densities.one_grid = true;
+  densities.sums = &sums;
+  densities.samplers[0] = ImageSampler(&sums.sum(0));
+  densities.images.grid = &densities.samplers[0], densities.images.count = p.class_count;
+  densities.images.cumulative = true;
+  for (std::uint32_t k = 0; k < p.class_count; ++k)
+    densities.images.values[k] = sums.sum(k).values, densities.images.sums[k] = &sums.sum(k);
+  q = p.query;
+  q.density = QueryDensity{};
+  q.density.kind = QueryDensity::Kind::kImage;
+  q.density.image = &sums.sum(p.class_count - 1);
+  return Status::kOk;
+}
+
 /// Checks `p` and `written` (set to 0) and sets up what both outputs share: the classes' densities and the
 /// one-class query at their sum (`q`). kOk, or kInvalidArgument by `refuse`.
 Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::size_t* written,
@@ -95,6 +128,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
   if (p.class_count < 1 || p.class_count > kMaxQueryClasses)
     return refuse(Kind::kBadClassCount, "class_count", p.class_count, kMaxQueryClasses);
   densities.params = &p;
+  if (p.image_sums) return prepare_sums(p, densities, q, refuse);
   const bool joint = densities.joint = p.joint.densities || p.joint.batch_densities;
   if (p.joint.densities && p.joint.batch_densities)  // which one is meant is unclear
     return refuse(Kind::kBadDensity, "joint.batch_densities");

@@ -182,8 +182,12 @@ class Classifier {
     double x[detail::kImageBlock], y[detail::kImageBlock], sums[detail::kImageBlock * kMaxQueryClasses];
     for (std::uint32_t r = first.rank; r < end;) {
       const std::uint32_t count = std::min(end - r, detail::kImageBlock);
-      detail::image_sums_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, images.count, x,
-                             y, sums);
+      if (densities_.sums)  // the running sums' own images: classes 0 … last - 1's only
+        detail::image_planes_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, last, x, y,
+                                 sums);
+      else
+        detail::image_sums_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, images.count,
+                               x, y, sums);
       for (std::uint32_t i = 0; i < count; ++i) {
         const float t = thresholds_[r + i];
         std::uint32_t cls = 0;
@@ -338,14 +342,11 @@ class Classifier {
   void read_cell(std::uint32_t cx, std::uint32_t cy, std::uint32_t cell) {
     constexpr double kStep = 1.0 / (1 << kCellBits);
     const double wx = double(tile_.tile_x) * side_, wy = double(tile_.tile_y) * side_;
-    double l[kMaxQueryClasses], h[kMaxQueryClasses];
-    densities_.bounds(wx + (cx * kStep) * side_, wy + (cy * kStep) * side_, wx + ((cx + 1) * kStep) * side_,
-                      wy + ((cy + 1) * kStep) * side_, l, h);
-    double lo = 0, hi = 0;
-    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k) {
-      lo += l[k], hi += h[k];
-      cell_lo_[cell][k] = lo * area_ * (1 - 1e-9), cell_hi_[cell][k] = hi * area_ * (1 + 1e-9);
-    }
+    double lo[kMaxQueryClasses], hi[kMaxQueryClasses];
+    densities_.cumulative_bounds(wx + (cx * kStep) * side_, wy + (cy * kStep) * side_,
+                                 wx + ((cx + 1) * kStep) * side_, wy + ((cy + 1) * kStep) * side_, lo, hi);
+    for (std::uint32_t k = 0; k + 1 < p_.class_count; ++k)
+      cell_lo_[cell][k] = lo[k] * area_ * (1 - 1e-9), cell_hi_[cell][k] = hi[k] * area_ * (1 + 1e-9);
     cells_read_ |= std::uint64_t(1) << cell;
   }
 
@@ -389,13 +390,11 @@ class Classifier {
                            [](float t, double c) { return TilesetShape::emits(t, c); }) -
           thresholds_);
     };
-    double l[kMaxQueryClasses], h[kMaxQueryClasses];
-    densities_.bounds(wx, wy, wx + side_, wy + side_, l, h);
-    double lo = 0, hi = 0;
+    double lo[kMaxQueryClasses], hi[kMaxQueryClasses];
+    densities_.cumulative_bounds(wx, wy, wx + side_, wy + side_, lo, hi);
     for (std::uint32_t k = 0; k < p_.class_count; ++k) {
-      sure_from_[k] = k == 0 ? 0 : first_not_emitted(hi * area_ * (1 + 1e-9));
-      lo += l[k], hi += h[k];
-      sure_to_[k] = k + 1 == p_.class_count ? ~0u : first_not_emitted(lo * area_ * (1 - 1e-9));
+      sure_from_[k] = k == 0 ? 0 : first_not_emitted(hi[k - 1] * area_ * (1 + 1e-9));
+      sure_to_[k] = k + 1 == p_.class_count ? ~0u : first_not_emitted(lo[k] * area_ * (1 - 1e-9));
     }
   }
 

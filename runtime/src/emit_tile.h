@@ -420,11 +420,34 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     double bx[kImageBlock], by[kImageBlock], rho[kImageBlock];
     if (!image_runs_fit(*j.sampler->image))
       for (; c < end && stopped == kNone; ++c) stopped = visit(c);
+    // Classes by their running sums' images: the union is the last one, and the emitted candidates are
+    // classed from the same texels (their classes then at cls[i], else null).
+    std::uint8_t cls[kImageBlock] = {};
+    double lo[kMaxQueryClasses], hi[kMaxQueryClasses];  // the sums' expected counts' bounds over the tile
+    bool bounded = false;
+    auto read_block = [&](std::uint32_t count) -> const std::uint8_t* {
+      if constexpr (kClassesAtDensity<Sink>) {
+        if (const ClassImages* sums = out.images(); sums && sums->cumulative) {
+          const double area = out.class_area();
+          for (std::uint32_t k = 0; k + 1 < sums->count && !bounded; ++k) {  // widened as the classifier's
+            lo[k] = sums->sums[k]->min_over(j.wx, j.wy, j.wx + j.S, j.wy + j.S) * area * (1 - 1e-9);
+            hi[k] = sums->sums[k]->max_over(j.wx, j.wy, j.wx + j.S, j.wy + j.S) * area * (1 + 1e-9);
+          }
+          bounded = true;
+          image_classes_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler, sums->values, sums->count, lo,
+                            hi, j.thresholds + c, j.area_scale, area, bx, by, rho, cls);
+          return cls;
+        }
+      }
+      image_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler, bx, by, rho);
+      return nullptr;
+    };
     while (c < end && stopped == kNone) {
       const std::uint32_t count = std::min(end - c, kImageBlock);
-      image_run(j.points + c, count, j.wx, j.wy, j.S, *j.sampler, bx, by, rho);
+      const std::uint8_t* classed = read_block(count);
       for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
-        if (!beyond_reach(c, j.points[c])) stopped = decide(c, j.points[c], bx[i], by[i], rho[i]);
+        if (!beyond_reach(c, j.points[c]))
+          stopped = decide(c, j.points[c], bx[i], by[i], rho[i], classed ? classed + i : nullptr);
     }
   } else if constexpr (kKind == QueryDensity::Kind::kCallback && kClassesAtDensity<Sink> &&
                        (kSmooth || kInside)) {

@@ -67,4 +67,50 @@ KDM_RUN_CLONES void image_sums_run(const TilePoint* from, std::size_t count, dou
   }
 }
 
+KDM_RUN_CLONES void image_planes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                                     const ImageSampler& sampler, const float* const* values,
+                                     std::uint32_t images, double* x, double* y, double* sums) {
+  BlockTexels t;
+  block_texels(from, count, wx, wy, S, sampler, x, y, t);
+  for (std::uint32_t i = 0; i < images; ++i)
+    for (std::size_t k = 0; k < count; ++k) sums[i * kImageBlock + k] = blend(values[i], t, k);
+}
+
+KDM_RUN_CLONES void image_classes_run(const TilePoint* from, std::size_t count, double wx, double wy,
+                                      double S, const ImageSampler& sampler, const float* const* sums,
+                                      std::uint32_t classes, const double* lo, const double* hi,
+                                      const float* thresholds, double area_scale, double area, double* x,
+                                      double* y, double* rho, std::uint8_t* cls) {
+  BlockTexels t;
+  block_texels(from, count, wx, wy, S, sampler, x, y, t);
+  const float* values = sampler.image->values;
+  for (std::size_t k = 0; k < count; ++k) rho[k] = blend(values, t, k);
+  // The emitted candidates whose class the bounds leave open are gathered, so that the loops stay
+  // branch-free; the bounds settle the others (the classes short of a threshold are a prefix).
+  std::uint8_t short_everywhere[kImageBlock] = {}, short_somewhere[kImageBlock] = {};
+  for (std::uint32_t c = 0; c + 1 < classes; ++c) {
+    const double l = lo[c], h = hi[c];
+    for (std::size_t k = 0; k < count; ++k) {
+      short_everywhere[k] += !TilesetShape::emits(thresholds[k], h);
+      short_somewhere[k] += !TilesetShape::emits(thresholds[k], l);
+    }
+  }
+  std::copy(short_everywhere, short_everywhere + count, cls);
+  // A byte store may alias any pointer: the gathering loop stores only into locals.
+  std::uint8_t open[kImageBlock];
+  std::uint32_t m = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    open[m] = static_cast<std::uint8_t>(k);
+    m +=
+        TilesetShape::emits(thresholds[k], rho[k] * area_scale) & (short_everywhere[k] != short_somewhere[k]);
+  }
+  std::uint8_t found[kImageBlock] = {};
+  for (std::uint32_t c = 0; c + 1 < classes; ++c)
+    for (std::uint32_t i = 0; i < m; ++i) {
+      const std::size_t k = open[i];
+      found[i] += !TilesetShape::emits(thresholds[k], blend(sums[c], t, k) * area);
+    }
+  for (std::uint32_t i = 0; i < m; ++i) cls[open[i]] = found[i];
+}
+
 }  // namespace kdm::detail

@@ -32,4 +32,22 @@ void image_sums_run(const TilePoint* from, std::size_t count, double wx, double 
                     const ImageSampler& sampler, const float* const* values, std::uint32_t images, double* x,
                     double* y, double* sums);
 
+/// The same for `images` images on `sampler`'s grid, each read on its own: values[i]'s into
+/// sums[i · kImageBlock + k] (images already summed: ClassImageSums).
+void image_planes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                      const ImageSampler& sampler, const float* const* values, std::uint32_t images,
+                      double* x, double* y, double* sums);
+
+/// The same for classes by the images of their running sums on `sampler`'s grid (ClassImageSums), sums[i]
+/// the i-th one's texels, `classes` of them: sampler's image (the last sum) read into rho[k] as image_run
+/// reads it, and for each candidate it emits (TilesetShape::emits(thresholds[k], rho[k] · area_scale))
+/// its class into cls[k]: how many of sums 0 … classes - 2, read at the same texels and times `area`, do
+/// not pass its threshold. Sum c times `area` lies in [lo[c], hi[c]] at every candidate, so a threshold
+/// outside every such band is classed without reading the sums. cls[k] of a candidate not emitted is left
+/// as it was.
+void image_classes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                       const ImageSampler& sampler, const float* const* sums, std::uint32_t classes,
+                       const double* lo, const double* hi, const float* thresholds, double area_scale,
+                       double area, double* x, double* y, double* rho, std::uint8_t* cls);
+
 }  // namespace kdm::detail

@@ -274,6 +274,8 @@ struct VaryingClassSink {
   }
   /// Classes all images on one grid (ClassImages), else null.
   const ClassImages* images() const { return c->images; }
+  /// A depth-0 tile's area times the scale, which the classes' densities multiply.
+  double class_area() const { return c->area; }
   /// Ranks [first, first + count) of tile j from their classes' running sums at their stable positions
   /// (sums[k · stride + i] for rank first + i, image_sums_run's), into out[0 … count): class_at's rule, in a
   /// loop the compiler vectorises.

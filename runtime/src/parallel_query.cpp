@@ -10,6 +10,7 @@
 
 #include "density_bounds.h"
 #include "kdm/runtime/check.h"
+#include "kdm/runtime/class_image_sums.h"
 #include "query_counted.h"
 #include "query_tables.h"
 
@@ -139,6 +140,11 @@ UnitGrid plan_units(const Tileset& tileset, const QueryParams& q, double target)
 QueryParams union_plan(const ClassQueryParams& p) {
   QueryParams q = p.query;
   q.density = QueryDensity{};
+  if (p.image_sums) {  // the union is the last sum's image
+    q.density.kind = QueryDensity::Kind::kCallback;
+    q.density.callback_max = p.image_sums->sum(p.class_count - 1).max_over(q.x0, q.y0, q.x1, q.y1);
+    return q;
+  }
   const bool joint = p.joint.densities || p.joint.batch_densities;
   bool constant = !joint;
   double sum = 0;

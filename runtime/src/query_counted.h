@@ -87,11 +87,14 @@ struct ClassScratch {
 /// [first, first + count) of depth-0 tile (tx, ty) into out[0..count)) or, past the top level,
 /// `class_of_id`. `area` is a depth-0 tile's area times the scale, as the classifier multiplies it.
 /// Classes that are all images on one grid of texels (class_query.cpp): `grid` reads class 0's, values[k]
-/// are class k's texels, k < count.
+/// are class k's texels, k < count; or, `cumulative`, classes 0 … k's summed density's (ClassImageSums),
+/// the union's density then being the last one's image.
 struct ClassImages {
   const ImageSampler* grid;
   const float* values[kMaxQueryClasses];
   std::uint32_t count;
+  bool cumulative;
+  const DensityImageView* sums[kMaxQueryClasses];  ///< when cumulative: the images of values[k], with mips
 };
 
 struct VaryingClasses {
@@ -110,7 +113,8 @@ struct VaryingClasses {
   void (*class_records)(void* user, const QueryPoint* p, std::size_t n, std::uint8_t* out);
   void* user;
   /// Classes all images on one grid, else null: the union's density is then read a block of candidates
-  /// at a time (emit_tile.h, image_sums_run) instead of through its callback.
+  /// at a time (emit_tile.h: image_sums_run instead of its callback, or for running sums
+  /// image_classes_run, the union being an image).
   const ClassImages* images = nullptr;
 };
 

@@ -39,6 +39,8 @@ namespace kdm {
 /// Most classes one query may carry.
 inline constexpr std::uint32_t kMaxQueryClasses = 8;
 
+class ClassImageSums;  // class_image_sums.h
+
 /// Every class's density from one call, for classes that share their inputs (a biome map that gives the
 /// densities of trees, bushes and rocks at once): one call where separate callbacks would take one each,
 /// at every candidate the bounds leave open.
@@ -67,6 +69,10 @@ struct ClassQueryParams {
   /// Optional: when joint.densities or joint.batch_densities is set, it gives every class's density and
   /// `classes` is not read.
   JointClassDensity joint;
+  /// Optional: classes that are images on one grid, by the images of their running sums
+  /// (class_image_sums.h; image_sums->count() must equal class_count). When set it gives every class's
+  /// density, `classes` is not read, and the query reads one image where `classes` would read each.
+  const ClassImageSums* image_sums = nullptr;
 };
 
 /// A hash of every field of `params` that a query reads: the identity its cursor keeps.
@@ -78,8 +84,9 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
 /// with `problem` (optional) naming the parameter for: a class count of 0 or more than kMaxQueryClasses
 /// (kBadClassCount), a class's missing image or callback or bad callback_max (parameter
 /// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a bad joint maximum
-/// ("joint.max[k]"), both joint functions ("joint.batch_densities"), a null `classes` with room in
-/// `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
+/// ("joint.max[k]"), both joint functions ("joint.batch_densities"), image sums for another class count
+/// or with a joint density, or with an image the query cannot read ("image_sums"), a null `classes` with room
+/// in `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
 KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
                                      std::uint8_t* classes, std::size_t capacity, std::size_t* written,
                                      QueryCursor* cursor, QueryProblem* problem = nullptr);

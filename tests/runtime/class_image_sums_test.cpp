@@ -1,0 +1,312 @@
+// Classes of images on one grid by the images of their running sums (ClassImageSums): the union is the
+// one-class query at the last sum's image, in stable mode classes 0 … k together exactly the one-class query
+// at sum k, smooth mode's classes stable mode's; parts of a region, the compact output and ParallelQuery
+// give the same points and classes; the classes follow those of the images given one by one; refusals by
+// name; no allocation in queries.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <tuple>
+#include <vector>
+
+#include "allocation_counter.h"
+#include "kdm/runtime/class_image_sums.h"
+#include "kdm/runtime/class_query.h"
+#include "kdm/runtime/parallel_query.h"
+#include "random_partition.h"
+
+namespace kdm {
+namespace {
+
+using Id = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
+struct Emitted {
+  double x, y;
+  int cls;
+};
+using Points = std::map<Id, Emitted>;
+
+Id id_of(const QueryPoint& p) {
+  return {p.id.tile_x, p.id.tile_y, p.id.rank, p.id.depth};
+}
+
+/// query_classes resumed through a buffer of `capacity`, or query_points when `one` is not null.
+Points run(const ClassQueryParams* classes, const QueryParams* one, std::size_t capacity = 1 << 14) {
+  std::vector<QueryPoint> out(capacity);
+  std::vector<std::uint8_t> cls(capacity);
+  Points points;
+  QueryCursor cursor;
+  for (;;) {
+    std::size_t written = 0;
+    const Status s = one ? query_points(Tileset::builtin(), *one, out.data(), out.size(), &written, &cursor)
+                         : query_classes(Tileset::builtin(), *classes, out.data(), cls.data(), out.size(),
+                                         &written, &cursor);
+    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
+    for (std::size_t i = 0; i < written; ++i)
+      EXPECT_TRUE(points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, one ? 0 : cls[i]}).second);
+    if (s != Status::kBufferFull) break;
+  }
+  return points;
+}
+
+/// Same ids at the same positions, bit for bit.
+void expect_same(const Points& a, const Points& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
+    ASSERT_TRUE(i->first == j->first) << what;
+    ASSERT_EQ(i->second.x, j->second.x) << what;
+    ASSERT_EQ(i->second.y, j->second.y) << what;
+  }
+}
+
+/// Three images over [0, 4)² on one 32 × 32 grid: a ramp in x, a ramp in y and a bump.
+struct ThreeImages {
+  std::vector<float> values[3];
+  DensityImageView views[3];
+  const DensityImageView* pointers[3] = {&views[0], &views[1], &views[2]};
+  ClassImageSums sums;
+  ThreeImages() {
+    for (int k = 0; k < 3; ++k) {
+      values[k].resize(32 * 32);
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
+          values[k][y * 32 + x] =
+              static_cast<float>(k == 0   ? u
+                                 : k == 1 ? 0.2 + v
+                                          : std::exp(-8 * ((u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5))));
+        }
+      views[k].width = views[k].height = 32;
+      views[k].x1 = views[k].y1 = 4;
+      views[k].values = values[k].data();
+    }
+    EXPECT_EQ(sums.build(pointers, 3), Status::kOk);
+  }
+  ClassQueryParams query(double x0, double y0, double x1, double y1, double scale, QueryMode mode) const {
+    ClassQueryParams q;
+    q.query.x0 = x0, q.query.y0 = y0, q.query.x1 = x1, q.query.y1 = y1;
+    q.query.scale = scale, q.query.mode = mode;
+    q.class_count = 3;
+    q.image_sums = &sums;
+    return q;
+  }
+};
+
+/// The one-class query at sum k's image over q's region.
+QueryParams at_sum(const ClassQueryParams& q, std::uint32_t k) {
+  QueryParams one = q.query;
+  one.density.kind = QueryDensity::Kind::kImage;
+  one.density.image = &q.image_sums->sum(k);
+  return one;
+}
+
+TEST(ClassImageSumsTest, SumsAreTheImagesAddedTexelByTexel) {
+  ThreeImages im;
+  ASSERT_EQ(im.sums.count(), 3u);
+  for (std::size_t i = 0; i < 32 * 32; ++i) {
+    float sum = 0;
+    for (int k = 0; k < 3; ++k) {
+      sum += im.values[k][i];
+      ASSERT_EQ(im.sums.sum(k).values[i], sum) << i;
+    }
+  }
+  ClassImageSums moved = std::move(im.sums);  // it owns its texels: a move keeps the views valid
+  EXPECT_NEAR(moved.sum(2).at(1.3, 2.2),
+              im.views[0].at(1.3, 2.2) + im.views[1].at(1.3, 2.2) + im.views[2].at(1.3, 2.2), 1e-5);
+  EXPECT_GT(moved.sum(2).max_over(0, 0, 4, 4), moved.sum(1).max_over(0, 0, 4, 4));
+}
+
+TEST(ClassImageSumsTest, StableClassesAreTheOneClassQueriesAtTheSums) {
+  ThreeImages im;
+  const ClassQueryParams q = im.query(-0.4, 0.3, 4.3, 4.6, 900, QueryMode::kStable);
+  const Points all = run(&q, nullptr, 1000);
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    Points upto;
+    for (const auto& [id, e] : all)
+      if (e.cls <= int(k)) upto.emplace(id, e);
+    const QueryParams one = at_sum(q, k);
+    expect_same(upto, run(nullptr, &one), "classes 0 … k against the one-class query at sum k");
+    EXPECT_GT(upto.size(), 3000u * (k + 1));
+  }
+}
+
+TEST(ClassImageSumsTest, SmoothUnionIsTheSmoothQueryAtTheLastSumWithStableModesClasses) {
+  ThreeImages im;
+  // At the top level and past it (the sum's peak, about 3.2, at 20,000 per unit area passes the top
+  // level's 32,768 points per tile).
+  for (double scale : {900.0, 20000.0}) {
+    const double side = scale > 1000 ? 0.6 : 3.7;
+    const ClassQueryParams smooth = im.query(1.7, 1.6, 1.7 + side, 1.6 + side, scale, QueryMode::kSmooth);
+    const Points all = run(&smooth, nullptr, 777);
+    const QueryParams one = at_sum(smooth, 2);
+    expect_same(all, run(nullptr, &one), "the smooth union");
+    std::size_t deep = 0;
+    for (const auto& [id, e] : all) deep += std::get<3>(id) > 0;
+    if (scale > 1000) {
+      EXPECT_GT(deep, all.size() / 10);
+      continue;
+    }  // past the top level a point is classed by its subtile's threshold
+    ClassQueryParams stable = smooth;
+    stable.query.mode = QueryMode::kStable;
+    const Points fixed = run(&stable, nullptr);
+    std::size_t both = 0;
+    for (const auto& [id, e] : all) {
+      const auto it = fixed.find(id);
+      if (it == fixed.end()) continue;
+      ASSERT_EQ(e.cls, it->second.cls);
+      ++both;
+    }
+    EXPECT_GT(both, all.size() * 9 / 10);
+  }
+}
+
+TEST(ClassImageSumsTest, ClassesFollowTheImagesGivenOneByOne) {
+  // The sums are added in float and read once where the images are read one by one and added in double:
+  // the same points and classes but for a threshold within rounding of a density (none here; a few in
+  // 10^7 would be).
+  ThreeImages im;
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    const ClassQueryParams sums = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
+    ClassQueryParams images = sums;
+    images.image_sums = nullptr;
+    std::vector<float> mips[3];
+    DensityImageView views[3] = {im.views[0], im.views[1], im.views[2]};
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(make_density_max_mip(views[k], mips[k]), Status::kOk);
+      images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &views[k];
+    }
+    const Points a = run(&sums, nullptr), b = run(&images, nullptr);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0;
+    for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
+      ASSERT_TRUE(i->first == j->first);
+      differ += i->second.cls != j->second.cls;
+    }
+    EXPECT_EQ(differ, 0u) << "mode " << int(mode);
+  }
+}
+
+TEST(ClassImageSumsTest, PartsCompactOutputAndThreadsGiveTheSamePointsAndClasses) {
+  ThreeImages im;
+  std::mt19937 rng(5);
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    const ClassQueryParams whole = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
+    const Points all = run(&whole, nullptr, 1000);
+    Points joined;
+    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
+      ClassQueryParams p = whole;
+      p.query = part;
+      for (const auto& [id, e] : run(&p, nullptr)) EXPECT_TRUE(joined.emplace(id, e).second);
+    }
+    expect_same(all, joined, "parts");
+    for (const auto& [id, e] : all) ASSERT_EQ(e.cls, joined.at(id).cls);
+
+    // The records in order, then the compact output and two workers over the same buffer size.
+    std::vector<QueryPoint> out(all.size() + 1);
+    std::vector<std::uint8_t> cls(out.size()), cls2(out.size());
+    std::size_t written = 0, written2 = 0;
+    QueryCursor cursor;
+    ASSERT_EQ(query_classes(Tileset::builtin(), whole, out.data(), cls.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    std::vector<float> xy(2 * out.size());
+    std::vector<std::uint64_t> keys(out.size());
+    cursor = QueryCursor{};
+    ASSERT_EQ(query_classes_compact(Tileset::builtin(), whole, CompactPoints{xy.data(), keys.data()},
+                                    cls2.data(), out.size(), &written2, &cursor),
+              Status::kOk);
+    ASSERT_EQ(written2, written);
+    for (std::size_t i = 0; i < written; ++i) {
+      ASSERT_EQ(keys[i], point_key(out[i].id)) << i;
+      ASSERT_EQ(cls2[i], cls[i]) << i;
+    }
+    ParallelQuery pq;
+    ASSERT_EQ(pq.init(2), Status::kOk);
+    std::vector<QueryPoint> par(out.size());
+    std::vector<std::uint8_t> par_cls(out.size());
+    ASSERT_EQ(pq.run(Tileset::builtin(), whole, par.data(), par_cls.data(), par.size(), &written2,
+                     std_thread_runner()),
+              Status::kOk);
+    ASSERT_EQ(written2, written);
+    std::map<Id, int> by_id;
+    for (std::size_t i = 0; i < written; ++i) by_id[id_of(par[i])] = par_cls[i];
+    for (std::size_t i = 0; i < written; ++i) ASSERT_EQ(by_id.at(id_of(out[i])), cls[i]) << i;
+  }
+}
+
+TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
+  ThreeImages im;
+  ClassImageSums sums;
+  const char* why = nullptr;
+  EXPECT_EQ(sums.build(im.pointers, 0, &why), Status::kInvalidArgument);
+  EXPECT_STREQ(why, "the class count is not 1 ... 8");
+  EXPECT_EQ(sums.build(im.pointers, 9, &why), Status::kInvalidArgument);
+  EXPECT_EQ(sums.build(nullptr, 2, &why), Status::kInvalidArgument);
+  DensityImageView other = im.views[1];
+  other.x1 = 5;  // another grid
+  const DensityImageView* mixed[2] = {&im.views[0], &other};
+  EXPECT_EQ(sums.build(mixed, 2, &why), Status::kInvalidArgument);
+  EXPECT_STREQ(why, "an image is not on the first image's grid (size and world rectangle)");
+  std::vector<float> bad = im.values[1];
+  bad[17] = std::numeric_limits<float>::quiet_NaN();
+  other = im.views[1], other.values = bad.data();
+  EXPECT_EQ(sums.build(mixed, 2, &why), Status::kInvalidArgument);
+  EXPECT_STREQ(why, "an image has a negative or non-finite value");
+  bad[17] = -1;
+  EXPECT_EQ(sums.build(mixed, 2, &why), Status::kInvalidArgument);
+  bad[17] = 3e38f;
+  std::vector<float> big(bad.size(), 3e38f);
+  other.values = big.data();
+  const DensityImageView* twice[3] = {&other, &other, &other};
+  EXPECT_EQ(sums.build(twice, 3, &why), Status::kInvalidArgument);
+  EXPECT_STREQ(why, "the images' sum overflows a float");
+  EXPECT_EQ(sums.count(), 0u);  // a refused build leaves it empty
+
+  // Queries: sums for another class count, or beside a joint density.
+  ClassQueryParams q = im.query(0, 0, 4, 4, 100, QueryMode::kStable);
+  std::vector<QueryPoint> out(16);
+  std::uint8_t cls[16];
+  std::size_t written = 0;
+  QueryProblem problem;
+  q.class_count = 2;
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(problem.parameter, "image_sums");
+  q.class_count = 3;
+  q.joint.densities = [](void*, double, double, double* v) { v[0] = v[1] = v[2] = 1; };
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(problem.parameter, "image_sums");
+  q.joint.densities = nullptr;
+  const ClassImageSums empty;
+  q.image_sums = &empty;
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(problem.parameter, "image_sums");
+}
+
+TEST(ClassImageSumsTest, QueriesAllocateNothing) {
+  ThreeImages im;
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> cls(out.size());
+  std::vector<float> xy(2 * out.size());
+  (void)Tileset::builtin();
+  const long before = testing::allocations();
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    const ClassQueryParams q = im.query(0, 0, 4, 4, 500, mode);
+    QueryCursor cursor;
+    std::size_t written = 0;
+    EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    EXPECT_GT(written, 10000u);
+    cursor = QueryCursor{};
+    EXPECT_EQ(query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), nullptr}, cls.data(),
+                                    out.size(), &written, &cursor),
+              Status::kOk);
+  }
+  EXPECT_EQ(testing::allocations(), before);
+}
+
+}  // namespace
+}  // namespace kdm
