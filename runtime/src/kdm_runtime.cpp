@@ -8,6 +8,7 @@
 #include <new>
 #include <vector>
 
+#include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/kdm_runtime.h"
@@ -29,6 +30,10 @@ struct kdm_density_image {
 
 struct kdm_parallel_query {
   kdm::ParallelQuery parallel;
+};
+
+struct kdm_class_images {
+  kdm::ClassImageSums sums;
 };
 
 namespace {
@@ -180,31 +185,46 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
   return status;
 }
 
-/// Reads the class densities (`classes`, or `joint` when `is_joint`) into `q` and runs
+/// The densities a C class query reads: separate classes, one joint density, or images by their sums.
+struct ClassSource {
+  enum Kind { kClasses, kJoint, kImages } kind;
+  const kdm_class_density* classes = nullptr;
+  const kdm_joint_class_density* joint = nullptr;
+  const kdm_class_images* images = nullptr;
+};
+
+/// Reads the class densities (`source`) into `q` and runs
 /// `run(q, cursor, why)` (a class query) with the C cursor.
 template <class Run>
-kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query,
-                           const kdm_class_density* classes, const kdm_joint_class_density* joint,
-                           bool is_joint, uint32_t class_count, size_t* written, kdm_cursor* cursor,
+kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, const ClassSource& source,
+                           uint32_t class_count, size_t* written, kdm_cursor* cursor,
                            kdm_query_problem* problem, Run run) {
+  const kdm_class_density* classes = source.classes;
+  const kdm_joint_class_density* joint = source.joint;
   kdm::QueryProblem why;
   kdm::ClassQueryParams q;
   kdm_status status = KDM_INVALID_ARGUMENT;
   if (!read_query(tileset, query, cursor, written, q.query, why)) {
-  } else if (is_joint ? !(joint && (joint->densities || joint->batch_densities)) : !classes) {
-    why.kind = kdm::QueryProblem::Kind::kMissingArgument, why.parameter = is_joint ? "joint" : "classes";
+  } else if (source.kind == ClassSource::kJoint    ? !(joint && (joint->densities || joint->batch_densities))
+             : source.kind == ClassSource::kImages ? !source.images
+                                                   : !classes) {
+    why.kind = kdm::QueryProblem::Kind::kMissingArgument;
+    why.parameter = source.kind == ClassSource::kJoint    ? "joint"
+                    : source.kind == ClassSource::kImages ? "images"
+                                                          : "classes";
   } else if (class_count < 1 || class_count > kdm::kMaxQueryClasses) {
     why.kind = kdm::QueryProblem::Kind::kBadClassCount, why.parameter = "class_count";
     why.value = class_count, why.limit = kdm::kMaxQueryClasses;
   } else {
     q.class_count = class_count;
-    for (uint32_t k = 0; k < class_count && !is_joint; ++k) {
+    for (uint32_t k = 0; k < class_count && source.kind == ClassSource::kClasses; ++k) {
       const kdm_class_density& c = classes[k];
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
       q.classes[k].bounds = c.density_bounds;
       with_batch_callback(q.classes[k], c.density_batch_callback, c.user, c.density_max, c.density_image);
     }
-    if (is_joint) {
+    if (source.kind == ClassSource::kImages) q.image_sums = &source.images->sums;
+    if (source.kind == ClassSource::kJoint) {
       q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,
       q.joint.user = joint->user, q.joint.batch_densities = joint->batch_densities;
       std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
@@ -223,23 +243,21 @@ kdm::Status with_c_names(kdm::Status status, kdm::QueryProblem* why) {
   return status;
 }
 
-/// The class queries into records and into the compact output, for either kind of densities.
-kdm_status class_records(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
-                         const kdm_joint_class_density* joint, bool is_joint, uint32_t class_count,
-                         kdm_point* out, uint8_t* out_classes, size_t capacity, size_t* written,
-                         kdm_cursor* cursor, kdm_query_problem* problem) {
-  return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+/// The class queries into records and into the compact output, for any kind of densities.
+kdm_status class_records(const kdm_tileset* tileset, const kdm_query* query, const ClassSource& source,
+                         uint32_t class_count, kdm_point* out, uint8_t* out_classes, size_t capacity,
+                         size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_class_query(tileset, query, source, class_count, written, cursor, problem,
                          [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
                            return with_c_names(kdm::query_classes(*tileset->set, q, as_points(out),
                                                                   out_classes, capacity, written, k, why),
                                                why);
                          });
 }
-kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, const kdm_class_density* classes,
-                         const kdm_joint_class_density* joint, bool is_joint, uint32_t class_count, float* xy,
-                         uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written,
-                         kdm_cursor* cursor, kdm_query_problem* problem) {
-  return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+kdm_status class_compact(const kdm_tileset* tileset, const kdm_query* query, const ClassSource& source,
+                         uint32_t class_count, float* xy, uint64_t* keys, uint8_t* out_classes,
+                         size_t capacity, size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_class_query(tileset, query, source, class_count, written, cursor, problem,
                          [&](const kdm::ClassQueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
                            return with_c_names(
                                kdm::query_classes_compact(*tileset->set, q, kdm::CompactPoints{xy, keys},
@@ -268,15 +286,13 @@ kdm_status run_parallel(const kdm_parallel_query* parallel, const kdm_task_runne
   return KDM_INVALID_ARGUMENT;
 }
 
-/// The parallel class queries, for either kind of densities (run_class_query's `is_joint`).
+/// The parallel class queries, for any kind of densities (run_class_query's `source`).
 kdm_status parallel_classes(kdm_parallel_query* parallel, const kdm_task_runner* runner,
-                            const kdm_tileset* tileset, const kdm_query* query,
-                            const kdm_class_density* classes, const kdm_joint_class_density* joint,
-                            bool is_joint, uint32_t class_count, float* xy, uint64_t* keys,
-                            uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed,
-                            kdm_query_problem* problem) {
+                            const kdm_tileset* tileset, const kdm_query* query, const ClassSource& source,
+                            uint32_t class_count, float* xy, uint64_t* keys, uint8_t* out_classes,
+                            size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem) {
   return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
-    return run_class_query(tileset, query, classes, joint, is_joint, class_count, written, cursor, problem,
+    return run_class_query(tileset, query, source, class_count, written, cursor, problem,
                            [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
                              return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
                                                            out_classes, capacity, written, r, needed, why);
@@ -302,7 +318,7 @@ kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out)
     return KDM_OUT_OF_MEMORY;
   }
 #else
-  handle->parallel.init(workers);  // a refused allocation ends the program (allocator.h)
+  handle->parallel.init(workers);        // a refused allocation ends the program (allocator.h)
 #endif
   *out = handle;
   return KDM_OK;
@@ -344,8 +360,8 @@ kdm_status kdm_parallel_query_classes_compact(kdm_parallel_query* parallel, cons
                                               float* xy, uint64_t* keys, uint8_t* out_classes,
                                               size_t capacity, size_t* written, size_t* needed,
                                               kdm_query_problem* problem) {
-  return parallel_classes(parallel, runner, tileset, query, classes, nullptr, false, class_count, xy, keys,
-                          out_classes, capacity, written, needed, problem);
+  return parallel_classes(parallel, runner, tileset, query, ClassSource{ClassSource::kClasses, classes},
+                          class_count, xy, keys, out_classes, capacity, written, needed, problem);
 }
 
 kdm_status kdm_parallel_query_classes_joint_compact(kdm_parallel_query* parallel,
@@ -355,8 +371,54 @@ kdm_status kdm_parallel_query_classes_joint_compact(kdm_parallel_query* parallel
                                                     uint32_t class_count, float* xy, uint64_t* keys,
                                                     uint8_t* out_classes, size_t capacity, size_t* written,
                                                     size_t* needed, kdm_query_problem* problem) {
-  return parallel_classes(parallel, runner, tileset, query, nullptr, joint, true, class_count, xy, keys,
-                          out_classes, capacity, written, needed, problem);
+  return parallel_classes(parallel, runner, tileset, query, ClassSource{ClassSource::kJoint, nullptr, joint},
+                          class_count, xy, keys, out_classes, capacity, written, needed, problem);
+}
+
+kdm_status kdm_parallel_query_class_images_compact(kdm_parallel_query* parallel,
+                                                   const kdm_task_runner* runner, const kdm_tileset* tileset,
+                                                   const kdm_query* query, const kdm_class_images* images,
+                                                   float* xy, uint64_t* keys, uint8_t* out_classes,
+                                                   size_t capacity, size_t* written, size_t* needed,
+                                                   kdm_query_problem* problem) {
+  return parallel_classes(
+      parallel, runner, tileset, query, ClassSource{ClassSource::kImages, nullptr, nullptr, images},
+      images ? images->sums.count() : 0, xy, keys, out_classes, capacity, written, needed, problem);
+}
+
+kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
+                                   kdm_class_images** out) {
+  if (!out) return KDM_INVALID_ARGUMENT;
+  *out = nullptr;
+  if (!images || count < 1 || count > kdm::kMaxQueryClasses) return KDM_INVALID_ARGUMENT;
+  const kdm::DensityImageView* views[kdm::kMaxQueryClasses];
+  for (uint32_t k = 0; k < count; ++k) {
+    if (!images[k]) return KDM_INVALID_ARGUMENT;
+    views[k] = &images[k]->view;
+  }
+  auto* handle = new (std::nothrow) kdm_class_images;
+  if (!handle) return KDM_OUT_OF_MEMORY;
+  kdm::Status s;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+    s = handle->sums.build(views, count);
+  } catch (const std::bad_alloc&) {
+    delete handle;
+    return KDM_OUT_OF_MEMORY;
+  }
+#else
+  s = handle->sums.build(views, count);  // a refused allocation ends the program
+#endif
+  if (s != kdm::Status::kOk) {
+    delete handle;
+    return to_c(s);
+  }
+  *out = handle;
+  return KDM_OK;
+}
+
+void kdm_class_images_free(kdm_class_images* images) {
+  delete images;
 }
 
 void kdm_set_tileset_allocator(void* (*allocate)(size_t, size_t, void*),
@@ -472,32 +534,50 @@ kdm_status kdm_query_classes(const kdm_tileset* tileset, const kdm_query* query,
                              const kdm_class_density* classes, uint32_t class_count, kdm_point* out,
                              uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
                              kdm_query_problem* problem) {
-  return class_records(tileset, query, classes, nullptr, false, class_count, out, out_classes, capacity,
-                       written, cursor, problem);
+  return class_records(tileset, query, ClassSource{ClassSource::kClasses, classes}, class_count, out,
+                       out_classes, capacity, written, cursor, problem);
 }
 
 kdm_status kdm_query_classes_compact(const kdm_tileset* tileset, const kdm_query* query,
                                      const kdm_class_density* classes, uint32_t class_count, float* xy,
                                      uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written,
                                      kdm_cursor* cursor, kdm_query_problem* problem) {
-  return class_compact(tileset, query, classes, nullptr, false, class_count, xy, keys, out_classes, capacity,
-                       written, cursor, problem);
+  return class_compact(tileset, query, ClassSource{ClassSource::kClasses, classes}, class_count, xy, keys,
+                       out_classes, capacity, written, cursor, problem);
 }
 
 kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
                                    const kdm_joint_class_density* joint, uint32_t class_count, kdm_point* out,
                                    uint8_t* out_classes, size_t capacity, size_t* written, kdm_cursor* cursor,
                                    kdm_query_problem* problem) {
-  return class_records(tileset, query, nullptr, joint, true, class_count, out, out_classes, capacity, written,
-                       cursor, problem);
+  return class_records(tileset, query, ClassSource{ClassSource::kJoint, nullptr, joint}, class_count, out,
+                       out_classes, capacity, written, cursor, problem);
 }
 
 kdm_status kdm_query_classes_joint_compact(const kdm_tileset* tileset, const kdm_query* query,
                                            const kdm_joint_class_density* joint, uint32_t class_count,
                                            float* xy, uint64_t* keys, uint8_t* out_classes, size_t capacity,
                                            size_t* written, kdm_cursor* cursor, kdm_query_problem* problem) {
-  return class_compact(tileset, query, nullptr, joint, true, class_count, xy, keys, out_classes, capacity,
-                       written, cursor, problem);
+  return class_compact(tileset, query, ClassSource{ClassSource::kJoint, nullptr, joint}, class_count, xy,
+                       keys, out_classes, capacity, written, cursor, problem);
+}
+
+kdm_status kdm_query_class_images(const kdm_tileset* tileset, const kdm_query* query,
+                                  const kdm_class_images* images, kdm_point* out, uint8_t* out_classes,
+                                  size_t capacity, size_t* written, kdm_cursor* cursor,
+                                  kdm_query_problem* problem) {
+  return class_records(tileset, query, ClassSource{ClassSource::kImages, nullptr, nullptr, images},
+                       images ? images->sums.count() : 0, out, out_classes, capacity, written, cursor,
+                       problem);
+}
+
+kdm_status kdm_query_class_images_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                          const kdm_class_images* images, float* xy, uint64_t* keys,
+                                          uint8_t* out_classes, size_t capacity, size_t* written,
+                                          kdm_cursor* cursor, kdm_query_problem* problem) {
+  return class_compact(tileset, query, ClassSource{ClassSource::kImages, nullptr, nullptr, images},
+                       images ? images->sums.count() : 0, xy, keys, out_classes, capacity, written, cursor,
+                       problem);
 }
 
 const char* kdm_status_message(kdm_status status) {

@@ -122,6 +122,35 @@ int main(void) {
       for (i = 0; i < one; ++i) ++counts[0][one_classes[i]], ++counts[1][classes[0][i]];
       CHECK(memcmp(counts[0], counts[1], sizeof counts[0]) == 0 && counts[0][0] > 10000);
     }
+    {
+      /* Classes of images by their sums: one query's keys and classes, on two threads. */
+      static float texels[3][8 * 8];
+      kdm_density_image* images[3];
+      kdm_class_images* class_images = NULL;
+      uint64_t hash[2] = {0, 0};
+      int k;
+      for (i = 0; i < 64; ++i)
+        texels[0][i] = 1.0f / 7, texels[1][i] = (float)(0.1 + 0.1 * (double)(i % 8)), texels[2][i] = 4.0f / 7;
+      for (k = 0; k < 3; ++k)
+        CHECK(kdm_density_image_create(8, 8, texels[k], -2, 0, 5, 5, &images[k]) == KDM_OK);
+      CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 3, &class_images) == KDM_OK);
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_class_images_compact(builtin, &q, class_images, one_xy, one_keys, one_classes,
+                                           kCapacity, &one, &cursor, NULL) == KDM_OK);
+      CHECK(kdm_parallel_query_class_images_compact(parallel, &on_threads, builtin, &q, class_images, xy[1],
+                                                    keys[1], classes[1], kCapacity, &n[1], NULL,
+                                                    NULL) == KDM_OK);
+      for (i = 0; i < one; ++i)
+        hash[0] += (one_keys[i] ^ one_classes[i]) * 2654435761u,
+            hash[1] += (keys[1][i] ^ classes[1][i]) * 2654435761u;
+      CHECK(n[1] == one && one > 100000 && hash[0] == hash[1]);
+      CHECK(kdm_parallel_query_class_images_compact(parallel, &on_threads, builtin, &q, NULL, xy[1], keys[1],
+                                                    classes[1], kCapacity, &n[1], NULL,
+                                                    &problem) == KDM_INVALID_ARGUMENT);
+      CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "images") == 0);
+      kdm_class_images_free(class_images);
+      for (k = 0; k < 3; ++k) kdm_density_image_free(images[k]);
+    }
   }
   /* A short buffer: the first points and the full count. */
   CHECK(kdm_parallel_query_compact(parallel, &on_threads, builtin, &q, xy[0], keys[0], kCapacity, &n[0], NULL,

@@ -266,6 +266,71 @@ int main(int argc, char** argv) {
       CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT);
     }
   }
+  /* Classes of images by their sums: the union is kdm_query_points at the summed image, class 0 the query
+   * at the first image (stable mode); compact output and two workers give the same classes. */
+  {
+    static kdm_point points[8192], single[8192];
+    static uint8_t classes[8192], compact_classes[8192];
+    static float xy[2 * 8192], texels[3][16 * 16], sum[16 * 16];
+    kdm_density_image *images[3] = {NULL, NULL, NULL}, *summed = NULL, *other = NULL, *kept = NULL;
+    kdm_class_images* class_images = NULL;
+    kdm_cursor cursor;
+    size_t written = 0, alone = 0, compact = 0, zeros = 0, i;
+    int k;
+    for (i = 0; i < 16 * 16; ++i) {
+      texels[0][i] = (float)(0.2 + 0.05 * (double)(i % 16));
+      texels[1][i] = (float)(0.3 + 0.04 * (double)(i / 16));
+      texels[2][i] = (float)(1.0 + 0.5 * sin((double)i));
+      sum[i] = texels[0][i] + texels[1][i] + texels[2][i];
+    }
+    for (k = 0; k < 3; ++k)
+      CHECK(kdm_density_image_create(16, 16, texels[k], 0, 0, 2, 2, &images[k]) == KDM_OK);
+    CHECK(kdm_density_image_create(16, 16, sum, 0, 0, 2, 2, &summed) == KDM_OK);
+    CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 3, &class_images) == KDM_OK);
+    q = uniform_query();
+    q.scale = 400;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_class_images(builtin, &q, class_images, points, classes, 8192, &written, &cursor,
+                                 &problem) == KDM_OK);
+    q.density_image = summed;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, single, 8192, &alone, &cursor, NULL) == KDM_OK && alone == written);
+    CHECK(memcmp(points, single, written * sizeof(kdm_point)) == 0);
+    q.density_image = images[0];
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, single, 8192, &alone, &cursor, NULL) == KDM_OK);
+    for (i = 0; i < written; ++i)
+      if (classes[i] == 0) CHECK(memcmp(&points[i], &single[zeros++], sizeof(kdm_point)) == 0);
+    CHECK(zeros == alone && alone > 500 && written > 2 * alone);
+    q.density_image = NULL;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_class_images_compact(builtin, &q, class_images, xy, NULL, compact_classes, 8192, &compact,
+                                         &cursor, NULL) == KDM_OK &&
+          compact == written);
+    CHECK(memcmp(classes, compact_classes, written) == 0);
+    /* Refusals: no images, images on different grids. */
+    CHECK(kdm_query_class_images(builtin, &q, NULL, points, classes, 8192, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "images") == 0);
+    kdm_class_images_free(class_images);
+    class_images = NULL;
+    CHECK(kdm_density_image_create(16, 16, sum, 0, 0, 3, 2, &other) == KDM_OK);
+    kept = images[1], images[1] = other;
+    CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 3, &class_images) ==
+              KDM_INVALID_ARGUMENT &&
+          class_images == NULL);
+    CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 0, &class_images) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(kdm_class_images_create(NULL, 3, &class_images) == KDM_INVALID_ARGUMENT);
+    images[1] = NULL;
+    CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 3, &class_images) ==
+          KDM_INVALID_ARGUMENT);
+    kdm_class_images_free(NULL);
+    images[1] = kept;
+    for (k = 0; k < 3; ++k) kdm_density_image_free(images[k]);
+    kdm_density_image_free(other);
+    kdm_density_image_free(summed);
+  }
   /* A callback's bounds: the same points, far fewer calls. */
   {
     static kdm_point with[8192], without[8192];

@@ -257,6 +257,33 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
                                                            size_t* written, kdm_cursor* cursor,
                                                            kdm_query_problem* problem);
 
+/* Classes whose densities are images on one grid (kdm::ClassImageSums, kdm/runtime/class_image_sums.h):
+ * the running sums of `count` density images (1 ... KDM_MAX_CLASSES, class 0 first, all of one size and
+ * world rectangle), added texel by texel in float, each with its max-mip, into *out. A query then reads one
+ * image where kdm_query_classes reads every class's at every candidate: its points are exactly
+ * kdm_query_points' at the images' summed texels, and in stable mode classes 0 ... k together exactly those
+ * at the first k + 1 images' sum. KDM_INVALID_ARGUMENT for a NULL `out`, `images` or image, a count out of
+ * range, images on different grids, or a sum that overflows a float; KDM_OUT_OF_MEMORY (a library built
+ * without exceptions ends the program instead). The images may be freed once it is built. Free it with
+ * kdm_class_images_free. Added in 0.4. */
+typedef struct kdm_class_images kdm_class_images;
+KDM_RUNTIME_API kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
+                                                   kdm_class_images** out);
+KDM_RUNTIME_API void kdm_class_images_free(kdm_class_images* images);
+
+/* kdm_query_classes and kdm_query_classes_compact with the classes of `images` (their count is its own):
+ * statuses, resumption and refusals as theirs, and KDM_INVALID_ARGUMENT for a NULL `images` ("images").
+ * Added in 0.4. */
+KDM_RUNTIME_API kdm_status kdm_query_class_images(const kdm_tileset* tileset, const kdm_query* query,
+                                                  const kdm_class_images* images, kdm_point* out,
+                                                  uint8_t* out_classes, size_t capacity, size_t* written,
+                                                  kdm_cursor* cursor, kdm_query_problem* problem);
+KDM_RUNTIME_API kdm_status kdm_query_class_images_compact(const kdm_tileset* tileset, const kdm_query* query,
+                                                          const kdm_class_images* images, float* xy,
+                                                          uint64_t* keys, uint8_t* out_classes,
+                                                          size_t capacity, size_t* written,
+                                                          kdm_cursor* cursor, kdm_query_problem* problem);
+
 /* One query over several threads (kdm::ParallelQuery, kdm/runtime/parallel_query.h), for callers that fill
  * a large region at once: the region is cut into units fixed by the parameters, so any number of workers
  * gives the same bits, the region's points in kdm_query_points' order (in the units' order where a tile
@@ -309,6 +336,12 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_classes_joint_compact(
     const kdm_query* query, const kdm_joint_class_density* joint, uint32_t class_count, float* xy,
     uint64_t* keys, uint8_t* out_classes, size_t capacity, size_t* written, size_t* needed,
     kdm_query_problem* problem);
+
+/* Classes of images by their sums (kdm_query_class_images_compact's points and classes) the same way. */
+KDM_RUNTIME_API kdm_status kdm_parallel_query_class_images_compact(
+    kdm_parallel_query* parallel, const kdm_task_runner* runner, const kdm_tileset* tileset,
+    const kdm_query* query, const kdm_class_images* images, float* xy, uint64_t* keys, uint8_t* out_classes,
+    size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
 
 /* A static English description of `status` / of a problem kind. */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
