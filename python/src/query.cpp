@@ -408,6 +408,7 @@ struct PreparedClasses {
   ClassQueryParams q;
   std::vector<std::unique_ptr<SpecDensity>> densities;
   std::vector<std::unique_ptr<CallableDensity>> callables;
+  ClassImageSums sums;  ///< images on one grid: their running sums (tools::read_images_by_sums)
   /// Raises the first exception a class's callable raised, in class order. Call with the GIL held.
   void rethrow() {
     for (const std::unique_ptr<CallableDensity>& c : callables) c->rethrow();
@@ -453,6 +454,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
     prepared.densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
     q.classes[k] = prepared.densities.back()->density;
   }
+  tools::read_images_by_sums(q, prepared.sums);
 }
 
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as

@@ -400,6 +400,28 @@ def test_callable_classes(mode):
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_image_classes_are_read_by_their_sums(mode):
+    # Classes that are all arrays of one shape are read by their running sums, added texel by texel in
+    # float32: the union is the one-class query at that sum, in stable mode class 0 the query at its own.
+    rect = (0.0, 0.0, 3.0, 2.0)
+    v, u = np.mgrid[0:20, 0:30].astype(np.float32) / np.float32(20)
+    images = [0.2 + u, 0.3 + v, (1 + np.sin(3 * u) * np.cos(2 * v)).astype(np.float32)]
+    images = [np.asarray(i, dtype=np.float32) for i in images]
+    r = BUILTIN.query(rect, scale=300, classes=images, mode=mode)
+    assert len(r) > 3000 and set(np.unique(r.classes)) == {0, 1, 2}
+    total = (images[0] + images[1]) + images[2]
+    assert same(r, BUILTIN.query(rect, scale=300, density=total, mode=mode))
+    if mode == "stable":
+        zero = r.classes == 0
+        alone = BUILTIN.query(rect, scale=300, density=images[0])
+        assert same((r.xy[zero], r.tile[zero], r.rank[zero]), (alone.xy, alone.tile, alone.rank))
+    xy, labels = BUILTIN.positions(rect, scale=300, classes=images, mode=mode, threads=2)
+    order = np.lexsort((r.xy[:, 1], r.xy[:, 0]))
+    order2 = np.lexsort((xy[:, 1], xy[:, 0]))
+    assert np.array_equal(labels[order2], r.classes[order])
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
 def test_vectorized_classes(mode):
     # Callable classes on arrays: the points and classes of the same functions called point by point, in
     # calls of many positions (measured 104-107 on average below the top level, 42 at 1.2-2.3 times it),

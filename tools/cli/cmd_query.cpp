@@ -109,6 +109,8 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     cq.query = q;
     cq.class_count = static_cast<std::uint32_t>(densities.size());
     for (std::size_t k = 0; k < densities.size(); ++k) cq.classes[k] = densities[k]->density;
+    ClassImageSums sums;
+    tools::read_images_by_sums(cq, sums);
     tools::query_all(tiles, cq, points, classes, kCommandLineNames);
   } else {
     tools::query_all(tiles, q, points, kCommandLineNames);

@@ -52,4 +52,16 @@ SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
   density.image = &image;
 }
 
+bool read_images_by_sums(ClassQueryParams& params, ClassImageSums& sums) {
+  const DensityImageView* images[kMaxQueryClasses];
+  if (params.class_count < 2 || params.class_count > kMaxQueryClasses) return false;
+  for (std::uint32_t k = 0; k < params.class_count; ++k) {
+    if (params.classes[k].kind != QueryDensity::Kind::kImage || !params.classes[k].image) return false;
+    images[k] = params.classes[k].image;
+  }
+  if (sums.build(images, params.class_count) != Status::kOk) return false;  // not on one grid
+  params.image_sums = &sums;
+  return true;
+}
+
 }  // namespace kdm::tools

@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "density_spec.h"
+#include "kdm/runtime/class_image_sums.h"
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
 
 namespace kdm::tools {
@@ -24,5 +26,10 @@ struct SpecDensity {
   const DensitySpec& spec;
   double rect[4];
 };
+
+/// Classes that are all images on one grid are read by the images of their running sums: builds `sums`
+/// and points params.image_sums at it (the query then reads one image where it would read every class's).
+/// Returns whether it did; with other classes it leaves both as they are.
+bool read_images_by_sums(ClassQueryParams& params, ClassImageSums& sums);
 
 }  // namespace kdm::tools

@@ -57,6 +57,10 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   aspect_ = double(first.width) / first.height;  // world: [0, aspect] × [0, 1]
   const double world[4] = {0, 0, aspect_, 1};
   for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
+  ClassQueryParams classes;  // the inks as a class query reads them: by their sums, built once
+  classes.class_count = static_cast<std::uint32_t>(densities_.size());
+  for (std::size_t k = 0; k < densities_.size(); ++k) classes.classes[k] = densities_[k]->density;
+  read_images_by_sums(classes, sums_);
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
   scale_ = points > 0 ? points / (mean * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
@@ -87,6 +91,7 @@ PointSet TileStippler::render(const double uv[4]) const {
   cq.query = q;
   cq.class_count = static_cast<std::uint32_t>(densities_.size());
   for (std::size_t k = 0; k < densities_.size(); ++k) cq.classes[k] = densities_[k]->density;
+  if (sums_.count() == cq.class_count) cq.image_sums = &sums_;
   std::vector<std::uint8_t> classes;
   query_all_xy(tiles_, cq, xy, classes);
   PointSet set = normalise_to_rect(xy, rect);

@@ -50,6 +50,7 @@ class TileStippler {
   double aspect_ = 1, scale_ = 0, tile_size_ = 1;
   QueryMode mode_;
   std::vector<std::unique_ptr<SpecDensity>> densities_;  ///< each image over [0, aspect] × [0, 1]
+  ClassImageSums sums_;  ///< several inks: their images' running sums (read_images_by_sums)
 };
 
 }  // namespace kdm::tools
