@@ -17,6 +17,7 @@
 //    same points and classes;
 //  - query_points_compact gives the same points as floats, with their keys;
 //  - a callback read through batch_callback gives the same points, in batches of 1 to kDensityBatch;
+//  - an image class beside an empty one, by their running sums (ClassImageSums), gives the same points;
 //  - ParallelQuery (two workers run in turn) gives the same points, and the same classes.
 // A failed check aborts.
 #include <algorithm>
@@ -31,6 +32,7 @@
 #include <utility>
 #include <vector>
 
+#include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/parallel_query.h"
@@ -390,6 +392,31 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (std::size_t i = 0; i < joint.size; ++i)
           if (!same(joint[i], classed[i]) || joint_classes[i] != classes[i]) fail();
       }
+    }
+    // An image and an empty one by their running sums (ClassImageSums): the same status and points, all
+    // of class 0, one worker or two.
+    if (kind == 1) {
+      static float zeros[4 * 4] = {};
+      static kdm::ClassImageSums sums;
+      kdm::DensityImageView empty = image;
+      empty.values = zeros;
+      const kdm::DensityImageView* images[2] = {&image, &empty};
+      if (sums.build(images, 2) != kdm::Status::kOk) fail();  // make_density_max_mip took the image
+      kdm::ClassQueryParams by_sums = cq;
+      by_sums.image_sums = &sums;
+      static Points summed;
+      static std::uint8_t summed_classes[kBigCapacity];
+      kdm::QueryCursor sums_cursor;
+      summed.status = kdm::query_classes(kdm::Tileset::builtin(), by_sums, summed.data, summed_classes,
+                                         kBigCapacity, &summed.size, &sums_cursor);
+      if (summed.status != kdm::Status::kOk || summed.size != all.size) fail();  // exactly `all`'s query
+      for (std::size_t i = 0; i < summed.size; ++i)
+        if (!same(summed[i], all[i]) || summed_classes[i] != 0) fail();
+      std::size_t n = 0;
+      if (two_workers().run(kdm::Tileset::builtin(), by_sums, summed.data, summed_classes, kBigCapacity, &n,
+                            in_turn()) != kdm::Status::kOk ||
+          n != all.size || std::count(summed_classes, summed_classes + n, 0) != std::ptrdiff_t(n))
+        fail();
     }
   }
 
