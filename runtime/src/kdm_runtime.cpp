@@ -42,6 +42,32 @@ kdm_status to_c(kdm::Status s) {
   return static_cast<kdm_status>(static_cast<int>(s));
 }
 
+/// build()'s status, KDM_OUT_OF_MEMORY where it throws std::bad_alloc (a library built without exceptions
+/// ends the program there instead).
+template <class Build>
+kdm_status unless_out_of_memory(Build build) {
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+    return to_c(build());
+  } catch (const std::bad_alloc&) {
+    return KDM_OUT_OF_MEMORY;
+  }
+#else
+  return to_c(build());
+#endif
+}
+
+/// A new handle whose building returned `status`: into *out when KDM_OK, else freed. Returns `status`.
+template <class Handle>
+kdm_status hand_over(Handle* handle, kdm_status status, Handle** out) {
+  if (status != KDM_OK) {
+    delete handle;
+    return status;
+  }
+  *out = handle;
+  return KDM_OK;
+}
+
 template <class Load>
 kdm_status load_into(kdm_tileset** out, Load&& load) {
   if (!out) return KDM_INVALID_ARGUMENT;
@@ -310,18 +336,7 @@ kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out)
   if (workers < 1 || workers > kdm::kMaxParallelWorkers) return KDM_INVALID_ARGUMENT;
   auto* handle = new (std::nothrow) kdm_parallel_query;
   if (!handle) return KDM_OUT_OF_MEMORY;
-#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
-  try {
-    handle->parallel.init(workers);
-  } catch (const std::bad_alloc&) {
-    delete handle;
-    return KDM_OUT_OF_MEMORY;
-  }
-#else
-  handle->parallel.init(workers);        // a refused allocation ends the program (allocator.h)
-#endif
-  *out = handle;
-  return KDM_OK;
+  return hand_over(handle, unless_out_of_memory([&] { return handle->parallel.init(workers); }), out);
 }
 
 void kdm_parallel_query_free(kdm_parallel_query* parallel) {
@@ -398,23 +413,7 @@ kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint3
   }
   auto* handle = new (std::nothrow) kdm_class_images;
   if (!handle) return KDM_OUT_OF_MEMORY;
-  kdm::Status s;
-#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
-  try {
-    s = handle->sums.build(views, count);
-  } catch (const std::bad_alloc&) {
-    delete handle;
-    return KDM_OUT_OF_MEMORY;
-  }
-#else
-  s = handle->sums.build(views, count);  // a refused allocation ends the program
-#endif
-  if (s != kdm::Status::kOk) {
-    delete handle;
-    return to_c(s);
-  }
-  *out = handle;
-  return KDM_OK;
+  return hand_over(handle, unless_out_of_memory([&] { return handle->sums.build(views, count); }), out);
 }
 
 void kdm_class_images_free(kdm_class_images* images) {
@@ -498,13 +497,8 @@ kdm_status kdm_density_image_create(int width, int height, const float* values, 
   kdm::DensityImageView& v = image->view;
   v.width = width, v.height = height, v.x0 = x0, v.y0 = y0, v.x1 = x1, v.y1 = y1;
   v.values = image->values.get();
-  const kdm::Status s = kdm::make_density_max_mip(v, image->mip);
-  if (s != kdm::Status::kOk) {
-    delete image;
-    return to_c(s);
-  }
-  *out = image;
-  return KDM_OK;
+  return hand_over(image, unless_out_of_memory([&] { return kdm::make_density_max_mip(v, image->mip); }),
+                   out);
 }
 
 void kdm_density_image_free(kdm_density_image* image) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "allocation_counter.h"
+#include "class_points.h"
 #include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/parallel_query.h"
@@ -21,69 +22,19 @@
 namespace kdm {
 namespace {
 
-using Id = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
-struct Emitted {
-  double x, y;
-  int cls;
-};
-using Points = std::map<Id, Emitted>;
+using testing::expect_same;
+using testing::Id;
+using testing::id_of;
+using testing::Points;
+using testing::run_classes;
+using testing::run_one;
+using testing::up_to_class;
 
-Id id_of(const QueryPoint& p) {
-  return {p.id.tile_x, p.id.tile_y, p.id.rank, p.id.depth};
-}
-
-/// query_classes resumed through a buffer of `capacity`, or query_points when `one` is not null.
-Points run(const ClassQueryParams* classes, const QueryParams* one, std::size_t capacity = 1 << 14) {
-  std::vector<QueryPoint> out(capacity);
-  std::vector<std::uint8_t> cls(capacity);
-  Points points;
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s = one ? query_points(Tileset::builtin(), *one, out.data(), out.size(), &written, &cursor)
-                         : query_classes(Tileset::builtin(), *classes, out.data(), cls.data(), out.size(),
-                                         &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    for (std::size_t i = 0; i < written; ++i)
-      EXPECT_TRUE(points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, one ? 0 : cls[i]}).second);
-    if (s != Status::kBufferFull) break;
-  }
-  return points;
-}
-
-/// Same ids at the same positions, bit for bit.
-void expect_same(const Points& a, const Points& b, const char* what) {
-  ASSERT_EQ(a.size(), b.size()) << what;
-  for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
-    ASSERT_TRUE(i->first == j->first) << what;
-    ASSERT_EQ(i->second.x, j->second.x) << what;
-    ASSERT_EQ(i->second.y, j->second.y) << what;
-  }
-}
-
-/// Three images over [0, 4)² on one 32 × 32 grid: a ramp in x, a ramp in y and a bump.
-struct ThreeImages {
-  std::vector<float> values[3];
-  DensityImageView views[3];
+/// ThreeImages by their running sums.
+struct SummedImages : testing::ThreeImages {
   const DensityImageView* pointers[3] = {&views[0], &views[1], &views[2]};
   ClassImageSums sums;
-  ThreeImages() {
-    for (int k = 0; k < 3; ++k) {
-      values[k].resize(32 * 32);
-      for (int y = 0; y < 32; ++y)
-        for (int x = 0; x < 32; ++x) {
-          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
-          values[k][y * 32 + x] =
-              static_cast<float>(k == 0   ? u
-                                 : k == 1 ? 0.2 + v
-                                          : std::exp(-8 * ((u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5))));
-        }
-      views[k].width = views[k].height = 32;
-      views[k].x1 = views[k].y1 = 4;
-      views[k].values = values[k].data();
-    }
-    EXPECT_EQ(sums.build(pointers, 3), Status::kOk);
-  }
+  SummedImages() { EXPECT_EQ(sums.build(pointers, 3), Status::kOk); }
   ClassQueryParams query(double x0, double y0, double x1, double y1, double scale, QueryMode mode) const {
     ClassQueryParams q;
     q.query.x0 = x0, q.query.y0 = y0, q.query.x1 = x1, q.query.y1 = y1;
@@ -103,7 +54,7 @@ QueryParams at_sum(const ClassQueryParams& q, std::uint32_t k) {
 }
 
 TEST(ClassImageSumsTest, SumsAreTheImagesAddedTexelByTexel) {
-  ThreeImages im;
+  SummedImages im;
   ASSERT_EQ(im.sums.count(), 3u);
   for (std::size_t i = 0; i < 32 * 32; ++i) {
     float sum = 0;
@@ -119,29 +70,27 @@ TEST(ClassImageSumsTest, SumsAreTheImagesAddedTexelByTexel) {
 }
 
 TEST(ClassImageSumsTest, StableClassesAreTheOneClassQueriesAtTheSums) {
-  ThreeImages im;
+  SummedImages im;
   const ClassQueryParams q = im.query(-0.4, 0.3, 4.3, 4.6, 900, QueryMode::kStable);
-  const Points all = run(&q, nullptr, 1000);
+  const Points all = run_classes(q, 1000);
   for (std::uint32_t k = 0; k < 3; ++k) {
-    Points upto;
-    for (const auto& [id, e] : all)
-      if (e.cls <= int(k)) upto.emplace(id, e);
+    const Points upto = up_to_class(all, int(k));
     const QueryParams one = at_sum(q, k);
-    expect_same(upto, run(nullptr, &one), "classes 0 … k against the one-class query at sum k");
+    expect_same(upto, run_one(one), "classes 0 … k against the one-class query at sum k");
     EXPECT_GT(upto.size(), 3000u * (k + 1));
   }
 }
 
 TEST(ClassImageSumsTest, SmoothUnionIsTheSmoothQueryAtTheLastSumWithStableModesClasses) {
-  ThreeImages im;
+  SummedImages im;
   // At the top level and past it (the sum's peak, about 3.2, at 20,000 per unit area passes the top
   // level's 32,768 points per tile).
   for (double scale : {900.0, 20000.0}) {
     const double side = scale > 1000 ? 0.6 : 3.7;
     const ClassQueryParams smooth = im.query(1.7, 1.6, 1.7 + side, 1.6 + side, scale, QueryMode::kSmooth);
-    const Points all = run(&smooth, nullptr, 777);
+    const Points all = run_classes(smooth, 777);
     const QueryParams one = at_sum(smooth, 2);
-    expect_same(all, run(nullptr, &one), "the smooth union");
+    expect_same(all, run_one(one), "the smooth union");
     std::size_t deep = 0;
     for (const auto& [id, e] : all) deep += std::get<3>(id) > 0;
     if (scale > 1000) {
@@ -150,7 +99,7 @@ TEST(ClassImageSumsTest, SmoothUnionIsTheSmoothQueryAtTheLastSumWithStableModesC
     }  // past the top level a point is classed by its subtile's threshold
     ClassQueryParams stable = smooth;
     stable.query.mode = QueryMode::kStable;
-    const Points fixed = run(&stable, nullptr);
+    const Points fixed = run_classes(stable);
     std::size_t both = 0;
     for (const auto& [id, e] : all) {
       const auto it = fixed.find(id);
@@ -166,18 +115,14 @@ TEST(ClassImageSumsTest, ClassesFollowTheImagesGivenOneByOne) {
   // The sums are added in float and read once where the images are read one by one and added in double:
   // the same points and classes but for a threshold within rounding of a density (none here; a few in
   // 10^7 would be).
-  ThreeImages im;
+  SummedImages im;
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     const ClassQueryParams sums = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
     ClassQueryParams images = sums;
     images.image_sums = nullptr;
-    std::vector<float> mips[3];
-    DensityImageView views[3] = {im.views[0], im.views[1], im.views[2]};
-    for (int k = 0; k < 3; ++k) {
-      ASSERT_EQ(make_density_max_mip(views[k], mips[k]), Status::kOk);
-      images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &views[k];
-    }
-    const Points a = run(&sums, nullptr), b = run(&images, nullptr);
+    for (int k = 0; k < 3; ++k)
+      images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &im.views[k];
+    const Points a = run_classes(sums), b = run_classes(images);
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
     for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
@@ -189,19 +134,12 @@ TEST(ClassImageSumsTest, ClassesFollowTheImagesGivenOneByOne) {
 }
 
 TEST(ClassImageSumsTest, PartsCompactOutputAndThreadsGiveTheSamePointsAndClasses) {
-  ThreeImages im;
+  SummedImages im;
   std::mt19937 rng(5);
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     const ClassQueryParams whole = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
-    const Points all = run(&whole, nullptr, 1000);
-    Points joined;
-    for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
-      ClassQueryParams p = whole;
-      p.query = part;
-      for (const auto& [id, e] : run(&p, nullptr)) EXPECT_TRUE(joined.emplace(id, e).second);
-    }
-    expect_same(all, joined, "parts");
-    for (const auto& [id, e] : all) ASSERT_EQ(e.cls, joined.at(id).cls);
+    testing::expect_parts_give_the_whole(whole, rng);
+    const Points all = run_classes(whole);
 
     // The records in order, then the compact output and two workers over the same buffer size.
     std::vector<QueryPoint> out(all.size() + 1);
@@ -236,7 +174,7 @@ TEST(ClassImageSumsTest, PartsCompactOutputAndThreadsGiveTheSamePointsAndClasses
 }
 
 TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
-  ThreeImages im;
+  SummedImages im;
   ClassImageSums sums;
   const char* why = nullptr;
   EXPECT_EQ(sums.build(im.pointers, 0, &why), Status::kInvalidArgument);
@@ -287,7 +225,7 @@ TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
 }
 
 TEST(ClassImageSumsTest, QueriesAllocateNothing) {
-  ThreeImages im;
+  SummedImages im;
   std::vector<QueryPoint> out(1 << 16);
   std::vector<std::uint8_t> cls(out.size());
   std::vector<float> xy(2 * out.size());

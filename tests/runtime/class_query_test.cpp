@@ -13,75 +13,23 @@
 #include <vector>
 
 #include "allocation_counter.h"
+#include "class_points.h"
 #include "kdm/runtime/class_query.h"
 #include "random_partition.h"
 
 namespace kdm {
 namespace {
 
-using Id = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
-struct Emitted {
-  double x, y;
-  int cls;
-};
-using Points = std::map<Id, Emitted>;
-
-Id id_of(const QueryPoint& p) {
-  return {p.id.tile_x, p.id.tile_y, p.id.rank, p.id.depth};
-}
-
-Points run_classes(const ClassQueryParams& q, std::size_t capacity = 1 << 14) {
-  std::vector<QueryPoint> out(capacity);
-  std::vector<std::uint8_t> classes(capacity);
-  Points points;
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s =
-        query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    for (std::size_t i = 0; i < written; ++i) {
-      EXPECT_LT(classes[i], q.class_count);
-      EXPECT_TRUE(points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, classes[i]}).second)
-          << "a point emitted twice";
-    }
-    if (s != Status::kBufferFull) break;
-  }
-  return points;
-}
-
-Points run_one(const QueryParams& q) {
-  std::vector<QueryPoint> out(1 << 14);
-  Points points;
-  QueryCursor cursor;
-  for (;;) {
-    std::size_t written = 0;
-    const Status s = query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
-    EXPECT_TRUE(s == Status::kOk || s == Status::kBufferFull) << status_message(s);
-    for (std::size_t i = 0; i < written; ++i) points.emplace(id_of(out[i]), Emitted{out[i].x, out[i].y, 0});
-    if (s != Status::kBufferFull) break;
-  }
-  return points;
-}
-
-/// The points of `all` whose class is at most `last`.
-Points up_to_class(const Points& all, int last) {
-  Points some;
-  for (const auto& [id, p] : all)
-    if (p.cls <= last) some.emplace(id, p);
-  return some;
-}
-
-/// Whether two point sets hold the same ids at the same positions (bit for bit).
-void expect_same(const Points& a, const Points& b, const char* what) {
-  ASSERT_EQ(a.size(), b.size()) << what;
-  auto j = b.begin();
-  for (auto i = a.begin(); i != a.end(); ++i, ++j) {
-    ASSERT_TRUE(i->first == j->first) << what;
-    ASSERT_EQ(i->second.x, j->second.x) << what;
-    ASSERT_EQ(i->second.y, j->second.y) << what;
-  }
-}
+using testing::Emitted;
+using testing::expect_parts_give_the_whole;
+using testing::expect_same;
+using testing::Id;
+using testing::id_of;
+using testing::Points;
+using testing::run_classes;
+using testing::run_one;
+using testing::ThreeImages;
+using testing::up_to_class;
 
 ClassQueryParams three_constants(double x0, double y0, double x1, double y1, double scale, QueryMode mode) {
   ClassQueryParams q;
@@ -91,30 +39,6 @@ ClassQueryParams three_constants(double x0, double y0, double x1, double y1, dou
   for (int k = 0; k < 3; ++k) q.classes[k].constant = double(1 << k);  // 1 : 2 : 4
   return q;
 }
-
-/// Three images over [0, 4)²: a ramp in x, a ramp in y and a bump, each with its max-mip.
-struct ThreeImages {
-  std::vector<float> values[3], mips[3];
-  DensityImageView views[3];
-  ThreeImages() {
-    for (int k = 0; k < 3; ++k) {
-      values[k].resize(32 * 32);
-      for (int y = 0; y < 32; ++y)
-        for (int x = 0; x < 32; ++x) {
-          const double u = (x + 0.5) / 32, v = (y + 0.5) / 32;
-          values[k][y * 32 + x] =
-              static_cast<float>(k == 0   ? u
-                                 : k == 1 ? 0.2 + v
-                                          : std::exp(-8 * ((u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5))));
-        }
-      DensityImageView& view = views[k];
-      view.width = view.height = 32;
-      view.x1 = view.y1 = 4;
-      view.values = values[k].data();
-      EXPECT_EQ(make_density_max_mip(view, mips[k]), Status::kOk);
-    }
-  }
-};
 
 double sum_of_images(void* user, double x, double y) {
   const auto& images = *static_cast<const ThreeImages*>(user);
@@ -212,25 +136,6 @@ TEST(ClassQueryTest, ClassCountsFollowTheirDensities) {
       EXPECT_NEAR(double(counts[k]) / expected, 1.0, 0.01);
     }
   }
-}
-
-/// Parts of `whole` (a random grid of them) give its points and classes, the whole resumed many times;
-/// returns the whole's count per class.
-std::vector<std::size_t> expect_parts_give_the_whole(const ClassQueryParams& whole, std::mt19937& rng) {
-  const Points all = run_classes(whole, 1000);
-  Points joined;
-  for (const QueryParams& part : testing::random_grid_parts(whole.query, 4, rng)) {
-    ClassQueryParams p = whole;
-    p.query = part;
-    for (const auto& [id, e] : run_classes(p)) EXPECT_TRUE(joined.emplace(id, e).second);
-  }
-  expect_same(all, joined, "parts");
-  std::vector<std::size_t> counts(whole.class_count);
-  for (const auto& [id, e] : all) {
-    EXPECT_EQ(e.cls, joined.at(id).cls);
-    ++counts.at(e.cls);
-  }
-  return counts;
 }
 
 TEST(ClassQueryTest, PartsOfARegionGiveItsPointsAndClasses) {
