@@ -1,8 +1,8 @@
 // The running sums of classes' density images (kdm/runtime/class_image_sums.h).
 #include "kdm/runtime/class_image_sums.h"
 
-#include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include "image_sampler.h"
 
@@ -32,15 +32,18 @@ Status ClassImageSums::build(const DensityImageView* const* images, std::uint32_
     const float* v = images[k]->values;
     float* out = texels_.data() + k * n;
     const float* below = k > 0 ? out - n : nullptr;
+    bool valid = true, finite = true;  // checked after the loop, which then has no branch
     for (std::size_t i = 0; i < n; ++i) {
-      if (!(v[i] >= 0 && std::isfinite(v[i]))) return refuse("an image has a negative or non-finite value");
+      valid &= v[i] >= 0 && v[i] <= std::numeric_limits<float>::max();  // false for NaN
       out[i] = below ? below[i] + v[i] : v[i];
-      if (!std::isfinite(out[i])) return refuse("the images' sum overflows a float");
+      finite &= out[i] <= std::numeric_limits<float>::max();
     }
+    if (!valid) return refuse("an image has a negative or non-finite value");
+    if (!finite) return refuse("the images' sum overflows a float");
     DensityImageView& s = sums_[k];
     s = first;
-    s.values = out, s.max_mip = s.min_mip = nullptr;
-    if (make_density_max_mip(s, mips_[k]) != Status::kOk) return refuse("make_density_max_mip refuses a sum");
+    s.values = out;
+    detail::fill_mips(s, mips_[k]);
   }
   count_ = count;
   return Status::kOk;

@@ -54,23 +54,42 @@ Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
   const std::size_t count = static_cast<std::size_t>(image.width) * image.height;
   for (std::size_t i = 0; i < count; ++i)
     if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;
+  detail::fill_mips(image, mip);
+  return Status::kOk;
+}
+
+void detail::fill_mips(DensityImageView& image, std::vector<float>& mip) {
   image.mip_width = (image.width + 7) / 8;
   image.mip_height = (image.height + 7) / 8;
-  const std::size_t blocks = static_cast<std::size_t>(image.mip_width) * image.mip_height;
+  const int w = image.width, h = image.height, bw = image.mip_width, bh = image.mip_height;
+  const std::size_t blocks = static_cast<std::size_t>(bw) * bh;
   mip.assign(2 * blocks, 0.0f);
-  std::fill(mip.begin() + std::ptrdiff_t(blocks), mip.end(), std::numeric_limits<float>::infinity());
-  // Each block also covers one texel around it: bilinear values inside a block mix in its neighbours.
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) {
-      const float v = image.values[static_cast<std::size_t>(y) * image.width + x];
-      for (int by = std::max(0, (y - 1) / 8); by <= std::min(image.mip_height - 1, (y + 1) / 8); ++by)
-        for (int bx = std::max(0, (x - 1) / 8); bx <= std::min(image.mip_width - 1, (x + 1) / 8); ++bx) {
-          const std::size_t b = static_cast<std::size_t>(by) * image.mip_width + bx;
-          mip[b] = std::max(mip[b], v), mip[blocks + b] = std::min(mip[blocks + b], v);
-        }
+  // Each block also covers one texel around it: bilinear values inside a block mix in its neighbours. Rows
+  // first (each row's extremes over every block's columns), then each block's rows: about two reads a texel.
+  std::vector<float> row_max(static_cast<std::size_t>(h) * bw), row_min(row_max.size());
+  for (int y = 0; y < h; ++y) {
+    const float* row = image.values + static_cast<std::size_t>(y) * w;
+    for (int bx = 0; bx < bw; ++bx) {
+      const int x0 = std::max(0, 8 * bx - 1), x1 = std::min(w, 8 * bx + 9);
+      float hi = row[x0], lo = row[x0];
+      for (int x = x0 + 1; x < x1; ++x) hi = std::max(hi, row[x]), lo = std::min(lo, row[x]);
+      row_max[static_cast<std::size_t>(y) * bw + bx] = hi,
+                                                 row_min[static_cast<std::size_t>(y) * bw + bx] = lo;
     }
+  }
+  for (int by = 0; by < bh; ++by) {
+    const int y0 = std::max(0, 8 * by - 1), y1 = std::min(h, 8 * by + 9);
+    float* hi = mip.data() + static_cast<std::size_t>(by) * bw;
+    float* lo = hi + blocks;
+    std::copy(row_max.begin() + std::ptrdiff_t(y0) * bw, row_max.begin() + std::ptrdiff_t(y0 + 1) * bw, hi);
+    std::copy(row_min.begin() + std::ptrdiff_t(y0) * bw, row_min.begin() + std::ptrdiff_t(y0 + 1) * bw, lo);
+    for (int y = y0 + 1; y < y1; ++y)
+      for (int bx = 0; bx < bw; ++bx) {
+        hi[bx] = std::max(hi[bx], row_max[static_cast<std::size_t>(y) * bw + bx]);
+        lo[bx] = std::min(lo[bx], row_min[static_cast<std::size_t>(y) * bw + bx]);
+      }
+  }
   image.max_mip = mip.data(), image.min_mip = mip.data() + blocks;
-  return Status::kOk;
 }
 
 }  // namespace kdm

@@ -5,10 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
 #include "kdm/runtime/density_image.h"
 
 namespace kdm::detail {
+
+/// make_density_max_mip's mips of an image it has checked (values finite and >= 0, a usable rectangle).
+void fill_mips(DensityImageView& image, std::vector<float>& mip);
 
 /// Whether world positions map to texels as numbers: a finite rectangle of positive size whose texels per
 /// world unit are finite (a rectangle hundreds of orders of magnitude smaller than its texels is not, nor one

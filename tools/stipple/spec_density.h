@@ -28,8 +28,9 @@ struct SpecDensity {
 };
 
 /// Classes that are all images on one grid are read by the images of their running sums: builds `sums`
-/// and points params.image_sums at it (the query then reads one image where it would read every class's).
-/// Returns whether it did; with other classes it leaves both as they are.
+/// and points params.image_sums at it (the query then reads one image where it would read every class's),
+/// when params.query expects at least as many points as the sums hold texels (else building them costs
+/// more than they save). Returns whether it did; otherwise it leaves both as they are.
 bool read_images_by_sums(ClassQueryParams& params, ClassImageSums& sums);
 
 }  // namespace kdm::tools

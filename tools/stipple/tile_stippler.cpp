@@ -57,10 +57,6 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   aspect_ = double(first.width) / first.height;  // world: [0, aspect] × [0, 1]
   const double world[4] = {0, 0, aspect_, 1};
   for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
-  ClassQueryParams classes;  // the inks as a class query reads them: by their sums, built once
-  classes.class_count = static_cast<std::uint32_t>(densities_.size());
-  for (std::size_t k = 0; k < densities_.size(); ++k) classes.classes[k] = densities_[k]->density;
-  read_images_by_sums(classes, sums_);
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
   scale_ = points > 0 ? points / (mean * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
@@ -68,6 +64,12 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   // every region and frame sees the same dots.
   tile_size_ =
       std::sqrt(tiles_.max_points_per_tile() / (kStippleZoomRoom * kStippleZoomRoom * scale_ * peak));
+  ClassQueryParams
+      classes;  // the inks over the whole image, as a frame reads them: by their sums, built once
+  classes.query.x1 = aspect_, classes.query.y1 = 1, classes.query.scale = scale_;
+  classes.class_count = static_cast<std::uint32_t>(densities_.size());
+  for (std::size_t k = 0; k < densities_.size(); ++k) classes.classes[k] = densities_[k]->density;
+  read_images_by_sums(classes, sums_);
 }
 
 PointSet TileStippler::render(const double uv[4]) const {
