@@ -3,11 +3,13 @@
 // for bit, in both modes, and the callback is called far less.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -214,6 +216,36 @@ TEST(DensityBoundsTest, ACallbackDensityNeedsExactlyOneOfItsFunctions) {
   EXPECT_STREQ(both.parameter, "density.batch_callback");
   q.density.callback = nullptr, q.density.batch_callback = nullptr;
   EXPECT_STREQ(testing::refusal(q).parameter, "density.callback");
+}
+
+TEST(DensityBoundsTest, AnImagesMipsHoldEachBlocksExtremesWidenedByATexel) {
+  // Every size up to a few blocks, odd ones included: each block's maximum and minimum over its 8 × 8
+  // texels and the ring of one texel around them (clamped to the image), and bilinear values between
+  // them anywhere in the block.
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int w = 1 + int(rng() % 40), h = 1 + int(rng() % 40);
+    std::vector<float> values(std::size_t(w) * h), mip;
+    for (float& v : values) v = std::uniform_real_distribution<float>(0, 5)(rng);
+    DensityImageView image;
+    image.width = w, image.height = h, image.x1 = w, image.y1 = h, image.values = values.data();
+    ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
+    ASSERT_EQ(image.mip_width, (w + 7) / 8);
+    ASSERT_EQ(image.mip_height, (h + 7) / 8);
+    for (int by = 0; by < image.mip_height; ++by)
+      for (int bx = 0; bx < image.mip_width; ++bx) {
+        float hi = 0, lo = std::numeric_limits<float>::infinity();
+        for (int y = std::max(0, 8 * by - 1); y < std::min(h, 8 * by + 9); ++y)
+          for (int x = std::max(0, 8 * bx - 1); x < std::min(w, 8 * bx + 9); ++x)
+            hi = std::max(hi, values[std::size_t(y) * w + x]),
+            lo = std::min(lo, values[std::size_t(y) * w + x]);
+        ASSERT_EQ(image.max_mip[by * image.mip_width + bx], hi) << w << " x " << h;
+        ASSERT_EQ(image.min_mip[by * image.mip_width + bx], lo) << w << " x " << h;
+        const double x = std::min(8 * bx + 8.0, double(w)) - 0.3, y = 8 * by + 0.2;  // inside the block
+        EXPECT_LE(image.at(x, y), image.max_over(x, y, x, y));
+        EXPECT_GE(image.at(x, y), image.min_over(x, y, x, y));
+      }
+  }
 }
 
 TEST(DensityBoundsTest, AnImagesPointsAreThoseOfReadingItEverywhere) {
