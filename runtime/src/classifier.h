@@ -180,18 +180,25 @@ class Classifier {
     const detail::ClassImages& images = densities_.images;
     const std::uint32_t last = p_.class_count - 1;
     double x[detail::kImageBlock], y[detail::kImageBlock], sums[detail::kImageBlock * kMaxQueryClasses];
+    // By the running sums' own images, only sums [from, to) are read: the tile's bounds have every rank
+    // of the range short of the sums below `from` and passing the sums from `to` on (enter_bounds).
+    std::uint32_t from = 0, to = last;
+    if (densities_.sums) {
+      while (from < last && first.rank >= sure_from_[from + 1]) ++from;
+      while (to > from && end - 1 < sure_to_[to - 1]) --to;
+    }
     for (std::uint32_t r = first.rank; r < end;) {
       const std::uint32_t count = std::min(end - r, detail::kImageBlock);
-      if (densities_.sums)  // the running sums' own images: classes 0 … last - 1's only
-        detail::image_planes_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, last, x, y,
-                                 sums);
+      if (densities_.sums)
+        detail::image_planes_run(points_ + r, count, wx, wy, side_, *images.grid, images.values + from,
+                                 to - from, x, y, sums);
       else
         detail::image_sums_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, images.count,
                                x, y, sums);
       for (std::uint32_t i = 0; i < count; ++i) {
         const float t = thresholds_[r + i];
-        std::uint32_t cls = 0;
-        for (std::uint32_t k = 0; k < last; ++k)
+        std::uint32_t cls = from;
+        for (std::uint32_t k = 0; k < to - from; ++k)
           cls += !TilesetShape::emits(t, sums[k * detail::kImageBlock + i] * area_);
         out[r + i - first.rank] = static_cast<std::uint8_t>(cls);
       }
