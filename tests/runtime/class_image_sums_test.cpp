@@ -12,7 +12,6 @@
 #include <tuple>
 #include <vector>
 
-#include "allocation_counter.h"
 #include "class_points.h"
 #include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
@@ -21,14 +20,6 @@
 
 namespace kdm {
 namespace {
-
-using testing::expect_same;
-using testing::Id;
-using testing::id_of;
-using testing::Points;
-using testing::run_classes;
-using testing::run_one;
-using testing::up_to_class;
 
 /// ThreeImages by their running sums.
 struct SummedImages : testing::ThreeImages {
@@ -72,11 +63,11 @@ TEST(ClassImageSumsTest, SumsAreTheImagesAddedTexelByTexel) {
 TEST(ClassImageSumsTest, StableClassesAreTheOneClassQueriesAtTheSums) {
   SummedImages im;
   const ClassQueryParams q = im.query(-0.4, 0.3, 4.3, 4.6, 900, QueryMode::kStable);
-  const Points all = run_classes(q, 1000);
+  const testing::Points all = testing::run_classes(q, 1000);
   for (std::uint32_t k = 0; k < 3; ++k) {
-    const Points upto = up_to_class(all, int(k));
+    const testing::Points upto = testing::up_to_class(all, int(k));
     const QueryParams one = at_sum(q, k);
-    expect_same(upto, run_one(one), "classes 0 … k against the one-class query at sum k");
+    testing::expect_same(upto, testing::run_one(one), "classes 0 … k against the one-class query at sum k");
     EXPECT_GT(upto.size(), 3000u * (k + 1));
   }
 }
@@ -88,9 +79,9 @@ TEST(ClassImageSumsTest, SmoothUnionIsTheSmoothQueryAtTheLastSumWithStableModesC
   for (double scale : {900.0, 20000.0}) {
     const double side = scale > 1000 ? 0.6 : 3.7;
     const ClassQueryParams smooth = im.query(1.7, 1.6, 1.7 + side, 1.6 + side, scale, QueryMode::kSmooth);
-    const Points all = run_classes(smooth, 777);
+    const testing::Points all = testing::run_classes(smooth, 777);
     const QueryParams one = at_sum(smooth, 2);
-    expect_same(all, run_one(one), "the smooth union");
+    testing::expect_same(all, testing::run_one(one), "the smooth union");
     std::size_t deep = 0;
     for (const auto& [id, e] : all) deep += std::get<3>(id) > 0;
     if (scale > 1000) {
@@ -99,7 +90,7 @@ TEST(ClassImageSumsTest, SmoothUnionIsTheSmoothQueryAtTheLastSumWithStableModesC
     }  // past the top level a point is classed by its subtile's threshold
     ClassQueryParams stable = smooth;
     stable.query.mode = QueryMode::kStable;
-    const Points fixed = run_classes(stable);
+    const testing::Points fixed = testing::run_classes(stable);
     std::size_t both = 0;
     for (const auto& [id, e] : all) {
       const auto it = fixed.find(id);
@@ -122,7 +113,7 @@ TEST(ClassImageSumsTest, ClassesFollowTheImagesGivenOneByOne) {
     images.image_sums = nullptr;
     for (int k = 0; k < 3; ++k)
       images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &im.views[k];
-    const Points a = run_classes(sums), b = run_classes(images);
+    const testing::Points a = testing::run_classes(sums), b = testing::run_classes(images);
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
     for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
@@ -139,7 +130,7 @@ TEST(ClassImageSumsTest, PartsCompactOutputAndThreadsGiveTheSamePointsAndClasses
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     const ClassQueryParams whole = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
     testing::expect_parts_give_the_whole(whole, rng);
-    const Points all = run_classes(whole);
+    const testing::Points all = testing::run_classes(whole);
 
     // The records in order, then the compact output and two workers over the same buffer size.
     std::vector<QueryPoint> out(all.size() + 1);
@@ -167,9 +158,9 @@ TEST(ClassImageSumsTest, PartsCompactOutputAndThreadsGiveTheSamePointsAndClasses
                      std_thread_runner()),
               Status::kOk);
     ASSERT_EQ(written2, written);
-    std::map<Id, int> by_id;
-    for (std::size_t i = 0; i < written; ++i) by_id[id_of(par[i])] = par_cls[i];
-    for (std::size_t i = 0; i < written; ++i) ASSERT_EQ(by_id.at(id_of(out[i])), cls[i]) << i;
+    std::map<testing::Id, int> by_id;
+    for (std::size_t i = 0; i < written; ++i) by_id[testing::id_of(par[i])] = par_cls[i];
+    for (std::size_t i = 0; i < written; ++i) ASSERT_EQ(by_id.at(testing::id_of(out[i])), cls[i]) << i;
   }
 }
 
@@ -226,24 +217,7 @@ TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
 
 TEST(ClassImageSumsTest, QueriesAllocateNothing) {
   SummedImages im;
-  std::vector<QueryPoint> out(1 << 16);
-  std::vector<std::uint8_t> cls(out.size());
-  std::vector<float> xy(2 * out.size());
-  (void)Tileset::builtin();
-  const long before = testing::allocations();
-  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
-    const ClassQueryParams q = im.query(0, 0, 4, 4, 500, mode);
-    QueryCursor cursor;
-    std::size_t written = 0;
-    EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls.data(), out.size(), &written, &cursor),
-              Status::kOk);
-    EXPECT_GT(written, 10000u);
-    cursor = QueryCursor{};
-    EXPECT_EQ(query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), nullptr}, cls.data(),
-                                    out.size(), &written, &cursor),
-              Status::kOk);
-  }
-  EXPECT_EQ(testing::allocations(), before);
+  testing::expect_class_queries_allocate_nothing(im.query(0, 0, 4, 4, 500, QueryMode::kStable));
 }
 
 }  // namespace

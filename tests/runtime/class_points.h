@@ -1,5 +1,5 @@
 // Class queries' points by id, for the tests that compare them: whole queries resumed through a buffer,
-// one-class queries, bit-for-bit comparison, and three images on one grid to query.
+// one-class queries, bit-for-bit comparison, no allocation, and three images on one grid to query.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -11,6 +11,7 @@
 #include <tuple>
 #include <vector>
 
+#include "allocation_counter.h"
 #include "kdm/runtime/class_query.h"
 #include "random_partition.h"
 
@@ -100,6 +101,31 @@ inline std::vector<std::size_t> expect_parts_give_the_whole(const ClassQueryPara
     ++counts.at(e.cls);
   }
   return counts;
+}
+
+/// Runs `q` in both modes into records and into the compact output with keys (each emitting more than
+/// 10,000 points) and expects no allocation among them.
+inline void expect_class_queries_allocate_nothing(ClassQueryParams q) {
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  std::vector<float> xy(2 * out.size());
+  std::vector<std::uint64_t> keys(out.size());
+  (void)Tileset::builtin();
+  const long before = allocations();
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    q.query.mode = mode;
+    QueryCursor cursor;
+    std::size_t written = 0;
+    EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    EXPECT_GT(written, 10000u);
+    cursor = QueryCursor{};
+    EXPECT_EQ(query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), keys.data()},
+                                    classes.data(), out.size(), &written, &cursor),
+              Status::kOk);
+    EXPECT_GT(written, 10000u);
+  }
+  EXPECT_EQ(allocations(), before);
 }
 
 /// Three images over [0, 4)²: a ramp in x, a ramp in y and a bump, each with its max-mip.

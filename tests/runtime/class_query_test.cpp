@@ -12,7 +12,6 @@
 #include <tuple>
 #include <vector>
 
-#include "allocation_counter.h"
 #include "class_points.h"
 #include "kdm/runtime/class_query.h"
 #include "random_partition.h"
@@ -616,26 +615,7 @@ TEST(ClassQueryTest, QueriesAllocateNothing) {
   ClassQueryParams q = three_constants(0, 0, 4, 4, 500, QueryMode::kSmooth);
   q.classes[2].kind = QueryDensity::Kind::kImage;
   q.classes[2].image = &images.views[0];
-  std::vector<QueryPoint> out(1 << 16);
-  std::vector<std::uint8_t> classes(out.size());
-  std::vector<float> xy(2 * out.size());
-  std::vector<std::uint64_t> keys(out.size());
-  (void)Tileset::builtin();
-  const long before = testing::allocations();
-  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
-    q.query.mode = mode;
-    QueryCursor cursor;
-    std::size_t written = 0;
-    EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), classes.data(), out.size(), &written, &cursor),
-              Status::kOk);
-    EXPECT_GT(written, 10000u);
-    cursor = QueryCursor{};
-    EXPECT_EQ(query_classes_compact(Tileset::builtin(), q, CompactPoints{xy.data(), keys.data()},
-                                    classes.data(), out.size(), &written, &cursor),
-              Status::kOk);
-    EXPECT_GT(written, 10000u);
-  }
-  EXPECT_EQ(testing::allocations(), before);
+  testing::expect_class_queries_allocate_nothing(q);
 }
 
 }  // namespace
