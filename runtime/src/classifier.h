@@ -189,18 +189,20 @@ class Classifier {
     }
     for (std::uint32_t r = first.rank; r < end;) {
       const std::uint32_t count = std::min(end - r, detail::kImageBlock);
-      if (densities_.sums)
-        detail::image_planes_run(points_ + r, count, wx, wy, side_, *images.grid, images.values + from,
-                                 to - from, x, y, sums);
-      else
+      if (densities_.sums) {
+        detail::image_sum_classes_run(points_ + r, count, wx, wy, side_, *images.grid, images.values + from,
+                                      to - from, thresholds_ + r, area_, static_cast<std::uint8_t>(from),
+                                      out + (r - first.rank));
+      } else {
         detail::image_sums_run(points_ + r, count, wx, wy, side_, *images.grid, images.values, images.count,
                                x, y, sums);
-      for (std::uint32_t i = 0; i < count; ++i) {
-        const float t = thresholds_[r + i];
-        std::uint32_t cls = from;
-        for (std::uint32_t k = 0; k < to - from; ++k)
-          cls += !TilesetShape::emits(t, sums[k * detail::kImageBlock + i] * area_);
-        out[r + i - first.rank] = static_cast<std::uint8_t>(cls);
+        for (std::uint32_t i = 0; i < count; ++i) {
+          const float t = thresholds_[r + i];
+          std::uint32_t cls = 0;
+          for (std::uint32_t k = 0; k < last; ++k)
+            cls += !TilesetShape::emits(t, sums[k * detail::kImageBlock + i] * area_);
+          out[r + i - first.rank] = static_cast<std::uint8_t>(cls);
+        }
       }
       r += count;
     }

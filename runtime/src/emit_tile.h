@@ -48,6 +48,36 @@ inline RegionFlagBoxes region_flag_boxes(const TileJob& j) {
 /// candidate between the tile's bounds without reading the density where they can.
 constexpr std::uint32_t kCellBits = 2;
 
+/// Stable mode, a class query: candidates c … c + count - 1 (count ≤ kImageBlock) of tile j inside the
+/// region, their densities rho[i] and classes cls[i] read together, decided as emit_tile's `decide` decides
+/// (each written at the next slot, which only an emitted one keeps) from slot n on; returns the rank that did
+/// not fit, or ~0u. Their classes are gathered here and written together: a byte stored through the
+/// output's pointer could alias the loop's state, which the compiler would then reload at every candidate.
+template <class Sink>
+[[gnu::always_inline]] inline std::uint32_t put_classed_block(const TileJob& j, const Sink& out,
+                                                              std::uint32_t c, std::uint32_t count,
+                                                              const double* rho, const std::uint8_t* cls,
+                                                              std::size_t capacity, std::size_t& n) {
+  std::uint8_t classes[kImageBlock];
+  const std::size_t first = n;
+  std::size_t m = first;
+  std::uint32_t stopped = ~0u;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const bool emitted = TilesetShape::emits(j.thresholds[c + i], rho[i] * j.area_scale);
+    if (m == capacity) {
+      if (!emitted) continue;
+      stopped = c + i;
+      break;
+    }
+    out.put_stable_unclassed(m, j, j.points[c + i], c + i);
+    classes[m - first] = cls[i];
+    m += emitted;
+  }
+  out.put_classes(first, classes, m - first);
+  n = m;
+  return stopped;
+}
+
 /// Emits the candidates [c, end) of one tile into out[n ..) (at most `capacity` in all); returns the rank
 /// it stopped at (end, or the first point that did not fit). kInside: every point the tile can emit, glided
 /// or not, lies inside the region, so no point is tested against it. kListed: only the ranks of
@@ -445,6 +475,13 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     while (c < end && stopped == kNone) {
       const std::uint32_t count = std::min(end - c, kImageBlock);
       const std::uint8_t* classed = read_block(count);
+      if constexpr (kClassesAtDensity<Sink> && !kSmooth) {
+        if (classed) {
+          stopped = put_classed_block(j, out, c, count, rho, classed, capacity, n);
+          c += count;
+          continue;
+        }
+      }
       for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
         if (!beyond_reach(c, j.points[c]))
           stopped = decide(c, j.points[c], bx[i], by[i], rho[i], classed ? classed + i : nullptr);
@@ -454,7 +491,7 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
     // Classes that are all images on one grid: their running sums a block at a time, as above.
     const ClassImages* images = out.images();
     if (images && image_runs_fit(*images->grid->image)) {
-      double bx[kImageBlock], by[kImageBlock], sums[kImageBlock * kMaxQueryClasses];
+      double bx[kImageBlock], by[kImageBlock], rho[kImageBlock], sums[kImageBlock * kMaxQueryClasses];
       std::uint8_t cls[kImageBlock];
       const double* total = sums + (images->count - 1) * std::size_t(kImageBlock);
       while (c < end && stopped == kNone) {
@@ -462,6 +499,12 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
         image_sums_run(j.points + c, count, j.wx, j.wy, j.S, *images->grid, images->values, images->count, bx,
                        by, sums);
         out.classes_of_sums(j, c, count, sums, kImageBlock, cls);
+        if constexpr (!kSmooth) {
+          for (std::uint32_t i = 0; i < count; ++i) rho[i] = density_or_zero(total[i]);
+          stopped = put_classed_block(j, out, c, count, rho, cls, capacity, n);
+          c += count;
+          continue;
+        }
         for (std::uint32_t i = 0; i < count && stopped == kNone; ++i, ++c)
           if (!beyond_reach(c, j.points[c]))
             stopped = decide(c, j.points[c], bx[i], by[i], density_or_zero(total[i]), cls + i);

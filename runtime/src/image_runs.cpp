@@ -67,13 +67,19 @@ KDM_RUN_CLONES void image_sums_run(const TilePoint* from, std::size_t count, dou
   }
 }
 
-KDM_RUN_CLONES void image_planes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
-                                     const ImageSampler& sampler, const float* const* values,
-                                     std::uint32_t images, double* x, double* y, double* sums) {
+KDM_RUN_CLONES void image_sum_classes_run(const TilePoint* from, std::size_t count, double wx, double wy,
+                                          double S, const ImageSampler& sampler, const float* const* sums,
+                                          std::uint32_t planes, const float* thresholds, double area,
+                                          std::uint8_t first_class, std::uint8_t* cls) {
   BlockTexels t;
+  double x[kImageBlock], y[kImageBlock];
   block_texels(from, count, wx, wy, S, sampler, x, y, t);
-  for (std::uint32_t i = 0; i < images; ++i)
-    for (std::size_t k = 0; k < count; ++k) sums[i * kImageBlock + k] = blend(values[i], t, k);
+  std::uint8_t found[kImageBlock];
+  for (std::size_t k = 0; k < count; ++k) found[k] = first_class;
+  for (std::uint32_t i = 0; i < planes; ++i)
+    for (std::size_t k = 0; k < count; ++k)
+      found[k] += !TilesetShape::emits(thresholds[k], blend(sums[i], t, k) * area);
+  std::copy(found, found + count, cls);
 }
 
 KDM_RUN_CLONES void image_classes_run(const TilePoint* from, std::size_t count, double wx, double wy,
@@ -85,6 +91,12 @@ KDM_RUN_CLONES void image_classes_run(const TilePoint* from, std::size_t count, 
   block_texels(from, count, wx, wy, S, sampler, x, y, t);
   const float* values = sampler.image->values;
   for (std::size_t k = 0; k < count; ++k) rho[k] = blend(values, t, k);
+  // Thresholds rise with the rank, and so do the sums with the class: a block whose first threshold
+  // every sum but the last falls short of everywhere is all of the last class.
+  if (classes > 1 && !TilesetShape::emits(thresholds[0], hi[classes - 2])) {
+    std::fill(cls, cls + count, static_cast<std::uint8_t>(classes - 1));
+    return;
+  }
   // The emitted candidates whose class the bounds leave open are gathered, so that the loops stay
   // branch-free; the bounds settle the others (the classes short of a threshold are a prefix).
   std::uint8_t short_everywhere[kImageBlock] = {}, short_somewhere[kImageBlock] = {};

@@ -32,11 +32,12 @@ void image_sums_run(const TilePoint* from, std::size_t count, double wx, double 
                     const ImageSampler& sampler, const float* const* values, std::uint32_t images, double* x,
                     double* y, double* sums);
 
-/// The same for `images` images on `sampler`'s grid, each read on its own: values[i]'s into
-/// sums[i · kImageBlock + k] (images already summed: ClassImageSums).
-void image_planes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
-                      const ImageSampler& sampler, const float* const* values, std::uint32_t images,
-                      double* x, double* y, double* sums);
+/// Classes by the images of their running sums on `sampler`'s grid (ClassImageSums), of candidates
+/// from[0 … count) of a tile at (wx, wy) of side S: cls[k] = first_class plus how many of sums[0 … planes),
+/// read at the candidate's stable position and times `area`, do not pass thresholds[k].
+void image_sum_classes_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
+                           const ImageSampler& sampler, const float* const* sums, std::uint32_t planes,
+                           const float* thresholds, double area, std::uint8_t first_class, std::uint8_t* cls);
 
 /// The same for classes by the images of their running sums on `sampler`'s grid (ClassImageSums), sums[i]
 /// the i-th one's texels, `classes` of them: sampler's image (the last sum) read into rho[k] as image_run

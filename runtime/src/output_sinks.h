@@ -296,6 +296,15 @@ struct VaryingClassSink {
     base.put_stable(i, j, p, rank);
     c->classes[i] = k;
   }
+  /// put_stable of a point whose class is written apart (put_classes).
+  [[gnu::always_inline]] void put_stable_unclassed(std::size_t i, const TileJob& j, TilePoint p,
+                                                   std::uint32_t rank) const {
+    base.put_stable(i, j, p, rank);
+  }
+  /// The classes of slots i … i + count - 1.
+  void put_classes(std::size_t i, const std::uint8_t* classes, std::size_t count) const {
+    std::memcpy(c->classes + i, classes, count);
+  }
   /// A point whose class class_at gave (smooth mode: found before the glide, written after it).
   void put_classed(std::size_t i, double x, double y, const PointId& id, std::uint8_t k) const {
     base.put(i, x, y, id);
