@@ -25,9 +25,19 @@ double checked_value(double v, double x, double y) {
   return v;
 }
 
+/// Raises TypeError (as error_already_set) naming what a density callable returned instead of numbers.
+[[noreturn]] void not_numbers(const py::handle& value, const char* what) {
+  PyErr_Format(PyExc_TypeError, "density callable returned %s, not %s", Py_TYPE(value.ptr())->tp_name, what);
+  throw py::error_already_set();
+}
+
 /// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all.
 void read_values(const py::object& value, std::size_t n, const double* x, const double* y, double* out) {
   using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  // Cast to double, None would become NaN and a complex number lose its imaginary part.
+  if (value.is_none()) not_numbers(value, "an array of numbers");
+  if (const py::array raw = py::array::ensure(value); raw && raw.dtype().kind() == 'c')
+    not_numbers(value, "real numbers (its dtype is complex)");
   const Array v = Array::ensure(value);
   if (!v) throw std::invalid_argument("a vectorized density callable must return an array of numbers");
   const bool one = v.ndim() == 0 || (v.ndim() == 1 && v.shape(0) == 1);
@@ -91,7 +101,11 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
       guarded(d, [&] {
         const py::object value = d.function(x, y);
         const double got = PyFloat_AsDouble(value.ptr());  // any number, numpy's too
-        if (got == -1 && PyErr_Occurred()) throw py::error_already_set();
+        if (got == -1 && PyErr_Occurred()) {
+          if (!PyErr_ExceptionMatches(PyExc_TypeError)) throw py::error_already_set();
+          PyErr_Clear();
+          not_numbers(value, "a number");
+        }
         v = checked_value(got, x, y);
       });
       return v;

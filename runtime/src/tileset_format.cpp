@@ -507,7 +507,21 @@ Status load_tileset(const std::string& path, TilesetData& out, std::string* deta
   return decode_tileset(bytes.data(), bytes.size(), out, detail);
 }
 
+Status check_tileset_path(const std::string& path, std::string* detail) {
+  if (path.empty()) return fail(Status::kIoError, detail, "no file name to save the tile set to");
+  struct stat info;
+  if (stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+    return fail(Status::kIoError, detail, "cannot write '" + path + "': it is a directory");
+  const std::string temp = path + ".partial";
+  std::FILE* f = std::fopen(temp.c_str(), "wb");
+  if (!f) return fail(Status::kIoError, detail, "cannot create '" + temp + "': " + std::strerror(errno));
+  std::fclose(f);
+  std::remove(temp.c_str());
+  return Status::kOk;
+}
+
 Status save_tileset(const TilesetData& set, const std::string& path, std::string* detail) {
+  if (const Status s = check_tileset_path(path, detail); s != Status::kOk) return s;
   std::vector<std::uint8_t> bytes;
   if (const Status s = encode_tileset(set, bytes, detail); s != Status::kOk) return s;
   const std::string temp = path + ".partial";

@@ -356,6 +356,17 @@ TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
 TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
   const TilesetData set = make_tileset();
   EXPECT_EQ(save_tileset(set, "/nonexistent-dir/x.kdmt"), Status::kIoError);
+  // A path that cannot take the set is found before any work (check_tileset_path), named in the detail.
+  std::string detail;
+  EXPECT_EQ(check_tileset_path(testing::TempDir(), &detail), Status::kIoError);
+  EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
+  EXPECT_EQ(save_tileset(set, testing::TempDir(), &detail), Status::kIoError);
+  EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
+  EXPECT_EQ(check_tileset_path("", &detail), Status::kIoError);
+  EXPECT_EQ(check_tileset_path("/nonexistent-dir/x.kdmt", &detail), Status::kIoError);
+  EXPECT_NE(detail.find("/nonexistent-dir/x.kdmt.partial"), std::string::npos) << detail;
+  EXPECT_EQ(check_tileset_path(testing::TempDir() + "/fresh.kdmt"), Status::kOk);
+  EXPECT_FALSE(std::ifstream(testing::TempDir() + "/fresh.kdmt.partial").good());  // removed again
   const std::string path = testing::TempDir() + "/atomic.kdmt";
   { std::ofstream(path) << "old contents"; }
   ASSERT_EQ(save_tileset(set, path), Status::kOk);

@@ -109,7 +109,9 @@ void run_analyze(const AnalyzeArgs& args) {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
     gen::Density target = gen::Density::constant();
     if (!args.density.empty()) {
-      target = cli::to_generator_density(parse_density(args.density, args.gamma, args.invert));
+      const tools::DensitySpec spec = parse_density(args.density, args.gamma, args.invert);
+      check_image_options({&spec}, args.gamma, args.invert);
+      target = cli::to_generator_density(spec);
       o.density = tools::analysis_density(target);
     }
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);

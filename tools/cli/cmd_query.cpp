@@ -65,6 +65,11 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const std::ve
 }
 
 void run_query_command(const QueryArgs& a, bool density_given) {
+  bool known = false;  // before the query, which may take long
+  for (const char* extension : {".csv", ".json", ".txt", ".svg", ".png"})
+    known = known || ends_with(a.output, extension);
+  if (!known)
+    throw CommandError("unknown output format for '" + a.output + "' (use .csv, .json, .txt, .svg or .png)");
   double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
   if (density_given && !a.classes.empty())
@@ -79,6 +84,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   std::vector<const tools::DensitySpec*> class_specs;
   for (const auto& spec : specs) class_specs.push_back(spec.get());
   check_class_images(class_specs);
+  check_image_options(class_specs, a.gamma, a.invert);
   const bool any_map = std::any_of(specs.begin(), specs.end(), [](const auto& s) {
     return s->kind != tools::DensitySpec::Kind::kConstant;
   });
@@ -99,6 +105,17 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.scale = a.scale;
   q.density = densities[0]->density;
   q.mode = parse_mode(a.mode);
+  // Below a point per tile a tile's count rounds (README, "Known limits"): said, not refused, since a
+  // sparse corner of a map is no mistake.
+  double densest = 0;
+  for (const auto& spec : specs) densest += spec->max_value();
+  const double per_tile = densest * a.scale * a.tile_size * a.tile_size;
+  if (per_tile > 0 && per_tile < 1)
+    std::fprintf(
+        stderr,
+        "kdm query: warning: at most %.3g points per tile; below 1 a tile's expected count rounds to "
+        "steps of 1/%zu of a point (use a larger --tile-size)\n",
+        per_tile, tiles.data().tiles.size());
   const auto t0 = std::chrono::steady_clock::now();
   // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;

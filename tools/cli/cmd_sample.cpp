@@ -14,6 +14,7 @@
 #include "kdm/generator/sampler.h"
 #include "point_output.h"
 #include "progress.h"
+#include "seed_arg.h"
 #include "threads_arg.h"
 
 namespace kdm::cli {
@@ -69,6 +70,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   std::vector<const tools::DensitySpec*> class_specs;
   for (const tools::DensitySpec& s : specs) class_specs.push_back(&s);
   check_class_images(class_specs);
+  check_image_options(class_specs, args.gamma, args.invert);
   bool image = false, edged = false;
   for (const tools::DensitySpec& s : specs) {
     image = image || s.kind == tools::DensitySpec::Kind::kImage;
@@ -181,7 +183,7 @@ void add_sample_command(CLI::App& app) {
                   "Temperature in the reference implementation's units (0.5 = the paper's look; lower = more "
                   "ordered; 0 = deterministic descent)")
       ->capture_default_str();
-  cmd->add_option("--seed", o.seed, "Random seed; the output depends on nothing else")->capture_default_str();
+  add_seed_option(cmd, o.seed, "Random seed; the output depends on nothing else");
   cmd->add_option("--density", args->density,
                   "const:V, an image whose darkness is the density, or a test map: ramp:R (R^-x, dynamic "
                   "range R) or radial:R (R^-(2r) around the centre)")

@@ -15,6 +15,7 @@
 #include "full_stippler.h"
 #include "point_output.h"
 #include "runtime_args.h"
+#include "seed_arg.h"
 #include "tile_stippler.h"
 
 namespace kdm::cli {
@@ -199,7 +200,7 @@ void add_stipple_command(CLI::App& app) {
                   "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
                   "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
                   "(a layer per pen), .csv an ink column (default: black dots of the image's darkness)");
-  cmd->add_option("--seed", a->seed, "Random seed for --method full")->capture_default_str();
+  add_seed_option(cmd, a->seed, "Random seed for --method full");
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
   cmd->add_option("--mode", a->mode,
                   "--method tiles: smooth (dots glide with the density: good blue noise at every tone) or "

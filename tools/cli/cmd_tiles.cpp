@@ -42,13 +42,15 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   } catch (const gen::InvalidArgument& e) {
     throw CommandError("'" + recipe_path + "': " + e.what());
   }
+  std::string detail;
+  if (const Status s = check_tileset_path(output, &detail); s != Status::kOk)  // before minutes of baking
+    throw CommandError(std::string(status_message(s)) + ": " + detail);
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("baking");
   gen::BakeReport report;
   const TilesetData set = gen::bake_tileset(
       recipe, threads, [&bar](double f) { bar.update(f); }, &report);
   bar.finish();
-  std::string detail;
   const Status s = save_tileset(set, output, &detail);
   if (s != Status::kOk) throw CommandError(std::string(status_message(s)) + ": " + detail);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

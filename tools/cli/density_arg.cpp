@@ -29,4 +29,12 @@ void check_class_images(const std::vector<const tools::DensitySpec*>& classes) {
   }
 }
 
+void check_image_options(const std::vector<const tools::DensitySpec*>& densities, double gamma, bool invert) {
+  if (gamma == 1 && !invert) return;
+  for (const tools::DensitySpec* s : densities)
+    if (s->kind == tools::DensitySpec::Kind::kImage) return;
+  throw CommandError(std::string(invert ? "--invert" : "--gamma") +
+                     " applies to image files only, and no density given is one");
+}
+
 }  // namespace kdm::cli

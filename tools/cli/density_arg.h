@@ -17,4 +17,8 @@ tools::DensitySpec parse_density(const std::string& text, double gamma, bool inv
 /// would each be stretched differently. Throws CommandError naming two that differ.
 void check_class_images(const std::vector<const tools::DensitySpec*>& classes);
 
+/// --gamma and --invert reshape image files' tones only: given (gamma ≠ 1 or invert) with no image among
+/// `densities`, they would be silently ignored. Throws CommandError saying so.
+void check_image_options(const std::vector<const tools::DensitySpec*>& densities, double gamma, bool invert);
+
 }  // namespace kdm::cli

@@ -445,10 +445,12 @@ bool write_png(const std::string& path, const RgbImage& image, std::string& erro
 
 void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode) {
   // Coverage by distance to the edge, one pixel of antialiasing ramp.
-  const int x0 = std::max(0, static_cast<int>(std::floor(cx - r - 1)));
-  const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(cx + r + 1)));
-  const int y0 = std::max(0, static_cast<int>(std::floor(cy - r - 1)));
-  const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(cy + r + 1)));
+  // Clamped in double first: a far or huge disc's bounds do not fit an int.
+  auto pixel = [](double v, int last) { return static_cast<int>(std::clamp(v, -1.0, double(last) + 1)); };
+  const int x0 = std::max(0, pixel(std::floor(cx - r - 1), image.width));
+  const int x1 = std::min(image.width - 1, pixel(std::ceil(cx + r + 1), image.width));
+  const int y0 = std::max(0, pixel(std::floor(cy - r - 1), image.height));
+  const int y1 = std::min(image.height - 1, pixel(std::ceil(cy + r + 1), image.height));
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);

@@ -22,6 +22,12 @@ double auto_radius(const PointSet& points, double width_px, double height_px) {
   return std::max(0.5, 0.25 * spacing);
 }
 
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 std::string hex(const Ink& ink) {
   char text[8];
   std::snprintf(text, sizeof text, "#%02x%02x%02x", ink.rgb[0], ink.rgb[1], ink.rgb[2]);
@@ -60,6 +66,13 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     throw std::invalid_argument("a picture of " + std::to_string(w) + "x" + std::to_string(h) +
                                 " pixels is too large (limit 2^28 pixels); lower the width");
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
+  // A dot wider than the picture only blackens it, and painting large dots costs their area each.
+  if (!(r <= std::max(w, h)))
+    throw std::invalid_argument("a dot size of " + number(r) + " pixels is larger than the " +
+                                std::to_string(w) + "x" + std::to_string(h) + " picture");
+  if (png && double(points.size()) * (2 * r + 3) * (2 * r + 3) > double(std::uint64_t(1) << 32))
+    throw std::invalid_argument("painting " + std::to_string(points.size()) + " dots of " + number(r) +
+                                " pixels would take too long: lower the dot size or the point count");
   const bool classed = style.classes != nullptr;
   if (classed && style.classes->size() != points.size())
     throw std::invalid_argument("a picture's classes do not match its points");

@@ -271,8 +271,14 @@ KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<ch
 /// Reads (read_tileset_file) and decodes the file at `path`.
 KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
+/// Whether a tile set can be saved at `path`: not a directory, and its temporary file (`path` + ".partial")
+/// can be created there (it is created and removed). Returns kOk, or kIoError with `detail` (optional)
+/// naming the problem. save_tileset checks it first; call it before work whose result is to be saved.
+KDM_RUNTIME_API Status check_tileset_path(const std::string& path, std::string* detail = nullptr);
+
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
-/// so an interrupted save never leaves a damaged file at `path`.
+/// so an interrupted save never leaves a damaged file at `path`. Checks `path` (check_tileset_path)
+/// before encoding.
 KDM_RUNTIME_API Status save_tileset(const TilesetData& set, const std::string& path,
                                     std::string* detail = nullptr);
 
