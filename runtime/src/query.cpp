@@ -391,6 +391,13 @@ Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, boo
   const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
   if (far_x > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x);
   if (far_y > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y);
+  // Where a float's step (2^-23 of the distance) reaches a tile, a tile's points fall together: an origin
+  // that far from the region is a mistake (closer, the step is the documented rounding).
+  if (q.tile_size > 0) {
+    const double farthest = std::ldexp(q.tile_size, 23);
+    if (far_x > farthest) return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x, farthest);
+    if (far_y > farthest) return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y, farthest);
+  }
   if (keys && !tileset.empty()) {
     const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
     if (most > (std::uint64_t(1) << kKeyRankBits))

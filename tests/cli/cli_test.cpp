@@ -443,6 +443,9 @@ TEST_F(CliTest, StippleScaleIsChecked) {
     expect_error(stipple + scale, "--scale must be a number > 0");
   }
   expect_error(stipple + "1e300 --method full", "--scale 1e+300 asks for");
+  // The tiles: said in dots and scale, not in the tile size derived from them.
+  expect_error(stipple + "1e300", "more than kdm stipple places");
+  expect_error(stipple + "1e-308", "too small to place a dot");
   EXPECT_FALSE(fs::exists(path("s.txt")));
   ASSERT_EQ(kdm(stipple + "500 --method full").status, 0);
   std::vector<kdm::tools::PointSet> sets;

@@ -157,6 +157,13 @@ def test_a_callable_density_that_returns_no_density_is_an_error(bad):
         BUILTIN.positions((0, 0, 2, 2), scale=100, density=f, density_max=1)
 
 
+def test_positions_refuse_an_origin_where_floats_lose_the_tiles():
+    # float32 positions 10^20 from the origin would all be the same number: refused, not returned.
+    with pytest.raises(ValueError, match="origin_x"):
+        BUILTIN.positions((0, 0, 2, 2), scale=100, origin=(1e20, 0))
+    assert len(BUILTIN.positions((0, 0, 2, 2), scale=100, origin=(1e3, 0))) > 0
+
+
 @pytest.mark.parametrize("bounds", [(math.nan, 1.0), (2.0, 1.0), (-1.0, 1.0), (0.0, math.nan)])
 def test_density_bounds_that_are_no_bounds_are_an_error(bounds):
     with pytest.raises(ValueError, match=r"density_bounds returned .*0 <= lo <= hi"):

@@ -250,6 +250,18 @@ TEST(CompactQueryTest, RefusesMissingOutputByName) {
             Status::kInvalidArgument);
   EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
   EXPECT_STREQ(why.parameter, "origin_y");
+  // Within a float's range but where its step reaches a tile: every tile's points would fall together.
+  far.origin_y = 0, far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 1.01;
+  fresh = QueryCursor{};
+  EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_STREQ(why.parameter, "origin_x");
+  EXPECT_EQ(why.limit, std::ldexp(q.tile_size, 23));
+  far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 0.99;  // nearer: served, with the documented rounding
+  fresh = QueryCursor{};
+  EXPECT_NE(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
 }
 
 TEST(CompactQueryTest, RefusesKeysForTilesTooLargeToNumber) {

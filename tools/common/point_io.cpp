@@ -123,7 +123,9 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
   const bool csv = ends_with(path, ".csv");
   const bool labelled = !set.classes.empty();
   if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
-    error = "'" + path + "': points with classes are written as .csv (x,y,class)";
+    error = "'" + path + "': " +
+            (set.dim != 2 ? std::string("points with classes are 2D only")
+                          : "points with classes are written as .csv (x,y,class)");
     return false;
   }
   // One string grown once, numbers by to_chars (printf's %.17g, as `ostream << double` at precision 17

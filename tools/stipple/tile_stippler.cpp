@@ -64,6 +64,18 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   // every region and frame sees the same dots.
   tile_size_ =
       std::sqrt(tiles_.max_points_per_tile() / (kStippleZoomRoom * kStippleZoomRoom * scale_ * peak));
+  // Said in the caller's terms (dots, scale) before a query would name the tile size derived from them.
+  const double dots = scale_ * mean * aspect_;
+  char text[160];
+  if (!(dots <= double(1 << 28))) {
+    std::snprintf(text, sizeof text, "%.3g dots over the image is more than kdm stipple places (2^28)", dots);
+    throw std::invalid_argument(text);
+  }
+  if (!(tile_size_ > 0 && tile_size_ < HUGE_VAL)) {
+    std::snprintf(text, sizeof text, "a scale of %.3g dots per unit area is too small to place a dot",
+                  scale_);
+    throw std::invalid_argument(text);
+  }
   ClassQueryParams
       classes;  // the inks over the whole image, as a frame reads them: by their sums, built once
   classes.query.x1 = aspect_, classes.query.y1 = 1, classes.query.scale = scale_;

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <limits>
 
 #include "kdm/analysis/common.h"
@@ -102,7 +103,13 @@ Periodogram make_grid(double mean_n, double fmax) {
   p.n = mean_n;
   p.fmax = fmax;
   const double kmax = std::ceil(fmax * std::sqrt(mean_n)) + 1;  // checked before it becomes an int
-  if (!(kmax <= 4096)) throw InvalidInput("periodogram grid too large (fmax·sqrt(n) > 4095)");
+  if (!(kmax <= 4096)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "periodogram grid too large (fmax·sqrt(n) = %.6g > 4095): lower fmax to %.4g", kmax - 1,
+                  std::floor(4095 / std::sqrt(mean_n) * 1e3) / 1e3);
+    throw InvalidInput(text);
+  }
   p.kmax = static_cast<int>(kmax);
   p.power.assign(static_cast<std::size_t>(p.side()) * p.side(), 0.0);
   return p;
