@@ -11,6 +11,7 @@
 #include <system_error>
 #include <vector>
 
+#include "checked_options.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "generator_density.h"
@@ -22,7 +23,6 @@
 #include "kdm/analysis/report.h"
 #include "kdm/generator/sampler.h"
 #include "sampler_density.h"
-#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {

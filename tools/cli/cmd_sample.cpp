@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "checked_options.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "generator_density.h"
@@ -14,8 +15,6 @@
 #include "kdm/generator/sampler.h"
 #include "point_output.h"
 #include "progress.h"
-#include "seed_arg.h"
-#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {

@@ -9,13 +9,13 @@
 #include <memory>
 #include <string>
 
+#include "checked_options.h"
 #include "colour_separation.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "full_stippler.h"
 #include "point_output.h"
 #include "runtime_args.h"
-#include "seed_arg.h"
 #include "tile_stippler.h"
 
 namespace kdm::cli {

@@ -10,12 +10,12 @@
 #include <sstream>
 #include <vector>
 
+#include "checked_options.h"
 #include "commands.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
 #include "progress.h"
-#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {

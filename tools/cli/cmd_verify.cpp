@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <memory>
 
+#include "checked_options.h"
 #include "commands.h"
 #include "kdm/verify/verify.h"
 #include "progress.h"
-#include "threads_arg.h"
 
 namespace kdm::cli {
 namespace {

@@ -1,7 +1,8 @@
-// --threads, the same in every command that runs worker threads: one limit, checked as the command line
-// is parsed.
+// Options that every command taking them checks alike, as the command line is parsed: --threads (one
+// limit) and --seed (CLI11 alone wraps -1 and saturates a larger number, which would silently reuse a seed).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace CLI {
@@ -19,5 +20,8 @@ inline constexpr int kMaxThreads = 256;
 /// Adds --threads to `cmd`, bound to `threads`: 0 (the default count) or 1 to kMaxThreads, anything else
 /// refused by name. `independence` ends the help text (e.g. "output does not depend on it").
 CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& independence);
+
+/// Adds --seed to `cmd`, bound to `seed`: 0 to 2^64 - 1, anything else refused by name.
+CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::string& description);
 
 }  // namespace kdm::cli
