@@ -10,13 +10,19 @@ namespace kdm::tools {
 std::string describe(const QueryProblem& p, const ParameterNames& names) {
   char text[400];
   switch (p.kind) {
-    case QueryProblem::Kind::kDensityTooHigh:
+    case QueryProblem::Kind::kDensityTooHigh: {
+      // Only advice that can be followed: a scale or tile size that fits and is still > 0.
+      char scale[120] = "", tile[120] = "";
+      if (p.largest_valid > 0)
+        std::snprintf(scale, sizeof scale, "%s %.6g or less", names.scale, p.largest_valid);
+      if (p.largest_tile_size > 0)
+        std::snprintf(tile, sizeof tile, "%s %.6g or less", names.tile_size, p.largest_tile_size);
       std::snprintf(text, sizeof text,
-                    "%s: %.6g points per tile where the tile set holds at most %.0f; use %s %.6g or less, or "
-                    "%s %.6g or less",
-                    query_problem_message(p.kind), p.value, p.limit, names.scale, p.largest_valid,
-                    names.tile_size, p.largest_tile_size);
+                    "%s: %.6g points per tile where the tile set holds at most %.0f; use %s%s%s",
+                    query_problem_message(p.kind), p.value, p.limit, scale, *scale && *tile ? ", or " : "",
+                    *scale || *tile ? tile : "a lower density");
       break;
+    }
     case QueryProblem::Kind::kTooManyTiles:
       std::snprintf(text, sizeof text, "%s: %.6g tiles, at most %.0f; use a larger %s or a smaller region",
                     query_problem_message(p.kind), p.value, p.limit, names.tile_size);
