@@ -428,11 +428,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::size_t size = 0;
     const kdm::Status status = kdm::query_points_compact(
         kdm::Tileset::builtin(), q, kdm::CompactPoints{xy, keys}, kBigCapacity, &size, &compact_cursor);
-    const bool beyond_float = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x)) > 1e38 ||
-                              std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y)) > 1e38;
-    if (beyond_float != (status == kdm::Status::kInvalidArgument)) fail();  // refused by name, and only then
-    if (!beyond_float && (status != all.status || size != all.size)) fail();
-    for (std::size_t i = 0; i < (beyond_float ? 0 : size); ++i) {
+    // Refused by name, and only where a float's step reaches a tile (2^23 tiles) or beyond a float.
+    const double far = std::max({std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x),
+                                 std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y)});
+    const bool too_far = far > 1e38 || (q.tile_size > 0 && far > std::ldexp(q.tile_size, 23));
+    if (too_far != (status == kdm::Status::kInvalidArgument)) fail();
+    if (!too_far && (status != all.status || size != all.size)) fail();
+    for (std::size_t i = 0; i < (too_far ? 0 : size); ++i) {
       const kdm::QueryPoint& p = all[i];
       if (keys[i] != kdm::point_key(p.id)) fail();
       if (!(std::fabs(xy[2 * i] - p.x) <= std::ldexp(std::fabs(p.x) + q.tile_size, -21))) fail();
