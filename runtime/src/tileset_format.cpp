@@ -407,7 +407,12 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
   const std::uint32_t header_size = get32(p + 12);
   if (header_size < kFixedHeaderBytes || header_size > kMaxTilesetHeaderBytes)
     return fail(Status::kHeaderChecksumMismatch, detail, "header size field is implausible (damaged header)");
-  if (size < header_size) return fail(Status::kTruncated, detail, "file ends inside the header");
+  if (size < header_size) {  // a cut file, unless the size field disagrees with the header's own text sizes
+    const std::uint64_t text_sizes = std::uint64_t(get32(p + 48)) + get32(p + 52);
+    return text_sizes + kFixedHeaderBytes != header_size
+               ? fail(Status::kHeaderChecksumMismatch, detail, "header size field is damaged")
+               : fail(Status::kTruncated, detail, "file ends inside the header");
+  }
   if (header_crc(p, header_size) != get32(p + kHeaderCrcOffset))
     return fail(Status::kHeaderChecksumMismatch, detail, "header bytes are damaged");
   const std::uint64_t payload_size = get64(p + 16), body_size = get64(p + 24);

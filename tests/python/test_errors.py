@@ -54,6 +54,7 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, "gamma must be > 0", dict(n=10, density="const:1", gamma=0)),
     (TypeError, "invert must be True or False", dict(n=10, density="const:1", invert="yes")),
     (ValueError, "const:V needs a finite V >= 0", dict(n=10, density="const:x")),
+    (ValueError, "not finite or exceeds a float", dict(n=10, density=np.full((2, 2), 1e308))),
     (ValueError, r"ramp:R needs a dynamic range R in \[1, 1e9\]", dict(n=10, density="ramp:0.5")),
     (ValueError, "image densities are 2D", dict(n=10, density=np.ones((2, 2)), dim=3)),
 ])
@@ -144,6 +145,7 @@ def test_query_refusals(kind, match, kwargs):
     (ValueError, "needs method='tiles'", lambda: kdm.stipple(SPHERE, method="full", region=(0, 0, 1, 1))),
     (ValueError, "width must be <= 65536", lambda: kdm.stipple(SPHERE, width=10**6)),
     (ValueError, "dot_size must be >= 0", lambda: kdm.stipple(SPHERE, dot_size=-1)),
+    (ValueError, "^colours must be cmyk, rgb or a number of inks", lambda: kdm.stipple(SPHERE, colours="9")),
     (ValueError, "unknown output format", lambda: kdm.stipple(SPHERE, points=100, output="x.gif")),
     (ValueError, "luminances in", lambda: kdm.stipple(np.full((4, 4), 2.0))),
     (ValueError, "has no ink", lambda: kdm.stipple(np.ones((4, 4)))),

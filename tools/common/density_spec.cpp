@@ -62,12 +62,11 @@ double parse_number(const std::string& text) {
 DensitySpec parse_density_spec(const std::string& text, double gamma, bool invert) {
   DensitySpec spec;
   spec.text = text;
-  if (!(std::isfinite(gamma) && gamma > 0))
-    throw std::invalid_argument("--gamma must be a finite number > 0");
+  if (!(std::isfinite(gamma) && gamma > 0)) throw std::invalid_argument("gamma must be a finite number > 0");
   if (text.rfind("const:", 0) == 0) {
     const double v = parse_number(text.substr(6));
     if (!(v >= 0))
-      throw std::invalid_argument("--density const:V needs a finite V >= 0, got '" + text.substr(6) + "'");
+      throw std::invalid_argument("density const:V needs a finite V >= 0, got '" + text.substr(6) + "'");
     spec.constant = v;
     return spec;
   }
@@ -76,7 +75,7 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
     if (text.compare(0, len, kind) != 0) continue;
     const double range = parse_number(text.substr(len));
     if (!(range >= 1 && range <= 1e9))
-      throw std::invalid_argument("--density " + std::string(kind) +
+      throw std::invalid_argument("density " + std::string(kind) +
                                   "R needs a dynamic range R in [1, 1e9], got '" + text.substr(len) + "'");
     spec.kind = len == 5 ? DensitySpec::Kind::kRamp : DensitySpec::Kind::kRadial;
     spec.range = range;

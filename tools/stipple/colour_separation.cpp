@@ -111,7 +111,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     char* end = nullptr;
     const long n = std::strtol(scheme.c_str(), &end, 10);
     if (scheme.empty() || *end != '\0' || n < 2 || n > 8)
-      throw std::invalid_argument("--colours must be cmyk, rgb or a number of inks from 2 to 8, got '" +
+      throw std::invalid_argument("colours must be cmyk, rgb or a number of inks from 2 to 8, got '" +
                                   scheme + "'");
     const auto centres = cluster_colours(image, int(n));
     for (std::size_t c = 0; c < centres.size(); ++c) {

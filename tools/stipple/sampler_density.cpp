@@ -14,7 +14,7 @@ gen::Density to_generator_density(const DensitySpec& spec) {
     case Kind::kConstant:
       if (!(spec.constant > 0))
         throw std::invalid_argument(
-            "--density const:V needs V > 0 for the full sampler (it has nothing to sample)");
+            "density const:V needs V > 0 here (zero everywhere: nothing to place or compare)");
       return gen::Density::constant();
     case Kind::kRamp:
     case Kind::kRadial: {

@@ -327,7 +327,8 @@ Density Density::from_values(int width, int height, std::vector<float> values) {
     throw InvalidArgument("density image has the wrong number of values");
   bool any = false;
   for (float v : values) {
-    if (!std::isfinite(v)) throw InvalidArgument("density image holds a non-finite value");
+    if (!std::isfinite(v))
+      throw InvalidArgument("density image holds a value that is not finite or exceeds a float (3.4e38)");
     if (v < 0) throw InvalidArgument("density image holds a negative value");
     any |= v > 0;
   }
