@@ -221,6 +221,11 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   expect_error("sample --n 100 --vector-lanes 5" + out, "vector-lanes");  // 16, 8 or 4 only
   const Outcome one = kdm("sample --n 1" + out);
   ASSERT_EQ(one.status, 0) << one.err;
+  // Analysing against an all-zero density: named as such, not as the sampler's need.
+  const Outcome zero = kdm("analyze '" + path("s.txt") + "' --density const:0 -o '" + path("a") + "'");
+  EXPECT_EQ(zero.status, 1);
+  EXPECT_NE(zero.err.find("needs V > 0 here (zero everywhere"), std::string::npos) << zero.err;
+  EXPECT_EQ(zero.err.find("sampler"), std::string::npos) << zero.err;
   std::vector<kdm::tools::PointSet> sets;
   std::string error;
   ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
