@@ -55,16 +55,20 @@ bool emit_cells(const QueryTables& tables, std::size_t index, const CellSpan& sp
     // A batch: the cells' ranks from at on, while they fit and the budget lasts.
     std::uint32_t m = 0, batched = 0;
     const std::uint64_t most = std::min<std::uint64_t>(kBatch, budget);
+    // Cell at.cell is k in the tile's numbering, stepped along rather than divided out at every cell.
+    std::uint32_t column = at.cell % columns,
+                  k = (span.y0 + at.cell / columns) * kIndexCells + span.x0 + column;
     for (; at.cell < cells; ++at.cell, at.rank = 0, p = nullptr) {
-      const std::uint32_t k = (span.y0 + at.cell / columns) * kIndexCells + span.x0 + at.cell % columns;
+      if (column == columns) column = 0, k += kIndexCells - columns;
       const std::uint16_t* const stop = ranks + start[k + 1];
-      if (!p) p = std::lower_bound(ranks + start[k], stop, at.rank);
+      if (!p) p = at.rank == 0 ? ranks + start[k] : std::lower_bound(ranks + start[k], stop, at.rank);
       cell_of[batched] = at.cell, first_of[batched++] = m;
       for (; m < most && p != stop && *p < end; ++p) listed[m++] = *p;
       if (m == most && p != stop && *p < end) {  // the cell goes on in the next batch
         at.rank = *p;
         break;
       }
+      ++column, ++k;
     }
     if (m == 0) {
       if (at.cell == cells) break;

@@ -5,12 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "class_densities.h"
 #include "classifier.h"
+#include "fingerprint.h"
 #include "kdm/runtime/class_image_sums.h"
-#include "kdm/runtime/hash.h"
 #include "query_counted.h"
 #include "query_tables.h"
 
@@ -60,31 +59,26 @@ double density_bound(const QueryDensity& d, const QueryParams& q, double reach) 
 std::uint64_t query_fingerprint(const ClassQueryParams& p) {
   QueryParams q = p.query;
   q.density = QueryDensity{};
-  std::uint64_t h = mix64(query_fingerprint(q) ^ 0x636c6173736573ull);  // "classes"
-  auto add = [&](std::uint64_t v) { h = mix64(h ^ v); };
-  auto add_double = [&](double v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    add(bits);
-  };
-  add(p.class_count);
-  add(reinterpret_cast<std::uintptr_t>(p.joint.densities));
-  add(reinterpret_cast<std::uintptr_t>(p.joint.batch_densities));
-  add(reinterpret_cast<std::uintptr_t>(p.joint.user));
-  for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) add_double(p.joint.max[k]);
-  add(reinterpret_cast<std::uintptr_t>(p.image_sums));
+  detail::Fingerprint f(query_fingerprint(q) ^ 0x636c6173736573ull);  // "classes"
+  f.add(p.class_count);
+  f.add_pointer(reinterpret_cast<const void*>(p.joint.densities));
+  f.add_pointer(reinterpret_cast<const void*>(p.joint.batch_densities));
+  f.add_pointer(p.joint.user);
+  for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) f.add_double(p.joint.max[k]);
+  f.add_pointer(p.image_sums);
   for (std::uint32_t k = 0; p.image_sums && k < p.image_sums->count(); ++k)
-    add(reinterpret_cast<std::uintptr_t>(p.image_sums->sum(k).values));
+    f.add_pointer(p.image_sums->sum(k).values);
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) {
     const QueryDensity& d = p.classes[k];
-    add(static_cast<std::uint64_t>(d.kind));
-    add_double(d.constant), add_double(d.callback_max);
-    add(reinterpret_cast<std::uintptr_t>(d.image));
-    add(reinterpret_cast<std::uintptr_t>(d.callback));
-    add(reinterpret_cast<std::uintptr_t>(d.batch_callback));
-    add(reinterpret_cast<std::uintptr_t>(d.user));
+    f.add(static_cast<std::uint64_t>(d.kind));
+    f.add_double(d.constant), f.add_double(d.callback_max);
+    f.add_pointer(d.image);
+    f.add_pointer(reinterpret_cast<const void*>(d.callback));
+    f.add_pointer(reinterpret_cast<const void*>(d.batch_callback));
+    f.add_pointer(d.user);
+    f.add_pointer(reinterpret_cast<const void*>(d.bounds));
   }
-  return h;
+  return f.value();
 }
 
 namespace {

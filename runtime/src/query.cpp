@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -11,9 +10,9 @@
 #include "cell_index.h"
 #include "descent.h"
 #include "emit_tile.h"
+#include "fingerprint.h"
 #include "image_sampler.h"
 #include "kdm/runtime/compact_query.h"
-#include "kdm/runtime/hash.h"
 #include "keyframe_lookup.h"
 #include "query_counted.h"
 #include "query_tables.h"
@@ -542,24 +541,18 @@ const char* query_problem_message(QueryProblem::Kind kind) {
 }
 
 std::uint64_t query_fingerprint(const QueryParams& q) {
-  std::uint64_t h = 0x6b646d71756572ull;  // "kdmquer"
-  auto add = [&](std::uint64_t v) { h = mix64(h ^ v); };
-  auto add_double = [&](double v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    add(bits);
-  };
+  detail::Fingerprint f(0x6b646d71756572ull);  // "kdmquer"
   for (double v : {q.x0, q.y0, q.x1, q.y1, q.origin_x, q.origin_y, q.tile_size, q.scale, q.density.constant,
                    q.density.callback_max})
-    add_double(v);
-  add(static_cast<std::uint64_t>(q.density.kind));
-  add(static_cast<std::uint64_t>(q.mode));
-  add(reinterpret_cast<std::uintptr_t>(q.density.image));
-  add(reinterpret_cast<std::uintptr_t>(q.density.callback));
-  add(reinterpret_cast<std::uintptr_t>(q.density.batch_callback));
-  add(reinterpret_cast<std::uintptr_t>(q.density.user));
-  add(reinterpret_cast<std::uintptr_t>(q.density.bounds));
-  return h;
+    f.add_double(v);
+  f.add(static_cast<std::uint64_t>(q.density.kind));
+  f.add(static_cast<std::uint64_t>(q.mode));
+  f.add_pointer(q.density.image);
+  f.add_pointer(reinterpret_cast<const void*>(q.density.callback));
+  f.add_pointer(reinterpret_cast<const void*>(q.density.batch_callback));
+  f.add_pointer(q.density.user);
+  f.add_pointer(reinterpret_cast<const void*>(q.density.bounds));
+  return f.value();
 }
 
 }  // namespace kdm

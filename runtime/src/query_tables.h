@@ -24,7 +24,7 @@ struct GlideSpan {
 inline constexpr double kEdgeSlack = 8;
 
 /// QueryTables::cell_ranks cuts a tile into 2^kIndexCellBits × 2^kIndexCellBits cells.
-inline constexpr std::uint32_t kIndexCellBits = 4, kIndexCells = 1u << kIndexCellBits;
+inline constexpr std::uint32_t kIndexCellBits = 5, kIndexCells = 1u << kIndexCellBits;
 
 struct QueryTables {
   /// Per tile, its points' emission thresholds (TilesetShape::emission_threshold), non-decreasing.

@@ -61,7 +61,8 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   EXPECT_GT(t.data().colours, 1u);  // aperiodic corner tiles, not one periodic tile
   // Resident size: 4 bytes of position, 2 of key, 4 of threshold and 2 of cell list per point, 2 per gliding
   // position (one per coordinate), 4 per entry of the edge lists; for the hand-over 2 bytes of table, 4 of
-  // end and 4 of inherited id per point and 4 + 4 per appearing sub-point, 8 per subtile; plus small tables.
+  // end and 4 of inherited id per point and 4 + 4 per appearing sub-point, 8 per subtile, 4 per cell of the
+  // cell lists; plus small tables.
   ASSERT_TRUE(t.has_glide_track());
   std::size_t points = 0, glide = 0, listed = 0, handover = 0, appearing = 0;
   for (const Tile& tile : t.data().tiles) {
@@ -79,7 +80,8 @@ TEST(QueryTest, BuiltinTilesetIsAvailable) {
   ASSERT_EQ(handover, points);  // the built-in set descends into subtiles
   const std::size_t m = t.data().subtiles_per_side();
   const std::size_t expected = 12 * points + glide + 4 * listed + 10 * handover + 8 * appearing +
-                               8 * t.data().tiles.size() * (m * m + 1);
+                               8 * t.data().tiles.size() * (m * m + 1) +
+                               4 * t.data().tiles.size() * (detail::kIndexCells * detail::kIndexCells + 1);
   EXPECT_GE(t.resident_bytes(), expected);
   EXPECT_LE(t.resident_bytes(), expected + 64 * 1024);
   EXPECT_LT(Tileset{}.resident_bytes(), 1024u);

@@ -178,8 +178,9 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 
 /// Writes the region's points into `out[0..capacity)` in a fixed order (tiles row by row, ranks
 /// ascending, then past the top level each tile's appearing sub-points and its subtiles, depth first; a
-/// tile of which the region, widened by the glide's reach, meets at most half gives its points cell by
-/// cell instead, cells of a 16 × 16 grid row by row, ranks ascending in each);
+/// tile of which the region, widened by the glide's reach (a constant density's at its count, else the
+/// farthest any point glides), meets at most half gives its points cell by cell instead, cells of a
+/// 32 × 32 grid row by row, ranks ascending in each);
 /// `*written` receives the count, and slots from there to capacity may be overwritten too (a candidate is
 /// written before it is known to be kept). Returns kOk when the region is complete (a finished cursor called
 /// again with the same params gives kOk and no points), kBufferFull when `out` filled up first or the call
