@@ -5,6 +5,9 @@
 #include <cerrno>
 #include <cstdlib>
 
+#include "commands.h"
+#include "point_io.h"
+
 namespace kdm::cli {
 
 CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& independence) {
@@ -38,6 +41,11 @@ CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::stri
   return cmd->add_option("--seed", seed, description)
       ->capture_default_str()
       ->check(CLI::Validator(in_range, ""));
+}
+
+void check_output_option(const std::string& path, const std::vector<const char*>& extensions) {
+  std::string error;
+  if (!tools::check_output_path(path, extensions, error)) throw CommandError(error);
 }
 
 }  // namespace kdm::cli

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -23,5 +24,9 @@ CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& 
 
 /// Adds --seed to `cmd`, bound to `seed`: 0 to 2^64 - 1, anything else refused by name.
 CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::string& description);
+
+/// Refuses, before any long work, an output path that write would refuse later: an extension not among
+/// `extensions` (".csv", ".png", …), a directory, or a directory that does not exist. Throws CommandError.
+void check_output_option(const std::string& path, const std::vector<const char*>& extensions);
 
 }  // namespace kdm::cli

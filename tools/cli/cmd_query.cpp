@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
+#include "checked_options.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "image_io.h"
@@ -22,10 +24,6 @@ struct QueryArgs {
   double scale = 1000, tile_size = 1, gamma = 1;
   bool invert = false, normalised = false;
 };
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 /// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level, and its
 /// class when `classes` is given. Positions are world coordinates printed exactly (%.17g), so the points of
@@ -65,11 +63,7 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const std::ve
 }
 
 void run_query_command(const QueryArgs& a, bool density_given) {
-  bool known = false;  // before the query, which may take long
-  for (const char* extension : {".csv", ".json", ".txt", ".svg", ".png"})
-    known = known || ends_with(a.output, extension);
-  if (!known)
-    throw CommandError("unknown output format for '" + a.output + "' (use .csv, .json, .txt, .svg or .png)");
+  check_output_option(a.output, {".csv", ".json", ".txt", ".svg", ".png"});  // before a long query
   double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
   if (density_given && !a.classes.empty())
@@ -136,7 +130,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   char line[200];
   std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
                 a.rect.c_str(), a.scale, a.tile_size);
-  const bool csv = ends_with(a.output, ".csv"), json = ends_with(a.output, ".json");
+  const bool csv = tools::has_extension(a.output, ".csv"), json = tools::has_extension(a.output, ".json");
   if (csv || json) {
     std::string error;
     if (!tools::write_text_file_atomic(
@@ -148,6 +142,9 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     for (QueryPoint& p : points) p.x -= r[0], p.y -= r[1];
     tools::DrawStyle style;
     style.aspect = (r[2] - r[0]) / (r[3] - r[1]);
+    // The longer side 1,024 pixels: a tall, narrow rect is a tall picture, not one 1,024 pixels wide.
+    style.width_px =
+        style.aspect >= 1 ? 1024 : static_cast<int>(std::max(1.0, std::round(1024 * style.aspect)));
     if (classed) style.classes = &classes, style.inks = tools::class_inks(densities.size());
     tools::write_points(a.output, tools::normalise_to_rect(points, r),
                         {line, "coordinates normalised to the rect"}, style);

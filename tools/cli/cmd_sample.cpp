@@ -48,6 +48,7 @@ gen::Density class_density(const tools::DensitySpec& spec) {
 }
 
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
+  check_output_option(args.output, {".txt", ".csv", ".svg", ".png"});  // before minutes of sampling
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
   if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
   if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");

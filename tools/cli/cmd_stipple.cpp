@@ -50,6 +50,7 @@ std::string frame_path(const std::string& output, int i) {
 }
 
 void run_stipple(const StippleArgs& a, bool scale_given) {
+  check_output_option(a.output, {".png", ".svg", ".txt", ".csv"});  // before the dots are placed
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
     throw CommandError("--scale must be a number > 0 (dots per unit area at full darkness)");
   if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
@@ -83,6 +84,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                        (a.invert ? "" : " (an all-white image has no ink)"));
   const bool coloured = !a.colours.empty();
   const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
+  double ink = 0;  // the inks' mean darkness: --scale's dots over the whole image are scale · aspect · ink
+  for (const tools::DensitySpec& channel : inks.channels) ink += channel.mean_value();
+  const double whole_dots = a.points > 0 ? double(a.points) : a.scale * aspect * ink;
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
   if (a.method == "full" && !a.region.empty())
@@ -113,14 +117,19 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      const double dots = a.points > 0 ? double(a.points) : a.scale * aspect;
-      if (!(dots <= double(std::int64_t(1) << 31))) {  // the full sampler's limit, before llround overflows
+      if (!(whole_dots <= double(std::int64_t(1) << 31))) {  // the full sampler's limit, before llround
         char message[160];
         std::snprintf(message, sizeof message,
-                      "--scale %g asks for %.3g dots, more than the full sampler's 2^31", a.scale, dots);
+                      "--scale %g asks for %.3g dots, more than the full sampler's 2^31", a.scale,
+                      whole_dots);
         throw CommandError(message);
       }
-      const std::int64_t count = std::llround(dots);
+      const std::int64_t count = std::llround(whole_dots);
+      if (count < 1) {
+        char message[120];
+        std::snprintf(message, sizeof message, "--scale %g places no dot on this image", a.scale);
+        throw CommandError(message);
+      }
       if (coloured) {
         std::vector<const tools::DensitySpec*> specs;
         for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
@@ -130,15 +139,23 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       }
       how = "full KDM sampler";
     } else {
-      set = stippler->render(uv);
+      try {
+        set = stippler->render(uv);
+      } catch (const std::runtime_error& e) {  // the collecting query's limit, said in stipple's terms
+        char message[200];
+        std::snprintf(message, sizeof message,
+                      "the picture of region %g,%g,%g,%g would hold more than 2^25 dots; lower --points or "
+                      "--scale",
+                      uv[0], uv[1], uv[2], uv[3]);
+        throw CommandError(message);
+      }
       how = "runtime tiles";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (dot_radius <= 0) {
-      const double full = a.points > 0 ? double(a.points) : double(set.size());
       // Colour dots larger (0.7 of the mean spacing): inks then cover their share of the paper.
       dot_radius = (coloured ? 0.7 : 0.25) *
-                   std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, full));
+                   std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, whole_dots));
     }
     tools::DrawStyle style;
     style.width_px = a.width_px;

@@ -1,20 +1,59 @@
 #include "point_io.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "image_io.h"
 
 namespace kdm::tools {
-namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+bool has_extension(const std::string& path, const char* extension) {
+  const std::size_t n = std::strlen(extension);
+  if (path.size() < n) return false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::tolower(static_cast<unsigned char>(path[path.size() - n + i])) !=
+        std::tolower(static_cast<unsigned char>(extension[i])))
+      return false;
+  return true;
 }
 
-}  // namespace
+bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
+                       std::string& error) {
+  bool known = false;
+  std::string list;
+  for (std::size_t i = 0; i < extensions.size(); ++i) {
+    known = known || has_extension(path, extensions[i]);
+    list += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + std::string(extensions[i]);
+  }
+  if (!known) {
+    error = "unknown output format for '" + path + "' (use " + list + ")";
+    return false;
+  }
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    error = "output '" + path + "' is a directory";
+    return false;
+  }
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+    error = "cannot write '" + path + "': directory '" + dir.string() + "' does not exist";
+    return false;
+  }
+  return true;
+}
+
+std::string comment_safe(std::string line) {
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  for (std::size_t at = line.find("--"); at != std::string::npos; at = line.find("--", at + 2))
+    line.insert(at + 1, " ");
+  return line;
+}
 
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error) {
   std::ifstream in(path);
@@ -120,7 +159,7 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
 
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
                      std::string& error) {
-  const bool csv = ends_with(path, ".csv");
+  const bool csv = has_extension(path, ".csv");
   const bool labelled = !set.classes.empty();
   if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
     error = "'" + path + "': " +
@@ -136,7 +175,7 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
   if (csv) {
     out += set.dim == 3 ? "x,y,z\n" : labelled ? "x,y,class\n" : "x,y\n";
   } else {
-    for (const std::string& h : header) out += "# " + h + '\n';
+    for (const std::string& h : header) out += "# " + comment_safe(h) + '\n';
   }
   const char sep = csv ? ',' : ' ';
   char number[32];

@@ -22,6 +22,19 @@ struct PointSet {
   std::size_t size() const { return dim > 0 ? coords.size() / dim : 0; }
 };
 
+/// Whether `path` ends in `extension` (".csv"), in any case: ".CSV" is a CSV file too.
+bool has_extension(const std::string& path, const char* extension);
+
+/// Checks, before any long work, that `path` can be written as one of `extensions` (a list such as
+/// {".csv", ".png"}): its extension is one of them, it is not a directory, and its directory exists.
+/// Returns false with `error` naming the path and what is wrong.
+bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
+                       std::string& error);
+
+/// `line` made safe as one comment line of a text or SVG file: line breaks become spaces, and "--" (which
+/// would end an XML comment) becomes "- -".
+std::string comment_safe(std::string line);
+
 /// Reads every set in `path`. All sets must share one dimension (2 or 3); coordinates must be finite.
 /// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error);

@@ -12,10 +12,6 @@
 namespace kdm::tools {
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 double auto_radius(const PointSet& points, double width_px, double height_px) {
   // Dots a quarter of the mean spacing across: distinct at uniform density, dark where points crowd.
   const double spacing = std::sqrt(width_px * height_px / std::max<std::size_t>(1, points.size()));
@@ -51,11 +47,11 @@ std::vector<Ink> class_inks(std::size_t count) {
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
                   const DrawStyle& style) {
   std::string error;
-  if (ends_with(path, ".txt") || ends_with(path, ".csv")) {
+  if (has_extension(path, ".txt") || has_extension(path, ".csv")) {
     if (!write_point_set(path, points, header, error)) throw std::runtime_error(error);
     return;
   }
-  const bool png = ends_with(path, ".png"), svg = ends_with(path, ".svg");
+  const bool png = has_extension(path, ".png"), svg = has_extension(path, ".svg");
   if (!png && !svg)
     throw std::invalid_argument("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
   if (points.dim != 2)
@@ -92,7 +88,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   std::ostringstream out;
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
       << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
-  for (const std::string& line : header) out << "<!-- " << line << " -->\n";
+  for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
   Ink paper;
   std::copy(style.background, style.background + 3, paper.rgb);
   out << "<rect width=\"100%\" height=\"100%\" fill=\"" << hex(paper) << "\"/>\n";

@@ -3,9 +3,25 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 namespace kdm::tools {
+namespace {
+
+/// `v` (> 0) to six significant digits, rounded down: advice of "X or less" must itself be accepted.
+std::string six_digits_down(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  if (std::strtod(text, nullptr) <= v) return text;
+  const double unit = std::pow(10.0, std::floor(std::log10(v)) - 5);
+  for (double w = std::floor(v / unit) * unit;; w -= unit) {
+    std::snprintf(text, sizeof text, "%.6g", w);
+    if (std::strtod(text, nullptr) <= v) return text;
+  }
+}
+
+}  // namespace
 
 std::string describe(const QueryProblem& p, const ParameterNames& names) {
   char text[400];
@@ -14,9 +30,11 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
       // Only advice that can be followed: a scale or tile size that fits and is still > 0.
       char scale[120] = "", tile[120] = "";
       if (p.largest_valid > 0)
-        std::snprintf(scale, sizeof scale, "%s %.6g or less", names.scale, p.largest_valid);
+        std::snprintf(scale, sizeof scale, "%s %s or less", names.scale,
+                      six_digits_down(p.largest_valid).c_str());
       if (p.largest_tile_size > 0)
-        std::snprintf(tile, sizeof tile, "%s %.6g or less", names.tile_size, p.largest_tile_size);
+        std::snprintf(tile, sizeof tile, "%s %s or less", names.tile_size,
+                      six_digits_down(p.largest_tile_size).c_str());
       std::snprintf(text, sizeof text,
                     "%s: %.6g points per tile where the tile set holds at most %.0f; use %s%s%s",
                     query_problem_message(p.kind), p.value, p.limit, scale, *scale && *tile ? ", or " : "",

@@ -67,8 +67,8 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   // Said in the caller's terms (dots, scale) before a query would name the tile size derived from them.
   const double dots = scale_ * mean * aspect_;
   char text[160];
-  if (!(dots <= double(1 << 28))) {
-    std::snprintf(text, sizeof text, "%.3g dots over the image is more than kdm stipple places (2^28)", dots);
+  if (!(dots <= double(kMaxCollectedPoints))) {
+    std::snprintf(text, sizeof text, "%.3g dots over the image is more than one picture holds (2^25)", dots);
     throw std::invalid_argument(text);
   }
   if (!(tile_size_ > 0 && tile_size_ < HUGE_VAL)) {

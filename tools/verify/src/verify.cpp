@@ -178,6 +178,9 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
   if (options.reference_runs < 2) throw gen::InvalidArgument("verify: at least 2 reference runs are needed");
   if (options.levels.empty())
     for (std::uint32_t k = 0; k < set.levels; ++k) options.levels.push_back(k);
+  // A level named twice is judged once.
+  std::sort(options.levels.begin(), options.levels.end());
+  options.levels.erase(std::unique(options.levels.begin(), options.levels.end()), options.levels.end());
   for (std::uint32_t k : options.levels)
     if (k >= set.levels)
       throw gen::InvalidArgument("verify: level " + std::to_string(k) + " is not in the tile set (it has " +
