@@ -172,6 +172,7 @@ kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
   return to_c(status);
 }
 
+static_assert(static_cast<int>(kdm::Status::kOutOfMemory) == KDM_OUT_OF_MEMORY, "one code for running out");
 static_assert(KDM_DENSITY_BATCH == kdm::kDensityBatch, "the C and C++ batch sizes agree");
 static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN,
               "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
@@ -445,15 +446,23 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_memory(data, size, t); });
 }
 
+namespace {
+// The built-in set's handle, known without decoding the set, which only kdm_tileset_builtin() does:
+// freeing another set must not decode it.
+kdm_tileset& builtin_handle() {
+  static kdm_tileset handle;
+  return handle;
+}
+}  // namespace
+
 const kdm_tileset* kdm_tileset_builtin(void) {
-  static kdm_tileset builtin;
-  static const bool shared = (builtin.set = &kdm::Tileset::builtin(), true);  // no second decoded copy
+  static const bool shared = (builtin_handle().set = &kdm::Tileset::builtin(), true);  // no second copy
   (void)shared;
-  return &builtin;
+  return &builtin_handle();
 }
 
 void kdm_tileset_free(kdm_tileset* tileset) {
-  if (tileset != kdm_tileset_builtin()) delete tileset;
+  if (tileset != &builtin_handle()) delete tileset;
 }
 
 size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset) {
@@ -575,7 +584,6 @@ kdm_status kdm_query_class_images_compact(const kdm_tileset* tileset, const kdm_
 }
 
 const char* kdm_status_message(kdm_status status) {
-  if (status == KDM_OUT_OF_MEMORY) return "out of memory";
   return kdm::status_message(static_cast<kdm::Status>(static_cast<int>(status)));
 }
 

@@ -168,11 +168,15 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     return Status::kOk;
   }
   // Depth-0 positions are summed in world units and a point's place in the region is decided in them: a
-  // double's step there (at most 2^-52 of the distance) must stay below a 16th of the spacing at depth 0
-  // and a quarter of the region's side, or positions fall together and regions lose their points.
+  // double's step there (at most 2^-52 of the distance) must stay below a 16th of the spacing at depth 0,
+  // or positions fall together, and below a quarter of the region's side where the region is wider than
+  // the spacing at the density's depth, or regions lose their points. A region narrower than that spacing
+  // (a sliver a chunk loop's rounding leaves) holds its points, if any, by the same test as any other.
   const double far = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
   const double spacing = S / std::sqrt(std::min(max_density * area_scale, top));
-  const double farthest = std::ldexp(std::min(spacing / 16, std::min(q.x1 - q.x0, q.y1 - q.y0) / 4), 52);
+  const double deepest_spacing = S / std::sqrt(max_density * area_scale);
+  const double side = std::max(std::min(q.x1 - q.x0, q.y1 - q.y0), deepest_spacing);
+  const double farthest = std::ldexp(std::min(spacing / 16, side / 4), 52);
   if (far > farthest)
     return refuse(Kind::kTooFarFromOrigin, far == std::fabs(q.x0) || far == std::fabs(q.x1) ? "x0" : "y0",
                   far, farthest);

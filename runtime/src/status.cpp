@@ -31,6 +31,8 @@ const char* status_message(Status status) {
       return "invalid argument";
     case Status::kBufferFull:
       return "output buffer full; resume with the same cursor";
+    case Status::kOutOfMemory:
+      return "out of memory";
   }
   return "unknown status";
 }

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <new>
 #include <sstream>
 #include <streambuf>
 #include <tuple>
@@ -465,6 +466,8 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   std::vector<std::vector<std::uint8_t>> glide;     // and format 4's (glide_differences)
   try {
     parse_body(body.get(), body_size, version, set, glide16, glide);
+  } catch (const std::bad_alloc&) {  // not damage
+    return fail(Status::kOutOfMemory, detail, "payload: an allocation failed");
   } catch (const std::exception& e) {
     return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
   }

@@ -29,6 +29,10 @@ static void* hooked_allocate(size_t bytes, size_t alignment, void* user) {
   *(size_t*)user += bytes;
   return malloc(bytes ? bytes : 1);
 }
+static void* failing_allocate(size_t bytes, size_t alignment, void* user) {
+  (void)bytes, (void)alignment, (void)user;
+  return NULL;
+}
 static void hooked_deallocate(void* p, size_t bytes, size_t alignment, void* user) {
   (void)alignment;
   *(size_t*)user -= bytes;
@@ -82,8 +86,14 @@ int main(int argc, char** argv) {
   kdm_tileset* loaded = NULL;
   kdm_query q = uniform_query();
   kdm_query_problem problem;
-  const kdm_tileset* builtin = kdm_tileset_builtin();
+  const kdm_tileset* builtin = NULL;
   CHECK(argc == 2);
+  /* Freeing no set (or a loaded one) leaves the built-in set undecoded: nothing reaches the allocator. */
+  kdm_set_tileset_allocator(hooked_allocate, hooked_deallocate, &g_hooked_bytes);
+  kdm_tileset_free(NULL);
+  kdm_set_tileset_allocator(NULL, NULL, NULL);
+  CHECK(g_hooked_bytes == 0);
+  builtin = kdm_tileset_builtin();
   CHECK(builtin != NULL);
   CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OK && loaded != NULL);
   {
@@ -497,6 +507,10 @@ int main(int argc, char** argv) {
   CHECK(g_hooked_bytes > 4000000 && g_hooked_bytes <= kdm_tileset_resident_bytes(loaded));
   kdm_tileset_free(loaded);
   CHECK(g_hooked_bytes == 0);
+  /* An allocator that runs out is said as such, not as a damaged file. */
+  kdm_set_tileset_allocator(failing_allocate, hooked_deallocate, &g_hooked_bytes);
+  CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OUT_OF_MEMORY && loaded == NULL);
+  kdm_set_tileset_allocator(NULL, NULL, NULL);
   printf("c api ok\n");
   return 0;
 }

@@ -575,6 +575,23 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   for (const Key& k : far_points) distinct.insert({std::get<3>(k), std::get<4>(k)});
   EXPECT_GT(far_points.size(), 900u);
   EXPECT_EQ(distinct.size(), far_points.size());
+  // A chunk loop stepping by 0.1 ends at 0.9999999999999999, leaving a sliver [1 - 2^-53, 1) a step wide:
+  // served like any chunk (both modes), and the chunks' points are the whole's.
+  for (const QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    std::vector<Key> chunks;
+    int count = 0;
+    for (double x = 0; x < 1; ++count) {
+      const double next = std::min(1.0, x + 0.1);
+      const std::vector<Key> part = run(region(x, 0, next, 1, 1000, mode));  // run expects no refusal
+      chunks.insert(chunks.end(), part.begin(), part.end());
+      x = next;
+    }
+    EXPECT_EQ(count, 11);  // the sliver is there
+    std::vector<Key> whole = run(region(0, 0, 1, 1, 1000, mode));
+    std::sort(chunks.begin(), chunks.end());
+    std::sort(whole.begin(), whole.end());
+    EXPECT_TRUE(chunks == whole);
+  }
   // 100,000 points per unit area at density 0.5 on tiles of side 2: 200,000 per tile, past the top level.
   q = region(0, 0, 4, 4, 100000);
   q.tile_size = 2, q.density.constant = 0.5;

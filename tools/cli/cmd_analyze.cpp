@@ -108,6 +108,7 @@ void run_analyze(const AnalyzeArgs& args) {
   try {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
     gen::Density target = gen::Density::constant();
+    if (args.density.empty()) check_image_options({}, args.gamma, args.invert);  // refused as sample does
     if (!args.density.empty()) {
       const tools::DensitySpec spec = parse_density(args.density, args.gamma, args.invert);
       check_image_options({&spec}, args.gamma, args.invert);

@@ -153,8 +153,9 @@ struct QueryProblem {
                         ///< more than a key's ranks (`limit`, 2^19)
     kTooFarFromOrigin,  ///< the region lies `value` world units from the world origin, farther than
                         ///< `limit`, where a double's step is over a 16th of the points' spacing (or a
-                        ///< quarter of the region's side): move the world's origin nearer, or query a
-                        ///< larger region at a lower density
+                        ///< quarter of the region's side, if that is wider than the spacing at the
+                        ///< density's depth): move the world's origin nearer, or query a larger region
+                        ///< at a lower density
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage

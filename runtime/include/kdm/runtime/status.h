@@ -20,6 +20,7 @@ enum class Status : int {
   kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
   kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TilesetData)
   kBufferFull,               ///< a query filled the caller's buffer; resume with the same cursor
+  kOutOfMemory,              ///< an allocation failed while a tile set was read (its allocator hook's too)
 };
 
 /// A short English description of `status` (static storage).
