@@ -158,9 +158,10 @@ class Tileset:
             all of them, or a sequence with one entry per class (None for the others); they are called
             point by point, or on arrays with `vectorized`; `density_bounds` then holds one bounds
             function (or None) per class. Classes that are all 2-D arrays (or image files) of one
-            shape, in a query expecting at least as many points as they hold texels, are read by their
-            running sums, added texel by texel in float32: the union is then exactly the query at that
-            sum, and the query reads one image instead of one per class. ``kdm query --class``.
+            shape, with at most 2**20 texels in all, are read by their running sums, added texel by
+            texel in float32: the union is then exactly the query at that sum, and the query reads one
+            image instead of one per class (larger ones are read one by one; the choice never depends on
+            the region, so chunks give the whole's points). As ``kdm query --class``.
         tile_size : float
             World units per tile side. A tile expects density * scale * tile_size**2 points, at most
             info["max_points_per_tile"] where the density is highest in stable mode, or

@@ -91,8 +91,12 @@ struct Storage {
       return;
     py::array records = t[0].cast<py::array>();
     py::array_t<std::uint32_t> levels_array = t[1].cast<py::array_t<std::uint32_t>>();
+    // Written through plain pointers: only whole, forward, contiguous arrays (not a reversed or strided
+    // view).
+    const auto contiguous = [](const py::array& a) { return (a.flags() & py::array::c_style) != 0; };
     if (records.itemsize() != sizeof(QueryPoint) || records.ndim() != 1 || !records.writeable() ||
-        !levels_array.writeable() || levels_array.ndim() != 1 || levels_array.shape(0) != records.shape(0))
+        !levels_array.writeable() || levels_array.ndim() != 1 || levels_array.shape(0) != records.shape(0) ||
+        !contiguous(records) || !contiguous(levels_array))
       return;
     points = static_cast<QueryPoint*>(records.mutable_data());
     levels = levels_array.mutable_data();

@@ -49,6 +49,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     tools::ColourImage image;
     std::string error;
     if (!tools::load_colour_image(label, image, error)) throw FileError(error);
+    py::gil_scoped_release release;  // a clustering of every pixel: seconds for a large photograph
     inks = tools::separate_colours(image, *colours, gamma);
     specs.clear();
     for (const DensitySpec& channel : inks.channels) specs.push_back(&channel);
@@ -74,7 +75,8 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   {
     py::gil_scoped_release release;
     const Tileset& tiles = given ? *given : Tileset::builtin();
-    const std::int64_t count = points > 0 ? points : std::llround(scale * aspect);
+    const double whole_dots = tools::stipple_dot_count(specs, double(points), scale);
+    const std::int64_t count = method == "full" ? tools::full_stipple_count(whole_dots, scale) : 0;
     if (method == "full") {
       set = colours ? tools::stipple_full(specs, count, aspect, seed, threads)
                     : tools::stipple_full(spec, count, aspect, seed, threads);
@@ -84,15 +86,11 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     }
     if (colours && set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left
     if (output) {
-      // Dots a quarter of the whole image's mean spacing (0.7 in colour), as kdm stipple draws them.
-      const double full = points > 0 ? double(points) : double(set.size());
       tools::DrawStyle style;
       style.width_px = width;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px =
-          dot_size > 0
-              ? dot_size
-              : (colours ? 0.7 : 0.25) * std::sqrt(double(width) * (width / aspect) / std::max(1.0, full));
+          dot_size > 0 ? dot_size : tools::stipple_dot_radius(whole_dots, width, aspect, colours.has_value());
       if (colours) {
         style.classes = &set.classes, style.inks = inks.inks, style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);
@@ -124,8 +122,12 @@ py::tuple separate(const std::string& path, const std::string& colours, double g
   check_number("gamma", gamma, 0, true);
   tools::ColourImage image;
   std::string error;
-  if (!tools::load_colour_image(path, image, error)) throw FileError(error);
-  const tools::ColourSeparation inks = tools::separate_colours(image, colours, gamma);
+  tools::ColourSeparation inks;
+  {
+    py::gil_scoped_release release;
+    if (!tools::load_colour_image(path, image, error)) throw FileError(error);
+    inks = tools::separate_colours(image, colours, gamma);
+  }
   const auto k = static_cast<py::ssize_t>(inks.channels.size());
   py::array_t<float> channels({k, py::ssize_t(image.height), py::ssize_t(image.width)});
   float* out = channels.mutable_data();

@@ -467,7 +467,7 @@ TEST_F(CliTest, StippleScaleIsChecked) {
     SCOPED_TRACE(scale);
     expect_error(stipple + scale, "--scale must be a number > 0");
   }
-  expect_error(stipple + "1e300 --method full", "--scale 1e+300 asks for");
+  expect_error(stipple + "1e300 --method full", "scale 1e+300 asks for");
   // The tiles: said in dots and scale, not in the tile size derived from them.
   expect_error(stipple + "1e300", "more than one picture holds");
   expect_error(stipple + "1e-308", "too small to place a dot");

@@ -325,6 +325,15 @@ def test_out_refills_an_earlier_results_arrays():
     assert np.array_equal(np.bincount(again.level, minlength=levels) > 0, np.ones(levels, bool))
     with pytest.raises(TypeError):
         tiles.query((0, 0, 2, 2), scale=400, out=big.xy)
+    # Storage that is not whole and forward (reversed, strided) is not written through: new memory.
+    records, levels = big._storage
+    for view in (slice(None, None, -1), slice(None, None, 2)):
+        odd = kdm.QueryResult(records[:0], None, None, None, None, storage=(records[view], levels[view]))
+        got = tiles.query((0, 0, 4, 4), scale=400, out=odd)
+        assert not np.shares_memory(got.xy, records)
+        again_fresh = tiles.query((0, 0, 4, 4), scale=400)
+        for name in ("xy", "tile", "rank", "level"):
+            np.testing.assert_array_equal(getattr(got, name), getattr(again_fresh, name))
 
 
 @pytest.fixture(scope="module")
@@ -432,6 +441,26 @@ def test_image_classes_are_read_by_their_sums(mode):
     order = np.lexsort((r.xy[:, 1], r.xy[:, 0]))
     order2 = np.lexsort((xy[:, 1], xy[:, 0]))
     assert np.array_equal(labels[order2], r.classes[order])
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+@pytest.mark.parametrize("side", [64, 1024])
+def test_image_classes_give_the_same_points_in_chunks(mode, side):
+    # Whether images are read by their sums depends on the images (64² arrays are, 1024² are not), never
+    # on the region: 16 chunks of a region, a few hundred points each, give the whole region's points.
+    rng = np.random.default_rng(5)
+    images = [rng.uniform(0.05, 0.3, (side, side)) for _ in range(2)]
+    whole_rect = (0.0, 0.0, 16.0, 16.0)
+    whole = BUILTIN.query(whole_rect, scale=337, classes=images, mode=mode)
+    keys = lambda r: {(int(t[0]), int(t[1]), int(k), float(p[0]), float(p[1]), int(c))
+                      for t, k, p, c in zip(r.tile, r.rank, r.xy, r.classes)}
+    parts = set()
+    for x in range(0, 16, 4):
+        for y in range(0, 16, 4):
+            part = BUILTIN.query((x, y, x + 4.0, y + 4.0), scale=337, classes=images, mode=mode,
+                                 density_rect=whole_rect)
+            parts |= keys(part)
+    assert len(whole) > 10000 and parts == keys(whole)
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])

@@ -56,6 +56,14 @@ def test_stipple_scale_region_mode_and_tileset(tiny_tileset):
     assert not np.array_equal(stable, kdm.stipple(str(SPHERE), points=3000))
     own = kdm.stipple(str(SPHERE), points=3000, tileset=tiny_tileset)
     assert len(own) > 1000 and not np.array_equal(own, kdm.stipple(str(SPHERE), points=3000))
+    # scale counts dots at full darkness for both methods: the sphere's mean darkness is 0.17, and the
+    # runtime's count is within 0.3% of scale times it (deterministic).
+    full = kdm.stipple(str(SPHERE), scale=8000, method="full")
+    assert abs(len(full) - len(whole)) < 0.01 * len(whole) and len(full) < 0.2 * 8000
+    with pytest.raises(ValueError, match="places no dot"):
+        kdm.stipple(str(SPHERE), scale=1e-9, method="full")
+    with pytest.raises(ValueError, match="more than the full sampler's 2\\^31"):
+        kdm.stipple(str(SPHERE), scale=1e300, method="full")
 
 
 def test_analyze_gives_metrics_json(cli, tmp_path):

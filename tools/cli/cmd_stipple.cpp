@@ -84,9 +84,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                        (a.invert ? "" : " (an all-white image has no ink)"));
   const bool coloured = !a.colours.empty();
   const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
-  double ink = 0;  // the inks' mean darkness: --scale's dots over the whole image are scale · aspect · ink
-  for (const tools::DensitySpec& channel : inks.channels) ink += channel.mean_value();
-  const double whole_dots = a.points > 0 ? double(a.points) : a.scale * aspect * ink;
+  std::vector<const tools::DensitySpec*> specs;
+  for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
+  const double whole_dots = tools::stipple_dot_count(specs, double(a.points), a.scale);
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
   if (a.method == "full" && !a.region.empty())
@@ -99,8 +99,6 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
   if (a.method != "full") {
-    std::vector<const tools::DensitySpec*> specs;
-    for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
     stippler =
         std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale, parse_mode(a.mode));
   }
@@ -117,22 +115,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     set.dim = 2;
     std::string how;
     if (a.method == "full") {
-      if (!(whole_dots <= double(std::int64_t(1) << 31))) {  // the full sampler's limit, before llround
-        char message[160];
-        std::snprintf(message, sizeof message,
-                      "--scale %g asks for %.3g dots, more than the full sampler's 2^31", a.scale,
-                      whole_dots);
-        throw CommandError(message);
-      }
-      const std::int64_t count = std::llround(whole_dots);
-      if (count < 1) {
-        char message[120];
-        std::snprintf(message, sizeof message, "--scale %g places no dot on this image", a.scale);
-        throw CommandError(message);
-      }
+      const std::int64_t count = tools::full_stipple_count(whole_dots, a.scale);
       if (coloured) {
-        std::vector<const tools::DensitySpec*> specs;
-        for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
         set = tools::stipple_full(specs, count, aspect, a.seed);
       } else {
         set = tools::stipple_full(spec, count, aspect, a.seed);
@@ -152,11 +136,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       how = "runtime tiles";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (dot_radius <= 0) {
-      // Colour dots larger (0.7 of the mean spacing): inks then cover their share of the paper.
-      dot_radius = (coloured ? 0.7 : 0.25) *
-                   std::sqrt(double(a.width_px) * (a.width_px / aspect) / std::max(1.0, whole_dots));
-    }
+    if (dot_radius <= 0) dot_radius = tools::stipple_dot_radius(whole_dots, a.width_px, aspect, coloured);
     tools::DrawStyle style;
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);

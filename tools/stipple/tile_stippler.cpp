@@ -21,6 +21,33 @@ void stipple_frame_region(const double region[4], int i, int k, double out[4]) {
   if (i == k - 1) std::copy(region, region + 4, out);  // exactly the region, whatever the rounding
 }
 
+double stipple_dot_count(const std::vector<const DensitySpec*>& inks, double points, double scale) {
+  if (points > 0) return points;
+  double mean = 0;
+  for (const DensitySpec* ink : inks) mean += ink->mean_value();
+  return inks.empty() ? 0.0 : scale * double(inks.front()->width) / inks.front()->height * mean;
+}
+
+std::int64_t full_stipple_count(double whole_dots, double scale) {
+  char message[160];
+  if (!(whole_dots <= double(std::int64_t(1) << 31))) {  // before llround overflows
+    std::snprintf(message, sizeof message, "scale %g asks for %.3g dots, more than the full sampler's 2^31",
+                  scale, whole_dots);
+    throw std::invalid_argument(message);
+  }
+  const std::int64_t count = std::llround(whole_dots);
+  if (count < 1) {
+    std::snprintf(message, sizeof message, "scale %g places no dot on this image", scale);
+    throw std::invalid_argument(message);
+  }
+  return count;
+}
+
+double stipple_dot_radius(double whole_dots, int width_px, double aspect, bool coloured) {
+  return (coloured ? 0.7 : 0.25) *
+         std::sqrt(double(width_px) * (width_px / aspect) / std::max(1.0, whole_dots));
+}
+
 double max_stipple_zoom(const Tileset& tileset, QueryMode mode) {
   return kStippleZoomRoom * std::sqrt(query_density_limit(tileset, mode) / tileset.max_points_per_tile());
 }
@@ -81,7 +108,7 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   classes.query.x1 = aspect_, classes.query.y1 = 1, classes.query.scale = scale_;
   classes.class_count = static_cast<std::uint32_t>(densities_.size());
   for (std::size_t k = 0; k < densities_.size(); ++k) classes.classes[k] = densities_[k]->density;
-  read_images_by_sums(classes, sums_);
+  read_images_by_sums(classes, sums_, HUGE_VAL);  // built once for every frame
 }
 
 PointSet TileStippler::render(const double uv[4]) const {

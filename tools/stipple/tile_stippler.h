@@ -3,6 +3,7 @@
 // same dots. Built apart from the generator: nothing here includes its headers.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,18 @@ namespace kdm::tools {
 
 /// The tile size leaves room for this many times more dots per axis than the whole image shows.
 inline constexpr double kStippleZoomRoom = 2;
+
+/// Dots over a whole image of `inks` (one or more images of one size, over [0, aspect] × [0, 1]): `points`
+/// when > 0, else `scale` dots per unit area at full darkness, scale · aspect · the inks' summed mean.
+double stipple_dot_count(const std::vector<const DensitySpec*>& inks, double points, double scale);
+
+/// The full sampler's count for `whole_dots` (stipple_dot_count; `scale` names the request in messages):
+/// throws std::invalid_argument when it rounds to no dot or exceeds the sampler's 2^31.
+std::int64_t full_stipple_count(double whole_dots, double scale);
+
+/// A dot's radius in pixels when none is given: a quarter of the whole image's mean dot spacing (0.7 of
+/// it in colour, so that inks cover their share of the paper), whatever region is drawn.
+double stipple_dot_radius(double whole_dots, int width_px, double aspect, bool coloured);
 
 /// The most a region may zoom into an image with `tileset` in `mode`: kStippleZoomRoom, times m^4 in
 /// smooth mode with a set that hands over to m×m subtiles past its top level (query_density_limit).
