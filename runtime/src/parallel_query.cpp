@@ -419,6 +419,8 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
     p = job.why;
     return Status::kInvalidArgument;
   }
+  // A runner that returned without running its tasks left units unclaimed: an error, not an empty region.
+  if (job.next.load() < job.units) return refuse(QueryProblem::Kind::kMissingArgument, "runner.run");
   const std::size_t total = job.end.load();
   if (written) *written = std::min(total, capacity);
   if (needed) *needed = total;

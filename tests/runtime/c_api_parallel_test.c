@@ -27,6 +27,9 @@ static void* call_task(void* arg) {
   c->task(c->task_context, c->index);
   return NULL;
 }
+static void run_nothing(void* context, void (*task)(void*, size_t), void* task_context, size_t count) {
+  (void)context, (void)task, (void)task_context, (void)count;
+}
 static void run_on_threads(void* context, void (*task)(void*, size_t), void* task_context, size_t count) {
   pthread_t threads[8];
   struct task_call calls[8];
@@ -171,6 +174,12 @@ int main(void) {
   CHECK(kdm_parallel_query_compact(parallel, NULL, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==
         KDM_INVALID_ARGUMENT);
   CHECK(strcmp(problem.parameter, "runner.run") == 0);
+  { /* a runner that returns without running its tasks: an error, not an empty region */
+    const kdm_task_runner idle = {run_nothing, NULL};
+    CHECK(kdm_parallel_query_compact(parallel, &idle, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "runner.run") == 0);
+  }
   q.scale = -1;
   CHECK(kdm_parallel_query_compact(parallel, &in_turn, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==
         KDM_INVALID_ARGUMENT);

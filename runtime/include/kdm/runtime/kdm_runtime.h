@@ -89,8 +89,9 @@ typedef struct kdm_cursor {
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {
   KDM_PROBLEM_NONE = 0,
-  KDM_PROBLEM_MISSING_ARGUMENT = 1,  /* `parameter` is NULL (or the tile set is empty) */
-  KDM_PROBLEM_NOT_FINITE = 2,        /* `parameter` is NaN or infinite; `value` holds it */
+  KDM_PROBLEM_MISSING_ARGUMENT =
+      1,                      /* `parameter` is NULL (or the tile set is empty; "runner.run": ran no task) */
+  KDM_PROBLEM_NOT_FINITE = 2, /* `parameter` is NaN or infinite; `value` holds it */
   KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 */
   KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
   KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing, or both callbacks are set */

@@ -135,7 +135,8 @@ struct QueryCursor {
 struct QueryProblem {
   enum class Kind : int {
     kNone = 0,          ///< no problem
-    kMissingArgument,   ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
+    kMissingArgument,   ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty (a
+                        ///< parallel query's "runner.run": or it returned without running its tasks)
     kNotFinite,         ///< `parameter` is NaN or infinite; `value` holds it
     kNotPositive,       ///< `parameter` ("tile_size") must be > 0; `value` holds it
     kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
