@@ -442,8 +442,10 @@ TEST_F(CliTest, AspectRatiosTheSamplerCannotFillAreRefused) {
   expect_error("sample -n 100 --aspect 0" + out, "--aspect must be a number > 0");
   std::vector<std::uint16_t> row(4000, 100);
   write_bytes(path("wide.png"), grey_png(4000, 1, 8, row));
-  expect_error("sample -n 300 --density '" + path("wide.png") + "'" + out, "at aspect ratio 4000");
-  expect_error("stipple '" + path("wide.png") + "' --method full --points 300" + out, "at aspect ratio 4000");
+  expect_error("sample -n 300 --density '" + path("wide.png") + "'" + out,
+               "its long side is 4000 times its short side");
+  expect_error("stipple '" + path("wide.png") + "' --method full --points 300" + out,
+               "its long side is 4000 times its short side");
   EXPECT_FALSE(fs::exists(path("s.csv")));
 }
 

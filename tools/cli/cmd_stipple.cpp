@@ -196,7 +196,8 @@ void add_stipple_command(CLI::App& app) {
                   "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
                   "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
                   "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
-                  "(a layer per pen), .csv an ink column (default: black dots of the image's darkness)");
+                  "(a layer per pen), .csv a class column, the ink's number (default: black dots of the "
+                  "image's darkness)");
   add_seed_option(cmd, a->seed, "Random seed for --method full");
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
   cmd->add_option("--mode", a->mode,
@@ -206,6 +207,8 @@ void add_stipple_command(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([a, cmd] {
     const bool scale_given = cmd->get_option("--scale")->count() > 0;
+    if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())
+      throw CommandError("--colours must be cmyk, rgb or a count of inks (2-8), got ''");
     if (scale_given) a->points = 0;
     run_stipple(*a, scale_given);
   });

@@ -51,6 +51,12 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
                     "coordinates nearer its origin (move the origin), or ask for fewer points per unit area",
                     query_problem_message(p.kind), p.value, p.limit);
       break;
+    case QueryProblem::Kind::kNotFinite:
+      if (!std::isfinite(p.value)) {  // the kind also covers places too far out for a finite value
+        std::snprintf(text, sizeof text, "'%s' is not a finite number (%g)", p.parameter, p.value);
+        break;
+      }
+      [[fallthrough]];
     default:
       std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
                     p.value);

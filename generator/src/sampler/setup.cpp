@@ -154,9 +154,9 @@ InvalidArgument too_narrow(const SamplerOptions& o) {
   for (int k = 1; k < o.dim; ++k)
     min_extent = std::min(min_extent, o.extent[k]), max_extent = std::max(max_extent, o.extent[k]);
   std::ostringstream s;
-  s << "the domain is too narrow for " << o.n << " points: at aspect ratio " << max_extent / min_extent
-    << " its short side would be one grid node wide, and the sampler needs two (an aspect ratio, or its "
-       "inverse, of at most about 10 times the point count); ask for more points or a squarer domain";
+  s << "the domain is too narrow for " << o.n << " points: its long side is " << max_extent / min_extent
+    << " times its short side, which would be one grid node wide, and the sampler needs two (sides at "
+       "most about 10 times the point count apart); ask for more points or a squarer domain";
   return InvalidArgument(s.str());
 }
 
