@@ -234,8 +234,7 @@ class Tileset:
         class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
             rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max)
-        if not isinstance(keys, bool):
-            raise TypeError(f"keys must be a bool, got {type(keys).__name__}")
+        keys = _checks.flag("keys", keys)  # the one rule for flags: bool or numpy's
         workers = 0
         if threads is not None:
             if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):

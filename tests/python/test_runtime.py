@@ -620,8 +620,10 @@ def test_positions_refuse_bad_arguments():
         BUILTIN.positions((0, 0, 1, 1), scale=10, threads=0)
     with pytest.raises(TypeError, match="threads must be an int"):
         BUILTIN.positions((0, 0, 1, 1), scale=10, threads=1.5)
-    with pytest.raises(TypeError, match="keys must be a bool"):
+    with pytest.raises(TypeError, match="keys must be True or False"):
         BUILTIN.positions((0, 0, 1, 1), scale=10, keys=1)
+    xy, keys = BUILTIN.positions((0, 0, 1, 1), scale=10, keys=np.True_)  # numpy's bool is a bool
+    assert len(xy) == len(keys) > 0
     with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less"):
         BUILTIN.positions((0, 0, 1, 1), scale=1e9)
     with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less"):
