@@ -182,7 +182,8 @@ class Tileset:
         -------
         QueryResult
             Positions, ids and levels; any partition of a region gives the region's points, and the same
-            arguments give the same bits as ``kdm query ... -o points.csv``.
+            arguments give the same bits as ``kdm query ... -o points.csv``. A query of more than 2**25
+            points raises ValueError (1 GiB of records): split the region.
         """
         class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
@@ -230,6 +231,7 @@ class Tileset:
         region in a fixed order: the same bits for any N, in query()'s order unless a tile holds more
         points than a unit); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
+        More than 2**25 points raise ValueError, as query() does.
         """
         class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
