@@ -58,9 +58,10 @@ void print_report(const Report& report, std::FILE* out) {
     std::fprintf(
         out,
         "\nlevel %u, %u points per tile; reference: full-sampler runs on the %g×%g torus: E/n %.4f  "
-        "δavg %.4f  NN1%% %.3f  lowP %.4f (largest %.4f); freed for 15 sweeps: drop %.4f, drift %.3f\n",
+        "δavg %.4f  NN1%% %.3f  lowP %.4f (largest %.4f); freed for 15 sweeps: drop %s, drift %s\n",
         level.level, level.points_per_tile, level.side, level.side, level.energy, level.davg, level.nn1,
-        level.low_p, level.low_p_max, level.control_drop, level.control_drift);
+        level.low_p, level.low_p_max, cell(level.control_drop, "%.4f", {}, "", 0).c_str(),
+        cell(level.control_drift, "%.3f", {}, "", 0).c_str());  // "-" where not measured (--no-direct)
     std::fprintf(out, "%5s %11s %7s %8s %8s %7s %8s %5s %8s %7s  %s\n", "tile", "sw se ne nw", "points",
                  "E/n", "δavg", "NN1%", "lowP", "RAPS", "drop", "drift", "result");
     for (const TileResult& t : report.tiles) {
@@ -101,11 +102,12 @@ void print_report(const Report& report, std::FILE* out) {
     std::fprintf(out, "%11s %9s %7s %8s %11s %10s %6s %7s  %s\n", "points/tile", "kind", "δavg", "closest",
                  "motion mean", "motion p99", "hole", "/1e5", "result");
     for (const KeyframeResult& k : report.keyframes) {
-      std::fprintf(out, "%11.1f %9s %7.4f %s %11.3f %s %s  %s\n", k.points_per_tile,
+      std::fprintf(out, "%11.1f %9s %7.4f %s %s %s %s  %s\n", k.points_per_tile,
                    k.handover   ? "hand-over"
                    : k.keyframe ? "keyframe"
                                 : "half-way",
-                   k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(), k.motion_mean,
+                   k.davg, cell(k.closest_pair, "%.3f", k.checks, "closest pair", 8).c_str(),
+                   cell(k.motion_mean, "%.3f", k.checks, "motion mean", 11).c_str(),
                    cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(),
                    hole_cells(k.holes, k.checks).c_str(), k.passed() ? "pass" : "FAIL");
       checks += k.checks.size();
