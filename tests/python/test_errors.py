@@ -155,6 +155,7 @@ def test_query_refusals(kind, match, kwargs):
     (ValueError, r"points must be an \(n, 2\) or \(n, 3\) array", lambda: kdm.analyze(np.ones((5, 4)))),
     (ValueError, "must be a 2-D array", lambda: kdm.analyze(np.ones(5))),
     (ValueError, "outside|inside", lambda: kdm.analyze(np.full((5, 2), 1.5))),
+    (ValueError, r"outside the unit domain \(coordinate 1e\+300\)", lambda: kdm.analyze(np.full((5, 2), 1e300))),
     (ValueError, "finite|non-finite", lambda: kdm.analyze(np.full((5, 2), NAN))),
     (ValueError, "at least 2 points", lambda: kdm.analyze(np.full((1, 2), 0.5))),
     (ValueError, "1 / tile size must be an", lambda: kdm.analyze(np.random.rand(50, 2), tile_size=0.3)),

@@ -3,6 +3,7 @@
 #include "kdm/analysis/common.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -33,9 +34,12 @@ void validate_points(const std::vector<double>& coords, int dim) {
     const double v = coords[i];
     if (!std::isfinite(v))
       throw InvalidInput("point " + std::to_string(i / dim) + " has a non-finite coordinate");
-    if (v < 0.0 || v > 1.0)
+    if (v < 0.0 || v > 1.0) {
+      char value[32];  // %g: std::to_string prints 1e300 with 300 digits, and 1e-7 as 0.000000
+      std::snprintf(value, sizeof value, "%g", v);
       throw InvalidInput("point " + std::to_string(i / dim) + " lies outside the unit domain (coordinate " +
-                         std::to_string(v) + "); normalise points to [0,1)");
+                         value + "); normalise points to [0,1)");
+    }
   }
 }
 
