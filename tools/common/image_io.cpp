@@ -145,6 +145,20 @@ bool png_truncated(const std::uint8_t* data, std::size_t size) {
   return false;
 }
 
+// A PNG's size from its IHDR chunk (the first), or false: stb refuses to read even the header of a PNG
+// whose pixels would pass 2^30 bytes, and its reason then names no size.
+bool png_size(const std::uint8_t* data, std::size_t size, std::uint64_t& w, std::uint64_t& h) {
+  static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (size < 24 || std::memcmp(data, kSignature, 8) != 0 || std::memcmp(data + 12, "IHDR", 4) != 0)
+    return false;
+  auto be32 = [data](std::size_t at) {
+    return std::uint32_t(data[at]) << 24 | std::uint32_t(data[at + 1]) << 16 |
+           std::uint32_t(data[at + 2]) << 8 | data[at + 3];
+  };
+  w = be32(16), h = be32(20);
+  return true;
+}
+
 // A binary PGM/PPM header (P5, P6) as stbi__pnm_info reads it.
 struct PnmHeader {
   bool pnm = false, overflow = false;  // overflow: a number past INT_MAX (undefined behaviour in stb)
@@ -312,8 +326,13 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   const int length = static_cast<int>(size);
   int w = 0, h = 0, header_channels = 0;  // PNGs may decode to one more channel (a tRNS chunk): not used
   if (!stbi_info_from_memory(bytes, length, &w, &h, &header_channels)) {
-    error = "cannot read image '" + name + "': " + stb_reason();
-    return false;
+    std::uint64_t pw = 0, ph = 0;
+    if (png_size(bytes, size, pw, ph) && pw * ph > max_pixels) {
+      w = int(std::min<std::uint64_t>(pw, INT32_MAX)), h = int(std::min<std::uint64_t>(ph, INT32_MAX));
+    } else {
+      error = "cannot read image '" + name + "': " + stb_reason();
+      return false;
+    }
   }
   if (w <= 0 || h <= 0) {
     error = "image '" + name + "' is empty or has a corrupt header";
