@@ -144,8 +144,19 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       reach = std::max(reach, tables.glide_reach[g] * S);
     if (descend) reach = std::max(reach, tables.descent_reach * S) + S * (2.0 / 65536.0);
   }
-  const double tx0d = std::floor((q.x0 - reach) / S), tx1d = std::ceil((q.x1 + reach) / S);
-  const double ty0d = std::floor((q.y0 - reach) / S), ty1d = std::ceil((q.y1 + reach) / S);
+  // Far out a position's rounding (under 1.5 ulp of the coordinate, less than 2^-50 of it) can carry a
+  // point across its tile's side, at most S/131072 from it: onto a region's side that is a tile's, where a
+  // chunk beyond it would not visit the tile. Where that can happen, the tiles that near are visited too.
+  // (A region too thin to span a tile column or row, its side rounded onto the other, stays empty.)
+  const double coordinate = std::max({std::fabs(q.x0), std::fabs(q.x1), std::fabs(q.y0), std::fabs(q.y1)});
+  const bool spans = std::ceil((q.x1 + reach) / S) > std::floor((q.x0 - reach) / S) &&
+                     std::ceil((q.y1 + reach) / S) > std::floor((q.y0 - reach) / S);
+  const double rounding =
+      spans && std::ldexp(coordinate, -50) >= S * 0x1p-18 ? std::ldexp(coordinate, -50) : 0.0;
+  const double tx0d = std::floor((q.x0 - reach - rounding) / S),
+               tx1d = std::ceil((q.x1 + reach + rounding) / S);
+  const double ty0d = std::floor((q.y0 - reach - rounding) / S),
+               ty1d = std::ceil((q.y1 + reach + rounding) / S);
   if (!(max_density * area_scale > tables.min_threshold)) {  // no tile can emit even its first point
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
@@ -153,14 +164,15 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   const double tiles = (tx1d - tx0d) * (ty1d - ty0d);
   if (!(tiles <= double(kMaxQueryTiles)))
     return refuse(Kind::kTooManyTiles, "x0", tiles, double(kMaxQueryTiles));
-  if (std::fabs(tx0d) > 9e15 || std::fabs(tx1d) > 9e15)  // tile coordinates must fit an int64 exactly
-    return refuse(Kind::kNotFinite, "x0", q.x0);
-  if (std::fabs(ty0d) > 9e15 || std::fabs(ty1d) > 9e15) return refuse(Kind::kNotFinite, "y0", q.y0);
-  if (descend) {  // subtile coordinates, m^kMaxQueryDepth times the tile's, must fit an int64 too
-    const double far = std::ldexp(1.0, 62) / std::pow(double(tables.subtiles), kMaxQueryDepth);
-    if (std::fabs(tx0d) > far || std::fabs(tx1d) > far) return refuse(Kind::kNotFinite, "x0", q.x0);
-    if (std::fabs(ty0d) > far || std::fabs(ty1d) > far) return refuse(Kind::kNotFinite, "y0", q.y0);
-  }
+  // Tile coordinates must fit an int64 exactly, and past the top level so must the subtiles' (m^depth
+  // times the tile's): farther out is too far from the world origin, whatever the spacing.
+  const double most_tiles =
+      descend ? std::min(9e15, std::ldexp(1.0, 62) / std::pow(double(tables.subtiles), kMaxQueryDepth))
+              : 9e15;
+  if (std::fabs(tx0d) > most_tiles || std::fabs(tx1d) > most_tiles)
+    return refuse(Kind::kTooFarFromOrigin, "x0", std::max(std::fabs(q.x0), std::fabs(q.x1)), most_tiles * S);
+  if (std::fabs(ty0d) > most_tiles || std::fabs(ty1d) > most_tiles)
+    return refuse(Kind::kTooFarFromOrigin, "y0", std::max(std::fabs(q.y0), std::fabs(q.y1)), most_tiles * S);
   const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
   const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
   if (tx1 <= tx0 || ty1 <= ty0) {  // x1 / S rounded onto x0 / S: no tile column (or row) to visit at all

@@ -615,6 +615,32 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_STREQ(missing.parameter, "cursor");
 }
 
+// Far out a position's rounding can carry a point of a tile's last row onto the next tile's side. Chunks of
+// one tile each then still give the whole region's points (at 10^11 and 10^12, 4 × 4 tiles at 20,000
+// points per tile: the rounding there is 2^-14 and 2^-10 of a tile, and 3 to 17 points fell between the
+// chunks when the chunk beyond the side did not visit the tile they came from).
+TEST(QueryTest, TileSizedChunksFarFromTheOriginKeepEveryPoint) {
+  for (const double far : {1e11, -1e12}) {
+    for (const QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+      QueryParams whole = region(far, far, far + 4, far + 4, 20000, mode);
+      whole.origin_x = whole.origin_y = far;
+      std::vector<Key> all = run(whole), parts;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          QueryParams part = whole;
+          part.x0 = far + i, part.x1 = far + i + 1, part.y0 = far + j, part.y1 = far + j + 1;
+          const std::vector<Key> got = run(part);
+          parts.insert(parts.end(), got.begin(), got.end());
+        }
+      std::sort(all.begin(), all.end());
+      std::sort(parts.begin(), parts.end());
+      EXPECT_GT(all.size(), 300000u);
+      EXPECT_TRUE(parts == all) << far << ": " << parts.size() << " points in the chunks, " << all.size()
+                                << " in the whole";
+    }
+  }
+}
+
 // A cursor belongs to the parameters that started it: resuming or reusing it with others is refused.
 TEST(QueryTest, ACursorIsRefusedWithOtherParameters) {
   std::vector<QueryPoint> buffer(16);

@@ -40,11 +40,12 @@ struct CompactPoints {
 
 /// query_points into a compact output: the same points in the same order, point i's position as floats
 /// at xy[2i], xy[2i + 1] and, if keys is not null, keys[i] = point_key(its id). A position lies within
-/// 2^-21 · (|position| + tile_size) of the double query_points writes: with a constant density it is
-/// computed in float from the tile's corner relative to the origin (and the point's glide offsets), so that
-/// whole tiles convert as fast as a copy; with a varying one it is that double rounded to float. Either way
-/// it depends only on the point and the parameters, so partitions of a region give the same bits. Slots from
-/// *written to capacity may be overwritten. Statuses, resumption (a cursor serves query_points and this
+/// 2^-21 · (|position| + tile_size) + 2^-50 · |world coordinate| of the double query_points writes (the
+/// second term is that double's own rounding, far from the world origin, where the float is the nearer
+/// to the exact place): with a constant density it is computed in float from the tile's corner relative
+/// to the origin (and the point's glide offsets), so that whole tiles convert as fast as a copy. Either
+/// way it depends only on the point and the parameters, so partitions of a region give the same bits. Slots
+/// from *written to capacity may be overwritten. Statuses, resumption (a cursor serves query_points and this
 /// function alike) and refusals as query_points', with parameter "out.xy" for a null xy with room in it,
 /// "origin_x" or "origin_y" (kNotFinite, `limit` the farthest allowed) for a region so far from the origin
 /// that a float's step there reaches a tile (2^23 tiles), and
