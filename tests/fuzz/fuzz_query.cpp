@@ -420,7 +420,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
 
-  // The compact output: the same points, as floats within 2^-21 · (|position| + tile size), with their keys.
+  // The compact output: the same points, as floats within 2^-21 · (|position| + tile size) + 2^-50 ·
+  // |world coordinate| (the double's own rounding far out), with their keys.
   {
     static float xy[2 * kBigCapacity];
     static std::uint64_t keys[kBigCapacity];
@@ -437,8 +438,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < (too_far ? 0 : size); ++i) {
       const kdm::QueryPoint& p = all[i];
       if (keys[i] != kdm::point_key(p.id)) fail();
-      if (!(std::fabs(xy[2 * i] - p.x) <= std::ldexp(std::fabs(p.x) + q.tile_size, -21))) fail();
-      if (!(std::fabs(xy[2 * i + 1] - p.y) <= std::ldexp(std::fabs(p.y) + q.tile_size, -21))) fail();
+      const double wx = std::ldexp(std::fabs(p.x + q.origin_x), -50),
+                   wy = std::ldexp(std::fabs(p.y + q.origin_y), -50);
+      if (!(std::fabs(xy[2 * i] - p.x) <= std::ldexp(std::fabs(p.x) + q.tile_size, -21) + wx)) fail();
+      if (!(std::fabs(xy[2 * i + 1] - p.y) <= std::ldexp(std::fabs(p.y) + q.tile_size, -21) + wy)) fail();
     }
   }
 
