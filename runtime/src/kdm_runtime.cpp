@@ -327,6 +327,12 @@ kdm_status parallel_classes(kdm_parallel_query* parallel, const kdm_task_runner*
   });
 }
 
+// The built-in set's handle, known without decoding the set, which only kdm_tileset_builtin() does:
+// freeing another set must not decode it.
+kdm_tileset& builtin_handle() {
+  static kdm_tileset handle;
+  return handle;
+}
 }  // namespace
 
 extern "C" {
@@ -445,15 +451,6 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
   if (!data && size) return KDM_INVALID_ARGUMENT;
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_memory(data, size, t); });
 }
-
-namespace {
-// The built-in set's handle, known without decoding the set, which only kdm_tileset_builtin() does:
-// freeing another set must not decode it.
-kdm_tileset& builtin_handle() {
-  static kdm_tileset handle;
-  return handle;
-}
-}  // namespace
 
 const kdm_tileset* kdm_tileset_builtin(void) {
   static const bool shared = (builtin_handle().set = &kdm::Tileset::builtin(), true);  // no second copy
