@@ -339,6 +339,7 @@ TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   expect_error("stipple " + image + " --points 30000000 --method full -o '" + path("missing/s.png") + "'",
                "directory");
   expect_error("sample --n 100000000 -o '" + path("s.json") + "'", "unknown output format");
+  expect_error("sample --n 99 --class const:1 --class const:1 --dim 3 -o '" + path("c.txt") + "'", "--dim 3");
   // Extensions in any case.
   ASSERT_EQ(kdm("stipple " + image + " -o '" + path("S.PNG") + "'").status, 0);
   EXPECT_TRUE(fs::exists(path("S.PNG")));

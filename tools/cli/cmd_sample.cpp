@@ -64,6 +64,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     throw CommandError("--class given " + std::to_string(args.classes.size()) + " times; at most 8 classes");
   const bool classed = !args.classes.empty();
   if (classed && args.options.n <= 0) throw CommandError("--class needs --n > 0 (the points of all classes)");
+  if (classed && args.options.dim != 2) throw CommandError("--class samples 2D points: drop --dim 3");
   std::vector<tools::DensitySpec> specs;
   for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density})
     specs.push_back(parse_density(text, args.gamma, args.invert));
