@@ -84,6 +84,12 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("rank_context 2\n").to_text()).rank_context, 2);
   EXPECT_THROW(BakeRecipe::parse("edge_gap 0.2\n"), InvalidArgument);
   EXPECT_THROW(BakeRecipe::parse("rank_context 3\n"), InvalidArgument);
+  try {  // patches too narrow for a sparse coarsest level: the message names base_points, the usual cause
+    BakeRecipe::parse("colours 2\nlevels 2\nbase_points 24\n");
+    ADD_FAILURE() << "base_points 24 was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("base_points 24"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(BakeRecipe::parse("levels three\n"), InvalidArgument);
   EXPECT_THROW(BakeRecipe::parse("colour 1\n"), InvalidArgument);    // unknown key
   EXPECT_THROW(BakeRecipe::parse("levels 0\n"), InvalidArgument);    // out of range

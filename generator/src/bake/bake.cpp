@@ -5,6 +5,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
 #include <map>
@@ -136,10 +137,15 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
   if (make_keyframe_nominal(r.nominal_counts(), r.keyframes_per_level).size() > kMaxKeyframes)
     throw InvalidArgument("recipe: more than " + std::to_string(kMaxKeyframes) + " keyframes in all");
-  if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty())
-    throw InvalidArgument("recipe: band " + std::to_string(r.band) + " with erosion " +
-                          std::to_string(r.erosion) + " and edge gap " + std::to_string(r.edge_gap) +
-                          " leaves some level's edge patches narrower than half a point spacing");
+  if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty()) {
+    char text[300];  // every term named, base_points too: a sparse coarsest level is the usual cause
+    std::snprintf(text, sizeof text,
+                  "recipe: base_points %u with band %g, erosion %g and edge_gap %g leaves some level's edge "
+                  "patches narrower than half a point spacing (more base_points, or a smaller erosion or "
+                  "edge_gap, widens them)",
+                  unsigned(r.base_points), r.band, r.erosion, r.edge_gap);
+    throw InvalidArgument(text);
+  }
   if (r.handover_zone) {
     const std::uint32_t m = 1u << (r.levels - 1);  // √(N_top / N_0)
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
