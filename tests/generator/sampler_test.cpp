@@ -179,6 +179,11 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   o = options_for(100, Domain::kTorus);
   o.dim = 4;
   EXPECT_THROW(sample(o), InvalidArgument);
+  for (double sigma_max : {0.5, -1.0, std::nan("")}) {
+    o = options_for(100, Domain::kTorus);
+    o.sigma_max = sigma_max;
+    EXPECT_THROW(sample(o), InvalidArgument) << sigma_max;
+  }
   o = options_for(100, Domain::kTorus);
   Density negative;
   negative.function = [](const double* u) { return u[0] - 0.5; };

@@ -56,6 +56,15 @@ int splits_for(double rho, int max_splits) {
   return q;
 }
 
+/// splits_for(), lowered until the kernel's weight 2^(D q) fits in `room` (what is left of n): where the
+/// last few points belong on a dense spot, lighter kernels go there, not whole ones where ρ is nearly zero.
+template <int D>
+int splits_within(double rho, int max_splits, double room) {
+  int q = splits_for<D>(rho, max_splits);
+  while (q > 0 && std::ldexp(1.0, D * q) > room) --q;
+  return q;
+}
+
 template <int D>
 struct Driver {
   const SamplerOptions& options;
@@ -66,9 +75,16 @@ struct Driver {
   std::vector<Particle<D>> fixed;  ///< constrained sampling: background kernels on the finest grid
   double total_sweeps = 0, done_sweeps = 0;
   int threads = 1;          ///< threads for the set-up of each level (sweeps take options.threads)
+  double sigma_max;         ///< options.sigma_max, or the default for D
   FootprintCache<D> cache;  ///< lent to every level's chain
 
-  Driver(const SamplerOptions& o, ModelSetup<D>& s) : options(o), setup(s), threads(thread_count(o.threads)) {
+  Driver(const SamplerOptions& o, ModelSetup<D>& s)
+      : options(o),
+        setup(s),
+        threads(thread_count(o.threads)),
+        sigma_max(o.sigma_max > 0 ? o.sigma_max
+                  : D == 2        ? 16
+                                  : 4) {
     params.temperature = o.temperature * kModelTemperaturePerUser;
     params.step = o.step > 0 ? o.step : (D == 2 ? 0.35 : 0.1);
     params.metropolis = o.metropolis;
@@ -130,7 +146,7 @@ struct Driver {
         if (!(rho > 0)) continue;
         Particle<D> p;
         p.x = node_centre(g, node);
-        p.splits = static_cast<std::uint8_t>(splits_for<D>(rho, max_splits));
+        p.splits = static_cast<std::uint8_t>(splits_within<D>(rho, max_splits, n - w));
         if (w + p.weight() > n) continue;
         const double gain = chain.energy_change_if_added(p, scratch) / p.weight();
         if (gain < best_gain) best_gain = gain, best = p;
@@ -198,7 +214,7 @@ struct Driver {
     };
     CountBalanceSettings<D> settings;
     if (base > 0) settings.support = &setup.levels[0], settings.support_scale = std::ldexp(1.0, base);
-    settings.frozen_below = std::pow(options.sigma_max, -D);  // σ = (ρ/w)^(-1/D) >= σmax
+    settings.frozen_below = std::pow(sigma_max, -D);  // σ = (ρ/w)^(-1/D) >= σmax
     settings.move_frozen = base == 0;
     settings.mass_per_point = setup.mass_per_point;
     const DensityGrid<D>& here = setup.levels[base];
@@ -241,6 +257,7 @@ struct Driver {
       for (int k = 0; k < D; ++k) centre[k] = 2 * p.x[k];
       if (p.splits == 0) {
         *out = p;
+        out->fresh = p.fresh && !p.active;
         out->x = fine.at(centre) > 0 ? centre : relocate(fine, centre);
         return;
       }
@@ -387,16 +404,17 @@ struct Driver {
     }
     if (!coarsest && !relaxing && options.n > 0) fix_count_level(chain, level);
 
-    // Freeze wide kernels; bound the rest (a support constraint that keeps footprints small).
+    // Freeze wide kernels; bound the rest (a support constraint that keeps footprints small). Kernels not
+    // yet relaxed get twice the width: a split's children are crowded and would stay so if frozen at birth.
     double widest_active = 0;
     LevelReport lr;
     for (auto& p : particles) {
       const double sigma = chain.sigma_at(p);
-      p.active = sigma < options.sigma_max;
+      p.active = sigma < (p.fresh ? 2 : 1) * sigma_max;
       if (p.active) widest_active = std::max(widest_active, sigma), ++lr.active_points;
     }
     ChainParams level_params = params;
-    level_params.sigma_bound = std::min(2 * options.sigma_max, 1.5 * std::max(widest_active, 1.0));
+    level_params.sigma_bound = std::min(2 * sigma_max, 1.5 * std::max(widest_active, 1.0));
     level_params.max_step = level_params.sigma_bound;
     chain.set_params(level_params);
 

@@ -196,7 +196,8 @@ void validate_options(const SamplerOptions& o) {
     throw InvalidArgument("temperature must be a finite number >= 0");
   if (!(std::isfinite(o.step) && o.step >= 0)) throw InvalidArgument("step must be a finite number >= 0");
   if (!(o.peak_density > 0 && o.peak_density <= 1)) throw InvalidArgument("peak density must be in (0, 1]");
-  if (!(o.sigma_max >= 1)) throw InvalidArgument("sigma_max must be >= 1");
+  if (!(o.sigma_max == 0 || o.sigma_max >= 1))
+    throw InvalidArgument("sigma_max must be 0 (automatic) or >= 1");
   if (o.sweeps < 0 || o.coarse_sweeps < 0 || o.coarsest_sweeps < 0 || o.burn_in_sweeps < 0)
     throw InvalidArgument("sweep counts must be >= 0");
   if (o.coarsest_grid < 4) throw InvalidArgument("coarsest grid must have at least 4 nodes per axis");

@@ -113,8 +113,10 @@ struct SamplerOptions {
   /// range (docs/design.md §2.6); off only to measure that.
   bool count_balance = true;
   double peak_density = 0.43;  ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
-  double sigma_max = 4.0;      ///< kernels at least this wide (grid units) are frozen (paper: σmax)
-  int coarsest_grid = 32;      ///< nodes along the shortest axis of the coarsest grid (paper: 32)
+  /// Kernels at least this wide (grid units) are frozen (paper: σmax); 0: 16 in 2D, 4 in 3D, where a
+  /// footprint grows as σ³ (docs/design.md §2.4).
+  double sigma_max = 0;
+  int coarsest_grid = 32;  ///< nodes along the shortest axis of the coarsest grid (paper: 32)
   std::int64_t max_grid_nodes = std::int64_t(1) << 27;  ///< refuse larger finest grids (memory guard)
   /// Constrained sampling: points already placed (normalised coordinates, dim per point). Their kernels are
   /// background that never moves; the chain samples the n new points from P(new | fixed). The result
