@@ -12,12 +12,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
+#include "tile_torus.h"
 
 namespace kdm::verify {
 namespace {
@@ -102,6 +104,18 @@ TEST(GeneratorTest, TileEdgesAndInBetweenDensitiesLookLikeTheRest) {
   const Report report = verify_tileset(shipped(), parts(false, false, true));
   EXPECT_EQ(report.densities.size(), 4 * shipped().levels - 3);  // complete levels and quarters between
   expect_all_pass(report);
+}
+
+// The seam check's ratio on per-tile δmin (shortest edge link, shortest other link), from the shipped set
+// at 20,480 points per tile (four of its tiles, in units of 0.01 d_hex): tile 0's interior holds no close
+// pair (66.7 against 45–51 elsewhere), and the edge pair it shares with the second tile must not fail it
+// there when it passes in that tile. A short edge link in a tile with a typical interior still fails.
+TEST(GeneratorTest, SeamCheckJudgesEdgesAgainstATypicalInterior) {
+  const std::vector<double> other = {66.7, 46.3, 46.4, 51.0};
+  EXPECT_NEAR(worst_edge_ratio({57.2, 57.1, 65.1, 83.0}, other), 57.2 / 46.4, 1e-12);
+  EXPECT_LT(worst_edge_ratio({57.2, 40.0, 65.1, 83.0}, other), Bars{}.edge_dmin);
+  EXPECT_NEAR(worst_edge_ratio({30.0}, {40.0}), 0.75, 1e-12);  // one tile: its own interior
+  EXPECT_EQ(worst_edge_ratio({}, {}), std::numeric_limits<double>::infinity());
 }
 
 TEST(GeneratorTest, GlidingTrackIsBlueAtAndBetweenKeyframesAndMovesLittle) {

@@ -20,6 +20,11 @@ namespace kdm::verify {
 std::vector<double> torus_points(const TilesetData& set, std::size_t t, double count,
                                  std::vector<double>* own = nullptr, std::vector<double>* others = nullptr);
 
+/// The seam check's ratio (Bars::edge_dmin): the smallest over tiles of the tile's edge-link δmin over its
+/// other links' δmin, or over the median tile's if that is less. Inputs are per tile, in one order.
+/// Returns infinity for no tiles.
+double worst_edge_ratio(const std::vector<double>& edge_min, const std::vector<double>& other_min);
+
 /// Each tile's points at one density, in its own unit coordinates (a glided point may lie outside the
 /// tile): the first n ranks, as (x, y) pairs, then any points without a rank (a hand-over's appearing
 /// points), which lie where they are stored.

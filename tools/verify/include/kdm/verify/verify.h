@@ -53,8 +53,9 @@ struct Bars {
   double small_energy = 1.20, small_low_p = 3.0, small_low_p_of_largest = 3.0, small_nn1 = 0.80;
   double energy_drop = 0.03;  ///< direct check: 1 − E_after / E_before ≤ this (small tiles: the next)
   double small_energy_drop = 0.06;
-  double drift = 1.25;     ///< direct check: mean drift ≤ drift × a full-sampler set's
-  double edge_dmin = 0.9;  ///< per tile: δmin of edge links ≥ edge_dmin × δmin of the other links
+  double drift = 1.25;  ///< direct check: mean drift ≤ drift × a full-sampler set's
+  /// Per tile: δmin of edge links ≥ edge_dmin × δmin of its other links, or of the median tile's if less.
+  double edge_dmin = 0.9;
   /// Pooled edge vs midline links: a seam defect is an excess of short edge links that is both large
   /// (one-sided KS D+ > ks_d_plus) and significant (p < ks_p).
   double ks_d_plus = 0.1, ks_p = 0.001;
@@ -149,9 +150,10 @@ struct Holes {
 struct DensityResult {
   double points_per_tile = 0;
   bool complete_level = false;
-  double davg = 0;              ///< mean over the tiles' tori
-  double worst_low_p = 0;       ///< largest lowP over the tiles (NaN if none measured)
-  double worst_edge_ratio = 0;  ///< smallest edge-link δmin / other-link δmin over the tiles
+  double davg = 0;         ///< mean over the tiles' tori
+  double worst_low_p = 0;  ///< largest lowP over the tiles (NaN if none measured)
+  double worst_edge_ratio =
+      0;  ///< smallest edge-link δmin / other-link δmin over the tiles (Bars::edge_dmin)
   /// Smallest distance between two points of any tile's torus or of two tiles that can meet across an edge,
   /// in d_hex.
   double closest_pair = 0;
