@@ -66,6 +66,10 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
   EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
   EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);
+  EXPECT_EQ(r.to_text().find("glide_late"), std::string::npos);  // off unless named
+  EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_late 0.75\n").to_text()).glide_late, 0.75);
+  EXPECT_THROW(BakeRecipe::parse("glide_late 1\n"), InvalidArgument);
+  EXPECT_THROW(BakeRecipe::parse("glide_late -0.1\n"), InvalidArgument);
   EXPECT_EQ(r.to_text().find("split_shared"), std::string::npos);  // off unless named
   EXPECT_TRUE(BakeRecipe::parse(BakeRecipe::parse("split_shared 1\n").to_text()).split_shared);
   EXPECT_THROW(BakeRecipe::parse("split_shared 2\n"), InvalidArgument);

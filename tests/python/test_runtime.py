@@ -438,8 +438,12 @@ def test_image_classes_are_read_by_their_sums(mode):
         alone = BUILTIN.query(rect, scale=300, density=images[0])
         assert same((r.xy[zero], r.tile[zero], r.rank[zero]), (alone.xy, alone.tile, alone.rank))
     xy, labels = BUILTIN.positions(rect, scale=300, classes=images, mode=mode, threads=2)
-    order = np.lexsort((r.xy[:, 1], r.xy[:, 0]))
+    # Both sorted by the float32 positions: sorted by the float64 ones, two points whose x rounds to one
+    # float32 could come in the other order.
+    f32 = r.xy.astype(np.float32)
+    order = np.lexsort((f32[:, 1], f32[:, 0]))
     order2 = np.lexsort((xy[:, 1], xy[:, 0]))
+    assert np.array_equal(xy[order2], f32[order])
     assert np.array_equal(labels[order2], r.classes[order])
 
 

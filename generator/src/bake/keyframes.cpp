@@ -225,12 +225,13 @@ void relative(const PatchPointRef& ref, const double* stable, int w, int h, doub
 }
 
 /// Relaxes keyframe g on one run's torus: the points of kinds >= run.stage descend from where keyframe
-/// g - 1 left them, then are kept apart. With `part_only`, the points of kind run.stage are already at g
-/// (their consensus mean) and are only kept apart, from each other and from earlier kinds; later kinds
-/// are left out (their own stages keep them off these).
+/// g - 1 left them, then are kept apart; with `late_from` > 0, the points new at g shown later than that
+/// fraction of the way from g - 1 stay where they enter (only kept apart). With `part_only`, the points of
+/// kind run.stage are already at g (their consensus mean) and are only kept apart, from each other and from
+/// earlier kinds; later kinds are left out (their own stages keep them off these).
 FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
                    const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                   int sweeps, std::uint64_t seed, int threads, bool part_only = false) {
+                   int sweeps, std::uint64_t seed, int threads, double late_from, bool part_only = false) {
   const Colouring col = Colouring::torus(shape.colours, run.w, run.h, run.grid);
   const std::uint32_t count = shape.keyframe_nominal[g];
   const std::uint32_t previous = g ? shape.keyframe_nominal[g - 1] : 0;
@@ -395,13 +396,21 @@ FrameRun relax_run(const std::vector<LevelPatches>& levels, const BakeRun& run,
   o.threads = threads;
   o.seed = seed;
   o.fixed_points = std::move(fixed);
-  for (std::size_t i = 0; i < start.size(); i += 2)
-    o.initial_points.insert(o.initial_points.end(), {start[i] / run.w, start[i + 1] / run.h});
+  // Late arrivals (shown after late_from of the way here) are left out of the descent: the points around
+  // them make their room in the next interval, while they are shown, not before (docs/design.md §3).
+  std::vector<std::size_t> in_descent;
+  for (std::size_t i = 0; i < out.refs.size(); ++i)
+    if (!(late_from > 0 && out.arrives[i] && out.paths[i].appear > late_from)) {
+      in_descent.push_back(i);
+      o.initial_points.insert(o.initial_points.end(), {start[2 * i] / run.w, start[2 * i + 1] / run.h});
+    }
   std::vector<double> end = start;
-  if (!part_only) {
+  if (!part_only && !in_descent.empty()) {
     const SampleResult relaxed = sample(o);
-    for (std::size_t i = 0; i < end.size(); i += 2)
-      end[i] = relaxed.points[i] * run.w, end[i + 1] = relaxed.points[i + 1] * run.h;
+    for (std::size_t k = 0; k < in_descent.size(); ++k) {
+      end[2 * in_descent[k]] = relaxed.points[2 * k] * run.w;
+      end[2 * in_descent[k] + 1] = relaxed.points[2 * k + 1] * run.h;
+    }
   }
   std::vector<std::size_t> moving(out.refs.size());
   for (std::size_t i = 0; i < moving.size(); ++i) moving[i] = i, confine_end(end, i);
@@ -451,7 +460,8 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below) {
+                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below,
+                    double late_from) {
   const bool consensus = shape.keyframe_nominal[g] <= consensus_below;
   struct Sum {
     std::vector<double> b, a;
@@ -526,7 +536,7 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
     for_each_run(
         plan, threads,
         [&](std::size_t r, int run_threads) {
-          return relax_run(levels, plan[r], widths, shape, g, sweeps, run_seed(r), run_threads);
+          return relax_run(levels, plan[r], widths, shape, g, sweeps, run_seed(r), run_threads, late_from);
         },
         [&](std::size_t r, FrameRun& result) { add_moves(plan[r], r, result, consensus); });
     commit(true);
@@ -541,7 +551,7 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
         own_runs, threads,
         [&](std::size_t r, int run_threads) {
           return relax_run(levels, own_runs[r], widths, shape, g, sweeps, run_seed(own[r]), run_threads,
-                           true);
+                           late_from, true);
         },
         [&](std::size_t r, FrameRun& result) { add_moves(own_runs[r], r, result, false); });
     commit(false);

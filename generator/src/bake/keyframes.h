@@ -38,8 +38,11 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 /// g − 1 must be done). `shape` supplies the colours and the level and keyframe counts. Descends
 /// `sweeps` sweeps; `seed` picks the sweep order. Keyframes of at most `consensus_below` points per tile
 /// move shared patches by consensus (above; it costs about 3.6 times the relaxation with 2 colours).
+/// With `late_from` in (0, 1), the points new at g that are shown later than that fraction of the way from
+/// keyframe g − 1 are left out of g's descent (kept apart only), so their room is made after they appear.
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below = 0);
+                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below = 0,
+                    double late_from = 0);
 
 }  // namespace kdm::gen

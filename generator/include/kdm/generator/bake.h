@@ -93,6 +93,10 @@ struct BakeRecipe {
   /// torus of the bake that holds it, not on its own run's alone (keyframes.h says why). 0 (off) in recipes
   /// that do not name it.
   std::uint32_t glide_consensus = 0;
+  /// A point new at a keyframe and shown later than this fraction of the way there is left out of that
+  /// keyframe's relaxation: the points around it make its room over the next interval, once it is shown,
+  /// instead of leaving an empty place for it before (keyframes.h). 0 (off) in recipes that do not name it.
+  double glide_late = 0;
   /// The hand-over between depths (bake/handover.h): the half-width, in subtile sides, of the corner
   /// squares and edge bands whose sub-vertices take their colours from that corner or edge alone; at
   /// least the top level's corner patch half-width (an error names the least). 0 (off, recipes that do
