@@ -1,5 +1,5 @@
-// The C interface (kdm_runtime.h) over kdm/runtime/query.h. Nothing here throws (it builds with
-// -fno-exceptions); allocations that fail return KDM_OUT_OF_MEMORY where the library checks them.
+// The C interface (kdm_runtime.h) over kdm/runtime/query.h. Nothing here throws: every function that
+// allocates returns KDM_OUT_OF_MEMORY when an allocation is refused, and queries allocate nothing.
 #include <algorithm>
 #include <cstddef>
 #include <cstdlib>

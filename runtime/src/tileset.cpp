@@ -28,9 +28,19 @@ std::uint32_t vertex_colour(std::int64_t vx, std::int64_t vy, std::uint32_t colo
 /// hooks they came from.
 detail::QueryTables* make_tables(const TilesetData& set) {
   TilesetAllocator<detail::QueryTables> from;
-  detail::QueryTables* tables = new (from.allocate(1)) detail::QueryTables(set);
-  tables->hooks = from.hooks;
-  return tables;
+  void* memory = from.allocate(1);
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+#endif
+    detail::QueryTables* tables = new (memory) detail::QueryTables(set);
+    tables->hooks = from.hooks;
+    return tables;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  } catch (...) {  // a placement new gives nothing back when the constructor throws
+    from.deallocate(static_cast<detail::QueryTables*>(memory), 1);
+    throw;
+  }
+#endif
 }
 
 void free_tables(detail::QueryTables* tables) {
@@ -77,20 +87,33 @@ void Tileset::adopt(TilesetData&& set) {
   tables_ = make_tables(set_);
 }
 
-Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
+/// decode() into a set `out` adopts: an allocation refused on the way (the query tables come last) is
+/// kOutOfMemory with `out` left empty, not an exception through a caller that asked for a status.
+template <class Decode>
+Status Tileset::load_with(Tileset& out, std::string* detail, Decode&& decode) {
   out = Tileset{};
-  TilesetData set;
-  const Status s = decode_tileset(data, size, set, detail);
-  if (s == Status::kOk) out.adopt(std::move(set));
-  return s;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+#endif
+    TilesetData set;
+    const Status s = decode(set);
+    if (s == Status::kOk) out.adopt(std::move(set));
+    return s;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  } catch (const std::bad_alloc&) {
+    out = Tileset{};
+    if (detail) *detail = "an allocation failed while the tile set was loaded";
+    return Status::kOutOfMemory;
+  }
+#endif
+}
+
+Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail) {
+  return load_with(out, detail, [&](TilesetData& set) { return decode_tileset(data, size, set, detail); });
 }
 
 Status Tileset::load_file(const std::string& path, Tileset& out, std::string* detail) {
-  out = Tileset{};
-  TilesetData set;
-  const Status s = load_tileset(path, set, detail);
-  if (s == Status::kOk) out.adopt(std::move(set));
-  return s;
+  return load_with(out, detail, [&](TilesetData& set) { return load_tileset(path, set, detail); });
 }
 
 const Tileset& Tileset::builtin() {

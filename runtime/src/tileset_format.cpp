@@ -456,7 +456,8 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
       ZSTD_findFrameCompressedSize(payload, payload_size) != payload_size)  // one frame, nothing after it
     return fail(Status::kDecompressionFailed, detail, "payload is not one zstd frame of the stated size");
   // Not zero-filled first: zstd writes every byte (5 MB for the built-in set, a fifth of its load time).
-  const std::unique_ptr<char[]> body(new char[static_cast<std::size_t>(body_size)]);
+  const std::unique_ptr<char[]> body(new (std::nothrow) char[static_cast<std::size_t>(body_size)]);
+  if (!body) return fail(Status::kOutOfMemory, detail, "payload: no memory to decompress it into");
   const std::size_t unpacked = ZSTD_decompress(body.get(), body_size, payload, payload_size);
   if (ZSTD_isError(unpacked) || unpacked != body_size)
     return fail(Status::kDecompressionFailed, detail,

@@ -33,6 +33,12 @@ static void* failing_allocate(size_t bytes, size_t alignment, void* user) {
   (void)bytes, (void)alignment, (void)user;
   return NULL;
 }
+/* Counts its calls and refuses the one numbered g_refuse_at (counting from 0; never if negative). */
+static long g_allocations = 0, g_refuse_at = -1;
+static void* refusing_allocate(size_t bytes, size_t alignment, void* user) {
+  if (g_allocations++ == g_refuse_at) return NULL;
+  return hooked_allocate(bytes, alignment, user);
+}
 static void hooked_deallocate(void* p, size_t bytes, size_t alignment, void* user) {
   (void)alignment;
   *(size_t*)user -= bytes;
@@ -511,6 +517,30 @@ int main(int argc, char** argv) {
   kdm_set_tileset_allocator(failing_allocate, hooked_deallocate, &g_hooked_bytes);
   CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OUT_OF_MEMORY && loaded == NULL);
   kdm_set_tileset_allocator(NULL, NULL, NULL);
+  /* So does one that runs out at any later allocation, the query tables built last included, and what
+   * the load had taken goes back. (A table trimmed to size keeps its spare room when the trimmed copy is
+   * refused: that load succeeds.) Every allocation near the end, a sample of the rest, since each load
+   * decodes the whole set. */
+  {
+    long count, k, refused = 0;
+    kdm_set_tileset_allocator(refusing_allocate, hooked_deallocate, &g_hooked_bytes);
+    g_allocations = 0, g_refuse_at = -1;
+    CHECK(kdm_tileset_load_file(argv[1], &loaded) == KDM_OK);
+    count = g_allocations;
+    kdm_tileset_free(loaded);
+    CHECK(count > 16 && g_hooked_bytes == 0);
+    for (k = 0; k < count; k += (k < 4 || k + 40 >= count) ? 1 : count / 16) {
+      kdm_status s;
+      g_allocations = 0, g_refuse_at = k;
+      s = kdm_tileset_load_file(argv[1], &loaded);
+      CHECK((s == KDM_OUT_OF_MEMORY && loaded == NULL) || (s == KDM_OK && loaded != NULL));
+      refused += s == KDM_OUT_OF_MEMORY;
+      kdm_tileset_free(loaded);
+      CHECK(g_hooked_bytes == 0);
+    }
+    CHECK(refused > 20);
+    kdm_set_tileset_allocator(NULL, NULL, NULL);
+  }
   printf("c api ok\n");
   return 0;
 }

@@ -29,7 +29,8 @@ class KDM_RUNTIME_API Tileset {
   Tileset& operator=(Tileset&& other) noexcept;
 
   /// Loads and validates a file / memory buffer (untrusted input; see decode_tileset). On failure the
-  /// returned status says why, `detail` (optional) says more, and `out` is left empty.
+  /// returned status says why (kOutOfMemory when an allocation, through the tile-set allocator or not,
+  /// is refused), `detail` (optional) says more, and `out` is left empty.
   static Status load_file(const std::string& path, Tileset& out, std::string* detail = nullptr);
   static Status load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail = nullptr);
   /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe. It is decoded on
@@ -63,6 +64,8 @@ class KDM_RUNTIME_API Tileset {
  private:
   friend struct detail::TilesetInternals;
   void adopt(TilesetData&& set);
+  template <class Decode>
+  static Status load_with(Tileset& out, std::string* detail, Decode&& decode);
   TilesetData set_;
   detail::QueryTables* tables_ = nullptr;  ///< built by adopt, through the tile-set allocator
 };
