@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -751,10 +752,23 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
       << json.substr(0, 80);
   EXPECT_NE(json.find("\"tile_x\": 1, \"tile_y\": 1, \"rank\": 0, \"level\": 0"), std::string::npos);
   EXPECT_EQ(json.substr(json.size() - 4), "\n]}\n");
+  // Normalised: the same rows, each position relative to the rectangle's corner over its sides.
   ASSERT_EQ(kdm("query --rect 1,1,3,2 --scale 100 --normalised -o '" + path("n.csv") + "'").status, 0);
-  for (const std::string& row : sorted_rows(slurp(path("n.csv")))) {
+  ASSERT_EQ(kdm("query --rect 1,1,3,2 --scale 100 -o '" + path("w.csv") + "'").status, 0);
+  const std::vector<std::string> unit = sorted_rows(slurp(path("n.csv")));
+  std::vector<std::string> world = sorted_rows(slurp(path("w.csv")));
+  ASSERT_EQ(unit.size(), world.size());
+  ASSERT_GT(unit.size(), 100u);
+  auto id_of = [](const std::string& row) { return row.substr(row.find(',', row.find(',') + 1)); };
+  std::map<std::string, std::string> world_by_id;
+  for (const std::string& row : world) world_by_id[id_of(row)] = row;
+  for (const std::string& row : unit) {
     const double x = std::atof(row.c_str()), y = std::atof(row.c_str() + row.find(',') + 1);
-    EXPECT_TRUE(x >= 0 && x < 1 && y >= 0 && y < 1) << row;
+    const std::string& w = world_by_id[id_of(row)];
+    ASSERT_FALSE(w.empty()) << row;
+    const double wx = std::atof(w.c_str()), wy = std::atof(w.c_str() + w.find(',') + 1);
+    EXPECT_NEAR(x, (wx - 1) / 2, 1e-12) << row;
+    EXPECT_NEAR(y, wy - 1, 1e-12) << row;
   }
   // No density, two ways: const:0 and an all-white image (no ink) both give an empty result.
   write_bytes(path("white.png"), grey_png(2, 2, 8, {255, 255, 255, 255}));

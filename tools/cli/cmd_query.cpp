@@ -31,7 +31,12 @@ struct QueryArgs {
 /// [0, 1) of the rectangle.
 std::string points_with_ids(const std::vector<QueryPoint>& points, const std::vector<std::uint8_t>* classes,
                             const Tileset& tiles, const double r[4], bool normalised, bool json) {
-  const tools::PointSet unit = tools::normalise_to_rect(points, r);
+  std::vector<QueryPoint> from_corner;  // normalise_to_rect takes positions relative to the corner
+  if (normalised) {
+    from_corner = points;
+    for (QueryPoint& p : from_corner) p.x -= r[0], p.y -= r[1];
+  }
+  const tools::PointSet unit = tools::normalise_to_rect(from_corner, r);
   std::string out = json      ? "{\"rect\": ["
                     : classes ? "x,y,tile_x,tile_y,rank,level,class\n"
                               : "x,y,tile_x,tile_y,rank,level\n";
