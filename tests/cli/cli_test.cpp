@@ -844,6 +844,13 @@ TEST_F(CliTest, QueryClassesWriteAClassColumnAndOneGroupPerClass) {
   ASSERT_NE(at, std::string::npos) << json.substr(0, 200);
   EXPECT_GT(std::atof(json.c_str() + at + 23), 0.3);
   EXPECT_NE(json.find("{\"class\": 1, \"metrics\": {"), std::string::npos);
+  // A class too small to analyse is said so and left out of the list, which stays valid JSON.
+  std::ofstream(path("few.csv")) << "x,y,class\n0.5,0.5,0\n0.6,0.6,1\n0.7,0.1,1\n";
+  const Outcome few = kdm("analyze '" + path("few.csv") + "' --no-energy -o '" + path("f") + "'");
+  ASSERT_EQ(few.status, 0) << few.err;
+  EXPECT_NE(few.out.find("class 0 alone: fewer than 2 points"), std::string::npos) << few.out;
+  const std::string listed = slurp(path("f") + "/classes.json");
+  EXPECT_NE(listed.find("\"classes\": [{\"class\": 1, "), std::string::npos) << listed.substr(0, 200);
 }
 
 // kdm stipple --colours: one class per ink, an SVG group per ink, a class column in .csv; a grey picture

@@ -67,13 +67,17 @@ void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::A
   analysis::JsonWriter number;
   number.value(closest);  // null when no two classes meet
   std::string json = "{\"cross_class_closest\": " + number.str() + ", \"classes\": [";
+  bool first = true;
   for (std::size_t c = 0; c < present.size(); ++c) {
     std::vector<tools::PointSet> subsets;
     for (const tools::PointSet& set : sets) {
       subsets.push_back(analysis::class_subset(set, present[c]));
       if (subsets.back().size() < 2) subsets.pop_back();
     }
-    if (subsets.empty()) continue;
+    if (subsets.empty()) {
+      std::printf("\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(present[c]));
+      continue;
+    }
     analysis::AnalysisReport report = analysis::analyze(subsets, o);
     if (!args.no_energy) {
       report.energy_per_point = tools::mean_energy_per_point(subsets, o.torus, target);
@@ -81,8 +85,9 @@ void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::A
     }
     std::printf("\nclass %u alone:\n", unsigned(present[c]));
     std::fputs(analysis::format_summary(report).c_str(), stdout);
-    json += std::string(c ? ", " : "") + "{\"class\": " + std::to_string(present[c]) +
+    json += std::string(first ? "" : ", ") + "{\"class\": " + std::to_string(present[c]) +
             ", \"metrics\": " + analysis::metrics_json(report, args.files) + "}";
+    first = false;
   }
   json += "]}\n";
   std::string error;
