@@ -226,7 +226,8 @@ class Tileset:
         The arguments are query()'s. Returns an (n, 2) float32 array of positions relative to `origin`
         (keep it near `rect`: float32 holds about 7 digits), the same points as query() within
         2**-21 * (|position| + tile_size) (plus 2**-50 of the world coordinate: query()'s own rounding far
-        from the world origin); with ``keys=True`` also an (n,) uint64 array of point keys
+        from the world origin; a `rect` more than 2**21 point spacings from `origin`, where points would
+        fall together, raises ValueError); with ``keys=True`` also an (n,) uint64 array of point keys
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
         region in a fixed order: the same bits for any N, in query()'s order unless a tile holds more

@@ -24,6 +24,9 @@
 namespace kdm::python {
 namespace {
 
+/// A refused query's parameters as Python's keyword arguments.
+constexpr tools::ParameterNames kKeywordNames{"scale=", "tile_size=", "origin="};
+
 using Rect = std::array<double, 4>;
 
 void check_rect(const char* name, const Rect& r) {
@@ -154,8 +157,7 @@ std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) 
           "the query emits more than 2^25 points; lower the scale or split the region");
     if (s == Status::kOk) return m;
     if (s != Status::kBufferFull)
-      throw std::invalid_argument("query: " +
-                                  tools::describe(problem, tools::ParameterNames{"scale=", "tile_size="}));
+      throw std::invalid_argument("query: " + tools::describe(problem, kKeywordNames));
   }
 }
 
@@ -289,8 +291,7 @@ struct CompactBuffer {
 };
 
 [[noreturn]] void refused(const QueryProblem& problem) {
-  throw std::invalid_argument("query: " +
-                              tools::describe(problem, tools::ParameterNames{"scale=", "tile_size="}));
+  throw std::invalid_argument("query: " + tools::describe(problem, kKeywordNames));
 }
 
 void check_collected(std::size_t m) {
@@ -477,7 +478,7 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
   Buffer buffer;
   {
     py::gil_scoped_release release;  // a callable class takes it back at each call
-    tools::query_all(*handle.set, prepared.q, points, classes, tools::ParameterNames{"scale=", "tile_size="});
+    tools::query_all(*handle.set, prepared.q, points, classes, kKeywordNames);
     buffer.reserve(std::max<std::size_t>(points.size(), 1), 0);
     std::copy(points.begin(), points.end(), buffer.points);
     for (std::size_t i = 0; i < points.size(); ++i)

@@ -75,6 +75,9 @@ struct ConstantGlide {
 struct PointSink {
   /// Whether put_glided_run is a vector loop (emit_tile: how it writes beside the region).
   static constexpr bool kVectorRuns = false;
+  /// Positions lie at most 2^kOriginSpanBits point spacings from the query's origin, where a double's
+  /// step is a 16th of a spacing: farther, points fall together (query_into refuses).
+  static constexpr int kOriginSpanBits = 48;
   QueryPoint* points;
   void put(std::size_t i, double x, double y, const PointId& id) const { points[i] = QueryPoint{x, y, id}; }
   void put_stable(std::size_t i, const TileJob& j, TilePoint p, std::uint32_t rank) const {
@@ -99,6 +102,7 @@ struct PointSink {
 template <bool kKeys>
 struct CompactSink {
   static constexpr bool kVectorRuns = true;
+  static constexpr int kOriginSpanBits = 21;  ///< a float's step at most a quarter of a spacing
   float* xy;
   std::uint64_t* keys;
   void put(std::size_t i, double x, double y, const PointId& id) const {
@@ -152,6 +156,7 @@ struct CompactSink {
 template <class Base>
 struct ClassSink {
   static constexpr bool kVectorRuns = Base::kVectorRuns;
+  static constexpr int kOriginSpanBits = Base::kOriginSpanBits;
   Base base;
   std::uint8_t* classes;
   const double* counts;  ///< cumulative expected counts per tile, classes 0 … last - 1
@@ -212,6 +217,7 @@ struct ClassSink {
 template <class Base>
 struct VaryingClassSink {
   static constexpr bool kVectorRuns = Base::kVectorRuns;
+  static constexpr int kOriginSpanBits = Base::kOriginSpanBits;
   Base base;
   const VaryingClasses* c;
   void put(std::size_t i, double x, double y, const PointId& id) const {
@@ -345,6 +351,7 @@ inline void PointSink::put_glided_run(std::size_t i, const TileJob& j, const Con
 /// Counts without writing (detail::count_points).
 struct CountSink {
   static constexpr bool kVectorRuns = false;
+  static constexpr int kOriginSpanBits = 48;  ///< writes nothing: the query that writes refuses for itself
   void put(std::size_t, double, double, const PointId&) const {}
   void put_stable(std::size_t, const TileJob&, TilePoint, std::uint32_t) const {}
   void put_stable_run(std::size_t, const TileJob&, std::uint32_t, std::uint32_t) const {}

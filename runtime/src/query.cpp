@@ -192,6 +192,15 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   if (far > farthest)
     return refuse(Kind::kTooFarFromOrigin, far == std::fabs(q.x0) || far == std::fabs(q.x1) ? "x0" : "y0",
                   far, farthest);
+  // The output is relative to the query's origin, exactly past the top level too (integer tile paths),
+  // but it is written in doubles or floats: the origin must lie near enough for their steps to keep the
+  // densest points apart.
+  const double out_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x)),
+               out_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
+  const double out_farthest = std::ldexp(deepest_spacing, Sink::kOriginSpanBits);
+  if (std::max(out_x, out_y) > out_farthest)
+    return refuse(Kind::kTooFarFromOrigin, out_x >= out_y ? "origin_x" : "origin_y", std::max(out_x, out_y),
+                  out_farthest);
   if (!cursor->started) {  // at the first tile of the run the query visits
     std::int64_t sx = tx0, sy = ty0;
     if (run.from_y > ty0 || (run.from_y == ty0 && run.from_x > tx0)) {
@@ -401,17 +410,15 @@ Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::s
 }
 
 Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, bool keys, Refusal& refuse) {
-  // Positions relative to the origin must fit a float (3.4e38); a margin for the region's own width.
   const double far_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x));
   const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
-  if (far_x > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x);
-  if (far_y > 1e38) return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y);
-  // Where a float's step (2^-23 of the distance) reaches a tile, a tile's points fall together: an origin
-  // that far from the region is a mistake (closer, the step is the documented rounding).
+  // Where a float's step (2^-23 of the distance) reaches a tile, a tile's points fall together, whatever
+  // the density (query_into holds the step to the densest spacing once it knows it); and a float ends
+  // at 3.4e38.
   if (q.tile_size > 0) {
-    const double farthest = std::ldexp(q.tile_size, 23);
-    if (far_x > farthest) return refuse(QueryProblem::Kind::kNotFinite, "origin_x", q.origin_x, farthest);
-    if (far_y > farthest) return refuse(QueryProblem::Kind::kNotFinite, "origin_y", q.origin_y, farthest);
+    const double farthest = std::min(1e38, std::ldexp(q.tile_size, 23));
+    if (far_x > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_x", far_x, farthest);
+    if (far_y > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_y", far_y, farthest);
   }
   if (keys && !tileset.empty()) {
     const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
@@ -551,7 +558,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kKeysUnsupported:
       return "the tile set's tiles hold more points than a 64-bit point key can number";
     case QueryProblem::Kind::kTooFarFromOrigin:
-      return "the region lies too far from the world origin for doubles to place its points";
+      return "the region lies too far from the origin (the world's, or the query's for its output) for its "
+             "points to keep their places";
   }
   return "unknown problem";
 }

@@ -162,6 +162,13 @@ def test_positions_refuse_an_origin_where_floats_lose_the_tiles():
     with pytest.raises(ValueError, match="origin_x"):
         BUILTIN.positions((0, 0, 2, 2), scale=100, origin=(1e20, 0))
     assert len(BUILTIN.positions((0, 0, 2, 2), scale=100, origin=(1e3, 0))) > 0
+    # Nearer, but float32's step 4e6 out (0.5) is 50 spacings of 10^4 points per unit area: refused too;
+    # with the origin at the region every point keeps its own place.
+    far = (4e6, 4e6, 4e6 + 1, 4e6 + 1)
+    with pytest.raises(ValueError, match=r"'origin_x'.*origin= nearer the region"):
+        BUILTIN.positions(far, scale=1e4)
+    xy = BUILTIN.positions(far, scale=1e4, origin=(4e6, 4e6))
+    assert len(xy) > 9000 and len(np.unique(xy, axis=0)) == len(xy)
 
 
 @pytest.mark.parametrize("bounds", [(math.nan, 1.0), (2.0, 1.0), (-1.0, 1.0), (0.0, math.nan)])

@@ -121,8 +121,9 @@ TEST(CompactQueryTest, WritesTheSubtilesPointsPastTheTopLevel) {
 TEST(CompactQueryTest, KeepsTheFullQuerysPointsFarFromTheOrigin) {
   // Smooth mode settles a border tile's points by their float positions where these are far enough from
   // the region's sides, and by the full query's test in double where they are not: far from the origin a
-  // float's step (2.4e-4 at 3,000, 0.06 at 10^6) leaves more, or nearly all, points to the test.
-  for (double at : {3000.0, 1e6}) {
+  // float's step (2.4e-4 at 3,000; 3.9e-3 at 4·10^4, near the farthest a float output may lie at this
+  // density, 2^21 spacings of 0.022) leaves more points to the test.
+  for (double at : {3000.0, 4e4}) {
     QueryParams q = region(QueryMode::kSmooth);
     q.x0 += at, q.x1 += at, q.y0 -= at, q.y1 -= at;
     q.origin_x = q.origin_y = 0;
@@ -248,17 +249,27 @@ TEST(CompactQueryTest, RefusesMissingOutputByName) {
   QueryCursor fresh;
   EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
             Status::kInvalidArgument);
-  EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(why.parameter, "origin_y");
   // Within a float's range but where its step reaches a tile: every tile's points would fall together.
   far.origin_y = 0, far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 1.01;
   fresh = QueryCursor{};
   EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
             Status::kInvalidArgument);
-  EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(why.parameter, "origin_x");
   EXPECT_EQ(why.limit, std::ldexp(q.tile_size, 23));
-  far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 0.99;  // nearer: served, with the documented rounding
+  // Nearer, but where the step passes a quarter of the spacing at the query's density (2^21 spacings
+  // out): points would still fall together, and only the density says so.
+  const double spacing = q.tile_size / std::sqrt(q.scale * q.density.constant * q.tile_size * q.tile_size);
+  far.origin_x = q.x1 + std::ldexp(spacing, 21) * 1.01;
+  fresh = QueryCursor{};
+  EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(why.parameter, "origin_x");
+  EXPECT_DOUBLE_EQ(why.limit, std::ldexp(spacing, 21));
+  far.origin_x = q.x1 + std::ldexp(spacing, 21) * 0.99;  // nearer: served, with the documented rounding
   fresh = QueryCursor{};
   EXPECT_NE(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
             Status::kInvalidArgument);

@@ -570,7 +570,21 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   p = problem_of(region(0, -1e10, 2e-6, -1e10 + 2e-6, 1e16, QueryMode::kSmooth));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(p.parameter, "y0");
-  std::set<std::pair<double, double>> distinct;  // 10^12 out (a step of 1/8192) points stay apart
+  // Past the top level the points are placed exactly relative to the query's origin, but written as
+  // doubles: 10^12 from the origin (a step of 1/8192) points 10^-5 apart would fall together, so the
+  // origin must come near; there they all stay apart.
+  q = region(1e12, 1e12, 1e12 + 0.003, 1e12 + 0.003, 1e10, QueryMode::kSmooth);
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(p.parameter, "origin_x");
+  EXPECT_NEAR(p.value, 1e12, 1.0);
+  q.origin_x = q.origin_y = 1e12;
+  std::set<std::pair<double, double>> distinct;
+  const std::vector<Key> deep = run(q);
+  for (const Key& k : deep) distinct.insert({std::get<3>(k), std::get<4>(k)});
+  EXPECT_GT(deep.size(), 80000u);
+  EXPECT_EQ(distinct.size(), deep.size());
+  distinct.clear();  // 10^12 out (a step of 1/8192) points 1/32 apart stay apart
   const std::vector<Key> far_points = run(region(1e12, 0, 1e12 + 1, 1, 1000));
   for (const Key& k : far_points) distinct.insert({std::get<3>(k), std::get<4>(k)});
   EXPECT_GT(far_points.size(), 900u);

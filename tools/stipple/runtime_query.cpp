@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 namespace kdm::tools {
@@ -46,10 +47,21 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
                     query_problem_message(p.kind), p.value, p.limit, names.tile_size);
       break;
     case QueryProblem::Kind::kTooFarFromOrigin:
-      std::snprintf(text, sizeof text,
-                    "%s: %.6g from it, at most %.6g for this density and region; keep the world's "
-                    "coordinates nearer its origin (move the origin), or ask for fewer points per unit area",
-                    query_problem_message(p.kind), p.value, p.limit);
+      // "origin_x" / "origin_y": the output's numbers are too coarse, not the world's.
+      if (std::strncmp(p.parameter, "origin", 6) == 0 && names.origin)
+        std::snprintf(
+            text, sizeof text,
+            "the region lies too far from the query's origin ('%s') for the output to keep its points "
+            "apart: %.6g from it, at most %.6g for this density; use an %s nearer the region, or ask "
+            "for fewer points per unit area",
+            p.parameter, p.value, p.limit, names.origin);
+      else
+        std::snprintf(
+            text, sizeof text,
+            "the region lies too far from the world origin for doubles to place its points: %.6g from "
+            "it, at most %.6g for this density and region; keep the world's coordinates nearer its "
+            "origin (move the origin), or ask for fewer points per unit area",
+            p.value, p.limit);
       break;
     case QueryProblem::Kind::kNotFinite:
       if (!std::isfinite(p.value)) {  // the kind also covers places too far out for a finite value

@@ -22,6 +22,7 @@ inline constexpr std::size_t kMaxCollectedPoints = std::size_t(1) << 25;
 struct ParameterNames {
   const char* scale = "scale";
   const char* tile_size = "tile_size";
+  const char* origin = "origin";  ///< null where the caller cannot set one (the world origin is the query's)
 };
 
 /// A refused query's problem in one line: which parameter, which limit, what works.

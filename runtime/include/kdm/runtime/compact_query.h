@@ -47,8 +47,9 @@ struct CompactPoints {
 /// way it depends only on the point and the parameters, so partitions of a region give the same bits. Slots
 /// from *written to capacity may be overwritten. Statuses, resumption (a cursor serves query_points and this
 /// function alike) and refusals as query_points', with parameter "out.xy" for a null xy with room in it,
-/// "origin_x" or "origin_y" (kNotFinite, `limit` the farthest allowed) for a region so far from the origin
-/// that a float's step there reaches a tile (2^23 tiles), and
+/// "origin_x" or "origin_y" (kTooFarFromOrigin, `limit` the farthest allowed) for a region so far from the
+/// origin that a float's step there passes a quarter of the densest points' spacing (2^21 spacings) or
+/// reaches a tile (2^23 tiles), and
 /// kKeysUnsupported when keys are asked of a set whose tiles hold more than 2^19 points (ranks would not fit
 /// a key). No allocation.
 KDM_RUNTIME_API Status query_points_compact(const Tileset& tileset, const QueryParams& params,

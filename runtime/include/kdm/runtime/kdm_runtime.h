@@ -103,8 +103,10 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_BAD_CLASS_COUNT = 10,  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
   KDM_PROBLEM_KEYS_UNSUPPORTED = 11, /* kdm_query_compact: keys asked of a set whose tiles hold `value`
                                         points, more than a key's ranks (`limit`) */
-  KDM_PROBLEM_TOO_FAR_FROM_ORIGIN = 12 /* the region lies `value` from the world origin, farther than
-                                          `limit`, where doubles cannot place its points */
+  KDM_PROBLEM_TOO_FAR_FROM_ORIGIN = 12 /* the region lies `value` from the world origin ("x0", "y0"),
+                                          farther than `limit`, where doubles cannot place its points; or
+                                          from the query's origin ("origin_x", "origin_y"), where the
+                                          output's doubles or floats cannot keep its densest points apart */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {

@@ -152,11 +152,15 @@ struct QueryProblem {
     kBadClassCount,     ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
     kKeysUnsupported,   ///< query_points_compact: keys asked of a set whose tiles hold `value` points,
                         ///< more than a key's ranks (`limit`, 2^19)
-    kTooFarFromOrigin,  ///< the region lies `value` world units from the world origin, farther than
-                        ///< `limit`, where a double's step is over a 16th of the points' spacing (or a
-                        ///< quarter of the region's side, if that is wider than the spacing at the
-                        ///< density's depth): move the world's origin nearer, or query a larger region
-                        ///< at a lower density
+    kTooFarFromOrigin,  ///< `parameter` "x0" or "y0": the region lies `value` world units from the world
+                        ///< origin, farther than `limit`, where a double's step is over a 16th of the
+                        ///< points' spacing (or a quarter of the region's side, if that is wider than the
+                        ///< spacing at the density's depth): move the world's origin nearer, or query a
+                        ///< larger region at a lower density. "origin_x" or "origin_y": the region lies
+                        ///< `value` from the query's origin, farther than `limit`, where the output's
+                        ///< step (a double's, or a compact output's float) is over a 16th (a float's: a
+                        ///< quarter) of the densest points' spacing, or a float's reaches a tile: set
+                        ///< the origin nearer the region
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage
