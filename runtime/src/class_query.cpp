@@ -63,6 +63,7 @@ std::uint64_t query_fingerprint(const ClassQueryParams& p) {
   f.add(p.class_count);
   f.add_pointer(reinterpret_cast<const void*>(p.joint.densities));
   f.add_pointer(reinterpret_cast<const void*>(p.joint.batch_densities));
+  f.add_pointer(reinterpret_cast<const void*>(p.joint.bounds));
   f.add_pointer(p.joint.user);
   for (std::uint32_t k = 0; k < p.class_count && k < kMaxQueryClasses; ++k) f.add_double(p.joint.max[k]);
   f.add_pointer(p.image_sums);
@@ -162,6 +163,8 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     q.density.constant = 0;  // not QueryDensity's default of 1
     for (std::uint32_t k = 0; k < p.class_count; ++k)
       q.density.constant += density_or_zero(p.classes[k].constant);
+    // Each finite, their sum need not be: named as the classes' (the union query would say density).
+    if (!std::isfinite(q.density.constant)) return refuse(Kind::kNotFinite, "classes", q.density.constant);
     return Status::kOk;
   }
   q.density.kind = QueryDensity::Kind::kCallback;

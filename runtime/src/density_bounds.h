@@ -23,10 +23,12 @@ inline double callback_value(const QueryDensity& d, double x, double y) {
   return density_or_zero(v);
 }
 
-/// A caller's bounds l ≤ ρ ≤ h of a density whose maximum is `max`, as queries use them: an upper bound
-/// that is not a number in [0, max) is max, a lower one that is not positive is 0.
+/// A caller's bounds l ≤ ρ ≤ h of a density whose maximum is `max`, as queries use them: a pair that
+/// contradicts itself (l > h, or either NaN) is no bounds at all; an upper bound that is not a number in
+/// [0, max) is max, a lower one that is not positive is 0.
 inline void trusted_bounds(double l, double h, double max, double& lo, double& hi) {
-  hi = h >= 0 && h < max ? h : max;  // NaN bounds fail both tests
+  if (!(l <= h)) l = 0, h = max;
+  hi = h >= 0 && h < max ? h : max;
   lo = l > 0 ? std::min(l, hi) : 0;
 }
 

@@ -177,13 +177,55 @@ static_assert(KDM_DENSITY_BATCH == kdm::kDensityBatch, "the C and C++ batch size
 static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN,
               "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
 
+// C's names for class k's density fields (kdm_class_density's, not kdm::QueryDensity's) and the joint
+// density's maxima.
+#define KDM_CLASS_NAMES(field)                                                                               \
+  {                                                                                                          \
+    "classes[0]." field, "classes[1]." field, "classes[2]." field, "classes[3]." field, "classes[4]." field, \
+        "classes[5]." field, "classes[6]." field, "classes[7]." field                                        \
+  }
+constexpr const char* kClassDensityNames[][KDM_MAX_CLASSES] = {
+    KDM_CLASS_NAMES("density"), KDM_CLASS_NAMES("density_max"), KDM_CLASS_NAMES("density_image"),
+    KDM_CLASS_NAMES("density_callback")};
+#undef KDM_CLASS_NAMES
+constexpr const char* kJointMaxNames[KDM_MAX_CLASSES] = {
+    "joint.density_max[0]", "joint.density_max[1]", "joint.density_max[2]", "joint.density_max[3]",
+    "joint.density_max[4]", "joint.density_max[5]", "joint.density_max[6]", "joint.density_max[7]"};
+
+/// The C spelling of a refused parameter (static storage): kdm_query's density fields and the C
+/// functions' arguments where C++ names them otherwise (QueryParams' density.*, CompactPoints' out.*,
+/// ClassQueryParams' classes[k].* and joint.max[k]).
+const char* c_parameter(const char* name) {
+  static constexpr const char* kRenamed[][2] = {{"density.constant", "density"},
+                                                {"density.callback_max", "density_max"},
+                                                {"density.image", "density_image"},
+                                                {"density.callback", "density_callback"},
+                                                {"density.batch_callback", "density_batch_callback"},
+                                                {"out.xy", "xy"},
+                                                {"out.keys", "keys"}};
+  for (const auto& r : kRenamed)
+    if (std::strcmp(name, r[0]) == 0) return r[1];
+  static constexpr const char* kClassFields[] = {"constant", "callback_max", "image", "callback"};
+  if (std::strncmp(name, "classes[", 8) == 0) {  // "classes[k].field", k one digit
+    const unsigned k = static_cast<unsigned>(name[8] - '0');
+    if (k < KDM_MAX_CLASSES && std::strncmp(name + 9, "].", 2) == 0)
+      for (std::size_t f = 0; f < 4; ++f)
+        if (std::strcmp(name + 11, kClassFields[f]) == 0) return kClassDensityNames[f][k];
+  }
+  if (std::strncmp(name, "joint.max[", 10) == 0) {
+    const unsigned k = static_cast<unsigned>(name[10] - '0');
+    if (k < KDM_MAX_CLASSES) return kJointMaxNames[k];
+  }
+  return name;
+}
+
 /// Writes `why` into the caller's problem struct, if it gave one.
 void report(const kdm::QueryProblem& why, kdm_query_problem* problem) {
   if (!problem || problem->struct_size < kProblemV1) return;
   kdm_query_problem p;
   std::memset(&p, 0, sizeof p);
   p.kind = static_cast<kdm_problem_kind>(static_cast<int>(why.kind));
-  p.parameter = why.parameter;
+  p.parameter = c_parameter(why.parameter);
   p.value = why.value, p.limit = why.limit;
   p.largest_valid = why.largest_valid, p.largest_tile_size = why.largest_tile_size;
   write_grown(p, problem);

@@ -181,10 +181,10 @@ int main(int argc, char** argv) {
     q = uniform_query();
     q.density = -1; /* a constant density that is none */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "density.constant") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "density") == 0);
     q.density = 0.0 / 0.0;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_NOT_FINITE && strcmp(problem.parameter, "density.constant") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_FINITE && strcmp(problem.parameter, "density") == 0);
     q = uniform_query();
     q.mode = 7;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
@@ -250,6 +250,12 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_classes(builtin, &q, densities, 3, points, NULL, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out_classes") == 0);
+    /* A class's field is named as kdm_class_density spells it. */
+    densities[1].density = -1;
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "classes[1].density") == 0);
+    densities[1].density = 2;
     /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
     {
       static float xy[2 * 4096], sum_xy[2 * 4096];
@@ -276,7 +282,7 @@ int main(int argc, char** argv) {
       }
       CHECK(kdm_query_classes_compact(builtin, &q, densities, 3, NULL, keys, compact_classes, 4096, &compact,
                                       &cursor, &problem) == KDM_INVALID_ARGUMENT);
-      CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out.xy") == 0);
+      CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "xy") == 0);
       CHECK(kdm_query_classes_compact(builtin, &q, densities, 0, xy, keys, compact_classes, 4096, &compact,
                                       &cursor, &problem) == KDM_INVALID_ARGUMENT);
       CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT);
@@ -372,7 +378,7 @@ int main(int argc, char** argv) {
       memset(&cursor, 0, sizeof cursor);
       CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, &problem) == KDM_INVALID_ARGUMENT);
       CHECK(problem.kind == KDM_PROBLEM_BAD_DENSITY &&
-            strcmp(problem.parameter, "density.batch_callback") == 0);
+            strcmp(problem.parameter, "density_batch_callback") == 0);
       q.density_callback = NULL;
       memset(&cursor, 0, sizeof cursor);
       CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
@@ -457,7 +463,7 @@ int main(int argc, char** argv) {
         joint.density_max[1] = -1;
         CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
                                       &problem) == KDM_INVALID_ARGUMENT &&
-              strcmp(problem.parameter, "joint.max[1]") == 0);
+              strcmp(problem.parameter, "joint.density_max[1]") == 0);
       }
     }
   }
@@ -490,7 +496,7 @@ int main(int argc, char** argv) {
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_compact(builtin, &q, NULL, keys, 100, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out.xy") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "xy") == 0);
     CHECK(kdm_query_compact(builtin, &q, xy, NULL, 100, &written, &cursor, NULL) == KDM_BUFFER_FULL);
     CHECK(written == 100);
   }

@@ -268,6 +268,10 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(refusal(q).parameter, "classes[2].constant");
   q.classes[2].constant = -5;
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);
+  q.classes[1].constant = q.classes[2].constant = 1e308;  // each finite, their sum not
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNotFinite);
+  EXPECT_STREQ(refusal(q).parameter, "classes");
+  q.classes[1].constant = 2;
   q.classes[2].constant = 0.5;
   q.classes[1].kind = QueryDensity::Kind::kImage;
   EXPECT_STREQ(refusal(q).parameter, "classes[1].image");

@@ -40,6 +40,9 @@ struct Ramp {
   static void no_bounds(void*, double, double, double, double, double* lo, double* hi) {
     *lo = *hi = std::numeric_limits<double>::quiet_NaN();
   }
+  static void crossed_bounds(void*, double, double, double, double, double* lo, double* hi) {
+    *lo = 5, *hi = 0;  // a bug in the caller's bounds, not a density of 0
+  }
 };
 
 QueryParams ramp_query(Ramp& ramp, QueryMode mode) {
@@ -67,9 +70,12 @@ TEST(DensityBoundsTest, ACallbacksBoundsKeepItsPointsAndSaveItsCalls) {
     // measured 0.037 with its cells'); smooth mode below its upper bound, once per point (measured 0.433).
     EXPECT_LT(calls_bounded, (mode == QueryMode::kStable ? 0.06 : 0.65) * calls_everywhere)
         << "mode " << int(mode);
-    q.density.bounds = Ramp::no_bounds;  // NaN bounds are no bounds
-    EXPECT_TRUE(same_bits(run(q), read_everywhere)) << "mode " << int(mode);
-    EXPECT_EQ(ramp.calls.exchange(0), calls_everywhere);
+    // NaN bounds, and bounds that contradict themselves, are no bounds.
+    for (auto* none : {Ramp::no_bounds, Ramp::crossed_bounds}) {
+      q.density.bounds = none;
+      EXPECT_TRUE(same_bits(run(q), read_everywhere)) << "mode " << int(mode);
+      EXPECT_EQ(ramp.calls.exchange(0), calls_everywhere);
+    }
   }
 }
 

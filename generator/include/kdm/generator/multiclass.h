@@ -24,7 +24,7 @@ struct ClassSample {
   std::vector<double> points;         ///< n * dim coordinates in [0, 1), class 0's points first
   std::vector<std::uint8_t> classes;  ///< each point's class
   std::vector<std::int64_t> counts;   ///< points per class
-  std::vector<SampleReport> reports;  ///< one per class's run
+  std::vector<SampleReport> reports;  ///< one per run: each class with points, then the union's sweeps
   std::size_t size() const { return classes.size(); }
 };
 

@@ -47,7 +47,8 @@ class ClassImageSums;  // class_image_sums.h
 struct JointClassDensity {
   /// Writes the class_count densities at world position (x, y), points per unit area at scale 1, class 0
   /// first, into values[0 … class_count). NaN, negative and infinite values count as 0. Called from the
-  /// querying thread only; it must give the same values for the same position.
+  /// querying thread (from every worker at once under ParallelQuery); it must give the same values for
+  /// the same position.
   void (*densities)(void* user, double x, double y, double* values) = nullptr;
   /// Optional: bounds of each class's density over [x0, x1] × [y0, y1] into lo[k] ≤ ρ_k ≤ hi[k], as
   /// QueryDensity::bounds gives one density's (values that are not numbers fall back to 0 and max[k]).

@@ -20,21 +20,23 @@
 extern "C" {
 #endif
 
+/* What every call returns (kdm::Status, value for value). */
 typedef enum kdm_status {
   KDM_OK = 0,
-  KDM_IO_ERROR = 1,
-  KDM_BAD_MAGIC = 2,
-  KDM_UNSUPPORTED_VERSION = 3,
-  KDM_TRUNCATED = 4,
-  KDM_TRAILING_BYTES = 5,
-  KDM_HEADER_CHECKSUM_MISMATCH = 6,
-  KDM_PAYLOAD_CHECKSUM_MISMATCH = 7,
-  KDM_TOO_LARGE = 8,
-  KDM_DECOMPRESSION_FAILED = 9,
-  KDM_INVALID_CONTENT = 10,
-  KDM_INVALID_ARGUMENT = 11, /* kdm_query_points: see kdm_query_problem for which argument and limit */
-  KDM_BUFFER_FULL = 12,
-  KDM_OUT_OF_MEMORY = 13
+  KDM_IO_ERROR = 1,                  /* a file could not be opened or read */
+  KDM_BAD_MAGIC = 2,                 /* not a kdm tile set */
+  KDM_UNSUPPORTED_VERSION = 3,       /* written in a format version this library does not read */
+  KDM_TRUNCATED = 4,                 /* shorter than its header says */
+  KDM_TRAILING_BYTES = 5,            /* longer than its header says */
+  KDM_HEADER_CHECKSUM_MISMATCH = 6,  /* header bytes damaged */
+  KDM_PAYLOAD_CHECKSUM_MISMATCH = 7, /* payload bytes damaged */
+  KDM_TOO_LARGE = 8,                 /* a size past the reader's caps */
+  KDM_DECOMPRESSION_FAILED = 9,      /* the payload is not one zstd frame of its stated size */
+  KDM_INVALID_CONTENT = 10,          /* checksums match but the content is inconsistent */
+  KDM_INVALID_ARGUMENT = 11, /* a caller's error; queries say which argument and limit in kdm_query_problem */
+  KDM_BUFFER_FULL = 12,      /* a query filled the buffer, or examined its most candidates (2^24) in one
+                                call: call again with the same cursor */
+  KDM_OUT_OF_MEMORY = 13     /* an allocation was refused (by the tile-set allocator's hooks too) */
 } kdm_status;
 
 typedef struct kdm_tileset kdm_tileset;             /* a loaded tile set */
@@ -43,7 +45,8 @@ typedef struct kdm_density_image kdm_density_image; /* a density image with its 
 typedef struct kdm_point {
   double x, y;            /* world position minus the query origin */
   int64_t tile_x, tile_y; /* stable id: tile coordinates ... */
-  uint32_t rank;          /* ... and rank within the tile (its level follows from kdm_tileset_info) */
+  uint32_t rank;          /* ... and rank within the tile (emitted in rank order: a tile's first points
+                             are its coarsest level's) */
   uint32_t depth;         /* past the top level (smooth mode): tiles m^depth times smaller (kdm::PointId) */
 } kdm_point;
 
@@ -56,7 +59,7 @@ typedef struct kdm_query {
   double density;            /* constant density (finite, >= 0), used without an image or a callback */
   /* Optional: density at world (x, y); NaN, negative and infinite values count as 0. */
   double (*density_callback)(void* user, double x, double y);
-  void* user;
+  void* user;                             /* passed to the density and bounds callbacks */
   double density_max;                     /* upper bound of the callback's values */
   const kdm_density_image* density_image; /* optional; takes precedence over the callback */
   /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
@@ -64,7 +67,8 @@ typedef struct kdm_query {
                density, so every density is good blue noise (tile sets with a glide track) */
   /* Added in 0.4: optional bounds of the callback's density over a world rectangle (*lo <= density <= *hi
    * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
-   * called only where emission is in doubt (kdm::QueryDensity::bounds). */
+   * called only where emission is in doubt (kdm::QueryDensity::bounds). NaN bounds, and *lo > *hi, are
+   * ignored; bounds that do not hold make points appear or vanish as if the density were *lo or *hi. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback (set one of the two), the density at n positions at once,
    * out[i] at (x[i], y[i]), 1 <= n <= KDM_DENSITY_BATCH, for vectorised functions: a query gathers each
@@ -78,13 +82,13 @@ typedef struct kdm_query {
 enum { KDM_MODE_STABLE = 0, KDM_MODE_SMOOTH = 1 };
 
 typedef struct kdm_cursor {
-  int64_t tile_x, tile_y;
-  uint32_t rank;
-  int started, finished;
-  uint64_t fingerprint; /* of the query that started it: a cursor is refused with other parameters */
-  uint32_t depth;       /* where in the tile's subtiles it stopped (past the top level) */
-  uint64_t path;        /* the subtiles it went through; at depth 0, the tile's cell it stopped in + 1 */
-} kdm_cursor;           /* zero-initialise before the first call */
+  int64_t tile_x, tile_y; /* the tile the query stopped in */
+  uint32_t rank;          /* the next rank to examine there */
+  int started, finished;  /* set by the first call, and once the region is complete */
+  uint64_t fingerprint;   /* of the query that started it: a cursor is refused with other parameters */
+  uint32_t depth;         /* where in the tile's subtiles it stopped (past the top level) */
+  uint64_t path;          /* the subtiles it went through; at depth 0, the tile's cell it stopped in + 1 */
+} kdm_cursor;             /* zero-initialise before the first call */
 
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {
@@ -92,7 +96,7 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_MISSING_ARGUMENT =
       1,                      /* `parameter` is NULL (or the tile set is empty; "runner.run": ran no task) */
   KDM_PROBLEM_NOT_FINITE = 2, /* `parameter` is NaN or infinite; `value` holds it */
-  KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 */
+  KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 ("query.struct_size": at least `limit`) */
   KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
   KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing, or both callbacks are set */
   KDM_PROBLEM_TOO_MANY_TILES = 6,    /* `value` tiles, more than `limit`: split the region */
@@ -112,19 +116,24 @@ typedef enum kdm_problem_kind {
 typedef struct kdm_query_problem {
   size_t struct_size; /* sizeof(kdm_query_problem) */
   kdm_problem_kind kind;
-  const char* parameter; /* the kdm_query field or argument at fault (static string) */
-  double value, limit, largest_valid, largest_tile_size;
+  const char* parameter;    /* the kdm_query field ("x0", "density_max", "mode", ...), the function's argument
+                               ("xy", "out_classes", "cursor", ...) or its field ("classes[2].density",
+                               "joint.density_max[1]", "query.struct_size") at fault; a static string */
+  double value;             /* the value refused, where it is a number */
+  double limit;             /* the limit it broke, where there is one (see each kind) */
+  double largest_valid;     /* KDM_PROBLEM_DENSITY_TOO_HIGH: the largest scale that fits */
+  double largest_tile_size; /* KDM_PROBLEM_DENSITY_TOO_HIGH: the largest tile size that fits this scale */
 } kdm_query_problem;
 
 typedef struct kdm_tileset_info {
-  size_t struct_size;      /* sizeof(kdm_tileset_info) */
-  uint32_t format_version; /* the format version the set is written in (4 without a hand-over) */
-  uint32_t colours, tiles, levels;
-  uint32_t max_points_per_tile;  /* the densest query: scale * density * tile_size^2 up to this */
-  uint32_t level_points[16];     /* nominal points per tile of levels 0 .. levels - 1 */
-  size_t resident_bytes;         /* heap bytes the loaded set occupies */
-  const char* generator_version; /* the kdm version that baked it; valid while the tile set lives */
-  const char* recipe;            /* the recipe text that rebakes it; valid while the tile set lives */
+  size_t struct_size;              /* sizeof(kdm_tileset_info) */
+  uint32_t format_version;         /* the format version the set is written in (4 without a hand-over) */
+  uint32_t colours, tiles, levels; /* corner colours C, tiles (C^4) and density levels */
+  uint32_t max_points_per_tile;    /* the densest query: scale * density * tile_size^2 up to this */
+  uint32_t level_points[16];       /* nominal points per tile of levels 0 .. levels - 1 */
+  size_t resident_bytes;           /* heap bytes the loaded set occupies */
+  const char* generator_version;   /* the kdm version that baked it; valid while the tile set lives */
+  const char* recipe;              /* the recipe text that rebakes it; valid while the tile set lives */
   /* Added in 0.2: */
   uint32_t keyframes; /* keyframes of its glide track (0: none; smooth queries emit stable positions) */
   /* Added in 0.3: */
@@ -133,9 +142,10 @@ typedef struct kdm_tileset_info {
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`
- * returns `bytes` bytes aligned to `alignment` or NULL, `deallocate` frees them. Both NULL: malloc-like
- * operator new again. Memory always returns to the functions it came from. Call it while no other thread
- * is loading a tile set. */
+ * returns `bytes` bytes aligned to `alignment` (a power of two, at most alignof(max_align_t)) or NULL,
+ * which the load returns as KDM_OUT_OF_MEMORY; `deallocate` frees them. Either NULL: operator new and
+ * delete again. Memory always returns to the functions it came from. Call it while no other thread is
+ * loading a tile set. */
 KDM_RUNTIME_API void kdm_set_tileset_allocator(void* (*allocate)(size_t bytes, size_t alignment, void* user),
                                                void (*deallocate)(void* p, size_t bytes, size_t alignment,
                                                                   void* user),
@@ -147,32 +157,38 @@ KDM_RUNTIME_API const char* kdm_version(void);
 KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 
 /* Loads a tile-set file / memory buffer (untrusted input is validated). *out receives a new handle to
- * free with kdm_tileset_free, or NULL on failure. */
+ * free with kdm_tileset_free, or NULL on failure: KDM_INVALID_ARGUMENT for a NULL `path` or `out` (or NULL
+ * `data` with `size` > 0), KDM_IO_ERROR for a file that cannot be read, the format's statuses
+ * (KDM_BAD_MAGIC ... KDM_INVALID_CONTENT) for a damaged or foreign one, KDM_OUT_OF_MEMORY. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
 /* The default tile set compiled into the library: decoded on first use (about 0.1 s; call it
  * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). Never free
  * it. */
 KDM_RUNTIME_API const kdm_tileset* kdm_tileset_builtin(void);
+/* Frees a loaded set; NULL and the built-in set are ignored. */
 KDM_RUNTIME_API void kdm_tileset_free(kdm_tileset* tileset);
 /* Heap bytes a loaded set occupies (positions, keys, emission thresholds, tables); 0 for NULL. */
 KDM_RUNTIME_API size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset);
 /* Fills `info` (set info->struct_size first). KDM_INVALID_ARGUMENT for NULL or a struct_size too small. */
 KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info);
 
-/* A density image over the world rectangle [x0, x1) x [y0, y1): `width` x `height` values, row-major,
- * row 0 at y0, bilinear between texel centres and clamped at the edges. The values are copied and an
+/* A density image over the world rectangle [x0, x1) x [y0, y1) (world units): `width` x `height` texels
+ * of density (as kdm_query's `density`: multiplied by `scale`), row-major, row 0 at y0, bilinear between
+ * texel centres and clamped at the edges. The values are copied and an
  * 8x8 max-mip is built, so queries skip what cannot be emitted. KDM_INVALID_ARGUMENT for an empty image,
  * a NULL or negative or non-finite value, or a rectangle that is empty, not finite, or so narrow that its
  * texels per unit overflow (make_density_max_mip's rule); KDM_OUT_OF_MEMORY when its copy does
  * not fit in memory. Free with kdm_density_image_free. */
 KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const float* values, double x0,
                                                     double y0, double x1, double y1, kdm_density_image** out);
+/* Frees an image (NULL is ignored); no query may be using it. */
 KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 
-/* Writes up to `capacity` points into `out`, *written = count. KDM_OK when the region is complete,
- * KDM_BUFFER_FULL to be resumed with the same cursor and query, KDM_INVALID_ARGUMENT for bad parameters,
- * with `problem` (optional: NULL, or with struct_size set) saying which and why. */
+/* Writes up to `capacity` points into `out` (NULL only with capacity 0), *written = count (`written` and
+ * `cursor` are required). KDM_OK when the region is complete, KDM_BUFFER_FULL to be resumed with the same
+ * cursor and query (also with room left, after 2^24 candidates in one call), KDM_INVALID_ARGUMENT for bad
+ * parameters, with `problem` (optional: NULL, or with struct_size set) saying which and why. */
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);
@@ -247,7 +263,8 @@ typedef struct kdm_joint_class_density {
 /* kdm_query_classes and kdm_query_classes_compact with the classes' densities from one call: the same
  * points and classes as separate callbacks giving the same values, one call per candidate instead of one
  * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` or neither of its two density functions
- * ("joint"), both of them ("joint.batch_densities") and a bad density_max ("joint.max[k]"). Added in 0.4. */
+ * ("joint"), both of them ("joint.batch_densities") and a bad density_max ("joint.density_max[k]"). Added
+ * in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
                                                    const kdm_joint_class_density* joint, uint32_t class_count,
                                                    kdm_point* out, uint8_t* out_classes, size_t capacity,
@@ -272,6 +289,7 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
 typedef struct kdm_class_images kdm_class_images;
 KDM_RUNTIME_API kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
                                                    kdm_class_images** out);
+/* Frees the sums (NULL is ignored); no query may be using them. */
 KDM_RUNTIME_API void kdm_class_images_free(kdm_class_images* images);
 
 /* kdm_query_classes and kdm_query_classes_compact with the classes of `images` (their count is its own):
@@ -308,12 +326,13 @@ typedef struct kdm_parallel_query kdm_parallel_query; /* per-worker scratch, all
  * library built without exceptions ends the program instead). One kdm_parallel_query serves one run at a
  * time. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out);
+/* Frees the scratch (NULL is ignored); no run may be using it. */
 KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
 
 /* The region's points into out[0 ... capacity) (kdm_query_points' points, in the order above), *written
- * the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first `capacity`,
- * *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out only
- * count); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
+ * (if not NULL) the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first
+ * `capacity`, *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out
+ * only count); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
  * ("parallel") or runner or runner->run ("runner.run"). Allocates nothing. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel,
                                                      const kdm_task_runner* runner,
@@ -346,7 +365,7 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_class_images_compact(
     const kdm_query* query, const kdm_class_images* images, float* xy, uint64_t* keys, uint8_t* out_classes,
     size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
 
-/* A static English description of `status` / of a problem kind. */
+/* A static English description of `status` / of a problem kind ("unknown ..." for a value not listed). */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
 

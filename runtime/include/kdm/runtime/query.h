@@ -75,8 +75,8 @@ struct QueryDensity {
   /// only the ones the bounds over their quarter-by-quarter cell of the tile leave in doubt too (asked
   /// when a point first lies in the cell: up to 16 more calls a tile); in smooth mode
   /// the points below hi, without the second call at a glided position where lo > 0. Bounds that are not
-  /// true bounds make points appear or vanish as if the density were lo or hi there; NaN bounds are
-  /// ignored (0 and callback_max serve).
+  /// true bounds make points appear or vanish as if the density were lo or hi there; NaN bounds, and
+  /// *lo > *hi, are ignored (0 and callback_max serve).
   void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
 };
 
@@ -192,10 +192,11 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// again with the same params gives kOk and no points), kBufferFull when `out` filled up first or the call
 /// examined kMaxQueryCandidates points — call again with the same cursor and params to continue. Empty or
 /// inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional) saying which
-/// parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative scale, a missing
-/// image or callback (or both callbacks set), a region of more than kMaxQueryTiles tiles, a density beyond
-/// the density limit (scale · max density · tile_size² > query_density_limit: use smaller tiles or a lower
-/// scale), or a cursor started with other params. No allocation.
+/// parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative scale, a bad
+/// mode, a missing image or callback (or both callbacks set), a region of more than kMaxQueryTiles tiles,
+/// a density beyond the density limit (scale · max density · tile_size² > query_density_limit: use smaller
+/// tiles or a lower scale), a region too far from the world origin or from the query's origin
+/// (kTooFarFromOrigin), or a cursor started with other params. No allocation.
 KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem = nullptr);

@@ -5,7 +5,8 @@
 
 namespace kdm {
 
-/// Result of reading or writing a tile set. Every failure has its own code.
+/// Result of reading or writing a tile set, building a density's tables, or a query. Every failure has its
+/// own code.
 enum class Status : int {
   kOk = 0,
   kIoError,                  ///< the file could not be opened, read, written or renamed
@@ -19,8 +20,10 @@ enum class Status : int {
   kDecompressionFailed,      ///< the payload is not a valid zstd frame of the stated size
   kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
   kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TilesetData)
-  kBufferFull,               ///< a query filled the caller's buffer; resume with the same cursor
-  kOutOfMemory,              ///< an allocation failed while a tile set was read (its allocator hook's too)
+  kBufferFull,               ///< a query filled the caller's buffer, or examined its most candidates in one
+                             ///< call (kMaxQueryCandidates): resume with the same cursor
+  kOutOfMemory,              ///< an allocation failed (a tile set's, through its allocator hook too, an
+                             ///< image's, a class-image sum's or a parallel query's scratch)
 };
 
 /// A short English description of `status` (static storage).
