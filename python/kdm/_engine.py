@@ -108,6 +108,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         self.density = density
         self.threads = _checks.threads(threads)
         self._spec = _checks.sampler_density(density, 1.0, False)  # read once, refused now if bad
+        if d != 2 and self._spec is not None and self._spec.kind == "image":
+            raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
 
     def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
         n = _checks.integer("n", n, 0, 2**31)

@@ -76,6 +76,8 @@ def test_engine_options():
         kdm.BlueNoise(2, density=0.0)
     with pytest.raises(TypeError):
         kdm.BlueNoise(2.0)
+    with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
+        kdm.BlueNoise(3, density=np.ones((4, 4)))
 
 
 def test_without_scipy():
