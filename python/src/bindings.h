@@ -41,6 +41,9 @@ py::array_t<T> owning_array(std::vector<T>&& values, const std::vector<py::ssize
   return py::array_t<T>(shape, owned->data(), owner);
 }
 
+/// Tileset::builtin(), or MemoryError (std::bad_alloc) where memory ran out while it was decoded.
+const Tileset& builtin_tileset();
+
 /// Throws std::invalid_argument("`name` must be ...") unless `value` is finite and at least `min`
 /// (above it when `strict`).
 void check_number(const char* name, double value, double min, bool strict);

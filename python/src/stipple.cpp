@@ -68,13 +68,13 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   const QueryMode query_mode = mode == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
   const Tileset* given = tileset ? tileset->set.get() : nullptr;
   if (region && 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]) >
-                    tools::max_stipple_zoom(given ? *given : Tileset::builtin(), query_mode) * (1 + 1e-9))
+                    tools::max_stipple_zoom(given ? *given : builtin_tileset(), query_mode) * (1 + 1e-9))
     throw std::invalid_argument(
-        tools::stipple_zoom_error("region", given ? *given : Tileset::builtin(), query_mode));
+        tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
   tools::PointSet set;
   {
     py::gil_scoped_release release;
-    const Tileset& tiles = given ? *given : Tileset::builtin();
+    const Tileset& tiles = given ? *given : builtin_tileset();
     const double whole_dots = tools::stipple_dot_count(specs, double(points), scale);
     const std::int64_t count = method == "full" ? tools::full_stipple_count(whole_dots, scale) : 0;
     if (method == "full") {

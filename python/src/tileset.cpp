@@ -2,6 +2,7 @@
 // kdm._kdm.bake: the tile baker. Queries on them are query.cpp's.
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -12,13 +13,19 @@
 #include "kdm/runtime/version.h"
 
 namespace kdm::python {
+const Tileset& builtin_tileset() {
+  const Tileset& set = Tileset::builtin();
+  if (set.empty()) throw std::bad_alloc();
+  return set;
+}
+
 namespace {
 
 TilesetHandle builtin() {
   TilesetHandle h;
   {
     py::gil_scoped_release release;  // the first call decodes the set (a tenth of a second)
-    h.set = std::shared_ptr<const Tileset>(&Tileset::builtin(), [](const Tileset*) {});
+    h.set = std::shared_ptr<const Tileset>(&builtin_tileset(), [](const Tileset*) {});
   }
   h.format_version = tileset_format_version_for(h.set->data());  // as tilesets/default.kdmt has it
   return h;

@@ -495,9 +495,10 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
 }
 
 const kdm_tileset* kdm_tileset_builtin(void) {
-  static const bool shared = (builtin_handle().set = &kdm::Tileset::builtin(), true);  // no second copy
-  (void)shared;
-  return &builtin_handle();
+  const kdm::Tileset& set = kdm::Tileset::builtin();
+  if (set.empty()) return nullptr;  // out of memory: the next call tries again
+  static kdm_tileset* const shared = (builtin_handle().set = &set, &builtin_handle());  // no second copy
+  return shared;
 }
 
 void kdm_tileset_free(kdm_tileset* tileset) {

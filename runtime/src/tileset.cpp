@@ -3,8 +3,10 @@
 #include "kdm/runtime/tileset.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <new>
 #include <utility>
 
@@ -117,16 +119,22 @@ Status Tileset::load_file(const std::string& path, Tileset& out, std::string* de
 }
 
 const Tileset& Tileset::builtin() {
-  static const Tileset set = [] {
-    Tileset t;
-    std::string detail;
-    if (load_memory(kdm_builtin_tileset, kdm_builtin_tileset_size, t, &detail) != Status::kOk) {
-      // The embedded bytes were validated when the library was tested; failing here is a build bug.
-      std::fprintf(stderr, "kdm: the built-in tile set does not decode: %s\n", detail.c_str());
-      std::abort();
-    }
-    return t;
-  }();
+  static std::atomic<const Tileset*> ready{nullptr};
+  if (const Tileset* set = ready.load(std::memory_order_acquire)) return *set;
+  static std::mutex decoding;  // taken only until the set is decoded
+  const std::lock_guard<std::mutex> lock(decoding);
+  if (const Tileset* set = ready.load(std::memory_order_relaxed)) return *set;
+  static Tileset set;
+  static const Tileset none;
+  std::string detail;
+  const Status s = load_memory(kdm_builtin_tileset, kdm_builtin_tileset_size, set, &detail);
+  if (s == Status::kOutOfMemory) return none;  // empty; the next call tries again
+  if (s != Status::kOk) {
+    // The embedded bytes were validated when the library was tested; failing here is a build bug.
+    std::fprintf(stderr, "kdm: the built-in tile set does not decode: %s\n", detail.c_str());
+    std::abort();
+  }
+  ready.store(&set, std::memory_order_release);
   return set;
 }
 

@@ -98,6 +98,11 @@ int main(int argc, char** argv) {
   kdm_set_tileset_allocator(hooked_allocate, hooked_deallocate, &g_hooked_bytes);
   kdm_tileset_free(NULL);
   kdm_set_tileset_allocator(NULL, NULL, NULL);
+  /* The built-in set, decoded on first use, is NULL while memory runs out, and there once it does not. */
+  kdm_set_tileset_allocator(failing_allocate, hooked_deallocate, &g_hooked_bytes);
+  CHECK(kdm_tileset_builtin() == NULL && g_hooked_bytes == 0);
+  kdm_set_tileset_allocator(NULL, NULL, NULL);
+  CHECK(kdm_tileset_builtin() != NULL && kdm_tileset_builtin() == kdm_tileset_builtin());
   CHECK(g_hooked_bytes == 0);
   builtin = kdm_tileset_builtin();
   CHECK(builtin != NULL);

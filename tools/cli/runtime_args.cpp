@@ -23,7 +23,11 @@ void parse_rect(const std::string& text, const char* option, double r[4]) {
 }
 
 const Tileset& tileset_for(const std::string& path, Tileset& storage) {
-  if (path.empty()) return Tileset::builtin();
+  if (path.empty()) {
+    const Tileset& builtin = Tileset::builtin();
+    if (builtin.empty()) throw CommandError("not enough memory to decode the built-in tile set");
+    return builtin;
+  }
   std::string detail;
   const Status s = Tileset::load_file(path, storage, &detail);
   if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");

@@ -163,8 +163,8 @@ KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
 /* The default tile set compiled into the library: decoded on first use (about 0.1 s; call it
- * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). Never free
- * it. */
+ * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). NULL when
+ * memory runs out while it is decoded (a later call tries again). Never free it. */
 KDM_RUNTIME_API const kdm_tileset* kdm_tileset_builtin(void);
 /* Frees a loaded set; NULL and the built-in set are ignored. */
 KDM_RUNTIME_API void kdm_tileset_free(kdm_tileset* tileset);

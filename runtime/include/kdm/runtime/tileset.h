@@ -35,7 +35,8 @@ class KDM_RUNTIME_API Tileset {
   static Status load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail = nullptr);
   /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe. It is decoded on
   /// the first call, which takes about a tenth of a second (docs/performance.md): call it once at start-up
-  /// to keep that out of a frame. The C API's kdm_tileset_builtin() shares this copy.
+  /// to keep that out of a frame. The C API's kdm_tileset_builtin() shares this copy. An empty set (no
+  /// tiles; queries refuse it) when memory runs out while it is decoded: a later call tries again.
   static const Tileset& builtin();
 
   /// The set as the file holds it.
