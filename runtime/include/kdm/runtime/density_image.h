@@ -12,16 +12,17 @@ namespace kdm {
 /// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
 /// Values must be finite and >= 0 (validated by make_density_max_mip). Built once, shared read-only.
 struct KDM_RUNTIME_API DensityImageView {
-  int width = 0, height = 0;
+  int width = 0, height = 0;              ///< texels
   double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  ///< world rectangle covered; row 0 at y0
   const float* values = nullptr;          ///< width·height, row-major, owned by the caller
   const float* max_mip = nullptr;         ///< per 8×8 texel block maximum (see make_density_max_mip)
   const float* min_mip = nullptr;         ///< per 8×8 texel block minimum (optional: null means 0)
-  int mip_width = 0, mip_height = 0;
+  int mip_width = 0, mip_height = 0;      ///< blocks of 8×8 texels: ceil(width / 8) × ceil(height / 8)
   /// The density at world position (x, y): bilinear, clamped at the edges (a NaN position reads the first
   /// texel); 0 for an image without values or with a rectangle make_density_max_mip refuses.
   double at(double x, double y) const;
-  /// Upper bound of the density over a world rectangle (from the max-mip; exact bound, maybe loose).
+  /// Upper bound of the density over a world rectangle (from the max-mip, which must be set; exact bound,
+  /// maybe loose).
   double max_over(double x0, double y0, double x1, double y1) const;
   /// Lower bound of the density over a world rectangle (from the min-mip; 0 without one).
   double min_over(double x0, double y0, double x1, double y1) const;

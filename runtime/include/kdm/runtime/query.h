@@ -43,9 +43,10 @@ struct PointId {
   }
 };
 
+/// One emitted point.
 struct QueryPoint {
   double x = 0, y = 0;  ///< world position minus the query origin
-  PointId id;
+  PointId id;           ///< the same in every query that emits the point (key instances on it)
 };
 
 /// The density of a query: constant, an image, or a callback (called once per candidate point, and in
@@ -53,9 +54,11 @@ struct QueryPoint {
 /// thread-safe if queries run concurrently). Negative, NaN and infinite values
 /// from a callback are treated as 0 (documented: a bad value never emits points or crashes).
 struct QueryDensity {
-  enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;
+  enum class Kind { kConstant, kImage, kCallback } kind = Kind::kConstant;  ///< which of the fields below
   double constant = 1;  ///< kConstant: finite and >= 0, or the query is refused
+  /// kImage: the image with its mips (make_density_max_mip), outliving the query; values as `constant`'s.
   const DensityImageView* image = nullptr;
+  /// kCallback: the density at world (x, y) (set this or batch_callback).
   double (*callback)(void* user, double x, double y) = nullptr;
   /// For callbacks, instead of `callback` (set one of the two): the densities at n positions at once,
   /// out[i] at (x[i], y[i]), 1 ≤ n ≤ kDensityBatch, with callback's rules (thread-safe, values that are
@@ -65,7 +68,7 @@ struct QueryDensity {
   /// hold are read a block of ranks ahead, in several smaller batches (about 50 positions a call). The
   /// points are those of `callback` giving the same values (18 KiB more stack past the top level).
   void (*batch_callback)(void* user, std::size_t n, const double* x, const double* y, double* out) = nullptr;
-  void* user = nullptr;
+  void* user = nullptr;  ///< passed to callback, batch_callback and bounds
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
   double callback_max = 1;
   /// For callbacks, optional: bounds of the density over a world rectangle, *lo ≤ ρ ≤ *hi everywhere in
@@ -96,13 +99,15 @@ enum class QueryMode : int {
   kSmooth = 1,
 };
 
+/// What a query asks for: a region, where its positions are measured from, the tiling, and the density
+/// (a tile expects density · scale · tile_size² points).
 struct QueryParams {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< half-open world region [x0, x1) × [y0, y1); none if x1 ≤ x0
   double origin_x = 0, origin_y = 0;      ///< subtracted from every output position
   double tile_size = 1;                   ///< world units per tile side
   double scale = 1;                       ///< points per unit area at density 1
-  QueryDensity density;
-  QueryMode mode = QueryMode::kStable;
+  QueryDensity density;                   ///< multiplies scale: constant, image or callback
+  QueryMode mode = QueryMode::kStable;    ///< stable (points never move) or smooth (points glide)
 };
 
 /// Most tiles one query may cover (2^24): a bound on the work of a single call, whatever the region.
@@ -120,11 +125,11 @@ inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 /// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call; a cursor
 /// belongs to the parameters of the call that started it (their fingerprint), and is refused with others.
 struct QueryCursor {
-  std::int64_t tile_x = 0, tile_y = 0;
+  std::int64_t tile_x = 0, tile_y = 0;  ///< the tile the query stopped in
   std::uint32_t rank = 0;  ///< in the tile or subtile reached; past its ranks, its appearing sub-points
-  bool started = false, finished = false;
-  std::uint64_t fingerprint = 0;  ///< of the parameters that started it (query_fingerprint)
-  std::uint32_t depth = 0;        ///< how deep into tile (tile_x, tile_y) the query stopped
+  bool started = false, finished = false;  ///< set by the first call, and once the region is complete
+  std::uint64_t fingerprint = 0;           ///< of the parameters that started it (query_fingerprint)
+  std::uint32_t depth = 0;                 ///< how deep into tile (tile_x, tile_y) the query stopped
   /// The subtiles it went through, 16 bits per depth from the lowest; at depth 0 in a tile visited cell by
   /// cell (query_points), the cell it stopped in plus one.
   std::uint64_t path = 0;
@@ -163,8 +168,11 @@ struct QueryProblem {
                         ///< the origin nearer the region
   };
   Kind kind = Kind::kNone;
-  const char* parameter = "";  ///< the QueryParams field (or argument) at fault; static storage
-  double value = 0, limit = 0, largest_valid = 0, largest_tile_size = 0;
+  const char* parameter = "";    ///< the QueryParams field (or argument) at fault; static storage
+  double value = 0;              ///< the value refused, where it is a number
+  double limit = 0;              ///< the limit it broke, where there is one (see each kind)
+  double largest_valid = 0;      ///< kDensityTooHigh: the largest scale that fits
+  double largest_tile_size = 0;  ///< kDensityTooHigh: the largest tile size that fits this scale
 };
 
 /// The most expected points per tile a query in `mode` may ask for: the top level's count, or in smooth

@@ -47,7 +47,8 @@ class KDM_RUNTIME_API Tileset {
   std::uint32_t max_points_per_tile() const {
     return set_.level_nominal.empty() ? 0 : set_.level_nominal.back();
   }
-  /// Index into data().tiles of the tile shown at tile coordinates (tx, ty). Thread-safe.
+  /// Index into data().tiles of the tile shown at tile coordinates (tx, ty), and that tile. Thread-safe;
+  /// the set must not be empty.
   std::size_t tile_index_at(std::int64_t tx, std::int64_t ty) const;
   const Tile& tile_at(std::int64_t tx, std::int64_t ty) const { return set_.tiles[tile_index_at(tx, ty)]; }
   /// Whether the set has a glide track (smooth queries then glide; without one they emit stable
