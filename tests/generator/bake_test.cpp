@@ -63,6 +63,14 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(r.to_text().find("fill_holes"), std::string::npos);  // off unless named
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("fill_holes 0.8\n").to_text()).fill_holes, 0.8);
   EXPECT_THROW(BakeRecipe::parse("fill_holes 0.3\n"), InvalidArgument);
+  // In range, but so low on a one-level set that it fills the corners' ordinary gaps until the interior
+  // has no points left to draw: the refusal names the key.
+  try {
+    bake_tileset(BakeRecipe::parse("levels 1\ncolours 1\nsweeps 2\nfill_holes 0.5\n"), 1);
+    ADD_FAILURE() << "baked";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("fill_holes 0.5"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
   EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
   EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);

@@ -318,7 +318,14 @@ class Baker {
     o.extent[0] = run.w, o.extent[1] = run.h;
     const std::int64_t present = static_cast<std::int64_t>((rank.fixed.size() + rank.timed.size()) / 2);
     o.n = std::int64_t(run.w * run.h) * nominal_[k] - present;
-    if (o.n <= 0) throw InvalidArgument("recipe: a patch's context already holds all of its level's points");
+    if (o.n <= 0) {
+      // fill_holes near its lower limit also fills a blue-noise set's ordinary gaps (up to 0.85 d_hex).
+      const std::string fill = recipe_.fill_holes > 0
+                                   ? " (fill_holes " + shortest(recipe_.fill_holes) +
+                                         " added points in ordinary gaps: try 0.8 or more, or leave it out)"
+                                   : "";
+      throw InvalidArgument("recipe: a patch's context already holds all of its level's points" + fill);
+    }
     o.temperature = recipe_.temperature;
     o.sweeps = recipe_.sweeps_for(nominal_[k]);
     o.coarse_sweeps = o.sweeps;
