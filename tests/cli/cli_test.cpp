@@ -918,6 +918,11 @@ TEST_F(CliTest, SampleClassesSplitTheCountByTheDensities) {
   expect_error("sample --n 100 --density const:1 --class const:1 -o '" + path("z.csv") + "'", "not both");
   expect_error("sample --n 0 --resolution 64 --class const:1 -o '" + path("z.csv") + "'", "--n > 0");
   expect_error("sample --n 100 --class const:1 -o '" + path("z.txt") + "'", ".csv");
+  // A class too faint for a float (1e-46 rounds to 0) has no points, as a class of 0 has.
+  ASSERT_EQ(kdm("sample --n 100 --class const:1 --class const:1e-46 -o '" + path("f.csv") + "'").status, 0);
+  const std::string faint = slurp(path("f.csv"));
+  EXPECT_EQ(std::count(faint.begin(), faint.end(), '\n'), 101);
+  EXPECT_EQ(faint.find(",1\n"), std::string::npos);
 }
 
 TEST_F(CliTest, SmallFrictions) {

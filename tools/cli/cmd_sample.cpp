@@ -38,7 +38,8 @@ struct SampleArgs {
 /// class's share of the points follows it), as a one-texel image.
 gen::Density class_density(const tools::DensitySpec& spec) {
   if (spec.kind != tools::DensitySpec::Kind::kConstant) return to_generator_density(spec);
-  if (spec.constant == 0) {  // a class with no points
+  // A class with no points; also a constant too small for a float texel (it would have none anyway).
+  if (static_cast<float>(spec.constant) == 0) {
     gen::Density none;
     none.function = [](const double*) { return 0.0; };
     none.thread_safe = true;
