@@ -112,6 +112,7 @@ struct BakeRecipe {
   /// (at most 64×) for small levels. They are cheap, and every finer level is built on them, so they get
   /// closer to equilibrium. The generator test draws its reference runs with the same schedule.
   int sweeps_for(std::uint64_t level_points) const;
+  /// N for the top level: base_points · 4^(levels − 1) points per tile.
   std::uint64_t top_level_points() const { return std::uint64_t(base_points) << (2 * (levels - 1)); }
   /// N_k for every level: the tile set's level_nominal.
   std::vector<std::uint32_t> nominal_counts() const;
@@ -124,8 +125,10 @@ struct BakeReport {
   std::size_t glide_split = 0, glide_removed = 0;  ///< after the glide track is relaxed
 };
 
-/// Bakes `recipe`. `progress` (optional) receives the fraction done; `report` (optional) what the
-/// separation passes did. Throws InvalidArgument on a bad recipe.
+/// Bakes `recipe` (as BakeRecipe::parse checked it) on `threads` worker threads (0: default_thread_count());
+/// the file is the same for any count. `progress` (optional) receives the fraction done; `report`
+/// (optional) what the separation passes did. Throws InvalidArgument for a recipe whose values are in
+/// range but do not fit together (patches eroded too narrow, a context that leaves a patch no points).
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads = 0,
                          const std::function<void(double)>& progress = {}, BakeReport* report = nullptr);
 

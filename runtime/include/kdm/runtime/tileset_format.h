@@ -213,19 +213,21 @@ struct TilesetData : TilesetShape {
 
 /// What a tile-set file's header says (its fields in docs/tileset-format.md §1), once validated.
 struct TilesetHeader {
-  std::uint32_t format_version = 0;  ///< kOldestTilesetFormatVersion to kTilesetFormatVersion
-  std::uint32_t header_bytes = 0;    ///< where the payload starts
-  std::uint64_t payload_bytes = 0;   ///< the zstd frame's size in the file
-  std::uint64_t decompressed_bytes = 0;
-  std::uint32_t payload_crc = 0;
-  std::uint32_t tiles = 0, colours = 0, levels = 0;
-  std::string recipe, generator_version;
+  std::uint32_t format_version = 0;                  ///< kOldestTilesetFormatVersion to kTilesetFormatVersion
+  std::uint32_t header_bytes = 0;                    ///< where the payload starts
+  std::uint64_t payload_bytes = 0;                   ///< the zstd frame's size in the file
+  std::uint64_t decompressed_bytes = 0;              ///< the payload's size once decompressed
+  std::uint32_t payload_crc = 0;                     ///< CRC-32 of the payload bytes as stored
+  std::uint32_t tiles = 0, colours = 0, levels = 0;  ///< as the payload holds them (checked against it)
+  std::string recipe, generator_version;             ///< the recipe that rebakes it, the kdm that baked it
 };
 
 /// Reads and validates the header of a tile-set file of `size` bytes at `data` (the whole file: its size
 /// is checked against the header's): magic, version, sizes, the header's CRC, the text sizes and the
 /// tile, colour and level counts, before anything else is read. The payload is not decompressed or
-/// checked (decode_tileset does both). On failure `out` is left empty.
+/// checked (decode_tileset does both). Returns kOk, or the first problem: kTruncated, kBadMagic,
+/// kUnsupportedVersion, kHeaderChecksumMismatch, kTooLarge (a size past the caps), kTrailingBytes or
+/// kInvalidContent (counts out of range), with `detail` (optional); on failure `out` is left empty.
 KDM_RUNTIME_API Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& out,
                                            std::string* detail = nullptr);
 
@@ -252,12 +254,16 @@ KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* det
 /// hand-over, so that format-4 readers keep reading it; else kTilesetFormatVersion).
 KDM_RUNTIME_API std::uint32_t tileset_format_version_for(const TilesetShape& set);
 
-/// Encodes `set` into `out` (replaced). Returns kInvalidArgument if validate_tileset fails.
+/// Encodes `set` into `out` (replaced). Returns kOk; kInvalidArgument if validate_tileset fails, the
+/// header with its texts would pass kMaxTilesetHeaderBytes, or zstd fails; kTooLarge for a payload past
+/// kMaxTilesetPayloadBytes.
 KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::uint8_t>& out,
                                       std::string* detail = nullptr);
 
 /// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
-/// checked before use; nothing is allocated beyond the caps). On failure `out` is left empty.
+/// checked before use; nothing is allocated beyond the caps). Returns kOk, read_tileset_header's
+/// statuses, kPayloadChecksumMismatch, kDecompressionFailed, kInvalidContent (validate_tileset's, or a
+/// payload that does not parse) or kOutOfMemory, with `detail` (optional). On failure `out` is left empty.
 KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, TilesetData& out,
                                       std::string* detail = nullptr);
 
@@ -268,7 +274,8 @@ KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, Tilese
 KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<char>& bytes,
                                          std::string* detail = nullptr);
 
-/// Reads (read_tileset_file) and decodes the file at `path`.
+/// Reads (read_tileset_file) and decodes the file at `path`: read_tileset_file's and decode_tileset's
+/// statuses.
 KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Whether a tile set can be saved at `path`: not a directory, and its temporary file (`path` + ".partial")
@@ -278,7 +285,8 @@ KDM_RUNTIME_API Status check_tileset_path(const std::string& path, std::string* 
 
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
 /// so an interrupted save never leaves a damaged file at `path`. Checks `path` (check_tileset_path)
-/// before encoding.
+/// before encoding. Returns kOk, check_tileset_path's kIoError, encode_tileset's statuses, or kIoError
+/// when writing or renaming fails.
 KDM_RUNTIME_API Status save_tileset(const TilesetData& set, const std::string& path,
                                     std::string* detail = nullptr);
 
