@@ -415,7 +415,9 @@ Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, boo
   // Where a float's step (2^-23 of the distance) reaches a tile, a tile's points fall together, whatever
   // the density (query_into holds the step to the densest spacing once it knows it); and a float ends
   // at 3.4e38.
-  if (q.tile_size > 0) {
+  const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
+                      std::isfinite(q.y1) && std::isfinite(q.origin_x) && std::isfinite(q.origin_y);
+  if (finite && q.tile_size > 0) {  // else query_into names the number that is not finite
     const double farthest = std::min(1e38, std::ldexp(q.tile_size, 23));
     if (far_x > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_x", far_x, farthest);
     if (far_y > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_y", far_y, farthest);

@@ -429,11 +429,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::size_t size = 0;
     const kdm::Status status = kdm::query_points_compact(
         kdm::Tileset::builtin(), q, kdm::CompactPoints{xy, keys}, kBigCapacity, &size, &compact_cursor);
-    // Refused by name, and only where a float's step reaches a tile (2^23 tiles) or beyond a float.
+    // Refused by name, and only where a float's step reaches a tile (2^23 tiles), beyond a float, or past
+    // a quarter of the densest points' spacing (2^21 spacings: judged where a non-empty region's tiles
+    // can emit a point, so either answer passes below one point per tile, and within rounding of the
+    // limit).
     const double far = std::max({std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x),
                                  std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y)});
-    const bool too_far = far > 1e38 || (q.tile_size > 0 && far > std::ldexp(q.tile_size, 23));
-    if (too_far != (status == kdm::Status::kInvalidArgument)) fail();
+    double density = peak;
+    if (q.density.kind == kdm::QueryDensity::Kind::kImage)
+      density = q.density.image->max_over(q.x0, q.y0, q.x1, q.y1);
+    const double per_tile = density * q.tile_size * q.tile_size * q.scale;
+    const double spacings = std::ldexp(q.tile_size / std::sqrt(per_tile), 21);
+    const bool past_tiles = far > 1e38 || (q.tile_size > 0 && far > std::ldexp(q.tile_size, 23));
+    const bool answered_early = !(q.x1 > q.x0 && q.y1 > q.y0 && q.scale > 0);  // before the density
+    const bool must = past_tiles || (!answered_early && per_tile >= 1 && far > spacings * 1.000001);
+    const bool too_far = status == kdm::Status::kInvalidArgument;
+    if ((must && !too_far) || (too_far && !past_tiles && !(far > spacings * 0.999999))) fail();
     if (!too_far && (status != all.status || size != all.size)) fail();
     for (std::size_t i = 0; i < (too_far ? 0 : size); ++i) {
       const kdm::QueryPoint& p = all[i];

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -250,6 +251,12 @@ TEST(CompactQueryTest, RefusesMissingOutputByName) {
   EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
             Status::kInvalidArgument);
   EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(why.parameter, "origin_y");
+  far.origin_y = std::numeric_limits<double>::infinity();  // not a distance: named as not finite
+  fresh = QueryCursor{};
+  EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
   EXPECT_STREQ(why.parameter, "origin_y");
   // Within a float's range but where its step reaches a tile: every tile's points would fall together.
   far.origin_y = 0, far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 1.01;
