@@ -942,6 +942,13 @@ TEST_F(CliTest, SmallFrictions) {
                           " (header "),
             std::string::npos)
       << info.out;
+  // Tiles too small for a point each are said, not refused: also where the count underflows to 0.
+  for (const char* tiny : {"0.001", "1e-300"}) {
+    const Outcome sparse =
+        kdm(std::string("query --rect 0,0,1,1 --tile-size ") + tiny + " -o '" + path("t.csv") + "'");
+    ASSERT_EQ(sparse.status, 0) << sparse.err;
+    EXPECT_NE(sparse.err.find("warning: at most"), std::string::npos) << tiny << ": " << sparse.err;
+  }
 }
 
 // The per-band bias table users check their own maps with: a ramp sampled and analysed by the same spec
