@@ -164,7 +164,7 @@ TEST(ImageLimit, FuzzerFoundImagesAreRefusedCleanly) {
     const char* problem;
   } cases[] = {{"jpeg_huffman_overflow.jpg", "Huffman table of more than 256 codes"},
                {"jpeg_no_huffman_tables.jpg", ""},
-               {"png_chunk_past_end.png", "runs past the end of the file"},
+               {"png_chunk_past_end.png", "ends inside a chunk"},
                {"pnm_header_overflow.pgm", "header number too large"},
                {"pnm_pixels_cut_short.pgm", "pixels cut short"}};
   for (const auto& c : cases) {
@@ -178,6 +178,24 @@ TEST(ImageLimit, FuzzerFoundImagesAreRefusedCleanly) {
     error.clear();
     EXPECT_FALSE(kdm::tools::load_grey_image_memory(bytes.data(), bytes.size(), image, error, c.file));
     EXPECT_TRUE(contains(error, c.file) && contains(error, c.problem)) << error;
+  }
+}
+
+// A PNG cut short is said so, wherever the cut falls: inside a chunk's header (stb would name an unknown
+// chunk type), inside its CRC, or before IEND (a file missing only IEND's CRC is whole: stb reads no
+// further).
+TEST(ImageLimit, APngCutShortIsSaidSo) {
+  const std::vector<std::uint8_t> whole =
+      read_bytes(std::string(KDM_SOURCE_DIR) + "/tests/fuzz/corpus/image/grey8.png");
+  ASSERT_GT(whole.size(), 60u);
+  GreyImage image;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image_memory(whole.data(), whole.size(), image, error, "whole")) << error;
+  for (const std::size_t cut : {std::size_t(40), std::size_t(31), whole.size() - 12, whole.size() - 6}) {
+    SCOPED_TRACE(cut);
+    error.clear();
+    EXPECT_FALSE(kdm::tools::load_grey_image_memory(whole.data(), cut, image, error, "cut.png"));
+    EXPECT_TRUE(contains(error, "cut.png") && contains(error, "cut short")) << error;
   }
 }
 

@@ -125,8 +125,9 @@ bool jpeg_faults(const std::uint8_t* data, std::size_t size) {
   return false;
 }
 
-// Whether a PNG's chunks claim more bytes than there are: stb allocates an IDAT buffer of the claimed
-// length before reading it (gigabytes from a few bytes).
+// Whether a PNG ends before its IEND chunk, or its chunks claim more bytes than there are: stb allocates
+// an IDAT buffer of the claimed length before reading it (gigabytes from a few bytes), and a file cut
+// inside a chunk header it reports as an unknown chunk type.
 bool png_truncated(const std::uint8_t* data, std::size_t size) {
   static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   if (size < 8 || std::memcmp(data, kSignature, 8) != 0) return false;
@@ -139,10 +140,10 @@ bool png_truncated(const std::uint8_t* data, std::size_t size) {
     if (type == 0x49454E44) return false;  // IEND: stb reads no further
     if (length > size - pos - 8) return true;
     pos += 8 + std::size_t(length);
-    if (size - pos < 4) return false;  // no CRC: stb fails on the next chunk header
+    if (size - pos < 4) return true;  // no CRC
     pos += 4;
   }
-  return false;
+  return true;  // no IEND: stb decodes nothing without one
 }
 
 // A PNG's size from its IHDR chunk (the first), or false: stb refuses to read even the header of a PNG
@@ -221,7 +222,7 @@ bool pnm_faults(const std::uint8_t* data, std::size_t size) {
 // The input stb would fault on, or nullptr.
 const char* stb_fault(const std::uint8_t* data, std::size_t size) {
   if (jpeg_faults(data, size)) return "corrupt JPEG (a Huffman table of more than 256 codes)";
-  if (png_truncated(data, size)) return "corrupt PNG (a chunk runs past the end of the file)";
+  if (png_truncated(data, size)) return "corrupt PNG (cut short: it ends inside a chunk or before IEND)";
   if (pnm_faults(data, size)) return "corrupt PGM/PPM (a header number too large, or pixels cut short)";
   return nullptr;
 }
