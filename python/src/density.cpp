@@ -3,7 +3,9 @@
 // the top, as pictures are stored; like the command line, this flips them once, here, to kdm's row 0 at
 // the bottom.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "bindings.h"
@@ -15,6 +17,13 @@ namespace {
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using tools::DensitySpec;
+
+/// A refused value as a person reads it (std::to_string writes 1e300 in 301 digits).
+std::string shown(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
 
 /// The array's size, checked: 2-D, not empty, no larger than the images the command line reads.
 void check_shape(const Array& a, const char* what, int& width, int& height) {
@@ -45,9 +54,10 @@ DensitySpec flipped(const Array& a, const char* what, F f) {
 
 DensitySpec from_values(const Array& a) {
   for (py::ssize_t i = 0; i < a.size(); ++i)
-    if (!(std::isfinite(a.data()[i]) && a.data()[i] >= 0))
-      throw std::invalid_argument("density array values must be finite and >= 0, got " +
-                                  std::to_string(a.data()[i]));
+    if (!(a.data()[i] >= 0 && a.data()[i] <= FLT_MAX))  // kept as floats, as images are
+      throw std::invalid_argument(
+          "density array values must be finite and >= 0, at most 3.4e38 (kept as floats), got " +
+          shown(a.data()[i]));
   return flipped(a, "density array", [](double v) { return v; });
 }
 
@@ -57,7 +67,7 @@ DensitySpec from_luminance(const Array& a, double gamma, bool invert) {
   for (py::ssize_t i = 0; i < a.size(); ++i)
     if (!(a.data()[i] >= 0 && a.data()[i] <= 1))
       throw std::invalid_argument("image array values must be luminances in [0, 1], got " +
-                                  std::to_string(a.data()[i]));
+                                  shown(a.data()[i]));
   DensitySpec spec = flipped(a, "image array", [gamma, invert](double grey) {
     const double tone = invert ? grey : 1.0 - grey;
     return std::pow(std::max(0.0, tone), gamma);
