@@ -119,4 +119,5 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             seed = int(self.rng.integers(0, 2**63, dtype=np.int64))
         else:  # a legacy RandomState
             seed = int(self.rng.randint(0, 2**63, dtype=np.int64))
-        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, self.threads, None)
+        threads = _checks.threads(self.threads)  # an attribute: it may have been set since __init__
+        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, threads, None)

@@ -78,6 +78,9 @@ def test_engine_options():
         kdm.BlueNoise(2.0)
     with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
         kdm.BlueNoise(3, density=np.ones((4, 4)))
+    e.threads = 10**9  # set after __init__: checked at the draw
+    with pytest.raises(ValueError, match="threads must be"):
+        e.random(10)
 
 
 def test_without_scipy():
