@@ -19,8 +19,9 @@ namespace kdm::gen {
 /// class 0 .781 (.871 before them); docs/design.md.
 inline constexpr int kUnionSweeps = 30;
 
+/// sample_classes' labelled points.
 struct ClassSample {
-  int dim = 2;
+  int dim = 2;                        ///< 2: classes are sampled in the plane
   std::vector<double> points;         ///< n * dim coordinates in [0, 1), class 0's points first
   std::vector<std::uint8_t> classes;  ///< each point's class
   std::vector<std::int64_t> counts;   ///< points per class

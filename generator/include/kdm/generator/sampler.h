@@ -68,9 +68,10 @@ enum class Numerics {
   kOriginal,
 };
 
+/// What sample() draws: the count, domain, temperature, seed and sweep schedule.
 struct SamplerOptions {
-  int dim = 2;  ///< 2 or 3
-  Domain domain = Domain::kTorus;
+  int dim = 2;                     ///< 2 or 3
+  Domain domain = Domain::kTorus;  ///< periodic, or a box with walls
   double extent[3] = {1, 1,
                       1};  ///< relative side lengths (aspect ratio); normalised output is still [0,1)^dim
   /// Exact number of points to return (> 0). Set to 0 to use `resolution` instead.
@@ -81,8 +82,8 @@ struct SamplerOptions {
   /// User-facing temperature (>= 0). 0.5 is the reference implementation's default look; 0 is a
   /// deterministic energy descent. The model temperature of eq. 4 is temperature * kModelTemperaturePerUser.
   double temperature = 0.5;
-  std::uint64_t seed = 1;
-  int threads = 0;  ///< 0 = default_thread_count(). The output does not depend on this.
+  std::uint64_t seed = 1;  ///< any value; the same options and seed give the same points
+  int threads = 0;         ///< 0 = default_thread_count(). The output does not depend on this.
   /// MH-Langevin sweeps on the finest level. The paper uses 15 (unadjusted); with the MH test 30 reach
   /// the reference implementation's statistics (docs/design.md §2).
   int sweeps = 30;
@@ -136,27 +137,29 @@ struct SamplerOptions {
 /// in the units of eq. 3–4. We keep its scale so that `temperature 0.5` looks like the paper's figures.
 inline constexpr double kModelTemperaturePerUser = 1.0 / 4.5;
 
+/// One level of the multi-scale run (docs/design.md §2.4).
 struct LevelReport {
-  int grid[3] = {0, 0, 0};
-  std::int64_t points = 0;
+  int grid[3] = {0, 0, 0};         ///< grid nodes per axis
+  std::int64_t points = 0;         ///< points present at this level
   std::int64_t active_points = 0;  ///< points relaxed at this level (σ < sigma_max)
-  int sweeps = 0;
-  std::uint64_t proposals = 0;
-  std::uint64_t accepted = 0;
+  int sweeps = 0;                  ///< MH-Langevin sweeps run
+  std::uint64_t proposals = 0;     ///< moves proposed
+  std::uint64_t accepted = 0;      ///< moves the MH test accepted
   /// Wall seconds: refinement, splats, initial configuration and count fixing; the descent (burn-in)
   /// sweeps; the MH sweeps. For finding where a run's time goes (`kdm sample --timing`).
   double setup_seconds = 0, burn_in_seconds = 0, sweep_seconds = 0;
 };
 
+/// How a sample() run went.
 struct SampleReport {
   std::vector<LevelReport> levels;  ///< coarsest first
-  std::uint64_t proposals = 0;
-  std::uint64_t accepted = 0;
+  std::uint64_t proposals = 0;      ///< over all levels
+  std::uint64_t accepted = 0;       ///< over all levels
   double acceptance_rate() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
-  double model_temperature = 0;
-  double energy_per_point = 0;  ///< E / n at the end, finest grid
-  std::int64_t inserted_for_exact_count = 0;
-  std::int64_t removed_for_exact_count = 0;
+  double model_temperature = 0;  ///< the temperature of eq. 4 (temperature · kModelTemperaturePerUser)
+  double energy_per_point = 0;   ///< E / n at the end, finest grid
+  std::int64_t inserted_for_exact_count = 0;  ///< points added so that exactly n come out
+  std::int64_t removed_for_exact_count = 0;   ///< points removed so that exactly n come out
   /// Varying densities: Σ|count − target| / n on a coarse grid before and after the refined points'
   /// large-scale counts were balanced for the finest sweeps (0 when no balance ran).
   double count_mismatch_before = 0, count_mismatch_after = 0;
@@ -165,8 +168,9 @@ struct SampleReport {
   double seconds = 0;        ///< the whole call, model_seconds included
 };
 
+/// sample()'s points and report.
 struct SampleResult {
-  int dim = 2;
+  int dim = 2;                 ///< as SamplerOptions::dim
   std::vector<double> points;  ///< n * dim coordinates, normalised to [0, 1) on every axis
   SampleReport report;
   std::size_t size() const { return points.size() / dim; }
