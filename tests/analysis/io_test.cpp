@@ -85,6 +85,10 @@ TEST(PointFiles, LabelledPointsRoundTripAndQueryCsvReads) {
   EXPECT_NE(read_error("x,y,class\n0.1,0.2,1.5\n", "half.csv").find(":2: a class must be an integer"),
             std::string::npos);
   EXPECT_NE(read_error("x,y,class\n0.1,0.2,256\n", "big.csv").find("0 to 255"), std::string::npos);
+  EXPECT_NE(read_error("x,y,class\n0.1,0.2,nan\n", "nan.csv").find(":2: a class must be an integer"),
+            std::string::npos);
+  EXPECT_NE(read_error("x,y,class\nnan,0.2,1\n", "x.csv").find(":2: non-finite coordinate"),
+            std::string::npos);
   EXPECT_NE(read_error("x,y,class\n0.1,0.2\n", "short.csv").find("expected 3 columns"), std::string::npos);
 }
 

@@ -111,7 +111,9 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
         return false;
       }
       if (!std::isfinite(v)) {
-        error = path + ":" + std::to_string(line_no) + ": non-finite coordinate";
+        const bool a_class = class_column >= 0 && static_cast<int>(values.size()) == class_column;
+        error = path + ":" + std::to_string(line_no) +
+                (a_class ? ": a class must be an integer 0 to 255" : ": non-finite coordinate");
         return false;
       }
       values.push_back(v);
