@@ -94,6 +94,7 @@ void Tileset::adopt(TilesetData&& set) {
 template <class Decode>
 Status Tileset::load_with(Tileset& out, std::string* detail, Decode&& decode) {
   out = Tileset{};
+  (void)detail;  // said only where an exception can be caught
 #if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
   try {
 #endif
