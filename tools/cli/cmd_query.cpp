@@ -104,7 +104,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.scale = a.scale;
   q.density = densities[0]->density;
   q.mode = parse_mode(a.mode);
-  // Below a point per tile a tile's count rounds (README, "Known limits"): said, not refused, since a
+  // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;
   for (const auto& spec : specs) densest += spec->max_value();
