@@ -550,7 +550,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kTooManyTiles:
       return "the region covers more tiles than one query may (split it)";
     case QueryProblem::Kind::kDensityTooHigh:
-      return "the density asks for more points per tile than the tile set's top level holds";
+      return "the density asks for more points per tile than the tile set serves in this mode (stable mode "
+             "stops at its top level, smooth mode at its depth cap)";
     case QueryProblem::Kind::kCursorMismatch:
       return "the cursor was started by a query with other parameters";
     case QueryProblem::Kind::kBadMode:

@@ -110,7 +110,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   for (const auto& spec : specs) densest += spec->max_value();
   const double per_tile = densest * a.scale * a.tile_size * a.tile_size;
   // (a tile so small that its count underflows to 0 warns as well: its density is not 0)
-  if (per_tile < 1 && densest > 0 && a.scale > 0)
+  if (per_tile < 1 && densest > 0 && a.scale > 0 && a.tile_size > 0)
     std::fprintf(
         stderr,
         "kdm query: warning: at most %.3g points per tile; below 1 a tile's expected count rounds to "

@@ -25,6 +25,12 @@ std::string six_digits_down(double v) {
 }  // namespace
 
 std::string describe(const QueryProblem& p, const ParameterNames& names) {
+  // The parameter as the caller spells it ("--tile-size", "tile_size"), not as QueryParams does.
+  std::string shown = p.parameter ? p.parameter : "";
+  if (shown == "scale" || shown == "tile_size") {
+    shown = shown == "scale" ? names.scale : names.tile_size;
+    if (!shown.empty() && shown.back() == '=') shown.pop_back();
+  }
   char text[400];
   switch (p.kind) {
     case QueryProblem::Kind::kDensityTooHigh: {
@@ -36,8 +42,7 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
       if (p.largest_tile_size > 0)
         std::snprintf(tile, sizeof tile, "%s %s or less", names.tile_size,
                       six_digits_down(p.largest_tile_size).c_str());
-      std::snprintf(text, sizeof text,
-                    "%s: %.6g points per tile where the tile set holds at most %.0f; use %s%s%s",
+      std::snprintf(text, sizeof text, "%s: %.6g points per tile where it serves at most %.0f; use %s%s%s",
                     query_problem_message(p.kind), p.value, p.limit, scale, *scale && *tile ? ", or " : "",
                     *scale || *tile ? tile : "a lower density");
       break;
@@ -65,12 +70,12 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
       break;
     case QueryProblem::Kind::kNotFinite:
       if (!std::isfinite(p.value)) {  // the kind also covers places too far out for a finite value
-        std::snprintf(text, sizeof text, "'%s' is not a finite number (%g)", p.parameter, p.value);
+        std::snprintf(text, sizeof text, "'%s' is not a finite number (%g)", shown.c_str(), p.value);
         break;
       }
       [[fallthrough]];
     default:
-      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), p.parameter,
+      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), shown.c_str(),
                     p.value);
   }
   return text;
