@@ -846,6 +846,19 @@ TEST_F(CliTest, QueryClassesWriteAClassColumnAndOneGroupPerClass) {
   ASSERT_NE(at, std::string::npos) << json.substr(0, 200);
   EXPECT_GT(std::atof(json.c_str() + at + 23), 0.3);
   EXPECT_NE(json.find("{\"class\": 1, \"metrics\": {"), std::string::npos);
+  // Without -o the same summary is printed and nothing is written.
+  const auto files_before = std::distance(fs::directory_iterator(dir_), fs::directory_iterator());
+  const Outcome printed = kdm("analyze '" + path("n.csv") + "' --no-energy");
+  ASSERT_EQ(printed.status, 0) << printed.err;
+  const auto untimed = [](const std::string& text) {  // the lines but the analysis time
+    std::string kept;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);)
+      if (line.rfind("analysis time", 0) != 0) kept += line + "\n";
+    return kept;
+  };
+  EXPECT_EQ(untimed(printed.out), untimed(analyzed.out));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), files_before);
   // A class too small to analyse is said so and left out of the list, which stays valid JSON.
   std::ofstream(path("few.csv")) << "x,y,class\n0.5,0.5,0\n0.6,0.6,1\n0.7,0.1,1\n";
   const Outcome few = kdm("analyze '" + path("few.csv") + "' --no-energy -o '" + path("f") + "'");

@@ -48,8 +48,8 @@ void save_png(const std::string& path, const tools::RgbImage& image) {
   if (!tools::write_png(path, image, error)) throw CommandError(error);
 }
 
-/// Labelled points (several classes): each class alone, as the whole set was analysed (printed, and in
-/// DIR/classes.json with the closest pair of points of different classes).
+/// Labelled points (several classes): each class alone, as the whole set was analysed (printed, and, with
+/// a directory `dir`, in dir/classes.json with the closest pair of points of different classes).
 void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
                      const gen::Density& target, const AnalyzeArgs& args, const std::filesystem::path& dir) {
   double closest = HUGE_VAL;
@@ -91,7 +91,25 @@ void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::A
   }
   json += "]}\n";
   std::string error;
-  if (!tools::write_text_file_atomic((dir / "classes.json").string(), json, error)) throw CommandError(error);
+  if (!dir.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(), json, error))
+    throw CommandError(error);
+}
+
+/// Creates `output` as analyze's directory (it receives metrics.json and pictures), or says why it cannot.
+void prepare_output_directory(const std::string& output) {
+  // A name like metrics.json is a mistake that would make a directory of it.
+  const std::string ext = std::filesystem::path(output).extension().string();
+  for (const char* file_ext : {".json", ".png", ".txt", ".csv", ".svg"})
+    if (ext == file_ext && !std::filesystem::is_directory(output))
+      throw CommandError(
+          "-o is the output directory (it receives metrics.json and pictures), got the file name '" + output +
+          "'");
+  std::error_code ec;
+  if (std::filesystem::exists(output) && !std::filesystem::is_directory(output))
+    throw CommandError("-o must be a directory, but '" + output + "' is a file");
+  std::filesystem::create_directories(output, ec);
+  if (ec || !std::filesystem::is_directory(output))
+    throw CommandError("cannot create output directory '" + output + "'" + (ec ? ": " + ec.message() : ""));
 }
 
 void run_analyze(const AnalyzeArgs& args) {
@@ -123,21 +141,7 @@ void run_analyze(const AnalyzeArgs& args) {
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
-    // -o names a directory; a name like metrics.json is a mistake that would make a directory of it.
-    const std::string ext = std::filesystem::path(args.output).extension().string();
-    for (const char* file_ext : {".json", ".png", ".txt", ".csv", ".svg"})
-      if (ext == file_ext && !std::filesystem::is_directory(args.output))
-        throw CommandError(
-            "-o is the output directory (it receives metrics.json and pictures), got the file "
-            "name '" +
-            args.output + "'");
-    std::error_code ec;
-    if (std::filesystem::exists(args.output) && !std::filesystem::is_directory(args.output))
-      throw CommandError("-o must be a directory, but '" + args.output + "' is a file");
-    std::filesystem::create_directories(args.output, ec);
-    if (ec || !std::filesystem::is_directory(args.output))
-      throw CommandError("cannot create output directory '" + args.output + "'" +
-                         (ec ? ": " + ec.message() : ""));
+    if (!args.output.empty()) prepare_output_directory(args.output);
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (!args.no_energy) {
       report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target);
@@ -145,6 +149,10 @@ void run_analyze(const AnalyzeArgs& args) {
     }
     std::fputs(analysis::format_summary(report).c_str(), stdout);
     const std::filesystem::path dir(args.output);
+    if (args.output.empty()) {  // the summary alone
+      if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
+      return;
+    }
     std::string error;
     if (!tools::write_text_file_atomic((dir / "metrics.json").string(),
                                        analysis::metrics_json(report, args.files), error))
@@ -198,7 +206,9 @@ void add_analyze_command(CLI::App& app) {
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
   add_threads_option(cmd, args->threads, "results do not depend on it");
-  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Output directory (created if missing) for metrics.json and pictures (default: the "
+                  "summary is only printed)");
   cmd->callback([args] { run_analyze(*args); });
 }
 
