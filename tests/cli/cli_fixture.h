@@ -1,0 +1,151 @@
+// The kdm command line driven as a process: the fixture of the CLI tests (a scratch directory per test,
+// `kdm ARGS` with its exit status and output, the one-line error contract) and a PNG writer for images
+// stb_image_write cannot make (16-bit, cut or damaged files).
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace kdm_cli_test {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int status = -1;  // exit status, or -1 if the process did not exit normally (a crash)
+  std::string out, err;
+};
+
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(KDM_CLI_TEST_DIR) / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Runs `PREFIX kdm ARGS` (ARGS already shell-quoted where needed; PREFIX e.g. an environment or
+  // `taskset`), capturing stdout and stderr.
+  Outcome kdm(const std::string& args, const std::string& prefix = "") const {
+    const std::string out = path("stdout"), err = path("stderr");
+    const std::string command =
+        prefix + " '" + KDM_EXECUTABLE + "' " + args + " >'" + out + "' 2>'" + err + "'";
+    const int raw = std::system(command.c_str());
+    Outcome r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  // Asserts the one-line error contract and that the message mentions `naming` (the problem or the file).
+  void expect_error(const std::string& args, const std::string& naming) const {
+    const Outcome r = kdm(args);
+    EXPECT_EQ(r.status, 1) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_EQ(r.err.rfind("kdm: error: ", 0), 0u) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_NE(r.err.find(naming), std::string::npos) << "kdm " << args << "\nstderr: " << r.err;
+  }
+
+  fs::path dir_;
+};
+
+// Data lines of a query's .csv (its header checked and dropped), sorted.
+inline std::vector<std::string> sorted_rows(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,y,tile_x,tile_y,rank,level");
+  std::vector<std::string> rows;
+  while (std::getline(in, line)) rows.push_back(line);
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+// ---- A minimal PNG encoder (stb_image_write cannot write 16-bit or broken files): zlib stored blocks.
+inline std::uint32_t crc32(const std::uint8_t* p, std::size_t n, std::uint32_t crc = 0) {
+  crc = ~crc;
+  for (std::size_t i = 0; i < n; ++i) {
+    crc ^= p[i];
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+inline void put32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<std::uint8_t>(v >> s));
+}
+
+inline void chunk(std::vector<std::uint8_t>& png, const char type[5], const std::vector<std::uint8_t>& data) {
+  put32(png, static_cast<std::uint32_t>(data.size()));
+  const std::size_t start = png.size();
+  png.insert(png.end(), type, type + 4);
+  png.insert(png.end(), data.begin(), data.end());
+  put32(png, crc32(&png[start], png.size() - start));
+}
+
+// A greyscale PNG of `depth` bits (8 or 16); `samples` row-major, top row first.
+inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int depth,
+                                          const std::vector<std::uint16_t>& samples) {
+  std::vector<std::uint8_t> raw;  // filter byte 0 per row, then big-endian samples
+  for (std::uint32_t y = 0; y < h; ++y) {
+    raw.push_back(0);
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const std::uint16_t v = samples[y * w + x];
+      if (depth == 16) raw.push_back(static_cast<std::uint8_t>(v >> 8));
+      raw.push_back(static_cast<std::uint8_t>(v));
+    }
+  }
+  std::vector<std::uint8_t> z = {0x78, 0x01};  // zlib header, then stored blocks of up to 65535 bytes
+  std::size_t at = 0;
+  do {
+    const std::size_t n = std::min<std::size_t>(65535, raw.size() - at);
+    z.push_back(at + n == raw.size() ? 1 : 0);
+    z.insert(z.end(), {static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(n >> 8),
+                       static_cast<std::uint8_t>(~n), static_cast<std::uint8_t>(~n >> 8)});
+    z.insert(z.end(), raw.begin() + at, raw.begin() + at + n);
+    at += n;
+  } while (at < raw.size());
+  std::uint32_t a = 1, b = 0;  // Adler-32
+  for (std::uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
+  put32(z, (b << 16) | a);
+  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  std::vector<std::uint8_t> ihdr;
+  put32(ihdr, w);
+  put32(ihdr, h);
+  ihdr.insert(ihdr.end(), {static_cast<std::uint8_t>(depth), 0, 0, 0, 0});  // greyscale, no interlace
+  chunk(png, "IHDR", ihdr);
+  chunk(png, "IDAT", z);
+  chunk(png, "IEND", {});
+  return png;
+}
+
+inline void write_bytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(f.good()) << path;
+}
+
+// A 64×64 8-bit horizontal ramp: a valid image to cut and damage.
+inline std::vector<std::uint8_t> ramp_png() {
+  std::vector<std::uint16_t> v(64 * 64);
+  for (int i = 0; i < 64 * 64; ++i) v[i] = static_cast<std::uint16_t>(4 * (i % 64));
+  return grey_png(64, 64, 8, v);
+}
+
+}  // namespace kdm_cli_test
