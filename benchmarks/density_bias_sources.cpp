@@ -121,12 +121,13 @@ int main(int argc, char** argv) {
                   o.initial_points = exact_start(ramp, seed), o.sweeps = 400, o.sigma_max = 1000;
                 }}},
               seeds);
-  print_table("Radial 1:1000: walls or none",
-              {{"box, default", radial, [](SamplerOptions&, std::uint64_t) {}},
-               {"box, no count balance", radial, [&](SamplerOptions& o, std::uint64_t) { off(o); }},
-               {"torus, default", radial, [](SamplerOptions& o, std::uint64_t) { o.domain = Domain::kTorus; }},
-               {"torus, no count balance", radial,
-                [&](SamplerOptions& o, std::uint64_t) { off(o), o.domain = Domain::kTorus; }}},
-              seeds);
+  print_table(
+      "Radial 1:1000: walls or none",
+      {{"box, default", radial, [](SamplerOptions&, std::uint64_t) {}},
+       {"box, no count balance", radial, [&](SamplerOptions& o, std::uint64_t) { off(o); }},
+       {"torus, default", radial, [](SamplerOptions& o, std::uint64_t) { o.domain = Domain::kTorus; }},
+       {"torus, no count balance", radial,
+        [&](SamplerOptions& o, std::uint64_t) { off(o), o.domain = Domain::kTorus; }}},
+      seeds);
   return 0;
 }

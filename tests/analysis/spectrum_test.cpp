@@ -148,7 +148,8 @@ TEST(Periodogram, RejectsBadInput) {
   EXPECT_THROW(periodogram({0.1, 0.2}, 2, 0.0), InvalidInput);
   EXPECT_THROW(periodogram({0.1, 1.2}, 2, 1.0), InvalidInput);
   EXPECT_THROW(average_periodogram({}, 1.0), InvalidInput);
-  EXPECT_THROW(periodogram({0.1, 0.2, 0.5, 0.5}, 2, 1e300), InvalidInput);  // too fine a grid, not an overflow
+  // Too fine a grid, not an overflow.
+  EXPECT_THROW(periodogram({0.1, 0.2, 0.5, 0.5}, 2, 1e300), InvalidInput);
 }
 
 }  // namespace

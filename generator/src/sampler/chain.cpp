@@ -1,8 +1,8 @@
 #include "sampler/chain.h"
 
 #include "platform/huge_pages.h"
-#include "sampler/lanes.h"
 #include "platform/parallel.h"
+#include "sampler/lanes.h"
 
 #include <algorithm>
 #include <cmath>

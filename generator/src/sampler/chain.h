@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "kdm/runtime/check.h"
-#include "sampler/lanes_wide.h"
 #include "sampler/checkerboard.h"
 #include "sampler/grid.h"
 #include "sampler/kernel.h"
+#include "sampler/lanes_wide.h"
 #include "sampler/particle.h"
 #include "sampler/rng.h"
 

@@ -1,8 +1,8 @@
 #include "sampler/kernel.h"
 
 #include "platform/huge_pages.h"
-#include "sampler/lanes_wide.h"
 #include "platform/parallel.h"
+#include "sampler/lanes_wide.h"
 #include "sampler/simd.h"
 
 namespace kdm::gen {
