@@ -98,6 +98,20 @@ class Tileset:
         glide_reach (tile sides)."""
         return self._handle.info
 
+    def thresholds(self, result: "QueryResult") -> np.ndarray:
+        """Each point's emission threshold: the expected count per tile above which it is emitted.
+
+        A point of `result` (a QueryResult of this set) is present where its tile's expected count,
+        density * scale * (tile_size / m**depth)**2 at the point, exceeds its threshold. To fade objects
+        in as the density rises instead of letting them pop up, weigh each by
+        ``np.clip((count / threshold - 1) / f, 0, 1)``: 0 as it appears, 1 once the density has risen a
+        fraction f. Returns an (m,) float64 array. Raises TypeError for anything but a QueryResult and
+        ValueError for a point this set does not have (a result of another set).
+        """
+        if not isinstance(result, QueryResult):
+            raise TypeError(f"result must be a kdm.QueryResult, got {type(result).__name__}")
+        return self._handle.thresholds(result.tile, result.rank, result.points["depth"])
+
     def __repr__(self) -> str:
         i = self.info
         return (

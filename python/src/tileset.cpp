@@ -97,6 +97,34 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
   return {std::move(set), version};
 }
 
+/// emission_threshold of every id given as tile (m × 2), rank and depth (m each).
+py::array_t<double> thresholds(
+    const TilesetHandle& h, const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& tile,
+    const py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>& rank,
+    const py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>& depth) {
+  const py::ssize_t n = rank.size();
+  if (tile.ndim() != 2 || tile.shape(0) != n || tile.shape(1) != 2 || rank.ndim() != 1 || depth.ndim() != 1 ||
+      depth.size() != n)
+    throw std::invalid_argument("tile must be (m, 2) and rank, depth (m,), as a query's result holds them");
+  py::array_t<double> out(n);
+  const std::int64_t* t = tile.data();
+  const std::uint32_t *r = rank.data(), *d = depth.data();
+  double* o = out.mutable_data();
+  py::ssize_t bad = -1;
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t i = 0; i < n && bad < 0; ++i) {
+      o[i] = emission_threshold(*h.set, PointId{t[2 * i], t[2 * i + 1], r[i], d[i]});
+      if (o[i] < 0) bad = i;
+    }
+  }
+  if (bad >= 0)
+    throw std::invalid_argument("point " + std::to_string(bad) + " (tile " + std::to_string(t[2 * bad]) +
+                                ", " + std::to_string(t[2 * bad + 1]) + ", rank " + std::to_string(r[bad]) +
+                                ", depth " + std::to_string(d[bad]) + ") is not a point of this tile set");
+  return out;
+}
+
 }  // namespace
 
 void bind_tileset(py::module_& m) {
@@ -104,6 +132,7 @@ void bind_tileset(py::module_& m) {
       .def_static("builtin", &builtin)
       .def_static("load", &load, py::arg("path"))
       .def("save", &save, py::arg("path"))
+      .def("thresholds", &thresholds, py::arg("tile"), py::arg("rank"), py::arg("depth"))
       .def_property_readonly("info", &info);
   m.def("bake", &bake, py::arg("recipe_text"), py::arg("threads"));
 }

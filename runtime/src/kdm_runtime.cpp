@@ -509,6 +509,15 @@ size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset) {
   return tileset ? tileset->set->resident_bytes() : 0;
 }
 
+kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* point, double* threshold) {
+  if (!tileset || !point || !threshold) return KDM_INVALID_ARGUMENT;
+  const double t = kdm::emission_threshold(
+      *tileset->set, kdm::PointId{point->tile_x, point->tile_y, point->rank, point->depth});
+  if (t < 0) return KDM_INVALID_ARGUMENT;
+  *threshold = t;
+  return KDM_OK;
+}
+
 kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info) {
   kdm_tileset_info v;
   if (!tileset || !read_grown(info, kInfoV1, v)) return KDM_INVALID_ARGUMENT;

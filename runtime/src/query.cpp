@@ -514,12 +514,17 @@ double query_density_limit(const Tileset& tileset, QueryMode mode) {
   return top * std::pow(double(m), 2.0 * kMaxQueryDepth);
 }
 
-const Tile* tile_of(const Tileset& tileset, const PointId& id) {
-  if (tileset.empty()) return nullptr;
-  if (id.depth == 0) return &tileset.tile_at(id.tile_x, id.tile_y);
+namespace {
+
+/// The index in data().tiles of the tile point `id` belongs to, at any depth; kNoTile for a depth the set
+/// does not have.
+constexpr std::size_t kNoTile = ~std::size_t(0);
+std::size_t tile_type_of(const Tileset& tileset, const PointId& id) {
+  if (tileset.empty()) return kNoTile;
+  if (id.depth == 0) return tileset.tile_index_at(id.tile_x, id.tile_y);
   const QueryTables& tables = detail::TilesetInternals::tables(tileset);
   const std::int64_t m = tables.subtiles;
-  if (m == 0 || id.depth > kMaxQueryDepth) return nullptr;
+  if (m == 0 || id.depth > kMaxQueryDepth) return kNoTile;
   // The depth-0 tile and the subtile path down from it: the digits of the coordinates in base m.
   std::int64_t x = id.tile_x, y = id.tile_y, digits[kMaxQueryDepth];
   for (std::uint32_t d = id.depth; d-- > 0;) {
@@ -530,7 +535,21 @@ const Tile* tile_of(const Tileset& tileset, const PointId& id) {
   std::size_t type = tileset.tile_index_at(x, y);
   for (std::uint32_t d = 0; d < id.depth; ++d)
     type = tables.child_type[type * std::size_t(m * m) + std::size_t(digits[d])];
-  return &tileset.data().tiles[type];
+  return type;
+}
+
+}  // namespace
+
+const Tile* tile_of(const Tileset& tileset, const PointId& id) {
+  const std::size_t type = tile_type_of(tileset, id);
+  return type == kNoTile ? nullptr : &tileset.data().tiles[type];
+}
+
+double emission_threshold(const Tileset& tileset, const PointId& id) {
+  const std::size_t type = tile_type_of(tileset, id);
+  if (type == kNoTile) return -1;
+  const auto& thresholds = detail::TilesetInternals::tables(tileset).thresholds[type];
+  return id.rank < thresholds.size() ? double(thresholds[id.rank]) : -1;
 }
 
 const char* query_problem_message(QueryProblem::Kind kind) {

@@ -111,6 +111,28 @@ int main(int argc, char** argv) {
     const size_t a = count_points(builtin, &q, 64), b = count_points(loaded, &q, 5);
     CHECK(a > 1000 && a == b); /* same set from the file and built in; resumed buffers lose nothing */
   }
+  /* Every point's threshold lies below its tile's expected count (500 here), and an id the set does not
+   * have, or a NULL argument, is refused. */
+  {
+    kdm_point buffer[256];
+    kdm_cursor cursor;
+    size_t written = 0, i;
+    double t = 0, highest = 0;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, buffer, 256, &written, &cursor, NULL) == KDM_BUFFER_FULL);
+    for (i = 0; i < written; ++i) {
+      CHECK(kdm_point_threshold(builtin, &buffer[i], &t) == KDM_OK && t >= 0 && t < 500);
+      highest = t > highest ? t : highest;
+    }
+    CHECK(highest > 100); /* the first 256 points span several levels of 32, 128, 512 points */
+    CHECK(kdm_point_threshold(NULL, &buffer[0], &t) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_point_threshold(builtin, NULL, &t) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_point_threshold(builtin, &buffer[0], NULL) == KDM_INVALID_ARGUMENT);
+    buffer[0].rank = 1u << 30;
+    CHECK(kdm_point_threshold(builtin, &buffer[0], &t) == KDM_INVALID_ARGUMENT);
+    buffer[1].depth = 99;
+    CHECK(kdm_point_threshold(builtin, &buffer[1], &t) == KDM_INVALID_ARGUMENT);
+  }
   CHECK(kdm_tileset_resident_bytes(loaded) == kdm_tileset_resident_bytes(builtin));
   CHECK(kdm_tileset_resident_bytes(loaded) > 1000000 && kdm_tileset_resident_bytes(NULL) == 0);
 

@@ -172,6 +172,12 @@ KDM_RUNTIME_API void kdm_tileset_free(kdm_tileset* tileset);
 KDM_RUNTIME_API size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset);
 /* Fills `info` (set info->struct_size first). KDM_INVALID_ARGUMENT for NULL or a struct_size too small. */
 KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info);
+/* The expected count per tile above which `point` is emitted (kdm::emission_threshold): to fade objects in
+   as the density rises, weigh each by (count / threshold - 1) / f clamped to [0, 1], count being
+   density * scale * (tile_size / m^depth)^2 at the point. KDM_INVALID_ARGUMENT for a NULL argument or a
+   point the set does not have (a depth it does not reach, a rank past its tile's points). */
+KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* point,
+                                               double* threshold);
 
 /* A density image over the world rectangle [x0, x1) x [y0, y1) (world units): `width` x `height` texels
  * of density (as kdm_query's `density`: multiplied by `scale`), row-major, row 0 at y0, bilinear between

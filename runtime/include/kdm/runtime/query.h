@@ -183,6 +183,14 @@ KDM_RUNTIME_API double query_density_limit(const Tileset& tileset, QueryMode mod
 /// points, so its level is tile_of(…).level_of(id.rank). Null for a depth the set does not have.
 KDM_RUNTIME_API const Tile* tile_of(const Tileset& tileset, const PointId& id);
 
+/// The expected count per tile above which point `id` is emitted: where its tile's expected count,
+/// ρ · scale · (tile_size / m^depth)² with ρ the density at the point's stable position, exceeds it (in
+/// smooth mode also only where the density at its glided position is above 0). A caller fading objects in
+/// as the density rises, so that they do not pop up, weighs each by (count / threshold − 1) / f clamped to
+/// [0, 1]: it appears at weight 0 and is fully shown once the density has risen a fraction f. Negative for
+/// an id the set does not have (a depth it does not reach, a rank past its tile's points).
+KDM_RUNTIME_API double emission_threshold(const Tileset& tileset, const PointId& id);
+
 /// A short English description of a problem kind (static storage).
 KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 
