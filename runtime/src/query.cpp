@@ -520,7 +520,11 @@ namespace {
 /// does not have.
 constexpr std::size_t kNoTile = ~std::size_t(0);
 std::size_t tile_type_of(const Tileset& tileset, const PointId& id) {
-  if (tileset.empty()) return kNoTile;
+  // No query reaches tiles this far out, and the corner colours' tx + 1 must not overflow.
+  constexpr std::int64_t kFarthestTile = std::int64_t(1) << 62;
+  if (tileset.empty() || id.tile_x < -kFarthestTile || id.tile_x > kFarthestTile ||
+      id.tile_y < -kFarthestTile || id.tile_y > kFarthestTile)
+    return kNoTile;
   if (id.depth == 0) return tileset.tile_index_at(id.tile_x, id.tile_y);
   const QueryTables& tables = detail::TilesetInternals::tables(tileset);
   const std::int64_t m = tables.subtiles;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -83,6 +84,11 @@ TEST(EmissionThreshold, IsNegativeForIdsTheSetDoesNotHave) {
   EXPECT_LT(emission_threshold(set, PointId{0, 0, 0, kMaxQueryDepth + 1}), 0);
   EXPECT_LT(emission_threshold(Tileset(), PointId{0, 0, 0, 0}), 0);
   EXPECT_GE(emission_threshold(set, PointId{-7, 1000000007, 0, kMaxQueryDepth}), 0);
+  // Tiles no query reaches (and whose neighbours' coordinates would overflow).
+  const std::int64_t most = std::numeric_limits<std::int64_t>::max();
+  EXPECT_LT(emission_threshold(set, PointId{most, 0, 0, 0}), 0);
+  EXPECT_LT(emission_threshold(set, PointId{0, -most - 1, 0, 1}), 0);
+  EXPECT_EQ(tile_of(set, PointId{most, most, 0, 0}), nullptr);
 }
 
 }  // namespace

@@ -180,7 +180,8 @@ struct QueryProblem {
 KDM_RUNTIME_API double query_density_limit(const Tileset& tileset, QueryMode mode);
 
 /// The tile (of data().tiles) that point `id` belongs to, at any depth: its rank indexes that tile's
-/// points, so its level is tile_of(…).level_of(id.rank). Null for a depth the set does not have.
+/// points, so its level is tile_of(…).level_of(id.rank). Null for a depth the set does not have (or tile
+/// coordinates beyond ±2^62, which no query emits).
 KDM_RUNTIME_API const Tile* tile_of(const Tileset& tileset, const PointId& id);
 
 /// The expected count per tile above which point `id` is emitted: where its tile's expected count,
