@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 
 #include "kdm/analysis/common.h"
@@ -134,22 +135,32 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   return r;
 }
 
+namespace {
+
+/// Appends printf-style text to `s` (a line of the summary; the format checked as printf's).
+__attribute__((format(printf, 2, 3))) void append(std::string& s, const char* fmt, ...) {
+  char line[512];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(line, sizeof line, fmt, args);
+  va_end(args);
+  s += line;
+}
+
+}  // namespace
+
 std::string format_summary(const AnalysisReport& r) {
   std::string s;
-  char line[512];
-  auto add = [&](const char* fmt, auto... args) {
-    std::snprintf(line, sizeof line, fmt, args...);
-    s += line;
-  };
-  add("%zu set(s) of %zu", r.sets, r.points_min);
-  if (r.points_max != r.points_min) add("..%zu", r.points_max);
-  add(" %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
-  add("nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n", r.nn.dmin,
-      r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
+  append(s, "%zu set(s) of %zu", r.sets, r.points_min);
+  if (r.points_max != r.points_min) append(s, "..%zu", r.points_max);
+  append(s, " %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
+  append(s, "nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n",
+         r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
   if (r.has_spectrum) {
     const SpectrumStats& st = r.spectrum_stats;
-    add("spectrum (f ≤ %.2f, %d set(s))  lowP %.4f  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n",
-        r.spectrum.fmax, r.spectrum.sets, st.low_p, st.peak, st.peak_f, st.nu_eff, st.anisotropy_db);
+    append(s,
+           "spectrum (f ≤ %.2f, %d set(s))  lowP %.4f  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n",
+           r.spectrum.fmax, r.spectrum.sets, st.low_p, st.peak, st.peak_f, st.nu_eff, st.anisotropy_db);
   }
   double gmax = 0, rpeak = 0;
   for (std::size_t b = 0; b < r.gr.g.size(); ++b)
@@ -157,49 +168,56 @@ std::string format_summary(const AnalysisReport& r) {
       gmax = r.gr.g[b];
       rpeak = r.gr.r[b];
     }
-  add("pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  append(s, "pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
   if (r.has_empty_circles) {
     const EmptyCircles& e = r.empty_circles;
-    add("empty circles      largest %.3f  99.9%% %.3f  > 0.85: %zu (%.1f per 10^5 points)  > 1.0: %zu (%.1f) "
+    append(
+        s,
+        "empty circles      largest %.3f  99.9%% %.3f  > 0.85: %zu (%.1f per 10^5 points)  > 1.0: %zu (%.1f) "
         " "
         "(Delaunay, local d_hex%s)\n",
         e.largest, e.p999, e.over_085, e.over_085_per_1e5(), e.over_100, e.over_100_per_1e5(),
         r.torus ? "" : ", away from the border");
     if (r.has_tiling && e.over_085 > 0)
-      add("                   of those > 0.85, %.0f%% within one spacing of a tile edge (%.0f%% of all "
-          "circles)\n",
-          100.0 * e.over_085_near_edge / e.over_085, 100 * e.near_edge_share);
+      append(s,
+             "                   of those > 0.85, %.0f%% within one spacing of a tile edge (%.0f%% of all "
+             "circles)\n",
+             100.0 * e.over_085_near_edge / e.over_085, 100 * e.near_edge_share);
   }
   if (r.has_density)
-    add("density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
+    append(
+        s,
+        "density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
         r.density.windows, r.density.mean_expected, r.density.rms_z, r.density.max_abs_z, r.density.bias,
         r.density.zero_density);
   if (r.has_density && r.density.bands.size() > 1) {
-    add("density bands      ρ/ρmax from        expected      points  count/target   ±1σ (Poisson)\n");
+    append(s, "density bands      ρ/ρmax from        expected      points  count/target   ±1σ (Poisson)\n");
     for (const DensityBand& b : r.density.bands)
-      add("                   %.3g–%-10.3g %10.1f  %10.0f  %12.4f  %8.4f\n", b.lo, b.hi, b.expected, b.count,
-          1 + b.bias(), b.expected > 0 ? 1 / std::sqrt(b.expected) : 0.0);
+      append(s, "                   %.3g–%-10.3g %10.1f  %10.0f  %12.4f  %8.4f\n", b.lo, b.hi, b.expected,
+             b.count, 1 + b.bias(), b.expected > 0 ? 1 / std::sqrt(b.expected) : 0.0);
   }
   if (r.has_tiling) {
-    add("tiling (s=%g)      periodicity ratio %.2f over %zu frequencies; lattice power ratio %.2f (up to 2 "
+    append(
+        s,
+        "tiling (s=%g)      periodicity ratio %.2f over %zu frequencies; lattice power ratio %.2f (up to 2 "
         "cycles per tile, against their neighbours)\n",
         r.tile_size, r.periodicity.ratio, r.periodicity.frequencies, r.periodicity.lattice_ratio);
-    add("  seams   %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f\n", r.seams.seam.count, r.seams.seam.dmin,
-        r.seams.seam.davg, r.seams.seam.nn1);
-    add("  inside  %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f   KS D %.4f  p %.3g\n",
-        r.seams.interior.count, r.seams.interior.dmin, r.seams.interior.davg, r.seams.interior.nn1,
-        r.seams.ks.statistic, r.seams.ks.p_value);
+    append(s, "  seams   %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f\n", r.seams.seam.count,
+           r.seams.seam.dmin, r.seams.seam.davg, r.seams.seam.nn1);
+    append(s, "  inside  %6zu links  δmin %.3f  δavg %.3f  NN1%% %.3f   KS D %.4f  p %.3g\n",
+           r.seams.interior.count, r.seams.interior.dmin, r.seams.interior.davg, r.seams.interior.nn1,
+           r.seams.ks.statistic, r.seams.ks.p_value);
     if (r.dim == 2) {
-      add("  edges   density within one spacing of tile edges %+.2f%% of the mean; by quarter spacing:",
-          100 * (r.edges.first_spacing_ratio() - 1));
-      for (int b = 0; b < EdgeBands::kBands; ++b) add(" %+.1f", 100 * (r.edges.ratio(b) - 1));
-      add("%%\n");
+      append(s, "  edges   density within one spacing of tile edges %+.2f%% of the mean; by quarter spacing:",
+             100 * (r.edges.first_spacing_ratio() - 1));
+      for (int b = 0; b < EdgeBands::kBands; ++b) append(s, " %+.1f", 100 * (r.edges.ratio(b) - 1));
+      append(s, "%%\n");
     }
   }
   if (r.has_energy)
-    add("KDM energy         E/n %.4f (finest grid of the model for this count and density)\n",
-        r.energy_per_point);
-  add("analysis time %.2f s\n", r.seconds);
+    append(s, "KDM energy         E/n %.4f (finest grid of the model for this count and density)\n",
+           r.energy_per_point);
+  append(s, "analysis time %.2f s\n", r.seconds);
   return s;
 }
 
