@@ -175,7 +175,7 @@ KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_
 /* The expected count per tile above which `point` is emitted (kdm::emission_threshold): to fade objects in
    as the density rises, weigh each by (count / threshold - 1) / f clamped to [0, 1], count being
    density * scale * (tile_size / m^depth)^2 at the point. KDM_INVALID_ARGUMENT for a NULL argument or a
-   point the set does not have (a depth it does not reach, a rank past its tile's points). */
+   point the set does not have (a depth it does not reach, a rank past its tile's points). Added in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* point,
                                                double* threshold);
 
