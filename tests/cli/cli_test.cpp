@@ -527,6 +527,43 @@ TEST_F(CliTest, StippleFramesZoomCoherently) {
   }
 }
 
+// --fade: a dot's area grows from 0 where it appears to full a fraction F of density later, so about
+// F / (1 + F) of the dots are partly grown (1/6 at F = 0.2: the dots whose thresholds lie within the last
+// 1/1.2 of the count; measured 0.172) and the picture lightens by about F / (2 + 2F) (0.083; measured 0.092).
+TEST_F(CliTest, StippleFadeGrowsAppearingDots) {
+  const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  const auto radii = [&](const std::string& name) {
+    std::vector<double> r;
+    const std::string svg = slurp(path(name));
+    for (std::size_t at = svg.find(" r=\""); at != std::string::npos; at = svg.find(" r=\"", at + 1))
+      r.push_back(std::atof(svg.c_str() + at + 4));
+    return r;
+  };
+  ASSERT_EQ(kdm("stipple " + image + " --points 20000 -o '" + path("plain.svg") + "'").status, 0);
+  const Outcome faded = kdm("stipple " + image + " --points 20000 --fade 0.2 -o '" + path("fade.svg") + "'");
+  ASSERT_EQ(faded.status, 0) << faded.err;
+  const std::vector<double> plain = radii("plain.svg"), fade = radii("fade.svg");
+  ASSERT_GT(plain.size(), 19000u);
+  const double full = plain.front();
+  EXPECT_TRUE(std::all_of(plain.begin(), plain.end(), [&](double r) { return r == full; }));
+  EXPECT_NE(faded.err.find(std::to_string(plain.size()) + " dots"), std::string::npos)
+      << faded.err;  // the same dots
+  double ink = 0;
+  std::size_t grown = 0;
+  for (double r : fade) {
+    ASSERT_GT(r, 0);
+    ASSERT_LE(r, full * (1 + 1e-5));
+    ink += (r / full) * (r / full);
+    grown += r >= full * (1 - 1e-5);
+  }
+  const double partial = 1 - double(grown) / double(plain.size());  // dots of size 0 are not drawn
+  EXPECT_GT(partial, 0.12);
+  EXPECT_LT(partial, 0.22);
+  EXPECT_NEAR(1 - ink / double(plain.size()), 0.09, 0.03);
+  expect_error("stipple " + image + " --fade -1 -o '" + path("x.png") + "'", "--fade");
+  expect_error("stipple " + image + " --fade 0.2 --method full -o '" + path("x.png") + "'", "--method tiles");
+}
+
 // A zoomed region keeps the whole image's dot size whether --points or --scale counts the dots, and a
 // picture's comments stay comments whatever the image is called ("--" ends an XML comment).
 TEST_F(CliTest, StippleRegionsKeepTheDotSizeAndPathsStayComments) {

@@ -24,7 +24,7 @@ namespace {
 struct StippleArgs {
   std::string image, output, method = "tiles", region, tileset, mode = "smooth", colours;
   std::int64_t points = 20000;
-  double scale = 0, gamma = 1, dot_size = 0;
+  double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
   int width_px = 1024;
   int frames = 0;
@@ -58,6 +58,13 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
                        std::to_string(a.frames));
   if (a.frames > 0 && a.region.empty()) throw CommandError("--frames needs --region (where the zoom ends)");
+  if (!(a.fade >= 0 && a.fade <= 10)) {
+    char message[120];
+    std::snprintf(message, sizeof message, "--fade must be a fraction of density from 0 (off) to 10, got %g",
+                  a.fade);
+    throw CommandError(message);
+  }
+  if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
   // One ink (the image's darkness), or with --colours the image separated into several.
@@ -124,7 +131,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       how = "full KDM sampler";
     } else {
       try {
-        set = stippler->render(uv);
+        set = stippler->render(uv, a.fade);
       } catch (const std::runtime_error& e) {  // the collecting query's limit, said in stipple's terms
         char message[200];
         std::snprintf(message, sizeof message,
@@ -183,6 +190,11 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--frames", a->frames,
                   "Zoom sequence of K numbered pictures from the whole image into --region (geometric "
                   "zoom, zoom-coherent; needs --method tiles; 0: one picture)")
+      ->capture_default_str();
+  cmd->add_option("--fade", a->fade,
+                  "Dots grow in as they appear instead of popping up: a dot's area grows from 0 where it "
+                  "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
+                  "sequence; pictures only, which it lightens by about F / (2 + 2F); 0: off)")
       ->capture_default_str();
   cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option(

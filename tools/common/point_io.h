@@ -19,6 +19,8 @@ struct PointSet {
   int dim = 2;
   std::vector<double> coords;
   std::vector<std::uint8_t> classes;  ///< empty, or one class (0 … 255) per point
+  /// Empty, or each point's dot radius as a fraction (0 … 1) of the picture's (pictures only).
+  std::vector<float> sizes;
   std::size_t size() const { return dim > 0 ? coords.size() / dim : 0; }
 };
 

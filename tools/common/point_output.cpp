@@ -72,6 +72,9 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   const bool classed = style.classes != nullptr;
   if (classed && style.classes->size() != points.size())
     throw std::invalid_argument("a picture's classes do not match its points");
+  if (!points.sizes.empty() && points.sizes.size() != points.size())
+    throw std::invalid_argument("a picture's dot sizes do not match its points");
+  const auto radius = [&](std::size_t i) { return points.sizes.empty() ? r : r * points.sizes[i]; };
   std::vector<Ink> inks = style.inks.empty() ? class_inks(1) : style.inks;
   if (classed)
     for (std::uint8_t c : *style.classes)
@@ -80,8 +83,9 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     RgbImage image(w, h, 255);
     for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = style.background[i % 3];
     for (std::size_t i = 0; i < points.size(); ++i)
-      draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, r,
-                inks[classed ? (*style.classes)[i] : 0].rgb, static_cast<int>(style.blend));
+      if (radius(i) > 0)
+        draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, radius(i),
+                  inks[classed ? (*style.classes)[i] : 0].rgb, static_cast<int>(style.blend));
     if (!write_png(path, image, error)) throw std::runtime_error(error);
     return;
   }
@@ -100,9 +104,9 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     out << "<g id=\"" << (classed ? inks[k].name : "points") << "\" fill=\"" << hex(inks[k]) << "\"" << blend
         << ">\n";
     for (std::size_t i = 0; i < points.size(); ++i)
-      if (!classed || (*style.classes)[i] == k)
+      if ((!classed || (*style.classes)[i] == k) && radius(i) > 0)
         out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h
-            << "\" r=\"" << r << "\"/>\n";
+            << "\" r=\"" << radius(i) << "\"/>\n";
     out << "</g>\n";
   }
   out << "</svg>\n";

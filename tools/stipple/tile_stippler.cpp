@@ -111,7 +111,41 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   read_images_by_sums(classes, sums_, HUGE_VAL);  // built once for every frame
 }
 
-PointSet TileStippler::render(const double uv[4]) const {
+ClassQueryParams TileStippler::class_params(const QueryParams& q) const {
+  ClassQueryParams cq;
+  cq.query = q;
+  cq.class_count = static_cast<std::uint32_t>(densities_.size());
+  for (std::size_t k = 0; k < densities_.size(); ++k) cq.classes[k] = densities_[k]->density;
+  if (sums_.count() == cq.class_count) cq.image_sums = &sums_;
+  return cq;
+}
+
+PointSet TileStippler::with_sizes(const QueryParams& q, const double rect[4], double fade) const {
+  std::vector<QueryPoint> points;  // the ids too, for their thresholds
+  std::vector<std::uint8_t> classes;
+  if (densities_.size() == 1) {
+    query_all(tiles_, q, points);
+  } else {
+    query_all(tiles_, class_params(q), points, classes);
+  }
+  PointSet set = normalise_to_rect(points, rect);
+  set.classes = std::move(classes);
+  set.sizes.resize(points.size());
+  const double m = tiles_.data().subtiles_per_side();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const QueryPoint& p = points[i];
+    // The union's count at the dot (the inks together), in its own (sub)tile.
+    double density = 0;
+    for (const auto& d : densities_) density += d->image.at(q.origin_x + p.x, q.origin_y + p.y);
+    const double side = q.tile_size / std::pow(m, p.id.depth);
+    const double count = density * q.scale * side * side, threshold = emission_threshold(tiles_, p.id);
+    const double weight = threshold > 0 ? std::clamp((count / threshold - 1) / fade, 0.0, 1.0) : 1.0;
+    set.sizes[i] = static_cast<float>(std::sqrt(weight));  // area, so ink, in proportion to the weight
+  }
+  return set;
+}
+
+PointSet TileStippler::render(const double uv[4], double fade) const {
   const double zoom = 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]);
   if (zoom > max_stipple_zoom(tiles_, mode_) * (1 + 1e-9))
     throw std::invalid_argument(stipple_zoom_error("the region", tiles_, mode_));
@@ -123,18 +157,14 @@ PointSet TileStippler::render(const double uv[4]) const {
   q.density = densities_.front()->density;
   q.mode = mode_;
   const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
+  if (fade > 0) return with_sizes(q, rect, fade);
   std::vector<float> xy;  // positions only: the compact output
   if (densities_.size() == 1) {
     query_all_xy(tiles_, q, xy);
     return normalise_to_rect(xy, rect);
   }
-  ClassQueryParams cq;
-  cq.query = q;
-  cq.class_count = static_cast<std::uint32_t>(densities_.size());
-  for (std::size_t k = 0; k < densities_.size(); ++k) cq.classes[k] = densities_[k]->density;
-  if (sums_.count() == cq.class_count) cq.image_sums = &sums_;
   std::vector<std::uint8_t> classes;
-  query_all_xy(tiles_, cq, xy, classes);
+  query_all_xy(tiles_, class_params(q), xy, classes);
   PointSet set = normalise_to_rect(xy, rect);
   set.classes = std::move(classes);
   return set;

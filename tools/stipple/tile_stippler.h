@@ -53,12 +53,18 @@ class TileStippler {
   TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
                double scale, QueryMode mode);
   /// The dots of the UV rectangle `uv` (x0, y0, x1, y1 in [0, 1]², y up), normalised to it: [0, 1)².
-  /// Throws std::invalid_argument when it zooms more than max_stipple_zoom, std::runtime_error when the
-  /// query would emit more than 2^25 dots.
-  PointSet render(const double uv[4]) const;
+  /// With `fade` > 0 each dot also gets a size (PointSet::sizes) that grows from 0 where it appears to 1
+  /// once the density there has risen a fraction `fade` more (emission_threshold), its area in proportion:
+  /// the ink of a zoom changes continuously instead of dots popping up. Throws std::invalid_argument when
+  /// it zooms more than max_stipple_zoom, std::runtime_error when the query would emit more than 2^25
+  /// dots.
+  PointSet render(const double uv[4], double fade = 0) const;
   double aspect() const { return aspect_; }
 
  private:
+  ClassQueryParams class_params(const QueryParams& q) const;  ///< the inks' query over q
+  PointSet with_sizes(const QueryParams& q, const double rect[4], double fade) const;
+
   const Tileset& tiles_;
   double aspect_ = 1, scale_ = 0, tile_size_ = 1;
   QueryMode mode_;
