@@ -56,6 +56,7 @@ class Tileset:
     def save(self, path: _Path) -> None: ...
     @property
     def info(self) -> Dict[str, Any]: ...
+    def thresholds(self, result: QueryResult) -> npt.NDArray[np.float64]: ...
     def query(
         self,
         rect: _Rect,
@@ -115,6 +116,7 @@ def stipple(
     dot_size: Optional[float] = ...,
     threads: int = ...,
     colours: Union[str, int, None] = ...,
+    fade: float = ...,
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],

@@ -28,6 +28,7 @@ def stipple(
     dot_size: Optional[float] = None,
     threads: int = 0,
     colours: Any = None,
+    fade: float = 0.0,
 ) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
@@ -65,6 +66,11 @@ def stipple(
         A colour stipple of an image file (``kdm stipple --colours``): "cmyk" (black by under-colour
         removal), "rgb" (light on black) or a number of inks, 2 to 8, clustered from the image; one class
         of dots per ink, all of them one blue-noise set.
+    fade : float
+        For method "tiles", in the picture written to `output`: a dot's area grows from 0 where it
+        appears to full once the density there is this fraction higher (``kdm stipple --fade``), so
+        that the dots of a zoom sequence grow in instead of popping up; it lightens the picture by about
+        fade / (2 + 2 fade). 0 (off) to 10. The same dots are returned (to float precision).
 
     Returns
     -------
@@ -100,6 +106,11 @@ def stipple(
     width = _checks.integer("width", width, 1, 65536)
     dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)
     threads = _checks.threads(threads)
+    fade = _checks.number("fade", fade, 0.0)
+    if fade > 10:
+        raise ValueError(f"fade must be a fraction of density from 0 (off) to 10, got {fade}")
+    if fade > 0 and method == "full":
+        raise ValueError("fade needs method='tiles' (dots that appear)")
     if colours is not None:
         if label == "array":
             raise ValueError("colours needs an image file (an array holds luminance only)")
@@ -112,7 +123,7 @@ def stipple(
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
-        colours, gamma,
+        colours, gamma, fade,
     )
 
 

@@ -25,8 +25,8 @@ using Region = std::array<double, 4>;
 py::object stipple(const DensitySpec& spec, const std::string& label, std::int64_t points, double scale,
                    const std::string& method, const std::string& mode, std::optional<Region> region,
                    std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
-                   int width, double dot_size, int threads, std::optional<std::string> colours,
-                   double gamma) {
+                   int width, double dot_size, int threads, std::optional<std::string> colours, double gamma,
+                   double fade) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -82,7 +82,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                     : tools::stipple_full(spec, count, aspect, seed, threads);
     } else {
       const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode);
-      set = stippler.render(uv.data());
+      set = stippler.render(uv.data(), fade);
     }
     if (colours && set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left
     if (output) {
@@ -148,7 +148,7 @@ void bind_stipple(py::module_& m) {
   m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
         py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
-        py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"),
+        py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"), py::arg("fade"),
         "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 

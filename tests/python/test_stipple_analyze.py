@@ -18,6 +18,23 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     assert np.array_equal(full, read_txt(tmp_path / "full.txt"))
 
 
+def test_stipple_fade_draws_what_kdm_stipple_draws(cli, tmp_path):
+    # The same SVG as the command line's, about 1/6 of its dots partly grown at fade=0.2 (measured 0.17;
+    # tests/cli has the full rule), and the same dots returned as without fade, to float precision.
+    cli("stipple", SPHERE, "--points", 4000, "--fade", 0.2, "-o", tmp_path / "cli.svg")
+    dots = kdm.stipple(SPHERE, points=4000, fade=0.2, output=tmp_path / "py.svg")
+    assert (tmp_path / "py.svg").read_bytes() == (tmp_path / "cli.svg").read_bytes()
+    radii = np.array([float(part.split('"')[1]) for part in (tmp_path / "py.svg").read_text().split(" r=")[1:]])
+    partial = np.mean(radii < radii.max() * (1 - 1e-5))
+    assert 0.1 < partial < 0.25
+    plain = kdm.stipple(SPHERE, points=4000)
+    assert dots.shape == plain.shape and np.abs(np.sort(dots, axis=0) - np.sort(plain, axis=0)).max() < 1e-5
+    with pytest.raises(ValueError, match="fade"):
+        kdm.stipple(SPHERE, points=4000, fade=-0.1)
+    with pytest.raises(ValueError, match="method='tiles'"):
+        kdm.stipple(SPHERE, points=400, fade=0.2, method="full")
+
+
 def test_stipple_to_png_and_svg(tmp_path, gradient_png):
     dots = kdm.stipple(str(gradient_png), points=3000, output=tmp_path / "s.png", width=300)
     assert dots.shape[1] == 2 and 2000 < len(dots) < 4000  # about the dots asked for
