@@ -4,7 +4,9 @@
 // density there is chosen per frame so that on screen the dots keep one size and spacing: (dots per unit
 // screen area) × (screen area per unit texture area, from the projection) × darkness. As the camera nears
 // the surface that density grows 10,000-fold; smooth mode glides the points continuously with it and,
-// past the tile set's top level, hands them over to subtiles, so each frame moves each dot a little.
+// past the tile set's top level, hands them over to subtiles, so each frame moves each dot a little. A dot
+// that appears grows in (its area from 0 to full as its density rises 20% past its emission threshold)
+// instead of popping up.
 //
 // Per frame it prints the query's point count, the deepest subtile depth, the dot density on screen where
 // the tone is fixed (also relative to its target D × darkness), and the largest motion of a dot over the
@@ -248,7 +250,7 @@ int main(int argc, char** argv) {
               kdm::query_density_limit(tileset, kdm::QueryMode::kSmooth));
   // The fixed tone whose dot density is compared across frames: the view centre's, ± 0.08.
   const double band_tone = tone(target_u, target_v, dir), spacing = 1 / std::sqrt(dots),
-               radius = 0.45 * spacing;
+               radius = 0.45 * spacing, fade = 0.2, subtiles = tileset.data().subtiles_per_side();
   std::printf("tile side %.4g texture units; fixed-tone band: tone %.3f ± 0.08\n", tile_size, band_tone);
 
   std::vector<kdm::QueryPoint> buffer(1 << 16);
@@ -310,7 +312,12 @@ int main(int argc, char** argv) {
       depth = std::max(depth, p.id.depth);
       if (!visible) continue;
       ++shown;
-      draw_disc(image, size, sx, sy, radius);
+      // The fade weight (docs/runtime.md, "Fading objects in"): the count of the point's (sub)tile here
+      // against the count at which it appears.
+      const double side = tile_size / std::pow(subtiles, p.id.depth);
+      const double count = texture_density(&frame, p.x, p.y) * q.scale * side * side;
+      const double weight = std::clamp((count / kdm::emission_threshold(tileset, p.id) - 1) / fade, 0.0, 1.0);
+      if (weight > 0) draw_disc(image, size, sx, sy, radius * std::sqrt(weight));
       if (std::abs(tone(p.x, p.y, s) - band_tone) < 0.08) ++band_dots;
     }
     deepest = std::max(deepest, depth);
