@@ -25,7 +25,8 @@ bool same(const kdm::gen::BakeRecipe& a, const kdm::gen::BakeRecipe& b) {
          a.separation == b.separation && a.separation_push == b.separation_push &&
          a.fill_holes == b.fill_holes && a.keyframes_per_level == b.keyframes_per_level &&
          a.glide_separation == b.glide_separation && a.glide_consensus == b.glide_consensus &&
-         a.glide_late == b.glide_late && a.handover_zone == b.handover_zone &&
+         a.glide_late == b.glide_late && a.glide_corner_consensus == b.glide_corner_consensus &&
+         a.handover_zone == b.handover_zone &&
          (a.keyframes_per_level == 0 || a.glide_sweeps == b.glide_sweeps);
 }
 

@@ -74,6 +74,11 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
   EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
   EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);
+  EXPECT_EQ(r.to_text().find("glide_corner_consensus"), std::string::npos);  // off unless named
+  EXPECT_EQ(
+      BakeRecipe::parse(BakeRecipe::parse("glide_corner_consensus 32768\n").to_text()).glide_corner_consensus,
+      32768u);
+  EXPECT_THROW(BakeRecipe::parse("glide_corner_consensus -1\n"), InvalidArgument);
   EXPECT_EQ(r.to_text().find("glide_late"), std::string::npos);  // off unless named
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_late 0.75\n").to_text()).glide_late, 0.75);
   EXPECT_THROW(BakeRecipe::parse("glide_late 1\n"), InvalidArgument);

@@ -124,7 +124,8 @@ void add_tile_commands(CLI::App& app) {
                    "Recipe file: 'key value' lines (seed, colours, levels, base_points, "
                    "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
                    "separation_push, split_shared, separation_fill, separation_per_level, fill_holes, "
-                   "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_late, handover_zone)")
+                   "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_corner_consensus, "
+                   "glide_late, handover_zone)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   add_threads_option(bake, *threads, "the file does not depend on it");

@@ -125,6 +125,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
     } else if (key == "glide_consensus") {
       r.glide_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
+    } else if (key == "glide_corner_consensus") {
+      r.glide_corner_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
     } else if (key == "glide_late") {
       r.glide_late = within(0, 0.95);
     } else if (key == "glide_sweeps") {
@@ -190,6 +192,7 @@ std::string BakeRecipe::to_text() const {
     s << "keyframes " << keyframes_per_level << "\nglide_sweeps " << glide_sweeps << "\n";
   if (glide_separation > 0) s << "glide_separation " << shortest(glide_separation) << "\n";
   if (glide_consensus) s << "glide_consensus " << glide_consensus << "\n";
+  if (glide_corner_consensus) s << "glide_corner_consensus " << glide_corner_consensus << "\n";
   if (glide_late > 0) s << "glide_late " << shortest(glide_late) << "\n";
   if (handover_zone) s << "handover_zone " << handover_zone << "\n";
   return s.str();
@@ -244,7 +247,7 @@ class Baker {
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
       relax_keyframe(levels_, runs_, widths_, shape_, g, recipe_.glide_sweeps, recipe_.seed, threads_,
-                     recipe_.glide_consensus, recipe_.glide_late);
+                     {recipe_.glide_consensus, recipe_.glide_corner_consensus}, recipe_.glide_late);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }

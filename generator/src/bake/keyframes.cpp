@@ -460,14 +460,14 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below,
-                    double late_from) {
-  const bool consensus = shape.keyframe_nominal[g] <= consensus_below;
+                    int sweeps, std::uint64_t seed, int threads, Consensus by_consensus, double late_from) {
+  const std::uint32_t count = shape.keyframe_nominal[g];
   struct Sum {
     std::vector<double> b, a;
     std::vector<int> nb, na;
   };
   for (int stage = 0; stage < 4; ++stage) {
+    const bool consensus = count <= by_consensus.all || (stage == 0 && count <= by_consensus.corners);
     // The stage's own runs, and with consensus the later stages' tori relaxed as this stage too, so that
     // a shared patch moves by the mean of its moves in every context it meets.
     std::vector<BakeRun> plan;

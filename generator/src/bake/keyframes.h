@@ -34,15 +34,23 @@ namespace kdm::gen {
 std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t>& nominal,
                                                  std::uint32_t per_level);
 
+/// Up to which keyframe counts (points per tile) shared patches move by consensus: every kind up to
+/// `all`, the corner patches alone up to `corners` (the costliest tori are the interiors', which every
+/// earlier stage's consensus relaxes again; corners are where one run's moves leave most holes).
+struct Consensus {
+  std::uint32_t all = 0;
+  std::uint32_t corners = 0;
+};
+
 /// Relaxes keyframe g: every patch of the levels up to `shape.keyframe_nominal[g]` gets frames[g] (keyframe
 /// g − 1 must be done). `shape` supplies the colours and the level and keyframe counts. Descends
-/// `sweeps` sweeps; `seed` picks the sweep order. Keyframes of at most `consensus_below` points per tile
-/// move shared patches by consensus (above; it costs about 3.6 times the relaxation with 2 colours).
+/// `sweeps` sweeps; `seed` picks the sweep order. `consensus` says which keyframes move which shared patches
+/// by consensus (above; for every kind it costs about 3.6 times the relaxation with 2 colours).
 /// With `late_from` in (0, 1), the points new at g that are shown later than that fraction of the way from
 /// keyframe g − 1 are left out of g's descent (kept apart only), so their room is made after they appear.
 void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun>& runs,
                     const std::vector<PatchWidths>& widths, const TilesetShape& shape, std::size_t g,
-                    int sweeps, std::uint64_t seed, int threads, std::uint32_t consensus_below = 0,
+                    int sweeps, std::uint64_t seed, int threads, Consensus consensus = {},
                     double late_from = 0);
 
 }  // namespace kdm::gen

@@ -93,6 +93,10 @@ struct BakeRecipe {
   /// torus of the bake that holds it, not on its own run's alone (keyframes.h says why). 0 (off) in recipes
   /// that do not name it.
   std::uint32_t glide_consensus = 0;
+  /// Keyframes above glide_consensus and up to this many points per tile move their corner patches by
+  /// consensus, and their edges and interiors on their own runs: most of consensus's effect on holes for
+  /// about a third of its cost (docs/design.md §3). 0 (off) in recipes that do not name it.
+  std::uint32_t glide_corner_consensus = 0;
   /// A point new at a keyframe and shown later than this fraction of the way there is left out of that
   /// keyframe's relaxation: the points around it make its room over the next interval, once it is shown,
   /// instead of leaving an empty place for it before (keyframes.h). 0 (off) in recipes that do not name it.
