@@ -334,6 +334,26 @@ TEST(GlideTest, CornerConsensusRemovesMostOfTheHoles) {
   EXPECT_GE(worst_davg[1], worst_davg[0] - 0.01);
 }
 
+TEST(GlideTest, BakeProgressCountsConsensusAndEndsAtOne) {
+  // The progress bar weighs each keyframe by the tori it relaxes, consensus included, so the pyramid's
+  // share of the bar shrinks as consensus grows; the fractions reported rise from 0 to exactly 1.
+  const std::size_t keyframes = make_keyframe_nominal({32, 128}, 16).size();  // one report each, last
+  double pyramid_share[3] = {0, 0, 0};
+  int i = 0;
+  for (const char* keys : {"", "glide_corner_consensus 128\n", "glide_consensus 128\n"}) {
+    std::vector<double> seen;
+    bake_tileset(BakeRecipe::parse(std::string(kSmallRecipe) + keys), 2,
+                 [&](double f) { seen.push_back(f); });
+    ASSERT_GT(seen.size(), keyframes) << keys;
+    EXPECT_GE(seen.front(), 0.0) << keys;
+    EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end())) << keys;
+    EXPECT_NEAR(seen.back(), 1.0, 1e-9) << keys;
+    pyramid_share[i++] = seen[seen.size() - keyframes - 1];
+  }
+  EXPECT_GT(pyramid_share[0], pyramid_share[1]);
+  EXPECT_GT(pyramid_share[1], pyramid_share[2]);
+}
+
 TEST(GlideTest, LateArrivalsFindNoPlaceMadeBeforeTheyAppear) {
   // Late in a keyframe interval the points about to appear find their room made by neighbours that glided
   // towards a keyframe relaxed with them; left out of that relaxation (glide_late), their room is made in

@@ -247,7 +247,7 @@ class Baker {
     shape_.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     for (std::size_t g = 0; g < keyframes.size(); ++g) {
       relax_keyframe(levels_, runs_, widths_, shape_, g, recipe_.glide_sweeps, recipe_.seed, threads_,
-                     {recipe_.glide_consensus, recipe_.glide_corner_consensus}, recipe_.glide_late);
+                     Consensus{recipe_.glide_consensus, recipe_.glide_corner_consensus}, recipe_.glide_late);
       done_work_ += glide_work(keyframes[g]);
       if (progress_) progress_(done_work_ / total_work_);
     }
@@ -291,9 +291,13 @@ class Baker {
     return double(run.w * run.h) * nominal_[level] * recipe_.sweeps_for(nominal_[level]);
   }
 
+  /// A keyframe's relaxation: each stage's own tori, and with consensus the later stages' too.
   double glide_work(std::uint32_t count) const {
+    const Consensus consensus{recipe_.glide_consensus, recipe_.glide_corner_consensus};
     double area = 0;
-    for (const BakeRun& run : runs_) area += run.w * run.h;
+    for (const BakeRun& run : runs_)
+      for (int stage = 0; stage <= run.stage; ++stage)
+        if (stage == run.stage || consensus.covers(count, stage)) area += run.w * run.h;
     return area * count * recipe_.glide_sweeps;
   }
 

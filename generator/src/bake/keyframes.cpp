@@ -467,7 +467,7 @@ void relax_keyframe(std::vector<LevelPatches>& levels, const std::vector<BakeRun
     std::vector<int> nb, na;
   };
   for (int stage = 0; stage < 4; ++stage) {
-    const bool consensus = count <= by_consensus.all || (stage == 0 && count <= by_consensus.corners);
+    const bool consensus = by_consensus.covers(count, stage);
     // The stage's own runs, and with consensus the later stages' tori relaxed as this stage too, so that
     // a shared patch moves by the mean of its moves in every context it meets.
     std::vector<BakeRun> plan;

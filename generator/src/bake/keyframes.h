@@ -40,6 +40,10 @@ std::vector<std::uint32_t> make_keyframe_nominal(const std::vector<std::uint32_t
 struct Consensus {
   std::uint32_t all = 0;
   std::uint32_t corners = 0;
+  /// Whether the patches of stage `stage` (a PatchKind) move by consensus at keyframe count `count`.
+  bool covers(std::uint32_t count, int stage) const {
+    return count <= all || (stage == 0 && count <= corners);
+  }
 };
 
 /// Relaxes keyframe g: every patch of the levels up to `shape.keyframe_nominal[g]` gets frames[g] (keyframe
