@@ -357,7 +357,7 @@ void BM_QueryThreeClasses(benchmark::State& state) {
 
 // Smooth mode past the top level: a constant density whose depth-d subtiles hold 15,000 expected points
 // each (as depth 0's tiles do in BM_QueryConstant), over 8 × 8 of them: the same ~960k points, emitted
-// by tiles 32^d times smaller, with the hand-over's ancestors above them. BM_QueryRampAtDepth: the same
+// by tiles m^d times smaller, with the hand-over's ancestors above them. BM_QueryRampAtDepth: the same
 // with BM_QueryDensityCallback's ramp over the region (0.2 to 1, ~576k points).
 // KDM_BENCHMARK_TILESET names another set (one with a hand-over) to measure instead of the built-in one.
 double ramp_side = kSide;

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 5).
+"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 6).
 
 Written from docs/tileset-format.md alone, not from the C++ sources: the test
 runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
@@ -26,7 +26,7 @@ try:
 except ImportError:  # the reader is useless without it: say what to install
     zstandard = None
 
-FORMAT_VERSION = 5
+FORMAT_VERSION = 6
 OLDEST_FORMAT_VERSION = 2
 MAX_KEYFRAMES = 256
 GLIDE_UNITS_PER_SPACING = 32.0
@@ -71,6 +71,7 @@ class Tileset:
         self.level_nominal = []
         self.keyframe_nominal = []
         self.handover_zone = 0
+        self.handover_level = 0
         self.tiles = []
         self.recipe = b""
         self.generator_version = b""
@@ -271,6 +272,8 @@ def decode(data):
         ts.keyframe_nominal = list(reader.array(U32, "keyframe_nominal"))
     if handing_over:
         ts.handover_zone = reader.u32("handover_zone")
+    if version >= 6:
+        ts.handover_level = reader.u32("handover_level")
     if body_tiles > reader.remaining() // (48 if handing_over else 32 if gliding else 24):
         raise TilesetError(f"tile count {body_tiles} exceeds what {reader.remaining()} body bytes can hold")
     for t in range(body_tiles):
@@ -369,25 +372,37 @@ def subvertex_colour(ts, m, sw, se, ne, nw, i, j):
     return _mix64(h ^ ((b + 0x8000) & mask)) % C
 
 
+def handover_keyframe(ts):
+    """Doc §7: h, the first keyframe above N_j (j the hand-over level), at least 1."""
+    return max(1, bisect.bisect_right(ts.keyframe_nominal, ts.level_nominal[ts.handover_level]))
+
+
 def _validate_handover(ts):
     """Doc §6, invariant 9."""
     if ts.handover_zone == 0:
+        if ts.handover_level:
+            raise TilesetError("a hand-over level in a set without a hand-over")
         for t, tile in enumerate(ts.tiles):
             if len(tile.handover) or len(tile.appearing):
                 raise TilesetError(f"tile {t} has hand-over tables in a set without a hand-over")
         return
-    C, z = ts.colours, ts.handover_zone
+    C, z, level = ts.colours, ts.handover_zone, ts.handover_level
     if len(ts.keyframe_nominal) < 2:
         raise TilesetError("a hand-over needs a glide track of at least two keyframes")
-    m = round(math.sqrt(ts.level_nominal[-1] / ts.level_nominal[0]))
-    if m * m * ts.level_nominal[0] != ts.level_nominal[-1] or not 2 <= m <= 256:
-        raise TilesetError("a hand-over needs N_top / N_0 to be the square of an integer m in 2..256")
+    if level + 1 >= ts.levels:
+        raise TilesetError(f"the hand-over level {level} is not below the top level")
+    m = round(math.sqrt(ts.level_nominal[-1] / ts.level_nominal[level]))
+    if m * m * ts.level_nominal[level] != ts.level_nominal[-1] or not 2 <= m <= 256:
+        raise TilesetError("a hand-over needs N_top / N_j to be the square of an integer m in 2..256")
     if 2 * z + 1 >= m:
         raise TilesetError(f"the hand-over zone {z} is too wide")
+    h = handover_keyframe(ts)
+    if h + 1 >= len(ts.keyframe_nominal):
+        raise TilesetError("the hand-over keyframe is the top one")
     present = []
     for tile in ts.tiles:
         ts.offsets_at_keyframe(tile, 0)  # fills tile.thresholds
-        present.append(bisect.bisect_left(tile.thresholds, ts.keyframe_nominal[1]))
+        present.append(bisect.bisect_left(tile.thresholds, ts.keyframe_nominal[h]))
     for t, tile in enumerate(ts.tiles):
         sw, se, ne, nw = t // C**3, t // C**2 % C, t // C % C, t % C
         colour = {}
@@ -405,7 +420,7 @@ def _validate_handover(ts):
 
         def take(j, q):
             if q >= present[types[j]]:
-                raise TilesetError(f"tile {t} names rank {q} of subtile {j}, which has {present[types[j]]} at keyframe 1")
+                raise TilesetError(f"tile {t} names rank {q} of subtile {j}, which has {present[types[j]]} at keyframe {h}")
             if taken[first[j] + q]:
                 raise TilesetError(f"tile {t} takes a sub-point twice")
             taken[first[j] + q] = 1
@@ -486,7 +501,9 @@ def summary(ts):
         f"tiles {len(ts.tiles)}",
         "level_nominal " + " ".join(str(n) for n in ts.level_nominal),
         "keyframe_nominal" + "".join(f" {n}" for n in ts.keyframe_nominal),
-    ] + ([f"handover_zone {ts.handover_zone}"] if ts.handover_zone else []) + [
+    ] + ([f"handover_zone {ts.handover_zone}"] if ts.handover_zone else []) + (
+        [f"handover_level {ts.handover_level}"] if ts.handover_level else []
+    ) + [
         f"recipe_bytes {len(ts.recipe)}",
         f"recipe_crc32 {_crc32(ts.recipe):08x}",
         f"generator_version {_escaped(ts.generator_version)}",
@@ -524,7 +541,7 @@ def point_lines(ts, t):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 5).")
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 6).")
     parser.add_argument("file")
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--summary", action="store_true", help="print the canonical summary")

@@ -4,7 +4,7 @@
 // Every choice about a point is made from canonical quantities (its tile path, its rank, the density at
 // its stable position or at its sub-point's), so partitions of a region stay exact; and a tile and its
 // subtile make the one choice they share, whether a sub-point q is the subtile's, with the same
-// expression: ρ(x_q) · area[d + 1] > K_1, x_q computed as the subtile computes its own points.
+// expression: ρ(x_q) · area[d + 1] > K_h, x_q computed as the subtile computes its own points.
 #include "descent.h"
 
 #include "read_ahead.h"
@@ -36,7 +36,7 @@ DescentQuery::DescentQuery(const Tileset& tileset, const QueryParams& q, const I
     origin_frac_x = q.origin_x, origin_frac_y = q.origin_y;
   }
   reach = tables->descent_reach;
-  top = set->keyframe_nominal.back(), k1 = set->keyframe_nominal[1];
+  top = set->keyframe_nominal.back(), kh = set->keyframe_nominal[tables->handover_keyframe];
   appearing_end = set->appearing_end();
 }
 
@@ -116,9 +116,9 @@ class Descent {
   }
 
  private:
-  /// Whether a tile's subtiles can emit anything: some sub-point's expected count can exceed K_1.
+  /// Whether a tile's subtiles can emit anything: some sub-point's expected count can exceed K_h.
   bool descends(const Node& n) const {
-    return n.depth < kMaxQueryDepth && n.rho_max * q_.area[n.depth + 1] > q_.k1;
+    return n.depth < kMaxQueryDepth && n.rho_max * q_.area[n.depth + 1] > q_.kh;
   }
   /// Whether the tile's points can glide past its top keyframe (it has a hand-over there).
   bool hands_over(const Node& n) const { return n.depth < kMaxQueryDepth; }
@@ -135,12 +135,12 @@ class Descent {
   }
 
   /// Whether a subtile can emit a point into the region: it (with its farthest glide) meets the region
-  /// and some of its points can be emitted (every one needs an expected count above K_1).
+  /// and some of its points can be emitted (every one needs an expected count above K_h).
   bool wanted(const Node& c) const {
     const QueryParams& p = *q_.params;
     const double s = q_.side[c.depth], r = q_.reach * s;
     return c.wx - r < p.x1 && c.wx + s + r > p.x0 && c.wy - r < p.y1 && c.wy + s + r > p.y0 &&
-           c.rho_max * q_.area[c.depth] > q_.k1;
+           c.rho_max * q_.area[c.depth] > q_.kh;
   }
 
   /// A sub-point of tile `n`: its subtile's coordinates and type, its stable position and the expected
@@ -160,13 +160,13 @@ class Descent {
     s.expected = read(s.x, s.y) * q_.area[d];
     return s;
   }
-  /// Where sub-point s lies when its subtile's count at it is `count` (at least K_1), in its parent's unit
+  /// Where sub-point s lies when its subtile's count at it is `count` (at least K_h), in its parent's unit
   /// coordinates: as the subtile places it once it owns it.
   void glided(const SubPoint& s, double count, double& ux, double& uy) const {
     const TilePoint& p = set_.tiles[s.type].points[s.rank];
     const std::int8_t* glide = set_.tiles[s.type].glide.data();
     const std::uint32_t* start = t_.glide_start[s.type].data();
-    const GlideBracket g(q_.keyframes, std::max(count, q_.k1));
+    const GlideBracket g(q_.keyframes, std::max(count, q_.kh));
     const std::int8_t *o0 = glide + 2 * (std::size_t(start[g.g0]) + s.rank),
                       *o1 = glide + 2 * (std::size_t(start[g.g1]) + s.rank);
     const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
@@ -174,20 +174,20 @@ class Descent {
     ux = (s.cx + p.unit_x() + dx * (1.0 / 65536.0)) / m_,
     uy = (s.cy + p.unit_y() + dy * (1.0 / 65536.0)) / m_;
   }
-  /// Where sub-point s lies at its subtile's keyframe 1, in its parent's unit coordinates.
+  /// Where sub-point s lies at its subtile's keyframe h, in its parent's unit coordinates.
   void keyframe_one(const SubPoint& s, double& ux, double& uy) const {
     const TilePoint& p = set_.tiles[s.type].points[s.rank];
-    const std::int8_t* o =
-        set_.tiles[s.type].glide.data() + 2 * (std::size_t(t_.glide_start[s.type][1]) + s.rank);
-    const double unit = t_.glide_scale[1] * (1.0 / 65536.0);
+    const std::int8_t* o = set_.tiles[s.type].glide.data() +
+                           2 * (std::size_t(t_.glide_start[s.type][t_.handover_keyframe]) + s.rank);
+    const double unit = t_.glide_scale[t_.handover_keyframe] * (1.0 / 65536.0);
     ux = (s.cx + p.unit_x() + o[0] * unit) / m_, uy = (s.cy + p.unit_y() + o[1] * unit) / m_;
   }
 
   /// Whose a point is and the count that places it. Rank `rank` of stack_[k], with `expected` the tile's
   /// count at its stable position: a rank the tile inherits (one of its parent's sub-points) is its own
-  /// once taken over: past K_1 there and, unless it appears on its own, its parent's point gliding onto
-  /// it its parent's own and past the end of its hand-over (m² K_1). Such a point is placed by the smaller
-  /// of its count and its parent point's over m², so that it stands at its keyframe-1 position when taken
+  /// once taken over: past K_h there and, unless it appears on its own, its parent's point gliding onto
+  /// it its parent's own and past the end of its hand-over (m² K_h). Such a point is placed by the smaller
+  /// of its count and its parent point's over m², so that it stands at its keyframe-h position when taken
   /// over, however unequal the two counts; every count is proportional to the scale, so no point ever
   /// jumps. Other ranks are the tile's own, placed by their count (whether it is emitted is the caller's).
   struct Share {
@@ -195,22 +195,23 @@ class Descent {
     double count;
   };
   Share share(int k, std::uint32_t rank, double expected) {
-    if (k == 0 || rank >= t_.points_at_keyframe[stack_[k].type][1]) return {true, expected};
+    if (k == 0 || rank >= t_.points_at_keyframe[stack_[k].type][t_.handover_keyframe])
+      return {true, expected};
     const Node& p = stack_[k - 1];
     const std::uint32_t from =
         t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
-    if (from == QueryTables::kAppearing) return {expected > q_.k1, expected};
+    if (from == QueryTables::kAppearing) return {expected > q_.kh, expected};
     const TilePoint& point = set_.tiles[p.type].points[from];
     const double side = q_.side[p.depth];  // as emit computes the parent's own count there
     const Share parent = share(
         k - 1, from, read(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
-    return {parent.own && expected > q_.k1 && parent.count > t_.handover_end[p.type][from],
+    return {parent.own && expected > q_.kh && parent.count > t_.handover_end[p.type][from],
             std::min(expected, parent.count / (double(m_) * m_))};
   }
 
   /// The id of rank `rank` of stack_[k]: a sub-point a point glided onto keeps that point's id.
   PointId id_of(int k, std::uint32_t rank) const {
-    while (k > 0 && rank < t_.points_at_keyframe[stack_[k].type][1]) {
+    while (k > 0 && rank < t_.points_at_keyframe[stack_[k].type][t_.handover_keyframe]) {
       const Node& p = stack_[k - 1];
       const std::uint32_t from =
           t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
@@ -297,13 +298,13 @@ class Descent {
       const SubPoint s = sub_point(n, TilesetShape::subtile_of(p.x, m_) + code % 5 - 2,
                                    TilesetShape::subtile_of(p.y, m_) + code / 5 - 2, v / 25);
       const double end = t_.handover_end[n.type][r];
-      if (s.expected > q_.k1 && expected > end) return true;  // its subtile took it over
+      if (s.expected > q_.kh && expected > end) return true;  // its subtile took it over
       // On the straight line from its top-keyframe position to where its subtile will place the sub-point,
       // a fraction f of the way, linear in the scale: 0 where its own count a · N_top reaches N_top, 1
-      // where both its own count passes the hand-over's end and the sub-point's b · K_1 passes K_1 (a and
+      // where both its own count passes the hand-over's end and the sub-point's b · K_h passes K_h (a and
       // b are proportional to the scale), which is where its subtile takes it over and places it by the
-      // smaller of b · K_1 and its count over m² (share).
-      const double a = expected / q_.top, b = s.expected / q_.k1;
+      // smaller of b · K_h and its count over m² (share).
+      const double a = expected / q_.top, b = s.expected / q_.kh;
       const double f = (a - 1) / (std::max(b > 0 ? a / b : HUGE_VAL, end / q_.top) - 1);
       const std::int8_t* o = tile.glide.data() + 2 * (std::size_t(L.start[top_keyframe]) + r);
       const double unit = t_.glide_scale[top_keyframe] * (1.0 / 65536.0);
@@ -365,11 +366,11 @@ class Descent {
                          [](float t, double l) { return TilesetShape::emits(t, l); }) -
         thresholds);
     // A subtile's first points come from its parent, which emits them until the subtile takes them over.
-    const std::uint32_t inherited = n.depth > 0 ? t_.points_at_keyframe[n.type][1] : 0;
+    const std::uint32_t inherited = n.depth > 0 ? t_.points_at_keyframe[n.type][t_.handover_keyframe] : 0;
     // Every point has a sub-point: where the density's lower bound puts the tile's own points past the end
-    // of their hand-over and every sub-point past K_1, its subtiles hold all but the inherited ones.
+    // of their hand-over and every sub-point past K_h, its subtiles hold all but the inherited ones.
     const bool handed_over = n.depth < kMaxQueryDepth && n.rho_min * area > t_.handover_end_max[n.type] &&
-                             n.rho_min * q_.area[n.depth + 1] > q_.k1;
+                             n.rho_min * q_.area[n.depth + 1] > q_.kh;
     if (handed_over) candidates = std::min(candidates, inherited);
     const std::uint32_t* start = t_.glide_start[n.type].data();
     // A constant density: one count and one bracket for the tile's own points (the same values the
@@ -434,13 +435,13 @@ class Descent {
       }
       if (stopped != kDone) return stopped;
     }
-    // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_1].
+    // The sub-points no point glides onto appear at evenly spread thresholds over (N_top, m² K_h].
     if (!hands_over(n) || !(bound > q_.top) || handed_over) return kDone;
     const auto listed = static_cast<std::uint32_t>(tile.appearing.size());
     const auto appear = [&](std::uint32_t a) {  // false when the buffer is full
       const std::uint32_t w = tile.appearing[a], j = w >> 16;
       const SubPoint s = sub_point(n, j % m_, j / m_, w & 0xFFFF);
-      if (s.expected > q_.k1) return true;  // its subtile took it over (share: it appears on its own)
+      if (s.expected > q_.kh) return true;  // its subtile took it over (share: it appears on its own)
       const double threshold = q_.top + (a + 0.5) / listed * (q_.appearing_end - q_.top);
       if (!(read(s.x, s.y) * area > threshold)) return true;
       double ux, uy;

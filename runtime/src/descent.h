@@ -1,7 +1,7 @@
 // Internal: smooth queries past a tile set's top level (docs/design.md §3, "Unbounded zoom"). Past N_top a
-// tile's points glide onto points of its m×m subtiles at their keyframe 1 (Tile::handover), and the
+// tile's points glide onto points of its m×m subtiles at their keyframe h (Tile::handover), and the
 // subtiles' points no point takes appear on the way (Tile::appearing). Where a subtile's expected count at
-// such a sub-point's stable position exceeds K_1 the subtile emits it itself, with the id of the point it
+// such a sub-point's stable position exceeds K_h the subtile emits it itself, with the id of the point it
 // came from, and the same happens one depth further down, to kMaxQueryDepth.
 #pragma once
 
@@ -30,7 +30,7 @@ struct DescentQuery {
   double origin_frac_x = 0, origin_frac_y = 0;  ///< the origin's place in its depth-0 tile, world units
   std::int64_t origin_tile_x = 0, origin_tile_y = 0;
   double reach = 0;  ///< the farthest a tile's points (and its subtiles') lie outside it, in its sides
-  double top = 0, k1 = 0, appearing_end = 0;  ///< N_top, K_1 and m² K_1
+  double top = 0, kh = 0, appearing_end = 0;  ///< N_top, K_h (h: the hand-over keyframe) and m² K_h
 
   /// Prepares a query that query_points has validated.
   DescentQuery(const Tileset& tileset, const QueryParams& q, const ImageSampler& sampler);

@@ -99,6 +99,7 @@ void QueryTables::index_handover(const TilesetData& set) {
   const Subdivision sub = set.subdivision();
   if (set.handover_zone == 0 || sub.m == 0 || set.keyframe_nominal.size() < 2) return;
   const std::uint32_t m = subtiles = sub.m, m2 = m * m;
+  const std::size_t h = handover_keyframe = static_cast<std::uint32_t>(set.handover_keyframe());
   child_type.assign(set.tiles.size() * m2, 0);
   inherited_start.assign(set.tiles.size() * (m2 + 1), 0);
   inherited.assign(set.tiles.size(), {});
@@ -110,7 +111,7 @@ void QueryTables::index_handover(const TilesetData& set) {
     for (std::uint32_t j = 0; j < m2; ++j) {
       const std::size_t c = set.subtile_index(t, j % m, j / m);
       child_type[t * m2 + j] = static_cast<std::uint32_t>(c);
-      start[j + 1] = start[j] + points_at_keyframe[c][1];
+      start[j + 1] = start[j] + points_at_keyframe[c][h];
     }
     TilesetArray<std::uint32_t>& from = inherited[t];
     from.assign(start[m2], kAppearing);
@@ -121,7 +122,7 @@ void QueryTables::index_handover(const TilesetData& set) {
                               TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
       if (j < m2 && start[j] + v / 25 < start[j + 1]) from[start[j] + v / 25] = r;  // validated: always
     }
-    // Each point's glide, top-keyframe position to sub-point's keyframe-1 position (tile units), in
+    // Each point's glide, top-keyframe position to sub-point's position at keyframe h (tile units), in
     // spacings 1/√N_top; the expressions descent.cpp's positions use.
     handover_end[t].assign(tile.points.size(), 0.0f);
     for (std::uint32_t j = 0; j < m2; ++j) {
@@ -131,16 +132,16 @@ void QueryTables::index_handover(const TilesetData& set) {
         if (r == kAppearing) continue;
         const std::int8_t* a = tile.glide.data() + 2 * (std::size_t(glide_start[t][top]) + r);
         const std::int8_t* b =
-            child.glide.data() + 2 * (std::size_t(glide_start[child_type[t * m2 + j]][1]) + q);
+            child.glide.data() + 2 * (std::size_t(glide_start[child_type[t * m2 + j]][h]) + q);
         const double ax = tile.points[r].unit_x() + a[0] * (glide_scale[top] / 65536.0),
                      ay = tile.points[r].unit_y() + a[1] * (glide_scale[top] / 65536.0);
-        const double bx = (j % m + child.points[q].unit_x() + b[0] * (glide_scale[1] / 65536.0)) / m,
-                     by = (j / m + child.points[q].unit_y() + b[1] * (glide_scale[1] / 65536.0)) / m;
+        const double bx = (j % m + child.points[q].unit_x() + b[0] * (glide_scale[h] / 65536.0)) / m,
+                     by = (j / m + child.points[q].unit_y() + b[1] * (glide_scale[h] / 65536.0)) / m;
         const double glide = std::hypot(bx - ax, by - ay) * std::sqrt(double(set.level_nominal.back()));
         handover_end[t][r] = static_cast<float>(set.handover_end(glide));
         handover_end_max[t] = std::max(handover_end_max[t], double(handover_end[t][r]));
-        // The path's far end: the sub-point's stable position, and its glide at any count from K_1 on.
-        const double sub_reach = glide_reach_from[1] / m;
+        // The path's far end: the sub-point's stable position, and its glide at any count from K_h on.
+        const double sub_reach = glide_reach_from[h] / m;
         const double ex = std::fabs((j % m + child.points[q].unit_x()) / m - tile.points[r].unit_x()),
                      ey = std::fabs((j / m + child.points[q].unit_y()) / m - tile.points[r].unit_y());
         handover_reach = std::max({handover_reach, ex + sub_reach, ey + sub_reach});

@@ -66,9 +66,10 @@ struct QueryTables {
   /// tile visits only their points. Empty when a tile holds more than 65,536 points.
   TilesetArray<TilesetArray<std::uint16_t>> cell_ranks;
   TilesetArray<std::uint32_t> cell_start;
-  /// The hand-over between depths (sets with a handover_zone; else empty). Subtiles per side m, and per
-  /// tile t and subtile j = row · m + column, the tile its subtile shows: child_type[t · m² + j].
-  std::uint32_t subtiles = 0;
+  /// The hand-over between depths (sets with a handover_zone; else empty). Subtiles per side m, the
+  /// hand-over keyframe h (TilesetShape::handover_keyframe), and per tile t and subtile j = row · m +
+  /// column, the tile its subtile shows: child_type[t · m² + j].
+  std::uint32_t subtiles = 0, handover_keyframe = 0;
   TilesetArray<std::uint32_t> child_type;
   /// Which point of tile t glides onto rank q of its subtile j: inherited[t][inherited_start[t · (m² + 1)
   /// + j] + q], a rank of t, or kAppearing for a sub-point that appears on its own. A point emitted by a
@@ -77,12 +78,12 @@ struct QueryTables {
   TilesetArray<std::uint32_t> inherited_start;
   static constexpr std::uint32_t kAppearing = ~0u;
   /// Per tile and rank, the count where its subtile takes the point over (TilesetShape::handover_end of
-  /// its glide, from its top-keyframe position to its sub-point's keyframe-1 position), and per tile the
+  /// its glide, from its top-keyframe position to its sub-point's position at keyframe h), and per tile the
   /// largest of them.
   TilesetArray<TilesetArray<float>> handover_end;
   TilesetArray<double> handover_end_max;
   /// The farthest, per axis in tile sides, that a hand-over's straight path (from a point's top-keyframe
-  /// position to its sub-point's glide track from K_1 on) lies from the point's stable position; and the
+  /// position to its sub-point's glide track from K_h on) lies from the point's stable position; and the
   /// farthest any point of a tile or of its subtiles lies from its stable position at any count, the
   /// larger of that and glide_reach_from[0]: queries past the top level look this far beyond their region.
   double handover_reach = 0, descent_reach = 0;

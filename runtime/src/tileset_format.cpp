@@ -147,13 +147,15 @@ std::uint32_t version_for(const TilesetData& set) {
 
 std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
   std::ostringstream stream(std::ios::binary);
-  const bool handover = version_for(set) >= 5;
+  const std::uint32_t version = version_for(set);
+  const bool handover = version >= 5;
   {
     cereal::PortableBinaryOutputArchive ar(stream);
     ar(set.colours, set.levels, static_cast<std::uint32_t>(set.tiles.size()));
     save_array(ar, set.level_nominal);
     save_array(ar, set.keyframe_nominal);
     if (handover) ar(set.handover_zone);
+    if (version >= 6) ar(set.handover_level);
     std::vector<std::uint16_t> xy;
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
@@ -188,6 +190,7 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
   const bool gliding = version >= 3, handover = version >= 5;
   if (gliding) load_array(ar, buffer, set.keyframe_nominal);
   if (handover) ar(set.handover_zone);
+  if (version >= 6) ar(set.handover_level);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
   if (tile_count > buffer.remaining() / (handover ? 48 : gliding ? 32 : 24))
     throw ContentError("tile count exceeds the payload");
@@ -218,14 +221,18 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
 }
 
 /// The first problem of a set's hand-over tables (empty if none): every point of a tile glides onto its own
-/// sub-point of that tile's subtiles at keyframe 1, and those no point takes appear, each once.
+/// sub-point of that tile's subtiles at the hand-over keyframe h, and those no point takes appear, each once.
 std::string handover_problem(const TilesetData& set) {
   const std::uint32_t m = set.subtiles_per_side(), zone = set.handover_zone;
   if (set.keyframe_nominal.size() < 2) return "a hand-over needs a glide track of at least two keyframes";
-  if (m < 2 || m > 256) return "a hand-over needs N_top / N_0 to be the square of an integer m in 2..256";
+  if (set.handover_level + 1 >= set.levels)
+    return "the hand-over level " + std::to_string(set.handover_level) + " is not below the top level";
+  if (m < 2 || m > 256) return "a hand-over needs N_top / N_j to be the square of an integer m in 2..256";
   if (2 * std::uint64_t(zone) + 1 >= m) return "the hand-over zone " + std::to_string(zone) + " is too wide";
-  std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe 1, per tile
-  for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], 1);
+  const std::size_t h = set.handover_keyframe();
+  if (h + 1 >= set.keyframe_nominal.size()) return "the hand-over keyframe is the top one";
+  std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe h, per tile
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], h);
   std::vector<std::uint32_t> type(std::size_t(m) * m), first(std::size_t(m) * m + 1);
   std::vector<char> taken;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
@@ -242,7 +249,7 @@ std::string handover_problem(const TilesetData& set) {
     const auto take = [&](std::uint32_t j, std::uint32_t q) -> std::string {
       if (q >= present[type[j]])
         return name + " names rank " + std::to_string(q) + " of subtile " + std::to_string(j) +
-               ", which has " + std::to_string(present[type[j]]) + " at keyframe 1";
+               ", which has " + std::to_string(present[type[j]]) + " at keyframe " + std::to_string(h);
       if (taken[first[j] + q]++) return name + " takes a sub-point twice";
       return {};
     };
@@ -268,7 +275,8 @@ std::string handover_problem(const TilesetData& set) {
 }  // namespace
 
 std::uint32_t tileset_format_version_for(const TilesetShape& set) {
-  return set.handover_zone ? kTilesetFormatVersion : 4;  // 4 also rebakes older recipes byte for byte
+  // The oldest that holds it, so that older recipes rebake byte for byte.
+  return !set.handover_zone ? 4 : set.handover_level ? 6 : 5;
 }
 
 std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set) {
@@ -348,6 +356,7 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
   if (set.handover_zone) {
     if (const std::string problem = handover_problem(set); !problem.empty()) return bad(problem);
   } else {
+    if (set.handover_level) return bad("a hand-over level in a set without a hand-over");
     for (std::size_t t = 0; t < set.tiles.size(); ++t)
       if (!set.tiles[t].handover.empty() || !set.tiles[t].appearing.empty())
         return bad("tile " + std::to_string(t) + " has hand-over tables in a set without a hand-over");

@@ -26,7 +26,7 @@ bool same(const kdm::gen::BakeRecipe& a, const kdm::gen::BakeRecipe& b) {
          a.fill_holes == b.fill_holes && a.keyframes_per_level == b.keyframes_per_level &&
          a.glide_separation == b.glide_separation && a.glide_consensus == b.glide_consensus &&
          a.glide_late == b.glide_late && a.glide_corner_consensus == b.glide_corner_consensus &&
-         a.handover_zone == b.handover_zone &&
+         a.handover_zone == b.handover_zone && a.handover_level == b.handover_level &&
          (a.keyframes_per_level == 0 || a.glide_sweeps == b.glide_sweeps);
 }
 

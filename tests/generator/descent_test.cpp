@@ -1,8 +1,10 @@
-// Smooth queries past the top level (runtime/src/descent.h) on a small set with a hand-over (three levels,
-// 32 … 512 points per tile, 4×4 subtiles per tile): the densities asked for are served to four depths, a
+// Smooth queries past the top level (runtime/src/descent.h) on two small sets with a hand-over onto 4×4
+// subtiles per tile: three levels (32 … 512 points per tile) handed over onto the subtiles' level 0, and
+// four (32 … 2,048) onto their level 1. For both, the densities asked for are served to four depths, a
 // point once emitted stays emitted with its id and moves continuously, partitions (random grids of cuts),
 // resumed calls and threads give the same bits at depths 0 to 4 and 10^9 units from the origin, the loops
 // for varying and constant densities agree, and positions far from the world origin keep their precision.
+// Densities are stated in units of the set's top level, N_top.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,19 +28,45 @@
 namespace kdm {
 namespace {
 
-const Tileset& small_set() {
-  static const Tileset set = [] {
-    gen::BakeRecipe r;
-    r.levels = 3, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
-    r.handover_zone = 1;
-    std::vector<std::uint8_t> bytes;
-    EXPECT_EQ(encode_tileset(gen::bake_tileset(r, 2), bytes), Status::kOk);
-    Tileset t;
-    EXPECT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
-    return t;
-  }();
-  return set;
+/// A small set handing over onto its subtiles' level `level`, with 4×4 subtiles per tile.
+Tileset bake_small_set(std::uint32_t level) {
+  gen::BakeRecipe r;
+  r.levels = 3 + level, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
+  r.handover_zone = 1, r.handover_level = level;
+  std::vector<std::uint8_t> bytes;
+  EXPECT_EQ(encode_tileset(gen::bake_tileset(r, 2), bytes), Status::kOk);
+  Tileset t;
+  EXPECT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
+  return t;
 }
+
+/// The set the running test queries (DescentTest::SetUp), each baked once.
+const Tileset* current_set = nullptr;
+const Tileset& small_set() {
+  return *current_set;
+}
+/// Its top level's nominal points per tile, N_top.
+double top() {
+  return current_set->max_points_per_tile();
+}
+
+class DescentTest : public ::testing::TestWithParam<std::uint32_t> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == 0) {
+      static const Tileset level0 = bake_small_set(0);
+      current_set = &level0;
+    } else {
+      static const Tileset level1 = bake_small_set(1);
+      current_set = &level1;
+    }
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(HandoverLevel, DescentTest, ::testing::Values(0u, 1u),
+                         [](const ::testing::TestParamInfo<std::uint32_t>& i) {
+                           return "OntoLevel" + std::to_string(i.param);
+                         });
 
 using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
 Key key(const PointId& id) {
@@ -71,29 +99,30 @@ double ramp(void*, double x, double) {
   return 0.25 + 0.75 * std::clamp(x / 2, 0.0, 1.0);
 }
 
-TEST(DescentTest, SmoothQueriesGoFourDepthsPastTheTopAndStableOnesStopThere) {
+TEST_P(DescentTest, SmoothQueriesGoFourDepthsPastTheTopAndStableOnesStopThere) {
   const Tileset& t = small_set();
   ASSERT_EQ(t.data().subtiles_per_side(), 4u);
-  EXPECT_EQ(query_density_limit(t, QueryMode::kStable), 512.0);
-  EXPECT_EQ(query_density_limit(t, QueryMode::kSmooth), 512.0 * std::pow(4.0, 8));
-  QueryParams p = uniform(0.01, 512.0 * std::pow(4.0, 8) * 1.01);
+  EXPECT_EQ(query_density_limit(t, QueryMode::kStable), top());
+  EXPECT_EQ(query_density_limit(t, QueryMode::kSmooth), top() * std::pow(4.0, 8));
+  QueryParams p = uniform(0.01, top() * std::pow(4.0, 8) * 1.01);
   std::vector<QueryPoint> out(16);
   std::size_t n = 0;
   QueryCursor cursor;
   QueryProblem why;
   EXPECT_EQ(query_points(t, p, out.data(), out.size(), &n, &cursor, &why), Status::kInvalidArgument);
   EXPECT_EQ(why.kind, QueryProblem::Kind::kDensityTooHigh);
-  p.scale = 600, p.mode = QueryMode::kStable, cursor = {};
+  p.scale = 1.17 * top(), p.mode = QueryMode::kStable, cursor = {};
   EXPECT_EQ(query_points(t, p, out.data(), out.size(), &n, &cursor, &why), Status::kInvalidArgument);
-  EXPECT_EQ(why.limit, 512.0);
+  EXPECT_EQ(why.limit, top());
   p.mode = QueryMode::kSmooth, cursor = {};
   EXPECT_EQ(query_points(t, p, out.data(), out.size(), &n, &cursor, &why), Status::kOk);
 }
 
-TEST(DescentTest, EveryDepthHasTheExpectedCount) {
+TEST_P(DescentTest, EveryDepthHasTheExpectedCount) {
   // Windows of 20,000 expected points. Over 20 windows each, count / expected had means 0.993–1.011 (the
   // small set's own counts per tile) and standard deviations 0.12–0.24%: 3% is 8 deviations past the bias.
-  for (const double per_tile : {700.0, 3000.0, 512.0 * 16 * 3, 512.0 * 256 * 1.7, 512.0 * 4096 * 2.5}) {
+  for (const double n : {1.37, 5.86, 16.0 * 3, 256 * 1.7, 4096 * 2.5}) {
+    const double per_tile = n * top();
     const double side = std::sqrt(20000 / per_tile);
     const std::vector<QueryPoint> points = query(uniform(side, per_tile));
     const double expected = per_tile * side * side;
@@ -104,7 +133,7 @@ TEST(DescentTest, EveryDepthHasTheExpectedCount) {
     EXPECT_EQ(ids.size(), points.size()) << "every id once";
     // Depth d + 1's first points (the sub-points no point glides onto) appear past N_top · m^(2d).
     std::uint32_t depth = 0;
-    for (double from = 512; per_tile > from; from *= 16) ++depth;
+    for (double from = top(); per_tile > from; from *= 16) ++depth;
     EXPECT_EQ(deepest, depth) << per_tile;
   }
 }
@@ -115,7 +144,7 @@ double step(void*, double x, double) {
   return x < 0.5037 ? 1.0 : 0.05;
 }
 
-TEST(DescentTest, PointsStayWithTheirIdsAndMoveContinuouslyAsTheScaleGrows) {
+TEST_P(DescentTest, PointsStayWithTheirIdsAndMoveContinuouslyAsTheScaleGrows) {
   // A tile by half a tile, through the hand-overs from depth 0 to depth 2 in steps of 1.25% in scale.
   for (double (*density)(void*, double, double) : {ramp, step}) {
     QueryParams p = uniform(1, 0);
@@ -125,7 +154,7 @@ TEST(DescentTest, PointsStayWithTheirIdsAndMoveContinuouslyAsTheScaleGrows) {
     double largest_step = 0;  // in spacings where the point is
     const int steps = 300;
     for (int s = 0; s <= steps; ++s) {
-      p.scale = 400 * std::pow(512.0 * 16 * 2 / 400, double(s) / steps);
+      p.scale = 0.78 * top() * std::pow(32 / 0.78, double(s) / steps);
       std::map<Key, std::pair<double, double>> now;
       const std::vector<QueryPoint> points = query(p);
       for (const QueryPoint& q : points) now[key(q.id)] = {q.x, q.y};
@@ -152,10 +181,10 @@ TEST(DescentTest, PointsStayWithTheirIdsAndMoveContinuouslyAsTheScaleGrows) {
   }
 }
 
-TEST(DescentTest, OneQueryServesARadialMapOf1To100000) {
+TEST_P(DescentTest, OneQueryServesARadialMapOf1To100000) {
   // exp(-ln(10^5) · min(1, 2r)) over the unit square, as a 256² image: 1 at the centre, 10^-5 from r = ½
-  // on, 52 to 5.2·10^6 points per tile of side ¼ (10^4 times the top). Each tenth of the log range
-  // gets the points the image's own integral asks for.
+  // on, 0.1 to 10^4 times N_top points per tile. Each tenth of the log range gets the points the image's
+  // own integral asks for.
   const int texels = 256;
   std::vector<float> values(texels * texels), mip;
   const double a = std::log(1e5);
@@ -170,7 +199,7 @@ TEST(DescentTest, OneQueryServesARadialMapOf1To100000) {
   image.values = values.data();
   ASSERT_EQ(make_density_max_mip(image, mip), Status::kOk);
   QueryParams p = uniform(1, 8.4e7);
-  p.tile_size = 0.25;
+  p.tile_size = 0.25 * std::sqrt(top() / 512);  // the same points per tile relative to N_top
   p.density.kind = QueryDensity::Kind::kImage, p.density.image = &image;
   auto band = [&](double rho) { return std::min(9, int(std::log(std::max(rho, 1e-300)) / -a * 10)); };
   std::vector<double> got(10), expected(10);
@@ -184,7 +213,7 @@ TEST(DescentTest, OneQueryServesARadialMapOf1To100000) {
     }
   std::uint32_t deepest = 0;
   for (const QueryPoint& q : points) deepest = std::max(deepest, q.id.depth);
-  EXPECT_EQ(deepest, 4u);  // past 512 · 16^3 points per tile, depth-4 sub-points appear
+  EXPECT_EQ(deepest, 4u);  // past N_top · 16^3 points per tile, depth-4 sub-points appear
   // Counts in a band of N expected points spread by about √N (1/√200 = 7% for the smallest band tested,
   // under 0.3% for the largest); smooth mode moves points up to a spacing across band borders. Measured:
   // 0.982–1.023 (bands 0–7 within 0.3–0.9%; the last two, 659 and 413 points expected, within one √N).
@@ -195,11 +224,11 @@ TEST(DescentTest, OneQueryServesARadialMapOf1To100000) {
   }
 }
 
-TEST(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
+TEST_P(DescentTest, PartitionsAndResumedCallsGiveTheSameBits) {
   // A ramp (every point through the general loop) and a constant density (subtiles inside the region emit
   // their own points through a loop of their own, those cut by a border through the general one).
   for (const bool constant : {false, true}) {
-    QueryParams p = uniform(0, 512.0 * 40);
+    QueryParams p = uniform(0, top() * 40);
     p.x0 = 0.3, p.y0 = -0.2, p.x1 = 1.1, p.y1 = 0.45;
     p.origin_x = 0.25, p.origin_y = 0.125;
     if (!constant)
@@ -233,12 +262,13 @@ double three_quarters(void*, double, double) {
   return 0.75;
 }
 
-TEST(DescentTest, AConstantCallbackGivesTheConstantDensitysBitsAtEveryDepth) {
+TEST_P(DescentTest, AConstantCallbackGivesTheConstantDensitysBitsAtEveryDepth) {
   // A varying density's loops (each point's own count, batched, and culled beside the region) and a
   // constant density's (one count and bracket per tile) meet the same counts here, so they must emit the
   // same points, ids and position bits: at depths 0 to 3, through a small buffer. (A tile the region cuts
   // may give them in another order: whether it goes cell by cell is decided by the density's glide reach.)
-  for (const double per_tile : {400.0, 512.0 * 16 * 3, 512.0 * 256 * 2.2, 512.0 * 4096 * 1.3}) {
+  for (const double n : {0.78, 16.0 * 3, 256 * 2.2, 4096 * 1.3}) {
+    const double per_tile = n * top();
     QueryParams p = uniform(0, per_tile / 0.75);
     const double side = std::sqrt(9000 / per_tile);
     p.x0 = 0.37, p.y0 = -0.61, p.x1 = p.x0 + side, p.y1 = p.y0 + side * 0.7;
@@ -261,11 +291,11 @@ TEST(DescentTest, AConstantCallbackGivesTheConstantDensitysBitsAtEveryDepth) {
   }
 }
 
-TEST(DescentTest, PartitionsFarFromTheWorldOriginAtDepthFourKeepEveryPoint) {
+TEST_P(DescentTest, PartitionsFarFromTheWorldOriginAtDepthFourKeepEveryPoint) {
   // Depth 4 at 10^11 world units, where a coordinate's rounding (2^-20 ≈ 1e-6) spans many of a subtile's
   // position units (1/65536 of its side, 6e-8): the subtiles beside a cut, which pass over the points that
   // cannot glide into their part, still emit every point of the whole once.
-  const double far = 1e11, per_tile = 512.0 * 65536 * 0.9;
+  const double far = 1e11, per_tile = top() * 65536 * 0.9;
   QueryParams p = uniform(0, per_tile);
   p.x0 = p.origin_x = far, p.y0 = p.origin_y = -far;
   p.x1 = far + 1.0 / 32, p.y1 = -far + 1.0 / 64;
@@ -312,13 +342,14 @@ std::vector<Bits> sorted_bits(const std::vector<QueryPoint>& points) {
   return out;
 }
 
-TEST(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThree) {
-  // Depths 0, 1 and 3 of the small set (m = 4: depth d's points appear past 512 · 16^(d-1) points per
+TEST_P(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThree) {
+  // Depths 0, 1 and 3 of the small set (m = 4: depth d's points appear past N_top · 16^(d-1) points per
   // tile), at the origin and 10^9 units from it, for a constant density, a callback and an image: a random
   // grid of cuts, the parts queried through a small buffer, gives the whole region's points bit for bit,
   // and four threads querying at once give a single thread's.
   std::mt19937 rng(7);
-  for (const double per_tile : {400.0, 512.0 * 9, 512.0 * 256 * 5}) {
+  for (const double n : {0.78, 9.0, 256.0 * 5}) {
+    const double per_tile = n * top();
     for (const double offset : {0.0, 1e9}) {
       const double side = std::sqrt(12000 / per_tile);
       QueryParams p = uniform(0, per_tile);
@@ -335,7 +366,7 @@ TEST(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThr
         ASSERT_GT(expected.size(), 3000u) << what;
         std::uint32_t deepest = 0;
         for (const QueryPoint& q : all) deepest = std::max(deepest, q.id.depth);
-        EXPECT_EQ(deepest, per_tile < 512 ? 0u : per_tile < 512 * 16 ? 1u : 3u) << what;
+        EXPECT_EQ(deepest, n < 1 ? 0u : n < 16 ? 1u : 3u) << what;
         std::vector<QueryPoint> parts;
         for (const QueryParams& part : testing::random_grid_parts(whole, 3, rng)) {
           const std::vector<QueryPoint> got = query(part, 61);
@@ -356,12 +387,12 @@ TEST(DescentTest, RandomPartitionsAndThreadsGiveTheSameBitsAtDepthsZeroOneAndThr
   }
 }
 
-TEST(DescentTest, RaisingTheScaleThroughDepthFourKeepsEveryPoint) {
-  // Zoom coherence from depth 3 into depth 4 (whose points appear past 512 · 16^3 points per tile; here
+TEST_P(DescentTest, RaisingTheScaleThroughDepthFourKeepsEveryPoint) {
+  // Zoom coherence from depth 3 into depth 4 (whose points appear past N_top · 16^3 points per tile; here
   // 0.7 to 2.5 times that, ×1.1 a step) on a fixed region, for a constant density and a callback: every
   // id emitted at one scale at least two spacings inside the region (a point glides less than one per
   // step) is emitted at the next.
-  const double first = 512.0 * 4096 * 0.7, last = 512.0 * 4096 * 2.5;
+  const double first = top() * 4096 * 0.7, last = top() * 4096 * 2.5;
   QueryParams p = uniform(0, first);
   p.x0 = 0.4, p.y0 = 0.2, p.x1 = p.x0 + std::sqrt(3000 / first), p.y1 = p.y0 + std::sqrt(3000 / first);
   for (const bool constant : {true, false}) {
@@ -388,12 +419,12 @@ TEST(DescentTest, RaisingTheScaleThroughDepthFourKeepsEveryPoint) {
   }
 }
 
-TEST(DescentTest, BelowTheTopTheDescentGivesTheOrdinaryPathsBits) {
-  // The same density (a ramp up to 1, 400 points per tile at most, below N_top = 512) with a bound of 1
+TEST_P(DescentTest, BelowTheTopTheDescentGivesTheOrdinaryPathsBits) {
+  // The same density (a ramp up to 1, 0.78 N_top points per tile at most) with a bound of 1
   // (every tile takes the ordinary path) and of 50 (every tile takes the descent, which emits the same
   // points: none is past N_top): the same points, ids and position bits (in id order: the ordinary path
   // gives a tile the region meets a small part of cell by cell, the descent in rank order).
-  QueryParams p = uniform(0, 400);
+  QueryParams p = uniform(0, 0.78 * top());
   p.x0 = -1.3, p.y0 = 0.2, p.x1 = 2.1, p.y1 = 1.9, p.origin_x = 0.6, p.origin_y = -0.3;
   p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
   auto by_id = [](std::vector<QueryPoint> points) {
@@ -413,9 +444,9 @@ TEST(DescentTest, BelowTheTopTheDescentGivesTheOrdinaryPathsBits) {
   }
 }
 
-TEST(DescentTest, DeepQueriesAllocateNothing) {
+TEST_P(DescentTest, DeepQueriesAllocateNothing) {
   const Tileset& t = small_set();  // baked and loaded outside the measured window
-  QueryParams p = uniform(0.2, 512.0 * 16 * 40);
+  QueryParams p = uniform(0.2, top() * 16 * 40);
   p.density.kind = QueryDensity::Kind::kCallback, p.density.callback = ramp, p.density.callback_max = 1;
   std::vector<QueryPoint> buffer(64);  // small: the cursor resumes inside subtiles
   const long before = testing::allocations();
@@ -428,13 +459,13 @@ TEST(DescentTest, DeepQueriesAllocateNothing) {
   EXPECT_GT(total, 2000u);  // about 3,750 points, down to depth 3
 }
 
-TEST(DescentTest, PositionsFarFromTheWorldOriginKeepTheirPrecision) {
+TEST_P(DescentTest, PositionsFarFromTheWorldOriginKeepTheirPrecision) {
   // At 10^12 world units a double's step is 2^-13 ≈ 1.2e-4, about the spacing at depth 4 here: positions
   // summed in world units would land on that grid. Relative to the origin they do not.
-  const double far = 1e12, per_tile = 512.0 * 65536 * 0.9;
+  const double far = 1e12, per_tile = top() * 65536 * 0.9;
   QueryParams p = uniform(0, per_tile);
   p.x0 = p.origin_x = far, p.y0 = p.origin_y = far;
-  p.x1 = p.y1 = far + 1.0 / 64;
+  p.x1 = p.y1 = far + std::sqrt(512 / top()) / 64;  // about 7,000 points
   const std::vector<QueryPoint> points = query(p);
   ASSERT_GT(points.size(), 5000u);
   std::size_t off_grid = 0;

@@ -25,18 +25,40 @@ struct Baked {
   Subdivision sub;
 };
 
-const Baked& small_set() {
-  static const Baked baked = [] {
-    BakeRecipe r;
-    r.levels = 3, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
-    r.handover_zone = 1;
-    Baked b;
-    b.set = bake_tileset(r, 2);
-    b.sub = b.set.subdivision();
-    return b;
-  }();
-  return baked;
+/// A small set whose hand-over goes onto its subtiles' level `level`, with 4×4 subtiles per tile.
+Baked bake_small_set(std::uint32_t level) {
+  BakeRecipe r;
+  r.levels = 3 + level, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
+  r.handover_zone = 1, r.handover_level = level;
+  Baked b;
+  b.set = bake_tileset(r, 2);
+  b.sub = b.set.subdivision();
+  return b;
 }
+
+/// The set the running test judges (HandoverTest::SetUp), each baked once.
+const Baked* current_set = nullptr;
+const Baked& small_set() {
+  return *current_set;
+}
+
+class HandoverTest : public ::testing::TestWithParam<std::uint32_t> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == 0) {
+      static const Baked level0 = bake_small_set(0);
+      current_set = &level0;
+    } else {
+      static const Baked level1 = bake_small_set(1);
+      current_set = &level1;
+    }
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(HandoverLevel, HandoverTest, ::testing::Values(0u, 1u),
+                         [](const ::testing::TestParamInfo<std::uint32_t>& i) {
+                           return "OntoLevel" + std::to_string(i.param);
+                         });
 
 /// The sub-point (j << 16 | q) that rank r of tile t glides onto, decoded from the file's encoding.
 std::uint32_t target(const Baked& b, std::size_t t, std::uint32_t r) {
@@ -56,17 +78,18 @@ std::pair<double, double> at_keyframe(const TilesetData& set, const Tile& tile, 
           tile.points[rank].unit_y() + tile.glide[at + 2 * rank + 1] * set.glide_unit(g)};
 }
 
-/// The tile shown by subtile j of tile t, and the sub-point's position at keyframe 1 in t's units.
+/// The tile shown by subtile j of tile t, and the sub-point's position at the hand-over keyframe in t's
+/// units.
 std::size_t subtile_type(const Baked& b, std::size_t t, std::uint32_t j) {
   return b.set.subtile_index(t, j % b.sub.m, j / b.sub.m);
 }
 std::pair<double, double> sub_position(const Baked& b, std::size_t t, std::uint32_t packed) {
   const std::uint32_t j = packed >> 16, q = packed & 0xFFFF;
-  const auto [x, y] = at_keyframe(b.set, b.set.tiles[subtile_type(b, t, j)], 1, q);
+  const auto [x, y] = at_keyframe(b.set, b.set.tiles[subtile_type(b, t, j)], b.set.handover_keyframe(), q);
   return {(j % b.sub.m + x) / b.sub.m, (j / b.sub.m + y) / b.sub.m};
 }
 
-TEST(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
+TEST_P(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
   const Baked& b = small_set();
   ASSERT_EQ(b.sub.m, 4u);
   for (std::size_t t = 0; t < b.set.tiles.size(); ++t) {
@@ -79,12 +102,12 @@ TEST(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
     std::set<std::uint32_t> seen;
     std::size_t sub_points = 0;
     for (std::uint32_t j = 0; j < b.sub.m * b.sub.m; ++j)
-      sub_points += b.set.points_at_keyframe(b.set.tiles[subtile_type(b, t, j)], 1);
+      sub_points += b.set.points_at_keyframe(b.set.tiles[subtile_type(b, t, j)], b.set.handover_keyframe());
     for (const std::vector<std::uint32_t>* list : {&targets, &appearing})
       for (std::uint32_t packed : *list) {
         const std::uint32_t j = packed >> 16, q = packed & 0xFFFF;
         ASSERT_LT(j, b.sub.m * b.sub.m);
-        ASSERT_LT(q, b.set.points_at_keyframe(b.set.tiles[subtile_type(b, t, j)], 1));
+        ASSERT_LT(q, b.set.points_at_keyframe(b.set.tiles[subtile_type(b, t, j)], b.set.handover_keyframe()));
         EXPECT_TRUE(seen.insert(packed).second) << "tile " << t << " sub-point " << j << "/" << q << " twice";
       }
     EXPECT_EQ(seen.size(), sub_points) << "tile " << t;
@@ -92,7 +115,7 @@ TEST(HandoverTest, EverySubPointIsTakenOnceOrAppears) {
   }
 }
 
-TEST(HandoverTest, PointsGlideOnlyAFewSpacings) {
+TEST_P(HandoverTest, PointsGlideOnlyAFewSpacings) {
   // In top square-grid spacings 1/√N_top. Measured: at most 1.09, mean 0.34 (8,185 points; on the
   // built-in recipe with handover_zone 3: 1.66, 0.40, the longest from points the top keyframe moved
   // past their tile's edge); bars with room for another seed, not for a matching that strays.
@@ -111,7 +134,7 @@ TEST(HandoverTest, PointsGlideOnlyAFewSpacings) {
   EXPECT_LT(sum / n, 0.5);
 }
 
-/// How many of tile t's appearing sub-points appear (at their thresholds, evenly over (N_top, m² K_1] in
+/// How many of tile t's appearing sub-points appear (at their thresholds, evenly over (N_top, m² K_h] in
 /// `order`) within `clearance` (tile units) of one of the tile's gliders, each on its straight path at the
 /// runtime's pace (TilesetShape::handover_end of its length).
 std::size_t appearing_on_paths(const Baked& b, std::size_t t, const std::vector<std::uint32_t>& order,
@@ -139,7 +162,7 @@ std::size_t appearing_on_paths(const Baked& b, std::size_t t, const std::vector<
   return found;
 }
 
-TEST(HandoverTest, SubPointsAppearWhereTheGlidersHaveLeft) {
+TEST_P(HandoverTest, SubPointsAppearWhereTheGlidersHaveLeft) {
   // A sub-point appearing on a glider's path is a close pair until the glider has passed, so each slot
   // takes a sub-point the gliders have cleared by half a d_hex where one is left. Measured on this set:
   // 58 of 3,241 appearing sub-points within 0.5 d_hex of a glider of their own tile (slots none could
@@ -159,7 +182,7 @@ TEST(HandoverTest, SubPointsAppearWhereTheGlidersHaveLeft) {
   EXPECT_GT(reversed, 3 * ordered) << reversed << " against " << ordered;
 }
 
-TEST(HandoverTest, GlidesMeetOnlyWhereBothAreThereAtOnce) {
+TEST_P(HandoverTest, GlidesMeetOnlyWhereBothAreThereAtOnce) {
   // Glides in tile 0 of the small set, past a top of 1,000 points per tile, 0.01 tile sides apart at the
   // least: paths that cross meet only if both reach the crossing at the same count.
   const Baked& b = small_set();
@@ -182,13 +205,15 @@ TEST(HandoverTest, GlidesMeetOnlyWhereBothAreThereAtOnce) {
   EXPECT_EQ(clear[1], top);  // never near it
 }
 
-TEST(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
+TEST_P(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
   const Baked& b = small_set();
   std::vector<std::uint8_t> bytes;
   ASSERT_EQ(encode_tileset(b.set, bytes), Status::kOk);
   TilesetHeader header;
   ASSERT_EQ(read_tileset_header(bytes.data(), bytes.size(), header), Status::kOk);
-  EXPECT_EQ(header.format_version, kTilesetFormatVersion);
+  // Format 5 for a hand-over onto level 0, so that older readers still read such sets; 6 for one onto a
+  // finer level, which names it.
+  EXPECT_EQ(header.format_version, b.set.handover_level ? 6u : 5u);
   TilesetData back;
   ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
   EXPECT_TRUE(back == b.set);
@@ -218,9 +243,16 @@ TEST(HandoverTest, TablesSurviveTheFileAndADamagedOneIsRefused) {
   TilesetData plain = b.set;  // tables without a hand-over
   plain.handover_zone = 0;
   EXPECT_EQ(validate_tileset(plain, &detail), Status::kInvalidContent);
+  TilesetData top = b.set;  // a hand-over onto the top level itself
+  top.handover_level = top.levels - 1;
+  EXPECT_EQ(validate_tileset(top, &detail), Status::kInvalidContent);
+  EXPECT_NE(detail.find("not below the top level"), std::string::npos) << detail;
+  TilesetData other = b.set;  // tables planned for another level: counts and ranks no longer agree
+  other.handover_level = b.set.handover_level ? 0 : 1;
+  EXPECT_EQ(validate_tileset(other, &detail), Status::kInvalidContent);
 }
 
-TEST(HandoverTest, TheVerifierJudgesTheHandOverAlongItsPaths) {
+TEST_P(HandoverTest, TheVerifierJudgesTheHandOverAlongItsPaths) {
   // Part 6 of kdm verify: four rows evenly spaced from just past the top level to where 99% of the points
   // are their subtiles' (each glide ends at TilesetShape::handover_end of its length), the last with the
   // glides' motion per top keyframe interval. The set is baked with few sweeps and keyframes, so δavg is
@@ -252,7 +284,7 @@ TEST(HandoverTest, TheVerifierJudgesTheHandOverAlongItsPaths) {
   EXPECT_TRUE(std::isnan(rows[0]->motion_p99));
 }
 
-TEST(HandoverTest, RecipesNameTheZonesTheyCanHave) {
+TEST(HandoverRecipeTest, RecipesNameTheZonesAndLevelsTheyCanHave) {
   BakeRecipe r = BakeRecipe::parse("levels 3\nkeyframes 4\nhandover_zone 1\n");
   EXPECT_EQ(r.handover_zone, 1u);
   EXPECT_EQ(BakeRecipe::parse(r.to_text()).handover_zone, 1u);
@@ -261,6 +293,21 @@ TEST(HandoverTest, RecipesNameTheZonesTheyCanHave) {
   EXPECT_EQ(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 3\n").handover_zone, 3u);
   EXPECT_EQ(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 15\n").handover_zone, 15u);
   EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 16\n"), InvalidArgument);  // 33 ≥ 32
+  // Onto level j: m = 2^(levels - 1 - j) subtiles per side.
+  r = BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 2\nhandover_level 2\n");
+  EXPECT_EQ(r.handover_level, 2u);
+  EXPECT_EQ(BakeRecipe::parse(r.to_text()).handover_level, 2u);
+  EXPECT_EQ(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 3\n").to_text().find("handover_level"),
+            std::string::npos);  // written only when set, so older recipes keep their bytes
+  EXPECT_EQ(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 3\nhandover_level 2\n").handover_zone,
+            3u);  // 2·3+1 < 8
+  EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 4\nhandover_level 2\n"),
+               InvalidArgument);  // 2·4+1 ≥ 8
+  EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 1\nhandover_level 4\n"),
+               InvalidArgument);  // 2 subtiles per side
+  EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_zone 1\nhandover_level 5\n"),
+               InvalidArgument);  // the top level itself
+  EXPECT_THROW(BakeRecipe::parse("levels 6\nkeyframes 4\nhandover_level 1\n"), InvalidArgument);  // no zone
 }
 
 }  // namespace

@@ -26,6 +26,8 @@ def test_builtin_info():
     assert info["max_points_per_tile"] == info["level_points"][-1]
     assert info["tiles"] == info["colours"] ** 4 and info["keyframes"][-1] == info["max_points_per_tile"]
     assert info["smooth_limit_per_tile"] == info["max_points_per_tile"] * max(info["subtiles_per_side"], 1) ** 8
+    m = info["subtiles_per_side"]
+    assert m == 0 or info["level_points"][info["handover_level"]] * m * m == info["max_points_per_tile"]
     assert "seed" in info["recipe"] and info["resident_bytes"] > 0
     assert kdm.Tileset.builtin() is BUILTIN
 

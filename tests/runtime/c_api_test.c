@@ -153,6 +153,9 @@ int main(int argc, char** argv) {
     CHECK(info.subtiles_per_side == 0
               ? info.smooth_limit_per_tile == 32768.0
               : info.smooth_limit_per_tile == 32768.0 * pow(info.subtiles_per_side, 8));
+    /* m subtiles per side hold at their hand-over level as many points as the tile's top level. */
+    CHECK(info.subtiles_per_side == 0 ||
+          info.level_points[info.handover_level] * info.subtiles_per_side * info.subtiles_per_side == 32768);
     CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
     CHECK(strchr(kdm_version(), '.') != NULL);
   }

@@ -104,9 +104,10 @@ void run_info(const std::string& path) {
         loaded.glide_reach());
   if (set.handover_zone)
     std::printf(
-        "hand-over      onto %u x %u subtiles past the top level (zones of %u sub-steps; smooth queries "
-        "descend)\n",
-        set.subtiles_per_side(), set.subtiles_per_side(), set.handover_zone);
+        "hand-over      onto %u x %u subtiles past the top level, at their first keyframe above level %u "
+        "(%u points per tile; zones of %u sub-steps; smooth queries descend)\n",
+        set.subtiles_per_side(), set.subtiles_per_side(), set.handover_level,
+        set.keyframe_nominal[set.handover_keyframe()], set.handover_zone);
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());
@@ -125,7 +126,7 @@ void add_tile_commands(CLI::App& app) {
                    "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
                    "separation_push, split_shared, separation_fill, separation_per_level, fill_holes, "
                    "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_corner_consensus, "
-                   "glide_late, handover_zone)")
+                   "glide_late, handover_zone, handover_level)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   add_threads_option(bake, *threads, "the file does not depend on it");

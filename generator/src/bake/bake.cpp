@@ -123,6 +123,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.keyframes_per_level = static_cast<std::uint32_t>(whole(0, 32));
     } else if (key == "handover_zone") {
       r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
+    } else if (key == "handover_level") {
+      r.handover_level = static_cast<std::uint32_t>(whole(0, 7));
     } else if (key == "glide_consensus") {
       r.glide_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
     } else if (key == "glide_corner_consensus") {
@@ -150,20 +152,27 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
                   unsigned(r.base_points), r.band, r.erosion, r.edge_gap);
     throw InvalidArgument(text);
   }
+  if (r.handover_level && !r.handover_zone)
+    throw InvalidArgument("recipe: handover_level needs handover_zone (a hand-over)");
   if (r.handover_zone) {
-    const std::uint32_t m = 1u << (r.levels - 1);  // √(N_top / N_0)
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
       throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
+    if (r.handover_level + 1 >= r.levels)
+      throw InvalidArgument("recipe: handover_level " + std::to_string(r.handover_level) +
+                            " must be below the top level (" + std::to_string(r.levels - 1) + ")");
+    const std::uint32_t m = 1u << (r.levels - 1 - r.handover_level);  // √(N_top / N_j)
     // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side), which
-    // 2 levels' 2 subtiles per side cannot give for any zone.
+    // 2 subtiles per side cannot give for any zone.
     if (m < 4)
-      throw InvalidArgument("recipe: handover_zone needs at least 3 levels: " + std::to_string(r.levels) +
-                            " levels give " + std::to_string(m) +
-                            " subtiles per side, too few for a zone of 1 (2 * zone + 1 must be below it)");
+      throw InvalidArgument(
+          "recipe: handover_zone needs at least " + std::to_string(r.handover_level + 3) + " levels" +
+          (r.handover_level ? " with handover_level " + std::to_string(r.handover_level) : std::string()) +
+          ": " + std::to_string(r.levels) + " levels give " + std::to_string(m) +
+          " subtiles per side, too few for a zone of 1 (2 * zone + 1 must be below it)");
     if (2 * r.handover_zone + 1 >= m)
       throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) + "] for " +
-                            std::to_string(r.levels) + " levels (" + std::to_string(m) +
-                            " subtiles per side)");
+                            std::to_string(m) + " subtiles per side (levels " + std::to_string(r.levels) +
+                            ", handover_level " + std::to_string(r.handover_level) + ")");
   }
   return r;
 }
@@ -195,6 +204,7 @@ std::string BakeRecipe::to_text() const {
   if (glide_corner_consensus) s << "glide_corner_consensus " << glide_corner_consensus << "\n";
   if (glide_late > 0) s << "glide_late " << shortest(glide_late) << "\n";
   if (handover_zone) s << "handover_zone " << handover_zone << "\n";
+  if (handover_level) s << "handover_level " << handover_level << "\n";
   return s.str();
 }
 
@@ -254,7 +264,7 @@ class Baker {
     const SeparationResult glides =
         drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation, recipe_.split_shared);
     report.glide_removed = glides.removed, report.glide_split = glides.split;
-    shape_.handover_zone = recipe_.handover_zone;
+    shape_.handover_zone = recipe_.handover_zone, shape_.handover_level = recipe_.handover_level;
     TilesetData set = assemble();
     if (set.handover_zone) add_handover(set);
     return set;

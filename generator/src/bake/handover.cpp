@@ -85,7 +85,7 @@ std::vector<std::uint32_t> match(const std::vector<double>& rows, const std::vec
 /// One tile's sub-points and which of them each of its points glides onto.
 struct Matched {
   std::vector<double> start;          ///< per rank: the top keyframe's position (x y pairs, tile units)
-  std::vector<double> columns;        ///< the sub-points at their keyframe 1 (x y pairs, tile units)
+  std::vector<double> columns;        ///< the sub-points at the hand-over keyframe (x y pairs, tile units)
   std::vector<std::uint32_t> packed;  ///< the same, packed as TileHandover's
   std::vector<std::uint32_t> column;  ///< per rank: its sub-point
 };
@@ -93,6 +93,7 @@ struct Matched {
 Matched match_tile(const TilesetData& set, std::size_t t) {
   const Subdivision sub = set.subdivision();
   const std::uint32_t m = sub.m;
+  const std::size_t h = set.handover_keyframe();
   const double top = set.level_nominal.back();
   const Tile& tile = set.tiles[t];
   Matched out;
@@ -101,8 +102,8 @@ Matched match_tile(const TilesetData& set, std::size_t t) {
   for (std::uint32_t k = 0; k < m; ++k)
     for (std::uint32_t i = 0; i < m; ++i) {
       const Tile& child = set.tiles[set.subtile_index(t, i, k)];
-      const std::uint32_t present = set.points_at_keyframe(child, 1);
-      const std::vector<double> xy = keyframe_positions(set, child, 1, present);
+      const std::uint32_t present = set.points_at_keyframe(child, h);
+      const std::vector<double> xy = keyframe_positions(set, child, h, present);
       for (std::uint32_t q = 0; q < present; ++q) {
         out.columns.insert(out.columns.end(), {(i + xy[2 * q]) / m, (k + xy[2 * q + 1]) / m});
         out.packed.push_back((k * m + i) << 16 | q);
@@ -185,7 +186,7 @@ void untangle(const TilesetData& set, std::vector<Matched>& matched, std::vector
 }
 
 /// The order tile t's leftover sub-points appear in: a void-and-cluster order among the taken ones, then
-/// each slot (thresholds evenly over (N_top, m² K_1]) takes the first in that order whose place every
+/// each slot (thresholds evenly over (N_top, m² K_h]) takes the first in that order whose place every
 /// glide that can pass near it has cleared.
 std::vector<std::uint32_t> appearing_order(const TilesetData& set, const std::vector<Matched>& matched,
                                            const std::vector<std::vector<Glide>>& glides, std::size_t t) {

@@ -1,7 +1,8 @@
 // The hand-over between depths (docs/design.md §3, "Unbounded zoom"): past the top keyframe every point of
 // a tile glides onto a point of one of its m×m subtiles (tiles of the same set at 1/m the size, laid out
-// by kdm/runtime/subdivision.h) as they stand at keyframe 1, the first past their level 0; the sub-points
-// no point takes appear on the way. Each tile's points are matched to its own sub-points as one whole,
+// by kdm/runtime/subdivision.h) as they stand at the hand-over keyframe h, the first past their level j
+// (TilesetShape::handover_level); the sub-points no point takes appear on the way. Each tile's points are
+// matched to its own sub-points as one whole,
 // least total squared distance: straight paths of such a matching, travelled in step, never meet (the
 // displacement interpolation of optimal transport), and the tile's whole surplus of sub-points is there
 // for a point wherever it lies. The sub-points left over appear in an order that lets the gliders around
@@ -26,7 +27,7 @@ struct TileHandover {
 
 /// Plans the hand-over of every tile of `set`, whose levels, glide track and handover_zone are final (its
 /// hand-over tables are not read). Positions are the file's (quantised), as the runtime shows them.
-/// Throws std::runtime_error if a tile's subtiles hold fewer points at keyframe 1 than the tile holds.
+/// Throws std::runtime_error if a tile's subtiles hold fewer points at keyframe h than the tile holds.
 std::vector<TileHandover> plan_handover(const TilesetData& set);
 
 }  // namespace kdm::gen

@@ -129,12 +129,13 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
   const std::size_t top = set.keyframe_nominal.size() - 1;
   const Subdivision sub = set.subdivision();
   const std::uint32_t m = sub.m;
-  const double n_top = set.level_nominal.back(), k1 = set.keyframe_nominal[1];
+  const std::size_t h = set.handover_keyframe();
+  const double n_top = set.level_nominal.back(), kh = set.keyframe_nominal[h];
   const double appearing_end = set.appearing_end(), top_step = n_top / set.keyframe_nominal[top - 1];
-  TilePositions start(set.tiles.size()), keyframe_one(set.tiles.size());
+  TilePositions start(set.tiles.size()), at_handover(set.tiles.size());
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     start[t] = glided(set, t, std::numeric_limits<double>::infinity(), top, top, 0);
-    keyframe_one[t] = glided(set, t, k1, 1, 1, 0);
+    at_handover[t] = glided(set, t, kh, h, h, 0);
   }
   // Each tile's points (rank order) as the sub-point each glides onto (subtile, rank) and the count where
   // its subtile takes it over, and its appearing sub-points.
@@ -155,8 +156,8 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
       SubRef q{TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2,
                TilesetShape::subtile_of(tile.points[r].y, m) + d / 5 - 2, v / 25, 0};
       q.type = subtiles[t][q.k * m + q.i];
-      const double gx = (q.i + keyframe_one[q.type][2 * q.rank]) / m - start[t][2 * r],
-                   gy = (q.k + keyframe_one[q.type][2 * q.rank + 1]) / m - start[t][2 * r + 1];
+      const double gx = (q.i + at_handover[q.type][2 * q.rank]) / m - start[t][2 * r],
+                   gy = (q.k + at_handover[q.type][2 * q.rank + 1]) / m - start[t][2 * r + 1];
       const double glide = std::hypot(gx, gy) * std::sqrt(n_top);  // as the runtime's tables
       q.end = set.handover_end(glide);
       ends.push_back(q.end);
@@ -177,9 +178,9 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
     row.keyframe = false;
     row.handover = true;
     row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
-    // The subtiles' points at their count, on their glide track (at keyframe 1 until it passes K_1).
-    const double count = std::max(k1, row.points_per_tile / (double(m) * m));
-    std::size_t g0 = 1;
+    // The subtiles' points at their count, on their glide track (at keyframe h until it passes K_h).
+    const double count = std::max(kh, row.points_per_tile / (double(m) * m));
+    std::size_t g0 = h;
     while (g0 + 1 < top && set.keyframe_nominal[g0 + 1] <= count) ++g0;
     const double w = std::clamp(
         (count - set.keyframe_nominal[g0]) / (set.keyframe_nominal[g0 + 1] - set.keyframe_nominal[g0]), 0.0,
@@ -199,15 +200,15 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
                                    start[t][2 * i + 1] + f * (y - start[t][2 * i + 1])});
       }
       const std::size_t n = appearing[t].size();
-      for (std::size_t a = 0; a < n; ++a)  // thresholds spread evenly over (N_top, m² K_1], in table order
+      for (std::size_t a = 0; a < n; ++a)  // thresholds spread evenly over (N_top, m² K_h], in table order
         if (row.points_per_tile > n_top + (double(a) + 0.5) / double(n) * (appearing_end - n_top)) {
           place(appearing[t][a], x, y);
           at[t].insert(at[t].end(), {x, y});
         }
-      // The subtiles' own points past keyframe 1, present once their count passes K_1.
+      // The subtiles' own points past keyframe h, present once their count passes K_h.
       for (std::uint32_t j = 0; j < m * m; ++j) {
         const std::size_t type = subtiles[t][j];
-        for (std::size_t q = set.points_at_keyframe(set.tiles[type], 1); 2 * q < sub_at[type].size(); ++q)
+        for (std::size_t q = set.points_at_keyframe(set.tiles[type], h); 2 * q < sub_at[type].size(); ++q)
           at[t].insert(at[t].end(),
                        {(j % m + sub_at[type][2 * q]) / m, (j / m + sub_at[type][2 * q + 1]) / m});
       }

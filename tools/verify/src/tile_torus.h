@@ -102,9 +102,9 @@ void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Repor
 /// Part 6 (glide.cpp), sets with a hand-over: appends a KeyframeResult (handover set) for a quarter, half,
 /// three quarters and all of the way from the top keyframe to where the subtiles have taken 99% of the
 /// points over, as the runtime places them: each point on its straight path onto its sub-point (which
-/// glides with its subtile's count once that passes K_1) by the end its glide sets, the appearing points
-/// in at evenly spread thresholds, the subtiles' own points by theirs; the last with the glides' motion per
-/// top keyframe interval of the scale they span.
+/// glides with its subtile's count once that passes K_h, the hand-over keyframe's count) by the end its glide
+/// sets, the appearing points in at evenly spread thresholds, the subtiles' own points by theirs; the last
+/// with the glides' motion per top keyframe interval of the scale they span.
 void judge_handover(const TilesetData& set, const VerifyOptions& options, Report& report,
                     const std::function<void(double)>& done);
 

@@ -102,10 +102,14 @@ struct BakeRecipe {
   /// instead of leaving an empty place for it before (keyframes.h). 0 (off) in recipes that do not name it.
   double glide_late = 0;
   /// The hand-over between depths (bake/handover.h): the half-width, in subtile sides, of the corner
-  /// squares and edge bands whose sub-vertices take their colours from that corner or edge alone; at
-  /// least the top level's corner patch half-width (an error names the least). 0 (off, recipes that do
-  /// not name it): the set ends at its top level. Needs a glide track.
+  /// squares and edge bands whose sub-vertices take their colours from that corner or edge alone, with
+  /// 2 · zone + 1 below the subtiles per side (an error names the range). 0 (off, recipes that do not
+  /// name it): the set ends at its top level. Needs a glide track.
   std::uint32_t handover_zone = 0;
+  /// The subtiles' level j the hand-over glides onto: m = √(N_top / N_j) subtiles per side, and a depth's
+  /// subtiles never show fewer points than their first keyframe above N_j (levels 0..j are not shown past
+  /// depth 0). 0 in recipes that do not name it. Needs handover_zone.
+  std::uint32_t handover_level = 0;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).

@@ -139,6 +139,8 @@ typedef struct kdm_tileset_info {
   /* Added in 0.3: */
   uint32_t subtiles_per_side;   /* m of its hand-over to subtiles past the top level (0: none) */
   double smooth_limit_per_tile; /* the densest smooth query (max_points_per_tile * m^8 with a hand-over) */
+  /* Added in 0.4: */
+  uint32_t handover_level; /* the subtiles' level its hand-over glides onto (m^2 * its count = the top's) */
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`

@@ -112,22 +112,35 @@ struct TilesetShape {
   /// The hand-over's corner squares and edge bands, in sub-steps (kdm/runtime/subdivision.h); 0: the set
   /// has no hand-over, and no density beyond its top level.
   std::uint32_t handover_zone = 0;
+  /// The level j of the subtiles the hand-over glides onto (format 6; 0 in older files): a depth's
+  /// subtiles then never show fewer points than their first keyframe above N_j.
+  std::uint32_t handover_level = 0;
 
-  /// Subtiles per tile side in the hand-over: m with m² · N_0 = N_top (0 if there is no such integer).
+  /// Subtiles per tile side in the hand-over: m with m² · N_j = N_top, j = handover_level (0 if there is
+  /// no such integer).
   std::uint32_t subtiles_per_side() const {
-    if (level_nominal.empty()) return 0;
-    const auto m =
-        static_cast<std::uint32_t>(std::lround(std::sqrt(double(level_nominal.back()) / level_nominal[0])));
-    return std::uint64_t(m) * m * level_nominal[0] == level_nominal.back() ? m : 0;
+    if (handover_level + 1 >= level_nominal.size()) return 0;
+    const std::uint32_t n_j = level_nominal[handover_level];
+    const auto m = static_cast<std::uint32_t>(std::lround(std::sqrt(double(level_nominal.back()) / n_j)));
+    return std::uint64_t(m) * m * n_j == level_nominal.back() ? m : 0;
   }
   Subdivision subdivision() const { return {colours, subtiles_per_side(), handover_zone}; }
+  /// The hand-over keyframe h: the subtiles' first keyframe above N_j, where they stand when a point
+  /// glides onto them (1 for j = 0); their points present there are the ones their parent hands over.
+  std::size_t handover_keyframe() const {
+    if (handover_level >= level_nominal.size()) return 1;
+    const auto* k = keyframe_nominal.data();
+    const auto above = std::upper_bound(k, k + keyframe_nominal.size(), level_nominal[handover_level]) - k;
+    return std::max<std::size_t>(1, static_cast<std::size_t>(above));
+  }
   /// The hand-over past the top level, in points per tile (docs/design.md §3, "Unbounded zoom"): the
-  /// sub-points no point glides onto have appeared by appearing_end() = m² K_1, and a point whose glide
-  /// onto its sub-point is `glide` square-grid spacings (1/√N_top) long is taken over by its subtile at
-  /// handover_end(glide), m² K_1 or later for a long glide.
+  /// sub-points no point glides onto have appeared by appearing_end() = m² K_h (h = handover_keyframe()),
+  /// and a point whose glide onto its sub-point is `glide` square-grid spacings (1/√N_top) long is taken
+  /// over by its subtile at handover_end(glide), m² K_h or later for a long glide.
   double appearing_end() const {
     const double m = subtiles_per_side();
-    return keyframe_nominal.size() < 2 ? 0.0 : m * m * keyframe_nominal[1];
+    const std::size_t h = handover_keyframe();
+    return h >= keyframe_nominal.size() ? 0.0 : m * m * keyframe_nominal[h];
   }
   /// A glide of `glide` spacings spans at least glide / kHandoverSpacingsPerKeyframe of the top keyframe
   /// intervals (its ratio of counts), so that no glide moves faster with the scale than the keyframes'
@@ -195,7 +208,8 @@ struct TilesetShape {
   }
   friend bool operator==(const TilesetShape& a, const TilesetShape& b) {
     return a.colours == b.colours && a.levels == b.levels && a.level_nominal == b.level_nominal &&
-           a.keyframe_nominal == b.keyframe_nominal && a.handover_zone == b.handover_zone;
+           a.keyframe_nominal == b.keyframe_nominal && a.handover_level == b.handover_level &&
+           a.handover_zone == b.handover_zone;
   }
 };
 
@@ -251,7 +265,7 @@ KDM_RUNTIME_API std::vector<std::vector<float>> coarsest_level_thresholds(const 
 KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 
 /// The format version encode_tileset writes `set` in: the oldest that holds it (4 for a set without a
-/// hand-over, so that format-4 readers keep reading it; else kTilesetFormatVersion).
+/// hand-over, 5 for one onto the subtiles' level 0, so that older readers keep reading them; else 6).
 KDM_RUNTIME_API std::uint32_t tileset_format_version_for(const TilesetShape& set);
 
 /// Encodes `set` into `out` (replaced). Returns kOk; kInvalidArgument if validate_tileset fails, the
