@@ -201,12 +201,21 @@ class Descent {
     const std::uint32_t from =
         t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
     if (from == QueryTables::kAppearing) return {expected > q_.kh, expected};
-    const TilePoint& point = set_.tiles[p.type].points[from];
-    const double side = q_.side[p.depth];  // as emit computes the parent's own count there
-    const Share parent = share(
-        k - 1, from, read(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth]);
-    return {parent.own && expected > q_.kh && parent.count > t_.handover_end[p.type][from],
-            std::min(expected, parent.count / (double(m_) * m_))};
+    // The parent's count at its point, as emit computes it there; a constant density's needs no position
+    // (the same value, without a load from the parent's points at a rank far from the last one).
+    double here;
+    if (q_.params->density.kind == QueryDensity::Kind::kConstant) {
+      here = density_or_zero(q_.params->density.constant) * q_.area[p.depth];
+    } else {
+      const TilePoint& point = set_.tiles[p.type].points[from];
+      const double side = q_.side[p.depth];
+      here = read(p.wx + point.unit_x() * side, p.wy + point.unit_y() * side) * q_.area[p.depth];
+    }
+    const Share parent = share(k - 1, from, here);
+    // Past the tile's latest hand-over end every point has ended its own: no lookup of it.
+    const bool ended =
+        parent.count > t_.handover_end_max[p.type] || parent.count > t_.handover_end[p.type][from];
+    return {parent.own && expected > q_.kh && ended, std::min(expected, parent.count / (double(m_) * m_))};
   }
 
   /// The id of rank `rank` of stack_[k]: a sub-point a point glided onto keeps that point's id.
@@ -326,6 +335,64 @@ class Descent {
     return write_unit(n, p.unit_x() + dx * (1.0 / 65536.0), p.unit_y() + dy * (1.0 / 65536.0), id_of(k, r));
   }
 
+  /// Which point of its parent each rank of stack_[k] (k > 0) is (QueryTables::inherited), by rank.
+  const std::uint32_t* inherited_row(int k) const {
+    const Node& p = stack_[k - 1];
+    return t_.inherited[p.type].data() + t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1];
+  }
+  static constexpr std::uint32_t kPrefetch = 16;
+  /// Starts loading what share reads of point `from` of the parent of stack_[k].
+  void prefetch_parent(int k, std::uint32_t from) const {
+    if (from == QueryTables::kAppearing) return;
+    const std::size_t type = stack_[k - 1].type;
+    __builtin_prefetch(set_.tiles[type].points.data() + from);
+    __builtin_prefetch(t_.handover_end[type].data() + from);
+  }
+  /// The count a constant density gives the parent of stack_[k] (k > 0), as share computes it there.
+  double parent_count(int k) const {
+    return density_or_zero(q_.params->density.constant) * q_.area[stack_[k - 1].depth];
+  }
+  /// Whether a constant density at `count` in subtile stack_[k] (k > 0) makes each of its inherited ranks
+  /// its own: its parent's count is past the end of every point's hand-over, and its own past K_h.
+  bool handed_over_whole(int k, double count) const {
+    return k > 0 && parent_count(k) > t_.handover_end_max[stack_[k - 1].type] && count > q_.kh;
+  }
+  /// A constant density's inherited ranks of subtile stack_[k] from L.seq to `end`, where
+  /// handed_over_whole: each is placed by one of two counts known here (share's, without its lookups of
+  /// the parent's points and ends) and keeps its parent point's id. Ranks inherited through more than
+  /// one depth go through visit. kDone, or the rank where the buffer or the budget ran out.
+  std::uint32_t emit_inherited(int k, const RankLoop& L, std::uint32_t end) {
+    const Node& n = *L.n;
+    const Node& p = stack_[k - 1];
+    const double here = parent_count(k);
+    const std::uint32_t* from_of = inherited_row(k);
+    const std::uint32_t chained = p.depth > 0 ? t_.points_at_keyframe[p.type][t_.handover_keyframe] : 0;
+    const GlideBracket taken(q_.keyframes, std::min(L.constant_count, here / (double(m_) * m_)));
+    const Tile& tile = *L.tile;
+    RankLoop general = L;
+    general.culled = false;  // visit is called out of order here; culling only saves work
+    for (std::uint32_t r = L.seq; r < end; ++r) {
+      if (budget_ == 0) return r;
+      --budget_;
+      const std::uint32_t from = from_of[r];
+      const bool appearing = from == QueryTables::kAppearing;
+      if (!appearing && from < chained) {
+        if (!visit(k, general, r)) return r;
+        continue;
+      }
+      const GlideBracket& g = appearing ? L.constant_bracket : taken;
+      const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(L.start[g.g0]) + r);
+      const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(L.start[g.g1]) + r);
+      const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
+                   dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
+      const PointId id = appearing ? PointId{n.gx, n.gy, r, n.depth} : PointId{p.gx, p.gy, from, p.depth};
+      const TilePoint& point = tile.points[r];
+      if (!write_unit(n, point.unit_x() + dx * (1.0 / 65536.0), point.unit_y() + dy * (1.0 / 65536.0), id))
+        return r;
+    }
+    return kDone;
+  }
+
   /// Reads ahead the values that items [from, …) of a loop will read, by dry runs of `pass(from, to)`,
   /// which visits them (ReadAhead), setting dry_item_ to the item it is at; `reads` bounds the values an
   /// item reads. Returns the end of the items read for. Most items read far fewer (culled, not emitted,
@@ -404,10 +471,21 @@ class Descent {
     RankLoop loop{&n,       &tile,  thresholds,       start, t_.points_at_keyframe[n.type].data(),
                   side,     area,   constant_count,   seq,   inherited,
                   constant, culled, constant_bracket, around};
-    std::uint32_t read_to = seq;  // the ranks whose values are read ahead (a batch callback's)
-    for (std::uint32_t r = seq; r < general_end; ++r) {
+    std::uint32_t first = seq;  // the first rank left to the general loop
+    if (direct && seq < general_end && handed_over_whole(k, constant_count)) {
+      const std::uint32_t stopped = emit_inherited(k, loop, general_end);
+      if (stopped != kDone) return stopped;
+      first = general_end;
+    }
+    std::uint32_t read_to = first;  // the ranks whose values are read ahead (a batch callback's)
+    // An inherited rank reads its parent point's position and hand-over end, at ranks of the parent far
+    // apart: fetched kPrefetch ranks ahead, so the loop does not wait for each.
+    const std::uint32_t* from_of = k > 0 ? inherited_row(k) : nullptr;
+    const std::uint32_t prefetch_end = k > 0 ? std::min(general_end, inherited) : 0;
+    for (std::uint32_t r = first; r < general_end; ++r) {
       if (budget_ == 0) return r;
       --budget_;
+      if (r + kPrefetch < prefetch_end) prefetch_parent(k, from_of[r + kPrefetch]);
       // A rank reads at most its count, its k ancestors', its sub-point's and its glided position's.
       if (ahead_ && r == read_to)
         read_to = read_ahead(r, general_end, std::uint32_t(k) + 3, [&](std::uint32_t from, std::uint32_t to) {
