@@ -88,6 +88,10 @@ class Classifier {
         tile = id, cls = 0, previous = 0;
         std::copy(first_rank_, first_rank_ + kMaxQueryClasses, first_rank);
       }
+      if (float t; appearing_threshold(id.rank, t)) {
+        classes[i] = class_at(id, t);
+        continue;
+      }
       if (id.rank < previous) cls = 0;
       previous = id.rank;
       while (cls < last && id.rank >= first_rank[cls]) ++cls;
@@ -104,6 +108,10 @@ class Classifier {
     for (std::size_t i = 0; i < count; ++i) {
       const PointId& id = ids(i);
       if (id.tile_x != tile_.tile_x || id.tile_y != tile_.tile_y || id.depth != tile_.depth) enter(id), k = 0;
+      if (float t; appearing_threshold(id.rank, t)) {
+        classes[i] = class_at(id, t);
+        continue;
+      }
       if (id.rank < previous) k = 0;
       previous = id.rank;
       if (id.rank >= thresholds_size_) {  // not a point of its tile (never for a valid set): the last class
@@ -297,6 +305,14 @@ class Classifier {
         out[i] = static_cast<std::uint8_t>(p_.class_count - 1);
         continue;
       }
+      const TilePoint& point = points_[id.rank];
+      const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+      if (float appearing; appearing_threshold(id.rank, appearing)) {
+        open[m] = std::uint32_t(i), t[m] = appearing, area[m] = area_;
+        x[m] = wx + point.unit_x() * side_, y[m++] = wy + point.unit_y() * side_;
+        if (m == kDensityBatch) read_open();
+        continue;
+      }
       std::uint32_t k = 0;
       while (id.rank >= sure_to_[k]) ++k;
       if (id.rank >= sure_from_[k]) {
@@ -304,8 +320,6 @@ class Classifier {
         continue;
       }
       if (settled_by_cell(id.rank, out[i])) continue;
-      const TilePoint& point = points_[id.rank];
-      const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
       open[m] = std::uint32_t(i), t[m] = thresholds_[id.rank], area[m] = area_;
       x[m] = wx + point.unit_x() * side_, y[m++] = wy + point.unit_y() * side_;
       if (m == kDensityBatch) read_open();
@@ -345,6 +359,26 @@ class Classifier {
                                area_);
   }
 
+  /// A sub-point that appears on its own (a rank of a subtile below its hand-over keyframe that carries
+  /// its subtile's id) comes after every point of its parent in the union's order, at its place in the
+  /// parent's list (descent.cpp): its class follows that threshold, over m² into its subtile's counts,
+  /// not its rank's, or the parent's points and it would both fill the first classes. False for any
+  /// other point of the current tile.
+  bool appearing_threshold(std::uint32_t rank, float& t) const {
+    if (rank >= appearing_ranks_ || !QueryTables::appearing(appearing_row_[rank])) return false;
+    const double a = appearing_row_[rank] & ~QueryTables::kAppearing, top = set_.level_nominal.back();
+    const double m2 = double(tables_.subtiles) * tables_.subtiles;
+    t = static_cast<float>((top + (a + 0.5) / appearing_listed_ * (set_.appearing_end() - top)) / m2);
+    return true;
+  }
+  /// The class of point `id` of the current tile with threshold `t`, from the classes' densities at its
+  /// stable position.
+  std::uint8_t class_at(const PointId& id, float t) const {
+    const TilePoint& point = points_[id.rank];
+    const double wx = double(id.tile_x) * side_, wy = double(id.tile_y) * side_;
+    return densities_.class_of(t, wx + point.unit_x() * side_, wy + point.unit_y() * side_, area_);
+  }
+
   /// The classes' cumulative expected counts' bounds over cell (cx, cy) of the current tile, widened by
   /// 10^-9 as the tile's. The cell's sides are computed as positions are (corner plus a fraction times the
   /// side), and rounding is monotonic, so every point of the cell lies in the rectangle bounded.
@@ -369,6 +403,18 @@ class Classifier {
     thresholds_ = tables_.thresholds[index].data();
     thresholds_size_ = tables_.thresholds[index].size();
     points_ = set_.tiles[index].points.data();
+    appearing_ranks_ = 0;
+    if (id.depth > 0) {  // its parent's table of which of its ranks it inherits and which appear
+      const std::int64_t m = tables_.subtiles;
+      const std::int64_t cx = ((id.tile_x % m) + m) % m, cy = ((id.tile_y % m) + m) % m;
+      const PointId parent{(id.tile_x - cx) / m, (id.tile_y - cy) / m, 0, id.depth - 1};
+      const auto p = static_cast<std::size_t>(tile_of(tileset_, parent) - set_.tiles.data());
+      const std::uint32_t* start =
+          tables_.inherited_start.data() + p * std::size_t(m * m + 1) + (cy * m + cx);
+      appearing_row_ = tables_.inherited[p].data() + start[0];
+      appearing_ranks_ = start[1] - start[0];
+      appearing_listed_ = double(set_.tiles[p].appearing.size());
+    }
     side_ = id.depth == 0 ? S_ : S_ / std::pow(double(tables_.subtiles), double(id.depth));
     area_ = side_ * side_ * scale_;
     if (!densities_.all_constant) {
@@ -418,6 +464,10 @@ class Classifier {
   const float* thresholds_ = nullptr;
   std::size_t thresholds_size_ = 0;
   const TilePoint* points_ = nullptr;
+  // Past the top level: which of the current subtile's first ranks its parent hands over (share's table).
+  const std::uint32_t* appearing_row_ = nullptr;
+  std::uint32_t appearing_ranks_ = 0;
+  double appearing_listed_ = 1;
   double side_ = 0, area_ = 0;
   std::uint32_t first_rank_[kMaxQueryClasses] = {};
   std::uint32_t sure_from_[kMaxQueryClasses] = {}, sure_to_[kMaxQueryClasses] = {};

@@ -200,7 +200,7 @@ class Descent {
     const Node& p = stack_[k - 1];
     const std::uint32_t from =
         t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
-    if (from == QueryTables::kAppearing) return {expected > q_.kh, expected};
+    if (QueryTables::appearing(from)) return {expected > q_.kh, expected};
     // The parent's count at its point, as emit computes it there; a constant density's needs no position
     // (the same value, without a load from the parent's points at a rank far from the last one).
     double here;
@@ -224,7 +224,7 @@ class Descent {
       const Node& p = stack_[k - 1];
       const std::uint32_t from =
           t_.inherited[p.type][t_.inherited_start[p.type * (m_ * m_ + 1) + p.next_child - 1] + rank];
-      if (from == QueryTables::kAppearing) break;
+      if (QueryTables::appearing(from)) break;
       rank = from, --k;
     }
     return PointId{stack_[k].gx, stack_[k].gy, rank, std::uint32_t(k)};
@@ -343,7 +343,7 @@ class Descent {
   static constexpr std::uint32_t kPrefetch = 16;
   /// Starts loading what share reads of point `from` of the parent of stack_[k].
   void prefetch_parent(int k, std::uint32_t from) const {
-    if (from == QueryTables::kAppearing) return;
+    if (QueryTables::appearing(from)) return;
     const std::size_t type = stack_[k - 1].type;
     __builtin_prefetch(set_.tiles[type].points.data() + from);
     __builtin_prefetch(t_.handover_end[type].data() + from);
@@ -375,7 +375,7 @@ class Descent {
       if (budget_ == 0) return r;
       --budget_;
       const std::uint32_t from = from_of[r];
-      const bool appearing = from == QueryTables::kAppearing;
+      const bool appearing = QueryTables::appearing(from);
       if (!appearing && from < chained) {
         if (!visit(k, general, r)) return r;
         continue;

@@ -122,6 +122,10 @@ void QueryTables::index_handover(const TilesetData& set) {
                               TilesetShape::subtile_of(tile.points[r].x, m) + d % 5 - 2;
       if (j < m2 && start[j] + v / 25 < start[j + 1]) from[start[j] + v / 25] = r;  // validated: always
     }
+    for (std::uint32_t a = 0; a < tile.appearing.size(); ++a) {
+      const std::uint32_t w = tile.appearing[a], j = w >> 16, q = w & 0xFFFF;
+      if (j < m2 && start[j] + q < start[j + 1]) from[start[j] + q] = kAppearing | a;  // validated: always
+    }
     // Each point's glide, top-keyframe position to sub-point's position at keyframe h (tile units), in
     // spacings 1/√N_top; the expressions descent.cpp's positions use.
     handover_end[t].assign(tile.points.size(), 0.0f);
@@ -129,7 +133,7 @@ void QueryTables::index_handover(const TilesetData& set) {
       const Tile& child = set.tiles[child_type[t * m2 + j]];
       for (std::uint32_t q = 0; q < start[j + 1] - start[j]; ++q) {
         const std::uint32_t r = from[start[j] + q];
-        if (r == kAppearing) continue;
+        if (appearing(r)) continue;
         const std::int8_t* a = tile.glide.data() + 2 * (std::size_t(glide_start[t][top]) + r);
         const std::int8_t* b =
             child.glide.data() + 2 * (std::size_t(glide_start[child_type[t * m2 + j]][h]) + q);

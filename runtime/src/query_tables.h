@@ -72,11 +72,13 @@ struct QueryTables {
   std::uint32_t subtiles = 0, handover_keyframe = 0;
   TilesetArray<std::uint32_t> child_type;
   /// Which point of tile t glides onto rank q of its subtile j: inherited[t][inherited_start[t · (m² + 1)
-  /// + j] + q], a rank of t, or kAppearing for a sub-point that appears on its own. A point emitted by a
+  /// + j] + q], a rank of t, or kAppearing | a for a sub-point that appears on its own, the a-th of t's
+  /// Tile::appearing. A point emitted by a
   /// subtile keeps the id of the point it came from.
   TilesetArray<TilesetArray<std::uint32_t>> inherited;
   TilesetArray<std::uint32_t> inherited_start;
-  static constexpr std::uint32_t kAppearing = ~0u;
+  static constexpr std::uint32_t kAppearing = 1u << 31;  // tiles hold fewer points (2^22 at most)
+  static bool appearing(std::uint32_t from) { return (from & kAppearing) != 0; }
   /// Per tile and rank, the count where its subtile takes the point over (TilesetShape::handover_end of
   /// its glide, from its top-keyframe position to its sub-point's position at keyframe h), and per tile the
   /// largest of them.
