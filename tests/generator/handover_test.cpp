@@ -1,8 +1,8 @@
-// The hand-over between depths (bake/handover.h) on a small set of three levels (32 … 512 points per tile,
-// 4×4 subtiles per tile), as the file holds it: every point gets its own sub-point in its own tile, the
-// sub-points left over appear, nothing else; targets are near; sub-points appear where the gliders have
-// left; glides meet only where both are there at once; the tables survive the file and a damaged one is
-// refused.
+// The hand-over between depths (bake/handover.h) on two small sets with 4×4 subtiles per tile, three
+// levels (32 … 512 points per tile) onto the subtiles' level 0 and four (32 … 2,048) onto their level 1,
+// as the file holds it: every point gets its own sub-point in its own tile, the sub-points left over
+// appear, nothing else; targets are near; sub-points appear where the gliders have left; glides meet only
+// where both are there at once; the tables survive the file and a damaged one is refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
