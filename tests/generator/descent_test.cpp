@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "allocation_counter.h"
+#include "handover_levels.h"
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
@@ -29,45 +30,26 @@
 namespace kdm {
 namespace {
 
-/// A small set handing over onto its subtiles' level `level`, with 4×4 subtiles per tile.
+/// The small set handing over onto its subtiles' level `level`, loaded as a query would.
 Tileset bake_small_set(std::uint32_t level) {
-  gen::BakeRecipe r;
-  r.levels = 3 + level, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
-  r.handover_zone = 1, r.handover_level = level;
   std::vector<std::uint8_t> bytes;
-  EXPECT_EQ(encode_tileset(gen::bake_tileset(r, 2), bytes), Status::kOk);
+  EXPECT_EQ(encode_tileset(gen::bake_tileset(testing::small_handover_recipe(level), 2), bytes), Status::kOk);
   Tileset t;
   EXPECT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
   return t;
 }
 
-/// The set the running test queries (DescentTest::SetUp), each baked once.
-const Tileset* current_set = nullptr;
+class DescentTest : public testing::HandoverLevelTest<Tileset, bake_small_set> {};
+INSTANTIATE_TEST_SUITE_P(HandoverLevel, DescentTest, ::testing::Values(0u, 1u), testing::handover_level_name);
+
+/// The set the running test queries.
 const Tileset& small_set() {
-  return *current_set;
+  return DescentTest::set();
 }
 /// Its top level's nominal points per tile, N_top.
 double top() {
-  return current_set->max_points_per_tile();
+  return small_set().max_points_per_tile();
 }
-
-class DescentTest : public ::testing::TestWithParam<std::uint32_t> {
- protected:
-  void SetUp() override {
-    if (GetParam() == 0) {
-      static const Tileset level0 = bake_small_set(0);
-      current_set = &level0;
-    } else {
-      static const Tileset level1 = bake_small_set(1);
-      current_set = &level1;
-    }
-  }
-};
-
-INSTANTIATE_TEST_SUITE_P(HandoverLevel, DescentTest, ::testing::Values(0u, 1u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& i) {
-                           return "OntoLevel" + std::to_string(i.param);
-                         });
 
 using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, std::uint32_t>;
 Key key(const PointId& id) {

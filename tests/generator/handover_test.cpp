@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bake/glider_field.h"
+#include "handover_levels.h"
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset_format.h"
@@ -25,40 +26,22 @@ struct Baked {
   Subdivision sub;
 };
 
-/// A small set whose hand-over goes onto its subtiles' level `level`, with 4×4 subtiles per tile.
+/// The small set handing over onto its subtiles' level `level`, as the baker returns it.
 Baked bake_small_set(std::uint32_t level) {
-  BakeRecipe r;
-  r.levels = 3 + level, r.base_points = 32, r.sweeps = 20, r.keyframes_per_level = 4, r.glide_sweeps = 10;
-  r.handover_zone = 1, r.handover_level = level;
   Baked b;
-  b.set = bake_tileset(r, 2);
+  b.set = bake_tileset(testing::small_handover_recipe(level), 2);
   b.sub = b.set.subdivision();
   return b;
 }
 
-/// The set the running test judges (HandoverTest::SetUp), each baked once.
-const Baked* current_set = nullptr;
-const Baked& small_set() {
-  return *current_set;
-}
-
-class HandoverTest : public ::testing::TestWithParam<std::uint32_t> {
- protected:
-  void SetUp() override {
-    if (GetParam() == 0) {
-      static const Baked level0 = bake_small_set(0);
-      current_set = &level0;
-    } else {
-      static const Baked level1 = bake_small_set(1);
-      current_set = &level1;
-    }
-  }
-};
-
+class HandoverTest : public testing::HandoverLevelTest<Baked, bake_small_set> {};
 INSTANTIATE_TEST_SUITE_P(HandoverLevel, HandoverTest, ::testing::Values(0u, 1u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& i) {
-                           return "OntoLevel" + std::to_string(i.param);
-                         });
+                         testing::handover_level_name);
+
+/// The set the running test judges.
+const Baked& small_set() {
+  return HandoverTest::set();
+}
 
 /// The sub-point (j << 16 | q) that rank r of tile t glides onto, decoded from the file's encoding.
 std::uint32_t target(const Baked& b, std::size_t t, std::uint32_t r) {
