@@ -26,6 +26,8 @@ void run_verify(VerifyArgs args) {
     throw CommandError("--hole-largest must be a number >= 0 (0: report only)");
   if (!(args.options.bars.holes_per_1e5 >= 0 && std::isfinite(args.options.bars.holes_per_1e5)))
     throw CommandError("--holes-per-1e5 must be a number >= 0 (0: report only)");
+  if (args.options.handover_rows < 1 || args.options.handover_rows > 1000)
+    throw CommandError("--handover-rows must be in [1, 1000]");
   TilesetData set;
   std::string detail;
   const Status s = load_tileset(args.path, set, &detail);
@@ -75,6 +77,9 @@ void add_verify_command(CLI::App& app) {
   cmd->add_option("--holes-per-1e5", args->options.bars.holes_per_1e5,
                   "Fail a complete level or keyframe with more empty circles above 0.85 d_hex per 10^5 "
                   "points (0: report only; the design's bar is 10)")
+      ->capture_default_str();
+  cmd->add_option("--handover-rows", args->options.handover_rows,
+                  "Densities at which the hand-over past the top level is judged, in even steps (1 to 1000)")
       ->capture_default_str();
   add_threads_option(cmd, args->options.threads, "results do not depend on it");
   cmd->callback([args] { run_verify(*args); });

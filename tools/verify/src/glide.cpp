@@ -170,11 +170,13 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
       appearing[t].push_back({j % m, j / m, w & 0xFFFF, subtiles[t][j], 0});
     }
   }
-  // Judged at a quarter, half, three quarters and all of the way to where 99% of the points are taken over.
-  const double end99 = analysis::quantile(ends, 0.99);
-  for (const double s : {0.25, 0.5, 0.75, 1.0}) {
+  // Judged at `handover_rows` even steps to where 99% of the points have arrived and every appearing
+  // point has appeared.
+  const double end = std::max(analysis::quantile(ends, 0.99), appearing_end);
+  const int rows = std::max(1, options.handover_rows);
+  for (int i = 1; i <= rows; ++i) {
     KeyframeResult row;
-    row.points_per_tile = n_top + s * (end99 - n_top);
+    row.points_per_tile = n_top + double(i) / rows * (end - n_top);
     row.keyframe = false;
     row.handover = true;
     row.motion_mean = row.motion_p99 = std::numeric_limits<double>::quiet_NaN();
@@ -224,7 +226,7 @@ void judge_handover(const TilesetData& set, const VerifyOptions& options, Report
     row.checks.push_back({"δavg", row.davg, b.glide_between_davg, false});
     if (b.handover_closest_pair > 0)
       row.checks.push_back({"closest pair", row.closest_pair, b.handover_closest_pair, false});
-    if (s == 1.0) {  // each glide per top keyframe interval of the scale it spans, as keyframes' motion
+    if (i == rows) {  // each glide per top keyframe interval of the scale it spans, as keyframes' motion
       double sum = 0;
       for (double& v : speeds) sum += (v /= row.davg);
       row.motion_mean = sum / double(speeds.size());

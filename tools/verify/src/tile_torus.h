@@ -99,12 +99,13 @@ bool keyframe_judged(const TilesetData& set, const std::vector<std::uint32_t>& l
 void judge_keyframes(const TilesetData& set, const VerifyOptions& options, Report& report,
                      const std::function<void(double)>& done);
 
-/// Part 6 (glide.cpp), sets with a hand-over: appends a KeyframeResult (handover set) for a quarter, half,
-/// three quarters and all of the way from the top keyframe to where the subtiles have taken 99% of the
-/// points over, as the runtime places them: each point on its straight path onto its sub-point (which
-/// glides with its subtile's count once that passes K_h, the hand-over keyframe's count) by the end its glide
-/// sets, the appearing points in at evenly spread thresholds, the subtiles' own points by theirs; the last
-/// with the glides' motion per top keyframe interval of the scale they span.
+/// Part 6 (glide.cpp), sets with a hand-over: appends a KeyframeResult (handover set) for each of
+/// VerifyOptions::handover_rows even steps from the top keyframe to where 99% of the glides have arrived
+/// and every appearing point has appeared, as the runtime places them (a constant density): each point on its
+/// straight path onto its sub-point (which glides with its subtile's count once that passes K_h, the
+/// hand-over keyframe's count) by the end its glide sets, the appearing points in at evenly spread
+/// thresholds, the subtiles' own points by theirs; the last with the glides' motion per top keyframe interval
+/// of the scale they span.
 void judge_handover(const TilesetData& set, const VerifyOptions& options, Report& report,
                     const std::function<void(double)>& done);
 
