@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 6).
+"""An independent reader of kdm tile sets (.kdmt, format versions 2 to 7).
 
 Written from docs/tileset-format.md alone, not from the C++ sources: the test
 runtime.independent_python_reader compares its --summary with the C++ runtime's decoding of the shipped
@@ -26,7 +26,7 @@ try:
 except ImportError:  # the reader is useless without it: say what to install
     zstandard = None
 
-FORMAT_VERSION = 6
+FORMAT_VERSION = 7
 OLDEST_FORMAT_VERSION = 2
 MAX_KEYFRAMES = 256
 GLIDE_UNITS_PER_SPACING = 32.0
@@ -72,6 +72,7 @@ class Tileset:
         self.keyframe_nominal = []
         self.handover_zone = 0
         self.handover_level = 0
+        self.handover_slack = 0
         self.tiles = []
         self.recipe = b""
         self.generator_version = b""
@@ -274,6 +275,8 @@ def decode(data):
         ts.handover_zone = reader.u32("handover_zone")
     if version >= 6:
         ts.handover_level = reader.u32("handover_level")
+    if version >= 7:
+        ts.handover_slack = reader.u32("handover_slack")
     if body_tiles > reader.remaining() // (48 if handing_over else 32 if gliding else 24):
         raise TilesetError(f"tile count {body_tiles} exceeds what {reader.remaining()} body bytes can hold")
     for t in range(body_tiles):
@@ -373,8 +376,8 @@ def subvertex_colour(ts, m, sw, se, ne, nw, i, j):
 
 
 def handover_keyframe(ts):
-    """Doc §7: h, the first keyframe above N_j (j the hand-over level), at least 1."""
-    return max(1, bisect.bisect_right(ts.keyframe_nominal, ts.level_nominal[ts.handover_level]))
+    """Doc §7: h, S keyframes past the first above N_j (j the hand-over level, S its slack; at least 1)."""
+    return max(1, bisect.bisect_right(ts.keyframe_nominal, ts.level_nominal[ts.handover_level])) + ts.handover_slack
 
 
 def _validate_handover(ts):
@@ -382,6 +385,8 @@ def _validate_handover(ts):
     if ts.handover_zone == 0:
         if ts.handover_level:
             raise TilesetError("a hand-over level in a set without a hand-over")
+        if ts.handover_slack:
+            raise TilesetError("a hand-over slack in a set without a hand-over")
         for t, tile in enumerate(ts.tiles):
             if len(tile.handover) or len(tile.appearing):
                 raise TilesetError(f"tile {t} has hand-over tables in a set without a hand-over")
@@ -396,6 +401,8 @@ def _validate_handover(ts):
         raise TilesetError("a hand-over needs N_top / N_j to be the square of an integer m in 2..256")
     if 2 * z + 1 >= m:
         raise TilesetError(f"the hand-over zone {z} is too wide")
+    if ts.handover_slack > 16:
+        raise TilesetError(f"the hand-over slack {ts.handover_slack} is above 16")
     h = handover_keyframe(ts)
     if h + 1 >= len(ts.keyframe_nominal):
         raise TilesetError("the hand-over keyframe is the top one")
@@ -503,7 +510,7 @@ def summary(ts):
         "keyframe_nominal" + "".join(f" {n}" for n in ts.keyframe_nominal),
     ] + ([f"handover_zone {ts.handover_zone}"] if ts.handover_zone else []) + (
         [f"handover_level {ts.handover_level}"] if ts.handover_level else []
-    ) + [
+    ) + ([f"handover_slack {ts.handover_slack}"] if ts.handover_slack else []) + [
         f"recipe_bytes {len(ts.recipe)}",
         f"recipe_crc32 {_crc32(ts.recipe):08x}",
         f"generator_version {_escaped(ts.generator_version)}",

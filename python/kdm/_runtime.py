@@ -94,7 +94,8 @@ class Tileset:
         """What the set holds: levels, level_points (nominal points per tile, cumulative), keyframes,
         max_points_per_tile (the stable-mode limit), smooth_limit_per_tile (the smooth-mode limit: with a
         hand-over to subtiles, max_points_per_tile * subtiles_per_side**8), subtiles_per_side (0 without a
-        hand-over), handover_level (the subtiles' level it glides onto), colours, tiles, format_version, resident_bytes, recipe, generator_version and
+        hand-over), handover_level (the subtiles' level it glides onto), handover_slack (keyframes
+        past their first above that level at which they are handed over), colours, tiles, format_version, resident_bytes, recipe, generator_version and
         glide_reach (tile sides)."""
         return self._handle.info
 

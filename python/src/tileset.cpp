@@ -69,6 +69,7 @@ py::dict info(const TilesetHandle& h) {
   out["smooth_limit_per_tile"] = query_density_limit(t, QueryMode::kSmooth);
   out["subtiles_per_side"] = d.handover_zone ? d.subtiles_per_side() : 0u;
   out["handover_level"] = d.handover_level;
+  out["handover_slack"] = d.handover_slack;
   out["colours"] = d.colours;
   out["tiles"] = d.tiles.size();
   out["format_version"] = h.format_version;

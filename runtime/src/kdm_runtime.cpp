@@ -534,6 +534,7 @@ kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* in
   v.keyframes = static_cast<uint32_t>(d.keyframe_nominal.size());
   v.subtiles_per_side = d.handover_zone ? d.subtiles_per_side() : 0;
   v.handover_level = d.handover_level;
+  v.handover_slack = d.handover_slack;
   v.smooth_limit_per_tile = kdm::query_density_limit(*tileset->set, kdm::QueryMode::kSmooth);
   write_grown(v, info);
   return KDM_OK;

@@ -156,6 +156,7 @@ std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
     save_array(ar, set.keyframe_nominal);
     if (handover) ar(set.handover_zone);
     if (version >= 6) ar(set.handover_level);
+    if (version >= 7) ar(set.handover_slack);
     std::vector<std::uint16_t> xy;
     for (const Tile& tile : set.tiles) {
       save_array(ar, tile.level_end);
@@ -191,6 +192,7 @@ void parse_body(const char* body, std::size_t size, std::uint32_t version, Tiles
   if (gliding) load_array(ar, buffer, set.keyframe_nominal);
   if (handover) ar(set.handover_zone);
   if (version >= 6) ar(set.handover_level);
+  if (version >= 7) ar(set.handover_slack);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
   if (tile_count > buffer.remaining() / (handover ? 48 : gliding ? 32 : 24))
     throw ContentError("tile count exceeds the payload");
@@ -229,6 +231,9 @@ std::string handover_problem(const TilesetData& set) {
     return "the hand-over level " + std::to_string(set.handover_level) + " is not below the top level";
   if (m < 2 || m > 256) return "a hand-over needs N_top / N_j to be the square of an integer m in 2..256";
   if (2 * std::uint64_t(zone) + 1 >= m) return "the hand-over zone " + std::to_string(zone) + " is too wide";
+  if (set.handover_slack > kMaxHandoverSlack)
+    return "the hand-over slack " + std::to_string(set.handover_slack) + " is above " +
+           std::to_string(kMaxHandoverSlack);
   const std::size_t h = set.handover_keyframe();
   if (h + 1 >= set.keyframe_nominal.size()) return "the hand-over keyframe is the top one";
   std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe h, per tile
@@ -276,7 +281,7 @@ std::string handover_problem(const TilesetData& set) {
 
 std::uint32_t tileset_format_version_for(const TilesetShape& set) {
   // The oldest that holds it, so that older recipes rebake byte for byte.
-  return !set.handover_zone ? 4 : set.handover_level ? 6 : 5;
+  return !set.handover_zone ? 4 : set.handover_slack ? 7 : set.handover_level ? 6 : 5;
 }
 
 std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set) {
@@ -357,6 +362,7 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
     if (const std::string problem = handover_problem(set); !problem.empty()) return bad(problem);
   } else {
     if (set.handover_level) return bad("a hand-over level in a set without a hand-over");
+    if (set.handover_slack) return bad("a hand-over slack in a set without a hand-over");
     for (std::size_t t = 0; t < set.tiles.size(); ++t)
       if (!set.tiles[t].handover.empty() || !set.tiles[t].appearing.empty())
         return bad("tile " + std::to_string(t) + " has hand-over tables in a set without a hand-over");

@@ -252,7 +252,8 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   kdm::Tile& tile = set.tiles[3];
   for (std::uint32_t i = tile.level_end[1], j = 0; i < tile.level_end[2]; ++i, ++j)  // a clump in a corner
     tile.points[i] = kdm::TilePoint::from_unit(0.1 + 0.001 * (j % 37), 0.1 + 0.001 * (j / 37));
-  set.handover_zone = 0;  // the hand-over names sub-points near each point's old place: drop it
+  // The hand-over names sub-points near each point's old place: drop it.
+  set.handover_zone = set.handover_level = set.handover_slack = 0;
   for (kdm::Tile& t : set.tiles) t.handover.clear(), t.appearing.clear();
   ASSERT_EQ(kdm::save_tileset(set, path("bad.kdmt")), kdm::Status::kOk);
   const Outcome bad = kdm("verify '" + path("bad.kdmt") + "'" + quick);
@@ -264,6 +265,7 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
 
   expect_error("verify '" + path("missing.kdmt") + "'", "missing.kdmt");
   expect_error("verify '" + shipped + "' --level 9", "level 9");
+  expect_error("verify '" + shipped + "' --handover-rows 0", "--handover-rows");
   expect_error("verify '" + shipped + "' --runs 1", "runs");
 }
 
@@ -596,8 +598,11 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   expect_error("stipple " + image + " --frames -3 --region 0,0,.5,.5" + out, "--frames");
   expect_error("stipple " + image + " --frames 5" + out, "--region");
   expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2 --mode stable" + out, "2× (");
-  // Smooth mode descends into the built-in set's 32 × 32 subtiles, four depths deep: 2 · 32^4 ×.
-  expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, "2.09715e+06× (");
+  // Smooth mode descends into the built-in set's m × m subtiles, four depths deep: 2 · m^4 ×.
+  const double m = kdm::Tileset::builtin().data().subtiles_per_side();
+  char deepest[32];
+  std::snprintf(deepest, sizeof deepest, "%g× (", 2 * m * m * m * m);
+  expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, deepest);
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
   EXPECT_FALSE(fs::exists(path("z_0000.png")));  // refused before any frame is written
 }

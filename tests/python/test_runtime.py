@@ -28,6 +28,8 @@ def test_builtin_info():
     assert info["smooth_limit_per_tile"] == info["max_points_per_tile"] * max(info["subtiles_per_side"], 1) ** 8
     m = info["subtiles_per_side"]
     assert m == 0 or info["level_points"][info["handover_level"]] * m * m == info["max_points_per_tile"]
+    assert 0 <= info["handover_slack"] <= 16 and (m or not info["handover_slack"])
+    assert info["format_version"] == (7 if info["handover_slack"] else 6 if info["handover_level"] else 5 if m else 4)
     assert "seed" in info["recipe"] and info["resident_bytes"] > 0
     assert kdm.Tileset.builtin() is BUILTIN
 

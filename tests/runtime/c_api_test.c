@@ -156,6 +156,7 @@ int main(int argc, char** argv) {
     /* m subtiles per side hold at their hand-over level as many points as the tile's top level. */
     CHECK(info.subtiles_per_side == 0 ||
           info.level_points[info.handover_level] * info.subtiles_per_side * info.subtiles_per_side == 32768);
+    CHECK(info.handover_slack <= 16 && (info.subtiles_per_side > 0 || info.handover_slack == 0));
     CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
     CHECK(strchr(kdm_version(), '.') != NULL);
   }

@@ -560,14 +560,16 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_EQ(p.limit, double(kMaxQueryTiles));
   EXPECT_EQ(p.value, 8192.0 * 4097.0);
   // 10^15 units out a double's step is 1/8, more than the spacing of 1,000 points per unit area: positions
-  // would fall together. 10^10 out, a region 2·10^-6 wide is one step wide, however deep smooth mode goes.
+  // would fall together. 10^10 out, a region 2·10^-6 wide is one step wide, however deep smooth mode goes
+  // (10^11 points per unit area, within the built-in set's deepest).
   p = problem_of(region(1e15, 0, 1e15 + 1, 1, 1000));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(p.parameter, "x0");
   EXPECT_NEAR(p.value, 1e15, 1.0);  // |x1|, the farthest side
   EXPECT_LT(p.limit, 1e15);
   EXPECT_GT(p.limit, 1e12);  // 2^52 · spacing / 16 ≈ 8.9 · 10^12
-  p = problem_of(region(0, -1e10, 2e-6, -1e10 + 2e-6, 1e16, QueryMode::kSmooth));
+  ASSERT_GT(query_density_limit(Tileset::builtin(), QueryMode::kSmooth), 1e11);
+  p = problem_of(region(0, -1e10, 2e-6, -1e10 + 2e-6, 1e11, QueryMode::kSmooth));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(p.parameter, "y0");
   // Past the top level the points are placed exactly relative to the query's origin, but written as

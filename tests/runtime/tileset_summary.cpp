@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
   for (const std::uint32_t n : set.keyframe_nominal) std::printf(" %u", n);
   if (set.handover_zone) std::printf("\nhandover_zone %u", set.handover_zone);
   if (set.handover_level) std::printf("\nhandover_level %u", set.handover_level);
+  if (set.handover_slack) std::printf("\nhandover_slack %u", set.handover_slack);
   std::printf("\nrecipe_bytes %zu\nrecipe_crc32 %08x\ngenerator_version %s\n", set.recipe.size(),
               crc32({set.recipe.begin(), set.recipe.end()}), escaped(set.generator_version).c_str());
   std::vector<std::uint8_t> triples, thresholds;

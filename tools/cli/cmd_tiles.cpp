@@ -102,12 +102,19 @@ void run_info(const std::string& path) {
         "glide track    %zu keyframes, %u to %u points per tile (--mode smooth; %.2f tile sides at most)\n",
         set.keyframe_nominal.size(), set.keyframe_nominal.front(), set.keyframe_nominal.back(),
         loaded.glide_reach());
-  if (set.handover_zone)
+  if (set.handover_zone) {
+    char keyframe[80];
+    if (set.handover_slack)
+      std::snprintf(keyframe, sizeof keyframe, "%u keyframe%s past their first above level %u",
+                    set.handover_slack, set.handover_slack == 1 ? "" : "s", set.handover_level);
+    else
+      std::snprintf(keyframe, sizeof keyframe, "their first keyframe above level %u", set.handover_level);
     std::printf(
-        "hand-over      onto %u x %u subtiles past the top level, at their first keyframe above level %u "
-        "(%u points per tile; zones of %u sub-steps; smooth queries descend)\n",
-        set.subtiles_per_side(), set.subtiles_per_side(), set.handover_level,
+        "hand-over      onto %u x %u subtiles past the top level, at %s (%u points per tile; zones of %u "
+        "sub-steps; smooth queries descend)\n",
+        set.subtiles_per_side(), set.subtiles_per_side(), keyframe,
         set.keyframe_nominal[set.handover_keyframe()], set.handover_zone);
+  }
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
   for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());
@@ -126,7 +133,7 @@ void add_tile_commands(CLI::App& app) {
                    "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
                    "separation_push, split_shared, separation_fill, separation_per_level, fill_holes, "
                    "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_corner_consensus, "
-                   "glide_late, handover_zone, handover_level)")
+                   "glide_late, handover_zone, handover_level, handover_slack)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   add_threads_option(bake, *threads, "the file does not depend on it");

@@ -125,6 +125,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
     } else if (key == "handover_level") {
       r.handover_level = static_cast<std::uint32_t>(whole(0, 7));
+    } else if (key == "handover_slack") {
+      r.handover_slack = static_cast<std::uint32_t>(whole(0, kMaxHandoverSlack));
     } else if (key == "glide_consensus") {
       r.glide_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
     } else if (key == "glide_corner_consensus") {
@@ -154,6 +156,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
   }
   if (r.handover_level && !r.handover_zone)
     throw InvalidArgument("recipe: handover_level needs handover_zone (a hand-over)");
+  if (r.handover_slack && !r.handover_zone)
+    throw InvalidArgument("recipe: handover_slack needs handover_zone (a hand-over)");
   if (r.handover_zone) {
     if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
       throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
@@ -173,6 +177,20 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) + "] for " +
                             std::to_string(m) + " subtiles per side (levels " + std::to_string(r.levels) +
                             ", handover_level " + std::to_string(r.handover_level) + ")");
+    TilesetShape shape;
+    const std::vector<std::uint32_t> nominal = r.nominal_counts();
+    const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal, r.keyframes_per_level);
+    shape.level_nominal.assign(nominal.begin(), nominal.end());
+    shape.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
+    shape.handover_level = r.handover_level, shape.handover_slack = r.handover_slack;
+    if (shape.handover_keyframe() + 1 >= keyframes.size()) {
+      // The most slack there is room for: the hand-over keyframe must lie below the top one.
+      const auto most = std::int64_t(keyframes.size()) - std::int64_t(shape.handover_keyframe()) +
+                        std::int64_t(r.handover_slack) - 2;
+      throw InvalidArgument("recipe: handover_slack " + std::to_string(r.handover_slack) +
+                            " puts the hand-over keyframe at or past the top one (" +
+                            (most >= 0 ? std::to_string(most) + " at most" : "more keyframes needed") + ")");
+    }
   }
   return r;
 }
@@ -205,6 +223,7 @@ std::string BakeRecipe::to_text() const {
   if (glide_late > 0) s << "glide_late " << shortest(glide_late) << "\n";
   if (handover_zone) s << "handover_zone " << handover_zone << "\n";
   if (handover_level) s << "handover_level " << handover_level << "\n";
+  if (handover_slack) s << "handover_slack " << handover_slack << "\n";
   return s.str();
 }
 
@@ -265,6 +284,7 @@ class Baker {
         drop_close_glides(levels_, recipe_.colours, shape_, recipe_.glide_separation, recipe_.split_shared);
     report.glide_removed = glides.removed, report.glide_split = glides.split;
     shape_.handover_zone = recipe_.handover_zone, shape_.handover_level = recipe_.handover_level;
+    shape_.handover_slack = recipe_.handover_slack;
     TilesetData set = assemble();
     if (set.handover_zone) add_handover(set);
     return set;

@@ -1,8 +1,8 @@
 // The hand-over between depths (docs/design.md §3, "Unbounded zoom"): past the top keyframe every point of
 // a tile glides onto a point of one of its m×m subtiles (tiles of the same set at 1/m the size, laid out
 // by kdm/runtime/subdivision.h) as they stand at the hand-over keyframe h, the first past their level j
-// (TilesetShape::handover_level); the sub-points no point takes appear on the way. Each tile's points are
-// matched to its own sub-points as one whole,
+// (TilesetShape::handover_level) or handover_slack keyframes later; the sub-points no point takes appear
+// on the way. Each tile's points are matched to its own sub-points as one whole,
 // least total squared distance: straight paths of such a matching, travelled in step, never meet (the
 // displacement interpolation of optimal transport), and the tile's whole surplus of sub-points is there
 // for a point wherever it lies. The sub-points left over appear in an order that lets the gliders around

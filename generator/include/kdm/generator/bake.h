@@ -110,6 +110,11 @@ struct BakeRecipe {
   /// subtiles never show fewer points than their first keyframe above N_j (levels 0..j are not shown past
   /// depth 0). 0 in recipes that do not name it. Needs handover_zone.
   std::uint32_t handover_level = 0;
+  /// Keyframes past the subtiles' first above N_j at which they are handed over (0 to 16; 0 in recipes that
+  /// do not name it): with 2 they hold a fifth more points than the tile, every glide but the longest has
+  /// arrived before their own points enter, and the leftovers appear farthest from the points present.
+  /// Needs handover_zone, and keyframes enough above N_j (an error names the most).
+  std::uint32_t handover_slack = 0;
 
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).

@@ -141,6 +141,7 @@ typedef struct kdm_tileset_info {
   double smooth_limit_per_tile; /* the densest smooth query (max_points_per_tile * m^8 with a hand-over) */
   /* Added in 0.4: */
   uint32_t handover_level; /* the subtiles' level its hand-over glides onto (m^2 * its count = the top's) */
+  uint32_t handover_slack; /* keyframes past their first above that level at which they are handed over */
 } kdm_tileset_info;
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`

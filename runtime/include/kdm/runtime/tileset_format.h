@@ -46,6 +46,7 @@ inline constexpr std::uint32_t kMaxTilesetHeaderBytes = 1u << 20;
 inline constexpr std::uint32_t kMaxTileColours = 16;  ///< at most 16^4 = 65536 tiles
 inline constexpr std::uint32_t kMaxTileLevels = 16;
 inline constexpr std::uint32_t kMaxKeyframes = 256;
+inline constexpr std::uint32_t kMaxHandoverSlack = 16;  ///< TilesetShape::handover_slack
 
 /// Glide offsets count in 1/kGlideUnitsPerSpacing of a keyframe's square-grid spacing 1/√K (8 bits: up to
 /// ±3.97 spacings, in steps of 0.03 of the point spacing).
@@ -115,6 +116,11 @@ struct TilesetShape {
   /// The level j of the subtiles the hand-over glides onto (format 6; 0 in older files): a depth's
   /// subtiles then never show fewer points than their first keyframe above N_j.
   std::uint32_t handover_level = 0;
+  /// Keyframes past the subtiles' first above N_j at which they are handed over (format 7; 0 in older
+  /// files): with 2 their points present there outnumber the tile's by a fifth instead of a twentieth,
+  /// and every glide but the longest has arrived before the subtiles' own points enter (docs/design.md
+  /// §3, "Slack").
+  std::uint32_t handover_slack = 0;
 
   /// Subtiles per tile side in the hand-over: m with m² · N_j = N_top, j = handover_level (0 if there is
   /// no such integer).
@@ -125,13 +131,14 @@ struct TilesetShape {
     return std::uint64_t(m) * m * n_j == level_nominal.back() ? m : 0;
   }
   Subdivision subdivision() const { return {colours, subtiles_per_side(), handover_zone}; }
-  /// The hand-over keyframe h: the subtiles' first keyframe above N_j, where they stand when a point
-  /// glides onto them (1 for j = 0); their points present there are the ones their parent hands over.
+  /// The hand-over keyframe h: handover_slack keyframes past the subtiles' first keyframe above N_j (at
+  /// least 1), where they stand when a point glides onto them; their points present there are the ones
+  /// their parent hands over.
   std::size_t handover_keyframe() const {
-    if (handover_level >= level_nominal.size()) return 1;
+    if (handover_level >= level_nominal.size()) return 1 + handover_slack;
     const auto* k = keyframe_nominal.data();
     const auto above = std::upper_bound(k, k + keyframe_nominal.size(), level_nominal[handover_level]) - k;
-    return std::max<std::size_t>(1, static_cast<std::size_t>(above));
+    return std::max<std::size_t>(1, static_cast<std::size_t>(above)) + handover_slack;
   }
   /// The hand-over past the top level, in points per tile (docs/design.md §3, "Unbounded zoom"): the
   /// sub-points no point glides onto have appeared by appearing_end() = m² K_h (h = handover_keyframe()),
