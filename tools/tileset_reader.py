@@ -548,7 +548,7 @@ def point_lines(ts, t):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 6).")
+    parser = argparse.ArgumentParser(description="Reads and checks a kdm tile set (.kdmt, format versions 2 to 7).")
     parser.add_argument("file")
     mode = parser.add_mutually_exclusive_group(required=True)
     mode.add_argument("--summary", action="store_true", help="print the canonical summary")
