@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "kdm/runtime/check.h"
 
@@ -85,10 +86,11 @@ void GliderField::replace(std::uint32_t r, const Glide& g) {
   add(r);
 }
 
-bool GliderField::meet(const Glide& a, const Glide& b) const {
+double GliderField::approach(const Glide& a, const Glide& b) const {
   // Both move linearly in the count until the first arrives, then one does until the other arrives: on
   // each piece the difference is linear, so its least length is a projection.
   const double ends[3] = {top_, std::min(a.end, b.end), std::max(a.end, b.end)};
+  double least = std::numeric_limits<double>::infinity();
   for (int piece = 0; piece < 2; ++piece) {
     if (!(ends[piece + 1] > ends[piece])) continue;
     double ax, ay, bx, by, cx, cy, dx, dy;
@@ -99,21 +101,37 @@ bool GliderField::meet(const Glide& a, const Glide& b) const {
     const double x0 = ax - bx, y0 = ay - by, vx = (cx - dx) - x0, vy = (cy - dy) - y0;
     const double v2 = vx * vx + vy * vy;
     const double s = v2 > 0 ? std::clamp(-(x0 * vx + y0 * vy) / v2, 0.0, 1.0) : 0.0;
-    if (std::hypot(x0 + s * vx, y0 + s * vy) < distance_) return true;
+    least = std::min(least, std::hypot(x0 + s * vx, y0 + s * vy));
   }
-  return false;
+  return least;
+}
+
+template <class Visit>
+void GliderField::for_glides_near(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b,
+                                  Visit&& visit) const {
+  ++query_;
+  bool done = false;
+  for_cells(g, 0, [&](std::size_t c) {
+    for (std::uint32_t i : grid_[c]) {
+      if (done || stamp_[i] == query_ || i == skip_a || i == skip_b) continue;
+      stamp_[i] = query_;
+      done = visit(glides_[i]);
+    }
+  });
+}
+
+double GliderField::nearest(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b) const {
+  double least = distance_;
+  for_glides_near(g, skip_a, skip_b, [&](const Glide& other) {
+    least = std::min(least, approach(g, other));
+    return false;
+  });
+  return least;
 }
 
 bool GliderField::meets(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b) const {
-  ++query_;
   bool close = false;
-  for_cells(g, 0, [&](std::size_t c) {
-    for (std::uint32_t i : grid_[c]) {
-      if (close || stamp_[i] == query_ || i == skip_a || i == skip_b) continue;
-      stamp_[i] = query_;
-      close = meet(g, glides_[i]);
-    }
-  });
+  for_glides_near(g, skip_a, skip_b, [&](const Glide& other) { return close = meet(g, other); });
   return close;
 }
 

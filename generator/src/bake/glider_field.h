@@ -32,7 +32,12 @@ class GliderField {
   /// the subtiles' own points).
   bool meets(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b) const;
   /// Whether two glides come closer than the field's distance to each other before both arrive.
-  bool meet(const Glide& a, const Glide& b) const;
+  bool meet(const Glide& a, const Glide& b) const { return approach(a, b) < distance_; }
+  /// The least distance between two glides before both arrive (tile units).
+  double approach(const Glide& a, const Glide& b) const;
+  /// The least distance from `g` to any of the field's glides (leaving out tile t's ranks `skip_a` and
+  /// `skip_b`) among those that come within the field's distance; the field's distance if none does.
+  double nearest(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b) const;
   /// Replaces tile t's own glide of rank r (its copies shifted as a neighbour of itself are left).
   void replace(std::uint32_t r, const Glide& g);
 
@@ -45,6 +50,10 @@ class GliderField {
   void remove(std::uint32_t i);
   template <class Visit>
   void for_cells(const Glide& g, double margin, Visit&& visit) const;
+  /// visit(glide) for each glide whose box meets g's but tile t's ranks skip_a and skip_b, until it
+  /// returns true.
+  template <class Visit>
+  void for_glides_near(const Glide& g, std::uint32_t skip_a, std::uint32_t skip_b, Visit&& visit) const;
 
   double distance_ = 0, top_ = 0, cell_ = 1;
   std::int64_t cells_ = 1;

@@ -27,6 +27,12 @@ constexpr double kLongGlideWeight = 10;
 constexpr double kMaxGlide = 1.2;
 // Passes of untangle over the tiles (each sees its neighbours' moves of the pass before).
 constexpr int kPasses = 2;
+// What untangle leaves closer than kRepairBelow (d_hex at N_top), mostly a long glide coming back into
+// its tile past a neighbour tile's glide, repair moves apart as far as a swap within kMaxRepairGlide
+// spacings allows, in kRepairPasses passes.
+constexpr double kRepairBelow = 0.2;
+constexpr double kMaxRepairGlide = 1.5;
+constexpr int kRepairPasses = 3;
 
 /// Positions (tile units, x y pairs) of ranks [0, n) of `tile` at keyframe g, as the file holds them.
 std::vector<double> keyframe_positions(const TilesetData& set, const Tile& tile, std::size_t g,
@@ -124,64 +130,150 @@ Glide glide_to(const TilesetData& set, const Matched& m, std::uint32_t r, std::u
   return g;
 }
 
+double length(const Glide& g) {
+  return std::hypot(g.bx - g.ax, g.by - g.ay);
+}
+
+/// Tile t's points set up to swap sub-points: the glides that can pass near them (a GliderField), its
+/// sub-points by cells of 2 spacings, and the rank that takes each.
+class TileSwaps {
+ public:
+  TileSwaps(const TilesetData& set, std::vector<Matched>& matched, std::vector<std::vector<Glide>>& glides,
+            std::size_t t, double distance)
+      : set_(set),
+        m_(matched[t]),
+        own_(glides[t]),
+        field(set, glides, t, distance, set.level_nominal.back()),
+        n(static_cast<std::uint32_t>(own_.size())),
+        spacing_(1 / std::sqrt(double(set.level_nominal.back()))),
+        cells_(static_cast<std::int64_t>(std::ceil(1.5 / (2 * spacing_)))),
+        near_(std::size_t(cells_ * cells_)),
+        owner_(m_.packed.size(), n) {
+    for (std::uint32_t c = 0; c < m_.packed.size(); ++c)
+      near_[std::size_t(cell_of(m_.columns[2 * c + 1]) * cells_ + cell_of(m_.columns[2 * c]))].push_back(c);
+    for (std::uint32_t r = 0; r < n; ++r) owner_[m_.column[r]] = r;
+  }
+
+  const Glide& glide(std::uint32_t r) const { return own_[r]; }
+
+  /// For each sub-point c near rank r's start but its own: visit(c, mine, other, theirs) with r's glide
+  /// onto c, the rank `other` that takes c (n if none) and its glide onto r's sub-point, where neither
+  /// glide is longer than `longest` spacings or than the one it replaces.
+  template <class Visit>
+  void for_swaps(std::uint32_t r, double longest, Visit&& visit) const {
+    const double max_length = longest * spacing_;
+    const std::int64_t cx = cell_of(m_.start[2 * r]), cy = cell_of(m_.start[2 * r + 1]);
+    for (std::int64_t y = std::max<std::int64_t>(0, cy - 1); y <= std::min(cells_ - 1, cy + 1); ++y)
+      for (std::int64_t x = std::max<std::int64_t>(0, cx - 1); x <= std::min(cells_ - 1, cx + 1); ++x)
+        for (std::uint32_t c : near_[std::size_t(y * cells_ + x)]) {
+          if (c == m_.column[r]) continue;
+          const Glide mine = glide_to(set_, m_, r, c);
+          if (length(mine) > std::max(max_length, length(own_[r]))) continue;
+          const std::uint32_t other = owner_[c];
+          Glide theirs;
+          if (other < n) {
+            theirs = glide_to(set_, m_, other, m_.column[r]);
+            if (length(theirs) > std::max(max_length, length(own_[other]))) continue;
+          }
+          visit(c, mine, other, theirs);
+        }
+  }
+
+  /// Rank r takes sub-point c with glide `mine`; c's rank, if any, takes r's with `theirs`.
+  void swap(std::uint32_t r, std::uint32_t c, const Glide& mine, const Glide& theirs) {
+    const std::uint32_t old = m_.column[r], other = owner_[c];
+    m_.column[r] = c, owner_[c] = r, own_[r] = mine;
+    field.replace(r, mine);
+    owner_[old] = other;
+    if (other < n) m_.column[other] = old, own_[other] = theirs, field.replace(other, theirs);
+  }
+
+ private:
+  std::int64_t cell_of(double v) const {
+    return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((v + 0.25) / (2 * spacing_))), 0,
+                                    cells_ - 1);
+  }
+
+  const TilesetData& set_;
+  Matched& m_;
+  std::vector<Glide>& own_;
+
+ public:
+  GliderField field;
+  const std::uint32_t n;  ///< the tile's ranks
+
+ private:
+  double spacing_;
+  std::int64_t cells_;
+  std::vector<std::vector<std::uint32_t>> near_;
+  std::vector<std::uint32_t> owner_;
+};
+
+/// The squared length a swap adds.
+double added_length(const TileSwaps& swaps, std::uint32_t r, const Glide& mine, std::uint32_t other,
+                    const Glide& theirs) {
+  double added = length(mine) * length(mine) - length(swaps.glide(r)) * length(swaps.glide(r));
+  if (other < swaps.n)
+    added += length(theirs) * length(theirs) - length(swaps.glide(other)) * length(swaps.glide(other));
+  return added;
+}
+
 /// Parts tile t's glides that come close to another (its own at another pace, or a neighbour tile's):
 /// each such point swaps sub-points with a nearby point of its tile, or takes a sub-point no point has,
 /// where that leaves both clear (some cannot: where a glide crosses its tile's edge, or meets a point
 /// that stays).
 void untangle(const TilesetData& set, std::vector<Matched>& matched, std::vector<std::vector<Glide>>& glides,
               std::size_t t) {
-  const double top = set.level_nominal.back(), spacing = 1 / std::sqrt(top);
-  const double distance = kGlideSeparation * std::sqrt(2 / (std::sqrt(3.0) * top));
-  Matched& m = matched[t];
-  std::vector<Glide>& own = glides[t];
-  GliderField field(set, glides, t, distance, top);
-  const auto n = static_cast<std::uint32_t>(own.size());
-  // Ranks and free sub-points by cells of 2 spacings, for neighbours.
-  const double cell = 2 * spacing;
-  const auto cells = static_cast<std::int64_t>(std::ceil(1.5 / cell));
-  const auto cell_of = [&](double v) {
-    return std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((v + 0.25) / cell)), 0, cells - 1);
-  };
-  std::vector<std::vector<std::uint32_t>> columns_near(std::size_t(cells * cells));
-  for (std::uint32_t c = 0; c < m.packed.size(); ++c)
-    columns_near[std::size_t(cell_of(m.columns[2 * c + 1]) * cells + cell_of(m.columns[2 * c]))].push_back(c);
-  std::vector<std::uint32_t> owner(m.packed.size(), n);
-  for (std::uint32_t r = 0; r < n; ++r) owner[m.column[r]] = r;
-  const double max_length = kMaxGlide * spacing;
-  const auto length = [](const Glide& g) { return std::hypot(g.bx - g.ax, g.by - g.ay); };
-  for (std::uint32_t r = 0; r < n; ++r) {
-    if (!field.meets(own[r], r, r)) continue;
+  const double top = set.level_nominal.back();
+  TileSwaps swaps(set, matched, glides, t, kGlideSeparation * std::sqrt(2 / (std::sqrt(3.0) * top)));
+  const GliderField& field = swaps.field;
+  for (std::uint32_t r = 0; r < swaps.n; ++r) {
+    if (!field.meets(swaps.glide(r), r, r)) continue;
     // The best move: least added squared length among those that leave every glide it changes clear.
     double best = std::numeric_limits<double>::infinity();
     std::uint32_t best_column = 0;
     Glide best_r, best_other;
-    const std::int64_t cx = cell_of(m.start[2 * r]), cy = cell_of(m.start[2 * r + 1]);
-    const double before = length(own[r]) * length(own[r]);
-    for (std::int64_t y = std::max<std::int64_t>(0, cy - 1); y <= std::min(cells - 1, cy + 1); ++y)
-      for (std::int64_t x = std::max<std::int64_t>(0, cx - 1); x <= std::min(cells - 1, cx + 1); ++x)
-        for (std::uint32_t c : columns_near[std::size_t(y * cells + x)]) {
-          if (c == m.column[r]) continue;
-          const Glide mine = glide_to(set, m, r, c);
-          if (length(mine) > std::max(max_length, length(own[r]))) continue;
-          const std::uint32_t other = owner[c];
-          double added = length(mine) * length(mine) - before;
-          Glide theirs;
-          if (other < n) {
-            theirs = glide_to(set, m, other, m.column[r]);
-            if (length(theirs) > std::max(max_length, length(own[other]))) continue;
-            added += length(theirs) * length(theirs) - length(own[other]) * length(own[other]);
+    swaps.for_swaps(r, kMaxGlide,
+                    [&](std::uint32_t c, const Glide& mine, std::uint32_t other, const Glide& theirs) {
+                      const double added = added_length(swaps, r, mine, other, theirs);
+                      if (added >= best) return;
+                      if (field.meets(mine, r, other < swaps.n ? other : r)) return;
+                      if (other < swaps.n && (field.meets(theirs, r, other) || field.meet(mine, theirs)))
+                        return;
+                      best = added, best_column = c, best_r = mine, best_other = theirs;
+                    });
+    if (best < std::numeric_limits<double>::infinity()) swaps.swap(r, best_column, best_r, best_other);
+  }
+}
+
+/// Moves apart tile t's glides that still come within kRepairBelow of another (its own or a neighbour
+/// tile's): each such point takes the swap with a nearby point of its tile, or the free sub-point, that
+/// leaves the glides it changes farthest from every other, where that is farther than before.
+void repair(const TilesetData& set, std::vector<Matched>& matched, std::vector<std::vector<Glide>>& glides,
+            std::size_t t) {
+  const double d_hex = std::sqrt(2 / (std::sqrt(3.0) * set.level_nominal.back()));
+  TileSwaps swaps(set, matched, glides, t, kGlideSeparation * d_hex);
+  const GliderField& field = swaps.field;
+  for (std::uint32_t r = 0; r < swaps.n; ++r) {
+    const double now = field.nearest(swaps.glide(r), r, r);
+    if (now >= kRepairBelow * d_hex) continue;
+    double best = now, best_added = 0;
+    std::uint32_t best_column = 0;
+    bool found = false;
+    Glide best_r, best_other;
+    swaps.for_swaps(
+        r, kMaxRepairGlide,
+        [&](std::uint32_t c, const Glide& mine, std::uint32_t other, const Glide& theirs) {
+          double before = now, after = field.nearest(mine, r, other < swaps.n ? other : r);
+          if (other < swaps.n) {
+            before = std::min(before, field.nearest(swaps.glide(other), other, other));
+            after = std::min({after, field.nearest(theirs, r, other), field.approach(mine, theirs)});
           }
-          if (added >= best) continue;
-          if (field.meets(mine, r, other < n ? other : r)) continue;
-          if (other < n && (field.meets(theirs, r, other) || field.meet(mine, theirs))) continue;
-          best = added, best_column = c, best_r = mine, best_other = theirs;
-        }
-    if (best == std::numeric_limits<double>::infinity()) continue;
-    const std::uint32_t old = m.column[r], other = owner[best_column];
-    m.column[r] = best_column, owner[best_column] = r, own[r] = best_r;
-    field.replace(r, best_r);
-    owner[old] = other;
-    if (other < n) m.column[other] = old, own[other] = best_other, field.replace(other, best_other);
+          const double added = added_length(swaps, r, mine, other, theirs);
+          if (after <= before || after < best || (after == best && added >= best_added)) return;
+          best = after, best_added = added, best_column = c, best_r = mine, best_other = theirs, found = true;
+        });
+    if (found) swaps.swap(r, best_column, best_r, best_other);
   }
 }
 
@@ -241,6 +333,8 @@ std::vector<TileHandover> plan_handover(const TilesetData& set) {
   // Tiles in turn, each against its neighbours as they stand: a few passes.
   for (int pass = 0; pass < kPasses; ++pass)
     for (std::size_t t = 0; t < set.tiles.size(); ++t) untangle(set, matched, glides, t);
+  for (int pass = 0; pass < kRepairPasses; ++pass)
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) repair(set, matched, glides, t);
   std::vector<TileHandover> out(set.tiles.size());
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     for (std::uint32_t c : matched[t].column) out[t].target.push_back(matched[t].packed[c]);

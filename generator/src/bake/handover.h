@@ -5,8 +5,9 @@
 // on the way. Each tile's points are matched to its own sub-points as one whole,
 // least total squared distance: straight paths of such a matching, travelled in step, never meet (the
 // displacement interpolation of optimal transport), and the tile's whole surplus of sub-points is there
-// for a point wherever it lies. The sub-points left over appear in an order that lets the gliders around
-// each clear its place first.
+// for a point wherever it lies. Paths are not in step (a long glide is slow), so points whose paths come
+// close to another's then swap sub-points with a nearby point where that parts them. The sub-points left
+// over appear in an order that lets the gliders around each clear its place first.
 //
 // Thread safety: plan_handover is a pure function of its arguments.
 #pragma once
