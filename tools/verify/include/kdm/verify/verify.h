@@ -102,9 +102,9 @@ struct VerifyOptions {
   /// half of part 5's time). Off, no hole checks are made whatever the bars.
   bool holes = true;
   /// Part 6: the hand-over judged at this many even steps of the way (at least 1). A close pair lasts a
-  /// few per cent of the way: on the shipped set four steps miss one of 0.075 d_hex that 20 find
-  /// (docs/design.md §3, "Slack").
-  int handover_rows = 4;
+  /// few per cent of the way, so that four steps can miss one that 20 find (docs/design.md §3, "The
+  /// hand-over").
+  int handover_rows = 20;
   int threads = 0;  ///< worker threads, 0 = gen::default_thread_count(); results do not depend on it
   Bars bars;
   std::function<void(double)> progress;  ///< fraction done in [0, 1], from the calling thread (optional)
