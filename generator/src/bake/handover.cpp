@@ -143,21 +143,25 @@ class TileSwaps {
       : set_(set),
         m_(matched[t]),
         own_(glides[t]),
-        field(set, glides, t, distance, set.level_nominal.back()),
-        n(static_cast<std::uint32_t>(own_.size())),
+        field_(set, glides, t, distance, set.level_nominal.back()),
+        n_(static_cast<std::uint32_t>(own_.size())),
         spacing_(1 / std::sqrt(double(set.level_nominal.back()))),
         cells_(static_cast<std::int64_t>(std::ceil(1.5 / (2 * spacing_)))),
         near_(std::size_t(cells_ * cells_)),
-        owner_(m_.packed.size(), n) {
+        owner_(m_.packed.size(), n_) {
     for (std::uint32_t c = 0; c < m_.packed.size(); ++c)
       near_[std::size_t(cell_of(m_.columns[2 * c + 1]) * cells_ + cell_of(m_.columns[2 * c]))].push_back(c);
-    for (std::uint32_t r = 0; r < n; ++r) owner_[m_.column[r]] = r;
+    for (std::uint32_t r = 0; r < n_; ++r) owner_[m_.column[r]] = r;
   }
 
+  /// The tile's ranks, [0, ranks()), and rank r's glide.
+  std::uint32_t ranks() const { return n_; }
   const Glide& glide(std::uint32_t r) const { return own_[r]; }
+  /// The glides that can pass near the tile's, as they stand.
+  const GliderField& field() const { return field_; }
 
   /// For each sub-point c near rank r's start but its own: visit(c, mine, other, theirs) with r's glide
-  /// onto c, the rank `other` that takes c (n if none) and its glide onto r's sub-point, where neither
+  /// onto c, the rank `other` that takes c (ranks() if none) and its glide onto r's sub-point, where neither
   /// glide is longer than `longest` spacings or than the one it replaces.
   template <class Visit>
   void for_swaps(std::uint32_t r, double longest, Visit&& visit) const {
@@ -171,7 +175,7 @@ class TileSwaps {
           if (length(mine) > std::max(max_length, length(own_[r]))) continue;
           const std::uint32_t other = owner_[c];
           Glide theirs;
-          if (other < n) {
+          if (other < n_) {
             theirs = glide_to(set_, m_, other, m_.column[r]);
             if (length(theirs) > std::max(max_length, length(own_[other]))) continue;
           }
@@ -183,9 +187,9 @@ class TileSwaps {
   void swap(std::uint32_t r, std::uint32_t c, const Glide& mine, const Glide& theirs) {
     const std::uint32_t old = m_.column[r], other = owner_[c];
     m_.column[r] = c, owner_[c] = r, own_[r] = mine;
-    field.replace(r, mine);
+    field_.replace(r, mine);
     owner_[old] = other;
-    if (other < n) m_.column[other] = old, own_[other] = theirs, field.replace(other, theirs);
+    if (other < n_) m_.column[other] = old, own_[other] = theirs, field_.replace(other, theirs);
   }
 
  private:
@@ -197,12 +201,8 @@ class TileSwaps {
   const TilesetData& set_;
   Matched& m_;
   std::vector<Glide>& own_;
-
- public:
-  GliderField field;
-  const std::uint32_t n;  ///< the tile's ranks
-
- private:
+  GliderField field_;
+  std::uint32_t n_;
   double spacing_;
   std::int64_t cells_;
   std::vector<std::vector<std::uint32_t>> near_;
@@ -213,7 +213,7 @@ class TileSwaps {
 double added_length(const TileSwaps& swaps, std::uint32_t r, const Glide& mine, std::uint32_t other,
                     const Glide& theirs) {
   double added = length(mine) * length(mine) - length(swaps.glide(r)) * length(swaps.glide(r));
-  if (other < swaps.n)
+  if (other < swaps.ranks())
     added += length(theirs) * length(theirs) - length(swaps.glide(other)) * length(swaps.glide(other));
   return added;
 }
@@ -226,22 +226,21 @@ void untangle(const TilesetData& set, std::vector<Matched>& matched, std::vector
               std::size_t t) {
   const double top = set.level_nominal.back();
   TileSwaps swaps(set, matched, glides, t, kGlideSeparation * std::sqrt(2 / (std::sqrt(3.0) * top)));
-  const GliderField& field = swaps.field;
-  for (std::uint32_t r = 0; r < swaps.n; ++r) {
+  const GliderField& field = swaps.field();
+  for (std::uint32_t r = 0; r < swaps.ranks(); ++r) {
     if (!field.meets(swaps.glide(r), r, r)) continue;
     // The best move: least added squared length among those that leave every glide it changes clear.
     double best = std::numeric_limits<double>::infinity();
     std::uint32_t best_column = 0;
     Glide best_r, best_other;
-    swaps.for_swaps(r, kMaxGlide,
-                    [&](std::uint32_t c, const Glide& mine, std::uint32_t other, const Glide& theirs) {
-                      const double added = added_length(swaps, r, mine, other, theirs);
-                      if (added >= best) return;
-                      if (field.meets(mine, r, other < swaps.n ? other : r)) return;
-                      if (other < swaps.n && (field.meets(theirs, r, other) || field.meet(mine, theirs)))
-                        return;
-                      best = added, best_column = c, best_r = mine, best_other = theirs;
-                    });
+    swaps.for_swaps(
+        r, kMaxGlide, [&](std::uint32_t c, const Glide& mine, std::uint32_t other, const Glide& theirs) {
+          const double added = added_length(swaps, r, mine, other, theirs);
+          if (added >= best) return;
+          if (field.meets(mine, r, other < swaps.ranks() ? other : r)) return;
+          if (other < swaps.ranks() && (field.meets(theirs, r, other) || field.meet(mine, theirs))) return;
+          best = added, best_column = c, best_r = mine, best_other = theirs;
+        });
     if (best < std::numeric_limits<double>::infinity()) swaps.swap(r, best_column, best_r, best_other);
   }
 }
@@ -253,8 +252,8 @@ void repair(const TilesetData& set, std::vector<Matched>& matched, std::vector<s
             std::size_t t) {
   const double d_hex = std::sqrt(2 / (std::sqrt(3.0) * set.level_nominal.back()));
   TileSwaps swaps(set, matched, glides, t, kGlideSeparation * d_hex);
-  const GliderField& field = swaps.field;
-  for (std::uint32_t r = 0; r < swaps.n; ++r) {
+  const GliderField& field = swaps.field();
+  for (std::uint32_t r = 0; r < swaps.ranks(); ++r) {
     const double now = field.nearest(swaps.glide(r), r, r);
     if (now >= kRepairBelow * d_hex) continue;
     double best = now, best_added = 0;
@@ -264,8 +263,8 @@ void repair(const TilesetData& set, std::vector<Matched>& matched, std::vector<s
     swaps.for_swaps(
         r, kMaxRepairGlide,
         [&](std::uint32_t c, const Glide& mine, std::uint32_t other, const Glide& theirs) {
-          double before = now, after = field.nearest(mine, r, other < swaps.n ? other : r);
-          if (other < swaps.n) {
+          double before = now, after = field.nearest(mine, r, other < swaps.ranks() ? other : r);
+          if (other < swaps.ranks()) {
             before = std::min(before, field.nearest(swaps.glide(other), other, other));
             after = std::min({after, field.nearest(theirs, r, other), field.approach(mine, theirs)});
           }
