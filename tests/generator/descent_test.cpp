@@ -33,7 +33,7 @@ namespace {
 /// The small set handing over onto its subtiles' level `level`, loaded as a query would.
 Tileset bake_small_set(std::uint32_t level) {
   std::vector<std::uint8_t> bytes;
-  EXPECT_EQ(encode_tileset(gen::bake_tileset(testing::small_handover_recipe(level), 2), bytes), Status::kOk);
+  EXPECT_EQ(encode_tileset(testing::small_handover_set(level), bytes), Status::kOk);
   Tileset t;
   EXPECT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), t), Status::kOk);
   return t;

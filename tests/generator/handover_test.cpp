@@ -26,10 +26,10 @@ struct Baked {
   Subdivision sub;
 };
 
-/// The small set handing over onto its subtiles' level `level`, as the baker returns it.
+/// The small set handing over onto its subtiles' level `level`, with its subdivision.
 Baked bake_small_set(std::uint32_t level) {
   Baked b;
-  b.set = bake_tileset(testing::small_handover_recipe(level), 2);
+  b.set = testing::small_handover_set(level);
   b.sub = b.set.subdivision();
   return b;
 }
