@@ -27,7 +27,9 @@ namespace {
 
 using Key = std::tuple<std::int64_t, std::int64_t, std::uint32_t, double, double>;
 
-std::vector<Key> run(const QueryParams& q, std::size_t capacity = 1 << 16) {
+/// The query's points (ids and positions), fetched `capacity` at a time. The default is small, as a query
+/// test runs thousands of queries and a sanitizer clears and unmaps a large buffer at each.
+std::vector<Key> run(const QueryParams& q, std::size_t capacity = 4096) {
   std::vector<QueryPoint> buffer(capacity);
   std::vector<Key> keys;
   QueryCursor cursor;
