@@ -255,9 +255,33 @@ TEST(PointFileInput, NulBytesAreMalformed) {
   std::istringstream nul(std::string(text, sizeof text - 1));
   EXPECT_FALSE(kdm::tools::read_point_sets(nul, "nul.txt", sets, error));
   EXPECT_TRUE(contains(error, "nul.txt:2: malformed")) << error;
+  EXPECT_TRUE(contains(error, "'0.3 0.4\\x00 0.5'")) << error;  // quoted printably
   std::istringstream good("x,y\n0.1,0.2\n#\n0.3 0.4\n");
   ASSERT_TRUE(kdm::tools::read_point_sets(good, "good.csv", sets, error)) << error;
   EXPECT_EQ(sets.size(), 2u);
+}
+
+// A file that never ends a line (a binary file, /dev/zero) is refused at its first long line, not read
+// whole; a quoted excerpt of a malformed line is short and printable; a directory is named as one.
+TEST(PointFileInput, EndlessLinesBinaryBytesAndDirectoriesAreRefused) {
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  std::istringstream endless("0.1 0.2\n" + std::string(5000, '\0'));
+  EXPECT_FALSE(kdm::tools::read_point_sets(endless, "zero.txt", sets, error));
+  EXPECT_TRUE(contains(error, "zero.txt:2: a line longer than 4096 characters")) << error;
+  std::istringstream longest("0.1 " + std::string(4092, '1') + "\n");  // 4096 characters: still read
+  EXPECT_FALSE(kdm::tools::read_point_sets(longest, "long.txt", sets, error));
+  EXPECT_TRUE(contains(error, "non-finite")) << error;  // read as a number too large for a double
+  std::istringstream binary(
+      "\x7f"
+      "ELF\x02\x01\x01" +
+      std::string(100, 'a') + "\n");
+  EXPECT_FALSE(kdm::tools::read_point_sets(binary, "kdm", sets, error));
+  EXPECT_TRUE(contains(error, "'\\x7fELF\\x02\\x01\\x01aaa")) << error;
+  EXPECT_TRUE(contains(error, "aaa...'")) << error;
+  EXPECT_LT(error.size(), 100u) << error;
+  EXPECT_FALSE(kdm::tools::read_point_sets(::testing::TempDir(), sets, error));
+  EXPECT_TRUE(contains(error, "is a directory")) << error;
 }
 
 }  // namespace

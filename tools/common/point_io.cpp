@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -56,6 +57,11 @@ std::string comment_safe(std::string line) {
 }
 
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    error = "point file '" + path + "' is a directory";
+    return false;
+  }
   std::ifstream in(path);
   if (!in) {
     error = "cannot open point file '" + path + "'";
@@ -63,6 +69,44 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
   }
   return read_point_sets(in, path, sets, error);
 }
+
+namespace {
+
+/// The longest line a point file may have: seven numbers of 17 digits with room to spare. A file that
+/// never ends a line (a binary file, /dev/zero) is refused there instead of read whole.
+constexpr std::size_t kMaxLineLength = 4096;
+
+/// Reads one line into `line` (without its '\n'). False at the end of `in`, or when the line is longer
+/// than kMaxLineLength (`too_long` set).
+bool read_line(std::istream& in, std::string& line, bool& too_long) {
+  line.clear();
+  std::streambuf* buffer = in.rdbuf();
+  for (int c = buffer->sbumpc(); c != std::char_traits<char>::eof(); c = buffer->sbumpc()) {
+    if (c == '\n') return true;
+    if (line.size() == kMaxLineLength) return !(too_long = true);
+    line.push_back(static_cast<char>(c));
+  }
+  return !line.empty();
+}
+
+/// The start of `line` for an error message: at most 40 characters, bytes that are not printable ASCII as
+/// \xNN.
+std::string excerpt(const std::string& line) {
+  std::string out;
+  for (std::size_t i = 0; i < line.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(line[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out.push_back(static_cast<char>(c));
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return line.size() > 40 ? out + "..." : out;
+}
+
+}  // namespace
 
 bool read_point_sets(std::istream& in, const std::string& path, std::vector<PointSet>& sets,
                      std::string& error) {
@@ -77,7 +121,8 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
     if (!current.coords.empty()) sets.push_back(current);
     current.coords.clear(), current.classes.clear();
   };
-  while (std::getline(in, line)) {
+  bool too_long = false;
+  while (read_line(in, line, too_long)) {
     ++line_no;
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos) continue;
@@ -107,7 +152,7 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
       char* end = nullptr;
       const double v = std::strtod(p, &end);
       if (end == p) {
-        error = path + ":" + std::to_string(line_no) + ": malformed number in '" + line + "'";
+        error = path + ":" + std::to_string(line_no) + ": malformed number in '" + excerpt(line) + "'";
         return false;
       }
       if (!std::isfinite(v)) {
@@ -150,6 +195,11 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
     }
     current.dim = dim;
     current.coords.insert(current.coords.end(), values.begin(), values.end());
+  }
+  if (too_long) {
+    error = path + ":" + std::to_string(line_no + 1) + ": a line longer than " +
+            std::to_string(kMaxLineLength) + " characters: not a point file";
+    return false;
   }
   finish_set();
   if (sets.empty()) {

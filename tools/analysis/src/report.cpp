@@ -158,9 +158,14 @@ std::string format_summary(const AnalysisReport& r) {
          r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
   if (r.has_spectrum) {
     const SpectrumStats& st = r.spectrum_stats;
-    append(s,
-           "spectrum (f ≤ %.2f, %d set(s))  lowP %.4f  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n",
-           r.spectrum.fmax, r.spectrum.sets, st.low_p, st.peak, st.peak_f, st.nu_eff, st.anisotropy_db);
+    append(s, "spectrum (f ≤ %.2f, %d set(s))  ", r.spectrum.fmax, r.spectrum.sets);
+    // lowP's band (below half the points' mean frequency) holds no frequency for sets of 4 points or fewer.
+    if (std::isfinite(st.low_p))
+      append(s, "lowP %.4f", st.low_p);
+    else
+      append(s, "lowP n/a (too few points)");
+    append(s, "  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n", st.peak, st.peak_f, st.nu_eff,
+           st.anisotropy_db);
   }
   double gmax = 0, rpeak = 0;
   for (std::size_t b = 0; b < r.gr.g.size(); ++b)

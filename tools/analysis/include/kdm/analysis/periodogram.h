@@ -47,10 +47,10 @@ struct SpectrumStats {
   std::vector<double> ring_f;          ///< f of rings r = 1..ring_max (index r−1)
   std::vector<double> raps;            ///< RAPS of those rings
   std::vector<std::size_t> ring_size;  ///< number of integer k in each ring
-  double low_p = 0;                    ///< mean P over all k with 0 < f < 0.5
-  double peak = 0, peak_f = 0;         ///< max RAPS and its f
-  double nu_eff = 0;                   ///< 0 when the first ring already has RAPS ≥ 0.1
-  double anisotropy_db = 0;  ///< mean over rings 0.5 < f < 2.5 (and ≤ fmax) of 10·log10(var/mean²)
+  double low_p = 0;  ///< mean P over all k with 0 < f < 0.5; NaN where none lies there (4 points or fewer)
+  double peak = 0, peak_f = 0;  ///< max RAPS and its f
+  double nu_eff = 0;            ///< 0 when the first ring already has RAPS ≥ 0.1
+  double anisotropy_db = 0;     ///< mean over rings 0.5 < f < 2.5 (and ≤ fmax) of 10·log10(var/mean²)
   double raps_at(double k_norm) const;  ///< RAPS of the ring holding |k| (NaN outside 1..ring_max)
 };
 
