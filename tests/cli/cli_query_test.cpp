@@ -100,6 +100,11 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
   expect_error("query --rect 0,0,4,4 --density-rect 0,0,1,1 -o '" + path("z.csv") + "'", "--density-rect");
   expect_error("query --rect 0,0,10,10 --scale 100000 -o '" + path("z.csv") + "'", "--tile-size 0.572433");
   expect_error("sample --n 100 --density const:0 -o '" + path("z.txt") + "'", "> 0");
+  // Bounds that differ as typed but are one double are said to be, not called inverted.
+  expect_error("query --rect 1e17,0,100000000000000001,1 -o '" + path("z.csv") + "'", "less than a double");
+  const Outcome inverted = kdm("query --rect 2,0,1,1 -o '" + path("z.csv") + "'");
+  EXPECT_NE(inverted.err.find("empty or inverted"), std::string::npos) << inverted.err;
+  EXPECT_EQ(inverted.err.find("double"), std::string::npos) << inverted.err;
 }
 
 // --class, repeated: one query, each row with its class; class 0's rows are the one-class query's at its

@@ -17,9 +17,18 @@ void parse_rect(const std::string& text, const char* option, double r[4]) {
   if (!parsed || !(std::isfinite(r[0]) && std::isfinite(r[1]) && std::isfinite(r[2]) && std::isfinite(r[3])))
     throw CommandError(std::string(option) + " must be x0,y0,x1,y1 (four finite numbers), got '" + text +
                        "'");
-  if (!(r[2] > r[0] && r[3] > r[1]))
-    throw CommandError(std::string(option) + " is empty or inverted (needs x0 < x1 and y0 < y1): '" + text +
-                       "'");
+  if (!(r[2] > r[0] && r[3] > r[1])) {
+    // Far from 0, two numbers that differ as typed can be one double: say so rather than "inverted".
+    long double typed[4];
+    std::istringstream again(text);
+    for (long double& v : typed) again >> v >> c[0];
+    const bool rounded = (r[2] == r[0] && typed[2] > typed[0]) || (r[3] == r[1] && typed[3] > typed[1]);
+    throw CommandError(std::string(option) + " is empty or inverted (needs x0 < x1 and y0 < y1" +
+                       (rounded ? "; numbers this far from 0 that differ by less than a double resolves are "
+                                  "equal"
+                                : "") +
+                       "): '" + text + "'");
+  }
 }
 
 const Tileset& tileset_for(const std::string& path, Tileset& storage) {
