@@ -420,6 +420,18 @@ struct PreparedClasses {
   }
 };
 
+/// specs[k] where callables[k] is None (a density of its own), else a constant standing in for the callable.
+std::vector<const tools::DensitySpec*> image_specs(const std::vector<const tools::DensitySpec*>& specs,
+                                                   const std::vector<py::object>& callables) {
+  static const tools::DensitySpec callable;
+  std::vector<const tools::DensitySpec*> out;
+  for (std::size_t k = 0; k < specs.size(); ++k)
+    out.push_back(k < callables.size() && !callables[k].is_none() ? &callable
+                  : specs[k]                                      ? specs[k]
+                                                                  : &callable);
+  return out;
+}
+
 /// A class's density is specs[k], or callables[k] where that is not None (bounded by maxima[k]).
 void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<const tools::DensitySpec*>& specs,
@@ -434,6 +446,17 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
     throw std::invalid_argument(
         "classes: one callable (or None), one maximum and one bounds (or None) per class");
   if (density_rect) check_rect("density_rect", *density_rect);
+  const auto [i, j] = tools::images_of_different_shapes(image_specs(specs, callables));
+  if (j >= 0) {
+    auto shape = [&](int k) {
+      return "classes[" + std::to_string(k) + "] is " + std::to_string(specs[k]->width) + "x" +
+             std::to_string(specs[k]->height);
+    };
+    throw std::invalid_argument(
+        "class images must have one shape (width to height), each stretched over the "
+        "same rectangle: " +
+        shape(i) + ", " + shape(j));
+  }
   const Rect r = density_rect ? *density_rect : rect;
   ClassQueryParams& q = prepared.q;
   q.query.x0 = rect[0], q.query.y0 = rect[1], q.query.x1 = rect[2], q.query.y1 = rect[3];

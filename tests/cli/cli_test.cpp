@@ -383,17 +383,19 @@ TEST_F(CliTest, StippleScaleIsChecked) {
   EXPECT_NEAR(counts[1], expected, 1.0);
 }
 
-// --class images cover one domain: images of different sizes (each stretched its own way) are refused;
-// images of one size are fine.
-TEST_F(CliTest, ClassImagesMustShareOneSize) {
+// --class images cover one domain: images of different shapes (each stretched its own way) are refused;
+// images of one shape are fine, at any resolutions.
+TEST_F(CliTest, ClassImagesMustShareOneShape) {
   write_bytes(path("a.png"), grey_png(32, 32, 8, std::vector<std::uint16_t>(32 * 32, 100)));
   write_bytes(path("b.png"), grey_png(32, 16, 8, std::vector<std::uint16_t>(32 * 16, 100)));
-  const std::string a = " --class '" + path("a.png") + "'", b = " --class '" + path("b.png") + "'";
+  write_bytes(path("c.png"), grey_png(16, 16, 8, std::vector<std::uint16_t>(16 * 16, 200)));
+  const std::string a = " --class '" + path("a.png") + "'", b = " --class '" + path("b.png") + "'",
+                    c = " --class '" + path("c.png") + "'";
   expect_error("sample -n 100" + a + b + " -o '" + path("s.csv") + "'", "b.png' is 32x16");
   expect_error("query --rect 0,0,1,1" + b + a + " -o '" + path("q.csv") + "'", "a.png' is 32x32");
   EXPECT_FALSE(fs::exists(path("s.csv")) || fs::exists(path("q.csv")));
-  EXPECT_EQ(kdm("sample -n 100" + a + a + " -o '" + path("s.csv") + "'").status, 0);
-  EXPECT_EQ(kdm("query --rect 0,0,1,1" + a + a + " -o '" + path("q.csv") + "'").status, 0);
+  EXPECT_EQ(kdm("sample -n 100" + a + c + " -o '" + path("s.csv") + "'").status, 0);
+  EXPECT_EQ(kdm("query --rect 0,0,1,1" + a + c + " -o '" + path("q.csv") + "'").status, 0);
 }
 
 // Smaller refusals that named the wrong thing or nothing: verify's bars below 0 or NaN (silently off), a

@@ -406,6 +406,11 @@ def test_classes_refuse_bad_input():
         BUILTIN.query(rect, scale=10, classes=[1.0, -2.0])
     with pytest.raises(ValueError, match="scale="):
         BUILTIN.query(rect, scale=1e9, classes=[1.0, 1.0])
+    # Images are stretched over one rectangle: of one shape at any resolutions, as kdm query --class.
+    with pytest.raises(ValueError, match=r"one shape .*classes\[0\] is 32x32, classes\[2\] is 32x16"):
+        BUILTIN.query(rect, scale=100, classes=[np.ones((32, 32)), 0.5, np.ones((16, 32))])
+    both = BUILTIN.query(rect, scale=100, classes=[np.ones((32, 32)), 0.5, np.full((16, 16), 0.5)])
+    assert set(np.unique(both.classes)) == {0, 1, 2}
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])

@@ -15,18 +15,15 @@ tools::DensitySpec parse_density(const std::string& text, double gamma, bool inv
 }
 
 void check_class_images(const std::vector<const tools::DensitySpec*>& classes) {
-  const tools::DensitySpec* first = nullptr;
-  for (const tools::DensitySpec* s : classes) {
-    if (s->kind != tools::DensitySpec::Kind::kImage) continue;
-    if (!first) {
-      first = s;
-    } else if (s->width != first->width || s->height != first->height) {
-      auto size = [](const tools::DensitySpec& i) {
-        return "'" + i.text + "' is " + std::to_string(i.width) + "x" + std::to_string(i.height);
-      };
-      throw CommandError("--class images must all have one size: " + size(*first) + ", " + size(*s));
-    }
-  }
+  const auto [i, j] = tools::images_of_different_shapes(classes);
+  if (j < 0) return;
+  auto shape = [](const tools::DensitySpec& s) {
+    return "'" + s.text + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height);
+  };
+  throw CommandError(
+      "--class images must have one shape (width to height), each stretched over the same "
+      "rectangle: " +
+      shape(*classes[i]) + ", " + shape(*classes[j]));
 }
 
 void check_image_options(const std::vector<const tools::DensitySpec*>& densities, double gamma, bool invert) {

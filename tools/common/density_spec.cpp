@@ -97,4 +97,20 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   return spec;
 }
 
+std::pair<int, int> images_of_different_shapes(const std::vector<const DensitySpec*>& specs) {
+  int first = -1;
+  for (int k = 0; k < static_cast<int>(specs.size()); ++k) {
+    const DensitySpec& s = *specs[k];
+    if (s.kind != DensitySpec::Kind::kImage) continue;
+    if (first < 0) {
+      first = k;
+      continue;
+    }
+    const DensitySpec& f = *specs[first];
+    const double a = double(s.width) * f.height, b = double(f.width) * s.height;  // ratios times heights
+    if (std::fabs(a - b) > 0.01 * b) return {first, k};
+  }
+  return {-1, -1};
+}
+
 }  // namespace kdm::tools

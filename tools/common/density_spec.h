@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kdm::tools {
@@ -36,5 +37,11 @@ struct DensitySpec {
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
 /// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance.
 DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false);
+
+/// Densities that share one domain (the classes of a query or a sample) stretch each image over all of it:
+/// images whose sides differ in ratio (by more than 1%) would be stretched differently, while images of one
+/// shape at any resolutions line up. Returns the indices {i, j} (i < j) of the first image `specs[j]`
+/// whose shape differs from the first image's `specs[i]`, or {-1, -1} where every image has one shape.
+std::pair<int, int> images_of_different_shapes(const std::vector<const DensitySpec*>& specs);
 
 }  // namespace kdm::tools
