@@ -102,6 +102,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             raise TypeError(
                 f"seed must be None, an int or a numpy.random.Generator, got {type(seed).__name__}"
             )
+        if isinstance(seed, numbers.Integral) and seed < 0:  # numpy's own refusal does not name it
+            raise ValueError(f"seed must be a non-negative int, got {seed}")
         super().__init__(d=d, seed=seed)
         self.temperature = _checks.number("temperature", temperature, 0.0)
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))

@@ -60,7 +60,7 @@ def test_seeds_as_scipy_takes_them():
     assert kdm.BlueNoise(2, seed=1).random(0).shape == (0, 2)
     with pytest.raises(TypeError, match="seed must be None, an int or a numpy.random.Generator"):
         kdm.BlueNoise(2, seed="seven")
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="seed must be a non-negative int, got -1"):
         kdm.BlueNoise(2, seed=-1)
 
 
