@@ -103,20 +103,28 @@ def is_array(value: Any) -> bool:
     return isinstance(value, (np.ndarray, list, tuple)) or hasattr(value, "__array__")
 
 
-def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str = "density") -> Any:
+def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str = "density",
+                 one_of_several: bool = False) -> Any:
     """A density as the C++ side takes it (_kdm.DensitySpec), or None for None.
 
     A number is a constant (finite, >= 0); a str or path is what `--density` accepts ("const:V", "ramp:R",
     "radial:R" or an image file, whose darkness to the power `gamma` is the density, or its luminance with
-    `invert`); a 2-D array holds densities with row 0 at the top.
+    `invert`); a 2-D array holds densities with row 0 at the top. `gamma` or `invert` with no image file
+    is refused (they would be ignored), unless `one_of_several` (the caller checks the densities together).
     """
     gamma = number("gamma", gamma, 0.0, strict=True)
     invert = flag("invert", invert)
+    reshaped = gamma != 1.0 or invert
     if density is None:
+        if reshaped and not one_of_several:
+            raise ValueError("gamma and invert apply to image files only, and no density is given")
         return None
     if isinstance(density, (str, os.PathLike)):
-        return _kdm.DensitySpec.parse(path(name, density), gamma, invert)
-    if gamma != 1.0 or invert:
+        spec = _kdm.DensitySpec.parse(path(name, density), gamma, invert)
+        if reshaped and spec.kind != "image" and not one_of_several:
+            raise ValueError(f"gamma and invert apply to image files only, and {name} {spec.text!r} is not one")
+        return spec
+    if reshaped:
         raise ValueError("gamma and invert apply to image files only (an array or a number is the density)")
     if isinstance(density, numbers.Real) and not isinstance(density, (bool, np.bool_)):
         return _kdm.DensitySpec.constant(number(name, density, 0.0))

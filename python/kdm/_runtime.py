@@ -355,10 +355,15 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
             raise ValueError(f"density_bounds[{k}] is given but {name} is not a callable")
         if d is None:
             raise TypeError(f"{name} must be a number, a str, a 2-D array or a callable, got None")
-        image = isinstance(d, (str, os.PathLike))
-        specs.append(_checks.density_spec(d, gamma if image else 1.0, invert if image else False, name))
+        text = isinstance(d, (str, os.PathLike))
+        specs.append(_checks.density_spec(d, gamma if text else 1.0, invert if text else False, name,
+                                          one_of_several=True))
         callables.append(None)
         maxima.append(0.0)
+    reshaped = _checks.number("gamma", gamma, 0.0, strict=True) != 1.0 or _checks.flag("invert", invert)
+    files = [s for d, s in zip(classes, specs) if isinstance(d, (str, os.PathLike))]
+    if reshaped and not any(s.kind == "image" for s in files):
+        raise ValueError("gamma and invert apply to image files only, and no class is one")
     return specs, callables, maxima, bounds
 
 

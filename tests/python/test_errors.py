@@ -52,6 +52,8 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, "threads must be >= 0", dict(n=10, threads=-1)),
     (ValueError, "aspect must be > 0", dict(n=10, aspect=0)),
     (ValueError, "gamma must be > 0", dict(n=10, density="const:1", gamma=0)),
+    (ValueError, "image files only, and density 'const:1' is not one", dict(n=10, density="const:1", gamma=2)),
+    (ValueError, "image files only, and no density is given", dict(n=10, invert=True)),
     (TypeError, "invert must be True or False", dict(n=10, density="const:1", invert="yes")),
     (ValueError, "const:V needs a finite V >= 0", dict(n=10, density="const:x")),
     (ValueError, r"at most 3\.4e38 \(kept as floats\), got 1e\+308$", dict(n=10, density=np.full((2, 2), 1e308))),
@@ -125,11 +127,24 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
     (ValueError, "density must be >= 0", dict(density=-0.5)),
     (ValueError, "finite and >= 0", dict(density=np.full((3, 3), NAN))),
     (TypeError, "density must be None, a number", dict(density=object())),
+    (ValueError, "image files only, and no density is given", dict(gamma=2)),
+    (ValueError, "image files only, and no class is one", dict(classes=[1.0, "const:0.5"], gamma=2)),
 ])
 def test_query_refusals(kind, match, kwargs):
     args = dict(rect=(0, 0, 1, 1), scale=100)
     args.update(kwargs)
     raises(kind, match, TILES.query, args.pop("rect"), **args)
+
+
+def test_gamma_reshapes_an_image_file_or_is_refused():
+    # As the command line's --gamma and --invert: ignored silently nowhere.
+    points = kdm.sample(200)
+    raises(ValueError, "no density is given", kdm.analyze, points, gamma=2)
+    raises(ValueError, "density 'ramp:4' is not one", kdm.analyze, points, density="ramp:4", invert=True)
+    # Among classes, one image file is enough: gamma reshapes it, and the constant is left as it is.
+    plain = TILES.query((0, 0, 1, 1), scale=400, classes=[str(SPHERE), "const:0.5"])
+    darker = TILES.query((0, 0, 1, 1), scale=400, classes=[str(SPHERE), "const:0.5"], gamma=0.5)
+    assert (darker.classes == 0).sum() > (plain.classes == 0).sum()
 
 
 @pytest.mark.parametrize("kind,match,call", [
