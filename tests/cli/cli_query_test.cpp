@@ -76,6 +76,12 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
     EXPECT_NEAR(x, (wx - 1) / 2, 1e-12) << row;
     EXPECT_NEAR(y, wy - 1, 1e-12) << row;
   }
+  // Options an output would silently drop are refused: --normalised where the output always is, and
+  // classes where it has no column for them.
+  expect_error("query --rect 1,1,3,2 --normalised -o '" + path("n.png") + "'", "--normalised is for .csv");
+  expect_error("query --rect 1,1,3,2 --class const:1 --class const:1 -o '" + path("c.txt") + "'",
+               ".txt has no class column");
+  EXPECT_FALSE(fs::exists(path("n.png")) || fs::exists(path("c.txt")));
   // No density, two ways: const:0 and an all-white image (no ink) both give an empty result.
   write_bytes(path("white.png"), grey_png(2, 2, 8, {255, 255, 255, 255}));
   for (const std::string& none : {std::string("const:0"), "'" + path("white.png") + "'"}) {

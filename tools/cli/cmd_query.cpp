@@ -73,6 +73,13 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   parse_rect(a.rect, "--rect", r);
   if (density_given && !a.classes.empty())
     throw CommandError("give either --density or --class (one per class), not both");
+  const bool ids = tools::has_extension(a.output, ".csv") || tools::has_extension(a.output, ".json");
+  if (a.normalised && !ids)
+    throw CommandError(
+        "--normalised is for .csv and .json output (.txt and pictures are always normalised to "
+        "the rect)");
+  if (!a.classes.empty() && tools::has_extension(a.output, ".txt"))
+    throw CommandError("--class: .txt has no class column; write .csv, .json, .svg or .png");
   if (a.classes.size() > kMaxQueryClasses)
     throw CommandError("--class given " + std::to_string(a.classes.size()) + " times; at most " +
                        std::to_string(kMaxQueryClasses) + " classes");
