@@ -40,8 +40,9 @@ def number(name: str, value: Any, minimum: Optional[float] = None, strict: bool 
 
 
 def threads(value: Any) -> int:
-    """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use)."""
-    return integer("threads", value, 0, 1 << 16)
+    """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use), at
+    most 256 as on the command line."""
+    return integer("threads", value, 0, 256)
 
 
 def flag(name: str, value: Any) -> bool:

@@ -246,7 +246,7 @@ class Tileset:
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
         region in a fixed order: the same bits for any N, in query()'s order unless a tile holds more
-        points than a unit); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
+        points than a unit; 0 for the CPUs this process may use, at most 64); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         More than 2**25 points raise ValueError, as query() does.
         """
@@ -258,9 +258,9 @@ class Tileset:
         if threads is not None:
             if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
                 raise TypeError(f"threads must be an int, got {type(threads).__name__}")
-            if not 1 <= threads <= 64:
-                raise ValueError(f"threads must be 1 to 64, got {threads}")
-            workers = int(threads)
+            if not 0 <= threads <= 64:
+                raise ValueError(f"threads must be 0 (the CPUs this process may use) or 1 to 64, got {threads}")
+            workers = int(threads) or max(1, min(64, len(os.sched_getaffinity(0))))
         if classes is not None:
             if density is not None:
                 raise ValueError("give either density or classes, not both")

@@ -50,6 +50,7 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, "seed must be >= 0", dict(n=10, seed=-1)),
     (ValueError, "seed must be <= ", dict(n=10, seed=2**64)),
     (ValueError, "threads must be >= 0", dict(n=10, threads=-1)),
+    (ValueError, "threads must be <= 256", dict(n=10, threads=1000)),  # as the command line's
     (ValueError, "aspect must be > 0", dict(n=10, aspect=0)),
     (ValueError, "gamma must be > 0", dict(n=10, density="const:1", gamma=0)),
     (ValueError, "image files only, and density 'const:1' is not one", dict(n=10, density="const:1", gamma=2)),

@@ -617,8 +617,8 @@ def test_positions_with_classes_are_the_class_querys_points(mode):
     order = np.lexsort((xy[:, 1], xy[:, 0]))
     order_2 = np.lexsort((xy_2[:, 1], xy_2[:, 0]))
     assert np.array_equal(xy[order], xy_2[order_2]) and np.array_equal(labels[order], labels_2[order_2])
-    with pytest.raises(ValueError, match="threads must be 1 to 64"):
-        BUILTIN.positions(rect, scale=150, classes=classes, threads=0)
+    with pytest.raises(ValueError, match=r"threads must be 0 \(the CPUs this process may use\) or 1 to 64"):
+        BUILTIN.positions(rect, scale=150, classes=classes, threads=65)
     with pytest.raises(ValueError, match="give either density or classes, not both"):
         BUILTIN.positions(rect, scale=150, classes=classes, density=1.0)
     with pytest.raises(ValueError, match="1 to 8"):
@@ -631,14 +631,16 @@ def test_positions_over_threads_give_the_same_bits_for_any_count():
         one, one_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True, threads=1)
         two, two_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True, threads=2)
         assert len(one) > 100000 and np.array_equal(one, two) and np.array_equal(one_keys, two_keys)
+        auto, auto_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True, threads=0)  # the CPUs'
+        assert np.array_equal(one, auto) and np.array_equal(one_keys, auto_keys)
         # The same points as one query, in an order of their own.
         plain_xy, plain_keys = BUILTIN.positions(rect, scale=6000, mode=mode, keys=True)
         assert np.array_equal(np.sort(plain_keys), np.sort(one_keys))
 
 
 def test_positions_refuse_bad_arguments():
-    with pytest.raises(ValueError, match="threads must be 1 to 64"):
-        BUILTIN.positions((0, 0, 1, 1), scale=10, threads=0)
+    with pytest.raises(ValueError, match="threads must be 0 .* or 1 to 64, got -1"):
+        BUILTIN.positions((0, 0, 1, 1), scale=10, threads=-1)
     with pytest.raises(TypeError, match="threads must be an int"):
         BUILTIN.positions((0, 0, 1, 1), scale=10, threads=1.5)
     with pytest.raises(TypeError, match="keys must be True or False"):
