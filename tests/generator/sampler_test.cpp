@@ -120,6 +120,21 @@ TEST(SamplerTest, SameSeedSameBitsForAnyThreadCount) {
   }
 }
 
+// A pyramid of one level (a few hundred points) is the finest and the coarsest level: it runs the larger of
+// `sweeps` and `coarsest_sweeps`, so that asking for more sweeps there is not silently ignored.
+TEST(SamplerTest, OneLevelRunsTheLargerOfTheFinestAndCoarsestSweeps) {
+  SamplerOptions o = options_for(100, Domain::kTorus, 3);
+  const SampleResult plain = sample(o);
+  ASSERT_EQ(plain.report.levels.size(), 1u);
+  EXPECT_EQ(plain.report.levels[0].sweeps, 30);
+  o.sweeps = 80;
+  const SampleResult more = sample(o);
+  EXPECT_EQ(more.report.levels[0].sweeps, 80);
+  EXPECT_NE(more.points, plain.points);
+  o.sweeps = 0;  // the coarsest level's count still holds: the points start at random
+  EXPECT_EQ(sample(o).points, plain.points);
+}
+
 // The footprint cache only saves work: with no room for it, and on a varying density (every kernel its
 // own σ), the bits are the same. The two arithmetics (Numerics) are two different streams.
 TEST(SamplerTest, FootprintCacheDoesNotChangeTheOutput) {

@@ -198,7 +198,9 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   add_threads_option(cmd, o.threads, "output does not depend on it");
-  cmd->add_option("--sweeps", o.sweeps, "Metropolis-Hastings sweeps over all points on the finest level")
+  cmd->add_option("--sweeps", o.sweeps,
+                  "Metropolis-Hastings sweeps over all points on the finest level (where that is "
+                  "the only level, as for a few hundred points, at least 30: points start there at random)")
       ->capture_default_str();
   cmd->add_option("--coarse-sweeps", o.coarse_sweeps,
                   "Metropolis-Hastings sweeps on each level between the coarsest and the finest")

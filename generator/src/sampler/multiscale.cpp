@@ -450,9 +450,11 @@ struct Driver {
       report.energy_per_point = chain.energy() / std::max<std::size_t>(1, particles.size() + fixed.size());
   }
 
-  /// MH sweeps at level l (0 = finest).
+  /// MH sweeps at level l (0 = finest). A pyramid of one level is both: it runs the larger count, so that
+  /// `sweeps` asks for more there too (the baker's coarsest count is never below its `sweeps`).
   int sweeps_at(int l) const {
     const int levels = static_cast<int>(setup.levels.size());
+    if (levels == 1) return std::max(options.sweeps, options.coarsest_sweeps);
     if (l == levels - 1) return options.coarsest_sweeps;
     return l == 0 ? options.sweeps : options.coarse_sweeps;
   }

@@ -92,7 +92,7 @@ struct SamplerOptions {
   int coarse_sweeps = 15;
   /// Sweeps on the coarsest grid, where points start far from equilibrium (tile baking keeps 60). This
   /// level is too small to cut into cells for two threads, so its sweeps run on one.
-  int coarsest_sweeps = 30;
+  int coarsest_sweeps = 30;  ///< a pyramid of one level runs max(sweeps, coarsest_sweeps)
   /// Deterministic descent sweeps (T = 0) right after each refinement, before the MH sweeps: they spread
   /// the crowded children of split kernels. Initialisation only; the MH sweeps then sample P.
   int burn_in_sweeps = 3;
