@@ -412,6 +412,15 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   std::ofstream(path("h.recipe")) << "levels 2\nbase_points 32\nkeyframes 2\nhandover_zone 1\n";
   expect_error("bake '" + path("h.recipe") + "' -o '" + path("h.kdmt") + "'",
                "handover_zone needs at least 3 levels");
+  // Values that would be silently dropped: a tile size of 0 and an empty -o, --fade for a points file.
+  const std::string reference = "'" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt'";
+  expect_error("analyze " + reference + " --tile-size 0", "--tile-size must be > 0");
+  expect_error("analyze " + reference + " -o ''", "-o names no directory");
+  expect_error("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png' --fade 0.2 -o '" +
+                   path("f.csv") + "'",
+               "--fade grows dots in pictures");
+  std::ofstream(path("empty.recipe")) << "# a comment only\n\n  # indented\n";  // not minutes of defaults
+  expect_error("bake '" + path("empty.recipe") + "' -o '" + path("e.kdmt") + "'", "gives no key");
   for (const char* points :
        {"0.5 0.5\n0.5 0.5\n0.5 0.5\n0.5 0.5\n", "0.1 0.5\n0.2 0.5\n0.3 0.5\n0.9 0.5\n"}) {
     std::ofstream(path("flat.txt")) << points;

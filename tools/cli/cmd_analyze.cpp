@@ -41,6 +41,7 @@ struct AnalyzeArgs {
   double holes_min_density = 0;
   int threads = 0;
   std::string output;
+  bool tile_size_given = false, output_given = false;  // 0 and "" given are mistakes, not the defaults
 };
 
 void save_png(const std::string& path, const tools::RgbImage& image) {
@@ -116,6 +117,10 @@ void run_analyze(const AnalyzeArgs& args) {
   if (args.torus && args.box) throw CommandError("--torus and --box are mutually exclusive");
   if (!(args.fmax > 0) || !std::isfinite(args.fmax)) throw CommandError("--fmax must be a positive number");
   if (!(args.min_expected > 0)) throw CommandError("--min-expected must be positive");
+  if (args.tile_size_given && args.tile_size == 0)
+    throw CommandError("--tile-size must be > 0 (leave it out for no tiling diagnostics)");
+  if (args.output_given && args.output.empty())
+    throw CommandError("-o names no directory (leave it out to print the summary only)");
   analysis::AnalysisOptions o;
   o.torus = !args.box;
   o.fmax = args.fmax;
@@ -153,16 +158,17 @@ void run_analyze(const AnalyzeArgs& args) {
       if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
       return;
     }
-    std::string error;
-    if (!tools::write_text_file_atomic((dir / "metrics.json").string(),
-                                       analysis::metrics_json(report, args.files), error))
-      throw CommandError(error);
     if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
     save_png((dir / "points.png").string(), analysis::plot_points(sets.front()));
     if (report.has_spectrum) {
       save_png((dir / "spectrum.png").string(), analysis::plot_spectrum(report.spectrum));
       save_png((dir / "raps.png").string(), analysis::plot_raps(report.spectrum_stats, report.spectrum.fmax));
     }
+    // Last: a metrics.json is there only when the pictures before it were written too.
+    std::string error;
+    if (!tools::write_text_file_atomic((dir / "metrics.json").string(),
+                                       analysis::metrics_json(report, args.files), error))
+      throw CommandError(error);
     std::fprintf(stderr, "kdm analyze: wrote %s/metrics.json and pictures\n", args.output.c_str());
   } catch (const analysis::InvalidInput& e) {
     throw CommandError(e.what());
@@ -190,9 +196,10 @@ void add_analyze_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
   cmd->add_flag("--no-energy", args->no_energy, "Skip the KDM energy per point (default: computed)");
-  cmd->add_option("--tile-size", args->tile_size,
-                  "Tile side s in unit-square units (1/s an integer) for periodicity and seam statistics "
-                  "(default: none, no tiling diagnostics)");
+  cmd->add_option_function<double>(
+      "--tile-size", [a = args.get()](double s) { a->tile_size = s, a->tile_size_given = true; },
+      "Tile side s in unit-square units (1/s an integer) for periodicity and seam statistics "
+      "(default: none, no tiling diagnostics)");
   cmd->add_option("--fmax", args->fmax, "Periodogram limit in normalised frequency |k|/sqrt(n)")
       ->capture_default_str();
   cmd->add_option("--min-expected", args->min_expected, "Density windows expect at least this many points")
@@ -206,9 +213,10 @@ void add_analyze_command(CLI::App& app) {
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
   add_threads_option(cmd, args->threads, "results do not depend on it");
-  cmd->add_option("-o,--output", args->output,
-                  "Output directory (created if missing) for metrics.json and pictures (default: the "
-                  "summary is only printed)");
+  cmd->add_option_function<std::string>(
+      "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },
+      "Output directory (created if missing) for metrics.json and pictures (default: the "
+      "summary is only printed)");
   cmd->callback([args] { run_analyze(*args); });
 }
 

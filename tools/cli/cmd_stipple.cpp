@@ -65,6 +65,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     throw CommandError(message);
   }
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
+  if (a.fade > 0 && !tools::has_extension(a.output, ".png") && !tools::has_extension(a.output, ".svg"))
+    throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
   // One ink (the image's darkness), or with --colours the image separated into several.
@@ -199,8 +201,8 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option(
       "--dot-size", a->dot_size,
-      "Dot radius in pixels (default: a quarter of the whole image's mean dot spacing, 0.7 of it with "
-      "--colours)");
+      "Dot radius in pixels (default, or 0: a quarter of the whole image's mean dot spacing, 0.7 of it "
+      "with --colours)");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
