@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iterator>
 #include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,10 @@ py::dict info(const TilesetHandle& h) {
 
 TilesetHandle bake(const std::string& recipe_text, int threads) {
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
+  if (!gen::BakeRecipe::gives_any_key(recipe_text))
+    throw std::invalid_argument(
+        "recipe_text gives no key, only blank lines and comments (the defaults alone bake for minutes: give "
+        "at least one key, e.g. 'levels 6')");
   const gen::BakeRecipe recipe = gen::BakeRecipe::parse(recipe_text);  // gen::InvalidArgument: ValueError
   auto set = std::make_shared<Tileset>();
   std::string detail;

@@ -306,6 +306,8 @@ def test_load_save_and_bake(tmp_path, tiny_tileset):
     kw = dict(scale=100, mode="smooth")
     assert same(loaded.query((0, 0, 3, 3), **kw), tiny_tileset.query((0, 0, 3, 3), **kw))
     assert kdm.bake(TINY_RECIPE, threads=1).info == info  # any thread count, the same set
+    with pytest.raises(ValueError, match="recipe_text gives no key"):  # not minutes of the defaults
+        kdm.bake("# a comment only\n\n")
     with pytest.raises(ValueError, match="density too high|points per tile"):
         loaded.query((0, 0, 1, 1), scale=129)
 

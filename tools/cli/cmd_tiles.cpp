@@ -38,7 +38,12 @@ std::string read_text(const std::string& path) {
 void run_bake(const std::string& recipe_path, const std::string& output, int threads) {
   gen::BakeRecipe recipe;
   try {
-    recipe = gen::BakeRecipe::parse(read_text(recipe_path));
+    const std::string text = read_text(recipe_path);
+    if (!gen::BakeRecipe::gives_any_key(text))
+      throw CommandError("recipe '" + recipe_path +
+                         "' gives no key, only blank lines and comments (the "
+                         "defaults alone bake for minutes: give at least one key, e.g. 'levels 6')");
+    recipe = gen::BakeRecipe::parse(text);
   } catch (const gen::InvalidArgument& e) {
     throw CommandError("'" + recipe_path + "': " + e.what());
   }

@@ -52,6 +52,14 @@ std::string shortest(double v) {
 
 }  // namespace
 
+bool BakeRecipe::gives_any_key(const std::string& text) {
+  std::istringstream in(text);
+  std::string line, key;
+  while (std::getline(in, line))
+    if (std::istringstream(line.substr(0, line.find('#'))) >> key) return true;
+  return false;
+}
+
 BakeRecipe BakeRecipe::parse(const std::string& text) {
   BakeRecipe r;
   std::istringstream in(text);

@@ -119,6 +119,9 @@ struct BakeRecipe {
   /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
   /// out-of-range count, patches that erode away).
   static BakeRecipe parse(const std::string& text);
+  /// Whether `text` gives any key (a line with more than blanks and a comment). `kdm bake` and kdm.bake
+  /// refuse a recipe that gives none: it is most likely the wrong file, and the defaults bake for minutes.
+  static bool gives_any_key(const std::string& text);
   /// The canonical text form (parse(to_text()) == *this).
   std::string to_text() const;
   /// MH sweeps for a level holding `level_points` points in all: `sweeps`, times 4096 / level_points
