@@ -3,16 +3,19 @@
 // memory and path loaders agreeing on the fuzz seeds; NUL bytes in point files.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "image_io.h"
@@ -259,6 +262,29 @@ TEST(PointFileInput, NulBytesAreMalformed) {
   std::istringstream good("x,y\n0.1,0.2\n#\n0.3 0.4\n");
   ASSERT_TRUE(kdm::tools::read_point_sets(good, "good.csv", sets, error)) << error;
   EXPECT_EQ(sets.size(), 2u);
+}
+
+// A device has no size to check before reading: /dev/zero, with no image header in its first bytes, is
+// refused there (it was read to 2 GiB, 12 s, before its size was), and a pipe holding a PNG still reads.
+TEST(ImageInput, ADeviceWithNoImageHeaderIsRefusedAtOnce) {
+  kdm::tools::GreyImage image;
+  std::string error;
+  if (!std::filesystem::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero";
+  EXPECT_FALSE(kdm::tools::load_grey_image("/dev/zero", image, error));
+  EXPECT_TRUE(contains(error, "'/dev/zero': not a file, and its first bytes are no image header")) << error;
+  const std::string fifo = ::testing::TempDir() + "kdm_image_fifo";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] {
+    const std::string png = std::string(KDM_SOURCE_DIR) + "/examples/sphere.png";
+    std::ifstream in(png, std::ios::binary);
+    std::ofstream(fifo, std::ios::binary) << in.rdbuf();
+  });
+  const bool read = kdm::tools::load_grey_image(fifo, image, error);
+  writer.join();
+  EXPECT_TRUE(read) << error;
+  EXPECT_GT(image.width, 100);
+  std::filesystem::remove(fifo);
 }
 
 // A file that never ends a line (a binary file, /dev/zero) is refused at its first long line, not read

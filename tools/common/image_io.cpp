@@ -398,8 +398,9 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
-  struct stat info;  // a directory opens, and then reads as an error or as a huge size
-  if (fstat(fileno(file.get()), &info) == 0 && S_ISDIR(info.st_mode)) {
+  struct stat info {};  // a directory opens, and then reads as an error or as a huge size
+  const bool stated = fstat(fileno(file.get()), &info) == 0;
+  if (stated && S_ISDIR(info.st_mode)) {
     error = "cannot read image '" + path + "': it is a directory";
     return false;
   }
@@ -419,6 +420,14 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
   for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, file.get())) > 0;) {
     if (bytes.size() + n > kMaxBytes) return too_large();
     bytes.insert(bytes.end(), chunk, chunk + n);
+    // A device or a pipe has no size to check up front: /dev/zero would be read to 2 GiB. Its first
+    // 64 KiB must begin an image stb_image knows.
+    int w, h, channels;
+    if (bytes.size() == n && stated && !S_ISREG(info.st_mode) &&
+        !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &channels)) {
+      error = "cannot read image '" + path + "': not a file, and its first bytes are no image header";
+      return false;
+    }
   }
   if (std::ferror(file.get())) {
     error = "cannot read image '" + path + "': " + std::strerror(errno);
