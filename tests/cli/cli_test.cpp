@@ -281,6 +281,12 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   expect_error("sample --n 2000 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
   expect_error("stipple --frames 2x a.png" + out, "--frames");
   expect_error("query --rect 0,0,1" + out, "--rect");
+  // An option that needs a value, followed by another option: named as such, not read as its value.
+  expect_error("sample --n 10 --density" + out, "--density needs a value, but is followed by the option -o");
+  expect_error("stipple a.png --points --help",
+               "--points needs a value, but is followed by the option --help");
+  const Outcome negative = kdm("query --rect -1,-1,0,0 --scale 40" + out);  // a value may start with '-'
+  EXPECT_EQ(negative.status, 0) << negative.err;
 }
 
 // --threads has one limit in every command that takes it, checked before any work: negative counts and

@@ -9,6 +9,38 @@
 #include "commands.h"
 #include "kdm/runtime/version.h"
 
+namespace {
+
+// CLI11 takes the word after an option that needs a value as that value even when the word is another of
+// the command's options ("--density -o x" read "-o" as the density, then reported -o missing). Returns
+// the error for the first such pair on the command line, or "" if there is none.
+std::string option_given_as_value(const CLI::App& app, int argc, char** argv) {
+  if (argc < 3) return "";
+  const CLI::App* cmd = nullptr;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (sub->get_name() == argv[1]) cmd = sub;
+  if (cmd == nullptr) return "";
+  const auto option_named = [cmd](const std::string& word) -> const CLI::Option* {
+    if (word.size() < 2 || word[0] != '-') return nullptr;
+    for (const CLI::Option* opt : cmd->get_options())
+      if (!opt->get_positional() && opt->check_name(word)) return opt;
+    return nullptr;
+  };
+  for (int i = 2; i + 1 < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--") break;
+    const CLI::Option* opt = option_named(word);
+    if (opt == nullptr || opt->get_type_size_min() == 0) continue;  // not an option, or a flag
+    const std::string next = argv[i + 1];
+    if (option_named(next) != nullptr || next == "-h" || next == "--help")
+      return word + " needs a value, but is followed by the option " + next;
+    ++i;  // the value
+  }
+  return "";
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"kdm — blue-noise point sets from Fattal's kernel density model (KDM, SIGGRAPH 2011)"};
   app.set_version_flag("--version", std::string("kdm ") + kdm::version_string() + " (tile-set format " +
@@ -21,6 +53,10 @@ int main(int argc, char** argv) {
   kdm::cli::add_analyze_command(app);
   kdm::cli::add_verify_command(app);
   try {
+    if (const std::string error = option_given_as_value(app, argc, argv); !error.empty()) {
+      std::fprintf(stderr, "kdm: error: %s (see kdm %s --help)\n", error.c_str(), argv[1]);
+      return 1;
+    }
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
