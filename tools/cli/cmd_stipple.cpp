@@ -177,7 +177,11 @@ void add_stipple_command(CLI::App& app) {
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
                   "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...")
       ->required();
-  cmd->add_option("--points", a->points, "Dots over the whole image")->capture_default_str();
+  cmd->add_option(
+         "--points", a->points,
+         "Dots over the whole image: exactly this many with --method full; about this many with tiles "
+         "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none)")
+      ->capture_default_str();
   cmd->add_option("--scale", a->scale,
                   "Dots per unit area at full darkness (image height = 1 unit); overrides --points "
                   "(default: unset, --points decides)");
