@@ -148,6 +148,12 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (classed) style.classes = &set.classes, style.inks = tools::class_inks(specs.size());
   tools::write_points(args.output, set, header, style);
   std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds, args.output.c_str());
+  // A step far too large is rejected almost always: the points stay where the coarser levels put them.
+  if (o.step > 0 && r.acceptance_rate() < 0.01)
+    std::fprintf(stderr,
+                 "kdm sample: warning: %.2f%% of moves were accepted, so the points barely moved; --step %g "
+                 "is too large (0, the default, picks the step)\n",
+                 100 * r.acceptance_rate(), o.step);
   if (args.timing) {
     std::printf("points %zu seconds %.4f points_per_second %.0f threads %d acceptance %.4f\n", set.size(),
                 r.seconds, set.size() / std::max(1e-9, r.seconds), r.threads, r.acceptance_rate());
