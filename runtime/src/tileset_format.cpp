@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -544,8 +545,15 @@ Status check_tileset_path(const std::string& path, std::string* detail) {
   return Status::kOk;
 }
 
-Status save_tileset(const TilesetData& set, const std::string& path, std::string* detail) {
-  if (const Status s = check_tileset_path(path, detail); s != Status::kOk) return s;
+Status save_tileset(const TilesetData& set, const std::string& given_path, std::string* detail) {
+  if (const Status s = check_tileset_path(given_path, detail); s != Status::kOk) return s;
+  // A symbolic link is written through, as cp and a shell's > do: the rename replaces its target.
+  std::string path = given_path;
+  std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
+    const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
+    if (!ec) path = target.string();
+  }
   std::vector<std::uint8_t> bytes;
   if (const Status s = encode_tileset(set, bytes, detail); s != Status::kOk) return s;
   const std::string temp = path + ".partial";

@@ -205,6 +205,19 @@ TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
   EXPECT_EQ(followed.status, 0) << advised << ": " << followed.err;
 }
 
+// An output that is a symbolic link is written through it, as cp and a shell's > do.
+TEST_F(CliTest, OutputsThroughSymbolicLinksReplaceTheirTargets) {
+  for (const std::string name : {"s.txt", "s.png", "s.svg"}) {
+    const fs::path target = path("target-" + name), link = path(name);
+    std::ofstream(target) << "old";
+    fs::create_symlink(target, link);
+    const Outcome r = kdm("sample --n 50 -o '" + link.string() + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link))) << name;
+    EXPECT_GT(fs::file_size(target), 3u) << name;
+  }
+}
+
 TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   // A path below a regular file cannot be created, even by root (CI runs as root).
   write_bytes(path("file"), {'x'});

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -376,6 +377,17 @@ TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
   EXPECT_FALSE(partial.good());  // no temporary left behind
   std::remove(path.c_str());
   EXPECT_EQ(load_tileset(path, loaded), Status::kIoError);
+  // Through a symbolic link the set replaces the link's target; the link stays a link.
+  namespace fs = std::filesystem;
+  const fs::path target = fs::path(testing::TempDir()) / "target.kdmt",
+                 link = fs::path(testing::TempDir()) / "link.kdmt";
+  fs::remove(target), fs::remove(link);
+  { std::ofstream(target) << "old contents"; }
+  fs::create_symlink(target, link);
+  ASSERT_EQ(save_tileset(set, link.string()), Status::kOk);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(load_tileset(target.string(), loaded), Status::kOk);
+  fs::remove(target), fs::remove(link);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -497,7 +498,14 @@ void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8
   }
 }
 
-bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error) {
+bool write_text_file_atomic(const std::string& given_path, const std::string& text, std::string& error) {
+  // A symbolic link is written through, as cp and a shell's > do: the rename replaces its target.
+  std::string path = given_path;
+  std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
+    const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
+    if (!ec) path = target.string();
+  }
   const std::string tmp = temp_path_for(path);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) {
