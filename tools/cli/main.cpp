@@ -30,7 +30,7 @@ std::string option_given_as_value(const CLI::App& app, int argc, char** argv) {
     const std::string word = argv[i];
     if (word == "--") break;
     const CLI::Option* opt = option_named(word);
-    if (opt == nullptr || opt->get_type_size_min() == 0) continue;  // not an option, or a flag
+    if (opt == nullptr || opt->get_expected_min() == 0) continue;  // not an option, or a flag
     const std::string next = argv[i + 1];
     if (option_named(next) != nullptr || next == "-h" || next == "--help")
       return word + " needs a value, but is followed by the option " + next;
