@@ -25,6 +25,8 @@ Status ClassImageSums::build(const DensityImageView* const* images, std::uint32_
   }
   const DensityImageView& first = *images[0];
   if (first.width <= 0 || first.height <= 0) return refuse("an image is empty");
+  if (first.width > kMaxDensityImageSide || first.height > kMaxDensityImageSide)
+    return refuse("an image is wider or taller than kMaxDensityImageSide texels");
   if (!detail::image_rect_usable(first)) return refuse("the images' world rectangle is unusable");
   const std::size_t n = static_cast<std::size_t>(first.width) * static_cast<std::size_t>(first.height);
   texels_.resize(n * count);

@@ -49,8 +49,7 @@ double DensityImageView::min_over(double qx0, double qy0, double qx1, double qy1
 }
 
 Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip) {
-  if (image.width <= 0 || image.height <= 0 || !image.values) return Status::kInvalidArgument;
-  if (!detail::image_rect_usable(image)) return Status::kInvalidArgument;
+  if (!image.values || !detail::image_rect_usable(image)) return Status::kInvalidArgument;
   const std::size_t count = static_cast<std::size_t>(image.width) * image.height;
   for (std::size_t i = 0; i < count; ++i)
     if (!(image.values[i] >= 0 && std::isfinite(image.values[i]))) return Status::kInvalidArgument;

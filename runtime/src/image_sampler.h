@@ -16,9 +16,12 @@ void fill_mips(DensityImageView& image, std::vector<float>& mip);
 
 /// Whether world positions map to texels as numbers: a finite rectangle of positive size whose texels per
 /// world unit are finite (a rectangle hundreds of orders of magnitude smaller than its texels is not, nor one
-/// whose size overflows), so that no position gives NaN (0 · ∞) where the texels are found.
+/// whose size overflows), so that no position gives NaN (0 · ∞) where the texels are found, and whose sides
+/// leave texel and block indices within int (kMaxDensityImageSide).
 inline bool image_rect_usable(const DensityImageView& im) {
-  if (!(im.width > 0 && im.height > 0)) return false;
+  if (!(im.width > 0 && im.height > 0 && im.width <= kMaxDensityImageSide &&
+        im.height <= kMaxDensityImageSide))
+    return false;
   const double sx = im.width / (im.x1 - im.x0), sy = im.height / (im.y1 - im.y0);
   return std::isfinite(im.x0) && std::isfinite(im.y0) && sx > 0 && sy > 0 && std::isfinite(sx) &&
          std::isfinite(sy) && std::isfinite(im.x1 - im.x0) && std::isfinite(im.y1 - im.y0);

@@ -544,7 +544,9 @@ kdm_status kdm_density_image_create(int width, int height, const float* values, 
                                     double x1, double y1, kdm_density_image** out) {
   if (!out) return KDM_INVALID_ARGUMENT;
   *out = nullptr;
-  if (!values || width <= 0 || height <= 0) return KDM_INVALID_ARGUMENT;
+  if (!values || width <= 0 || height <= 0 || width > kdm::kMaxDensityImageSide ||
+      height > kdm::kMaxDensityImageSide)
+    return KDM_INVALID_ARGUMENT;  // before copying the texels
   const std::size_t texels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   auto* image = new (std::nothrow) kdm_density_image;
   if (!image) return KDM_OUT_OF_MEMORY;

@@ -172,8 +172,11 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_image_create(2, 2, bad, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT && image == NULL);
     CHECK(kdm_density_image_create(0, 2, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 0, 2, &image) == KDM_INVALID_ARGUMENT);
-    /* 16 EiB of texels: no memory holds their copy, which is said, not thrown. */
-    CHECK(kdm_density_image_create(INT_MAX, INT_MAX, values, 0, 0, 2, 2, &image) == KDM_OUT_OF_MEMORY &&
+    /* A side past 2^30 texels is refused before its texels are read (INT_MAX overflowed the mips' block
+       count); 4 EiB of texels within that: no memory holds their copy, which is said, not thrown. */
+    CHECK(kdm_density_image_create(INT_MAX, 1, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_image_create(1, (1 << 30) + 1, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_image_create(1 << 30, 1 << 30, values, 0, 0, 2, 2, &image) == KDM_OUT_OF_MEMORY &&
           image == NULL);
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 2, 2, &image) == KDM_OK && image != NULL);
     q.density_image = image;

@@ -439,6 +439,15 @@ TEST(QueryTest, FollowsADensityImage) {
   EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
   values[5] = std::nanf("");
   EXPECT_EQ(make_density_max_mip(image, mip), Status::kInvalidArgument);
+  // A side past kMaxDensityImageSide is refused before any texel is read (INT_MAX overflowed the block
+  // count).
+  for (const auto& [w, h] :
+       {std::pair{std::numeric_limits<int>::max(), 1}, std::pair{1, kMaxDensityImageSide + 1}}) {
+    DensityImageView huge = image;
+    huge.width = w, huge.height = h;
+    std::vector<float> huge_mip;
+    EXPECT_EQ(make_density_max_mip(huge, huge_mip), Status::kInvalidArgument) << w << " x " << h;
+  }
   // So is a rectangle whose texels per world unit are not finite numbers (one 10^-323 wide, or one whose
   // width overflows a double), where a position would map to texel NaN: by the mips, and by a query whose
   // image was changed after them.

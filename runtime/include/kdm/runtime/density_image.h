@@ -9,6 +9,9 @@
 
 namespace kdm {
 
+/// The widest and tallest density image, in texels (2^30): texel and block arithmetic stays within int.
+inline constexpr int kMaxDensityImageSide = 1 << 30;
+
 /// A density image over a world rectangle: bilinear between texel centres, clamped at the edges.
 /// Values must be finite and >= 0 (validated by make_density_max_mip). Built once, shared read-only.
 struct KDM_RUNTIME_API DensityImageView {
@@ -30,7 +33,8 @@ struct KDM_RUNTIME_API DensityImageView {
 
 /// Fills `mip` (resized to 2·ceil(w/8)·ceil(h/8)) with the 8×8 block maxima of `image.values`, then their
 /// minima, each block widened by one texel so they bound bilinear values too, and points the image's
-/// max_mip and min_mip at them. Returns kInvalidArgument for empty images, values that are negative or
+/// max_mip and min_mip at them. Returns kInvalidArgument for empty images, a side longer than
+/// kMaxDensityImageSide, values that are negative or
 /// not finite, and a world rectangle that is not finite and of positive size, or whose texels per world
 /// unit overflow (a rectangle narrower than about 10^-300 of a unit per texel). Queries refuse such an
 /// image too ("density.image"), should its rectangle change after this call.

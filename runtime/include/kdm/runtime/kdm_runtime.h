@@ -184,11 +184,11 @@ KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const
 
 /* A density image over the world rectangle [x0, x1) x [y0, y1) (world units): `width` x `height` texels
  * of density (as kdm_query's `density`: multiplied by `scale`), row-major, row 0 at y0, bilinear between
- * texel centres and clamped at the edges. The values are copied and an
- * 8x8 max-mip is built, so queries skip what cannot be emitted. KDM_INVALID_ARGUMENT for an empty image,
- * a NULL or negative or non-finite value, or a rectangle that is empty, not finite, or so narrow that its
- * texels per unit overflow (make_density_max_mip's rule); KDM_OUT_OF_MEMORY when its copy does
- * not fit in memory. Free with kdm_density_image_free. */
+ * texel centres and clamped at the edges. The values are copied and an 8x8 max-mip is built, so queries
+ * skip what cannot be emitted. KDM_INVALID_ARGUMENT for an empty image, a side longer than 2^30 texels, a
+ * NULL or negative or non-finite value, or a rectangle that is empty, not finite, or so narrow that its
+ * texels per unit overflow (make_density_max_mip's rule); KDM_OUT_OF_MEMORY when its copy does not fit in
+ * memory. Free with kdm_density_image_free. */
 KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const float* values, double x0,
                                                     double y0, double x1, double y1, kdm_density_image** out);
 /* Frees an image (NULL is ignored); no query may be using it. */
