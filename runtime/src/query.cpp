@@ -208,6 +208,13 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       if (sx >= tx1) ++sy, sx = tx0;
     }
     *cursor = QueryCursor{sx, sy, 0, true, false, fingerprint};
+  } else {
+    // A saved cursor stopped in a tile of the region and the run: a damaged one is refused, not walked
+    // from afar (a call ran for seconds) nor taken past tiles it never visited (their points lost).
+    const std::int64_t x = cursor->tile_x, y = cursor->tile_y;
+    const bool in_run = (y > run.from_y || (y == run.from_y && x >= run.from_x)) &&
+                        (y < run.to_y || (y == run.to_y && x < run.to_x));
+    if (x < tx0 || x >= tx1 || y < ty0 || y >= ty1 || !in_run) return refuse(Kind::kCursorMismatch, "cursor");
   }
   // A cursor inside a tile's subtiles names them by a path of subtile indices: a damaged one is refused.
   if (cursor->depth > (descend ? kMaxQueryDepth : 0)) return refuse(Kind::kCursorMismatch, "cursor");
@@ -267,7 +274,8 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
         }
         continue;
       }
-      if (resumed && cursor->depth != 0) return refuse(Kind::kCursorMismatch, "cursor");
+      if (resumed && (cursor->depth != 0 || cursor->rank > tile.points.size()))
+        return refuse(Kind::kCursorMismatch, "cursor");
       const std::uint32_t c = resumed ? cursor->rank : 0;
       if (c >= candidates) continue;
       // Bounded work per call, whatever the region and density.
@@ -576,7 +584,7 @@ const char* query_problem_message(QueryProblem::Kind kind) {
       return "the density asks for more points per tile than the tile set serves in this mode (stable mode "
              "stops at its top level, smooth mode at its depth cap)";
     case QueryProblem::Kind::kCursorMismatch:
-      return "the cursor was started by a query with other parameters";
+      return "the cursor was started by a query with other parameters, or is damaged";
     case QueryProblem::Kind::kBadMode:
       return "the mode is neither stable nor smooth";
     case QueryProblem::Kind::kBadClassCount:

@@ -695,6 +695,36 @@ TEST(QueryTest, ACursorIsRefusedWithOtherParameters) {
   EXPECT_NE(query_fingerprint(region(0, 0, 1, 1, 1)), query_fingerprint(region(0, 0, 1, 1, 2)));
 }
 
+// A cursor whose tile lies outside the region, or whose rank lies past its tile's points, is refused at
+// once: a tile far off was walked to (seconds a call), one beyond the region ended the query with its points
+// missing, and a rank past the tile skipped the rest of it. Both modes; the undamaged cursor goes on.
+TEST(QueryTest, ADamagedCursorIsRefused) {
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    std::vector<QueryPoint> buffer(16);
+    std::size_t written = 0;
+    QueryProblem problem;
+    QueryParams q = region(0, 0, 4, 4, 500);
+    q.mode = mode;
+    QueryCursor cursor;
+    ASSERT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+              Status::kBufferFull);
+    const auto damaged = [&](auto change) {
+      QueryCursor c = cursor;
+      change(c);
+      return query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &c, &problem) ==
+                 Status::kInvalidArgument &&
+             problem.kind == QueryProblem::Kind::kCursorMismatch;
+    };
+    EXPECT_TRUE(damaged([](QueryCursor& c) { c.tile_x = std::numeric_limits<std::int64_t>::min(); }));
+    EXPECT_TRUE(damaged([](QueryCursor& c) { c.tile_y = -100000000; }));
+    EXPECT_TRUE(damaged([](QueryCursor& c) { c.tile_x = 100; }));
+    EXPECT_TRUE(damaged([](QueryCursor& c) { c.tile_y = std::numeric_limits<std::int64_t>::max(); }));
+    EXPECT_TRUE(damaged([](QueryCursor& c) { c.rank = 4000000000u; }));
+    EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor, &problem),
+              Status::kBufferFull);
+  }
+}
+
 // A chunk that stops inside a tile it visits cell by cell keeps the cell in the cursor's path: a path
 // naming no cell of the chunk, or naming one where the tile is scanned whole, is refused, not followed.
 TEST(QueryTest, ACursorNamingNoCellIsRefused) {
