@@ -41,8 +41,8 @@ def number(name: str, value: Any, minimum: Optional[float] = None, strict: bool 
 
 def threads(value: Any) -> int:
     """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use), at
-    most 256 as on the command line."""
-    return integer("threads", value, 0, 256)
+    most _kdm.MAX_THREADS (256) as on the command line."""
+    return integer("threads", value, 0, _kdm.MAX_THREADS)
 
 
 def flag(name: str, value: Any) -> bool:

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "bindings.h"
+#include "kdm/generator/sampler.h"
 #include "kdm/runtime/version.h"
 
 namespace kdm::python {
@@ -23,6 +24,7 @@ PYBIND11_MODULE(_kdm, m) {
   using namespace kdm::python;
   m.doc() = "kdm's C++ libraries for the Python package kdm (use kdm, not this module)";
   m.attr("__version__") = kdm::version_string();
+  m.attr("MAX_THREADS") = kdm::gen::kMaxThreads;
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

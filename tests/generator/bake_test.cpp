@@ -49,6 +49,8 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
   EXPECT_DOUBLE_EQ(guarded.min_distance, 0.35);
   EXPECT_DOUBLE_EQ(BakeRecipe::parse(guarded.to_text()).min_distance, 0.35);
   EXPECT_THROW(BakeRecipe::parse("min_distance 0.8\n"), InvalidArgument);
+  EXPECT_THROW(bake_tileset(r, -1), InvalidArgument);  // before any work: 0 or 1 to kMaxThreads
+  EXPECT_THROW(bake_tileset(r, kMaxThreads + 1), InvalidArgument);
   try {  // a key given twice: which value was meant is not known
     BakeRecipe::parse("levels 3\ncolours 2\nlevels 4\n");
     ADD_FAILURE() << "a repeated key was accepted";

@@ -199,6 +199,15 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
     o.sigma_max = sigma_max;
     EXPECT_THROW(sample(o), InvalidArgument) << sigma_max;
   }
+  // Thread counts past kMaxThreads started them all (32,000 threads for 300 points); -1 meant the default.
+  for (int threads : {-1, kMaxThreads + 1, 100000}) {
+    o = options_for(100, Domain::kTorus);
+    o.threads = threads;
+    EXPECT_THROW(sample(o), InvalidArgument) << threads;
+  }
+  o = options_for(100, Domain::kTorus);
+  o.vector_lanes = 3;  // 16, 8 or 4 only
+  EXPECT_THROW(sample(o), InvalidArgument);
   o = options_for(100, Domain::kTorus);
   Density negative;
   negative.function = [](const double* u) { return u[0] - 0.5; };

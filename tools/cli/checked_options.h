@@ -13,12 +13,7 @@ class Option;
 
 namespace kdm::cli {
 
-/// The most worker threads --threads accepts: more than the cores of today's largest machines, yet few
-/// enough that a typo cannot exhaust memory or time (each worker has its own stack and megabytes of
-/// scratch).
-inline constexpr int kMaxThreads = 256;
-
-/// Adds --threads to `cmd`, bound to `threads`: 0 (the default count) or 1 to kMaxThreads, anything else
+/// Adds --threads to `cmd`, bound to `threads`: 0 (the default count) or 1 to gen::kMaxThreads, anything else
 /// refused by name. `independence` ends the help text (e.g. "output does not depend on it").
 CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& independence);
 

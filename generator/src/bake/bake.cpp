@@ -569,6 +569,7 @@ class Baker {
 
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress,
                          BakeReport* report) {
+  check_thread_count(threads);
   Baker baker(recipe, threads, progress);
   TilesetData set = baker.bake();
   if (report) *report = baker.report;

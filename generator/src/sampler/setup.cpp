@@ -8,6 +8,7 @@
 #include "kdm/runtime/check.h"
 #include "platform/huge_pages.h"
 #include "platform/parallel.h"
+#include "platform/thread_count.h"
 #include "sampler/kernel.h"
 
 namespace kdm::gen {
@@ -190,6 +191,9 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
 void validate_options(const SamplerOptions& o) {
   if (o.dim != 2 && o.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
   if (o.n < 0) throw InvalidArgument("point count must be >= 0");
+  check_thread_count(o.threads);
+  if (o.vector_lanes != 16 && o.vector_lanes != 8 && o.vector_lanes != 4)
+    throw InvalidArgument("vector_lanes must be 16, 8 or 4, got " + std::to_string(o.vector_lanes));
   if (o.n == 0 && o.resolution <= 0)
     throw InvalidArgument("give a point count n > 0 or a grid resolution > 0");
   if (!(std::isfinite(o.temperature) && o.temperature >= 0))

@@ -83,7 +83,8 @@ struct SamplerOptions {
   /// deterministic energy descent. The model temperature of eq. 4 is temperature * kModelTemperaturePerUser.
   double temperature = 0.5;
   std::uint64_t seed = 1;  ///< any value; the same options and seed give the same points
-  int threads = 0;         ///< 0 = default_thread_count(). The output does not depend on this.
+  /// 0 = default_thread_count(), else 1 to kMaxThreads. The output does not depend on this.
+  int threads = 0;
   /// MH-Langevin sweeps on the finest level. The paper uses 15 (unadjusted); with the MH test 30 reach
   /// the reference implementation's statistics (docs/design.md §2).
   int sweeps = 30;
@@ -103,7 +104,7 @@ struct SamplerOptions {
   Numerics numerics = Numerics::kFast;
   /// The widest vectors the update passes may use: 16 lanes (AVX-512, where the CPU has it), 8 (AVX2),
   /// 4 (SSE2, every x86-64). The output does not depend on it (the passes give the same bits at every
-  /// width); lower values are for testing that and for measuring.
+  /// width); lower values are for testing that and for measuring. Other values are refused.
   int vector_lanes = 16;
   /// Memory for keeping each point's kernel footprint between sweeps (about 300 bytes per point in 2D):
   /// an update then builds one footprint, not two (docs/design.md §2.9). Levels with more points than fit
@@ -182,6 +183,10 @@ struct SampleResult {
 /// At least 1. Worked out once per process. Waiting threads spin for at most 50 µs and then sleep, so a
 /// run on a busy machine does not burn the cores its own threads are waiting for.
 int default_thread_count();
+
+/// The most threads sample() and bake_tileset() take: more than the cores of today's largest machines,
+/// yet few enough that a typo cannot exhaust memory or time (each has its own stack and scratch).
+inline constexpr int kMaxThreads = 256;
 
 /// Draws one point set from the KDM model. Throws InvalidArgument on bad options or density.
 SampleResult sample(const SamplerOptions& options, const Density& density = Density::constant());
