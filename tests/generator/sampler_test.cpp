@@ -208,6 +208,24 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   o = options_for(100, Domain::kTorus);
   o.vector_lanes = 3;  // 16, 8 or 4 only
   EXPECT_THROW(sample(o), InvalidArgument);
+  // Only a density's shape matters, within float's range: a constant 1e10 or 1e-10 gives the constant's
+  // points; 1e100 became infinite ("the domain is too narrow") and 1e-100 zero ("zero everywhere").
+  o = options_for(100, Domain::kTorus);
+  const std::vector<double> uniform = sample(o).points;
+  for (double v : {1e10, 1e-10, 1e100, 1e-100}) {
+    Density constant;
+    constant.function = [v](const double*) { return v; };
+    if (v >= kMinDensityPeak && v <= kMaxDensityValue) {
+      EXPECT_EQ(sample(o, constant).points, uniform) << v;
+      continue;
+    }
+    try {
+      sample(o, constant);
+      ADD_FAILURE() << v << " was accepted";
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("only its shape matters"), std::string::npos) << e.what();
+    }
+  }
   o = options_for(100, Domain::kTorus);
   Density negative;
   negative.function = [](const double* u) { return u[0] - 0.5; };

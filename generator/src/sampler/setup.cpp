@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <sstream>
 
@@ -61,6 +62,7 @@ std::vector<float> sample_function(const Grid<D>& grid, const Density& density, 
   const int parts = density.thread_safe && grid.size() >= (1 << 16) ? std::max(1, threads) : 1;
   std::vector<std::int64_t> bad_node(static_cast<std::size_t>(parts), grid.size());
   std::vector<std::string> bad_message(static_cast<std::size_t>(parts));
+  std::vector<double> part_peak(static_cast<std::size_t>(parts), 0.0);
   for_each_part(parts, parts > 1, [&](int part, int) {
     for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
       std::array<int, D> node{};
@@ -89,12 +91,23 @@ std::vector<float> sample_function(const Grid<D>& grid, const Density& density, 
           }
           sum += v;
         }
+        part_peak[part] = std::max(part_peak[part], sum / subsamples);
         rho[static_cast<std::size_t>(row * grid.dims[0] + node[0])] = static_cast<float>(sum / subsamples);
       }
     }
   });
   const auto first_bad = std::min_element(bad_node.begin(), bad_node.end());
   if (*first_bad < grid.size()) throw InvalidArgument(bad_message[first_bad - bad_node.begin()]);
+  // Nodes keep floats: a density far outside their range would become infinite or zero.
+  const double peak = *std::max_element(part_peak.begin(), part_peak.end());
+  if (peak > kMaxDensityValue || (peak > 0 && peak < kMinDensityPeak)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "density peaks at %.3g, outside %g ... %g (kept as floats); only its shape matters, so %s "
+                  "it by a constant",
+                  peak, kMinDensityPeak, kMaxDensityValue, peak > 1 ? "divide" : "multiply");
+    throw InvalidArgument(text);
+  }
   return rho;
 }
 

@@ -36,7 +36,12 @@ struct DensityImage {
   std::vector<float> values;  ///< finite and >= 0, row by row
 };
 
-/// The target density. Only its shape matters: the sampler scales it to the requested point count.
+/// The range a density function's peak must lie in: the sampler keeps densities as floats. Densities
+/// outside it are refused; only the shape matters, so scale them by a constant.
+inline constexpr double kMinDensityPeak = 1e-30, kMaxDensityValue = 1e30;
+
+/// The target density. Only its shape matters: the sampler scales it to the requested point count. Its
+/// peak must lie within kMinDensityPeak ... kMaxDensityValue.
 struct Density {
   DensityFunction function;  ///< empty means constant
   /// For densities sampled from an image: its size in pixels per axis. When the computational grid is
