@@ -363,8 +363,10 @@ kdm_status parallel_classes(kdm_parallel_query* parallel, const kdm_task_runner*
   return run_parallel(parallel, runner, written, problem, [&](const kdm::TaskRunner& r, kdm_cursor* cursor) {
     return run_class_query(tileset, query, source, class_count, written, cursor, problem,
                            [&](const kdm::ClassQueryParams& q, kdm::QueryCursor*, kdm::QueryProblem* why) {
-                             return parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
-                                                           out_classes, capacity, written, r, needed, why);
+                             return with_c_names(
+                                 parallel->parallel.run(*tileset->set, q, kdm::CompactPoints{xy, keys},
+                                                        out_classes, capacity, written, r, needed, why),
+                                 why);
                            });
   });
 }

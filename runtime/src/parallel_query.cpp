@@ -196,7 +196,8 @@ struct PointOutput {
     std::uint64_t examined = 0;
     return detail::query_points_counted(t, u.part, out + at, room, w, c, nullptr, examined, u.run);
   }
-  bool has_output() const { return out != nullptr; }
+  /// The output argument that is null, named as the one-call query names it; null if none is.
+  const char* missing_output() const { return out ? nullptr : "out"; }
   void copy(std::size_t to, std::size_t count) const { std::memcpy(out + to, scratch, count * sizeof *out); }
 };
 
@@ -217,7 +218,7 @@ struct CompactOutput {
                                      CompactPoints{out.xy + 2 * at, out.keys ? out.keys + at : nullptr}, room,
                                      w, c, nullptr, u.run);
   }
-  bool has_output() const { return out.xy != nullptr; }
+  const char* missing_output() const { return out.xy ? nullptr : "out.xy"; }
   void copy(std::size_t to, std::size_t count) const {
     std::memcpy(out.xy + 2 * to, scratch.xy, 2 * count * sizeof(float));
     if (out.keys) std::memcpy(out.keys + to, scratch.keys, count * sizeof(std::uint64_t));
@@ -259,7 +260,9 @@ struct ClassOutput {
       return detail::query_classes_run(t, over(u.part), base.out + at, classes + at, room, w, c, nullptr,
                                        u.run);
   }
-  bool has_output() const { return base.has_output() && classes != nullptr; }
+  const char* missing_output() const {
+    return base.missing_output() ? base.missing_output() : classes ? nullptr : "classes";
+  }
   void copy(std::size_t to, std::size_t count) const {
     base.copy(to, count);
     std::memcpy(classes + to, class_scratch, count);
@@ -384,7 +387,8 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
   };
   if (workers_ == 0) return refuse(QueryProblem::Kind::kMissingArgument, "ParallelQuery::init");
   if (!runner.run) return refuse(QueryProblem::Kind::kMissingArgument, "runner.run");
-  if (capacity > 0 && !out.has_output()) return refuse(QueryProblem::Kind::kMissingArgument, "out");
+  if (const char* missing = out.missing_output(); capacity > 0 && missing)
+    return refuse(QueryProblem::Kind::kMissingArgument, missing);
   if (s == Status::kOk) return Status::kOk;  // no point at all
 
   // Classes: units planned and counted over their union.

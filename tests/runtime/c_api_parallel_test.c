@@ -188,6 +188,13 @@ int main(void) {
   CHECK(kdm_parallel_query_classes_compact(parallel, &in_turn, builtin, &q, three, 9, xy[0], NULL, classes[0],
                                            16, &n[0], NULL, &problem) == KDM_INVALID_ARGUMENT);
   CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT);
+  /* A null output is named as the one-call queries name it. */
+  CHECK(kdm_parallel_query_compact(parallel, &in_turn, builtin, &q, NULL, NULL, 16, &n[0], NULL, &problem) ==
+        KDM_INVALID_ARGUMENT);
+  CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "xy") == 0);
+  CHECK(kdm_parallel_query_classes_compact(parallel, &in_turn, builtin, &q, three, 3, xy[0], NULL, NULL, 16,
+                                           &n[0], NULL, &problem) == KDM_INVALID_ARGUMENT);
+  CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "out_classes") == 0);
   kdm_parallel_query_free(parallel);
   kdm_parallel_query_free(NULL);
   printf("c api parallel ok\n");
