@@ -54,7 +54,8 @@ struct JointClassDensity {
   /// QueryDensity::bounds gives one density's (values that are not numbers fall back to 0 and max[k]).
   void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
   void* user = nullptr;  ///< passed to all three
-  /// An upper bound of each class's density wherever it is read (finite, ≥ 0), as QueryDensity::callback_max.
+  /// An upper bound of each class's density wherever it is read (finite, ≥ 0), as QueryDensity::callback_max
+  /// (which says what values above it do).
   double max[kMaxQueryClasses] = {};
   /// Instead of `densities` (set one of the two): the densities at n positions (x[i], y[i]) at once, class
   /// k's at position i into values[k · n + i], n ≤ kDensityBatch, for a vectorised function. The query

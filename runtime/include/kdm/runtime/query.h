@@ -70,6 +70,10 @@ struct QueryDensity {
   void (*batch_callback)(void* user, std::size_t n, const double* x, const double* y, double* out) = nullptr;
   void* user = nullptr;  ///< passed to callback, batch_callback and bounds
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
+  /// Values above it break that promise: stable mode then emits as if they were capped there, smooth mode
+  /// glides its points as their own values ask, and a class query gives such a class more than its share
+  /// (at the later classes' expense). Smooth mode also reads positions up to a glide's reach outside the
+  /// region, so the bound must hold there too.
   double callback_max = 1;
   /// For callbacks, optional: bounds of the density over a world rectangle, *lo ≤ ρ ≤ *hi everywhere in
   /// [x0, x1] × [y0, y1] (must be thread-safe, like the callback). A query asks once per tile and then
