@@ -208,6 +208,11 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   o = options_for(100, Domain::kTorus);
   o.vector_lanes = 3;  // 16, 8 or 4 only
   EXPECT_THROW(sample(o), InvalidArgument);
+  o = options_for(100, Domain::kTorus);
+  Density negative_size;
+  negative_size.function = [](const double*) { return 1.0; };
+  negative_size.native_resolution[0] = -3;
+  EXPECT_THROW(sample(o, negative_size), InvalidArgument);
   // Only a density's shape matters, within float's range: a constant 1e10 or 1e-10 gives the constant's
   // points; 1e100 became infinite ("the domain is too narrow") and 1e-100 zero ("zero everywhere").
   o = options_for(100, Domain::kTorus);

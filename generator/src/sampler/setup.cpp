@@ -233,6 +233,10 @@ void validate_options(const SamplerOptions& o) {
 template <int D>
 ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
   validate_options(o);
+  for (int k = 0; k < 3; ++k)
+    if (density.native_resolution[k] < 0)
+      throw InvalidArgument("density native_resolution must be >= 0 (0: unknown), got " +
+                            std::to_string(density.native_resolution[k]));
   const int threads = thread_count(o.threads);
   ModelSetup<D> setup;
   setup.mass_per_point = std::pow(truncated_factor_integral(), D);

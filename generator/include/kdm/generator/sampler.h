@@ -45,7 +45,8 @@ inline constexpr double kMinDensityPeak = 1e-30, kMaxDensityValue = 1e30;
 struct Density {
   DensityFunction function;  ///< empty means constant
   /// For densities sampled from an image: its size in pixels per axis. When the computational grid is
-  /// coarser than this, each grid node averages several samples so no image detail aliases.
+  /// coarser than this, each grid node averages several samples so no image detail aliases. 0: unknown;
+  /// negative values are refused.
   int native_resolution[3] = {0, 0, 0};
   /// `function` may be called from several threads at once: the set-up then samples it on up to
   /// SamplerOptions::threads threads (the result is the same). from_values() sets it.
