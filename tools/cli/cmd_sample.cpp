@@ -225,7 +225,7 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({4, 8, 16}))
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
-                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,class]), .svg or .png")
+                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,z][,class]), .svg or .png")
       ->required();
   cmd->callback([args, cmd] {
     run_sample(*args, cmd->get_option("--density")->count() > 0, cmd->get_option("--aspect")->count() > 0);
