@@ -1,0 +1,57 @@
+# kdm_bake_tileset(OUTPUT <file> RECIPE <file> [TARGET <name>] [THREADS <n>] [VERIFY])
+#
+# Adds a build step that bakes the tile set OUTPUT from RECIPE with the kdm command line (kdm::kdm), and
+# bakes it again whenever the recipe or kdm changes.
+#   OUTPUT   the tile-set file to write; a relative path is taken from the current binary directory.
+#   RECIPE   the recipe file; a relative path is taken from the current source directory.
+#   TARGET   a custom target, built by default, that makes OUTPUT; other targets may add_dependencies on
+#            it. Without it, name OUTPUT among a target's sources (or in another custom command's DEPENDS).
+#   THREADS  baking threads (0, the default, takes every core). The file does not depend on it.
+#   VERIFY   also runs `kdm verify` (the generator test) on the baked file, and fails the build if any
+#            check fails.
+# The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed:
+# a failed or interrupted step leaves OUTPUT as it was, older than the recipe, so the next build tries again.
+function(kdm_bake_tileset)
+  cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;THREADS" "")
+  if(arg_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "kdm_bake_tileset: unknown argument(s) ${arg_UNPARSED_ARGUMENTS}")
+  endif()
+  foreach(required OUTPUT RECIPE)
+    if(NOT arg_${required})
+      message(FATAL_ERROR "kdm_bake_tileset: ${required} is required")
+    endif()
+  endforeach()
+  if(NOT DEFINED arg_THREADS)
+    set(arg_THREADS 0)
+  elseif(NOT arg_THREADS MATCHES "^[0-9]+$")
+    message(FATAL_ERROR "kdm_bake_tileset: THREADS must be a count (0 for every core), not '${arg_THREADS}'")
+  endif()
+  if(NOT TARGET kdm::kdm)
+    message(FATAL_ERROR "kdm_bake_tileset: the kdm command line (kdm::kdm) is not there; build kdm with "
+                        "KDM_BUILD_TOOLS=ON, or install it with its tools")
+  endif()
+  if(arg_TARGET AND TARGET ${arg_TARGET})
+    message(FATAL_ERROR "kdm_bake_tileset: TARGET '${arg_TARGET}' already exists")
+  endif()
+
+  get_filename_component(recipe "${arg_RECIPE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  get_filename_component(output "${arg_OUTPUT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
+  if(NOT EXISTS "${recipe}" OR IS_DIRECTORY "${recipe}")
+    message(FATAL_ERROR "kdm_bake_tileset: RECIPE '${recipe}' is not a file")
+  endif()
+  get_filename_component(output_dir "${output}" DIRECTORY)
+  set(scratch "${output}.baking")
+  set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
+            COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS})
+  if(arg_VERIFY)
+    list(APPEND steps COMMAND kdm::kdm verify "${scratch}")
+  endif()
+  list(APPEND steps COMMAND "${CMAKE_COMMAND}" -E rename "${scratch}" "${output}")
+  add_custom_command(OUTPUT "${output}" ${steps}
+                     DEPENDS "${recipe}" "$<TARGET_FILE:kdm::kdm>"
+                     COMMENT "Baking tile set ${output} from ${recipe}"
+                     VERBATIM)
+  if(arg_TARGET)
+    add_custom_target(${arg_TARGET} ALL DEPENDS "${output}")
+  endif()
+endfunction()

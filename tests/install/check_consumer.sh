@@ -1,0 +1,30 @@
+#!/bin/sh
+# Builds and runs the find_package consumer (consumer/) against an installed kdm at PREFIX, in WORK, and
+# checks its build-time bake (kdm_bake_tileset): a second build bakes nothing, a changed recipe is baked
+# again, and a recipe that cannot be baked, or whose set fails verification, fails the build.
+# Usage: check_consumer.sh PREFIX WORK
+set -eu
+prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
+rm -rf "$work" && mkdir -p "$work"
+cp -R "$here/consumer" "$work/src"
+cmake -S "$work/src" -B "$work/build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/build" >/dev/null
+"$work/build/consumer"
+baked=$work/build/tiles/small.kdmt
+cp "$baked" "$work/first.kdmt"
+cmake --build "$work/build" >"$work/again.log"
+if grep -q "Baking tile set" "$work/again.log"; then echo "an unchanged recipe was baked again"; exit 1; fi
+echo "seed 2" >>"$work/src/small.recipe"
+cmake --build "$work/build" >"$work/changed.log"
+grep -q "Baking tile set" "$work/changed.log" || { echo "a changed recipe was not baked again"; exit 1; }
+if cmp -s "$baked" "$work/first.kdmt"; then echo "the recipe's new seed left the tile set as it was"; exit 1; fi
+# A recipe the baker refuses, and one too hot to pass the verification: each fails the build,
+# and each time the next build tries again.
+printf 'levels 0\n' >"$work/src/small.recipe"
+if cmake --build "$work/build" >"$work/bad.log" 2>&1; then echo "a recipe with 0 levels was baked"; exit 1; fi
+grep -q "levels" "$work/bad.log" || { echo "the refused bake did not say why:"; cat "$work/bad.log"; exit 1; }
+printf 'colours 1\nlevels 2\nbase_points 32\ntemperature 50\n' >"$work/src/small.recipe"
+if cmake --build "$work/build" >"$work/unverified.log" 2>&1; then echo "a set failing verification was built"; exit 1; fi
+grep -q "failed [0-9]* check" "$work/unverified.log" || { echo "verification did not say why:"; cat "$work/unverified.log"; exit 1; }
+if cmake --build "$work/build" >/dev/null 2>&1; then echo "the build after a failed verification passed"; exit 1; fi
+echo "consumer ok"
