@@ -1,4 +1,4 @@
-# kdm_bake_tileset(OUTPUT <file> RECIPE <file> [TARGET <name>] [THREADS <n>] [VERIFY])
+# kdm_bake_tileset(OUTPUT <file> RECIPE <file> [TARGET <name>] [EMBED <name>] [THREADS <n>] [VERIFY])
 #
 # Adds a build step that bakes the tile set OUTPUT from RECIPE with the kdm command line (kdm::kdm), and
 # bakes it again whenever the recipe or kdm changes.
@@ -6,13 +6,16 @@
 #   RECIPE   the recipe file; a relative path is taken from the current source directory.
 #   TARGET   a custom target, built by default, that makes OUTPUT; other targets may add_dependencies on
 #            it. Without it, name OUTPUT among a target's sources (or in another custom command's DEPENDS).
+#   EMBED    a static library of that name holding the set's bytes, for a program that carries its set
+#            inside it: link it, `#include "<name>.h"` and pass `<name>, <name>_size` to
+#            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier.
 #   THREADS  baking threads (0, the default, takes every core). The file does not depend on it.
 #   VERIFY   also runs `kdm verify` (the generator test) on the baked file, and fails the build if any
 #            check fails.
 # The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed:
 # a failed or interrupted step leaves OUTPUT as it was, older than the recipe, so the next build tries again.
 function(kdm_bake_tileset)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;THREADS" "")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;EMBED;THREADS" "")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "kdm_bake_tileset: unknown argument(s) ${arg_UNPARSED_ARGUMENTS}")
   endif()
@@ -30,8 +33,13 @@ function(kdm_bake_tileset)
     message(FATAL_ERROR "kdm_bake_tileset: the kdm command line (kdm::kdm) is not there; build kdm with "
                         "KDM_BUILD_TOOLS=ON, or install it with its tools")
   endif()
-  if(arg_TARGET AND TARGET ${arg_TARGET})
-    message(FATAL_ERROR "kdm_bake_tileset: TARGET '${arg_TARGET}' already exists")
+  foreach(name TARGET EMBED)
+    if(arg_${name} AND TARGET ${arg_${name}})
+      message(FATAL_ERROR "kdm_bake_tileset: ${name} '${arg_${name}}' already exists")
+    endif()
+  endforeach()
+  if(arg_EMBED AND NOT arg_EMBED MATCHES "^[A-Za-z_][A-Za-z0-9_]*$")
+    message(FATAL_ERROR "kdm_bake_tileset: EMBED '${arg_EMBED}' is not a C identifier")
   endif()
 
   get_filename_component(recipe "${arg_RECIPE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
@@ -53,5 +61,25 @@ function(kdm_bake_tileset)
                      VERBATIM)
   if(arg_TARGET)
     add_custom_target(${arg_TARGET} ALL DEPENDS "${output}")
+  endif()
+  if(arg_EMBED)
+    set(include_dir "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}")
+    file(WRITE "${include_dir}/${arg_EMBED}.h.tmp"
+      "// The bytes of ${output}, baked from ${recipe} (kdm_bake_tileset). Generated: do not edit.\n"
+      "#pragma once\n#include <stddef.h>\n"
+      "#ifdef __cplusplus\nextern \"C\" {\n#endif\n"
+      "extern const unsigned char ${arg_EMBED}[];\nextern const size_t ${arg_EMBED}_size;\n"
+      "#ifdef __cplusplus\n}\n#endif\n")
+    file(COPY_FILE "${include_dir}/${arg_EMBED}.h.tmp" "${include_dir}/${arg_EMBED}.h" ONLY_IF_DIFFERENT)
+    file(REMOVE "${include_dir}/${arg_EMBED}.h.tmp")
+    set(source "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}.cpp")
+    add_custom_command(OUTPUT "${source}"
+                       COMMAND "${CMAKE_COMMAND}" "-DKDM_EMBED_INPUT=${output}" "-DKDM_EMBED_OUTPUT=${source}"
+                               "-DKDM_EMBED_SYMBOL=${arg_EMBED}" -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmEmbed.cmake"
+                       DEPENDS "${output}" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmEmbed.cmake"
+                       COMMENT "Embedding tile set ${output} as ${arg_EMBED}"
+                       VERBATIM)
+    add_library(${arg_EMBED} STATIC "${source}")
+    target_include_directories(${arg_EMBED} PUBLIC "$<BUILD_INTERFACE:${include_dir}>")
   endif()
 endfunction()

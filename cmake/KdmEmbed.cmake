@@ -1,8 +1,20 @@
 # kdm_embed_file(INPUT OUTPUT SYMBOL): writes OUTPUT, a C++ source defining
 #   extern const unsigned char SYMBOL[]; extern const std::size_t SYMBOL_size;
 # with the bytes of INPUT. Runs at configure time and again whenever INPUT changes.
-function(kdm_embed_file input output symbol)
-  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${input})
+# As a script, it does the same at build time (kdm_bake_tileset's EMBED):
+#   cmake -DKDM_EMBED_INPUT=... -DKDM_EMBED_OUTPUT=... -DKDM_EMBED_SYMBOL=... -P KdmEmbed.cmake
+if(CMAKE_SCRIPT_MODE_FILE)
+  cmake_minimum_required(VERSION 3.20)  # a script has no project to set its policies
+endif()
+
+# Rewrites OUTPUT only where its bytes change (at configure time, so that an unchanged set is not compiled
+# again), unless ALWAYS is given (at build time, where OUTPUT must end newer than INPUT). C_LINKAGE gives
+# the symbols C linkage, for C callers.
+function(kdm_write_embedded_source input output symbol)
+  set(extern "extern")
+  if("C_LINKAGE" IN_LIST ARGN)
+    set(extern "extern \"C\"")  # a declaration, as extern is
+  endif()
   file(READ ${input} hex HEX)
   string(LENGTH "${hex}" hex_length)
   math(EXPR size "${hex_length} / 2")
@@ -11,8 +23,22 @@ function(kdm_embed_file input output symbol)
   file(WRITE ${output}.tmp
     "// Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit.\n"
     "#include <cstddef>\n"
-    "extern const unsigned char ${symbol}[];\nextern const std::size_t ${symbol}_size;\n"
+    "${extern} const unsigned char ${symbol}[];\n${extern} const std::size_t ${symbol}_size;\n"
     "alignas(16) const unsigned char ${symbol}[] = {\n${bytes}\n};\n"
     "const std::size_t ${symbol}_size = ${size};\n")
-  file(COPY_FILE ${output}.tmp ${output} ONLY_IF_DIFFERENT)
+  if("ALWAYS" IN_LIST ARGN)
+    file(RENAME ${output}.tmp ${output})
+  else()
+    file(COPY_FILE ${output}.tmp ${output} ONLY_IF_DIFFERENT)
+    file(REMOVE ${output}.tmp)
+  endif()
 endfunction()
+
+function(kdm_embed_file input output symbol)
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${input})
+  kdm_write_embedded_source(${input} ${output} ${symbol})
+endfunction()
+
+if(CMAKE_SCRIPT_MODE_FILE AND DEFINED KDM_EMBED_INPUT)
+  kdm_write_embedded_source("${KDM_EMBED_INPUT}" "${KDM_EMBED_OUTPUT}" "${KDM_EMBED_SYMBOL}" ALWAYS C_LINKAGE)
+endif()

@@ -18,6 +18,7 @@ echo "seed 2" >>"$work/src/small.recipe"
 cmake --build "$work/build" >"$work/changed.log"
 grep -q "Baking tile set" "$work/changed.log" || { echo "a changed recipe was not baked again"; exit 1; }
 if cmp -s "$baked" "$work/first.kdmt"; then echo "the recipe's new seed left the tile set as it was"; exit 1; fi
+"$work/build/consumer" >"$work/changed.out" || { cat "$work/changed.out"; exit 1; }  # the embedded set follows
 # A recipe the baker refuses, and one too hot to pass the verification: each fails the build,
 # and each time the next build tries again.
 printf 'levels 0\n' >"$work/src/small.recipe"
