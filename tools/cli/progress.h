@@ -1,14 +1,17 @@
-// A progress bar with ETA on stderr, drawn only when stderr is a terminal.
+// Progress on stderr: a bar with ETA redrawn in place on a terminal; elsewhere (a build log, a pipe) a line
+// every half minute, so a long bake shows it is alive and a short one prints nothing.
 #pragma once
 
 #include <chrono>
+#include <cstdio>
 #include <string>
 
 namespace kdm::cli {
 
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label);
+  /// `out` is stderr but for tests; a log line at most every `line_every_seconds` where it is no terminal.
+  explicit ProgressBar(std::string label, std::FILE* out = stderr, double line_every_seconds = 30);
   ~ProgressBar();
   /// fraction in [0, 1]. Cheap when nothing needs redrawing. Call from one thread.
   void update(double fraction);
@@ -16,8 +19,11 @@ class ProgressBar {
 
  private:
   std::string label_;
-  bool enabled_;
+  std::FILE* out_;
+  double line_every_seconds_;
+  bool terminal_;
   int last_permille_ = -1;
+  double last_line_seconds_ = 0;
   std::chrono::steady_clock::time_point start_;
 };
 
