@@ -155,6 +155,14 @@ void with_batch_callback(kdm::QueryDensity& d,
   d.batch_callback = batch, d.user = user, d.callback_max = callback_max;
 }
 
+/// A C callback bounded by 0 would never be called: its struct was zeroed and density_max left unset (C++'s
+/// default bound is 1). Refused as `name`, where C++ takes 0 as an empty density.
+bool unset_callback_bound(const kdm::QueryDensity& d, const char* name, kdm::QueryProblem& why) {
+  if (d.kind != kdm::QueryDensity::Kind::kCallback || d.callback_max != 0) return false;
+  why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = name, why.value = 0;
+  return true;
+}
+
 /// kdm_point and QueryPoint share their layout: queries write straight into the caller's buffer.
 kdm::QueryPoint* as_points(kdm_point* out) {
   static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
@@ -248,7 +256,8 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
         offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback)
       with_batch_callback(q.density, query->density_batch_callback, query->user, query->density_max,
                           query->density_image);
-    status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
+    if (!unset_callback_bound(q.density, "density_max", why))
+      status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);
   return status;
@@ -286,11 +295,13 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
     why.value = class_count, why.limit = kdm::kMaxQueryClasses;
   } else {
     q.class_count = class_count;
-    for (uint32_t k = 0; k < class_count && source.kind == ClassSource::kClasses; ++k) {
+    bool unset = false;
+    for (uint32_t k = 0; k < class_count && source.kind == ClassSource::kClasses && !unset; ++k) {
       const kdm_class_density& c = classes[k];
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
       q.classes[k].bounds = c.density_bounds;
       with_batch_callback(q.classes[k], c.density_batch_callback, c.user, c.density_max, c.density_image);
+      unset = unset_callback_bound(q.classes[k], kClassDensityNames[1][k], why);
     }
     if (source.kind == ClassSource::kImages) q.image_sums = &source.images->sums;
     if (source.kind == ClassSource::kJoint) {
@@ -298,7 +309,7 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
       q.joint.user = joint->user, q.joint.batch_densities = joint->batch_densities;
       std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
     }
-    status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
+    if (!unset) status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);
   return status;

@@ -220,6 +220,10 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NOT_FINITE && strcmp(problem.parameter, "density") == 0);
     q = uniform_query();
+    q.density_callback = ramp; /* density_max left as the zeroed struct has it: nothing would be called */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && strcmp(problem.parameter, "density_max") == 0);
+    q = uniform_query();
     q.mode = 7;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_BAD_MODE && strcmp(problem.parameter, "mode") == 0);
@@ -290,6 +294,11 @@ int main(int argc, char** argv) {
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NEGATIVE && strcmp(problem.parameter, "classes[1].density") == 0);
     densities[1].density = 2;
+    densities[2].density_callback = ramp; /* its density_max unset */
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && strcmp(problem.parameter, "classes[2].density_max") == 0);
+    densities[2].density_callback = NULL;
     /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
     {
       static float xy[2 * 4096], sum_xy[2 * 4096];

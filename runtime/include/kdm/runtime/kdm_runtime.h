@@ -60,7 +60,8 @@ typedef struct kdm_query {
   /* Optional: density at world (x, y); NaN, negative and infinite values count as 0. */
   double (*density_callback)(void* user, double x, double y);
   void* user;                             /* passed to the density and bounds callbacks */
-  double density_max;                     /* upper bound of the callback's values */
+  double density_max;                     /* upper bound of the callback's values: > 0 with a callback
+                                             (0, a zeroed struct's, is refused: it would call nothing) */
   const kdm_density_image* density_image; /* optional; takes precedence over the callback */
   /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
   int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
@@ -218,7 +219,7 @@ typedef struct kdm_class_density {
   double density;
   double (*density_callback)(void* user, double x, double y);
   void* user;
-  double density_max;
+  double density_max; /* > 0 with a callback, as kdm_query's */
   const kdm_density_image* density_image;
   /* Added in 0.4 (the struct grew: rebuild callers; arrays of it have a new stride): optional bounds of
    * the callback's density, as kdm_query's density_bounds; the union takes their sum, and a tile's
