@@ -32,6 +32,9 @@ constexpr const char* kImageNames[kMaxQueryClasses] = {
 constexpr const char* kCallbackNames[kMaxQueryClasses] = {
     "classes[0].callback", "classes[1].callback", "classes[2].callback", "classes[3].callback",
     "classes[4].callback", "classes[5].callback", "classes[6].callback", "classes[7].callback"};
+constexpr const char* kKindNames[kMaxQueryClasses] = {"classes[0].kind", "classes[1].kind", "classes[2].kind",
+                                                      "classes[3].kind", "classes[4].kind", "classes[5].kind",
+                                                      "classes[6].kind", "classes[7].kind"};
 constexpr const char* kCallbackMaxNames[kMaxQueryClasses] = {
     "classes[0].callback_max", "classes[1].callback_max", "classes[2].callback_max",
     "classes[3].callback_max", "classes[4].callback_max", "classes[5].callback_max",
@@ -151,7 +154,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
         if (d.callback_max < 0) return refuse(Kind::kNegative, kCallbackMaxNames[k], d.callback_max);
         break;
       default:
-        return refuse(Kind::kBadDensity, kCallbackNames[k], static_cast<double>(static_cast<int>(d.kind)));
+        return refuse(Kind::kBadDensity, kKindNames[k], static_cast<double>(static_cast<int>(d.kind)));
     }
     densities.all_constant = false;
   }

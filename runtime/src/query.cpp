@@ -122,6 +122,8 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       if (d.callback_max < 0) return refuse(Kind::kNegative, "density.callback_max", d.callback_max);
       max_density = d.callback_max;
       break;
+    default:  // not a Kind: a cast, or memory the caller never set
+      return refuse(Kind::kBadDensity, "density.kind", static_cast<double>(static_cast<int>(d.kind)));
   }
   const double S = q.tile_size, area_scale = S * S * q.scale;
   const ImageSampler sampler(d.kind == QueryDensity::Kind::kImage ? d.image : nullptr);

@@ -287,6 +287,9 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);
   q.classes[1].callback_max = NAN;
   EXPECT_STREQ(refusal(q).parameter, "classes[1].callback_max");
+  q.classes[1].kind = static_cast<QueryDensity::Kind>(9);  // memory never set, or a bad cast
+  EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kBadDensity);
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].kind");
   q.classes[1] = QueryDensity{};
   // A joint density's maxima.
   ClassQueryParams qj = q;

@@ -549,6 +549,12 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   p = problem_of(region(0, 0, 1, 1, -1));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kNegative);
   EXPECT_STREQ(p.parameter, "scale");
+  q = region(0, 0, 1, 1, 100);
+  q.density.kind = static_cast<QueryDensity::Kind>(9);  // memory never set, or a bad cast
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kBadDensity);
+  EXPECT_STREQ(p.parameter, "density.kind");
+  EXPECT_EQ(p.value, 9);
   // A constant density is the caller's number, refused even for a region that holds no point.
   for (const double region_side : {1.0, 0.0}) {
     q = region(0, 0, region_side, 1, 100);

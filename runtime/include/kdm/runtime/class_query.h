@@ -9,7 +9,8 @@
 // one at ρ_0 + … + ρ_k, and all classes together exactly the one at the sum; each later class fills in
 // around the earlier ones. In smooth mode every point glides on the track of the sum (so the union is
 // exactly the smooth one-class query at the sum and no two points of any classes come closer than its
-// points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions.
+// points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions
+// (but within a glide's reach of the region's sides, which each query's points cross by their own track).
 // Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps.
 // Give a callback class its bounds (QueryDensity::bounds): the union's are their sum, and a tile's bounds
 // settle most of its points' classes without reading any density. Classes whose densities come from one

@@ -151,7 +151,7 @@ struct QueryProblem {
     kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
                         ///< >= 0; `value` holds it
     kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared,
-                        ///< or both callbacks are set
+                        ///< or both callbacks are set; "density.kind" is not a QueryDensity::Kind
     kTooManyTiles,      ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
     kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
                         ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
