@@ -10,12 +10,13 @@ std::vector<kdm::QueryPoint> scatter(double x0, double y0, double x1, double y1)
   std::vector<kdm::QueryPoint> out(4096);
   kdm::QueryCursor cursor;
   std::size_t n = 0, total = 0;
-  while (kdm::query_points(kdm::Tileset::builtin(), q, out.data() + total, out.size() - total, &n, &cursor) ==
-         kdm::Status::kBufferFull) {
+  kdm::Status status;
+  while ((status = kdm::query_points(kdm::Tileset::builtin(), q, out.data() + total, out.size() - total, &n,
+                                     &cursor)) == kdm::Status::kBufferFull) {
     total += n;
     out.resize(out.size() * 2);
   }
-  out.resize(total + n);
+  out.resize(status == kdm::Status::kOk ? total + n : 0);  // else kdm::status_message(status) says why
   return out;  // each point has a stable id (tile_x, tile_y, rank) to key instances on
 }
 

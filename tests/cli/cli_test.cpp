@@ -304,6 +304,11 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   expect_error("sample --n 10 --density" + out, "--density needs a value, but is followed by the option -o");
   expect_error("stipple a.png --points --help",
                "--points needs a value, but is followed by the option --help");
+  // A density that is no file names the maps it could have meant.
+  expect_error("query --rect 0,0,1,1 --density ramp" + out,
+               "'ramp': no such file (a density is a picture, const:V");
+  expect_error("query --rect 0,0,1,1 --class const:1 --density-rect 0,0,2,2 -o '" + path("x.csv") + "'",
+               "(--density or --class)");
   const Outcome negative = kdm("query --rect -1,-1,0,0 --scale 40" + out);  // a value may start with '-'
   EXPECT_EQ(negative.status, 0) << negative.err;
 }

@@ -95,7 +95,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     return s->kind != tools::DensitySpec::Kind::kConstant;
   });
   if (!a.density_rect.empty() && !any_map)
-    throw CommandError("--density-rect needs an image or a test map --density");
+    throw CommandError("--density-rect needs an image or a test map (--density or --class)");
   if (a.density_rect.empty()) {
     std::copy(r, r + 4, dr);  // the image stretched over the rectangle queried
   } else {
@@ -195,7 +195,8 @@ void add_query_command(CLI::App& app) {
          "Several classes in one query (instead of --density): repeat it, one density each, the "
          "first given first place (largest objects first), up to 8; every point gets a class "
          "(a class column in .csv/.json, a colour in pictures, a group per class in .svg); by default "
-         "one class, --density")
+         "one class, --density. Colours: " +
+             std::string(tools::kClassInkNames))
       ->take_all();
   cmd->add_option(
       "--density-rect", a->density_rect,

@@ -200,7 +200,8 @@ void add_sample_command(CLI::App& app) {
                   "Several classes (instead of --density): repeat it, one density each, highest priority "
                   "first, up to 8; --n counts all of them, split by each density's integral; class k is "
                   "sampled around classes 0 … k-1 at their summed density (a class column in .csv, a colour "
-                  "in pictures); by default one class, --density");
+                  "in pictures); by default one class, --density. Colours: " +
+                      std::string(tools::kClassInkNames));
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   add_threads_option(cmd, o.threads, "output does not depend on it");

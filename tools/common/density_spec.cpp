@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 
 #include "image_io.h"
 
@@ -81,6 +82,10 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
     spec.range = range;
     return spec;
   }
+  std::error_code missing;
+  if (!std::filesystem::exists(text, missing))  // a misspelt map more often than a missing picture
+    throw std::runtime_error("density '" + text +
+                             "': no such file (a density is a picture, const:V, ramp:R or radial:R)");
   GreyImage image;
   std::string error;
   if (!load_grey_image(text, image, error)) throw std::runtime_error(error);

@@ -32,7 +32,10 @@ std::string hex(const Ink& ink) {
 
 }  // namespace
 
+const char* const kClassInkNames = "black (class 0), red, blue, green, orange, purple, brown, pink (class 7)";
+
 std::vector<Ink> class_inks(std::size_t count) {
+  // The order of kClassInkNames.
   static constexpr std::uint8_t kColours[8][3] = {{0, 0, 0},     {214, 39, 40},  {31, 119, 180},
                                                   {44, 160, 44}, {255, 127, 14}, {148, 103, 189},
                                                   {140, 86, 75}, {227, 119, 194}};

@@ -17,6 +17,8 @@ struct Ink {
 
 /// Distinct inks for `count` classes (at most 8), named class-0, class-1, …: black first, then colours.
 std::vector<Ink> class_inks(std::size_t count);
+/// The colours of class_inks, in words for help texts: "black (class 0), red, ...".
+extern const char* const kClassInkNames;
 
 /// How a dot's ink meets what is under it: painted over, multiplied (inks on paper: overlapping cyan and
 /// yellow make green) or added (light on black).
