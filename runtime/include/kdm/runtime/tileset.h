@@ -34,8 +34,8 @@ class KDM_RUNTIME_API Tileset {
   static Status load_file(const std::string& path, Tileset& out, std::string* detail = nullptr);
   static Status load_memory(const void* data, std::size_t size, Tileset& out, std::string* detail = nullptr);
   /// The default tile set compiled into the library (tilesets/default.kdmt). Thread-safe. It is decoded on
-  /// the first call, which takes about a tenth of a second (docs/performance.md): call it once at start-up
-  /// to keep that out of a frame. The C API's kdm_tileset_builtin() shares this copy. An empty set (no
+  /// the first call, which takes a tenth to a third of a second (the more in a fresh process, which first
+  /// touches the memory; docs/performance.md): call it once at start-up to keep that out of a frame. The C API's kdm_tileset_builtin() shares this copy. An empty set (no
   /// tiles; queries refuse it) when memory runs out while it is decoded: a later call tries again.
   static const Tileset& builtin();
 
