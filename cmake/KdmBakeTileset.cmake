@@ -52,7 +52,7 @@ function(kdm_bake_tileset)
   set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
             COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS})
   if(arg_VERIFY)
-    list(APPEND steps COMMAND kdm::kdm verify "${scratch}")
+    list(APPEND steps COMMAND kdm::kdm verify --quiet "${scratch}")
   endif()
   list(APPEND steps COMMAND "${CMAKE_COMMAND}" -E rename "${scratch}" "${output}")
   add_custom_command(OUTPUT "${output}" ${steps}

@@ -281,6 +281,16 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
   EXPECT_NE(bad.err.find("failed"), std::string::npos) << bad.err;
   EXPECT_NE(bad.out.find("FAIL tile 3 level 2"), std::string::npos) << bad.out;
+  // --quiet (build logs): the failed checks and the count, no tables.
+  const Outcome quiet = kdm("verify --quiet '" + path("bad.kdmt") + "'" + quick);
+  EXPECT_EQ(quiet.status, 1);
+  EXPECT_NE(quiet.out.find("FAIL tile 3 level 2"), std::string::npos) << quiet.out;
+  EXPECT_NE(quiet.out.find(" checks failed\n"), std::string::npos) << quiet.out;
+  EXPECT_EQ(quiet.out.find("level 2, 512 points per tile"), std::string::npos) << quiet.out;
+  EXPECT_EQ(quiet.out.find("result"), std::string::npos) << quiet.out;  // a table's header
+  EXPECT_LT(std::count(quiet.out.begin(), quiet.out.end(), '\n'),
+            std::count(bad.out.begin(), bad.out.end(), '\n') / 2)
+      << quiet.out;
 
   expect_error("verify '" + path("missing.kdmt") + "'", "missing.kdmt");
   expect_error("verify '" + shipped + "' --level 9", "level 9");

@@ -17,7 +17,7 @@ namespace {
 struct VerifyArgs {
   std::string path;
   verify::VerifyOptions options;
-  bool no_seams = false, no_direct = false, no_glide_track = false;
+  bool no_seams = false, no_direct = false, no_glide_track = false, quiet = false;
 };
 
 void run_verify(VerifyArgs args) {
@@ -42,7 +42,7 @@ void run_verify(VerifyArgs args) {
   bar.finish();
   std::printf("%s: %zu tile(s), %u levels, %u reference runs per level\n", args.path.c_str(),
               set.tiles.size(), set.levels, unsigned(args.options.reference_runs));
-  verify::print_report(report, stdout);
+  verify::print_report(report, stdout, !args.quiet);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("(%.1f s)\n", seconds);
   std::fflush(stdout);
@@ -81,6 +81,8 @@ void add_verify_command(CLI::App& app) {
   cmd->add_option("--handover-rows", args->options.handover_rows,
                   "Densities at which the hand-over past the top level is judged, in even steps (1 to 1000)")
       ->capture_default_str();
+  cmd->add_flag("--quiet", args->quiet,
+                "Print only the failed checks and the count, not the tables (build logs)");
   add_threads_option(cmd, args->options.threads, "results do not depend on it");
   cmd->callback([args] { run_verify(*args); });
 }

@@ -49,12 +49,15 @@ void print_failures(const std::vector<Check>& checks, const std::string& what, s
 
 }  // namespace
 
-void print_report(const Report& report, std::FILE* out) {
+void print_report(const Report& report, std::FILE* out, bool tables) {
   std::size_t checks = 0;
   bool tile_checks = false;
-  for (const TileResult& t : report.tiles) tile_checks = tile_checks || !t.checks.empty();
+  for (const TileResult& t : report.tiles)
+    tile_checks = tile_checks || !t.checks.empty(), checks += t.checks.size();
+  for (const DensityResult& d : report.densities) checks += d.checks.size();
+  for (const KeyframeResult& k : report.keyframes) checks += k.checks.size();
   for (const LevelReference& level : report.levels) {
-    if (!tile_checks) break;
+    if (!tile_checks || !tables) break;
     std::fprintf(
         out,
         "\nlevel %u, %u points per tile; reference: full-sampler runs on the %g×%g torus: E/n %.4f  "
@@ -74,10 +77,9 @@ void print_report(const Report& report, std::FILE* out) {
           cell(t.low_p, "%.4f", t.checks, "lowP", 8).c_str(), raps ? (raps->passed() ? "ok" : "FAIL!") : "-",
           cell(t.drop, "%.4f", t.checks, "energy drop", 8).c_str(),
           cell(t.drift, "%.3f", t.checks, "drift", 7).c_str(), t.passed() ? "pass" : "FAIL");
-      checks += t.checks.size();
     }
   }
-  if (!report.densities.empty()) {
+  if (!report.densities.empty() && tables) {
     std::fprintf(out, "\nseams and in-between densities, over every tile's torus\n");
     std::fprintf(out, "%11s %7s %7s %10s %10s %8s %9s %10s %8s %9s %6s %7s  %s\n", "points/tile", "kind",
                  "δavg", "edge/other", "edge links", "KS D+", "p", "worst lowP", "closest", "edge band",
@@ -91,10 +93,9 @@ void print_report(const Report& report, std::FILE* out) {
                    cell(d.closest_pair, "%.3f", d.checks, "closest pair", 8).c_str(),
                    cell(100 * (d.edge_band - 1), "%+.1f%%", d.checks, "|edge band", 9).c_str(),
                    hole_cells(d.holes, d.checks).c_str(), d.passed() ? "pass" : "FAIL");
-      checks += d.checks.size();
     }
   }
-  if (!report.keyframes.empty()) {
+  if (!report.keyframes.empty() && tables) {
     std::fprintf(
         out,
         "\nglide track (smooth mode), over every tile's torus; closest pair in d_hex; motion from the "
@@ -110,10 +111,9 @@ void print_report(const Report& report, std::FILE* out) {
                    cell(k.motion_mean, "%.3f", k.checks, "motion mean", 11).c_str(),
                    cell(k.motion_p99, "%.3f", k.checks, "motion p99", 10).c_str(),
                    hole_cells(k.holes, k.checks).c_str(), k.passed() ? "pass" : "FAIL");
-      checks += k.checks.size();
     }
   }
-  std::fprintf(out, "\n");
+  if (tables) std::fprintf(out, "\n");
   for (const TileResult& t : report.tiles)
     print_failures(t.checks, "tile " + std::to_string(t.tile) + " level " + std::to_string(t.level), out);
   for (const DensityResult& d : report.densities)

@@ -199,7 +199,8 @@ struct Report {
 /// fewer than 2 reference runs or an unknown level; never for a tile that fails (that is in the report).
 Report verify_tileset(const TilesetData& set, const VerifyOptions& options = {});
 
-/// Writes `report` as tables (one row per tile and level, one per density; failing values marked '!').
-void print_report(const Report& report, std::FILE* out);
+/// Writes `report` as tables (one row per tile and level, one per density; failing values marked '!'), then
+/// each failed check and a count; without `tables`, only the failed checks and the count.
+void print_report(const Report& report, std::FILE* out, bool tables = true);
 
 }  // namespace kdm::verify
