@@ -171,6 +171,35 @@ void BM_QueryDensityCallback(benchmark::State& state) {
   run_against_baseline(state, [&] { return run_query(q, buffer); });
 }
 
+// Smooth mode gliding together (QueryParams::glide_together) against gliding by each point's own density,
+// rounds alternating (args: density, 0 the ramp by callback, 1 with its bounds, 2 a 256² image of it):
+// `of_own` is the own-density query's time over this one's.
+void BM_QueryGlideTogether(benchmark::State& state) {
+  kdm::QueryParams q = params();
+  q.mode = kdm::QueryMode::kSmooth;
+  q.density.kind = kdm::QueryDensity::Kind::kCallback, q.density.callback = ramp, q.density.callback_max = 1;
+  if (state.range(0) == 1) q.density.bounds = ramp_bounds;
+  std::vector<float> values(256 * 256), mip;
+  kdm::DensityImageView image;
+  if (state.range(0) == 2) {
+    for (int y = 0; y < 256; ++y)
+      for (int x = 0; x < 256; ++x)
+        values[y * 256 + x] = static_cast<float>(ramp(nullptr, (x + 0.5) / 256 * kSide, 0));
+    image.width = image.height = 256, image.x1 = image.y1 = kSide, image.values = values.data();
+    kdm::make_density_max_mip(image, mip);
+    q.density = kdm::QueryDensity{};
+    q.density.kind = kdm::QueryDensity::Kind::kImage, q.density.image = &image;
+  }
+  kdm::QueryParams own = q;
+  q.glide_together = true;
+  std::vector<kdm::QueryPoint> buffer(1 << 20), other(1 << 20);
+  std::size_t n = 0;
+  const double ratio = alternate(
+      state, n, [&] { return run_query(q, buffer); }, [&] { return run_query(own, other); });
+  report(state, n);
+  state.counters["of_own"] = ratio;
+}
+
 // Three classes at 1 : 2 : 4 of the constant density (args: smooth; ramp: 0 constants, 1 three ramps by
 // callback, 2 the same with their bounds (and the sum's), 3 the ramps and bounds from one joint call
 // (ClassQueryParams::joint), 4 and 5 as 2 and 3 with a texture over the ramps, 6 the ramps as images against
@@ -725,6 +754,11 @@ BENCHMARK(BM_QueryDensityImage)->ArgName("smooth")->Arg(0)->Arg(1)->Unit(benchma
 BENCHMARK(BM_QueryDensityCallback)
     ->ArgNames({"smooth", "bounds"})
     ->ArgsProduct({{0, 1}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryGlideTogether)
+    ->ArgName("density")
+    ->DenseRange(0, 2)
+    ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_QueryThreeClasses)
     ->ArgNames({"smooth", "ramp", "compact"})

@@ -36,10 +36,14 @@ void check_rect(const char* name, const Rect& r) {
     throw std::invalid_argument(std::string(name) + " is empty or inverted (needs x0 < x1 and y0 < y1)");
 }
 
-QueryMode parse_mode(const std::string& mode) {
-  if (mode == "stable") return QueryMode::kStable;
-  if (mode == "smooth") return QueryMode::kSmooth;
-  throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
+/// A query's mode from the package's "stable" or "smooth", with "/together" for QueryParams::glide_together.
+void set_mode(QueryParams& q, const std::string& mode) {
+  const std::size_t slash = mode.find('/');
+  const std::string name = mode.substr(0, slash), rest = slash == std::string::npos ? "" : mode.substr(slash);
+  if ((name != "stable" && name != "smooth") || (!rest.empty() && rest != "/together"))
+    throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
+  q.mode = name == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
+  q.glide_together = !rest.empty();
 }
 
 /// Points and their levels in memory numpy arrays view: the runtime's QueryPoint records themselves (no
@@ -217,7 +221,7 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
   q.origin_x = origin[0], q.origin_y = origin[1];
   q.tile_size = tile_size;
   q.scale = scale;
-  q.mode = parse_mode(mode);
+  set_mode(q, mode);
   const bool call = !callable.is_none();
   if (call == (spec != nullptr)) throw std::invalid_argument("give one density: a spec or a callable");
   if (density_rect && (call || spec->kind == tools::DensitySpec::Kind::kConstant))
@@ -463,7 +467,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
   q.query.origin_x = origin[0], q.query.origin_y = origin[1];
   q.query.tile_size = tile_size;
   q.query.scale = scale;
-  q.query.mode = parse_mode(mode);
+  set_mode(q.query, mode);
   q.class_count = static_cast<std::uint32_t>(specs.size());
   if (vectorized &&
       std::all_of(callables.begin(), callables.end(), [](const py::object& f) { return f.is_none(); }))

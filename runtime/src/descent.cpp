@@ -7,6 +7,7 @@
 // expression: ρ(x_q) · area[d + 1] > K_h, x_q computed as the subtile computes its own points.
 #include "descent.h"
 
+#include "glide_count.h"
 #include "read_ahead.h"
 #include "subtile_loops.h"
 
@@ -322,8 +323,14 @@ class Descent {
       glided(s, std::min(s.expected, expected / (double(m_) * m_)), bx, by);
       return write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r));
     }
+    // At depth 0 a varying density's points glide as query.cpp's do (glide_together: glide_count.h); past
+    // the top level by their own counts, which the hand-over's sub-points continue.
+    const double placed =
+        !L.constant && n.depth == 0 && q_.params->glide_together
+            ? glide_count(expected, xs, ys, side, area, [&](double x, double y) { return read(x, y); })
+            : expected;
     const GlideBracket g =
-        L.constant && r >= inherited ? L.constant_bracket : GlideBracket(q_.keyframes, expected);
+        L.constant && r >= inherited ? L.constant_bracket : GlideBracket(q_.keyframes, placed);
     const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(L.start[g.g0]) + r);
     const std::int8_t* o1 = tile.glide.data() + 2 * (std::size_t(L.start[g.g1]) + r);
     const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
@@ -486,12 +493,16 @@ class Descent {
       if (budget_ == 0) return r;
       --budget_;
       if (r + kPrefetch < prefetch_end) prefetch_parent(k, from_of[r + kPrefetch]);
-      // A rank reads at most its count, its k ancestors', its sub-point's and its glided position's.
+      // A rank reads at most its count, its k ancestors', its sub-point's, its glide count's probes and its
+      // glided position's.
       if (ahead_ && r == read_to)
-        read_to = read_ahead(r, general_end, std::uint32_t(k) + 3, [&](std::uint32_t from, std::uint32_t to) {
-          RankLoop dry = loop;
-          for (std::uint32_t i = from; i < to; ++i) dry_item_ = i, missed_ = false, visit(k, dry, i);
-        });
+        read_to = read_ahead(r, general_end,
+                             std::uint32_t(k) + 3 + (q_.params->glide_together ? GlideLattice::kCorners : 0),
+                             [&](std::uint32_t from, std::uint32_t to) {
+                               RankLoop dry = loop;
+                               for (std::uint32_t i = from; i < to; ++i)
+                                 dry_item_ = i, missed_ = false, visit(k, dry, i);
+                             });
       if (!visit(k, loop, r)) return r;
     }
     if ((direct || varying) && candidates > inherited) {

@@ -9,6 +9,7 @@
 
 #include "density_bounds.h"
 #include "float_runs.h"
+#include "glide_count.h"
 #include "image_runs.h"
 #include "image_sampler.h"
 #include "keyframe_lookup.h"
@@ -183,12 +184,42 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
   std::uint8_t pending_class[kBatch];
   int pending = 0;
+  // The expected count each pending point glides by: its own, or glide_count.h's (glide_together); a batch
+  // callback reads each corner of the batch's points in one call.
+  auto glide_counts = [&](double* count) {
+    if (!j.glide_together) {
+      std::copy(pending_expected, pending_expected + pending, count);
+      return;
+    }
+    if (!batch_reads) {
+      for (int i = 0; i < pending; ++i)
+        count[i] = glide_count(pending_expected[i], pending_x[i], pending_y[i], j.S, j.area_scale,
+                               [&](double x, double y) {
+                                 if constexpr (kKind == QueryDensity::Kind::kImage)
+                                   return j.sampler->at(x, y);
+                                 return density_or_zero(j.density->callback(j.density->user, x, y));
+                               });
+      return;
+    }
+    double most[2][kBatch] = {};
+    for (int k = 0; k < GlideLattice::kCorners && pending > 0; ++k) {
+      for (int i = 0; i < pending; ++i)
+        GlideLattice(pending_expected[i], pending_x[i], pending_y[i], j.S).corner(k, gx[i], gy[i]);
+      j.density->batch_callback(j.density->user, std::size_t(pending), gx, gy, glided);
+      for (int i = 0; i < pending; ++i)
+        most[k >> 2][i] = std::max(most[k >> 2][i], density_or_zero(glided[i]));
+    }
+    for (int i = 0; i < pending; ++i)
+      count[i] = GlideLattice(pending_expected[i], pending_x[i], pending_y[i], j.S)
+                     .count(pending_expected[i], most[0][i], most[1][i], j.area_scale);
+  };
   auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
     // Two passes, each short enough for the processor to overlap many points' latency chains.
     const std::int8_t *o0[kBatch], *o1[kBatch];
-    double w0[kBatch], w1[kBatch];
+    double w0[kBatch], w1[kBatch], count[kBatch];
+    glide_counts(count);
     for (int i = 0; i < pending; ++i) {
-      const GlideBracket b(j.keyframes, pending_expected[i]);
+      const GlideBracket b(j.keyframes, count[i]);
       o0[i] = j.glide + 2 * (std::size_t(j.starts[b.g0]) + pending_rank[i]);
       o1[i] = j.glide + 2 * (std::size_t(j.starts[b.g1]) + pending_rank[i]);
       w0[i] = b.w0, w1[i] = b.w1;

@@ -125,6 +125,7 @@ bool read_query(const kdm_tileset* tileset, const kdm_query* query, const kdm_cu
     q.origin_x = c.origin_x, q.origin_y = c.origin_y;
     q.tile_size = c.tile_size, q.scale = c.scale;
     q.mode = static_cast<kdm::QueryMode>(c.mode);  // the query refuses values it does not know
+    q.glide_together = c.glide_together != 0;
     return true;
   }
   return false;

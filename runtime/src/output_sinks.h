@@ -45,6 +45,8 @@ struct TileJob {
   const ImageSampler* sampler;
   /// Smooth mode with a varying density: whether it can be 0 where the tile's points glide (its bounds).
   bool zero_possible;
+  /// Smooth mode with a varying density: points glide by glide_count.h's count (QueryParams::glide_together).
+  bool glide_together;
   /// Stable mode with a varying density: ranks below this are emitted wherever they lie in the tile (their
   /// thresholds lie below the density's lower bound there), without reading the density.
   std::uint32_t sure;

@@ -236,6 +236,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   job.S = S, job.x0 = q.x0, job.y0 = q.y0, job.x1 = q.x1, job.y1 = q.y1;
   job.origin_x = q.origin_x, job.origin_y = q.origin_y, job.area_scale = area_scale;
   job.density = &d, job.sampler = &sampler;
+  job.glide_together = q.glide_together;
   for (std::int64_t ty = cursor->tile_y; ty < ty1 && ty <= run.to_y; ++ty) {
     const double wy = double(ty) * S;
     const std::int64_t row_end = ty == run.to_y ? std::min(tx1, run.to_x) : tx1;
@@ -607,6 +608,7 @@ std::uint64_t query_fingerprint(const QueryParams& q) {
     f.add_double(v);
   f.add(static_cast<std::uint64_t>(q.density.kind));
   f.add(static_cast<std::uint64_t>(q.mode));
+  f.add(q.glide_together ? 1 : 0);
   f.add_pointer(q.density.image);
   f.add_pointer(reinterpret_cast<const void*>(q.density.callback));
   f.add_pointer(reinterpret_cast<const void*>(q.density.batch_callback));

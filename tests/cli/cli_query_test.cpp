@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -48,6 +49,48 @@ TEST_F(CliTest, QueryPartitionsConcatenateToTheWhole) {
               6);
     EXPECT_TRUE(x >= 0 && x < 6 && y >= 0 && y < 5 && level < 6) << whole.front();
     EXPECT_EQ(tx, static_cast<long long>(std::floor(x / 0.5)));
+  }
+}
+
+// --glide-together moves smooth points (same ids) and partitions still concatenate to the whole; stable
+// mode ignores it.
+TEST_F(CliTest, QueryGlideTogetherMovesTheSamePointsAndKeepsPartitions) {
+  const std::string image =
+      "'" + std::string(KDM_SOURCE_DIR) + "/examples/coffee.png' --density-rect 0,0,3,2";
+  const std::string common = " --scale 3000 --tile-size 0.5 --density " + image;
+  auto ids = [](const std::vector<std::string>& rows) {
+    std::vector<std::string> out;
+    for (const std::string& row : rows) out.push_back(row.substr(row.find(',', row.find(',') + 1)));
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  for (const char* mode : {"smooth", "stable"}) {
+    const std::string m = std::string(" --mode ") + mode;
+    ASSERT_EQ(kdm("query --rect 0,0,3,2" + common + m + " -o '" + path("own.csv") + "'").status, 0);
+    ASSERT_EQ(
+        kdm("query --rect 0,0,3,2" + common + m + " --glide-together -o '" + path("whole.csv") + "'").status,
+        0);
+    ASSERT_EQ(
+        kdm("query --rect 0,0,1.3,2" + common + m + " --glide-together -o '" + path("left.csv") + "'").status,
+        0);
+    ASSERT_EQ(kdm("query --rect 1.3,0,3,2" + common + m + " --glide-together -o '" + path("right.csv") + "'")
+                  .status,
+              0);
+    const std::vector<std::string> own = sorted_rows(slurp(path("own.csv"))),
+                                   whole = sorted_rows(slurp(path("whole.csv")));
+    std::vector<std::string> parts = sorted_rows(slurp(path("left.csv")));
+    for (const std::string& row : sorted_rows(slurp(path("right.csv")))) parts.push_back(row);
+    std::sort(parts.begin(), parts.end());
+    EXPECT_GT(whole.size(), 5000u) << mode;
+    EXPECT_EQ(parts, whole) << mode;
+    if (std::string(mode) == "stable") {
+      EXPECT_EQ(whole, own);
+    } else {
+      EXPECT_NE(whole, own);
+      std::vector<std::string> a = ids(own), b = ids(whole), both;
+      std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
+      EXPECT_GT(both.size(), 0.98 * a.size());  // only the region's sides differ
+    }
   }
 }
 

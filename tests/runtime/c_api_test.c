@@ -297,7 +297,8 @@ int main(int argc, char** argv) {
     densities[2].density_callback = ramp; /* its density_max unset */
     CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && strcmp(problem.parameter, "classes[2].density_max") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE &&
+          strcmp(problem.parameter, "classes[2].density_max") == 0);
     densities[2].density_callback = NULL;
     /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
     {
@@ -428,6 +429,32 @@ int main(int argc, char** argv) {
       CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
       CHECK(g_batch_values == calls_without && g_batch_calls * 20 < g_batch_values);
       q.density_callback = ramp, q.density_batch_callback = NULL;
+    }
+    /* Smooth mode, glide_together: the same points glide elsewhere (about as many are emitted: the region
+     * keeps those that glide into it); a batch callback gives the scalar one's positions; a cursor started
+     * without it does not continue with it. */
+    {
+      static kdm_point together[8192];
+      size_t c = 0, d = 0, moved = 0, i;
+      q.mode = KDM_MODE_SMOOTH;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, without, 8192, &a, &cursor, NULL) == KDM_OK && a > 2000);
+      q.glide_together = 1;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, together, 8192, &c, &cursor, NULL) == KDM_OK);
+      CHECK(c > a - a / 50 && c < a + a / 50);
+      for (i = 0; i < a && i < c; ++i) moved += together[i].x != without[i].x;
+      CHECK(moved > a / 10);
+      q.density_callback = NULL, q.density_batch_callback = ramp_batch;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, with, 8192, &d, &cursor, NULL) == KDM_OK);
+      CHECK(c == d && memcmp(with, together, c * sizeof(kdm_point)) == 0);
+      q.density_callback = ramp, q.density_batch_callback = NULL, q.glide_together = 0;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(builtin, &q, with, 256, &d, &cursor, NULL) == KDM_BUFFER_FULL);
+      q.glide_together = 1;
+      CHECK(kdm_query_points(builtin, &q, with, 256, &d, &cursor, NULL) == KDM_INVALID_ARGUMENT);
+      q.glide_together = 0, q.mode = KDM_MODE_STABLE;
     }
     /* Classes of callback densities: their bounds keep the points and classes and save calls. */
     {

@@ -22,7 +22,7 @@ struct QueryArgs {
   std::string tileset, rect, density_rect, density = "const:1", output, mode = "stable";
   std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
   double scale = 1000, tile_size = 1, gamma = 1;
-  bool invert = false, normalised = false;
+  bool invert = false, normalised = false, glide_together = false;
 };
 
 /// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level, and its
@@ -111,6 +111,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.scale = a.scale;
   q.density = densities[0]->density;
   q.mode = parse_mode(a.mode);
+  q.glide_together = a.glide_together;
   // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;
@@ -211,6 +212,10 @@ void add_query_command(CLI::App& app) {
                   "the density, so every density is good blue noise (stippling, sample patterns)")
       ->check(CLI::IsMember({"stable", "smooth"}))
       ->capture_default_str();
+  cmd->add_flag("--glide-together", a->glide_together,
+                "Smooth mode with a varying density: each point glides by the most density around it, so "
+                "neighbours do not close up where the density changes from dot to dot (pictures, textures); "
+                "several times slower");
   cmd->add_flag("--normalised", a->normalised,
                 ".csv/.json coordinates in [0, 1) of --rect instead of world units");
   cmd->add_option(

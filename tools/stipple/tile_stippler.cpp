@@ -156,6 +156,7 @@ PointSet TileStippler::render(const double uv[4], double fade) const {
   q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
   q.density = densities_.front()->density;
   q.mode = mode_;
+  q.glide_together = true;  // a picture's tone changes from dot to dot
   const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
   if (fade > 0) return with_sizes(q, rect, fade);
   std::vector<float> xy;  // positions only: the compact output

@@ -76,6 +76,11 @@ typedef struct kdm_query {
    * tile's reads into such calls (kdm::QueryDensity::batch_callback). The same points as density_callback
    * giving the same values. */
   void (*density_batch_callback)(void* user, size_t n, const double* x, const double* y, double* out);
+  /* Added in 0.5 (callers built before it get 0): nonzero, in smooth mode with a varying density, makes
+   * each point glide by the most density around it, so that neighbours do not close up where the density
+   * changes from one dot to the next; about 8 density reads more per emitted point
+   * (kdm::QueryParams::glide_together). */
+  int glide_together;
 } kdm_query;
 
 #define KDM_DENSITY_BATCH 128 /* kdm::kDensityBatch */

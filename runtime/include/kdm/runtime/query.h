@@ -112,6 +112,13 @@ struct QueryParams {
   double scale = 1;                       ///< points per unit area at density 1
   QueryDensity density;                   ///< multiplies scale: constant, image or callback
   QueryMode mode = QueryMode::kStable;    ///< stable (points never move) or smooth (points glide)
+  /// Smooth mode with a varying density: each point glides by the most density around it (at the corners
+  /// of lattice cells about its spacing wide) rather than by its own alone, so that neighbours glide
+  /// together and do not close up where the density changes from one dot to the next (a photograph, a
+  /// texture). The same points are emitted; only where they glide changes. Costs about 8 density reads per
+  /// emitted point: a varying-density smooth query takes several times as long. Use it for pictures and
+  /// sample patterns; ignored in stable mode and with a constant density.
+  bool glide_together = false;
 };
 
 /// Most tiles one query may cover (2^24): a bound on the work of a single call, whatever the region.
