@@ -1,10 +1,10 @@
 // Fuzz target: query_points on the built-in tile set, with every parameter taken from the input: per
 // parameter a selector bit picks a raw double (NaN, infinities and extremes included) or a small value
 // from one byte; the density is a constant, a 4×4 image (raw or byte texels) or a callback; the mode
-// stable or smooth (past the top level smooth queries descend into subtiles). The work per input is
-// bounded: when the region would hold more than kBudget candidate points it is cut to a few tiles and
-// then the scale lowered, or past the top level the region shrunk (huge regions and scales are the unit
-// tests' business). Checks:
+// stable or smooth, gliding together or not (past the top level smooth queries descend into subtiles). The
+// work per input is bounded: when the region would hold more than kBudget candidate points it is cut to a few
+// tiles and then the scale lowered, or past the top level the region shrunk (huge regions and scales are the
+// unit tests' business). Checks:
 //  - every point, origin added back, lies in [x0, x1) × [y0, y1) and in the tile its id names (in smooth
 //    mode within a side of that tile, at the id's depth: points glide);
 //  - points come in the documented order (depth-0 tiles row by row), and ids are unique;
@@ -206,6 +206,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Reader r{data + 3, size - 3, std::uint32_t(data[1]) | std::uint32_t(data[2]) << 8};
   kdm::QueryParams q;
   q.mode = smooth ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable;
+  q.glide_together = (data[0] >> 6) & 1;
   q.x0 = r.next(coordinate), q.y0 = r.next(coordinate), q.x1 = r.next(coordinate), q.y1 = r.next(coordinate);
   q.origin_x = r.next(coordinate), q.origin_y = r.next(coordinate);
   q.tile_size = r.next([](std::uint8_t b) { return b / 64.0; });
