@@ -189,7 +189,7 @@ class Tileset:
         glide_together : bool
             Smooth mode with a varying density: each point glides by the most density around it, so that
             neighbours do not close up where the density changes from one dot to the next (pictures,
-            textures). The same points; several times slower (about 8 more density reads a point).
+            textures). The same points; about twice as slow (8 more density reads a point).
         origin : (float, float)
             Subtracted from every position (keep it near the region in large worlds).
         gamma, invert

@@ -9,7 +9,7 @@
 
 #include "density_bounds.h"
 #include "float_runs.h"
-#include "glide_count.h"
+#include "glide_runs.h"
 #include "image_runs.h"
 #include "image_sampler.h"
 #include "keyframe_lookup.h"
@@ -184,34 +184,38 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   double pending_expected[kBatch], pending_x[kBatch], pending_y[kBatch];
   std::uint8_t pending_class[kBatch];
   int pending = 0;
-  // The expected count each pending point glides by: its own, or glide_count.h's (glide_together); a batch
-  // callback reads each corner of the batch's points in one call.
+  // The expected count each pending point glides by: its own, or glide_count.h's (glide_together), a block
+  // of points at a time (glide_runs.h): their corners in one vectorised loop, read in one batch callback's
+  // call or the image's vectorised reads, and their counts in another loop.
   auto glide_counts = [&](double* count) {
     if (!j.glide_together) {
       std::copy(pending_expected, pending_expected + pending, count);
       return;
     }
-    if (!batch_reads) {
-      for (int i = 0; i < pending; ++i)
-        count[i] = glide_count(pending_expected[i], pending_x[i], pending_y[i], j.S, j.area_scale,
-                               [&](double x, double y) {
-                                 if constexpr (kKind == QueryDensity::Kind::kImage)
-                                   return j.sampler->at(x, y);
-                                 return density_or_zero(j.density->callback(j.density->user, x, y));
-                               });
-      return;
+    constexpr std::size_t kReads = GlideLattice::kCorners * kGlideBlock;
+    static_assert(kReads <= kDensityBatch, "a block's corners in one batch call");
+    double cx[kReads], cy[kReads], value[kReads], coarse[kGlideBlock];
+    for (std::size_t b = 0; b < std::size_t(pending); b += kGlideBlock) {
+      const std::size_t m = std::min(kGlideBlock, std::size_t(pending) - b),
+                        reads = GlideLattice::kCorners * m;
+      glide_corners_run(pending_expected + b, pending_x + b, pending_y + b, m, j.S, cx, cy, coarse);
+      if constexpr (kKind == QueryDensity::Kind::kImage) {
+        if (image_runs_fit(*j.sampler->image))
+          for (std::size_t r = 0; r < reads; r += kImageBlock)
+            image_read_run(cx + r, cy + r, std::min<std::size_t>(kImageBlock, reads - r), *j.sampler,
+                           value + r);
+        else
+          for (std::size_t r = 0; r < reads; ++r) value[r] = j.sampler->at(cx[r], cy[r]);
+      } else {
+        if (batch_reads)
+          j.density->batch_callback(j.density->user, reads, cx, cy, value);
+        else
+          for (std::size_t r = 0; r < reads; ++r)
+            value[r] = j.density->callback(j.density->user, cx[r], cy[r]);
+        for (std::size_t r = 0; r < reads; ++r) value[r] = density_or_zero(value[r]);
+      }
+      glide_counts_run(pending_expected + b, coarse, value, m, j.area_scale, count + b);
     }
-    double most[2][kBatch] = {};
-    for (int k = 0; k < GlideLattice::kCorners && pending > 0; ++k) {
-      for (int i = 0; i < pending; ++i)
-        GlideLattice(pending_expected[i], pending_x[i], pending_y[i], j.S).corner(k, gx[i], gy[i]);
-      j.density->batch_callback(j.density->user, std::size_t(pending), gx, gy, glided);
-      for (int i = 0; i < pending; ++i)
-        most[k >> 2][i] = std::max(most[k >> 2][i], density_or_zero(glided[i]));
-    }
-    for (int i = 0; i < pending; ++i)
-      count[i] = GlideLattice(pending_expected[i], pending_x[i], pending_y[i], j.S)
-                     .count(pending_expected[i], most[0][i], most[1][i], j.area_scale);
   };
   auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
     // Two passes, each short enough for the processor to overlap many points' latency chains.

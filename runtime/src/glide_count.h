@@ -16,14 +16,15 @@ struct GlideLattice {
   static constexpr int kCorners = 8;
   double fine_x, fine_y, h, coarse_x, coarse_y, coarse;  // the cells' lower corners, the fine side
   /// A point of expected count `expected` in a tile of side `side`.
-  GlideLattice(double expected, double x, double y, double side) {
+  [[gnu::always_inline]] GlideLattice(double expected, double x, double y, double side) {
     // √2 · its spacing = 2^L · m, m in [1, 2): L and the coarser lattice's weight m − 1 (a piecewise linear
     // log₂, continuous and increasing) straight from the bits, without a library call.
     const double u = side * std::sqrt(2.0 / std::max(expected, 1.0));
     std::uint64_t bits;
     std::memcpy(&bits, &u, sizeof bits);
     // L within a normal double's exponents (a spacing never nears either end; this keeps the bits valid).
-    const std::uint64_t exponent = std::clamp<std::uint64_t>((bits >> 52) & 0x7ff, 1, 2045);
+    const std::uint64_t biased = (bits >> 52) & 0x7ff;  // selects, not branches: glide_runs.cpp vectorises
+    const std::uint64_t exponent = biased < 1 ? 1 : biased > 2045 ? 2045 : biased;
     const std::uint64_t one = (bits & ~(std::uint64_t(0x7ff) << 52)) | (std::uint64_t(1023) << 52);
     double m;
     std::memcpy(&m, &one, sizeof m);
@@ -34,16 +35,19 @@ struct GlideLattice {
     fine_x = ix * h, fine_y = iy * h;
     coarse_x = floor(ix * 0.5) * (2 * h), coarse_y = floor(iy * 0.5) * (2 * h);
   }
-  static double power_of_two(int e) {  // 2^e, -1022 <= e <= 1023
+  [[gnu::always_inline]] static double power_of_two(int e) {  // 2^e, -1022 <= e <= 1023
     const std::uint64_t bits = std::uint64_t(e + 1023) << 52;
     double v;
     std::memcpy(&v, &bits, sizeof v);
     return v;
   }
-  static double floor(double v) {                        // std::floor, which is a library call without SSE4.1
-    if (!(std::fabs(v) < 4503599627370496.0)) return v;  // 2^52 and above (and NaN): whole already
-    const double t = static_cast<double>(static_cast<std::int64_t>(v));
-    return t > v ? t - 1 : t;
+  /// std::floor (but +0 for −0), which is a library call without SSE4.1; without branches or integer
+  /// conversions, so that loops over many points vectorise (glide_runs.cpp). Below 2^52, adding and taking
+  /// away 2^52 (of v's sign) rounds v to an integer exactly; 2^52 and above (and NaN) are whole already.
+  [[gnu::always_inline]] static double floor(double v) {
+    const double big = std::copysign(4503599627370496.0, v), r = (v + big) - big;
+    const double below = r > v ? r - 1 : r;
+    return std::fabs(v) < 4503599627370496.0 ? below : v;
   }
   void corner(int k, double& x, double& y) const {
     const double s = k < 4 ? h : 2 * h;

@@ -15,6 +15,18 @@ struct BlockTexels {
   double ax[kImageBlock], ay[kImageBlock];
 };
 
+/// Texel k of a block: ImageSampler::texels at world (px, py), its transform and limits passed in.
+[[gnu::always_inline]] inline void texels_at(double px, double py, double x0, double y0, double sx, double sy,
+                                             double last_x, double last_y, int w, int wmax, int hmax,
+                                             BlockTexels& __restrict t, std::size_t k) {
+  double fx = (px - x0) * sx - 0.5, fy = (py - y0) * sy - 0.5;
+  fx = std::min(std::max(0.0, fx), last_x), fy = std::min(std::max(0.0, fy), last_y);  // ImageSampler's
+  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+  const int jx = std::min(ix + 1, wmax), jy = std::min(iy + 1, hmax);
+  t.i00[k] = iy * w + ix, t.i01[k] = iy * w + jx, t.i10[k] = jy * w + ix, t.i11[k] = jy * w + jx;
+  t.ax[k] = fx - ix, t.ay[k] = fy - iy;
+}
+
 [[gnu::always_inline]] inline void block_texels(const TilePoint* __restrict from, std::size_t count,
                                                 double wx, double wy, double S, const ImageSampler& sampler,
                                                 double* __restrict x, double* __restrict y,
@@ -26,14 +38,21 @@ struct BlockTexels {
   for (std::size_t k = 0; k < count; ++k) {
     const double px = wx + ((from[k].x + 0.5) * (1.0 / 65536.0)) * S;  // TilePoint::unit_x
     const double py = wy + ((from[k].y + 0.5) * (1.0 / 65536.0)) * S;
-    double fx = (px - x0) * sx - 0.5, fy = (py - y0) * sy - 0.5;
-    fx = std::min(std::max(0.0, fx), last_x), fy = std::min(std::max(0.0, fy), last_y);  // ImageSampler's
-    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
-    const int jx = std::min(ix + 1, wmax), jy = std::min(iy + 1, hmax);
     x[k] = px, y[k] = py;
-    t.i00[k] = iy * w + ix, t.i01[k] = iy * w + jx, t.i10[k] = jy * w + ix, t.i11[k] = jy * w + jx;
-    t.ax[k] = fx - ix, t.ay[k] = fy - iy;
+    texels_at(px, py, x0, y0, sx, sy, last_x, last_y, w, wmax, hmax, t, k);
   }
+}
+
+/// The same at world positions (x[k], y[k]).
+[[gnu::always_inline]] inline void block_texels_at(const double* __restrict x, const double* __restrict y,
+                                                   std::size_t count, const ImageSampler& sampler,
+                                                   BlockTexels& __restrict t) {
+  const DensityImageView& image = *sampler.image;
+  const double x0 = image.x0, y0 = image.y0, sx = sampler.sx, sy = sampler.sy;
+  const double last_x = image.width - 1.0, last_y = image.height - 1.0;
+  const int w = image.width, wmax = image.width - 1, hmax = image.height - 1;
+  for (std::size_t k = 0; k < count; ++k)
+    texels_at(x[k], y[k], x0, y0, sx, sy, last_x, last_y, w, wmax, hmax, t, k);
 }
 
 /// ImageSampler::blend of `values` at the block's texels, k < count.
@@ -50,6 +69,14 @@ KDM_RUN_CLONES void image_run(const TilePoint* from, std::size_t count, double w
                               const ImageSampler& sampler, double* x, double* y, double* rho) {
   BlockTexels t;
   block_texels(from, count, wx, wy, S, sampler, x, y, t);
+  const float* values = sampler.image->values;
+  for (std::size_t k = 0; k < count; ++k) rho[k] = blend(values, t, k);
+}
+
+KDM_RUN_CLONES void image_read_run(const double* x, const double* y, std::size_t count,
+                                   const ImageSampler& sampler, double* rho) {
+  BlockTexels t;
+  block_texels_at(x, y, count, sampler, t);
   const float* values = sampler.image->values;
   for (std::size_t k = 0; k < count; ++k) rho[k] = blend(values, t, k);
 }

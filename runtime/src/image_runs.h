@@ -25,6 +25,11 @@ inline bool image_runs_fit(const DensityImageView& image) {
 void image_run(const TilePoint* from, std::size_t count, double wx, double wy, double S,
                const ImageSampler& sampler, double* x, double* y, double* rho);
 
+/// The density of `sampler`'s image at world positions (x[k], y[k]), k < count ≤ kImageBlock, into rho[k],
+/// as sampler.at reads it.
+void image_read_run(const double* x, const double* y, std::size_t count, const ImageSampler& sampler,
+                    double* rho);
+
 /// The same for `images` images on `sampler`'s grid of texels (ImageSampler::same_grid), values[i] the
 /// i-th one's: their running sums into sums[i · kImageBlock + k] (image 0's value, then plus image 1's,
 /// …), as sampler.texels and ImageSampler::blend add them up one by one.

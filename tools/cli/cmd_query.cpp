@@ -215,7 +215,7 @@ void add_query_command(CLI::App& app) {
   cmd->add_flag("--glide-together", a->glide_together,
                 "Smooth mode with a varying density: each point glides by the most density around it, so "
                 "neighbours do not close up where the density changes from dot to dot (pictures, textures); "
-                "several times slower");
+                "about twice as slow");
   cmd->add_flag("--normalised", a->normalised,
                 ".csv/.json coordinates in [0, 1) of --rect instead of world units");
   cmd->add_option(

@@ -115,9 +115,10 @@ struct QueryParams {
   /// Smooth mode with a varying density: each point glides by the most density around it (at the corners
   /// of lattice cells about its spacing wide) rather than by its own alone, so that neighbours glide
   /// together and do not close up where the density changes from one dot to the next (a photograph, a
-  /// texture). The same points are emitted; only where they glide changes. Costs about 8 density reads per
-  /// emitted point: a varying-density smooth query takes several times as long. Use it for pictures and
-  /// sample patterns; ignored in stable mode and with a constant density.
+  /// texture). The same points are emitted; only where they glide changes. Costs 8 density reads per
+  /// emitted point: a varying-density smooth query takes about twice as long. Use it for pictures and
+  /// sample patterns; ignored in stable mode, with a constant density and past the tile set's top level
+  /// (where points glide by their own density).
   bool glide_together = false;
 };
 

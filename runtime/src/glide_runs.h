@@ -1,0 +1,26 @@
+// Internal: glide_count.h's counts for a block of points at once (emit_tile.h), in loops the compiler
+// vectorises (run_clones.h), bit for bit as glide_count computes one point's.
+#pragma once
+
+#include <cstddef>
+
+#include "glide_count.h"
+
+namespace kdm::detail {
+
+/// Most points one block holds: their corners, 8 a point, fill one batch callback's call (kDensityBatch).
+inline constexpr std::size_t kGlideBlock = 16;
+
+/// The corners of points k < count ≤ kGlideBlock (expected count expected[k] at stable position (x[k],
+/// y[k]) in a tile of side `side`): corner c of point k (GlideLattice::corner) at (cx[c · count + k],
+/// cy[c · count + k]), so that the 8 · count positions are contiguous; the coarser lattice's weight into
+/// coarse[k].
+void glide_corners_run(const double* expected, const double* x, const double* y, std::size_t count,
+                       double side, double* cx, double* cy, double* coarse);
+
+/// Their glide counts into out[k]: glide_count's, from the density at corner c of point k in
+/// value[c · count + k], `area` the count per unit of density.
+void glide_counts_run(const double* expected, const double* coarse, const double* value, std::size_t count,
+                      double area, double* out);
+
+}  // namespace kdm::detail
