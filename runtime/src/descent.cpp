@@ -76,7 +76,8 @@ class Descent {
         capacity_(capacity),
         n_(written),
         budget_(budget),
-        ahead_(ahead) {}
+        ahead_(ahead),
+        together_(q.params->glide_together && q.params->density.kind != QueryDensity::Kind::kConstant) {}
 
   bool run(std::int64_t tx, std::int64_t ty, std::size_t index, DescentPlace& at) {
     Node& root = stack_[0];
@@ -147,14 +148,14 @@ class Descent {
   /// A sub-point of tile `n`: its subtile's coordinates and type, its stable position and the expected
   /// count of its subtile there.
   struct SubPoint {
-    std::uint32_t cx, cy, rank;
+    std::uint32_t cx, cy, rank, depth;
     std::size_t type;
     double x, y, expected;
   };
   SubPoint sub_point(const Node& n, std::uint32_t cx, std::uint32_t cy, std::uint32_t rank) {
-    SubPoint s{cx, cy, rank, t_.child_type[n.type * m_ * m_ + cy * m_ + cx], 0, 0, 0};
-    const TilePoint& p = set_.tiles[s.type].points[rank];
     const std::uint32_t d = n.depth + 1;
+    SubPoint s{cx, cy, rank, d, t_.child_type[n.type * m_ * m_ + cy * m_ + cx], 0, 0, 0};
+    const TilePoint& p = set_.tiles[s.type].points[rank];
     // As the subtile computes its own points' positions (run, emit): the same bits.
     const double wx = double(n.gx * m_ + cx) * q_.side[d], wy = double(n.gy * m_ + cy) * q_.side[d];
     s.x = wx + p.unit_x() * q_.side[d], s.y = wy + p.unit_y() * q_.side[d];
@@ -162,18 +163,25 @@ class Descent {
     return s;
   }
   /// Where sub-point s lies when its subtile's count at it is `count` (at least K_h), in its parent's unit
-  /// coordinates: as the subtile places it once it owns it.
-  void glided(const SubPoint& s, double count, double& ux, double& uy) const {
+  /// coordinates: as the subtile places it once it owns it (gliding together too, as visit does).
+  void glided(const SubPoint& s, double count, double& ux, double& uy) {
     const TilePoint& p = set_.tiles[s.type].points[s.rank];
     const std::int8_t* glide = set_.tiles[s.type].glide.data();
     const std::uint32_t* start = t_.glide_start[s.type].data();
-    const GlideBracket g(q_.keyframes, std::max(count, q_.kh));
+    const GlideBracket g(q_.keyframes, placing_count(std::max(count, q_.kh), s.x, s.y, s.depth));
     const std::int8_t *o0 = glide + 2 * (std::size_t(start[g.g0]) + s.rank),
                       *o1 = glide + 2 * (std::size_t(start[g.g1]) + s.rank);
     const double dx = double(o0[0]) * g.w0 + double(o1[0]) * g.w1,
                  dy = double(o0[1]) * g.w0 + double(o1[1]) * g.w1;
     ux = (s.cx + p.unit_x() + dx * (1.0 / 65536.0)) / m_,
     uy = (s.cy + p.unit_y() + dy * (1.0 / 65536.0)) / m_;
+  }
+  /// The count a point of expected count `count` at stable world position (x, y) in a tile at depth `depth`
+  /// glides by: its own, or with a varying density and glide_together, glide_count.h's.
+  double placing_count(double count, double x, double y, std::uint32_t depth) {
+    if (!together_) return count;
+    return glide_count(count, x, y, q_.side[depth], q_.area[depth],
+                       [&](double u, double v) { return read(u, v); });
   }
   /// Where sub-point s lies at its subtile's keyframe h, in its parent's unit coordinates.
   void keyframe_one(const SubPoint& s, double& ux, double& uy) const {
@@ -323,12 +331,9 @@ class Descent {
       glided(s, std::min(s.expected, expected / (double(m_) * m_)), bx, by);
       return write_unit(n, ax + f * (bx - ax), ay + f * (by - ay), id_of(k, r));
     }
-    // At depth 0 a varying density's points glide as query.cpp's do (glide_together: glide_count.h); past
-    // the top level by their own counts, which the hand-over's sub-points continue.
-    const double placed =
-        !L.constant && n.depth == 0 && q_.params->glide_together
-            ? glide_count(expected, xs, ys, side, area, [&](double x, double y) { return read(x, y); })
-            : expected;
+    // A varying density's points glide as query.cpp's do, at every depth (glide_together: glide_count.h);
+    // a handed-over point's sub-point is placed by the same count (glided), so it does not jump.
+    const double placed = L.constant ? expected : placing_count(expected, xs, ys, n.depth);
     const GlideBracket g =
         L.constant && r >= inherited ? L.constant_bracket : GlideBracket(q_.keyframes, placed);
     const std::int8_t* o0 = tile.glide.data() + 2 * (std::size_t(L.start[g.g0]) + r);
@@ -533,18 +538,25 @@ class Descent {
       if (s.expected > q_.kh) return true;  // its subtile took it over (share: it appears on its own)
       const double threshold = q_.top + (a + 0.5) / listed * (q_.appearing_end - q_.top);
       if (!(read(s.x, s.y) * area > threshold)) return true;
+      // At its keyframe h, where its subtile places it once it owns it: gliding together, by the count
+      // that lifts it there (glided), so that it does not jump when taken over.
       double ux, uy;
-      keyframe_one(s, ux, uy);
+      if (together_)
+        glided(s, q_.kh, ux, uy);
+      else
+        keyframe_one(s, ux, uy);
       return write_unit(n, ux, uy, PointId{n.gx * m_ + s.cx, n.gy * m_ + s.cy, s.rank, n.depth + 1});
     };
     read_to = seq > count ? seq - count : 0;
     for (std::uint32_t a = read_to; a < listed; ++a) {
       if (budget_ == 0) return count + a;
       --budget_;
-      if (ahead_ && a == read_to)  // two values: at the sub-point and where it appears
-        read_to = read_ahead(a, listed, 2, [&](std::uint32_t from, std::uint32_t to) {
-          for (std::uint32_t i = from; i < to; ++i) dry_item_ = i, missed_ = false, appear(i);
-        });
+      if (ahead_ && a == read_to)  // two values, at the sub-point and where it appears, and its glide count's
+        read_to = read_ahead(a, listed, 2 + (together_ ? GlideLattice::kCorners : 0),
+                             [&](std::uint32_t from, std::uint32_t to) {
+                               for (std::uint32_t i = from; i < to; ++i)
+                                 dry_item_ = i, missed_ = false, appear(i);
+                             });
       if (!appear(a)) return count + a;
     }
     return kDone;
@@ -559,6 +571,7 @@ class Descent {
   std::size_t& n_;
   std::uint64_t& budget_;
   ReadAhead* const ahead_;  // set for a batch callback
+  const bool together_;     // points glide together (glide_count.h)
   bool dry_ = false;        // a run that only finds the values to read ahead
   bool missed_ = false;     // the candidate a dry run is at stopped at a value not yet read
   std::uint32_t dry_item_ = 0, overflow_item_ = 0;  // the item a dry run is at; the first the table refused

@@ -187,41 +187,39 @@ std::uint32_t emit_tile(const TileJob& job, std::uint32_t c, std::uint32_t end, 
   // The expected count each pending point glides by: its own, or glide_count.h's (glide_together), a block
   // of points at a time (glide_runs.h): their corners in one vectorised loop, read in one batch callback's
   // call or the image's vectorised reads, and their counts in another loop.
-  auto glide_counts = [&](double* count) {
+  auto counts_to_glide_by = [&](double* count) {
     if (!j.glide_together) {
       std::copy(pending_expected, pending_expected + pending, count);
       return;
     }
-    constexpr std::size_t kReads = GlideLattice::kCorners * kGlideBlock;
-    static_assert(kReads <= kDensityBatch, "a block's corners in one batch call");
-    double cx[kReads], cy[kReads], value[kReads], coarse[kGlideBlock];
-    for (std::size_t b = 0; b < std::size_t(pending); b += kGlideBlock) {
-      const std::size_t m = std::min(kGlideBlock, std::size_t(pending) - b),
-                        reads = GlideLattice::kCorners * m;
-      glide_corners_run(pending_expected + b, pending_x + b, pending_y + b, m, j.S, cx, cy, coarse);
-      if constexpr (kKind == QueryDensity::Kind::kImage) {
-        if (image_runs_fit(*j.sampler->image))
-          for (std::size_t r = 0; r < reads; r += kImageBlock)
-            image_read_run(cx + r, cy + r, std::min<std::size_t>(kImageBlock, reads - r), *j.sampler,
-                           value + r);
-        else
-          for (std::size_t r = 0; r < reads; ++r) value[r] = j.sampler->at(cx[r], cy[r]);
-      } else {
-        if (batch_reads)
-          j.density->batch_callback(j.density->user, reads, cx, cy, value);
-        else
-          for (std::size_t r = 0; r < reads; ++r)
-            value[r] = j.density->callback(j.density->user, cx[r], cy[r]);
-        for (std::size_t r = 0; r < reads; ++r) value[r] = density_or_zero(value[r]);
-      }
-      glide_counts_run(pending_expected + b, coarse, value, m, j.area_scale, count + b);
-    }
+    static_assert(GlideLattice::kCorners * kGlideBlock <= kDensityBatch,
+                  "a block's corners in one batch call");
+    glide_counts(
+        pending_expected, pending_x, pending_y, std::size_t(pending), j.S, j.area_scale,
+        [&](std::size_t reads, const double* cx, const double* cy, double* value) {
+          if constexpr (kKind == QueryDensity::Kind::kImage) {
+            if (image_runs_fit(*j.sampler->image))
+              for (std::size_t r = 0; r < reads; r += kImageBlock)
+                image_read_run(cx + r, cy + r, std::min<std::size_t>(kImageBlock, reads - r), *j.sampler,
+                               value + r);
+            else
+              for (std::size_t r = 0; r < reads; ++r) value[r] = j.sampler->at(cx[r], cy[r]);
+          } else {
+            if (batch_reads)
+              j.density->batch_callback(j.density->user, reads, cx, cy, value);
+            else
+              for (std::size_t r = 0; r < reads; ++r)
+                value[r] = j.density->callback(j.density->user, cx[r], cy[r]);
+            for (std::size_t r = 0; r < reads; ++r) value[r] = density_or_zero(value[r]);
+          }
+        },
+        count);
   };
   auto flush = [&]() -> std::uint32_t {  // the rank that did not fit, or kNone
     // Two passes, each short enough for the processor to overlap many points' latency chains.
     const std::int8_t *o0[kBatch], *o1[kBatch];
     double w0[kBatch], w1[kBatch], count[kBatch];
-    glide_counts(count);
+    counts_to_glide_by(count);
     for (int i = 0; i < pending; ++i) {
       const GlideBracket b(j.keyframes, count[i]);
       o0[i] = j.glide + 2 * (std::size_t(j.starts[b.g0]) + pending_rank[i]);

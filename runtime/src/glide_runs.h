@@ -1,7 +1,8 @@
-// Internal: glide_count.h's counts for a block of points at once (emit_tile.h), in loops the compiler
-// vectorises (run_clones.h), bit for bit as glide_count computes one point's.
+// Internal: glide_count.h's counts for a block of points at once (emit_tile.h, subtile_loops.h), in loops
+// the compiler vectorises (run_clones.h), bit for bit as glide_count computes one point's.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 
 #include "glide_count.h"
@@ -22,5 +23,21 @@ void glide_corners_run(const double* expected, const double* x, const double* y,
 /// value[c · count + k], `area` the count per unit of density.
 void glide_counts_run(const double* expected, const double* coarse, const double* value, std::size_t count,
                       double area, double* out);
+
+/// The glide counts of points i < count (expected count expected[i] at stable position (x[i], y[i]) in a
+/// tile of side `side`, `area` the count per unit of density) into out[i], a block at a time:
+/// read(n, x, y, value) puts the density at n ≤ 8 · kGlideBlock positions into value (each ≥ 0, finite).
+template <class Read>
+void glide_counts(const double* expected, const double* x, const double* y, std::size_t count, double side,
+                  double area, Read&& read, double* out) {
+  constexpr std::size_t kReads = GlideLattice::kCorners * kGlideBlock;
+  double cx[kReads], cy[kReads], value[kReads], coarse[kGlideBlock];
+  for (std::size_t b = 0; b < count; b += kGlideBlock) {
+    const std::size_t m = std::min(kGlideBlock, count - b);
+    glide_corners_run(expected + b, x + b, y + b, m, side, cx, cy, coarse);
+    read(GlideLattice::kCorners * m, cx, cy, value);
+    glide_counts_run(expected + b, coarse, value, m, area, out + b);
+  }
+}
 
 }  // namespace kdm::detail

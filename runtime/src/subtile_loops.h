@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "descent.h"
+#include "glide_runs.h"
 #include "signed_byte_table.h"
 
 namespace kdm::detail {
@@ -263,9 +264,27 @@ std::uint32_t emit_varying(const DescentQuery& q, const DescentNode& n, DescentS
   std::uint32_t rank[kBatch];
   double count[kBatch];
   int pending = 0;
-  auto flush = [&]() -> std::uint32_t {  // kDescentDone, or the rank that did not fit
+  const bool together = p.glide_together;  // a varying density: glide_count.h, as emit_tile.h does
+  auto flush = [&]() -> std::uint32_t {    // kDescentDone, or the rank that did not fit
     const std::int8_t *o0[kBatch], *o1[kBatch];
     double w0[kBatch], w1[kBatch];
+    if (together && pending > 0) {
+      double sx[kBatch], sy[kBatch], own[kBatch];
+      std::copy(count, count + pending, own);
+      for (int i = 0; i < pending; ++i)
+        sx[i] = wx + points[rank[i]].unit_x() * s, sy[i] = wy + points[rank[i]].unit_y() * s;
+      glide_counts(
+          own, sx, sy, std::size_t(pending), s, area,
+          [&](std::size_t reads, const double* cx, const double* cy, double* value) {
+            if constexpr (kBatchReads) {
+              read_many(reads, cx, cy, value);
+              for (std::size_t r = 0; r < reads; ++r) value[r] = density_or_zero(value[r]);
+            } else {
+              for (std::size_t r = 0; r < reads; ++r) value[r] = density_at(cx[r], cy[r]);
+            }
+          },
+          count);
+    }
     for (int i = 0; i < pending; ++i) {
       const GlideBracket g(q.keyframes, count[i]);
       o0[i] = glide + 2 * (std::size_t(start[g.g0]) + rank[i]);

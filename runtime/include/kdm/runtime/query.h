@@ -117,8 +117,7 @@ struct QueryParams {
   /// together and do not close up where the density changes from one dot to the next (a photograph, a
   /// texture). The same points are emitted; only where they glide changes. Costs 8 density reads per
   /// emitted point: a varying-density smooth query takes about twice as long. Use it for pictures and
-  /// sample patterns; ignored in stable mode, with a constant density and past the tile set's top level
-  /// (where points glide by their own density).
+  /// sample patterns; ignored in stable mode and with a constant density.
   bool glide_together = false;
 };
 
