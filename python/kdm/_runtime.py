@@ -152,7 +152,8 @@ class Tileset:
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
             GIL held; an exception it raises is raised here once the query ends, and a value that is
             not finite and >= 0 raises ValueError), which needs `density_max`, a true upper bound of
-            its values (a larger value counts as density_max: too few points there). Default: 1.
+            its values (a larger one raises ValueError; smooth mode also reads up to a glide's reach
+            outside `rect`). Default: 1.
         vectorized : bool
             For a callable density: True if f takes arrays, f(x, y) -> array of the same length (x and y
             float64 arrays of up to 128 positions, a tile's candidates at a time; scipy's `vectorized`).

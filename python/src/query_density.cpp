@@ -16,12 +16,18 @@ std::string number(double v) {
   return text;
 }
 
-/// A density value from Python: the C++ query counts a bad one as 0; from Python it is a bug in the
-/// callable, said so.
-double checked_value(double v, double x, double y) {
+/// A density value from Python: the C++ query counts a bad one as 0 and one above its bound as the bound
+/// (too few points there); from Python either is a bug in the callable or its density_max, said so. A
+/// value within rounding of the bound (10^-9 of it) passes: a maximum computed another way may differ so.
+double checked_value(double v, double x, double y, double max_value) {
   if (!(v >= 0 && v < std::numeric_limits<double>::infinity()))
     throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
                             number(y) + "): a density must be finite and >= 0");
+  if (v > max_value * (1 + 1e-9))
+    throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
+                            number(y) + "), above density_max " + number(max_value) +
+                            ": density_max must bound every value (smooth mode also reads up to a glide's "
+                            "reach outside the rect)");
   return v;
 }
 
@@ -32,7 +38,8 @@ double checked_value(double v, double x, double y) {
 }
 
 /// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all.
-void read_values(const py::object& value, std::size_t n, const double* x, const double* y, double* out) {
+void read_values(const py::object& value, std::size_t n, const double* x, const double* y, double max_value,
+                 double* out) {
   using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
   // Cast to double, None would become NaN and a complex number lose its imaginary part.
   if (value.is_none()) not_numbers(value, "an array of numbers");
@@ -48,7 +55,7 @@ void read_values(const py::object& value, std::size_t n, const double* x, const 
                                 std::to_string(n) + " positions: it must return one value per position");
   }
   const double* values = v.data();
-  for (std::size_t i = 0; i < n; ++i) out[i] = checked_value(values[one ? 0 : i], x[i], y[i]);
+  for (std::size_t i = 0; i < n; ++i) out[i] = checked_value(values[one ? 0 : i], x[i], y[i], max_value);
 }
 
 /// Runs `call` (which talks to Python) with the GIL held, unless an earlier call failed: true if it
@@ -90,7 +97,7 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
       const bool read = guarded(d, [&] {
         const py::array_t<double> xs(py::ssize_t(n), x),
             ys(py::ssize_t(n), y);  // copies the callable may keep
-        read_values(d.function(xs, ys), n, x, y, out);
+        read_values(d.function(xs, ys), n, x, y, d.density.callback_max, out);
       });
       if (!read) std::fill(out, out + n, 0.0);
     };
@@ -106,7 +113,7 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
           PyErr_Clear();
           not_numbers(value, "a number");
         }
-        v = checked_value(got, x, y);
+        v = checked_value(got, x, y, d.density.callback_max);
       });
       return v;
     };

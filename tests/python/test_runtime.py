@@ -161,6 +161,30 @@ def test_a_callable_density_that_returns_no_density_is_an_error(bad):
         BUILTIN.positions((0, 0, 2, 2), scale=100, density=f, density_max=1)
 
 
+def test_a_callable_density_above_its_density_max_is_an_error():
+    # The C++ query would count 1.5 as the bound 1 (too few points there, silently): said where. Smooth
+    # mode reads beyond the rect too, so a value above the bound just outside it is found as well.
+    def f(x, y):
+        return 1.5 if x > 1.0 else 1.0
+    with pytest.raises(ValueError, match=r"returned 1\.5 at \(1\.\d+, .*above density_max 1:"):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=f, density_max=1)
+    with pytest.raises(ValueError, match="above density_max 1:"):
+        BUILTIN.positions((0, 0, 2, 2), scale=100, density=f, density_max=1, mode="smooth")
+    with pytest.raises(ValueError, match="above density_max 1:"):
+        BUILTIN.query((0, 0, 1, 1), scale=100, density=lambda x, y: np.where(x > 0.5, 2.0, 1.0), density_max=1,
+                      vectorized=True)
+    with pytest.raises(ValueError, match="above density_max 0.5:"):
+        BUILTIN.query((0, 0, 1, 1), scale=100, classes=[lambda x, y: 0.2, lambda x, y: 0.7],
+                      density_max=[1, 0.5])
+    with pytest.raises(ValueError, match="above density_max 1:"):
+        BUILTIN.query((0, 0, 0.98, 0.5), scale=1000, density=lambda x, y: 1.0 if x < 1 else 3.0, density_max=1,
+                      mode="smooth")
+    # Rounding above the bound passes: a maximum computed another way may differ in its last bits.
+    top = 1 + 1e-12
+    assert same(BUILTIN.query((0, 0, 1, 1), scale=100, density=lambda x, y: top, density_max=1),
+                BUILTIN.query((0, 0, 1, 1), scale=100, density=lambda x, y: 1.0, density_max=1))
+
+
 def test_positions_refuse_an_origin_where_floats_lose_the_tiles():
     # float32 positions 10^20 from the origin would all be the same number: refused, not returned.
     with pytest.raises(ValueError, match="origin_x"):
@@ -424,19 +448,20 @@ def test_callable_classes(mode):
     def ramp(x, y):
         return 0.5 + 0.5 * x
     image = np.full((4, 6), 0.75)
-    r = BUILTIN.query(rect, scale=150, classes=[ramp, 1.0, image], density_max=[2.0, None, None], mode=mode)
+    # The ramp's bound holds a little past the rect too, where smooth mode also reads (x < 4).
+    r = BUILTIN.query(rect, scale=150, classes=[ramp, 1.0, image], density_max=[2.5, None, None], mode=mode)
     assert len(r) > 1000 and set(np.unique(r.classes)) == {0, 1, 2}
-    union = BUILTIN.query(rect, scale=150, density=lambda x, y: ramp(x, y) + 1.0 + 0.75, density_max=3.75,
+    union = BUILTIN.query(rect, scale=150, density=lambda x, y: ramp(x, y) + 1.0 + 0.75, density_max=4.25,
                           mode=mode)
     assert same(r, union)
     if mode == "stable":
         zero = r.classes == 0
-        alone = BUILTIN.query(rect, scale=150, density=ramp, density_max=2.0)
+        alone = BUILTIN.query(rect, scale=150, density=ramp, density_max=2.5)
         assert same((r.xy[zero], r.tile[zero], r.rank[zero]), (alone.xy, alone.tile, alone.rank))
     constants = BUILTIN.query(rect, scale=150, classes=[1.0, 2.0], mode=mode)
     called = BUILTIN.query(rect, scale=150, classes=[lambda x, y: 1.0, 2.0], density_max=1.0, mode=mode)
     assert same(called, constants) and np.array_equal(called.classes, constants.classes)
-    xy, labels = BUILTIN.positions(rect, scale=150, classes=[ramp, 1.0, image], density_max=2.0, mode=mode)
+    xy, labels = BUILTIN.positions(rect, scale=150, classes=[ramp, 1.0, image], density_max=2.5, mode=mode)
     assert np.array_equal(labels, r.classes) and np.array_equal(xy, r.xy.astype(np.float32))
 
 
@@ -489,7 +514,7 @@ def test_image_classes_give_the_same_points_in_chunks(mode, side):
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
 def test_vectorized_classes(mode):
     # Callable classes on arrays: the points and classes of the same functions called point by point, in
-    # calls of many positions (measured 104-107 on average below the top level, 42 at 1.2-2.3 times it),
+    # calls of many positions (measured 115 on average below the top level, 50 at 1.2-2.3 times it),
     # with a constant class that lets the union's bounds emit points unread, classed afterwards.
     def ramp(x, y):
         return 0.5 + 0.5 * x
@@ -505,7 +530,7 @@ def test_vectorized_classes(mode):
                 sizes.append(len(x))
                 return f(x, y)
             return g
-        kwargs = dict(scale=scale, density_max=[1.0, None, 1.0], mode=mode)
+        kwargs = dict(scale=scale, density_max=[2.5, None, 1.0], mode=mode)  # the ramp's, past the rect too
         scalar = BUILTIN.query(rect, classes=[ramp, 0.5, bump], **kwargs)
         batched = BUILTIN.query(rect, classes=[counted(ramp), 0.5, counted(bump)], vectorized=True, **kwargs)
         assert len(scalar) > 3000 and set(np.unique(scalar.classes)) == {0, 1, 2}
@@ -661,16 +686,16 @@ def test_positions_refuse_bad_arguments():
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
 def test_density_bounds_keep_the_points_and_save_calls(mode):
     ramp, bounds, calls = counted_ramp(0.1)
-    rect = (0.0, 0.0, 8.0, 1.0)
-    plain = BUILTIN.query(rect, scale=600, density=ramp, density_max=1.0, mode=mode)
+    rect = (0.0, 0.0, 8.0, 1.0)  # the ramp reaches 1 at x = 8, and a little more where smooth mode reads past it
+    plain = BUILTIN.query(rect, scale=600, density=ramp, density_max=1.1, mode=mode)
     everywhere, calls[0] = calls[0], 0
-    bounded = BUILTIN.query(rect, scale=600, density=ramp, density_max=1.0, density_bounds=bounds, mode=mode)
+    bounded = BUILTIN.query(rect, scale=600, density=ramp, density_max=1.1, density_bounds=bounds, mode=mode)
     assert len(plain) > 2000 and same(plain, bounded)
-    # Stable mode calls the density only between a tile's bounds (measured: 0.10 of the calls),
-    # smooth mode only below the upper bound (0.48).
+    # Stable mode calls the density only between a tile's bounds and its cells' (measured: 0.02 of the
+    # calls), smooth mode only below the upper bound (0.46).
     assert calls[0] < (0.3 if mode == "stable" else 0.7) * everywhere
-    xy = BUILTIN.positions(rect, scale=600, density=ramp, density_max=1.0, density_bounds=bounds, mode=mode)
-    assert np.array_equal(xy, BUILTIN.positions(rect, scale=600, density=ramp, density_max=1.0, mode=mode))
+    xy = BUILTIN.positions(rect, scale=600, density=ramp, density_max=1.1, density_bounds=bounds, mode=mode)
+    assert np.array_equal(xy, BUILTIN.positions(rect, scale=600, density=ramp, density_max=1.1, mode=mode))
 
 
 def test_density_bounds_refuse_bad_use_and_pass_errors_on():
