@@ -12,9 +12,17 @@
 // the tone is fixed (also relative to its target D × darkness), and the largest motion of a dot over the
 // surface since the previous frame, in its spacing along the way it moved (near the silhouette apart). With
 // --check it exits non-zero if the relative density of the last frame differs from the first's by more than
-// 10% or a dot away from the silhouette moves half a spacing or more in one frame.
+// 10% or a dot away from the silhouette moves half a spacing or more in one frame (or, with --colours, an
+// ink's dots on screen are more than 10% off D × its cover in a frame where it expects 100 or more).
 //
-//   texture_stipple [--tileset FILE] [--frames K] [--size PIXELS] [--dots-per-pixel-area D] [--check] -o DIR
+// With --colours the checker is orange and blue, and the dots are cyan, magenta, yellow and black: four
+// classes of one query (kdm::query_classes), whose densities one joint callback gives from the shaded
+// colour (CMYK with full under-colour removal), so the inks together are one blue-noise set and each
+// follows its share of the colour.
+//
+//   texture_stipple [--tileset FILE] [--frames K] [--size PIXELS] [--dots-per-pixel-area D] [--colours]
+//                   [--check] -o DIR
+#include <kdm/runtime/class_query.h>
 #include <kdm/runtime/query.h>
 #include <kdm/runtime/tileset.h>
 
@@ -57,10 +65,38 @@ Vec surface(double u, double v) {  // the point of the unit sphere at (u, v), al
   const double c = 1 / std::cosh(v);
   return {c * std::cos(u), c * std::sin(u), std::tanh(v)};
 }
-double tone(double u, double v, Vec normal) {  // texture × Lambert shading, 0 black … 1 white
-  const bool light =
-      ((static_cast<long>(std::floor(u / kChecker)) + static_cast<long>(std::floor(v / kChecker))) & 1) == 0;
-  return (light ? 0.8 : 0.4) * (0.1 + 0.9 * std::max(0.0, dot(normal, kLight)));
+bool light_square(double u, double v) {
+  return ((static_cast<long>(std::floor(u / kChecker)) + static_cast<long>(std::floor(v / kChecker))) & 1) ==
+         0;
+}
+double shading(Vec normal) {  // Lambert's, and some ambient light
+  return 0.1 + 0.9 * std::max(0.0, dot(normal, kLight));
+}
+double tone(double u, double v, Vec normal) {  // texture × shading, 0 black … 1 white
+  return (light_square(u, v) ? 0.8 : 0.4) * shading(normal);
+}
+
+// --colours: the checker's colours, shaded, as the cover of each ink (0 … 1) in class order. Full
+// under-colour removal: black takes the grey all three channels share, and at most two of cyan, magenta
+// and yellow remain. The order is the classes' (class 0 first): the inks by their share of the dots,
+// least first (magenta .20, yellow .24, cyan .24, black .33, averaged over the frames), as `kdm stipple
+// --colours` orders them, so that a small share is not left the count errors of the sums before it.
+constexpr int kInks = 4;
+constexpr const char* kInkNames[kInks] = {"magenta", "yellow", "cyan", "black"};
+constexpr unsigned char kInkRgb[kInks][3] = {{255, 0, 255}, {255, 255, 0}, {0, 255, 255}, {0, 0, 0}};
+void ink_cover(double u, double v, Vec normal, double cover[kInks]) {
+  const double light = shading(normal);
+  const double r = (light_square(u, v) ? 0.95 : 0.20) * light, g = (light_square(u, v) ? 0.75 : 0.45) * light,
+               b = (light_square(u, v) ? 0.35 : 0.70) * light;
+  const double k = 1 - std::max({r, g, b}), rest = 1 - k;  // rest > 0: the shading is at least 0.1
+  cover[0] = (1 - g - k) / rest, cover[1] = (1 - b - k) / rest, cover[2] = (1 - r - k) / rest, cover[3] = k;
+}
+// The dot density's share at (u, v): darkness, or with colours every ink's cover together.
+double darkness(double u, double v, Vec normal, bool colours) {
+  if (!colours) return 1 - tone(u, v, normal);
+  double cover[kInks];
+  ink_cover(u, v, normal, cover);
+  return cover[0] + cover[1] + cover[2] + cover[3];
 }
 
 // A pinhole camera at distance `r` from the sphere's centre along `dir`, looking at the centre.
@@ -91,25 +127,42 @@ void texture_coords(Vec p, double& u, double& v) {
 
 struct Frame {
   Camera camera;
-  double dots = 0;  // D, dots per pixel area at full darkness
+  double dots = 0;  // D, dots per pixel area at full darkness (with colours: per ink, at full cover)
+  bool colours = false;
 };
 
-// Dots per unit texture area at (u, v): D × (screen area per unit texture area) × darkness. A surface
-// element dA at p, facing the eye by (eye − p)·n and at depth z, covers f² (eye − p)·n / z³ · dA pixels;
-// Mercator's dA is h² du dv, h = 1 / cosh v.
-double texture_density(void* user, double u, double v) {
-  const Frame& f = *static_cast<const Frame*>(user);
-  const Vec p = surface(u, v);
+// Dots per unit texture area at (u, v) and full darkness: D × (screen area per unit texture area). A
+// surface element dA at p, facing the eye by (eye − p)·n and at depth z, covers f² (eye − p)·n / z³ · dA
+// pixels; Mercator's dA is h² du dv, h = 1 / cosh v.
+double full_density(const Frame& f, double v, Vec p) {
   const double facing = dot(f.camera.eye - p, p);
   if (facing <= 0) return 0;  // the far side: no dots
   const double z = dot(p - f.camera.eye, f.camera.forward), h = 1 / std::cosh(v);
-  return f.dots * f.camera.focal * f.camera.focal * facing / (z * z * z) * h * h * (1 - tone(u, v, p));
+  return f.dots * f.camera.focal * f.camera.focal * facing / (z * z * z) * h * h;
 }
-// Its bound: with the eye at distance r, facing = eye·p − 1 ≤ r − 1 and z = r − p·dir ≥ r − 1, h ≤ 1 and
-// the darkness ≤ 1, so density ≤ D f² / (r − 1)², reached facing the eye on the equator in black.
-double texture_density_bound(const Frame& f) {
+// The dots' density: full_density × darkness (with colours, of all inks together).
+double texture_density(void* user, double u, double v) {
+  const Frame& f = *static_cast<const Frame*>(user);
+  const Vec p = surface(u, v);
+  return full_density(f, v, p) * darkness(u, v, p, f.colours);
+}
+// With colours, each ink's: full_density × its cover (a joint density: one call for the four classes).
+void ink_densities(void* user, double u, double v, double* values) {
+  const Frame& f = *static_cast<const Frame*>(user);
+  const Vec p = surface(u, v);
+  const double full = full_density(f, v, p);
+  ink_cover(u, v, p, values);
+  for (int k = 0; k < kInks; ++k) values[k] *= full;
+}
+// The bounds: with the eye at distance r, facing = eye·p − 1 ≤ r − 1 and z = r − p·dir ≥ r − 1 and h ≤ 1,
+// so full_density ≤ D f² / (r − 1)², reached facing the eye on the equator. An ink's cover is at most 1,
+// the darkness too, and the inks' sum at most 3 (black and two of the others).
+double full_density_bound(const Frame& f) {
   const double h = std::sqrt(dot(f.camera.eye, f.camera.eye)) - 1;
   return f.dots * f.camera.focal * f.camera.focal / (h * h);
+}
+double texture_density_bound(const Frame& f) {
+  return full_density_bound(f) * (f.colours ? 3 : 1);
 }
 
 // The texture rectangle holding every visible point: its outline is where the screen's border meets the
@@ -155,14 +208,18 @@ bool id_less(const Dot& a, const Dot& b) {
          std::tie(b.id.depth, b.id.tile_x, b.id.tile_y, b.id.rank);
 }
 
-void draw_disc(std::vector<unsigned char>& image, int size, double cx, double cy, double radius) {
+// A dot of ink `rgb` (one channel: black) on the picture, as inks print: each channel times the ink's.
+void draw_disc(std::vector<unsigned char>& image, int size, int channels, double cx, double cy, double radius,
+               const unsigned char* rgb) {
   const int x0 = std::max(0, int(cx - radius - 1)), x1 = std::min(size - 1, int(cx + radius + 1));
   const int y0 = std::max(0, int(cy - radius - 1)), y1 = std::min(size - 1, int(cy + radius + 1));
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {  // coverage from the distance to the edge: antialiased over a pixel
       const double cover = std::clamp(radius + 0.5 - std::hypot(x + 0.5 - cx, y + 0.5 - cy), 0.0, 1.0);
-      unsigned char& px = image[std::size_t(y) * size + x];
-      px = static_cast<unsigned char>(std::lround(px * (1 - cover)));
+      for (int c = 0; c < channels; ++c) {
+        unsigned char& px = image[(std::size_t(y) * size + x) * channels + c];
+        px = static_cast<unsigned char>(std::lround(px * (1 - cover * (1 - rgb[c] / 255.0))));
+      }
     }
 }
 
@@ -177,7 +234,7 @@ int usage(const char* problem) {
       stderr,
       "texture_stipple: %s\nusage: texture_stipple [--tileset FILE] [--frames K (2-100000, default 24)] "
       "[--size PIXELS (32-4096, default 512)] [--dots-per-pixel-area D (0.001-1, default 0.0625)] "
-      "[--check] -o DIR\n",
+      "[--colours] [--check] -o DIR\n",
       problem);
   return 2;
 }
@@ -187,12 +244,14 @@ int usage(const char* problem) {
 int main(int argc, char** argv) {
   std::string tileset_path, out_dir;
   double frames_arg = 24, size_arg = 512, dots = 0.0625;
-  bool check = false;
+  bool check = false, colours = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
     if (a == "--check") {
       check = true;
+    } else if (a == "--colours") {
+      colours = true;
     } else if (!has_value && (a == "--tileset" || a == "-o" || a == "--frames" || a == "--size" ||
                               a == "--dots-per-pixel-area")) {
       return usage((a + " needs a value").c_str());
@@ -243,20 +302,25 @@ int main(int argc, char** argv) {
 
   // One tile size for every frame (another tile size is another tiling): the first frame's densest tile
   // expects a quarter of the set's top level, so the last, 10^4 times denser, lies past it.
-  Frame frame{camera_at(0), dots};
+  Frame frame{camera_at(0), dots, colours};
   const double top = tileset.max_points_per_tile();
   const double tile_size = std::sqrt(top / 4 / texture_density_bound(frame));
   std::printf("tile set: %g points per tile at its top level, density limit %g (smooth mode)\n", top,
               kdm::query_density_limit(tileset, kdm::QueryMode::kSmooth));
-  // The fixed tone whose dot density is compared across frames: the view centre's, ± 0.08.
-  const double band_tone = tone(target_u, target_v, dir), spacing = 1 / std::sqrt(dots),
+  // The fixed darkness whose dot density is compared across frames: the view centre's, ± 0.08.
+  const double band_darkness = darkness(target_u, target_v, dir, colours), spacing = 1 / std::sqrt(dots),
                radius = 0.45 * spacing, fade = 0.2, subtiles = tileset.data().subtiles_per_side();
-  std::printf("tile side %.4g texture units; fixed-tone band: tone %.3f ± 0.08\n", tile_size, band_tone);
+  std::printf("tile side %.4g texture units; fixed-tone band: darkness %.3f ± 0.08\n", tile_size,
+              band_darkness);
 
   std::vector<kdm::QueryPoint> buffer(1 << 16);
+  std::vector<std::uint8_t> inks(colours ? buffer.size() : 0);  // each point's class: its ink
   std::vector<Dot> previous, current;
-  std::vector<unsigned char> image(std::size_t(size) * size);
+  const int channels = colours ? 3 : 1;
+  std::vector<unsigned char> image(std::size_t(size) * size * channels);
   double first_density = 0, last_density = 0, lowest = 1e9, highest = 0, worst_jump = 0, worst_rim = 0;
+  double ink_lowest[kInks], ink_highest[kInks];  // with colours: each ink's dots on screen ÷ D × its cover
+  std::fill(ink_lowest, ink_lowest + kInks, 1e9), std::fill(ink_highest, ink_highest + kInks, 0.0);
   unsigned deepest = 0;
   std::printf("frame  magnif.  points  shown depth  band dots/px² (÷ D·dark)  jump (rim)  query ms\n");
   for (int k = 0; k < frames; ++k) {
@@ -268,6 +332,12 @@ int main(int argc, char** argv) {
     q.density.kind = kdm::QueryDensity::Kind::kCallback;
     q.density.callback = texture_density, q.density.user = &frame;
     q.density.callback_max = texture_density_bound(frame);
+    kdm::ClassQueryParams inked;  // with colours: the inks as classes, from one joint density
+    if (colours) {
+      inked.query = q, inked.class_count = kInks;
+      inked.joint.densities = ink_densities, inked.joint.user = &frame;
+      for (int c = 0; c < kInks; ++c) inked.joint.max[c] = full_density_bound(frame);
+    }
 
     // The cursor loop into a caller-owned buffer, grown only when it fills up.
     const auto t0 = std::chrono::steady_clock::now();
@@ -275,10 +345,15 @@ int main(int argc, char** argv) {
     kdm::QueryProblem problem;
     std::size_t n = 0, total = 0;
     kdm::Status status;
-    while ((status = kdm::query_points(tileset, q, buffer.data() + total, buffer.size() - total, &n, &cursor,
-                                       &problem)) == kdm::Status::kBufferFull) {
+    const auto run = [&] {
+      return colours ? kdm::query_classes(tileset, inked, buffer.data() + total, inks.data() + total,
+                                          buffer.size() - total, &n, &cursor, &problem)
+                     : kdm::query_points(tileset, q, buffer.data() + total, buffer.size() - total, &n,
+                                         &cursor, &problem);
+    };
+    while ((status = run()) == kdm::Status::kBufferFull) {
       total += n;
-      if (total == buffer.size()) buffer.resize(2 * buffer.size());
+      if (total == buffer.size()) buffer.resize(2 * buffer.size()), inks.resize(colours ? buffer.size() : 0);
     }
     total += n;
     const double query_ms =
@@ -301,7 +376,7 @@ int main(int argc, char** argv) {
     std::fill(image.begin(), image.end(), 255);
     current.clear();
     unsigned depth = 0;
-    int shown = 0, band_dots = 0;
+    int shown = 0, band_dots = 0, ink_dots[kInks] = {};
     for (std::size_t i = 0; i < total; ++i) {
       const kdm::QueryPoint& p = buffer[i];
       const Vec s = surface(p.x, p.y);  // the origin is 0: positions are texture coordinates
@@ -317,23 +392,37 @@ int main(int argc, char** argv) {
       const double side = tile_size / std::pow(subtiles, p.id.depth);
       const double count = texture_density(&frame, p.x, p.y) * q.scale * side * side;
       const double weight = std::clamp((count / kdm::emission_threshold(tileset, p.id) - 1) / fade, 0.0, 1.0);
-      if (weight > 0) draw_disc(image, size, sx, sy, radius * std::sqrt(weight));
-      if (std::abs(tone(p.x, p.y, s) - band_tone) < 0.08) ++band_dots;
+      static constexpr unsigned char kBlack[3] = {0, 0, 0};
+      if (weight > 0)
+        draw_disc(image, size, channels, sx, sy, radius * std::sqrt(weight),
+                  colours ? kInkRgb[inks[i]] : kBlack);
+      if (std::abs(darkness(p.x, p.y, s, colours) - band_darkness) < 0.08) ++band_dots;
+      if (colours) ++ink_dots[inks[i]];
     }
     deepest = std::max(deepest, depth);
     double band_area = 0, band_expected = 0;  // pixels of the band, and the dots they should hold
+    double ink_expected[kInks] = {};          // with colours: the dots each ink should put on screen
     for (int y = 0; y < size; ++y)
       for (int x = 0; x < size; ++x) {
         Vec s;
         double u, v;
         if (!cam.cast(x + 0.5, y + 0.5, s)) continue;
         texture_coords(s, u, v);
-        const double t = tone(u, v, s);
-        if (std::abs(t - band_tone) < 0.08) band_area += 1, band_expected += dots * (1 - t);
+        const double d = darkness(u, v, s, colours);
+        if (std::abs(d - band_darkness) < 0.08) band_area += 1, band_expected += dots * d;
+        if (!colours) continue;
+        double cover[kInks];
+        ink_cover(u, v, s, cover);
+        for (int c = 0; c < kInks; ++c) ink_expected[c] += dots * cover[c];
       }
     const double density = band_area > 0 ? band_dots / band_area : 0;
     const double relative = band_expected > 0 ? band_dots / band_expected : 0;
     if (k == 0) first_density = relative;
+    for (int c = 0; c < (colours ? kInks : 0); ++c) {
+      if (ink_expected[c] < 100) continue;  // too few to judge
+      const double share = ink_dots[c] / ink_expected[c];
+      ink_lowest[c] = std::min(ink_lowest[c], share), ink_highest[c] = std::max(ink_highest[c], share);
+    }
     last_density = relative, lowest = std::min(lowest, relative), highest = std::max(highest, relative);
 
     // Dots in both frames, matched by id: how far each moved over the surface, in its own spacing along
@@ -363,7 +452,7 @@ int main(int argc, char** argv) {
     char name[64];
     std::snprintf(name, sizeof name, "/frame_%03d.png", k);
     const std::string path = out_dir + name;
-    if (!stbi_write_png(path.c_str(), size, size, 1, image.data(), size))
+    if (!stbi_write_png(path.c_str(), size, size, channels, image.data(), size * channels))
       return std::fprintf(stderr, "texture_stipple: cannot write '%s'\n", path.c_str()), 1;
   }
   const double drift = last_density / first_density - 1;
@@ -371,11 +460,17 @@ int main(int argc, char** argv) {
               highest, last_density / first_density, 100 * drift);
   std::printf("largest jump %.3f spacings (%.2f near the silhouette); deepest depth %u\n", worst_jump,
               worst_rim, deepest);
+  bool inks_follow = true;
+  for (int c = 0; c < (colours ? kInks : 0); ++c) {
+    std::printf("%s dots on screen ÷ D·cover: %.3f to %.3f\n", kInkNames[c], ink_lowest[c], ink_highest[c]);
+    inks_follow = inks_follow && ink_lowest[c] >= 0.9 && ink_highest[c] <= 1.1;
+  }
   std::fflush(stdout);  // before any message on stderr
-  if (check && (!(std::abs(drift) <= 0.10) || !(worst_jump < 0.5))) {
-    std::fprintf(stderr, "texture_stipple: check failed:%s%s\n",
+  if (check && (!(std::abs(drift) <= 0.10) || !(worst_jump < 0.5) || !inks_follow)) {
+    std::fprintf(stderr, "texture_stipple: check failed:%s%s%s\n",
                  std::abs(drift) <= 0.10 ? "" : " the band's dot density drifts by more than 10%;",
-                 worst_jump < 0.5 ? "" : " a dot moved half a spacing or more in one frame");
+                 worst_jump < 0.5 ? "" : " a dot moved half a spacing or more in one frame;",
+                 inks_follow ? "" : " an ink's dots on screen are more than 10% off its cover");
     return 1;
   }
   return 0;
