@@ -73,6 +73,7 @@ class Tileset:
         origin: Sequence[float] = ...,
         gamma: float = ...,
         invert: bool = ...,
+        glide_together: bool = ...,
         out: Optional[QueryResult] = ...,
     ) -> QueryResult: ...
     def positions(
@@ -90,6 +91,7 @@ class Tileset:
         origin: Sequence[float] = ...,
         gamma: float = ...,
         invert: bool = ...,
+        glide_together: bool = ...,
         keys: bool = ...,
         threads: Optional[int] = ...,
         classes: Optional[Sequence[Union[_Density, _Function]]] = ...,

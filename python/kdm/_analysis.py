@@ -75,5 +75,6 @@ def analyze(
     energy = _checks.flag("energy", energy)
     if sets[0].shape[1] == 3 and (spec is not None or tile_size is not None):
         warnings.warn("density and tiling diagnostics are 2D only; skipped", stacklevel=2)
+        spec, tile = None, 0.0
     text = _kdm.analyze(sets, names, box, spec, tile, fmax, threads, energy)
     return _arrays(json.loads(text))

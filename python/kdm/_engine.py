@@ -107,11 +107,20 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         super().__init__(d=d, seed=seed)
         self.temperature = _checks.number("temperature", temperature, 0.0)
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
-        self.density = density
         self.threads = _checks.threads(threads)
-        self._spec = _checks.sampler_density(density, 1.0, False)  # read once, refused now if bad
-        if d != 2 and self._spec is not None and self._spec.kind == "image":
+        self.density = density
+
+    @property
+    def density(self) -> Any:
+        """The density, as kdm.sample takes it; set it to draw from another (checked when set)."""
+        return self._density
+
+    @density.setter
+    def density(self, value: Any) -> None:
+        spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
+        if self.d != 2 and spec is not None and spec.kind == "image":
             raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
+        self._density, self._spec = value, spec
 
     def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
         n = _checks.integer("n", n, 0, 2**31)

@@ -47,7 +47,7 @@ def stipple(
         For tiles: dots glide with the tone (smooth) or never move (stable).
     region : (x0, y0, x1, y1) or None
         Part of the image's UV square [0, 1]^2 (y up) to render at the whole image's dot size (tiles
-        only), zooming at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
+        only), a zoom of 1 / its width, at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
         subtiles past its top level, 2 * m**4 x. None: the whole image.
     gamma, invert
         Darkness ** gamma is the density; invert: luminance instead of darkness.

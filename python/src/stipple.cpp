@@ -35,6 +35,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (mode != "stable" && mode != "smooth")
     throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
   if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
+  if (output) tools::refuse_writing_over(label, *output);
   check_number("dot_size", dot_size, 0, false);
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   if (spec.kind != DensitySpec::Kind::kImage)
@@ -67,7 +68,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   }
   const QueryMode query_mode = mode == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
   const Tileset* given = tileset ? tileset->set.get() : nullptr;
-  if (region && 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]) >
+  if (region && tools::stipple_zoom(uv.data()) >
                     tools::max_stipple_zoom(given ? *given : builtin_tileset(), query_mode) * (1 + 1e-9))
     throw std::invalid_argument(
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));

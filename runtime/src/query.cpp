@@ -130,10 +130,16 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   const double top = tileset.max_points_per_tile(), most = query_density_limit(tileset, q.mode);
   if (!(max_density * area_scale <= most + 0.5)) {
     refuse(Kind::kDensityTooHigh, "scale", max_density * area_scale, most);
-    why.largest_valid = most / (max_density * S * S);
-    why.largest_tile_size = std::sqrt(most / (max_density * q.scale));
+    why.largest_valid = most / max_density / S / S;  // divided in turn: a product could overflow
+    why.largest_tile_size = std::sqrt(most / max_density) / std::sqrt(q.scale);
     return Status::kInvalidArgument;
   }
+  // The region's own tiles, whatever its density (a tile size in the wrong units is refused, not answered
+  // with no points); the visit below adds a margin of a few tiles for glides and rounding.
+  const double region_tiles =
+      (std::ceil(q.x1 / S) - std::floor(q.x0 / S)) * (std::ceil(q.y1 / S) - std::floor(q.y0 / S));
+  if (!(region_tiles <= double(kMaxQueryTiles)))
+    return refuse(Kind::kTooManyTiles, "x0", region_tiles, double(kMaxQueryTiles));
   // Smooth mode visits the tiles whose points can glide into the region too: as far as any glides at the
   // keyframes a constant density's points sit between, or at any keyframe up to a varying one's maximum.
   // Past the top level, where tiles hand over to their subtiles, every keyframe's reach bounds the way.
@@ -163,9 +169,6 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
-  const double tiles = (tx1d - tx0d) * (ty1d - ty0d);
-  if (!(tiles <= double(kMaxQueryTiles)))
-    return refuse(Kind::kTooManyTiles, "x0", tiles, double(kMaxQueryTiles));
   // Tile coordinates must fit an int64 exactly, and past the top level so must the subtiles' (m^depth
   // times the tile's): farther out is too far from the world origin, whatever the spacing.
   const double most_tiles =
@@ -241,6 +244,15 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     const double wy = double(ty) * S;
     const std::int64_t row_end = ty == run.to_y ? std::min(tx1, run.to_x) : tx1;
     for (std::int64_t tx = (ty == cursor->tile_y ? cursor->tile_x : tx0); tx < row_end; ++tx) {
+      const bool resumed = tx == cursor->tile_x && ty == cursor->tile_y;
+      // A tile visited counts as kTileCandidates candidates examined (about what it costs), so that a call
+      // over many tiles with few candidates or none (a sparse density) is bounded too.
+      if (!resumed && examined >= kMaxQueryCandidates) {
+        *cursor = QueryCursor{tx, ty, 0, true, false, fingerprint};
+        *written = n;
+        return Status::kBufferFull;
+      }
+      examined = std::min(examined + kTileCandidates, kMaxQueryCandidates);
       const std::size_t index = tileset.tile_index_at(tx, ty);
       const Tile& tile = tileset.data().tiles[index];
       const float* thresholds = tables.thresholds[index].data();
@@ -262,7 +274,6 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
           std::lower_bound(thresholds, thresholds + tile.points.size(), limit,
                            [](float t, double l) { return TilesetShape::emits(t, l); }) -
           thresholds);
-      const bool resumed = tx == cursor->tile_x && ty == cursor->tile_y;
       if (descend && limit > top) {  // the tile hands over to its subtiles somewhere: descent.h
         detail::DescentPlace at;
         if (resumed) at = detail::DescentPlace{cursor->depth, cursor->path, cursor->rank};
@@ -574,7 +585,7 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kMissingArgument:
       return "a required argument is null, or the tile set is empty";
     case QueryProblem::Kind::kNotFinite:
-      return "a parameter is not a finite number (or too far from the origin)";
+      return "a parameter is not a finite number";
     case QueryProblem::Kind::kNotPositive:
       return "a parameter must be greater than 0";
     case QueryProblem::Kind::kNegative:

@@ -99,14 +99,15 @@ inline void chunk(std::vector<std::uint8_t>& png, const char type[5], const std:
   put32(png, crc32(&png[start], png.size() - start));
 }
 
-// A greyscale PNG of `depth` bits (8 or 16); `samples` row-major, top row first.
+// A greyscale PNG of `depth` bits (8 or 16), with alpha when `channels` is 2 (grey, alpha per pixel);
+// `samples` row-major, top row first.
 inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int depth,
-                                          const std::vector<std::uint16_t>& samples) {
+                                          const std::vector<std::uint16_t>& samples, int channels = 1) {
   std::vector<std::uint8_t> raw;  // filter byte 0 per row, then big-endian samples
   for (std::uint32_t y = 0; y < h; ++y) {
     raw.push_back(0);
-    for (std::uint32_t x = 0; x < w; ++x) {
-      const std::uint16_t v = samples[y * w + x];
+    for (std::uint32_t x = 0; x < w * channels; ++x) {
+      const std::uint16_t v = samples[y * w * channels + x];
       if (depth == 16) raw.push_back(static_cast<std::uint8_t>(v >> 8));
       raw.push_back(static_cast<std::uint8_t>(v));
     }
@@ -128,7 +129,8 @@ inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int 
   std::vector<std::uint8_t> ihdr;
   put32(ihdr, w);
   put32(ihdr, h);
-  ihdr.insert(ihdr.end(), {static_cast<std::uint8_t>(depth), 0, 0, 0, 0});  // greyscale, no interlace
+  ihdr.insert(ihdr.end(), {static_cast<std::uint8_t>(depth), static_cast<std::uint8_t>(channels == 2 ? 4 : 0),
+                           0, 0, 0});  // greyscale (with alpha), no interlace
   chunk(png, "IHDR", ihdr);
   chunk(png, "IDAT", z);
   chunk(png, "IEND", {});

@@ -451,7 +451,11 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
                "dir.png': it is a directory");
   std::ofstream(path("h.recipe")) << "levels 2\nbase_points 32\nkeyframes 2\nhandover_zone 1\n";
   expect_error("bake '" + path("h.recipe") + "' -o '" + path("h.kdmt") + "'",
-               "handover_zone needs at least 3 levels");
+               "handover_zone 1 needs at least 3 levels: 2 give 2 subtiles per side");
+  // The shipped recipe cut to 2 levels, as a first try would: the levels its zone of 3 needs.
+  std::ofstream(path("h.recipe")) << "levels 2\nbase_points 32\nkeyframes 2\nhandover_zone 3\n";
+  expect_error("bake '" + path("h.recipe") + "' -o '" + path("h.kdmt") + "'",
+               "handover_zone 3 needs at least 4 levels");
   // Values that would be silently dropped: a tile size of 0 and an empty -o, --fade for a points file.
   const std::string reference = "'" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt'";
   expect_error("analyze " + reference + " --tile-size 0", "--tile-size must be > 0");
@@ -640,6 +644,69 @@ TEST_F(CliTest, StippleRegionsKeepTheDotSizeAndPathsStayComments) {
     EXPECT_GT(whole, 0);
     EXPECT_DOUBLE_EQ(radius(std::string(count) + " --region 0.25,0.25,0.75,0.75"), whole);
   }
+}
+
+// A region's zoom is 1 / its width (the picture keeps its width), whatever its shape: on a uniform grey
+// the dots per unit of picture area stay those of the whole image. The runtime's count for a uniform
+// density is the expectation up to partly covered edge tiles; 5% is several times that at these counts.
+TEST_F(CliTest, StippleRegionsOfAnyShapeKeepTheDotDensity) {
+  write_bytes(path("grey.png"), grey_png(1, 1, 8, {128}));
+  const auto dots = [&](const std::string& region) {
+    const Outcome r = kdm("stipple '" + path("grey.png") + "' --points 2000 --region " + region + " -o '" +
+                          path("r.txt") + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::vector<kdm::tools::PointSet> sets;
+    std::string error;
+    EXPECT_TRUE(kdm::tools::read_point_sets(path("r.txt"), sets, error)) << error;
+    return sets.empty() ? 0.0 : double(sets[0].size());
+  };
+  EXPECT_NEAR(dots("0,0,0.25,1"), 8000.0, 400.0);  // 4× the density over a quarter of the image
+  EXPECT_NEAR(dots("0,0,1,0.25"), 500.0, 25.0);    // the whole image's size, a quarter as tall
+  EXPECT_NEAR(dots("0.2,0.3,0.7,0.8"), 2000.0, 100.0);
+}
+
+// Frames of a zoom into a region of another shape than the image's all have the region's shape: the first
+// holds the whole image with blank paper beside it (no dot there), and the zoom is geometric.
+TEST_F(CliTest, StippleFramesOfAnotherShapeKeepTheRegionsShape) {
+  write_bytes(path("grey.png"), grey_png(1, 1, 8, {128}));
+  const Outcome r = kdm("stipple '" + path("grey.png") +
+                        "' --points 2000 --region 0,0,0.5,1 --frames 3 -o '" + path("f.txt") + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<Frame> frames;
+  for (int i = 0; i < 3; ++i) frames.push_back(read_frame(path("f_000" + std::to_string(i) + ".txt")));
+  EXPECT_EQ(std::vector<double>(frames[0].region, frames[0].region + 4),
+            (std::vector<double>{0, -0.5, 1, 1.5}));
+  EXPECT_EQ(std::vector<double>(frames[2].region, frames[2].region + 4), (std::vector<double>{0, 0, 0.5, 1}));
+  for (const Frame& f : frames) {
+    EXPECT_NEAR((f.region[2] - f.region[0]) / (f.region[3] - f.region[1]), 0.5, 1e-12);
+    for (std::size_t p = 1; p < f.uv.size(); p += 2) ASSERT_TRUE(f.uv[p] >= 0 && f.uv[p] < 1) << f.uv[p];
+  }
+  EXPECT_NEAR((frames[1].region[2] - frames[1].region[0]), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(double(frames[0].uv.size() / 2), 2000.0, 100.0);  // the whole image at its own zoom
+  EXPECT_NEAR(double(frames[2].uv.size() / 2), 4000.0, 200.0);  // half of it at twice the zoom
+}
+
+// Transparent pixels are paper: white under dark dots, black under --invert's bright ones, so neither
+// puts dots there. The image: its left half opaque mid-grey, its right half transparent.
+TEST_F(CliTest, StippleLeavesTransparentPixelsEmpty) {
+  std::vector<std::uint16_t> samples;
+  for (int x = 0; x < 8; ++x) samples.insert(samples.end(), {128, std::uint16_t(x < 4 ? 255 : 0)});
+  write_bytes(path("half.png"), grey_png(8, 1, 8, samples, 2));
+  for (const char* invert : {"", " --invert"}) {
+    SCOPED_TRACE(invert);
+    const Outcome r =
+        kdm("stipple '" + path("half.png") + "' --points 2000" + invert + " -o '" + path("h.txt") + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<kdm::tools::PointSet> sets;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::read_point_sets(path("h.txt"), sets, error)) << error;
+    ASSERT_GT(sets.at(0).size(), 1500u);
+    std::size_t right = 0;  // past the last opaque texel's centre, where bilinear reaches zero
+    for (std::size_t i = 0; i < sets[0].size(); ++i) right += sets[0].coords[2 * i] > 4.5 / 8;
+    EXPECT_EQ(right, 0u);
+  }
+  expect_error("stipple '" + path("half.png") + "' -o '" + path("half.png") + "'", "is the input image");
+  expect_error("stipple '" + path("half.png") + "' --colours cmyk -o '" + path("c.txt") + "'", ".csv");
 }
 
 TEST_F(CliTest, StippleFramesRejectBadCounts) {

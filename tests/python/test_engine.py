@@ -81,6 +81,17 @@ def test_engine_options():
     e.threads = 10**9  # set after __init__: checked at the draw
     with pytest.raises(ValueError, match="threads must be"):
         e.random(10)
+    # A density set after __init__ is checked when set and drawn from: uniform now, so about as many
+    # points on each side of x = 0.5 (the ramp above gives three times more on the left).
+    e.threads = 1
+    e.density = None
+    p = e.random(2000)
+    assert abs((p[:, 0] < 0.5).mean() - 0.5) < 0.05
+    with pytest.raises(ValueError):
+        e.density = 0.0
+    e3 = kdm.BlueNoise(3, seed=1)
+    with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
+        e3.density = np.ones((4, 4))
 
 
 def test_without_scipy():

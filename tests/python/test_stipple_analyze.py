@@ -127,6 +127,23 @@ def test_analyze_options_and_several_sets(gradient_png):
     assert kdm.analyze(kdm.sample(2000), energy=False)["nearest_neighbour"]["dmin"] > 0.4
 
 
+def test_stipple_never_writes_over_its_image(tmp_path):
+    image = tmp_path / "sphere.png"
+    image.write_bytes(open(SPHERE, "rb").read())
+    with pytest.raises(ValueError, match="is the input image"):
+        kdm.stipple(str(image), points=500, output=str(image))
+    assert image.read_bytes() == open(SPHERE, "rb").read()
+
+
+def test_analyze_skips_the_2d_diagnostics_of_3d_points():
+    p = kdm.sample(1000, dim=3, seed=1, threads=1)
+    plain = kdm.analyze(p, threads=1)
+    with pytest.warns(UserWarning, match="2D only; skipped"):
+        given = kdm.analyze(p, density=np.array([[1.0, 0.01]]), tile_size=0.5, threads=1)
+    assert given["energy_per_point"] == plain["energy_per_point"]  # the density is not used
+    assert "tiling" not in given
+
+
 @pytest.mark.parametrize("method", ["tiles", "full"])
 def test_each_inks_tone_follows_its_separation(method):
     # 100,000 dots of the coffee picture: each ink's windowed density z-scores against its own channel, RMS

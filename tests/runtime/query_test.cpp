@@ -511,7 +511,10 @@ TEST(QueryTest, BadInputIsRejectedOrHarmless) {
   EXPECT_EQ(
       query_points(Tileset::builtin(), region(0, 0, 8192, 4097, 1), buffer.data(), 16, &written, &cursor),
       Status::kInvalidArgument);  // just over kMaxQueryTiles = 2^24 tiles: bounded work per call
-  EXPECT_TRUE(run(region(-1e6, -1e6, 1e6, 1e6, 1e-20)).empty());  // 4·10^12 tiles, but none can emit
+  cursor = QueryCursor{};
+  EXPECT_EQ(query_points(Tileset::builtin(), region(-1e6, -1e6, 1e6, 1e6, 1e-20), buffer.data(), 16, &written,
+                         &cursor),
+            Status::kInvalidArgument);  // 4·10^12 tiles, though none can emit: the region decides
   // x1 / tile_size rounds to x0 / tile_size: zero columns of 2.5·10^14 rows. Once, the row loop visited
   // them all (found by fuzz_query; tests/fuzz/crashes/query/zero_columns_many_rows).
   QueryParams thin = region(0, 0, 5e-324, 1e15, 1);
@@ -576,6 +579,25 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
   EXPECT_EQ(p.limit, double(kMaxQueryTiles));
   EXPECT_EQ(p.value, 8192.0 * 4097.0);
+  // The count is the region's own tiles, whatever its density and the margin a visit adds around it: 10^8
+  // tiles asking for a thousand points in all (a tile size in the wrong units) are refused, not answered
+  // with none; a far region names its own count (the visit there adds rows for rounding); and a smooth
+  // query of exactly kMaxQueryTiles tiles is served, though its glides visit a ring of tiles more.
+  q = region(0, 0, 10, 10, 10);
+  q.tile_size = 1e-3;
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
+  EXPECT_EQ(p.value, 1e8);
+  p = problem_of(region(0, 0, 1e10, 10, 1e-3, QueryMode::kSmooth));
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
+  EXPECT_EQ(p.value, 1e11);
+  for (const QueryMode mode : kModes) {
+    QueryCursor cursor;
+    EXPECT_EQ(query_points(Tileset::builtin(), region(0, 0, 4096, 4096, 1e-3, mode), buffer.data(), 16,
+                           &written, &cursor),
+              Status::kOk);
+    EXPECT_EQ(written, 0u);
+  }
   // 10^15 units out a double's step is 1/8, more than the spacing of 1,000 points per unit area: positions
   // would fall together. 10^10 out, a region 2·10^-6 wide is one step wide, however deep smooth mode goes
   // (10^11 points per unit area, within the built-in set's deepest).
@@ -675,6 +697,34 @@ TEST(QueryTest, TileSizedChunksFarFromTheOriginKeepEveryPoint) {
 }
 
 // A cursor belongs to the parameters that started it: resuming or reusing it with others is refused.
+// A call's work is bounded by tiles visited as well as candidates examined: a smooth query of 2^24 tiles
+// whose density bounds leave no candidate in any tile visits (4096 + 2)² tiles with its glides' ring,
+// kMaxQueryCandidates / kTileCandidates = 2^20 a call: 17 calls, each but the last stopping with no point
+// and the cursor saved, where one call would have walked them all.
+TEST(QueryTest, ACallOverManyEmptyTilesIsBoundedToo) {
+  struct Empty {
+    static double density(void*, double, double) { return 0; }
+    static void bounds(void*, double, double, double, double, double* lo, double* hi) { *lo = *hi = 0; }
+  };
+  QueryParams q = region(0, 0, 4096, 4096, 100, QueryMode::kSmooth);
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = Empty::density;
+  q.density.bounds = Empty::bounds;
+  q.density.callback_max = 1;
+  std::vector<QueryPoint> out(16);
+  QueryCursor cursor;
+  std::size_t written = 1;
+  int calls = 1;
+  for (;
+       query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor) == Status::kBufferFull;
+       ++calls) {
+    EXPECT_EQ(written, 0u);
+    ASSERT_LT(calls, 100);
+  }
+  EXPECT_EQ(written, 0u);
+  EXPECT_EQ(calls, 17);
+}
+
 TEST(QueryTest, ACursorIsRefusedWithOtherParameters) {
   std::vector<QueryPoint> buffer(16);
   std::size_t written = 0;

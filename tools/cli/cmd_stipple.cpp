@@ -51,6 +51,8 @@ std::string frame_path(const std::string& output, int i) {
 
 void run_stipple(const StippleArgs& a, bool scale_given) {
   check_output_option(a.output, {".png", ".svg", ".txt", ".csv"});  // before the dots are placed
+  for (int i = 0; i < std::max(1, a.frames); ++i)
+    tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output);
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
     throw CommandError("--scale must be a number > 0 (dots per unit area at full darkness)");
   if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
@@ -64,6 +66,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                   a.fade);
     throw CommandError(message);
   }
+  if (!a.colours.empty() && tools::has_extension(a.output, ".txt"))  // said before the dots are placed
+    throw CommandError("--colours writes each dot's ink as a class: write .csv (x,y,class), .svg or .png");
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
   if (a.fade > 0 && !tools::has_extension(a.output, ".png") && !tools::has_extension(a.output, ".svg"))
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
@@ -103,13 +107,18 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   Tileset storage;
   const Tileset& tiles = tileset_for(a.tileset, storage);
   if (a.method != "full" &&  // before any frame
-      1 / std::max(region[2] - region[0], region[3] - region[1]) >
-          tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
+      tools::stipple_zoom(region) > tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
   if (a.method != "full") {
     stippler =
         std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale, parse_mode(a.mode));
+  }
+  if (coloured) {  // which ink each class number of a .csv is
+    std::string names;
+    for (std::size_t k = 0; k < inks.inks.size(); ++k)
+      names += (k ? ", " : "") + std::to_string(k) + " " + inks.inks[k].name;
+    std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
   const int frames = std::max(1, a.frames);
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
@@ -180,7 +189,8 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option(
          "--points", a->points,
          "Dots over the whole image: exactly this many with --method full; about this many with tiles "
-         "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none)")
+         "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none). A pale "
+         "image gets as many as a dark one: --scale keeps the tone's absolute darkness")
       ->capture_default_str();
   cmd->add_option("--scale", a->scale,
                   "Dots per unit area at full darkness (image height = 1 unit); overrides --points "
@@ -188,14 +198,15 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--method", a->method, "tiles: runtime + tile set (fast); full: the full KDM sampler")
       ->check(CLI::IsMember({"tiles", "full"}))
       ->capture_default_str();
-  cmd->add_option(
-      "--region", a->region,
-      "x0,y0,x1,y1 in the image's UV square [0,1]² (y up): render that part at the same dot "
-      "size with more dots; zoom at most 2× in stable mode, in smooth mode as deep as the tile set's "
-      "subtiles go (2·m^4×: about 2·10^6 for 32×32 subtiles) (default: the whole image)");
+  cmd->add_option("--region", a->region,
+                  "x0,y0,x1,y1 in the image's UV square [0,1]² (y up): render that part at the same dot "
+                  "size with more dots, a zoom of 1 / its width; zoom at most 2× in stable mode, in smooth "
+                  "mode as deep as the tile set's "
+                  "subtiles go (2·m^4×: about 2·10^6 for 32×32 subtiles) (default: the whole image)");
   cmd->add_option("--frames", a->frames,
                   "Zoom sequence of K numbered pictures from the whole image into --region (geometric "
-                  "zoom, zoom-coherent; needs --method tiles; 0: one picture)")
+                  "zoom, zoom-coherent; every picture has the region's shape, the first blank beside the "
+                  "image where the shapes differ; needs --method tiles; 0: one picture)")
       ->capture_default_str();
   cmd->add_option("--fade", a->fade,
                   "Dots grow in as they appear instead of popping up: a dot's area grows from 0 where it "
@@ -214,8 +225,8 @@ void add_stipple_command(CLI::App& app) {
                   "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
                   "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
                   "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
-                  "(a layer per pen), .csv a class column, the ink's number (default: black dots of the "
-                  "image's darkness)");
+                  "(a layer per pen), .csv a class column, the ink's number, least-used ink first, as the "
+                  "run prints them (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed, "Random seed for --method full");
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
   cmd->add_option("--mode", a->mode,

@@ -95,7 +95,12 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   spec.values.resize(image.pixels.size());
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x) {
-      const double grey = image.at(x, image.height - 1 - y), tone = invert ? grey : 1.0 - grey;
+      // Transparent is paper: white for dark dots, black for --invert's bright ones (its luminance on
+      // black is that on white less 1 − alpha).
+      const int row = image.height - 1 - y;
+      const double grey = image.at(x, row),
+                   paper = image.alpha.empty() ? 0.0 : 1.0 - image.alpha[std::size_t(row) * image.width + x],
+                   tone = invert ? grey - paper : 1.0 - grey;
       spec.values[static_cast<std::size_t>(y) * image.width + x] =
           static_cast<float>(std::pow(std::max(0.0, tone), gamma));
     }

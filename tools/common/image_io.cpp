@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <type_traits>
 #include <utility>
 
 #include <sys/stat.h>
@@ -274,19 +275,29 @@ void to_rgb(const Sample* data, int channels, float full, std::vector<float>& pi
   }
 }
 
-template <class Sample>
-void convert(const Sample* data, int channels, float full, GreyImage& image) {
-  to_luminance(data, channels, full, image.pixels);
-}
-template <class Sample>
-void convert(const Sample* data, int channels, float full, ColourImage& image) {
-  to_rgb(data, channels, full, image.pixels);
-}
 constexpr std::size_t channels_of(const GreyImage&) {
   return 1;
 }
 constexpr std::size_t channels_of(const ColourImage&) {
   return 3;
+}
+
+// The alpha channel alone (grey + alpha, or RGBA), for densities that composite on black paper instead.
+template <class Sample>
+void to_alpha(const Sample* data, int channels, float full, std::vector<float>& alpha) {
+  if (channels != 2 && channels != 4) return alpha.clear();
+  for (std::size_t i = 0; i < alpha.size(); ++i)
+    alpha[i] = std::clamp(static_cast<float>(data[i * channels + channels - 1]) / full, 0.0f, 1.0f);
+}
+
+template <class Sample, class Image>
+void convert(const Sample* data, int channels, float full, Image& image) {
+  if constexpr (std::is_same_v<Image, GreyImage>)
+    to_luminance(data, channels, full, image.pixels);
+  else
+    to_rgb(data, channels, full, image.pixels);
+  image.alpha.resize(image.pixels.size() / channels_of(image));
+  to_alpha(data, channels, full, image.alpha);
 }
 
 /// Whether every PGM/PPM sample is at most the file's maxval (else `error`: the file is corrupt).

@@ -13,7 +13,8 @@ namespace kdm::tools {
 struct GreyImage {
   int width = 0;
   int height = 0;
-  std::vector<float> pixels;
+  std::vector<float> pixels;  ///< composited on white paper
+  std::vector<float> alpha;   ///< coverage in [0, 1] per pixel; empty for a file without alpha
   float at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
@@ -21,7 +22,8 @@ struct GreyImage {
 struct ColourImage {
   int width = 0;
   int height = 0;
-  std::vector<float> pixels;
+  std::vector<float> pixels;  ///< composited on white paper
+  std::vector<float> alpha;   ///< coverage in [0, 1] per pixel; empty for a file without alpha
 };
 
 /// An 8-bit RGB image, row-major, row 0 at the top.

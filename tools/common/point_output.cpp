@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <string>
 
@@ -47,6 +48,12 @@ std::vector<Ink> class_inks(std::size_t count) {
   return inks;
 }
 
+void refuse_writing_over(const std::string& input, const std::string& output) {
+  std::error_code unknown;
+  if (output == input || std::filesystem::equivalent(input, output, unknown))
+    throw std::invalid_argument("the output '" + output + "' is the input image: write another file");
+}
+
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
                   const DrawStyle& style) {
   std::string error;
@@ -59,8 +66,8 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     throw std::invalid_argument("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
   if (points.dim != 2)
     throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
-  const int w = std::max(16, style.width_px);
-  const int h = std::max(16, static_cast<int>(std::lround(w / style.aspect)));
+  const int w = std::max(1, style.width_px);
+  const int h = std::max(1, static_cast<int>(std::lround(w / style.aspect)));  // the picture's own shape
   if (double(w) * h > double(1 << 28))  // 768 MiB of RGB: refuse rather than die allocating
     throw std::invalid_argument("a picture of " + std::to_string(w) + "x" + std::to_string(h) +
                                 " pixels is too large (limit 2^28 pixels); lower the width");

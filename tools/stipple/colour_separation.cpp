@@ -102,7 +102,11 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   } else if (scheme == "rgb") {
     for (int c = 0; c < 3; ++c) {
       const char* names[3] = {"red", "green", "blue"};
-      s.channels.push_back(channel(image, gamma, names[c], [c](const float* p) { return double(p[c]); }));
+      // Light on black paper: transparent is black (the colour on white less 1 − alpha).
+      s.channels.push_back(channel(image, gamma, names[c], [c, &image](const float* p) {
+        const std::size_t i = std::size_t(p - image.pixels.data()) / 3;
+        return double(p[c]) - (image.alpha.empty() ? 0.0 : 1.0 - image.alpha[i]);
+      }));
     }
     s.inks = {ink(255, 0, 0, "red"), ink(0, 255, 0, "green"), ink(0, 0, 255, "blue")};
     std::fill(s.background, s.background + 3, 0);

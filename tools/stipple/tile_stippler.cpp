@@ -10,15 +10,27 @@
 
 namespace kdm::tools {
 
+double stipple_zoom(const double uv[4]) {
+  return 1 / (uv[2] - uv[0]);
+}
+
 void stipple_frame_region(const double region[4], int i, int k, double out[4]) {
-  const double last = std::max(region[2] - region[0], region[3] - region[1]);  // 1 / final zoom
-  const double extent = std::pow(last, k > 1 ? double(i) / (k - 1) : 1.0);     // 1 / this frame's zoom
-  const double s = last < 1 ? (1 - extent) / (1 - last) : 1;                   // 0: whole image, 1: region
+  const double size[2] = {region[2] - region[0], region[3] - region[1]};
+  const double first = 1 / std::min(size[0], size[1]);  // frame 0's size over the region's
+  double whole[4];                                      // frame 0
   for (int j = 0; j < 2; ++j) {
-    out[j] = s * region[j];
-    out[j + 2] = 1 + s * (region[j + 2] - 1);
+    // Zoomed about the point of the region that lies in it as the region lies in the image; across the
+    // image exactly where the region is the narrower way.
+    const double fixed = size[j] < 1 ? region[j] / (1 - size[j]) : 0.5;
+    const bool across = size[j] == std::min(size[0], size[1]);
+    whole[j] = across ? 0.0 : fixed + (region[j] - fixed) * first;
+    whole[j + 2] = across ? 1.0 : whole[j] + size[j] * first;
   }
-  if (i == k - 1) std::copy(region, region + 4, out);  // exactly the region, whatever the rounding
+  const double f = std::pow(first, k > 1 ? 1 - double(i) / (k - 1) : 0.0);  // this frame's size
+  const double t = first > 1 ? (f - 1) / (first - 1) : 0;                   // 1: frame 0, 0: the region
+  for (int j = 0; j < 4; ++j) out[j] = region[j] + (whole[j] - region[j]) * t;
+  if (i == 0 && k > 1) std::copy(whole, whole + 4, out);  // exactly, whatever the rounding
+  if (i == k - 1) std::copy(region, region + 4, out);
 }
 
 double stipple_dot_count(const std::vector<const DensitySpec*>& inks, double points, double scale) {
@@ -146,18 +158,20 @@ PointSet TileStippler::with_sizes(const QueryParams& q, const double rect[4], do
 }
 
 PointSet TileStippler::render(const double uv[4], double fade) const {
-  const double zoom = 1 / std::max(uv[2] - uv[0], uv[3] - uv[1]);
+  const double zoom = stipple_zoom(uv);
   if (zoom > max_stipple_zoom(tiles_, mode_) * (1 + 1e-9))
     throw std::invalid_argument(stipple_zoom_error("the region", tiles_, mode_));
+  // Dots only on the image: a rectangle past its sides (a frame zoomed out) shows blank paper there.
   QueryParams q;
-  q.x0 = uv[0] * aspect_, q.y0 = uv[1], q.x1 = uv[2] * aspect_, q.y1 = uv[3];
-  q.origin_x = q.x0, q.origin_y = q.y0;
+  q.x0 = std::max(uv[0], 0.0) * aspect_, q.y0 = std::max(uv[1], 0.0);
+  q.x1 = std::min(uv[2], 1.0) * aspect_, q.y1 = std::min(uv[3], 1.0);
+  q.origin_x = uv[0] * aspect_, q.origin_y = uv[1];
   q.tile_size = tile_size_;
   q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
   q.density = densities_.front()->density;
   q.mode = mode_;
   q.glide_together = true;  // a picture's tone changes from dot to dot
-  const double rect[4] = {q.x0, q.y0, q.x1, q.y1};
+  const double rect[4] = {uv[0] * aspect_, uv[1], uv[2] * aspect_, uv[3]};
   if (fade > 0) return with_sizes(q, rect, fade);
   std::vector<float> xy;  // positions only: the compact output
   if (densities_.size() == 1) {

@@ -37,9 +37,16 @@ double max_stipple_zoom(const Tileset& tileset, QueryMode mode);
 /// The message for a region that zooms more than max_stipple_zoom.
 std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMode mode);
 
-/// The UV rectangle of frame i of k, zooming from the whole image (frame 0) into `region` (frame k − 1):
-/// the zoom grows geometrically and each rectangle lies inside the one before, so zoom coherence keeps
-/// every dot that stays in view.
+/// How much a UV rectangle magnifies the image: pictures have a fixed width in pixels, so 1 / its width
+/// (a region as wide as the image but shorter is drawn at the whole image's size, only less tall).
+double stipple_zoom(const double uv[4]);
+
+/// The UV rectangle of frame i of k, zooming into `region` (frame k − 1) from the smallest rectangle of
+/// its shape that holds the whole image (frame 0: the whole image when the region has the image's shape,
+/// else the image with blank paper beside it). Every frame has the region's shape (pictures of one size);
+/// the zoom grows geometrically about a fixed point of the region (where it lies in the image as the
+/// region lies in the image), so each rectangle holds the next and zoom coherence keeps every dot that
+/// stays in view.
 void stipple_frame_region(const double region[4], int i, int k, double out[4]);
 
 class TileStippler {
@@ -52,7 +59,9 @@ class TileStippler {
   /// count the dots of all of them, and render() gives each dot its ink's class.
   TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
                double scale, QueryMode mode);
-  /// The dots of the UV rectangle `uv` (x0, y0, x1, y1 in [0, 1]², y up), normalised to it: [0, 1)².
+  /// The dots of the UV rectangle `uv` (x0, y0, x1, y1, y up; past [0, 1]² is blank paper), normalised
+  /// to it: [0, 1)²; drawn at stipple_zoom(uv), so that dots keep their size and spacing in a picture of
+  /// fixed width.
   /// With `fade` > 0 each dot also gets a size (PointSet::sizes) that grows from 0 where it appears to 1
   /// once the density there has risen a fraction `fade` more (emission_threshold), its area in proportion:
   /// the ink of a zoom changes continuously instead of dots popping up. Throws std::invalid_argument when

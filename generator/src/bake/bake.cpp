@@ -173,18 +173,18 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       throw InvalidArgument("recipe: handover_level " + std::to_string(r.handover_level) +
                             " must be below the top level (" + std::to_string(r.levels - 1) + ")");
     const std::uint32_t m = 1u << (r.levels - 1 - r.handover_level);  // √(N_top / N_j)
-    // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side), which
-    // 2 subtiles per side cannot give for any zone.
-    if (m < 4)
+    // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side).
+    if (2 * r.handover_zone + 1 >= m) {
+      std::uint32_t levels = r.handover_level + 1;
+      while ((1u << (levels - 1 - r.handover_level)) <= 2 * r.handover_zone + 1) ++levels;
       throw InvalidArgument(
-          "recipe: handover_zone needs at least " + std::to_string(r.handover_level + 3) + " levels" +
+          "recipe: handover_zone " + std::to_string(r.handover_zone) + " needs at least " +
+          std::to_string(levels) + " levels" +
           (r.handover_level ? " with handover_level " + std::to_string(r.handover_level) : std::string()) +
-          ": " + std::to_string(r.levels) + " levels give " + std::to_string(m) +
-          " subtiles per side, too few for a zone of 1 (2 * zone + 1 must be below it)");
-    if (2 * r.handover_zone + 1 >= m)
-      throw InvalidArgument("recipe: handover_zone must be in [1, " + std::to_string((m - 2) / 2) + "] for " +
-                            std::to_string(m) + " subtiles per side (levels " + std::to_string(r.levels) +
-                            ", handover_level " + std::to_string(r.handover_level) + ")");
+          ": " + std::to_string(r.levels) + " give " + std::to_string(m) +
+          " subtiles per side, and 2 * zone + 1 must be below that (a set without a hand-over has no "
+          "handover_zone line)");
+    }
     TilesetShape shape;
     const std::vector<std::uint32_t> nominal = r.nominal_counts();
     const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal, r.keyframes_per_level);

@@ -34,8 +34,9 @@ typedef enum kdm_status {
   KDM_DECOMPRESSION_FAILED = 9,      /* the payload is not one zstd frame of its stated size */
   KDM_INVALID_CONTENT = 10,          /* checksums match but the content is inconsistent */
   KDM_INVALID_ARGUMENT = 11, /* a caller's error; queries say which argument and limit in kdm_query_problem */
-  KDM_BUFFER_FULL = 12,      /* a query filled the buffer, or examined its most candidates (2^24) in one
-                                call: call again with the same cursor */
+  KDM_BUFFER_FULL = 12,      /* a query filled the buffer, or examined its most candidates and tiles
+                                (2^24) in one call: call again with the same cursor; a parallel query's
+                                output was too small: call again with room for the count it gave */
   KDM_OUT_OF_MEMORY = 13     /* an allocation was refused (by the tile-set allocator's hooks too) */
 } kdm_status;
 
@@ -202,7 +203,8 @@ KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 
 /* Writes up to `capacity` points into `out` (NULL only with capacity 0), *written = count (`written` and
  * `cursor` are required). KDM_OK when the region is complete, KDM_BUFFER_FULL to be resumed with the same
- * cursor and query (also with room left, after 2^24 candidates in one call), KDM_INVALID_ARGUMENT for bad
+ * cursor and query (also with room left, after 2^24 candidates in one call, a tile
+ * visited counting as 16: kdm::kMaxQueryCandidates), KDM_INVALID_ARGUMENT for bad
  * parameters, with `problem` (optional: NULL, or with struct_size set) saying which and why. */
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,

@@ -21,7 +21,8 @@ enum class Status : int {
   kInvalidContent,           ///< checksums match but the content is inconsistent (hostile or buggy writer)
   kInvalidArgument,          ///< a caller-side error (e.g. saving an inconsistent TilesetData)
   kBufferFull,               ///< a query filled the caller's buffer, or examined its most candidates in one
-                             ///< call (kMaxQueryCandidates): resume with the same cursor
+                             ///< call (kMaxQueryCandidates): resume with the same cursor; a parallel
+                             ///< query's output was too small: call again with room for the count given
   kOutOfMemory,              ///< an allocation failed (a tile set's, through its allocator hook too, an
                              ///< image's, a class-image sum's or a parallel query's scratch)
 };
