@@ -36,11 +36,13 @@ class _Engine:
         self.num_generated = 0
 
     def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
+        """n points in [0, 1)^d, shape (n, d)."""
         points = self._random(n, workers=workers)
         self.num_generated += n
         return points
 
     def reset(self) -> "_Engine":
+        """Back to the engine's first draw."""
         self.rng = _generator(copy.deepcopy(self.rng_seed))
         self.num_generated = 0
         return self
@@ -52,6 +54,7 @@ class _Engine:
     def integers(
         self, l_bounds: Any, *, u_bounds: Any = None, n: int = 1, endpoint: bool = False, workers: int = 1
     ) -> np.ndarray:
+        """n integer points in [l_bounds, u_bounds) ([l_bounds, u_bounds] with endpoint), shape (n, d)."""
         if u_bounds is None:
             u_bounds, l_bounds = l_bounds, 0
         low, high = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds) + (1 if endpoint else 0)
@@ -71,7 +74,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
 
     Each ``random(n)`` returns `n` fresh points (a whole set drawn with a new seed taken from the engine's
     generator, so it is blue noise by itself); ``reset()`` replays the same sets; ``fast_forward(n)``
-    draws and drops one set of n. Points lie in [0, 1)^d.
+    skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d.
 
     Parameters
     ----------
@@ -122,13 +125,35 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
         self._density, self._spec = value, spec
 
+    def _draw_seed(self) -> int:
+        if hasattr(self.rng, "integers"):
+            return int(self.rng.integers(0, 2**63, dtype=np.int64))
+        return int(self.rng.randint(0, 2**63, dtype=np.int64))  # a legacy RandomState
+
     def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
         n = _checks.integer("n", n, 0, 2**31)
         if n == 0:
             return np.empty((0, self.d))
-        if hasattr(self.rng, "integers"):
-            seed = int(self.rng.integers(0, 2**63, dtype=np.int64))
-        else:  # a legacy RandomState
-            seed = int(self.rng.randint(0, 2**63, dtype=np.int64))
+        seed = self._draw_seed()
         threads = _checks.threads(self.threads)  # an attribute: it may have been set since __init__
         return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, threads, None)
+
+    def fast_forward(self, n: int) -> "BlueNoise":
+        """Skip what ``random(n)`` would return: one set's seed, whatever n (each call draws a whole set
+        from one seed), without computing its points.
+
+        Parameters
+        ----------
+        n : int
+            The size of the skipped set (0 skips nothing); counted in ``num_generated``.
+
+        Returns
+        -------
+        BlueNoise
+            The engine, advanced.
+        """
+        n = _checks.integer("n", n, 0, 2**31)
+        if n > 0:
+            self._draw_seed()
+        self.num_generated += n
+        return self

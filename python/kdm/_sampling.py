@@ -38,7 +38,8 @@ def sample(
     domain : {"torus", "box"} or None
         Periodic or bounded. None: a box for images, arrays and "ramp:R", a torus otherwise.
     temperature : float
-        >= 0; 0.5 is the paper's look, lower is more ordered, 0 a deterministic descent.
+        0 to 1000; 0.5 is the paper's look, lower is more ordered, 0 a deterministic descent, about
+        300 white noise.
     seed : int
         0 to 2**64 - 1. The points depend on the arguments and the seed only, never on `threads`.
     threads : int

@@ -148,6 +148,15 @@ TEST(Periodogram, RejectsBadInput) {
   EXPECT_THROW(periodogram({0.1, 0.2}, 2, 0.0), InvalidInput);
   EXPECT_THROW(periodogram({0.1, 1.2}, 2, 1.0), InvalidInput);
   EXPECT_THROW(average_periodogram({}, 1.0), InvalidInput);
+  // Sets pooled on one frequency axis must be of about one size: 11 and 10 points pool, 12 and 10 not.
+  const auto grid = [](int n) {
+    tools::PointSet s;
+    s.dim = 2;
+    for (int i = 0; i < n; ++i) s.coords.insert(s.coords.end(), {(i + 0.5) / n, std::fmod(0.618 * i, 1.0)});
+    return s;
+  };
+  EXPECT_NO_THROW(average_periodogram({grid(11), grid(10)}, 1.0));
+  EXPECT_THROW(average_periodogram({grid(12), grid(10)}, 1.0), InvalidInput);
   // Too fine a grid, not an overflow.
   EXPECT_THROW(periodogram({0.1, 0.2, 0.5, 0.5}, 2, 1e300), InvalidInput);
 }

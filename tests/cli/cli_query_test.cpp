@@ -67,9 +67,12 @@ TEST_F(CliTest, QueryGlideTogetherMovesTheSamePointsAndKeepsPartitions) {
   for (const char* mode : {"smooth", "stable"}) {
     const std::string m = std::string(" --mode ") + mode;
     ASSERT_EQ(kdm("query --rect 0,0,3,2" + common + m + " -o '" + path("own.csv") + "'").status, 0);
-    ASSERT_EQ(
-        kdm("query --rect 0,0,3,2" + common + m + " --glide-together -o '" + path("whole.csv") + "'").status,
-        0);
+    const Outcome together =
+        kdm("query --rect 0,0,3,2" + common + m + " --glide-together -o '" + path("whole.csv") + "'");
+    ASSERT_EQ(together.status, 0) << together.err;
+    EXPECT_EQ(together.err.find("--glide-together applies to --mode smooth only") != std::string::npos,
+              std::string(mode) == "stable")
+        << together.err;
     ASSERT_EQ(
         kdm("query --rect 0,0,1.3,2" + common + m + " --glide-together -o '" + path("left.csv") + "'").status,
         0);

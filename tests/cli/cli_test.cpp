@@ -105,6 +105,9 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   expect_error("sample --n 100000000" + out, "limit");       // the grid would exceed max_grid_nodes
   expect_error("sample --n 100 --temperature nan" + out, "temperature");
   expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
+  expect_error("sample --n 100 --temperature 1e4" + out, "temperature must be at most 1000");
+  const Outcome hot = kdm("sample --n 100 --temperature 1000" + out);  // the limit itself is taken
+  EXPECT_EQ(hot.status, 0) << hot.err;
   expect_error("sample --n 100 --density const:0" + out, "const:V");  // all-zero density
   expect_error("sample --n 100 --density const:-1" + out, "const:V");
   expect_error("sample --n 100 --vector-lanes 5" + out, "vector-lanes");  // 16, 8 or 4 only

@@ -20,9 +20,10 @@ def test_a_qmc_engine_of_scipy():
     engine.reset()
     assert engine.num_generated == 0
     assert np.array_equal(engine.random(512), first) and np.array_equal(engine.random(512), second)
-    # fast_forward(n) draws one set of n and drops it.
+    # fast_forward(n) skips one set of n (its seed: its points are never computed); of 0, nothing.
     engine.reset().fast_forward(512)
     assert engine.num_generated == 512 and np.array_equal(engine.random(512), second)
+    assert np.array_equal(engine.reset().fast_forward(0).random(512), first)
     ints = engine.integers(10, n=256)
     assert ints.shape == (256, 2) and ints.dtype == np.int64 and 0 <= ints.min() and ints.max() < 10
     # SciPy's tools take it: the discrepancy of blue noise is far below that of random points.

@@ -47,6 +47,7 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, "domain must be one of 'torus', 'box'", dict(n=10, domain="sphere")),
     (ValueError, "temperature must be a finite number", dict(n=10, temperature=NAN)),
     (ValueError, "temperature must be >= 0", dict(n=10, temperature=-1)),
+    (ValueError, "temperature must be at most 1000", dict(n=10, temperature=1e4)),
     (ValueError, "seed must be >= 0", dict(n=10, seed=-1)),
     (ValueError, "seed must be <= ", dict(n=10, seed=2**64)),
     (ValueError, "threads must be >= 0", dict(n=10, threads=-1)),

@@ -135,6 +135,12 @@ def test_stipple_never_writes_over_its_image(tmp_path):
     assert image.read_bytes() == open(SPHERE, "rb").read()
 
 
+def test_analyze_pools_sets_of_about_one_size_only():
+    a, b = kdm.sample(1024, seed=3, threads=1), kdm.sample(100, seed=4, threads=1)
+    with pytest.raises(ValueError, match="100 to 1024 points"):
+        kdm.analyze([a, b], energy=False, threads=1)
+
+
 def test_analyze_skips_the_2d_diagnostics_of_3d_points():
     p = kdm.sample(1000, dim=3, seed=1, threads=1)
     plain = kdm.analyze(p, threads=1)

@@ -112,6 +112,8 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.density = densities[0]->density;
   q.mode = parse_mode(a.mode);
   q.glide_together = a.glide_together;
+  if (a.glide_together && q.mode != QueryMode::kSmooth)  // stable points never glide: said, not refused
+    std::fprintf(stderr, "kdm query: warning: --glide-together applies to --mode smooth only; ignored\n");
   // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;

@@ -188,8 +188,8 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)");
   cmd->add_option("--temperature,-T", o.temperature,
-                  "Temperature in the reference implementation's units (0.5 = the paper's look; lower = more "
-                  "ordered; 0 = deterministic descent)")
+                  "Temperature in the reference implementation's units, 0 to 1000 (0.5 = the paper's look; "
+                  "lower = more ordered; 0 = deterministic descent; about 300 = white noise)")
       ->capture_default_str();
   add_seed_option(cmd, o.seed, "Random seed; the output depends on nothing else");
   cmd->add_option("--density", args->density,

@@ -211,6 +211,10 @@ void validate_options(const SamplerOptions& o) {
     throw InvalidArgument("give a point count n > 0 or a grid resolution > 0");
   if (!(std::isfinite(o.temperature) && o.temperature >= 0))
     throw InvalidArgument("temperature must be a finite number >= 0");
+  if (o.temperature > kMaxTemperature)
+    throw InvalidArgument(
+        "temperature must be at most 1000: past it nearly every move is refused and the "
+        "points keep their starting places (300 already gives white noise)");
   if (!(std::isfinite(o.step) && o.step >= 0)) throw InvalidArgument("step must be a finite number >= 0");
   if (!(o.peak_density > 0 && o.peak_density <= 1)) throw InvalidArgument("peak density must be in (0, 1]");
   if (!(o.sigma_max == 0 || o.sigma_max >= 1))

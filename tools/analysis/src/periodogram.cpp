@@ -6,10 +6,12 @@
 #include "kdm/analysis/periodogram.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
 #include <limits>
+#include <string>
 
 #include "kdm/analysis/common.h"
 #include "parallel.h"
@@ -127,12 +129,19 @@ Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax,
 Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads) {
   if (sets.empty()) throw InvalidInput("no point sets to analyse");
   double total = 0;
+  std::size_t fewest = sets.front().size(), most = fewest;
   for (const tools::PointSet& s : sets) {
     if (s.dim != 2) throw InvalidInput("the periodogram is implemented for 2D sets only");
     validate_points(s.coords, s.dim);
     if (s.size() == 0) throw InvalidInput("empty point set");
     total += static_cast<double>(s.size());
+    fewest = std::min(fewest, s.size()), most = std::max(most, s.size());
   }
+  // Frequencies are in units of each set's √n: on one grid, sets of other sizes would mix frequencies
+  // (at 10% apart in count, 5% apart in frequency).
+  if (double(most) > 1.1 * double(fewest))
+    throw InvalidInput("the spectrum pools sets of about one size: these hold " + std::to_string(fewest) +
+                       " to " + std::to_string(most) + " points (more than 10% apart); analyse them apart");
   Periodogram p = make_grid(total / static_cast<double>(sets.size()), fmax);
   for (const tools::PointSet& s : sets) accumulate_set(s.coords, p.kmax, threads, p.power);
   for (double& v : p.power) v /= static_cast<double>(sets.size());

@@ -143,6 +143,10 @@ struct SamplerOptions {
 /// kernel derivative by 4 where d/dx of Φ(r) = exp(-(2r/3)^2) gives 8/9, so its T = 0.5 is T = 0.5 / 4.5
 /// in the units of eq. 3–4. We keep its scale so that `temperature 0.5` looks like the paper's figures.
 inline constexpr double kModelTemperaturePerUser = 1.0 / 4.5;
+/// The highest temperature SamplerOptions takes. Points are white noise by about 300 (at 4,096 points:
+/// lowP 0.91 at 100, 1.00 at 300); past 1,000 the MH test refuses nearly every move (acceptance 4% at
+/// 1,000, 1.5% at 3,000) and the points keep their starting places, a set more ordered again.
+inline constexpr double kMaxTemperature = 1000;
 
 /// One level of the multi-scale run (docs/design.md §2.4).
 struct LevelReport {

@@ -39,7 +39,7 @@ struct Periodogram {
 Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0);
 
 /// Mean periodogram of several 2D sets (all on the grid of the mean point count). Throws InvalidInput for an
-/// empty list, 3D sets or invalid points. Thread-safe.
+/// empty list, 3D sets, invalid points or counts more than 10% apart. Thread-safe.
 Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads = 0);
 
 /// Radial statistics of a periodogram (see the file comment for definitions).
