@@ -142,6 +142,7 @@ class BlueNoise:
     domain: Optional[str]
     density: _Density
     threads: int
+    aspect: Optional[float]
     def __init__(
         self,
         d: int = ...,
@@ -151,6 +152,7 @@ class BlueNoise:
         domain: Optional[str] = ...,
         density: _Density = ...,
         threads: int = ...,
+        aspect: Optional[float] = ...,
     ) -> None: ...
     def random(self, n: int = ..., *, workers: int = ...) -> npt.NDArray[np.float64]: ...
     def reset(self) -> BlueNoise: ...

@@ -83,6 +83,10 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     seed : None, int or numpy.random.Generator
         As SciPy's engines take it: an int or None seeds a new ``numpy.random.default_rng``; a Generator
         is used as it is (and replayed from a copy by reset()).
+    aspect : float or None
+        Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
+        density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
+        aspect=1 spaces them evenly in the unit square whatever the density's shape.
     temperature, domain, density, threads
         As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise);
         ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
@@ -98,6 +102,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         domain: Optional[str] = None,
         density: Any = None,
         threads: int = 0,
+        aspect: Optional[float] = None,
     ) -> None:
         d = _checks.integer("d", d, 2, 3)
         seeds = (numbers.Integral, np.random.Generator, np.random.RandomState)
@@ -112,6 +117,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
         self.threads = _checks.threads(threads)
         self.density = density
+        self.aspect = None if aspect is None else _checks.number("aspect", aspect, 0.0, strict=True)
 
     @property
     def density(self) -> Any:
@@ -136,7 +142,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             return np.empty((0, self.d))
         seed = self._draw_seed()
         threads = _checks.threads(self.threads)  # an attribute: it may have been set since __init__
-        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, threads, None)
+        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, threads, self.aspect)
 
     def fast_forward(self, n: int) -> "BlueNoise":
         """Skip what ``random(n)`` would return: one set's seed, whatever n (each call draws a whole set
