@@ -1,0 +1,81 @@
+// The longest single call of a query: each call stops after kMaxQueryCandidates candidates (a tile visited
+// counting as kTileCandidates), so a program with a frame budget knows what one call can take. Each case
+// runs a whole large query call after call; `worst_call_ms` is the longest call seen, `calls` how many
+// one query took. Figures: docs/limits.md ("The longest call").
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include "kdm/runtime/query.h"
+
+namespace {
+
+double zero(void*, double, double) {
+  return 0;
+}
+void zero_bounds(void*, double, double, double, double, double* lo, double* hi) {
+  *lo = *hi = 0;
+}
+
+enum Case { kConstantDense, kCallbackDense, kCallbackManyTiles, kEmptyTiles };
+
+/// The query of each case: dense tiles (64 × 64 at 32,768 points each, over 2^27 points) or many tiles
+/// (4,096 × 4,096 at 32 points each), read at every candidate or bounded to nothing.
+kdm::QueryParams query_for(Case c, kdm::QueryMode mode) {
+  kdm::QueryParams q;
+  q.mode = mode;
+  q.x1 = q.y1 = c == kConstantDense || c == kCallbackDense ? 64 : 4096;
+  q.scale = c == kConstantDense || c == kCallbackDense ? 32768 : 32;
+  if (c != kConstantDense) {
+    q.density.kind = kdm::QueryDensity::Kind::kCallback;
+    q.density.callback = zero;
+    q.density.callback_max = 1;
+    if (c == kEmptyTiles) q.density.bounds = zero_bounds;
+  }
+  return q;
+}
+
+void BM_LongestCall(benchmark::State& state) {
+  const kdm::QueryParams q =
+      query_for(Case(state.range(0)), state.range(1) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable);
+  std::vector<kdm::QueryPoint> out(std::size_t(1) << 22);  // past the points one call can examine
+  // Untimed first: the built-in set loads at its first use, and the buffer's pages are touched once.
+  std::fill(out.begin(), out.end(), kdm::QueryPoint{});
+  kdm::Tileset::builtin();
+  double worst = 0;
+  int calls = 0;
+  for (auto _ : state) {
+    kdm::QueryCursor cursor;
+    std::size_t written = 0;
+    calls = 0;
+    kdm::Status status;
+    do {
+      const auto t0 = std::chrono::steady_clock::now();
+      status = kdm::query_points(kdm::Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
+      worst = std::max(
+          worst, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      ++calls;
+    } while (status == kdm::Status::kBufferFull);
+    if (status != kdm::Status::kOk) state.SkipWithError(kdm::status_message(status));
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["worst_call_ms"] = worst;
+  state.counters["calls"] = calls;
+}
+
+}  // namespace
+
+// Args: the case (0 constant and dense, 1 a callback at every candidate of dense tiles, 2 the same over
+// 2^24 tiles of 32 points, 3 a callback bounded to nothing over 2^24 tiles), then smooth mode (0 or 1).
+BENCHMARK(BM_LongestCall)
+    ->ArgNames({"case", "smooth"})
+    ->Args({kConstantDense, 0})
+    ->Args({kConstantDense, 1})
+    ->Args({kCallbackDense, 0})
+    ->Args({kCallbackManyTiles, 0})
+    ->Args({kEmptyTiles, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
