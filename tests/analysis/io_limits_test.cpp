@@ -1,6 +1,7 @@
 // Untrusted input files (tools/common): the image pixel limit, read from the header before any pixel is
 // allocated; the hostile images the fuzzer found (tests/fuzz/crashes/image) refused or read cleanly; the
-// memory and path loaders agreeing on the fuzz seeds; NUL bytes in point files.
+// memory and path loaders agreeing on the fuzz seeds; NUL bytes in point files; a JPEG's EXIF orientation,
+// applied, and damaged EXIF ignored.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -20,6 +21,7 @@
 
 #include "image_io.h"
 #include "point_io.h"
+#include "stb_image_write.h"
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
@@ -308,6 +310,75 @@ TEST(PointFileInput, EndlessLinesBinaryBytesAndDirectoriesAreRefused) {
   EXPECT_LT(error.size(), 100u) << error;
   EXPECT_FALSE(kdm::tools::read_point_sets(::testing::TempDir(), sets, error));
   EXPECT_TRUE(contains(error, "is a directory")) << error;
+}
+
+// A 16 × 8 grey JPEG, its left half black and right half white, with an EXIF segment (big-endian TIFF,
+// one entry: Orientation = `orientation`) after its SOI; none for 0. `cut` drops that many bytes off the
+// segment's end, its length with them (a segment whose entry is cut short).
+std::vector<std::uint8_t> halves_jpeg(int orientation, std::size_t cut = 0) {
+  std::vector<std::uint8_t> pixels(16 * 8);
+  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = i % 16 < 8 ? 0 : 255;
+  std::vector<std::uint8_t> jpeg;
+  stbi_write_jpg_to_func(
+      [](void* to, void* data, int n) {
+        auto* v = static_cast<std::vector<std::uint8_t>*>(to);
+        v->insert(v->end(), static_cast<std::uint8_t*>(data), static_cast<std::uint8_t*>(data) + n);
+      },
+      &jpeg, 16, 8, 1, pixels.data(), 95);
+  if (orientation == 0) return jpeg;
+  std::vector<std::uint8_t> exif = {0xFF, 0xE1, 0, 34, 'E', 'x', 'i', 'f', 0, 0,
+                                    'M',  'M',  0, 42, 0,   0,   0,   8,   0, 1,
+                                    0x01, 0x12, 0, 3,  0,   0,   0,   1,   0, std::uint8_t(orientation),
+                                    0,    0,    0, 0,  0,   0};
+  exif.resize(exif.size() - cut);
+  exif[3] = std::uint8_t(exif.size() - 2);
+  jpeg.insert(jpeg.begin() + 2, exif.begin(), exif.end());
+  return jpeg;
+}
+
+// Mean luminance of the top half of rows and of the left half of columns.
+std::pair<double, double> top_and_left(const GreyImage& image) {
+  double top = 0, left = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      if (y < image.height / 2) top += image.at(x, y);
+      if (x < image.width / 2) left += image.at(x, y);
+    }
+  const double half = image.width * image.height / 2.0;
+  return {top / half, left / half};
+}
+
+TEST(ImageLimits, AJpegIsTurnedAsItsExifOrientationSays) {
+  struct Seen {
+    int orientation, width, height;
+    double top, left;  // 0 black, 1 white, 0.5 half of each
+  };
+  // 1: as stored; 3: turned 180°; 6: 90° clockwise (the left half on top); 8: 90° counter-clockwise.
+  const Seen cases[] = {{0, 16, 8, 0.5, 0}, {1, 16, 8, 0.5, 0}, {3, 16, 8, 0.5, 1}, {6, 8, 16, 0, 0.5},
+                        {8, 8, 16, 1, 0.5}, {2, 16, 8, 0.5, 1}, {5, 8, 16, 0, 0.5}};
+  for (const Seen& c : cases) {
+    SCOPED_TRACE(c.orientation);
+    const std::vector<std::uint8_t> jpeg = halves_jpeg(c.orientation);
+    GreyImage image;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::load_grey_image_memory(jpeg.data(), jpeg.size(), image, error)) << error;
+    EXPECT_EQ(image.width, c.width);
+    EXPECT_EQ(image.height, c.height);
+    const auto [top, left] = top_and_left(image);
+    EXPECT_NEAR(top, c.top, 0.05);  // JPEG rounding near the halves' edge: a few per cent
+    EXPECT_NEAR(left, c.left, 0.05);
+  }
+  // A segment cut short at any byte: its last 4 (the next directory's offset) leave the entry whole and
+  // turned; an entry cut short, or an orientation that is none (9), reads as stored.
+  for (std::size_t cut = 1; cut <= 16; ++cut) {
+    for (const int orientation : {6, 9}) {
+      const std::vector<std::uint8_t> jpeg = halves_jpeg(orientation, cut);
+      GreyImage image;
+      std::string error;
+      ASSERT_TRUE(kdm::tools::load_grey_image_memory(jpeg.data(), jpeg.size(), image, error)) << error;
+      EXPECT_EQ(image.width, orientation == 6 && cut <= 4 ? 8 : 16) << cut;
+    }
+  }
 }
 
 }  // namespace

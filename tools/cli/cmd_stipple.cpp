@@ -180,7 +180,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
 void add_stipple_command(CLI::App& app) {
   auto a = std::make_shared<StippleArgs>();
   CLI::App* cmd = app.add_subcommand("stipple", "Stipple an image: darkness becomes dot density");
-  cmd->add_option("image", a->image, "Image (8/16-bit PNG, JPEG, ...); darkness is the dot density")
+  cmd->add_option("image", a->image, "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
+                  "density; transparent pixels are paper")
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "

@@ -313,6 +313,84 @@ bool samples_within(const Sample* data, std::size_t count, std::int64_t max_valu
   return true;
 }
 
+// A JPEG's EXIF orientation (1 to 8: how the stored pixels turn to be seen; 1, the default, as stored),
+// every read bounds-checked: a file is anyone's.
+int jpeg_orientation(const std::uint8_t* bytes, std::size_t size) {
+  if (size < 4 || bytes[0] != 0xFF || bytes[1] != 0xD8) return 1;
+  std::size_t at = 2;
+  while (at + 4 <= size && bytes[at] == 0xFF) {
+    const int marker = bytes[at + 1];
+    if (marker == 0xD9 || marker == 0xDA) break;  // the image data: no EXIF past it
+    const std::size_t length = std::size_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    if (length < 2 || at + 2 + length > size) break;
+    if (marker == 0xE1 && length >= 16 && std::memcmp(bytes + at + 4, "Exif\0\0", 6) == 0) {
+      const std::uint8_t* tiff = bytes + at + 10;
+      const std::size_t n = length - 8;
+      const bool little = tiff[0] == 'I' && tiff[1] == 'I';
+      if (!little && !(tiff[0] == 'M' && tiff[1] == 'M')) return 1;
+      auto u16 = [&](std::size_t i) {
+        return little ? tiff[i] | tiff[i + 1] << 8 : tiff[i] << 8 | tiff[i + 1];
+      };
+      auto u32 = [&](std::size_t i) {
+        return little ? std::uint32_t(u16(i)) | std::uint32_t(u16(i + 2)) << 16
+                      : std::uint32_t(u16(i)) << 16 | std::uint32_t(u16(i + 2));
+      };
+      if (u16(2) != 42) return 1;
+      const std::size_t ifd = u32(4);
+      if (ifd > n || n - ifd < 2) return 1;
+      const std::size_t entries = std::size_t(u16(ifd));
+      for (std::size_t e = 0; e < entries && ifd + 2 + 12 * (e + 1) <= n; ++e) {
+        const std::size_t entry = ifd + 2 + 12 * e;
+        if (u16(entry) == 0x0112 && u16(entry + 2) == 3) {  // Orientation, a SHORT
+          const int value = u16(entry + 8);
+          return value >= 1 && value <= 8 ? value : 1;
+        }
+      }
+      return 1;
+    }
+    at += 2 + length;
+  }
+  return 1;
+}
+
+// The image turned as its EXIF `orientation` says it is seen (rows top first; 5 to 8 swap the sides).
+template <class Image>
+void apply_orientation(Image& image, int orientation) {
+  if (orientation == 1) return;
+  const int w = image.width, h = image.height;
+  const bool swap = orientation >= 5;
+  const int ow = swap ? h : w, oh = swap ? w : h;
+  const std::size_t c = channels_of(image);
+  auto source = [&](int x, int y) {  // the stored pixel shown at (x, y)
+    switch (orientation) {
+      case 2:
+        return std::pair{w - 1 - x, y};
+      case 3:
+        return std::pair{w - 1 - x, h - 1 - y};
+      case 4:
+        return std::pair{x, h - 1 - y};
+      case 5:
+        return std::pair{y, x};
+      case 6:
+        return std::pair{y, h - 1 - x};
+      case 7:
+        return std::pair{w - 1 - y, h - 1 - x};
+      default:
+        return std::pair{w - 1 - y, x};  // 8
+    }
+  };
+  std::vector<float> pixels(image.pixels.size()), alpha(image.alpha.size());
+  for (int y = 0; y < oh; ++y)
+    for (int x = 0; x < ow; ++x) {
+      const auto [sx, sy] = source(x, y);
+      const std::size_t to = std::size_t(y) * ow + x, from = std::size_t(sy) * w + sx;
+      for (std::size_t k = 0; k < c; ++k) pixels[to * c + k] = image.pixels[from * c + k];
+      if (!alpha.empty()) alpha[to] = image.alpha[from];
+    }
+  image.pixels = std::move(pixels), image.alpha = std::move(alpha);
+  image.width = ow, image.height = oh;
+}
+
 // Both loaders end here, with the image file's bytes: the known faults of stb refused, then the header
 // read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
 template <class Image>
@@ -394,6 +472,7 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   }
   image.width = w;
   image.height = h;
+  apply_orientation(image, jpeg_orientation(bytes, size));  // as a photo is seen, not as it is stored
   out = std::move(image);
   return true;
 }
