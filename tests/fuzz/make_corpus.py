@@ -82,6 +82,12 @@ def images():
     write("image", "rgb.bmp", bmp)
     tga = struct.pack("<BBBHHBHHHHBB", 0, 0, 3, 0, 0, 0, 0, 0, 2, 2, 8, 0) + bytes([0, 85, 170, 255])
     write("image", "grey.tga", tga)
+    # tiny.jpg with an EXIF segment after its SOI: big-endian TIFF, one entry, Orientation 6.
+    with open(os.path.join(HERE, "image", "tiny.jpg"), "rb") as f:
+        jpeg = f.read()
+    tiff = b"MM\x00\x2a" + struct.pack(">IH", 8, 1) + struct.pack(">HHIHH", 0x0112, 3, 1, 6, 0) + b"\0\0\0\0"
+    exif = b"Exif\0\0" + tiff
+    write("image", "exif_orientation.jpg", jpeg[:2] + b"\xff\xe1" + struct.pack(">H", len(exif) + 2) + exif + jpeg[2:])
 
 
 # ---- Query: byte 0 = density kind (0 constant, 1 image, 2 callback) + (capacity - 1) << 2; bytes 1-2 =
