@@ -82,15 +82,18 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
     throw std::invalid_argument("stippling takes 1 to 8 inks, got " + std::to_string(inks.size()));
   const DensitySpec& first = *inks.front();
   double mean = 0;
-  std::vector<double> sum(first.values.size(), 0.0);  // the inks' summed density per pixel
   for (const DensitySpec* spec : inks) {
     if (spec->kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
     if (spec->width != first.width || spec->height != first.height)
       throw std::invalid_argument("the inks' images differ in size");
     mean += spec->mean_value();
-    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += spec->values[i];
   }
-  const double peak = sum.empty() ? 0.0 : *std::max_element(sum.begin(), sum.end());
+  double peak = 0;  // of the inks' summed density, pixel by pixel (no image of sums: a large one is GBs)
+  for (std::size_t i = 0; i < first.values.size(); ++i) {
+    double sum = 0;
+    for (const DensitySpec* spec : inks) sum += spec->values[i];
+    peak = std::max(peak, sum);
+  }
   if (!(peak > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
   if (!(points > 0 || scale > 0)) throw std::invalid_argument("give a number of dots > 0 or a scale > 0");
   aspect_ = double(first.width) / first.height;  // world: [0, aspect] × [0, 1]
