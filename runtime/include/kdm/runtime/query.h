@@ -131,10 +131,9 @@ inline constexpr std::uint32_t kMaxQueryDepth = 4;
 
 /// Most candidate points one call examines (2^24), a tile visited counting as kTileCandidates of them: a
 /// call that reaches it returns kBufferFull with the cursor saved, even if the buffer has room, so no call
-/// runs unbounded. Measured worst calls (2-vCPU AMD EPYC VM, Release, 2026-12-05): 11 ms stable and 16 ms
-/// smooth at a constant density, 65-95 ms with a trivial callback read at every candidate, 40 ms walking
-/// 2^20 tiles that hold no candidate. A caller with a frame budget queries smaller regions per frame, or off
-/// its main thread.
+/// runs unbounded: 10-20 ms at a constant density, about 0.1 s with a callback read at every
+/// candidate (docs/limits.md, "The longest call"). A caller with a frame budget queries smaller regions
+/// per frame, or off its main thread.
 inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 /// What a tile visited counts for in kMaxQueryCandidates: a tile costs about as much as 16 candidates.
 inline constexpr std::uint64_t kTileCandidates = 16;
