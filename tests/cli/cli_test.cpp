@@ -307,6 +307,12 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   expect_error("frobnicate", "unknown subcommand 'frobnicate'");
   expect_error("sample --n abc" + out, "--n");
   expect_error("sample --n -5" + out, "--n");
+  // Counts also in float notation when whole (1e3); a fraction or past 2^63 refused by name.
+  expect_error("sample --n 1.5" + out, "--n: must be a whole number, got 1.5");
+  expect_error("stipple x.png --points 99999999999999999999" + out, "--points: must be below 2^63");
+  const Outcome thousand = kdm("sample --n 1e3" + out);
+  ASSERT_EQ(thousand.status, 0) << thousand.err;
+  EXPECT_NE(thousand.err.find("1000 points"), std::string::npos) << thousand.err;
   expect_error("sample --n 10", "--output");
   expect_error("sample --n 10 --aspect -1" + out, "--aspect");
   expect_error("sample --n 10 --width 0 -o '" + path("x.png") + "'", "--width");

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 
 #include "commands.h"
@@ -42,6 +43,28 @@ CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::stri
   return cmd->add_option("--seed", seed, description)
       ->capture_default_str()
       ->check(CLI::Validator(in_range, ""));
+}
+
+CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,
+                              const std::string& description) {
+  // A transform sees the text before conversion: a whole number in float notation becomes its digits.
+  auto whole = [](std::string& text) -> std::string {
+    if (text.find_first_of(".eE") == std::string::npos) {  // an integer, or CLI11's own message
+      char* end = nullptr;
+      errno = 0;
+      std::strtoll(text.c_str(), &end, 10);
+      return end != text.c_str() && *end == '\0' && errno == ERANGE ? "must be below 2^63, got " + text : "";
+    }
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0') return "";
+    if (!(std::fabs(v) < 0x1p63) || v != std::floor(v)) return "must be a whole number, got " + text;
+    text = std::to_string(static_cast<std::int64_t>(v));
+    return "";
+  };
+  return cmd->add_option(names, count, description)
+      ->capture_default_str()
+      ->transform(CLI::Validator(whole, ""));
 }
 
 void check_output_option(const std::string& path, const std::vector<const char*>& extensions) {

@@ -20,6 +20,11 @@ CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& 
 /// Adds --seed to `cmd`, bound to `seed`: 0 to 2^64 - 1, anything else refused by name.
 CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::string& description);
 
+/// Adds a count option (`names`, e.g. "-n,--n") to `cmd`, bound to `count`: an integer, also written as a
+/// whole number in float notation (1e5, 20000.0); a fraction or a number past 2^63 refused by name.
+CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,
+                              const std::string& description);
+
 /// Refuses, before any long work, an output path that write would refuse later: an extension not among
 /// `extensions` (".csv", ".png", …), a directory, or a directory that does not exist. Throws CommandError.
 void check_output_option(const std::string& path, const std::vector<const char*>& extensions);

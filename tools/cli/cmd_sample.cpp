@@ -177,7 +177,7 @@ void add_sample_command(CLI::App& app) {
   auto args = std::make_shared<SampleArgs>();
   CLI::App* cmd = app.add_subcommand("sample", "Draw a point set from the KDM model (the full sampler)");
   gen::SamplerOptions& o = args->options;
-  cmd->add_option("-n,--n", o.n, "Exact number of points (0: use --resolution)")->capture_default_str();
+  add_count_option(cmd, "-n,--n", o.n, "Exact number of points (0: use --resolution)");
   cmd->add_option("--resolution", o.resolution,
                   "Finest grid nodes along the short axis, used when --n 0 (default: unset)");
   cmd->add_option("--dim", o.dim, "Dimension of the points (2 or 3)")

@@ -180,19 +180,19 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
 void add_stipple_command(CLI::App& app) {
   auto a = std::make_shared<StippleArgs>();
   CLI::App* cmd = app.add_subcommand("stipple", "Stipple an image: darkness becomes dot density");
-  cmd->add_option("image", a->image, "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
+  cmd->add_option("image", a->image,
+                  "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
                   "density; transparent pixels are paper")
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
                   "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...")
       ->required();
-  cmd->add_option(
-         "--points", a->points,
-         "Dots over the whole image: exactly this many with --method full; about this many with tiles "
-         "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none). A pale "
-         "image gets as many as a dark one: --scale keeps the tone's absolute darkness")
-      ->capture_default_str();
+  add_count_option(
+      cmd, "--points", a->points,
+      "Dots over the whole image: exactly this many with --method full; about this many with tiles "
+      "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none). A pale "
+      "image gets as many as a dark one: --scale keeps the tone's absolute darkness");
   cmd->add_option("--scale", a->scale,
                   "Dots per unit area at full darkness (image height = 1 unit); overrides --points "
                   "(default: unset, --points decides)");
