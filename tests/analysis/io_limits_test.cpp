@@ -21,7 +21,6 @@
 
 #include "image_io.h"
 #include "point_io.h"
-#include "stb_image_write.h"
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
@@ -312,19 +311,14 @@ TEST(PointFileInput, EndlessLinesBinaryBytesAndDirectoriesAreRefused) {
   EXPECT_TRUE(contains(error, "is a directory")) << error;
 }
 
-// A 16 × 8 grey JPEG, its left half black and right half white, with an EXIF segment (big-endian TIFF,
-// one entry: Orientation = `orientation`) after its SOI; none for 0. `cut` drops that many bytes off the
-// segment's end, its length with them (a segment whose entry is cut short).
+// tests/data/halves.jpg (16 × 8 grey, its left half black and right half white; written by stb_image_write's
+// stbi_write_jpg at quality 95) with an EXIF segment (big-endian TIFF, one entry: Orientation =
+// `orientation`) after its SOI; none for 0. `cut` drops that many bytes off the segment's end, its length
+// with them (a segment whose entry is cut short).
 std::vector<std::uint8_t> halves_jpeg(int orientation, std::size_t cut = 0) {
-  std::vector<std::uint8_t> pixels(16 * 8);
-  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = i % 16 < 8 ? 0 : 255;
-  std::vector<std::uint8_t> jpeg;
-  stbi_write_jpg_to_func(
-      [](void* to, void* data, int n) {
-        auto* v = static_cast<std::vector<std::uint8_t>*>(to);
-        v->insert(v->end(), static_cast<std::uint8_t*>(data), static_cast<std::uint8_t*>(data) + n);
-      },
-      &jpeg, 16, 8, 1, pixels.data(), 95);
+  std::ifstream file(KDM_TEST_DATA_DIR "/halves.jpg", std::ios::binary);
+  std::vector<std::uint8_t> jpeg((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_GT(jpeg.size(), 100u);
   if (orientation == 0) return jpeg;
   std::vector<std::uint8_t> exif = {0xFF, 0xE1, 0, 34, 'E', 'x', 'i', 'f', 0, 0,
                                     'M',  'M',  0, 42, 0,   0,   0,   8,   0, 1,
