@@ -52,7 +52,8 @@ def stipple(
     gamma, invert
         Darkness ** gamma is the density; invert: luminance instead of darkness.
     seed : int
-        For method "full".
+        Method "full": the sampler's seed. Method "tiles": where the image lies in the tile set's endless
+        tiling (another seed, other dots; one seed, the same dots in every region).
     tileset : Tileset or None
         For method "tiles" (default: the built-in set).
     output : str, os.PathLike or None

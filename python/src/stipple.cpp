@@ -82,7 +82,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       set = colours ? tools::stipple_full(specs, count, aspect, seed, threads)
                     : tools::stipple_full(spec, count, aspect, seed, threads);
     } else {
-      const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode);
+      const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode, seed);
       set = stippler.render(uv.data(), fade);
     }
     if (colours && set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left

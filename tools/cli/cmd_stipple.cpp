@@ -111,8 +111,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
   if (a.method != "full") {
-    stippler =
-        std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale, parse_mode(a.mode));
+    stippler = std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale,
+                                                     parse_mode(a.mode), a.seed);
   }
   if (coloured) {  // which ink each class number of a .csv is
     std::string names;
@@ -228,7 +228,10 @@ void add_stipple_command(CLI::App& app) {
                   "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
                   "(a layer per pen), .csv a class column, the ink's number, least-used ink first, as the "
                   "run prints them (default: black dots of the image's darkness)");
-  add_seed_option(cmd, a->seed, "Random seed for --method full");
+  add_seed_option(cmd, a->seed,
+                  "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
+                  "set's endless tiling (another seed, other dots; one seed, the same dots in every region "
+                  "and frame)");
   cmd->add_option("--tileset", a->tileset, "Tile-set file for --method tiles (default: the built-in set)");
   cmd->add_option("--mode", a->mode,
                   "--method tiles: smooth (dots glide with the density: good blue noise at every tone) or "

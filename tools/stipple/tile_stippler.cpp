@@ -72,11 +72,11 @@ std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMo
 }
 
 TileStippler::TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale,
-                           QueryMode mode)
-    : TileStippler(std::vector<const DensitySpec*>{&spec}, tileset, points, scale, mode) {}
+                           QueryMode mode, std::uint64_t seed)
+    : TileStippler(std::vector<const DensitySpec*>{&spec}, tileset, points, scale, mode, seed) {}
 
 TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
-                           double scale, QueryMode mode)
+                           double scale, QueryMode mode, std::uint64_t seed)
     : tiles_(tileset), mode_(mode) {
   if (inks.empty() || inks.size() > kMaxQueryClasses)
     throw std::invalid_argument("stippling takes 1 to 8 inks, got " + std::to_string(inks.size()));
@@ -97,8 +97,6 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   if (!(peak > 0)) throw std::invalid_argument("the image has no ink: nothing to stipple");
   if (!(points > 0 || scale > 0)) throw std::invalid_argument("give a number of dots > 0 or a scale > 0");
   aspect_ = double(first.width) / first.height;  // world: [0, aspect] × [0, 1]
-  const double world[4] = {0, 0, aspect_, 1};
-  for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
   // The scale that gives `points` dots over the whole image (∫ρ dA = mean · aspect).
   scale_ = points > 0 ? points / (mean * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
@@ -118,9 +116,22 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
                   scale_);
     throw std::invalid_argument(text);
   }
+  // The seed picks where in the endless tiling the image lies: another seed, other dots. Whole tiles and a
+  // fraction, within 2^12 tiles of the world's origin, where positions keep their precision at every zoom.
+  std::uint64_t h = seed + 0x9e3779b97f4a7c15u;  // SplitMix64 (Steele et al. 2014)
+  for (double* offset : {&offset_[0], &offset_[1]}) {
+    std::uint64_t z = (h += 0x9e3779b97f4a7c15u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    z ^= z >> 31;
+    *offset = double(z >> 40) * 0x1p-24 * 4096 * tile_size_;
+  }
+  const double world[4] = {offset_[0], offset_[1], offset_[0] + aspect_, offset_[1] + 1};
+  for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
   ClassQueryParams
       classes;  // the inks over the whole image, as a frame reads them: by their sums, built once
-  classes.query.x1 = aspect_, classes.query.y1 = 1, classes.query.scale = scale_;
+  classes.query.x0 = world[0], classes.query.y0 = world[1];
+  classes.query.x1 = world[2], classes.query.y1 = world[3], classes.query.scale = scale_;
   classes.class_count = static_cast<std::uint32_t>(densities_.size());
   for (std::size_t k = 0; k < densities_.size(); ++k) classes.classes[k] = densities_[k]->density;
   read_images_by_sums(classes, sums_, HUGE_VAL);  // built once for every frame
@@ -166,9 +177,9 @@ PointSet TileStippler::render(const double uv[4], double fade) const {
     throw std::invalid_argument(stipple_zoom_error("the region", tiles_, mode_));
   // Dots only on the image: a rectangle past its sides (a frame zoomed out) shows blank paper there.
   QueryParams q;
-  q.x0 = std::max(uv[0], 0.0) * aspect_, q.y0 = std::max(uv[1], 0.0);
-  q.x1 = std::min(uv[2], 1.0) * aspect_, q.y1 = std::min(uv[3], 1.0);
-  q.origin_x = uv[0] * aspect_, q.origin_y = uv[1];
+  q.x0 = offset_[0] + std::max(uv[0], 0.0) * aspect_, q.y0 = offset_[1] + std::max(uv[1], 0.0);
+  q.x1 = offset_[0] + std::min(uv[2], 1.0) * aspect_, q.y1 = offset_[1] + std::min(uv[3], 1.0);
+  q.origin_x = offset_[0] + uv[0] * aspect_, q.origin_y = offset_[1] + uv[1];
   q.tile_size = tile_size_;
   q.scale = scale_ * zoom * zoom;  // the same dots on screen, so the zoomed view shows more of them
   q.density = densities_.front()->density;

@@ -53,12 +53,15 @@ class TileStippler {
  public:
   /// The image `spec` (kImage, with some ink) over the world [0, aspect] × [0, 1], aspect its width /
   /// height. `points` dots over the whole image (> 0), or, when points is 0, `scale` dots per unit area at
-  /// full darkness. `tileset` must outlive the stippler; so must `spec`. Throws std::invalid_argument.
-  TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode);
+  /// full darkness. `seed` picks where in the tile set's endless tiling the image lies (another seed, other
+  /// dots; one seed, the same dots in every region and frame). `tileset` must outlive the stippler; so must
+  /// `spec`. Throws std::invalid_argument.
+  TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode,
+               std::uint64_t seed);
   /// Several inks (1 … kMaxQueryClasses images of one size, highest priority first): `points` and `scale`
   /// count the dots of all of them, and render() gives each dot its ink's class.
   TileStippler(const std::vector<const DensitySpec*>& inks, const Tileset& tileset, double points,
-               double scale, QueryMode mode);
+               double scale, QueryMode mode, std::uint64_t seed);
   /// The dots of the UV rectangle `uv` (x0, y0, x1, y1, y up; past [0, 1]² is blank paper), normalised
   /// to it: [0, 1)²; drawn at stipple_zoom(uv), so that dots keep their size and spacing in a picture of
   /// fixed width.
@@ -76,6 +79,7 @@ class TileStippler {
 
   const Tileset& tiles_;
   double aspect_ = 1, scale_ = 0, tile_size_ = 1;
+  double offset_[2] = {0, 0};  ///< the image's world place: [offset, offset + (aspect, 1)]
   QueryMode mode_;
   std::vector<std::unique_ptr<SpecDensity>> densities_;  ///< each image over [0, aspect] × [0, 1]
   ClassImageSums sums_;  ///< several inks: their images' running sums (read_images_by_sums)
