@@ -1,17 +1,18 @@
-// Periodogram P(k) = |Σ_j exp(−2πi k·x_j)|² / n on the integer grid (docs/design.md §6), evaluated as the
-// complex matrix product S = E_xᵀ E_y where E_x(j, kx) = exp(−2πi kx x_j) for kx ∈ [0, kmax] and
-// E_y(j, ky) = exp(−2πi ky y_j) for ky ∈ [−kmax, kmax]; P(−k) = P(k) fills the other half-plane.
-// Points are processed in chunks (bounded memory) on a fixed number of accumulation lanes, so the
-// summation order (and the result) does not depend on the number of threads.
+// Periodogram P(k) = |S(k)|² / n, S(k) = Σ_j exp(−2πi k·x_j), on the integer grid (docs/design.md §6).
+// S is a type-1 non-uniform FFT by Gaussian gridding: Greengard & Lee, "Accelerating the Nonuniform Fast
+// Fourier Transform", SIAM Review 46(3), 2004. Each point spreads a periodised Gaussian onto an oversampled
+// grid, an FFT takes the grid's Fourier coefficients, and dividing by the Gaussian's own coefficients
+// leaves S. O(n + kmax² log kmax) instead of the direct sum's O(n kmax²): 200,000 points to f = 2.5 in
+// seconds, not minutes. Every step has a fixed order, so the result does not depend on the thread count.
 #include "kdm/analysis/periodogram.h"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <unsupported/Eigen/FFT>
 
 #include "kdm/analysis/common.h"
 #include "parallel.h"
@@ -19,28 +20,86 @@
 namespace kdm::analysis {
 namespace {
 
-// Exponentials and the per-chunk products are single precision (twice the SIMD throughput); each chunk's
-// product (≤ 256 terms of modulus 1, error ≲ 1e-5 absolute) is accumulated in double precision, so P has
-// an absolute error ≲ 1e-8 · |S| / n — far below any statistic reported.
-using MatF = Eigen::Matrix<std::complex<float>, Eigen::Dynamic, Eigen::Dynamic>;
-using Mat = Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic>;
-constexpr double kTwoPi = 6.283185307179586476925286766559;
-constexpr std::ptrdiff_t kChunk = 256;  // points per matrix product
-constexpr int kLanes = 4;               // independent partial sums (fixed: determinism)
-constexpr int kRowBlock = 32;           // kx rows per product (the half-disc is covered by such strips)
+constexpr double kPi = 3.14159265358979323846264338327950288;
+// Grid points each side of a point that its Gaussian reaches. With the grid oversampled R = 2 times this
+// truncates the Gaussian at e^(−π·12·(R − ½)/R) ≈ 5e-13 of its peak (Greengard & Lee, §2): S has an
+// absolute error of about 1e-12 · n · e^(π·12/(4R(R − ½))) ≈ 1e-9 · n at |k| = kmax, far below any
+// statistic reported.
+constexpr int kSpread = 12;
 
-// Column j of `e` (rows 0..kmax) gets exp(−2πi k v) for k = 0..kmax: a rotation recurrence, re-anchored
-// with an exact sincos every 32 steps to keep the phase error ≲ 1e-14.
-void fill_exponentials(MatF& e, Eigen::Index col, double v, int kmax, int row0, bool mirror) {
-  const std::complex<double> step = std::polar(1.0, -kTwoPi * v);
-  std::complex<double> z(1.0, 0.0);
-  for (int k = 0; k <= kmax; ++k) {
-    if (k % 32 == 0) z = std::polar(1.0, -kTwoPi * std::fmod(k * v, 1.0));
-    const std::complex<float> zf(static_cast<float>(z.real()), static_cast<float>(z.imag()));
-    e(row0 + k, col) = zf;
-    if (mirror && k > 0) e(row0 - k, col) = std::conj(zf);
-    z *= step;
+// The smallest 2^a 3^b 5^c ≥ at_least: the FFT's fast sizes.
+int fft_size(int at_least) {
+  for (int m = std::max(at_least, 1);; ++m) {
+    int r = m;
+    for (int f : {2, 3, 5})
+      while (r % f == 0) r /= f;
+    if (r == 1) return m;
   }
+}
+
+// Adds |S(k)|²/n of one set to `acc` ((2kmax+1)² grid, disc |k| ≤ kmax; NaN outside it).
+void accumulate_set(const std::vector<double>& coords, int kmax, int threads, std::vector<double>& acc) {
+  const std::size_t n = coords.size() / 2;
+  const int modes = 2 * kmax + 1;
+  const int m = fft_size(2 * modes);  // the oversampled grid's side
+  const double ratio = double(m) / modes;
+  // The Gaussian exp(−d²/(4τ)) (d in units of the unit square), its width chosen for the oversampling.
+  const double tau = kSpread / (4 * kPi * ratio * (ratio - 0.5) * double(modes) * modes);
+  std::vector<double> grid(std::size_t(m) * std::size_t(m), 0.0);  // row y, column x
+  {
+    constexpr int w = 2 * kSpread;
+    double wx[w], wy[w];
+    int ix[w], iy[w];
+    const auto weights = [&](double v, double* out, int* index) {
+      const int c = static_cast<int>(std::floor(v * m));
+      for (int t = 0; t < w; ++t) {
+        const int g = c - kSpread + 1 + t;
+        const double d = v - double(g) / m;
+        out[t] = std::exp(-d * d / (4 * tau));
+        index[t] = ((g % m) + m) % m;
+      }
+    };
+    for (std::size_t j = 0; j < n; ++j) {  // in order: the sums do not depend on threads
+      weights(coords[2 * j], wx, ix);
+      weights(coords[2 * j + 1], wy, iy);
+      for (int ty = 0; ty < w; ++ty) {
+        double* row = grid.data() + std::size_t(iy[ty]) * m;
+        for (int tx = 0; tx < w; ++tx) row[ix[tx]] += wy[ty] * wx[tx];
+      }
+    }
+  }
+  // Rows: kx ∈ [0, kmax] of each (the other half plane is the mirror image: P(−k) = P(k)).
+  const int kx_count = kmax + 1;
+  std::vector<std::complex<double>> half(std::size_t(m) * kx_count);
+  const int workers = detail::worker_count(threads, m);
+  std::vector<Eigen::FFT<double>> ffts(workers);
+  std::vector<std::vector<double>> row_in(workers, std::vector<double>(m));
+  std::vector<std::vector<std::complex<double>>> out(workers, std::vector<std::complex<double>>(m));
+  detail::parallel_for(m, workers, [&](std::ptrdiff_t y, int t) {
+    std::copy_n(grid.data() + y * m, m, row_in[t].data());
+    ffts[t].fwd(out[t], row_in[t]);
+    std::copy_n(out[t].data(), kx_count, half.data() + y * kx_count);
+  });
+  std::vector<double>().swap(grid);
+  // Columns, then the Gaussian divided out: its coefficients are √(4πτ)·exp(−4π²τk²) per axis, and the
+  // FFT's sum over m grid points stands for m times the integral.
+  const int side = 2 * kmax + 1;
+  const double inv_n = 1.0 / static_cast<double>(n), nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<std::complex<double>>> column(workers, std::vector<std::complex<double>>(m));
+  std::vector<double> deconvolve(kx_count);
+  for (int k = 0; k <= kmax; ++k)
+    deconvolve[k] = std::exp(4 * kPi * kPi * tau * double(k) * k) / (m * std::sqrt(4 * kPi * tau));
+  detail::parallel_for(kx_count, workers, [&](std::ptrdiff_t kx, int t) {
+    for (int y = 0; y < m; ++y) column[t][y] = half[std::size_t(y) * kx_count + kx];
+    ffts[t].fwd(out[t], column[t]);
+    for (int ky = -kmax; ky <= kmax; ++ky) {
+      const bool inside = kx * kx + ky * ky <= std::ptrdiff_t(kmax) * kmax;
+      const std::complex<double> s = out[t][(ky + m) % m] * (deconvolve[kx] * deconvolve[std::abs(ky)]);
+      const double p = inside ? std::norm(s) * inv_n : nan;
+      acc[static_cast<std::size_t>(ky + kmax) * side + (kx + kmax)] += p;
+      if (kx > 0) acc[static_cast<std::size_t>(kmax - ky) * side + (kmax - kx)] += p;
+    }
+  });
 }
 
 }  // namespace
@@ -55,49 +114,6 @@ int Periodogram::ring_max() const {
 }
 
 namespace {
-
-// Adds |S(k)|²/n of one set to `acc` ((2kmax+1)² grid). n_norm is the set's own point count.
-void accumulate_set(const std::vector<double>& coords, int kmax, int threads, std::vector<double>& acc) {
-  const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(coords.size() / 2);
-  const int kx_count = kmax + 1, ky_count = 2 * kmax + 1;
-  const std::ptrdiff_t chunks = (n + kChunk - 1) / kChunk;
-  const int lanes = static_cast<int>(std::min<std::ptrdiff_t>(kLanes, std::max<std::ptrdiff_t>(1, chunks)));
-  // Only the half-disc |k| ≤ kmax is needed: rows kx of a block share the ky range of their smallest kx.
-  std::vector<int> block_width;
-  for (int kx0 = 0; kx0 <= kmax; kx0 += kRowBlock)
-    block_width.push_back(static_cast<int>(std::floor(std::sqrt(double(kmax) * kmax - double(kx0) * kx0))));
-  std::vector<Mat> partial(lanes, Mat::Zero(kx_count, ky_count));
-  detail::parallel_for(lanes, threads, [&](std::ptrdiff_t lane, int) {
-    MatF ex(kx_count, kChunk), ey(ky_count, kChunk), prod(kRowBlock, ky_count);
-    for (std::ptrdiff_t c = lane; c < chunks; c += lanes) {
-      const std::ptrdiff_t j0 = c * kChunk, m = std::min(kChunk, n - j0);
-      for (std::ptrdiff_t j = 0; j < m; ++j) {
-        fill_exponentials(ex, j, coords[2 * (j0 + j)], kmax, 0, false);
-        fill_exponentials(ey, j, coords[2 * (j0 + j) + 1], kmax, kmax, true);
-      }
-      for (std::size_t b = 0; b < block_width.size(); ++b) {
-        const int kx0 = static_cast<int>(b) * kRowBlock, rows = std::min(kRowBlock, kx_count - kx0);
-        const int w = block_width[b], cols = 2 * w + 1;
-        prod.topLeftCorner(rows, cols).noalias() =
-            ex.block(kx0, 0, rows, m) * ey.block(kmax - w, 0, cols, m).transpose();
-        partial[lane].block(kx0, kmax - w, rows, cols) +=
-            prod.topLeftCorner(rows, cols).cast<std::complex<double>>();
-      }
-    }
-  });
-  for (int l = 1; l < lanes; ++l) partial[0] += partial[l];
-  const Mat& s = partial[0];
-  const int side = 2 * kmax + 1;
-  const double inv_n = 1.0 / static_cast<double>(n);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (int kx = 0; kx <= kmax; ++kx)
-    for (int ky = -kmax; ky <= kmax; ++ky) {
-      const bool inside = kx * kx + ky * ky <= kmax * kmax;
-      const double p = inside ? std::norm(s(kx, ky + kmax)) * inv_n : nan;
-      acc[static_cast<std::size_t>(ky + kmax) * side + (kx + kmax)] += p;
-      if (kx > 0) acc[static_cast<std::size_t>(kmax - ky) * side + (kmax - kx)] += p;
-    }
-}
 
 Periodogram make_grid(double mean_n, double fmax) {
   if (!(fmax > 0) || !std::isfinite(fmax)) throw InvalidInput("fmax must be a positive number");

@@ -4,7 +4,7 @@
 //   r/√n), lowP = mean P over 0 < f < 0.5, peak height/position of RAPS, ν_eff = largest f with RAPS < 0.1 on
 //   every ring in (0, f], anisotropy (dB) = mean over rings 0.5 < f < 2.5 of 10·log10(var/mean²).
 // P is exact for periodic (torus) sets; for box sets it includes the square window's leakage.
-// Computed as a complex matrix product S = E_xᵀ E_y of per-axis exponentials, chunked over points.
+// S(k) is a non-uniform FFT (Gaussian gridding; relative error about 1e-10).
 #pragma once
 
 #include <cstddef>
@@ -32,10 +32,10 @@ struct Periodogram {
 };
 
 /// Periodogram of one 2D set up to normalised frequency `fmax` (kmax = ceil(fmax·√n) + 1). `coords`
-/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n · kmax²) flops, memory
-/// O(kmax²). Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the
-/// result does not depend on the thread count (fixed summation order). With threads = 1 the matrix products
-/// themselves may still use Eigen's OpenMP threads. A time for scale: docs/design.md §6.
+/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n + kmax² log kmax),
+/// memory about 200 · kmax² bytes. Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no
+/// shared state); the result does not depend on the thread count (fixed summation order). A time for
+/// scale: docs/design.md §6.
 Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0);
 
 /// Mean periodogram of several 2D sets (all on the grid of the mean point count). Throws InvalidInput for an
