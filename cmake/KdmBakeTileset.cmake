@@ -9,7 +9,7 @@
 #   EMBED    a static library of that name holding the set's bytes, for a program that carries its set
 #            inside it: link it, `#include "<name>.h"` and pass `<name>, <name>_size` to
 #            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier.
-#   THREADS  baking threads (0, the default, takes every core). The file does not depend on it.
+#   THREADS  baking and verifying threads (0, the default, takes every core). The file does not depend on it.
 #   VERIFY   also runs `kdm verify` (the generator test) on the baked file, and fails the build if any
 #            check fails.
 # The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed:
@@ -52,11 +52,13 @@ function(kdm_bake_tileset)
   set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
             COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS})
   if(arg_VERIFY)
-    list(APPEND steps COMMAND kdm::kdm verify --quiet "${scratch}")
+    list(APPEND steps COMMAND "${CMAKE_COMMAND}" "-DKDM_VERIFY_KDM=$<TARGET_FILE:kdm::kdm>"
+                              "-DKDM_VERIFY_FILE=${scratch}" "-DKDM_VERIFY_THREADS=${arg_THREADS}"
+                              -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake")
   endif()
   list(APPEND steps COMMAND "${CMAKE_COMMAND}" -E rename "${scratch}" "${output}")
   add_custom_command(OUTPUT "${output}" ${steps}
-                     DEPENDS "${recipe}" "$<TARGET_FILE:kdm::kdm>"
+                     DEPENDS "${recipe}" "$<TARGET_FILE:kdm::kdm>" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake"
                      COMMENT "Baking tile set ${output} from ${recipe}"
                      VERBATIM)
   if(arg_TARGET)

@@ -389,8 +389,10 @@ def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:
 def bake(recipe_text: str, *, threads: int = 0) -> Tileset:
     """Bakes a tile set from recipe text ("key value" lines, as ``kdm bake`` reads from a file).
 
-    A recipe gives the same set for any `threads`. Real sets take minutes to hours; a recipe of a few
-    small levels bakes in seconds. Raises ValueError for a bad recipe.
+    A recipe gives the same set for any `threads` (worker threads; 0: one per core). Real sets take
+    minutes to hours; a recipe of a few small levels bakes in seconds. Ctrl-C stops it after the runs it is
+    sampling. Raises ValueError for a bad recipe, some values only once baking finds them (a hand-over
+    whose subtiles hold too few points: the message names the key to change).
     """
     if not isinstance(recipe_text, str):
         raise TypeError(f"recipe_text must be a str, got {type(recipe_text).__name__}")

@@ -35,7 +35,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (mode != "stable" && mode != "smooth")
     throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
   if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
-  if (output) tools::refuse_writing_over(label, *output);
+  if (output) tools::refuse_writing_over(label, *output, "input image");
   check_number("dot_size", dot_size, 0, false);
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   if (spec.kind != DensitySpec::Kind::kImage)

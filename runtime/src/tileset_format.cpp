@@ -532,12 +532,26 @@ Status load_tileset(const std::string& path, TilesetData& out, std::string* deta
   return decode_tileset(bytes.data(), bytes.size(), out, detail);
 }
 
+namespace {
+
+// A device or a pipe (/dev/null, /dev/stdout, a FIFO): written into, as a shell's > does, since a rename
+// would replace it with a regular file.
+bool is_special_file(const std::string& path) {
+  struct stat info;
+  return stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISDIR(info.st_mode);
+}
+
+}  // namespace
+
 Status check_tileset_path(const std::string& path, std::string* detail) {
   if (path.empty()) return fail(Status::kIoError, detail, "no file name to save the tile set to");
   struct stat info;
   if (stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
     return fail(Status::kIoError, detail, "cannot write '" + path + "': it is a directory");
+  if (is_special_file(path)) return Status::kOk;
   const std::string temp = path + ".partial";
+  if (stat(temp.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+    return fail(Status::kIoError, detail, "cannot create '" + temp + "': it is a directory");
   std::FILE* f = std::fopen(temp.c_str(), "wb");
   if (!f) return fail(Status::kIoError, detail, "cannot create '" + temp + "': " + std::strerror(errno));
   std::fclose(f);
@@ -547,26 +561,28 @@ Status check_tileset_path(const std::string& path, std::string* detail) {
 
 Status save_tileset(const TilesetData& set, const std::string& given_path, std::string* detail) {
   if (const Status s = check_tileset_path(given_path, detail); s != Status::kOk) return s;
+  const bool special = is_special_file(given_path);
   // A symbolic link is written through, as cp and a shell's > do: the rename replaces its target.
   std::string path = given_path;
   std::error_code ec;
-  if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
+  if (!special && std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
     const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
     if (!ec) path = target.string();
   }
   std::vector<std::uint8_t> bytes;
   if (const Status s = encode_tileset(set, bytes, detail); s != Status::kOk) return s;
-  const std::string temp = path + ".partial";
+  const std::string temp = special ? path : path + ".partial";
   {
     std::ofstream f(temp, std::ios::binary | std::ios::trunc);
     if (!f) return fail(Status::kIoError, detail, "cannot create '" + temp + "': " + std::strerror(errno));
     f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     f.flush();
     if (!f) {
-      std::remove(temp.c_str());
+      if (!special) std::remove(temp.c_str());
       return fail(Status::kIoError, detail, "cannot write '" + temp + "'");
     }
   }
+  if (special) return Status::kOk;
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     const std::string reason = std::strerror(errno);
     std::remove(temp.c_str());

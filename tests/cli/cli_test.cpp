@@ -760,3 +760,48 @@ TEST_F(CliTest, PointFilesAreByteIdenticalAcrossRuns) {
 }
 
 }  // namespace
+
+namespace {
+
+// The bytes a background reader copied out of a pipe, once the writer has closed it (the reader may still
+// be copying when kdm returns: up to 10 s for `min_bytes`).
+std::string drain(const std::string& copy, std::size_t min_bytes) {
+  std::string bytes;
+  for (int i = 0; i < 1000 && bytes.size() < min_bytes; ++i) {
+    bytes = slurp(copy);
+    if (bytes.size() < min_bytes) std::system("sleep 0.01");
+  }
+  return bytes;
+}
+
+}  // namespace
+
+// Output into a pipe (or a device such as /dev/null) is written into it, as a shell's > does; an atomic
+// rename would replace it with a regular file. And a bake never writes over its own recipe.
+TEST_F(CliTest, OutputsGoIntoPipesAndABakeKeepsItsRecipe) {
+  namespace fs = std::filesystem;
+  const std::string pipe = path("points.csv"), copy = path("copy.csv");
+  ASSERT_EQ(std::system(("mkfifo '" + pipe + "'").c_str()), 0);
+  const Outcome q =
+      kdm("query --rect 0,0,1,1 --scale 200 -o '" + pipe + "'", "cat '" + pipe + "' >'" + copy + "' & ");
+  ASSERT_EQ(q.status, 0) << q.err;
+  EXPECT_TRUE(fs::is_fifo(pipe));
+  const std::string csv = drain(copy, 2000);
+  EXPECT_EQ(csv.rfind("x,y,", 0), 0u) << csv.substr(0, 80);
+  EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 150);  // ~200 points and a header
+
+  std::ofstream(path("r.recipe")) << "levels 1\ncolours 1\nsweeps 2\n";
+  const std::string set_pipe = path("set.kdmt"), set_copy = path("set_copy.kdmt");
+  ASSERT_EQ(std::system(("mkfifo '" + set_pipe + "'").c_str()), 0);
+  const Outcome b = kdm("bake '" + path("r.recipe") + "' --threads 1 -o '" + set_pipe + "'",
+                        "cat '" + set_pipe + "' >'" + set_copy + "' & ");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_TRUE(fs::is_fifo(set_pipe));
+  EXPECT_FALSE(fs::exists(set_pipe + ".partial"));
+  const std::string bytes = drain(set_copy, 64);
+  kdm::Tileset loaded;
+  EXPECT_EQ(kdm::Tileset::load_memory(bytes.data(), bytes.size(), loaded), kdm::Status::kOk);
+
+  expect_error("bake '" + path("r.recipe") + "' -o '" + path("r.recipe") + "'", "is the recipe");
+  EXPECT_EQ(slurp(path("r.recipe")), "levels 1\ncolours 1\nsweeps 2\n");
+}

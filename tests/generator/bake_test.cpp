@@ -31,6 +31,53 @@ std::vector<std::uint8_t> encoded(const TilesetData& set) {
   return bytes;
 }
 
+/// parse's refusal of `text`, or "" when it parses.
+std::string refusal(const std::string& text) {
+  try {
+    BakeRecipe::parse(text);
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A key that only tunes another key's pass is refused without it (alone it would do nothing, silently);
+// numbers are decimal, a seed is read exactly, and an invisible byte is shown.
+TEST(BakeTest, RecipeRefusesKeysThatWouldDoNothingAndOddNumbers) {
+  for (const char* text : {"separation_push 0.55\n", "separation 0.3\nseparation_fill 1\n",
+                           "separation 0.3\nseparation_per_level 1\n", "split_shared 1\n", "glide_sweeps 5\n",
+                           "glide_separation 0.3\n", "glide_consensus 8192\n",
+                           "glide_corner_consensus 8192\n", "glide_late 0.5\n"})
+    EXPECT_NE(refusal(text).find(" needs "), std::string::npos) << text << ": " << refusal(text);
+  EXPECT_NE(refusal("separation 0.5\nseparation_push 0.3\n").find("at least separation 0.5"),
+            std::string::npos);
+  EXPECT_EQ(refusal("keyframes 2\nglide_sweeps 5\nglide_separation 0.3\nsplit_shared 1\n"), "");
+  EXPECT_EQ(BakeRecipe::parse("seed 9007199254740993\n").seed, 9007199254740993u);  // past a double's
+  EXPECT_EQ(BakeRecipe::parse("seed 18446744073709551615\n").seed, 18446744073709551615u);
+  EXPECT_NE(refusal("seed 18446744073709551616\n").find("seed must be a whole number"), std::string::npos);
+  EXPECT_NE(refusal("seed 0x10\n").find("seed must be a whole number"), std::string::npos);
+  EXPECT_NE(refusal("levels 0x3\n").find("is not a number"), std::string::npos);
+  EXPECT_NE(refusal("band inf\n").find("is not a number"), std::string::npos);
+  EXPECT_NE(refusal("band 1e400\n").find("out of range"), std::string::npos);
+  EXPECT_NE(refusal(std::string("colours 1\0junk\n", 15)).find("'1\\x00junk' is not a number"),
+            std::string::npos)
+      << refusal(std::string("colours 1\0junk\n", 15));
+  EXPECT_EQ(BakeRecipe::parse("\xEF\xBB\xBFlevels 3\n").levels, 3u);  // a byte order mark is skipped
+  EXPECT_NE(refusal("lev\x01"
+                    "els 3\n")
+                .find("unknown key 'lev\\x01els'"),
+            std::string::npos);
+  EXPECT_NE(refusal("temperature 2000\n").find("temperature must be in [0, 1000]"), std::string::npos)
+      << refusal("temperature 2000\n");
+  EXPECT_EQ(BakeRecipe::parse("fill_holes 0\n").fill_holes, 0.0);  // off, said explicitly
+  // A hand-over whose subtiles hand over more points than the format's hand-over entries address is
+  // refused here, not after the bake.
+  EXPECT_NE(refusal("levels 3\ncolours 1\nbase_points 700\nkeyframes 1\nhandover_zone 1\n")
+                .find("more than a tile set's hand-over addresses (2621)"),
+            std::string::npos)
+      << refusal("levels 3\ncolours 1\nbase_points 700\nkeyframes 1\nhandover_zone 1\n");
+}
+
 TEST(BakeTest, RecipeRoundTripAndErrors) {
   const BakeRecipe r = BakeRecipe::parse(
       "# comment\nseed 7\nlevels 3 # trailing\nbase_points 32\ntemperature 0.25\ncolours 3\nband 0.34\n"
@@ -74,25 +121,30 @@ TEST(BakeTest, RecipeRoundTripAndErrors) {
     EXPECT_NE(std::string(e.what()).find("fill_holes 0.5"), std::string::npos) << e.what();
   }
   EXPECT_EQ(r.to_text().find("glide_consensus"), std::string::npos);  // off unless named
-  EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_consensus 2048\n").to_text()).glide_consensus, 2048u);
+  EXPECT_EQ(
+      BakeRecipe::parse(BakeRecipe::parse("keyframes 2\nglide_consensus 2048\n").to_text()).glide_consensus,
+      2048u);
   EXPECT_THROW(BakeRecipe::parse("glide_consensus 0.5\n"), InvalidArgument);
   EXPECT_EQ(r.to_text().find("glide_corner_consensus"), std::string::npos);  // off unless named
-  EXPECT_EQ(
-      BakeRecipe::parse(BakeRecipe::parse("glide_corner_consensus 32768\n").to_text()).glide_corner_consensus,
-      32768u);
+  EXPECT_EQ(BakeRecipe::parse(BakeRecipe::parse("keyframes 2\nglide_corner_consensus 32768\n").to_text())
+                .glide_corner_consensus,
+            32768u);
   EXPECT_THROW(BakeRecipe::parse("glide_corner_consensus -1\n"), InvalidArgument);
   EXPECT_EQ(r.to_text().find("glide_late"), std::string::npos);  // off unless named
-  EXPECT_DOUBLE_EQ(BakeRecipe::parse(BakeRecipe::parse("glide_late 0.75\n").to_text()).glide_late, 0.75);
-  EXPECT_THROW(BakeRecipe::parse("glide_late 1\n"), InvalidArgument);
-  EXPECT_THROW(BakeRecipe::parse("glide_late -0.1\n"), InvalidArgument);
+  EXPECT_DOUBLE_EQ(
+      BakeRecipe::parse(BakeRecipe::parse("keyframes 2\nglide_late 0.75\n").to_text()).glide_late, 0.75);
+  EXPECT_THROW(BakeRecipe::parse("keyframes 2\nglide_late 1\n"), InvalidArgument);
+  EXPECT_THROW(BakeRecipe::parse("keyframes 2\nglide_late -0.1\n"), InvalidArgument);
   EXPECT_EQ(r.to_text().find("split_shared"), std::string::npos);  // off unless named
-  EXPECT_TRUE(BakeRecipe::parse(BakeRecipe::parse("split_shared 1\n").to_text()).split_shared);
-  EXPECT_THROW(BakeRecipe::parse("split_shared 2\n"), InvalidArgument);
+  EXPECT_TRUE(
+      BakeRecipe::parse(BakeRecipe::parse("separation 0.3\nsplit_shared 1\n").to_text()).split_shared);
+  EXPECT_THROW(BakeRecipe::parse("separation 0.3\nsplit_shared 2\n"), InvalidArgument);
   for (const char* key : {"separation_fill", "separation_per_level"}) {
     EXPECT_EQ(r.to_text().find(key), std::string::npos) << key;  // off unless named
-    const BakeRecipe on = BakeRecipe::parse(BakeRecipe::parse(std::string(key) + " 1\n").to_text());
+    const std::string push = "separation 0.3\nseparation_push 0.5\n";
+    const BakeRecipe on = BakeRecipe::parse(BakeRecipe::parse(push + key + " 1\n").to_text());
     EXPECT_TRUE(std::string(key) == "separation_fill" ? on.separation_fill : on.separation_per_level) << key;
-    EXPECT_THROW(BakeRecipe::parse(std::string(key) + " 2\n"), InvalidArgument) << key;
+    EXPECT_THROW(BakeRecipe::parse(push + key + " 2\n"), InvalidArgument) << key;
   }
   EXPECT_EQ(r.edge_gap, kFirstEdgeGap);
   EXPECT_EQ(r.rank_context, 0);

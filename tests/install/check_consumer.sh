@@ -27,5 +27,6 @@ grep -q "levels" "$work/bad.log" || { echo "the refused bake did not say why:"; 
 printf 'colours 1\nlevels 2\nbase_points 32\ntemperature 50\n' >"$work/src/small.recipe"
 if cmake --build "$work/build" >"$work/unverified.log" 2>&1; then echo "a set failing verification was built"; exit 1; fi
 grep -q "failed [0-9]* check" "$work/unverified.log" || { echo "verification did not say why:"; cat "$work/unverified.log"; exit 1; }
+if [ -e "$baked.baking" ]; then echo "the failed verification left $baked.baking behind"; exit 1; fi
 if cmake --build "$work/build" >/dev/null 2>&1; then echo "the build after a failed verification passed"; exit 1; fi
 echo "consumer ok"

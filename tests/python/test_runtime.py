@@ -744,3 +744,32 @@ def test_glide_together_moves_the_same_points_and_keeps_them_apart():
                           BUILTIN.query((0, 0, 1, 1), **stable).xy)
     with pytest.raises(TypeError, match="glide_together"):
         BUILTIN.query((0, 0, 1, 1), glide_together="yes", **args)
+
+
+def test_a_signal_stops_a_bake_inside_its_call():
+    # As for the sampler: a handler that raises (as Ctrl-C's does) runs between the bake's runs, so the call
+    # ends with the exception ("c_exception") instead of returning the set. This recipe takes about 9 s on
+    # one thread; the alarm comes after 0.3 s.
+    import signal
+    import sys
+
+    events = []
+
+    def profile(frame, event, arg):
+        if event in ("c_return", "c_exception") and getattr(arg, "__name__", "") == "bake":
+            events.append(event)
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.3)
+    sys.setprofile(profile)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            kdm.bake("levels 3\ncolours 2\nsweeps 100\n", threads=1)
+    finally:
+        sys.setprofile(None)
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert events == ["c_exception"]

@@ -52,7 +52,7 @@ std::string frame_path(const std::string& output, int i) {
 void run_stipple(const StippleArgs& a, bool scale_given) {
   check_output_option(a.output, {".png", ".svg", ".txt", ".csv"});  // before the dots are placed
   for (int i = 0; i < std::max(1, a.frames); ++i)
-    tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output);
+    tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output, "input image");
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
     throw CommandError("--scale must be a number > 0 (dots per unit area at full darkness)");
   if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");

@@ -8,6 +8,7 @@
 #include <iterator>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "checked_options.h"
@@ -15,6 +16,7 @@
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
+#include "point_output.h"
 #include "progress.h"
 
 namespace kdm::cli {
@@ -47,14 +49,24 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   } catch (const gen::InvalidArgument& e) {
     throw CommandError("'" + recipe_path + "': " + e.what());
   }
+  try {
+    tools::refuse_writing_over(recipe_path, output, "recipe");
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(e.what());
+  }
   std::string detail;
   if (const Status s = check_tileset_path(output, &detail); s != Status::kOk)  // before minutes of baking
     throw CommandError(std::string(status_message(s)) + ": " + detail);
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("baking");
   gen::BakeReport report;
-  const TilesetData set = gen::bake_tileset(
-      recipe, threads, [&bar](double f) { bar.update(f); }, &report);
+  TilesetData set;
+  try {
+    set = gen::bake_tileset(
+        recipe, threads, [&bar](double f) { bar.update(f); }, &report);
+  } catch (const gen::InvalidArgument& e) {  // the recipe's values, found while baking
+    throw CommandError("'" + recipe_path + "': " + e.what());
+  }
   bar.finish();
   const Status s = save_tileset(set, output, &detail);
   if (s != Status::kOk) throw CommandError(std::string(status_message(s)) + ": " + detail);
@@ -67,6 +79,19 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   if (recipe.glide_separation > 0)
     std::fprintf(stderr, "  close glides: %zu point(s) split per tile, %zu removed\n", report.glide_split,
                  report.glide_removed);
+}
+
+/// Text from a file for the terminal: bytes outside printable ASCII as \xNN, so that a damaged or hostile
+/// file cannot send control sequences.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "\\x%02X", byte);
+    out += byte >= 0x20 && byte < 0x7F ? std::string(1, c) : std::string(hex);
+  }
+  return out;
 }
 
 void run_info(const std::string& path) {
@@ -88,8 +113,9 @@ void run_info(const std::string& path) {
               header.format_version, header.header_bytes,
               static_cast<unsigned long long>(header.payload_bytes),
               static_cast<unsigned long long>(header.decompressed_bytes));
-  std::printf("generator      kdm %s\n", set.generator_version.c_str());
-  std::printf("colours        %u (%zu tiles)\n", set.colours, set.tiles.size());
+  std::printf("generator      kdm %s\n", printable(set.generator_version).c_str());
+  std::printf("colours        %u (%zu tile%s)\n", set.colours, set.tiles.size(),
+              set.tiles.size() == 1 ? "" : "s");
   std::printf("levels         %u\n", set.levels);
   std::printf("points/level   ");
   for (std::uint32_t k = 0; k < set.levels; ++k) std::printf("%s%u", k ? " " : "", set.level_nominal[k]);
@@ -116,13 +142,13 @@ void run_info(const std::string& path) {
       std::snprintf(keyframe, sizeof keyframe, "their first keyframe above level %u", set.handover_level);
     std::printf(
         "hand-over      onto %u x %u subtiles past the top level, at %s (%u points per tile; zones of %u "
-        "sub-steps; smooth queries descend)\n",
+        "sub-step%s; smooth queries descend)\n",
         set.subtiles_per_side(), set.subtiles_per_side(), keyframe,
-        set.keyframe_nominal[set.handover_keyframe()], set.handover_zone);
+        set.keyframe_nominal[set.handover_keyframe()], set.handover_zone, set.handover_zone == 1 ? "" : "s");
   }
   std::printf("recipe\n");
   std::istringstream recipe(set.recipe);
-  for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", line.c_str());
+  for (std::string line; std::getline(recipe, line);) std::printf("  %s\n", printable(line).c_str());
 }
 
 }  // namespace

@@ -589,14 +589,19 @@ void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8
 }
 
 bool write_text_file_atomic(const std::string& given_path, const std::string& text, std::string& error) {
+  // A device or a pipe (/dev/null, /dev/stdout, a FIFO) is written into, as a shell's > does: a rename
+  // would replace it with a regular file.
+  struct stat info;
+  const bool special =
+      stat(given_path.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISDIR(info.st_mode);
   // A symbolic link is written through, as cp and a shell's > do: the rename replaces its target.
   std::string path = given_path;
   std::error_code ec;
-  if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
+  if (!special && std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) {
     const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
     if (!ec) path = target.string();
   }
-  const std::string tmp = temp_path_for(path);
+  const std::string tmp = special ? path : temp_path_for(path);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) {
     error = "cannot write '" + path + "': " + std::strerror(errno);
@@ -607,10 +612,10 @@ bool write_text_file_atomic(const std::string& given_path, const std::string& te
   const int write_errno = errno;
   if (std::fclose(f) != 0 || !written) {
     error = "cannot write '" + path + "': " + std::strerror(written ? errno : write_errno);
-    std::remove(tmp.c_str());
+    if (!special) std::remove(tmp.c_str());
     return false;
   }
-  return commit_temp(tmp, path, error);
+  return special || commit_temp(tmp, path, error);
 }
 
 }  // namespace kdm::tools

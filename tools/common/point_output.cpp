@@ -48,10 +48,10 @@ std::vector<Ink> class_inks(std::size_t count) {
   return inks;
 }
 
-void refuse_writing_over(const std::string& input, const std::string& output) {
+void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what) {
   std::error_code unknown;
   if (output == input || std::filesystem::equivalent(input, output, unknown))
-    throw std::invalid_argument("the output '" + output + "' is the input image: write another file");
+    throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,

@@ -36,9 +36,9 @@ struct DrawStyle {
   Blend blend = Blend::kOver;
 };
 
-/// Throws std::invalid_argument when `output` names the file `input` (the same path, or a link to it):
-/// a picture written over the image it came from.
-void refuse_writing_over(const std::string& input, const std::string& output);
+/// Throws std::invalid_argument when `output` names the file `input` (the same path, or a link to it),
+/// `what` saying what the input is ("input image"): a result written over what it came from.
+void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.
 /// Throws std::invalid_argument on an unknown extension or a picture too large, std::runtime_error on a

@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <map>
@@ -50,6 +52,19 @@ std::string shortest(double v) {
   return std::string(text, r.ptr);
 }
 
+/// `text` for a message: bytes outside printable ASCII as \xNN (a key or value with an invisible byte in it
+/// would print as if it were right), and at most 40 bytes of it.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "\\x%02X", c);
+    out += c >= 0x20 && c < 0x7F ? std::string(1, char(c)) : std::string(hex);
+  }
+  return text.size() > 40 ? out + "..." : out;
+}
+
 }  // namespace
 
 bool BakeRecipe::gives_any_key(const std::string& text) {
@@ -68,6 +83,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
   std::map<std::string, int> seen;  // key -> the line that gave it
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
     std::istringstream fields(line);
     std::string key, value, extra;
@@ -77,9 +93,25 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     // A second value would silently win over the first: which one the author meant is not known.
     if (const auto [it, first] = seen.emplace(key, line_no); !first)
       throw InvalidArgument(where + key + " was already given on line " + std::to_string(it->second));
+    if (key == "seed") {  // every 64-bit seed, exactly: not through a double
+      errno = 0;
+      char* end = nullptr;
+      r.seed = std::strtoull(value.c_str(), &end, 10);
+      if (value.find_first_not_of("0123456789") != std::string::npos || errno == ERANGE)
+        throw InvalidArgument(where + "seed must be a whole number in [0, 18446744073709551615], got '" +
+                              printable(value) + "'");
+      continue;
+    }
+    // Decimal numbers only: strtod also reads hexadecimal, "inf" and "nan", and stops at a NUL byte.
+    if (value.find_first_not_of("0123456789+-.eE") != std::string::npos)
+      throw InvalidArgument(where + "'" + printable(value) + "' is not a number");
     char* end = nullptr;
+    errno = 0;
     const double v = std::strtod(value.c_str(), &end);
-    if (*end != '\0' || !std::isfinite(v)) throw InvalidArgument(where + "'" + value + "' is not a number");
+    if (end != value.c_str() + value.size())
+      throw InvalidArgument(where + "'" + printable(value) + "' is not a number");
+    if (errno == ERANGE && std::fabs(v) > 1)
+      throw InvalidArgument(where + key + " " + value + " is out of range");
     auto whole = [&](double lo, double hi) {
       if (v != std::floor(v) || v < lo || v > hi)
         throw InvalidArgument(where + key + " must be a whole number in [" +
@@ -92,9 +124,7 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
         throw InvalidArgument(where + key + " must be in [" + shortest(lo) + ", " + shortest(hi) + "]");
       return v;
     };
-    if (key == "seed")
-      r.seed = static_cast<std::uint64_t>(whole(0, 9007199254740992.0));
-    else if (key == "colours")
+    if (key == "colours")
       r.colours = static_cast<std::uint32_t>(whole(1, kMaxTileColours));
     else if (key == "levels")
       r.levels = static_cast<std::uint32_t>(whole(1, 10));
@@ -124,7 +154,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "separation_per_level") {
       r.separation_per_level = whole(0, 1) != 0;
     } else if (key == "fill_holes") {
-      r.fill_holes = within(0.5, 2);
+      if (v != 0 && !(v >= 0.5 && v <= 2))
+        throw InvalidArgument(where + "fill_holes must be 0 (off) or in [0.5, 2]");
+      r.fill_holes = v;
     } else if (key == "glide_separation") {
       r.glide_separation = within(0, 0.7);
     } else if (key == "keyframes") {
@@ -144,10 +176,9 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     } else if (key == "glide_sweeps") {
       r.glide_sweeps = static_cast<int>(whole(1, 1000));
     } else if (key == "temperature") {
-      if (v < 0) throw InvalidArgument(where + "temperature must be >= 0");
-      r.temperature = v;
+      r.temperature = within(0, kMaxTemperature);
     } else {
-      throw InvalidArgument(where + "unknown key '" + key + "'");
+      throw InvalidArgument(where + "unknown key '" + printable(key) + "'");
     }
   }
   if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
@@ -162,6 +193,24 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
                   unsigned(r.base_points), r.band, r.erosion, r.edge_gap);
     throw InvalidArgument(text);
   }
+  // Keys that only tune another's pass: alone they would do nothing, silently.
+  const auto needs = [&](const char* key, bool on, bool parent_on, const char* parent) {
+    if (on && !parent_on) throw InvalidArgument(std::string("recipe: ") + key + " needs " + parent);
+  };
+  needs("separation_push", r.separation_push > 0, r.separation > 0, "separation");
+  if (r.separation_push > 0 && r.separation_push < r.separation)
+    throw InvalidArgument("recipe: separation_push " + shortest(r.separation_push) +
+                          " must be at least separation " + shortest(r.separation));
+  needs("separation_fill", r.separation_fill, r.separation_push > 0, "separation_push");
+  needs("separation_per_level", r.separation_per_level, r.separation_push > 0, "separation_push");
+  needs("split_shared", r.split_shared, r.separation > 0 || r.glide_separation > 0,
+        "separation or glide_separation");
+  const bool track = r.keyframes_per_level > 0;
+  needs("glide_sweeps", seen.count("glide_sweeps") > 0, track, "a glide track (keyframes)");
+  needs("glide_separation", r.glide_separation > 0, track, "a glide track (keyframes)");
+  needs("glide_consensus", r.glide_consensus > 0, track, "a glide track (keyframes)");
+  needs("glide_corner_consensus", r.glide_corner_consensus > 0, track, "a glide track (keyframes)");
+  needs("glide_late", r.glide_late > 0, track, "a glide track (keyframes)");
   if (r.handover_level && !r.handover_zone)
     throw InvalidArgument("recipe: handover_level needs handover_zone (a hand-over)");
   if (r.handover_slack && !r.handover_zone)
@@ -191,6 +240,14 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
     shape.level_nominal.assign(nominal.begin(), nominal.end());
     shape.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
     shape.handover_level = r.handover_level, shape.handover_slack = r.handover_slack;
+    if (shape.handover_keyframe() + 1 < keyframes.size() &&
+        keyframes[shape.handover_keyframe()] > Tile::kMaxHandoverRank + 1) {
+      throw InvalidArgument("recipe: the hand-over keyframe holds " +
+                            std::to_string(keyframes[shape.handover_keyframe()]) +
+                            " points per subtile, more than a tile set's hand-over addresses (" +
+                            std::to_string(Tile::kMaxHandoverRank + 1) +
+                            "): fewer base_points, a lower handover_level or less handover_slack");
+    }
     if (shape.handover_keyframe() + 1 >= keyframes.size()) {
       // The most slack there is room for: the hand-over keyframe must lie below the top one.
       const auto most = std::int64_t(keyframes.size()) - std::int64_t(shape.handover_keyframe()) +
@@ -316,7 +373,11 @@ class Baker {
         const std::uint32_t j = plan[t].target[r] >> 16, q = plan[t].target[r] & 0xFFFF;
         const std::int64_t dx = std::int64_t(j % sub.m) - TilesetShape::subtile_of(tile.points[r].x, sub.m);
         const std::int64_t dy = std::int64_t(j / sub.m) - TilesetShape::subtile_of(tile.points[r].y, sub.m);
-        if (std::abs(dx) > 2 || std::abs(dy) > 2 || q >= 2621)
+        if (q > Tile::kMaxHandoverRank)  // parse refuses recipes whose hand-over keyframe holds more
+          throw InvalidArgument("hand-over: a subtile hands over more than " +
+                                std::to_string(Tile::kMaxHandoverRank + 1) +
+                                " points (fewer base_points, a lower handover_level or less handover_slack)");
+        if (std::abs(dx) > 2 || std::abs(dy) > 2)
           throw InvalidArgument("hand-over: a point's sub-point lies more than two subtiles away");
         tile.handover.push_back(static_cast<std::uint16_t>(q * 25 + (dy + 2) * 5 + (dx + 2)));
       }

@@ -10,6 +10,7 @@
 #include "bake/glider_field.h"
 #include "bake/min_cost_assignment.h"
 #include "bake/progressive_order.h"
+#include "kdm/generator/sampler.h"
 #include "kdm/runtime/check.h"
 
 namespace kdm::gen {
@@ -115,8 +116,14 @@ Matched match_tile(const TilesetData& set, std::size_t t) {
         out.packed.push_back((k * m + i) << 16 | q);
       }
     }
-  if (out.columns.size() < out.start.size())
-    throw std::runtime_error("hand-over: tile " + std::to_string(t) + " holds more points than its subtiles");
+  if (out.columns.size() < out.start.size()) {  // the passes that keep points apart removed too many
+    const std::string k = std::to_string(set.keyframe_nominal[h]), s = std::to_string(set.handover_slack);
+    throw InvalidArgument("hand-over: tile " + std::to_string(t) + " holds " +
+                          std::to_string(out.start.size()) + " points at its top level, its " +
+                          std::to_string(m * m) + " subtiles only " + std::to_string(out.columns.size()) +
+                          " at the hand-over keyframe (" + k + " points per tile): a larger handover_slack " +
+                          "(now " + s + ") hands them over later, holding more");
+  }
   out.column = match(out.start, out.columns, 2.5 / std::sqrt(top), kLongGlide / std::sqrt(top), t);
   return out;
 }

@@ -185,7 +185,15 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     if (k >= set.levels)
       throw gen::InvalidArgument("verify: level " + std::to_string(k) + " is not in the tile set (it has " +
                                  std::to_string(set.levels) + ")");
-  const double temperature = gen::BakeRecipe::parse(set.recipe).temperature;
+  double temperature = 0;  // the reference runs sample at the bake's temperature
+  try {
+    temperature = gen::BakeRecipe::parse(set.recipe).temperature;
+  } catch (const gen::InvalidArgument& e) {
+    throw gen::InvalidArgument("verify: the recipe stored in the tile set does not parse (" +
+                               std::string(e.what()) +
+                               "), so the temperature it was baked at is unknown (a set from another kdm "
+                               "version? verify it with that version)");
+  }
 
   // Progress in units of points sampled or measured, roughly proportional to the time they take.
   double total = 0, finished = 0;

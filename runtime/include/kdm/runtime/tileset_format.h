@@ -82,7 +82,9 @@ struct Tile {
   /// The hand-over between depths (sets whose handover_zone is not 0; else empty): per rank, the sub-point
   /// the point glides onto past the top keyframe, as q · 25 + (dy + 2) · 5 + (dx + 2): rank q of the
   /// subtile (dx, dy) away from the one holding the point's stable position (TilesetShape::subtile_of).
+  /// So q ≤ kMaxHandoverRank.
   TilesetArray<std::uint16_t> handover;
+  static constexpr std::uint32_t kMaxHandoverRank = (65535 - 24) / 25;  ///< 2620
   /// The subtiles' points present at their keyframe 1 that no point glides onto, in the order they appear
   /// during the hand-over: (j << 16) | q, rank q of subtile j = row · m + column (row 0 at the south).
   TilesetArray<std::uint32_t> appearing;
@@ -300,12 +302,14 @@ KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<ch
 KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Whether a tile set can be saved at `path`: not a directory, and its temporary file (`path` + ".partial")
-/// can be created there (it is created and removed). Returns kOk, or kIoError with `detail` (optional)
-/// naming the problem. save_tileset checks it first; call it before work whose result is to be saved.
+/// can be created there (it is created and removed), unless `path` is a device or a pipe. Returns kOk, or
+/// kIoError with `detail` (optional) naming the problem. save_tileset checks it first; call it before work
+/// whose result is to be saved.
 KDM_RUNTIME_API Status check_tileset_path(const std::string& path, std::string* detail = nullptr);
 
 /// Encodes and writes `set` to `path` atomically: a temporary file in the same directory, then rename,
-/// so an interrupted save never leaves a damaged file at `path`. Checks `path` (check_tileset_path)
+/// so an interrupted save never leaves a damaged file at `path`; a device or a pipe at `path` (/dev/null,
+/// a FIFO) is written into, as a shell's > does. Checks `path` (check_tileset_path)
 /// before encoding. Returns kOk, check_tileset_path's kIoError, encode_tileset's statuses, or kIoError
 /// when writing or renaming fails.
 KDM_RUNTIME_API Status save_tileset(const TilesetData& set, const std::string& path,
