@@ -97,8 +97,7 @@ Status prepare_sums(const ClassQueryParams& p, ClassDensities& densities, QueryP
     return refuse(Kind::kBadDensity, "image_sums");
   for (std::uint32_t k = 0; k < p.class_count; ++k) {
     const DensityImageView& im = sums.sum(k);
-    if (!im.values || !im.max_mip || !detail::image_rect_usable(im) ||
-        !ImageSampler(&sums.sum(0)).same_grid(im))
+    if (!detail::image_queryable(im) || !ImageSampler(&sums.sum(0)).same_grid(im))
       return refuse(Kind::kBadDensity, "image_sums");
   }
   densities.all_constant = false;
@@ -143,7 +142,7 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
         if (d.constant < 0) return refuse(Kind::kNegative, kConstantNames[k], d.constant);
         continue;
       case QueryDensity::Kind::kImage:
-        if (!d.image || !d.image->values || !d.image->max_mip || !detail::image_rect_usable(*d.image))
+        if (!d.image || !detail::image_queryable(*d.image))
           return refuse(Kind::kBadDensity, kImageNames[k]);
         densities.samplers[k] = ImageSampler(d.image);
         break;

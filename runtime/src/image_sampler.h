@@ -27,6 +27,13 @@ inline bool image_rect_usable(const DensityImageView& im) {
          std::isfinite(sy) && std::isfinite(im.x1 - im.x0) && std::isfinite(im.y1 - im.y0);
 }
 
+/// Whether a query can read `im`: values, and a max-mip whose blocks match its size (a view reused for a
+/// larger image with its old mips would read past them), over a usable rectangle.
+inline bool image_queryable(const DensityImageView& im) {
+  return im.values && im.max_mip && image_rect_usable(im) && im.mip_width == (im.width + 7) / 8 &&
+         im.mip_height == (im.height + 7) / 8;
+}
+
 struct ImageSampler {
   const DensityImageView* image = nullptr;
   double sx = 0, sy = 0;

@@ -111,7 +111,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       max_density = density_or_zero(d.constant);
       break;
     case QueryDensity::Kind::kImage:
-      if (!d.image || !d.image->values || !d.image->max_mip || !detail::image_rect_usable(*d.image))
+      if (!d.image || !detail::image_queryable(*d.image))
         return refuse(Kind::kBadDensity, "density.image");
       max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
       break;

@@ -465,6 +465,16 @@ TEST(QueryTest, FollowsADensityImage) {
     EXPECT_EQ(problem.kind, QueryProblem::Kind::kBadDensity);
     EXPECT_STREQ(problem.parameter, "density.image");
   }
+  // And one whose size no longer matches its mips (a view reused for a larger image with its old mips):
+  // its blocks would be read past the end.
+  std::vector<float> larger(100 * 100, 0.5f);
+  DensityImageView stale = image;
+  stale.values = larger.data(), stale.width = stale.height = 100;
+  QueryParams s = region(-1, -1, 1, 1, 1000);
+  s.density.kind = QueryDensity::Kind::kImage, s.density.image = &stale;
+  const QueryProblem problem = testing::refusal(s);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kBadDensity);
+  EXPECT_STREQ(problem.parameter, "density.image");
 }
 
 TEST(QueryTest, MipsBoundAnImageFromAboveAndBelow) {

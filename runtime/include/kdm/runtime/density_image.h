@@ -37,7 +37,8 @@ struct KDM_RUNTIME_API DensityImageView {
 /// kMaxDensityImageSide, values that are negative or
 /// not finite, and a world rectangle that is not finite and of positive size, or whose texels per world
 /// unit overflow (a rectangle narrower than about 10^-300 of a unit per texel). Queries refuse such an
-/// image too ("density.image"), should its rectangle change after this call.
+/// image too ("density.image"), should its rectangle change after this call, and one whose size no longer
+/// matches its mips' (make the mips again for a new size).
 KDM_RUNTIME_API Status make_density_max_mip(DensityImageView& image, std::vector<float>& mip);
 
 }  // namespace kdm
