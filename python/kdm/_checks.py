@@ -31,7 +31,10 @@ def number(name: str, value: Any, minimum: Optional[float] = None, strict: bool 
     """`value` as a finite float, at least `minimum` (above it when `strict`)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a number, got {type(value).__name__}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # an int past a double's range
+        raise ValueError(f"{name} must be a finite number, got an integer of {value.bit_length()} bits") from None
     if not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value}")
     if minimum is not None and (value <= minimum if strict else value < minimum):
@@ -77,10 +80,11 @@ def numbers_tuple(name: str, value: Any, count: int) -> Tuple[float, ...]:
     return tuple(number(f"{name}[{i}]", value[i]) for i in range(count))
 
 
-def rect(name: str, value: Any) -> Tuple[float, ...]:
-    """(x0, y0, x1, y1) with x0 < x1 and y0 < y1."""
+def rect(name: str, value: Any, allow_empty: bool = False) -> Tuple[float, ...]:
+    """(x0, y0, x1, y1) with x0 < x1 and y0 < y1, or with `allow_empty` any four finite numbers (a query's
+    region: none of its points when x1 <= x0 or y1 <= y0, as in C and C++)."""
     r = numbers_tuple(name, value, 4)
-    if not (r[0] < r[2] and r[1] < r[3]):
+    if not allow_empty and not (r[0] < r[2] and r[1] < r[3]):
         raise ValueError(f"{name} is empty or inverted (needs x0 < x1 and y0 < y1): {r}")
     return r
 

@@ -139,7 +139,8 @@ class Tileset:
         out: Optional["QueryResult"] = None,
         glide_together: bool = False,
     ) -> QueryResult:
-        """The points of the world rectangle `rect` = (x0, y0, x1, y1), half-open (``kdm query``).
+        """The points of the world rectangle `rect` = (x0, y0, x1, y1), half-open (``kdm query``); none
+        when x1 <= x0 or y1 <= y0, as in C and C++.
 
         Parameters
         ----------
@@ -151,7 +152,7 @@ class Tileset:
             two stretched over `density_rect` (default: `rect`; fix it to query parts of one region). Or a
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
             GIL held; an exception it raises is raised here once the query ends, and a value that is
-            not finite and >= 0 raises ValueError), which needs `density_max`, a true upper bound of
+            not finite and >= 0 raises ValueError), which needs `density_max` (> 0), a true upper bound of
             its values (a larger one raises ValueError; smooth mode also reads up to a glide's reach
             outside `rect`). Default: 1.
         vectorized : bool
@@ -197,7 +198,8 @@ class Tileset:
             How an image file's pixels become density.
         out : QueryResult, optional
             An earlier result whose memory this query refills, where it is large enough (its arrays are
-            overwritten): a loop of queries then writes into warm memory instead of new memory.
+            overwritten): a loop of queries then writes into warm memory instead of new memory. Not with
+            `classes` (ValueError).
 
         Returns
         -------
@@ -304,7 +306,7 @@ class Tileset:
 def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, density_rect: Any,
                 density_max: Any, glide_together: Any = False) -> Tuple[Any, ...]:
     """A query's common arguments, checked (ValueError, TypeError) and normalised."""
-    rect = _checks.rect("rect", rect)
+    rect = _checks.rect("rect", rect, allow_empty=True)
     scale = _checks.number("scale", scale)
     tile_size = _checks.number("tile_size", tile_size)
     mode = _checks.choice("mode", mode, ("stable", "smooth"))
@@ -313,8 +315,8 @@ def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, d
     origin = _checks.numbers_tuple("origin", origin, 2)
     if density_rect is not None:
         density_rect = _checks.rect("density_rect", density_rect)
-    if density_max is not None:
-        density_max = _checks.number("density_max", density_max, 0.0)
+    if density_max is not None:  # 0 would never call the callable: no points, and no check of its values
+        density_max = _checks.number("density_max", density_max, 0.0, strict=True)
     return rect, scale, tile_size, mode, origin, density_rect, density_max
 
 
@@ -328,6 +330,8 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
     ValueError): a class is its spec, or its callable (not None) bounded by its maximum, from `density_max`
     (one number for every callable class, or one entry per class), with its bounds function if
     `density_bounds` (one entry per class) gives one."""
+    if isinstance(classes, np.ndarray) and classes.ndim == 1:  # constant densities, one per class
+        classes = [float(v) for v in classes]
     if isinstance(classes, (str, numbers.Real)) or not isinstance(classes, Sequence):
         raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
     if not 1 <= len(classes) <= 8:
@@ -360,8 +364,11 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
                 raise ValueError(f"{name} is a callable: density_max must give an upper bound of its values")
             specs.append(_kdm.DensitySpec.constant(0.0))
             callables.append(d)
-            maxima.append(_checks.number(f"density_max[{k}]" if per_class else "density_max", bound, 0.0))
+            maxima.append(_checks.number(f"density_max[{k}]" if per_class else "density_max", bound, 0.0,
+                                         strict=True))
             continue
+        if per_class and density_max[k] is not None:
+            raise ValueError(f"density_max[{k}] is given but {name} is not a callable (give None there)")
         if b is not None:
             raise ValueError(f"density_bounds[{k}] is given but {name} is not a callable")
         if d is None:

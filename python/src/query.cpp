@@ -29,11 +29,20 @@ constexpr tools::ParameterNames kKeywordNames{"scale=", "tile_size=", "origin="}
 
 using Rect = std::array<double, 4>;
 
-void check_rect(const char* name, const Rect& r) {
+/// Four finite numbers, and unless `allow_empty` (a query's region: no points when x1 <= x0 or y1 <= y0, as
+/// in C and C++) x0 < x1 and y0 < y1.
+void check_rect(const char* name, const Rect& r, bool allow_empty = false) {
   for (double v : r)
     if (!std::isfinite(v)) throw std::invalid_argument(std::string(name) + " must be four finite numbers");
-  if (!(r[2] > r[0] && r[3] > r[1]))
+  if (!allow_empty && !(r[2] > r[0] && r[3] > r[1]))
     throw std::invalid_argument(std::string(name) + " is empty or inverted (needs x0 < x1 and y0 < y1)");
+}
+
+/// Where a query's image lies: `density_rect`, by default the region queried. An empty region has no points
+/// and its image is never read: the unit square stands in for it.
+Rect image_rect(const Rect& rect, const std::optional<Rect>& density_rect) {
+  if (density_rect) return *density_rect;
+  return rect[2] > rect[0] && rect[3] > rect[1] ? rect : Rect{0, 0, 1, 1};
 }
 
 /// A query's mode from the package's "stable" or "smooth", with "/together" for QueryParams::glide_together.
@@ -215,7 +224,7 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
              py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
              std::optional<double> density_max, double tile_size, const std::string& mode,
              const std::array<double, 2>& origin) {
-  check_rect("rect", rect);
+  check_rect("rect", rect, true);
   QueryParams& q = p.q;
   q.x0 = rect[0], q.y0 = rect[1], q.x1 = rect[2], q.y1 = rect[3];
   q.origin_x = origin[0], q.origin_y = origin[1];
@@ -239,7 +248,7 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
         std::make_unique<CallableDensity>(std::move(callable), *density_max, std::move(bounds), vectorized);
     q.density = p.from_callable->density;
   } else {
-    const Rect r = density_rect ? *density_rect : rect;  // by default the image covers the rectangle queried
+    const Rect r = image_rect(rect, density_rect);
     p.from_spec = std::make_unique<SpecDensity>(*spec, r.data());
     q.density = p.from_spec->density;
   }
@@ -442,7 +451,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<py::object>& callables, const std::vector<double>& maxima,
                      const std::vector<py::object>& bounds, bool vectorized, std::optional<Rect> density_rect,
                      double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
-  check_rect("rect", rect);
+  check_rect("rect", rect, true);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
                                 " densities, got " + std::to_string(specs.size()));
@@ -461,7 +470,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
         "same rectangle: " +
         shape(i) + ", " + shape(j));
   }
-  const Rect r = density_rect ? *density_rect : rect;
+  const Rect r = image_rect(rect, density_rect);
   ClassQueryParams& q = prepared.q;
   q.query.x0 = rect[0], q.query.y0 = rect[1], q.query.x1 = rect[2], q.query.y1 = rect[3];
   q.query.origin_x = origin[0], q.query.origin_y = origin[1];

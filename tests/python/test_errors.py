@@ -104,8 +104,9 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
 
 
 @pytest.mark.parametrize("kind,match,kwargs", [
-    (ValueError, "rect is empty or inverted", dict(rect=(0, 0, 0, 1))),
-    (ValueError, "rect is empty or inverted", dict(rect=(2, 0, 1, 1))),
+    (ValueError, "density_rect is empty or inverted",
+     dict(density=np.ones((4, 4)), density_rect=(0, 0, 0, 1))),
+    (ValueError, r"rect\[2\] must be a finite number, got an integer of 1329 bits", dict(rect=(0, 0, 10**400, 1))),
     (ValueError, r"rect\[1\] must be a finite number", dict(rect=(0, NAN, 1, 1))),
     (ValueError, "rect must hold 4 numbers", dict(rect=(0, 0, 1))),
     (TypeError, "rect must be a sequence of 4 numbers", dict(rect="0,0,1,1")),
@@ -125,7 +126,8 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
      dict(density=np.ones((4, 4)), density_rect=(-1e308, -1e308, 1e308, 1e308))),
     (ValueError, "density_max is for a callable density only", dict(density=0.5, density_max=1)),
     (ValueError, "a callable density needs density_max", dict(density=lambda x, y: 1.0)),
-    (ValueError, "density_max must be >= 0", dict(density=lambda x, y: 1.0, density_max=-1)),
+    (ValueError, "density_max must be > 0", dict(density=lambda x, y: 1.0, density_max=-1)),
+    (ValueError, "density_max must be > 0, got 0", dict(density=lambda x, y: 1.0, density_max=0)),
     (ValueError, "density must be >= 0", dict(density=-0.5)),
     (ValueError, "finite and >= 0", dict(density=np.full((3, 3), NAN))),
     (TypeError, "density must be None, a number", dict(density=object())),

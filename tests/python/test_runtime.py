@@ -589,10 +589,12 @@ def test_callable_classes_refuse_bad_input():
         BUILTIN.query(rect, scale=10, classes=[f, f], density_max=[1.0, None])
     with pytest.raises(ValueError, match="callable classes only"):
         BUILTIN.positions(rect, scale=10, classes=[1.0, 2.0], density_max=1.0)
-    with pytest.raises(ValueError, match=r"density_max\[0\] must be >= 0"):
+    with pytest.raises(ValueError, match=r"density_max\[0\] must be > 0"):
         BUILTIN.query(rect, scale=10, classes=[f], density_max=[-1.0])
     with pytest.raises(TypeError, match="density_max must be a number or a sequence"):
         BUILTIN.query(rect, scale=10, classes=[f], density_max="1")
+    with pytest.raises(ValueError, match=r"density_max\[1\] is given but classes\[1\] is not a callable"):
+        BUILTIN.query(rect, scale=10, classes=[f, 0.2], density_max=[1.0, 0.2])
     with pytest.raises(ValueError, match=r"returned nan at \("):
         BUILTIN.query(rect, scale=100, classes=[1.0, lambda x, y: math.nan], density_max=1.0)
     class Boom(Exception):
@@ -773,3 +775,18 @@ def test_a_signal_stops_a_bake_inside_its_call():
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
     assert events == ["c_exception"]
+
+
+def test_an_empty_or_inverted_region_has_no_points():
+    # As in C and C++ (query.h: none if x1 <= x0): chunk code that clips regions to a world's bounds needs no
+    # special case. Whatever the density, an image stretched over the region included.
+    tiles = kdm.Tileset.builtin()
+    for rect in [(10, 0, 0, 10), (5, 5, 5, 5), (0, 3, 1, 2)]:
+        for density in [1.0, np.ones((4, 4)), "ramp:10", lambda x, y: 0.5]:
+            bound = dict(density_max=1.0) if callable(density) else {}
+            assert len(tiles.query(rect, scale=100, density=density, **bound)) == 0
+            assert tiles.positions(rect, scale=100, density=density, **bound).shape == (0, 2)
+        assert len(tiles.query(rect, scale=100, classes=[np.ones((4, 4)), 0.2])) == 0
+    # Classes may come as a 1-D array of constant densities.
+    assert np.array_equal(tiles.query((0, 0, 4, 4), scale=100, classes=np.array([0.1, 0.2])).classes,
+                          tiles.query((0, 0, 4, 4), scale=100, classes=[0.1, 0.2]).classes)
