@@ -11,6 +11,9 @@
 // exactly the smooth one-class query at the sum and no two points of any classes come closer than its
 // points do); class 0 then holds the same ids as a one-class query at ρ_0, at the union's positions
 // (but within a glide's reach of the region's sides, which each query's points cross by their own track).
+// A point's class is settled at its stable position, so where a class's own density drops sharply
+// to 0 (and the sum's does not) its points may show up to about a spacing inside the zero side; no point
+// shows where the sum is 0. Objects that must keep out of an area exactly are placed in stable mode.
 // Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps.
 // Give a callback class its bounds (QueryDensity::bounds): the union's are their sum, and a tile's bounds
 // settle most of its points' classes without reading any density. Classes whose densities come from one
