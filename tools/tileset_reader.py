@@ -104,11 +104,11 @@ class Tileset:
         return expected > self.threshold(level, key)
 
     def glide_unit(self, g):
-        """Doc §8: keyframe g's glide offset unit in tile sides."""
+        """Doc §7: keyframe g's glide offset unit in tile sides."""
         return 1.0 / (GLIDE_UNITS_PER_SPACING * math.sqrt(self.keyframe_nominal[g]))
 
     def offsets_at_keyframe(self, tile, g):
-        """Doc §8: the points with a position at keyframe g, those emitted at the next keyframe's count
+        """Doc §7: the points with a position at keyframe g, those emitted at the next keyframe's count
         (every point at the last keyframe)."""
         if g + 1 == len(self.keyframe_nominal):
             return len(tile.xs)
@@ -454,7 +454,7 @@ def _round_half_away(v):
 
 
 def _glide_sums(ts, tile, stored, mask):
-    """Doc §8: an offset with one at the keyframe before is stored as the difference (mod 2^8, format 3:
+    """Doc §7: an offset with one at the keyframe before is stored as the difference (mod 2^8, format 3:
     mod 2^16); returns the offsets as unsigned values."""
     values = list(stored)
     at, before = 0, 0
@@ -467,7 +467,7 @@ def _glide_sums(ts, tile, stored, mask):
 
 
 def _glide_from_format3(ts, tile, offsets):
-    """Doc §8: format 3's 16-bit offsets (in 1/65536 tile sides) into 8-bit units of glide_unit, rounded
+    """Doc §7: format 3's 16-bit offsets (in 1/65536 tile sides) into 8-bit units of glide_unit, rounded
     half away from zero and clamped to +-127."""
     out = array.array("b", bytes(len(offsets)))
     at = 0

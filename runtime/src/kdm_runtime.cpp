@@ -159,8 +159,9 @@ void with_batch_callback(kdm::QueryDensity& d,
 /// A C callback bounded by 0 would never be called: its struct was zeroed and density_max left unset (C++'s
 /// default bound is 1). Refused as `name`, where C++ takes 0 as an empty density.
 bool unset_callback_bound(const kdm::QueryDensity& d, const char* name, kdm::QueryProblem& why) {
-  if (d.kind != kdm::QueryDensity::Kind::kCallback || d.callback_max != 0) return false;
-  why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = name, why.value = 0;
+  // Negative too: "must be > 0" names what is wanted, where "must not be negative" would allow 0.
+  if (d.kind != kdm::QueryDensity::Kind::kCallback || !(d.callback_max <= 0)) return false;
+  why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = name, why.value = d.callback_max;
   return true;
 }
 

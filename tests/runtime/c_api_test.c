@@ -223,6 +223,9 @@ int main(int argc, char** argv) {
     q.density_callback = ramp; /* density_max left as the zeroed struct has it: nothing would be called */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && strcmp(problem.parameter, "density_max") == 0);
+    q.density_max = -1; /* "must be > 0" too, not "must not be negative", which would allow the 0 above */
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && problem.value == -1);
     q = uniform_query();
     q.mode = 7;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);

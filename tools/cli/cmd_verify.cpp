@@ -60,7 +60,8 @@ void add_verify_command(CLI::App& app) {
       "Judge every tile and level of a tile set against the full KDM sampler (the generator test); "
       "prints a table per level and exits 1 if any check fails");
   cmd->add_option("file", args->path, "Tile-set file")->required();
-  cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (>= 2)")
+  cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (2 to 1000)")
+      ->check(CLI::Range(2, 1000))
       ->capture_default_str();
   cmd->add_option("--level", args->options.levels,
                   "Judge only these levels and the keyframes within them (repeatable; default: all)");

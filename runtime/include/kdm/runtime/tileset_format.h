@@ -172,7 +172,7 @@ struct TilesetShape {
   /// them; queries spread them over the set's tiles first (coarsest_level_thresholds).
   float emission_threshold(std::uint32_t level, std::uint16_t key) const {
     const double lo = level == 0 ? 0.0 : level_nominal[level - 1], hi = level_nominal[level];
-    return static_cast<float>(lo + (key + 0.5) * (1.0 / 65536.0) * (hi - lo));
+    return static_cast<float>(lo + (double(key) + 0.5) * (1.0 / 65536.0) * (hi - lo));
   }
   /// The emission rule, stated once for the runtime and the generator test: a point with threshold
   /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
