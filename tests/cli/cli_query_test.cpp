@@ -376,3 +376,15 @@ TEST_F(CliTest, AnalyzeReportsTheBiasOfEveryDensityBand) {
 }
 
 }  // namespace
+
+// The analysis measures in the unit square: a set sampled in a wider domain is measured stretched, and
+// kdm analyze says so (from the aspect kdm sample writes in its header); a square one draws no warning.
+TEST_F(CliTest, AnalyzeWarnsOfASetSampledInAnotherShape) {
+  for (const std::string aspect : {"2", "1"}) {
+    ASSERT_EQ(kdm("sample --n 200 --aspect " + aspect + " -o '" + path("s.txt") + "'").status, 0);
+    const Outcome r = kdm("analyze '" + path("s.txt") + "' --no-energy");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const bool warned = r.err.find("sampled in a domain of aspect 2 (width / height)") != std::string::npos;
+    EXPECT_EQ(warned, aspect == "2") << r.err;
+  }
+}

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -96,6 +98,17 @@ void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::A
     throw CommandError(error);
 }
 
+/// The aspect (width / height) a point file says its points were sampled in (`kdm sample --aspect` writes
+/// ", aspect A" in its header lines), or 1.
+double sampled_aspect(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i)
+    if (const std::size_t at = line.find(", aspect "); at != std::string::npos)
+      return std::atof(line.c_str() + at + 9);
+  return 1;
+}
+
 /// Creates `output` as analyze's directory (it receives metrics.json and pictures), or says why it cannot.
 void prepare_output_directory(const std::string& output) {
   // A name like metrics.json is a mistake that would make a directory of it.
@@ -144,6 +157,12 @@ void run_analyze(const AnalyzeArgs& args) {
       o.density = tools::analysis_density(target);
     }
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
+    for (const std::string& file : args.files)
+      if (const double aspect = sampled_aspect(file); aspect != 1)
+        std::fprintf(stderr,
+                     "kdm: warning: %s was sampled in a domain of aspect %g (width / height); the measures "
+                     "take its points in the unit square, so distances and the spectrum are stretched\n",
+                     file.c_str(), aspect);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
     if (!args.output.empty()) prepare_output_directory(args.output);

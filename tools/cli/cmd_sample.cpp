@@ -140,7 +140,13 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     what = "classes";
     for (const std::string& c : args.classes) what += " " + c;
   }
-  std::vector<std::string> header = {line, what + ", domain " + domain};
+  std::string shape;  // kdm analyze warns of it: it measures in the unit square
+  if (aspect != 1) {
+    char text[40];
+    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
+    shape = text;
+  }
+  std::vector<std::string> header = {line, what + ", domain " + domain + shape};
   tools::DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;
