@@ -66,7 +66,7 @@ void add_verify_command(CLI::App& app) {
   cmd->add_option("--level", args->options.levels,
                   "Judge only these levels and the keyframes within them (repeatable; default: all)");
   cmd->add_option("--spectrum-budget", args->options.spectrum_budget,
-                  "Largest tile torus (points) whose spectra (lowP, RAPS) are computed: they cost O(n^2)")
+                  "Largest tile torus (points) whose spectra (lowP, RAPS) are computed (default: every one)")
       ->capture_default_str();
   cmd->add_flag("--no-seams", args->no_seams, "Skip the seam and in-between-density checks");
   cmd->add_flag("--no-direct", args->no_direct, "Skip the direct check (tiles freed for 15 sweeps)");

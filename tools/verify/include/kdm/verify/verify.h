@@ -21,7 +21,8 @@
 //     (δavg, closest pair), and how far points move from one keyframe to the next.
 //  6. Sets with a hand-over between depths, when the top level is judged: even steps along it (δavg,
 //     closest pair; straight paths, appearing points at evenly spread thresholds).
-// Spectra cost O(n · f²): tori above `spectrum_budget` points skip lowP and RAPS (reported as NaN).
+// Spectra (a non-uniform FFT, seconds for the largest torus) are computed for tori of up to
+// `spectrum_budget` points; larger ones skip lowP and RAPS (reported as NaN).
 //
 // Thread safety: verify_tileset is reentrant (no shared state); it uses up to `threads` threads.
 #pragma once
@@ -91,8 +92,8 @@ struct Bars {
 };
 
 struct VerifyOptions {
-  int reference_runs = 16;              ///< full-sampler runs per level (≥ 2)
-  std::size_t spectrum_budget = 40000;  ///< largest torus (points) whose spectra are computed
+  int reference_runs = 16;                             ///< full-sampler runs per level (≥ 2)
+  std::size_t spectrum_budget = std::size_t(1) << 30;  ///< largest torus (points) whose spectra are computed
   std::vector<std::uint32_t> levels;  ///< levels to judge (every part; a keyframe by its count); empty = all
   bool statistics = true;             ///< run part 1
   bool direct_check = true;           ///< run part 2
