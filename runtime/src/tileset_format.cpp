@@ -443,9 +443,19 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
     return fail(Status::kTrailingBytes, detail, "bytes follow the payload");
   if (body_size > kMaxTilesetPayloadBytes)
     return fail(Status::kTooLarge, detail, "payload decompresses to " + std::to_string(body_size) + " bytes");
-  if (colours < 1 || colours > kMaxTileColours || levels < 1 || levels > kMaxTileLevels ||
-      tile_count != std::uint64_t(colours) * colours * colours * colours)
-    return fail(Status::kInvalidContent, detail, "header counts are inconsistent");
+  // Each count named: a reader of a damaged file learns which one.
+  if (colours < 1 || colours > kMaxTileColours)
+    return fail(Status::kInvalidContent, detail,
+                "header counts are inconsistent: colour count " + std::to_string(colours) +
+                    " is outside 1.." + std::to_string(kMaxTileColours));
+  if (levels < 1 || levels > kMaxTileLevels)
+    return fail(Status::kInvalidContent, detail,
+                "header counts are inconsistent: level count " + std::to_string(levels) + " is outside 1.." +
+                    std::to_string(kMaxTileLevels));
+  if (tile_count != std::uint64_t(colours) * colours * colours * colours)
+    return fail(Status::kInvalidContent, detail,
+                "header counts are inconsistent: " + std::to_string(tile_count) + " tiles for " +
+                    std::to_string(colours) + " colours (colours^4 expected)");
   out.format_version = version;
   out.header_bytes = header_size;
   out.payload_bytes = payload_size, out.decompressed_bytes = body_size;

@@ -446,6 +446,19 @@ TEST(TilesetFormatTest, TheHeaderDescribesTheFileAndIsValidatedAlone) {
   EXPECT_EQ(read_tileset_header(damaged.data(), damaged.size(), h), Status::kOk);
   damaged[41] ^= 1;  // the colours field
   EXPECT_EQ(read_tileset_header(damaged.data(), damaged.size(), h), Status::kHeaderChecksumMismatch);
+  // With a checksum that matches, each count the header holds is checked and named.
+  const auto refusal = [&](std::uint32_t colours, std::uint32_t tiles) {
+    std::vector<std::uint8_t> file = bytes;
+    put32(&file[36], tiles), put32(&file[40], colours);
+    put32(&file[60], 0);
+    put32(&file[60], detail::crc32(file.data(), get32(&file[12])));
+    std::string why;
+    EXPECT_EQ(read_tileset_header(file.data(), file.size(), h, &why), Status::kInvalidContent);
+    return why;
+  };
+  EXPECT_NE(refusal(17, 17 * 17 * 17 * 17).find("colour count 17 is outside 1..16"), std::string::npos);
+  EXPECT_NE(refusal(0, 0).find("colour count 0"), std::string::npos);
+  EXPECT_NE(refusal(2, 15).find("15 tiles for 2 colours"), std::string::npos);
   EXPECT_EQ(read_tileset_header(nullptr, 0, h), Status::kTruncated);
 }
 
