@@ -1,8 +1,10 @@
 """Shared fixtures of the Python package's tests: the `kdm` command to compare with, test images, a tiny
 recipe. ctest runs them with PYTHONPATH=<build>/python and KDM_CLI=<build>/tools/kdm."""
 import os
+import signal
 import struct
 import subprocess
+import sys
 import zlib
 from pathlib import Path
 
@@ -16,6 +18,32 @@ SPHERE = SOURCE_DIR / "examples" / "sphere.png"
 # Two levels of 32 and 128 points per tile and a short glide track: bakes in a few seconds
 # (tests/generator/bake_test.cpp's small recipe, with keyframes).
 TINY_RECIPE = "colours 2\nlevels 2\nbase_points 32\nsweeps 10\nkeyframes 2\nglide_sweeps 2\n"
+
+
+def interrupted(name, call, after):
+    """Runs call() with an alarm after `after` seconds whose handler raises KeyboardInterrupt (as Ctrl-C's
+    does), and returns how the extension function `name` ended: ["c_exception"] when the signal stopped it
+    inside its call, ["c_return"] when it returned first. The call must raise KeyboardInterrupt."""
+    events = []
+
+    def profile(frame, event, arg):
+        if event in ("c_return", "c_exception") and getattr(arg, "__name__", "") == name:
+            events.append(event)
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, after)
+    sys.setprofile(profile)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        sys.setprofile(None)
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    return events
 
 
 @pytest.fixture(scope="session")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import kdm
-from conftest import TINY_RECIPE, read_query_csv
+from conftest import TINY_RECIPE, interrupted, read_query_csv
 
 BUILTIN = kdm.Tileset.builtin()
 
@@ -749,32 +749,10 @@ def test_glide_together_moves_the_same_points_and_keeps_them_apart():
 
 
 def test_a_signal_stops_a_bake_inside_its_call():
-    # As for the sampler: a handler that raises (as Ctrl-C's does) runs between the bake's runs, so the call
-    # ends with the exception ("c_exception") instead of returning the set. This recipe takes about 9 s on
-    # one thread; the alarm comes after 0.3 s.
-    import signal
-    import sys
-
-    events = []
-
-    def profile(frame, event, arg):
-        if event in ("c_return", "c_exception") and getattr(arg, "__name__", "") == "bake":
-            events.append(event)
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
-    old = signal.signal(signal.SIGALRM, interrupt)
-    signal.setitimer(signal.ITIMER_REAL, 0.3)
-    sys.setprofile(profile)
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            kdm.bake("levels 3\ncolours 2\nsweeps 100\n", threads=1)
-    finally:
-        sys.setprofile(None)
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-    assert events == ["c_exception"]
+    # As for the sampler: the handler runs between the bake's runs, so the call ends with the exception
+    # instead of returning the set. This recipe takes about 9 s on one thread; the alarm comes after 0.3 s.
+    bake = lambda: kdm.bake("levels 3\ncolours 2\nsweeps 100\n", threads=1)  # noqa: E731
+    assert interrupted("bake", bake, 0.3) == ["c_exception"]
 
 
 def test_an_empty_or_inverted_region_has_no_points():

@@ -1,12 +1,10 @@
 """kdm.sample: the command line's bits, its defaults, determinism and densities."""
-import signal
-import sys
 
 import numpy as np
 import pytest
 
 import kdm
-from conftest import SPHERE, read_txt
+from conftest import SPHERE, interrupted, read_txt
 
 
 def test_same_bits_as_kdm_sample(cli, tmp_path):
@@ -115,25 +113,6 @@ def test_result_owns_its_memory():
 
 def test_a_signal_stops_the_sampler_inside_its_call():
     # A handler that raises (as Ctrl-C's does) is run between the sampler's sweeps: the call ends with the
-    # exception (a "c_exception" event) instead of returning its points first ("c_return"). 400,000
-    # points take seconds; the alarm comes after 0.2 s.
-    events = []
-
-    def profile(frame, event, arg):
-        if event in ("c_return", "c_exception") and getattr(arg, "__name__", "") == "sample":
-            events.append(event)
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
-    old = signal.signal(signal.SIGALRM, interrupt)
-    signal.setitimer(signal.ITIMER_REAL, 0.2)
-    sys.setprofile(profile)
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            kdm.sample(400_000, threads=1)
-    finally:
-        sys.setprofile(None)
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-    assert events == ["c_exception"]
+    # exception instead of returning its points first. 400,000 points take seconds; the alarm comes after
+    # 0.2 s.
+    assert interrupted("sample", lambda: kdm.sample(400_000, threads=1), 0.2) == ["c_exception"]
