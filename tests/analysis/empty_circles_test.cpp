@@ -55,6 +55,37 @@ TEST(EmptyCircles, TheLargestMatchesABruteForceSearch) {
   EXPECT_GT(e.over_085, 0u);  // white noise is full of holes
 }
 
+// Sets whose holes are wide against their spacing (a band of points with an empty half, and sets of a few
+// points): every triangle of the torus once (2n) and the largest circle the true one, where a margin of
+// copies a few spacings wide misses triangles across the hole and invents circles far wider than it.
+TEST(EmptyCircles, WideHolesAndFewPointsAreTriangulatedWhole) {
+  auto farthest = [](const tools::PointSet& s, int grid) {  // the largest empty circle, from below
+    double best = 0;
+    for (int j = 0; j < grid; ++j)
+      for (int i = 0; i < grid; ++i) {
+        const double x = (i + 0.5) / grid, y = (j + 0.5) / grid;
+        double nearest = HUGE_VAL;
+        for (std::size_t p = 0; p < s.size(); ++p)
+          nearest = std::min(nearest, std::hypot(axis_delta(x, s.coords[2 * p], true),
+                                                 axis_delta(y, s.coords[2 * p + 1], true)));
+        best = std::max(best, nearest);
+      }
+    return best;
+  };
+  tools::PointSet band = uniform_set(2000, 1);
+  for (std::size_t p = 0; p < band.size(); ++p) band.coords[2 * p] = 0.25 + 0.5 * band.coords[2 * p];
+  std::vector<tools::PointSet> sets = {band};
+  for (std::size_t n = 3; n <= 19; ++n)
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) sets.push_back(uniform_set(n, seed));
+  for (const tools::PointSet& s : sets) {
+    const EmptyCircles e = empty_circles({s});
+    EXPECT_EQ(e.triangles, 2 * s.size()) << s.size() << " points";
+    const double d = hex_spacing(s.size()), found = farthest(s, 200);
+    EXPECT_GE(e.largest * d + 1e-12, found) << s.size() << " points";
+    EXPECT_LE(e.largest * d, found + std::sqrt(0.5) / 200) << s.size() << " points";
+  }
+}
+
 TEST(EmptyCircles, BoxSetsJudgeOnlyCirclesAwayFromTheBorder) {
   const tools::PointSet s = uniform_set(2000, 3);
   EmptyCircleOptions box;

@@ -1,7 +1,8 @@
 // Empty circles of the Delaunay triangulation (empty_circles.h). The triangulation is Qhull's (Barber,
 // Dobkin & Huhdanpaa, "The Quickhull algorithm for convex hulls", ACM TOMS 1996): the lower hull of the
 // points lifted onto a paraboloid. A torus is triangulated with copies of the points near its sides, and
-// each triangle is counted once, in the copy that holds its lowest-numbered point itself.
+// each triangle is counted once, in the copy whose circumcentre lies in the unit square. The copies reach
+// as far as the widest such circle, so that every circle is judged against every point it could hold.
 #include "kdm/analysis/empty_circles.h"
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <utility>
 
 extern "C" {
@@ -97,42 +99,71 @@ struct SetCircles {
   std::size_t over_085 = 0, over_100 = 0, over_085_near_edge = 0, near_edge_judged = 0;
 };
 
+/// The circumcircles of a torus set's Delaunay triangles, each once: in the copy that holds its lowest-
+/// numbered point itself (a rule of indices and whole shifts, so no rounding counts a triangle twice or
+/// never). The set is
+/// triangulated with its copies within a margin m of the square; a circle that lies within the copies is
+/// empty of every point, copies beyond the margin too: a Delaunay triangle of the torus. A torus of n
+/// points has 2n of them (Euler): fewer, or a circle past the copies, mean the margin was too narrow for
+/// some (a wide hole, or few points). It then grows and the set is triangulated again, up to m = 2: no
+/// empty circle of a torus is wider than √2/2, so none reaches farther than √2 past its lowest point.
+std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing) {
+  const std::size_t n = coords.size() / 2;
+  for (double m = std::min(2.0, 4 * spacing);;) {
+    std::vector<double> xy = coords;
+    std::vector<std::size_t> original;  // the point each copy stands for
+    for (std::size_t i = 0; i < n; ++i) original.push_back(i);
+    const int shifts = static_cast<int>(std::ceil(m));
+    for (std::size_t i = 0; i < n; ++i)
+      for (int sx = -shifts; sx <= shifts; ++sx)
+        for (int sy = -shifts; sy <= shifts; ++sy) {
+          const double x = coords[2 * i] + sx, y = coords[2 * i + 1] + sy;
+          if ((sx || sy) && x > -m && x < 1 + m && y > -m && y < 1 + m)
+            xy.insert(xy.end(), {x, y}), original.push_back(i);
+        }
+    std::vector<Circle> circles;
+    double reach = 0;  // how far the circles reach past the square
+    delaunay(xy, [&](int i, int j, int k) {
+      const int v[3] = {i, j, k};
+      // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
+      // one translate of the triangle has the point itself there.
+      const int* first = std::min_element(v, v + 3, [&](int a, int b) {
+        return std::tie(original[a], xy[2 * a], xy[2 * a + 1]) <
+               std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
+      });
+      if (std::size_t(*first) >= n) return;  // another copy's
+      const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+      if (!std::isfinite(c.r)) return;  // flat
+      circles.push_back(c);
+      reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
+    });
+    if ((reach <= m && circles.size() == 2 * n) || m >= 2) return circles;
+    m = std::min(2.0, std::max(2 * m, 1.01 * reach));
+  }
+}
+
+/// The box set's circumcircles: those at least `border` spacings plus their radius inside the square.
+std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double border) {
+  std::vector<Circle> circles;
+  delaunay(xy, [&](int i, int j, int k) {
+    const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+    const double m = border * spacing + c.r;
+    if (std::isfinite(c.r) && c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m) circles.push_back(c);
+  });
+  return circles;
+}
+
 SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, double mean_rho,
                      double max_rho) {
   SetCircles out;
-  const std::size_t n = set.size();
-  const double spacing = hex_spacing(n);
-  std::vector<double> xy = set.coords;
-  std::vector<std::size_t> original;  // torus: the point each copy stands for
-  if (o.torus) {  // copies within a few spacings of each side, so triangles across the sides are whole
-    const double m = std::min(0.5, 4 * spacing);
-    for (std::size_t i = 0; i < n; ++i) original.push_back(i);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int sx = -1; sx <= 1; ++sx)
-        for (int sy = -1; sy <= 1; ++sy) {
-          if (!sx && !sy) continue;
-          const double x = set.coords[2 * i] + sx, y = set.coords[2 * i + 1] + sy;
-          if (x > -m && x < 1 + m && y > -m && y < 1 + m) xy.insert(xy.end(), {x, y}), original.push_back(i);
-        }
-  }
+  const double spacing = hex_spacing(set.size());
   const double edge_band = o.tile_size > 0 ? spacing : 0;
-  delaunay(xy, [&](int i, int j, int k) {
-    const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
-    if (!std::isfinite(c.r)) return;
-    if (o.torus) {
-      // A triangle across a side appears once per copy: it counts where its first point (by index)
-      // is the point itself, not a copy.
-      const int v[3] = {i, j, k};
-      const int* first = std::min_element(v, v + 3, [&](int a, int b) { return original[a] < original[b]; });
-      if (std::size_t(*first) >= n) return;
-    } else {
-      const double m = o.border * spacing + c.r;
-      if (!(c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m)) return;
-    }
+  for (const Circle& c :
+       o.torus ? torus_circles(set.coords, spacing) : box_circles(set.coords, spacing, o.border)) {
     double local = spacing;
     if (o.density) {
       const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
-      if (!(rho > 0) || rho < o.min_relative_density * max_rho) return;
+      if (!(rho > 0) || rho < o.min_relative_density * max_rho) continue;
       local = spacing * std::sqrt(mean_rho / rho);
     }
     const double r = c.r / local;
@@ -148,7 +179,7 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
     }
     if (r > 0.85) out.over_085 += 1, out.over_085_near_edge += near_edge;
     if (r > 1.0) out.over_100 += 1;
-  });
+  }
   return out;
 }
 
