@@ -11,7 +11,9 @@ from . import _checks, _kdm
 
 
 def _arrays(value: Any) -> Any:
-    """metrics.json's lists of numbers as float64 arrays (null, a non-finite value, as NaN)."""
+    """metrics.json's lists of numbers as float64 arrays, and its nulls (non-finite values) as NaN."""
+    if value is None:
+        return np.nan
     if isinstance(value, dict):
         return {k: _arrays(v) for k, v in value.items()}
     if isinstance(value, list):

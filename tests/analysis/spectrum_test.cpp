@@ -63,6 +63,17 @@ TEST(Periodogram, MatchesDirectSum) {
   }
 }
 
+// lowP's frequencies (f < 0.5) are computed whatever fmax asks for: a spectrum to f = 0.3 has the same
+// lowP as one to 2.5 (its rings stop at 0.3).
+TEST(Periodogram, LowPowerIsMeasuredWhateverTheLimit) {
+  const tools::PointSet s = uniform_set(1000, 5);
+  const SpectrumStats low = spectrum_stats(periodogram(s.coords, 2, 0.3)),
+                      full = spectrum_stats(periodogram(s.coords, 2, 2.5));
+  ASSERT_TRUE(std::isfinite(low.low_p));
+  EXPECT_NEAR(low.low_p, full.low_p, 1e-9 * full.low_p);
+  EXPECT_EQ(low.raps.size(), 9u);  // rings 1 .. floor(0.3 · √1000)
+}
+
 TEST(Periodogram, IndependentOfThreadCount) {
   const tools::PointSet s = uniform_set(3000, 4);
   const Periodogram a = periodogram(s.coords, 2, 1.5, 1), b = periodogram(s.coords, 2, 1.5, 2);

@@ -205,3 +205,13 @@ def test_stipple_tiles_seed_picks_another_part_of_the_tiling():
     for dots in (one, other):
         rows = np.clip(((1 - dots[:, 1]) * h).astype(int), 0, h - 1)
         assert luminance[rows, np.clip((dots[:, 0] * w).astype(int), 0, w - 1)].mean() < 0.5
+
+
+def test_analyze_gives_nan_for_what_cannot_be_measured():
+    # Four points have no frequency below f = 0.5 (lowP is NaN, null in metrics.json): a float, NaN, not
+    # None, so arithmetic on the result works. A low fmax still measures lowP.
+    few = kdm.analyze(np.random.default_rng(1).random((4, 2)), energy=False, threads=1)
+    assert isinstance(few["spectrum"]["low_p"], float) and np.isnan(few["spectrum"]["low_p"])
+    many = np.random.default_rng(2).random((1000, 2))
+    low = kdm.analyze(many, energy=False, fmax=0.3, threads=1)["spectrum"]["low_p"]
+    assert low == pytest.approx(kdm.analyze(many, energy=False, threads=1)["spectrum"]["low_p"], rel=1e-9)

@@ -120,7 +120,8 @@ Periodogram make_grid(double mean_n, double fmax) {
   Periodogram p;
   p.n = mean_n;
   p.fmax = fmax;
-  const double kmax = std::ceil(fmax * std::sqrt(mean_n)) + 1;  // checked before it becomes an int
+  // Up to f = 0.5 at least, where lowP is measured, whatever the rings asked for.
+  const double kmax = std::ceil(std::max(fmax, 0.5) * std::sqrt(mean_n)) + 1;  // checked before it is an int
   if (!(kmax <= 4096)) {
     char text[160];
     std::snprintf(text, sizeof text,

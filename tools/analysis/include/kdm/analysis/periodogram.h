@@ -31,7 +31,8 @@ struct Periodogram {
   int ring_max() const;                   ///< last complete ring: floor(fmax · sqrt(n)), ≤ kmax − 1
 };
 
-/// Periodogram of one 2D set up to normalised frequency `fmax` (kmax = ceil(fmax·√n) + 1). `coords`
+/// Periodogram of one 2D set up to normalised frequency `fmax`, and 0.5 at least, lowP's (kmax =
+/// ceil(max(fmax, 0.5)·√n) + 1). `coords`
 /// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n + kmax² log kmax),
 /// memory about 200 · kmax² bytes. Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no
 /// shared state); the result does not depend on the thread count (fixed summation order). A time for
