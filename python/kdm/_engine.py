@@ -90,7 +90,9 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     temperature, domain, density, threads
         As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise);
         ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
-        draws.
+        draws; ``random(n, workers=k)`` draws with k threads (-1: every core) as SciPy's engines do. A
+        draw that fails or is interrupted uses no seed. There is no ``optimization``: the points are
+        blue noise already.
     """
 
     def __init__(
@@ -137,12 +139,30 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         return int(self.rng.randint(0, 2**63, dtype=np.int64))  # a legacy RandomState
 
     def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
+        # `workers` as SciPy's engines take it: -1 every core, 1 (the default) the engine's `threads`.
+        if isinstance(workers, bool) or not isinstance(workers, numbers.Integral) or not (
+                workers == -1 or workers >= 1):
+            raise ValueError(f"Invalid number of workers: {workers!r}, must be -1 or > 0")
         n = _checks.integer("n", n, 0, 2**31)
         if n == 0:
             return np.empty((0, self.d))
+        # Attributes may have been set since __init__: checked again, before a seed is drawn.
+        threads = _checks.threads(self.threads) if workers == 1 else (0 if workers == -1 else workers)
+        threads = _checks.threads(threads)
+        temperature = _checks.number("temperature", self.temperature, 0.0)
+        domain = None if self.domain is None else _checks.choice("domain", self.domain, ("torus", "box"))
+        aspect = None if self.aspect is None else _checks.number("aspect", self.aspect, 0.0, strict=True)
+        state = copy.deepcopy(self.rng.bit_generator.state if hasattr(self.rng, "bit_generator")
+                              else self.rng.get_state())
         seed = self._draw_seed()
-        threads = _checks.threads(self.threads)  # an attribute: it may have been set since __init__
-        return _kdm.sample(n, self._spec, self.d, self.domain, self.temperature, seed, threads, self.aspect)
+        try:
+            return _kdm.sample(n, self._spec, self.d, domain, temperature, seed, threads, aspect)
+        except BaseException:  # a refused or interrupted draw uses no seed: the next is the one it was
+            if hasattr(self.rng, "bit_generator"):
+                self.rng.bit_generator.state = state
+            else:
+                self.rng.set_state(state)
+            raise
 
     def fast_forward(self, n: int) -> "BlueNoise":
         """Skip what ``random(n)`` would return: one set's seed, whatever n (each call draws a whole set

@@ -132,3 +132,21 @@ def test_without_scipy():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == f"ok {kdm.__version__}"
+
+
+def test_a_refused_draw_uses_no_seed_and_workers_follow_scipy():
+    # The draw after a refused one is the draw a fresh engine makes first: the refused one used no seed.
+    engine = kdm.BlueNoise(d=2, seed=1, threads=1)
+    with pytest.raises(ValueError, match="computational grid"):
+        engine.random(2**31)
+    assert np.array_equal(engine.random(10), kdm.BlueNoise(d=2, seed=1, threads=1).random(10))
+    # workers as SciPy's engines take it (-1: every core), the same points whatever the count.
+    for bad in (0, -2, "x", 2.5, True):
+        with pytest.raises(ValueError, match="Invalid number of workers"):
+            engine.random(8, workers=bad)
+    one, two, every = (kdm.BlueNoise(d=2, seed=3).random(64, workers=w) for w in (1, 2, -1))
+    assert np.array_equal(one, two) and np.array_equal(one, every)
+    # An attribute set to nonsense is refused by name at the next draw, which then uses no seed either.
+    engine.temperature = "hot"
+    with pytest.raises(TypeError, match="temperature must be a number"):
+        engine.random(5)
