@@ -215,3 +215,15 @@ def test_analyze_gives_nan_for_what_cannot_be_measured():
     many = np.random.default_rng(2).random((1000, 2))
     low = kdm.analyze(many, energy=False, fmax=0.3, threads=1)["spectrum"]["low_p"]
     assert low == pytest.approx(kdm.analyze(many, energy=False, threads=1)["spectrum"]["low_p"], rel=1e-9)
+
+
+def test_analyze_of_points_without_a_triangulation_keeps_the_other_measures():
+    # Points on one line (a box) or all at one place have no Delaunay triangulation: the empty circles are
+    # skipped, saying why, and the nearest neighbours, spectrum and g(r) are still measured. So for 2 points.
+    line = np.c_[np.linspace(0.05, 0.95, 100), np.full(100, 0.5)]
+    for points, box in ((line, True), (np.full((100, 2), 0.5), False)):
+        result = kdm.analyze(points, box=box, energy=False, threads=1)
+        assert "degenerate" in result["empty_circles_skipped"] and "empty_circles" not in result
+        assert result["nearest_neighbour"]["count"] == 100 and "spectrum" in result
+    two = kdm.analyze(np.array([[0.1, 0.2], [0.6, 0.7]]), energy=False, threads=1)
+    assert "fewer than 3 points" in two["empty_circles_skipped"]

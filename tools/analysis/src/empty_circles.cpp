@@ -50,7 +50,7 @@ void delaunay(std::vector<double>& xy, Visit&& visit) {
     if (dx * dx + dy * dy > fx * fx + fy * fy) far = i;
   }
   if (flat)
-    throw InvalidInput(
+    throw DegenerateSet(
         "the points are degenerate (all coincident or on one line): they have no Delaunay "
         "triangulation");
   // Qhull's own report of any other failure goes to a scratch file: the error below says it in one line.
@@ -201,15 +201,20 @@ EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const Empty
   // Sets are triangulated in parallel and pooled in their order, so nothing depends on the thread count.
   std::vector<SetCircles> per_set(sets.size());
   std::vector<std::string> failure(sets.size());
+  std::vector<char> degenerate(sets.size(), 0);
   detail::parallel_for(std::ptrdiff_t(sets.size()), o.threads, [&](std::ptrdiff_t s, int) {
     try {
       per_set[s] = judge_set(sets[s], o, mean_rho, max_rho);
+    } catch (const DegenerateSet& e) {
+      failure[s] = e.what(), degenerate[s] = 1;
     } catch (const InvalidInput& e) {
       failure[s] = e.what();
     }
   });
-  for (const std::string& f : failure)
-    if (!f.empty()) throw InvalidInput(f);
+  for (std::size_t s = 0; s < sets.size(); ++s) {
+    if (degenerate[s]) throw DegenerateSet(failure[s]);
+    if (!failure[s].empty()) throw InvalidInput(failure[s]);
+  }
   std::vector<double> radii;
   std::size_t near_edge_judged = 0;
   for (const SetCircles& c : per_set) {

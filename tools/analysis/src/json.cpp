@@ -153,6 +153,7 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
   }
   w.key("pair_correlation").begin_object();
   w.key("r_max").value(r.gr.r_max).key("r").value(r.gr.r).key("g").value(r.gr.g).end_object();
+  if (!r.empty_circles_skipped.empty()) w.key("empty_circles_skipped").value(r.empty_circles_skipped);
   if (r.has_empty_circles) {
     const EmptyCircles& e = r.empty_circles;
     w.key("empty_circles").begin_object();

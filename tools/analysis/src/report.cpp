@@ -77,6 +77,8 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     r.has_spectrum = true;
   }
   r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
+  if (r.dim == 2 && r.points_min < 3)
+    r.empty_circles_skipped = "a set of fewer than 3 points has no triangle";
   if (r.dim == 2 && r.points_min >= 3) {
     EmptyCircleOptions eo;
     eo.torus = o.torus;
@@ -84,8 +86,12 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     eo.tile_size = o.tile_size;
     eo.min_relative_density = o.holes_min_density;
     eo.threads = o.threads;
-    r.empty_circles = empty_circles(sets, eo);
-    r.has_empty_circles = true;
+    try {  // the other measures stand without them
+      r.empty_circles = empty_circles(sets, eo);
+      r.has_empty_circles = true;
+    } catch (const DegenerateSet& e) {
+      r.empty_circles_skipped = e.what();
+    }
   }
 
   if (o.density && r.dim == 2) {
@@ -174,6 +180,8 @@ std::string format_summary(const AnalysisReport& r) {
       rpeak = r.gr.r[b];
     }
   append(s, "pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  if (!r.empty_circles_skipped.empty())
+    append(s, "empty circles      skipped: %s\n", r.empty_circles_skipped.c_str());
   if (r.has_empty_circles) {
     const EmptyCircles& e = r.empty_circles;
     append(

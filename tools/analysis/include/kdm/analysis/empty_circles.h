@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
 #include "point_io.h"
 
@@ -28,6 +29,11 @@ struct EmptyCircleOptions {
   int threads = 1;
 };
 
+/// Thrown for a set whose points span no area (all coincident or on one line): it has no triangulation.
+struct DegenerateSet : InvalidInput {
+  using InvalidInput::InvalidInput;
+};
+
 struct EmptyCircles {
   std::size_t points = 0;                  ///< points of the sets, pooled
   std::size_t triangles = 0;               ///< Delaunay triangles judged
@@ -41,7 +47,8 @@ struct EmptyCircles {
 };
 
 /// Empty circles pooled over `sets` (2D, each of at least 3 points, in [0,1]²; each normalised by its own
-/// count). Throws InvalidInput for other input. O(n log n) (Qhull's Delaunay triangulation).
+/// count). Throws DegenerateSet for a set that spans no area, InvalidInput for other input. O(n log n)
+/// (Qhull's Delaunay triangulation).
 EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& options = {});
 
 }  // namespace kdm::analysis

@@ -50,8 +50,9 @@ struct AnalysisReport {
   Periodogram spectrum;  ///< set-averaged periodogram
   SpectrumStats spectrum_stats;
   PairCorrelation gr;
-  bool has_empty_circles = false;  ///< 2D sets of at least 3 points
-  EmptyCircles empty_circles;      ///< holes: radii in local d_hex (of the target density, if given)
+  bool has_empty_circles = false;     ///< 2D sets of at least 3 points that span an area
+  std::string empty_circles_skipped;  ///< why a 2D analysis has none (few or degenerate points), or ""
+  EmptyCircles empty_circles;         ///< holes: radii in local d_hex (of the target density, if given)
   bool has_density = false;
   DensityAccuracy density;  ///< pooled: rms/max over all windows of all sets, summed counts
   bool has_tiling = false;
