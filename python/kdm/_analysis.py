@@ -40,12 +40,16 @@ def analyze(
     Parameters
     ----------
     points : array or list of arrays
-        One (n, 2) or (n, 3) set with coordinates in [0, 1], or a list of such sets of one dimension
-        (statistics are pooled over them, as over the sets of one file).
+        One (n, 2) or (n, 3) set with coordinates in [0, 1], or a list of such sets (arrays or nested
+        lists) of one dimension: statistics are pooled over them, as over the sets of one file, and the
+        spectrum refuses sets more than 10% apart in count (their frequencies would not line up).
     box : bool
         Bounded-box distances instead of periodic (torus) ones.
     density : None, float, str or 2-D array
-        The target density, as kdm.sample takes it, for the density accuracy test (default: uniform).
+        The target density, as kdm.sample takes it (default: uniform): for the density accuracy test,
+        and the local spacing empty circles are measured in.
+    gamma, invert
+        How an image file's pixels become density, as kdm.sample takes them.
     tile_size : float or None
         Tile side in unit-square units (1 / tile_size an integer) for the periodicity and seam
         statistics.
@@ -63,12 +67,16 @@ def analyze(
         pair_correlation, density, tiling, energy_per_point, seconds: those that apply), with its lists
         of numbers (spectrum.raps_f, spectrum.raps, pair_correlation.r and .g, ...) as numpy arrays.
     """
+    # A list whose entries are 2-D (arrays or nested lists) is several sets; else it is one set's points.
     several = isinstance(points, (list, tuple)) and len(points) > 0
-    if several and all(isinstance(p, np.ndarray) and p.ndim == 2 for p in points):
-        sets = [_checks.array2d(f"points[{i}]", p) for i, p in enumerate(points)]
-        names = [f"points[{i}]" for i in range(len(sets))]
+    if several and all(_checks.is_array(p) and np.ndim(p) == 2 for p in points):
+        raw, names = list(points), [f"points[{i}]" for i in range(len(points))]
     else:
-        sets, names = [_checks.array2d("points", points)], ["points"]
+        raw, names = [points], ["points"]
+    for name, p in zip(names, raw):
+        if _checks.is_array(p) and np.asarray(p).dtype == np.bool_:
+            raise TypeError(f"{name} must hold coordinates, got booleans")
+    sets = [_checks.array2d(name, p) for name, p in zip(names, raw)]
     box = _checks.flag("box", box)
     spec = _checks.sampler_density(density, gamma, invert)
     tile = 0.0 if tile_size is None else _checks.number("tile_size", tile_size, 0.0, strict=True)

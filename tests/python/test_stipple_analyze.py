@@ -227,3 +227,12 @@ def test_analyze_of_points_without_a_triangulation_keeps_the_other_measures():
         assert result["nearest_neighbour"]["count"] == 100 and "spectrum" in result
     two = kdm.analyze(np.array([[0.1, 0.2], [0.6, 0.7]]), energy=False, threads=1)
     assert "fewer than 3 points" in two["empty_circles_skipped"]
+
+
+def test_analyze_pools_sets_given_as_nested_lists_too():
+    rng = np.random.default_rng(8)
+    a, b = rng.random((300, 2)), rng.random((300, 2))
+    pooled = kdm.analyze([a, b.tolist()], energy=False, threads=1)
+    assert pooled["sets"] == 2
+    assert pooled["nearest_neighbour"]["davg"] == kdm.analyze([a, b], energy=False, threads=1)["nearest_neighbour"]["davg"]
+    assert kdm.analyze(a.tolist(), energy=False, threads=1)["sets"] == 1  # a list of points is one set

@@ -2,6 +2,7 @@
 // nearest-neighbour spacing (sqrt(2)/n)^(1/3) on the unit cube) and input validation shared by every metric.
 #include "kdm/analysis/common.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -35,10 +36,12 @@ void validate_points(const std::vector<double>& coords, int dim) {
     if (!std::isfinite(v))
       throw InvalidInput("point " + std::to_string(i / dim) + " has a non-finite coordinate");
     if (v < 0.0 || v > 1.0) {
-      char value[32];  // %g: std::to_string prints 1e300 with 300 digits, and 1e-7 as 0.000000
-      std::snprintf(value, sizeof value, "%g", v);
+      // The shortest text that reads back as v: std::to_string prints 1e300 with 300 digits, %g
+      // 1.0000001 as 1.
+      char value[32];
+      const std::to_chars_result end = std::to_chars(value, value + sizeof value, v);
       throw InvalidInput("point " + std::to_string(i / dim) + " lies outside the unit domain (coordinate " +
-                         value + "); normalise points to [0,1)");
+                         std::string(value, end.ptr) + "); normalise points to [0, 1]");
     }
   }
 }
