@@ -35,6 +35,7 @@ std::string analyze(const std::vector<Array>& arrays, const std::vector<std::str
   o.fmax = fmax;
   o.tile_size = tile_size;
   o.threads = threads;
+  o.checkpoint = [] { stop_on_signal(0); };                 // Ctrl-C stops it between its measures
   if (tile_size != 0) analysis::tiles_per_axis(tile_size);  // 1 / tile_size an integer
   gen::Density target = gen::Density::constant();
   if (density) {

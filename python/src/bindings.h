@@ -26,6 +26,13 @@ struct FileError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A long call's progress callback: raises a pending signal's exception (Ctrl-C's KeyboardInterrupt) in
+/// the call, which then stops at its next step instead of running to its end. Takes the GIL.
+inline void stop_on_signal(double /*progress*/) {
+  py::gil_scoped_acquire held;
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+}
+
 /// A loaded tile set as Python holds it: shared, immutable, so queries run on it with the GIL released.
 struct TilesetHandle {
   std::shared_ptr<const Tileset> set;

@@ -39,11 +39,7 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
   o.temperature = temperature;
   o.seed = seed;
   o.threads = threads;
-  // Ctrl-C (a signal whose Python handler raises) stops the sampler at its next sweep, not at its end.
-  o.progress = [](double) {
-    py::gil_scoped_acquire held;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-  };
+  o.progress = stop_on_signal;  // Ctrl-C stops the sampler at its next sweep
   const gen::Density target = tools::to_generator_density(spec);
   gen::SampleResult result;
   {

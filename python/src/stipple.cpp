@@ -79,8 +79,8 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     const double whole_dots = tools::stipple_dot_count(specs, double(points), scale);
     const std::int64_t count = method == "full" ? tools::full_stipple_count(whole_dots, scale) : 0;
     if (method == "full") {
-      set = colours ? tools::stipple_full(specs, count, aspect, seed, threads)
-                    : tools::stipple_full(spec, count, aspect, seed, threads);
+      set = colours ? tools::stipple_full(specs, count, aspect, seed, threads, stop_on_signal)
+                    : tools::stipple_full(spec, count, aspect, seed, threads, stop_on_signal);
     } else {
       const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode, seed);
       set = stippler.render(uv.data(), fade);

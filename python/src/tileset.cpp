@@ -91,14 +91,10 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
   auto set = std::make_shared<Tileset>();
   std::string detail;
   Status s;
-  // Ctrl-C (a signal whose Python handler raises) stops the bake after its current runs, not at its end.
-  const auto interruptible = [](double) {
-    py::gil_scoped_acquire held;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-  };
   {
     py::gil_scoped_release release;
-    const TilesetData data = gen::bake_tileset(recipe, threads, interruptible);
+    const TilesetData data =
+        gen::bake_tileset(recipe, threads, stop_on_signal);  // Ctrl-C: after the runs it samples
     std::vector<std::uint8_t> bytes;  // through the file format, as `kdm bake` then a load would go
     s = encode_tileset(data, bytes, &detail);
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import kdm
-from conftest import SPHERE, read_txt
+from conftest import SPHERE, interrupted, read_txt
 
 
 def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
@@ -236,3 +236,17 @@ def test_analyze_pools_sets_given_as_nested_lists_too():
     assert pooled["sets"] == 2
     assert pooled["nearest_neighbour"]["davg"] == kdm.analyze([a, b], energy=False, threads=1)["nearest_neighbour"]["davg"]
     assert kdm.analyze(a.tolist(), energy=False, threads=1)["sets"] == 1  # a list of points is one set
+
+
+def test_a_signal_stops_a_full_stipple_inside_its_call():
+    # The full sampler's stipple stops at its next sweep on Ctrl-C, as kdm.sample does (100,000 dots take
+    # seconds; the alarm comes after 0.3 s).
+    call = lambda: kdm.stipple(str(SPHERE), points=100_000, method="full", threads=1)  # noqa: E731
+    assert interrupted("stipple", call, 0.3) == ["c_exception"]
+
+
+def test_a_signal_stops_an_analysis_between_its_measures():
+    # 150,000 points take seconds to measure; the alarm after 0.3 s stops the call at its next measure.
+    points = np.random.default_rng(3).random((150_000, 2))
+    call = lambda: kdm.analyze(points, energy=False, threads=1)  # noqa: E731
+    assert interrupted("analyze", call, 0.3) == ["c_exception"]

@@ -9,8 +9,10 @@ namespace kdm::tools {
 namespace {
 
 /// The sampler's options for `points` dots of an image over [0, aspect] × [0, 1] in a box.
-gen::SamplerOptions stipple_options(std::int64_t points, double aspect, std::uint64_t seed, int threads) {
+gen::SamplerOptions stipple_options(std::int64_t points, double aspect, std::uint64_t seed, int threads,
+                                    const std::function<void(double)>& progress) {
   gen::SamplerOptions o;
+  o.progress = progress;
   o.n = points;
   o.domain = gen::Domain::kBox;
   o.extent[0] = aspect;
@@ -22,9 +24,9 @@ gen::SamplerOptions stipple_options(std::int64_t points, double aspect, std::uin
 }  // namespace
 
 PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspect, std::uint64_t seed,
-                      int threads) {
+                      int threads, const std::function<void(double)>& progress) {
   if (spec.kind != DensitySpec::Kind::kImage) throw std::invalid_argument("stippling needs an image");
-  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads);
+  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads, progress);
   PointSet set;
   set.dim = 2;
   set.coords = gen::sample(o, gen::Density::from_values(spec.width, spec.height, spec.values)).points;
@@ -32,9 +34,9 @@ PointSet stipple_full(const DensitySpec& spec, std::int64_t points, double aspec
 }
 
 PointSet stipple_full(const std::vector<const DensitySpec*>& inks, std::int64_t points, double aspect,
-                      std::uint64_t seed, int threads) {
+                      std::uint64_t seed, int threads, const std::function<void(double)>& progress) {
   if (inks.size() == 1) {
-    PointSet set = stipple_full(*inks.front(), points, aspect, seed, threads);
+    PointSet set = stipple_full(*inks.front(), points, aspect, seed, threads, progress);
     set.classes.assign(set.size(), 0);
     return set;
   }
@@ -49,7 +51,7 @@ PointSet stipple_full(const std::vector<const DensitySpec*>& inks, std::int64_t 
       densities.back().thread_safe = true;
     }
   }
-  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads);
+  const gen::SamplerOptions o = stipple_options(points, aspect, seed, threads, progress);
   gen::ClassSample sample = gen::sample_classes(o, densities);
   PointSet set;
   set.dim = 2;

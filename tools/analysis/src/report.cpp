@@ -54,8 +54,12 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   r.points_mean = total / static_cast<double>(sets.size());
   if (o.tile_size > 0) tiles_per_axis(o.tile_size);  // validate options before the expensive parts
 
+  const auto checkpoint = [&] {
+    if (o.checkpoint) o.checkpoint();
+  };
   std::vector<double> pooled, seam, interior;
   for (const tools::PointSet& s : sets) {
+    checkpoint();
     const NearestNeighbours nn = nearest_neighbours(s.coords, s.dim, o.torus, o.threads);
     const double spacing = reference_spacing(s.dim, s.size());
     double lo = nn.distance.front();
@@ -71,12 +75,15 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   r.dmin_mean = 0;
   for (double d : r.dmin_per_set) r.dmin_mean += d / static_cast<double>(r.dmin_per_set.size());
 
+  checkpoint();
   if (o.spectrum && r.dim == 2) {
     r.spectrum = average_periodogram(sets, o.fmax, o.threads);
     r.spectrum_stats = spectrum_stats(r.spectrum);
     r.has_spectrum = true;
   }
+  checkpoint();
   r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
+  checkpoint();
   if (r.dim == 2 && r.points_min < 3)
     r.empty_circles_skipped = "a set of fewer than 3 points has no triangle";
   if (r.dim == 2 && r.points_min >= 3) {
@@ -100,6 +107,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     dopt.bands = o.density_bands;
     double z2 = 0, mu_sum = 0, count_sum = 0;  // pooled over all windows of all sets
     for (const tools::PointSet& s : sets) {
+      checkpoint();
       const DensityAccuracy d = density_accuracy(s.coords, s.dim, o.density, dopt);
       const double w = static_cast<double>(d.windows);
       z2 += d.rms_z * d.rms_z * w;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct AnalysisOptions {
   double tile_size = 0;          ///< tile side for the tiling diagnostics (0: skip)
   double holes_min_density = 0;  ///< empty circles: only where ρ ≥ this fraction of its largest value
   int threads = 0;               ///< worker threads, 0 = gen::default_thread_count()
+  /// Called from the calling thread between the measures and the sets (optional): an exception it throws
+  /// stops the analysis there (Python's Ctrl-C).
+  std::function<void()> checkpoint;
 };
 
 struct AnalysisReport {
