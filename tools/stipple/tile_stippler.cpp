@@ -116,16 +116,12 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
                   scale_);
     throw std::invalid_argument(text);
   }
-  // The seed picks where in the endless tiling the image lies: another seed, other dots. Whole tiles and a
-  // fraction, within 2^12 tiles of the world's origin, where positions keep their precision at every zoom.
-  std::uint64_t h = seed + 0x9e3779b97f4a7c15u;  // SplitMix64 (Steele et al. 2014)
-  for (double* offset : {&offset_[0], &offset_[1]}) {
-    std::uint64_t z = (h += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    z ^= z >> 31;
-    *offset = double(z >> 40) * 0x1p-24 * 4096 * tile_size_;
-  }
+  // The seed picks where in the endless tiling the image lies: another seed, other dots. Seeds step along
+  // the R2 sequence (Roberts 2018: fractions of the plastic number's powers, in 64-bit fixed point), so
+  // they spread evenly over 2^12 tiles, where positions keep their precision at every zoom; seed 1, the
+  // default, lies at the world's origin.
+  const std::uint64_t step = seed - 1, fraction[2] = {step * 0xC13FA9A902A6328Fu, step * 0x91E10DA5C79E7B1Du};
+  for (int k = 0; k < 2; ++k) offset_[k] = double(fraction[k] >> 40) * 0x1p-24 * 4096 * tile_size_;
   const double world[4] = {offset_[0], offset_[1], offset_[0] + aspect_, offset_[1] + 1};
   for (const DensitySpec* spec : inks) densities_.push_back(std::make_unique<SpecDensity>(*spec, world));
   ClassQueryParams
