@@ -222,12 +222,13 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
-  cmd->add_option("--colours", a->colours,
-                  "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
-                  "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
-                  "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
-                  "(a layer per pen), .csv a class column, the ink's number, least-used ink first, as the "
-                  "run prints them (default: black dots of the image's darkness)");
+  cmd->add_option(
+      "--colours", a->colours,
+      "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
+      "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
+      "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
+      "(a layer per pen), .csv a class column, the ink's number, least-used ink first (but inks "
+      "under a tenth of all ink last), as the run prints them (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
                   "set's endless tiling (another seed, other dots; one seed, the same dots in every region "
