@@ -41,13 +41,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!*e.what()) fail();
     return 0;
   }
-  if (r.seed > (std::uint64_t(1) << 53) || r.colours < 1 || r.colours > kdm::kMaxTileColours ||
-      r.levels < 1 || r.levels > 10 || r.base_points < 1 || r.base_points > (1u << 16) || r.sweeps < 1 ||
-      r.sweeps > 10000)
+  if (r.colours < 1 || r.colours > kdm::kMaxTileColours || r.levels < 1 || r.levels > 10 ||
+      r.base_points < 1 || r.base_points > (1u << 16) || r.sweeps < 1 || r.sweeps > 10000)
     fail();
   if (!(r.band > 0 && r.band < 0.5) || !(r.erosion >= 0 && r.erosion <= 8) ||
       !(r.min_distance >= 0 && r.min_distance <= 0.7) || !(r.separation >= 0 && r.separation <= 0.7) ||
-      !(r.edge_gap >= 0.5 && r.edge_gap <= 4) || !(r.temperature >= 0 && std::isfinite(r.temperature)))
+      !(r.edge_gap >= 0.5 && r.edge_gap <= 4) || !(r.temperature >= 0 && r.temperature <= 1000) ||
+      !(r.fill_holes == 0 || (r.fill_holes >= 0.5 && r.fill_holes <= 2)) ||
+      (r.separation_push > 0 && !(r.separation > 0 && r.separation_push >= r.separation)) ||
+      (r.keyframes_per_level == 0 && (r.glide_late > 0 || r.glide_consensus || r.glide_separation > 0)))
     fail();
   if (r.top_level_points() > (1u << 22)) fail();
   const auto counts = r.nominal_counts();
