@@ -15,6 +15,22 @@ namespace {
 using testing::torus_hex_lattice;
 using testing::uniform_set;
 
+// The largest empty circle on a torus is the farthest any place is from every point: a search over a
+// grid of `grid`² places finds it to within the grid's half-diagonal from below.
+double farthest_from_every_point(const tools::PointSet& s, int grid) {
+  double farthest = 0;
+  for (int j = 0; j < grid; ++j)
+    for (int i = 0; i < grid; ++i) {
+      const double x = (i + 0.5) / grid, y = (j + 0.5) / grid;
+      double nearest = HUGE_VAL;
+      for (std::size_t p = 0; p < s.size(); ++p)
+        nearest = std::min(nearest, std::hypot(axis_delta(x, s.coords[2 * p], true),
+                                               axis_delta(y, s.coords[2 * p + 1], true)));
+      farthest = std::max(farthest, nearest);
+    }
+  return farthest;
+}
+
 TEST(EmptyCircles, AHexagonalLatticeHasNoHoleAndAMissingPointIsOne) {
   const int cols = 26, rows = 30;  // a near-hexagonal lattice on the torus (spacing ≈ d_hex)
   tools::PointSet s = torus_hex_lattice(cols, rows);
@@ -32,22 +48,11 @@ TEST(EmptyCircles, AHexagonalLatticeHasNoHoleAndAMissingPointIsOne) {
 }
 
 TEST(EmptyCircles, TheLargestMatchesABruteForceSearch) {
-  // The largest empty circle on a torus is the farthest any place is from every point: a fine grid search
-  // finds it to within the grid's half-diagonal from below.
   const tools::PointSet s = uniform_set(400, 7);
   const EmptyCircles e = empty_circles({s});
   EXPECT_EQ(e.triangles, 2 * s.size());
   constexpr int kGrid = 600;
-  double farthest = 0;
-  for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i) {
-      const double x = (i + 0.5) / kGrid, y = (j + 0.5) / kGrid;
-      double nearest = HUGE_VAL;
-      for (std::size_t p = 0; p < s.size(); ++p)
-        nearest = std::min(nearest, std::hypot(axis_delta(x, s.coords[2 * p], true),
-                                               axis_delta(y, s.coords[2 * p + 1], true)));
-      farthest = std::max(farthest, nearest);
-    }
+  const double farthest = farthest_from_every_point(s, kGrid);
   const double d = hex_spacing(s.size()), slack = std::sqrt(0.5) / kGrid;
   EXPECT_GE(e.largest * d + 1e-12, farthest);
   EXPECT_LE(e.largest * d, farthest + slack);
@@ -59,19 +64,6 @@ TEST(EmptyCircles, TheLargestMatchesABruteForceSearch) {
 // points): every triangle of the torus once (2n) and the largest circle the true one, where a margin of
 // copies a few spacings wide misses triangles across the hole and invents circles far wider than it.
 TEST(EmptyCircles, WideHolesAndFewPointsAreTriangulatedWhole) {
-  auto farthest = [](const tools::PointSet& s, int grid) {  // the largest empty circle, from below
-    double best = 0;
-    for (int j = 0; j < grid; ++j)
-      for (int i = 0; i < grid; ++i) {
-        const double x = (i + 0.5) / grid, y = (j + 0.5) / grid;
-        double nearest = HUGE_VAL;
-        for (std::size_t p = 0; p < s.size(); ++p)
-          nearest = std::min(nearest, std::hypot(axis_delta(x, s.coords[2 * p], true),
-                                                 axis_delta(y, s.coords[2 * p + 1], true)));
-        best = std::max(best, nearest);
-      }
-    return best;
-  };
   tools::PointSet band = uniform_set(2000, 1);
   for (std::size_t p = 0; p < band.size(); ++p) band.coords[2 * p] = 0.25 + 0.5 * band.coords[2 * p];
   std::vector<tools::PointSet> sets = {band};
@@ -80,7 +72,7 @@ TEST(EmptyCircles, WideHolesAndFewPointsAreTriangulatedWhole) {
   for (const tools::PointSet& s : sets) {
     const EmptyCircles e = empty_circles({s});
     EXPECT_EQ(e.triangles, 2 * s.size()) << s.size() << " points";
-    const double d = hex_spacing(s.size()), found = farthest(s, 200);
+    const double d = hex_spacing(s.size()), found = farthest_from_every_point(s, 200);
     EXPECT_GE(e.largest * d + 1e-12, found) << s.size() << " points";
     EXPECT_LE(e.largest * d, found + std::sqrt(0.5) / 200) << s.size() << " points";
   }

@@ -476,9 +476,16 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   expect_error("bake '" + path("empty.recipe") + "' -o '" + path("e.kdmt") + "'", "gives no key");
   for (const char* points :
        {"0.5 0.5\n0.5 0.5\n0.5 0.5\n0.5 0.5\n", "0.1 0.5\n0.2 0.5\n0.3 0.5\n0.9 0.5\n"}) {
+    // No triangulation: the empty circles are skipped, saying why, and the other measures still made.
     std::ofstream(path("flat.txt")) << points;
-    expect_error("analyze '" + path("flat.txt") + "' -o '" + path("a") + "'", "degenerate");
+    const Outcome r = kdm("analyze '" + path("flat.txt") + "' --box -o '" + path("a") + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("empty circles      skipped: the points are degenerate"), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("nearest neighbour"), std::string::npos) << r.out;
+    EXPECT_NE(slurp(path("a/metrics.json")).find("\"empty_circles_skipped\""), std::string::npos);
   }
+  expect_error("verify '" + path("a/metrics.json") + "' --runs 1001", "--runs must be in [2, 1000]");
   // A directory or an endless device where a tile set or a recipe belongs fails at once, saying so.
   expect_error("info '" + path("dir.png") + "'", "is a directory, not a tile set file");
   expect_error("query --tileset '" + path("dir.png") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
