@@ -109,13 +109,14 @@ def is_array(value: Any) -> bool:
 
 
 def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str = "density",
-                 one_of_several: bool = False) -> Any:
+                 one_of_several: bool = False, callable_ok: bool = False) -> Any:
     """A density as the C++ side takes it (_kdm.DensitySpec), or None for None.
 
     A number is a constant (finite, >= 0); a str or path is what `--density` accepts ("const:V", "ramp:R",
     "radial:R" or an image file, whose darkness to the power `gamma` is the density, or its luminance with
     `invert`); a 2-D array holds densities with row 0 at the top. `gamma` or `invert` with no image file
-    is refused (they would be ignored), unless `one_of_several` (the caller checks the densities together).
+    is refused (they would be ignored), unless `one_of_several` (the caller checks the densities together:
+    then None is no density either). `callable_ok`: the caller takes callables too (the TypeError says so).
     """
     gamma = number("gamma", gamma, 0.0, strict=True)
     invert = flag("invert", invert)
@@ -135,10 +136,9 @@ def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str 
         return _kdm.DensitySpec.constant(number(name, density, 0.0))
     if is_array(density):
         return _kdm.DensitySpec.from_values(array2d(name, density))
-    raise TypeError(
-        f"{name} must be None, a number, a str (const:V, ramp:R, radial:R or an image path) or a 2-D array, "
-        f"got {type(density).__name__}"
-    )
+    kinds = ([] if one_of_several else ["None"]) + ["a number", "a str (const:V, ramp:R, radial:R or an image "
+                                                    "path)", "a 2-D array"] + (["a callable"] if callable_ok else [])
+    raise TypeError(f"{name} must be {', '.join(kinds[:-1])} or {kinds[-1]}, got {type(density).__name__}")
 
 
 def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:

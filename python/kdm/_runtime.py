@@ -375,7 +375,7 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
             raise TypeError(f"{name} must be a number, a str, a 2-D array or a callable, got None")
         text = isinstance(d, (str, os.PathLike))
         specs.append(_checks.density_spec(d, gamma if text else 1.0, invert if text else False, name,
-                                          one_of_several=True))
+                                          one_of_several=True, callable_ok=True))
         callables.append(None)
         maxima.append(0.0)
     reshaped = _checks.number("gamma", gamma, 0.0, strict=True) != 1.0 or _checks.flag("invert", invert)
@@ -389,7 +389,7 @@ def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any]:
     """A query's density as (spec, callable): one of them None; no density is the constant 1."""
     if _is_callable(density):
         return None, density
-    spec = _checks.density_spec(density, gamma, invert)
+    spec = _checks.density_spec(density, gamma, invert, callable_ok=True)
     return (spec if spec is not None else _kdm.DensitySpec.constant(1.0)), None
 
 

@@ -93,7 +93,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       style.dot_radius_px =
           dot_size > 0 ? dot_size : tools::stipple_dot_radius(whole_dots, width, aspect, colours.has_value());
       if (colours) {
-        style.classes = &set.classes, style.inks = inks.inks, style.blend = inks.blend;
+        style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);
       }
       char line[200], where[160];

@@ -238,10 +238,21 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   const std::string svg = slurp(path("c.svg"));
   for (const char* ink : {"black", "cyan", "magenta", "yellow"})
     EXPECT_NE(svg.find("<g id=\"" + std::string(ink) + "\""), std::string::npos) << ink;
-  ASSERT_EQ(kdm("stipple " + sphere + " --colours cmyk -o '" + path("s.svg") + "'").status, 0);
+  const Outcome grey_run = kdm("stipple " + sphere + " --colours cmyk -o '" + path("s.svg") + "'");
+  ASSERT_EQ(grey_run.status, 0) << grey_run.err;
+  EXPECT_NE(grey_run.err.find("classes 0 black; no pixel uses cyan, magenta, yellow"), std::string::npos)
+      << grey_run.err;
+  // A grey picture has no colour to separate: black holds every dot, the other pens' layers stay, empty.
   const std::string grey = slurp(path("s.svg"));
-  EXPECT_NE(grey.find("<g id=\"black\""), std::string::npos);
-  EXPECT_EQ(grey.find("<g id=\"cyan\""), std::string::npos);  // a grey picture has no colour to separate
+  const auto layer = [&](const std::string& ink) {
+    const std::size_t start = grey.find("<g id=\"" + ink + "\"");
+    return start == std::string::npos ? std::string() : grey.substr(start, grey.find("</g>", start) - start);
+  };
+  EXPECT_NE(layer("black").find("<circle"), std::string::npos);
+  for (const char* ink : {"cyan", "magenta", "yellow"}) {
+    ASSERT_FALSE(layer(ink).empty()) << ink;
+    EXPECT_EQ(layer(ink).find("<circle"), std::string::npos) << ink;
+  }
   ASSERT_EQ(kdm("stipple " + coffee + " --colours 3 --points 8000 -o '" + path("c.csv") + "'").status, 0);
   std::istringstream in(slurp(path("c.csv")));
   std::string line;

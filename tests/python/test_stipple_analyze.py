@@ -182,6 +182,10 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
     assert np.array_equal(rows[:, :2], dots) and np.array_equal(rows[:, 2], classes)
     assert classes.dtype == np.uint8 and len(inks) == 4 and set(inks) == {"cyan", "magenta", "yellow", "black"}
     assert '<g id="%s"' % inks[0] in (tmp_path / "py.svg").read_text()
+    # A grey picture: black holds every dot, but the SVG keeps a layer for each of the scheme's pens.
+    _, grey_classes, grey_inks = kdm.stipple(str(SPHERE), points=2000, colours="cmyk", output=tmp_path / "g.svg")
+    assert grey_inks == ["black"] and not grey_classes.any()
+    assert all('<g id="%s"' % ink in (tmp_path / "g.svg").read_text() for ink in ("cyan", "magenta", "yellow"))
     full = kdm.stipple(str(coffee), points=2000, colours=3, method="full", threads=1)
     assert len(full[0]) == 2000 and set(np.unique(full[1])) <= {0, 1, 2}
     with pytest.raises(ValueError, match="cmyk, rgb"):

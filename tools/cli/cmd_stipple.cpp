@@ -118,6 +118,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::string names;
     for (std::size_t k = 0; k < inks.inks.size(); ++k)
       names += (k ? ", " : "") + std::to_string(k) + " " + inks.inks[k].name;
+    for (std::size_t k = 0; k < inks.unused.size(); ++k)  // still a layer in .svg, for the plotter's pens
+      names += (k ? ", " : "; no pixel uses ") + inks.unused[k].name;
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
   const int frames = std::max(1, a.frames);
@@ -161,7 +163,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     style.dot_radius_px = dot_radius;
     if (coloured) {
       if (set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left: a one-class query
-      style.classes = &set.classes, style.inks = inks.inks;
+      style.classes = &set.classes, style.inks = inks.layers();
       std::copy(inks.background, inks.background + 3, style.background);
       style.blend = inks.blend;
     }
@@ -227,7 +229,8 @@ void add_stipple_command(CLI::App& app) {
       "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
       "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
       "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
-      "(a layer per pen), .csv a class column, the ink's number, least-used ink first (but inks "
+      "(a layer per pen, empty for an ink no pixel uses), .csv a class column, the ink's number, least-used "
+      "ink first (but inks "
       "under a tenth of all ink last), as the run prints them (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "

@@ -137,9 +137,12 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     }
   }
   // Inks that no pixel uses would only waste a class: keep those with some coverage.
+  std::vector<Ink> unused;
   for (std::size_t c = s.channels.size(); c-- > 0;)
-    if (!(s.channels[c].max_value() > 0))
+    if (!(s.channels[c].max_value() > 0)) {
+      unused.insert(unused.begin(), s.inks[c]);
       s.channels.erase(s.channels.begin() + c), s.inks.erase(s.inks.begin() + c);
+    }
   if (s.channels.empty())
     throw std::invalid_argument("the image has no ink in any colour: nothing to stipple");
   // A later class's dots are those its cumulative density adds to the earlier classes', so its tone carries
@@ -160,6 +163,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   ColourSeparation sorted;
   std::copy(s.background, s.background + 3, sorted.background);
   sorted.blend = s.blend;
+  sorted.unused = std::move(unused);
   for (std::size_t c : order)
     sorted.channels.push_back(std::move(s.channels[c])), sorted.inks.push_back(s.inks[c]);
   return sorted;

@@ -17,8 +17,18 @@ namespace kdm::tools {
 struct ColourSeparation {
   std::vector<DensitySpec> channels;
   std::vector<Ink> inks;
+  /// The scheme's inks that no pixel uses: no class of dots, but a picture still lists them (an empty SVG
+  /// group each), so that a plotter's pen layers are the same whatever the image.
+  std::vector<Ink> unused;
   std::uint8_t background[3] = {255, 255, 255};
   Blend blend = Blend::kMultiply;  ///< inks on paper multiply; light on black adds
+
+  /// Every ink of the scheme, for a picture's layers: the used ones in class order, then the unused.
+  std::vector<Ink> layers() const {
+    std::vector<Ink> all = inks;
+    all.insert(all.end(), unused.begin(), unused.end());
+    return all;
+  }
 };
 
 /// Separates `image` by `scheme`:
