@@ -422,8 +422,18 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
                     std::to_string(kTilesetFormatVersion));
   if (size < kFixedHeaderBytes) return fail(Status::kTruncated, detail, "file ends inside the header");
   const std::uint32_t header_size = get32(p + 12);
-  if (header_size < kFixedHeaderBytes || header_size > kMaxTilesetHeaderBytes)
+  if (header_size < kFixedHeaderBytes)
     return fail(Status::kHeaderChecksumMismatch, detail, "header size field is implausible (damaged header)");
+  if (header_size > kMaxTilesetHeaderBytes) {
+    // Sizes that agree with the texts' are a long recipe, too large to read, not a damaged field (the file
+    // reader stops at the fixed header then, so its checksum cannot be judged).
+    const bool agree = std::uint64_t(get32(p + 48)) + get32(p + 52) + kFixedHeaderBytes == header_size;
+    return agree ? fail(Status::kTooLarge, detail,
+                        "header of " + std::to_string(header_size) + " bytes passes this reader's limit of " +
+                            std::to_string(kMaxTilesetHeaderBytes))
+                 : fail(Status::kHeaderChecksumMismatch, detail,
+                        "header size field is implausible (damaged header)");
+  }
   if (size < header_size) {  // a cut file, unless the size field disagrees with the header's own text sizes
     const std::uint64_t text_sizes = std::uint64_t(get32(p + 48)) + get32(p + 52);
     return text_sizes + kFixedHeaderBytes != header_size

@@ -130,7 +130,8 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
     (ValueError, "density_max must be > 0, got 0", dict(density=lambda x, y: 1.0, density_max=0)),
     (ValueError, "density must be >= 0", dict(density=-0.5)),
     (ValueError, "finite and >= 0", dict(density=np.full((3, 3), NAN))),
-    (TypeError, "density must be None, a number", dict(density=object())),
+    (TypeError, "density must be None, a number, .* 2-D array or a callable, got object", dict(density=object())),
+    (TypeError, r"classes\[0\] must be a number, .* 2-D array or a callable, got bool", dict(classes=[True])),
     (ValueError, "image files only, and no density is given", dict(gamma=2)),
     (ValueError, "image files only, and no class is one", dict(classes=[1.0, "const:0.5"], gamma=2)),
 ])

@@ -462,6 +462,32 @@ TEST(TilesetFormatTest, TheHeaderDescribesTheFileAndIsValidatedAlone) {
   EXPECT_EQ(read_tileset_header(nullptr, 0, h), Status::kTruncated);
 }
 
+// A header past the reader's cap whose size agrees with its texts' (a 2 MiB recipe) is too large, not
+// damaged; a size field that alone is past the cap is damage. The file reader stops at the fixed header.
+TEST(TilesetFormatTest, AHeaderPastTheCapIsTooLargeNotDamaged) {
+  const std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
+  const std::uint32_t fixed = 64, long_recipe = 2u << 20, version_size = get32(&file[52]);
+  std::vector<std::uint8_t> big(file.begin(), file.begin() + fixed);  // the fixed header (format doc §2)
+  put32(&big[12], fixed + long_recipe + version_size), put32(&big[48], long_recipe);
+  const std::string path = testing::TempDir() + "/long_recipe.kdmt";
+  {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(big.data()), static_cast<std::streamsize>(big.size()));
+    f << std::string(long_recipe + version_size + 100, 'r');
+  }
+  TilesetData loaded;
+  std::string why;
+  EXPECT_EQ(load_tileset(path, loaded, &why), Status::kTooLarge);
+  const std::string size = std::to_string(fixed + long_recipe + version_size);
+  EXPECT_NE(why.find("header of " + size + " bytes passes this reader's limit of 1048576"), std::string::npos)
+      << why;
+  TilesetHeader h;
+  put32(&big[48], get32(&file[48]));  // the texts' sizes disagree with the header's
+  EXPECT_EQ(read_tileset_header(big.data(), big.size(), h, &why), Status::kHeaderChecksumMismatch);
+  EXPECT_NE(why.find("implausible"), std::string::npos) << why;
+  std::remove(path.c_str());
+}
+
 // An engine's allocator serves every array of a loaded tile set, and gets all of it back, even when
 // other hooks are installed in between.
 struct CountingHeap {
