@@ -8,6 +8,7 @@
 #include <chrono>
 #include <vector>
 
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/query.h"
 
 namespace {
@@ -17,6 +18,10 @@ double zero(void*, double, double) {
 }
 void zero_bounds(void*, double, double, double, double, double* lo, double* hi) {
   *lo = *hi = 0;
+}
+
+double eighth(void*, double, double) {
+  return 0.125;
 }
 
 enum Case { kConstantDense, kCallbackDense, kCallbackManyTiles, kEmptyTiles };
@@ -65,6 +70,37 @@ void BM_LongestCall(benchmark::State& state) {
   state.counters["calls"] = calls;
 }
 
+/// Calls that read more than once per candidate: `classes` callback classes of 1/8 each over 4,000 × 4,000
+/// units (tiles of 32, scale 30, every candidate emitted), smooth mode with glide_together or stable.
+void BM_LongestClassCall(benchmark::State& state) {
+  kdm::ClassQueryParams q;
+  q.query.x1 = q.query.y1 = 4000, q.query.tile_size = 32, q.query.scale = 30;
+  q.query.mode = state.range(1) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable;
+  q.query.glide_together = state.range(1) != 0;
+  q.class_count = static_cast<std::uint32_t>(state.range(0));
+  for (std::uint32_t k = 0; k < q.class_count; ++k) {
+    q.classes[k].kind = kdm::QueryDensity::Kind::kCallback;
+    q.classes[k].callback = eighth, q.classes[k].callback_max = 0.125;
+  }
+  std::vector<float> xy(std::size_t(2) << 22);
+  std::vector<std::uint8_t> classes(std::size_t(1) << 22);
+  std::fill(xy.begin(), xy.end(), 0.f), std::fill(classes.begin(), classes.end(), 0);
+  kdm::Tileset::builtin();
+  double worst = 0;
+  for (auto _ : state) {
+    kdm::QueryCursor cursor;
+    std::size_t written = 0;
+    const auto t0 = std::chrono::steady_clock::now();  // the first call: a full one
+    const kdm::Status status = kdm::query_classes_compact(kdm::Tileset::builtin(), q, {xy.data(), nullptr},
+                                                          classes.data(), classes.size(), &written, &cursor);
+    worst = std::max(
+        worst, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (status != kdm::Status::kBufferFull) state.SkipWithError("the first call did not stop at its bound");
+    benchmark::DoNotOptimize(xy.data());
+  }
+  state.counters["worst_call_ms"] = worst;
+}
+
 }  // namespace
 
 // Args: the case (0 constant and dense, 1 a callback at every candidate of dense tiles, 2 the same over
@@ -76,6 +112,15 @@ BENCHMARK(BM_LongestCall)
     ->Args({kCallbackDense, 0})
     ->Args({kCallbackManyTiles, 0})
     ->Args({kEmptyTiles, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
+// Args: the class count, then smooth mode with glide_together (0 or 1).
+BENCHMARK(BM_LongestClassCall)
+    ->ArgNames({"classes", "together"})
+    ->Args({1, 0})
+    ->Args({8, 0})
+    ->Args({1, 1})
+    ->Args({8, 1})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -32,6 +32,10 @@ constexpr const char* kImageNames[kMaxQueryClasses] = {
 constexpr const char* kCallbackNames[kMaxQueryClasses] = {
     "classes[0].callback", "classes[1].callback", "classes[2].callback", "classes[3].callback",
     "classes[4].callback", "classes[5].callback", "classes[6].callback", "classes[7].callback"};
+constexpr const char* kBatchCallbackNames[kMaxQueryClasses] = {
+    "classes[0].batch_callback", "classes[1].batch_callback", "classes[2].batch_callback",
+    "classes[3].batch_callback", "classes[4].batch_callback", "classes[5].batch_callback",
+    "classes[6].batch_callback", "classes[7].batch_callback"};
 constexpr const char* kKindNames[kMaxQueryClasses] = {"classes[0].kind", "classes[1].kind", "classes[2].kind",
                                                       "classes[3].kind", "classes[4].kind", "classes[5].kind",
                                                       "classes[6].kind", "classes[7].kind"};
@@ -142,12 +146,12 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
         if (d.constant < 0) return refuse(Kind::kNegative, kConstantNames[k], d.constant);
         continue;
       case QueryDensity::Kind::kImage:
-        if (!d.image || !detail::image_queryable(*d.image))
-          return refuse(Kind::kBadDensity, kImageNames[k]);
+        if (!d.image || !detail::image_queryable(*d.image)) return refuse(Kind::kBadDensity, kImageNames[k]);
         densities.samplers[k] = ImageSampler(d.image);
         break;
       case QueryDensity::Kind::kCallback:
-        if (!d.callback == !d.batch_callback) return refuse(Kind::kBadDensity, kCallbackNames[k]);
+        if (!d.callback == !d.batch_callback)  // neither or both, named as a one-class query names them
+          return refuse(Kind::kBadDensity, d.callback ? kBatchCallbackNames[k] : kCallbackNames[k]);
         if (!std::isfinite(d.callback_max))
           return refuse(Kind::kNotFinite, kCallbackMaxNames[k], d.callback_max);
         if (d.callback_max < 0) return refuse(Kind::kNegative, kCallbackMaxNames[k], d.callback_max);

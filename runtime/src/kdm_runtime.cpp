@@ -196,7 +196,7 @@ static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KD
   }
 constexpr const char* kClassDensityNames[][KDM_MAX_CLASSES] = {
     KDM_CLASS_NAMES("density"), KDM_CLASS_NAMES("density_max"), KDM_CLASS_NAMES("density_image"),
-    KDM_CLASS_NAMES("density_callback")};
+    KDM_CLASS_NAMES("density_callback"), KDM_CLASS_NAMES("density_batch_callback")};
 #undef KDM_CLASS_NAMES
 constexpr const char* kJointMaxNames[KDM_MAX_CLASSES] = {
     "joint.density_max[0]", "joint.density_max[1]", "joint.density_max[2]", "joint.density_max[3]",
@@ -215,11 +215,12 @@ const char* c_parameter(const char* name) {
                                                 {"out.keys", "keys"}};
   for (const auto& r : kRenamed)
     if (std::strcmp(name, r[0]) == 0) return r[1];
-  static constexpr const char* kClassFields[] = {"constant", "callback_max", "image", "callback"};
+  static constexpr const char* kClassFields[] = {"constant", "callback_max", "image", "callback",
+                                                 "batch_callback"};
   if (std::strncmp(name, "classes[", 8) == 0) {  // "classes[k].field", k one digit
     const unsigned k = static_cast<unsigned>(name[8] - '0');
     if (k < KDM_MAX_CLASSES && std::strncmp(name + 9, "].", 2) == 0)
-      for (std::size_t f = 0; f < 4; ++f)
+      for (std::size_t f = 0; f < 5; ++f)
         if (std::strcmp(name + 11, kClassFields[f]) == 0) return kClassDensityNames[f][k];
   }
   if (std::strncmp(name, "joint.max[", 10) == 0) {
@@ -310,6 +311,11 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
       q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,
       q.joint.user = joint->user, q.joint.batch_densities = joint->batch_densities;
       std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
+      for (uint32_t k = 0; k < class_count && !unset; ++k)
+        if (q.joint.max[k] == 0) {  // a zeroed struct's: it would silently leave class k out
+          why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = kJointMaxNames[k];
+          why.value = q.joint.max[k], unset = true;
+        }
     }
     if (!unset) status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }

@@ -527,8 +527,10 @@ Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std:
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
   struct stat info;
-  if (fstat(fileno(file.get()), &info) == 0 && S_ISDIR(info.st_mode))
+  const bool known = fstat(fileno(file.get()), &info) == 0;
+  if (known && S_ISDIR(info.st_mode))
     return fail(Status::kIoError, detail, "'" + path + "' is a directory, not a tile set file");
+  const bool regular = known && S_ISREG(info.st_mode);
   bytes.resize(kFixedHeaderBytes);
   std::size_t n = std::fread(bytes.data(), 1, bytes.size(), file.get());
   if (n == kFixedHeaderBytes && std::memcmp(bytes.data(), kMagic, 8) == 0) {
@@ -536,8 +538,17 @@ Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std:
     const std::uint64_t header_size = get32(h + 12), payload_size = get64(h + 16);
     if (header_size >= kFixedHeaderBytes && header_size <= kMaxTilesetHeaderBytes &&
         payload_size <= ZSTD_compressBound(kMaxTilesetPayloadBytes)) {
-      bytes.resize(static_cast<std::size_t>(header_size + payload_size + 1));
-      n += std::fread(bytes.data() + n, 1, bytes.size() - n, file.get());
+      // The buffer grows with the bytes the file holds, not with what its unchecked header claims: a
+      // damaged 64-byte file must not allocate half a gigabyte.
+      const std::uint64_t wanted = header_size + payload_size + 1;
+      std::uint64_t room = regular ? std::uint64_t(info.st_size) + 1 : std::uint64_t(1) << 16;
+      while (n < wanted) {
+        room = std::min(wanted, std::max(room, std::uint64_t(n) * 2));
+        bytes.resize(static_cast<std::size_t>(room));
+        const std::size_t got = std::fread(bytes.data() + n, 1, bytes.size() - n, file.get());
+        n += got;
+        if (n < bytes.size()) break;  // the end of the file (or an error, told below)
+      }
     }
   }
   bytes.resize(n);

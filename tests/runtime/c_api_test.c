@@ -302,7 +302,13 @@ int main(int argc, char** argv) {
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE &&
           strcmp(problem.parameter, "classes[2].density_max") == 0);
-    densities[2].density_callback = NULL;
+    densities[2].density_max = 1, densities[2].density_batch_callback = ramp_batch; /* two callbacks */
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_BAD_DENSITY &&
+          strcmp(problem.parameter, "classes[2].density_batch_callback") == 0);
+    densities[2].density_callback = NULL, densities[2].density_batch_callback = NULL;
+    densities[2].density_max = 0;
     /* The compact output: the same classes, keys and rounded positions (the union here is a constant). */
     {
       static float xy[2 * 4096], sum_xy[2 * 4096];
@@ -536,6 +542,11 @@ int main(int argc, char** argv) {
         joint.density_max[1] = -1;
         CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
                                       &problem) == KDM_INVALID_ARGUMENT &&
+              strcmp(problem.parameter, "joint.density_max[1]") == 0);
+        joint.density_max[1] = 0; /* a zeroed struct's, left unset: not a class left out in silence */
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              problem.kind == KDM_PROBLEM_NOT_POSITIVE &&
               strcmp(problem.parameter, "joint.density_max[1]") == 0);
       }
     }

@@ -281,7 +281,7 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(refusal(q).parameter, "classes[1].callback");
   q.classes[1].callback = [](void*, double, double) { return 1.0; };
   q.classes[1].batch_callback = [](void*, std::size_t, const double*, const double*, double*) {};
-  EXPECT_STREQ(refusal(q).parameter, "classes[1].callback");  // both: which one is meant is unclear
+  EXPECT_STREQ(refusal(q).parameter, "classes[1].batch_callback");  // both: which one is meant is unclear
   q.classes[1].batch_callback = nullptr;
   q.classes[1].callback_max = -1;
   EXPECT_EQ(refusal(q).kind, QueryProblem::Kind::kNegative);

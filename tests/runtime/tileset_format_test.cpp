@@ -602,6 +602,19 @@ TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
   for (const std::size_t size :
        {std::size_t(0), std::size_t(5), std::size_t(63), std::size_t(64), bytes.size() / 2, bytes.size() - 1})
     EXPECT_EQ(load_bytes(size, ""), Status::kTruncated) << size;
+  // A 64-byte file that claims a megabyte of header and half a gigabyte of payload is read as the 64
+  // bytes it is: what it claims is not allocated before it is checked.
+  std::vector<std::uint8_t> claims(bytes.begin(), bytes.begin() + 64);
+  put32(&claims[12], 1u << 20), put64(&claims[16], 530000000);
+  std::vector<char> read;
+  {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(claims.data()), 64);
+  }
+  ASSERT_EQ(read_tileset_file(path, read), Status::kOk);
+  EXPECT_EQ(read.size(), 64u);
+  EXPECT_LT(read.capacity(), 4096u);
+  EXPECT_EQ(load_tileset(path, loaded), Status::kHeaderChecksumMismatch);
   std::remove(path.c_str());
 }
 

@@ -265,7 +265,8 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_compact(const kdm_tileset* tileset,
 /* Every class's density from one call (kdm::JointClassDensity), for classes that share their inputs:
  * `densities` writes the class_count densities at (x, y), class 0 first, into values[0 ... class_count);
  * `density_bounds` (optional) each class's bounds over the rectangle into lo[k], hi[k]; density_max[k] an
- * upper bound of class k's density (finite, >= 0). Zero the struct before filling it. */
+ * upper bound of class k's density (finite, > 0: 0, a zeroed struct's, is refused as a callback's
+ * density_max is). Zero the struct before filling it. */
 typedef struct kdm_joint_class_density {
   void (*densities)(void* user, double x, double y, double* values);
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
