@@ -59,8 +59,9 @@ def stipple(
     output : str, os.PathLike or None
         Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does.
     width, dot_size
-        The picture's width in pixels, and the dot radius in pixels (None: a quarter of the whole
-        image's mean dot spacing).
+        The picture's width in pixels, and the dot radius in pixels (None: the size at which the
+        whole image's dots cover as much of the picture as the image's mean darkness, in colour the
+        inks' summed coverage, so that the picture keeps the image's tone).
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
     colours : {"cmyk", "rgb"}, int or None

@@ -38,9 +38,21 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (output) tools::refuse_writing_over(label, *output, "input image");
   check_number("dot_size", dot_size, 0, false);
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
+  // Before the dots are placed, as kdm stipple says them.
+  const auto picture = [&] {
+    return tools::has_extension(*output, ".png") || tools::has_extension(*output, ".svg");
+  };
+  if (fade > 0 && output && !picture())
+    throw std::invalid_argument(
+        "fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
+  if (colours && output && !picture() && !tools::has_extension(*output, ".csv"))
+    throw std::invalid_argument(
+        "colours writes each dot's ink as a class: write .csv (x,y,class), .svg or .png");
+  if (tileset && method == "full")
+    throw std::invalid_argument("tileset applies to method='tiles' (the full sampler has no tiles)");
   if (spec.kind != DensitySpec::Kind::kImage)
     throw std::invalid_argument("stipple needs an image; for a constant density use kdm.sample");
-  if (!(spec.max_value() > 0))
+  if (!(spec.max_value() > 0) && !colours)  // in colour, the separation says which inks there are
     throw std::invalid_argument("image '" + label + "' has no ink: nothing to stipple" +
                                 (spec.inverted ? "" : " (an all-white image has no ink)"));
   // With `colours`, the image file separated into inks, one class of dots each (kdm stipple --colours).
@@ -91,7 +103,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       style.width_px = width;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px =
-          dot_size > 0 ? dot_size : tools::stipple_dot_radius(whole_dots, width, aspect, colours.has_value());
+          dot_size > 0 ? dot_size : tools::stipple_dot_radius(whole_dots, width, aspect, specs);
       if (colours) {
         style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);

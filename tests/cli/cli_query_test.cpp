@@ -236,8 +236,16 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   const std::string sphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
   ASSERT_EQ(kdm("stipple " + coffee + " --colours cmyk --points 8000 -o '" + path("c.svg") + "'").status, 0);
   const std::string svg = slurp(path("c.svg"));
-  for (const char* ink : {"black", "cyan", "magenta", "yellow"})
-    EXPECT_NE(svg.find("<g id=\"" + std::string(ink) + "\""), std::string::npos) << ink;
+  // Inkscape layers, one per pen in the printing order whatever the classes' order; the paper one of its own.
+  std::size_t previous = svg.find("<g id=\"paper\" inkscape:groupmode=\"layer\" inkscape:label=\"paper\">");
+  EXPECT_NE(previous, std::string::npos);
+  for (const std::string ink : {"cyan", "magenta", "yellow", "black"}) {
+    const std::size_t at =
+        svg.find("<g id=\"" + ink + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + ink);
+    ASSERT_NE(at, std::string::npos) << ink;
+    EXPECT_GT(at, previous) << ink;
+    previous = at;
+  }
   const Outcome grey_run = kdm("stipple " + sphere + " --colours cmyk -o '" + path("s.svg") + "'");
   ASSERT_EQ(grey_run.status, 0) << grey_run.err;
   EXPECT_NE(grey_run.err.find("classes 0 black; no pixel uses cyan, magenta, yellow"), std::string::npos)

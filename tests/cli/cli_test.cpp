@@ -373,6 +373,28 @@ TEST_F(CliTest, TruncatedPngWritesAreErrors) {
   EXPECT_EQ(image.width, 1024);
 }
 
+// A stipple keeps the image's tone: the dots' default size makes their ink cover the image's mean darkness,
+// pale or dark, whatever the dot count. Measured 2026-12-06: 0.102 for 0.098 and 0.700 for 0.698 (dots
+// that overlap lighten darker tones, antialiasing darkens the smallest dots); the old fixed size drew
+// both at 0.20.
+TEST_F(CliTest, StippleKeepsTheImagesTone) {
+  for (const int grey : {230, 77}) {
+    SCOPED_TRACE(grey);
+    write_bytes(path("flat.png"),
+                grey_png(64, 64, 8, std::vector<std::uint16_t>(64 * 64, std::uint16_t(grey))));
+    for (const char* extra : {"", " --points 5000"}) {
+      const Outcome run = kdm("stipple '" + path("flat.png") + "'" + extra + " -o '" + path("s.png") + "'");
+      ASSERT_EQ(run.status, 0) << run.err;
+      kdm::tools::GreyImage picture;
+      std::string error;
+      ASSERT_TRUE(kdm::tools::load_grey_image(path("s.png"), picture, error)) << error;
+      double ink = 0;
+      for (float v : picture.pixels) ink += 1 - v;
+      EXPECT_NEAR(ink / picture.pixels.size(), 1 - grey / 255.0, 0.02) << extra;
+    }
+  }
+}
+
 // The full sampler cannot place points across a domain too narrow for their count (a short side of one
 // grid node): every one of them ended up in its left half. Such aspect ratios, from --aspect or from an
 // image's shape, are refused by name; --aspect 0 is no aspect ratio.
@@ -738,6 +760,11 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   std::snprintf(deepest, sizeof deepest, "%g× (", 2 * m * m * m * m);
   expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, deepest);
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
+  // Options of the tiles alone, which the full sampler would ignore.
+  expect_error("stipple " + image + " --method full --mode stable" + out, "--mode applies to --method tiles");
+  expect_error("stipple " + image + " --method full --tileset '" + std::string(KDM_SOURCE_DIR) +
+                   "/tilesets/default.kdmt'" + out,
+               "--tileset applies to --method tiles");
   EXPECT_FALSE(fs::exists(path("z_0000.png")));  // refused before any frame is written
 }
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import kdm
-from conftest import SPHERE, interrupted, read_txt
+from conftest import SPHERE, interrupted, read_txt, write_png
 
 
 def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
@@ -194,6 +194,22 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
         kdm.stipple(str(coffee), colours="rgb", invert=True)
     with pytest.raises(ValueError, match="image file"):
         kdm.stipple(np.ones((4, 4)) * 0.5, colours="cmyk")
+
+
+def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
+    # A white image in rgb is all light: dots, as the command line gives (no grey "no ink" refusal).
+    white = tmp_path / "white.png"
+    write_png(white, np.full((8, 8), 255))
+    dots, classes, inks = kdm.stipple(str(white), points=500, colours="rgb")
+    assert len(dots) > 400 and inks == ["red", "green", "blue"]
+    coffee = str(SPHERE.parent / "coffee.png")
+    with pytest.raises(ValueError, match="fade grows dots in pictures"):
+        kdm.stipple(str(SPHERE), points=500, fade=0.2, output=tmp_path / "x.csv")
+    with pytest.raises(ValueError, match="colours writes each dot's ink as a class"):
+        kdm.stipple(coffee, points=500, colours="cmyk", output=tmp_path / "x.txt")
+    with pytest.raises(ValueError, match="tileset applies to method='tiles'"):
+        kdm.stipple(str(SPHERE), points=500, method="full", tileset=kdm.Tileset.builtin())
+    assert not list(tmp_path.glob("x.*"))
 
 
 def test_stipple_tiles_seed_picks_another_part_of_the_tiling():

@@ -156,7 +156,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       how = "runtime tiles";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (dot_radius <= 0) dot_radius = tools::stipple_dot_radius(whole_dots, a.width_px, aspect, coloured);
+    if (dot_radius <= 0) dot_radius = tools::stipple_dot_radius(whole_dots, a.width_px, aspect, specs);
     tools::DrawStyle style;
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
@@ -219,8 +219,9 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option(
       "--dot-size", a->dot_size,
-      "Dot radius in pixels (default, or 0: a quarter of the whole image's mean dot spacing, 0.7 of it "
-      "with --colours)");
+      "Dot radius in pixels (default, or 0: the size at which the whole image's dots cover as much of "
+      "the picture as the image's mean darkness, with --colours the inks' summed coverage: the picture "
+      "keeps the image's tone)");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
@@ -247,6 +248,11 @@ void add_stipple_command(CLI::App& app) {
     if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())
       throw CommandError("--colours must be cmyk, rgb or a count of inks (2-8), got ''");
     if (scale_given) a->points = 0;
+    if (a->method == "full")  // options the full sampler would ignore
+      for (const char* tiles_only : {"--mode", "--tileset"})
+        if (cmd->get_option(tiles_only)->count() > 0)
+          throw CommandError(std::string(tiles_only) +
+                             " applies to --method tiles (the full sampler has no tiles)");
     run_stipple(*a, scale_given);
   });
 }

@@ -100,19 +100,28 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     return;
   }
   std::ostringstream out;
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << w << "\" height=\"" << h
-      << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
+  // Each group an Inkscape layer, so that plotter software draws a layer per pen; the paper is a layer of
+  // its own, to hide before plotting (a plotter would trace its outline).
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
+         "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
+      << w << "\" height=\"" << h << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
   for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
+  const auto layer = [&](const std::string& name) {
+    return "<g id=\"" + name + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + name + "\"";
+  };
   Ink paper;
   std::copy(style.background, style.background + 3, paper.rgb);
-  out << "<rect width=\"100%\" height=\"100%\" fill=\"" << hex(paper) << "\"/>\n";
+  out << layer("paper") << "><rect width=\"100%\" height=\"100%\" fill=\"" << hex(paper) << "\"/></g>\n";
   out.precision(6);
-  for (std::size_t k = 0; k < (classed ? inks.size() : 1); ++k) {
+  std::vector<std::size_t> order(classed ? inks.size() : 1);
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return inks[a].layer < inks[b].layer; });
+  for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
                                                         : "";
-    out << "<g id=\"" << (classed ? inks[k].name : "points") << "\" fill=\"" << hex(inks[k]) << "\"" << blend
-        << ">\n";
+    out << layer(classed ? inks[k].name : "points") << " fill=\"" << hex(inks[k]) << "\"" << blend << ">\n";
     for (std::size_t i = 0; i < points.size(); ++i)
       if ((!classed || (*style.classes)[i] == k) && radius(i) > 0)
         out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h

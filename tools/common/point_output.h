@@ -13,6 +13,7 @@ namespace kdm::tools {
 struct Ink {
   std::uint8_t rgb[3] = {0, 0, 0};
   std::string name;
+  int layer = 0;  ///< its place among an SVG's layers, lowest first (ties in class order)
 };
 
 /// Distinct inks for `count` classes (at most 8), named class-0, class-1, …: black first, then colours.
@@ -28,8 +29,8 @@ struct DrawStyle {
   int width_px = 1024;       ///< PNG width; height follows the aspect ratio
   double dot_radius_px = 0;  ///< 0 = automatic from the point count
   double aspect = 1;         ///< width / height of the domain
-  /// Optional: every point's class, drawn in inks[class] (SVG: a group per class, in class order); null
-  /// draws every point black.
+  /// Optional: every point's class, drawn in inks[class] (SVG: a layer per ink, in the inks' layer order);
+  /// null draws every point black.
   const std::vector<std::uint8_t>* classes = nullptr;
   std::vector<Ink> inks;
   std::uint8_t background[3] = {255, 255, 255};  ///< the paper

@@ -28,10 +28,10 @@ DensitySpec channel(const ColourImage& image, double gamma, const std::string& n
   return spec;
 }
 
-Ink ink(std::uint8_t r, std::uint8_t g, std::uint8_t b, const std::string& name) {
+Ink ink(std::uint8_t r, std::uint8_t g, std::uint8_t b, const std::string& name, int layer) {
   Ink i;
   i.rgb[0] = r, i.rgb[1] = g, i.rgb[2] = b;
-  i.name = name;
+  i.name = name, i.layer = layer;
   return i;
 }
 
@@ -97,8 +97,9 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     };
     s.channels = {channel(image, gamma, "black", black), channel(image, gamma, "cyan", part(0)),
                   channel(image, gamma, "magenta", part(1)), channel(image, gamma, "yellow", part(2))};
-    s.inks = {ink(0, 0, 0, "black"), ink(0, 174, 239, "cyan"), ink(236, 0, 140, "magenta"),
-              ink(255, 242, 0, "yellow")};
+    // Layers in the printing order, black last, whichever inks the image uses most.
+    s.inks = {ink(0, 0, 0, "black", 3), ink(0, 174, 239, "cyan", 0), ink(236, 0, 140, "magenta", 1),
+              ink(255, 242, 0, "yellow", 2)};
   } else if (scheme == "rgb") {
     for (int c = 0; c < 3; ++c) {
       const char* names[3] = {"red", "green", "blue"};
@@ -108,7 +109,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
         return double(p[c]) - (image.alpha.empty() ? 0.0 : 1.0 - image.alpha[i]);
       }));
     }
-    s.inks = {ink(255, 0, 0, "red"), ink(0, 255, 0, "green"), ink(0, 0, 255, "blue")};
+    s.inks = {ink(255, 0, 0, "red", 0), ink(0, 255, 0, "green", 1), ink(0, 0, 255, "blue", 2)};
     std::fill(s.background, s.background + 3, 0);
     s.blend = Blend::kAdd;
   } else {
@@ -132,8 +133,8 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
       const auto byte = [](double v) {
         return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
       };
-      s.inks.push_back(
-          ink(byte(centres[c][0]), byte(centres[c][1]), byte(centres[c][2]), "ink-" + std::to_string(c)));
+      s.inks.push_back(ink(byte(centres[c][0]), byte(centres[c][1]), byte(centres[c][2]),
+                           "ink-" + std::to_string(c), int(c)));
     }
   }
   // Inks that no pixel uses would only waste a class: keep those with some coverage.

@@ -10,6 +10,10 @@
 
 namespace kdm::tools {
 
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
 double stipple_zoom(const double uv[4]) {
   return 1 / (uv[2] - uv[0]);
 }
@@ -55,9 +59,12 @@ std::int64_t full_stipple_count(double whole_dots, double scale) {
   return count;
 }
 
-double stipple_dot_radius(double whole_dots, int width_px, double aspect, bool coloured) {
-  return (coloured ? 0.7 : 0.25) *
-         std::sqrt(double(width_px) * (width_px / aspect) / std::max(1.0, whole_dots));
+double stipple_dot_radius(double whole_dots, int width_px, double aspect,
+                          const std::vector<const DensitySpec*>& inks) {
+  double coverage = 0;  // the inks' mean densities: the share of the paper their dots should cover
+  for (const DensitySpec* ink : inks) coverage += ink->mean_value();
+  const double pixels = double(width_px) * (width_px / aspect);
+  return std::sqrt(coverage * pixels / (kPi * std::max(1.0, whole_dots)));
 }
 
 double max_stipple_zoom(const Tileset& tileset, QueryMode mode) {

@@ -26,9 +26,11 @@ double stipple_dot_count(const std::vector<const DensitySpec*>& inks, double poi
 /// throws std::invalid_argument when it rounds to no dot or exceeds the sampler's 2^31.
 std::int64_t full_stipple_count(double whole_dots, double scale);
 
-/// A dot's radius in pixels when none is given: a quarter of the whole image's mean dot spacing (0.7 of
-/// it in colour, so that inks cover their share of the paper), whatever region is drawn.
-double stipple_dot_radius(double whole_dots, int width_px, double aspect, bool coloured);
+/// A dot's radius in pixels when none is given: the whole image's `whole_dots` dots together cover as much
+/// of the picture as the inks' densities do on average (a pale image, small dots; in colour each ink its
+/// share, overlaps aside), whatever region is drawn, so that the picture's tone is the image's.
+double stipple_dot_radius(double whole_dots, int width_px, double aspect,
+                          const std::vector<const DensitySpec*>& inks);
 
 /// The most a region may zoom into an image with `tileset` in `mode`: kStippleZoomRoom, times m^4 in
 /// smooth mode with a set that hands over to m×m subtiles past its top level (query_density_limit).
