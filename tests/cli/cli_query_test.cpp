@@ -261,6 +261,19 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
     ASSERT_FALSE(layer(ink).empty()) << ink;
     EXPECT_EQ(layer(ink).find("<circle"), std::string::npos) << ink;
   }
+  // N inks are clustered beside the paper: none is spent on the image's white (one was #fdfdfd, with 547
+  // dots); the sphere's lightest ink is #cfcfcf.
+  ASSERT_EQ(kdm("stipple " + sphere + " --colours 4 -o '" + path("n.svg") + "'").status, 0);
+  const std::string inks = slurp(path("n.svg"));
+  int found = 0;
+  for (std::size_t at = inks.find("<g id=\"ink-"); at != std::string::npos;
+       at = inks.find("<g id=\"ink-", at + 1)) {
+    const std::size_t fill = inks.find(" fill=\"#", at);
+    const unsigned long rgb = std::stoul(inks.substr(fill + 8, 6), nullptr, 16);
+    EXPECT_LT(rgb & 0xff, 0xe8u) << inks.substr(at, 80);  // grey inks: blue alone tells how light
+    ++found;
+  }
+  EXPECT_EQ(found, 4);
   ASSERT_EQ(kdm("stipple " + coffee + " --colours 3 --points 8000 -o '" + path("c.csv") + "'").status, 0);
   std::istringstream in(slurp(path("c.csv")));
   std::string line;

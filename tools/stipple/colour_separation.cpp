@@ -23,7 +23,7 @@ DensitySpec channel(const ColourImage& image, double gamma, const std::string& n
       // Below 1e-6 is rounding (the chromatic parts of a grey pixel), not ink.
       const double raw = value(rgb), v = raw < 1e-6 ? 0.0 : std::min(raw, 1.0);
       spec.values[std::size_t(image.height - 1 - y) * image.width + x] =
-          static_cast<float>(std::pow(v, gamma));
+          static_cast<float>(gamma == 1 ? v : std::pow(v, gamma));
     }
   return spec;
 }
@@ -39,26 +39,39 @@ double luminance(const float* rgb) {
   return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
-/// N colours of the image by k-means (Lloyd's iterations from a farthest-point start on a subsample, so
-/// the result depends on the image alone).
+/// The paper's colour: a fixed centre among the inks' clusters, so that the image's white takes no ink.
+constexpr std::array<double, 3> kPaper = {1, 1, 1};
+
+double distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+/// The index of the centre nearest `p`, or centres.size() where the paper is nearer than every centre.
+std::size_t nearest_centre(const std::array<double, 3>& p,
+                           const std::vector<std::array<double, 3>>& centres) {
+  std::size_t best = centres.size();
+  double best_distance = distance(p, kPaper);
+  for (std::size_t c = 0; c < centres.size(); ++c)
+    if (const double d = distance(p, centres[c]); d < best_distance) best = c, best_distance = d;
+  return best;
+}
+
+/// N ink colours of the image by k-means beside the fixed paper (Lloyd's iterations from a farthest-point
+/// start on a subsample, so the result depends on the image alone).
 std::vector<std::array<double, 3>> cluster_colours(const ColourImage& image, int n) {
   const std::size_t pixels = std::size_t(image.width) * image.height;
   const std::size_t step = std::max<std::size_t>(1, pixels / 65536);
   std::vector<std::array<double, 3>> samples;
   for (std::size_t i = 0; i < pixels; i += step)
     samples.push_back({image.pixels[3 * i], image.pixels[3 * i + 1], image.pixels[3 * i + 2]});
-  auto distance = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
-  };
-  // Start from the darkest sample, then each next centre the sample farthest from those chosen.
-  std::vector<std::array<double, 3>> centres = {*std::min_element(
-      samples.begin(), samples.end(),
-      [](const auto& a, const auto& b) { return a[0] + a[1] + a[2] < b[0] + b[1] + b[2]; })};
-  std::vector<double> nearest(samples.size(), HUGE_VAL);
+  // Each centre the sample farthest from the paper and the centres chosen before it.
+  std::vector<std::array<double, 3>> centres;
+  std::vector<double> nearest(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) nearest[i] = distance(samples[i], kPaper);
   while (int(centres.size()) < n) {
     std::size_t far = 0;
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      nearest[i] = std::min(nearest[i], distance(samples[i], centres.back()));
+      if (!centres.empty()) nearest[i] = std::min(nearest[i], distance(samples[i], centres.back()));
       if (nearest[i] > nearest[far]) far = i;
     }
     centres.push_back(samples[far]);
@@ -66,9 +79,8 @@ std::vector<std::array<double, 3>> cluster_colours(const ColourImage& image, int
   for (int iteration = 0; iteration < 20; ++iteration) {
     std::vector<std::array<double, 4>> sums(centres.size(), {0, 0, 0, 0});
     for (const auto& s : samples) {
-      std::size_t best = 0;
-      for (std::size_t c = 1; c < centres.size(); ++c)
-        if (distance(s, centres[c]) < distance(s, centres[best])) best = c;
+      const std::size_t best = nearest_centre(s, centres);
+      if (best == centres.size()) continue;  // the paper's
       for (int k = 0; k < 3; ++k) sums[best][k] += s[k];
       sums[best][3] += 1;
     }
@@ -95,8 +107,10 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
         return k >= 1 ? 0.0 : (1 - p[c] - k) / (1 - k);
       };
     };
-    s.channels = {channel(image, gamma, "black", black), channel(image, gamma, "cyan", part(0)),
-                  channel(image, gamma, "magenta", part(1)), channel(image, gamma, "yellow", part(2))};
+    s.channels.push_back(channel(image, gamma, "black", black));  // one at a time: no copies of channels
+    s.channels.push_back(channel(image, gamma, "cyan", part(0)));
+    s.channels.push_back(channel(image, gamma, "magenta", part(1)));
+    s.channels.push_back(channel(image, gamma, "yellow", part(2)));
     // Layers in the printing order, black last, whichever inks the image uses most.
     s.inks = {ink(0, 0, 0, "black", 3), ink(0, 174, 239, "cyan", 0), ink(236, 0, 140, "magenta", 1),
               ink(255, 242, 0, "yellow", 2)};
@@ -119,16 +133,15 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
       throw std::invalid_argument("colours must be cmyk, rgb or a number of inks from 2 to 8, got '" +
                                   scheme + "'");
     const auto centres = cluster_colours(image, int(n));
+    // Each pixel's ink, once for all channels (centres.size(): the paper's, no ink).
+    std::vector<std::uint8_t> owner(std::size_t(image.width) * image.height);
+    for (std::size_t i = 0; i < owner.size(); ++i) {
+      const float* p = &image.pixels[3 * i];
+      owner[i] = static_cast<std::uint8_t>(nearest_centre({p[0], p[1], p[2]}, centres));
+    }
     for (std::size_t c = 0; c < centres.size(); ++c) {
       s.channels.push_back(channel(image, gamma, "ink-" + std::to_string(c), [&, c](const float* p) {
-        std::size_t best = 0;
-        auto d = [&](std::size_t k) {
-          return std::pow(p[0] - centres[k][0], 2) + std::pow(p[1] - centres[k][1], 2) +
-                 std::pow(p[2] - centres[k][2], 2);
-        };
-        for (std::size_t k = 1; k < centres.size(); ++k)
-          if (d(k) < d(best)) best = k;
-        return best == c ? 1 - luminance(p) : 0.0;
+        return owner[std::size_t(p - image.pixels.data()) / 3] == c ? 1 - luminance(p) : 0.0;
       }));
       const auto byte = [](double v) {
         return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
@@ -151,14 +164,15 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   // very little coverage first takes the union's lowest thresholds, which repeat a motif along tile edges:
   // inks under a tenth of the total coverage go last, most covering first (docs/design.md, "Several
   // classes in colour").
+  std::vector<double> mean(s.channels.size());  // each a pass over every pixel: once
   double total = 0;
-  for (const DensitySpec& c : s.channels) total += c.mean_value();
-  auto minor = [&](std::size_t c) { return s.channels[c].mean_value() < 0.1 * total; };
+  for (std::size_t c = 0; c < mean.size(); ++c) total += mean[c] = s.channels[c].mean_value();
+  auto minor = [&](std::size_t c) { return mean[c] < 0.1 * total; };
   std::vector<std::size_t> order(s.channels.size());
   for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     if (minor(a) != minor(b)) return minor(b);
-    const double ca = s.channels[a].mean_value(), cb = s.channels[b].mean_value();
+    const double ca = mean[a], cb = mean[b];
     return minor(a) ? ca > cb : ca < cb;
   });
   ColourSeparation sorted;
