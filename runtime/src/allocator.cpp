@@ -16,4 +16,8 @@ AllocatorHooks tileset_allocator() {
   return g_tileset_hooks;
 }
 
+void detail::tileset_allocation_refused() {
+  throw std::bad_alloc();
+}
+
 }  // namespace kdm

@@ -42,8 +42,8 @@ kdm_status to_c(kdm::Status s) {
   return static_cast<kdm_status>(static_cast<int>(s));
 }
 
-/// build()'s status, KDM_OUT_OF_MEMORY where it throws std::bad_alloc (a library built without exceptions
-/// ends the program there instead).
+/// build()'s status, KDM_OUT_OF_MEMORY where it throws std::bad_alloc (this file keeps exceptions in an
+/// engine's -fno-exceptions build: runtime/CMakeLists.txt).
 template <class Build>
 kdm_status unless_out_of_memory(Build build) {
 #if defined(__cpp_exceptions) || defined(__EXCEPTIONS)

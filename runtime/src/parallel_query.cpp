@@ -360,12 +360,25 @@ struct Job {
 
 Status ParallelQuery::init(std::uint32_t workers) {
   if (workers < 1 || workers > kMaxParallelWorkers) return Status::kInvalidArgument;
-  workers_ = workers;
-  points_.assign(std::size_t(workers) * kParallelUnitPoints, QueryPoint{});
-  xy_.assign(std::size_t(workers) * 2 * kParallelUnitPoints, 0.0f);
-  keys_.assign(std::size_t(workers) * kParallelUnitPoints, 0);
-  classes_.assign(std::size_t(workers) * kParallelUnitPoints, 0);
-  return Status::kOk;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  try {
+#endif
+    // New arrays, moved in with their allocators: the hooks in force now serve them.
+    const std::size_t n = std::size_t(workers) * kParallelUnitPoints;
+    *this = ParallelQuery{};
+    decltype(points_) points(n, QueryPoint{});
+    decltype(xy_) xy(2 * n, 0.0f);
+    decltype(keys_) keys(n, 0);
+    decltype(classes_) classes(n, 0);
+    points_ = std::move(points), xy_ = std::move(xy), keys_ = std::move(keys), classes_ = std::move(classes);
+    workers_ = workers;
+    return Status::kOk;
+#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
+  } catch (const std::bad_alloc&) {  // the hooks refused: no scratch, no workers
+    *this = ParallelQuery{};
+    return Status::kOutOfMemory;
+  }
+#endif
 }
 
 template <class Output>

@@ -5,10 +5,11 @@
 # Usage: check_runtime_consumers.sh PREFIX WORK
 set -eu
 prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
+tiles="$here/../../tilesets/default.kdmt"  # loaded through allocator hooks that refuse
 rm -rf "$work" && mkdir -p "$work"
 cmake -S "$here/runtime_consumer" -B "$work/cmake" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake" >/dev/null
-"$work/cmake/runtime_c"
+"$work/cmake/runtime_c" "$tiles"
 "$work/cmake/runtime_cpp"
 cmake -S "$here/runtime_c_consumer" -B "$work/cmake_c" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake_c" >/dev/null
@@ -20,6 +21,6 @@ cc -o "$work/pc_c" "$here/runtime_consumer/main.c" $flags
 # shellcheck disable=SC2086
 c++ -std=c++17 -fno-exceptions -fno-rtti -o "$work/pc_cpp" "$here/runtime_consumer/main.cpp" $flags
 libdir=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --variable=libdir kdm-runtime)
-LD_LIBRARY_PATH="$libdir" "$work/pc_c"
+LD_LIBRARY_PATH="$libdir" "$work/pc_c" "$tiles"
 LD_LIBRARY_PATH="$libdir" "$work/pc_cpp"
 echo "runtime consumers ok"

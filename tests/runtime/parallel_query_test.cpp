@@ -84,6 +84,21 @@ TEST(ParallelQueryTest, GivesTheSameBitsForAnyWorkerCountAndTheWholeQuerysPoints
   }
 }
 
+// An engine's budget refuses the scratch: a status, no workers, and a later init with memory works.
+TEST(ParallelQueryTest, ScratchTheAllocatorRefusesIsOutOfMemory) {
+  AllocatorHooks refusing;
+  refusing.allocate = [](std::size_t, std::size_t, void*) -> void* { return nullptr; };
+  refusing.deallocate = [](void*, std::size_t, std::size_t, void*) {};
+  set_tileset_allocator(refusing);
+  ParallelQuery parallel;
+  const Status refused = parallel.init(2);
+  set_tileset_allocator(AllocatorHooks{});
+  EXPECT_EQ(refused, Status::kOutOfMemory);
+  EXPECT_EQ(parallel.workers(), 0u);
+  EXPECT_EQ(parallel.init(2), Status::kOk);
+  EXPECT_EQ(parallel.workers(), 2u);
+}
+
 TEST(ParallelQueryTest, KeepsTheWholeQuerysOrderWhereTilesAreWhole) {
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     for (int kind = 0; kind < 2; ++kind) {      // counted and written in place, and through the scratch

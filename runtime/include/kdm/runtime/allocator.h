@@ -31,9 +31,15 @@ KDM_RUNTIME_API void set_tileset_allocator(const AllocatorHooks& hooks);
 /// The hooks in force (what new tile-set arrays will use).
 KDM_RUNTIME_API AllocatorHooks tileset_allocator();
 
+namespace detail {
+/// Throws std::bad_alloc for an allocation the hook refused. Out of line, in a file the runtime builds with
+/// exceptions even where an engine turns them off, so that a load still returns kOutOfMemory.
+[[noreturn]] KDM_RUNTIME_API void tileset_allocation_refused();
+}  // namespace detail
+
 /// A standard allocator over the hooks in force when it was made; it keeps them, so its memory goes
-/// back where it came from. An allocation the hook refuses ends the program (std::abort) when exceptions
-/// are off, or throws std::bad_alloc.
+/// back where it came from. An allocation the hook refuses throws std::bad_alloc (detail::
+/// tileset_allocation_refused), which a load returns as kOutOfMemory.
 template <class T>
 struct TilesetAllocator {
   using value_type = T;
@@ -50,7 +56,7 @@ struct TilesetAllocator {
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
     void* p = hooks.allocate ? hooks.allocate(bytes, alignof(T), hooks.user) : ::operator new(bytes);
-    if (!p) out_of_memory();
+    if (!p) detail::tileset_allocation_refused();
     return static_cast<T*>(p);
   }
   void deallocate(T* p, std::size_t n) {
@@ -67,15 +73,6 @@ struct TilesetAllocator {
   template <class U>
   friend bool operator!=(const TilesetAllocator& a, const TilesetAllocator<U>& b) {
     return !(a == b);
-  }
-
- private:
-  [[noreturn]] static void out_of_memory() {
-#if defined(__cpp_exceptions) || defined(__EXCEPTIONS)
-    throw std::bad_alloc();
-#else
-    std::abort();
-#endif
   }
 };
 

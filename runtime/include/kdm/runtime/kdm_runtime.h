@@ -301,8 +301,8 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
  * image where kdm_query_classes reads every class's at every candidate: its points are exactly
  * kdm_query_points' at the images' summed texels, and in stable mode classes 0 ... k together exactly those
  * at the first k + 1 images' sum. KDM_INVALID_ARGUMENT for a NULL `out`, `images` or image, a count out of
- * range, images on different grids, or a sum that overflows a float; KDM_OUT_OF_MEMORY (a library built
- * without exceptions ends the program instead). The images may be freed once it is built. Free it with
+ * range, images on different grids, or a sum that overflows a float; KDM_OUT_OF_MEMORY. The images may be
+ * freed once it is built. Free it with
  * kdm_class_images_free. Added in 0.4. */
 typedef struct kdm_class_images kdm_class_images;
 KDM_RUNTIME_API kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
@@ -340,9 +340,8 @@ typedef struct kdm_task_runner {
 typedef struct kdm_parallel_query kdm_parallel_query; /* per-worker scratch, allocated once */
 
 /* Scratch for `workers` workers (1 ... 64; about 1.9 MB each, through kdm_set_tileset_allocator's hooks)
- * into *out: KDM_OK, KDM_INVALID_ARGUMENT for a count out of range or a NULL `out`, KDM_OUT_OF_MEMORY (a
- * library built without exceptions ends the program instead). One kdm_parallel_query serves one run at a
- * time. */
+ * into *out: KDM_OK, KDM_INVALID_ARGUMENT for a count out of range or a NULL `out`, KDM_OUT_OF_MEMORY (the
+ * hooks refused it). One kdm_parallel_query serves one run at a time. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_create(uint32_t workers, kdm_parallel_query** out);
 /* Frees the scratch (NULL is ignored); no run may be using it. */
 KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);

@@ -62,7 +62,7 @@ inline constexpr std::size_t kParallelUnitPoints = std::size_t(1) << 15;
 class KDM_RUNTIME_API ParallelQuery {
  public:
   /// Scratch for `workers` workers (1 … kMaxParallelWorkers; about 1.9 MB each). kInvalidArgument for a
-  /// count out of range.
+  /// count out of range, kOutOfMemory (and no scratch) when the allocator refuses it.
   Status init(std::uint32_t workers);
   std::uint32_t workers() const { return workers_; }
 
