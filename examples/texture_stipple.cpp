@@ -229,14 +229,15 @@ bool parse_number(const char* text, double lo, double hi, double& out) {
   return end != text && *end == '\0' && out >= lo && out <= hi;
 }
 
+/// The usage line, after `problem` on stderr (exit status 2), or alone on stdout for --help (0).
 int usage(const char* problem) {
-  std::fprintf(
-      stderr,
-      "texture_stipple: %s\nusage: texture_stipple [--tileset FILE] [--frames K (2-100000, default 24)] "
-      "[--size PIXELS (32-4096, default 512)] [--dots-per-pixel-area D (0.001-1, default 0.0625)] "
-      "[--colours] [--check] -o DIR\n",
-      problem);
-  return 2;
+  std::FILE* to = problem ? stderr : stdout;
+  if (problem) std::fprintf(to, "texture_stipple: %s\n", problem);
+  std::fprintf(to,
+               "usage: texture_stipple [--tileset FILE] [--frames K (2-100000, default 24)] "
+               "[--size PIXELS (32-4096, default 512)] [--dots-per-pixel-area D (0.001-1, default 0.0625)] "
+               "[--colours] [--check] -o DIR\n");
+  return problem ? 2 : 0;
 }
 
 }  // namespace
@@ -248,7 +249,9 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
-    if (a == "--check") {
+    if (a == "--help" || a == "-h") {
+      return usage(nullptr);
+    } else if (a == "--check") {
       check = true;
     } else if (a == "--colours") {
       colours = true;

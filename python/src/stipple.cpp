@@ -84,6 +84,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                     tools::max_stipple_zoom(given ? *given : builtin_tileset(), query_mode) * (1 + 1e-9))
     throw std::invalid_argument(
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
+  if (output && picture()) tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]));
   tools::PointSet set;
   {
     py::gil_scoped_release release;
@@ -109,7 +110,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
         std::copy(inks.background, inks.background + 3, style.background);
       }
       char line[200], where[160];
-      std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s)", set.size(),
+      std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s)", set.size(), set.size() == 1 ? "" : "s",
                     method == "full" ? "full KDM sampler" : "runtime tiles");
       std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
       try {

@@ -760,6 +760,8 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   std::snprintf(deepest, sizeof deepest, "%g× (", 2 * m * m * m * m);
   expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, deepest);
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
+  // A picture too large is said before any dot is placed (a sliver of the image at the default width).
+  expect_error("stipple " + image + " --region 0.499,0,0.5,1" + out, "pixels is too large");
   // Options of the tiles alone, which the full sampler would ignore.
   expect_error("stipple " + image + " --method full --mode stable" + out, "--mode applies to --method tiles");
   expect_error("stipple " + image + " --method full --tileset '" + std::string(KDM_SOURCE_DIR) +

@@ -123,6 +123,19 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
   const int frames = std::max(1, a.frames);
+  if (tools::has_extension(a.output, ".png") || tools::has_extension(a.output, ".svg"))
+    for (int i = 0; i < frames; ++i) {  // each frame's picture, before any dot is placed
+      double uv[4];
+      if (a.frames > 0)
+        tools::stipple_frame_region(region, i, frames, uv);
+      else
+        std::copy(region, region + 4, uv);
+      try {
+        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]));
+      } catch (const std::invalid_argument& e) {
+        throw CommandError(e.what());
+      }
+    }
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
   for (int i = 0; i < frames; ++i) {
     double uv[4];
@@ -168,8 +181,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       style.blend = inks.blend;
     }
     char line[200], where[160];
-    std::snprintf(line, sizeof line, "kdm stipple: %zu dots (%s%s%s)", set.size(), how.c_str(),
-                  coloured ? ", inks " : "", coloured ? a.colours.c_str() : "");
+    std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s%s%s)", set.size(),
+                  set.size() == 1 ? "" : "s", how.c_str(), coloured ? ", inks " : "",
+                  coloured ? a.colours.c_str() : "");
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     tools::write_points(path, set, {line, "image " + a.image, where}, style);

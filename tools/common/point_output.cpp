@@ -54,6 +54,16 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
+int check_picture_size(int width_px, double aspect) {
+  const int w = std::max(1, width_px);
+  const double h = std::max(1.0, std::round(w / aspect));  // the picture's own shape
+  if (!(double(w) * h <= double(1 << 28)))  // 768 MiB of RGB: refuse rather than die allocating
+    throw std::invalid_argument("a picture of " + std::to_string(w) + "x" +
+                                std::to_string(std::llround(std::min(h, 1e18))) +
+                                " pixels is too large (limit 2^28 pixels); lower the width");
+  return static_cast<int>(h);
+}
+
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
                   const DrawStyle& style) {
   std::string error;
@@ -67,10 +77,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   if (points.dim != 2)
     throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(1, style.width_px);
-  const int h = std::max(1, static_cast<int>(std::lround(w / style.aspect)));  // the picture's own shape
-  if (double(w) * h > double(1 << 28))  // 768 MiB of RGB: refuse rather than die allocating
-    throw std::invalid_argument("a picture of " + std::to_string(w) + "x" + std::to_string(h) +
-                                " pixels is too large (limit 2^28 pixels); lower the width");
+  const int h = check_picture_size(style.width_px, style.aspect);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
   // A dot wider than the picture only blackens it, and painting large dots costs their area each.
   if (!(r <= std::max(w, h)))

@@ -41,6 +41,11 @@ struct DrawStyle {
 /// `what` saying what the input is ("input image"): a result written over what it came from.
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
+/// The height in pixels of a picture `width_px` wide of `aspect` (width / height); throws
+/// std::invalid_argument, naming the size, for one past 2^28 pixels (write_points checks it; a caller that
+/// computes points for a picture checks it first).
+int check_picture_size(int width_px, double aspect);
+
 /// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.
 /// Throws std::invalid_argument on an unknown extension or a picture too large, std::runtime_error on a
 /// write failure (one-line messages naming the file).
