@@ -84,6 +84,8 @@ def stipple(
     invert = _checks.flag("invert", invert)
     if isinstance(image, (str, os.PathLike)):
         label = _checks.path("image", image)
+        if not os.path.exists(label) and not label.startswith(("const:", "ramp:", "radial:")):
+            raise FileNotFoundError(f"cannot read image '{label}': no such file")  # not "a density is ..."
         spec = _kdm.DensitySpec.parse(label, gamma, invert)
     elif _checks.is_array(image):
         label = "array"

@@ -85,8 +85,10 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
         with pytest.raises(OSError) as info:
             kdm.sample(10, str(path))
         assert str(info.value) == message
-        with pytest.raises(OSError):
+        with pytest.raises(OSError) as info:
             kdm.stipple(path)
+        if path == missing:  # an image, not "a density is a picture, const:V, ..."
+            assert str(info.value) == cli_message(kdm_cli, "stipple", path, "-o", tmp_path / "x.png")
         with pytest.raises(OSError):
             TILES.query((0, 0, 1, 1), scale=10, density=str(path))
     damaged = tmp_path / "damaged.kdmt"

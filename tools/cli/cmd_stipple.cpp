@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -76,6 +77,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   // One ink (the image's darkness), or with --colours the image separated into several.
   tools::ColourSeparation inks;
   if (a.colours.empty()) {
+    const bool named = a.image.rfind("const:", 0) == 0 || a.image.rfind("ramp:", 0) == 0 ||
+                       a.image.rfind("radial:", 0) == 0;  // refused below: stipple needs an image
+    if (!named && !std::filesystem::exists(a.image))      // not "a density is a picture, const:V, …"
+      throw CommandError("cannot read image '" + a.image + "': no such file");
     inks.channels.push_back(parse_density(a.image, a.gamma, a.invert));
     inks.inks = tools::class_inks(1);
   } else {
