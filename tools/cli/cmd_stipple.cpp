@@ -230,10 +230,11 @@ void add_stipple_command(CLI::App& app) {
                   "zoom, zoom-coherent; every picture has the region's shape, the first blank beside the "
                   "image where the shapes differ; needs --method tiles; 0: one picture)")
       ->capture_default_str();
-  cmd->add_option("--fade", a->fade,
-                  "Dots grow in as they appear instead of popping up: a dot's area grows from 0 where it "
-                  "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
-                  "sequence; pictures only, which it lightens by about F / (2 + 2F); 0: off)")
+  cmd->add_option(
+         "--fade", a->fade,
+         "Dots grow in as they appear instead of popping up: a dot's area grows from 0 where it "
+         "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
+         "sequence; pictures only, which it lightens by about 1 - ln(1 + F) / F: 28% at 1, 61% at 5; 0: off)")
       ->capture_default_str();
   cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
   cmd->add_option(
