@@ -107,7 +107,7 @@ def stipple(
     points: int = ...,
     scale: Optional[float] = ...,
     method: str = ...,
-    mode: str = ...,
+    mode: Optional[str] = ...,
     region: Optional[_Rect] = ...,
     gamma: float = ...,
     invert: bool = ...,

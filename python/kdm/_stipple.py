@@ -17,7 +17,7 @@ def stipple(
     points: int = 20000,
     scale: Optional[float] = None,
     method: str = "tiles",
-    mode: str = "smooth",
+    mode: Optional[str] = None,
     region: Optional[Sequence[float]] = None,
     gamma: float = 1.0,
     invert: bool = False,
@@ -43,8 +43,9 @@ def stipple(
         Dots per unit area at full darkness (image height = 1 unit), instead of `points`.
     method : {"tiles", "full"}
         tiles: the runtime and a tile set (fast, zoom-coherent); full: the full KDM sampler (best, slow).
-    mode : {"smooth", "stable"}
-        For tiles: dots glide with the tone (smooth) or never move (stable).
+    mode : {"smooth", "stable"} or None
+        For tiles: dots glide with the tone (smooth, the default) or never move (stable); refused with
+        method "full", which has no tiles.
     region : (x0, y0, x1, y1) or None
         Part of the image's UV square [0, 1]^2 (y up) to render at the whole image's dot size (tiles
         only), a zoom of 1 / its width, at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
@@ -85,8 +86,11 @@ def stipple(
     invert = _checks.flag("invert", invert)
     if isinstance(image, (str, os.PathLike)):
         label = _checks.path("image", image)
-        if not os.path.exists(label) and not label.startswith(("const:", "ramp:", "radial:")):
-            raise FileNotFoundError(f"cannot read image '{label}': no such file")  # not "a density is ..."
+        if not label.startswith(("const:", "ramp:", "radial:")):
+            try:  # said as colours' loader says it, not "a density is a picture, const:V, ..."
+                os.stat(label)
+            except OSError as e:
+                raise type(e)(f"cannot read image '{label}': {e.strerror}") from None
         spec = _kdm.DensitySpec.parse(label, gamma, invert)
     elif _checks.is_array(image):
         label = "array"
@@ -100,7 +104,9 @@ def stipple(
         scale = _checks.number("scale", scale, 0.0, strict=True)
         points = 0
     method = _checks.choice("method", method, ("tiles", "full"))
-    mode = _checks.choice("mode", mode, ("smooth", "stable"))
+    if mode is not None and method == "full":
+        raise ValueError("mode applies to method='tiles' (the full sampler has no tiles)")
+    mode = _checks.choice("mode", "smooth" if mode is None else mode, ("smooth", "stable"))
     if region is not None:
         region = _checks.numbers_tuple("region", region, 4)
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)

@@ -1,6 +1,7 @@
 // The C interface (kdm_runtime.h) over kdm/runtime/query.h. Nothing here throws: every function that
 // allocates returns KDM_OUT_OF_MEMORY when an allocation is refused, and queries allocate nothing.
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -74,7 +75,9 @@ kdm_status load_into(kdm_tileset** out, Load&& load) {
   *out = nullptr;
   auto* handle = new (std::nothrow) kdm_tileset;
   if (!handle) return KDM_OUT_OF_MEMORY;
-  const kdm::Status s = load(handle->owned);
+  // The load itself says kOutOfMemory; this catches what comes before it (the path made a std::string).
+  const kdm_status c = unless_out_of_memory([&] { return load(handle->owned); });
+  const kdm::Status s = static_cast<kdm::Status>(static_cast<int>(c));
   if (s != kdm::Status::kOk) {
     delete handle;
     return to_c(s);
@@ -311,11 +314,13 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
       q.joint.densities = joint->densities, q.joint.bounds = joint->density_bounds,
       q.joint.user = joint->user, q.joint.batch_densities = joint->batch_densities;
       std::copy(joint->density_max, joint->density_max + class_count, q.joint.max);
-      for (uint32_t k = 0; k < class_count && !unset; ++k)
+      for (uint32_t k = 0; k < class_count && !unset; ++k) {
+        if (!(std::isfinite(q.joint.max[k]) && q.joint.max[k] >= 0)) break;  // C++ names it, in order
         if (q.joint.max[k] == 0) {  // a zeroed struct's: it would silently leave class k out
           why.kind = kdm::QueryProblem::Kind::kNotPositive, why.parameter = kJointMaxNames[k];
           why.value = q.joint.max[k], unset = true;
         }
+      }
     }
     if (!unset) status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }

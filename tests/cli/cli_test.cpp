@@ -59,9 +59,10 @@ TEST_F(CliTest, BadImagesGiveOneLineErrors) {
       expect_error("query --rect 0,0,1,1 --density '" + image + "' -o '" + path("q.txt") + "'", name);
     EXPECT_FALSE(fs::exists(path("s.txt")) || fs::exists(path("s.png")) || fs::exists(path("q.txt")));
   }
-  // stipple takes images alone: a missing one is not "a density is a picture, const:V, …".
-  expect_error("stipple '" + path("missing.png") + "' -o '" + path("s.png") + "'",
-               "cannot read image '" + path("missing.png") + "': no such file");
+  // stipple takes images alone: a missing one is not "a density is a picture, const:V, …", grey or in colour.
+  for (const char* colours : {"", " --colours cmyk"})
+    expect_error("stipple '" + path("missing.png") + "'" + colours + " -o '" + path("s.png") + "'",
+                 "cannot read image '" + path("missing.png") + "': No such file or directory");
   // A header of 100,000 × 100,000 pixels, which stb will not even read: refused by its size, by name.
   std::vector<std::uint8_t> huge = grey_png(1, 1, 8, {0});
   for (int at : {16, 20}) huge[at] = 0, huge[at + 1] = 0x01, huge[at + 2] = 0x86, huge[at + 3] = 0xA0;

@@ -209,6 +209,8 @@ def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
         kdm.stipple(coffee, points=500, colours="cmyk", output=tmp_path / "x.txt")
     with pytest.raises(ValueError, match="pixels is too large"):
         kdm.stipple(str(SPHERE), points=500, region=(0.499, 0, 0.5, 1), output=tmp_path / "x.png")
+    with pytest.raises(ValueError, match="mode applies to method='tiles'"):
+        kdm.stipple(str(SPHERE), points=500, method="full", mode="stable")
     with pytest.raises(ValueError, match="tileset applies to method='tiles'"):
         kdm.stipple(str(SPHERE), points=500, method="full", tileset=kdm.Tileset.builtin())
     assert not list(tmp_path.glob("x.*"))

@@ -548,6 +548,11 @@ int main(int argc, char** argv) {
                                       &problem) == KDM_INVALID_ARGUMENT &&
               problem.kind == KDM_PROBLEM_NOT_POSITIVE &&
               strcmp(problem.parameter, "joint.density_max[1]") == 0);
+        joint.density_max[0] = NAN; /* the first bad maximum is named, whatever is wrong with it */
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              problem.kind == KDM_PROBLEM_NOT_FINITE &&
+              strcmp(problem.parameter, "joint.density_max[0]") == 0);
       }
     }
   }

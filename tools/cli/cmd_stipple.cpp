@@ -3,9 +3,11 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -79,8 +81,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.colours.empty()) {
     const bool named = a.image.rfind("const:", 0) == 0 || a.image.rfind("ramp:", 0) == 0 ||
                        a.image.rfind("radial:", 0) == 0;  // refused below: stipple needs an image
-    if (!named && !std::filesystem::exists(a.image))      // not "a density is a picture, const:V, …"
-      throw CommandError("cannot read image '" + a.image + "': no such file");
+    std::error_code missing;  // said as --colours' loader says it, not "a density is a picture, const:V, …"
+    if (!named && !std::filesystem::exists(a.image, missing))
+      throw CommandError("cannot read image '" + a.image +
+                         "': " + (missing ? missing.message() : std::string(std::strerror(ENOENT))));
     inks.channels.push_back(parse_density(a.image, a.gamma, a.invert));
     inks.inks = tools::class_inks(1);
   } else {

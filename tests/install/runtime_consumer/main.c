@@ -14,8 +14,9 @@ static void never(void* p, size_t bytes, size_t alignment, void* user) {
 }
 
 static int refused_loads(const char* path) {
-  kdm_tileset* set = NULL;
-  kdm_parallel_query* parallel = NULL;
+  static char sentinel; /* a refusal sets the results to NULL */
+  kdm_tileset* set = (kdm_tileset*)&sentinel;
+  kdm_parallel_query* parallel = (kdm_parallel_query*)&sentinel;
   int ok;
   kdm_set_tileset_allocator(refuse, never, NULL);
   ok = kdm_tileset_load_file(path, &set) == KDM_OUT_OF_MEMORY && !set &&

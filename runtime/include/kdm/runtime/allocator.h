@@ -39,7 +39,9 @@ namespace detail {
 
 /// A standard allocator over the hooks in force when it was made; it keeps them, so its memory goes
 /// back where it came from. An allocation the hook refuses throws std::bad_alloc (detail::
-/// tileset_allocation_refused), which a load returns as kOutOfMemory.
+/// tileset_allocation_refused), which a load returns as kOutOfMemory. A copy of a Tileset or TilesetData
+/// throws it to the caller: in code built without exceptions that ends the program, so where a refusal
+/// must be survived, load again rather than copy.
 template <class T>
 struct TilesetAllocator {
   using value_type = T;
