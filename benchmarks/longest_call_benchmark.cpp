@@ -42,14 +42,12 @@ kdm::QueryParams query_for(Case c, kdm::QueryMode mode) {
   return q;
 }
 
-void BM_LongestCall(benchmark::State& state) {
-  const kdm::QueryParams q =
-      query_for(Case(state.range(0)), state.range(1) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable);
-  // Past the candidates one call examines (640 MB), so that a call stops at its bound, not a full buffer.
-  std::vector<kdm::QueryPoint> out((std::size_t(1) << 24) + 1);
-  // Untimed first: the built-in set loads at its first use, and the buffer's pages are touched once.
-  std::fill(out.begin(), out.end(), kdm::QueryPoint{});
-  kdm::Tileset::builtin();
+/// Runs a whole query call after call (`call(cursor, written)` one call) for each benchmark iteration, and
+/// records the longest call and how many one query took. A call that fills the buffer (`room` points) is
+/// an error: the buffer must hold more than a call examines, so that calls stop at their bound.
+template <class Call>
+void longest_calls(benchmark::State& state, std::size_t room, Call&& call) {
+  kdm::Tileset::builtin();  // loaded untimed, at its first use
   double worst = 0;
   int calls = 0;
   for (auto _ : state) {
@@ -59,25 +57,38 @@ void BM_LongestCall(benchmark::State& state) {
     kdm::Status status;
     do {
       const auto t0 = std::chrono::steady_clock::now();
-      status = kdm::query_points(kdm::Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
+      status = call(cursor, written);
       worst = std::max(
           worst, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       ++calls;
-      if (written == out.size()) state.SkipWithError("a call filled the buffer before its bound");
+      if (written == room) state.SkipWithError("a call filled the buffer before its bound");
     } while (status == kdm::Status::kBufferFull);
     if (status != kdm::Status::kOk) state.SkipWithError(kdm::status_message(status));
-    benchmark::DoNotOptimize(out.data());
   }
   state.counters["worst_call_ms"] = worst;
   state.counters["calls"] = calls;
 }
 
-/// Calls that read more than once per candidate: `classes` callback classes of 1/8 each over 4,000 × 4,000
-/// units (tiles of 32, scale 30, every candidate emitted), smooth mode with glide_together or stable; the
-/// first call, which stops at the candidate bound (the buffer holds more).
+void BM_LongestCall(benchmark::State& state) {
+  const kdm::QueryParams q =
+      query_for(Case(state.range(0)), state.range(1) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable);
+  // Past the candidates one call examines (640 MB), so that a call stops at its bound, not a full buffer.
+  std::vector<kdm::QueryPoint> out((std::size_t(1) << 24) + 1);
+  std::fill(out.begin(), out.end(), kdm::QueryPoint{});  // its pages touched once, untimed
+  longest_calls(state, out.size(), [&](kdm::QueryCursor& cursor, std::size_t& written) {
+    const kdm::Status s =
+        kdm::query_points(kdm::Tileset::builtin(), q, out.data(), out.size(), &written, &cursor);
+    benchmark::DoNotOptimize(out.data());
+    return s;
+  });
+}
+
+/// Calls that read more than once per candidate: `classes` callback classes of 1/8 each over 1,000 × 1,000
+/// units (tiles of 32, scale 30: 30 million points, every candidate emitted), smooth mode with
+/// glide_together or stable; the whole query call after call, into a buffer larger than a call examines.
 void BM_LongestClassCall(benchmark::State& state) {
   kdm::ClassQueryParams q;
-  q.query.x1 = q.query.y1 = 4000, q.query.tile_size = 32, q.query.scale = 30;
+  q.query.x1 = q.query.y1 = 1000, q.query.tile_size = 32, q.query.scale = 30;
   q.query.mode = state.range(1) ? kdm::QueryMode::kSmooth : kdm::QueryMode::kStable;
   q.query.glide_together = state.range(1) != 0;
   q.class_count = static_cast<std::uint32_t>(state.range(0));
@@ -85,26 +96,16 @@ void BM_LongestClassCall(benchmark::State& state) {
     q.classes[k].kind = kdm::QueryDensity::Kind::kCallback;
     q.classes[k].callback = eighth, q.classes[k].callback_max = 0.125;
   }
-  // Room past the candidates one call examines, so that the call stops at its bound, not a full buffer.
-  const std::size_t room = std::size_t(1) << 25;
+  const std::size_t room = (std::size_t(1) << 24) + 1;
   std::vector<float> xy(2 * room);
   std::vector<std::uint8_t> classes(room);
   std::fill(xy.begin(), xy.end(), 0.f), std::fill(classes.begin(), classes.end(), 0);
-  kdm::Tileset::builtin();
-  double worst = 0;
-  for (auto _ : state) {
-    kdm::QueryCursor cursor;
-    std::size_t written = 0;
-    const auto t0 = std::chrono::steady_clock::now();  // the first call: a full one
-    const kdm::Status status = kdm::query_classes_compact(kdm::Tileset::builtin(), q, {xy.data(), nullptr},
-                                                          classes.data(), classes.size(), &written, &cursor);
-    worst = std::max(
-        worst, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (status != kdm::Status::kBufferFull || written == room)
-      state.SkipWithError("the first call did not stop at its bound");
+  longest_calls(state, room, [&](kdm::QueryCursor& cursor, std::size_t& written) {
+    const kdm::Status s = kdm::query_classes_compact(kdm::Tileset::builtin(), q, {xy.data(), nullptr},
+                                                     classes.data(), room, &written, &cursor);
     benchmark::DoNotOptimize(xy.data());
-  }
-  state.counters["worst_call_ms"] = worst;
+    return s;
+  });
 }
 
 }  // namespace

@@ -231,7 +231,13 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
     if (cursor->fingerprint != fingerprint) return refuse(QueryProblem::Kind::kCursorMismatch, "cursor");
     cursor->fingerprint = query_fingerprint(q);
   }
-  std::uint64_t examined = 0;
+  std::uint32_t reads = 0;  // densities read at each candidate: the bound on a call's work counts them
+  if (densities.joint || densities.sums)
+    reads = 1;
+  else
+    for (std::uint32_t k = 0; k < p.class_count; ++k)
+      reads += p.classes[k].kind != QueryDensity::Kind::kConstant;
+  std::uint64_t examined = detail::first_examined(q, true, reads);
   Status status;
   if (densities.all_constant) {
     double counts[kMaxQueryClasses];

@@ -111,8 +111,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
       max_density = density_or_zero(d.constant);
       break;
     case QueryDensity::Kind::kImage:
-      if (!d.image || !detail::image_queryable(*d.image))
-        return refuse(Kind::kBadDensity, "density.image");
+      if (!d.image || !detail::image_queryable(*d.image)) return refuse(Kind::kBadDensity, "density.image");
       max_density = d.image->max_over(q.x0, q.y0, q.x1, q.y1);
       break;
     case QueryDensity::Kind::kCallback:
@@ -410,7 +409,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
 
 Status query_points(const Tileset& tileset, const QueryParams& q, QueryPoint* out, std::size_t capacity,
                     std::size_t* written, QueryCursor* cursor, QueryProblem* problem) {
-  std::uint64_t examined = 0;
+  std::uint64_t examined = detail::first_examined(q, false, 0);
   return detail::query_points_counted(tileset, q, out, capacity, written, cursor, problem, examined);
 }
 
@@ -518,7 +517,7 @@ Status detail::query_compact_run(const Tileset& tileset, const QueryParams& q, c
                                  std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                  QueryProblem* problem, const TileRun& run) {
   detail::Refusal refuse(problem);
-  std::uint64_t examined = 0;
+  std::uint64_t examined = detail::first_examined(q, false, 0);
   if (written) *written = 0;
   if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
     return Status::kInvalidArgument;

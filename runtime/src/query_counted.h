@@ -41,6 +41,17 @@ struct TileRun {
   std::int64_t to_x = std::numeric_limits<std::int64_t>::max(), to_y = to_x;
 };
 
+/// Where a call's count of candidates examined starts, so that a call that does more per candidate stops
+/// after about as much work as a plain one: a class query (`classes`) counts 1 + its classes read at each
+/// candidate (a callback, an image, the joint density or the images' sums each one), and smooth mode's
+/// glide_together, which reads the density again where a point glides, 8 times that (measured: the
+/// longest calls of longest_call_benchmark then take about as long).
+inline std::uint64_t first_examined(const QueryParams& q, bool classes, std::uint32_t reads) {
+  const std::uint64_t together = q.mode == QueryMode::kSmooth && q.glide_together ? 8 : 1;
+  const std::uint64_t weight = (classes ? 1 + std::uint64_t(reads) : 1) * together;
+  return kMaxQueryCandidates - kMaxQueryCandidates / weight;
+}
+
 /// query_points over the tiles of `run`, counting into `examined` (on entry, what this call of the caller
 /// has examined so far): it returns kBufferFull once `examined` reaches kMaxQueryCandidates.
 Status query_points_counted(const Tileset& tileset, const QueryParams& params, QueryPoint* out,

@@ -50,6 +50,41 @@ double sum_of_first_two_images(void* user, double x, double y) {
   return images.views[0].at(x, y) + images.views[1].at(x, y);
 }
 
+// A call's work is bounded whatever each candidate costs: a class query counts its classes' reads and
+// glide_together 8 times that, so one call of 8 callback classes gliding together stops after a 72nd of
+// the candidates a plain call may examine (it ran 3.5 s before), with room left in the buffer. In stable
+// mode every candidate here is emitted, so the points written count the candidates examined; in smooth
+// mode the glides' ring of tiles around the region is examined too, and emits few.
+TEST(ClassQueryTest, ACallThatReadsMorePerCandidateExaminesFewer) {
+  struct Eighth {
+    static double density(void*, double, double) { return 0.125; }
+  };
+  for (const auto& [classes, together] : {std::pair{1u, false}, std::pair{8u, false}, std::pair{8u, true}}) {
+    SCOPED_TRACE(classes);
+    ClassQueryParams p;
+    p.query.x1 = p.query.y1 = 4000, p.query.tile_size = 32, p.query.scale = 30;
+    p.query.mode = together ? QueryMode::kSmooth : QueryMode::kStable;
+    p.query.glide_together = together;
+    p.class_count = classes;
+    for (std::uint32_t k = 0; k < classes; ++k) {
+      p.classes[k].kind = QueryDensity::Kind::kCallback;
+      p.classes[k].callback = Eighth::density, p.classes[k].callback_max = 0.125;
+    }
+    const std::uint64_t weight = (1 + classes) * (together ? 8 : 1);
+    std::vector<float> xy(2 * (kMaxQueryCandidates / weight + 1024));
+    std::vector<std::uint8_t> labels(xy.size() / 2);
+    QueryCursor cursor;
+    std::size_t written = 0;
+    ASSERT_EQ(query_classes_compact(Tileset::builtin(), p, {xy.data(), nullptr}, labels.data(), labels.size(),
+                                    &written, &cursor),
+              Status::kBufferFull);
+    EXPECT_LE(written, kMaxQueryCandidates / weight);  // stopped by the bound, not the buffer
+    if (!together) {
+      EXPECT_GT(written, kMaxQueryCandidates / weight / 2);  // tiles visited count too
+    }
+  }
+}
+
 TEST(ClassQueryTest, StableClassesAreTheOneClassQueriesAtTheirCumulativeDensities) {
   // Constants 1 : 2 : 4 at a mid-level density (neither a level nor a keyframe) over 6×6 tiles.
   const ClassQueryParams q = three_constants(0.3, 0.2, 6.3, 6.2, 300, QueryMode::kStable);

@@ -129,11 +129,12 @@ inline constexpr std::uint64_t kMaxQueryTiles = std::uint64_t(1) << 24;
 /// kMaxQueryDepth) points per tile (query_density_limit), 2^40 times the top for m = 32.
 inline constexpr std::uint32_t kMaxQueryDepth = 4;
 
-/// Most candidate points one call examines (2^24), a tile visited counting as kTileCandidates of them: a
-/// call that reaches it returns kBufferFull with the cursor saved, even if the buffer has room, so no call
-/// runs unbounded: 10-20 ms at a constant density, about 0.1 s with a callback read at every
-/// candidate, more with several callback classes or glide_together (docs/limits.md, "The longest call"). A
-/// caller with a frame budget queries smaller regions per frame, or off its main thread.
+/// Most candidate points one call examines (2^24), a tile visited counting as kTileCandidates of them, a
+/// class query's candidate as 1 + the classes it reads, glide_together's as 8 times more: a call that
+/// reaches it returns kBufferFull with the cursor saved, even if the buffer has room, so no call runs
+/// unbounded: 40-80 ms at a constant density, about 0.1 s with callbacks read at every candidate
+/// (docs/limits.md, "The longest call"). A caller with a frame budget queries smaller regions per frame,
+/// or off its main thread.
 inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 /// What a tile visited counts for in kMaxQueryCandidates: a tile costs about as much as 16 candidates.
 inline constexpr std::uint64_t kTileCandidates = 16;
