@@ -35,6 +35,8 @@ class QueryResult:
     rank: npt.NDArray[np.uint32]
     level: npt.NDArray[np.uint32]
     classes: Optional[npt.NDArray[np.uint8]]
+    @property
+    def depth(self) -> npt.NDArray[np.uint32]: ...
     def __init__(
         self,
         points: npt.NDArray[np.void],

@@ -31,12 +31,14 @@ class QueryResult:
     xy : numpy.ndarray
         (m, 2) float64: world positions minus the query's origin.
     tile : numpy.ndarray
-        (m, 2) int64: each point's tile (tile_x, tile_y); with `rank` and ``points["depth"]``, its
-        stable id.
+        (m, 2) int64: each point's tile (tile_x, tile_y); with `rank` and `depth`, its stable id.
     rank : numpy.ndarray
         (m,) uint32: the point's index in its tile, in emission order.
     level : numpy.ndarray
         (m,) uint32: the pyramid level the rank belongs to.
+    depth : numpy.ndarray
+        (m,) uint32: 0, or past the top level the subtiles' depth that tile and rank count in (ranks
+        repeat across depths: key points on tile, rank and depth together).
     classes : numpy.ndarray or None
         (m,) uint8: each point's class, for a query with `classes` (None otherwise).
     """
@@ -50,6 +52,10 @@ class QueryResult:
         self.points, self.xy, self.tile, self.rank, self.level = points, xy, tile, rank, level
         self.classes = classes
         self._storage = storage  # the memory these are the first rows of (query's `out` refills it)
+
+    @property
+    def depth(self) -> np.ndarray:
+        return self.points["depth"]
 
     def __len__(self) -> int:
         return len(self.xy)

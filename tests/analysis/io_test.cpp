@@ -82,6 +82,17 @@ TEST(PointFiles, LabelledPointsRoundTripAndQueryCsvReads) {
   ASSERT_TRUE(tools::read_point_sets(
       write_temp("query1.csv", "x,y,tile_x,tile_y,rank,level\n0.25,0.5,0,0,3,0\n"), sets, error));
   EXPECT_TRUE(sets[0].classes.empty());
+  // Today's, with the depth column last.
+  ASSERT_TRUE(tools::read_point_sets(
+      write_temp("query2.csv", "x,y,tile_x,tile_y,rank,level,class,depth\n0.25,0.5,0,0,3,0,2,1\n"), sets,
+      error))
+      << error;
+  EXPECT_EQ(sets[0].coords, (std::vector<double>{0.25, 0.5}));
+  EXPECT_EQ(sets[0].classes, (std::vector<std::uint8_t>{2}));
+  ASSERT_TRUE(tools::read_point_sets(
+      write_temp("query3.csv", "x,y,tile_x,tile_y,rank,level,depth\n0.25,0.5,0,0,3,0,1\n"), sets, error))
+      << error;
+  EXPECT_TRUE(sets[0].classes.empty());
   EXPECT_NE(read_error("x,y,class\n0.1,0.2,1.5\n", "half.csv").find(":2: a class must be an integer"),
             std::string::npos);
   EXPECT_NE(read_error("x,y,class\n0.1,0.2,256\n", "big.csv").find("0 to 255"), std::string::npos);

@@ -70,7 +70,7 @@ inline std::vector<std::string> sorted_rows(const std::string& text) {
   std::istringstream in(text);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "x,y,tile_x,tile_y,rank,level");
+  EXPECT_EQ(line, "x,y,tile_x,tile_y,rank,level,depth");
   std::vector<std::string> rows;
   while (std::getline(in, line)) rows.push_back(line);
   std::sort(rows.begin(), rows.end());

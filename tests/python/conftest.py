@@ -69,10 +69,10 @@ def read_txt(path):
 
 
 def read_query_csv(path):
-    """kdm query's .csv: x, y, tile_x, tile_y, rank, level per point."""
+    """kdm query's .csv: x, y, tile_x, tile_y, rank, level (and depth) per point."""
     lines = Path(path).read_text().splitlines()
-    assert lines[0] == "x,y,tile_x,tile_y,rank,level"
-    cols = list(zip(*(line.split(",") for line in lines[1:]))) if len(lines) > 1 else [()] * 6
+    assert lines[0] == "x,y,tile_x,tile_y,rank,level,depth"
+    cols = list(zip(*(line.split(",") for line in lines[1:]))) if len(lines) > 1 else [()] * 7
     xy = np.array([cols[0], cols[1]], dtype=np.float64).T.reshape(-1, 2)
     tile = np.array([cols[2], cols[3]], dtype=np.int64).T.reshape(-1, 2)
     return xy, tile, np.array(cols[4], dtype=np.uint32), np.array(cols[5], dtype=np.uint32)

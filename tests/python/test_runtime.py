@@ -387,7 +387,8 @@ def test_smooth_queries_descend_past_the_top_level(handover_tileset):
     scale = 512 * 16 * 40  # points per tile: past 512 * 16**2, depth-3 sub-points appear
     r = handover_tileset.query((0, 0, 0.1, 0.1), scale=scale, mode="smooth")
     assert abs(len(r) / (scale * 0.01) - 1) < 0.05
-    depth = r.points["depth"]
+    depth = r.depth  # an attribute, as tile, rank and level are: the id needs it
+    assert np.array_equal(depth, r.points["depth"])
     assert depth.max() == 3 and (depth == 0).any()
     ids = set(zip(r.tile[:, 0].tolist(), r.tile[:, 1].tolist(), r.rank.tolist(), depth.tolist()))
     assert len(ids) == len(r)

@@ -25,9 +25,9 @@ struct QueryArgs {
   bool invert = false, normalised = false, glide_together = false;
 };
 
-/// .csv (with a header line) or .json: every point's position and its id (tile, rank) and level, and its
-/// class when `classes` is given. Positions are world coordinates printed exactly (%.17g), so the points of
-/// any partition of a region are the same lines as the region's own; or, with `normalised`, coordinates in
+/// .csv (with a header line) or .json: every point's position and its id (tile, rank, depth) and level, and
+/// its class when `classes` is given. Positions are world coordinates printed exactly (%.17g), so the points
+/// of any partition of a region are the same lines as the region's own; or, with `normalised`, coordinates in
 /// [0, 1) of the rectangle.
 std::string points_with_ids(const std::vector<QueryPoint>& points, const std::vector<std::uint8_t>* classes,
                             const Tileset& tiles, const double r[4], bool normalised, bool json) {
@@ -37,9 +37,11 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const std::ve
     for (QueryPoint& p : from_corner) p.x -= r[0], p.y -= r[1];
   }
   const tools::PointSet unit = tools::normalise_to_rect(from_corner, r);
+  // A point's id is (tile_x, tile_y, rank, depth): past the top level ranks repeat in subtiles. The depth
+  // comes last, so that the columns files had before it keep their places.
   std::string out = json      ? "{\"rect\": ["
-                    : classes ? "x,y,tile_x,tile_y,rank,level,class\n"
-                              : "x,y,tile_x,tile_y,rank,level\n";
+                    : classes ? "x,y,tile_x,tile_y,rank,level,class,depth\n"
+                              : "x,y,tile_x,tile_y,rank,level,depth\n";
   char line[192];
   if (json) {
     std::snprintf(line, sizeof line, "%.17g, %.17g, %.17g, %.17g], \"normalised\": %s, \"points\": [", r[0],
@@ -61,7 +63,7 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const std::ve
       std::snprintf(line, sizeof line, "%.17g,%.17g,%lld,%lld,%u,%u", x, y, tx, ty, p.id.rank, level);
     out += line;
     if (classes) out += (json ? ", \"class\": " : ",") + std::to_string((*classes)[i]);
-    out += json ? "}" : "\n";
+    out += (json ? ", \"depth\": " : ",") + std::to_string(p.id.depth) + (json ? "}" : "\n");
   }
   if (json) out += "\n]}\n";
   return out;

@@ -167,7 +167,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     } else {
       try {
         set = stippler->render(uv, a.fade);
-      } catch (const std::runtime_error& e) {  // the collecting query's limit, said in stipple's terms
+      } catch (const std::length_error& e) {  // the collecting query's limit, said in stipple's terms
         char message[200];
         std::snprintf(message, sizeof message,
                       "the picture of region %g,%g,%g,%g would hold more than 2^25 dots; lower --points or "

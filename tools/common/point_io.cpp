@@ -1,5 +1,6 @@
 #include "point_io.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -139,9 +140,15 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
         columns = 3, class_column = 2;
         continue;
       }
-      if (head == "x,y,tile_x,tile_y,rank,level" || head == "x,y,tile_x,tile_y,rank,level,class") {
-        columns = head.back() == 's' ? 7 : 6, class_column = columns == 7 ? 6 : -1;
-        continue;
+      // kdm query's, with a depth column since 0.5 (earlier files have none).
+      // kdm query's: the class (several classes) and the depth (since 0.5) after the six columns.
+      if (head.rfind("x,y,tile_x,tile_y,rank,level", 0) == 0) {
+        const std::string rest = head.substr(28);
+        if (rest.empty() || rest == ",class" || rest == ",depth" || rest == ",class,depth") {
+          columns = 6 + int(std::count(rest.begin(), rest.end(), ','));
+          class_column = rest.rfind(",class", 0) == 0 ? 6 : -1;
+          continue;
+        }
       }
     }
     std::vector<double> values;

@@ -2,7 +2,8 @@
 // follows points separates one set from the next; every other line holds D coordinates in [0, 1)
 // (separated by blanks or commas; a first line "x,y" or "x,y,z" — the CSV header we write — is skipped).
 // Labelled points (several classes) are CSV files whose header is "x,y,class", or `kdm query`'s CSV
-// ("x,y,tile_x,tile_y,rank,level", with ",class" for several classes), of which x, y and class are read.
+// ("x,y,tile_x,tile_y,rank,level[,class],depth": the class for several classes; files without the depth
+// column too), of which x, y and class are read.
 #pragma once
 
 #include <cstddef>

@@ -100,7 +100,7 @@ void collect(std::vector<T>& out, std::size_t per_point, const ParameterNames& n
     m += written;
     out.resize(per_point * m);
     if (m > kMaxCollectedPoints)  // 1 GiB of QueryPoint records: stop before memory runs out
-      throw std::runtime_error("the query emits more than 2^25 points; lower the scale or split the region");
+      throw std::length_error("the query emits more than 2^25 points; lower the scale or split the region");
     if (s == Status::kOk) return;
     if (s != Status::kBufferFull) throw std::invalid_argument("query: " + describe(problem, names));
   }

@@ -29,7 +29,7 @@ struct ParameterNames {
 std::string describe(const QueryProblem& problem, const ParameterNames& names = {});
 
 /// Runs a query to completion into `out` (replaced). Throws std::invalid_argument with describe()'s line
-/// on bad parameters, std::runtime_error when more than kMaxCollectedPoints points would be emitted.
+/// on bad parameters, std::length_error when more than kMaxCollectedPoints points would be emitted.
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names = {});
 /// The same into the compact output (compact_query.h): positions only, `xy` (replaced) holding x, y

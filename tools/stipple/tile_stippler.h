@@ -70,7 +70,7 @@ class TileStippler {
   /// With `fade` > 0 each dot also gets a size (PointSet::sizes) that grows from 0 where it appears to 1
   /// once the density there has risen a fraction `fade` more (emission_threshold), its area in proportion:
   /// the ink of a zoom changes continuously instead of dots popping up. Throws std::invalid_argument when
-  /// it zooms more than max_stipple_zoom, std::runtime_error when the query would emit more than 2^25
+  /// it zooms more than max_stipple_zoom, std::length_error when the query would emit more than 2^25
   /// dots.
   PointSet render(const double uv[4], double fade = 0) const;
   double aspect() const { return aspect_; }
