@@ -222,10 +222,10 @@ void add_query_command(CLI::App& app) {
                 "about twice as slow");
   cmd->add_flag("--normalised", a->normalised,
                 ".csv/.json coordinates in [0, 1) of --rect instead of world units");
-  cmd->add_option(
-         "-o,--output", a->output,
-         "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level[, class]), .txt (UTK format, "
-         "normalised to the rect), .svg or .png")
+  cmd->add_option("-o,--output", a->output,
+                  "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level[, class], depth: with "
+                  "tile_x, tile_y and rank the point's id), .txt (UTK format, "
+                  "normalised to the rect), .svg or .png")
       ->required();
   cmd->callback([a, density] { run_query_command(*a, density->count() > 0); });
 }
