@@ -98,6 +98,15 @@ TEST_F(CliTest, QueryGlideTogetherMovesTheSamePointsAndKeepsPartitions) {
   }
 }
 
+// A picture of a rect far longer than wide is refused before the query (it was 1 × 10^8 pixels).
+TEST_F(CliTest, QueryPicturesOfSliversAreRefused) {
+  expect_error("query --rect 0,0,1,1e8 --scale 0.001 --tile-size 1000 -o '" + path("tall.png") + "'",
+               "more than 1,024 times taller than wide");
+  expect_error("query --rect 0,0,2000,1 --scale 1 -o '" + path("wide.svg") + "'",
+               "more than 1,024 times wider than tall");
+  ASSERT_EQ(kdm("query --rect 0,0,1000,1 --scale 1 -o '" + path("long.png") + "'").status, 0);
+}
+
 // Past the top level ranks repeat in the subtiles: the depth column makes every id unique (without it,
 // 261 of 401,662 points shared (tile_x, tile_y, rank) with another point over 2 × 2 units).
 TEST_F(CliTest, QueryIdsPastTheTopLevelAreUniqueWithTheirDepth) {

@@ -82,6 +82,14 @@ void run_query_command(const QueryArgs& a, bool density_given) {
         "the rect)");
   if (!a.classes.empty() && tools::has_extension(a.output, ".txt"))
     throw CommandError("--class: .txt has no class column; write .csv, .json, .svg or .png");
+  // A picture's longer side is 1,024 pixels: a rect far longer than wide would be a line of pixels.
+  const double aspect = (r[2] - r[0]) / (r[3] - r[1]);
+  if ((tools::has_extension(a.output, ".png") || tools::has_extension(a.output, ".svg")) &&
+      !(aspect >= 1.0 / 1024 && aspect <= 1024))
+    throw CommandError(
+        "--rect is more than 1,024 times " +
+        std::string(aspect < 1 ? "taller than wide" : "wider than tall") +
+        ": its picture, 1,024 pixels long, would be less than a pixel across; write .csv or .json");
   if (a.classes.size() > kMaxQueryClasses)
     throw CommandError("--class given " + std::to_string(a.classes.size()) + " times; at most " +
                        std::to_string(kMaxQueryClasses) + " classes");
@@ -171,7 +179,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     // .txt is the UTK/psa format, [0, 1) by definition; pictures show the rectangle.
     for (QueryPoint& p : points) p.x -= r[0], p.y -= r[1];
     tools::DrawStyle style;
-    style.aspect = (r[2] - r[0]) / (r[3] - r[1]);
+    style.aspect = aspect;
     // The longer side 1,024 pixels: a tall, narrow rect is a tall picture, not one 1,024 pixels wide.
     style.width_px =
         style.aspect >= 1 ? 1024 : static_cast<int>(std::max(1.0, std::round(1024 * style.aspect)));
