@@ -186,6 +186,7 @@ TEST_F(CliTest, DefaultThreadsFollowTheEnvironmentAndTheAffinityMask) {
   EXPECT_EQ(threads_used("", "OMP_NUM_THREADS=3"), 3);
   EXPECT_EQ(threads_used("", "OMP_NUM_THREADS=1,2"), 1);  // a nesting list: its first level
   EXPECT_EQ(threads_used("--threads 2", "OMP_NUM_THREADS=1"), 2);
+  EXPECT_EQ(threads_used("", "OMP_NUM_THREADS=1000"), 256);  // capped as --threads is
   if (std::system("taskset -c 0 true >/dev/null 2>&1") == 0) {
     EXPECT_EQ(threads_used("", "env -u OMP_NUM_THREADS taskset -c 0"), 1);
   }

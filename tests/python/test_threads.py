@@ -86,3 +86,20 @@ def test_queries_stipples_and_analyses_at_once():
     alone = [job() for job in jobs]
     together = run_together(*jobs)
     assert all(np.array_equal(a, b) for a, b in zip(alone, together))
+
+
+def _sample_and_analyse(seed):
+    points = kdm.sample(3000, seed=seed, threads=2)
+    return points, kdm.analyze(points, threads=2)["nearest_neighbour"]["davg"]
+
+
+def test_forked_workers_sample_and_analyse_with_threads():
+    # multiprocessing's default start method on Linux forks a process whose threads are gone: a child must
+    # not wait for the parent's workers. The parent's own threads run first so that there are some.
+    multiprocessing = pytest.importorskip("multiprocessing")
+    expected = [_sample_and_analyse(s) for s in (1, 2)]
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        got = pool.map_async(_sample_and_analyse, [1, 2]).get(timeout=120)  # a hang fails, not blocks
+    for (points, davg), (want_points, want_davg) in zip(got, expected):
+        assert np.array_equal(points, want_points)
+        assert davg == want_davg

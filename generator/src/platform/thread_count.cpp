@@ -10,6 +10,8 @@
 #include <string>
 #include <thread>
 
+#include "kdm/generator/sampler.h"
+
 namespace kdm::gen {
 namespace {
 
@@ -34,7 +36,7 @@ int default_thread_count() {
   static const int count = [] {
     if (const char* env = std::getenv("OMP_NUM_THREADS")) {
       const long n = std::strtol(env, nullptr, 10);  // "4" or a nesting list "4,2": the first level
-      if (n > 0) return static_cast<int>(std::min(n, 1024L));
+      if (n > 0) return static_cast<int>(std::min(n, long(kMaxThreads)));  // as --threads is capped
     }
     int cpus = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     cpu_set_t mask;

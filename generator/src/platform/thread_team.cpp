@@ -1,7 +1,10 @@
 #include "platform/thread_team.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
+#include <new>
 #include <system_error>
 #include <utility>
 
@@ -33,6 +36,9 @@ bool spin_until(Pred&& pred) {
   }
 }
 
+/// How many times this process's ancestors forked into it (a child's atfork handler counts).
+std::atomic<unsigned> forks{0};
+
 }  // namespace
 
 ThreadTeam& ThreadTeam::for_this_thread() {
@@ -40,7 +46,31 @@ ThreadTeam& ThreadTeam::for_this_thread() {
   return team;
 }
 
+ThreadTeam::ThreadTeam() {
+  static const bool counting = [] { return pthread_atfork(nullptr, nullptr, [] { ++forks; }) == 0; }();
+  static_cast<void>(counting);
+  forks_seen_ = forks.load();
+}
+
+void ThreadTeam::forget_forked_workers() {
+  if (forks_seen_ == forks.load()) return;
+  forks_seen_ = forks.load();
+  if (workers_.empty()) return;
+  // Only the forking thread lives on in a child. Its workers' std::thread objects name threads that do not
+  // exist here (joining them would wait forever, destroying them ends the process), so they are leaked; the
+  // locks and counters may hold a worker's state at the fork, so they start afresh.
+  static_cast<void>(new std::vector<std::thread>(std::move(workers_)));
+  workers_.clear();
+  new (&mutex_) std::mutex;
+  new (&error_mutex_) std::mutex;
+  new (&wake_) std::condition_variable;
+  new (&done_) std::condition_variable;
+  running_.store(0);
+  sleepers_.store(0);
+}
+
 ThreadTeam::~ThreadTeam() {
+  forget_forked_workers();
   if (workers_.empty()) return;
   publish(0);
   for (std::thread& t : workers_) t.join();
@@ -62,6 +92,7 @@ void ThreadTeam::publish(std::uint64_t team) {
 
 void ThreadTeam::run(int threads, const std::function<void(int, int)>& body) {
   threads = std::min(threads, static_cast<int>(kTeamMask));
+  forget_forked_workers();
   while (static_cast<int>(workers_.size()) < threads - 1) {
     try {
       workers_.emplace_back(&ThreadTeam::work, this, static_cast<int>(workers_.size()) + 1, job_.load());

@@ -7,7 +7,8 @@
 // scheduler time slice), then sleeps until it is woken.
 //
 // Thread safety: each calling thread has its own team (ThreadTeam::for_this_thread), so concurrent
-// samplers on different threads never share workers; a team is used by its owner only.
+// samplers on different threads never share workers; a team is used by its owner only. A process forked
+// from one whose team had workers (Python's multiprocessing) starts new ones: the parent's are not there.
 #pragma once
 
 #include <atomic>
@@ -30,7 +31,7 @@ class ThreadTeam {
   /// when the calling thread ends).
   static ThreadTeam& for_this_thread();
 
-  ThreadTeam() = default;
+  ThreadTeam();
   ThreadTeam(const ThreadTeam&) = delete;
   ThreadTeam& operator=(const ThreadTeam&) = delete;
   ~ThreadTeam();
@@ -46,8 +47,10 @@ class ThreadTeam {
   void call(int index, int team) noexcept;
   void publish(std::uint64_t team);
   void notify(std::condition_variable& cv);
+  void forget_forked_workers();  // in a forked child, the parent's workers
 
   std::vector<std::thread> workers_;
+  unsigned forks_seen_ = 0;  // the process's fork count when workers_ were started
   std::mutex mutex_;
   std::condition_variable wake_, done_;
   // The current job: a generation count (bumped once per run) above the team size in the low 16 bits, in

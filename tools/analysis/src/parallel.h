@@ -1,6 +1,8 @@
-// Internal: a blocking parallel loop over [0, count) on `threads` workers (OpenMP when available, else
-// std::thread). Each index is handled exactly once; the body must only write data owned by its index
-// (or by its worker slot `w`, 0 <= w < workers) so results never depend on the thread count.
+// Internal: a blocking parallel loop over [0, count) on `threads` workers, started for the call. Each index
+// is handled exactly once; the body must only write data owned by its index (or by its worker slot `w`,
+// 0 <= w < workers) so results never depend on the thread count. Threads of the call's own, not a pool
+// kept between calls: a pool's threads do not survive fork(), so a forked child (Python's multiprocessing)
+// would wait on them forever.
 #pragma once
 
 #include <algorithm>
@@ -13,10 +15,6 @@
 #include <vector>
 
 #include "kdm/generator/sampler.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace kdm::analysis::detail {
 
@@ -48,10 +46,6 @@ void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
       if (!error) error = std::current_exception();
     }
   };
-#ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1) num_threads(workers)
-  for (std::ptrdiff_t i = 0; i < count; ++i) guarded(i, omp_get_thread_num());
-#else
   std::atomic<std::ptrdiff_t> next{0};
   std::vector<std::thread> pool;
   auto work = [&](int w) {
@@ -64,7 +58,6 @@ void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
   }
   work(0);
   for (std::thread& t : pool) t.join();
-#endif
   if (error) std::rethrow_exception(error);
 }
 
