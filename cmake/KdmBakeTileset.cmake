@@ -9,6 +9,8 @@
 #   EMBED    a static library of that name holding the set's bytes, for a program that carries its set
 #            inside it: link it, `#include "<name>.h"` and pass `<name>, <name>_size` to
 #            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier.
+#            Compiling the bytes as an array costs the compiler time and memory: for a set the size of the
+#            built-in one (14 MB), a 71 MB source, 24 s and 2.4 GB in g++; load such a set from its file.
 #   THREADS  baking and verifying threads (0, the default, takes every core). The file does not depend on it.
 #   VERIFY   also runs `kdm verify` (the generator test) on the baked file, and fails the build if any
 #            check fails.
@@ -74,7 +76,16 @@ function(kdm_bake_tileset)
       "#ifdef __cplusplus\n}\n#endif\n")
     file(COPY_FILE "${include_dir}/${arg_EMBED}.h.tmp" "${include_dir}/${arg_EMBED}.h" ONLY_IF_DIFFERENT)
     file(REMOVE "${include_dir}/${arg_EMBED}.h.tmp")
-    set(source "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}.cpp")
+    # The source is C and C++ alike: compiled as C++ where the project has it, else as C.
+    get_property(languages GLOBAL PROPERTY ENABLED_LANGUAGES)
+    if("CXX" IN_LIST languages)
+      set(extension cpp)
+    elseif("C" IN_LIST languages)
+      set(extension c)
+    else()
+      message(FATAL_ERROR "kdm_bake_tileset: EMBED compiles a C or C++ source; enable C or CXX in project()")
+    endif()
+    set(source "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}.${extension}")
     add_custom_command(OUTPUT "${source}"
                        COMMAND "${CMAKE_COMMAND}" "-DKDM_EMBED_INPUT=${output}" "-DKDM_EMBED_OUTPUT=${source}"
                                "-DKDM_EMBED_SYMBOL=${arg_EMBED}" -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmEmbed.cmake"

@@ -9,23 +9,32 @@ endif()
 
 # Rewrites OUTPUT only where its bytes change (at configure time, so that an unchanged set is not compiled
 # again), unless ALWAYS is given (at build time, where OUTPUT must end newer than INPUT). C_LINKAGE gives
-# the symbols C linkage, for C callers.
+# the symbols C linkage and writes a source that is C and C++ alike, for projects of either language.
 function(kdm_write_embedded_source input output symbol)
-  set(extern "extern")
-  if("C_LINKAGE" IN_LIST ARGN)
-    set(extern "extern \"C\"")  # a declaration, as extern is
-  endif()
   file(READ ${input} hex HEX)
   string(LENGTH "${hex}" hex_length)
   math(EXPR size "${hex_length} / 2")
   string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," bytes "${hex}")
   string(REGEX REPLACE "((0x..,){32})" "\\1\n" bytes "${bytes}")
+  if("C_LINKAGE" IN_LIST ARGN)
+    string(CONCAT head
+      "#include <stddef.h>\n"
+      "#ifdef __cplusplus\n#define KDM_EMBED_ALIGNED alignas(16)\nextern \"C\" {\n"
+      "#else\n#define KDM_EMBED_ALIGNED _Alignas(16)\n#endif\n"
+      "extern const unsigned char ${symbol}[];\nextern const size_t ${symbol}_size;\n"
+      "#ifdef __cplusplus\n}\n#endif\n"
+      "KDM_EMBED_ALIGNED const unsigned char ${symbol}[] = {\n")
+    set(size_type "size_t")
+  else()
+    string(CONCAT head
+      "#include <cstddef>\n"
+      "extern const unsigned char ${symbol}[];\nextern const std::size_t ${symbol}_size;\n"
+      "alignas(16) const unsigned char ${symbol}[] = {\n")
+    set(size_type "std::size_t")
+  endif()
   file(WRITE ${output}.tmp
-    "// Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit.\n"
-    "#include <cstddef>\n"
-    "${extern} const unsigned char ${symbol}[];\n${extern} const std::size_t ${symbol}_size;\n"
-    "alignas(16) const unsigned char ${symbol}[] = {\n${bytes}\n};\n"
-    "const std::size_t ${symbol}_size = ${size};\n")
+    "// Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit.\n" "${head}" "${bytes}\n};\n"
+    "const ${size_type} ${symbol}_size = ${size};\n")
   if("ALWAYS" IN_LIST ARGN)
     file(RENAME ${output}.tmp ${output})
   else()
