@@ -331,6 +331,8 @@ def _validate(ts):
             if any(a > b for a, b in zip(keys, keys[1:])):
                 raise TilesetError(f"tile {t} has unsorted keys in level {k}")
             start = end
+    if all(len(tile.xs) == 0 for tile in ts.tiles):
+        raise TilesetError("its tiles hold no points")
     if len(ts.keyframe_nominal) > MAX_KEYFRAMES:
         raise TilesetError(f"{len(ts.keyframe_nominal)} keyframes, more than {MAX_KEYFRAMES}")
     previous = 0

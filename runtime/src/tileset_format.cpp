@@ -344,6 +344,9 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
         if (tile.keys[i] < tile.keys[i - 1])
           return bad("tile " + std::to_string(t) + " has unsorted keys in level " + std::to_string(k));
   }
+  // A set of empty tiles emits nothing at any density: a damaged or forged file, not a tile set.
+  if (std::all_of(set.tiles.begin(), set.tiles.end(), [](const Tile& t) { return t.points.empty(); }))
+    return bad("its tiles hold no points");
   const std::size_t keyframes = set.keyframe_nominal.size();
   if (keyframes > kMaxKeyframes)
     return bad(std::to_string(keyframes) + " keyframes, more than " + std::to_string(kMaxKeyframes));

@@ -501,6 +501,11 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
                "--fade grows dots in pictures");
   std::ofstream(path("empty.recipe")) << "# a comment only\n\n  # indented\n";  // not minutes of defaults
   expect_error("bake '" + path("empty.recipe") + "' -o '" + path("e.kdmt") + "'", "gives no key");
+  // The arguments swapped (a baked set where its recipe belongs), and standard output for a binary file.
+  expect_error("bake " + shipped + " -o '" + path("s.kdmt") + "'", "is a tile-set file, not a recipe");
+  std::ofstream(path("one.recipe")) << "levels 1\n";
+  expect_error("bake '" + path("one.recipe") + "' -o -", "a tile set is written to a file");
+  EXPECT_FALSE(fs::exists("-"));
   for (const char* points :
        {"0.5 0.5\n0.5 0.5\n0.5 0.5\n0.5 0.5\n", "0.1 0.5\n0.2 0.5\n0.3 0.5\n0.9 0.5\n"}) {
     // No triangulation: the empty circles are skipped, saying why, and the other measures still made.

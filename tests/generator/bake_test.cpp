@@ -70,6 +70,9 @@ TEST(BakeTest, RecipeRefusesKeysThatWouldDoNothingAndOddNumbers) {
   EXPECT_NE(refusal("temperature 2000\n").find("temperature must be in [0, 1000]"), std::string::npos)
       << refusal("temperature 2000\n");
   EXPECT_EQ(BakeRecipe::parse("fill_holes 0\n").fill_holes, 0.0);  // off, said explicitly
+  EXPECT_NE(refusal("levels 1\nkeyframes 8\n").find("keyframes need 2 or more levels"), std::string::npos)
+      << refusal("levels 1\nkeyframes 8\n");
+  EXPECT_EQ(refusal("levels 2\nkeyframes 8\n"), "");
   // A hand-over whose subtiles hand over more points than the format's hand-over entries address is
   // refused here, not after the bake.
   EXPECT_NE(refusal("levels 3\ncolours 1\nbase_points 700\nkeyframes 1\nhandover_zone 1\n")

@@ -352,6 +352,14 @@ TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
   set = make_tileset();
   set.tiles[2].keys.pop_back();
   EXPECT_EQ(validate_tileset(set), Status::kInvalidContent);
+  // Tiles that hold no points: a set that emits nothing at any density (a forged 303-byte file of 65,536
+  // such tiles passed every other check and loaded into 291 MiB). One point anywhere is a set.
+  set = make_tileset();
+  for (Tile& tile : set.tiles) tile = Tile{}, tile.level_end.assign(set.levels, 0);
+  EXPECT_EQ(validate_tileset(set, &why), Status::kInvalidContent);
+  EXPECT_NE(why.find("hold no points"), std::string::npos) << why;
+  set.tiles[1] = make_tileset().tiles[1];
+  EXPECT_EQ(validate_tileset(set, &why), Status::kOk) << why;
 }
 
 TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {

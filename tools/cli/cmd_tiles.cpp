@@ -31,6 +31,9 @@ std::string read_text(const std::string& path) {
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw CommandError("cannot read recipe '" + path + "'");
   text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.compare(0, 8, "KDMTILES") == 0)  // the arguments swapped: a baked set where its recipe belongs
+    throw CommandError("'" + path + "' is a tile-set file, not a recipe (its recipe: kdm info '" + path +
+                       "')");
   if (text.size() > kMaxTilesetHeaderBytes)
     throw CommandError("recipe '" + path + "' is longer than " + std::to_string(kMaxTilesetHeaderBytes) +
                        " bytes: not a recipe");
@@ -49,6 +52,8 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   } catch (const gen::InvalidArgument& e) {
     throw CommandError("'" + recipe_path + "': " + e.what());
   }
+  if (output == "-")  // a binary file, written atomically: never to a terminal or a pipe
+    throw CommandError("-o -: a tile set is written to a file; name one, e.g. -o tiles.kdmt");
   try {
     tools::refuse_writing_over(recipe_path, output, "recipe");
   } catch (const std::invalid_argument& e) {
@@ -71,8 +76,9 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   const Status s = save_tileset(set, output, &detail);
   if (s != Status::kOk) throw CommandError(std::string(status_message(s)) + ": " + detail);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::fprintf(stderr, "kdm bake: %zu tile(s), %u levels, %u points per tile -> %s (%.1f s)\n",
-               set.tiles.size(), set.levels, set.level_nominal.back(), output.c_str(), seconds);
+  std::fprintf(stderr, "kdm bake: %zu tile(s), %u level%s, %u points per tile -> %s (%.1f s)\n",
+               set.tiles.size(), set.levels, set.levels == 1 ? "" : "s", set.level_nominal.back(),
+               output.c_str(), seconds);
   if (recipe.separation > 0)
     std::fprintf(stderr, "  close pairs: %zu point(s) moved, %zu split per tile, %zu removed\n", report.moved,
                  report.split, report.removed);

@@ -206,6 +206,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
   needs("split_shared", r.split_shared, r.separation > 0 || r.glide_separation > 0,
         "separation or glide_separation");
   const bool track = r.keyframes_per_level > 0;
+  if (track && r.levels < 2)  // one level has no density between levels for a point to glide through
+    throw InvalidArgument("recipe: keyframes need 2 or more levels (a glide track runs between levels)");
   needs("glide_sweeps", seen.count("glide_sweeps") > 0, track, "a glide track (keyframes)");
   needs("glide_separation", r.glide_separation > 0, track, "a glide track (keyframes)");
   needs("glide_consensus", r.glide_consensus > 0, track, "a glide track (keyframes)");

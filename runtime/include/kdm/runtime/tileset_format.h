@@ -273,8 +273,9 @@ KDM_RUNTIME_API std::vector<std::vector<float>> coarsest_level_thresholds(const 
 /// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
 KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 
-/// The format version encode_tileset writes `set` in: the oldest that holds it (4 for a set without a
-/// hand-over, 5 for one onto the subtiles' level 0, so that older readers keep reading them; else 6).
+/// The format version encode_tileset writes `set` in: the oldest that holds it, so that older readers keep
+/// reading them: 4 for a set without a hand-over, 5 for one onto the subtiles' level 0, 6 onto a finer
+/// level, 7 with a hand-over slack.
 KDM_RUNTIME_API std::uint32_t tileset_format_version_for(const TilesetShape& set);
 
 /// Encodes `set` into `out` (replaced). Returns kOk; kInvalidArgument if validate_tileset fails, the
