@@ -43,6 +43,8 @@ def analyze(
         One (n, 2) or (n, 3) set with coordinates in [0, 1], or a list of such sets (arrays or nested
         lists) of one dimension: statistics are pooled over them, as over the sets of one file, and the
         spectrum refuses sets more than 10% apart in count (their frequencies would not line up).
+        Distances are those of the unit square (cube): a set drawn for a non-square domain is judged
+        squeezed (docs/limits.md, "Analysing point sets").
     box : bool
         Bounded-box distances instead of periodic (torus) ones.
     density : None, float, str or 2-D array

@@ -42,6 +42,25 @@ def number(name: str, value: Any, minimum: Optional[float] = None, strict: bool 
     return value
 
 
+def temperature(value: Any) -> float:
+    """The sampler's temperature: 0 to 1000, as `kdm sample --temperature` takes it."""
+    value = number("temperature", value, 0.0)
+    if value > 1000:
+        raise ValueError("temperature must be at most 1000: past it nearly every move is refused and the points "
+                         "keep their starting places (300 already gives white noise)")
+    return value
+
+
+def aspect(value: Any, dim: int) -> Optional[float]:
+    """A 2-D domain's width / height, or None."""
+    if value is None:
+        return None
+    value = number("aspect", value, 0.0, strict=True)
+    if dim != 2:
+        raise ValueError("aspect is a 2-D domain's width / height; a 3-D domain is the unit cube")
+    return value
+
+
 def threads(value: Any) -> int:
     """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use), at
     most _kdm.MAX_THREADS (256) as on the command line."""
@@ -143,6 +162,13 @@ def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str 
 
 def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:
     """density_spec() for the full sampler, which needs something to sample."""
+    if is_array(density) and not isinstance(density, (str, bytes)):
+        # Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled
+        # into it rather than flushed to 0 or infinity.
+        values = array2d(name, density)
+        top = float(np.max(values)) if values.size else 0.0
+        if math.isfinite(top) and top > 0 and not 1e-30 <= top <= 1e30:
+            density = values / top
     spec = density_spec(density, gamma, invert, name)
     # Text gets the command line's refusal (from C++); numbers and arrays a message of their own.
     if spec is not None and spec.text in ("array", "number") and not spec.max_value > 0:

@@ -74,21 +74,26 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
 
     Each ``random(n)`` returns `n` fresh points (a whole set drawn with a new seed taken from the engine's
     generator, so it is blue noise by itself); ``reset()`` replays the same sets; ``fast_forward(n)``
-    skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d.
+    skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d, in the
+    sampler's order (kdm.sample: a prefix of a set is a patch of the domain). An engine pickles and
+    copies (a process pool's workers get it): its density is read again where it is unpickled, so an
+    image file must be there too.
 
     Parameters
     ----------
     d : int
         2 or 3.
     seed : None, int or numpy.random.Generator
-        As SciPy's engines take it: an int or None seeds a new ``numpy.random.default_rng``; a Generator
-        is used as it is (and replayed from a copy by reset()).
+        As SciPy's engines take it: an int seeds a new ``numpy.random.default_rng``, None one seeded
+        from fresh entropy (kept, so that reset() replays it too); a Generator is used as it is (and
+        replayed from a copy by reset()).
     aspect : float or None
         Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
         density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
-        aspect=1 spaces them evenly in the unit square whatever the density's shape.
+        aspect=1 spaces them evenly in the unit square whatever the density's shape. 2-D only.
     temperature, domain, density, threads
-        As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise);
+        As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise;
+        an array density is copied, and ``density`` returns that read-only copy);
         ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
         draws; ``random(n, workers=k)`` draws with k threads (-1: every core) as SciPy's engines do. A
         draw that fails or is interrupted uses no seed. There is no ``optimization``: the points are
@@ -114,12 +119,14 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             )
         if isinstance(seed, numbers.Integral) and seed < 0:  # numpy's own refusal does not name it
             raise ValueError(f"seed must be a non-negative int, got {seed}")
+        if seed is None:  # fresh entropy, kept as an int so that reset() replays it
+            seed = np.random.SeedSequence().entropy
         super().__init__(d=d, seed=seed)
-        self.temperature = _checks.number("temperature", temperature, 0.0)
+        self.temperature = _checks.temperature(temperature)
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
         self.threads = _checks.threads(threads)
         self.density = density
-        self.aspect = None if aspect is None else _checks.number("aspect", aspect, 0.0, strict=True)
+        self.aspect = _checks.aspect(aspect, d)
 
     @property
     def density(self) -> Any:
@@ -131,7 +138,37 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
         if self.d != 2 and spec is not None and spec.kind == "image":
             raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
+        if _checks.is_array(value):  # what is drawn from: later changes to the caller's array are not
+            value = np.array(value, dtype=np.float64)
+            value.flags.writeable = False
         self._density, self._spec = value, spec
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        del state["_spec"]  # the density as read (C++), read again from _density
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._spec = _checks.sampler_density(self._density, 1.0, False)
+
+    def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
+        """A new blue-noise set of `n` points in [0, 1)^d, drawn with the engine's next seed.
+
+        Parameters
+        ----------
+        n : int
+            Points in the set (0 to 2**31; the sampler's grid limits it as kdm.sample says).
+        workers : int
+            Threads for this draw: 1 (the default) the engine's `threads`, -1 every core, else that
+            many. The points do not depend on it.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n, d) float64.
+        """
+        return super().random(n, workers=workers)
 
     def _draw_seed(self) -> int:
         if hasattr(self.rng, "integers"):
@@ -149,9 +186,9 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         # Attributes may have been set since __init__: checked again, before a seed is drawn.
         threads = _checks.threads(self.threads) if workers == 1 else (0 if workers == -1 else workers)
         threads = _checks.threads(threads)
-        temperature = _checks.number("temperature", self.temperature, 0.0)
+        temperature = _checks.temperature(self.temperature)
         domain = None if self.domain is None else _checks.choice("domain", self.domain, ("torus", "box"))
-        aspect = None if self.aspect is None else _checks.number("aspect", self.aspect, 0.0, strict=True)
+        aspect = _checks.aspect(self.aspect, self.d)
         state = copy.deepcopy(self.rng.bit_generator.state if hasattr(self.rng, "bit_generator")
                               else self.rng.get_state())
         seed = self._draw_seed()

@@ -67,8 +67,9 @@ class QueryResult:
 class Tileset:
     """A loaded, immutable tile set: the runtime's source of points for any region and density.
 
-    Get one with Tileset.builtin(), Tileset.load(path) or kdm.bake(recipe). Any number of threads may
-    query one at once.
+    Get one with Tileset.builtin(), Tileset.load(path), Tileset.from_bytes(data) or kdm.bake(recipe).
+    Any number of threads may query one at once. It pickles (as its file's bytes; the built-in set as
+    itself), and copies are the set itself: it never changes.
     """
 
     __slots__ = ("_handle",)
@@ -91,9 +92,34 @@ class Tileset:
         """Loads and validates a .kdmt file. Raises OSError (the command line's message) if it cannot."""
         return cls(_kdm.Tileset.load(_checks.path("path", path)))
 
+    @classmethod
+    def from_bytes(cls, data: Any) -> "Tileset":
+        """Loads and validates a .kdmt file's bytes (bytes, bytearray or memoryview). Raises ValueError,
+        naming the problem, for bytes that are no valid tile set."""
+        if isinstance(data, (bytearray, memoryview)):
+            data = bytes(data)
+        if not isinstance(data, bytes):
+            raise TypeError(f"data must be bytes, got {type(data).__name__}")
+        return cls(_kdm.Tileset.from_bytes(data))
+
+    def to_bytes(self) -> bytes:
+        """The set as a .kdmt file's bytes (what save() writes)."""
+        return self._handle.to_bytes()
+
     def save(self, path: Any) -> None:
         """Writes the set as a .kdmt file (atomically). Raises OSError if it cannot."""
         self._handle.save(_checks.path("path", path))
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        if self is Tileset._builtin:
+            return (Tileset.builtin, ())
+        return (Tileset.from_bytes, (self.to_bytes(),))
+
+    def __copy__(self) -> "Tileset":
+        return self
+
+    def __deepcopy__(self, memo: Any) -> "Tileset":
+        return self
 
     @property
     def info(self) -> Dict[str, Any]:

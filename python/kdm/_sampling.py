@@ -26,7 +26,9 @@ def sample(
     Parameters
     ----------
     n : int
-        The number of points, 1 to 2**31.
+        The number of points, 1 to 2**31. The sampler's grid (at most 2**27 nodes) holds about 8 million
+        points in 2-D and 3 million in 3-D (fewer with a wide density range or a long domain); more raise
+        ValueError saying so.
     density : None, float, str or 2-D array
         The target density (only its shape matters: the sampler scales it to `n` points). None or a
         number > 0: uniform. A str: what ``kdm sample --density`` accepts, "const:V", the test maps
@@ -45,24 +47,26 @@ def sample(
     threads : int
         Worker threads; 0: OMP_NUM_THREADS if set, else the CPUs this process may use.
     aspect : float or None
-        Width / height of the domain; None: the image's or array's, else 1. Points are normalised to
-        [0, 1) on every axis whatever the aspect.
+        Width / height of a 2-D domain; None: the image's or array's, else 1. Points are normalised to
+        [0, 1) on every axis whatever the aspect. A 3-D domain is the unit cube.
     gamma, invert
         How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
 
     Returns
     -------
     numpy.ndarray
-        (n, dim) float64 in [0, 1)^dim: the same bits as ``kdm sample`` with the same arguments.
+        (n, dim) float64 in [0, 1)^dim: the same bits as ``kdm sample`` with the same arguments. Rows come
+        in the sampler's order, cell by cell of its grid, so neighbouring rows are neighbouring points: a
+        prefix ``x[:k]`` is a patch of the domain, not a thinner set (for k points, sample k; for a random
+        subset, index by ``rng.permutation(n)[:k]``).
     """
     n = _checks.integer("n", n, 1, 2**31)
     dim = _checks.integer("dim", dim, 2, 3)
     if domain is not None:
         domain = _checks.choice("domain", domain, ("torus", "box"))
-    temperature = _checks.number("temperature", temperature, 0.0)
+    temperature = _checks.temperature(temperature)
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
     threads = _checks.threads(threads)
-    if aspect is not None:
-        aspect = _checks.number("aspect", aspect, 0.0, strict=True)
+    aspect = _checks.aspect(aspect, dim)
     spec = _checks.sampler_density(density, gamma, invert)
     return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)

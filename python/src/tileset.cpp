@@ -49,6 +49,37 @@ TilesetHandle load(const std::string& path) {
   return {std::move(set), header.format_version};
 }
 
+/// The set from a .kdmt file's bytes, checked as load() checks a file.
+TilesetHandle from_bytes(const py::bytes& data) {
+  const std::string bytes = data;  // one copy, then the GIL is free
+  auto set = std::make_shared<Tileset>();
+  std::string detail;
+  TilesetHeader header;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+    if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
+  }
+  if (s != Status::kOk)
+    throw std::invalid_argument(std::string("data: ") + status_message(s) + " (" + detail + ")");
+  return {std::move(set), header.format_version};
+}
+
+/// The bytes save() writes.
+py::bytes to_bytes(const TilesetHandle& h) {
+  std::vector<std::uint8_t> bytes;
+  std::string detail;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = encode_tileset(h.set->data(), bytes, &detail);
+  }
+  if (s != Status::kOk)
+    throw std::runtime_error(std::string("tile set: ") + status_message(s) + " (" + detail + ")");
+  return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
+
 void save(const TilesetHandle& h, const std::string& path) {
   std::string detail;
   Status s;
@@ -139,6 +170,8 @@ void bind_tileset(py::module_& m) {
   py::class_<TilesetHandle>(m, "Tileset", "A loaded tile set (kdm::Tileset)")
       .def_static("builtin", &builtin)
       .def_static("load", &load, py::arg("path"))
+      .def_static("from_bytes", &from_bytes, py::arg("data"))
+      .def("to_bytes", &to_bytes)
       .def("save", &save, py::arg("path"))
       .def("thresholds", &thresholds, py::arg("tile"), py::arg("rank"), py::arg("depth"))
       .def_property_readonly("info", &info);

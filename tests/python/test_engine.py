@@ -57,6 +57,10 @@ def test_seeds_as_scipy_takes_them():
     engine.reset()  # a Generator is replayed from the copy taken at construction
     assert np.array_equal(engine.random(200), first)
     assert kdm.BlueNoise(2).random(10).shape == (10, 2)  # None: fresh entropy
+    fresh = kdm.BlueNoise(2)
+    first = fresh.random(100)
+    assert np.array_equal(fresh.reset().random(100), first)  # kept, so reset() replays it too
+    assert not np.array_equal(kdm.BlueNoise(2).random(100), first)  # fresh for each engine
     assert kdm.BlueNoise(3, seed=1).random(100).shape == (100, 3)
     assert kdm.BlueNoise(2, seed=1).random(0).shape == (0, 2)
     with pytest.raises(TypeError, match="seed must be None, an int or a numpy.random.Generator"):
@@ -93,6 +97,32 @@ def test_engine_options():
     e3 = kdm.BlueNoise(3, seed=1)
     with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
         e3.density = np.ones((4, 4))
+    # Checked at construction, not at the first draw, as kdm.sample checks them.
+    with pytest.raises(ValueError, match="temperature must be at most 1000"):
+        kdm.BlueNoise(2, temperature=2000)
+    with pytest.raises(ValueError, match="aspect is a 2-D domain's"):
+        kdm.BlueNoise(3, aspect=2.0)
+    with pytest.raises(ValueError, match="aspect is a 2-D domain's"):
+        kdm.sample(100, dim=3, aspect=2.0)
+    # An array density is copied: the caller's later changes neither reach the draws nor seem to.
+    ramp = np.tile(np.linspace(1.0, 10.0, 8), (8, 1))
+    e = kdm.BlueNoise(2, seed=3, density=ramp, threads=1)
+    before = e.random(500)
+    ramp[:] = 1.0
+    assert not np.array_equal(e.density, ramp) and not e.density.flags.writeable
+    assert np.array_equal(e.reset().random(500), before)
+
+
+def test_an_engine_pickles_and_copies():
+    import copy
+    import pickle
+    for density in (None, 2.0, "ramp:4", np.tile(np.linspace(1.0, 4.0, 6), (5, 1))):
+        e = kdm.BlueNoise(2, seed=7, density=density, threads=1)
+        e.random(50)  # the copy continues from here
+        for twin in (pickle.loads(pickle.dumps(e)), copy.deepcopy(e)):
+            assert np.array_equal(twin.random(300), e.random(300)), density
+            e.reset(), twin.reset()
+            assert np.array_equal(twin.random(300), e.random(300)), density
 
 
 def test_aspect_spaces_points_evenly_in_the_unit_square():

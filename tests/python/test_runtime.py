@@ -336,6 +336,25 @@ def test_load_save_and_bake(tmp_path, tiny_tileset):
         loaded.query((0, 0, 1, 1), scale=129)
 
 
+def test_a_set_from_bytes_pickles_and_copies(tiny_tileset):
+    import copy
+    import pickle
+    data = tiny_tileset.to_bytes()
+    again = kdm.Tileset.from_bytes(data)
+    assert again.info == tiny_tileset.info and again.to_bytes() == data
+    assert kdm.Tileset.from_bytes(memoryview(data)).info == tiny_tileset.info
+    kw = dict(scale=100, mode="smooth")
+    for twin in (pickle.loads(pickle.dumps(tiny_tileset)), copy.deepcopy(tiny_tileset)):
+        assert same(twin.query((0, 0, 3, 3), **kw), tiny_tileset.query((0, 0, 3, 3), **kw))
+    assert pickle.loads(pickle.dumps(BUILTIN)) is BUILTIN  # the built-in set as itself, not 14 MB
+    with pytest.raises(ValueError, match="truncated"):
+        kdm.Tileset.from_bytes(data[:-1])
+    with pytest.raises(ValueError, match="bad magic"):
+        kdm.Tileset.from_bytes(b"not a tile set at all, but long enough to hold a header")
+    with pytest.raises(TypeError, match="data must be bytes"):
+        kdm.Tileset.from_bytes("a str")
+
+
 def test_the_shipped_file_loads_as_the_builtin_set():
     from conftest import SOURCE_DIR
     shipped = kdm.Tileset.load(SOURCE_DIR / "tilesets" / "default.kdmt")

@@ -59,6 +59,10 @@ def test_array_dtype_and_layout_do_not_matter():
     assert np.array_equal(kdm.sample(500, d.tolist(), seed=2), expected)
     ints = np.arange(1, 13 * 5 + 1).reshape(13, 5)
     assert np.array_equal(kdm.sample(300, ints, seed=2), kdm.sample(300, ints.astype(float), seed=2))
+    # Only the shape matters: values past float32's range are scaled into it, not flushed to 0 or inf.
+    ramp = np.tile(np.array([1.0, 2.0, 4.0]), (3, 1))
+    for unit in (1e-300, 1e300):
+        assert np.array_equal(kdm.sample(300, ramp * unit, seed=2), kdm.sample(300, ramp, seed=2)), unit
 
 
 def test_defaults_and_domain_rules():
