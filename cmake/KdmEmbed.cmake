@@ -20,7 +20,8 @@ function(kdm_write_embedded_source input output symbol)
     string(CONCAT head
       "#include <stddef.h>\n"
       "#ifdef __cplusplus\n#define KDM_EMBED_ALIGNED alignas(16)\nextern \"C\" {\n"
-      "#else\n#define KDM_EMBED_ALIGNED _Alignas(16)\n#endif\n"
+      "#elif defined(__STDC_VERSION__) && __STDC_VERSION__ >= 201112L\n#define KDM_EMBED_ALIGNED _Alignas(16)\n"
+      "#else\n#define KDM_EMBED_ALIGNED\n#endif\n"
       "extern const unsigned char ${symbol}[];\nextern const size_t ${symbol}_size;\n"
       "#ifdef __cplusplus\n}\n#endif\n"
       "KDM_EMBED_ALIGNED const unsigned char ${symbol}[] = {\n")
@@ -33,7 +34,7 @@ function(kdm_write_embedded_source input output symbol)
     set(size_type "std::size_t")
   endif()
   file(WRITE ${output}.tmp
-    "// Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit.\n" "${head}" "${bytes}\n};\n"
+    "/* Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit. */\n" "${head}" "${bytes}\n};\n"
     "const ${size_type} ${symbol}_size = ${size};\n")
   if("ALWAYS" IN_LIST ARGN)
     file(RENAME ${output}.tmp ${output})

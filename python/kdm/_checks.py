@@ -51,14 +51,9 @@ def temperature(value: Any) -> float:
     return value
 
 
-def aspect(value: Any, dim: int) -> Optional[float]:
-    """A 2-D domain's width / height, or None."""
-    if value is None:
-        return None
-    value = number("aspect", value, 0.0, strict=True)
-    if dim != 2:
-        raise ValueError("aspect is a 2-D domain's width / height; a 3-D domain is the unit cube")
-    return value
+def aspect(value: Any) -> Optional[float]:
+    """A domain's width / height (in 3-D, its x side over its y and z sides), or None."""
+    return None if value is None else number("aspect", value, 0.0, strict=True)
 
 
 def threads(value: Any) -> int:
@@ -166,9 +161,10 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
         # Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled
         # into it rather than flushed to 0 or infinity.
         values = array2d(name, density)
-        top = float(np.max(values)) if values.size else 0.0
-        if math.isfinite(top) and top > 0 and not 1e-30 <= top <= 1e30:
-            density = values / top
+        if values.size and np.all(np.isfinite(values)) and float(np.min(values)) >= 0:  # else refused as it is
+            top = float(np.max(values))
+            if top > 0 and not 1e-30 <= top <= 1e30:
+                density = values / top
     spec = density_spec(density, gamma, invert, name)
     # Text gets the command line's refusal (from C++); numbers and arrays a message of their own.
     if spec is not None and spec.text in ("array", "number") and not spec.max_value > 0:

@@ -90,7 +90,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     aspect : float or None
         Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
         density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
-        aspect=1 spaces them evenly in the unit square whatever the density's shape. 2-D only.
+        aspect=1 spaces them evenly in the unit square whatever the density's shape.
     temperature, domain, density, threads
         As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise;
         an array density is copied, and ``density`` returns that read-only copy);
@@ -126,7 +126,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
         self.threads = _checks.threads(threads)
         self.density = density
-        self.aspect = _checks.aspect(aspect, d)
+        self.aspect = _checks.aspect(aspect)
 
     @property
     def density(self) -> Any:
@@ -149,8 +149,9 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         return state
 
     def __setstate__(self, state: dict) -> None:
+        density = state.pop("_density")
         self.__dict__.update(state)
-        self._spec = _checks.sampler_density(self._density, 1.0, False)
+        self.density = density  # read again, and kept read-only
 
     def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
         """A new blue-noise set of `n` points in [0, 1)^d, drawn with the engine's next seed.
@@ -188,7 +189,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         threads = _checks.threads(threads)
         temperature = _checks.temperature(self.temperature)
         domain = None if self.domain is None else _checks.choice("domain", self.domain, ("torus", "box"))
-        aspect = _checks.aspect(self.aspect, self.d)
+        aspect = _checks.aspect(self.aspect)
         state = copy.deepcopy(self.rng.bit_generator.state if hasattr(self.rng, "bit_generator")
                               else self.rng.get_state())
         seed = self._draw_seed()

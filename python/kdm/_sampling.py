@@ -47,8 +47,9 @@ def sample(
     threads : int
         Worker threads; 0: OMP_NUM_THREADS if set, else the CPUs this process may use.
     aspect : float or None
-        Width / height of a 2-D domain; None: the image's or array's, else 1. Points are normalised to
-        [0, 1) on every axis whatever the aspect. A 3-D domain is the unit cube.
+        Width / height of the domain (in 3-D, its x side over its y and z sides, as ``kdm sample
+        --aspect``); None: the image's or array's, else 1. Points are normalised to [0, 1) on every axis
+        whatever the aspect.
     gamma, invert
         How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
 
@@ -67,6 +68,6 @@ def sample(
     temperature = _checks.temperature(temperature)
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
     threads = _checks.threads(threads)
-    aspect = _checks.aspect(aspect, dim)
+    aspect = _checks.aspect(aspect)
     spec = _checks.sampler_density(density, gamma, invert)
     return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)

@@ -262,6 +262,7 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
           density_max, tile_size, mode, origin);
   const QueryParams& q = prepared.q;
+  tools::check_before_collecting(*handle.set, q, kKeywordNames);
   const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
   const Storage out(storage);
   Buffer buffer;  // an earlier result's memory while it has room, else new memory
@@ -378,12 +379,15 @@ std::size_t fill_compact(CompactBuffer& buffer, int threads, std::size_t wanted,
     }
   }
   ParallelQuery query;
-  query.init(static_cast<std::uint32_t>(threads));
+  if (query.init(static_cast<std::uint32_t>(threads)) != Status::kOk) throw std::bad_alloc();
   for (;;) {
     buffer.reserve(wanted);
     grow(buffer.capacity);
+    // Room for more than may be collected: a full buffer is refusal enough, and the run stops there.
+    const bool capped = wanted > tools::kMaxCollectedPoints;
     std::size_t needed = 0;
-    const Status s = parallel(query, &m, &needed, &problem);
+    const Status s = parallel(query, &m, capped ? nullptr : &needed, &problem);
+    if (capped && s == Status::kBufferFull) check_collected(wanted);
     check_collected(needed);
     if (s == Status::kOk) return m;
     if (s != Status::kBufferFull) refused(problem);
@@ -404,6 +408,7 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
           density_max, tile_size, mode, origin);
   const QueryParams& q = prepared.q;
+  tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   const std::size_t m = fill_compact(
@@ -540,6 +545,7 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
   prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin);
   const ClassQueryParams& q = prepared.q;
+  tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;

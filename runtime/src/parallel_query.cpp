@@ -283,6 +283,16 @@ struct Job {
   std::atomic<std::size_t> end{0};
   std::atomic<bool> refused{false};  // a unit was refused where the whole query was not (a bug): `why`
   QueryProblem why;
+  bool count_all = true;          // the caller asked how many points there are (`needed`)
+  std::atomic<bool> full{false};  // a unit's points passed `capacity`: without count_all the rest are skipped
+
+  /// Whether unit u, its place taken, is left undone: the buffer is full and nobody needs its count.
+  bool skipped(std::size_t u) {
+    if (count_all || !full.load(std::memory_order_relaxed)) return false;
+    place_of(u);  // in turn, so that `end` stays the last written unit's
+    counted.store(u + 1, std::memory_order_release);
+    return true;
+  }
 
   /// Unit u's first slot, once every unit before it has counted its points.
   std::size_t place_of(std::size_t u) {
@@ -310,6 +320,7 @@ struct Job {
     }
     const std::size_t base = place_of(u);
     end.store(base + count, std::memory_order_relaxed);
+    if (base + count > capacity) full.store(true, std::memory_order_relaxed);
     counted.store(u + 1, std::memory_order_release);
     const std::size_t room = base < capacity ? std::min(count, capacity - base) : 0;
     cursor = QueryCursor{};
@@ -326,6 +337,7 @@ struct Job {
     for (;;) {
       const std::size_t u = next.fetch_add(1, std::memory_order_relaxed);
       if (u >= units) return;
+      if (skipped(u)) continue;
       const Unit part = grid.unit(*params, u);
       if (direct) {
         count_and_write(o, u, part);
@@ -346,6 +358,7 @@ struct Job {
         if (base == kUnplaced) base = place_of(u);
         if (last) {
           end.store(base + count + w, std::memory_order_relaxed);
+          if (base + count + w > capacity) full.store(true, std::memory_order_relaxed);
           counted.store(u + 1, std::memory_order_release);
         }
         if (base + count < capacity) o.copy(base + count, std::min(w, capacity - base - count));
@@ -421,6 +434,7 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
   job.grid =
       plan_units(tileset, plan, constant && stable ? kDirectUnitPoints : double(kParallelUnitPoints) / 2);
   job.units = job.grid.units(), job.capacity = capacity;
+  job.count_all = needed != nullptr;
   Output outputs[kMaxParallelWorkers];
   for (std::uint32_t w = 0; w < workers_; ++w) {
     const std::size_t at = std::size_t(w) * kParallelUnitPoints;

@@ -76,8 +76,10 @@ QueryTables::QueryTables(const TilesetData& set) {
 }
 
 void QueryTables::index_cells(const TilesetData& set) {
-  if (most_points > 65536) return;
   constexpr std::uint32_t kCells = kIndexCells * kIndexCells, kShift = 16 - kIndexCellBits;
+  // Tiles of fewer points than cells are scanned whole at little cost, and their index would cost more
+  // than they hold (4 KB a tile: 270 MB for a 16-colour set of a few points a tile).
+  if (most_points > 65536 || most_points < kCells) return;
   cell_start.assign((kCells + 1) * set.tiles.size(), 0);
   cell_ranks.assign(set.tiles.size(), {});
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {

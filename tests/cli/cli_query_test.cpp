@@ -160,6 +160,18 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
   expect_error("query --rect 1,1,3,2 --class const:1 --class const:1 -o '" + path("c.txt") + "'",
                ".txt has no class column");
   EXPECT_FALSE(fs::exists(path("n.png")) || fs::exists(path("c.txt")));
+  // More points than a query collects, refused before querying: for an image (its values averaged over
+  // the region) as for a constant, and for classes; 4e10 and 1.2e11 points would take minutes to count.
+  const std::string sphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  expect_error("query --rect 0,0,2000,2000 --scale 20000 -o '" + path("big.csv") + "'",
+               "would emit about 8e+10 points, more than 2^25; lower the scale (--scale)");
+  expect_error(
+      "query --rect 0,0,2000,2000 --scale 20000 --density " + sphere + " -o '" + path("big.csv") + "'",
+      "would emit about");
+  expect_error("query --rect 0,0,2000,2000 --scale 20000 --class const:0.5 --class " + sphere + " -o '" +
+                   path("big.csv") + "'",
+               "would emit about");
+  EXPECT_FALSE(fs::exists(path("big.csv")));
   // No density, two ways: const:0 and an all-white image (no ink) both give an empty result.
   write_bytes(path("white.png"), grey_png(2, 2, 8, {255, 255, 255, 255}));
   for (const std::string& none : {std::string("const:0"), "'" + path("white.png") + "'"}) {

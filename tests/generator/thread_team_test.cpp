@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <new>
 #include <stdexcept>
 #include <vector>
@@ -59,38 +61,65 @@ TEST(ThreadTeamTest, TheCallersOwnExceptionWaitsForTheWorkers) {
   EXPECT_EQ(finished.load(), seen);
 }
 
-// Python's multiprocessing forks a process whose team has workers: the child's team starts its own (the
-// parent's threads are not there to wait for), runs, and ends without waiting for them either.
-TEST(ThreadTeamTest, AForkedChildRunsWithoutItsParentsWorkers) {
-  ThreadTeam team;
+/// The exit status of a child forked from here that runs `body` and leaves with its result, or -signal
+/// when it does not exit (a hang ends it with SIGALRM).
+template <class Body>
+int in_forked_child(Body&& body) {
+  std::fflush(nullptr);  // the parent's buffered output is not written twice
+  const pid_t child = fork();
+  if (child < 0) return -1000;
+  if (child == 0) {
+    alarm(30);
+    _exit(body());
+  }
+  int status = 0;
+  if (waitpid(child, &status, 0) != child) return -1001;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+/// How many threads `team` runs a body on with 3 asked for, and whether each ran once.
+int team_size(ThreadTeam& team, bool* each_once) {
   std::atomic<int> calls{0};
   int size = 0;
   team.run(3, [&](int, int threads) {
     size = threads;
     ++calls;
   });
+  *each_once = calls.load() == size;
+  return size;
+}
+
+// Python's multiprocessing forks a process whose team has workers: the child's team starts its own (the
+// parent's threads are not there to wait for), runs, and ends without waiting for them either.
+TEST(ThreadTeamTest, AForkedChildRunsWithoutItsParentsWorkers) {
+  ThreadTeam team;
+  bool once = false;
+  const int size = team_size(team, &once);
   ASSERT_GT(size, 1) << "no worker thread could be started";
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    alarm(30);  // a hang ends the child with SIGALRM, which the parent reports
-    std::atomic<int> child_calls{0};
-    int child_size = 0;
-    team.run(3, [&](int, int threads) {
-      child_size = threads;
-      ++child_calls;
-    });
+  auto run_then_end = [&] {
+    bool child_once = false;
+    const int child_size = team_size(team, &child_once);
     team.~ThreadTeam();  // joins the child's workers only
     new (&team) ThreadTeam;
-    _exit(child_size > 1 && child_calls.load() == child_size ? 0 : 1);
-  }
-  int status = 0;
-  ASSERT_EQ(waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFEXITED(status)) << "the child hung or crashed (signal " << WTERMSIG(status) << ")";
-  EXPECT_EQ(WEXITSTATUS(status), 0) << "the child's team did not run on workers of its own";
-  calls = 0;
-  team.run(3, [&](int, int) { ++calls; });  // the parent's team is untouched
-  EXPECT_EQ(calls.load(), size);
+    return child_size > 1 && child_once ? 0 : 1;
+  };
+  EXPECT_EQ(in_forked_child(run_then_end), 0) << "the child hung (-14), crashed, or ran on no workers (1)";
+  auto only_end = [&] {  // a child that never samples still ends
+    team.~ThreadTeam();
+    new (&team) ThreadTeam;
+    return 0;
+  };
+  EXPECT_EQ(in_forked_child(only_end), 0) << "ending the team waited for the parent's workers";
+  // The calling thread's own team (what the sampler uses), ended by exit() with the thread's objects.
+  EXPECT_GT(team_size(ThreadTeam::for_this_thread(), &once), 1);
+  auto own_team_then_exit = [] {
+    bool child_once = false;
+    if (team_size(ThreadTeam::for_this_thread(), &child_once) < 2 || !child_once) return 1;
+    std::exit(0);
+  };
+  EXPECT_EQ(in_forked_child(own_team_then_exit), 0);
+  EXPECT_EQ(team_size(team, &once), size);  // the parent's team is untouched
+  EXPECT_TRUE(once);
 }
 
 }  // namespace

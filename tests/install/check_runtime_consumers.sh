@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds and runs the runtime-only consumers against an installed kdm at PREFIX, in WORK: through
 # find_package(kdm COMPONENTS runtime) and through pkg-config, C and C++ (-fno-exceptions -fno-rtti), and
-# a project of C alone that embeds a set it bakes.
+# a project of C alone (which, where the command line is installed, embeds a set it bakes).
 # Usage: check_runtime_consumers.sh PREFIX WORK
 set -eu
 prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
@@ -14,7 +14,7 @@ cmake --build "$work/cmake" >/dev/null
 cmake -S "$here/runtime_c_consumer" -B "$work/cmake_c" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake_c" >/dev/null
 "$work/cmake_c/runtime_c_only"
-"$work/cmake_c/embedded_c_only"
+if [ -x "$prefix/bin/kdm" ]; then "$work/cmake_c/embedded_c_only"; fi  # a prefix with the command line
 pc_dir=$(dirname "$(find "$prefix" -name kdm-runtime.pc | head -n 1)")
 flags=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs kdm-runtime)
 # shellcheck disable=SC2086  # the flags are words

@@ -131,6 +131,9 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
     (ValueError, "density_max must be > 0, got 0", dict(density=lambda x, y: 1.0, density_max=0)),
     (ValueError, "density must be >= 0", dict(density=-0.5)),
     (ValueError, "finite and >= 0", dict(density=np.full((3, 3), NAN))),
+    # More than a query collects: refused before querying, an image's count from its values.
+    (ValueError, r"would emit about 2e\+10 points, more than 2\^25; lower the scale \(scale=\)",
+     dict(rect=(0, 0, 2000, 2000), scale=20000, density=np.full((4, 4), 0.25))),
     # A query's values are densities (the sampler's only a shape, scaled into float32's range).
     (ValueError, r"at most 3\.4e38 \(kept as floats\), got 1e\+308$", dict(density=np.full((2, 2), 1e308))),
     (TypeError, "density must be None, a number, .* 2-D array or a callable, got object", dict(density=object())),
@@ -275,3 +278,14 @@ def test_the_compiled_layer_checks_too():
     for call in calls:
         with pytest.raises((ValueError, TypeError)):
             call()
+
+
+def test_positions_past_what_is_collected_are_refused_before_querying():
+    # An image's or a constant's count is known from its values; a callable's is found by querying, and
+    # threads stop once the 2**25 + 1 slots are full rather than count the whole region (minutes here).
+    big = dict(scale=20000, density=np.full((4, 4), 0.25))
+    for threads in (None, 2):
+        with pytest.raises(ValueError, match=r"would emit about 2e\+10 points"):
+            TILES.positions((0, 0, 2000, 2000), threads=threads, **big)
+        with pytest.raises(ValueError, match="would emit about"):
+            TILES.positions((0, 0, 2000, 2000), threads=threads, scale=20000, classes=[0.25, np.ones((4, 4))])

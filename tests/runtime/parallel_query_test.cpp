@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -157,6 +158,37 @@ TEST(ParallelQueryTest, AShortBufferHoldsThePrefixAndTellsTheCount) {
             Status::kBufferFull);
   EXPECT_EQ(written, 0u);
   EXPECT_EQ(needed, all.size());
+}
+
+std::atomic<std::size_t> ramp_calls{0};
+double counted_ramp(void* user, double x, double y) {
+  ++ramp_calls;
+  return ramp(user, x, y);
+}
+
+// A caller that does not ask for the count (a collector refusing more than it holds) gets its prefix, and
+// the run stops soon after the buffer fills instead of querying the rest of the region.
+TEST(ParallelQueryTest, WithoutNeededARunStopsOnceItsBufferIsFull) {
+  for (const int kind : {0, 1}) {
+    QueryParams q = region(QueryMode::kStable, kind);
+    if (kind == 1) q.density.callback = counted_ramp;
+    ramp_calls = 0;
+    const std::vector<QueryPoint> all = run_parallel(q, 2, std_thread_runner());
+    const std::size_t calls_for_all = ramp_calls.load();
+    ParallelQuery pq;
+    ASSERT_EQ(pq.init(2), Status::kOk);
+    std::vector<QueryPoint> out(all.size() / 10);
+    std::size_t written = 0;
+    ramp_calls = 0;
+    EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), out.size(), &written, std_thread_runner()),
+              Status::kBufferFull);
+    EXPECT_EQ(written, out.size());
+    EXPECT_EQ(std::memcmp(out.data(), all.data(), out.size() * sizeof(QueryPoint)), 0) << kind;
+    // A tenth of the points, and the units the two workers had in hand: far from all of the calls.
+    if (kind == 1) {
+      EXPECT_LT(ramp_calls.load(), calls_for_all / 2) << calls_for_all;
+    }
+  }
 }
 
 TEST(ParallelQueryTest, ARegionEndingASliverPastATileSideIsServedWhole) {

@@ -136,18 +136,6 @@ void run_query_command(const QueryArgs& a, bool density_given) {
         "kdm query: warning: at most %.3g points per tile; below 1 a tile's expected count rounds to "
         "steps of 1/%zu of a point (use a larger --tile-size)\n",
         per_tile, tiles.data().tiles.size());
-  // Constants: a count past what a query collects is known before seconds of querying (a density past the
-  // tile set's is left to the query, whose refusal says what fits).
-  const double expected = densest * a.scale * (r[2] - r[0]) * (r[3] - r[1]);
-  if (!any_map && per_tile <= query_density_limit(tiles, q.mode) &&
-      expected > 1.01 * double(tools::kMaxCollectedPoints)) {
-    char message[200];
-    std::snprintf(message, sizeof message,
-                  "the query would emit about %.3g points, more than kdm query writes (2^25); lower --scale "
-                  "or split --rect",
-                  expected);
-    throw CommandError(message);
-  }
   const auto t0 = std::chrono::steady_clock::now();
   // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;

@@ -192,7 +192,9 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--domain", args->domain,
                   "torus (periodic) or box (bounded); default: box for images and ramp:R, torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
-  cmd->add_option("--aspect", args->aspect, "Width/height of the domain (default: the image's, or 1)");
+  cmd->add_option(
+      "--aspect", args->aspect,
+      "Width/height of the domain (in 3D its x side over its y and z sides; default: the image's, or 1)");
   cmd->add_option("--temperature,-T", o.temperature,
                   "Temperature in the reference implementation's units, 0 to 1000 (0.5 = the paper's look; "
                   "lower = more ordered; 0 = deterministic descent; about 300 = white noise)")

@@ -43,7 +43,7 @@ ProgressBar::ProgressBar(std::string label, std::FILE* out, double line_every_se
                          std::chrono::duration<double>(last_line_seconds_ + line_every_seconds_));
         if (finishing_.wait_until(lock, next, [this] { return finished_; })) break;
         const double now = elapsed();
-        if (now - last_line_seconds_ >= line_every_seconds_) log_line(now);
+        if (now - last_line_seconds_ >= line_every_seconds_ && fraction_ < 1) log_line(now);
       }
     });
   } catch (const std::system_error&) {
@@ -61,9 +61,10 @@ double ProgressBar::elapsed() const {
 
 void ProgressBar::log_line(double now) {
   last_line_seconds_ = now;
-  const double eta = now * (1 - fraction_) / fraction_;
+  const std::string left =
+      estimated(fraction_) ? ", about " + duration_text(now * (1 - fraction_) / fraction_) + " left" : "";
   std::fprintf(out_, "%s: %.0f%% after %s%s\n", label_.c_str(), fraction_ * 100, duration_text(now).c_str(),
-               estimated(fraction_) ? (", about " + duration_text(eta) + " left").c_str() : "");
+               left.c_str());
   std::fflush(out_);
 }
 

@@ -83,6 +83,47 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
 
 namespace {
 
+/// The density's integral over the region, per unit of scale; NaN for a callback.
+double density_integral(const QueryDensity& d, const QueryParams& q) {
+  const double w = q.x1 - q.x0, h = q.y1 - q.y0;
+  if (!(w > 0 && h > 0)) return 0;
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return d.constant * w * h;
+    case QueryDensity::Kind::kImage: {
+      if (!d.image) return std::nan("");
+      if (!(d.image->max_over(q.x0, q.y0, q.x1, q.y1) * w * h * q.scale > 0.5 * double(kMaxCollectedPoints)))
+        return 0;                 // surely collectable: no need to look closer
+      constexpr int kGrid = 128;  // midpoints: the image is bilinear, so finer grids change little
+      double sum = 0;
+      for (int j = 0; j < kGrid; ++j)
+        for (int i = 0; i < kGrid; ++i)
+          sum += d.image->at(q.x0 + (i + 0.5) * w / kGrid, q.y0 + (j + 0.5) * h / kGrid);
+      return sum / (kGrid * kGrid) * w * h;
+    }
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return std::nan("");
+}
+
+/// Whether `densest` (the most any point of the region may ask) passes what the tile set serves.
+bool past_the_set(const Tileset& tileset, const QueryParams& q, double densest) {
+  return densest * q.scale * q.tile_size * q.tile_size > query_density_limit(tileset, q.mode);
+}
+
+double upper_bound(const QueryDensity& d, const QueryParams& q) {
+  switch (d.kind) {
+    case QueryDensity::Kind::kConstant:
+      return d.constant;
+    case QueryDensity::Kind::kImage:
+      return d.image ? d.image->max_over(q.x0, q.y0, q.x1, q.y1) : 0;
+    case QueryDensity::Kind::kCallback:
+      break;
+  }
+  return d.callback_max;
+}
+
 /// Runs `step` (one call of a query writing points [from, from + room) into `out`, `per_point` elements
 /// each, and returning its status) until the region is complete; `out` ends holding exactly the points.
 /// The one rule of every collecting query: chunks of 2^16 points, at most kMaxCollectedPoints, refusals
@@ -124,8 +165,63 @@ void collect_classes(std::vector<T>& out, std::size_t per_point, std::vector<std
 
 }  // namespace
 
+double expected_points(const Tileset& tileset, const QueryParams& params) {
+  if (past_the_set(tileset, params, upper_bound(params.density, params))) return std::nan("");
+  return density_integral(params.density, params) * params.scale;
+}
+
+double expected_points(const Tileset& tileset, const ClassQueryParams& params) {
+  const std::uint32_t n = params.class_count;
+  if (n == 0 || n > kMaxQueryClasses || params.joint.densities || params.joint.batch_densities)
+    return std::nan("");
+  double densest = 0, integral = 0;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    densest += upper_bound(params.classes[k], params.query);
+    integral += density_integral(params.classes[k], params.query);
+  }
+  if (past_the_set(tileset, params.query, densest)) return std::nan("");
+  return integral * params.query.scale;
+}
+
+namespace {
+
+void check_collectable(double expected, const ParameterNames& names) {
+  // 5% of margin for an image's grid average and for the tiles' own counts around the density.
+  if (!(expected > 1.05 * double(kMaxCollectedPoints))) return;
+  char text[200];
+  std::snprintf(
+      text, sizeof text,
+      "the query would emit about %.3g points, more than 2^25; lower the scale (%s) or split the region",
+      expected, names.scale);
+  throw std::length_error(text);
+}
+
+}  // namespace
+
+void check_before_collecting(const Tileset& tileset, const QueryParams& params, const ParameterNames& names) {
+  // A call with no room checks the parameters and stops at the first point.
+  std::size_t written = 0;
+  QueryCursor cursor;
+  QueryProblem problem;
+  if (query_points(tileset, params, nullptr, 0, &written, &cursor, &problem) == Status::kInvalidArgument)
+    throw std::invalid_argument("query: " + describe(problem, names));
+  check_collectable(expected_points(tileset, params), names);
+}
+
+void check_before_collecting(const Tileset& tileset, const ClassQueryParams& params,
+                             const ParameterNames& names) {
+  std::size_t written = 0;
+  QueryCursor cursor;
+  QueryProblem problem;
+  if (query_classes(tileset, params, nullptr, nullptr, 0, &written, &cursor, &problem) ==
+      Status::kInvalidArgument)
+    throw std::invalid_argument("query: " + describe(problem, names));
+  check_collectable(expected_points(tileset, params), names);
+}
+
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names) {
+  check_before_collecting(tileset, params, names);
   collect(out, 1, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
               QueryProblem* problem) {
@@ -135,6 +231,7 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
 
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
                   const ParameterNames& names) {
+  check_before_collecting(tileset, params, names);
   collect(xy, 2, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
               QueryProblem* problem) {
@@ -145,6 +242,7 @@ void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector
 
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
                   std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+  check_before_collecting(tileset, params, names);
   collect_classes(xy, 2, classes, names,
                   [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
                       QueryCursor* cursor, QueryProblem* problem) {
@@ -156,6 +254,7 @@ void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::v
 
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+  check_before_collecting(tileset, params, names);
   collect_classes(out, 1, classes, names,
                   [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
                       QueryCursor* cursor, QueryProblem* problem) {

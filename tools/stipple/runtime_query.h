@@ -28,8 +28,24 @@ struct ParameterNames {
 /// A refused query's problem in one line: which parameter, which limit, what works.
 std::string describe(const QueryProblem& problem, const ParameterNames& names = {});
 
+/// About how many points a query of `params` emits: its density times scale over its region (an image's
+/// values averaged over a 128 × 128 grid of the region), summed over the classes; NaN where that is not
+/// known without querying (a callback, a joint class density) or where the query refuses its density
+/// (past query_density_limit: its refusal says what fits).
+double expected_points(const Tileset& tileset, const QueryParams& params);
+double expected_points(const Tileset& tileset, const ClassQueryParams& params);
+
+/// Refuses before any point is collected what collecting would refuse only later: parameters the query
+/// refuses (std::invalid_argument with describe()'s line), then a count (expected_points) clearly past
+/// kMaxCollectedPoints (std::length_error), so that such a query fails at once, not after seconds.
+void check_before_collecting(const Tileset& tileset, const QueryParams& params,
+                             const ParameterNames& names = {});
+void check_before_collecting(const Tileset& tileset, const ClassQueryParams& params,
+                             const ParameterNames& names = {});
+
 /// Runs a query to completion into `out` (replaced). Throws std::invalid_argument with describe()'s line
-/// on bad parameters, std::length_error when more than kMaxCollectedPoints points would be emitted.
+/// on bad parameters, std::length_error when more than kMaxCollectedPoints points would be emitted (before
+/// querying where check_before_collecting can tell).
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const ParameterNames& names = {});
 /// The same into the compact output (compact_query.h): positions only, `xy` (replaced) holding x, y

@@ -52,9 +52,10 @@ void parallel_for(std::ptrdiff_t count, int threads, Body&& body) {
     for (std::ptrdiff_t i; (i = next.fetch_add(1)) < count;) guarded(i, w);
   };
   try {
+    pool.reserve(static_cast<std::size_t>(workers - 1));
     for (int w = 1; w < workers; ++w) pool.emplace_back(work, w);
-  } catch (const std::system_error&) {
-    // no more threads to be had: the started ones and this one share the work
+  } catch (...) {
+    // no more threads (or memory for them) to be had: the started ones and this one share the work
   }
   work(0);
   for (std::thread& t : pool) t.join();

@@ -349,7 +349,7 @@ KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
 /* The region's points into out[0 ... capacity) (kdm_query_points' points, in the order above), *written
  * (if not NULL) the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first
  * `capacity`, *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out
- * only count); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
+ * only count; with `needed` NULL the run stops soon after the buffer is full); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
  * ("parallel") or runner or runner->run ("runner.run"). Allocates nothing. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel,
                                                      const kdm_task_runner* runner,

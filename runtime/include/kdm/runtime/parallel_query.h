@@ -69,7 +69,8 @@ class KDM_RUNTIME_API ParallelQuery {
   /// The region's points into out[0 .. capacity) in unit order, `*written` the count, with `workers()`
   /// tasks on `runner`. kOk when all fit; kBufferFull when there were more (out holds the first
   /// `capacity`, `*needed` the full count if not null: call again with room for it; capacity 0 with a
-  /// null out only counts). kInvalidArgument with
+  /// null out only counts; with `needed` null the run stops soon after the buffer is full, leaving the
+  /// rest of the region unvisited). kInvalidArgument with
   /// `problem` as query_points refuses the parameters, or for a ParallelQuery not initialised or a runner
   /// without a run function.
   Status run(const Tileset& tileset, const QueryParams& params, QueryPoint* out, std::size_t capacity,
