@@ -520,6 +520,23 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_memory(data, size, t); });
 }
 
+kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, char* detail,
+                                        size_t detail_size) {
+  if (detail && detail_size) detail[0] = '\0';
+  if (out) *out = nullptr;
+  if (!path) return KDM_INVALID_ARGUMENT;
+  std::string why;
+  const kdm_status s =
+      load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t, &why); });
+  if (s != KDM_OK && detail && detail_size) {
+    const std::string line = why.empty() ? kdm_status_message(s) : why;
+    const std::size_t n = std::min(line.size(), detail_size - 1);
+    std::memcpy(detail, line.data(), n);
+    detail[n] = '\0';
+  }
+  return s;
+}
+
 const kdm_tileset* kdm_tileset_builtin(void) {
   const kdm::Tileset& set = kdm::Tileset::builtin();
   if (set.empty()) return nullptr;  // out of memory: the next call tries again
@@ -591,6 +608,10 @@ kdm_status kdm_density_image_create(int width, int height, const float* values, 
 
 void kdm_density_image_free(kdm_density_image* image) {
   delete image;
+}
+
+double kdm_density_image_at(const kdm_density_image* image, double x, double y) {
+  return image ? image->view.at(x, y) : 0.0;
 }
 
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,

@@ -284,14 +284,15 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   for (kdm::Tile& t : set.tiles) t.handover.clear(), t.appearing.clear();
   ASSERT_EQ(kdm::save_tileset(set, path("bad.kdmt")), kdm::Status::kOk);
   const Outcome bad = kdm("verify '" + path("bad.kdmt") + "'" + quick);
-  EXPECT_EQ(bad.status, 1);
+  EXPECT_EQ(bad.status, 2);  // judged and failed; a file that cannot be read is 1
   EXPECT_EQ(bad.err.rfind("kdm: error: ", 0), 0u) << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
   EXPECT_NE(bad.err.find("failed"), std::string::npos) << bad.err;
   EXPECT_NE(bad.out.find("FAIL tile 3 level 2"), std::string::npos) << bad.out;
   // --quiet (build logs): the failed checks and the count, no tables.
   const Outcome quiet = kdm("verify --quiet '" + path("bad.kdmt") + "'" + quick);
-  EXPECT_EQ(quiet.status, 1);
+  EXPECT_EQ(quiet.status, 2);
+  EXPECT_EQ(kdm("verify '" + path("no-such.kdmt") + "'" + quick).status, 1);  // not judged: unreadable
   EXPECT_NE(quiet.out.find("FAIL tile 3 level 2"), std::string::npos) << quiet.out;
   EXPECT_NE(quiet.out.find(" checks failed\n"), std::string::npos) << quiet.out;
   EXPECT_EQ(quiet.out.find("level 2, 512 points per tile"), std::string::npos) << quiet.out;

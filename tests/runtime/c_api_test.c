@@ -179,6 +179,10 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_image_create(1 << 30, 1 << 30, values, 0, 0, 2, 2, &image) == KDM_OUT_OF_MEMORY &&
           image == NULL);
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 2, 2, &image) == KDM_OK && image != NULL);
+    /* Read as a query reads it: texel centres hold their values, half-way between them the mean. */
+    CHECK(kdm_density_image_at(image, 0.5, 0.5) == 0 && kdm_density_image_at(image, 1.5, 1.5) == 1);
+    CHECK(kdm_density_image_at(image, 1.0, 0.5) == 0.5 && kdm_density_image_at(image, -7, 1.5) == 0);
+    CHECK(kdm_density_image_at(NULL, 1, 1) == 0);
     q.density_image = image;
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, buffer, 4096, &written, &cursor, NULL) == KDM_OK);
@@ -596,6 +600,21 @@ int main(int argc, char** argv) {
     CHECK(kdm_tileset_load_file(".", &bad) == KDM_IO_ERROR && bad == NULL); /* a directory */
     bad = (kdm_tileset*)&q; /* set to NULL on every failure, a missing path too */
     CHECK(kdm_tileset_load_file(NULL, &bad) == KDM_INVALID_ARGUMENT && bad == NULL);
+  }
+  {
+    /* Why a load failed, for a log: the C++ loader's line, cut to the caller's buffer. */
+    kdm_tileset* bad = NULL;
+    char detail[64], tiny[8];
+    CHECK(kdm_tileset_load_file_detail("/nonexistent.kdmt", &bad, detail, sizeof detail) == KDM_IO_ERROR);
+    CHECK(bad == NULL && strstr(detail, "No such file") != NULL);
+    CHECK(kdm_tileset_load_file_detail(".", &bad, detail, sizeof detail) == KDM_IO_ERROR);
+    CHECK(strstr(detail, "directory") != NULL);
+    CHECK(kdm_tileset_load_file_detail("/nonexistent.kdmt", &bad, tiny, sizeof tiny) == KDM_IO_ERROR);
+    CHECK(strlen(tiny) == sizeof tiny - 1);
+    CHECK(kdm_tileset_load_file_detail("/nonexistent.kdmt", &bad, NULL, 0) == KDM_IO_ERROR);
+    CHECK(kdm_tileset_load_file_detail(argv[1], &bad, detail, sizeof detail) == KDM_OK && bad != NULL);
+    CHECK(detail[0] == '\0');
+    kdm_tileset_free(bad);
   }
   CHECK(strlen(kdm_status_message(KDM_TRUNCATED)) > 0);
   kdm_tileset_free(loaded);

@@ -50,7 +50,8 @@ void run_verify(VerifyArgs args) {
   std::fflush(stdout);
   if (!report.passed())
     throw CommandError("'" + args.path + "' failed " + std::to_string(report.failed_checks()) +
-                       " check(s) of the generator test");
+                           " check(s) of the generator test",
+                       2);  // a set that was read and judged, told apart from one that could not be
 }
 
 }  // namespace
@@ -60,7 +61,8 @@ void add_verify_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "verify",
       "Judge every tile and level of a tile set against the full KDM sampler (the generator test); "
-      "prints a table per level and exits 1 if any check fails");
+      "prints a table per level; exits 2 if any check fails, 1 if the file cannot be read or an option is "
+      "wrong");
   cmd->add_option("file", args->path, "Tile-set file")->required();
   cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (2 to 1000)")
       ->capture_default_str();

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const kdm::cli::CommandError& e) {
     std::fprintf(stderr, "kdm: error: %s\n", e.what());
-    return 1;
+    return e.exit_status;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr,
                  "kdm: error: out of memory (fewer --threads, fewer points or a smaller image may fit)\n");

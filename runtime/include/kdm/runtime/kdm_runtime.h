@@ -151,7 +151,9 @@ typedef struct kdm_tileset_info {
   uint32_t handover_slack; /* keyframes past their first above that level at which they are handed over */
 } kdm_tileset_info;
 
-/* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds): `allocate`
+/* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds), the built-in
+ * set too if its first kdm_tileset_builtin() call comes after (it is kept until the process ends: call that
+ * first where hooks are torn down before then): `allocate`
  * returns `bytes` bytes aligned to `alignment` (a power of two, at most alignof(max_align_t)) or NULL,
  * which the load returns as KDM_OUT_OF_MEMORY; `deallocate` frees them. Either NULL: operator new and
  * delete again. Memory always returns to the functions it came from. Call it while no other thread is
@@ -172,6 +174,11 @@ KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
  * (KDM_BAD_MAGIC ... KDM_INVALID_CONTENT) for a damaged or foreign one, KDM_OUT_OF_MEMORY. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
+/* kdm_tileset_load_file, and on failure why in `detail` (if not NULL): one line ("No such file or
+ * directory", "payload CRC-32 mismatch", ...), cut to `detail_size` bytes with its terminating NUL; "" on
+ * success. The status says what kind of failure; this, what a person reading a log needs. Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, char* detail,
+                                                        size_t detail_size);
 /* The default tile set compiled into the library: decoded on first use (about 0.1 s; call it
  * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). NULL when
  * memory runs out while it is decoded (a later call tries again). Never free it. */
@@ -200,9 +207,14 @@ KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const
                                                     double y0, double x1, double y1, kdm_density_image** out);
 /* Frees an image (NULL is ignored); no query may be using it. */
 KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
+/* The image's density at world (x, y) as a query reads it (bilinear between texel centres, clamped at the
+ * edges): what a caller weighing points by their thresholds needs. 0 for a NULL image. Added in 0.5. */
+KDM_RUNTIME_API double kdm_density_image_at(const kdm_density_image* image, double x, double y);
 
 /* Writes up to `capacity` points into `out` (NULL only with capacity 0), *written = count (`written` and
- * `cursor` are required). KDM_OK when the region is complete, KDM_BUFFER_FULL to be resumed with the same
+ * `cursor` are required). Capacity 0 checks the query: KDM_INVALID_ARGUMENT, or KDM_BUFFER_FULL at its first
+ * point (so a loop resuming while KDM_BUFFER_FULL needs room for a point). KDM_OK when the region is
+ * complete, KDM_BUFFER_FULL to be resumed with the same
  * cursor and query (also with room left, after 2^24 candidates in one call, a tile
  * visited counting as 16: kdm::kMaxQueryCandidates), KDM_INVALID_ARGUMENT for bad
  * parameters, with `problem` (optional: NULL, or with struct_size set) saying which and why. */
@@ -349,7 +361,8 @@ KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
 /* The region's points into out[0 ... capacity) (kdm_query_points' points, in the order above), *written
  * (if not NULL) the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first
  * `capacity`, *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out
- * only count; with `needed` NULL the run stops soon after the buffer is full); KDM_INVALID_ARGUMENT as kdm_query_points refuses the query, or for a NULL parallel query
+ * only count; with `needed` NULL the run stops soon after the buffer is full); KDM_INVALID_ARGUMENT as
+ * kdm_query_points refuses the query, or for a NULL parallel query
  * ("parallel") or runner or runner->run ("runner.run"). Allocates nothing. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel,
                                                      const kdm_task_runner* runner,
