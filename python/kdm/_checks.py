@@ -171,3 +171,26 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
         what = "an image or array that is zero everywhere" if spec.kind == "image" else "a density of 0"
         raise ValueError(f"{name}: {what} has nothing to sample (it needs some density > 0)")
     return spec
+
+
+def class_specs(classes: Any, gamma: Any, invert: Any) -> list:
+    """The full sampler's classes: 1 to 8 densities (numbers, str or 2-D arrays), as _kdm.DensitySpec."""
+    if isinstance(classes, np.ndarray) and classes.ndim == 1:  # constant densities, one per class
+        classes = [float(v) for v in classes]
+    if isinstance(classes, (str, bytes, numbers.Real)) or not isinstance(classes, Sequence):
+        raise TypeError(f"classes must be a sequence of densities, got {type(classes).__name__}")
+    if not 1 <= len(classes) <= 8:
+        raise ValueError(f"classes must hold 1 to 8 densities, got {len(classes)}")
+    specs = []
+    for k, d in enumerate(classes):
+        if d is None or callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
+            raise TypeError(f"classes[{k}] must be a number, a str or a 2-D array, got {type(d).__name__}")
+        text = isinstance(d, (str, os.PathLike))
+        specs.append(density_spec(d, gamma if text else 1.0, invert if text else False, f"classes[{k}]",
+                                  one_of_several=True))
+    reshaped = number("gamma", gamma, 0.0, strict=True) != 1.0 or flag("invert", invert)
+    if reshaped and not any(s.kind == "image" for d, s in zip(classes, specs) if isinstance(d, (str, os.PathLike))):
+        raise ValueError("gamma and invert apply to image files only, and no class is one")
+    if not any(s.max_value > 0 for s in specs):
+        raise ValueError("classes: every density is zero: nothing to sample")
+    return specs

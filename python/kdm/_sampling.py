@@ -1,7 +1,7 @@
 """kdm.sample: the full KDM sampler, as `kdm sample` runs it."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -20,7 +20,8 @@ def sample(
     aspect: Optional[float] = None,
     gamma: float = 1.0,
     invert: bool = False,
-) -> np.ndarray:
+    classes: Optional[Sequence[Any]] = None,
+) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """Draw exactly `n` blue-noise points from the KDM model (the full sampler, `kdm sample`).
 
     Parameters
@@ -52,6 +53,13 @@ def sample(
         whatever the aspect.
     gamma, invert
         How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
+    classes : sequence of densities, optional
+        Several kinds of points at once (instead of `density`; 2-D), as ``kdm sample --class``: 1 to 8
+        densities (numbers, str or 2-D arrays as `density` takes them; images of one shape), highest
+        priority first. `n` counts all of them, split by each density's integral (a number keeps its
+        value: ``classes=[1, 2]`` gives a third and two thirds). Class 0 is a KDM sample at its own
+        density, each later class is sampled around the earlier ones, then all are swept together at the
+        sum (docs/multiclass.md).
 
     Returns
     -------
@@ -59,7 +67,8 @@ def sample(
         (n, dim) float64 in [0, 1)^dim: the same bits as ``kdm sample`` with the same arguments. Rows come
         in the sampler's order, cell by cell of its grid, so neighbouring rows are neighbouring points: a
         prefix ``x[:k]`` is a patch of the domain, not a thinner set (for k points, sample k; for a random
-        subset, index by ``rng.permutation(n)[:k]``).
+        subset, index by ``rng.permutation(n)[:k]``). With `classes`: ``(points, labels)``, the points
+        (n, 2) class 0's first and labels (n,) uint8 each point's class.
     """
     n = _checks.integer("n", n, 1, 2**31)
     dim = _checks.integer("dim", dim, 2, 3)
@@ -69,5 +78,12 @@ def sample(
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
     threads = _checks.threads(threads)
     aspect = _checks.aspect(aspect)
+    if classes is not None:
+        if density is not None:
+            raise ValueError("give either density or classes, not both")
+        if dim != 2:
+            raise ValueError("classes are sampled in 2-D: use dim=2")
+        specs = _checks.class_specs(classes, gamma, invert)
+        return _kdm.sample_classes(n, specs, domain, temperature, seed, threads, aspect)
     spec = _checks.sampler_density(density, gamma, invert)
     return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)

@@ -120,3 +120,35 @@ def test_a_signal_stops_the_sampler_inside_its_call():
     # exception instead of returning its points first. 400,000 points take seconds; the alarm comes after
     # 0.2 s.
     assert interrupted("sample", lambda: kdm.sample(400_000, threads=1), 0.2) == ["c_exception"]
+
+
+def test_classes_are_kdm_sample_class(cli, tmp_path, gradient_png):
+    out = tmp_path / "classes.csv"
+    cli("sample", "--n", 3000, "--seed", 4, "--class", "const:1", "--class", "const:2", "--class",
+        gradient_png, "-o", out)
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    points, labels = kdm.sample(3000, seed=4, classes=[1, "const:2", str(gradient_png)])
+    assert points.shape == (3000, 2) and labels.dtype == np.uint8
+    assert np.array_equal(points, rows[:, :2]) and np.array_equal(labels, rows[:, 2])
+    # Constants keep their values: a third and two thirds, exactly the counts they ask for.
+    _, two = kdm.sample(900, classes=np.array([1.0, 2.0]), threads=1)
+    assert np.bincount(two).tolist() == [300, 600]
+    same = kdm.sample(900, classes=[1.0, 2.0], threads=2)[0]
+    assert np.array_equal(same, kdm.sample(900, classes=[1.0, 2.0], threads=1)[0])
+
+
+@pytest.mark.parametrize("kind,match,kwargs", [
+    (ValueError, "give either density or classes", dict(density=1.0, classes=[1.0])),
+    (ValueError, "classes are sampled in 2-D", dict(classes=[1.0], dim=3)),
+    (ValueError, "classes must hold 1 to 8 densities, got 9", dict(classes=[1.0] * 9)),
+    (ValueError, "classes must hold 1 to 8 densities, got 0", dict(classes=[])),
+    (TypeError, r"classes\[1\] must be a number, a str or a 2-D array, got function",
+     dict(classes=[1.0, lambda x, y: 1.0])),
+    (TypeError, "classes must be a sequence of densities", dict(classes="const:1")),
+    (ValueError, "every density is zero", dict(classes=[0.0, np.zeros((2, 2))])),
+    (ValueError, r"one shape.*classes\[0\] is 2x2, classes\[1\] 3x2",
+     dict(classes=[np.ones((2, 2)), np.ones((2, 3))])),
+])
+def test_classes_refusals(kind, match, kwargs):
+    with pytest.raises(kind, match=match):
+        kdm.sample(100, **kwargs)

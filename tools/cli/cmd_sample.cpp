@@ -34,20 +34,6 @@ struct SampleArgs {
   double dot_radius = 0;
 };
 
-/// A class's density for the full sampler: as --density gives it, but a constant keeps its value (a
-/// class's share of the points follows it), as a one-texel image.
-gen::Density class_density(const tools::DensitySpec& spec) {
-  if (spec.kind != tools::DensitySpec::Kind::kConstant) return to_generator_density(spec);
-  // A class with no points; also a constant too small for a float texel (it would have none anyway).
-  if (static_cast<float>(spec.constant) == 0) {
-    gen::Density none;
-    none.function = [](const double*) { return 0.0; };
-    none.thread_safe = true;
-    return none;
-  }
-  return gen::Density::from_values(1, 1, {static_cast<float>(spec.constant)});
-}
-
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   check_output_option(args.output, {".txt", ".csv", ".svg", ".png"});  // before minutes of sampling
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
@@ -94,7 +80,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
   std::vector<gen::Density> densities;
   for (const tools::DensitySpec& s : specs)
-    densities.push_back(classed ? class_density(s) : to_generator_density(s));
+    densities.push_back(classed ? to_class_density(s) : to_generator_density(s));
   o.extent[0] = aspect;
   o.extent[1] = 1;
   o.metropolis = !args.unadjusted;

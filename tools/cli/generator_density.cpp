@@ -16,4 +16,12 @@ gen::Density to_generator_density(const tools::DensitySpec& spec) {
   }
 }
 
+gen::Density to_class_density(const tools::DensitySpec& spec) {
+  try {
+    return tools::to_class_density(spec);
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(e.what());
+  }
+}
+
 }  // namespace kdm::cli

@@ -35,6 +35,18 @@ gen::Density to_generator_density(const DensitySpec& spec) {
   }
 }
 
+gen::Density to_class_density(const DensitySpec& spec) {
+  if (spec.kind != DensitySpec::Kind::kConstant) return to_generator_density(spec);
+  // A class with no points; also a constant too small for a float texel (it would have none anyway).
+  if (static_cast<float>(spec.constant) == 0) {
+    gen::Density none;
+    none.function = [](const double*) { return 0.0; };
+    none.thread_safe = true;
+    return none;
+  }
+  return gen::Density::from_values(1, 1, {static_cast<float>(spec.constant)});
+}
+
 std::function<double(double, double)> analysis_density(const gen::Density& density) {
   if (!density.function) return [](double, double) { return 1.0; };
   return [f = density.function](double x, double y) {
