@@ -153,6 +153,10 @@ def analyze(
     energy: bool = ...,
     gamma: float = ...,
     invert: bool = ...,
+    classes: Optional[Union[npt.ArrayLike, Sequence[npt.ArrayLike]]] = ...,
+    min_expected: float = ...,
+    density_bands: int = ...,
+    holes_min_density: float = ...,
 ) -> Dict[str, Any]: ...
 
 class BlueNoise:

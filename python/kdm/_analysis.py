@@ -34,6 +34,10 @@ def analyze(
     energy: bool = True,
     gamma: float = 1.0,
     invert: bool = False,
+    classes: Any = None,
+    min_expected: float = 20.0,
+    density_bands: int = 10,
+    holes_min_density: float = 0.0,
 ) -> Dict[str, Any]:
     """Measure point sets as ``kdm analyze`` does, returning what it writes to metrics.json.
 
@@ -61,6 +65,15 @@ def analyze(
         Worker threads (0: the default count); the results do not depend on it.
     energy : bool
         Compute E/n under the KDM model (``energy_per_point``).
+    classes : array or list of arrays, optional
+        Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them):
+        each point's class, an (n,) array per set. Each class is then also analysed alone, as
+        ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
+        (``cross_class_closest`` in d_hex of all points, and per class its "class" and "metrics").
+    min_expected, density_bands, holes_min_density
+        As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
+        windows expect at least that many points; its bias table has that many bands; empty circles
+        count only where the density is at least that fraction of its largest value.
 
     Returns
     -------
@@ -88,5 +101,22 @@ def analyze(
     if sets[0].shape[1] == 3 and (spec is not None or tile_size is not None):
         warnings.warn("density and tiling diagnostics are 2D only; skipped", stacklevel=2)
         spec, tile = None, 0.0
-    text = _kdm.analyze(sets, names, box, spec, tile, fmax, threads, energy)
-    return _arrays(json.loads(text))
+    min_expected = _checks.number("min_expected", min_expected, 0.0, strict=True)
+    density_bands = _checks.integer("density_bands", density_bands, 1, 1000)
+    holes_min_density = _checks.number("holes_min_density", holes_min_density, 0.0)
+    labels = []
+    if classes is not None:
+        given = list(classes) if several and isinstance(classes, (list, tuple)) else [classes]
+        if len(given) != len(sets):
+            raise ValueError(f"classes must hold one array of labels per set ({len(sets)}), got {len(given)}")
+        for k, c in enumerate(given):
+            a = np.asarray(c)
+            if a.ndim != 1 or a.dtype.kind not in "iu" or (a.size and (a.min() < 0 or a.max() > 255)):
+                raise ValueError(f"classes[{k}] must be an (n,) array of integer labels 0 to 255")
+            labels.append(np.ascontiguousarray(a, dtype=np.uint8))
+    text, classes_text = _kdm.analyze(sets, names, box, spec, tile, fmax, threads, energy, labels, min_expected,
+                                      density_bands, holes_min_density)
+    result = _arrays(json.loads(text))
+    if classes_text is not None:
+        result["classes"] = _arrays(json.loads(classes_text))
+    return result

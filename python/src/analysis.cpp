@@ -1,10 +1,12 @@
 // kdm._kdm.analyze: the point-set analysis as `kdm analyze` runs it (tools/cli/cmd_analyze.cpp), returned as
 // the text of the metrics.json it would write, which the Python side parses.
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "bindings.h"
+#include "kdm/analysis/classes.h"
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/report.h"
 #include "sampler_density.h"
@@ -24,10 +26,21 @@ tools::PointSet to_point_set(const Array& a) {
   return set;
 }
 
-std::string analyze(const std::vector<Array>& arrays, const std::vector<std::string>& names, bool box,
-                    const tools::DensitySpec* density, double tile_size, double fmax, int threads,
-                    bool energy) {
+using Labels = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+
+/// metrics.json's text, and with `labels` (one array per set, or none) classes.json's (else None).
+py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::string>& names, bool box,
+                  const tools::DensitySpec* density, double tile_size, double fmax, int threads, bool energy,
+                  const std::vector<Labels>& labels, double min_expected, int density_bands,
+                  double holes_min_density) {
   check_number("fmax", fmax, 0, true);
+  check_number("min_expected", min_expected, 0, true);
+  if (density_bands < 1 || density_bands > 1000)
+    throw std::invalid_argument("density_bands must be 1 to 1000, got " + std::to_string(density_bands));
+  if (!(holes_min_density >= 0 && holes_min_density <= 1))
+    throw std::invalid_argument("holes_min_density must be in [0, 1]");
+  if (!labels.empty() && labels.size() != arrays.size())
+    throw std::invalid_argument("classes must hold one array of labels per set");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   if (!std::isfinite(tile_size)) throw std::invalid_argument("tile_size must be a finite number");
   analysis::AnalysisOptions o;
@@ -35,6 +48,9 @@ std::string analyze(const std::vector<Array>& arrays, const std::vector<std::str
   o.fmax = fmax;
   o.tile_size = tile_size;
   o.threads = threads;
+  o.min_expected = min_expected;
+  o.density_bands = density_bands;
+  o.holes_min_density = holes_min_density;
   o.checkpoint = [] { stop_on_signal(0); };                 // Ctrl-C stops it between its measures
   if (tile_size != 0) analysis::tiles_per_axis(tile_size);  // 1 / tile_size an integer
   gen::Density target = gen::Density::constant();
@@ -43,26 +59,45 @@ std::string analyze(const std::vector<Array>& arrays, const std::vector<std::str
     o.density = tools::analysis_density(target);
   }
   std::vector<tools::PointSet> sets;
-  for (const Array& a : arrays) sets.push_back(to_point_set(a));
-  py::gil_scoped_release release;
-  analysis::AnalysisReport report = analysis::analyze(sets, o);
-  if (energy) {
-    try {
-      report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target, threads);
-    } catch (const gen::InvalidArgument& e) {
-      throw std::invalid_argument(std::string("energy: ") + e.what());
-    }
-    report.has_energy = true;
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    sets.push_back(to_point_set(arrays[i]));
+    if (labels.empty()) continue;
+    const Labels& l = labels[i];
+    if (l.ndim() != 1 || std::size_t(l.size()) != sets.back().size())
+      throw std::invalid_argument("classes[" + std::to_string(i) + "] must hold one label per point of " +
+                                  names[i] + " (" + std::to_string(sets.back().size()) + ")");
+    if (sets.back().dim != 2) throw std::invalid_argument("classes are 2-D point sets' labels");
+    sets.back().classes.assign(l.data(), l.data() + l.size());
   }
-  return analysis::metrics_json(report, names);
+  std::string metrics, classes;
+  {
+    py::gil_scoped_release release;
+    auto energy_of = [&](const std::vector<tools::PointSet>& of) {
+      try {
+        return tools::mean_energy_per_point(of, o.torus, target, threads);
+      } catch (const gen::InvalidArgument& e) {
+        throw std::invalid_argument(std::string("energy: ") + e.what());
+      }
+    };
+    analysis::AnalysisReport report = analysis::analyze(sets, o);
+    if (energy) report.energy_per_point = energy_of(sets), report.has_energy = true;
+    metrics = analysis::metrics_json(report, names);
+    if (!labels.empty()) {
+      std::function<double(const std::vector<tools::PointSet>&)> class_energy;
+      if (energy) class_energy = energy_of;
+      classes = analysis::classes_json(analysis::analyze_classes(sets, o, class_energy), names);
+    }
+  }
+  return py::make_tuple(metrics, labels.empty() ? py::object(py::none()) : py::object(py::str(classes)));
 }
 
 }  // namespace
 
 void bind_analysis(py::module_& m) {
   m.def("analyze", &analyze, py::arg("sets"), py::arg("names"), py::arg("box"), py::arg("density").none(true),
-        py::arg("tile_size"), py::arg("fmax"), py::arg("threads"), py::arg("energy"),
-        "kdm analyze's metrics.json for point sets in memory");
+        py::arg("tile_size"), py::arg("fmax"), py::arg("threads"), py::arg("energy"), py::arg("labels"),
+        py::arg("min_expected"), py::arg("density_bands"), py::arg("holes_min_density"),
+        "kdm analyze's metrics.json (and classes.json) for point sets in memory");
 }
 
 }  // namespace kdm::python

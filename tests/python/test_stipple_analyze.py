@@ -97,6 +97,37 @@ def test_analyze_gives_metrics_json(cli, tmp_path):
     assert got["inputs"] == ["points"] and got["domain"] == "torus" and got["energy_per_point"] > 0
 
 
+def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient_png):
+    # Labelled points: each class alone and the closest pair of different classes, classes.json's numbers;
+    # and the density test's options, metrics.json's.
+    points, labels = kdm.sample(3000, seed=5, classes=[1, 2, 4], threads=1)
+    path = tmp_path / "c.csv"
+    np.savetxt(path, np.column_stack([points, labels]), fmt=["%.17g", "%.17g", "%d"], delimiter=",",
+               header="x,y,class", comments="")
+    cli("analyze", path, "--no-energy", "--density", gradient_png, "--min-expected", 40, "--density-bands", 4,
+        "--holes-min-density", 0.2, "-o", tmp_path / "out")
+    expected = json.loads((tmp_path / "out" / "classes.json").read_text())
+    metrics = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    got = kdm.analyze(points, classes=labels, energy=False, density=str(gradient_png), min_expected=40,
+                      density_bands=4, holes_min_density=0.2)
+    assert [c["class"] for c in got["classes"]["classes"]] == [0, 1, 2]
+    assert got["classes"]["cross_class_closest"] == expected["cross_class_closest"]
+    for mine, theirs in zip(got["classes"]["classes"], expected["classes"]):
+        for key in ("nearest_neighbour", "spectrum", "empty_circles"):
+            assert json.dumps(_lists(mine["metrics"][key]), sort_keys=True) == json.dumps(
+                theirs["metrics"][key], sort_keys=True), key
+    for key in ("density", "empty_circles"):
+        assert json.dumps(_lists(got[key]), sort_keys=True) == json.dumps(metrics[key], sort_keys=True), key
+    with pytest.raises(ValueError, match="one array of labels per set"):
+        kdm.analyze([points, points], classes=[labels])
+    with pytest.raises(ValueError, match="must hold one label per point"):
+        kdm.analyze(points, classes=labels[:-1])
+    with pytest.raises(ValueError, match="integer labels 0 to 255"):
+        kdm.analyze(points, classes=labels + 0.5)
+    with pytest.raises(ValueError, match="density_bands must be <= 1000"):
+        kdm.analyze(points, density_bands=1001)
+
+
 def _lists(value):
     """The dict back with its arrays as lists, NaN as null, as metrics.json holds them."""
     if isinstance(value, dict):

@@ -55,46 +55,23 @@ void save_png(const std::string& path, const tools::RgbImage& image) {
 /// a directory `dir`, in dir/classes.json with the closest pair of points of different classes).
 void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
                      const gen::Density& target, const AnalyzeArgs& args, const std::filesystem::path& dir) {
-  double closest = HUGE_VAL;
-  std::vector<std::uint8_t> present;
-  for (const tools::PointSet& set : sets) {
-    if (set.classes.size() != set.size())
-      throw CommandError("every set of a labelled file needs its classes");
-    closest = std::min(closest, analysis::cross_class_closest(set, o.torus));
-    for (std::uint8_t k : analysis::classes_present(set))
-      if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
+  std::function<double(const std::vector<tools::PointSet>&)> energy;
+  if (!args.no_energy)
+    energy = [&](const std::vector<tools::PointSet>& subsets) {
+      return tools::mean_energy_per_point(subsets, o.torus, target);
+    };
+  const analysis::ClassesReport report = analysis::analyze_classes(sets, o, energy);
+  std::printf("\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n",
+              report.classes.size() + report.too_small.size(), report.cross_class_closest);
+  for (std::uint8_t k : report.too_small)
+    std::printf("\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(k));
+  for (std::size_t c = 0; c < report.classes.size(); ++c) {
+    std::printf("\nclass %u alone:\n", unsigned(report.classes[c]));
+    std::fputs(analysis::format_summary(report.reports[c]).c_str(), stdout);
   }
-  std::sort(present.begin(), present.end());
-  std::printf("\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n", present.size(),
-              closest);
-  analysis::JsonWriter number;
-  number.value(closest);  // null when no two classes meet
-  std::string json = "{\"cross_class_closest\": " + number.str() + ", \"classes\": [";
-  bool first = true;
-  for (std::size_t c = 0; c < present.size(); ++c) {
-    std::vector<tools::PointSet> subsets;
-    for (const tools::PointSet& set : sets) {
-      subsets.push_back(analysis::class_subset(set, present[c]));
-      if (subsets.back().size() < 2) subsets.pop_back();
-    }
-    if (subsets.empty()) {
-      std::printf("\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(present[c]));
-      continue;
-    }
-    analysis::AnalysisReport report = analysis::analyze(subsets, o);
-    if (!args.no_energy) {
-      report.energy_per_point = tools::mean_energy_per_point(subsets, o.torus, target);
-      report.has_energy = true;
-    }
-    std::printf("\nclass %u alone:\n", unsigned(present[c]));
-    std::fputs(analysis::format_summary(report).c_str(), stdout);
-    json += std::string(first ? "" : ", ") + "{\"class\": " + std::to_string(present[c]) +
-            ", \"metrics\": " + analysis::metrics_json(report, args.files) + "}";
-    first = false;
-  }
-  json += "]}\n";
   std::string error;
-  if (!dir.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(), json, error))
+  if (!dir.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(),
+                                                     analysis::classes_json(report, args.files), error))
     throw CommandError(error);
 }
 

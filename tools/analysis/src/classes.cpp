@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "kdm/analysis/common.h"
+#include "kdm/analysis/json.h"
 
 namespace kdm::analysis {
 
@@ -69,6 +70,48 @@ double cross_class_closest(const tools::PointSet& set, bool torus) {
         }
   }
   return best / spacing;
+}
+
+ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
+                              const std::function<double(const std::vector<tools::PointSet>&)>& energy) {
+  ClassesReport out;
+  double closest = HUGE_VAL;
+  std::vector<std::uint8_t> present;
+  for (const tools::PointSet& set : sets) {
+    if (set.classes.size() != set.size())
+      throw InvalidInput("every set of labelled points needs its classes");
+    closest = std::min(closest, cross_class_closest(set, options.torus));
+    for (std::uint8_t k : classes_present(set))
+      if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
+  }
+  std::sort(present.begin(), present.end());
+  out.cross_class_closest = closest;
+  for (std::uint8_t k : present) {
+    std::vector<tools::PointSet> subsets;
+    for (const tools::PointSet& set : sets) {
+      subsets.push_back(class_subset(set, k));
+      if (subsets.back().size() < 2) subsets.pop_back();
+    }
+    if (subsets.empty()) {
+      out.too_small.push_back(k);
+      continue;
+    }
+    AnalysisReport report = analyze(subsets, options);
+    if (energy) report.energy_per_point = energy(subsets), report.has_energy = true;
+    out.classes.push_back(k);
+    out.reports.push_back(std::move(report));
+  }
+  return out;
+}
+
+std::string classes_json(const ClassesReport& report, const std::vector<std::string>& inputs) {
+  JsonWriter number;
+  number.value(report.cross_class_closest);  // null when no two classes meet
+  std::string json = "{\"cross_class_closest\": " + number.str() + ", \"classes\": [";
+  for (std::size_t c = 0; c < report.classes.size(); ++c)
+    json += std::string(c ? ", " : "") + "{\"class\": " + std::to_string(report.classes[c]) +
+            ", \"metrics\": " + metrics_json(report.reports[c], inputs) + "}";
+  return json + "]}\n";
 }
 
 }  // namespace kdm::analysis

@@ -3,8 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
+#include "kdm/analysis/report.h"
 #include "point_io.h"
 
 namespace kdm::analysis {
@@ -19,5 +22,22 @@ tools::PointSet class_subset(const tools::PointSet& set, std::uint8_t k);
 /// set (hex_spacing(n)); NaN with fewer than two classes. 2D points in [0, 1]²; `torus`: periodic
 /// distances. Throws InvalidInput for an unlabelled or 3D set.
 double cross_class_closest(const tools::PointSet& set, bool torus);
+
+/// Labelled sets analysed class by class: each class alone as the whole sets are (analyze), and the
+/// closest pair of points of different classes over the sets.
+struct ClassesReport {
+  double cross_class_closest = 0;       ///< d_hex of all points; NaN when no two classes meet
+  std::vector<std::uint8_t> classes;    ///< analysed, ascending
+  std::vector<AnalysisReport> reports;  ///< one per analysed class
+  std::vector<std::uint8_t> too_small;  ///< present, but with fewer than 2 points in every set
+};
+
+/// Each class of `sets` (every set labelled; else InvalidInput) alone, under `options`; `energy`, if set,
+/// gives each class's E/n from its subsets.
+ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
+                              const std::function<double(const std::vector<tools::PointSet>&)>& energy = {});
+
+/// classes.json's text: {"cross_class_closest": …, "classes": [{"class": k, "metrics": {metrics.json}}]}.
+std::string classes_json(const ClassesReport& report, const std::vector<std::string>& inputs);
 
 }  // namespace kdm::analysis
