@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <csignal>
 
 #include <cstdint>
 #include <cstdio>
@@ -376,3 +377,40 @@ TEST(ImageLimits, AJpegIsTurnedAsItsExifOrientationSays) {
 }
 
 }  // namespace
+
+// A command interrupted while it writes an output leaves no OUT.tmp~ behind: the signal removes the file
+// being written, then ends the process as it would have. In a child, since the signal ends it.
+TEST(AtomicWrite, ASignalRemovesTheFileBeingWrittenAndStillEndsTheProcess) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "kdm_atomic_write_test";
+  std::filesystem::create_directories(dir);
+  const std::string temp = (dir / "out.csv.tmp~").string();
+  std::ofstream(temp) << "half a file";
+  std::fflush(nullptr);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    kdm::tools::remove_temporary_files_on_signals();
+    kdm::tools::detail::mark_temporary_file(temp.c_str());
+    std::raise(SIGINT);
+    _exit(0);  // not reached: the signal ends the child
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+  EXPECT_FALSE(std::filesystem::exists(temp));
+  // A whole write unmarks its file: a later signal removes nothing it should not.
+  const std::string kept = (dir / "kept.csv").string();
+  const pid_t second = fork();
+  ASSERT_GE(second, 0);
+  if (second == 0) {
+    kdm::tools::remove_temporary_files_on_signals();
+    std::string e;
+    if (!kdm::tools::write_text_file_atomic(kept, "x,y\n", e)) _exit(1);
+    std::raise(SIGTERM);
+    _exit(0);
+  }
+  ASSERT_EQ(waitpid(second, &status, 0), second);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_TRUE(std::filesystem::exists(kept));
+  std::filesystem::remove_all(dir);
+}

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.h"
+#include "image_io.h"
 #include "kdm/runtime/version.h"
 
 namespace {
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("kdm ") + kdm::version_string() + " (tile-set format " +
                                         std::to_string(kdm::kTilesetFormatVersion) + ")");
   app.require_subcommand(1);
+  kdm::tools::remove_temporary_files_on_signals();  // an interrupted write leaves no OUT.tmp~ behind
   kdm::cli::add_sample_command(app);
   kdm::cli::add_stipple_command(app);
   kdm::cli::add_query_command(app);

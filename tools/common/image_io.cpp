@@ -1,8 +1,10 @@
 #include "image_io.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -13,6 +15,7 @@
 #include <utility>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_FAILURE_USERMSG
@@ -30,6 +33,27 @@ namespace {
 
 std::string temp_path_for(const std::string& path) {
   return path + ".tmp~";
+}
+
+// The temporary file being written, for a signal handler to remove: marked only where the handlers are
+// installed (one writing thread), so that a library's threads never share it.
+std::atomic<bool> signals_handled{false};
+char marked_path[4096];
+volatile std::sig_atomic_t marked = 0;
+
+extern "C" void remove_marked_and_reraise(int signal) {
+  if (marked) unlink(marked_path);  // async-signal-safe
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);
+}
+
+/// Marks `path` (or nothing, for null) as the temporary file being written.
+void mark(const std::string* path) {
+  if (!signals_handled.load(std::memory_order_relaxed)) return;
+  marked = 0;
+  if (!path || path->size() >= sizeof marked_path) return;
+  std::memcpy(marked_path, path->c_str(), path->size() + 1);
+  marked = 1;
 }
 
 bool commit_temp(const std::string& tmp, const std::string& path, std::string& error) {
@@ -602,8 +626,10 @@ bool write_text_file_atomic(const std::string& given_path, const std::string& te
     if (!ec) path = target.string();
   }
   const std::string tmp = special ? path : temp_path_for(path);
+  if (!special) mark(&tmp);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) {
+    mark(nullptr);
     error = "cannot write '" + path + "': " + std::strerror(errno);
     return false;
   }
@@ -613,9 +639,22 @@ bool write_text_file_atomic(const std::string& given_path, const std::string& te
   if (std::fclose(f) != 0 || !written) {
     error = "cannot write '" + path + "': " + std::strerror(written ? errno : write_errno);
     if (!special) std::remove(tmp.c_str());
+    mark(nullptr);
     return false;
   }
-  return special || commit_temp(tmp, path, error);
+  const bool done = special || commit_temp(tmp, path, error);
+  mark(nullptr);
+  return done;
+}
+
+void remove_temporary_files_on_signals() {
+  signals_handled.store(true);
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, remove_marked_and_reraise);
+}
+
+void detail::mark_temporary_file(const char* path) {
+  const std::string text = path ? path : "";
+  mark(path ? &text : nullptr);
 }
 
 }  // namespace kdm::tools
