@@ -502,6 +502,12 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
                "--fade grows dots in pictures");
   std::ofstream(path("empty.recipe")) << "# a comment only\n\n  # indented\n";  // not minutes of defaults
   expect_error("bake '" + path("empty.recipe") + "' -o '" + path("e.kdmt") + "'", "gives no key");
+  // --gamma named as the option, in every command that takes it (grey and in colour).
+  const std::string sphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  expect_error("sample --n 10 --density " + sphere + " --gamma 0 -o '" + path("g.txt") + "'",
+               "--gamma must be a finite number > 0, got 0");
+  expect_error("stipple " + sphere + " --colours cmyk --gamma -1 -o '" + path("g.png") + "'",
+               "--gamma must be a finite number > 0, got -1");
   // The arguments swapped (a baked set where its recipe belongs), and standard output for a binary file.
   expect_error("bake " + shipped + " -o '" + path("s.kdmt") + "'", "is a tile-set file, not a recipe");
   std::ofstream(path("one.recipe")) << "levels 1\n";

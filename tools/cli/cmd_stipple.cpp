@@ -92,6 +92,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     tools::ColourImage image;
     std::string error;
     if (!tools::load_colour_image(a.image, image, error)) throw CommandError(error);
+    check_gamma(a.gamma);
     try {
       inks = tools::separate_colours(image, a.colours, a.gamma);
     } catch (const std::invalid_argument& e) {

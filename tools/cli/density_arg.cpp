@@ -1,12 +1,23 @@
 #include "density_arg.h"
 
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include "commands.h"
 
 namespace kdm::cli {
 
+void check_gamma(double gamma) {
+  if (std::isfinite(gamma) && gamma > 0) return;
+  char text[80];
+  std::snprintf(text, sizeof text, "--gamma must be a finite number > 0, got %g", gamma);
+  throw CommandError(text);
+}
+
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert) {
+  check_gamma(gamma);
   try {
     return tools::parse_density_spec(text, gamma, invert);
   } catch (const std::exception& e) {  // a bad value, or an image that cannot be read
