@@ -137,6 +137,8 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   // with no points); the visit below adds a margin of a few tiles for glides and rounding.
   const double region_tiles =
       (std::ceil(q.x1 / S) - std::floor(q.x0 / S)) * (std::ceil(q.y1 / S) - std::floor(q.y0 / S));
+  if (!std::isfinite(region_tiles))  // tiles too small to count in a double: the tile size is wrong
+    return refuse(Kind::kTooManyTiles, "tile_size", region_tiles, double(kMaxQueryTiles));
   if (!(region_tiles <= double(kMaxQueryTiles)))
     return refuse(Kind::kTooManyTiles, "x0", region_tiles, double(kMaxQueryTiles));
   // Smooth mode visits the tiles whose points can glide into the region too: as far as any glides at the

@@ -598,6 +598,12 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   p = problem_of(q);
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
   EXPECT_EQ(p.value, 1e8);
+  EXPECT_STREQ(p.parameter, "x0");
+  q.tile_size = 1e-300;  // too many tiles to count: the tile size is named, not the region
+  p = problem_of(q);
+  EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
+  EXPECT_STREQ(p.parameter, "tile_size");
+  EXPECT_EQ(p.value, HUGE_VAL);
   p = problem_of(region(0, 0, 1e10, 10, 1e-3, QueryMode::kSmooth));
   EXPECT_EQ(p.kind, QueryProblem::Kind::kTooManyTiles);
   EXPECT_EQ(p.value, 1e11);

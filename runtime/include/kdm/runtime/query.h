@@ -166,6 +166,7 @@ struct QueryProblem {
     kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared,
                         ///< or both callbacks are set; "density.kind" is not a QueryDensity::Kind
     kTooManyTiles,      ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
+                        ///< (`parameter` "x0"; "tile_size" when they are too many to count: value inf)
     kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
                         ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
                         ///< largest tile size that fits this scale
