@@ -1,6 +1,6 @@
 # Type hints of the kdm package (the implementation is kdm/*.py over the compiled kdm._kdm).
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -14,7 +14,6 @@ _Rect = Sequence[float]
 _Bounds = Callable[[float, float, float, float], Tuple[float, float]]
 _Function = Callable[[float, float], float]
 
-@overload
 def sample(
     n: int,
     density: _Density = ...,
@@ -27,23 +26,8 @@ def sample(
     aspect: Optional[float] = ...,
     gamma: float = ...,
     invert: bool = ...,
-    classes: None = ...,
-) -> npt.NDArray[np.float64]: ...
-@overload
-def sample(
-    n: int,
-    density: None = ...,
-    *,
-    dim: int = ...,
-    domain: Optional[str] = ...,
-    temperature: float = ...,
-    seed: int = ...,
-    threads: int = ...,
-    aspect: Optional[float] = ...,
-    gamma: float = ...,
-    invert: bool = ...,
-    classes: Sequence[_Density],
-) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+    classes: Optional[Sequence[_Density]] = ...,
+) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]]: ...
 
 class QueryResult:
     points: npt.NDArray[np.void]
