@@ -388,7 +388,7 @@ std::size_t fill_compact(CompactBuffer& buffer, int threads, std::size_t wanted,
     std::size_t needed = 0;
     const Status s = parallel(query, &m, capped ? nullptr : &needed, &problem);
     if (capped && s == Status::kBufferFull) check_collected(wanted);
-    check_collected(needed);
+    check_collected(std::max(m, needed));
     if (s == Status::kOk) return m;
     if (s != Status::kBufferFull) refused(problem);
     wanted = needed;

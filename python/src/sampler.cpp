@@ -77,7 +77,11 @@ py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& 
     const bool image = spec->kind == DensitySpec::Kind::kImage;
     edged = edged || image || spec->kind == DensitySpec::Kind::kRamp;
     if (image && !first_image) first_image = spec;
-    densities.push_back(tools::to_class_density(*spec));
+    try {
+      densities.push_back(tools::to_class_density(*spec));
+    } catch (const std::invalid_argument& e) {  // named as the caller gave it
+      throw std::invalid_argument("classes[" + std::to_string(densities.size()) + "]: " + e.what());
+    }
   }
   const std::string where = domain ? *domain : (edged ? "box" : "torus");
   if (where != "box" && where != "torus")

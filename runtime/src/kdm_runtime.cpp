@@ -524,14 +524,14 @@ kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, cha
                                         size_t detail_size) {
   if (detail && detail_size) detail[0] = '\0';
   if (out) *out = nullptr;
-  if (!path) return KDM_INVALID_ARGUMENT;
   std::string why;
   const kdm_status s =
-      load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t, &why); });
-  if (s != KDM_OK && detail && detail_size) {
-    const std::string line = why.empty() ? kdm_status_message(s) : why;
-    const std::size_t n = std::min(line.size(), detail_size - 1);
-    std::memcpy(detail, line.data(), n);
+      !path ? KDM_INVALID_ARGUMENT
+            : load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t, &why); });
+  if (s != KDM_OK && detail && detail_size) {  // no copy of the line: nothing here may throw
+    const char* line = !path ? "path is NULL" : why.empty() ? kdm_status_message(s) : why.c_str();
+    const std::size_t n = std::min(std::strlen(line), detail_size - 1);
+    std::memcpy(detail, line, n);
     detail[n] = '\0';
   }
   return s;

@@ -63,8 +63,8 @@ struct QueryTables {
   /// Per tile, the ranks of its points in each of its kIndexCells² cells (point p lies in cell
   /// (p.y >> (16 − kIndexCellBits)) · kIndexCells + (p.x >> (16 − kIndexCellBits))), ascending, the cells in
   /// turn; cell_start holds kIndexCells² + 1 offsets per tile. A query whose region meets a few cells of a
-  /// tile visits only their points. Empty when a tile holds more than 65,536 points, or none more than
-  /// kIndexCells² (a whole tile is then a short scan).
+  /// tile visits only their points. Empty when a tile holds more than 65,536 points, or every tile fewer
+  /// than kIndexCells² (a whole tile is then a short scan).
   TilesetArray<TilesetArray<std::uint16_t>> cell_ranks;
   TilesetArray<std::uint32_t> cell_start;
   /// The hand-over between depths (sets with a handover_zone; else empty). Subtiles per side m, the

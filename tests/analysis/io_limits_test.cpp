@@ -412,5 +412,16 @@ TEST(AtomicWrite, ASignalRemovesTheFileBeingWrittenAndStillEndsTheProcess) {
   ASSERT_EQ(waitpid(second, &status, 0), second);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
   EXPECT_TRUE(std::filesystem::exists(kept));
+  // A signal the process was started ignoring (nohup) stays ignored.
+  const pid_t third = fork();
+  ASSERT_GE(third, 0);
+  if (third == 0) {
+    std::signal(SIGHUP, SIG_IGN);
+    kdm::tools::remove_temporary_files_on_signals();
+    std::raise(SIGHUP);
+    _exit(7);
+  }
+  ASSERT_EQ(waitpid(third, &status, 0), third);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 7) << status;
   std::filesystem::remove_all(dir);
 }

@@ -612,6 +612,8 @@ int main(int argc, char** argv) {
     CHECK(kdm_tileset_load_file_detail("/nonexistent.kdmt", &bad, tiny, sizeof tiny) == KDM_IO_ERROR);
     CHECK(strlen(tiny) == sizeof tiny - 1);
     CHECK(kdm_tileset_load_file_detail("/nonexistent.kdmt", &bad, NULL, 0) == KDM_IO_ERROR);
+    CHECK(kdm_tileset_load_file_detail(NULL, &bad, detail, sizeof detail) == KDM_INVALID_ARGUMENT);
+    CHECK(strstr(detail, "path") != NULL);
     CHECK(kdm_tileset_load_file_detail(argv[1], &bad, detail, sizeof detail) == KDM_OK && bad != NULL);
     CHECK(detail[0] == '\0');
     kdm_tileset_free(bad);

@@ -13,12 +13,12 @@ namespace kdm::cli {
 /// Parses --density (see tools::parse_density_spec). Throws CommandError naming the problem.
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert);
 
-/// The --class densities share one domain, each image stretched over all of it: images of different shapes
-/// would each be stretched differently (tools::images_of_different_shapes; resolutions may differ). Throws
-/// CommandError naming two that differ.
 /// --gamma as every command takes it: a finite number > 0, else a CommandError naming the option.
 void check_gamma(double gamma);
 
+/// The --class densities share one domain, each image stretched over all of it: images of different shapes
+/// would each be stretched differently (tools::images_of_different_shapes; resolutions may differ). Throws
+/// CommandError naming two that differ.
 void check_class_images(const std::vector<const tools::DensitySpec*>& classes);
 
 /// --gamma and --invert reshape image files' tones only: given (gamma ≠ 1 or invert) with no image among

@@ -39,21 +39,24 @@ std::string temp_path_for(const std::string& path) {
 // installed (one writing thread), so that a library's threads never share it.
 std::atomic<bool> signals_handled{false};
 char marked_path[4096];
-volatile std::sig_atomic_t marked = 0;
+std::atomic<bool> marked{false};  // lock-free: a handler on any thread reads it; the path is whole once set
+static_assert(std::atomic<bool>::is_always_lock_free, "a signal handler may only read lock-free atomics");
 
 extern "C" void remove_marked_and_reraise(int signal) {
-  if (marked) unlink(marked_path);  // async-signal-safe
-  std::signal(signal, SIG_DFL);
-  std::raise(signal);
+  if (marked.load(std::memory_order_acquire)) unlink(marked_path);  // async-signal-safe
+  struct sigaction fallback = {};
+  fallback.sa_handler = SIG_DFL;
+  sigaction(signal, &fallback, nullptr);
+  raise(signal);
 }
 
 /// Marks `path` (or nothing, for null) as the temporary file being written.
 void mark(const std::string* path) {
   if (!signals_handled.load(std::memory_order_relaxed)) return;
-  marked = 0;
+  marked.store(false, std::memory_order_release);
   if (!path || path->size() >= sizeof marked_path) return;
   std::memcpy(marked_path, path->c_str(), path->size() + 1);
-  marked = 1;
+  marked.store(true, std::memory_order_release);
 }
 
 bool commit_temp(const std::string& tmp, const std::string& path, std::string& error) {
@@ -649,7 +652,15 @@ bool write_text_file_atomic(const std::string& given_path, const std::string& te
 
 void remove_temporary_files_on_signals() {
   signals_handled.store(true);
-  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, remove_marked_and_reraise);
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction current = {};
+    // A signal the process was started ignoring (nohup, a script's background job) stays ignored.
+    if (sigaction(signal, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+    struct sigaction handler = {};
+    handler.sa_handler = remove_marked_and_reraise;
+    sigemptyset(&handler.sa_mask);
+    sigaction(signal, &handler, nullptr);
+  }
 }
 
 void detail::mark_temporary_file(const char* path) {

@@ -73,7 +73,8 @@ bool write_text_file_atomic(const std::string& path, const std::string& text, st
 
 /// For a program that writes its files in turn from one thread (the command line): from now on SIGINT,
 /// SIGTERM and SIGHUP remove the temporary file write_text_file_atomic is writing, if any, before they end
-/// the process as they would have. A library's host (Python) keeps its own handlers: it does not call this.
+/// the process as they would have; a signal the process ignores stays ignored. A library's host (Python)
+/// keeps its own handlers: it does not call this.
 void remove_temporary_files_on_signals();
 
 namespace detail {

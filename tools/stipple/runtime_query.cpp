@@ -83,8 +83,8 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
 
 namespace {
 
-/// The density's integral over the region, per unit of scale; NaN for a callback.
-double density_integral(const QueryDensity& d, const QueryParams& q) {
+/// A lower bound of the density's integral over the region (exact for a constant); NaN for a callback.
+double density_integral_at_least(const QueryDensity& d, const QueryParams& q) {
   const double w = q.x1 - q.x0, h = q.y1 - q.y0;
   if (!(w > 0 && h > 0)) return 0;
   switch (d.kind) {
@@ -93,13 +93,16 @@ double density_integral(const QueryDensity& d, const QueryParams& q) {
     case QueryDensity::Kind::kImage: {
       if (!d.image) return std::nan("");
       if (!(d.image->max_over(q.x0, q.y0, q.x1, q.y1) * w * h * q.scale > 0.5 * double(kMaxCollectedPoints)))
-        return 0;                 // surely collectable: no need to look closer
-      constexpr int kGrid = 128;  // midpoints: the image is bilinear, so finer grids change little
+        return 0;  // surely collectable: no need to look closer
+      // Each block's lower bound (the min-mip) over its area: never more than the integral, whatever detail
+      // the image has between a grid's samples.
+      constexpr int kBlocks = 64;
       double sum = 0;
-      for (int j = 0; j < kGrid; ++j)
-        for (int i = 0; i < kGrid; ++i)
-          sum += d.image->at(q.x0 + (i + 0.5) * w / kGrid, q.y0 + (j + 0.5) * h / kGrid);
-      return sum / (kGrid * kGrid) * w * h;
+      for (int j = 0; j < kBlocks; ++j)
+        for (int i = 0; i < kBlocks; ++i)
+          sum += d.image->min_over(q.x0 + i * w / kBlocks, q.y0 + j * h / kBlocks,
+                                   q.x0 + (i + 1) * w / kBlocks, q.y0 + (j + 1) * h / kBlocks);
+      return sum / (kBlocks * kBlocks) * w * h;
     }
     case QueryDensity::Kind::kCallback:
       break;
@@ -165,19 +168,19 @@ void collect_classes(std::vector<T>& out, std::size_t per_point, std::vector<std
 
 }  // namespace
 
-double expected_points(const Tileset& tileset, const QueryParams& params) {
+double points_at_least(const Tileset& tileset, const QueryParams& params) {
   if (past_the_set(tileset, params, upper_bound(params.density, params))) return std::nan("");
-  return density_integral(params.density, params) * params.scale;
+  return density_integral_at_least(params.density, params) * params.scale;
 }
 
-double expected_points(const Tileset& tileset, const ClassQueryParams& params) {
+double points_at_least(const Tileset& tileset, const ClassQueryParams& params) {
   const std::uint32_t n = params.class_count;
   if (n == 0 || n > kMaxQueryClasses || params.joint.densities || params.joint.batch_densities)
     return std::nan("");
   double densest = 0, integral = 0;
   for (std::uint32_t k = 0; k < n; ++k) {
     densest += upper_bound(params.classes[k], params.query);
-    integral += density_integral(params.classes[k], params.query);
+    integral += density_integral_at_least(params.classes[k], params.query);
   }
   if (past_the_set(tileset, params.query, densest)) return std::nan("");
   return integral * params.query.scale;
@@ -185,14 +188,15 @@ double expected_points(const Tileset& tileset, const ClassQueryParams& params) {
 
 namespace {
 
-void check_collectable(double expected, const ParameterNames& names) {
-  // 5% of margin for an image's grid average and for the tiles' own counts around the density.
-  if (!(expected > 1.05 * double(kMaxCollectedPoints))) return;
+void check_collectable(double least, const ParameterNames& names) {
+  // 5% of margin for the tiles' own counts around the density.
+  if (!(least > 1.05 * double(kMaxCollectedPoints))) return;
   char text[200];
   std::snprintf(
       text, sizeof text,
-      "the query would emit about %.3g points, more than 2^25; lower the scale (%s) or split the region",
-      expected, names.scale);
+      "the query would emit at least %.3g points, more than 2^25; lower the scale (%s) or split the "
+      "region",
+      least, names.scale);
   throw std::length_error(text);
 }
 
@@ -205,7 +209,7 @@ void check_before_collecting(const Tileset& tileset, const QueryParams& params, 
   QueryProblem problem;
   if (query_points(tileset, params, nullptr, 0, &written, &cursor, &problem) == Status::kInvalidArgument)
     throw std::invalid_argument("query: " + describe(problem, names));
-  check_collectable(expected_points(tileset, params), names);
+  check_collectable(points_at_least(tileset, params), names);
 }
 
 void check_before_collecting(const Tileset& tileset, const ClassQueryParams& params,
@@ -216,7 +220,7 @@ void check_before_collecting(const Tileset& tileset, const ClassQueryParams& par
   if (query_classes(tileset, params, nullptr, nullptr, 0, &written, &cursor, &problem) ==
       Status::kInvalidArgument)
     throw std::invalid_argument("query: " + describe(problem, names));
-  check_collectable(expected_points(tileset, params), names);
+  check_collectable(points_at_least(tileset, params), names);
 }
 
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,

@@ -28,15 +28,16 @@ struct ParameterNames {
 /// A refused query's problem in one line: which parameter, which limit, what works.
 std::string describe(const QueryProblem& problem, const ParameterNames& names = {});
 
-/// About how many points a query of `params` emits: its density times scale over its region (an image's
-/// values averaged over a 128 × 128 grid of the region), summed over the classes; NaN where that is not
-/// known without querying (a callback, a joint class density) or where the query refuses its density
-/// (past query_density_limit: its refusal says what fits).
-double expected_points(const Tileset& tileset, const QueryParams& params);
-double expected_points(const Tileset& tileset, const ClassQueryParams& params);
+/// A lower bound of how many points a query of `params` emits: its density times scale over its region
+/// (exact for a constant; an image's min-mip over 64 × 64 blocks of the region, 0 where its maximum could
+/// not reach half of kMaxCollectedPoints), summed over the classes; NaN where nothing is known without
+/// querying (a callback, a joint class density) or where the query refuses its density (past
+/// query_density_limit: its refusal says what fits).
+double points_at_least(const Tileset& tileset, const QueryParams& params);
+double points_at_least(const Tileset& tileset, const ClassQueryParams& params);
 
 /// Refuses before any point is collected what collecting would refuse only later: parameters the query
-/// refuses (std::invalid_argument with describe()'s line), then a count (expected_points) clearly past
+/// refuses (std::invalid_argument with describe()'s line), then a count (points_at_least) clearly past
 /// kMaxCollectedPoints (std::length_error), so that such a query fails at once, not after seconds.
 void check_before_collecting(const Tileset& tileset, const QueryParams& params,
                              const ParameterNames& names = {});

@@ -85,7 +85,7 @@ ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const An
       if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
   }
   std::sort(present.begin(), present.end());
-  out.cross_class_closest = closest;
+  out.cross_class_closest = closest < HUGE_VAL ? closest : std::nan("");  // no set has two classes
   for (std::uint8_t k : present) {
     std::vector<tools::PointSet> subsets;
     for (const tools::PointSet& set : sets) {
