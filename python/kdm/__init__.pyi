@@ -16,7 +16,7 @@ _Function = Callable[[float, float], float]
 
 def sample(
     n: int,
-    density: _Density = ...,
+    density: Union[_Density, Callable[..., float]] = ...,
     *,
     dim: int = ...,
     domain: Optional[str] = ...,

@@ -135,6 +135,9 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
 
     @density.setter
     def density(self, value: Any) -> None:
+        if callable(value) and not isinstance(value, (np.ndarray, str)):  # called at each draw
+            self._density = self._spec = value
+            return
         spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
         if self.d != 2 and spec is not None and spec.kind == "image":
             raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
@@ -194,6 +197,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
                               else self.rng.get_state())
         seed = self._draw_seed()
         try:
+            if callable(self._spec):
+                return _kdm.sample_function(n, self._spec, self.d, domain, temperature, seed, threads, aspect)
             return _kdm.sample(n, self._spec, self.d, domain, temperature, seed, threads, aspect)
         except BaseException:  # a refused or interrupted draw uses no seed: the next is the one it was
             if hasattr(self.rng, "bit_generator"):

@@ -30,9 +30,12 @@ def sample(
         The number of points, 1 to 2**31. The sampler's grid (at most 2**27 nodes) holds about 8 million
         points in 2-D and 3 million in 3-D (fewer with a wide density range or a long domain); more raise
         ValueError saying so.
-    density : None, float, str or 2-D array
+    density : None, float, str, 2-D array or callable
         The target density (only its shape matters: the sampler scales it to `n` points). None or a
-        number > 0: uniform. A str: what ``kdm sample --density`` accepts, "const:V", the test maps
+        number > 0: uniform. A callable ``f(x, y)`` (``f(x, y, z)`` with dim=3) of coordinates in
+        [0, 1) returning a number >= 0: called once per node of the sampler's grid (about 16 per point
+        in 2-D, 40 in 3-D, one Python call each), in a box unless `domain` says otherwise. A str: what
+        ``kdm sample --density`` accepts, "const:V", the test maps
         "ramp:R" and "radial:R", or an image file whose darkness (to the power `gamma`; its luminance with
         `invert`) is the density. A 2-D array: density values (finite, >= 0, not all zero), stretched over
         the domain, with row 0 at the TOP, as pictures are stored (and as an image file is read).
@@ -85,5 +88,9 @@ def sample(
             raise ValueError("classes are sampled in 2-D: use dim=2")
         specs = _checks.class_specs(classes, gamma, invert)
         return _kdm.sample_classes(n, specs, domain, temperature, seed, threads, aspect)
+    if callable(density) and not isinstance(density, (np.ndarray, str)):
+        if gamma != 1.0 or invert:
+            raise ValueError("gamma and invert apply to image files only, and density is a function")
+        return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect)
     spec = _checks.sampler_density(density, gamma, invert)
     return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)

@@ -1,6 +1,8 @@
 // kdm._kdm.sample: the full KDM sampler (gen::sample) with `kdm sample`'s defaults and density conversion,
 // so the same arguments give the same bits as the command line, returned as a numpy array it owns.
 #include <algorithm>
+#include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,6 +51,64 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
     py::gil_scoped_release release;
     result = gen::sample(o, target);
   }
+  const auto count = static_cast<py::ssize_t>(result.size());
+  return owning_array(std::move(result.points), {count, result.dim});
+}
+
+/// gen::sample of a Python function of the point's coordinates: called once per node of the sampler's
+/// grid, on one thread, with the GIL taken for each call. The first exception it raises, or value that is
+/// not finite and >= 0, ends the call with that error once the sampler returns.
+py::array_t<double> sample_function(std::int64_t n, const py::object& function, int dim,
+                                    const std::optional<std::string>& domain, double temperature,
+                                    std::uint64_t seed, int threads, std::optional<double> aspect) {
+  if (n < 1) throw std::invalid_argument("n must be >= 1, got " + std::to_string(n));
+  if (dim != 2 && dim != 3) throw std::invalid_argument("dim must be 2 or 3, got " + std::to_string(dim));
+  check_number("temperature", temperature, 0, false);
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
+  if (aspect) check_number("aspect", *aspect, 0, true);
+  // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
+  const std::string where = domain ? *domain : "box";
+  if (where != "box" && where != "torus")
+    throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
+  std::unique_ptr<py::error_already_set> raised;  // the function's own exception, kept for the caller
+  std::string refused;                            // or why its value was refused
+  gen::Density density;
+  density.thread_safe = false;  // one thread calls it: the GIL would serialise the calls anyway
+  density.function = [&](const double* u) -> double {
+    py::gil_scoped_acquire gil;
+    if (raised || !refused.empty()) return 1;  // the call ends as soon as the sampler returns
+    try {
+      const py::object value = dim == 2 ? function(u[0], u[1]) : function(u[0], u[1], u[2]);
+      const double v = value.cast<double>();
+      if (std::isfinite(v) && v >= 0) return v;
+      refused = "density returned " + std::to_string(v) + " at (" + std::to_string(u[0]) + ", " +
+                std::to_string(u[1]) + "): values must be finite and >= 0";
+    } catch (py::error_already_set& e) {
+      raised = std::make_unique<py::error_already_set>(std::move(e));
+    } catch (const py::cast_error&) {
+      refused = "density must return a number";
+    }
+    return 1;
+  };
+  gen::SamplerOptions o;
+  o.n = n;
+  o.dim = dim;
+  o.domain = where == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
+  o.extent[0] = aspect ? *aspect : 1.0;
+  o.extent[1] = 1;
+  o.temperature = temperature;
+  o.seed = seed;
+  o.threads = threads;
+  o.progress = stop_on_signal;
+  gen::SampleResult result;
+  try {
+    py::gil_scoped_release release;
+    result = gen::sample(o, density);
+  } catch (...) {
+    if (!raised && refused.empty()) throw;  // the sampler's own refusal (a density zero everywhere)
+  }
+  if (raised) throw py::error_already_set(*raised);
+  if (!refused.empty()) throw std::invalid_argument(refused);
   const auto count = static_cast<py::ssize_t>(result.size());
   return owning_array(std::move(result.points), {count, result.dim});
 }
@@ -112,6 +172,9 @@ void bind_sampler(py::module_& m) {
   m.def("sample", &sample, py::arg("n"), py::arg("density").none(true), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), "gen::sample as kdm sample runs it");
+  m.def("sample_function", &sample_function, py::arg("n"), py::arg("function"), py::arg("dim"),
+        py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
+        py::arg("aspect").none(true), "gen::sample of a Python function of the coordinates");
   m.def("sample_classes", &sample_classes, py::arg("n"), py::arg("specs"), py::arg("domain").none(true),
         py::arg("temperature"), py::arg("seed"), py::arg("threads"), py::arg("aspect").none(true),
         "gen::sample_classes as kdm sample --class runs it");
