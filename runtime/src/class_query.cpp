@@ -299,7 +299,7 @@ Status detail::query_classes_run(const Tileset& tileset, const ClassQueryParams&
   QueryParams q;
   if (prepare_union(tileset, p, written, densities, q, refuse) != Status::kOk)
     return Status::kInvalidArgument;
-  if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
+  if (detail::compact_refusal(tileset, out.keys != nullptr, refuse) != Status::kOk)
     return Status::kInvalidArgument;
   if (capacity > 0 && !out.xy) return refuse(QueryProblem::Kind::kMissingArgument, "out.xy");
   if (capacity > 0 && !classes) return refuse(QueryProblem::Kind::kMissingArgument, "classes");

@@ -203,7 +203,12 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   // densest points apart.
   const double out_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x)),
                out_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
-  const double out_farthest = std::ldexp(deepest_spacing, Sink::kOriginSpanBits);
+  // A float output also loses a tile's points where its step reaches a tile, whatever the density, and
+  // ends at 3.4e38: one limit, the smaller, so that a caller moving the origin within it is served.
+  const double out_farthest =
+      Sink::kOriginSpanBits < 48
+          ? std::min({std::ldexp(deepest_spacing, Sink::kOriginSpanBits), 1e38, std::ldexp(S, 23)})
+          : std::ldexp(deepest_spacing, Sink::kOriginSpanBits);
   if (std::max(out_x, out_y) > out_farthest)
     return refuse(Kind::kTooFarFromOrigin, out_x >= out_y ? "origin_x" : "origin_y", std::max(out_x, out_y),
                   out_farthest);
@@ -432,19 +437,7 @@ Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::s
                     count, cursor, refuse, examined, run);
 }
 
-Status detail::compact_refusal(const Tileset& tileset, const QueryParams& q, bool keys, Refusal& refuse) {
-  const double far_x = std::max(std::fabs(q.x0 - q.origin_x), std::fabs(q.x1 - q.origin_x));
-  const double far_y = std::max(std::fabs(q.y0 - q.origin_y), std::fabs(q.y1 - q.origin_y));
-  // Where a float's step (2^-23 of the distance) reaches a tile, a tile's points fall together, whatever
-  // the density (query_into holds the step to the densest spacing once it knows it); and a float ends
-  // at 3.4e38.
-  const bool finite = std::isfinite(q.x0) && std::isfinite(q.y0) && std::isfinite(q.x1) &&
-                      std::isfinite(q.y1) && std::isfinite(q.origin_x) && std::isfinite(q.origin_y);
-  if (finite && q.tile_size > 0) {  // else query_into names the number that is not finite
-    const double farthest = std::min(1e38, std::ldexp(q.tile_size, 23));
-    if (far_x > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_x", far_x, farthest);
-    if (far_y > farthest) return refuse(QueryProblem::Kind::kTooFarFromOrigin, "origin_y", far_y, farthest);
-  }
+Status detail::compact_refusal(const Tileset& tileset, bool keys, Refusal& refuse) {
   if (keys && !tileset.empty()) {
     const std::uint64_t most = detail::TilesetInternals::tables(tileset).most_points;
     if (most > (std::uint64_t(1) << kKeyRankBits))
@@ -485,7 +478,7 @@ Status detail::query_classes_counted(const Tileset& tileset, const QueryParams& 
                                      QueryProblem* problem, std::uint64_t& examined, const TileRun& run) {
   detail::Refusal refuse(problem);
   if (written) *written = 0;
-  if (compact_refusal(tileset, q, compact.keys != nullptr, refuse) != Status::kOk)
+  if (compact_refusal(tileset, compact.keys != nullptr, refuse) != Status::kOk)
     return Status::kInvalidArgument;
   const bool room = compact.xy && classes.classes;
   if (compact.keys)
@@ -521,7 +514,7 @@ Status detail::query_compact_run(const Tileset& tileset, const QueryParams& q, c
   detail::Refusal refuse(problem);
   std::uint64_t examined = detail::first_examined(q, false, 0);
   if (written) *written = 0;
-  if (detail::compact_refusal(tileset, q, out.keys != nullptr, refuse) != Status::kOk)
+  if (detail::compact_refusal(tileset, out.keys != nullptr, refuse) != Status::kOk)
     return Status::kInvalidArgument;
   if (!out.keys)
     return query_into(tileset, q, CompactSink<false>{out.xy, nullptr}, out.xy != nullptr, "out.xy", capacity,

@@ -63,10 +63,10 @@ Status query_compact_run(const Tileset& tileset, const QueryParams& params, cons
                          std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                          QueryProblem* problem, const TileRun& run);
 
-/// The compact output's own refusals, before query_points': a region more than 1e38 from the origin
-/// (beyond a float), and `keys` asked of a set whose tiles hold more points than a key's ranks. kOk when
-/// none applies, else kInvalidArgument with `refuse`'s problem filled.
-Status compact_refusal(const Tileset& tileset, const QueryParams& params, bool keys, Refusal& refuse);
+/// The compact output's own refusal, before query_points': `keys` asked of a set whose tiles hold more
+/// points than a key's ranks (how far a float reaches from the origin is query_into's limit). kOk when
+/// it does not apply, else kInvalidArgument with `refuse`'s problem filled.
+Status compact_refusal(const Tileset& tileset, bool keys, Refusal& refuse);
 
 /// Classes of constant densities (class_query.h), classed as they are written (emit_tile.h's ClassSink:
 /// `counts` the classes' cumulative expected counts per depth-0 tile, `last` the last class, class_of_id

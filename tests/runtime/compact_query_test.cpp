@@ -259,16 +259,25 @@ TEST(CompactQueryTest, RefusesMissingOutputByName) {
   EXPECT_EQ(why.kind, QueryProblem::Kind::kNotFinite);
   EXPECT_STREQ(why.parameter, "origin_y");
   // Within a float's range but where its step reaches a tile: every tile's points would fall together.
+  // The limit stated is the nearer of that and the density's (2^21 spacings, below), so that a caller
+  // moving the origin within it is served, not refused again with another limit.
+  const double spacing = q.tile_size / std::sqrt(q.scale * q.density.constant * q.tile_size * q.tile_size);
   far.origin_y = 0, far.origin_x = q.x0 + std::ldexp(q.tile_size, 23) * 1.01;
   fresh = QueryCursor{};
   EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
             Status::kInvalidArgument);
   EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(why.parameter, "origin_x");
+  EXPECT_DOUBLE_EQ(why.limit, std::min(std::ldexp(q.tile_size, 23), std::ldexp(spacing, 21)));
+  QueryParams sparse = far;  // a twentieth of a point per tile: spacings of 4.5 tiles, the tile's bound first
+  sparse.scale = 0.05 / (q.density.constant * q.tile_size * q.tile_size);
+  fresh = QueryCursor{};
+  EXPECT_EQ(query_points_compact(Tileset::builtin(), sparse, {xy, nullptr}, 4, &written, &fresh, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_EQ(why.limit, std::ldexp(q.tile_size, 23));
   // Nearer, but where the step passes a quarter of the spacing at the query's density (2^21 spacings
   // out): points would still fall together, and only the density says so.
-  const double spacing = q.tile_size / std::sqrt(q.scale * q.density.constant * q.tile_size * q.tile_size);
   far.origin_x = q.x1 + std::ldexp(spacing, 21) * 1.01;
   fresh = QueryCursor{};
   EXPECT_EQ(query_points_compact(Tileset::builtin(), far, {xy, nullptr}, 4, &written, &fresh, &why),
