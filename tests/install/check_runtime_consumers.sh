@@ -24,4 +24,12 @@ c++ -std=c++17 -fno-exceptions -fno-rtti -o "$work/pc_cpp" "$here/runtime_consum
 libdir=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --variable=libdir kdm-runtime)
 LD_LIBRARY_PATH="$libdir" "$work/pc_c" "$tiles"
 LD_LIBRARY_PATH="$libdir" "$work/pc_cpp"
+# A component kdm does not have is named in the refusal.
+mkdir -p "$work/bogus"
+printf 'cmake_minimum_required(VERSION 3.20)\nproject(bogus LANGUAGES C)\nfind_package(kdm REQUIRED COMPONENTS bogus)\n' \
+  >"$work/bogus/CMakeLists.txt"
+if cmake -S "$work/bogus" -B "$work/bogus/build" -DCMAKE_PREFIX_PATH="$prefix" >"$work/bogus.log" 2>&1; then
+  echo "an unknown component was found"; exit 1
+fi
+grep -q "no component 'bogus'" "$work/bogus.log" || { echo "the unknown component was not named:"; cat "$work/bogus.log"; exit 1; }
 echo "runtime consumers ok"
