@@ -18,33 +18,39 @@ namespace {
 
 using tools::DensitySpec;
 
-py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
-                           const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
-                           int threads, std::optional<double> aspect) {
-  if (n < 1) throw std::invalid_argument("n must be >= 1, got " + std::to_string(n));
-  if (dim != 2 && dim != 3) throw std::invalid_argument("dim must be 2 or 3, got " + std::to_string(dim));
-  check_number("temperature", temperature, 0, false);
-  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
-  if (aspect) check_number("aspect", *aspect, 0, true);
-  DensitySpec uniform;  // kdm sample's default, const:1
-  const DensitySpec& spec = density ? *density : uniform;
-  const bool image = spec.kind == DensitySpec::Kind::kImage;
-  // As kdm sample: a ramp or a picture has edges that do not meet, so a box unless asked otherwise.
-  const bool edged = image || spec.kind == DensitySpec::Kind::kRamp;
+/// The options every sampling call shares, checked: `edged` densities (a picture, a ramp, a function) get
+/// a box unless `domain` says otherwise, as in kdm sample; `image_aspect` is the domain's width / height
+/// unless `aspect` is given.
+gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional<std::string>& domain,
+                                    bool edged, double temperature, std::uint64_t seed, int threads,
+                                    std::optional<double> aspect, double image_aspect) {
   const std::string where = domain ? *domain : (edged ? "box" : "torus");
   if (where != "box" && where != "torus")
     throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
-  if (image && dim != 2) throw std::invalid_argument("image densities are 2D; use dim=2");
   gen::SamplerOptions o;
   o.n = n;
   o.dim = dim;
   o.domain = where == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
-  o.extent[0] = aspect ? *aspect : (image ? double(spec.width) / spec.height : 1.0);
+  o.extent[0] = aspect ? *aspect : image_aspect;
   o.extent[1] = 1;
   o.temperature = temperature;
   o.seed = seed;
   o.threads = threads;
   o.progress = stop_on_signal;  // Ctrl-C stops the sampler at its next sweep
+  return o;
+}
+
+py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
+                           const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
+                           int threads, std::optional<double> aspect) {
+  DensitySpec uniform;  // kdm sample's default, const:1
+  const DensitySpec& spec = density ? *density : uniform;
+  const bool image = spec.kind == DensitySpec::Kind::kImage;
+  // As kdm sample: a ramp or a picture has edges that do not meet, so a box unless asked otherwise.
+  const gen::SamplerOptions o =
+      sampler_options(n, dim, domain, image || spec.kind == DensitySpec::Kind::kRamp, temperature, seed,
+                      threads, aspect, image ? double(spec.width) / spec.height : 1.0);
+  if (image && dim != 2) throw std::invalid_argument("image densities are 2D; use dim=2");
   const gen::Density target = tools::to_generator_density(spec);
   gen::SampleResult result;
   {
@@ -61,15 +67,9 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
 py::array_t<double> sample_function(std::int64_t n, const py::object& function, int dim,
                                     const std::optional<std::string>& domain, double temperature,
                                     std::uint64_t seed, int threads, std::optional<double> aspect) {
-  if (n < 1) throw std::invalid_argument("n must be >= 1, got " + std::to_string(n));
-  if (dim != 2 && dim != 3) throw std::invalid_argument("dim must be 2 or 3, got " + std::to_string(dim));
-  check_number("temperature", temperature, 0, false);
-  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
-  if (aspect) check_number("aspect", *aspect, 0, true);
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
-  const std::string where = domain ? *domain : "box";
-  if (where != "box" && where != "torus")
-    throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
+  const gen::SamplerOptions o =
+      sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0);
   std::unique_ptr<py::error_already_set> raised;  // the function's own exception, kept for the caller
   std::string refused;                            // or why its value was refused
   gen::Density density;
@@ -90,16 +90,6 @@ py::array_t<double> sample_function(std::int64_t n, const py::object& function, 
     }
     return 1;
   };
-  gen::SamplerOptions o;
-  o.n = n;
-  o.dim = dim;
-  o.domain = where == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
-  o.extent[0] = aspect ? *aspect : 1.0;
-  o.extent[1] = 1;
-  o.temperature = temperature;
-  o.seed = seed;
-  o.threads = threads;
-  o.progress = stop_on_signal;
   gen::SampleResult result;
   try {
     py::gil_scoped_release release;
@@ -118,12 +108,8 @@ py::array_t<double> sample_function(std::int64_t n, const py::object& function, 
 py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& specs,
                          const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
                          int threads, std::optional<double> aspect) {
-  if (n < 1) throw std::invalid_argument("n must be >= 1, got " + std::to_string(n));
   if (specs.empty() || specs.size() > 8)
     throw std::invalid_argument("classes must hold 1 to 8 densities, got " + std::to_string(specs.size()));
-  check_number("temperature", temperature, 0, false);
-  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
-  if (aspect) check_number("aspect", *aspect, 0, true);
   if (const auto [i, j] = tools::images_of_different_shapes(specs); j >= 0)
     throw std::invalid_argument("class images must have one shape (width to height): classes[" +
                                 std::to_string(i) + "] is " + std::to_string(specs[i]->width) + "x" +
@@ -143,18 +129,9 @@ py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& 
       throw std::invalid_argument("classes[" + std::to_string(densities.size()) + "]: " + e.what());
     }
   }
-  const std::string where = domain ? *domain : (edged ? "box" : "torus");
-  if (where != "box" && where != "torus")
-    throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
-  gen::SamplerOptions o;
-  o.n = n;
-  o.domain = where == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
-  o.extent[0] = aspect ? *aspect : (first_image ? double(first_image->width) / first_image->height : 1.0);
-  o.extent[1] = 1;
-  o.temperature = temperature;
-  o.seed = seed;
-  o.threads = threads;
-  o.progress = stop_on_signal;
+  const gen::SamplerOptions o =
+      sampler_options(n, 2, domain, edged, temperature, seed, threads, aspect,
+                      first_image ? double(first_image->width) / first_image->height : 1.0);
   gen::ClassSample result;
   {
     py::gil_scoped_release release;
