@@ -166,10 +166,12 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
             if top > 0 and not 1e-30 <= top <= 1e30:
                 density = values / top
     spec = density_spec(density, gamma, invert, name)
-    # Text gets the command line's refusal (from C++); numbers and arrays a message of their own.
-    if spec is not None and spec.text in ("array", "number") and not spec.max_value > 0:
-        what = "an image or array that is zero everywhere" if spec.kind == "image" else "a density of 0"
-        raise ValueError(f"{name}: {what} has nothing to sample (it needs some density > 0)")
+    if spec is not None and not spec.max_value > 0:  # now, not at the first draw
+        if spec.text in ("array", "number"):
+            what = "an array that is zero everywhere" if spec.text == "array" else "a density of 0"
+            raise ValueError(f"{name}: {what} has nothing to sample (it needs some density > 0)")
+        ink = "; an all-white image has no ink" if spec.kind == "image" else ""
+        raise ValueError(f"{name} {spec.text!r} is zero everywhere: nothing to sample{ink}")
     return spec
 
 
@@ -186,8 +188,11 @@ def class_specs(classes: Any, gamma: Any, invert: Any) -> list:
         if d is None or callable(d) and not isinstance(d, (np.ndarray, numbers.Real, str)):
             raise TypeError(f"classes[{k}] must be a number, a str or a 2-D array, got {type(d).__name__}")
         text = isinstance(d, (str, os.PathLike))
-        specs.append(density_spec(d, gamma if text else 1.0, invert if text else False, f"classes[{k}]",
-                                  one_of_several=True))
+        try:
+            specs.append(density_spec(d, gamma if text else 1.0, invert if text else False, f"classes[{k}]",
+                                      one_of_several=True))
+        except ValueError as e:  # the C++ side's messages do not know the name
+            raise ValueError(str(e) if str(e).startswith(f"classes[{k}]") else f"classes[{k}]: {e}") from None
     reshaped = number("gamma", gamma, 0.0, strict=True) != 1.0 or flag("invert", invert)
     if reshaped and not any(s.kind == "image" for d, s in zip(classes, specs) if isinstance(d, (str, os.PathLike))):
         raise ValueError("gamma and invert apply to image files only, and no class is one")

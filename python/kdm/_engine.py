@@ -77,7 +77,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d, in the
     sampler's order (kdm.sample: a prefix of a set is a patch of the domain). An engine pickles and
     copies (a process pool's workers get it): its density is read again where it is unpickled, so an
-    image file must be there too.
+    image file must be there too. A copy goes on from the same state, so workers given copies draw the
+    same sets: give each its own seed (``np.random.SeedSequence(s).spawn(k)``).
 
     Parameters
     ----------

@@ -94,12 +94,13 @@ class Tileset:
 
     @classmethod
     def from_bytes(cls, data: Any) -> "Tileset":
-        """Loads and validates a .kdmt file's bytes (bytes, bytearray or memoryview). Raises ValueError,
-        naming the problem, for bytes that are no valid tile set."""
-        if isinstance(data, (bytearray, memoryview)):
-            data = bytes(data)
+        """Loads and validates a .kdmt file's bytes (bytes, or any buffer of them: bytearray, memoryview, a
+        uint8 array). Raises ValueError, naming the problem, for bytes that are no valid tile set."""
         if not isinstance(data, bytes):
-            raise TypeError(f"data must be bytes, got {type(data).__name__}")
+            try:
+                data = memoryview(data).cast("B").tobytes()
+            except TypeError:
+                raise TypeError(f"data must be bytes or a buffer of them, got {type(data).__name__}") from None
         return cls(_kdm.Tileset.from_bytes(data))
 
     def to_bytes(self) -> bytes:

@@ -60,7 +60,8 @@ def sample(
         Several kinds of points at once (instead of `density`; 2-D), as ``kdm sample --class``: 1 to 8
         densities (numbers, str or 2-D arrays as `density` takes them; images of one shape), highest
         priority first. `n` counts all of them, split by each density's integral (a number keeps its
-        value: ``classes=[1, 2]`` gives a third and two thirds). Class 0 is a KDM sample at its own
+        value: ``classes=[1, 2]`` gives a third and two thirds; each class's cumulative share rounded,
+        so equal classes may give the spare points to a later one; 0 or a blank image: no points). Class 0 is a KDM sample at its own
         density, each later class is sampled around the earlier ones, then all are swept together at the
         sum (docs/multiclass.md).
 

@@ -38,7 +38,8 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
   if (density_bands < 1 || density_bands > 1000)
     throw std::invalid_argument("density_bands must be 1 to 1000, got " + std::to_string(density_bands));
   if (!(holes_min_density >= 0 && holes_min_density <= 1))
-    throw std::invalid_argument("holes_min_density must be in [0, 1]");
+    throw std::invalid_argument("holes_min_density must be in [0, 1], got " +
+                                std::to_string(holes_min_density));
   if (!labels.empty() && labels.size() != arrays.size())
     throw std::invalid_argument("classes must hold one array of labels per set");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");

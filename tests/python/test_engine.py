@@ -94,6 +94,8 @@ def test_engine_options():
     assert abs((p[:, 0] < 0.5).mean() - 0.5) < 0.05
     with pytest.raises(ValueError):
         e.density = 0.0
+    with pytest.raises(ValueError, match="'const:0' is zero everywhere"):  # when set, not at the draw
+        e.density = "const:0"
     e3 = kdm.BlueNoise(3, seed=1)
     with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
         e3.density = np.ones((4, 4))

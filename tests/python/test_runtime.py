@@ -343,6 +343,7 @@ def test_a_set_from_bytes_pickles_and_copies(tiny_tileset):
     again = kdm.Tileset.from_bytes(data)
     assert again.info == tiny_tileset.info and again.to_bytes() == data
     assert kdm.Tileset.from_bytes(memoryview(data)).info == tiny_tileset.info
+    assert kdm.Tileset.from_bytes(np.frombuffer(data, np.uint8)).info == tiny_tileset.info  # any buffer
     kw = dict(scale=100, mode="smooth")
     for twin in (pickle.loads(pickle.dumps(tiny_tileset)), copy.deepcopy(tiny_tileset)):
         assert same(twin.query((0, 0, 3, 3), **kw), tiny_tileset.query((0, 0, 3, 3), **kw))

@@ -133,6 +133,9 @@ def test_classes_are_kdm_sample_class(cli, tmp_path, gradient_png):
     # Constants keep their values: a third and two thirds, exactly the counts they ask for.
     _, two = kdm.sample(900, classes=np.array([1.0, 2.0]), threads=1)
     assert np.bincount(two).tolist() == [300, 600]
+    # A class of density 0 has no points, whatever its kind: a constant or a blank array.
+    for nothing in (0.0, np.zeros((2, 2))):
+        assert np.bincount(kdm.sample(90, classes=[nothing, 1.0])[1], minlength=2).tolist() == [0, 90]
     same = kdm.sample(900, classes=[1.0, 2.0], threads=2)[0]
     assert np.array_equal(same, kdm.sample(900, classes=[1.0, 2.0], threads=1)[0])
 
@@ -146,6 +149,7 @@ def test_classes_are_kdm_sample_class(cli, tmp_path, gradient_png):
      dict(classes=[1.0, lambda x, y: 1.0])),
     (TypeError, "classes must be a sequence of densities", dict(classes="const:1")),
     (ValueError, "every density is zero", dict(classes=[0.0, np.zeros((2, 2))])),
+    (ValueError, r"classes\[1\]: .*finite", dict(classes=[1.0, np.full((2, 2), np.nan)])),
     (ValueError, r"one shape.*classes\[0\] is 2x2, classes\[1\] 3x2",
      dict(classes=[np.ones((2, 2)), np.ones((2, 3))])),
 ])

@@ -118,6 +118,9 @@ def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient
                 theirs["metrics"][key], sort_keys=True), key
     for key in ("density", "empty_circles"):
         assert json.dumps(_lists(got[key]), sort_keys=True) == json.dumps(metrics[key], sort_keys=True), key
+    lone = labels.copy()
+    lone[0] = 7  # one point of its class: listed, not analysed
+    assert kdm.analyze(points, classes=lone, energy=False)["classes"]["too_small"].tolist() == [7]
     with pytest.raises(ValueError, match="one array of labels per set"):
         kdm.analyze([points, points], classes=[labels])
     with pytest.raises(ValueError, match="must hold one label per point"):

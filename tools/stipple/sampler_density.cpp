@@ -36,14 +36,16 @@ gen::Density to_generator_density(const DensitySpec& spec) {
 }
 
 gen::Density to_class_density(const DensitySpec& spec) {
-  if (spec.kind != DensitySpec::Kind::kConstant) return to_generator_density(spec);
-  // A class with no points; also a constant too small for a float texel (it would have none anyway).
-  if (static_cast<float>(spec.constant) == 0) {
+  const bool constant = spec.kind == DensitySpec::Kind::kConstant;
+  // A class with no points, whatever its kind (const:0, a blank image); also a constant too small for a
+  // float texel (it would have none anyway).
+  if (constant ? static_cast<float>(spec.constant) == 0 : !(spec.max_value() > 0)) {
     gen::Density none;
     none.function = [](const double*) { return 0.0; };
     none.thread_safe = true;
     return none;
   }
+  if (!constant) return to_generator_density(spec);
   return gen::Density::from_values(1, 1, {static_cast<float>(spec.constant)});
 }
 

@@ -18,7 +18,8 @@ namespace kdm::tools {
 gen::Density to_generator_density(const DensitySpec& spec);
 
 /// A class's density for the full sampler (gen::sample_classes): as to_generator_density, but a constant
-/// keeps its value, as a one-texel image, since a class's share of the points follows it (0: none).
+/// keeps its value, as a one-texel image, since a class's share of the points follows it, and a density
+/// of 0 (const:0, a blank image) is a class with no points.
 gen::Density to_class_density(const DensitySpec& spec);
 
 /// `density` as the point-set analysis reads it: a function of (x, y) in the unit square (1 for a constant).

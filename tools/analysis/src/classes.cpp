@@ -111,6 +111,9 @@ std::string classes_json(const ClassesReport& report, const std::vector<std::str
   for (std::size_t c = 0; c < report.classes.size(); ++c)
     json += std::string(c ? ", " : "") + "{\"class\": " + std::to_string(report.classes[c]) +
             ", \"metrics\": " + metrics_json(report.reports[c], inputs) + "}";
+  json += "], \"too_small\": [";  // present, but with fewer than 2 points in every set: not analysed
+  for (std::size_t c = 0; c < report.too_small.size(); ++c)
+    json += std::string(c ? ", " : "") + std::to_string(report.too_small[c]);
   return json + "]}\n";
 }
 

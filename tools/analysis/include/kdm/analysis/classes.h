@@ -37,7 +37,8 @@ struct ClassesReport {
 ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
                               const std::function<double(const std::vector<tools::PointSet>&)>& energy = {});
 
-/// classes.json's text: {"cross_class_closest": …, "classes": [{"class": k, "metrics": {metrics.json}}]}.
+/// classes.json's text: {"cross_class_closest": …, "classes": [{"class": k, "metrics": {metrics.json}}],
+/// "too_small": [classes with fewer than 2 points in every set]}.
 std::string classes_json(const ClassesReport& report, const std::vector<std::string>& inputs);
 
 }  // namespace kdm::analysis
