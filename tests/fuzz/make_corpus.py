@@ -172,6 +172,11 @@ def crashes():
     write("query", "zero_columns_many_rows",
           query(0, 1, raw=(1 << 2) | (1 << 3), values=[0, 0, 5e-324, 1e15, 0, 0, 255, 160, 16, 16, 0, 0, 16, 16]),
           root)
+    # Not a runtime bug but the fuzzer's: the same sliver 1e15 tall, compact, with scale 16 and the origin at
+    # 0. The query answers it with no points, as it covers no tile column, before it judges the origin's
+    # distance; the fuzzer expected the refusal whatever the region held.
+    write("query", "compact_sliver_far_from_origin", bytes.fromhex(
+        "000c000000010000000000000000003426f56b0c430000ff" "a01010000010108000070e151c232a31383f060d141b2229"), root)
     # Not a runtime bug but the fuzzer's: a region 1.8e-322 wide splits into a half 2e-323 wide, too narrow
     # for its distance from the world origin (kTooFarFromOrigin), which the split check took for a failure.
     write("query", "split_half_too_narrow_for_its_distance",
