@@ -439,6 +439,7 @@ class Baker {
     o.coarse_sweeps = o.sweeps;
     // The arithmetic of the first bakes: a recipe must give the same tiles in every kdm version.
     o.numerics = Numerics::kOriginal;
+    o.count_balance = false;  // a run with nothing fixed yet keeps the first bakes' schedule too
     o.coarsest_sweeps = std::max(kFirstCoarsestSweeps, o.sweeps);
     // Start two grid levels below the finest, not at 32 nodes: the coarse levels' heavy kernels cannot
     // resolve a residual density confined to patches between fixed bands, and spread the new points

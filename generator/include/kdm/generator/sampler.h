@@ -116,9 +116,11 @@ struct SamplerOptions {
   /// an update then builds one footprint, not two (docs/design.md §2.9). Levels with more points than fit
   /// skip it. The output does not depend on it.
   std::size_t footprint_cache_bytes = std::size_t(256) << 20;
-  /// Varying densities: before the finest sweeps, move the points so that their counts on coarse grids
-  /// match the density. Without it sparse regions get too few points, the more so the wider the density's
-  /// range (docs/design.md §2.6); off only to measure that.
+  /// Before a level's sweeps, move the points so that their counts on coarse grids match the density.
+  /// Without it sparse regions get too few points, the more so the wider the density's range, and even a
+  /// uniform density's counts drift by 1-2% across the domain (7% along a 3:1 box) that the finest sweeps
+  /// cannot carry back (docs/design.md §2.6). Off to measure that, and where a run must give the first
+  /// versions' bits (tile baking and its verification).
   bool count_balance = true;
   double peak_density = 0.43;  ///< ρ at the densest grid node, in (0, 1] (the paper requires ρ <= 1)
   /// Kernels at least this wide (grid units) are frozen (paper: σmax); 0: 16 in 2D, 4 in 3D, where a
