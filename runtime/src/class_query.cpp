@@ -138,6 +138,9 @@ Status prepare_union(const Tileset& tileset, const ClassQueryParams& p, std::siz
     if (p.joint.max[k] < 0) return refuse(Kind::kNegative, kJointMaxNames[k], p.joint.max[k]);
     densities.all_constant = false;
   }
+  // Every bound 0 would never call the function: max was left at its default, not meant as no points.
+  if (joint && std::all_of(p.joint.max, p.joint.max + p.class_count, [](double m) { return m == 0; }))
+    return refuse(Kind::kNotPositive, kJointMaxNames[0], 0.0);
   for (std::uint32_t k = 0; k < p.class_count && !joint; ++k) {
     const QueryDensity& d = p.classes[k];
     switch (d.kind) {
@@ -226,10 +229,11 @@ Status run_classed(const Tileset& tileset, const ClassQueryParams& p, const Quer
                    const ClassDensities& densities, Classifier& classify, Output out, std::uint8_t* classes,
                    std::size_t capacity, std::size_t* written, QueryCursor* cursor, detail::Refusal& refuse,
                    const detail::TileRun& run) {
-  const std::uint64_t fingerprint = query_fingerprint(p);
+  const std::uint64_t identity = detail::tileset_identity(tileset);  // as query_into mixes it in
+  const std::uint64_t fingerprint = query_fingerprint(p) ^ identity;
   if (cursor && cursor->started) {
     if (cursor->fingerprint != fingerprint) return refuse(QueryProblem::Kind::kCursorMismatch, "cursor");
-    cursor->fingerprint = query_fingerprint(q);
+    cursor->fingerprint = query_fingerprint(q) ^ identity;
   }
   std::uint32_t reads = 0;  // densities read at each candidate: the bound on a call's work counts them
   if (densities.joint || densities.sums)

@@ -98,7 +98,7 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     return refuse(Kind::kNotFinite, "density.constant", q.density.constant);
   if (q.density.kind == QueryDensity::Kind::kConstant && q.density.constant < 0)
     return refuse(Kind::kNegative, "density.constant", q.density.constant);
-  const std::uint64_t fingerprint = query_fingerprint(q);
+  const std::uint64_t fingerprint = query_fingerprint(q) ^ tables.identity;  // these parameters on this set
   if (cursor->started && cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
   if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
@@ -128,7 +128,9 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   const ImageSampler sampler(d.kind == QueryDensity::Kind::kImage ? d.image : nullptr);
   const double top = tileset.max_points_per_tile(), most = query_density_limit(tileset, q.mode);
   if (!(max_density * area_scale <= most + 0.5)) {
-    refuse(Kind::kDensityTooHigh, "scale", max_density * area_scale, most);
+    // A tile side whose square overflows is the one at fault, not the scale.
+    refuse(Kind::kDensityTooHigh, std::isfinite(S * S) ? "scale" : "tile_size", max_density * area_scale,
+           most);
     why.largest_valid = most / max_density / S / S;  // divided in turn: a product could overflow
     why.largest_tile_size = std::sqrt(most / max_density) / std::sqrt(q.scale);
     return Status::kInvalidArgument;
@@ -581,18 +583,20 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kNotFinite:
       return "a parameter is not a finite number";
     case QueryProblem::Kind::kNotPositive:
-      return "a parameter must be greater than 0";
+      return "a parameter must be greater than 0 (a struct_size: at least the limit)";
     case QueryProblem::Kind::kNegative:
       return "a parameter must not be negative";
     case QueryProblem::Kind::kBadDensity:
-      return "the density's image (with its max-mip) or callback is missing (or both callbacks are set)";
+      return "the density's image (with its max-mip), callback or image sums are missing or do not fit the "
+             "query "
+             "(or both callbacks are set)";
     case QueryProblem::Kind::kTooManyTiles:
       return "the region covers more tiles than one query may (split it)";
     case QueryProblem::Kind::kDensityTooHigh:
       return "the density asks for more points per tile than the tile set serves in this mode (stable mode "
              "stops at its top level, smooth mode at its depth cap)";
     case QueryProblem::Kind::kCursorMismatch:
-      return "the cursor was started by a query with other parameters, or is damaged";
+      return "the cursor was started by a query with other parameters or on another tile set, or is damaged";
     case QueryProblem::Kind::kBadMode:
       return "the mode is neither stable nor smooth";
     case QueryProblem::Kind::kBadClassCount:

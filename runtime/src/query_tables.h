@@ -33,6 +33,9 @@ struct QueryTables {
   double min_threshold = 0;
   /// The most points any tile holds (a rank is always below it).
   std::uint64_t most_points = 0;
+  /// A hash of the set's tiles (their points, thresholds and glides), mixed into a cursor's fingerprint:
+  /// a cursor is refused on another set, a set reloaded from another file included.
+  std::uint64_t identity = 0;
   /// Per tile, where each keyframe's offsets start in Tile::glide, in offset pairs (keyframes + 1 entries:
   /// keyframe g's pairs are [start[g], start[g + 1]), one per rank below TilesetShape::offsets_at_keyframe).
   TilesetArray<TilesetArray<std::uint32_t>> glide_start;
@@ -120,6 +123,11 @@ struct QueryTables {
 struct TilesetInternals {
   static const QueryTables& tables(const Tileset& set) { return *set.tables_; }
 };
+
+/// QueryTables::identity of `set` (0 for an empty set).
+inline std::uint64_t tileset_identity(const Tileset& set) {
+  return set.empty() ? 0 : TilesetInternals::tables(set).identity;
+}
 
 /// The first keyframe of `set` whose count is at least `expected` (> 0), or the keyframe count if none
 /// (0 without keyframes): a table lookup on the number's exponent and leading bits, then a step or two.

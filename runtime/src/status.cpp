@@ -30,8 +30,8 @@ const char* status_message(Status status) {
     case Status::kInvalidArgument:
       return "invalid argument";
     case Status::kBufferFull:
-      return "output buffer full (or the call's work bound reached): resume with the same cursor, or give a "
-             "parallel query room for the count it returned";
+      return "output buffer full, or the call's work bound reached: resume with the same cursor (a parallel "
+             "query: give it room for the count it returned)";
     case Status::kOutOfMemory:
       return "out of memory";
   }

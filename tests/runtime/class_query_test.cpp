@@ -334,6 +334,16 @@ TEST(ClassQueryTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(refusal(qj).parameter, "joint.max[2]");
   qj.joint.max[2] = INFINITY;
   EXPECT_EQ(refusal(qj).kind, QueryProblem::Kind::kNotFinite);
+  // Every maximum left at its default 0: the function would never be called. One class at 0 is an empty one.
+  ClassQueryParams unset = qj;
+  std::fill(unset.joint.max, unset.joint.max + kMaxQueryClasses, 0.0);
+  EXPECT_EQ(refusal(unset).kind, QueryProblem::Kind::kNotPositive);
+  EXPECT_STREQ(refusal(unset).parameter, "joint.max[0]");
+  unset.joint.max[1] = 1;
+  std::size_t some = 0;
+  QueryCursor unset_cursor;
+  EXPECT_EQ(query_classes(Tileset::builtin(), unset, out, classes, 4, &some, &unset_cursor),
+            Status::kBufferFull);
   // Both joint functions: which one is meant is unclear.
   qj.joint.max[2] = 1;
   qj.joint.batch_densities = [](void*, std::size_t, const double*, const double*, double*) {};

@@ -16,8 +16,10 @@
 
 #include "allocation_counter.h"
 #include "kdm/analysis/density.h"
+#include "kdm/runtime/class_query.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
+#include "kdm/runtime/tileset_format.h"
 #include "query_tables.h"
 #include "random_partition.h"
 #include "run_query.h"
@@ -677,6 +679,8 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_FALSE(run(q).empty());
   q.scale = 100000, q.tile_size = p.largest_tile_size * (1 - 1e-12);
   EXPECT_FALSE(run(q).empty());
+  q.scale = 1, q.tile_size = 1e300;  // a tile's area overflows: the tile size is named, not the scale
+  EXPECT_STREQ(problem_of(q).parameter, "tile_size");
   QueryCursor cursor;
   EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, nullptr, &cursor),
             Status::kInvalidArgument);
@@ -765,6 +769,47 @@ TEST(QueryTest, ACursorIsRefusedWithOtherParameters) {
             Status::kInvalidArgument);
   EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
   EXPECT_NE(query_fingerprint(region(0, 0, 1, 1, 1)), query_fingerprint(region(0, 0, 1, 1, 2)));
+}
+
+// A cursor belongs to its tile set too: resumed on another (here the built-in set with one point moved, as
+// a set reloaded while a world streams may be), it is refused, not continued with the other set's points;
+// on a copy of the same set it goes on. Class queries alike.
+TEST(QueryTest, ACursorIsRefusedOnAnotherTileset) {
+  TilesetData data = Tileset::builtin().data();
+  data.tiles[0].points[0].x ^= 1;
+  std::vector<std::uint8_t> bytes;
+  ASSERT_EQ(encode_tileset(data, bytes), Status::kOk);
+  Tileset other, copy = Tileset::builtin();
+  ASSERT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), other), Status::kOk);
+  const QueryParams q = region(0, 0, 4, 4, 100);
+  std::vector<QueryPoint> buffer(16);
+  std::size_t written = 0;
+  QueryProblem problem;
+  QueryCursor cursor;
+  ASSERT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &cursor), Status::kBufferFull);
+  QueryCursor resumed = cursor;
+  EXPECT_EQ(query_points(other, q, buffer.data(), 16, &written, &resumed, &problem),
+            Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+  resumed = cursor;
+  EXPECT_EQ(query_points(copy, q, buffer.data(), 16, &written, &resumed), Status::kBufferFull);
+  EXPECT_EQ(written, 16u);
+
+  ClassQueryParams cq;
+  cq.query = q;
+  cq.class_count = 2;
+  cq.classes[0].constant = 60, cq.classes[1].constant = 40;
+  std::vector<std::uint8_t> classes(16);
+  QueryCursor class_cursor;
+  ASSERT_EQ(query_classes(Tileset::builtin(), cq, buffer.data(), classes.data(), 16, &written, &class_cursor),
+            Status::kBufferFull);
+  resumed = class_cursor;
+  EXPECT_EQ(query_classes(other, cq, buffer.data(), classes.data(), 16, &written, &resumed, &problem),
+            Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+  resumed = class_cursor;
+  EXPECT_EQ(query_classes(copy, cq, buffer.data(), classes.data(), 16, &written, &resumed),
+            Status::kBufferFull);
 }
 
 // A cursor whose tile lies outside the region, or whose rank lies past its tile's points, is refused at

@@ -59,7 +59,8 @@ struct JointClassDensity {
   void (*bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) = nullptr;
   void* user = nullptr;  ///< passed to all three
   /// An upper bound of each class's density wherever it is read (finite, ≥ 0), as QueryDensity::callback_max
-  /// (which says what values above it do).
+  /// (which says what values above it do). A class bounded by 0 has no points; all of them 0 is refused
+  /// (the function would never be called: the bounds were left unset).
   double max[kMaxQueryClasses] = {};
   /// Instead of `densities` (set one of the two): the densities at n positions (x[i], y[i]) at once, class
   /// k's at position i into values[k · n + i], n ≤ kDensityBatch, for a vectorised function. The query

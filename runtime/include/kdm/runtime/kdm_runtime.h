@@ -92,7 +92,7 @@ typedef struct kdm_cursor {
   int64_t tile_x, tile_y; /* the tile the query stopped in */
   uint32_t rank;          /* the next rank to examine there */
   int started, finished;  /* set by the first call, and once the region is complete */
-  uint64_t fingerprint;   /* of the query that started it: a cursor is refused with other parameters */
+  uint64_t fingerprint;   /* of the query and tile set that started it: refused with others */
   uint32_t depth;         /* where in the tile's subtiles it stopped (past the top level) */
   uint64_t path;          /* the subtiles it went through; at depth 0, the tile's cell it stopped in + 1 */
 } kdm_cursor;             /* zero-initialise before the first call */
@@ -109,7 +109,7 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_TOO_MANY_TILES = 6,    /* `value` tiles, more than `limit`: split the region */
   KDM_PROBLEM_DENSITY_TOO_HIGH = 7,  /* `value` points per tile > `limit`; see largest_valid (scale) and
                                         largest_tile_size */
-  KDM_PROBLEM_CURSOR_MISMATCH = 8,   /* the cursor was started by a query with other parameters */
+  KDM_PROBLEM_CURSOR_MISMATCH = 8,   /* the cursor was started by another query or on another tile set */
   KDM_PROBLEM_BAD_MODE = 9,          /* `mode` is neither KDM_MODE_STABLE nor KDM_MODE_SMOOTH */
   KDM_PROBLEM_BAD_CLASS_COUNT = 10,  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
   KDM_PROBLEM_KEYS_UNSUPPORTED = 11, /* kdm_query_compact: keys asked of a set whose tiles hold `value`

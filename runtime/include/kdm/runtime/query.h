@@ -140,13 +140,14 @@ inline constexpr std::uint64_t kMaxQueryCandidates = std::uint64_t(1) << 24;
 inline constexpr std::uint64_t kTileCandidates = 16;
 
 /// Where a query stopped, so a full buffer can be resumed. Zero-initialise before the first call; a cursor
-/// belongs to the parameters of the call that started it (their fingerprint), and is refused with others.
+/// belongs to the parameters and the tile set of the call that started it (their fingerprint), and is
+/// refused with others (a copy of the same set serves, another set or one reloaded with other tiles not).
 struct QueryCursor {
   std::int64_t tile_x = 0, tile_y = 0;  ///< the tile the query stopped in
   std::uint32_t rank = 0;  ///< in the tile or subtile reached; past its ranks, its appearing sub-points
   bool started = false, finished = false;  ///< set by the first call, and once the region is complete
-  std::uint64_t fingerprint = 0;           ///< of the parameters that started it (query_fingerprint)
-  std::uint32_t depth = 0;                 ///< how deep into tile (tile_x, tile_y) the query stopped
+  std::uint64_t fingerprint = 0;  ///< of the parameters (query_fingerprint) and tile set that started it
+  std::uint32_t depth = 0;        ///< how deep into tile (tile_x, tile_y) the query stopped
   /// The subtiles it went through, 16 bits per depth from the lowest; at depth 0 in a tile visited cell by
   /// cell (query_points), the cell it stopped in plus one.
   std::uint64_t path = 0;
@@ -170,7 +171,8 @@ struct QueryProblem {
     kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
                         ///< `largest_valid` is the largest scale that fits, `largest_tile_size` the
                         ///< largest tile size that fits this scale
-    kCursorMismatch,    ///< the cursor was started by a call with other parameters (or damaged)
+    kCursorMismatch,    ///< the cursor was started by a call with other parameters or on another tile set
+                        ///< (or damaged)
     kBadMode,           ///< `parameter` ("mode") is not a QueryMode; `value` holds it
     kBadClassCount,     ///< query_classes: `value` classes, not 1 … `limit` (kMaxQueryClasses)
     kKeysUnsupported,   ///< query_points_compact: keys asked of a set whose tiles hold `value` points,
