@@ -118,7 +118,7 @@ def stipple(
     gamma: float = ...,
     invert: bool = ...,
     seed: int = ...,
-    tileset: Optional[Tileset] = ...,
+    tileset: Union[Tileset, _Path, None] = ...,
     output: Optional[_Path] = ...,
     width: int = ...,
     dot_size: Optional[float] = ...,

@@ -118,6 +118,41 @@ def array2d(name: str, value: Any) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+def luminance(name: str, value: Any) -> np.ndarray:
+    """An image array as luminance in [0, 1], 2-D float64, as an image file is read: float values as they
+    are; uint8 and uint16 divided by 255 and 65535; (rows, columns, 3 or 4) RGB(A), or 2 (grey and alpha),
+    to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in float32 as kdm reads files (the same
+    densities as the file's pixels). A PIL image is an array too."""
+    try:
+        a = np.asarray(value)
+    except ValueError as e:  # ragged nested lists
+        raise ValueError(f"{name} must be a 2-D array (rows, columns): {e}") from None
+    except Exception as e:  # an object whose __array__ fails
+        raise TypeError(f"{name} must be an array of numbers: {e}") from None
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if a.ndim == 3 and a.shape[2] in (1, 2, 3, 4):
+        full = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(a.dtype)
+        if full is None and a.dtype.kind != "f":
+            raise ValueError(f"{name}: colour arrays must be uint8, uint16 or floats in [0, 1], got {a.dtype}")
+        p = a.astype(np.float32) / np.float32(full or 1)
+        if full is None and not (np.isfinite(p).all() and p.min() >= 0 and p.max() <= 1):
+            raise ValueError(f"{name}: colour values must be in [0, 1] (8-bit values: a uint8 array)")
+        channels = a.shape[2]
+        lum = p[..., 0] if channels < 3 else (np.float32(0.2126) * p[..., 0] + np.float32(0.7152) * p[..., 1]
+                                              + np.float32(0.0722) * p[..., 2])
+        alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else np.float32(1)
+        return np.ascontiguousarray(np.clip(lum * alpha + (np.float32(1) - alpha), 0, 1), dtype=np.float64)
+    if a.ndim != 2:
+        raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, 3 or 4) "
+                         f"of colour, got shape {a.shape}")
+    if a.dtype in (np.uint8, np.uint16):
+        return (a.astype(np.float32) / np.float32(255 if a.dtype == np.uint8 else 65535)).astype(np.float64)
+    if a.dtype.kind in "iu":
+        raise ValueError(f"{name}: integer arrays must be uint8 (0-255) or uint16 (0-65535), got {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
 def is_array(value: Any) -> bool:
     return isinstance(value, (np.ndarray, list, tuple)) or hasattr(value, "__array__")
 

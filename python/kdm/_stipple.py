@@ -34,9 +34,11 @@ def stipple(
 
     Parameters
     ----------
-    image : str, os.PathLike or 2-D array
-        An image file (PNG, JPEG, ...), or luminance in [0, 1] with row 0 at the TOP (as pictures are
-        stored). The image spans [0, width/height] x [0, 1].
+    image : str, os.PathLike, array or PIL image
+        An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored):
+        luminance (rows, columns) as floats in [0, 1], uint8 or uint16; or colour (rows, columns, 3 or 4),
+        RGB(A), made luminance as a file is (0.2126 R + 0.7152 G + 0.0722 B, composited on white). The
+        image spans [0, width/height] x [0, 1]. An image with no ink gives no dots.
     points : int
         Dots over the whole image (ignored when `scale` is given).
     scale : float or None
@@ -55,8 +57,8 @@ def stipple(
     seed : int
         Method "full": the sampler's seed. Method "tiles": where the image lies in the tile set's endless
         tiling (another seed, other dots; one seed, the same dots in every region).
-    tileset : Tileset or None
-        For method "tiles" (default: the built-in set).
+    tileset : Tileset, str, os.PathLike or None
+        For method "tiles": a set, or a tile-set file to load (default: the built-in set).
     output : str, os.PathLike or None
         Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does.
     width, dot_size
@@ -92,11 +94,11 @@ def stipple(
             except OSError as e:
                 raise type(e)(f"cannot read image '{label}': {e.strerror}") from None
         spec = _kdm.DensitySpec.parse(label, gamma, invert)
-    elif _checks.is_array(image):
+    elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
         label = "array"
-        spec = _kdm.DensitySpec.from_luminance(_checks.array2d("image", image), gamma, invert)
+        spec = _kdm.DensitySpec.from_luminance(_checks.luminance("image", image), gamma, invert)
     else:
-        raise TypeError(f"image must be a path or a 2-D array of luminance, got {type(image).__name__}")
+        raise TypeError(f"image must be a path or an array (luminance or colour), got {type(image).__name__}")
     if scale is None:
         points = _checks.integer("points", points, 1, 2**31)
         scale = 0.0
@@ -110,8 +112,10 @@ def stipple(
     if region is not None:
         region = _checks.numbers_tuple("region", region, 4)
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
+    if isinstance(tileset, (str, os.PathLike)):  # a tile-set file, as kdm stipple --tileset takes
+        tileset = Tileset.load(tileset)
     if tileset is not None and not isinstance(tileset, Tileset):
-        raise TypeError(f"tileset must be a kdm.Tileset or None, got {type(tileset).__name__}")
+        raise TypeError(f"tileset must be a kdm.Tileset, a tile-set file or None, got {type(tileset).__name__}")
     if output is not None:
         output = _checks.path("output", output)
     width = _checks.integer("width", width, 1, 65536)

@@ -66,8 +66,9 @@ DensitySpec from_luminance(const Array& a, double gamma, bool invert) {
   check_number("gamma", gamma, 0, true);
   for (py::ssize_t i = 0; i < a.size(); ++i)
     if (!(a.data()[i] >= 0 && a.data()[i] <= 1))
-      throw std::invalid_argument("image array values must be luminances in [0, 1], got " +
-                                  shown(a.data()[i]));
+      throw std::invalid_argument(
+          "image array values must be luminances in [0, 1], got " + shown(a.data()[i]) +
+          (a.data()[i] > 1 ? " (8-bit pixels: pass them as uint8, or divide by 255)" : ""));
   DensitySpec spec = flipped(a, "image array", [gamma, invert](double grey) {
     const double tone = invert ? grey : 1.0 - grey;
     return std::pow(std::max(0.0, tone), gamma);

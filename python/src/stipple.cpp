@@ -52,9 +52,6 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     throw std::invalid_argument("tileset applies to method='tiles' (the full sampler has no tiles)");
   if (spec.kind != DensitySpec::Kind::kImage)
     throw std::invalid_argument("stipple needs an image; for a constant density use kdm.sample");
-  if (!(spec.max_value() > 0) && !colours)  // in colour, the separation says which inks there are
-    throw std::invalid_argument("image '" + label + "' has no ink: nothing to stipple" +
-                                (spec.inverted ? "" : " (an all-white image has no ink)"));
   // With `colours`, the image file separated into inks, one class of dots each (kdm stipple --colours).
   tools::ColourSeparation inks;
   std::vector<const DensitySpec*> specs = {&spec};
@@ -84,14 +81,19 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                     tools::max_stipple_zoom(given ? *given : builtin_tileset(), query_mode) * (1 + 1e-9))
     throw std::invalid_argument(
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
-  if (output && picture()) tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]));
+  if (output && picture())
+    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output);
   tools::PointSet set;
   {
     py::gil_scoped_release release;
     const Tileset& tiles = given ? *given : builtin_tileset();
-    const double whole_dots = tools::stipple_dot_count(specs, double(points), scale);
-    const std::int64_t count = method == "full" ? tools::full_stipple_count(whole_dots, scale) : 0;
-    if (method == "full") {
+    // No ink (in colour: in no ink): no dots, as kdm stipple gives an empty picture.
+    const bool blank = colours ? specs.empty() : !(spec.max_value() > 0);
+    const double whole_dots = blank ? 0.0 : tools::stipple_dot_count(specs, double(points), scale);
+    const std::int64_t count = method == "full" && !blank ? tools::full_stipple_count(whole_dots, scale) : 0;
+    if (blank) {
+      set.dim = 2;
+    } else if (method == "full") {
       set = colours ? tools::stipple_full(specs, count, aspect, seed, threads, stop_on_signal)
                     : tools::stipple_full(spec, count, aspect, seed, threads, stop_on_signal);
     } else {
@@ -103,8 +105,9 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       tools::DrawStyle style;
       style.width_px = width;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
-      style.dot_radius_px =
-          dot_size > 0 ? dot_size : tools::stipple_dot_radius(whole_dots, width, aspect, specs);
+      style.dot_radius_px = dot_size > 0 ? dot_size
+                            : blank      ? 1.0
+                                         : tools::stipple_dot_radius(whole_dots, width, aspect, specs);
       if (colours) {
         style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);

@@ -292,7 +292,8 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   }
   const Outcome grey_run = kdm("stipple " + sphere + " --colours cmyk -o '" + path("s.svg") + "'");
   ASSERT_EQ(grey_run.status, 0) << grey_run.err;
-  EXPECT_NE(grey_run.err.find("classes 0 black; no pixel uses cyan, magenta, yellow"), std::string::npos)
+  EXPECT_NE(grey_run.err.find("classes 0 black #000000; no pixel uses cyan, magenta, yellow"),
+            std::string::npos)
       << grey_run.err;
   // A grey picture has no colour to separate: black holds every dot, the other pens' layers stay, empty.
   const std::string grey = slurp(path("s.svg"));

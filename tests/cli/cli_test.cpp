@@ -48,13 +48,14 @@ TEST_F(CliTest, BadImagesGiveOneLineErrors) {
   corrupt[8 + 25 + 8 + 3] ^= 0xFF;
   write_bytes(path("corrupt.png"), corrupt);
   write_bytes(path("text.png"), std::vector<std::uint8_t>{'n', 'o', 't', ' ', 'a', 'n', ' ', 'i', 'm', 'g'});
-  write_bytes(path("white.png"), grey_png(1, 1, 8, {255}));  // defined, but no ink: nothing to stipple
+  write_bytes(path("white.png"), grey_png(1, 1, 8, {255}));  // defined, but no ink: no n points to sample
   for (const char* name : {"empty0x0.png", "zero-bytes.png", "truncated.png", "corrupt.png", "text.png",
                            "missing.png", "white.png"}) {
     SCOPED_TRACE(name);
     const std::string image = path(name);
     expect_error("sample --n 100 --density '" + image + "' -o '" + path("s.txt") + "'", name);
-    expect_error("stipple '" + image + "' -o '" + path("s.png") + "'", name);
+    if (std::string(name) != "white.png")  // a blank picture (StippleOfABlankImageIsAnEmptyPicture)
+      expect_error("stipple '" + image + "' -o '" + path("s.png") + "'", name);
     if (std::string(name) != "white.png")  // a query of an all-white image is empty, as one of const:0
       expect_error("query --rect 0,0,1,1 --density '" + image + "' -o '" + path("q.txt") + "'", name);
     EXPECT_FALSE(fs::exists(path("s.txt")) || fs::exists(path("s.png")) || fs::exists(path("q.txt")));
@@ -68,6 +69,41 @@ TEST_F(CliTest, BadImagesGiveOneLineErrors) {
   for (int at : {16, 20}) huge[at] = 0, huge[at + 1] = 0x01, huge[at + 2] = 0x86, huge[at + 3] = 0xA0;
   write_bytes(path("huge.png"), huge);
   expect_error("stipple '" + path("huge.png") + "' -o '" + path("s.png") + "'", "100000x100000 pixels");
+}
+
+// An image with no ink gives an empty picture, not an error (a blank frame in a batch or an animation), in
+// every method and output, grey or in colour; the run says so.
+TEST_F(CliTest, StippleOfABlankImageIsAnEmptyPicture) {
+  write_bytes(path("white.png"), grey_png(3, 2, 8, {255, 255, 255, 255, 255, 255}));
+  write_bytes(path("black.png"), grey_png(3, 2, 8, {0, 0, 0, 0, 0, 0}));
+  const std::string white = "stipple '" + path("white.png") + "' -o '";
+  for (const std::string& args :
+       {white + path("b.csv") + "'", white + path("b.csv") + "' --method full",
+        white + path("b.csv") + "' --colours 3",
+        "stipple '" + path("black.png") + "' --invert -o '" + path("b.csv") + "'"}) {
+    SCOPED_TRACE(args);
+    const Outcome o = kdm(args);
+    ASSERT_EQ(o.status, 0) << o.err;
+    EXPECT_NE(o.err.find("has no ink"), std::string::npos) << o.err;
+    const std::string csv = slurp(path("b.csv"));
+    EXPECT_EQ(csv.rfind("x,y", 0), 0u) << csv;
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1) << csv;  // the header, no dots
+  }
+  const Outcome picture = kdm(white + path("b.png") + "' --width 30");
+  ASSERT_EQ(picture.status, 0) << picture.err;
+  kdm::tools::GreyImage image;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("b.png"), image, error)) << error;
+  EXPECT_EQ(image.width, 30);
+  EXPECT_EQ(image.height, 20);
+  for (const float v : image.pixels) EXPECT_EQ(v, 1.0f);
+  const Outcome svg = kdm(white + path("b.svg") + "' --colours cmyk");  // every pen's layer, none with dots
+  ASSERT_EQ(svg.status, 0) << svg.err;
+  EXPECT_NE(slurp(path("b.svg")).find("inkscape:label=\"yellow\""), std::string::npos);
+  EXPECT_EQ(slurp(path("b.svg")).find("<circle"), std::string::npos);
+  const Outcome frames = kdm(white + path("f.png") + "' --region 0.2,0.2,0.6,0.6 --frames 2");
+  ASSERT_EQ(frames.status, 0) << frames.err;
+  EXPECT_TRUE(fs::exists(path("f_0000.png")) && fs::exists(path("f_0001.png")));
 }
 
 TEST_F(CliTest, OneByOneImageIsAConstantDensity) {
@@ -438,7 +474,7 @@ TEST_F(CliTest, StippleScaleIsChecked) {
   const std::string stipple = "stipple '" + path("grey.png") + "' -o '" + path("s.txt") + "' --scale ";
   for (const char* scale : {"-1", "nan", "0", "inf"}) {
     SCOPED_TRACE(scale);
-    expect_error(stipple + scale, "--scale must be a number > 0");
+    expect_error(stipple + scale, "--scale must be a finite number > 0");
   }
   expect_error(stipple + "1e300 --method full", "scale 1e+300 asks for");
   // The tiles: said in dots and scale, not in the tile size derived from them.

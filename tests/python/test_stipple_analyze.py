@@ -63,7 +63,41 @@ def test_stipple_an_array_as_the_picture():
     assert under(from_file) < 0.5 < 0.85 < under(kdm.stipple(luminance, points=4000, invert=True))
 
 
-def test_stipple_scale_region_mode_and_tileset(tiny_tileset):
+def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
+    # uint8 and uint16 luminance, RGB(A) and PIL images: the same dots as the file they came from.
+    from PIL import Image
+
+    coffee = SPHERE.parent / "coffee.png"
+    rgb = np.asarray(Image.open(coffee))
+    assert rgb.dtype == np.uint8 and rgb.shape[2] == 3
+    expected = kdm.stipple(str(coffee), points=2000)
+    np.testing.assert_array_equal(kdm.stipple(rgb, points=2000), expected)
+    np.testing.assert_array_equal(kdm.stipple(Image.open(coffee), points=2000), expected)
+    opaque = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    np.testing.assert_array_equal(kdm.stipple(opaque, points=2000), expected)
+    grey = np.asarray(Image.open(SPHERE))
+    assert grey.ndim == 2
+    np.testing.assert_array_equal(kdm.stipple(grey, points=2000), kdm.stipple(str(SPHERE), points=2000))
+    np.testing.assert_array_equal(kdm.stipple(grey.astype(np.uint16) * 257, points=2000),
+                                  kdm.stipple(grey, points=2000))  # 257 v / 65535 = v / 255, rounded alike
+
+
+def test_stipple_of_a_blank_image_has_no_dots(tmp_path):
+    # As kdm stipple: an empty picture, not an error (a blank frame of an animation).
+    assert kdm.stipple(np.ones((6, 9))).shape == (0, 2)
+    assert kdm.stipple(np.zeros((6, 9)), invert=True, method="full").shape == (0, 2)
+    white = tmp_path / "white.png"
+    write_png(white, np.full((6, 9), 255))
+    dots, classes, inks = kdm.stipple(str(white), colours="cmyk", output=tmp_path / "w.svg")
+    assert dots.shape == (0, 2) and classes.shape == (0,) and inks == []
+    assert "<circle" not in (tmp_path / "w.svg").read_text()
+    kdm.stipple(np.ones((6, 9)), output=tmp_path / "w.png", width=90)
+    from PIL import Image
+
+    assert np.asarray(Image.open(tmp_path / "w.png")).min() == 255
+
+
+def test_stipple_scale_region_mode_and_tileset(tiny_tileset, tmp_path):
     whole = kdm.stipple(str(SPHERE), scale=8000)
     part = kdm.stipple(str(SPHERE), scale=8000, region=(0.25, 0.25, 0.75, 0.75))
     # Zooming 2x into the middle shows 4x its dots at the same dot size (measured: 4.00x; deterministic).
@@ -73,6 +107,8 @@ def test_stipple_scale_region_mode_and_tileset(tiny_tileset):
     assert not np.array_equal(stable, kdm.stipple(str(SPHERE), points=3000))
     own = kdm.stipple(str(SPHERE), points=3000, tileset=tiny_tileset)
     assert len(own) > 1000 and not np.array_equal(own, kdm.stipple(str(SPHERE), points=3000))
+    tiny_tileset.save(tmp_path / "tiny.kdmt")  # a file, as kdm stipple --tileset takes
+    np.testing.assert_array_equal(kdm.stipple(str(SPHERE), points=3000, tileset=tmp_path / "tiny.kdmt"), own)
     # scale counts dots at full darkness for both methods: the sphere's mean darkness is 0.17, and the
     # runtime's count is within 0.3% of scale times it (deterministic).
     full = kdm.stipple(str(SPHERE), scale=8000, method="full")

@@ -30,7 +30,7 @@ struct StippleArgs {
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
   int width_px = 1024;
-  int frames = 0;
+  int frames = 0, threads = 0;
   std::uint64_t seed = 1;
 };
 
@@ -57,7 +57,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   for (int i = 0; i < std::max(1, a.frames); ++i)
     tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output, "input image");
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
-    throw CommandError("--scale must be a number > 0 (dots per unit area at full darkness)");
+    throw CommandError("--scale must be a finite number > 0 (dots per unit area at full darkness)");
   if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
   if (a.frames < 0 || a.frames == 1 || a.frames > 10000)
     throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
@@ -78,6 +78,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
   // One ink (the image's darkness), or with --colours the image separated into several.
   tools::ColourSeparation inks;
+  double aspect = 1;  // world: [0, aspect] × [0, 1]
   if (a.colours.empty()) {
     const bool named = a.image.rfind("const:", 0) == 0 || a.image.rfind("ramp:", 0) == 0 ||
                        a.image.rfind("radial:", 0) == 0;  // refused below: stipple needs an image
@@ -87,6 +88,11 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                          "': " + (missing ? missing.message() : std::string(std::strerror(ENOENT))));
     inks.channels.push_back(parse_density(a.image, a.gamma, a.invert));
     inks.inks = tools::class_inks(1);
+    const tools::DensitySpec& spec = inks.channels.front();
+    if (spec.kind != tools::DensitySpec::Kind::kImage)
+      throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
+    aspect = double(spec.width) / spec.height;
+    if (!(spec.max_value() > 0)) inks.channels.clear();  // no ink: an empty picture, below
   } else {
     if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
     tools::ColourImage image;
@@ -98,18 +104,13 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     } catch (const std::invalid_argument& e) {
       throw CommandError(e.what());
     }
+    aspect = double(image.width) / image.height;
   }
-  const tools::DensitySpec& spec = inks.channels.front();
-  if (spec.kind != tools::DensitySpec::Kind::kImage)
-    throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
-  if (!(spec.max_value() > 0) && a.colours.empty())
-    throw CommandError("image '" + a.image + "' has no ink: nothing to stipple" +
-                       (a.invert ? "" : " (an all-white image has no ink)"));
   const bool coloured = !a.colours.empty();
-  const double aspect = double(spec.width) / spec.height;  // world: [0, aspect] × [0, 1]
   std::vector<const tools::DensitySpec*> specs;
   for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
-  const double whole_dots = tools::stipple_dot_count(specs, double(a.points), a.scale);
+  const bool blank = specs.empty();  // a white image (a black one with --invert): no dots, not an error
+  const double whole_dots = blank ? 0.0 : tools::stipple_dot_count(specs, double(a.points), a.scale);
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, region);
   if (a.method == "full" && !a.region.empty())
@@ -120,14 +121,19 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       tools::stipple_zoom(region) > tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
-  if (a.method != "full") {
+  if (blank)
+    std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s: no dots\n", a.image.c_str(),
+                 coloured   ? " in any colour"
+                 : a.invert ? ""
+                            : " (it is all white)");
+  else if (a.method != "full") {
     stippler = std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale,
                                                      parse_mode(a.mode), a.seed);
   }
-  if (coloured) {  // which ink each class number of a .csv is
+  if (coloured && !blank) {  // which ink each class number of a .csv is, and its colour (a plotter's pen)
     std::string names;
     for (std::size_t k = 0; k < inks.inks.size(); ++k)
-      names += (k ? ", " : "") + std::to_string(k) + " " + inks.inks[k].name;
+      names += (k ? ", " : "") + std::to_string(k) + " " + inks.inks[k].name + " " + inks.inks[k].hex();
     for (std::size_t k = 0; k < inks.unused.size(); ++k)  // still a layer in .svg, for the plotter's pens
       names += (k ? ", " : "; no pixel uses ") + inks.unused[k].name;
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
@@ -141,7 +147,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       else
         std::copy(region, region + 4, uv);
       try {
-        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]));
+        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output);
       } catch (const std::invalid_argument& e) {
         throw CommandError(e.what());
       }
@@ -157,12 +163,14 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     tools::PointSet set;
     set.dim = 2;
     std::string how;
-    if (a.method == "full") {
+    if (blank) {
+      how = "no ink";
+    } else if (a.method == "full") {
       const std::int64_t count = tools::full_stipple_count(whole_dots, a.scale);
       if (coloured) {
-        set = tools::stipple_full(specs, count, aspect, a.seed);
+        set = tools::stipple_full(specs, count, aspect, a.seed, a.threads);
       } else {
-        set = tools::stipple_full(spec, count, aspect, a.seed);
+        set = tools::stipple_full(*specs.front(), count, aspect, a.seed, a.threads);
       }
       how = "full KDM sampler";
     } else {
@@ -179,7 +187,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       how = "runtime tiles";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (dot_radius <= 0) dot_radius = tools::stipple_dot_radius(whole_dots, a.width_px, aspect, specs);
+    if (dot_radius <= 0)
+      dot_radius = blank ? 1.0 : tools::stipple_dot_radius(whole_dots, a.width_px, aspect, specs);
     tools::DrawStyle style;
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
@@ -196,8 +205,11 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                   coloured ? a.colours.c_str() : "");
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
+    const auto t1 = std::chrono::steady_clock::now();
     tools::write_points(path, set, {line, "image " + a.image, where}, style);
-    std::fprintf(stderr, "%s in %.3f s -> %s\n", line, seconds, path.c_str());
+    const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    std::fprintf(stderr, "%s placed in %.3f s, written in %.3f s -> %s\n", line, seconds, writing,
+                 path.c_str());
   }
 }
 
@@ -217,7 +229,8 @@ void add_stipple_command(CLI::App& app) {
   add_count_option(
       cmd, "--points", a->points,
       "Dots over the whole image: exactly this many with --method full; about this many with tiles "
-      "(within 1% from a few thousand; a few dozen may be 10% off, and 1 may give none). A pale "
+      "(within 1% from a few thousand where the image has areas of tone; lines and details under a "
+      "dot's spacing get fewer, docs/limits.md; a few dozen may be 10% off, and 1 may give none). A pale "
       "image gets as many as a dark one: --scale keeps the tone's absolute darkness");
   cmd->add_option("--scale", a->scale,
                   "Dots per unit area at full darkness (image height = 1 unit); overrides --points "
@@ -268,6 +281,8 @@ void add_stipple_command(CLI::App& app) {
                   "stable (dots never move as the density or zoom changes)")
       ->check(CLI::IsMember({"stable", "smooth"}))
       ->capture_default_str();
+  add_threads_option(cmd, a->threads,
+                     "--method full's sampler (the dots do not depend on it; tiles use one)");
   cmd->callback([a, cmd] {
     const bool scale_given = cmd->get_option("--scale")->count() > 0;
     if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())

@@ -459,9 +459,11 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
   if (pixels > max_pixels) {
     const auto side = static_cast<std::uint64_t>(std::sqrt(double(max_pixels)));
-    error = "image '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) +
-            " pixels, more than the limit of " + std::to_string(max_pixels) + " pixels" +
-            (side * side == max_pixels ? " (" + std::to_string(side) + "x" + std::to_string(side) + ")" : "");
+    error =
+        "image '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) +
+        " pixels, more than the limit of " + std::to_string(max_pixels) + " pixels" +
+        (side * side == max_pixels ? " (" + std::to_string(side) + "x" + std::to_string(side) + ")" : "") +
+        ": scale it down (a density needs no more pixels than the dots it places)";
     return false;
   }
   int lw = 0, lh = 0, channels = 0;
@@ -590,29 +592,74 @@ bool write_png(const std::string& path, const RgbImage& image, std::string& erro
   return write_text_file_atomic(path, png, error);
 }
 
-void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode) {
-  // Coverage by distance to the edge, one pixel of antialiasing ramp.
+namespace {
+
+/// Calls f(pixel index, coverage) for each pixel of a w × h picture that the disc of radius r at (cx, cy)
+/// covers. Coverage by distance to the edge, a one-pixel ramp, so that a disc's coverages sum to its area
+/// π r² (a picture keeps its tone): the ramp adds π/12 of a pixel, taken off the radius; below 4 pixels,
+/// where pixels round a disc most, its partly covered pixels are scaled to the area, and it keeps a
+/// footprint of at least one pixel wherever it lies (an edge radius of 0.75 reaches a pixel centre from
+/// any point).
+template <class F>
+void for_each_disc_pixel(int w, int h, double cx, double cy, double r, F&& f) {
+  if (!(r > 0)) return;
+  const double edge = std::max(std::sqrt(std::max(0.0, r * r - 1.0 / 12)), 0.25) + 0.5;
   // Clamped in double first: a far or huge disc's bounds do not fit an int.
   auto pixel = [](double v, int last) { return static_cast<int>(std::clamp(v, -1.0, double(last) + 1)); };
-  const int x0 = std::max(0, pixel(std::floor(cx - r - 1), image.width));
-  const int x1 = std::min(image.width - 1, pixel(std::ceil(cx + r + 1), image.width));
-  const int y0 = std::max(0, pixel(std::floor(cy - r - 1), image.height));
-  const int y1 = std::min(image.height - 1, pixel(std::ceil(cy + r + 1), image.height));
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
-      const double coverage = std::clamp(r + 0.5 - d, 0.0, 1.0);
-      if (coverage <= 0) continue;
-      std::uint8_t* p = &image.pixels[(static_cast<std::size_t>(y) * image.width + x) * 3];
-      for (int c = 0; c < 3; ++c) {
-        const double under = p[c];
-        const double ink = mode == 1   ? under * rgb[c] / 255.0
-                           : mode == 2 ? std::min(255.0, under + rgb[c])
-                                       : rgb[c];
-        p[c] = static_cast<std::uint8_t>(std::lround(under + (ink - under) * coverage));
+  const int x0 = std::max(0, pixel(std::floor(cx - edge), w)),
+            x1 = std::min(w - 1, pixel(std::ceil(cx + edge), w));
+  const int y0 = std::max(0, pixel(std::floor(cy - edge), h)),
+            y1 = std::min(h - 1, pixel(std::ceil(cy + edge), h));
+  if (x0 > x1 || y0 > y1) return;  // wholly off the picture (and its footprint's bounds may not fit an int)
+  auto coverage_at = [&](int x, int y) {
+    return std::clamp(edge - std::hypot(x + 0.5 - cx, y + 0.5 - cy), 0.0, 1.0);
+  };
+  // Below 4 pixels the partly covered pixels take what the full ones leave of the area.
+  double full = 0, partial = 0, gain = 1;
+  if (r < 4) {  // the whole footprint, pixels past the picture's sides included
+    for (int y = int(std::floor(cy - edge)); y <= int(std::ceil(cy + edge)); ++y)
+      for (int x = int(std::floor(cx - edge)); x <= int(std::ceil(cx + edge)); ++x) {
+        const double c = coverage_at(x, y);
+        (c >= 1 ? full : partial) += c;
       }
-    }
+    if (partial > 0) gain = std::max(0.0, 3.141592653589793 * r * r - full) / partial;
   }
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const double c = coverage_at(x, y);
+      if (const double coverage = c >= 1 ? 1.0 : std::min(1.0, c * gain); coverage > 0)
+        f(static_cast<std::size_t>(y) * w + x, coverage);
+    }
+}
+
+/// `under` with `ink` laid over it at `coverage` (`mode` as draw_disc's: 0 over, 1 multiply, 2 add).
+std::uint8_t blend(std::uint8_t under, std::uint8_t ink, double coverage, int mode) {
+  const double u = under;
+  const double top = mode == 1 ? u * ink / 255.0 : mode == 2 ? std::min(255.0, u + ink) : double(ink);
+  return static_cast<std::uint8_t>(std::lround(u + (top - u) * coverage));
+}
+
+}  // namespace
+
+void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode) {
+  for_each_disc_pixel(image.width, image.height, cx, cy, r, [&](std::size_t i, double coverage) {
+    for (int c = 0; c < 3; ++c)
+      image.pixels[3 * i + c] = blend(image.pixels[3 * i + c], rgb[c], coverage, mode);
+  });
+}
+
+void add_disc(CoverageImage& layer, double cx, double cy, double r) {
+  for_each_disc_pixel(layer.width, layer.height, cx, cy, r, [&](std::size_t i, double coverage) {
+    const long sum = layer.values[i] + std::lround(coverage * 65535);
+    layer.values[i] = static_cast<std::uint16_t>(std::min(sum, 65535L));
+  });
+}
+
+void composite(RgbImage& image, const CoverageImage& layer, const std::uint8_t rgb[3], int mode) {
+  for (std::size_t i = 0; i < layer.values.size(); ++i)
+    if (layer.values[i])
+      for (int c = 0; c < 3; ++c)
+        image.pixels[3 * i + c] = blend(image.pixels[3 * i + c], rgb[c], layer.values[i] / 65535.0, mode);
 }
 
 bool write_text_file_atomic(const std::string& given_path, const std::string& text, std::string& error) {

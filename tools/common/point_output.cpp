@@ -25,13 +25,13 @@ std::string number(double v) {
   return text;
 }
 
-std::string hex(const Ink& ink) {
+}  // namespace
+
+std::string Ink::hex() const {
   char text[8];
-  std::snprintf(text, sizeof text, "#%02x%02x%02x", ink.rgb[0], ink.rgb[1], ink.rgb[2]);
+  std::snprintf(text, sizeof text, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
   return text;
 }
-
-}  // namespace
 
 const char* const kClassInkNames = "black (class 0), red, blue, green, orange, purple, brown, pink (class 7)";
 
@@ -54,13 +54,19 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
-int check_picture_size(int width_px, double aspect) {
+int check_picture_size(int width_px, double aspect, const std::string& path) {
   const int w = std::max(1, width_px);
   const double h = std::max(1.0, std::round(w / aspect));  // the picture's own shape
-  if (!(double(w) * h <= double(1 << 28)))  // 768 MiB of RGB: refuse rather than die allocating
+  const auto refuse = [&](const char* limit) {
     throw std::invalid_argument("a picture of " + std::to_string(w) + "x" +
-                                std::to_string(std::llround(std::min(h, 1e18))) +
-                                " pixels is too large (limit 2^28 pixels); lower the width");
+                                std::to_string(std::llround(std::min(h, 1e18))) + " pixels is too large (" +
+                                limit + "); lower the width");
+  };
+  if (!has_extension(path, ".png")) {  // an SVG's size is two numbers: only the height's int is a limit
+    if (!(h <= double(1 << 30))) refuse("limit 2^30 pixels high");
+  } else if (!(double(w) * h <= double(1 << 28))) {  // 768 MiB of RGB and 512 of coverage: refuse, not die
+    refuse("limit 2^28 pixels");
+  }
   return static_cast<int>(h);
 }
 
@@ -77,7 +83,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   if (points.dim != 2)
     throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(1, style.width_px);
-  const int h = check_picture_size(style.width_px, style.aspect);
+  const int h = check_picture_size(style.width_px, style.aspect, path);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
   // A dot wider than the picture only blackens it, and painting large dots costs their area each.
   if (!(r <= std::max(w, h)))
@@ -96,13 +102,22 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   if (classed)
     for (std::uint8_t c : *style.classes)
       if (c >= inks.size()) throw std::invalid_argument("a point's class has no ink");
-  if (png) {
+  // The inks in their layer order (a plotter's pens, the SVG's layers).
+  std::vector<std::size_t> order(classed ? inks.size() : 1);
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return inks[a].layer < inks[b].layer; });
+  if (png) {  // each ink's dots as one coverage layer, laid on the paper in turn
     RgbImage image(w, h, 255);
     for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = style.background[i % 3];
-    for (std::size_t i = 0; i < points.size(); ++i)
-      if (radius(i) > 0)
-        draw_disc(image, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, radius(i),
-                  inks[classed ? (*style.classes)[i] : 0].rgb, static_cast<int>(style.blend));
+    CoverageImage layer(w, h);
+    for (const std::size_t k : order) {
+      std::fill(layer.values.begin(), layer.values.end(), 0);
+      for (std::size_t i = 0; i < points.size(); ++i)
+        if (!classed || (*style.classes)[i] == k)
+          add_disc(layer, points.coords[2 * i] * w, (1 - points.coords[2 * i + 1]) * h, radius(i));
+      composite(image, layer, inks[k].rgb, static_cast<int>(style.blend));
+    }
     if (!write_png(path, image, error)) throw std::runtime_error(error);
     return;
   }
@@ -118,17 +133,13 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   };
   Ink paper;
   std::copy(style.background, style.background + 3, paper.rgb);
-  out << layer("paper") << "><rect width=\"100%\" height=\"100%\" fill=\"" << hex(paper) << "\"/></g>\n";
+  out << layer("paper") << "><rect width=\"100%\" height=\"100%\" fill=\"" << paper.hex() << "\"/></g>\n";
   out.precision(6);
-  std::vector<std::size_t> order(classed ? inks.size() : 1);
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return inks[a].layer < inks[b].layer; });
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
                                                         : "";
-    out << layer(classed ? inks[k].name : "points") << " fill=\"" << hex(inks[k]) << "\"" << blend << ">\n";
+    out << layer(classed ? inks[k].name : "points") << " fill=\"" << inks[k].hex() << "\"" << blend << ">\n";
     for (std::size_t i = 0; i < points.size(); ++i)
       if ((!classed || (*style.classes)[i] == k) && radius(i) > 0)
         out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h

@@ -13,7 +13,8 @@ namespace kdm::tools {
 struct Ink {
   std::uint8_t rgb[3] = {0, 0, 0};
   std::string name;
-  int layer = 0;  ///< its place among an SVG's layers, lowest first (ties in class order)
+  int layer = 0;            ///< its place among an SVG's layers, lowest first (ties in class order)
+  std::string hex() const;  ///< "#rrggbb"
 };
 
 /// Distinct inks for `count` classes (at most 8), named class-0, class-1, …: black first, then colours.
@@ -41,10 +42,10 @@ struct DrawStyle {
 /// `what` saying what the input is ("input image"): a result written over what it came from.
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
-/// The height in pixels of a picture `width_px` wide of `aspect` (width / height); throws
-/// std::invalid_argument, naming the size, for one past 2^28 pixels (write_points checks it; a caller that
-/// computes points for a picture checks it first).
-int check_picture_size(int width_px, double aspect);
+/// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path`; throws
+/// std::invalid_argument, naming the size, for a PNG past 2^28 pixels or an SVG past 2^30 pixels high
+/// (write_points checks it; a caller that computes points for a picture checks it first).
+int check_picture_size(int width_px, double aspect, const std::string& path);
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.
 /// Throws std::invalid_argument on an unknown extension or a picture too large, std::runtime_error on a

@@ -157,8 +157,10 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
       unused.insert(unused.begin(), s.inks[c]);
       s.channels.erase(s.channels.begin() + c), s.inks.erase(s.inks.begin() + c);
     }
-  if (s.channels.empty())
-    throw std::invalid_argument("the image has no ink in any colour: nothing to stipple");
+  if (s.channels.empty()) {  // a blank image: no dots, every ink an empty layer
+    s.unused = std::move(unused);
+    return s;
+  }
   // A later class's dots are those its cumulative density adds to the earlier classes', so its tone carries
   // their count errors too, the more the smaller its share: inks of least coverage first. But an ink of
   // very little coverage first takes the union's lowest thresholds, which repeat a motif along tile edges:

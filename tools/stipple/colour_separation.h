@@ -41,8 +41,8 @@ struct ColourSeparation {
 /// Each density is the coverage raised to `gamma` (> 0). The inks come in order of increasing mean coverage
 /// (a later class's tone carries the earlier classes' count errors, the more the smaller its share), except
 /// that inks under a tenth of the total coverage come last, most covering first (a sparse class early in
-/// the order shows the tile edges). Throws std::invalid_argument naming the problem for another scheme or
-/// an image with no ink.
+/// the order shows the tile edges). An image with no ink in any colour gives no channels (every ink
+/// unused). Throws std::invalid_argument naming the problem for another scheme.
 ColourSeparation separate_colours(const ColourImage& image, const std::string& scheme, double gamma);
 
 }  // namespace kdm::tools
