@@ -17,7 +17,7 @@ std::vector<kdm::QueryPoint> scatter(double x0, double y0, double x1, double y1)
     if (total == out.size()) out.resize(out.size() * 2);  // full; else it paused at its work bound
   }
   out.resize(status == kdm::Status::kOk ? total + n : 0);  // else kdm::status_message(status) says why
-  return out;  // each point has a stable id (tile_x, tile_y, rank) to key instances on
+  return out;  // each point has a stable id (tile_x, tile_y, rank, depth) to key instances on
 }
 
 #include <cstdio>

@@ -12,8 +12,9 @@
 // the tone is fixed (also relative to its target D × darkness), and the largest motion of a dot over the
 // surface since the previous frame, in its spacing along the way it moved (near the silhouette apart). With
 // --check it exits non-zero if the relative density of the last frame differs from the first's by more than
-// 10% or a dot away from the silhouette moves half a spacing or more in one frame (or, with --colours, an
-// ink's dots on screen are more than 10% off D × its cover in a frame where it expects 100 or more).
+// 10% or a dot away from the silhouette moves half a spacing or more in one frame (a motion that needs some
+// 300 frames for the 100× zoom: at 24, dots move 1.7-2.9 spacings a frame), or, with --colours, an
+// ink's dots on screen are more than 10% off D × its cover in a frame where it expects 100 or more.
 //
 // With --colours the checker is orange and blue, and the dots are cyan, magenta, yellow and black: four
 // classes of one query (kdm::query_classes), whose densities one joint callback gives from the shaded
@@ -472,7 +473,10 @@ int main(int argc, char** argv) {
   if (check && (!(std::abs(drift) <= 0.10) || !(worst_jump < 0.5) || !inks_follow)) {
     std::fprintf(stderr, "texture_stipple: check failed:%s%s%s\n",
                  std::abs(drift) <= 0.10 ? "" : " the band's dot density drifts by more than 10%;",
-                 worst_jump < 0.5 ? "" : " a dot moved half a spacing or more in one frame;",
+                 worst_jump < 0.5
+                     ? ""
+                     : " a dot moved half a spacing or more in one frame (the fewer the frames, the "
+                       "farther dots move: the 100x zoom needs about 300 to pass, --frames 300);",
                  inks_follow ? "" : " an ink's dots on screen are more than 10% off its cover");
     return 1;
   }

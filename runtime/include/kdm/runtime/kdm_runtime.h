@@ -4,7 +4,8 @@
  * Growing structs: kdm_query, kdm_query_problem and kdm_tileset_info begin with `struct_size`, which the
  * caller sets to sizeof(the struct) as its header declares it. A newer library reads only that many bytes
  * (later fields keep their defaults) and writes only that many, so programs built against an older header
- * keep working.
+ * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest:
+ * a program that sets a field newer than the library it runs with should check kdm_version().
  *
  * Thread safety: a loaded kdm_tileset and a kdm_density_image are immutable; queries on them may run
  * concurrently. No function here throws; every failure is a status code. Queries allocate nothing. */

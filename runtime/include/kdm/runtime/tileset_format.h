@@ -176,7 +176,7 @@ struct TilesetShape {
   }
   /// The emission rule, stated once for the runtime and the generator test: a point with threshold
   /// `threshold` is emitted where its tile's expected point count is `expected` iff expected > threshold.
-  static bool emits(float threshold, double expected) { return expected > threshold; }
+  static bool emits(float threshold, double expected) { return expected > static_cast<double>(threshold); }
   /// The unit of keyframe g's glide offsets in tile sides: 1 / (kGlideUnitsPerSpacing · √K_g).
   double glide_unit(std::size_t g) const {
     return 1.0 / (kGlideUnitsPerSpacing * std::sqrt(double(keyframe_nominal[g])));
