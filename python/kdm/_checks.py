@@ -118,11 +118,9 @@ def array2d(name: str, value: Any) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
-def luminance(name: str, value: Any) -> np.ndarray:
-    """An image array as luminance in [0, 1], 2-D float64, as an image file is read: float values as they
-    are; uint8 and uint16 divided by 255 and 65535; (rows, columns, 3 or 4) RGB(A), or 2 (grey and alpha),
-    to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in float32 as kdm reads files (the same
-    densities as the file's pixels). A PIL image is an array too."""
+def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
+    """An image array as float32 samples in [0, 1] (uint8 and uint16 divided by 255 and 65535) and its
+    channel count (1 for a 2-D array)."""
     try:
         a = np.asarray(value)
     except ValueError as e:  # ragged nested lists
@@ -131,26 +129,42 @@ def luminance(name: str, value: Any) -> np.ndarray:
         raise TypeError(f"{name} must be an array of numbers: {e}") from None
     if a.dtype.kind not in "biuf":
         raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
-    if a.ndim == 3 and a.shape[2] in (1, 2, 3, 4):
-        full = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(a.dtype)
-        if full is None and a.dtype.kind != "f":
-            raise ValueError(f"{name}: colour arrays must be uint8, uint16 or floats in [0, 1], got {a.dtype}")
-        p = a.astype(np.float32) / np.float32(full or 1)
-        if full is None and not (np.isfinite(p).all() and p.min() >= 0 and p.max() <= 1):
-            raise ValueError(f"{name}: colour values must be in [0, 1] (8-bit values: a uint8 array)")
-        channels = a.shape[2]
-        lum = p[..., 0] if channels < 3 else (np.float32(0.2126) * p[..., 0] + np.float32(0.7152) * p[..., 1]
-                                              + np.float32(0.0722) * p[..., 2])
-        alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else np.float32(1)
-        return np.ascontiguousarray(np.clip(lum * alpha + (np.float32(1) - alpha), 0, 1), dtype=np.float64)
-    if a.ndim != 2:
+    if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] in (1, 2, 3, 4))):
         raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, 3 or 4) "
                          f"of colour, got shape {a.shape}")
-    if a.dtype in (np.uint8, np.uint16):
-        return (a.astype(np.float32) / np.float32(255 if a.dtype == np.uint8 else 65535)).astype(np.float64)
-    if a.dtype.kind in "iu":
+    full = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(a.dtype)
+    if full is None and a.dtype.kind != "f":
         raise ValueError(f"{name}: integer arrays must be uint8 (0-255) or uint16 (0-65535), got {a.dtype}")
-    return np.ascontiguousarray(a, dtype=np.float64)
+    p = a.astype(np.float32) / np.float32(full or 1)
+    if full is None and not (np.isfinite(p).all() and p.min(initial=0) >= 0 and p.max(initial=0) <= 1):
+        raise ValueError(f"{name}: values must be in [0, 1] (8-bit pixels: pass them as uint8, or divide by 255)")
+    return (p[..., None] if a.ndim == 2 else p), (1 if a.ndim == 2 else a.shape[2])
+
+
+def colour(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """An image array as load_colour_image reads a file: (rows, columns, 3) float32 red, green and blue
+    composited on white (grey: three equal channels), and its alpha (rows, columns) or None."""
+    p, channels = _samples(name, np.asarray(value) if hasattr(value, "__array_interface__") else value)
+    alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else None
+    colour = p[..., :1].repeat(3, axis=2) if channels < 3 else p[..., :3]
+    a = np.float32(1) if alpha is None else alpha[..., None]
+    rgb = np.clip(colour * a + (np.float32(1) - a), 0, 1).astype(np.float32)
+    return np.ascontiguousarray(rgb), None if alpha is None else np.ascontiguousarray(alpha)
+
+
+def luminance(name: str, value: Any) -> np.ndarray:
+    """An image array as luminance in [0, 1], 2-D float64, as an image file is read: float values as they
+    are; uint8 and uint16 divided by 255 and 65535; (rows, columns, 3 or 4) RGB(A), or 2 (grey and alpha),
+    to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in float32 as kdm reads files (the same
+    densities as the file's pixels). A PIL image is an array too."""
+    a = np.asarray(value) if is_array(value) or hasattr(value, "__array_interface__") else value
+    if getattr(a, "ndim", 0) == 2 and getattr(a, "dtype", None) is not None and a.dtype.kind == "f":
+        return np.ascontiguousarray(a, dtype=np.float64)  # luminance as given (checked in [0, 1] after)
+    p, channels = _samples(name, a)
+    lum = p[..., 0] if channels < 3 else (np.float32(0.2126) * p[..., 0] + np.float32(0.7152) * p[..., 1]
+                                          + np.float32(0.0722) * p[..., 2])
+    alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else np.float32(1)
+    return np.ascontiguousarray(np.clip(lum * alpha + (np.float32(1) - alpha), 0, 1), dtype=np.float64)
 
 
 def is_array(value: Any) -> bool:

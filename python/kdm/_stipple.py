@@ -68,7 +68,7 @@ def stipple(
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
     colours : {"cmyk", "rgb"}, int or None
-        A colour stipple of an image file (``kdm stipple --colours``): "cmyk" (black by under-colour
+        A colour stipple of the image, a file or an array (``kdm stipple --colours``): "cmyk" (black by under-colour
         removal), "rgb" (light on black) or a number of inks, 2 to 8, clustered from the image; one class
         of dots per ink, all of them one blue-noise set.
     fade : float
@@ -94,9 +94,11 @@ def stipple(
             except OSError as e:
                 raise type(e)(f"cannot read image '{label}': {e.strerror}") from None
         spec = _kdm.DensitySpec.parse(label, gamma, invert)
+        rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
         label = "array"
         spec = _kdm.DensitySpec.from_luminance(_checks.luminance("image", image), gamma, invert)
+        rgb, alpha = _checks.colour("image", image) if colours is not None else (None, None)
     else:
         raise TypeError(f"image must be a path or an array (luminance or colour), got {type(image).__name__}")
     if scale is None:
@@ -127,8 +129,6 @@ def stipple(
     if fade > 0 and method == "full":
         raise ValueError("fade needs method='tiles' (dots that appear)")
     if colours is not None:
-        if label == "array":
-            raise ValueError("colours needs an image file (an array holds luminance only)")
         if invert:
             raise ValueError("invert does not apply to colours (each ink has its own channel)")
         if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
@@ -138,23 +138,27 @@ def stipple(
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
-        colours, gamma, fade,
+        colours, gamma, fade, rgb, alpha,
     )
 
 
 def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[np.ndarray, List[str]]:
-    """The inks of an image file as ``stipple(image, colours=...)`` separates them, to preview or measure.
+    """The inks of an image (a file, an array or a PIL image) as ``stipple(image, colours=...)`` separates
+    them, to preview or measure.
 
     Returns ``(channels, inks)``: channels a (k, height, width) float32 array, each ink's density in [0, 1]
     (its coverage raised to `gamma`), row 0 at the top as in the picture; inks the inks' names, in class
     order: the inks of least coverage first (a later class's tone carries the earlier classes' count
     errors, the more the smaller its share), except that inks under a tenth of the total coverage come last.
     """
-    label = _checks.path("image", image)
+    if isinstance(image, (str, os.PathLike)):
+        label, rgb, alpha = _checks.path("image", image), None, None
+    else:  # an array or a PIL image, as stipple() takes it
+        label, (rgb, alpha) = "array", _checks.colour("image", image)
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
         colours = str(int(colours))
     if not isinstance(colours, str):
         raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
-    channels, inks = _kdm.separate(label, colours, gamma)
+    channels, inks = _kdm.separate(label, colours, gamma, rgb, alpha)
     return channels, list(inks)

@@ -21,12 +21,33 @@ namespace {
 
 using tools::DensitySpec;
 using Region = std::array<double, 4>;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+/// A colour image for the separation: from `rgb` ((rows, columns, 3) in [0, 1], composited on white, row 0
+/// at the top) and its `alpha` when given (kdm._checks.colour made them as load_colour_image reads a file),
+/// else read from the file `label`.
+tools::ColourImage colour_image(const std::string& label, const std::optional<FloatArray>& rgb,
+                                const std::optional<FloatArray>& alpha) {
+  tools::ColourImage image;
+  if (!rgb) {
+    std::string error;
+    if (!tools::load_colour_image(label, image, error)) throw FileError(error);
+    return image;
+  }
+  if (rgb->ndim() != 3 || rgb->shape(2) != 3 ||
+      (alpha && (alpha->ndim() != 2 || alpha->shape(0) != rgb->shape(0) || alpha->shape(1) != rgb->shape(1))))
+    throw std::invalid_argument("a colour image is (rows, columns, 3) with an alpha of (rows, columns)");
+  image.height = static_cast<int>(rgb->shape(0)), image.width = static_cast<int>(rgb->shape(1));
+  image.pixels.assign(rgb->data(), rgb->data() + rgb->size());
+  if (alpha) image.alpha.assign(alpha->data(), alpha->data() + alpha->size());
+  return image;
+}
 
 py::object stipple(const DensitySpec& spec, const std::string& label, std::int64_t points, double scale,
                    const std::string& method, const std::string& mode, std::optional<Region> region,
                    std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
                    int width, double dot_size, int threads, std::optional<std::string> colours, double gamma,
-                   double fade) {
+                   double fade, std::optional<FloatArray> rgb, std::optional<FloatArray> alpha) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -56,9 +77,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   tools::ColourSeparation inks;
   std::vector<const DensitySpec*> specs = {&spec};
   if (colours) {
-    tools::ColourImage image;
-    std::string error;
-    if (!tools::load_colour_image(label, image, error)) throw FileError(error);
+    const tools::ColourImage image = colour_image(label, rgb, alpha);
     py::gil_scoped_release release;  // a clustering of every pixel: seconds for a large photograph
     inks = tools::separate_colours(image, *colours, gamma);
     specs.clear();
@@ -135,14 +154,13 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
 
 /// The inks of an image file as kdm stipple --colours separates them: (k, height, width) float32 densities,
 /// row 0 at the top as in the picture, and the inks' names, in class order.
-py::tuple separate(const std::string& path, const std::string& colours, double gamma) {
+py::tuple separate(const std::string& path, const std::string& colours, double gamma,
+                   std::optional<FloatArray> rgb, std::optional<FloatArray> alpha) {
   check_number("gamma", gamma, 0, true);
-  tools::ColourImage image;
-  std::string error;
+  const tools::ColourImage image = colour_image(path, rgb, alpha);
   tools::ColourSeparation inks;
   {
     py::gil_scoped_release release;
-    if (!tools::load_colour_image(path, image, error)) throw FileError(error);
     inks = tools::separate_colours(image, colours, gamma);
   }
   const auto k = static_cast<py::ssize_t>(inks.channels.size());
@@ -161,11 +179,13 @@ py::tuple separate(const std::string& path, const std::string& colours, double g
 
 void bind_stipple(py::module_& m) {
   m.def("separate", &separate, py::arg("path"), py::arg("colours"), py::arg("gamma"),
+        py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
         "The inks of an image file as kdm stipple --colours separates them (channels, names)");
   m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
         py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
         py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"), py::arg("fade"),
+        py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
         "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 

@@ -78,6 +78,17 @@ def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
     grey = np.asarray(Image.open(SPHERE))
     assert grey.ndim == 2
     np.testing.assert_array_equal(kdm.stipple(grey, points=2000), kdm.stipple(str(SPHERE), points=2000))
+    # In colour too, and separate(): the same inks as the file's (with alpha: light on black paper).
+    for colours in ("cmyk", "rgb", 4):
+        from_file, from_array = kdm.stipple(str(coffee), colours=colours, points=2000), kdm.stipple(
+            rgb, colours=colours, points=2000)
+        for a, b in zip(from_file, from_array):
+            np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(kdm.separate(rgb)[0], kdm.separate(str(coffee))[0])
+    translucent = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 128, np.uint8)], axis=2)
+    Image.fromarray(translucent).save(tmp_path / "translucent.png")
+    np.testing.assert_array_equal(kdm.stipple(translucent, colours="rgb", points=2000)[0],
+                                  kdm.stipple(str(tmp_path / "translucent.png"), colours="rgb", points=2000)[0])
     np.testing.assert_array_equal(kdm.stipple(grey.astype(np.uint16) * 257, points=2000),
                                   kdm.stipple(grey, points=2000))  # 257 v / 65535 = v / 255, rounded alike
 
@@ -262,8 +273,8 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
         kdm.stipple(str(coffee), colours="cmy")
     with pytest.raises(ValueError, match="invert"):
         kdm.stipple(str(coffee), colours="rgb", invert=True)
-    with pytest.raises(ValueError, match="image file"):
-        kdm.stipple(np.ones((4, 4)) * 0.5, colours="cmyk")
+    dots, classes, inks = kdm.stipple(np.ones((4, 4)) * 0.5, colours="cmyk", points=200)  # grey: black ink
+    assert len(dots) > 150 and set(classes) == {0} and inks == ["black"]
 
 
 def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
