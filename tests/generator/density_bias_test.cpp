@@ -139,7 +139,7 @@ double column_spread(Domain domain, double aspect, bool balance, int seeds) {
 // A uniform density's counts too: without the balance they drift across the domain by more than its own
 // blue noise (a 3:1 box: a U, 7% from the walls to the middle at 60,000 points), which the finest sweeps
 // cannot carry back. Measured per seed (20,000 points, seeds 1-6): a column's relative sd in the 3:1 box
-// 0.10-0.27% with the balance, 1.06-2.04% without; on the torus 0.25-0.43% with it (0.32-0.67% without:
+// 0.14-0.26% with the balance, 1.06-2.04% without; on the torus 0.24-0.40% with it (0.32-0.67% without:
 // too close to assert an order at this count).
 TEST(DensityBiasTest, UniformCountsAreEvenAcrossTheDomain) {
   const double box = column_spread(Domain::kBox, 3, true, 3);

@@ -194,12 +194,12 @@ struct Driver {
   /// first on the pyramid level that averages kBalancePointsPerNode or more, then on each finer one up to
   /// kBalanceMaxNodes where its nodes hold kBalanceFinePointsPerNode. On every level, so that kernels are
   /// balanced while they are still relaxed: the sparse regions' kernels freeze on coarse levels. A
-  /// uniform density, whose kernels are all alike and never freeze, only on the finest level: that alone
-  /// takes its large-scale counts from ±1-2% to ±0.1%, as the balance on every level does, at a third of
-  /// the cost (docs/design.md §2.6). Not for constrained sampling (tile baking), whose coarse densities
-  /// come from the fixed points.
+  /// uniform density, whose kernels are all alike and never freeze, on the two finest levels only: that
+  /// takes its large-scale counts from ±1-2% to ±0.2%, as every level does, at a fraction of the cost,
+  /// and leaves no wide hole where the finest level alone left a few (docs/design.md §2.6). Not for
+  /// constrained sampling (tile baking), whose coarse densities come from the fixed points.
   void balance_counts_at(int base) {
-    if (!options.count_balance || (setup.uniform && base > 0) || !fixed.empty() || options.n <= 0) return;
+    if (!options.count_balance || (setup.uniform && base > 1) || !fixed.empty() || options.n <= 0) return;
     const double max_nodes = std::min(double(options.n) / kBalancePointsPerNode, kBalanceMaxNodes);
     const int levels = static_cast<int>(setup.levels.size());
     int l = base + 1;  // the first grid: level l of the pyramid, or coarser still
