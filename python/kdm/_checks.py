@@ -103,8 +103,8 @@ def rect(name: str, value: Any, allow_empty: bool = False) -> Tuple[float, ...]:
     return r
 
 
-def array2d(name: str, value: Any) -> np.ndarray:
-    """A 2-D array of numbers as C-contiguous float64 (copied only when it is not that already)."""
+def _real_array(name: str, value: Any) -> np.ndarray:
+    """`value` as a numpy array of real numbers (bool, integer or float), else ValueError or TypeError."""
     try:
         a = np.asarray(value)
     except ValueError as e:  # ragged nested lists
@@ -113,6 +113,12 @@ def array2d(name: str, value: Any) -> np.ndarray:
         raise TypeError(f"{name} must be a 2-D array of numbers: {e}") from None
     if a.dtype.kind not in "biuf":
         raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    return a
+
+
+def array2d(name: str, value: Any) -> np.ndarray:
+    """A 2-D array of numbers as C-contiguous float64 (copied only when it is not that already)."""
+    a = _real_array(name, value)
     if a.ndim != 2:
         raise ValueError(f"{name} must be a 2-D array (rows, columns), got shape {a.shape}")
     return np.ascontiguousarray(a, dtype=np.float64)
@@ -121,14 +127,7 @@ def array2d(name: str, value: Any) -> np.ndarray:
 def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
     """An image array as float32 samples in [0, 1] (uint8 and uint16 divided by 255 and 65535) and its
     channel count (1 for a 2-D array)."""
-    try:
-        a = np.asarray(value)
-    except ValueError as e:  # ragged nested lists
-        raise ValueError(f"{name} must be a 2-D array (rows, columns): {e}") from None
-    except Exception as e:  # an object whose __array__ fails
-        raise TypeError(f"{name} must be an array of numbers: {e}") from None
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    a = _real_array(name, value)
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] in (1, 2, 3, 4))):
         raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, 3 or 4) "
                          f"of colour, got shape {a.shape}")
