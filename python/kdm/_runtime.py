@@ -186,8 +186,8 @@ class Tileset:
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
             GIL held; an exception it raises is raised here once the query ends, and a value that is
             not finite and >= 0 raises ValueError), which needs `density_max` (> 0), a true upper bound of
-            its values (a larger one raises ValueError; smooth mode also reads up to a glide's reach
-            outside `rect`). Default: 1.
+            its values (a larger one raises ValueError; smooth mode also reads up to twice the glide's
+            reach, ``info["glide_reach"]`` tile sides, outside `rect`). Default: 1.
         vectorized : bool
             For a callable density: True if f takes arrays, f(x, y) -> array of the same length (x and y
             float64 arrays of up to 128 positions, a tile's candidates at a time; scipy's `vectorized`).
@@ -436,7 +436,11 @@ def bake(recipe_text: str, *, threads: int = 0) -> Tileset:
     sampling. Raises ValueError for a bad recipe, some values only once baking finds them (a hand-over
     whose subtiles hold too few points: the message names the key to change).
     """
+    if isinstance(recipe_text, os.PathLike):
+        raise TypeError("recipe_text is the recipe's text: read the file first (pathlib.Path(p).read_text())")
     if not isinstance(recipe_text, str):
         raise TypeError(f"recipe_text must be a str, got {type(recipe_text).__name__}")
+    if recipe_text and not any(c.isspace() for c in recipe_text.strip()) and os.path.exists(recipe_text):
+        raise ValueError(f"recipe_text '{recipe_text}' names a file: give its text (open(...).read())")
     threads = _checks.threads(threads)
     return Tileset(_kdm.bake(recipe_text, threads))

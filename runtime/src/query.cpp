@@ -172,21 +172,6 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
     *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
     return Status::kOk;
   }
-  // Tile coordinates must fit an int64 exactly, and past the top level so must the subtiles' (m^depth
-  // times the tile's): farther out is too far from the world origin, whatever the spacing.
-  const double most_tiles =
-      descend ? std::min(9e15, std::ldexp(1.0, 62) / std::pow(double(tables.subtiles), kMaxQueryDepth))
-              : 9e15;
-  if (std::fabs(tx0d) > most_tiles || std::fabs(tx1d) > most_tiles)
-    return refuse(Kind::kTooFarFromOrigin, "x0", std::max(std::fabs(q.x0), std::fabs(q.x1)), most_tiles * S);
-  if (std::fabs(ty0d) > most_tiles || std::fabs(ty1d) > most_tiles)
-    return refuse(Kind::kTooFarFromOrigin, "y0", std::max(std::fabs(q.y0), std::fabs(q.y1)), most_tiles * S);
-  const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
-  const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
-  if (tx1 <= tx0 || ty1 <= ty0) {  // x1 / S rounded onto x0 / S: no tile column (or row) to visit at all
-    *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
-    return Status::kOk;
-  }
   // Depth-0 positions are summed in world units and a point's place in the region is decided in them: a
   // double's step there (at most 2^-52 of the distance) must stay below a 16th of the spacing at depth 0,
   // or positions fall together, and below a quarter of the region's side where the region is wider than
@@ -197,6 +182,24 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   const double deepest_spacing = S / std::sqrt(max_density * area_scale);
   const double side = std::max(std::min(q.x1 - q.x0, q.y1 - q.y0), deepest_spacing);
   const double farthest = std::ldexp(std::min(spacing / 16, side / 4), 52);
+  // Tile coordinates must fit an int64 exactly, and past the top level so must the subtiles' (m^depth
+  // times the tile's): farther out is too far from the world origin, whatever the spacing. The limit
+  // stated is the nearer of the two, so that a region moved within it is served.
+  const double most_tiles =
+      descend ? std::min(9e15, std::ldexp(1.0, 62) / std::pow(double(tables.subtiles), kMaxQueryDepth))
+              : 9e15;
+  if (std::fabs(tx0d) > most_tiles || std::fabs(tx1d) > most_tiles)
+    return refuse(Kind::kTooFarFromOrigin, "x0", std::max(std::fabs(q.x0), std::fabs(q.x1)),
+                  std::min(most_tiles * S, farthest));
+  if (std::fabs(ty0d) > most_tiles || std::fabs(ty1d) > most_tiles)
+    return refuse(Kind::kTooFarFromOrigin, "y0", std::max(std::fabs(q.y0), std::fabs(q.y1)),
+                  std::min(most_tiles * S, farthest));
+  const std::int64_t tx0 = static_cast<std::int64_t>(tx0d), tx1 = static_cast<std::int64_t>(tx1d);
+  const std::int64_t ty0 = static_cast<std::int64_t>(ty0d), ty1 = static_cast<std::int64_t>(ty1d);
+  if (tx1 <= tx0 || ty1 <= ty0) {  // x1 / S rounded onto x0 / S: no tile column (or row) to visit at all
+    *cursor = QueryCursor{cursor->tile_x, cursor->tile_y, cursor->rank, true, true, fingerprint};
+    return Status::kOk;
+  }
   if (far > farthest)
     return refuse(Kind::kTooFarFromOrigin, far == std::fabs(q.x0) || far == std::fabs(q.x1) ? "x0" : "y0",
                   far, farthest);

@@ -181,6 +181,8 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, r"or \(rows, columns, 3 or 4\) of colour", lambda: kdm.stipple(np.zeros((4, 4, 5)))),
     (ValueError, "stipple needs an image", lambda: kdm.stipple("const:1")),
     (TypeError, "image must be a path or an array", lambda: kdm.stipple(3)),
+    (ValueError, "names a file: give its text", lambda: kdm.bake(str(SPHERE))),
+    (TypeError, "read the file first", lambda: kdm.bake(SPHERE)),
     (OSError, "cannot open .default.", lambda: kdm.stipple(SPHERE, tileset="default")),
     (TypeError, "tileset must be a kdm.Tileset, a tile-set file", lambda: kdm.stipple(SPHERE, tileset=3)),
     (ValueError, r"points must be an \(n, 2\) or \(n, 3\) array", lambda: kdm.analyze(np.ones((5, 4)))),

@@ -681,6 +681,18 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   EXPECT_FALSE(run(q).empty());
   q.scale = 1, q.tile_size = 1e300;  // a tile's area overflows: the tile size is named, not the scale
   EXPECT_STREQ(problem_of(q).parameter, "tile_size");
+  // Too far from the origin: the limit stated is the nearer one (tile coordinates past 9e15 tiles, or a
+  // double's step past the spacing), so that a region moved within it is served. 256 units at 1e18 on
+  // tiles of 64 (1.6e16 tiles out) used to state 9e15 tiles, 5.8e17, where 5e17 was refused again.
+  q = region(1e18, 0, 1e18 + 256, 256, 0.02);
+  q.tile_size = 64;
+  p = problem_of(q);
+  ASSERT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_LT(p.limit, 5.76e17);
+  q.x0 = 0.9 * p.limit, q.x1 = q.x0 + 256;
+  QueryCursor served;
+  EXPECT_NE(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &served),
+            Status::kInvalidArgument);
   QueryCursor cursor;
   EXPECT_EQ(query_points(Tileset::builtin(), q, buffer.data(), 16, nullptr, &cursor),
             Status::kInvalidArgument);

@@ -124,6 +124,10 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.glide_together = a.glide_together;
   if (a.glide_together && q.mode != QueryMode::kSmooth)  // stable points never glide: said, not refused
     std::fprintf(stderr, "kdm query: warning: --glide-together applies to --mode smooth only; ignored\n");
+  if (q.mode == QueryMode::kSmooth && !tiles.has_glide_track())  // the runtime's rule, said
+    std::fprintf(stderr,
+                 "kdm query: warning: the tile set has no glide track: smooth mode gives stable "
+                 "positions (bake it with keyframes)\n");
   // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;
@@ -156,6 +160,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   char line[200];
   std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
                 a.rect.c_str(), a.scale, a.tile_size);
+  const auto t1 = std::chrono::steady_clock::now();
   const bool csv = tools::has_extension(a.output, ".csv"), json = tools::has_extension(a.output, ".json");
   if (csv || json) {
     std::string error;
@@ -175,7 +180,9 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     tools::write_points(a.output, tools::normalise_to_rect(points, r),
                         {line, "coordinates normalised to the rect"}, style);
   }
-  std::fprintf(stderr, "%s in %.4f s -> %s\n", line, seconds, a.output.c_str());
+  const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  std::fprintf(stderr, "%s queried in %.4f s, written in %.3f s -> %s\n", line, seconds, writing,
+               a.output.c_str());
 }
 
 }  // namespace
@@ -188,8 +195,9 @@ void add_query_command(CLI::App& app) {
   CLI::Option* density =
       cmd->add_option(
              "--density", a->density,
-             "const:V (V >= 0), an image (dark = dense), or a test map ramp:R or radial:R (dynamic range "
-             "R), stretched over --density-rect")
+             "const:V (V >= 0), an image (density = 1 - luminance, 0.2126 R + 0.7152 G + 0.0722 B of the "
+             "file's values, alpha on white; dark = dense), or a test map ramp:R or radial:R (dynamic range "
+             "R), stretched over --density-rect (past it the edge texels go on)")
           ->capture_default_str();
   cmd->add_option(
          "--class", a->classes,
@@ -201,11 +209,16 @@ void add_query_command(CLI::App& app) {
       ->take_all();
   cmd->add_option(
       "--density-rect", a->density_rect,
-      "World rectangle x0,y0,x1,y1 the image or test map covers (default: --rect); fix it to query parts of "
-      "one region and get exactly the region's points");
+      "World rectangle x0,y0,x1,y1 the image or test map covers (default: --rect, so that a chunk queried "
+      "without it stretches the whole map over itself); fix it to query chunks of one region and get "
+      "exactly the region's points. Past it the map's edge goes on");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
-  cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();
+  cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) { return text.empty() ? std::string("is empty (an unset variable?)") : ""; },
+          ""));  // CLI11 reads "" as 0, a query of no points
   cmd->add_option("--tile-size", a->tile_size, "World units per tile side")->capture_default_str();
   cmd->add_option("--mode", a->mode,
                   "stable: points never move once they appear (placing objects); smooth: points glide with "

@@ -63,16 +63,17 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // Bad command lines get the same one-line error as every other failure (CLI11 would add a hint line).
-    std::string message = e.what();
+    std::string message = e.what(), help = "kdm --help";
     if (argc > 1 && argv[1][0] != '-') {  // CLI11 calls an unknown subcommand "a subcommand is required"
       bool known = false;
       for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
         known = known || sub->get_name() == argv[1];
       if (!known) message = std::string("unknown subcommand '") + argv[1] + "'";
+      if (known) help = std::string("kdm ") + argv[1] + " --help";  // the command's own options
     }
     for (char& c : message)
       if (c == '\n') c = ' ';
-    std::fprintf(stderr, "kdm: error: %s (see kdm --help)\n", message.c_str());
+    std::fprintf(stderr, "kdm: error: %s (see %s)\n", message.c_str(), help.c_str());
     return 1;
   } catch (const kdm::cli::CommandError& e) {
     std::fprintf(stderr, "kdm: error: %s\n", e.what());

@@ -72,8 +72,9 @@ struct QueryDensity {
   /// For callbacks: an upper bound of the density (lets the query skip ranks that can never be emitted).
   /// Values above it break that promise: stable mode then emits as if they were capped there, smooth mode
   /// glides its points as their own values ask, and a class query gives such a class more than its share
-  /// (at the later classes' expense). Smooth mode also reads positions up to a glide's reach outside the
-  /// region, so the bound must hold there too.
+  /// (at the later classes' expense). Smooth mode also reads positions up to twice the glide's reach
+  /// (Tileset::glide_reach) outside the region, a point's stable place and where it glides from there, so
+  /// the bound must hold there too.
   double callback_max = 1;
   /// For callbacks, optional: bounds of the density over a world rectangle, *lo ≤ ρ ≤ *hi everywhere in
   /// [x0, x1] × [y0, y1] (must be thread-safe, like the callback). A query asks once per tile and then
