@@ -239,9 +239,10 @@ class Tileset:
         QueryResult
             Positions, ids and levels; any partition of a region gives the region's points, and the same
             arguments give the same bits as ``kdm query ... -o points.csv``. A query of more than 2**25
-            points raises ValueError (1 GiB of records): split the region. A constant's or an image's
-            count is known before querying, so such a query is refused at once; a callable's is refused
-            once 2**25 points are collected.
+            points raises ValueError (1 GiB of records): split the region. A constant's count is known
+            before querying, and an image's lower bound (its least value over blocks of the map), so such
+            a query is refused at once where that bound passes 2**25; otherwise once 2**25 points are
+            collected (seconds, and a few GB, for a map with empty parts, such as a river of zeros).
         """
         class_max = density_max  # a number or one entry per class, checked with the classes
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
