@@ -192,8 +192,8 @@ struct SampleResult {
 /// The threads sample() and bake_tileset() use when given 0: the first number in OMP_NUM_THREADS if it is
 /// set (build tools set it to share the machine), else the CPUs this process may run on (its affinity
 /// mask, as `taskset` or a container sets it), capped by its cgroup's CPU quota (a CI runner's share).
-/// At least 1, at most kMaxThreads. Worked out once per process. Waiting threads spin for at most 50 µs and then sleep, so a
-/// run on a busy machine does not burn the cores its own threads are waiting for.
+/// At least 1, at most kMaxThreads. Worked out once per process. Waiting threads spin for at most 50 µs and
+/// then sleep, so a run on a busy machine does not burn the cores its own threads are waiting for.
 int default_thread_count();
 
 /// The most threads sample() and bake_tileset() take: more than the cores of today's largest machines,
