@@ -53,6 +53,44 @@ TEST_F(CliTest, QueryPartitionsConcatenateToTheWhole) {
   }
 }
 
+// -o - writes to standard output in the --format given: the same bytes as the file, so that a pipeline
+// (`kdm sample -o - --format txt | kdm analyze -`) needs no scratch files; the summary stays on stderr.
+TEST_F(CliTest, OutputToStandardOutputIsTheFilesBytes) {
+  const std::string query = "query --rect 0,0,2,1.5 --scale 300 --density ramp:4 ";
+  ASSERT_EQ(kdm(query + "-o '" + path("q.csv") + "'").status, 0);
+  const Outcome csv = kdm(query + "-o - --format csv");
+  ASSERT_EQ(csv.status, 0) << csv.err;
+  EXPECT_EQ(csv.out, slurp(path("q.csv")));
+  EXPECT_GT(sorted_rows(csv.out).size(), 300u);
+  EXPECT_NE(csv.err.find("-> standard output"), std::string::npos) << csv.err;
+  // --format names the format of a file without an extension too.
+  ASSERT_EQ(kdm(query + "-o '" + path("q.points") + "' --format JSON").status, 0);
+  EXPECT_EQ(slurp(path("q.points")), kdm(query + "-o - --format json").out);
+  ASSERT_EQ(kdm("sample -n 300 --seed 4 -o '" + path("s.txt") + "'").status, 0);
+  const Outcome txt = kdm("sample -n 300 --seed 4 -o - --format txt");
+  ASSERT_EQ(txt.status, 0) << txt.err;
+  EXPECT_EQ(txt.out, slurp(path("s.txt")));
+  // Read back from standard input: the same report as from the file.
+  const Outcome piped = kdm("analyze - <'" + path("s.txt") + "'");
+  ASSERT_EQ(piped.status, 0) << piped.err;
+  EXPECT_NE(piped.out.find("300 2D points"), std::string::npos) << piped.out;
+  EXPECT_EQ(piped.out.substr(0, piped.out.find("analysis time")),
+            kdm("analyze '" + path("s.txt") + "'").out.substr(0, piped.out.find("analysis time")));
+  const Outcome png =
+      kdm("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png' --points 300 -o - --format png");
+  ASSERT_EQ(png.status, 0) << png.err;
+  EXPECT_EQ(png.out.substr(1, 3), "PNG");
+  // Standard output needs a format; one the command does not write, frames and --timing are refused.
+  expect_error("query --rect 0,0,1,1 -o -", "needs --format");
+  expect_error("query --rect 0,0,1,1 -o - --format bmp", "unknown --format 'bmp'");
+  expect_error("sample -n 10 -o - --format json", "unknown --format 'json'");
+  expect_error("sample -n 10 -o - --format txt --timing", "--timing");
+  expect_error("stipple '" + std::string(KDM_SOURCE_DIR) +
+                   "/examples/sphere.png' -o - --format png --frames 3 --region 0,0,0.5,0.5",
+               "--frames");
+  expect_error("analyze - </dev/null", "standard input");
+}
+
 // --glide-together moves smooth points (same ids) and partitions still concatenate to the whole; stable
 // mode ignores it.
 TEST_F(CliTest, QueryGlideTogetherMovesTheSamePointsAndKeepsPartitions) {

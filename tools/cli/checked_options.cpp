@@ -67,9 +67,23 @@ CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int6
       ->transform(CLI::Validator(whole, ""));
 }
 
-void check_output_option(const std::string& path, const std::vector<const char*>& extensions) {
+std::string check_output_option(const std::string& path, const std::vector<const char*>& extensions,
+                                const std::string& format) {
   std::string error;
-  if (!tools::check_output_path(path, extensions, error)) throw CommandError(error);
+  if (!tools::check_output_path(path, extensions, error, format)) throw CommandError(error);
+  return tools::output_format(path, format);
+}
+
+CLI::Option* add_format_option(CLI::App* cmd, std::string& format,
+                               const std::vector<const char*>& extensions) {
+  std::string names;
+  for (std::size_t i = 0; i < extensions.size(); ++i)
+    names += (i ? ", " : "") + std::string(extensions[i] + 1);
+  return cmd->add_option("--format", format,
+                         "The output's format (" + names +
+                             "; default: -o's extension): -o - writes to standard output, as in `-o - "
+                             "--format " +
+                             std::string(extensions[0] + 1) + " | …`");
 }
 
 }  // namespace kdm::cli

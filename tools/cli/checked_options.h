@@ -25,8 +25,16 @@ CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::stri
 CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,
                               const std::string& description);
 
-/// Refuses, before any long work, an output path that write would refuse later: an extension not among
-/// `extensions` (".csv", ".png", …), a directory, or a directory that does not exist. Throws CommandError.
-void check_output_option(const std::string& path, const std::vector<const char*>& extensions);
+/// Refuses, before any long work, an output path that write would refuse later: a format (`format`, the
+/// --format option, else the path's extension) not among `extensions` (".csv", ".png", …), a directory, a
+/// directory that does not exist, or "-" (standard output) without a format. Throws CommandError.
+/// Returns the format (".csv").
+std::string check_output_option(const std::string& path, const std::vector<const char*>& extensions,
+                                const std::string& format = "");
+
+/// Adds --format to `cmd`, bound to `format`: the output's format where -o does not name it (-o -,
+/// standard output), one of `extensions` without the dot.
+CLI::Option* add_format_option(CLI::App* cmd, std::string& format,
+                               const std::vector<const char*>& extensions);
 
 }  // namespace kdm::cli

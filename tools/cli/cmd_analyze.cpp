@@ -181,7 +181,7 @@ void add_analyze_command(CLI::App& app) {
       app.add_subcommand("analyze", "Point-set metrics: NN distances, spectrum, g(r), density, tiling");
   cmd->add_option("files", args->files,
                   "Point files: .txt (one point per line, sets separated by '#' lines) or .csv (x,y columns, "
-                  "and class for labelled points: each class is analysed alone too)")
+                  "and class for labelled points: each class is analysed alone too); - reads standard input")
       ->required();
   cmd->add_flag("--torus", args->torus, "Periodic distances (default)");
   cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");

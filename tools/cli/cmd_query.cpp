@@ -18,8 +18,10 @@
 namespace kdm::cli {
 namespace {
 
+const std::vector<const char*> kQueryFormats = {".csv", ".json", ".txt", ".svg", ".png"};
+
 struct QueryArgs {
-  std::string tileset, rect, density_rect, density = "const:1", output, mode = "stable";
+  std::string tileset, rect, density_rect, density = "const:1", output, format, mode = "stable";
   std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
   double scale = 1000, tile_size = 1, gamma = 1;
   bool invert = false, normalised = false, glide_together = false;
@@ -70,22 +72,21 @@ std::string points_with_ids(const std::vector<QueryPoint>& points, const std::ve
 }
 
 void run_query_command(const QueryArgs& a, bool density_given) {
-  check_output_option(a.output, {".csv", ".json", ".txt", ".svg", ".png"});  // before a long query
+  const std::string format = check_output_option(a.output, kQueryFormats, a.format);  // before a query
   double r[4], dr[4];
   parse_rect(a.rect, "--rect", r);
   if (density_given && !a.classes.empty())
     throw CommandError("give either --density or --class (one per class), not both");
-  const bool ids = tools::has_extension(a.output, ".csv") || tools::has_extension(a.output, ".json");
+  const bool csv = format == ".csv", json = format == ".json", ids = csv || json;
   if (a.normalised && !ids)
     throw CommandError(
         "--normalised is for .csv and .json output (.txt and pictures are always normalised to "
         "the rect)");
-  if (!a.classes.empty() && tools::has_extension(a.output, ".txt"))
+  if (!a.classes.empty() && format == ".txt")
     throw CommandError("--class: .txt has no class column; write .csv, .json, .svg or .png");
   // A picture's longer side is 1,024 pixels: a rect far longer than wide would be a line of pixels.
   const double aspect = (r[2] - r[0]) / (r[3] - r[1]);
-  if ((tools::has_extension(a.output, ".png") || tools::has_extension(a.output, ".svg")) &&
-      !(aspect >= 1.0 / 1024 && aspect <= 1024))
+  if ((format == ".png" || format == ".svg") && !(aspect >= 1.0 / 1024 && aspect <= 1024))
     throw CommandError(
         "--rect is more than 1,024 times " +
         std::string(aspect < 1 ? "taller than wide" : "wider than tall") +
@@ -161,8 +162,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   std::snprintf(line, sizeof line, "kdm query: %zu points (rect %s, scale %g, tile size %g)", points.size(),
                 a.rect.c_str(), a.scale, a.tile_size);
   const auto t1 = std::chrono::steady_clock::now();
-  const bool csv = tools::has_extension(a.output, ".csv"), json = tools::has_extension(a.output, ".json");
-  if (csv || json) {
+  if (ids) {
     std::string error;
     if (!tools::write_text_file_atomic(
             a.output, points_with_ids(points, classed ? &classes : nullptr, tiles, r, a.normalised, json),
@@ -178,11 +178,11 @@ void run_query_command(const QueryArgs& a, bool density_given) {
         style.aspect >= 1 ? 1024 : static_cast<int>(std::max(1.0, std::round(1024 * style.aspect)));
     if (classed) style.classes = &classes, style.inks = tools::class_inks(densities.size());
     tools::write_points(a.output, tools::normalise_to_rect(points, r),
-                        {line, "coordinates normalised to the rect"}, style);
+                        {line, "coordinates normalised to the rect"}, style, format);
   }
   const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   std::fprintf(stderr, "%s queried in %.4f s, written in %.3f s -> %s\n", line, seconds, writing,
-               a.output.c_str());
+               a.output == tools::kStandardOutput ? "standard output" : a.output.c_str());
 }
 
 }  // namespace
@@ -234,8 +234,9 @@ void add_query_command(CLI::App& app) {
   cmd->add_option("-o,--output", a->output,
                   "Output: .csv or .json (world x, y, tile_x, tile_y, rank, level[, class], depth: with "
                   "tile_x, tile_y and rank the point's id), .txt (UTK format, "
-                  "normalised to the rect), .svg or .png")
+                  "normalised to the rect), .svg or .png; - for standard output (with --format)")
       ->required();
+  add_format_option(cmd, a->format, kQueryFormats);
   cmd->callback([a, density] { run_query_command(*a, density->count() > 0); });
 }
 

@@ -19,12 +19,14 @@
 namespace kdm::cli {
 namespace {
 
+const std::vector<const char*> kSampleFormats = {".txt", ".csv", ".svg", ".png"};
+
 struct SampleArgs {
   gen::SamplerOptions options;
   std::string density = "const:1";
   std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
   std::string domain;                // empty: box for images and ramps, torus otherwise
-  std::string output;
+  std::string output, format;
   double aspect = 0;  // 0: from the image, or 1
   double gamma = 1;
   bool invert = false;
@@ -35,7 +37,10 @@ struct SampleArgs {
 };
 
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
-  check_output_option(args.output, {".txt", ".csv", ".svg", ".png"});  // before minutes of sampling
+  const std::string format =
+      check_output_option(args.output, kSampleFormats, args.format);  // before sampling
+  if (args.timing && args.output == tools::kStandardOutput)
+    throw CommandError("--timing prints on standard output, which -o - writes the points to: drop one");
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
   if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
   if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");
@@ -138,8 +143,9 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   style.dot_radius_px = args.dot_radius;
   style.aspect = aspect;
   if (classed) style.classes = &set.classes, style.inks = tools::class_inks(specs.size());
-  tools::write_points(args.output, set, header, style);
-  std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds, args.output.c_str());
+  tools::write_points(args.output, set, header, style, format);
+  std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds,
+               args.output == tools::kStandardOutput ? "standard output" : args.output.c_str());
   // A step far too large is rejected almost always: the points stay where the coarser levels put them.
   if (o.step > 0 && r.acceptance_rate() < 0.01)
     std::fprintf(stderr,
@@ -220,8 +226,10 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({4, 8, 16}))
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
-                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,z][,class]), .svg or .png")
+                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,z][,class]), .svg or .png; - for "
+                  "standard output (with --format)")
       ->required();
+  add_format_option(cmd, args->format, kSampleFormats);
   cmd->callback([args, cmd] {
     run_sample(*args, cmd->get_option("--density")->count() > 0, cmd->get_option("--aspect")->count() > 0);
   });

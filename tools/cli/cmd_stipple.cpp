@@ -24,8 +24,10 @@
 namespace kdm::cli {
 namespace {
 
+const std::vector<const char*> kStippleFormats = {".png", ".svg", ".txt", ".csv"};
+
 struct StippleArgs {
-  std::string image, output, method = "tiles", region, tileset, mode = "smooth", colours;
+  std::string image, output, format, method = "tiles", region, tileset, mode = "smooth", colours;
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
@@ -53,7 +55,9 @@ std::string frame_path(const std::string& output, int i) {
 }
 
 void run_stipple(const StippleArgs& a, bool scale_given) {
-  check_output_option(a.output, {".png", ".svg", ".txt", ".csv"});  // before the dots are placed
+  const std::string format = check_output_option(a.output, kStippleFormats, a.format);  // before the dots
+  if (a.frames > 0 && a.output == tools::kStandardOutput)
+    throw CommandError("--frames writes a file per frame: give -o a file name, not - (standard output)");
   for (int i = 0; i < std::max(1, a.frames); ++i)
     tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output, "input image");
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
@@ -69,10 +73,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
                   a.fade);
     throw CommandError(message);
   }
-  if (!a.colours.empty() && tools::has_extension(a.output, ".txt"))  // said before the dots are placed
+  if (!a.colours.empty() && format == ".txt")  // said before the dots are placed
     throw CommandError("--colours writes each dot's ink as a class: write .csv (x,y,class), .svg or .png");
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
-  if (a.fade > 0 && !tools::has_extension(a.output, ".png") && !tools::has_extension(a.output, ".svg"))
+  if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
@@ -139,7 +143,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
   const int frames = std::max(1, a.frames);
-  if (tools::has_extension(a.output, ".png") || tools::has_extension(a.output, ".svg"))
+  if (format == ".png" || format == ".svg")
     for (int i = 0; i < frames; ++i) {  // each frame's picture, before any dot is placed
       double uv[4];
       if (a.frames > 0)
@@ -147,7 +151,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       else
         std::copy(region, region + 4, uv);
       try {
-        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output);
+        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output, format);
       } catch (const std::invalid_argument& e) {
         throw CommandError(e.what());
       }
@@ -206,10 +210,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
-    tools::write_points(path, set, {line, "image " + a.image, where}, style);
+    tools::write_points(path, set, {line, "image " + a.image, where}, style, format);
     const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     std::fprintf(stderr, "%s placed in %.3f s, written in %.3f s -> %s\n", line, seconds, writing,
-                 path.c_str());
+                 path == tools::kStandardOutput ? "standard output" : path.c_str());
   }
 }
 
@@ -224,8 +228,10 @@ void add_stipple_command(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
-                  "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...")
+                  "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...; - for standard "
+                  "output (with --format)")
       ->required();
+  add_format_option(cmd, a->format, kStippleFormats);
   add_count_option(
       cmd, "--points", a->points,
       "Dots over the whole image: exactly this many with --method full; about this many with tiles "

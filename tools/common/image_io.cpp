@@ -663,6 +663,12 @@ void composite(RgbImage& image, const CoverageImage& layer, const std::uint8_t r
 }
 
 bool write_text_file_atomic(const std::string& given_path, const std::string& text, std::string& error) {
+  if (given_path == "-") {  // standard output (point_io.h's kStandardOutput): a pipe's reader sees it all
+    const bool written = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+    if (written && std::fflush(stdout) == 0) return true;
+    error = std::string("cannot write to standard output: ") + std::strerror(errno);
+    return false;
+  }
   // A device or a pipe (/dev/null, /dev/stdout, a FIFO) is written into, as a shell's > does: a rename
   // would replace it with a regular file.
   struct stat info;

@@ -85,7 +85,8 @@ void add_disc(CoverageImage& layer, double cx, double cy, double r);
 /// Lays `rgb` over `image` where `layer` covers it, by its coverage (`mode` as draw_disc's).
 void composite(RgbImage& image, const CoverageImage& layer, const std::uint8_t rgb[3], int mode = 0);
 
-/// Writes `text` (any bytes) to `path` atomically (temporary file, then rename), every write checked.
+/// Writes `text` (any bytes) to `path` atomically (temporary file, then rename), every write checked; "-"
+/// is standard output.
 bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error);
 
 /// For a program that writes its files in turn from one thread (the command line): from now on SIGINT,

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "image_io.h"
 
@@ -24,18 +25,39 @@ bool has_extension(const std::string& path, const char* extension) {
   return true;
 }
 
-bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
-                       std::string& error) {
-  bool known = false;
-  std::string list;
-  for (std::size_t i = 0; i < extensions.size(); ++i) {
-    known = known || has_extension(path, extensions[i]);
-    list += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + std::string(extensions[i]);
+std::string output_format(const std::string& path, const std::string& format) {
+  std::string ext = format;
+  if (ext.empty()) {
+    const std::size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+    if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) ext = path.substr(dot);
+  } else if (ext[0] != '.') {
+    ext = "." + ext;
   }
-  if (!known) {
-    error = "unknown output format for '" + path + "' (use " + list + ")";
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
+                       std::string& error, const std::string& format) {
+  const std::string ext = output_format(path, format);
+  bool known = false;
+  std::string list, names;
+  for (std::size_t i = 0; i < extensions.size(); ++i) {
+    known = known || ext == extensions[i];
+    const char* sep = i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ";
+    list += sep + std::string(extensions[i]);
+    names += sep + std::string(extensions[i] + 1);
+  }
+  if (path == kStandardOutput && format.empty()) {
+    error = "'-' (standard output) needs --format: " + names;
     return false;
   }
+  if (!known) {
+    error = format.empty() ? "unknown output format for '" + path + "' (use " + list + ")"
+                           : "unknown --format '" + format + "' (use " + names + ")";
+    return false;
+  }
+  if (path == kStandardOutput) return true;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     error = "output '" + path + "' is a directory";
@@ -58,6 +80,7 @@ std::string comment_safe(std::string line) {
 }
 
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error) {
+  if (path == "-") return read_point_sets(std::cin, "standard input", sets, error);
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     error = "point file '" + path + "' is a directory";
@@ -217,8 +240,8 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
 }
 
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
-                     std::string& error) {
-  const bool csv = has_extension(path, ".csv");
+                     std::string& error, const std::string& format) {
+  const bool csv = output_format(path, format) == ".csv";
   const bool labelled = !set.classes.empty();
   if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
     error = "'" + path + "': " +

@@ -28,17 +28,26 @@ struct PointSet {
 /// Whether `path` ends in `extension` (".csv"), in any case: ".CSV" is a CSV file too.
 bool has_extension(const std::string& path, const char* extension);
 
+/// The output path that stands for standard output (`-o -`): its format is named apart (`--format`).
+inline constexpr const char* kStandardOutput = "-";
+
+/// The format `path` is written in, as a lower-case extension (".csv"): `format` when given ("csv" or
+/// ".csv"), else the path's own extension; "" when neither names one.
+std::string output_format(const std::string& path, const std::string& format = "");
+
 /// Checks, before any long work, that `path` can be written as one of `extensions` (a list such as
-/// {".csv", ".png"}): its extension is one of them, it is not a directory, and its directory exists.
-/// Returns false with `error` naming the path and what is wrong.
+/// {".csv", ".png"}): its format (output_format(path, format)) is one of them, it is not a directory,
+/// and its directory exists. kStandardOutput needs `format`. Returns false with `error` naming the path
+/// and what is wrong.
 bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
-                       std::string& error);
+                       std::string& error, const std::string& format = "");
 
 /// `line` made safe as one comment line of a text or SVG file: line breaks become spaces, and "--" (which
 /// would end an XML comment) becomes "- -".
 std::string comment_safe(std::string line);
 
-/// Reads every set in `path`. All sets must share one dimension (2 or 3); coordinates must be finite.
+/// Reads every set in `path` ("-": standard input). All sets must share one dimension (2 or 3);
+/// coordinates must be finite.
 /// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error);
 
@@ -47,9 +56,10 @@ bool read_point_sets(std::istream& in, const std::string& name, std::vector<Poin
                      std::string& error);
 
 /// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
-/// or as CSV when `path` ends in ".csv" (with a class column for labelled points, which only CSV carries:
-/// false with `error` for a labelled set and another format). Atomic (temporary file, then rename).
+/// or as CSV when its format (output_format(path, format)) is ".csv" (with a class column for labelled
+/// points, which only CSV carries: false with `error` for a labelled set and another format). Atomic
+/// (temporary file, then rename); kStandardOutput writes to standard output.
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
-                     std::string& error);
+                     std::string& error, const std::string& format = "");
 
 }  // namespace kdm::tools

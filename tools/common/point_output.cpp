@@ -54,7 +54,7 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
-int check_picture_size(int width_px, double aspect, const std::string& path) {
+int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format) {
   const int w = std::max(1, width_px);
   const double h = std::max(1.0, std::round(w / aspect));  // the picture's own shape
   const auto refuse = [&](const char* limit) {
@@ -62,7 +62,8 @@ int check_picture_size(int width_px, double aspect, const std::string& path) {
                                 std::to_string(std::llround(std::min(h, 1e18))) + " pixels is too large (" +
                                 limit + "); lower the width");
   };
-  if (!has_extension(path, ".png")) {  // an SVG's size is two numbers: only the height's int is a limit
+  if (output_format(path, format) !=
+      ".png") {  // an SVG's size is two numbers: only the height's int is a limit
     if (!(h <= double(1 << 30))) refuse("limit 2^30 pixels high");
   } else if (!(double(w) * h <= double(1 << 28))) {  // 768 MiB of RGB and 512 of coverage: refuse, not die
     refuse("limit 2^28 pixels");
@@ -71,19 +72,20 @@ int check_picture_size(int width_px, double aspect, const std::string& path) {
 }
 
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
-                  const DrawStyle& style) {
+                  const DrawStyle& style, const std::string& format) {
   std::string error;
-  if (has_extension(path, ".txt") || has_extension(path, ".csv")) {
-    if (!write_point_set(path, points, header, error)) throw std::runtime_error(error);
+  const std::string ext = output_format(path, format);
+  if (ext == ".txt" || ext == ".csv") {
+    if (!write_point_set(path, points, header, error, ext)) throw std::runtime_error(error);
     return;
   }
-  const bool png = has_extension(path, ".png"), svg = has_extension(path, ".svg");
+  const bool png = ext == ".png", svg = ext == ".svg";
   if (!png && !svg)
     throw std::invalid_argument("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
   if (points.dim != 2)
     throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(1, style.width_px);
-  const int h = check_picture_size(style.width_px, style.aspect, path);
+  const int h = check_picture_size(style.width_px, style.aspect, path, ext);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
   // A dot wider than the picture only blackens it, and painting large dots costs their area each.
   if (!(r <= std::max(w, h)))

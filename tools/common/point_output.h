@@ -42,15 +42,17 @@ struct DrawStyle {
 /// `what` saying what the input is ("input image"): a result written over what it came from.
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
-/// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path`; throws
-/// std::invalid_argument, naming the size, for a PNG past 2^28 pixels or an SVG past 2^30 pixels high
-/// (write_points checks it; a caller that computes points for a picture checks it first).
-int check_picture_size(int width_px, double aspect, const std::string& path);
+/// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path` (in
+/// `format`, output_format's); throws std::invalid_argument, naming the size, for a PNG past 2^28 pixels or
+/// an SVG past 2^30 pixels high (write_points checks it; a caller that computes points for a picture
+/// checks it first).
+int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format = "");
 
-/// Writes `points` (normalised [0,1)^dim, y up) to `path`, choosing the format by extension.
-/// Throws std::invalid_argument on an unknown extension or a picture too large, std::runtime_error on a
-/// write failure (one-line messages naming the file).
+/// Writes `points` (normalised [0,1)^dim, y up) to `path` (kStandardOutput: standard output) in `format`
+/// (".txt", ".csv", ".svg", ".png"; by default the path's extension). Throws std::invalid_argument on an
+/// unknown format or a picture too large, std::runtime_error on a write failure (one-line messages naming
+/// the file).
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
-                  const DrawStyle& style);
+                  const DrawStyle& style, const std::string& format = "");
 
 }  // namespace kdm::tools
