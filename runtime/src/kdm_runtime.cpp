@@ -15,11 +15,7 @@
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/parallel_query.h"
 #include "kdm/runtime/query.h"
-
-struct kdm_tileset {
-  kdm::Tileset owned;                // empty for the built-in set
-  const kdm::Tileset* set = &owned;  // what queries read: `owned`, or the one built-in copy
-};
+#include "tileset_handle.h"
 
 struct kdm_density_image {
   kdm::DensityImageView view;
@@ -395,13 +391,12 @@ kdm_status parallel_classes(kdm_parallel_query* parallel, const kdm_task_runner*
   });
 }
 
-// The built-in set's handle, known without decoding the set, which only kdm_tileset_builtin() does:
-// freeing another set must not decode it.
-kdm_tileset& builtin_handle() {
+}  // namespace
+
+kdm_tileset& kdm::detail::builtin_handle() {
   static kdm_tileset handle;
   return handle;
 }
-}  // namespace
 
 extern "C" {
 
@@ -537,15 +532,8 @@ kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, cha
   return s;
 }
 
-const kdm_tileset* kdm_tileset_builtin(void) {
-  const kdm::Tileset& set = kdm::Tileset::builtin();
-  if (set.empty()) return nullptr;  // out of memory: the next call tries again
-  static kdm_tileset* const shared = (builtin_handle().set = &set, &builtin_handle());  // no second copy
-  return shared;
-}
-
 void kdm_tileset_free(kdm_tileset* tileset) {
-  if (tileset != &builtin_handle()) delete tileset;
+  if (tileset != &kdm::detail::builtin_handle()) delete tileset;
 }
 
 size_t kdm_tileset_resident_bytes(const kdm_tileset* tileset) {

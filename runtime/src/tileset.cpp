@@ -1,20 +1,13 @@
-// Loading a tile set for queries (kdm/runtime/tileset.h): the data, the tables the query loop reads, and
-// the built-in set.
+// Loading a tile set for queries (kdm/runtime/tileset.h): the data and the tables the query loop reads
+// (the built-in set: builtin.cpp).
 #include "kdm/runtime/tileset.h"
 
 #include <algorithm>
-#include <atomic>
-#include <cstdio>
-#include <cstdlib>
-#include <mutex>
 #include <new>
 #include <utility>
 
 #include "kdm/runtime/hash.h"
 #include "query_tables.h"
-
-extern const unsigned char kdm_builtin_tileset[];
-extern const std::size_t kdm_builtin_tileset_size;
 
 namespace kdm {
 namespace {
@@ -117,26 +110,6 @@ Status Tileset::load_memory(const void* data, std::size_t size, Tileset& out, st
 
 Status Tileset::load_file(const std::string& path, Tileset& out, std::string* detail) {
   return load_with(out, detail, [&](TilesetData& set) { return load_tileset(path, set, detail); });
-}
-
-const Tileset& Tileset::builtin() {
-  static std::atomic<const Tileset*> ready{nullptr};
-  if (const Tileset* set = ready.load(std::memory_order_acquire)) return *set;
-  static std::mutex decoding;  // taken only until the set is decoded
-  const std::lock_guard<std::mutex> lock(decoding);
-  if (const Tileset* set = ready.load(std::memory_order_relaxed)) return *set;
-  static Tileset set;
-  static const Tileset none;
-  std::string detail;
-  const Status s = load_memory(kdm_builtin_tileset, kdm_builtin_tileset_size, set, &detail);
-  if (s == Status::kOutOfMemory) return none;  // empty; the next call tries again
-  if (s != Status::kOk) {
-    // The embedded bytes were validated when the library was tested; failing here is a build bug.
-    std::fprintf(stderr, "kdm: the built-in tile set does not decode: %s\n", detail.c_str());
-    std::abort();
-  }
-  ready.store(&set, std::memory_order_release);
-  return set;
 }
 
 std::size_t Tileset::tile_index_at(std::int64_t tx, std::int64_t ty) const {

@@ -14,7 +14,13 @@ cmake --build "$work/cmake" >/dev/null
 cmake -S "$here/runtime_c_consumer" -B "$work/cmake_c" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake_c" >/dev/null
 "$work/cmake_c/runtime_c_only"
-if [ -x "$prefix/bin/kdm" ]; then "$work/cmake_c/embedded_c_only"; fi  # a prefix with the command line
+if [ -x "$prefix/bin/kdm" ]; then  # a prefix with the command line
+  "$work/cmake_c/embedded_c_only"
+  # A program that never asks for the built-in set does not carry its 14 MB from the static library.
+  if [ -n "$(find "$prefix" -name libkdm_runtime.a)" ] && nm "$work/cmake_c/embedded_c_only" | grep -q kdm_builtin_tileset; then
+    echo "a program without the built-in set carries it"; exit 1
+  fi
+fi
 pc_dir=$(dirname "$(find "$prefix" -name kdm-runtime.pc | head -n 1)")
 flags=$(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs kdm-runtime)
 # shellcheck disable=SC2086  # the flags are words

@@ -142,12 +142,12 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
   }
 }
 
-/// The box set's circumcircles: those at least `border` spacings plus their radius inside the square.
+/// The box set's circumcircles: those centred at least `border` spacings inside the square.
 std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double border) {
   std::vector<Circle> circles;
+  const double m = border * spacing;
   delaunay(xy, [&](int i, int j, int k) {
     const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
-    const double m = border * spacing + c.r;
     if (std::isfinite(c.r) && c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m) circles.push_back(c);
   });
   return circles;

@@ -15,8 +15,11 @@ namespace kdm::analysis {
 
 struct EmptyCircleOptions {
   bool torus =
-      true;  ///< periodic (else a box: circles reaching within `border` spacings of a side are left out)
-  double border = 1;  ///< box sets: spacings between a judged circle and the window's sides
+      true;  ///< periodic (else a box: circles centred within `border` spacings of a side are left out)
+  /// Box sets: the spacings between a judged circle's centre and the window's sides. A rule on the centre
+  /// alone, so that a large circle is no likelier left out than a small one; two spacings put every
+  /// circle up to that radius wholly inside, away from the sides' half-empty triangles.
+  double border = 2;
   /// Target density: radii are divided by the local spacing at each circle's centre (d_hex of the set's
   /// count, scaled by √(mean ρ / ρ(centre))); circles centred where ρ = 0 are left out. Empty: uniform.
   DensityFunction density;
@@ -42,8 +45,12 @@ struct EmptyCircles {
   std::size_t over_085 = 0, over_100 = 0;  ///< triangles with a radius above 0.85 and 1.0 local d_hex
   std::size_t over_085_near_edge = 0;      ///< of over_085, centred within one spacing of a tile edge
   double near_edge_share = 0;  ///< the share of the judged triangles centred there (what even spread gives)
-  double over_085_per_1e5() const { return points ? over_085 * 1e5 / double(points) : 0; }
-  double over_100_per_1e5() const { return points ? over_100 * 1e5 / double(points) : 0; }
+  /// The points the judged triangles stand for: half their count (a triangulation has two triangles per
+  /// point), so that a rate does not depend on how much of a box's border or of a density's pale part was
+  /// left out. A torus without a density: exactly `points`.
+  double judged_points() const { return 0.5 * double(triangles); }
+  double over_085_per_1e5() const { return triangles ? over_085 * 1e5 / judged_points() : 0; }
+  double over_100_per_1e5() const { return triangles ? over_100 * 1e5 / judged_points() : 0; }
 };
 
 /// Empty circles pooled over `sets` (2D, each of at least 3 points, in [0,1]²; each normalised by its own
