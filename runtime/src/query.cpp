@@ -582,7 +582,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kNone:
       return "no problem";
     case QueryProblem::Kind::kMissingArgument:
-      return "a required argument is null, or the tile set is empty";
+      return "a required argument is null or empty (the tile set, an output), or an object was not "
+             "initialised (ParallelQuery::init)";
     case QueryProblem::Kind::kNotFinite:
       return "a parameter is not a finite number";
     case QueryProblem::Kind::kNotPositive:

@@ -93,7 +93,11 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const ClassQueryParams& params);
 /// "classes[k].image", "classes[k].callback", "classes[k].callback_max"), a bad joint maximum
 /// ("joint.max[k]"), both joint functions ("joint.batch_densities"), image sums for another class count
 /// or with a joint density, or with an image the query cannot read ("image_sums"), a null `classes` with room
-/// in `out`, and everything query_points refuses, judged on the sum of the densities. No allocation.
+/// in `out`, and everything query_points refuses, judged on the sum of the densities (a density too high
+/// names the scale: lower it or the classes). Capacity 0 checks the query, as query_points'. In smooth
+/// mode points glide from the stable positions that keep classes apart, so where a class's density jumps
+/// (an image with hard edges) two of different classes may come closer than stable mode lets them: place
+/// objects that must keep apart in stable mode. No allocation.
 KDM_RUNTIME_API Status query_classes(const Tileset& tileset, const ClassQueryParams& params, QueryPoint* out,
                                      std::uint8_t* classes, std::size_t capacity, std::size_t* written,
                                      QueryCursor* cursor, QueryProblem* problem = nullptr);

@@ -234,7 +234,10 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// mode, a missing image or callback (or both callbacks set), a region of more than kMaxQueryTiles tiles,
 /// a density beyond the density limit (scale · max density · tile_size² > query_density_limit: use smaller
 /// tiles or a lower scale), a region too far from the world origin or from the query's origin
-/// (kTooFarFromOrigin), or a cursor started with other params. No allocation.
+/// (kTooFarFromOrigin), or a cursor started with other params. Capacity 0 (`out` may then be null) only
+/// checks the query: kInvalidArgument, or kBufferFull at its first point with the cursor unmoved (so a
+/// loop resuming while kBufferFull must give room for a point), or kOk for a region without points; to
+/// count a region, ParallelQuery::run with capacity 0. No allocation.
 KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem = nullptr);
