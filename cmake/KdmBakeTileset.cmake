@@ -1,4 +1,5 @@
-# kdm_bake_tileset(OUTPUT <file> RECIPE <file> [TARGET <name>] [EMBED <name>] [THREADS <n>] [VERIFY])
+# kdm_bake_tileset(OUTPUT <file> RECIPE <file> [TARGET <name>] [EMBED <name>] [THREADS <n>] [VERIFY]
+#                  [VERIFY_ARGS <kdm verify option>...])
 #
 # Adds a build step that bakes the tile set OUTPUT from RECIPE with the kdm command line (kdm::kdm), and
 # bakes it again whenever the recipe or kdm changes.
@@ -14,12 +15,23 @@
 #   THREADS  baking and verifying threads (0, the default, takes every core). The file does not depend on it.
 #   VERIFY   also runs `kdm verify` (the generator test) on the baked file, and fails the build if any
 #            check fails.
+#   VERIFY_ARGS  more `kdm verify` options (needs VERIFY), e.g. the design's bars for holes, which verify
+#            only reports by default: VERIFY_ARGS --hole-largest 1.0 --holes-per-1e5 10.
 # The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed:
 # a failed or interrupted step leaves OUTPUT as it was, older than the recipe, so the next build tries again.
 function(kdm_bake_tileset)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;EMBED;THREADS" "")
+  cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;EMBED;THREADS" "VERIFY_ARGS")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "kdm_bake_tileset: unknown argument(s) ${arg_UNPARSED_ARGUMENTS}")
+  endif()
+  if(arg_KEYWORDS_MISSING_VALUES)  # THREADS with no count would otherwise take every core, silently
+    message(FATAL_ERROR "kdm_bake_tileset: ${arg_KEYWORDS_MISSING_VALUES} given without a value")
+  endif()
+  if(arg_VERIFY_ARGS AND NOT arg_VERIFY)
+    message(FATAL_ERROR "kdm_bake_tileset: VERIFY_ARGS needs VERIFY")
+  endif()
+  if(arg_VERIFY_ARGS MATCHES "\\|")
+    message(FATAL_ERROR "kdm_bake_tileset: VERIFY_ARGS may not hold '|'")
   endif()
   foreach(required OUTPUT RECIPE)
     if(NOT arg_${required})
@@ -54,8 +66,10 @@ function(kdm_bake_tileset)
   set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
             COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS})
   if(arg_VERIFY)
+    list(JOIN arg_VERIFY_ARGS "|" verify_args)  # one word through the command line: '|' for ';'
     list(APPEND steps COMMAND "${CMAKE_COMMAND}" "-DKDM_VERIFY_KDM=$<TARGET_FILE:kdm::kdm>"
                               "-DKDM_VERIFY_FILE=${scratch}" "-DKDM_VERIFY_THREADS=${arg_THREADS}"
+                              "-DKDM_VERIFY_ARGS=${verify_args}"
                               -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake")
   endif()
   list(APPEND steps COMMAND "${CMAKE_COMMAND}" -E rename "${scratch}" "${output}")

@@ -19,6 +19,12 @@ cmake --build "$work/build" >"$work/changed.log"
 grep -q "Baking tile set" "$work/changed.log" || { echo "a changed recipe was not baked again"; exit 1; }
 if cmp -s "$baked" "$work/first.kdmt"; then echo "the recipe's new seed left the tile set as it was"; exit 1; fi
 "$work/build/consumer" >"$work/changed.out" || { cat "$work/changed.out"; exit 1; }  # the embedded set follows
+# VERIFY_ARGS reach kdm verify: a bar no set meets fails the build, and names the check.
+sed 's/VERIFY)/VERIFY VERIFY_ARGS --hole-largest 0.01)/' "$here/consumer/CMakeLists.txt" >"$work/src/CMakeLists.txt"
+touch "$work/src/small.recipe"  # Makefiles do not follow a custom command's own line
+if cmake --build "$work/build" >"$work/strict.log" 2>&1; then echo "a set failing VERIFY_ARGS' bar was built"; exit 1; fi
+grep -q "largest hole" "$work/strict.log" || { echo "VERIFY_ARGS' failure did not say why:"; cat "$work/strict.log"; exit 1; }
+cp "$here/consumer/CMakeLists.txt" "$work/src/CMakeLists.txt"
 # A recipe the baker refuses, and one too hot to pass the verification: each fails the build,
 # and each time the next build tries again.
 printf 'levels 0\n' >"$work/src/small.recipe"
