@@ -587,7 +587,15 @@ Status check_tileset_path(const std::string& path, std::string* detail) {
   if (stat(temp.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
     return fail(Status::kIoError, detail, "cannot create '" + temp + "': it is a directory");
   std::FILE* f = std::fopen(temp.c_str(), "wb");
-  if (!f) return fail(Status::kIoError, detail, "cannot create '" + temp + "': " + std::strerror(errno));
+  if (!f) {  // named by the caller's path: the scratch file beside it is ours
+    const std::size_t slash = path.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+    const int error = errno;
+    const bool no_dir = error == ENOENT && stat(dir.c_str(), &info) != 0;
+    return fail(Status::kIoError, detail,
+                "cannot write '" + path + "': " +
+                    (no_dir ? "directory '" + dir + "' does not exist" : std::string(std::strerror(error))));
+  }
   std::fclose(f);
   std::remove(temp.c_str());
   return Status::kOk;

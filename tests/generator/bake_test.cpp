@@ -67,8 +67,12 @@ TEST(BakeTest, RecipeRefusesKeysThatWouldDoNothingAndOddNumbers) {
                     "els 3\n")
                 .find("unknown key 'lev\\x01els'"),
             std::string::npos);
-  EXPECT_NE(refusal("temperature 2000\n").find("temperature must be in [0, 1000]"), std::string::npos)
+  EXPECT_NE(refusal("temperature 2000\n").find("temperature must be in [0, 1000], got '2000'"),
+            std::string::npos)
       << refusal("temperature 2000\n");
+  EXPECT_NE(refusal("levels -2\n").find("levels must be a whole number in [1, 10], got '-2'"),
+            std::string::npos)
+      << refusal("levels -2\n");
   EXPECT_EQ(BakeRecipe::parse("fill_holes 0\n").fill_holes, 0.0);  // off, said explicitly
   EXPECT_NE(refusal("levels 1\nkeyframes 8\n").find("keyframes need 2 or more levels"), std::string::npos)
       << refusal("levels 1\nkeyframes 8\n");

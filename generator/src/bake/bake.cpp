@@ -116,12 +116,13 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       if (v != std::floor(v) || v < lo || v > hi)
         throw InvalidArgument(where + key + " must be a whole number in [" +
                               std::to_string(std::int64_t(lo)) + ", " + std::to_string(std::int64_t(hi)) +
-                              "]");
+                              "], got '" + printable(value) + "'");
       return v;
     };
     auto within = [&](double lo, double hi) {  // a number in [lo, hi]
       if (!(v >= lo && v <= hi))
-        throw InvalidArgument(where + key + " must be in [" + shortest(lo) + ", " + shortest(hi) + "]");
+        throw InvalidArgument(where + key + " must be in [" + shortest(lo) + ", " + shortest(hi) +
+                              "], got '" + printable(value) + "'");
       return v;
     };
     if (key == "colours")

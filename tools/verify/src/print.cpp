@@ -60,13 +60,15 @@ void print_report(const Report& report, std::FILE* out, bool tables) {
     if (!tile_checks || !tables) break;
     std::fprintf(
         out,
-        "\nlevel %u, %u points per tile; reference: full-sampler runs on the %g×%g torus: E/n %.4f  "
+        "\nlevel %u, %u points per tile (each tile judged on a %g×%g torus of it and the tiles its corners "
+        "fit: 'torus' points); "
+        "reference: full-sampler runs on that torus: E/n %.4f  "
         "δavg %.4f  NN1%% %.3f  lowP %.4f (largest %.4f); freed for 15 sweeps: drop %s, drift %s\n",
         level.level, level.points_per_tile, level.side, level.side, level.energy, level.davg, level.nn1,
         level.low_p, level.low_p_max, cell(level.control_drop, "%.4f", {}, "", 0).c_str(),
         cell(level.control_drift, "%.3f", {}, "", 0).c_str());  // "-" where not measured (--no-direct)
-    std::fprintf(out, "%5s %11s %7s %8s %8s %7s %8s %5s %8s %7s  %s\n", "tile", "sw se ne nw", "points",
-                 "E/n", "δavg", "NN1%", "lowP", "RAPS", "drop", "drift", "result");
+    std::fprintf(out, "%5s %11s %7s %8s %8s %7s %8s %5s %8s %7s  %s\n", "tile", "sw se ne nw", "torus", "E/n",
+                 "δavg", "NN1%", "lowP", "RAPS", "drop", "drift", "result");
     for (const TileResult& t : report.tiles) {
       if (t.level != level.level) continue;
       const Check* raps = find(t.checks, "|ΔRAPS|");
