@@ -51,9 +51,11 @@ def analyze(
         squeezed (docs/limits.md, "Analysing point sets").
     box : bool
         Bounded-box distances instead of periodic (torus) ones.
-    density : None, float, str or 2-D array
+    density : None, float, str, 2-D array or callable
         The target density, as kdm.sample takes it (default: uniform): for the density accuracy test,
-        and the local spacing empty circles are measured in.
+        and the local spacing empty circles are measured in. A callable ``f(x, y)`` of coordinates in
+        [0, 1] is called point by point (its exception, or a value that is not finite and >= 0, is
+        raised).
     gamma, invert
         How an image file's pixels become density, as kdm.sample takes them.
     tile_size : float or None
@@ -79,8 +81,11 @@ def analyze(
     -------
     dict
         metrics.json's keys (inputs, dim, domain, sets, points_*, nearest_neighbour, spectrum,
-        pair_correlation, density, tiling, energy_per_point, seconds: those that apply), with its lists
-        of numbers (spectrum.raps_f, spectrum.raps, pair_correlation.r and .g, ...) as numpy arrays.
+        empty_circles, pair_correlation, density, tiling, energy_per_point, seconds: those that apply;
+        spectrum, empty_circles, density and tiling are 2-D measures, which a 3-D set does not get), with
+        its lists of numbers (spectrum.raps_f, spectrum.raps, pair_correlation.r and .g, ...) as numpy
+        arrays. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
+        their count): with ``box=True`` circles centred within two spacings of a side are left out.
     """
     # A list whose entries are 2-D (arrays or nested lists) is several sets; else it is one set's points.
     several = isinstance(points, (list, tuple)) and len(points) > 0
@@ -93,14 +98,20 @@ def analyze(
             raise TypeError(f"{name} must hold coordinates, got booleans")
     sets = [_checks.array2d(name, p) for name, p in zip(names, raw)]
     box = _checks.flag("box", box)
-    spec = _checks.sampler_density(density, gamma, invert)
+    function = None
+    if callable(density) and not isinstance(density, (np.ndarray, str)):
+        if gamma != 1.0 or invert:
+            raise ValueError("gamma and invert apply to image files only, and density is a function")
+        function, spec = density, None
+    else:
+        spec = _checks.sampler_density(density, gamma, invert)
     tile = 0.0 if tile_size is None else _checks.number("tile_size", tile_size, 0.0, strict=True)
     fmax = _checks.number("fmax", fmax, 0.0, strict=True)
     threads = _checks.threads(threads)
     energy = _checks.flag("energy", energy)
-    if sets[0].shape[1] == 3 and (spec is not None or tile_size is not None):
+    if sets[0].shape[1] == 3 and (spec is not None or function is not None or tile_size is not None):
         warnings.warn("density and tiling diagnostics are 2D only; skipped", stacklevel=2)
-        spec, tile = None, 0.0
+        spec, function, tile = None, None, 0.0
     min_expected = _checks.number("min_expected", min_expected, 0.0, strict=True)
     density_bands = _checks.integer("density_bands", density_bands, 1, 1000)
     holes_min_density = _checks.number("holes_min_density", holes_min_density, 0.0)
@@ -114,8 +125,8 @@ def analyze(
             if a.ndim != 1 or a.dtype.kind not in "iu" or (a.size and (a.min() < 0 or a.max() > 255)):
                 raise ValueError(f"classes[{k}] must be an (n,) array of integer labels 0 to 255")
             labels.append(np.ascontiguousarray(a, dtype=np.uint8))
-    text, classes_text = _kdm.analyze(sets, names, box, spec, tile, fmax, threads, energy, labels, min_expected,
-                                      density_bands, holes_min_density)
+    text, classes_text = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy, labels,
+                                      min_expected, density_bands, holes_min_density)
     result = _arrays(json.loads(text))
     if classes_text is not None:
         result["classes"] = _arrays(json.loads(classes_text))

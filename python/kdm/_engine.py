@@ -84,10 +84,11 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     ----------
     d : int
         2 or 3.
-    seed : None, int or numpy.random.Generator
-        As SciPy's engines take it: an int seeds a new ``numpy.random.default_rng``, None one seeded
-        from fresh entropy (kept, so that reset() replays it too); a Generator is used as it is (and
-        replayed from a copy by reset()).
+    seed, rng : None, int or numpy.random.Generator
+        As SciPy's engines take it (``seed`` up to SciPy 1.14, ``rng`` from 1.15; give one): an int seeds
+        a new ``numpy.random.default_rng``, None one seeded from fresh entropy (kept, so that reset()
+        replays it too); a Generator is used as it is (and replayed from a copy by reset()). Unlike
+        ``kdm.sample``, whose default seed is 1, two engines made without one draw different sets.
     aspect : float or None
         Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
         density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
@@ -106,6 +107,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         d: int = 2,
         *,
         seed: Any = None,
+        rng: Any = None,
         temperature: float = 0.5,
         domain: Optional[str] = None,
         density: Any = None,
@@ -113,6 +115,10 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         aspect: Optional[float] = None,
     ) -> None:
         d = _checks.integer("d", d, 2, 3)
+        if rng is not None:  # SciPy 1.15's name for it
+            if seed is not None:
+                raise TypeError("give seed or rng, not both")
+            seed = rng
         seeds = (numbers.Integral, np.random.Generator, np.random.RandomState)
         if not (seed is None or isinstance(seed, seeds)):
             raise TypeError(

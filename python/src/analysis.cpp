@@ -2,6 +2,7 @@
 // the text of the metrics.json it would write, which the Python side parses.
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "kdm/analysis/classes.h"
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/report.h"
+#include "python_density.h"
 #include "sampler_density.h"
 
 namespace kdm::python {
@@ -28,11 +30,12 @@ tools::PointSet to_point_set(const Array& a) {
 
 using Labels = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
 
-/// metrics.json's text, and with `labels` (one array per set, or none) classes.json's (else None).
+/// metrics.json's text, and with `labels` (one array per set, or none) classes.json's (else None). The
+/// target density is `density`, or `function` of the coordinates (PythonDensity), or uniform.
 py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::string>& names, bool box,
-                  const tools::DensitySpec* density, double tile_size, double fmax, int threads, bool energy,
-                  const std::vector<Labels>& labels, double min_expected, int density_bands,
-                  double holes_min_density) {
+                  const tools::DensitySpec* density, const py::object& function, double tile_size,
+                  double fmax, int threads, bool energy, const std::vector<Labels>& labels,
+                  double min_expected, int density_bands, double holes_min_density) {
   check_number("fmax", fmax, 0, true);
   check_number("min_expected", min_expected, 0, true);
   if (density_bands < 1 || density_bands > 1000)
@@ -54,11 +57,6 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
   o.holes_min_density = holes_min_density;
   o.checkpoint = [] { stop_on_signal(0); };                 // Ctrl-C stops it between its measures
   if (tile_size != 0) analysis::tiles_per_axis(tile_size);  // 1 / tile_size an integer
-  gen::Density target = gen::Density::constant();
-  if (density) {
-    target = tools::to_generator_density(*density);
-    o.density = tools::analysis_density(target);
-  }
   std::vector<tools::PointSet> sets;
   for (std::size_t i = 0; i < arrays.size(); ++i) {
     sets.push_back(to_point_set(arrays[i]));
@@ -70,8 +68,17 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     if (sets.back().dim != 2) throw std::invalid_argument("classes are 2-D point sets' labels");
     sets.back().classes.assign(l.data(), l.data() + l.size());
   }
+  gen::Density target = gen::Density::constant();
+  std::unique_ptr<PythonDensity> function_density;
+  if (density) {
+    target = tools::to_generator_density(*density);
+  } else if (!function.is_none()) {
+    function_density = std::make_unique<PythonDensity>(function, sets.empty() ? 2 : sets[0].dim);
+    target = function_density->density();
+  }
+  if (density || function_density) o.density = tools::analysis_density(target);
   std::string metrics, classes;
-  {
+  try {
     py::gil_scoped_release release;
     auto energy_of = [&](const std::vector<tools::PointSet>& of) {
       try {
@@ -88,7 +95,10 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
       if (energy) class_energy = energy_of;
       classes = analysis::classes_json(analysis::analyze_classes(sets, o, class_energy), names);
     }
+  } catch (...) {
+    if (!function_density || !function_density->failed()) throw;  // else its failure is the cause
   }
+  if (function_density) function_density->rethrow();
   return py::make_tuple(metrics, labels.empty() ? py::object(py::none()) : py::object(py::str(classes)));
 }
 
@@ -96,8 +106,9 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
 
 void bind_analysis(py::module_& m) {
   m.def("analyze", &analyze, py::arg("sets"), py::arg("names"), py::arg("box"), py::arg("density").none(true),
-        py::arg("tile_size"), py::arg("fmax"), py::arg("threads"), py::arg("energy"), py::arg("labels"),
-        py::arg("min_expected"), py::arg("density_bands"), py::arg("holes_min_density"),
+        py::arg("function").none(true), py::arg("tile_size"), py::arg("fmax"), py::arg("threads"),
+        py::arg("energy"), py::arg("labels"), py::arg("min_expected"), py::arg("density_bands"),
+        py::arg("holes_min_density"),
         "kdm analyze's metrics.json (and classes.json) for point sets in memory");
 }
 

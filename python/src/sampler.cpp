@@ -11,6 +11,7 @@
 #include "density_spec.h"
 #include "kdm/generator/multiclass.h"
 #include "kdm/generator/sampler.h"
+#include "python_density.h"
 #include "sampler_density.h"
 
 namespace kdm::python {
@@ -70,35 +71,15 @@ py::array_t<double> sample_function(std::int64_t n, const py::object& function, 
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
   const gen::SamplerOptions o =
       sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0);
-  std::unique_ptr<py::error_already_set> raised;  // the function's own exception, kept for the caller
-  std::string refused;                            // or why its value was refused
-  gen::Density density;
-  density.thread_safe = false;  // one thread calls it: the GIL would serialise the calls anyway
-  density.function = [&](const double* u) -> double {
-    py::gil_scoped_acquire gil;
-    if (raised || !refused.empty()) return 1;  // the call ends as soon as the sampler returns
-    try {
-      const py::object value = dim == 2 ? function(u[0], u[1]) : function(u[0], u[1], u[2]);
-      const double v = value.cast<double>();
-      if (std::isfinite(v) && v >= 0) return v;
-      refused = "density returned " + std::to_string(v) + " at (" + std::to_string(u[0]) + ", " +
-                std::to_string(u[1]) + "): values must be finite and >= 0";
-    } catch (py::error_already_set& e) {
-      raised = std::make_unique<py::error_already_set>(std::move(e));
-    } catch (const py::cast_error&) {
-      refused = "density must return a number";
-    }
-    return 1;
-  };
+  PythonDensity function_density(function, dim);
   gen::SampleResult result;
   try {
     py::gil_scoped_release release;
-    result = gen::sample(o, density);
+    result = gen::sample(o, function_density.density());
   } catch (...) {
-    if (!raised && refused.empty()) throw;  // the sampler's own refusal (a density zero everywhere)
+    if (!function_density.failed()) throw;  // the sampler's own refusal (a density zero everywhere)
   }
-  if (raised) throw py::error_already_set(*raised);
-  if (!refused.empty()) throw std::invalid_argument(refused);
+  function_density.rethrow();
   const auto count = static_cast<py::ssize_t>(result.size());
   return owning_array(std::move(result.points), {count, result.dim});
 }

@@ -67,6 +67,11 @@ def test_seeds_as_scipy_takes_them():
         kdm.BlueNoise(2, seed="seven")
     with pytest.raises(ValueError, match="seed must be a non-negative int, got -1"):
         kdm.BlueNoise(2, seed=-1)
+    # SciPy 1.15 names it rng: the same engine by either name, not both at once.
+    assert np.array_equal(kdm.BlueNoise(2, rng=5).random(300), b)
+    assert np.array_equal(kdm.BlueNoise(2, rng=np.random.default_rng(5)).random(300), b)
+    with pytest.raises(TypeError, match="seed or rng, not both"):
+        kdm.BlueNoise(2, seed=5, rng=5)
 
 
 def test_engine_options():
