@@ -45,8 +45,9 @@ def analyze(
     ----------
     points : array or list of arrays
         One (n, 2) or (n, 3) set with coordinates in [0, 1], or a list of such sets (arrays or nested
-        lists) of one dimension: statistics are pooled over them, as over the sets of one file, and the
-        spectrum refuses sets more than 10% apart in count (their frequencies would not line up).
+        lists) of one dimension: statistics are pooled over them, as over the sets of one file; sets more
+        than 10% apart in count get no spectrum (their frequencies would not line up: the result's
+        "spectrum_skipped" says so).
         Distances are those of the unit square (cube): a set drawn for a non-square domain is judged
         squeezed (docs/limits.md, "Analysing point sets").
     box : bool

@@ -235,10 +235,15 @@ def test_stipple_never_writes_over_its_image(tmp_path):
     assert image.read_bytes() == open(SPHERE, "rb").read()
 
 
-def test_analyze_pools_sets_of_about_one_size_only():
+def test_analyze_pools_sets_of_any_size_but_their_spectrum_only_of_one():
     a, b = kdm.sample(1024, seed=3, threads=1), kdm.sample(100, seed=4, threads=1)
-    with pytest.raises(ValueError, match="100 to 1024 points"):
-        kdm.analyze([a, b], energy=False, threads=1)
+    m = kdm.analyze([a, b], energy=False, threads=1)
+    assert "100 to 1024 points" in m["spectrum_skipped"] and "spectrum" not in m
+    assert m["points_min"] == 100 and m["points_max"] == 1024 and len(m["dmin_per_set"]) == 2
+    # The other measures pool the sets: both sets' triangles, as analysing them one by one finds.
+    one = [kdm.analyze(s, energy=False, threads=1)["empty_circles"]["triangles"] for s in (a, b)]
+    assert m["empty_circles"]["triangles"] == sum(one) == 2 * (1024 + 100)  # a torus: 2n each
+    assert "spectrum" in kdm.analyze([a, kdm.sample(1000, seed=5, threads=1)], energy=False, threads=1)
 
 
 def test_analyze_skips_the_2d_diagnostics_of_3d_points():

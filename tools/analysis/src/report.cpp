@@ -76,7 +76,11 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   for (double d : r.dmin_per_set) r.dmin_mean += d / static_cast<double>(r.dmin_per_set.size());
 
   checkpoint();
-  if (o.spectrum && r.dim == 2) {
+  // The other measures pool sets of any sizes; the spectrum's frequencies are in units of each set's √n.
+  if (o.spectrum && r.dim == 2 && double(r.points_max) > 1.1 * double(r.points_min)) {
+    r.spectrum_skipped = "sets of " + std::to_string(r.points_min) + " to " + std::to_string(r.points_max) +
+                         " points (more than 10% apart) have no common frequency axis: analyse them apart";
+  } else if (o.spectrum && r.dim == 2) {
     r.spectrum = average_periodogram(sets, o.fmax, o.threads);
     r.spectrum_stats = spectrum_stats(r.spectrum);
     r.has_spectrum = true;
@@ -170,6 +174,7 @@ std::string format_summary(const AnalysisReport& r) {
   append(s, " %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
   append(s, "nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n",
          r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
+  if (!r.spectrum_skipped.empty()) append(s, "spectrum           skipped: %s\n", r.spectrum_skipped.c_str());
   if (r.has_spectrum) {
     const SpectrumStats& st = r.spectrum_stats;
     append(s, "spectrum (f ≤ %.2f, %d set(s))  ", r.spectrum.fmax, r.spectrum.sets);

@@ -51,7 +51,8 @@ struct AnalysisReport {
   std::vector<double> dmin_per_set;  ///< δmin of each set
   double dmin_mean = 0;              ///< mean of dmin_per_set (nn.dmin is the worst)
   bool has_spectrum = false;
-  Periodogram spectrum;  ///< set-averaged periodogram
+  std::string spectrum_skipped;  ///< why a 2D analysis has none (sets more than 10% apart in count), or ""
+  Periodogram spectrum;          ///< set-averaged periodogram
   SpectrumStats spectrum_stats;
   PairCorrelation gr;
   bool has_empty_circles = false;     ///< 2D sets of at least 3 points that span an area
