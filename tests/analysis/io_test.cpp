@@ -180,7 +180,13 @@ TEST(Report, AnalyzeAggregatesSets) {
     EXPECT_NE(json.find(key), std::string::npos) << key;
   EXPECT_NE(format_summary(r).find("δavg"), std::string::npos);
   EXPECT_THROW(analyze({}, o), InvalidInput);
-  EXPECT_THROW(analyze({testing::uniform_set(1000, 21), testing::uniform_set(1200, 22)}, o), InvalidInput);
+  // Sets 20% apart in count: pooled, but with no spectrum (nor what reads it), and the summary says why.
+  const AnalysisReport apart = analyze({testing::uniform_set(1000, 21), testing::uniform_set(1200, 22)}, o);
+  EXPECT_FALSE(apart.has_spectrum);
+  EXPECT_NE(apart.spectrum_skipped.find("1000 to 1200 points"), std::string::npos) << apart.spectrum_skipped;
+  EXPECT_NE(format_summary(apart).find("spectrum           skipped"), std::string::npos);
+  EXPECT_NE(metrics_json(apart, {"a", "b"}).find("\"spectrum_skipped\""), std::string::npos);
+  EXPECT_TRUE(apart.has_empty_circles);
   o.tile_size = 0.3;
   EXPECT_THROW(analyze(sets, o), InvalidInput);
 }
