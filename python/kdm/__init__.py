@@ -12,7 +12,7 @@ pictures are stored. Wrong types raise TypeError, bad values ValueError, unreada
 C++ work runs with the GIL released, so Python threads sample and query in parallel; Ctrl-C stops a long
 sample, bake, analysis or full stipple within its current step.
 """
-from typing import Any
+from typing import Any as _Any
 
 from . import _kdm
 from ._analysis import analyze
@@ -25,7 +25,7 @@ __version__: str = _kdm.__version__
 __all__ = ["BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "__version__"]
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> _Any:
     # BlueNoise subclasses SciPy's QMCEngine when SciPy is installed: loaded on first use, so that
     # `import kdm` does not import scipy.stats.
     if name == "BlueNoise":

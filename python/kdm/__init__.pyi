@@ -38,6 +38,9 @@ class QueryResult:
     classes: Optional[npt.NDArray[np.uint8]]
     @property
     def depth(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def keys(self) -> npt.NDArray[np.uint64]: ...
+    def __getitem__(self, index: Union[int, slice, npt.ArrayLike]) -> QueryResult: ...
     def __init__(
         self,
         points: npt.NDArray[np.void],

@@ -41,9 +41,48 @@ class QueryResult:
         repeat across depths: key points on tile, rank and depth together).
     classes : numpy.ndarray or None
         (m,) uint8: each point's class, for a query with `classes` (None otherwise).
+    keys : numpy.ndarray
+        (m,) uint64: each point's id in one number, as ``positions(keys=True)`` gives it (tile x and y
+        modulo 2**21, rank, depth): unique within any region less than 2,097,152 tiles across, so usable
+        as a dict key or to join with positions' keys; thresholds() needs the result itself.
+
+    ``r[i]``, ``r[a:b]``, ``r[mask]`` and ``r[indices]`` give a new QueryResult of those points (copied);
+    a result pickles its points alone, not the buffer a reused ``out`` left behind it.
     """
 
     __slots__ = ("points", "xy", "tile", "rank", "level", "classes", "_storage")
+
+    @classmethod
+    def _of(cls, points: np.ndarray, level: np.ndarray, classes: Optional[np.ndarray]) -> "QueryResult":
+        """A result over `points` (a packed (m,) record array, owned): xy, tile and rank view it."""
+        points = np.ascontiguousarray(points)
+        m, step = len(points), points.dtype.itemsize
+
+        def view(dtype: Any, offset: int, shape: Tuple[int, ...], strides: Tuple[int, ...]) -> np.ndarray:
+            return np.ndarray(shape, dtype, buffer=points, offset=offset if m else 0, strides=strides)
+
+        xy = view(np.float64, 0, (m, 2), (step, 8))
+        tile = view(np.int64, 16, (m, 2), (step, 8))
+        rank = view(np.uint32, 32, (m,), (step,))
+        return cls(points, xy, tile, rank, np.ascontiguousarray(level, dtype=np.uint32),
+                   classes=None if classes is None else np.ascontiguousarray(classes, dtype=np.uint8))
+
+    @property
+    def keys(self) -> np.ndarray:
+        mask = np.uint64((1 << 21) - 1)
+        tile = self.tile.astype(np.uint64)  # two's complement, as C++'s cast: the low bits of a negative tile
+        return (tile[:, 0] & mask) | (tile[:, 1] & mask) << np.uint64(21) | \
+            self.rank.astype(np.uint64) << np.uint64(42) | self.depth.astype(np.uint64) << np.uint64(61)
+
+    def __getitem__(self, index: Any) -> "QueryResult":
+        if isinstance(index, numbers.Integral):
+            index = slice(index, index + 1 if index != -1 else None)  # a one-point result
+        return QueryResult._of(self.points[index].copy(), self.level[index],
+                               None if self.classes is None else self.classes[index])
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        return (QueryResult._of, (self.points.copy(), self.level.copy(),
+                                  None if self.classes is None else self.classes.copy()))
 
     def __init__(
         self, points: np.ndarray, xy: np.ndarray, tile: np.ndarray, rank: np.ndarray, level: np.ndarray,
@@ -139,8 +178,10 @@ class Tileset:
         density * scale * (tile_size / m**depth)**2 at the point, exceeds its threshold. To fade objects
         in as the density rises instead of letting them pop up, weigh each by
         ``np.clip((count / threshold - 1) / f, 0, 1)``: 0 as it appears, 1 once the density has risen a
-        fraction f. Returns an (m,) float64 array. Raises TypeError for anything but a QueryResult and
-        ValueError for a point this set does not have (a result of another set).
+        fraction f. For a result with classes, the count is that of the classes' summed density (the
+        points of all classes are the one-class query's at their sum). Returns an (m,) float64 array.
+        Raises TypeError for anything but a QueryResult and ValueError for a point this set does not
+        have (a result of another set).
         """
         if not isinstance(result, QueryResult):
             raise TypeError(f"result must be a kdm.QueryResult, got {type(result).__name__}")
@@ -181,8 +222,10 @@ class Tileset:
             Points per unit area where the density is 1.
         density : float, str, 2-D array or callable
             A constant >= 0; a str as ``kdm query --density`` takes it (an image, "const:V", "ramp:R",
-            "radial:R"); a 2-D array of densities (finite, >= 0) with row 0 at the TOP; either of the last
-            two stretched over `density_rect` (default: `rect`; fix it to query parts of one region). Or a
+            "radial:R"); a 2-D array of densities (finite, >= 0; its values as they are, integer arrays
+            too: divide an 8-bit mask by 255) with row 0 at the TOP, the largest y of `density_rect`;
+            either of the last two stretched over `density_rect` (default: `rect`; fix it to query parts
+            of one region), bilinear between texel centres, its edge texels going on past it. Or a
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
             GIL held; an exception it raises is raised here once the query ends, and a value that is
             not finite and >= 0 raises ValueError), which needs `density_max` (> 0), a true upper bound of

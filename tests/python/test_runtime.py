@@ -1,6 +1,7 @@
 """kdm.Tileset and its queries: the command line's bits, partitions, densities of every kind, loading,
 saving and baking."""
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -362,6 +363,39 @@ def test_the_shipped_file_loads_as_the_builtin_set():
     assert shipped.info == BUILTIN.info
 
 
+def test_results_index_key_and_pickle_their_own_points():
+    tiles = kdm.Tileset.builtin()
+    # Past the top level and left of the origin too: keys hold the depth, and a negative tile's low bits.
+    r = tiles.query((-1, -1, 0.5, 0.5), scale=200000, tile_size=0.5, mode="smooth", density="radial:8")
+    assert r.depth.max() >= 1 and r.tile.min() < 0
+    assert len(set(r.keys.tolist())) == len(r)  # unique: a dict key per point
+    key = (r.tile[:, 0].astype(np.uint64) & np.uint64(2**21 - 1)) | \
+        (r.tile[:, 1].astype(np.uint64) & np.uint64(2**21 - 1)) << np.uint64(21) | \
+        r.rank.astype(np.uint64) << np.uint64(42) | r.depth.astype(np.uint64) << np.uint64(61)
+    assert np.array_equal(r.keys, key)
+    left = r.xy[:, 0] < 0
+    part = r[left]
+    for name in ("points", "xy", "tile", "rank", "level", "depth", "keys"):
+        assert np.array_equal(getattr(part, name), getattr(r, name)[left]), name
+    np.testing.assert_array_equal(tiles.thresholds(part), tiles.thresholds(r)[left])
+    assert len(r[3]) == 1 and r[3].rank[0] == r.rank[3] and r[-1].rank[0] == r.rank[-1]
+    assert np.array_equal(r[10:20].xy, r.xy[10:20]) and np.array_equal(r[[5, 2]].rank, r.rank[[5, 2]])
+    part.xy[0, 0] = 1e9  # a copy: the query's result is untouched
+    assert r.xy[left][0, 0] != 1e9
+    c = tiles.query((0, 0, 3, 3), scale=900, classes=[0.2, 0.5])
+    assert np.array_equal(c[c.classes == 1].classes, np.ones(int(np.sum(c.classes == 1)), np.uint8))
+    # A pickle holds the points alone: not the rest of a reused `out` buffer.
+    big = tiles.query((0, 0, 30, 30), scale=2000)
+    small = tiles.query((0, 0, 0.2, 0.2), scale=2000, out=big)
+    again = pickle.loads(pickle.dumps(small))
+    assert big.points.nbytes > 10**6 and len(pickle.dumps(small)) < 100 * len(small) + 1000  # 40 B a point
+    for name in ("points", "xy", "tile", "rank", "level", "depth"):
+        assert np.array_equal(getattr(again, name), getattr(small, name)), name
+    back = pickle.loads(pickle.dumps(c))
+    assert np.array_equal(back.classes, c.classes) and np.array_equal(back.xy, c.xy)
+    assert len(pickle.loads(pickle.dumps(tiles.query((0, 0, 0, 0), scale=1)))) == 0
+
+
 def test_out_refills_an_earlier_results_arrays():
     tiles = kdm.Tileset.builtin()
     big = tiles.query((0, 0, 4, 4), scale=400)
@@ -641,6 +675,7 @@ def test_positions_are_the_querys_points_as_float32(mode):
         tile = full.tile.astype(np.uint64) & np.uint64(2**21 - 1)
         expected = tile[:, 0] | tile[:, 1] << np.uint64(21) | full.rank.astype(np.uint64) << np.uint64(42)
         assert keys.dtype == np.uint64 and np.array_equal(keys, expected)
+        assert np.array_equal(full.keys, keys)  # a result's keys join with positions'
         # Positions alone are the same numbers.
         assert np.array_equal(BUILTIN.positions(rect, density=density, **kwargs), xy)
 

@@ -68,6 +68,12 @@ std::string describe(const QueryProblem& p, const ParameterNames& names) {
             "origin (move the origin), or ask for fewer points per unit area",
             p.value, p.limit);
       break;
+    case QueryProblem::Kind::kNotPositive:  // the runtime's message also speaks of the C API's struct_size
+      std::snprintf(text, sizeof text, "'%s' must be > 0, got %.6g", shown.c_str(), p.value);
+      break;
+    case QueryProblem::Kind::kNegative:
+      std::snprintf(text, sizeof text, "'%s' must be >= 0, got %.6g", shown.c_str(), p.value);
+      break;
     case QueryProblem::Kind::kNotFinite:
       if (!std::isfinite(p.value)) {  // the kind also covers places too far out for a finite value
         std::snprintf(text, sizeof text, "'%s' is not a finite number (%g)", shown.c_str(), p.value);
