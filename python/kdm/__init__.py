@@ -18,11 +18,14 @@ from . import _kdm
 from ._analysis import analyze
 from ._runtime import QueryResult, Tileset, bake
 from ._sampling import sample
-from ._stipple import separate, stipple
+from ._stipple import separate, stipple, zoom_regions
 
 __version__: str = _kdm.__version__
 
-__all__ = ["BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "__version__"]
+__all__ = [
+    "BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "zoom_regions",
+    "__version__",
+]
 
 
 def __getattr__(name: str) -> _Any:

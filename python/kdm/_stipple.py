@@ -50,7 +50,8 @@ def stipple(
         method "full", which has no tiles.
     region : (x0, y0, x1, y1) or None
         Part of the image's UV square [0, 1]^2 (y up) to render at the whole image's dot size (tiles
-        only), a zoom of 1 / its width, at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
+        only; past the square is blank paper, as in the first frames of zoom_regions()), a zoom of
+        1 / its width, at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
         subtiles past its top level, 2 * m**4 x. None: the whole image.
     gamma, invert
         Darkness ** gamma is the density; invert: luminance instead of darkness.
@@ -140,6 +141,23 @@ def stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
         colours, gamma, fade, rgb, alpha,
     )
+
+
+def zoom_regions(region: Sequence[float], frames: int) -> np.ndarray:
+    """The regions of a zoom into `region`, as ``kdm stipple --region R --frames K`` renders them.
+
+    Frame 0 is the smallest rectangle of the region's shape that holds the whole image, frame K - 1 the
+    region; the zoom grows geometrically about a fixed point of the region, so each rectangle holds the
+    next and every dot that stays in view is kept. Stipple each with ``stipple(image, region=r, ...)``
+    (with `fade` and `output` for pictures). Returns a (frames, 4) float64 array of (x0, y0, x1, y1) in
+    the image's UV square [0, 1]^2, y up. Raises ValueError for a region outside [0, 1]^2, empty or
+    inverted, or `frames` not 2 to 10000.
+    """
+    r = _checks.rect("region", region)
+    if not (r[0] >= 0 and r[1] >= 0 and r[2] <= 1 and r[3] <= 1):
+        raise ValueError(f"region must lie in [0, 1]^2 (0 <= x0 < x1 <= 1, 0 <= y0 < y1 <= 1), got {r}")
+    frames = _checks.integer("frames", frames, 2, 10000)
+    return _kdm.zoom_regions(r, frames)
 
 
 def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[np.ndarray, List[str]]:

@@ -88,9 +88,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (region) {
     uv = *region;
     const bool finite = std::all_of(uv.begin(), uv.end(), [](double v) { return std::isfinite(v); });
-    if (!(finite && uv[0] >= 0 && uv[1] >= 0 && uv[2] <= 1 && uv[3] <= 1 && uv[0] < uv[2] && uv[1] < uv[3]))
+    // Past the image's square is blank paper, as a zoom's first frames show it (zoom_regions).
+    if (!(finite && uv[0] < uv[2] && uv[1] < uv[3] && uv[0] < 1 && uv[1] < 1 && uv[2] > 0 && uv[3] > 0))
       throw std::invalid_argument(
-          "region must be (x0, y0, x1, y1) with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1");
+          "region must be (x0, y0, x1, y1) with x0 < x1 and y0 < y1, meeting the image's [0, 1]^2");
     if (method == "full")
       throw std::invalid_argument("region needs method='tiles' (the full sampler has no zoom)");
   }
@@ -181,6 +182,15 @@ void bind_stipple(py::module_& m) {
   m.def("separate", &separate, py::arg("path"), py::arg("colours"), py::arg("gamma"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
         "The inks of an image file as kdm stipple --colours separates them (channels, names)");
+  m.def(
+      "zoom_regions",
+      [](const std::array<double, 4>& region, int frames) {
+        py::array_t<double> out({py::ssize_t(frames), py::ssize_t(4)});
+        for (int i = 0; i < frames; ++i)
+          tools::stipple_frame_region(region.data(), i, frames, out.mutable_data(i, 0));
+        return out;
+      },
+      py::arg("region"), py::arg("frames"), "The UV rectangles of kdm stipple --frames, one row per frame");
   m.def("stipple", &stipple, py::arg("spec"), py::arg("label"), py::arg("points"), py::arg("scale"),
         py::arg("method"), py::arg("mode"), py::arg("region").none(true), py::arg("seed"),
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),

@@ -234,12 +234,12 @@ TEST_F(CliTest, RuntimeScalesAtTheirLimits) {
   EXPECT_EQ(zero.status, 0) << zero.err;
   EXPECT_NE(zero.err.find("kdm query: 0 points"), std::string::npos) << zero.err;
   expect_error("query --rect 0,0,1,1 --scale 1e12" + out, "--scale 32768 or less");  // beyond the top level
-  expect_error("query --rect 0,0,1,1 --scale -1" + out, "'--scale' = -1");
+  expect_error("query --rect 0,0,1,1 --scale -1" + out, "'--scale' must be >= 0, got -1");
   // An empty value (an unset shell variable) is no scale 0: refused, pointing at the command's own help.
   expect_error("query --rect 0,0,1,1 --scale ''" + out,
                "--scale: is empty (an unset variable?) (see kdm query --help)");
   expect_error("query --rect 0,0,1,1 --tile-size 0" + out,
-               "'--tile-size' = 0");  // an error, no warning first
+               "'--tile-size' must be > 0, got 0");  // an error, no warning first
   // The advice can be followed: a limit printed to six digits is rounded down (smooth mode's deepest,
   // 2^55 = 3.6028797e16, rounded to nearest would print as 3.60288e+16, above it).
   const std::string deep = "query --rect 0,0,1e-7,1e-7 --mode smooth" + out + " --scale ";

@@ -166,7 +166,7 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, "points must be >= 1", lambda: kdm.stipple(SPHERE, points=0)),
     (ValueError, "scale must be > 0", lambda: kdm.stipple(SPHERE, scale=-1)),
     (ValueError, "method must be one of", lambda: kdm.stipple(SPHERE, method="fast")),
-    (ValueError, "region must be", lambda: kdm.stipple(SPHERE, region=(0, 0, 2, 1))),
+    (ValueError, "meeting the image", lambda: kdm.stipple(SPHERE, region=(1.5, 0, 2, 1))),
     (ValueError, "region zooms more than 2", lambda: kdm.stipple(SPHERE, region=(0, 0, 0.1, 0.1), mode="stable")),
     (ValueError, "needs method='tiles'", lambda: kdm.stipple(SPHERE, method="full", region=(0, 0, 1, 1))),
     (ValueError, "width must be <= 65536", lambda: kdm.stipple(SPHERE, width=10**6)),

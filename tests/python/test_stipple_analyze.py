@@ -18,6 +18,23 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     assert np.array_equal(full, read_txt(tmp_path / "full.txt"))
 
 
+def test_zoom_regions_are_the_frames_of_kdm_stipple(cli, tmp_path):
+    cli("stipple", SPHERE, "--points", 3000, "--region", "0.55,0.3,0.6,0.34", "--frames", 4,
+        "-o", tmp_path / "z.txt")
+    regions = kdm.zoom_regions((0.55, 0.3, 0.6, 0.34), 4)
+    assert regions.shape == (4, 4) and np.allclose(regions[-1], (0.55, 0.3, 0.6, 0.34), rtol=0, atol=1e-15)
+    for i, r in enumerate(regions):
+        frame = tmp_path / f"z_{i:04d}.txt"
+        header = [line for line in frame.read_text().splitlines() if line.startswith("# region")][0]
+        assert np.array_equal([float(v) for v in header.split()[2].split(",")], r)  # printed exactly
+        assert np.array_equal(kdm.stipple(str(SPHERE), points=3000, region=r), read_txt(frame))
+    assert np.all(np.diff(regions[:, 2] - regions[:, 0]) < 0)  # each frame narrower: a zoom
+    with pytest.raises(ValueError, match="region must lie in"):
+        kdm.zoom_regions((0.5, 0.5, 1.5, 0.9), 10)
+    with pytest.raises(ValueError, match="frames"):
+        kdm.zoom_regions((0.1, 0.1, 0.2, 0.2), 1)
+
+
 def test_stipple_fade_draws_what_kdm_stipple_draws(cli, tmp_path):
     # The same SVG as the command line's, about 1/6 of its dots partly grown at fade=0.2 (measured 0.17;
     # tests/cli has the full rule), and the same dots returned as without fade, to float precision.
