@@ -216,7 +216,9 @@ void add_sample_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--unadjusted", args->unadjusted,
                 "Skip the Metropolis-Hastings test (biased; experiments only)");
-  cmd->add_option("--width", args->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
+  cmd->add_option("--width", args->width_px,
+                  "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
+      ->capture_default_str();
   cmd->add_option("--dot-size", args->dot_radius, "Dot radius in pixels (default: from the point count)");
   cmd->add_flag("--timing", args->timing,
                 "Print points per second and each level's time on stdout (default: off)");

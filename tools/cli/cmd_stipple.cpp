@@ -212,7 +212,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     const auto t1 = std::chrono::steady_clock::now();
     tools::write_points(path, set, {line, "image " + a.image, where}, style, format);
     const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-    std::fprintf(stderr, "%s placed in %.3f s, written in %.3f s -> %s\n", line, seconds, writing,
+    // A frame's region is said too: a .csv frame has no header to hold it.
+    std::fprintf(stderr, "%s%s%s placed in %.3f s, written in %.3f s -> %s\n", line, a.frames > 0 ? ", " : "",
+                 a.frames > 0 ? where : "", seconds, writing,
                  path == tools::kStandardOutput ? "standard output" : path.c_str());
   }
 }
@@ -260,7 +262,9 @@ void add_stipple_command(CLI::App& app) {
          "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
          "sequence; pictures only, which it lightens by about 1 - ln(1 + F) / F: 28% at 1, 61% at 5; 0: off)")
       ->capture_default_str();
-  cmd->add_option("--width", a->width_px, "Picture width in pixels (.png/.svg)")->capture_default_str();
+  cmd->add_option("--width", a->width_px,
+                  "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
+      ->capture_default_str();
   cmd->add_option(
       "--dot-size", a->dot_size,
       "Dot radius in pixels (default, or 0: the size at which the whole image's dots cover as much of "
