@@ -83,6 +83,7 @@ class Tileset:
         gamma: float = ...,
         invert: bool = ...,
         glide_together: bool = ...,
+        threads: Optional[int] = ...,
         out: Optional[QueryResult] = ...,
     ) -> QueryResult: ...
     def positions(

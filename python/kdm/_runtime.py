@@ -212,6 +212,7 @@ class Tileset:
         invert: bool = False,
         out: Optional["QueryResult"] = None,
         glide_together: bool = False,
+        threads: Optional[int] = None,
     ) -> QueryResult:
         """The points of the world rectangle `rect` = (x0, y0, x1, y1), half-open (``kdm query``); none
         when x1 <= x0 or y1 <= y0, as in C and C++.
@@ -276,6 +277,12 @@ class Tileset:
             An earlier result whose memory this query refills, where it is large enough (its arrays are
             overwritten): a loop of queries then writes into warm memory instead of new memory. Not with
             `classes` (ValueError).
+        threads : int or None
+            None (the default) runs one query; N splits it over N threads as positions() does (the same
+            points for any N, in this order unless a tile holds more points than a unit of the split; 0
+            for the CPUs this process may use, at most 64): for large regions and maps. A density (or
+            class) that is a Python function runs one query whatever `threads` says: the GIL lets one
+            thread call it at a time, and two threads waiting on it ran 4 to 20 times slower.
 
         Returns
         -------
@@ -291,9 +298,10 @@ class Tileset:
         rect, scale, tile_size, mode, origin, density_rect, density_max = _query_args(
             rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max,
             glide_together)
+        workers = _workers(threads)
         if classes is not None:
             return self._query_classes(rect, scale, density, classes, density_rect, class_max, density_bounds,
-                                       vectorized, tile_size, mode, origin, gamma, invert, out)
+                                       vectorized, tile_size, mode, origin, gamma, invert, out, workers)
         spec, call = _density_arg(density, gamma, invert)
         if out is not None and not isinstance(out, QueryResult):
             raise TypeError(f"out must be a QueryResult, got {type(out).__name__}")
@@ -302,6 +310,7 @@ class Tileset:
         return QueryResult(*_kdm.query(
             self._handle, rect, scale, spec, call, _checks.flag("vectorized", vectorized), density_bounds,
             density_rect, density_max, tile_size, mode, origin, out._storage if out is not None else None,
+            workers,
         ))
 
 
@@ -335,7 +344,8 @@ class Tileset:
         (tile x and y modulo 2**21, rank and depth packed: the same in every query, unique within any
         region under 2**21 tiles across). ``threads=N`` splits the query over N threads (units of the
         region in a fixed order: the same bits for any N, in query()'s order unless a tile holds more
-        points than a unit; 0 for the CPUs this process may use, at most 64); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
+        points than a unit; 0 for the CPUs this process may use, at most 64; a Python function density
+        runs one query, as in query()); the default runs one query, in query()'s order. ``classes=[...]`` (as query()'s, instead of `density`; `threads` too)
         appends an (n,) uint8 array of each point's class: ``(xy, classes)`` or ``(xy, keys, classes)``.
         More than 2**25 points raise ValueError, as query() does.
         """
@@ -344,13 +354,7 @@ class Tileset:
             rect, scale, tile_size, mode, origin, density_rect, None if classes is not None else density_max,
             glide_together)
         keys = _checks.flag("keys", keys)  # the one rule for flags: bool or numpy's
-        workers = 0
-        if threads is not None:
-            if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
-                raise TypeError(f"threads must be an int, got {type(threads).__name__}")
-            if not 0 <= threads <= 64:
-                raise ValueError(f"threads must be 0 (the CPUs this process may use) or 1 to 64, got {threads}")
-            workers = int(threads) or max(1, min(64, len(os.sched_getaffinity(0))))
+        workers = _workers(threads)
         if classes is not None:
             if density is not None:
                 raise ValueError("give either density or classes, not both")
@@ -369,7 +373,7 @@ class Tileset:
     def _query_classes(
         self, rect: Any, scale: float, density: Any, classes: Any, density_rect: Any, density_max: Any,
         density_bounds: Any, vectorized: Any, tile_size: float, mode: str, origin: Any, gamma: Any, invert: Any,
-        out: Any,
+        out: Any, workers: int,
     ) -> QueryResult:
         if density is not None:
             raise ValueError("give either density or classes, not both")
@@ -378,8 +382,20 @@ class Tileset:
         specs, callables, maxima, bounds = _class_args(classes, gamma, invert, density_max, density_bounds)
         *fields, labels = _kdm.query_classes(
             self._handle, rect, scale, specs, callables, maxima, bounds, _checks.flag("vectorized", vectorized),
-            density_rect, tile_size, mode, origin)
+            density_rect, tile_size, mode, origin, workers)
         return QueryResult(*fields, classes=labels)
+
+
+def _workers(threads: Any) -> int:
+    """`threads` as query() and positions() take it: None, one query (0); else the workers of a parallel
+    query, 0 standing for the CPUs this process may use."""
+    if threads is None:
+        return 0
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+        raise TypeError(f"threads must be an int, got {type(threads).__name__}")
+    if not 0 <= threads <= 64:
+        raise ValueError(f"threads must be 0 (the CPUs this process may use) or 1 to 64, got {threads}")
+    return int(threads) or max(1, min(64, len(os.sched_getaffinity(0))))
 
 
 def _query_args(rect: Any, scale: Any, tile_size: Any, mode: Any, origin: Any, density_rect: Any,

@@ -122,48 +122,52 @@ struct Storage {
 
 constexpr std::size_t kChunk = std::size_t(1) << 14;
 
+/// Fills levels[from .. end) with the levels of points[from .. end). Points come tile by tile, ranks
+/// ascending: a run of one tile's points takes its levels a level at a time, the run's end at each level
+/// found by binary search (ranks ascend) and the levels filled.
+void fill_levels(const Tileset& tiles, const QueryPoint* points, std::uint32_t* levels, std::size_t from,
+                 std::size_t end) {
+  const Tile* t = nullptr;
+  PointId tile{std::numeric_limits<std::int64_t>::min(), 0, 0, 0};
+  for (std::size_t i = from; i < end;) {
+    const PointId& id = points[i].id;
+    if (!t || id.tile_x != tile.tile_x || id.tile_y != tile.tile_y || id.depth != tile.depth)
+      tile = id, t = tile_of(tiles, id);
+    std::size_t run = i + 1;
+    for (std::uint32_t last = id.rank; run < end; last = points[run++].id.rank) {
+      const PointId& next = points[run].id;
+      if (next.tile_x != tile.tile_x || next.tile_y != tile.tile_y || next.depth != tile.depth ||
+          next.rank <= last)
+        break;
+    }
+    for (std::uint32_t level = t->level_of(id.rank); i < run; ++level) {
+      const bool last_level = level + 1 >= t->level_end.size();
+      const std::size_t upto =
+          last_level ? run
+                     : static_cast<std::size_t>(std::partition_point(points + i, points + run,
+                                                                     [&](const QueryPoint& p) {
+                                                                       return p.id.rank < t->level_end[level];
+                                                                     }) -
+                                                points);
+      std::fill(levels + i, levels + upto, level);
+      i = upto;
+    }
+  }
+}
+
 /// Runs the query to completion (the rules of tools::query_all) into `buffer`, a chunk at a time so that
 /// each chunk's levels are found while its points are still in cache. Returns the count. Call without
 /// the GIL.
 std::size_t collect(const Tileset& tiles, const QueryParams& q, Buffer& buffer) {
   QueryCursor cursor;
   std::size_t m = 0;
-  // Points come tile by tile, ranks ascending: a run of one tile's points takes its levels a level at a
-  // time, the run's end at each level found by binary search (ranks ascend) and the levels filled.
-  const Tile* t = nullptr;
-  PointId tile{std::numeric_limits<std::int64_t>::min(), 0, 0, 0};
   for (;;) {
     if (m == buffer.capacity) buffer.reserve(m + kChunk, m);
     std::size_t written = 0;
     QueryProblem problem;
     const Status s = query_points(tiles, q, buffer.points + m, std::min(kChunk, buffer.capacity - m),
                                   &written, &cursor, &problem);
-    const QueryPoint* points = buffer.points;
-    for (std::size_t i = m, end = m + written; i < end;) {
-      const PointId& id = points[i].id;
-      if (!t || id.tile_x != tile.tile_x || id.tile_y != tile.tile_y || id.depth != tile.depth)
-        tile = id, t = tile_of(tiles, id);
-      std::size_t run = i + 1;
-      for (std::uint32_t last = id.rank; run < end; last = points[run++].id.rank) {
-        const PointId& next = points[run].id;
-        if (next.tile_x != tile.tile_x || next.tile_y != tile.tile_y || next.depth != tile.depth ||
-            next.rank <= last)
-          break;
-      }
-      for (std::uint32_t level = t->level_of(id.rank); i < run; ++level) {
-        const bool last_level = level + 1 >= t->level_end.size();
-        const std::size_t upto =
-            last_level
-                ? run
-                : static_cast<std::size_t>(std::partition_point(points + i, points + run,
-                                                                [&](const QueryPoint& p) {
-                                                                  return p.id.rank < t->level_end[level];
-                                                                }) -
-                                           points);
-        std::fill(buffer.levels + i, buffer.levels + upto, level);
-        i = upto;
-      }
-    }
+    fill_levels(tiles, buffer.points, buffer.levels, m, m + written);
     m += written;
     if (m > tools::kMaxCollectedPoints)  // 1 GiB of points: stop before memory runs out
       throw std::invalid_argument(
@@ -254,29 +258,6 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
   }
 }
 
-py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
-                py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
-                std::optional<double> density_max, double tile_size, const std::string& mode,
-                const std::array<double, 2>& origin, const py::object& storage) {
-  PreparedQuery prepared;
-  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
-          density_max, tile_size, mode, origin);
-  const QueryParams& q = prepared.q;
-  tools::check_before_collecting(*handle.set, q, kKeywordNames);
-  const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
-  const Storage out(storage);
-  Buffer buffer;  // an earlier result's memory while it has room, else new memory
-  if (out.capacity) buffer.points = out.points, buffer.levels = out.levels, buffer.capacity = out.capacity;
-  buffer.shared = out.capacity > 0;
-  std::size_t m = 0;
-  {
-    py::gil_scoped_release release;  // a callable density takes it back at each call
-    m = collect(*handle.set, q, buffer);
-  }
-  if (from_callable) from_callable->rethrow();
-  return result(m, buffer, storage);
-}
-
 /// Arrays of malloc'd memory that numpy takes over once filled: positions and, if asked, keys.
 struct CompactBuffer {
   float* xy = nullptr;
@@ -354,6 +335,68 @@ std::size_t room_for(double rho, const QueryParams& q) {
   return std::size_t(std::min(bound, double(tools::kMaxCollectedPoints) + 1));
 }
 
+/// Fills `buffer` by a ParallelQuery of `threads` workers, the GIL released: run(parallel, written,
+/// needed, problem) writes into buffer.points (with room first for `room` points, then for what the run
+/// said it needs; grow(capacity) sizes what is kept beside them). Returns the count; a refusal raises
+/// ValueError.
+template <class Grow, class Run>
+std::size_t collect_parallel(Buffer& buffer, int threads, std::size_t room, Grow&& grow, Run&& run) {
+  ParallelQuery parallel;
+  if (parallel.init(static_cast<std::uint32_t>(threads)) != Status::kOk) throw std::bad_alloc();
+  buffer.reserve(std::max<std::size_t>(room, 1), 0);
+  grow(buffer.capacity);
+  for (;;) {
+    std::size_t m = 0, needed = 0;
+    QueryProblem problem;
+    Status s;
+    {
+      py::gil_scoped_release release;  // a callable density takes it back at each call
+      s = run(parallel, &m, &needed, &problem);
+    }
+    if (s == Status::kOk) {
+      check_collected(m);
+      return m;
+    }
+    if (s != Status::kBufferFull || needed <= buffer.capacity) refused(problem);
+    check_collected(needed);
+    buffer.reserve(needed, 0);
+    grow(buffer.capacity);
+  }
+}
+
+py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
+                py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
+                std::optional<double> density_max, double tile_size, const std::string& mode,
+                const std::array<double, 2>& origin, const py::object& storage, int threads) {
+  check_threads(threads);
+  PreparedQuery prepared;
+  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
+          density_max, tile_size, mode, origin);
+  if (prepared.from_callable) threads = 0;  // a Python function runs on one thread at a time (the GIL)
+  const QueryParams& q = prepared.q;
+  tools::check_before_collecting(*handle.set, q, kKeywordNames);
+  const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
+  const Storage out(storage);
+  Buffer buffer;  // an earlier result's memory while it has room, else new memory
+  if (out.capacity) buffer.points = out.points, buffer.levels = out.levels, buffer.capacity = out.capacity;
+  buffer.shared = out.capacity > 0;
+  std::size_t m = 0;
+  if (threads == 0) {
+    py::gil_scoped_release release;  // a callable density takes it back at each call
+    m = collect(*handle.set, q, buffer);
+  } else {
+    m = collect_parallel(
+        buffer, threads, room_for(density_bound(q.density, q), q), [](std::size_t) {},
+        [&](ParallelQuery& parallel, std::size_t* written, std::size_t* needed, QueryProblem* problem) {
+          return parallel.run(*handle.set, q, buffer.points, buffer.capacity, written, std_thread_runner(),
+                              needed, problem);
+        });
+    fill_levels(*handle.set, buffer.points, buffer.levels, 0, m);
+  }
+  if (from_callable) from_callable->rethrow();
+  return result(m, buffer, storage);
+}
+
 /// Fills `buffer` with a compact query's points, the GIL released (a callable density takes it back at each
 /// call), and returns their count: with `threads` 0 by serial(at, written, cursor, problem), which writes
 /// from slot `at` on, resumed until done; else by parallel(query, written, needed, problem) on a
@@ -407,6 +450,7 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
   PreparedQuery prepared;
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
           density_max, tile_size, mode, origin);
+  if (prepared.from_callable) threads = 0;  // a Python function runs on one thread at a time (the GIL)
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
@@ -510,25 +554,40 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
                         const std::vector<py::object>& callables, const std::vector<double>& maxima,
                         const std::vector<py::object>& bounds, bool vectorized,
                         std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                        const std::array<double, 2>& origin) {
+                        const std::array<double, 2>& origin, int threads) {
+  check_threads(threads);
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin);
+  if (!prepared.callables.empty()) threads = 0;  // Python functions run one at a time (the GIL)
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
-  {
+  std::size_t m = 0;
+  if (threads == 0) {
     py::gil_scoped_release release;  // a callable class takes it back at each call
     tools::query_all(*handle.set, prepared.q, points, classes, kKeywordNames);
-    buffer.reserve(std::max<std::size_t>(points.size(), 1), 0);
+    m = points.size();
+    buffer.reserve(std::max<std::size_t>(m, 1), 0);
     std::copy(points.begin(), points.end(), buffer.points);
-    for (std::size_t i = 0; i < points.size(); ++i)
-      buffer.levels[i] = tile_of(*handle.set, points[i].id)->level_of(points[i].id.rank);
+  } else {
+    const ClassQueryParams& q = prepared.q;
+    tools::check_before_collecting(*handle.set, q, kKeywordNames);
+    double rho = 0;
+    for (std::uint32_t k = 0; k < q.class_count; ++k) rho += density_bound(q.classes[k], q.query);
+    m = collect_parallel(
+        buffer, threads, room_for(rho, q.query), [&](std::size_t capacity) { classes.resize(capacity); },
+        [&](ParallelQuery& parallel, std::size_t* written, std::size_t* needed, QueryProblem* problem) {
+          return parallel.run(*handle.set, q, buffer.points, classes.data(), buffer.capacity, written,
+                              std_thread_runner(), needed, problem);
+        });
+    classes.resize(m);
   }
+  fill_levels(*handle.set, buffer.points, buffer.levels, 0, m);
   prepared.rethrow();
   py::array_t<std::uint8_t> labels(static_cast<py::ssize_t>(classes.size()));
   std::copy(classes.begin(), classes.end(), labels.mutable_data());
-  const py::tuple base = result(points.size(), buffer, py::none());
+  const py::tuple base = result(m, buffer, py::none());
   return py::make_tuple(base[0], base[1], base[2], base[3], base[4], base[5], labels);
 }
 
@@ -544,6 +603,7 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin);
+  if (!prepared.callables.empty()) threads = 0;  // Python functions run one at a time (the GIL)
   const ClassQueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
@@ -575,7 +635,7 @@ void bind_query(py::module_& m) {
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
         py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-        "several classes in one query: query()'s tuple and each point's class");
+        py::arg("threads"), "several classes in one query: query()'s tuple and each point's class");
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
         py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
@@ -590,7 +650,7 @@ void bind_query(py::module_& m) {
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
       py::arg("callable").none(true), py::arg("vectorized"), py::arg("bounds").none(true),
       py::arg("density_rect").none(true), py::arg("density_max").none(true), py::arg("tile_size"),
-      py::arg("mode"), py::arg("origin"), py::arg("storage").none(true),
+      py::arg("mode"), py::arg("origin"), py::arg("storage").none(true), py::arg("threads"),
       "tools::query_all into numpy arrays (reusing `storage`, an earlier result's, when it is large enough)");
 }
 

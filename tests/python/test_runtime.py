@@ -723,6 +723,39 @@ def test_positions_over_threads_give_the_same_bits_for_any_count():
         assert np.array_equal(np.sort(plain_keys), np.sort(one_keys))
 
 
+def test_query_over_threads_gives_the_same_points():
+    rect = (-2.0, -1.0, 4.0, 3.5)
+    image = np.random.default_rng(3).random((40, 50))
+    for kwargs in (dict(density=image), dict(density="radial:30", mode="smooth"),
+                   dict(classes=[0.2, image], mode="smooth"), dict(density=0.9, scale=30000, mode="smooth")):
+        kwargs = {"scale": 2500, **kwargs}
+        one = BUILTIN.query(rect, **kwargs)
+        for threads in (1, 2, 0):
+            split = BUILTIN.query(rect, threads=threads, **kwargs)
+            assert len(split) == len(one) > 5000
+            order = np.argsort(split.keys)  # the same points, with their levels and classes
+            back = np.argsort(one.keys)
+            assert np.array_equal(split.points[order], one.points[back])
+            assert np.array_equal(split.level[order], one.level[back])
+            if one.classes is not None:
+                assert np.array_equal(split.classes[order], one.classes[back])
+            if threads == 1:
+                first = split
+            else:  # the same bits for any count
+                assert np.array_equal(split.points, first.points) and np.array_equal(split.level, first.level)
+    # Below a unit's points per tile the split keeps the query's order too.
+    small = BUILTIN.query(rect, scale=900, density=image, threads=2)
+    assert same(small, BUILTIN.query(rect, scale=900, density=image))
+    # A Python function runs one query (the GIL lets one thread call it at a time): the same bits.
+    def ramp(x, y):
+        return 0.3 + 0.1 * x
+
+    assert same(BUILTIN.query(rect, scale=900, density=ramp, density_max=1, threads=2),
+                BUILTIN.query(rect, scale=900, density=ramp, density_max=1))
+    with pytest.raises(ValueError, match="threads must be 0 .* or 1 to 64, got 65"):
+        BUILTIN.query(rect, scale=900, threads=65)
+
+
 def test_positions_refuse_bad_arguments():
     with pytest.raises(ValueError, match="threads must be 0 .* or 1 to 64, got -1"):
         BUILTIN.positions((0, 0, 1, 1), scale=10, threads=-1)
