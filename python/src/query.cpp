@@ -217,6 +217,13 @@ py::tuple result(std::size_t m, Buffer& buffer, const py::object& storage) {
   return py::make_tuple(records, xy, tile, rank, levels, full);
 }
 
+/// `threads` as positions() takes it: 0 (one query) or 1 … kMaxParallelWorkers.
+void check_threads(int threads) {
+  if (threads < 0 || threads > int(kMaxParallelWorkers))
+    throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
+                                std::to_string(threads));
+}
+
 /// A query's parameters and the density objects they point at (kept alive with them).
 struct PreparedQuery {
   QueryParams q;
@@ -227,7 +234,8 @@ struct PreparedQuery {
 void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::DensitySpec* spec,
              py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
              std::optional<double> density_max, double tile_size, const std::string& mode,
-             const std::array<double, 2>& origin) {
+             const std::array<double, 2>& origin, int& threads) {
+  check_threads(threads);
   check_rect("rect", rect, true);
   QueryParams& q = p.q;
   q.x0 = rect[0], q.y0 = rect[1], q.x1 = rect[2], q.y1 = rect[3];
@@ -251,6 +259,7 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
     p.from_callable =
         std::make_unique<CallableDensity>(std::move(callable), *density_max, std::move(bounds), vectorized);
     q.density = p.from_callable->density;
+    threads = 0;  // a Python function runs on one thread at a time (the GIL): one query
   } else {
     const Rect r = image_rect(rect, density_rect);
     p.from_spec = std::make_unique<SpecDensity>(*spec, r.data());
@@ -308,13 +317,6 @@ py::tuple take_compact(CompactBuffer& buffer, std::size_t m) {
   return py::make_tuple(xy_array, py::array_t<std::uint64_t>({rows}, key, keys_owner));
 }
 
-/// `threads` as positions() takes it: 0 (one query) or 1 … kMaxParallelWorkers.
-void check_threads(int threads) {
-  if (threads < 0 || threads > int(kMaxParallelWorkers))
-    throw std::invalid_argument("threads must be 1 to " + std::to_string(kMaxParallelWorkers) + ", got " +
-                                std::to_string(threads));
-}
-
 /// An upper bound of density `d` over the query's rectangle.
 double density_bound(const QueryDensity& d, const QueryParams& q) {
   switch (d.kind) {
@@ -368,11 +370,9 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
                 py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
                 std::optional<double> density_max, double tile_size, const std::string& mode,
                 const std::array<double, 2>& origin, const py::object& storage, int threads) {
-  check_threads(threads);
   PreparedQuery prepared;
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
-          density_max, tile_size, mode, origin);
-  if (prepared.from_callable) threads = 0;  // a Python function runs on one thread at a time (the GIL)
+          density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
@@ -446,11 +446,9 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
                     const tools::DensitySpec* spec, py::object callable, bool vectorized, py::object bounds,
                     std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
                     const std::string& mode, const std::array<double, 2>& origin, bool keys, int threads) {
-  check_threads(threads);
   PreparedQuery prepared;
   prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
-          density_max, tile_size, mode, origin);
-  if (prepared.from_callable) threads = 0;  // a Python function runs on one thread at a time (the GIL)
+          density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
@@ -499,7 +497,9 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<const tools::DensitySpec*>& specs,
                      const std::vector<py::object>& callables, const std::vector<double>& maxima,
                      const std::vector<py::object>& bounds, bool vectorized, std::optional<Rect> density_rect,
-                     double tile_size, const std::string& mode, const std::array<double, 2>& origin) {
+                     double tile_size, const std::string& mode, const std::array<double, 2>& origin,
+                     int& threads) {
+  check_threads(threads);
   check_rect("rect", rect, true);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
@@ -538,6 +538,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
       prepared.callables.push_back(
           std::make_unique<CallableDensity>(callables[k], maxima[k], bounds[k], vectorized));
       q.classes[k] = prepared.callables.back()->density;
+      threads = 0;  // Python functions run one at a time (the GIL): one query
       continue;
     }
     if (!specs[k]) throw std::invalid_argument(name + " is not a density");
@@ -555,11 +556,9 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
                         const std::vector<py::object>& bounds, bool vectorized,
                         std::optional<Rect> density_rect, double tile_size, const std::string& mode,
                         const std::array<double, 2>& origin, int threads) {
-  check_threads(threads);
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
-                  tile_size, mode, origin);
-  if (!prepared.callables.empty()) threads = 0;  // Python functions run one at a time (the GIL)
+                  tile_size, mode, origin, threads);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
@@ -599,11 +598,9 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
                           const std::vector<py::object>& bounds, bool vectorized,
                           std::optional<Rect> density_rect, double tile_size, const std::string& mode,
                           const std::array<double, 2>& origin, bool keys, int threads) {
-  check_threads(threads);
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
-                  tile_size, mode, origin);
-  if (!prepared.callables.empty()) threads = 0;  // Python functions run one at a time (the GIL)
+                  tile_size, mode, origin, threads);
   const ClassQueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
