@@ -509,6 +509,19 @@ kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out) {
   return load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t); });
 }
 
+/* A load's status, with `line` (else the status's message) in `detail` on failure and "" on success; *out
+ * is NULL on failure. No copy of the line: nothing here may throw. */
+static kdm_status with_detail(kdm_status s, const char* line, kdm_tileset** out, char* detail,
+                              size_t detail_size) {
+  if (s != KDM_OK && out) *out = nullptr;
+  if (!detail || !detail_size) return s;
+  if (s == KDM_OK || !*line) line = s == KDM_OK ? "" : kdm_status_message(s);
+  const std::size_t n = std::min(std::strlen(line), detail_size - 1);
+  std::memcpy(detail, line, n);
+  detail[n] = '\0';
+  return s;
+}
+
 kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out) {
   if (out) *out = nullptr;
   if (!data && size) return KDM_INVALID_ARGUMENT;
@@ -517,19 +530,29 @@ kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** 
 
 kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, char* detail,
                                         size_t detail_size) {
-  if (detail && detail_size) detail[0] = '\0';
-  if (out) *out = nullptr;
   std::string why;
   const kdm_status s =
       !path ? KDM_INVALID_ARGUMENT
             : load_into(out, [&](kdm::Tileset& t) { return kdm::Tileset::load_file(path, t, &why); });
-  if (s != KDM_OK && detail && detail_size) {  // no copy of the line: nothing here may throw
-    const char* line = !path ? "path is NULL" : why.empty() ? kdm_status_message(s) : why.c_str();
-    const std::size_t n = std::min(std::strlen(line), detail_size - 1);
-    std::memcpy(detail, line, n);
-    detail[n] = '\0';
-  }
-  return s;
+  return with_detail(s,
+                     !path  ? "path is NULL"
+                     : !out ? "out is NULL"
+                            : why.c_str(),
+                     out, detail, detail_size);
+}
+
+kdm_status kdm_tileset_load_memory_detail(const void* data, size_t size, kdm_tileset** out, char* detail,
+                                          size_t detail_size) {
+  std::string why;
+  const bool missing = !data && size;
+  const kdm_status s = missing ? KDM_INVALID_ARGUMENT : load_into(out, [&](kdm::Tileset& t) {
+    return kdm::Tileset::load_memory(data, size, t, &why);
+  });
+  return with_detail(s,
+                     missing ? "data is NULL with size > 0"
+                     : !out  ? "out is NULL"
+                             : why.c_str(),
+                     out, detail, detail_size);
 }
 
 void kdm_tileset_free(kdm_tileset* tileset) {

@@ -582,12 +582,12 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kNone:
       return "no problem";
     case QueryProblem::Kind::kMissingArgument:
-      return "a required argument is null or empty (the tile set, an output), or an object was not "
-             "initialised (ParallelQuery::init)";
+      return "a required argument is null or empty (the tile set, an output), or a parallel query's "
+             "scratch was not made";
     case QueryProblem::Kind::kNotFinite:
       return "a parameter is not a finite number";
     case QueryProblem::Kind::kNotPositive:
-      return "a parameter must be greater than 0 (a struct_size: at least the limit)";
+      return "a parameter must be greater than 0 (or, for a struct_size, at least the limit)";
     case QueryProblem::Kind::kNegative:
       return "a parameter must not be negative";
     case QueryProblem::Kind::kBadDensity:

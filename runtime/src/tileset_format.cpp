@@ -508,6 +508,8 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
     parse_body(body.get(), body_size, version, set, glide16, glide);
   } catch (const std::bad_alloc&) {  // not damage
     return fail(Status::kOutOfMemory, detail, "payload: an allocation failed");
+  } catch (const cereal::Exception&) {  // its own words ("Failed to read 8 bytes ...") say less than these
+    return fail(Status::kInvalidContent, detail, "payload: its records end before their stated sizes");
   } catch (const std::exception& e) {
     return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
   }

@@ -617,6 +617,32 @@ int main(int argc, char** argv) {
     CHECK(kdm_tileset_load_file_detail(argv[1], &bad, detail, sizeof detail) == KDM_OK && bad != NULL);
     CHECK(detail[0] == '\0');
     kdm_tileset_free(bad);
+    CHECK(kdm_tileset_load_file_detail(argv[1], NULL, detail, sizeof detail) == KDM_INVALID_ARGUMENT);
+    CHECK(strstr(detail, "out is NULL") != NULL);
+  }
+  {
+    /* The same from memory, for sets an engine reads itself: the bytes whole, cut, and none. */
+    FILE* f = fopen(argv[1], "rb");
+    long size = 0;
+    unsigned char* bytes = NULL;
+    kdm_tileset* set = NULL;
+    char detail[128];
+    CHECK(f != NULL && fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0);
+    bytes = (unsigned char*)malloc((size_t)size);
+    CHECK(bytes != NULL && fread(bytes, 1, (size_t)size, f) == (size_t)size);
+    fclose(f);
+    CHECK(kdm_tileset_load_memory_detail(bytes, (size_t)size, &set, detail, sizeof detail) == KDM_OK);
+    CHECK(set != NULL && detail[0] == '\0');
+    kdm_tileset_free(set);
+    CHECK(kdm_tileset_load_memory_detail(bytes, (size_t)size / 2, &set, detail, sizeof detail) != KDM_OK);
+    CHECK(set == NULL && strlen(detail) > 0); /* the decoder's line: what is cut */
+    CHECK(kdm_tileset_load_memory_detail(bytes, 0, &set, detail, sizeof detail) == KDM_TRUNCATED);
+    CHECK(kdm_tileset_load_memory_detail(NULL, 5, &set, detail, sizeof detail) == KDM_INVALID_ARGUMENT);
+    CHECK(strstr(detail, "data is NULL") != NULL);
+    CHECK(kdm_tileset_load_memory_detail(bytes, (size_t)size, NULL, detail, sizeof detail) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(strstr(detail, "out is NULL") != NULL);
+    free(bytes);
   }
   CHECK(strlen(kdm_status_message(KDM_TRUNCATED)) > 0);
   kdm_tileset_free(loaded);

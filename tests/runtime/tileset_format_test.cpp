@@ -233,6 +233,14 @@ TEST(TilesetFormatTest, HostileCountsBehindValidChecksumsAreRejected) {
   std::vector<std::uint8_t> bad = with_body(file, huge);
   EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
   EXPECT_NE(why.find("more than the payload"), std::string::npos) << "detail: " << why;
+  // A body that ends inside a record (its header's sizes fixed to match): said in kdm's words.
+  const std::string whole = body_bytes([&](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));
+    nominal(ar);
+  });
+  bad = with_body(file, whole.substr(0, whole.size() - 3));
+  EXPECT_EQ(decode_tileset(bad.data(), bad.size(), out, &why), Status::kInvalidContent);
+  EXPECT_EQ(why, "payload: its records end before their stated sizes");
   // A level table that does not end at the point count.
   const std::string inconsistent = body_bytes([&](auto& ar) {
     ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));

@@ -4,8 +4,12 @@
  * Growing structs: kdm_query, kdm_query_problem and kdm_tileset_info begin with `struct_size`, which the
  * caller sets to sizeof(the struct) as its header declares it. A newer library reads only that many bytes
  * (later fields keep their defaults) and writes only that many, so programs built against an older header
- * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest:
- * a program that sets a field newer than the library it runs with should check kdm_version().
+ * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest
+ * (any larger size is taken: only one below the struct's first version is refused): a program that sets a
+ * field newer than the library it runs with should check kdm_version(). The other structs (kdm_cursor,
+ * kdm_class_density, kdm_joint_class_density, kdm_task_runner, kdm_point) carry no size: where one grows,
+ * as kdm_class_density did in 0.4, callers are rebuilt with the new header (0.x minor versions may change
+ * the ABI; the shared library's soname carries MAJOR.MINOR).
  *
  * Thread safety: a loaded kdm_tileset and a kdm_density_image are immutable; queries on them may run
  * concurrently. No function here throws; every failure is a status code. Queries allocate nothing. */
@@ -63,7 +67,11 @@ typedef struct kdm_query {
   double (*density_callback)(void* user, double x, double y);
   void* user;                             /* passed to the density and bounds callbacks */
   double density_max;                     /* upper bound of the callback's values: > 0 with a callback
-                                             (0, a zeroed struct's, is refused: it would call nothing) */
+                                             (0, a zeroed struct's, is refused: it would call nothing).
+                                             Values above it break that promise: stable mode emits as if
+                                             they were density_max, smooth mode glides by them, and a
+                                             class query gives such a class more than its share, at the
+                                             later classes' expense (kdm::QueryDensity::callback_max) */
   const kdm_density_image* density_image; /* optional; takes precedence over the callback */
   /* Added in 0.2 (callers built before it have a smaller struct_size and get KDM_MODE_STABLE): */
   int mode; /* KDM_MODE_STABLE: points never move once they appear; KDM_MODE_SMOOTH: they glide with the
@@ -154,7 +162,10 @@ typedef struct kdm_tileset_info {
 
 /* Where tile sets loaded from now on keep their arrays (positions, keys, tables, thresholds), the built-in
  * set too if its first kdm_tileset_builtin() call comes after (it is kept until the process ends: call that
- * first where hooks are torn down before then): `allocate`
+ * first where hooks are torn down before then), and parallel queries their scratch. Not through them: a
+ * tile set's handle (a few hundred bytes), density images (kdm_density_image_create: their mips, a
+ * quarter of the texels' bytes) and class images (kdm_class_images_create: the texels of their running
+ * sums), which use malloc. `allocate`
  * returns `bytes` bytes aligned to `alignment` (a power of two, at most alignof(max_align_t)) or NULL,
  * which the load returns as KDM_OUT_OF_MEMORY; `deallocate` frees them. Either NULL: operator new and
  * delete again. Memory always returns to the functions it came from. Call it while no other thread is
@@ -172,7 +183,8 @@ KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 /* Loads a tile-set file / memory buffer (untrusted input is validated). *out receives a new handle to
  * free with kdm_tileset_free, or NULL on failure: KDM_INVALID_ARGUMENT for a NULL `path` or `out` (or NULL
  * `data` with `size` > 0), KDM_IO_ERROR for a file that cannot be read, the format's statuses
- * (KDM_BAD_MAGIC ... KDM_INVALID_CONTENT) for a damaged or foreign one, KDM_OUT_OF_MEMORY. */
+ * (KDM_BAD_MAGIC ... KDM_INVALID_CONTENT) for a damaged or foreign one (KDM_TRUNCATED for one shorter than
+ * its header, an empty buffer too), KDM_OUT_OF_MEMORY. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
 /* kdm_tileset_load_file, and on failure why in `detail` (if not NULL): one line ("No such file or
@@ -180,6 +192,11 @@ KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size
  * success. The status says what kind of failure; this, what a person reading a log needs. Added in 0.5. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file_detail(const char* path, kdm_tileset** out, char* detail,
                                                         size_t detail_size);
+/* kdm_tileset_load_memory with the same `detail` (for sets read through an engine's own file system).
+ * An empty buffer (size 0) is KDM_TRUNCATED, as is any buffer shorter than the file header. Added in
+ * 0.5. */
+KDM_RUNTIME_API kdm_status kdm_tileset_load_memory_detail(const void* data, size_t size, kdm_tileset** out,
+                                                          char* detail, size_t detail_size);
 /* The default tile set compiled into the library: decoded on first use (about 0.1 s; call it
  * once at start-up to keep that out of a frame), then shared with kdm::Tileset::builtin(). NULL when
  * memory runs out while it is decoded (a later call tries again). Never free it. */
@@ -340,10 +357,13 @@ KDM_RUNTIME_API kdm_status kdm_query_class_images_compact(const kdm_tileset* til
  * a large region at once: the region is cut into units fixed by the parameters, so any number of workers
  * gives the same bits, the region's points in kdm_query_points' order (in the units' order where a tile
  * holds more points than a unit: 262,144 at a constant density in stable mode, else 16,384). The library
- * starts no threads: runner->run(context, task, task_context, count) must call task(task_context, i) once
- * for every i in [0, count), concurrently (the tasks wait for one another; a single thread may run them all
- * in turn), and return when all have returned. Density callbacks are then called from those threads at
- * once. Added in 0.4. */
+ * starts no threads: runner->run(context, task, task_context, count) calls task(task_context, i) for i in
+ * [0, count) and returns when all it started have returned. Each task takes the region's units in order
+ * from a shared counter and may wait for the task holding the unit before its own, which is running, so
+ * any schedule works in which a started task runs to its end: concurrently, in turn on one thread, or some
+ * tasks not at all so long as one runs (the others take their units); not one that suspends a task to run
+ * another of the same call on its thread (fibers that switch while a task waits), which can wait forever.
+ * Density callbacks are called from the tasks' threads at once. Added in 0.4. */
 typedef struct kdm_task_runner {
   void (*run)(void* context, void (*task)(void* task_context, size_t index), void* task_context,
               size_t count);

@@ -28,10 +28,12 @@
 
 namespace kdm {
 
-/// A caller's task system: run(context, task, task_context, count) calls task(task_context, i) once for
-/// every i in [0, count), on as many threads as it has, and returns when all have returned. The tasks
-/// wait for one another (each for the unit before its own), so they must run concurrently, not one after
-/// another on one thread unless that thread runs them all in turn (as a sequential runner does).
+/// A caller's task system: run(context, task, task_context, count) calls task(task_context, i) for i in
+/// [0, count), on as many threads as it has, and returns when all it started have returned. Each task
+/// takes units in order from a shared counter and may wait for the task holding the unit before its own,
+/// which is running: any schedule works in which a started task runs to its end (concurrently, in turn on
+/// one thread, or some tasks not at all so long as one runs), not one that suspends a task to run another
+/// of the same call on its thread (fibers switching while a task waits), which can wait forever.
 struct TaskRunner {
   void (*run)(void* context, void (*task)(void* task_context, std::size_t index), void* task_context,
               std::size_t count) = nullptr;
