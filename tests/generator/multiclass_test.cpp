@@ -2,6 +2,8 @@
 // class 0's spacing against one-class samples, densities of every kind, refusals.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstdio>
 #include <vector>
 
@@ -98,6 +100,21 @@ TEST(MultiClassTest, BadInputIsRefused) {
   o.fixed_points.clear();
   o.n = 0;
   EXPECT_THROW(sample_classes(o, one_two_four()), InvalidArgument);
+  EXPECT_THROW(class_counts(o, one_two_four(), -1), InvalidArgument);  // had given {-1, 0, 0}
+}
+
+// Density::constant(v) gives a class its share without a function of one's own: the shares of 1:2:4,
+// as from_values' one-texel images give them.
+TEST(MultiClassTest, ConstantsWithValuesSetTheShares) {
+  SamplerOptions o;
+  const std::vector<Density> constants = {Density::constant(1), Density::constant(2), Density::constant(4)};
+  EXPECT_EQ(class_counts(o, constants, 7001), class_counts(o, one_two_four(), 7001));
+  EXPECT_EQ(class_counts(o, constants, 700), (std::vector<std::int64_t>{100, 200, 400}));
+  EXPECT_THROW(Density::constant(-1), InvalidArgument);
+  EXPECT_THROW(Density::constant(std::nan("")), InvalidArgument);
+  o.n = 300;
+  o.threads = 1;
+  EXPECT_EQ(sample(o, Density::constant(5)).points, sample(o).points);  // alone, only its shape matters
 }
 
 }  // namespace

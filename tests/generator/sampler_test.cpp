@@ -244,6 +244,32 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   EXPECT_THROW(Density::from_values(2, 2, {0, 0, 0, 0}), InvalidArgument);
   EXPECT_THROW(Density::from_values(2, 2, {1, 1, -1, 1}), InvalidArgument);
   EXPECT_THROW(Density::from_values(0, 0, {}), InvalidArgument);
+  // An image has no z: refused in 3D (it had been stretched along z, or ignored when built by hand).
+  o = options_for(100, Domain::kTorus);
+  o.dim = 3;
+  EXPECT_THROW(sample(o, Density::from_values(2, 2, {1, 2, 3, 4})), InvalidArgument);
+  // energy_per_point judges points of the unit domain only, as sample() takes fixed points.
+  o = options_for(100, Domain::kTorus);
+  EXPECT_THROW(energy_per_point(o, Density::constant(), {1.5, 0.2, 0.3, 0.3}), InvalidArgument);
+  EXPECT_THROW(energy_per_point(o, Density::constant(), {-0.1, 0.2, 0.3, 0.3}), InvalidArgument);
+  EXPECT_GT(energy_per_point(o, Density::constant(), {0.5, 0.2, 0.3, 0.3}), 0.0);
+}
+
+// Progress rises to 1 at the end, where a progress bar expects it; an exception it throws cancels the run.
+TEST(SamplerTest, ProgressEndsAtOneAndCancels) {
+  SamplerOptions o = options_for(3000, Domain::kTorus);
+  std::vector<double> seen;
+  o.progress = [&](double f) { seen.push_back(f); };
+  sample(o);
+  ASSERT_GT(seen.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_LT(seen[seen.size() - 2], 1.0);
+  struct Cancelled {};
+  o.progress = [](double f) {
+    if (f > 0.2) throw Cancelled{};
+  };
+  EXPECT_THROW(sample(o), Cancelled);
 }
 
 // from_values() densities are read straight from their values (sample_image()); the same density as a

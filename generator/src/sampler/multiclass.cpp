@@ -44,6 +44,7 @@ std::uint64_t class_seed(std::uint64_t seed, std::size_t k) {
 
 std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std::vector<Density>& densities,
                                        std::int64_t n) {
+  if (n < 0) throw InvalidArgument("point count must be >= 0, got " + std::to_string(n));
   std::vector<double> cumulative;
   double total = 0;
   for (const Density& d : densities) cumulative.push_back(total += mean_of(d, options.dim));

@@ -18,6 +18,7 @@ SampleResult sample_dim(const SamplerOptions& options, const Density& density) {
   ModelSetup<D> setup = build_model<D>(options, density);
   const double model_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   SampleResult result = run_multiscale<D>(options, setup);
+  if (options.progress) options.progress(1.0);  // the sweeps' last report stops short of the finish
   result.report.model_seconds = model_seconds;
   result.report.threads = thread_count(options.threads);
   result.report.seconds += model_seconds;
@@ -35,7 +36,7 @@ double energy_dim(const SamplerOptions& options, const Density& density, const s
     Particle<D> p;
     for (int k = 0; k < D; ++k) {
       const double u = points[j * D + k];
-      if (!std::isfinite(u)) throw InvalidArgument("point set holds a non-finite coordinate");
+      if (!(u >= 0 && u < 1)) throw InvalidArgument("points must lie in [0, 1) on every axis");
       p.x[k] = u * finest.grid.dims[k];
     }
     if (!finest.grid.canonical(p.x)) throw InvalidArgument("point lies outside the unit domain");

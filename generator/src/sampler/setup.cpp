@@ -203,7 +203,7 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
 
 void validate_options(const SamplerOptions& o) {
   if (o.dim != 2 && o.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
-  if (o.n < 0) throw InvalidArgument("point count must be >= 0");
+  if (o.n < 0) throw InvalidArgument("point count must be > 0 (or 0 with a grid resolution > 0)");
   check_thread_count(o.threads);
   if (o.vector_lanes != 16 && o.vector_lanes != 8 && o.vector_lanes != 4)
     throw InvalidArgument("vector_lanes must be 16, 8 or 4, got " + std::to_string(o.vector_lanes));
@@ -237,6 +237,8 @@ void validate_options(const SamplerOptions& o) {
 template <int D>
 ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
   validate_options(o);
+  if (D == 3 && density.image)  // its values hold no z: 3D wants a function of (x, y, z)
+    throw InvalidArgument("an image density (from_values) is 2D: sample it with dim 2, or give a function");
   for (int k = 0; k < 3; ++k)
     if (density.native_resolution[k] < 0)
       throw InvalidArgument("density native_resolution must be >= 0 (0: unknown), got " +
@@ -346,6 +348,15 @@ template std::vector<float> box_sum_half<2>(const Grid<2>&, const std::vector<fl
 template std::vector<float> box_sum_half<3>(const Grid<3>&, const std::vector<float>&, int);
 template ModelSetup<2> build_model<2>(const SamplerOptions&, const Density&);
 template ModelSetup<3> build_model<3>(const SamplerOptions&, const Density&);
+
+Density Density::constant(double value) {
+  if (!(std::isfinite(value) && value >= 0))
+    throw InvalidArgument("a constant density must be a finite number >= 0, got " + std::to_string(value));
+  Density d;
+  d.function = [value](const double*) { return value; };
+  d.thread_safe = true;
+  return d;
+}
 
 Density Density::from_values(int width, int height, std::vector<float> values) {
   if (width <= 0 || height <= 0) throw InvalidArgument("density image is empty");

@@ -21,11 +21,14 @@ struct InvalidArgument : std::invalid_argument {
 };
 
 /// Torus: periodic in every axis (tiles). Box: a bounded rectangle with reflecting walls, so kernels
-/// keep their full mass inside the domain and points reach the edge at the target density.
+/// keep their full mass inside the domain and points reach the edge at the target density on average:
+/// along a wall they stand in a row about half a spacing in, with an empty strip a quarter spacing wide
+/// before it and a ripple of density behind (docs/design.md §2.3, measured there).
 enum class Domain { kTorus, kBox };
 
 /// Relative target density at normalised position u in [0, 1)^dim. Must return a finite value >= 0.
-/// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe.
+/// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe. An
+/// exception it throws ends sample() with that exception.
 using DensityFunction = std::function<double(const double* u)>;
 
 /// A density given as `width`×`height` values, row 0 at the bottom (u_y near 0): kdm's one row
@@ -49,16 +52,22 @@ struct Density {
   /// negative values are refused.
   int native_resolution[3] = {0, 0, 0};
   /// `function` may be called from several threads at once: the set-up then samples it on up to
-  /// SamplerOptions::threads threads (the result is the same). from_values() sets it.
+  /// SamplerOptions::threads threads (the result is the same), on grids of 65,536 nodes or more (from a
+  /// few thousand points in 2D; smaller ones are sampled on one thread). from_values() sets it.
   bool thread_safe = false;
   /// Set by from_values() to the values `function` interpolates: sample() then reads them itself, with
   /// the same result as calling `function` at each node but without a call per node. Leave it empty for a
   /// density of your own; if you change `function`, reset it.
   std::shared_ptr<const DensityImage> image;
 
+  /// The uniform density (no function): 1 everywhere.
   static Density constant() { return {}; }
+  /// A uniform density of `value` (finite, >= 0, else InvalidArgument): alone only its shape matters, as
+  /// constant()'s; in sample_classes() (multiclass.h) the classes' values set their shares of the points.
+  static Density constant(double value);
   /// A 2D density from `width`×`height` values (row 0 at the bottom, i.e. at u_y near 0), bilinearly
   /// interpolated. Values must be finite and >= 0, and not all zero. Throws InvalidArgument otherwise.
+  /// 2D only: sample() refuses it with dim 3.
   static Density from_values(int width, int height, std::vector<float> values);
 };
 
@@ -80,10 +89,12 @@ struct SamplerOptions {
   Domain domain = Domain::kTorus;  ///< periodic, or a box with walls
   double extent[3] = {1, 1,
                       1};  ///< relative side lengths (aspect ratio); normalised output is still [0,1)^dim
-  /// Exact number of points to return (> 0). Set to 0 to use `resolution` instead.
+  /// Exact number of points to return (> 0), at most 2^31 and as many as a finest grid of
+  /// max_grid_nodes holds (about 9 million in 2D, InvalidArgument past it). Set to 0 to use `resolution`.
   std::int64_t n = 4096;
-  /// Used when n == 0: finest grid nodes along the shortest axis; the count then follows from the
-  /// model as in the paper (about resolution^dim * peak_density / 7.07 points for a uniform 2D density).
+  /// Used when n == 0: finest grid nodes along the shortest axis; the count then follows from the model
+  /// as in the paper: for a uniform density about 0.074 · resolution² points in 2D and 0.027 ·
+  /// resolution³ in 3D at the default peak_density, in proportion to it.
   int resolution = 0;
   /// User-facing temperature (>= 0). 0.5 is the reference implementation's default look; 0 is a
   /// deterministic energy descent. The model temperature of eq. 4 is temperature * kModelTemperaturePerUser.
@@ -137,7 +148,8 @@ struct SamplerOptions {
   /// on the finest grid, with no multi-scale. The result keeps their order. For checking that a point set
   /// already is an equilibrium sample (it then neither drifts nor drops in energy).
   std::vector<double> initial_points;
-  /// Called with (fraction done in [0,1]) between sweeps. Optional.
+  /// Called with (fraction done in [0,1]) between sweeps, and with 1 once the points are done. Optional.
+  /// An exception it throws ends sample() with that exception: a way to cancel a long run.
   std::function<void(double)> progress;
 };
 
