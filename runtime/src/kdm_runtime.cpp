@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <new>
 #include <vector>
 
+#include "image_sampler.h"
 #include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
@@ -596,25 +598,62 @@ kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* in
 
 kdm_status kdm_density_image_create(int width, int height, const float* values, double x0, double y0,
                                     double x1, double y1, kdm_density_image** out) {
-  if (!out) return KDM_INVALID_ARGUMENT;
-  *out = nullptr;
-  if (!values || width <= 0 || height <= 0 || width > kdm::kMaxDensityImageSide ||
-      height > kdm::kMaxDensityImageSide)
-    return KDM_INVALID_ARGUMENT;  // before copying the texels
+  return kdm_density_image_create_detail(width, height, values, x0, y0, x1, y1, out, nullptr, 0);
+}
+
+kdm_status kdm_density_image_create_detail(int width, int height, const float* values, double x0, double y0,
+                                           double x1, double y1, kdm_density_image** out, char* detail,
+                                           size_t detail_size) {
+  // The reason in a fixed buffer, first fault first: nothing here may throw.
+  char why[256] = "";
+  const auto refuse = [&](kdm_status s) {
+    if (detail && detail_size) {
+      const std::size_t n = std::min(std::strlen(why), detail_size - 1);
+      std::memcpy(detail, why, n);
+      detail[n] = '\0';
+    }
+    return s;
+  };
+  if (out) *out = nullptr;
+  if (!out) return std::snprintf(why, sizeof why, "out is NULL"), refuse(KDM_INVALID_ARGUMENT);
+  if (width <= 0 || height <= 0 || width > kdm::kMaxDensityImageSide || height > kdm::kMaxDensityImageSide)
+    return std::snprintf(why, sizeof why, "the image is %d x %d texels: each side must be 1 to 2^30", width,
+                         height),
+           refuse(KDM_INVALID_ARGUMENT);  // before copying the texels
+  if (!values) return std::snprintf(why, sizeof why, "values is NULL"), refuse(KDM_INVALID_ARGUMENT);
+  kdm::DensityImageView probe;
+  probe.width = width, probe.height = height, probe.x0 = x0, probe.y0 = y0, probe.x1 = x1, probe.y1 = y1;
+  if (!kdm::detail::image_rect_usable(probe))
+    return std::snprintf(why, sizeof why,
+                         "the rectangle (%g, %g, %g, %g) must be finite with x0 < x1 and y0 < y1, and wide "
+                         "enough that its texels per unit are finite",
+                         x0, y0, x1, y1),
+           refuse(KDM_INVALID_ARGUMENT);
   const std::size_t texels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   auto* image = new (std::nothrow) kdm_density_image;
-  if (!image) return KDM_OUT_OF_MEMORY;
+  if (!image) return std::snprintf(why, sizeof why, "out of memory"), refuse(KDM_OUT_OF_MEMORY);
   image->values.reset(static_cast<float*>(std::malloc(texels * sizeof(float))));  // ≤ 2^62 · 4 bytes
-  if (!image->values) {
+  if (!image->values) {  // before a texel is read: the caller's array may be smaller than it says
     delete image;
-    return KDM_OUT_OF_MEMORY;
+    return std::snprintf(why, sizeof why, "out of memory for %zu texels", texels), refuse(KDM_OUT_OF_MEMORY);
   }
-  std::copy(values, values + texels, image->values.get());
+  for (std::size_t i = 0; i < texels; ++i) {
+    if (!(values[i] >= 0 && std::isfinite(values[i]))) {
+      std::snprintf(why, sizeof why,
+                    "values[%zu] (column %zu, row %zu) is %g: values must be finite and >= 0", i,
+                    i % std::size_t(width), i / std::size_t(width), double(values[i]));
+      delete image;
+      return refuse(KDM_INVALID_ARGUMENT);
+    }
+    image->values.get()[i] = values[i];
+  }
   kdm::DensityImageView& v = image->view;
   v.width = width, v.height = height, v.x0 = x0, v.y0 = y0, v.x1 = x1, v.y1 = y1;
   v.values = image->values.get();
-  return hand_over(image, unless_out_of_memory([&] { return kdm::make_density_max_mip(v, image->mip); }),
-                   out);
+  const kdm_status s =
+      hand_over(image, unless_out_of_memory([&] { return kdm::make_density_max_mip(v, image->mip); }), out);
+  if (s != KDM_OK) std::snprintf(why, sizeof why, "%s", kdm_status_message(s));
+  return refuse(s);
 }
 
 void kdm_density_image_free(kdm_density_image* image) {

@@ -178,6 +178,27 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_image_create(1, (1 << 30) + 1, values, 0, 0, 2, 2, &image) == KDM_INVALID_ARGUMENT);
     CHECK(kdm_density_image_create(1 << 30, 1 << 30, values, 0, 0, 2, 2, &image) == KDM_OUT_OF_MEMORY &&
           image == NULL);
+    {
+      /* Why, for a log: the first fault, by name and place. */
+      char detail[160];
+      CHECK(kdm_density_image_create_detail(2, 2, bad, 0, 0, 2, 2, &image, detail, sizeof detail) ==
+            KDM_INVALID_ARGUMENT);
+      CHECK(image == NULL && strstr(detail, "values[1] (column 1, row 0) is -1") != NULL);
+      CHECK(kdm_density_image_create_detail(0, 2, values, 0, 0, 2, 2, &image, detail, sizeof detail) ==
+            KDM_INVALID_ARGUMENT);
+      CHECK(strstr(detail, "0 x 2 texels") != NULL);
+      CHECK(kdm_density_image_create_detail(2, 2, values, 0, 0, 0, 2, &image, detail, sizeof detail) ==
+            KDM_INVALID_ARGUMENT);
+      CHECK(strstr(detail, "rectangle (0, 0, 0, 2)") != NULL);
+      CHECK(kdm_density_image_create_detail(2, 2, NULL, 0, 0, 2, 2, &image, detail, sizeof detail) ==
+            KDM_INVALID_ARGUMENT);
+      CHECK(strstr(detail, "values is NULL") != NULL);
+      CHECK(kdm_density_image_create_detail(2, 2, values, 0, 0, 2, 2, &image, detail, sizeof detail) ==
+            KDM_OK);
+      CHECK(image != NULL && detail[0] == '\0');
+      kdm_density_image_free(image);
+      image = NULL;
+    }
     CHECK(kdm_density_image_create(2, 2, values, 0, 0, 2, 2, &image) == KDM_OK && image != NULL);
     /* Read as a query reads it: texel centres hold their values, half-way between them the mean. */
     CHECK(kdm_density_image_at(image, 0.5, 0.5) == 0 && kdm_density_image_at(image, 1.5, 1.5) == 1);

@@ -223,6 +223,13 @@ KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const
  * memory. Free with kdm_density_image_free. */
 KDM_RUNTIME_API kdm_status kdm_density_image_create(int width, int height, const float* values, double x0,
                                                     double y0, double x1, double y1, kdm_density_image** out);
+/* kdm_density_image_create, and on failure why in `detail` (if not NULL), as kdm_tileset_load_file_detail
+ * gives it: the first fault found ("values[17] (column 1, row 2) is -1: values must be finite and >= 0");
+ * "" on success. Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_density_image_create_detail(int width, int height, const float* values,
+                                                           double x0, double y0, double x1, double y1,
+                                                           kdm_density_image** out, char* detail,
+                                                           size_t detail_size);
 /* Frees an image (NULL is ignored); no query may be using it. */
 KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 /* The image's density at world (x, y) as a query reads it (bilinear between texel centres, clamped at the
