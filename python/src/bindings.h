@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -33,10 +34,19 @@ inline void stop_on_signal(double /*progress*/) {
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
 }
 
+/// A tile set's .kdmt bytes, kept once known: the file or bytes it was loaded from, or what the baker or
+/// a first to_bytes() encoded (at zstd's level 19 that takes 20 s for the built-in set's 14 MB, and a
+/// pickle asks for them every time).
+struct EncodedTileset {
+  std::mutex mutex;
+  std::vector<std::uint8_t> bytes;  ///< empty until known; never changed after
+};
+
 /// A loaded tile set as Python holds it: shared, immutable, so queries run on it with the GIL released.
 struct TilesetHandle {
   std::shared_ptr<const Tileset> set;
   std::uint32_t format_version = 0;  ///< of the file it came from (the current one when baked or built in)
+  std::shared_ptr<EncodedTileset> encoded = std::make_shared<EncodedTileset>();
 };
 
 /// A numpy array of `shape` that takes over `values` (moved, not copied): the vector is freed when the

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "image_io.h"
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset_format.h"
@@ -21,6 +22,15 @@ const Tileset& builtin_tileset() {
 }
 
 namespace {
+
+/// `h` keeping `bytes`, the file they were decoded from, for to_bytes() and save(), where they are what
+/// encoding the set gives (a file of the current format; an older one is encoded anew).
+template <class Bytes>
+TilesetHandle with_bytes(TilesetHandle h, const Bytes& bytes) {
+  if (h.format_version == tileset_format_version_for(h.set->data()))
+    h.encoded->bytes.assign(bytes.begin(), bytes.end());
+  return h;
+}
 
 TilesetHandle builtin() {
   TilesetHandle h;
@@ -37,16 +47,16 @@ TilesetHandle load(const std::string& path) {
   auto set = std::make_shared<Tileset>();
   std::string detail;
   TilesetHeader header;
+  std::vector<char> bytes;
   Status s;
   {
     py::gil_scoped_release release;
-    std::vector<char> bytes;  // the header's version too, which the loaded set does not keep
-    s = read_tileset_file(path, bytes, &detail);
+    s = read_tileset_file(path, bytes, &detail);  // the header's version too, which the set does not keep
     if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
   if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
-  return {std::move(set), header.format_version};
+  return with_bytes({std::move(set), header.format_version}, bytes);
 }
 
 /// The set from a .kdmt file's bytes, checked as load() checks a file.
@@ -63,29 +73,41 @@ TilesetHandle from_bytes(const py::bytes& data) {
   }
   if (s != Status::kOk)
     throw std::invalid_argument(std::string("data: ") + status_message(s) + " (" + detail + ")");
-  return {std::move(set), header.format_version};
+  return with_bytes({std::move(set), header.format_version}, bytes);
+}
+
+/// The set's .kdmt bytes: those it was read from, or encoded once (the GIL released). Throws
+/// std::runtime_error if the set cannot be encoded.
+const std::vector<std::uint8_t>& encoded_bytes(const TilesetHandle& h) {
+  EncodedTileset& e = *h.encoded;
+  py::gil_scoped_release release;  // another thread may be encoding: wait for it without the GIL
+  const std::lock_guard<std::mutex> lock(e.mutex);
+  if (e.bytes.empty()) {
+    std::string detail;
+    const Status s = encode_tileset(h.set->data(), e.bytes, &detail);
+    if (s != Status::kOk) {
+      e.bytes.clear();
+      throw std::runtime_error(std::string("tile set: ") + status_message(s) + " (" + detail + ")");
+    }
+  }
+  return e.bytes;
 }
 
 /// The bytes save() writes.
 py::bytes to_bytes(const TilesetHandle& h) {
-  std::vector<std::uint8_t> bytes;
-  std::string detail;
-  Status s;
-  {
-    py::gil_scoped_release release;
-    s = encode_tileset(h.set->data(), bytes, &detail);
-  }
-  if (s != Status::kOk)
-    throw std::runtime_error(std::string("tile set: ") + status_message(s) + " (" + detail + ")");
+  const std::vector<std::uint8_t>& bytes = encoded_bytes(h);
   return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 }
 
 void save(const TilesetHandle& h, const std::string& path) {
   std::string detail;
-  Status s;
-  {
+  Status s = check_tileset_path(path, &detail);  // before any encoding
+  if (s == Status::kOk) {
+    const std::vector<std::uint8_t>& bytes = encoded_bytes(h);
     py::gil_scoped_release release;
-    s = save_tileset(h.set->data(), path, &detail);
+    std::string error;
+    if (!tools::write_text_file_atomic(path, std::string(bytes.begin(), bytes.end()), error))
+      s = Status::kIoError, detail = error;
   }
   if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
 }
@@ -121,19 +143,19 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
   const gen::BakeRecipe recipe = gen::BakeRecipe::parse(recipe_text);  // gen::InvalidArgument: ValueError
   auto set = std::make_shared<Tileset>();
   std::string detail;
+  std::vector<std::uint8_t> bytes;
   Status s;
   {
     py::gil_scoped_release release;
     const TilesetData data =
         gen::bake_tileset(recipe, threads, stop_on_signal);  // Ctrl-C: after the runs it samples
-    std::vector<std::uint8_t> bytes;  // through the file format, as `kdm bake` then a load would go
-    s = encode_tileset(data, bytes, &detail);
+    s = encode_tileset(data, bytes, &detail);  // through the file format, as `kdm bake` then a load
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
   if (s != Status::kOk)
     throw std::runtime_error(std::string("baked set: ") + status_message(s) + " (" + detail + ")");
   const std::uint32_t version = tileset_format_version_for(set->data());
-  return {std::move(set), version};
+  return with_bytes({std::move(set), version}, bytes);
 }
 
 /// emission_threshold of every id given as tile (m × 2), rank and depth (m each).
