@@ -126,6 +126,27 @@ TEST(EmptyCircles, ADensityScalesTheLocalSpacingAndLocatesTileEdges) {
   EXPECT_LE(t.over_085_near_edge, t.over_085);
 }
 
+// Points in degenerate position: a square lattice (four points on every circle) and a line wrapped on
+// the torus. Qhull merged their facets for minutes (a line of 5,000 points: over two); the triangulation
+// of points moved by a hash of their index is a Delaunay triangulation of the points themselves.
+TEST(EmptyCircles, DegeneratePositionsAreTriangulated) {
+  const int side = 60;
+  tools::PointSet lattice;
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i)
+      lattice.coords.insert(lattice.coords.end(), {(i + 0.5) / side, (j + 0.5) / side});
+  const EmptyCircles e = empty_circles({lattice});
+  EXPECT_EQ(e.triangles, 2 * lattice.size());  // every square in two, each once
+  // Each circle is a square's: radius √2/2 of the spacing, whichever diagonal split it.
+  EXPECT_NEAR(e.largest, std::sqrt(0.5) / side / hex_spacing(lattice.size()), 1e-9);
+  EXPECT_NEAR(e.p999, e.largest, 1e-9);
+  tools::PointSet line;
+  for (int i = 0; i < 3000; ++i) line.coords.insert(line.coords.end(), {i / 3000.0, 0.0});
+  const EmptyCircles l = empty_circles({line});
+  EXPECT_GT(l.triangles, 0u);
+  EXPECT_EQ(l.over_100, l.triangles);  // everything off the line is one hole
+}
+
 TEST(EmptyCircles, BadInputIsRefused) {
   tools::PointSet s;
   s.coords = {0.1, 0.2, 0.3, 0.4};

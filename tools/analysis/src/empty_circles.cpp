@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -38,8 +39,9 @@ Circle circumcircle(const double* a, const double* b, const double* c) {
 }
 
 /// Calls visit(i, j, k) with the point indices of every Delaunay triangle of `xy` (interleaved x y).
+/// `original` (optional): the point each one is a copy of, so that copies move as their originals do.
 template <class Visit>
-void delaunay(std::vector<double>& xy, Visit&& visit) {
+void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::size_t>* original = nullptr) {
   const int n = static_cast<int>(xy.size() / 2);
   // Points that span no area have no triangulation: Qhull fails on them after pages of its internals.
   bool flat = true;
@@ -53,6 +55,18 @@ void delaunay(std::vector<double>& xy, Visit&& visit) {
     throw DegenerateSet(
         "the points are degenerate (all coincident or on one line): they have no Delaunay "
         "triangulation");
+  // Points in degenerate position (a lattice, a line wrapped on a torus) made Qhull merge facets for
+  // minutes (n³). It triangulates them moved by at most 2^-21 instead, each by a hash of its index (the
+  // same every run; a torus copy as its original, so that every translate of a triangle is triangulated
+  // alike): in general position, a Delaunay triangulation of the points themselves where ties allowed
+  // several. The caller measures circles on the points as given.
+  std::vector<double> moved(xy);
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const std::size_t point = original ? (*original)[i / 2] : i / 2;
+    std::uint64_t h = (2 * point + i % 2 + 1) * 0x9E3779B97F4A7C15ull;
+    h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull, h ^= h >> 29;
+    moved[i] += std::ldexp(double(h >> 11) * 0x1p-53 - 0.5, -20);
+  }
   // Qhull's own report of any other failure goes to a scratch file: the error below says it in one line.
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> sink(std::tmpfile(), std::fclose);
   std::FILE* err = sink ? sink.get() : stderr;
@@ -60,7 +74,7 @@ void delaunay(std::vector<double>& xy, Visit&& visit) {
   qhT* qh = &qh_qh;
   qh_zero(qh, err);
   char flags[] = "qhull d Qbb Qc Qz Q12 Qt";
-  const int failed = qh_new_qhull(qh, 2, n, xy.data(), False, flags, nullptr, err);
+  const int failed = qh_new_qhull(qh, 2, n, moved.data(), False, flags, nullptr, err);
   if (!failed) {
     facetT* facet;
     FORALLfacets {
@@ -123,20 +137,23 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
         }
     std::vector<Circle> circles;
     double reach = 0;  // how far the circles reach past the square
-    delaunay(xy, [&](int i, int j, int k) {
-      const int v[3] = {i, j, k};
-      // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
-      // one translate of the triangle has the point itself there.
-      const int* first = std::min_element(v, v + 3, [&](int a, int b) {
-        return std::tie(original[a], xy[2 * a], xy[2 * a + 1]) <
-               std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
-      });
-      if (std::size_t(*first) >= n) return;  // another copy's
-      const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
-      if (!std::isfinite(c.r)) return;  // flat
-      circles.push_back(c);
-      reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
-    });
+    delaunay(
+        xy,
+        [&](int i, int j, int k) {
+          const int v[3] = {i, j, k};
+          // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
+          // one translate of the triangle has the point itself there.
+          const int* first = std::min_element(v, v + 3, [&](int a, int b) {
+            return std::tie(original[a], xy[2 * a], xy[2 * a + 1]) <
+                   std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
+          });
+          if (std::size_t(*first) >= n) return;  // another copy's
+          const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+          if (!std::isfinite(c.r)) return;  // flat
+          circles.push_back(c);
+          reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
+        },
+        &original);
     if ((reach <= m && circles.size() == 2 * n) || m >= 2) return circles;
     m = std::min(2.0, std::max(2 * m, 1.01 * reach));
   }
