@@ -421,6 +421,16 @@ TEST_F(CliTest, SmallFrictions) {
                    path("metrics.json") + "'",
                "output directory");
   EXPECT_FALSE(fs::exists(path("metrics.json")));
+  // A picture is never written over the density image it was made from (stipple already refused it).
+  fs::copy_file(std::string(KDM_SOURCE_DIR) + "/examples/sphere.png", path("own.png"));
+  const std::string own = slurp(path("own.png"));
+  expect_error("sample -n 100 --density '" + path("own.png") + "' -o '" + path("own.png") + "'",
+               "is the density image");
+  expect_error(
+      "query --rect 0,0,1,1 --class const:1 --class '" + path("own.png") + "' -o '" + path("own.png") + "'",
+      "is the density image");
+  EXPECT_EQ(slurp(path("own.png")), own);
+  expect_error("bake '" + dir_.string() + "' -o '" + path("x.kdmt") + "'", "it is a directory");
   const Outcome sampled = kdm("sample -n 200 -o '" + path("s.txt") + "'");
   ASSERT_EQ(sampled.status, 0) << sampled.err;
   EXPECT_NE(slurp(path("s.txt")).find("kdm sample: 200 points"), std::string::npos);

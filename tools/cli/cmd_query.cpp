@@ -96,8 +96,10 @@ void run_query_command(const QueryArgs& a, bool density_given) {
                        std::to_string(kMaxQueryClasses) + " classes");
   // One density per class (--density alone is one class); specs and densities stay put (queries point in).
   std::vector<std::unique_ptr<tools::DensitySpec>> specs;
-  for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes)
+  for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes) {
+    tools::refuse_writing_over(text, a.output, "density image");  // a picture written over its input
     specs.push_back(std::make_unique<tools::DensitySpec>(parse_density(text, a.gamma, a.invert)));
+  }
   std::vector<const tools::DensitySpec*> class_specs;
   for (const auto& spec : specs) class_specs.push_back(spec.get());
   check_class_images(class_specs);

@@ -58,8 +58,10 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (classed && args.options.n <= 0) throw CommandError("--class needs --n > 0 (the points of all classes)");
   if (classed && args.options.dim != 2) throw CommandError("--class samples 2D points: drop --dim 3");
   std::vector<tools::DensitySpec> specs;
-  for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density})
+  for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density}) {
+    tools::refuse_writing_over(text, args.output, "density image");  // a picture written over its input
     specs.push_back(parse_density(text, args.gamma, args.invert));
+  }
   std::vector<const tools::DensitySpec*> class_specs;
   for (const tools::DensitySpec& s : specs) class_specs.push_back(&s);
   check_class_images(class_specs);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -29,7 +30,11 @@ std::string read_text(const std::string& path) {
   // pipe) or a directory fails instead of filling memory.
   std::string text(kMaxTilesetHeaderBytes + 1, '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  if (in.bad()) throw CommandError("cannot read recipe '" + path + "'");
+  if (in.bad()) {
+    std::error_code ec;
+    throw CommandError("cannot read recipe '" + path + "'" +
+                       (std::filesystem::is_directory(path, ec) ? ": it is a directory" : ""));
+  }
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.compare(0, 8, "KDMTILES") == 0)  // the arguments swapped: a baked set where its recipe belongs
     throw CommandError("'" + path + "' is a tile-set file, not a recipe (its recipe: kdm info '" + path +
