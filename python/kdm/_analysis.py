@@ -72,7 +72,8 @@ def analyze(
         Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them):
         each point's class, an (n,) array per set. Each class is then also analysed alone, as
         ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
-        (``cross_class_closest`` in d_hex of all points, and per class its "class" and "metrics").
+        (``cross_class_closest`` in d_hex of all points, per class its "class" and "metrics", and in
+        "too_small" the classes present with fewer than 2 points in every set, which are not analysed).
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles

@@ -84,10 +84,11 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     ----------
     d : int
         2 or 3.
-    seed, rng : None, int or numpy.random.Generator
-        As SciPy's engines take it (``seed`` up to SciPy 1.14, ``rng`` from 1.15; give one): an int seeds
-        a new ``numpy.random.default_rng``, None one seeded from fresh entropy (kept, so that reset()
-        replays it too); a Generator is used as it is (and replayed from a copy by reset()). Unlike
+    seed, rng : None, int, numpy.random.Generator, SeedSequence or BitGenerator
+        As SciPy's engines take it (``seed`` up to SciPy 1.14, ``rng`` from 1.15; give one): an int, a
+        SeedSequence or a BitGenerator seeds a new ``numpy.random.default_rng``, None one seeded from
+        fresh entropy (kept, so that reset() replays it too); a Generator is used as it is (and replayed
+        from a copy by reset()). Unlike
         ``kdm.sample``, whose default seed is 1, two engines made without one draw different sets.
     aspect : float or None
         Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
@@ -119,10 +120,13 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             if seed is not None:
                 raise TypeError("give seed or rng, not both")
             seed = rng
+        if isinstance(seed, (np.random.SeedSequence, np.random.BitGenerator)):  # as default_rng takes them
+            seed = np.random.default_rng(seed)
         seeds = (numbers.Integral, np.random.Generator, np.random.RandomState)
         if not (seed is None or isinstance(seed, seeds)):
             raise TypeError(
-                f"seed must be None, an int or a numpy.random.Generator, got {type(seed).__name__}"
+                "seed must be None, an int, a numpy.random.Generator, SeedSequence or BitGenerator, got "
+                f"{type(seed).__name__}"
             )
         if isinstance(seed, numbers.Integral) and seed < 0:  # numpy's own refusal does not name it
             raise ValueError(f"seed must be a non-negative int, got {seed}")

@@ -70,8 +70,9 @@ def stipple(
         For method "full": worker threads (0: the default count); the dots do not depend on it.
     colours : {"cmyk", "rgb"}, int or None
         A colour stipple of the image, a file or an array (``kdm stipple --colours``): "cmyk" (black by under-colour
-        removal), "rgb" (light on black) or a number of inks, 2 to 8, clustered from the image; one class
-        of dots per ink, all of them one blue-noise set.
+        removal), "rgb" (light on black) or a number of inks, 2 to 8: the image's main hues at full
+        strength (fewer if it has fewer; one black ink for a grey image), each pixel drawn by the ink of
+        its hue; one class of dots per ink, all of them one blue-noise set.
     fade : float
         For method "tiles", in the picture written to `output`: a dot's area grows from 0 where it
         appears to full once the density there is this fraction higher (``kdm stipple --fade``), so

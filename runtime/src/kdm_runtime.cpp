@@ -661,7 +661,7 @@ void kdm_density_image_free(kdm_density_image* image) {
 }
 
 double kdm_density_image_at(const kdm_density_image* image, double x, double y) {
-  return image ? image->view.at(x, y) : 0.0;
+  return image && std::isfinite(x) && std::isfinite(y) ? image->view.at(x, y) : 0.0;
 }
 
 kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, kdm_point* out,

@@ -189,6 +189,15 @@ TEST(Report, AnalyzeAggregatesSets) {
   EXPECT_TRUE(apart.has_empty_circles);
   o.tile_size = 0.3;
   EXPECT_THROW(analyze(sets, o), InvalidInput);
+  // A box set too small to judge any circle two spacings inside says so, where zeros would read as a set
+  // without holes.
+  AnalysisOptions box;
+  box.torus = false;
+  const AnalysisReport few = analyze({testing::uniform_set(12, 23)}, box);
+  EXPECT_FALSE(few.has_empty_circles);
+  EXPECT_NE(few.empty_circles_skipped.find("no circle was judged"), std::string::npos);
+  EXPECT_NE(metrics_json(few, {"a"}).find("\"empty_circles_skipped\""), std::string::npos);
+  EXPECT_EQ(metrics_json(few, {"a"}).find("\"empty_circles\":"), std::string::npos);
 }
 
 }  // namespace

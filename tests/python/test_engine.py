@@ -63,8 +63,16 @@ def test_seeds_as_scipy_takes_them():
     assert not np.array_equal(kdm.BlueNoise(2).random(100), first)  # fresh for each engine
     assert kdm.BlueNoise(3, seed=1).random(100).shape == (100, 3)
     assert kdm.BlueNoise(2, seed=1).random(0).shape == (0, 2)
-    with pytest.raises(TypeError, match="seed must be None, an int or a numpy.random.Generator"):
+    with pytest.raises(TypeError, match="seed must be None, an int, a numpy.random.Generator"):
         kdm.BlueNoise(2, seed="seven")
+    # A SeedSequence (the docstring's way to seed workers) or a BitGenerator seeds default_rng, as numpy's
+    # own default_rng takes them.
+    children = np.random.SeedSequence(3).spawn(2)
+    from_child = kdm.BlueNoise(2, seed=children[0]).random(100)
+    assert np.array_equal(from_child, kdm.BlueNoise(2, seed=np.random.default_rng(children[0])).random(100))
+    assert not np.array_equal(from_child, kdm.BlueNoise(2, seed=children[1]).random(100))
+    assert np.array_equal(kdm.BlueNoise(2, rng=np.random.PCG64(4)).random(100),
+                          kdm.BlueNoise(2, seed=np.random.default_rng(4)).random(100))
     with pytest.raises(ValueError, match="seed must be a non-negative int, got -1"):
         kdm.BlueNoise(2, seed=-1)
     # SciPy 1.15 names it rng: the same engine by either name, not both at once.

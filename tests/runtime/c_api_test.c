@@ -204,11 +204,33 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_image_at(image, 0.5, 0.5) == 0 && kdm_density_image_at(image, 1.5, 1.5) == 1);
     CHECK(kdm_density_image_at(image, 1.0, 0.5) == 0.5 && kdm_density_image_at(image, -7, 1.5) == 0);
     CHECK(kdm_density_image_at(NULL, 1, 1) == 0);
+    CHECK(kdm_density_image_at(image, NAN, 1.5) == 0 && kdm_density_image_at(image, 1.5, INFINITY) == 0);
     q.density_image = image;
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, buffer, 4096, &written, &cursor, NULL) == KDM_OK);
     CHECK(written > 300 && written < 1200); /* about half of the ~2000 uniform points, fewer at the ramp */
     for (i = 0; i < written; ++i) CHECK(buffer[i].x >= 0.5);
+    { /* A refused call sets *written to 0 and leaves the cursor: corrected, the query resumes it. */
+      kdm_point small[7];
+      size_t n = 99, resumed;
+      kdm_cursor c, before;
+      kdm_query bad = q;
+      kdm_status st;
+      memset(&c, 0, sizeof c);
+      CHECK(kdm_query_points(builtin, &q, small, 7, &n, &c, NULL) == KDM_BUFFER_FULL);
+      resumed = n;
+      before = c;
+      bad.tile_size = NAN;
+      CHECK(kdm_query_points(builtin, &bad, small, 7, &n, &c, NULL) == KDM_INVALID_ARGUMENT && n == 0);
+      CHECK(c.tile_x == before.tile_x && c.tile_y == before.tile_y && c.rank == before.rank &&
+            c.started == before.started && c.finished == before.finished &&
+            c.fingerprint == before.fingerprint && c.depth == before.depth && c.path == before.path);
+      do {
+        st = kdm_query_points(builtin, &q, small, 7, &n, &c, NULL);
+        resumed += n;
+      } while (st == KDM_BUFFER_FULL);
+      CHECK(st == KDM_OK && resumed == written);
+    }
     kdm_density_image_free(image);
     q.density_image = NULL;
   }

@@ -276,7 +276,8 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option(
       "--colours", a->colours,
       "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
-      "removal), rgb (red, green, blue on black) or N (2-8 inks clustered from the image); one "
+      "removal), rgb (red, green, blue on black) or N (up to N = 2-8 inks: the image's main hues at full "
+      "strength, fewer if it has fewer, one black for a grey image); one "
       "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
       "(a layer per pen, empty for an ink no pixel uses), .csv a class column, the ink's number, least-used "
       "ink first (but inks "

@@ -35,63 +35,73 @@ Ink ink(std::uint8_t r, std::uint8_t g, std::uint8_t b, const std::string& name,
   return i;
 }
 
-double luminance(const float* rgb) {
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+/// An ink or pixel on white paper as its absorbance, 1 − rgb per channel: a dot of ink a covering a
+/// fraction c of the paper leaves c · a, so a pixel a_p is drawn in ink a by coverage (a_p · a) / |a|².
+std::array<double, 3> absorbance(const float* rgb) {
+  return {1.0 - rgb[0], 1.0 - rgb[1], 1.0 - rgb[2]};
 }
 
-/// The paper's colour: a fixed centre among the inks' clusters, so that the image's white takes no ink.
-constexpr std::array<double, 3> kPaper = {1, 1, 1};
-
-double distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-  return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+double dot(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/// The index of the centre nearest `p`, or centres.size() where the paper is nearer than every centre.
-std::size_t nearest_centre(const std::array<double, 3>& p,
-                           const std::vector<std::array<double, 3>>& centres) {
-  std::size_t best = centres.size();
-  double best_distance = distance(p, kPaper);
-  for (std::size_t c = 0; c < centres.size(); ++c)
-    if (const double d = distance(p, centres[c]); d < best_distance) best = c, best_distance = d;
+/// Pixels fainter than this (|absorbance|) are paper: their hue is noise, and they need next to no ink.
+constexpr double kPaperAbsorbance = 0.02;
+
+/// The ink (a unit direction among `hues`) whose hue is nearest the absorbance `a`: the largest cosine.
+std::size_t nearest_hue(const std::array<double, 3>& a, const std::vector<std::array<double, 3>>& hues) {
+  std::size_t best = 0;
+  for (std::size_t c = 1; c < hues.size(); ++c)
+    if (dot(a, hues[c]) > dot(a, hues[best])) best = c;
   return best;
 }
 
-/// N ink colours of the image by k-means beside the fixed paper (Lloyd's iterations from a farthest-point
-/// start on a subsample, so the result depends on the image alone).
-std::vector<std::array<double, 3>> cluster_colours(const ColourImage& image, int n) {
+/// Up to N ink hues of the image: spherical k-means on the pixels' absorbance directions, each pixel
+/// weighing its absorbance (Lloyd's iterations from a farthest-point start on a subsample, so the result
+/// depends on the image alone). Fewer where the image holds fewer hues (a grey image: one). Unit vectors.
+std::vector<std::array<double, 3>> cluster_hues(const ColourImage& image, int n) {
   const std::size_t pixels = std::size_t(image.width) * image.height;
   const std::size_t step = std::max<std::size_t>(1, pixels / 65536);
   std::vector<std::array<double, 3>> samples;
-  for (std::size_t i = 0; i < pixels; i += step)
-    samples.push_back({image.pixels[3 * i], image.pixels[3 * i + 1], image.pixels[3 * i + 2]});
-  // Each centre the sample farthest from the paper and the centres chosen before it.
-  std::vector<std::array<double, 3>> centres;
-  std::vector<double> nearest(samples.size());
-  for (std::size_t i = 0; i < samples.size(); ++i) nearest[i] = distance(samples[i], kPaper);
-  while (int(centres.size()) < n) {
-    std::size_t far = 0;
+  for (std::size_t i = 0; i < pixels; i += step) {
+    const std::array<double, 3> a = absorbance(&image.pixels[3 * i]);
+    if (std::sqrt(dot(a, a)) > kPaperAbsorbance) samples.push_back(a);
+  }
+  std::vector<std::array<double, 3>> hues;
+  if (samples.empty()) return hues;
+  auto unit = [](std::array<double, 3> a) {
+    const double length = std::sqrt(dot(a, a));
+    for (double& v : a) v /= length;
+    return a;
+  };
+  // The darkest sample first, then each time the sample whose hue lies farthest from those chosen (1 −
+  // cosine), weighed by its absorbance so that a faint pixel's noisy hue does not count as a colour.
+  std::size_t first = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    if (dot(samples[i], samples[i]) > dot(samples[first], samples[first])) first = i;
+  hues.push_back(unit(samples[first]));
+  std::vector<double> far(samples.size(), HUGE_VAL);
+  while (int(hues.size()) < n) {
+    std::size_t best = 0;
+    double best_score = 0;
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      if (!centres.empty()) nearest[i] = std::min(nearest[i], distance(samples[i], centres.back()));
-      if (nearest[i] > nearest[far]) far = i;
+      const double length = std::sqrt(dot(samples[i], samples[i]));
+      far[i] = std::min(far[i], length - dot(samples[i], hues.back()));  // |a| (1 − cos)
+      if (far[i] > best_score) best = i, best_score = far[i];
     }
-    centres.push_back(samples[far]);
+    if (best_score < 0.01) break;  // every hue left is within about 8° of one chosen
+    hues.push_back(unit(samples[best]));
   }
   for (int iteration = 0; iteration < 20; ++iteration) {
-    std::vector<std::array<double, 4>> sums(centres.size(), {0, 0, 0, 0});
-    for (const auto& s : samples) {
-      const std::size_t best = nearest_centre(s, centres);
-      if (best == centres.size()) continue;  // the paper's
-      for (int k = 0; k < 3; ++k) sums[best][k] += s[k];
-      sums[best][3] += 1;
+    std::vector<std::array<double, 3>> sums(hues.size(), {0, 0, 0});
+    for (const auto& a : samples) {
+      const std::size_t c = nearest_hue(a, hues);
+      for (int k = 0; k < 3; ++k) sums[c][k] += a[k];
     }
-    for (std::size_t c = 0; c < centres.size(); ++c)
-      if (sums[c][3] > 0)
-        for (int k = 0; k < 3; ++k) centres[c][k] = sums[c][k] / sums[c][3];
+    for (std::size_t c = 0; c < hues.size(); ++c)
+      if (dot(sums[c], sums[c]) > 0) hues[c] = unit(sums[c]);
   }
-  // Darkest first: the inks that show most get the best-spread dots.
-  std::sort(centres.begin(), centres.end(),
-            [](const auto& a, const auto& b) { return a[0] + a[1] + a[2] < b[0] + b[1] + b[2]; });
-  return centres;
+  return hues;
 }
 
 }  // namespace
@@ -132,22 +142,29 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     if (scheme.empty() || *end != '\0' || n < 2 || n > 8)
       throw std::invalid_argument("colours must be cmyk, rgb or a number of inks from 2 to 8, got '" +
                                   scheme + "'");
-    const auto centres = cluster_colours(image, int(n));
-    // Each pixel's ink, once for all channels (centres.size(): the paper's, no ink).
-    std::vector<std::uint8_t> owner(std::size_t(image.width) * image.height);
-    for (std::size_t i = 0; i < owner.size(); ++i) {
-      const float* p = &image.pixels[3 * i];
-      owner[i] = static_cast<std::uint8_t>(nearest_centre({p[0], p[1], p[2]}, centres));
+    // Each ink is its hue at full strength (its strongest channel absorbs everything), so that its dots,
+    // covering part of the paper, can draw every tone of that hue: an ink of a pixel's own colour would
+    // need to cover all of it (a flat 50% grey drawn in a #808080 ink came out 25% grey).
+    const auto hues = cluster_hues(image, int(n));
+    std::vector<std::array<double, 3>> inks;
+    for (const auto& h : hues) {
+      const double strongest = std::max({h[0], h[1], h[2]});
+      inks.push_back({h[0] / strongest, h[1] / strongest, h[2] / strongest});
     }
-    for (std::size_t c = 0; c < centres.size(); ++c) {
+    // Each pixel's ink, once for all channels.
+    std::vector<std::uint8_t> owner(std::size_t(image.width) * image.height);
+    for (std::size_t i = 0; i < owner.size() && !hues.empty(); ++i)
+      owner[i] = static_cast<std::uint8_t>(nearest_hue(absorbance(&image.pixels[3 * i]), hues));
+    for (std::size_t c = 0; c < inks.size(); ++c) {
       s.channels.push_back(channel(image, gamma, "ink-" + std::to_string(c), [&, c](const float* p) {
-        return owner[std::size_t(p - image.pixels.data()) / 3] == c ? 1 - luminance(p) : 0.0;
+        const std::size_t i = std::size_t(p - image.pixels.data()) / 3;
+        return owner[i] == c ? dot(absorbance(p), inks[c]) / dot(inks[c], inks[c]) : 0.0;
       }));
       const auto byte = [](double v) {
-        return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255));
+        return static_cast<std::uint8_t>(std::lround(std::clamp(1 - v, 0.0, 1.0) * 255));
       };
-      s.inks.push_back(ink(byte(centres[c][0]), byte(centres[c][1]), byte(centres[c][2]),
-                           "ink-" + std::to_string(c), int(c)));
+      s.inks.push_back(
+          ink(byte(inks[c][0]), byte(inks[c][1]), byte(inks[c][2]), "ink-" + std::to_string(c), int(c)));
     }
   }
   // Inks that no pixel uses would only waste a class: keep those with some coverage.

@@ -35,9 +35,10 @@ struct ColourSeparation {
 /// - "cmyk": cyan, magenta, yellow and black on white paper, black by full under-colour removal
 ///   (K = 1 − max(R, G, B), C = (1 − R − K) / (1 − K), …);
 /// - "rgb": red, green and blue dots on black paper, each channel's intensity its density;
-/// - "N" (2 … 8): N inks on white paper, the image's colours clustered into N (k-means beside the paper's
-///   white, deterministic), each pixel's darkness the density of its nearest ink; pixels nearer the
-///   paper than every ink take none (the lightest tints go bare).
+/// - "N" (2 … 8): up to N inks on white paper, the image's hues clustered (spherical k-means of the
+///   pixels' absorbances 1 − rgb, deterministic; fewer inks where the image holds fewer hues, one for a
+///   grey image), each ink its hue at full strength (its strongest channel 0), each pixel drawn by the ink
+///   of the nearest hue with the coverage that gives its absorbance (least squares, at most 1).
 /// Each density is the coverage raised to `gamma` (> 0). The inks come in order of increasing mean coverage
 /// (a later class's tone carries the earlier classes' count errors, the more the smaller its share), except
 /// that inks under a tenth of the total coverage come last, most covering first (a sparse class early in

@@ -19,11 +19,12 @@ constexpr double kTolerance = 1e-4;  ///< relative residual of the Poisson solve
 template <int D>
 struct Buckets {
   const Grid<D>& g;
-  double scale;  ///< finest units to coarse
+  std::array<double, D> scale;  ///< finest units to coarse, per axis
   std::vector<std::int64_t> first;
   std::vector<std::int32_t> members;
 
-  Buckets(const Grid<D>& grid, const std::vector<Particle<D>>& particles, double to_coarse)
+  Buckets(const Grid<D>& grid, const std::vector<Particle<D>>& particles,
+          const std::array<double, D>& to_coarse)
       : g(grid),
         scale(to_coarse),
         first(static_cast<std::size_t>(grid.size()) + 1, 0),
@@ -39,29 +40,30 @@ struct Buckets {
   std::int64_t cell_of(const Vec<D>& x) const {
     std::int64_t idx = 0;
     for (int k = 0; k < D; ++k)
-      idx +=
-          std::clamp<std::int64_t>(static_cast<std::int64_t>(x[k] * scale), 0, g.dims[k] - 1) * g.stride(k);
+      idx += std::clamp<std::int64_t>(static_cast<std::int64_t>(x[k] * scale[k]), 0, g.dims[k] - 1) *
+             g.stride(k);
     return idx;
   }
 
   /// Whether a particle other than `self` lies within `radius` (finest units) of `x`. Particles move at
   /// most half a node per step, so the nodes within radius + 1/2 of x's node hold every candidate.
   bool any_within(const std::vector<Particle<D>>& particles, const Grid<D>& finest, const Vec<D>& x,
-                  double radius, const Particle<D>* self, int factor) const {
-    const int reach = static_cast<int>(std::ceil(radius / factor + 0.5));
-    std::array<int, D> centre{}, offset{};
-    int side = 2 * reach + 1, cells = 1;
+                  double radius, const Particle<D>* self) const {
+    std::array<int, D> centre{}, offset{}, reach{}, side{};
+    int cells = 1;
     for (int k = 0; k < D; ++k) {
+      reach[k] = static_cast<int>(std::ceil(radius * scale[k] + 0.5));
+      side[k] = 2 * reach[k] + 1;
       centre[k] = static_cast<int>(
-          std::clamp<std::int64_t>(static_cast<std::int64_t>(x[k] * scale), 0, g.dims[k] - 1));
-      cells *= std::min(side, g.dims[k]);
+          std::clamp<std::int64_t>(static_cast<std::int64_t>(x[k] * scale[k]), 0, g.dims[k] - 1));
+      cells *= std::min(side[k], g.dims[k]);
     }
     for (int c = 0; c < cells; ++c) {
       std::int64_t idx = 0;
       bool inside = true;
       for (int k = 0, rest = c; k < D; ++k) {
-        const int span = std::min(side, g.dims[k]);
-        offset[k] = rest % span - (span == side ? reach : span / 2);
+        const int span = std::min(side[k], g.dims[k]);
+        offset[k] = rest % span - (span == side[k] ? reach[k] : span / 2);
         rest /= span;
         int n = centre[k] + offset[k];
         if (g.torus)
@@ -165,23 +167,25 @@ void solve_poisson(const std::vector<std::int64_t>& neighbours, const std::vecto
 
 template <int D>
 CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const DensityGrid<D>& finest,
-                                  const DensityGrid<D>& source, int source_factor, int factor,
+                                  const DensityGrid<D>& source, int source_factor,
+                                  const std::array<int, D>& coarse_dims,
                                   const CountBalanceSettings<D>& settings) {
   const double min_target = settings.min_target;
-  KDM_CHECK(source_factor >= 1 && factor >= source_factor);
+  KDM_CHECK(source_factor >= 1);
   Grid<D> g = finest.grid;
+  std::array<double, D> scale;  // finest units to coarse: 1 / (finest nodes per coarse node)
   for (int k = 0; k < D; ++k) {
-    KDM_CHECK(finest.grid.dims[k] % factor == 0);
+    KDM_CHECK(coarse_dims[k] >= 1 && std::int64_t(coarse_dims[k]) * source_factor <= finest.grid.dims[k]);
     KDM_CHECK(std::int64_t(source.grid.dims[k]) * source_factor == finest.grid.dims[k]);
-    g.dims[k] = finest.grid.dims[k] / factor;
+    g.dims[k] = coarse_dims[k];
+    scale[k] = double(coarse_dims[k]) / finest.grid.dims[k];
   }
   CountBalanceReport report;
   for (int k = 0; k < D; ++k) report.grid[k] = g.dims[k];
   const std::size_t nodes = static_cast<std::size_t>(g.size());
-  const double scale = 1.0 / factor;
   auto to_coarse = [&](const Vec<D>& x) {
     Vec<D> c;
-    for (int k = 0; k < D; ++k) c[k] = x[k] * scale;
+    for (int k = 0; k < D; ++k) c[k] = x[k] * scale[k];
     return c;
   };
   // The target is binned exactly as the points are (each source node's mass at its centre, spread over
@@ -279,7 +283,7 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
       if (largest < kNegligibleStep) continue;  // spares the density lookups where little is left to do
       Vec<D> x = p.x;
       for (int k = 0; k < D; ++k) {
-        x[k] += u[k] * factor;
+        x[k] += u[k] / scale[k];
         if (!finest.grid.torus) {  // reflect at the walls, as refinement does
           const double m = finest.grid.dims[k];
           if (x[k] < 0) x[k] = std::min(-x[k], std::nextafter(m, 0.0));
@@ -295,7 +299,7 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
       if (rho_new < settings.frozen_below * p.weight()) {  // where no sweep will relax it
         if (!settings.move_frozen) continue;
         const double spacing = std::pow(settings.mass_per_point * p.weight() / rho_new, 1.0 / D);
-        if (buckets.any_within(particles, finest.grid, x, kFrozenMinSpacing * spacing, &p, factor)) continue;
+        if (buckets.any_within(particles, finest.grid, x, kFrozenMinSpacing * spacing, &p)) continue;
       }
       p.x = x;
       rho_of[j] = rho_new, inside_of[j] = inside;
@@ -317,10 +321,10 @@ CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const Den
 }
 
 template CountBalanceReport balance_counts<2>(std::vector<Particle<2>>&, const DensityGrid<2>&,
-                                              const DensityGrid<2>&, int, int,
+                                              const DensityGrid<2>&, int, const std::array<int, 2>&,
                                               const CountBalanceSettings<2>&);
 template CountBalanceReport balance_counts<3>(std::vector<Particle<3>>&, const DensityGrid<3>&,
-                                              const DensityGrid<3>&, int, int,
+                                              const DensityGrid<3>&, int, const std::array<int, 3>&,
                                               const CountBalanceSettings<3>&);
 
 }  // namespace kdm::gen

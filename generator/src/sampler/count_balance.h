@@ -9,6 +9,7 @@
 // counts match the target; the level's sweeps then relax them, and the finest sweeps sample the model.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "sampler/grid.h"
@@ -45,15 +46,16 @@ struct CountBalanceSettings {
 };
 
 /// Moves `particles` (positions in `finest` grid units, weights counted; `finest` is the level being
-/// balanced) so that their counts on a coarse
-/// grid, whose nodes each cover `factor` finest nodes per axis, match the target density there.
-/// `source` is a level of the density pyramid (its nodes each cover `source_factor` finest nodes; its
-/// values need only be proportional to the target); the finer it is, the more exact the target. Points are
-/// never moved onto zero density. Deterministic and single-threaded (the coarse grid is small). Requires
-/// 1 <= source_factor <= factor, both dividing the finest dims.
+/// balanced) so that their counts on a coarse grid of `coarse_dims` nodes spanning the same domain (a
+/// node covers finest.dims / coarse_dims finest nodes per axis, not necessarily a whole number) match
+/// the target density there. `source` is a level of the density pyramid (its nodes each cover
+/// `source_factor` finest nodes; its values need only be proportional to the target); the finer it is,
+/// the more exact the target. Points are never moved onto zero density. Deterministic and
+/// single-threaded (the coarse grid is small). Requires a source node no larger than a coarse one.
 template <int D>
 CountBalanceReport balance_counts(std::vector<Particle<D>>& particles, const DensityGrid<D>& finest,
-                                  const DensityGrid<D>& source, int source_factor, int factor,
+                                  const DensityGrid<D>& source, int source_factor,
+                                  const std::array<int, D>& coarse_dims,
                                   const CountBalanceSettings<D>& settings);
 
 }  // namespace kdm::gen

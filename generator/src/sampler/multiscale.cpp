@@ -202,6 +202,7 @@ struct Driver {
     if (!options.count_balance || (setup.uniform && base > 1) || !fixed.empty() || options.n <= 0) return;
     const double max_nodes = std::min(double(options.n) / kBalancePointsPerNode, kBalanceMaxNodes);
     const int levels = static_cast<int>(setup.levels.size());
+    const DensityGrid<D>& here = setup.levels[base];
     int l = base + 1;  // the first grid: level l of the pyramid, or coarser still
     while ((l < levels ? double(setup.levels[l].grid.size()) : nodes_at(l)) > max_nodes) {
       bool halves = true;  // past the pyramid's coarsest level, while its dims halve evenly
@@ -210,19 +211,29 @@ struct Driver {
       if (!halves) break;
       ++l;
     }
-    if (nodes_at(l) > 4 * max_nodes) return;  // under 2 points per node: counts too noisy to compare
     auto source_for = [&](int level) {  // a few levels finer: the targets follow ρ's shape within a node
       return std::min(std::max(base, level - kBalanceSourceLevels), levels - 1);
     };
+    std::array<int, D> first{};
+    int finer_from = l - 1;  // the pyramid levels finer than the first grid, for the passes below
+    int s0 = source_for(l);
+    if (nodes_at(l) <= 4 * max_nodes) {  // 2 points per node or more: counts worth comparing
+      for (int k = 0; k < D; ++k) first[k] = here.grid.dims[k] >> (l - base);
+    } else {
+      // Level l's dims are odd (a 63² coarsest level at 4,096 points): halving stops far above
+      // max_nodes, so the first grid is one of its own, a whole number of its nodes spanning the domain.
+      const double f = std::pow(nodes_at(base) / max_nodes, 1.0 / D);  // finest nodes per coarse node
+      for (int k = 0; k < D; ++k) first[k] = std::max(1, static_cast<int>(here.grid.dims[k] / f));
+      finer_from = l;
+      s0 = source_for(std::min(l, base + static_cast<int>(std::floor(std::log2(f)))));
+    }
     CountBalanceSettings<D> settings;
     if (base > 0) settings.support = &setup.levels[0], settings.support_scale = std::ldexp(1.0, base);
     settings.frozen_below = std::pow(sigma_max, -D);  // σ = (ρ/w)^(-1/D) >= σmax
     settings.move_frozen = base == 0;
     settings.mass_per_point = setup.mass_per_point;
-    const DensityGrid<D>& here = setup.levels[base];
-    const int s0 = source_for(l);
     const CountBalanceReport b =
-        balance_counts(particles, here, setup.levels[s0], 1 << (s0 - base), 1 << (l - base), settings);
+        balance_counts<D>(particles, here, setup.levels[s0], 1 << (s0 - base), first, settings);
     if (base == 0) {
       report.count_mismatch_before = b.mismatch_before;
       report.count_mismatch_after = b.mismatch_after;
@@ -230,9 +241,11 @@ struct Driver {
     // Finer passes where the density gives their nodes enough points: the steep parts of a varying
     // density have structure the first grid cannot resolve.
     settings.min_target = kBalanceFinePointsPerNode;
-    for (int f = l - 1; f > base && nodes_at(f) <= kBalanceMaxNodes; --f) {
+    for (int f = finer_from; f > base && nodes_at(f) <= kBalanceMaxNodes; --f) {
       const int sf = source_for(f);
-      balance_counts(particles, here, setup.levels[sf], 1 << (sf - base), 1 << (f - base), settings);
+      std::array<int, D> dims{};
+      for (int k = 0; k < D; ++k) dims[k] = here.grid.dims[k] >> (f - base);
+      balance_counts<D>(particles, here, setup.levels[sf], 1 << (sf - base), dims, settings);
     }
   }
 

@@ -34,13 +34,15 @@ void validate_points(const std::vector<double>& coords, int dim) {
   for (std::size_t i = 0; i < coords.size(); ++i) {
     const double v = coords[i];
     if (!std::isfinite(v))
-      throw InvalidInput("point " + std::to_string(i / dim) + " has a non-finite coordinate");
+      throw InvalidInput("point " + std::to_string(i / dim) +
+                         " (counting from 0) has a non-finite coordinate");
     if (v < 0.0 || v > 1.0) {
       // The shortest text that reads back as v: std::to_string prints 1e300 with 300 digits, %g
       // 1.0000001 as 1.
       char value[32];
       const std::to_chars_result end = std::to_chars(value, value + sizeof value, v);
-      throw InvalidInput("point " + std::to_string(i / dim) + " lies outside the unit domain (coordinate " +
+      throw InvalidInput("point " + std::to_string(i / dim) +
+                         " (counting from 0) lies outside the unit domain (coordinate " +
                          std::string(value, end.ptr) + "); normalise points to [0, 1]");
     }
   }

@@ -38,7 +38,23 @@ Circle circumcircle(const double* a, const double* b, const double* c) {
   return {a[0] + ux, a[1] + uy, std::hypot(ux, uy)};
 }
 
-/// Calls visit(i, j, k) with the point indices of every Delaunay triangle of `xy` (interleaved x y).
+/// How far a point is moved for the triangulation at most (below), in the square's units.
+constexpr double kMoveBound = 0x1p-21;
+
+/// A Delaunay triangle's circle, measured on the points as given where that is within a few moves of the
+/// circle of the moved points, else on the moved ones (empty of them, so within a move of an empty
+/// circle of the points as given). Two points closer than a move (10^6 uniform points hold some) can swap
+/// sides in the triangulation, and the given points' circle of such a sliver is no empty circle at all: in
+/// one set it was 5 d_hex where the largest is 2.
+Circle delaunay_circle(const std::vector<double>& xy, const std::vector<double>& moved, int i, int j, int k) {
+  const Circle given = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+  if (!std::isfinite(given.r)) return given;  // flat: a lattice row
+  const Circle m = circumcircle(&moved[2 * i], &moved[2 * j], &moved[2 * k]);
+  return std::fabs(given.r - m.r) <= 8 * kMoveBound ? given : m;
+}
+
+/// Calls visit(i, j, k, moved) with the point indices of every Delaunay triangle of `xy` (interleaved x
+/// y) and the moved points it was triangulated on (delaunay_circle measures it).
 /// `original` (optional): the point each one is a copy of, so that copies move as their originals do.
 template <class Visit>
 void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::size_t>* original = nullptr) {
@@ -56,16 +72,16 @@ void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::siz
         "the points are degenerate (all coincident or on one line): they have no Delaunay "
         "triangulation");
   // Points in degenerate position (a lattice, a line wrapped on a torus) made Qhull merge facets for
-  // minutes (n³). It triangulates them moved by at most 2^-21 instead, each by a hash of its index (the
-  // same every run; a torus copy as its original, so that every translate of a triangle is triangulated
-  // alike): in general position, a Delaunay triangulation of the points themselves where ties allowed
-  // several. The caller measures circles on the points as given.
+  // minutes (n³). It triangulates them moved by at most kMoveBound instead, each by a hash of its index
+  // (the same every run; a torus copy as its original, so that every translate of a triangle is
+  // triangulated alike): in general position, a Delaunay triangulation of the points themselves where ties
+  // allowed several.
   std::vector<double> moved(xy);
   for (std::size_t i = 0; i < moved.size(); ++i) {
     const std::size_t point = original ? (*original)[i / 2] : i / 2;
     std::uint64_t h = (2 * point + i % 2 + 1) * 0x9E3779B97F4A7C15ull;
     h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull, h ^= h >> 29;
-    moved[i] += std::ldexp(double(h >> 11) * 0x1p-53 - 0.5, -20);
+    moved[i] += (double(h >> 11) * 0x1p-53 - 0.5) * 2 * kMoveBound;
   }
   // Qhull's own report of any other failure goes to a scratch file: the error below says it in one line.
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> sink(std::tmpfile(), std::fclose);
@@ -85,7 +101,7 @@ void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::siz
         if (m < 3) id[m] = qh_pointid(qh, vertex->point);
         ++m;
       }
-      if (m == 3) visit(id[0], id[1], id[2]);
+      if (m == 3) visit(id[0], id[1], id[2], moved);
     }
   }
   qh_freeqhull(qh, !qh_ALL);
@@ -139,7 +155,7 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
     double reach = 0;  // how far the circles reach past the square
     delaunay(
         xy,
-        [&](int i, int j, int k) {
+        [&](int i, int j, int k, const std::vector<double>& moved) {
           const int v[3] = {i, j, k};
           // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
           // one translate of the triangle has the point itself there.
@@ -148,7 +164,7 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
                    std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
           });
           if (std::size_t(*first) >= n) return;  // another copy's
-          const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+          const Circle c = delaunay_circle(xy, moved, i, j, k);
           if (!std::isfinite(c.r)) return;  // flat
           circles.push_back(c);
           reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
@@ -163,8 +179,8 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
 std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double border) {
   std::vector<Circle> circles;
   const double m = border * spacing;
-  delaunay(xy, [&](int i, int j, int k) {
-    const Circle c = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
+  delaunay(xy, [&](int i, int j, int k, const std::vector<double>& moved) {
+    const Circle c = delaunay_circle(xy, moved, i, j, k);
     if (std::isfinite(c.r) && c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m) circles.push_back(c);
   });
   return circles;

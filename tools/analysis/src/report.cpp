@@ -99,7 +99,14 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     eo.threads = o.threads;
     try {  // the other measures stand without them
       r.empty_circles = empty_circles(sets, eo);
-      r.has_empty_circles = true;
+      r.has_empty_circles = r.empty_circles.triangles > 0;
+      if (!r.has_empty_circles)  // zeros would read as a set without holes
+        r.empty_circles_skipped =
+            o.torus     ? "no circle was judged: the density is too low at every one (--holes-min-density)"
+            : o.density ? "no circle was judged: none lies two spacings inside the window where the density "
+                          "is high enough (too few points for a box, or --holes-min-density)"
+                        : "no circle was judged: none lies two spacings inside the window (too few points "
+                          "for a box)";
     } catch (const DegenerateSet& e) {
       r.empty_circles_skipped = e.what();
     }

@@ -57,8 +57,9 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
     }
   if (on_count == 0)
     out.lattice_ratio = std::nan("");
-  else  // a strictly periodic set has no power off the lattice at all
-    out.lattice_ratio = off > 0 ? (on / on_count) / (off / off_count) : HUGE_VAL;
+  else  // a strictly periodic set has no power off the lattice, bar the transform's rounding (1e-10 of S)
+    out.lattice_ratio =
+        off / off_count > 1e-9 * (on / on_count) ? (on / on_count) / (off / off_count) : HUGE_VAL;
   return out;
 }
 

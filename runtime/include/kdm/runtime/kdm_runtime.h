@@ -130,7 +130,8 @@ typedef enum kdm_problem_kind {
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
-  size_t struct_size; /* sizeof(kdm_query_problem) */
+  size_t struct_size; /* sizeof(kdm_query_problem); a problem whose struct_size is below its first version
+                         (left 0, say) is not written at all: kind stays what the caller put there */
   kdm_problem_kind kind;
   const char* parameter;    /* the kdm_query field ("x0", "density_max", "mode", ...), the function's argument
                                ("xy", "out_classes", "cursor", ...) or its field ("classes[2].density",
@@ -233,7 +234,8 @@ KDM_RUNTIME_API kdm_status kdm_density_image_create_detail(int width, int height
 /* Frees an image (NULL is ignored); no query may be using it. */
 KDM_RUNTIME_API void kdm_density_image_free(kdm_density_image* image);
 /* The image's density at world (x, y) as a query reads it (bilinear between texel centres, clamped at the
- * edges): what a caller weighing points by their thresholds needs. 0 for a NULL image. Added in 0.5. */
+ * edges): what a caller weighing points by their thresholds needs. 0 for a NULL image or a NaN or infinite
+ * coordinate. Added in 0.5. */
 KDM_RUNTIME_API double kdm_density_image_at(const kdm_density_image* image, double x, double y);
 
 /* Writes up to `capacity` points into `out` (NULL only with capacity 0), *written = count (`written` and
@@ -242,7 +244,8 @@ KDM_RUNTIME_API double kdm_density_image_at(const kdm_density_image* image, doub
  * complete, KDM_BUFFER_FULL to be resumed with the same
  * cursor and query (also with room left, after 2^24 candidates in one call, a tile
  * visited counting as 16: kdm::kMaxQueryCandidates), KDM_INVALID_ARGUMENT for bad
- * parameters, with `problem` (optional: NULL, or with struct_size set) saying which and why. */
+ * parameters, with `problem` (optional: NULL, or with struct_size set) saying which and why. A refused
+ * call sets *written to 0 and leaves the cursor as it was: the query corrected, the cursor resumes. */
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);

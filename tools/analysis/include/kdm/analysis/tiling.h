@@ -35,7 +35,8 @@ struct PeriodicityResult {
   /// The tile lattice's own frequencies, up to two whole cycles per tile on either axis (k = (i, j) · tiles
   /// per axis, 1 ≤ max(|i|, |j|) ≤ 2): mean P there over the mean P of their eight off-lattice neighbours
   /// (k ± 1). 1: the lattice does not show; a repeated motif raises it by about the number of tiles. NaN
-  /// when they lie outside the periodogram.
+  /// when they lie outside the periodogram; infinite for a strictly periodic set (no power off the lattice
+  /// beyond the transform's rounding).
   double lattice_ratio = 0;
 };
 
