@@ -130,6 +130,7 @@ def stipple(
     threads: int = ...,
     colours: Union[str, int, None] = ...,
     fade: float = ...,
+    paper_width: Optional[str] = ...,
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],

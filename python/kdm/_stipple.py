@@ -29,6 +29,7 @@ def stipple(
     threads: int = 0,
     colours: Any = None,
     fade: float = 0.0,
+    paper_width: Optional[str] = None,
 ) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
@@ -66,6 +67,9 @@ def stipple(
         The picture's width in pixels, and the dot radius in pixels (None: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
         inks' summed coverage, so that the picture keeps the image's tone).
+    paper_width : str or None
+        For an .svg `output`: its printed width, a number and a unit ("180mm", "7.5in"; mm, cm, in, pt,
+        pc or px), the height in proportion (``kdm stipple --paper-width``). None: `width` pixels.
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
     colours : {"cmyk", "rgb"}, int or None
@@ -137,10 +141,12 @@ def stipple(
             colours = str(int(colours))
         if not isinstance(colours, str):
             raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
+    if paper_width is not None and not isinstance(paper_width, str):
+        raise TypeError(f"paper_width must be a str such as '180mm', got {type(paper_width).__name__}")
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
-        colours, gamma, fade, rgb, alpha,
+        colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width,
     )
 
 

@@ -47,7 +47,8 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                    const std::string& method, const std::string& mode, std::optional<Region> region,
                    std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
                    int width, double dot_size, int threads, std::optional<std::string> colours, double gamma,
-                   double fade, std::optional<FloatArray> rgb, std::optional<FloatArray> alpha) {
+                   double fade, std::optional<FloatArray> rgb, std::optional<FloatArray> alpha,
+                   const std::string& paper_width) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -57,6 +58,15 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
   if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
   if (output) tools::refuse_writing_over(label, *output, "input image");
+  if (!paper_width.empty()) {
+    if (!output || tools::output_format(*output) != ".svg")
+      throw std::invalid_argument("paper_width sizes an SVG for print: give output a .svg file");
+    try {
+      tools::check_paper_width(paper_width);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("paper_width ") + e.what());
+    }
+  }
   check_number("dot_size", dot_size, 0, false);
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   // Before the dots are placed, as kdm stipple says them.
@@ -124,6 +134,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     if (output) {
       tools::DrawStyle style;
       style.width_px = width;
+      style.paper_width = paper_width;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px = dot_size > 0 ? dot_size
                             : blank      ? 1.0
@@ -196,6 +207,7 @@ void bind_stipple(py::module_& m) {
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
         py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"), py::arg("fade"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
+        py::arg("paper_width") = std::string(),
         "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 

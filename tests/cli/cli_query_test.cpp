@@ -393,6 +393,19 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   for (std::size_t c : counts) EXPECT_GT(c, 100u);
   ASSERT_EQ(kdm("stipple " + coffee + " --colours rgb --points 2000 -o '" + path("rgb.svg") + "'").status, 0);
   EXPECT_NE(slurp(path("rgb.svg")).find("fill=\"#000000\"/>"), std::string::npos);  // black paper
+  // Printed at a size: the SVG's width and height in the unit given, the drawing in its pixels inside.
+  ASSERT_EQ(
+      kdm("stipple " + coffee + " --points 2000 --width 600 --paper-width 150mm -o '" + path("p.svg") + "'")
+          .status,
+      0);
+  const std::string printed = slurp(path("p.svg"));
+  EXPECT_NE(printed.find("width=\"150mm\" height=\"100mm\" viewBox=\"0 0 600 400\""), std::string::npos)
+      << printed.substr(0, 300);
+  expect_error("stipple " + coffee + " --paper-width 150 -o '" + path("p.svg") + "'",
+               "a number > 0 and a unit");
+  expect_error("stipple " + coffee + " --paper-width 0mm -o '" + path("p.svg") + "'",
+               "a number > 0 and a unit");
+  expect_error("stipple " + coffee + " --paper-width 150mm -o '" + path("p.png") + "'", "write .svg");
   expect_error("stipple " + coffee + " --colours 9 -o '" + path("x.png") + "'", "from 2 to 8");
   expect_error("stipple " + coffee + " --colours cmy -o '" + path("x.png") + "'", "cmyk, rgb");
   expect_error("stipple " + coffee + " --colours cmyk -o '" + path("x.txt") + "'", ".csv");

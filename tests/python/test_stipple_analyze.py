@@ -16,6 +16,11 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     cli("stipple", SPHERE, "--method", "full", "--points", 1500, "--seed", 4, "-o", tmp_path / "full.txt")
     full = kdm.stipple(SPHERE, method="full", points=1500, seed=4, threads=1)
     assert np.array_equal(full, read_txt(tmp_path / "full.txt"))
+    # An SVG for print, as --paper-width sizes it.
+    cli("stipple", SPHERE, "--points", 2000, "--paper-width", "7.5in", "-o", tmp_path / "cli.svg")
+    kdm.stipple(str(SPHERE), points=2000, paper_width="7.5in", output=tmp_path / "py.svg")
+    assert (tmp_path / "py.svg").read_bytes() == (tmp_path / "cli.svg").read_bytes()
+    assert b'width="7.5in" height="7.5in" viewBox="0 0 1024 1024"' in (tmp_path / "py.svg").read_bytes()
 
 
 def test_zoom_regions_are_the_frames_of_kdm_stipple(cli, tmp_path):
@@ -335,6 +340,12 @@ def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
         kdm.stipple(str(SPHERE), points=500, method="full", mode="stable")
     with pytest.raises(ValueError, match="tileset applies to method='tiles'"):
         kdm.stipple(str(SPHERE), points=500, method="full", tileset=kdm.Tileset.builtin())
+    with pytest.raises(ValueError, match="paper_width must be a number > 0 and a unit"):
+        kdm.stipple(str(SPHERE), points=500, paper_width="7.5", output=tmp_path / "x.svg")
+    with pytest.raises(ValueError, match="paper_width sizes an SVG"):
+        kdm.stipple(str(SPHERE), points=500, paper_width="7.5in", output=tmp_path / "x.png")
+    with pytest.raises(TypeError, match="paper_width must be a str"):
+        kdm.stipple(str(SPHERE), points=500, paper_width=7.5, output=tmp_path / "x.svg")
     assert not list(tmp_path.glob("x.*"))
 
 

@@ -27,7 +27,7 @@ namespace {
 const std::vector<const char*> kStippleFormats = {".png", ".svg", ".txt", ".csv"};
 
 struct StippleArgs {
-  std::string image, output, format, method = "tiles", region, tileset, mode = "smooth", colours;
+  std::string image, output, format, method = "tiles", region, tileset, mode = "smooth", colours, paper_width;
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
@@ -79,6 +79,14 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
+  if (!a.paper_width.empty()) {
+    if (format != ".svg") throw CommandError("--paper-width sizes an SVG for print: write .svg");
+    try {
+      tools::check_paper_width(a.paper_width);
+    } catch (const std::invalid_argument& e) {
+      throw CommandError(std::string("--paper-width ") + e.what());
+    }
+  }
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
   // One ink (the image's darkness), or with --colours the image separated into several.
   tools::ColourSeparation inks;
@@ -197,6 +205,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     style.width_px = a.width_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
+    style.paper_width = a.paper_width;
     if (coloured) {
       if (set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left: a one-class query
       style.classes = &set.classes, style.inks = inks.layers();
@@ -265,6 +274,11 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--width", a->width_px,
                   "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
       ->capture_default_str();
+  cmd->add_option(
+      "--paper-width", a->paper_width,
+      "SVG only: its printed width, a number and a unit (mm, cm, in, pt, pc, px: 180mm, 7.5in), the "
+      "height in proportion; the drawing stays --width pixels wide inside, so dot sizes keep their "
+      "share of it (default: --width pixels)");
   cmd->add_option(
       "--dot-size", a->dot_size,
       "Dot radius in pixels (default, or 0: the size at which the whole image's dots cover as much of "

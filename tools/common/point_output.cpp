@@ -1,6 +1,7 @@
 #include "point_output.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -71,6 +72,25 @@ int check_picture_size(int width_px, double aspect, const std::string& path, con
   return static_cast<int>(h);
 }
 
+void check_paper_width(const std::string& text) {
+  std::size_t digits = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &digits);
+  } catch (const std::exception&) {
+    digits = 0;
+  }
+  const std::string unit = text.substr(digits);
+  const bool known =
+      unit == "mm" || unit == "cm" || unit == "in" || unit == "pt" || unit == "pc" || unit == "px";
+  if (digits == 0 || !known || !(value > 0 && value < 1e9) ||
+      std::isspace(static_cast<unsigned char>(text[0])))
+    throw std::invalid_argument(
+        "must be a number > 0 and a unit (mm, cm, in, pt, pc or px), as 180mm or "
+        "7.5in, got '" +
+        text + "'");
+}
+
 void write_points(const std::string& path, const PointSet& points, const std::vector<std::string>& header,
                   const DrawStyle& style, const std::string& format) {
   std::string error;
@@ -126,9 +146,19 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   std::ostringstream out;
   // Each group an Inkscape layer, so that plotter software draws a layer per pen; the paper is a layer of
   // its own, to hide before plotting (a plotter would trace its outline).
+  std::string width = std::to_string(w), height = std::to_string(h);
+  if (!style.paper_width.empty()) {  // the same drawing, printed at a size: a plotter's or printer's units
+    check_paper_width(style.paper_width);
+    std::size_t digits = 0;
+    const double value = std::stod(style.paper_width, &digits);
+    const std::string unit = style.paper_width.substr(digits);
+    char text[64];
+    std::snprintf(text, sizeof text, "%.10g%s", value * h / w, unit.c_str());
+    width = style.paper_width, height = text;
+  }
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
          "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
-      << w << "\" height=\"" << h << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
+      << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
   for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
   const auto layer = [&](const std::string& name) {
     return "<g id=\"" + name + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + name + "\"";

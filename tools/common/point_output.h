@@ -36,7 +36,13 @@ struct DrawStyle {
   std::vector<Ink> inks;
   std::uint8_t background[3] = {255, 255, 255};  ///< the paper
   Blend blend = Blend::kOver;
+  /// SVG only: the printed width, a number > 0 and a unit (mm, cm, in, pt, pc or px: "180mm"), the height
+  /// in proportion; empty: width_px pixels. The drawing keeps its pixel coordinates (viewBox).
+  std::string paper_width;
 };
+
+/// Checks `text` as DrawStyle::paper_width takes it; throws std::invalid_argument naming the problem.
+void check_paper_width(const std::string& text);
 
 /// Throws std::invalid_argument when `output` names the file `input` (the same path, or a link to it),
 /// `what` saying what the input is ("input image"): a result written over what it came from.
