@@ -67,6 +67,9 @@ TEST_F(CliTest, OutputToStandardOutputIsTheFilesBytes) {
   // --format names the format of a file without an extension too.
   ASSERT_EQ(kdm(query + "-o '" + path("q.points") + "' --format JSON").status, 0);
   EXPECT_EQ(slurp(path("q.points")), kdm(query + "-o - --format json").out);
+  // A file named for another format than --format's is refused: its viewer would misread it.
+  expect_error(query + "-o '" + path("q2.png") + "' --format csv", "a png file name");
+  EXPECT_FALSE(fs::exists(path("q2.png")));
   ASSERT_EQ(kdm("sample -n 300 --seed 4 -o '" + path("s.txt") + "'").status, 0);
   const Outcome txt = kdm("sample -n 300 --seed 4 -o - --format txt");
   ASSERT_EQ(txt.status, 0) << txt.err;

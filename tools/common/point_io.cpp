@@ -58,6 +58,15 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
     return false;
   }
   if (path == kStandardOutput) return true;
+  // A file named for another format than --format gives it: its viewer would misread it.
+  const std::string named = output_format(path);
+  if (!format.empty() && named != ext)
+    for (const char* other : {".txt", ".csv", ".json", ".svg", ".png"})
+      if (named == other) {
+        error = "--format " + ext.substr(1) + " would write " + ext.substr(1) + " into '" + path +
+                "', a " + named.substr(1) + " file name: name the file ." + ext.substr(1);
+        return false;
+      }
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     error = "output '" + path + "' is a directory";
