@@ -131,6 +131,7 @@ def stipple(
     colours: Union[str, int, None] = ...,
     fade: float = ...,
     paper_width: Optional[str] = ...,
+    height: Optional[int] = ...,
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],

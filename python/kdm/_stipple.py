@@ -30,6 +30,7 @@ def stipple(
     colours: Any = None,
     fade: float = 0.0,
     paper_width: Optional[str] = None,
+    height: Optional[int] = None,
 ) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
@@ -67,6 +68,9 @@ def stipple(
         The picture's width in pixels, and the dot radius in pixels (None: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
         inks' summed coverage, so that the picture keeps the image's tone).
+    height : int or None
+        The picture's height in pixels instead of `width` (which then follows the picture's shape), 1
+        to 65536: for tall images (``kdm stipple --height``).
     paper_width : str or None
         For an .svg `output`: its printed width, a number and a unit ("180mm", "7.5in"; mm, cm, in, pt,
         pc or px), the height in proportion (``kdm stipple --paper-width``). None: `width` pixels.
@@ -127,6 +131,7 @@ def stipple(
     if output is not None:
         output = _checks.path("output", output)
     width = _checks.integer("width", width, 1, 65536)
+    height = 0 if height is None else _checks.integer("height", height, 1, 65536)
     dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)
     threads = _checks.threads(threads)
     fade = _checks.number("fade", fade, 0.0)
@@ -146,7 +151,7 @@ def stipple(
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
-        colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width,
+        colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height,
     )
 
 

@@ -48,7 +48,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                    std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
                    int width, double dot_size, int threads, std::optional<std::string> colours, double gamma,
                    double fade, std::optional<FloatArray> rgb, std::optional<FloatArray> alpha,
-                   const std::string& paper_width) {
+                   const std::string& paper_width, int height) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -57,6 +57,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (mode != "stable" && mode != "smooth")
     throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
   if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
+  if (!(height >= 0 && height <= 65536)) throw std::invalid_argument("height must be 1 to 65536 pixels");
   if (output) tools::refuse_writing_over(label, *output, "input image");
   if (!paper_width.empty()) {
     if (!output || tools::output_format(*output) != ".svg")
@@ -111,8 +112,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                     tools::max_stipple_zoom(given ? *given : builtin_tileset(), query_mode) * (1 + 1e-9))
     throw std::invalid_argument(
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
+  if (height > 0)  // the width follows the picture's shape (kdm stipple --height)
+    width = int(std::clamp(std::lround(height * aspect * (uv[2] - uv[0]) / (uv[3] - uv[1])), 1L, 65536L));
   if (output && picture())
-    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output);
+    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output, "", height);
   tools::PointSet set;
   {
     py::gil_scoped_release release;
@@ -135,6 +138,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       tools::DrawStyle style;
       style.width_px = width;
       style.paper_width = paper_width;
+      style.height_px = height;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px = dot_size > 0 ? dot_size
                             : blank      ? 1.0
@@ -207,7 +211,7 @@ void bind_stipple(py::module_& m) {
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
         py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"), py::arg("fade"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
-        py::arg("paper_width") = std::string(),
+        py::arg("paper_width") = std::string(), py::arg("height") = 0,
         "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 

@@ -445,6 +445,24 @@ TEST_F(CliTest, StippleKeepsTheImagesTone) {
   }
 }
 
+// A tall image has no --width that fits a picture (3 × 4,000 pixels at the default 1,024 wide is 1.4 million
+// high): --height sizes it instead, the width following its shape.
+TEST_F(CliTest, StippleHeightSizesATallPicture) {
+  write_bytes(path("strip.png"), grey_png(3, 4000, 8, std::vector<std::uint16_t>(3 * 4000, 100)));
+  expect_error("stipple '" + path("strip.png") + "' -o '" + path("s.png") + "'", "lower the width");
+  const Outcome run = kdm("stipple '" + path("strip.png") + "' --height 2000 -o '" + path("s.png") + "'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  kdm::tools::GreyImage picture;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("s.png"), picture, error)) << error;
+  EXPECT_EQ(picture.height, 2000);
+  EXPECT_EQ(picture.width, 2);  // 1.5 rounded
+  expect_error("stipple '" + path("strip.png") + "' --height 2000 --width 4 -o '" + path("s.png") + "'",
+               "--width excludes --height");
+  expect_error("stipple '" + path("strip.png") + "' --height 70000 -o '" + path("s.png") + "'",
+               "--height must be 1 to 65536");
+}
+
 // A flat tone is drawn between two keyframes of the glide track, not at one, where the dots that appeared
 // late in its interval stand crowded: of 10,000 dots on a flat 50% grey, 0.64-0.94% lay nearer another than
 // 0.45 d_hex at a keyframe (seeds 1-3), 0-0.02% between (stable mode 0.03%).

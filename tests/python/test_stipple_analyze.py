@@ -21,6 +21,10 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     kdm.stipple(str(SPHERE), points=2000, paper_width="7.5in", output=tmp_path / "py.svg")
     assert (tmp_path / "py.svg").read_bytes() == (tmp_path / "cli.svg").read_bytes()
     assert b'width="7.5in" height="7.5in" viewBox="0 0 1024 1024"' in (tmp_path / "py.svg").read_bytes()
+    # A picture sized by its height, as --height sizes it.
+    cli("stipple", SPHERE, "--points", 2000, "--height", 300, "--region", "0,0,1,0.5", "-o", tmp_path / "cli.png")
+    kdm.stipple(str(SPHERE), points=2000, height=300, region=(0, 0, 1, 0.5), output=tmp_path / "py.png")
+    assert (tmp_path / "py.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
 
 
 def test_zoom_regions_are_the_frames_of_kdm_stipple(cli, tmp_path):

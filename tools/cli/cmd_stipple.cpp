@@ -31,7 +31,7 @@ struct StippleArgs {
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
-  int width_px = 1024;
+  int width_px = 1024, height_px = 0;
   int frames = 0, threads = 0;
   std::uint64_t seed = 1;
 };
@@ -79,6 +79,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
+  if (!(a.height_px >= 0 && a.height_px <= 65536)) throw CommandError("--height must be 1 to 65536 pixels");
   if (!a.paper_width.empty()) {
     if (format != ".svg") throw CommandError("--paper-width sizes an SVG for print: write .svg");
     try {
@@ -151,6 +152,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
   const int frames = std::max(1, a.frames);
+  // --height sizes a tall picture (a strip 3 pixels wide and 4,000 high has no --width that fits).
+  const double picture_aspect = aspect * (region[2] - region[0]) / (region[3] - region[1]);
+  const int width_px =
+      a.height_px > 0 ? int(std::clamp(std::lround(a.height_px * picture_aspect), 1L, 65536L)) : a.width_px;
   if (format == ".png" || format == ".svg")
     for (int i = 0; i < frames; ++i) {  // each frame's picture, before any dot is placed
       double uv[4];
@@ -159,7 +164,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       else
         std::copy(region, region + 4, uv);
       try {
-        tools::check_picture_size(a.width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output, format);
+        tools::check_picture_size(width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output, format,
+                                  a.height_px);
       } catch (const std::invalid_argument& e) {
         throw CommandError(e.what());
       }
@@ -200,9 +206,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (dot_radius <= 0)
-      dot_radius = blank ? 1.0 : tools::stipple_dot_radius(whole_dots, a.width_px, aspect, specs);
+      dot_radius = blank ? 1.0 : tools::stipple_dot_radius(whole_dots, width_px, aspect, specs);
     tools::DrawStyle style;
-    style.width_px = a.width_px;
+    style.width_px = width_px;
+    style.height_px = a.height_px;
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
     style.paper_width = a.paper_width;
@@ -271,9 +278,16 @@ void add_stipple_command(CLI::App& app) {
          "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
          "sequence; pictures only, which it lightens by about 1 - ln(1 + F) / F: 28% at 1, 61% at 5; 0: off)")
       ->capture_default_str();
-  cmd->add_option("--width", a->width_px,
-                  "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
-      ->capture_default_str();
+  CLI::Option* width =
+      cmd->add_option(
+             "--width", a->width_px,
+             "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
+          ->capture_default_str();
+  cmd->add_option(
+         "--height", a->height_px,
+         "Picture height in pixels instead of --width, 1 to 65536 (the width follows the picture's shape: "
+         "for tall images)")
+      ->excludes(width);
   cmd->add_option(
       "--paper-width", a->paper_width,
       "SVG only: its printed width, a number and a unit (mm, cm, in, pt, pc, px: 180mm, 7.5in), the "

@@ -55,13 +55,14 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
-int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format) {
+int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format,
+                       int height_px) {
   const int w = std::max(1, width_px);
-  const double h = std::max(1.0, std::round(w / aspect));  // the picture's own shape
+  const double h = height_px > 0 ? height_px : std::max(1.0, std::round(w / aspect));  // the picture's shape
   const auto refuse = [&](const char* limit) {
     throw std::invalid_argument("a picture of " + std::to_string(w) + "x" +
                                 std::to_string(std::llround(std::min(h, 1e18))) + " pixels is too large (" +
-                                limit + "); lower the width");
+                                limit + "); lower the width" + (height_px > 0 ? " or height" : ""));
   };
   if (output_format(path, format) !=
       ".png") {  // an SVG's size is two numbers: only the height's int is a limit
@@ -105,7 +106,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   if (points.dim != 2)
     throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
   const int w = std::max(1, style.width_px);
-  const int h = check_picture_size(style.width_px, style.aspect, path, ext);
+  const int h = check_picture_size(style.width_px, style.aspect, path, ext, style.height_px);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
   // A dot wider than the picture only blackens it, and painting large dots costs their area each.
   if (!(r <= std::max(w, h)))

@@ -28,6 +28,7 @@ enum class Blend { kOver, kMultiply, kAdd };
 
 struct DrawStyle {
   int width_px = 1024;       ///< PNG width; height follows the aspect ratio
+  int height_px = 0;         ///< > 0: the height, width_px being the width that shape rounds to
   double dot_radius_px = 0;  ///< 0 = automatic from the point count
   double aspect = 1;         ///< width / height of the domain
   /// Optional: every point's class, drawn in inks[class] (SVG: a layer per ink, in the inks' layer order);
@@ -49,10 +50,11 @@ void check_paper_width(const std::string& text);
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
 /// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path` (in
-/// `format`, output_format's); throws std::invalid_argument, naming the size, for a PNG past 2^28 pixels or
-/// an SVG past 2^30 pixels high (write_points checks it; a caller that computes points for a picture
-/// checks it first).
-int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format = "");
+/// `format`, output_format's), or `height_px` if > 0; throws std::invalid_argument, naming the size, for a
+/// PNG past 2^28 pixels or an SVG past 2^30 pixels high (write_points checks it; a caller that computes
+/// points for a picture checks it first).
+int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format = "",
+                       int height_px = 0);
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path` (kStandardOutput: standard output) in `format`
 /// (".txt", ".csv", ".svg", ".png"; by default the path's extension). Throws std::invalid_argument on an
