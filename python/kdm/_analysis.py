@@ -96,6 +96,8 @@ def analyze(
     else:
         raw, names = [points], ["points"]
     for name, p in zip(names, raw):
+        if p is None:
+            raise TypeError(f"{name} must be an (n, 2) or (n, 3) array of points, got None")
         if _checks.is_array(p) and np.asarray(p).dtype == np.bool_:
             raise TypeError(f"{name} must hold coordinates, got booleans")
     sets = [_checks.array2d(name, p) for name, p in zip(names, raw)]

@@ -860,6 +860,10 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   const std::string out = " -o '" + path("z.png") + "'";
   expect_error("stipple " + image + " --frames 1 --region 0,0,.5,.5" + out, "--frames");
   expect_error("stipple " + image + " --frames -3 --region 0,0,.5,.5" + out, "--frames");
+  // Refused before anything loops over the frames (2·10^9 checked every frame's path first: minutes), and
+  // past an int by name too.
+  expect_error("stipple " + image + " --frames 2000000000 --region 0,0,.5,.5" + out, "from 2 to 10000");
+  expect_error("stipple " + image + " --frames 2147483648 --region 0,0,.5,.5" + out, "from 2 to 10000");
   expect_error("stipple " + image + " --frames 5" + out, "--region");
   expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2 --mode stable" + out, "2× (");
   // Smooth mode descends into the built-in set's m × m subtiles, four depths deep: 2 · m^4 ×.

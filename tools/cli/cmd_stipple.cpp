@@ -32,7 +32,8 @@ struct StippleArgs {
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
   bool invert = false;
   int width_px = 1024, height_px = 0;
-  int frames = 0, threads = 0;
+  std::int64_t frames = 0;  // wide, so that any count is refused by name, not by the option's parser
+  int threads = 0;
   std::uint64_t seed = 1;
 };
 
@@ -56,16 +57,16 @@ std::string frame_path(const std::string& output, int i) {
 
 void run_stipple(const StippleArgs& a, bool scale_given) {
   const std::string format = check_output_option(a.output, kStippleFormats, a.format);  // before the dots
+  if (a.frames < 0 || a.frames == 1 || a.frames > 10000)  // before anything loops over them
+    throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
+                       std::to_string(a.frames));
   if (a.frames > 0 && a.output == tools::kStandardOutput)
     throw CommandError("--frames writes a file per frame: give -o a file name, not - (standard output)");
-  for (int i = 0; i < std::max(1, a.frames); ++i)
+  for (int i = 0; i < std::max(1, int(a.frames)); ++i)
     tools::refuse_writing_over(a.image, a.frames > 0 ? frame_path(a.output, i) : a.output, "input image");
   if (scale_given && !(a.scale > 0 && std::isfinite(a.scale)))
     throw CommandError("--scale must be a finite number > 0 (dots per unit area at full darkness)");
   if (!scale_given && a.points <= 0) throw CommandError("give --points N > 0 or --scale S > 0");
-  if (a.frames < 0 || a.frames == 1 || a.frames > 10000)
-    throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
-                       std::to_string(a.frames));
   if (a.frames > 0 && a.region.empty()) throw CommandError("--frames needs --region (where the zoom ends)");
   if (!(a.fade >= 0 && a.fade <= 10)) {
     char message[120];
@@ -151,7 +152,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       names += (k ? ", " : "; no pixel uses ") + inks.unused[k].name;
     std::fprintf(stderr, "kdm stipple: classes %s\n", names.c_str());
   }
-  const int frames = std::max(1, a.frames);
+  const int frames = std::max(1, int(a.frames));
   // --height sizes a tall picture (a strip 3 pixels wide and 4,000 high has no --width that fits).
   const double picture_aspect = aspect * (region[2] - region[0]) / (region[3] - region[1]);
   const int width_px =
