@@ -16,14 +16,14 @@ from typing import Any as _Any
 
 from . import _kdm
 from ._analysis import analyze
-from ._runtime import QueryResult, Tileset, bake
+from ._runtime import DensityMap, QueryResult, Tileset, bake
 from ._sampling import sample
 from ._stipple import separate, stipple, zoom_regions
 
 __version__: str = _kdm.__version__
 
 __all__ = [
-    "BlueNoise", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "zoom_regions",
+    "BlueNoise", "DensityMap", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "zoom_regions",
     "__version__",
 ]
 

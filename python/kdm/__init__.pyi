@@ -53,6 +53,17 @@ class QueryResult:
     ) -> None: ...
     def __len__(self) -> int: ...
 
+class DensityMap:
+    rect: Tuple[float, float, float, float]
+    def __init__(
+        self, density: Union[float, _Path, npt.ArrayLike], rect: Optional[_Rect] = ..., *, gamma: float = ...,
+        invert: bool = ...
+    ) -> None: ...
+    @property
+    def kind(self) -> str: ...
+
+_QueryDensity = Union[_Density, DensityMap, _Function]
+
 class Tileset:
     def __init__(self, handle: Any) -> None: ...
     @classmethod
@@ -71,8 +82,8 @@ class Tileset:
         rect: _Rect,
         *,
         scale: float,
-        density: Union[_Density, _Function] = ...,
-        classes: Optional[Sequence[Union[_Density, _Function]]] = ...,
+        density: _QueryDensity = ...,
+        classes: Optional[Sequence[_QueryDensity]] = ...,
         density_rect: Optional[_Rect] = ...,
         density_max: Union[float, Sequence[Optional[float]], None] = ...,
         density_bounds: Optional[Union[_Bounds, Sequence[Optional[_Bounds]]]] = ...,
@@ -91,7 +102,7 @@ class Tileset:
         rect: _Rect,
         *,
         scale: float,
-        density: Union[_Density, _Function] = ...,
+        density: _QueryDensity = ...,
         density_rect: Optional[_Rect] = ...,
         density_max: Union[float, Sequence[Optional[float]], None] = ...,
         density_bounds: Optional[Union[_Bounds, Sequence[Optional[_Bounds]]]] = ...,
@@ -104,7 +115,7 @@ class Tileset:
         glide_together: bool = ...,
         keys: bool = ...,
         threads: Optional[int] = ...,
-        classes: Optional[Sequence[Union[_Density, _Function]]] = ...,
+        classes: Optional[Sequence[_QueryDensity]] = ...,
     ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[Any], ...]]: ...
 
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...

@@ -224,6 +224,24 @@ void check_threads(int threads) {
                                 std::to_string(threads));
 }
 
+/// A density prepared once for many queries (kdm.DensityMap): its spec stretched over `rect`, the max-mip
+/// of an image built and its values checked, so that a query of a chunk costs what the chunk does, not
+/// what the map does (a 1,024² array took 7 ms a query, converted and mipped each time).
+struct PreparedDensity {
+  PreparedDensity(std::shared_ptr<const tools::DensitySpec> s, const Rect& r) : spec(std::move(s)), rect(r) {
+    if (spec->kind != tools::DensitySpec::Kind::kConstant) check_rect("rect", rect);
+    density = std::make_unique<SpecDensity>(*spec, rect.data());
+  }
+  std::shared_ptr<const tools::DensitySpec> spec;  ///< what `density` points into
+  Rect rect;
+  std::unique_ptr<SpecDensity> density;
+};
+
+/// `ready` as a PreparedDensity, or null for None.
+const PreparedDensity* ready_density(const py::object& ready) {
+  return ready.is_none() ? nullptr : ready.cast<const PreparedDensity*>();
+}
+
 /// A query's parameters and the density objects they point at (kept alive with them).
 struct PreparedQuery {
   QueryParams q;
@@ -232,9 +250,10 @@ struct PreparedQuery {
 };
 
 void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::DensitySpec* spec,
-             py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
-             std::optional<double> density_max, double tile_size, const std::string& mode,
-             const std::array<double, 2>& origin, int& threads) {
+             const PreparedDensity* ready, py::object callable, bool vectorized, py::object bounds,
+             std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
+             const std::string& mode, const std::array<double, 2>& origin, int& threads) {
+  if (ready) spec = ready->spec.get();
   check_threads(threads);
   check_rect("rect", rect, true);
   QueryParams& q = p.q;
@@ -260,6 +279,9 @@ void prepare(PreparedQuery& p, const Rect& rect, double scale, const tools::Dens
         std::make_unique<CallableDensity>(std::move(callable), *density_max, std::move(bounds), vectorized);
     q.density = p.from_callable->density;
     threads = 0;  // a Python function runs on one thread at a time (the GIL): one query
+  } else if (ready) {
+    if (density_rect) throw std::invalid_argument("density_rect is the DensityMap's own: give it no other");
+    q.density = ready->density->density;
   } else {
     const Rect r = image_rect(rect, density_rect);
     p.from_spec = std::make_unique<SpecDensity>(*spec, r.data());
@@ -367,12 +389,13 @@ std::size_t collect_parallel(Buffer& buffer, int threads, std::size_t room, Grow
 }
 
 py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, const tools::DensitySpec* spec,
-                py::object callable, bool vectorized, py::object bounds, std::optional<Rect> density_rect,
-                std::optional<double> density_max, double tile_size, const std::string& mode,
-                const std::array<double, 2>& origin, const py::object& storage, int threads) {
+                const py::object& ready, py::object callable, bool vectorized, py::object bounds,
+                std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
+                const std::string& mode, const std::array<double, 2>& origin, const py::object& storage,
+                int threads) {
   PreparedQuery prepared;
-  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
-          density_max, tile_size, mode, origin, threads);
+  prepare(prepared, rect, scale, spec, ready_density(ready), std::move(callable), vectorized,
+          std::move(bounds), density_rect, density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
@@ -443,12 +466,13 @@ std::size_t fill_compact(CompactBuffer& buffer, int threads, std::size_t wanted,
 /// 0 runs one query (query_points' order); 1 or more a ParallelQuery on as many std::threads (the same
 /// bits for any count, in query_points' order where no tile is cut into units).
 py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
-                    const tools::DensitySpec* spec, py::object callable, bool vectorized, py::object bounds,
-                    std::optional<Rect> density_rect, std::optional<double> density_max, double tile_size,
-                    const std::string& mode, const std::array<double, 2>& origin, bool keys, int threads) {
+                    const tools::DensitySpec* spec, const py::object& ready, py::object callable,
+                    bool vectorized, py::object bounds, std::optional<Rect> density_rect,
+                    std::optional<double> density_max, double tile_size, const std::string& mode,
+                    const std::array<double, 2>& origin, bool keys, int threads) {
   PreparedQuery prepared;
-  prepare(prepared, rect, scale, spec, std::move(callable), vectorized, std::move(bounds), density_rect,
-          density_max, tile_size, mode, origin, threads);
+  prepare(prepared, rect, scale, spec, ready_density(ready), std::move(callable), vectorized,
+          std::move(bounds), density_rect, density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
   CompactBuffer buffer;
@@ -492,21 +516,35 @@ std::vector<const tools::DensitySpec*> image_specs(const std::vector<const tools
   return out;
 }
 
-/// A class's density is specs[k], or callables[k] where that is not None (bounded by maxima[k]).
+/// A class's density is specs[k], or ready[k] (a PreparedDensity, its spec specs[k]) where that is not None,
+/// or callables[k] where that is not None (bounded by maxima[k]).
 void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
                      const std::vector<const tools::DensitySpec*>& specs,
-                     const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                     const std::vector<py::object>& bounds, bool vectorized, std::optional<Rect> density_rect,
-                     double tile_size, const std::string& mode, const std::array<double, 2>& origin,
-                     int& threads) {
+                     const std::vector<py::object>& ready, const std::vector<py::object>& callables,
+                     const std::vector<double>& maxima, const std::vector<py::object>& bounds,
+                     bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                     const std::string& mode, const std::array<double, 2>& origin, int& threads) {
   check_threads(threads);
   check_rect("rect", rect, true);
   if (specs.empty() || specs.size() > kMaxQueryClasses)
     throw std::invalid_argument("classes must hold 1 to " + std::to_string(kMaxQueryClasses) +
                                 " densities, got " + std::to_string(specs.size()));
-  if (callables.size() != specs.size() || maxima.size() != specs.size() || bounds.size() != specs.size())
+  if (callables.size() != specs.size() || maxima.size() != specs.size() || bounds.size() != specs.size() ||
+      ready.size() != specs.size())
     throw std::invalid_argument(
-        "classes: one callable (or None), one maximum and one bounds (or None) per class");
+        "classes: one callable (or None), one maximum, one bounds (or None) and one map (or None) per class");
+  const bool any_ready =
+      std::any_of(ready.begin(), ready.end(), [](const py::object& r) { return !r.is_none(); });
+  if (any_ready && density_rect)
+    throw std::invalid_argument("density_rect is the DensityMaps' own: give it no other");
+  std::optional<Rect> map_rect;  // the DensityMaps' images, all over one rectangle
+  for (const py::object& r : ready)
+    if (const PreparedDensity* d = ready_density(r);
+        d && d->spec->kind != tools::DensitySpec::Kind::kConstant) {
+      if (map_rect && *map_rect != d->rect)
+        throw std::invalid_argument("class DensityMaps must all lie over one rect, as class images do");
+      map_rect = d->rect;
+    }
   if (density_rect) check_rect("density_rect", *density_rect);
   const auto [i, j] = tools::images_of_different_shapes(image_specs(specs, callables));
   if (j >= 0) {
@@ -541,8 +579,12 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
       threads = 0;  // Python functions run one at a time (the GIL): one query
       continue;
     }
+    if (const PreparedDensity* d = ready_density(ready[k])) {
+      q.classes[k] = d->density->density;
+      continue;
+    }
     if (!specs[k]) throw std::invalid_argument(name + " is not a density");
-    prepared.densities.push_back(std::make_unique<SpecDensity>(*specs[k], r.data()));
+    prepared.densities.push_back(std::make_unique<SpecDensity>(*specs[k], (map_rect ? *map_rect : r).data()));
     q.classes[k] = prepared.densities.back()->density;
   }
   tools::read_images_by_sums(q, prepared.sums);
@@ -552,12 +594,12 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
 /// query() returns them, then each point's class. New memory every call (no `storage`).
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
                         const std::vector<const tools::DensitySpec*>& specs,
-                        const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                        const std::vector<py::object>& bounds, bool vectorized,
-                        std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                        const std::array<double, 2>& origin, int threads) {
+                        const std::vector<py::object>& ready, const std::vector<py::object>& callables,
+                        const std::vector<double>& maxima, const std::vector<py::object>& bounds,
+                        bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                        const std::string& mode, const std::array<double, 2>& origin, int threads) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
+  prepare_classes(prepared, rect, scale, specs, ready, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin, threads);
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
@@ -594,12 +636,13 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
 /// (m × 2 float32), each point's key if asked (else None), and each point's class.
 py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double scale,
                           const std::vector<const tools::DensitySpec*>& specs,
-                          const std::vector<py::object>& callables, const std::vector<double>& maxima,
-                          const std::vector<py::object>& bounds, bool vectorized,
-                          std::optional<Rect> density_rect, double tile_size, const std::string& mode,
-                          const std::array<double, 2>& origin, bool keys, int threads) {
+                          const std::vector<py::object>& ready, const std::vector<py::object>& callables,
+                          const std::vector<double>& maxima, const std::vector<py::object>& bounds,
+                          bool vectorized, std::optional<Rect> density_rect, double tile_size,
+                          const std::string& mode, const std::array<double, 2>& origin, bool keys,
+                          int threads) {
   PreparedClasses prepared;
-  prepare_classes(prepared, rect, scale, specs, callables, maxima, bounds, vectorized, density_rect,
+  prepare_classes(prepared, rect, scale, specs, ready, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin, threads);
   const ClassQueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
@@ -629,25 +672,32 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
 }  // namespace
 
 void bind_query(py::module_& m) {
+  py::class_<PreparedDensity>(m, "PreparedDensity",
+                              "A density spec stretched over a rectangle, prepared once for many queries")
+      .def(py::init<std::shared_ptr<const tools::DensitySpec>, const Rect&>(), py::arg("spec"),
+           py::arg("rect"));
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
-        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-        py::arg("threads"), "several classes in one query: query()'s tuple and each point's class");
+        py::arg("specs"), py::arg("ready"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"),
+        py::arg("vectorized"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
+        py::arg("origin"), py::arg("threads"),
+        "several classes in one query: query()'s tuple and each point's class");
   m.def("class_positions", &class_positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("specs"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"), py::arg("vectorized"),
-        py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
-        py::arg("keys"), py::arg("threads"),
+        py::arg("specs"), py::arg("ready"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"),
+        py::arg("vectorized"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),
+        py::arg("origin"), py::arg("keys"), py::arg("threads"),
         "several classes into the compact output: float32 positions, keys if asked, each point's class");
   m.def("positions", &positions, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
-        py::arg("spec").none(true), py::arg("callable").none(true), py::arg("vectorized"),
-        py::arg("bounds").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),
-        py::arg("tile_size"), py::arg("mode"), py::arg("origin"), py::arg("keys"), py::arg("threads"),
+        py::arg("spec").none(true), py::arg("ready").none(true), py::arg("callable").none(true),
+        py::arg("vectorized"), py::arg("bounds").none(true), py::arg("density_rect").none(true),
+        py::arg("density_max").none(true), py::arg("tile_size"), py::arg("mode"), py::arg("origin"),
+        py::arg("keys"), py::arg("threads"),
         "the compact query into new arrays: float32 positions and, if asked, 64-bit keys");
   m.def(
       "query", &query, py::arg("tileset"), py::arg("rect"), py::arg("scale"), py::arg("spec").none(true),
-      py::arg("callable").none(true), py::arg("vectorized"), py::arg("bounds").none(true),
-      py::arg("density_rect").none(true), py::arg("density_max").none(true), py::arg("tile_size"),
-      py::arg("mode"), py::arg("origin"), py::arg("storage").none(true), py::arg("threads"),
+      py::arg("ready").none(true), py::arg("callable").none(true), py::arg("vectorized"),
+      py::arg("bounds").none(true), py::arg("density_rect").none(true), py::arg("density_max").none(true),
+      py::arg("tile_size"), py::arg("mode"), py::arg("origin"), py::arg("storage").none(true),
+      py::arg("threads"),
       "tools::query_all into numpy arrays (reusing `storage`, an earlier result's, when it is large enough)");
 }
 

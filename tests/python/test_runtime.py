@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import kdm
-from conftest import TINY_RECIPE, interrupted, read_query_csv
+from conftest import SPHERE, TINY_RECIPE, interrupted, read_query_csv
 
 BUILTIN = kdm.Tileset.builtin()
 
@@ -866,3 +866,58 @@ def test_an_empty_or_inverted_region_has_no_points():
     # Classes may come as a 1-D array of constant densities.
     assert np.array_equal(tiles.query((0, 0, 4, 4), scale=100, classes=np.array([0.1, 0.2])).classes,
                           tiles.query((0, 0, 4, 4), scale=100, classes=[0.1, 0.2]).classes)
+
+
+@pytest.mark.parametrize("mode", ["stable", "smooth"])
+def test_a_density_map_gives_the_points_of_its_density_and_rect(mode):
+    # A map prepared once (converted, checked and mipped once) gives every query the points that passing
+    # its array and density_rect each time gives: one density, classes (maps with an array and a constant,
+    # as class images are read by their sums) and positions(), in chunks of one region.
+    t = kdm.Tileset.builtin()
+    rng = np.random.default_rng(5)
+    world = (0.0, 0.0, 400.0, 300.0)
+    arrays = [rng.random((60, 80)) * c for c in (0.4, 1.0)]
+    maps = [kdm.DensityMap(a, world) for a in arrays]
+    assert maps[0].kind == "image" and maps[0].rect == world
+    for chunk in [(0, 0, 120, 90), (120, 0, 400, 300), (37.5, 12.25, 61, 80)]:
+        kw = dict(scale=0.5, tile_size=16, mode=mode)
+        a = t.query(chunk, density=arrays[1], density_rect=world, **kw)
+        b = t.query(chunk, density=maps[1], **kw)
+        assert np.array_equal(a.xy, b.xy) and np.array_equal(a.rank, b.rank)
+        a = t.query(chunk, classes=[arrays[0], 0.1, arrays[1]], density_rect=world, **kw)
+        b = t.query(chunk, classes=[maps[0], 0.1, maps[1]], **kw)
+        assert np.array_equal(a.xy, b.xy) and np.array_equal(a.classes, b.classes)
+        assert np.array_equal(t.positions(chunk, density=arrays[0], density_rect=world, **kw),
+                              t.positions(chunk, density=maps[0], **kw))
+    # A test map and an image file too; a pickle rebuilds the same map (an array from its own copy).
+    for m, given in [(kdm.DensityMap("ramp:8", world), dict(density="ramp:8")),
+                     (kdm.DensityMap(str(SPHERE), world, gamma=2), dict(density=str(SPHERE), gamma=2))]:
+        b = t.query(world, scale=0.5, tile_size=16, mode=mode, density=m)
+        assert np.array_equal(t.query(world, scale=0.5, tile_size=16, mode=mode, density_rect=world, **given).xy,
+                              b.xy)
+        assert np.array_equal(t.query(world, scale=0.5, tile_size=16, mode=mode,
+                                      density=pickle.loads(pickle.dumps(m))).xy, b.xy)
+    copy = pickle.loads(pickle.dumps(maps[1]))
+    arrays[1][:] = 0  # the map keeps its own values
+    assert np.array_equal(t.query(world, scale=0.5, tile_size=16, density=copy).xy,
+                          t.query(world, scale=0.5, tile_size=16, density=maps[1]).xy)
+
+
+def test_a_density_map_refuses_what_it_cannot_stand_for():
+    t = kdm.Tileset.builtin()
+    m = kdm.DensityMap(np.ones((4, 4)), (0, 0, 10, 10))
+    with pytest.raises(ValueError, match="rect is needed"):
+        kdm.DensityMap(np.ones((4, 4)))
+    with pytest.raises(TypeError, match="density must be a number, a str or a 2-D array"):
+        kdm.DensityMap(lambda x, y: 1.0, (0, 0, 1, 1))
+    with pytest.raises(ValueError, match="density_rect is the DensityMap's own"):
+        t.query((0, 0, 10, 10), scale=1, density=m, density_rect=(0, 0, 10, 10))
+    with pytest.raises(ValueError, match="gamma and invert are the DensityMap's own"):
+        t.query((0, 0, 10, 10), scale=1, density=m, gamma=2)
+    with pytest.raises(ValueError, match="one rect"):
+        t.query((0, 0, 10, 10), scale=1, classes=[m, kdm.DensityMap(np.ones((4, 4)), (0, 0, 20, 20))])
+    with pytest.raises(ValueError, match="rect is empty or inverted"):
+        kdm.DensityMap(np.ones((4, 4)), (0, 0, -1, 1))
+    with pytest.raises(ValueError, match="finite and >= 0"):
+        kdm.DensityMap(np.full((4, 4), -1.0), (0, 0, 1, 1))
+    assert len(t.query((0, 0, 10, 10), scale=5, density=kdm.DensityMap(2.0)).xy) > 100  # a constant: no rect
