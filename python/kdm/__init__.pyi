@@ -136,7 +136,7 @@ def stipple(
     seed: int = ...,
     tileset: Union[Tileset, _Path, None] = ...,
     output: Optional[_Path] = ...,
-    width: int = ...,
+    width: Optional[int] = ...,
     dot_size: Optional[float] = ...,
     threads: int = ...,
     colours: Union[str, int, None] = ...,

@@ -166,6 +166,28 @@ def luminance(name: str, value: Any) -> np.ndarray:
     return np.ascontiguousarray(np.clip(lum * alpha + (np.float32(1) - alpha), 0, 1), dtype=np.float64)
 
 
+def pil_pixels(value: Any) -> Any:
+    """A PIL image as the array of pixels luminance() and colour() read, as an image file of it is read: grey,
+    grey and alpha, RGB and RGBA as they are (16-bit grey too); a palette, CMYK, YCbCr and the other modes
+    converted to RGB, or RGBA where they hold transparency. Anything else is returned as it is."""
+    mode = getattr(value, "mode", None)
+    if not isinstance(mode, str) or not hasattr(value, "convert") or not hasattr(value, "info"):
+        return value
+    if mode in ("L", "LA", "RGB", "RGBA", "I;16", "I;16L", "I;16B"):
+        return value
+    if mode == "1":
+        return value.convert("L")
+    if mode == "I":  # how Pillow opens some 16-bit grey files: 32-bit integers holding 0 .. 65535
+        a = np.asarray(value)
+        if a.size and (a.min() < 0 or a.max() > 65535):
+            raise ValueError("a PIL image of mode 'I' must hold 16-bit grey levels 0 to 65535")
+        return a.astype(np.uint16)
+    if mode == "F":
+        raise ValueError("a PIL image of mode 'F' has no set range: give an array of luminances in [0, 1]")
+    transparent = "A" in mode or "a" in mode or "transparency" in value.info
+    return value.convert("RGBA" if transparent else "RGB")
+
+
 def is_array(value: Any) -> bool:
     return isinstance(value, (np.ndarray, list, tuple)) or hasattr(value, "__array__")
 

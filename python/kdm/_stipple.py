@@ -24,7 +24,7 @@ def stipple(
     seed: int = 1,
     tileset: Optional[Tileset] = None,
     output: Any = None,
-    width: int = 1024,
+    width: Optional[int] = None,
     dot_size: Optional[float] = None,
     threads: int = 0,
     colours: Any = None,
@@ -65,7 +65,7 @@ def stipple(
     output : str, os.PathLike or None
         Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does.
     width, dot_size
-        The picture's width in pixels, and the dot radius in pixels (None: the size at which the
+        The picture's width in pixels (None: 1024, or what `height` makes it), and the dot radius in pixels (None: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
         inks' summed coverage, so that the picture keeps the image's tone).
     height : int or None
@@ -106,7 +106,7 @@ def stipple(
         spec = _kdm.DensitySpec.parse(label, gamma, invert)
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
-        label = "array"
+        label, image = "array", _checks.pil_pixels(image)
         spec = _kdm.DensitySpec.from_luminance(_checks.luminance("image", image), gamma, invert)
         rgb, alpha = _checks.colour("image", image) if colours is not None else (None, None)
     else:
@@ -130,7 +130,9 @@ def stipple(
         raise TypeError(f"tileset must be a kdm.Tileset, a tile-set file or None, got {type(tileset).__name__}")
     if output is not None:
         output = _checks.path("output", output)
-    width = _checks.integer("width", width, 1, 65536)
+    if width is not None and height is not None:
+        raise ValueError("give width or height, not both (the other follows the picture's shape)")
+    width = 1024 if width is None else _checks.integer("width", width, 1, 65536)
     height = 0 if height is None else _checks.integer("height", height, 1, 65536)
     dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)
     threads = _checks.threads(threads)
@@ -148,6 +150,8 @@ def stipple(
             raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
     if paper_width is not None and not isinstance(paper_width, str):
         raise TypeError(f"paper_width must be a str such as '180mm', got {type(paper_width).__name__}")
+    if paper_width == "":
+        raise ValueError("paper_width must be a number and a unit ('180mm', '7.5in'), got ''")
     handle = tileset._handle if tileset is not None else None
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
@@ -184,7 +188,7 @@ def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[
     if isinstance(image, (str, os.PathLike)):
         label, rgb, alpha = _checks.path("image", image), None, None
     else:  # an array or a PIL image, as stipple() takes it
-        label, (rgb, alpha) = "array", _checks.colour("image", image)
+        label, (rgb, alpha) = "array", _checks.colour("image", _checks.pil_pixels(image))
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
         colours = str(int(colours))

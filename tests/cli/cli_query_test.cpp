@@ -404,10 +404,12 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   const std::string printed = slurp(path("p.svg"));
   EXPECT_NE(printed.find("width=\"150mm\" height=\"100mm\" viewBox=\"0 0 600 400\""), std::string::npos)
       << printed.substr(0, 300);
-  expect_error("stipple " + coffee + " --paper-width 150 -o '" + path("p.svg") + "'",
-               "a number > 0 and a unit");
+  expect_error("stipple " + coffee + " --paper-width 150 -o '" + path("p.svg") + "'", "and a unit");
   expect_error("stipple " + coffee + " --paper-width 0mm -o '" + path("p.svg") + "'",
-               "a number > 0 and a unit");
+               "from 0.001 to 1000000");
+  expect_error("stipple " + coffee + " --paper-width 0x10mm -o '" + path("p.svg") + "'",
+               "from 0.001 to 1000000");
+  expect_error("stipple " + coffee + " --paper-width '' -o '" + path("p.svg") + "'", "got ''");
   expect_error("stipple " + coffee + " --paper-width 150mm -o '" + path("p.png") + "'", "write .svg");
   expect_error("stipple " + coffee + " --colours 9 -o '" + path("x.png") + "'", "from 2 to 8");
   expect_error("stipple " + coffee + " --colours cmy -o '" + path("x.png") + "'", "cmyk, rgb");

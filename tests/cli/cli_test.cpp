@@ -445,6 +445,18 @@ TEST_F(CliTest, StippleKeepsTheImagesTone) {
   }
 }
 
+// Integers are decimal whatever zeros pad them (CLI11 read "010" as octal 8, and "0800" as no number).
+TEST_F(CliTest, ZeroPaddedIntegersAreDecimal) {
+  const Outcome ten = kdm("sample -n 010 --seed 007 -o - --format txt");
+  ASSERT_EQ(ten.status, 0) << ten.err;
+  EXPECT_NE(ten.err.find("10 points"), std::string::npos) << ten.err;
+  EXPECT_NE(ten.err.find("seed 7,"), std::string::npos) << ten.err;
+  const Outcome eight_hundred = kdm("sample -n 0800 -o - --format txt");
+  ASSERT_EQ(eight_hundred.status, 0) << eight_hundred.err;
+  EXPECT_NE(eight_hundred.err.find("800 points"), std::string::npos) << eight_hundred.err;
+  expect_error("sample -n -05 -o '" + path("x.txt") + "'", "--n must be >= 0");
+}
+
 // A tall image has no --width that fits a picture (3 × 4,000 pixels at the default 1,024 wide is 1.4 million
 // high): --height sizes it instead, the width following its shape.
 TEST_F(CliTest, StippleHeightSizesATallPicture) {
@@ -460,6 +472,8 @@ TEST_F(CliTest, StippleHeightSizesATallPicture) {
   expect_error("stipple '" + path("strip.png") + "' --height 2000 --width 4 -o '" + path("s.png") + "'",
                "--width excludes --height");
   expect_error("stipple '" + path("strip.png") + "' --height 70000 -o '" + path("s.png") + "'",
+               "--height must be 1 to 65536");
+  expect_error("stipple '" + path("strip.png") + "' --height 0 -o '" + path("s.png") + "'",
                "--height must be 1 to 65536");
 }
 

@@ -101,6 +101,18 @@ def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
     np.testing.assert_array_equal(kdm.stipple(Image.open(coffee), points=2000), expected)
     opaque = np.concatenate([rgb, np.full(rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
     np.testing.assert_array_equal(kdm.stipple(opaque, points=2000), expected)
+    # Other PIL modes as their file is read: a palette's colours (not its indices as grey levels), CMYK.
+    palette = Image.open(coffee).quantize(16)
+    assert palette.mode == "P"
+    palette.save(tmp_path / "palette.png")
+    for colours in (None, 3):
+        a, b = (kdm.stipple(im, points=2000, colours=colours) for im in (palette, str(tmp_path / "palette.png")))
+        for x, y in zip(a, b) if colours else [(a, b)]:
+            np.testing.assert_array_equal(x, y)
+    cmyk = Image.open(coffee).convert("CMYK")
+    np.testing.assert_array_equal(kdm.stipple(cmyk, points=2000), kdm.stipple(cmyk.convert("RGB"), points=2000))
+    with pytest.raises(ValueError, match="mode 'F' has no set range"):
+        kdm.stipple(Image.open(SPHERE).convert("F"), points=200)
     grey = np.asarray(Image.open(SPHERE))
     assert grey.ndim == 2
     np.testing.assert_array_equal(kdm.stipple(grey, points=2000), kdm.stipple(str(SPHERE), points=2000))
@@ -344,10 +356,16 @@ def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
         kdm.stipple(str(SPHERE), points=500, method="full", mode="stable")
     with pytest.raises(ValueError, match="tileset applies to method='tiles'"):
         kdm.stipple(str(SPHERE), points=500, method="full", tileset=kdm.Tileset.builtin())
-    with pytest.raises(ValueError, match="paper_width must be a number > 0 and a unit"):
+    with pytest.raises(ValueError, match="paper_width must be a number from 0.001 to 1000000 and a unit"):
         kdm.stipple(str(SPHERE), points=500, paper_width="7.5", output=tmp_path / "x.svg")
     with pytest.raises(ValueError, match="paper_width sizes an SVG"):
         kdm.stipple(str(SPHERE), points=500, paper_width="7.5in", output=tmp_path / "x.png")
+    with pytest.raises(ValueError, match="paper_width must be a number and a unit"):
+        kdm.stipple(str(SPHERE), points=500, paper_width="", output=tmp_path / "x.svg")
+    with pytest.raises(ValueError, match="paper_width must be a number from 0.001"):
+        kdm.stipple(str(SPHERE), points=500, paper_width="0x10mm", output=tmp_path / "x.svg")
+    with pytest.raises(ValueError, match="give width or height, not both"):
+        kdm.stipple(str(SPHERE), points=500, width=100, height=100, output=tmp_path / "x.png")
     with pytest.raises(TypeError, match="paper_width must be a str"):
         kdm.stipple(str(SPHERE), points=500, paper_width=7.5, output=tmp_path / "x.svg")
     assert not list(tmp_path.glob("x.*"))

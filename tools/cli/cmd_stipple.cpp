@@ -328,6 +328,11 @@ void add_stipple_command(CLI::App& app) {
     const bool scale_given = cmd->get_option("--scale")->count() > 0;
     if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())
       throw CommandError("--colours must be cmyk, rgb or a count of inks (2-8), got ''");
+    // Given empty or 0, these read as unset: say so rather than draw at the default size.
+    if (cmd->get_option("--height")->count() > 0 && a->height_px < 1)
+      throw CommandError("--height must be 1 to 65536 pixels");
+    if (cmd->get_option("--paper-width")->count() > 0 && a->paper_width.empty())
+      throw CommandError("--paper-width must be a number and a unit (180mm, 7.5in), got ''");
     if (scale_given) a->points = 0;
     if (a->method == "full")  // options the full sampler would ignore
       for (const char* tiles_only : {"--mode", "--tileset"})

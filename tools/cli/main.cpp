@@ -1,6 +1,7 @@
 // kdm: the command line. See `kdm --help` and README.md.
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -40,6 +41,26 @@ std::string option_given_as_value(const CLI::App& app, int argc, char** argv) {
   return "";
 }
 
+// CLI11 reads an integer with a leading 0 as octal: "--width 0100" drew 64 pixels, "--seed 010" seed 8,
+// and "--points 0800" was no number. A script's zero-padded numbers are decimal: strip the zeros.
+void read_integers_as_decimal(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* opt : sub->get_options()) {
+      const std::string type = opt->get_type_name();
+      if (type != "INT" && type != "UINT") continue;
+      opt->transform(
+          [](std::string word) {
+            const std::size_t sign = word.size() > 1 && (word[0] == '-' || word[0] == '+') ? 1 : 0;
+            std::size_t first = sign;
+            while (first + 1 < word.size() && word[first] == '0' &&
+                   std::isdigit(static_cast<unsigned char>(word[first + 1])))
+              ++first;
+            return word.substr(0, sign) + word.substr(first);
+          },
+          "", "decimal");
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -54,6 +75,7 @@ int main(int argc, char** argv) {
   kdm::cli::add_tile_commands(app);
   kdm::cli::add_analyze_command(app);
   kdm::cli::add_verify_command(app);
+  read_integers_as_decimal(app);
   try {
     if (const std::string error = option_given_as_value(app, argc, argv); !error.empty()) {
       std::fprintf(stderr, "kdm: error: %s (see kdm %s --help)\n", error.c_str(), argv[1]);

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -73,22 +74,29 @@ int check_picture_size(int width_px, double aspect, const std::string& path, con
   return static_cast<int>(h);
 }
 
+namespace {
+
+/// `text` as a paper width: a plain decimal number (digits, at most one point, no sign or exponent) and a
+/// unit; false if it is not one.
+bool parse_paper_width(const std::string& text, double& value, std::string& unit) {
+  std::size_t i = 0, digits = 0, points = 0;
+  for (; i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.'); ++i)
+    (text[i] == '.' ? points : digits) += 1;
+  if (digits == 0 || points > 1 || text[i - 1] == '.') return false;
+  unit = text.substr(i);
+  value = std::strtod(text.substr(0, i).c_str(), nullptr);
+  return unit == "mm" || unit == "cm" || unit == "in" || unit == "pt" || unit == "pc" || unit == "px";
+}
+
+}  // namespace
+
 void check_paper_width(const std::string& text) {
-  std::size_t digits = 0;
   double value = 0;
-  try {
-    value = std::stod(text, &digits);
-  } catch (const std::exception&) {
-    digits = 0;
-  }
-  const std::string unit = text.substr(digits);
-  const bool known =
-      unit == "mm" || unit == "cm" || unit == "in" || unit == "pt" || unit == "pc" || unit == "px";
-  if (digits == 0 || !known || !(value > 0 && value < 1e9) ||
-      std::isspace(static_cast<unsigned char>(text[0])))
+  std::string unit;
+  if (!parse_paper_width(text, value, unit) || !(value >= 0.001 && value <= 1e6))
     throw std::invalid_argument(
-        "must be a number > 0 and a unit (mm, cm, in, pt, pc or px), as 180mm or "
-        "7.5in, got '" +
+        "must be a number from 0.001 to 1000000 and a unit (mm, cm, in, pt, pc or px), "
+        "as 180mm or 7.5in, got '" +
         text + "'");
 }
 
@@ -150,12 +158,14 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   std::string width = std::to_string(w), height = std::to_string(h);
   if (!style.paper_width.empty()) {  // the same drawing, printed at a size: a plotter's or printer's units
     check_paper_width(style.paper_width);
-    std::size_t digits = 0;
-    const double value = std::stod(style.paper_width, &digits);
-    const std::string unit = style.paper_width.substr(digits);
+    double value = 0;
+    std::string unit;
+    parse_paper_width(style.paper_width, value, unit);
     char text[64];
+    std::snprintf(text, sizeof text, "%.10g%s", value, unit.c_str());
+    width = text;
     std::snprintf(text, sizeof text, "%.10g%s", value * h / w, unit.c_str());
-    width = style.paper_width, height = text;
+    height = text;
   }
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
          "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
