@@ -3,7 +3,9 @@
 
 #include "run_clones.h"
 
-namespace kdm::detail {
+namespace kdm_runs {  // outside kdm: float_runs.h says why
+using namespace kdm;
+using namespace kdm::detail;
 
 KDM_RUN_CLONES void stable_run_xy(const TilePoint* from, std::size_t count, float rx, float ry, float unit,
                                   float* to) {
@@ -34,4 +36,4 @@ KDM_RUN_CLONES void key_run(std::uint64_t* to, std::size_t count, std::uint64_t 
   for (std::size_t k = 0; k < count; ++k) to[k] = first + k * step;
 }
 
-}  // namespace kdm::detail
+}  // namespace kdm_runs

@@ -5,7 +5,9 @@
 
 #include "run_clones.h"
 
-namespace kdm::detail {
+namespace kdm_runs {  // outside kdm: float_runs.h says why
+using namespace kdm;
+using namespace kdm::detail;
 
 KDM_RUN_CLONES void glide_corners_run(const double* __restrict expected, const double* __restrict x,
                                       const double* __restrict y, std::size_t count, double side,
@@ -43,4 +45,4 @@ KDM_RUN_CLONES void glide_counts_run(const double* __restrict expected, const do
   }
 }
 
-}  // namespace kdm::detail
+}  // namespace kdm_runs

@@ -7,10 +7,11 @@
 
 #include "glide_count.h"
 
-namespace kdm::detail {
-
-/// Most points one block holds: their corners, 8 a point, fill one batch callback's call (kDensityBatch).
-inline constexpr std::size_t kGlideBlock = 16;
+// Outside namespace kdm: GCC gives a target_clones function's ifunc default visibility whatever
+// -fvisibility says, and the shared library's version script exports kdm::* (run_clones.h).
+namespace kdm_runs {
+using namespace kdm;
+using namespace kdm::detail;
 
 /// The corners of points k < count ≤ kGlideBlock (expected count expected[k] at stable position (x[k],
 /// y[k]) in a tile of side `side`): corner c of point k (GlideLattice::corner) at (cx[c · count + k],
@@ -23,6 +24,15 @@ void glide_corners_run(const double* expected, const double* x, const double* y,
 /// value[c · count + k], `area` the count per unit of density.
 void glide_counts_run(const double* expected, const double* coarse, const double* value, std::size_t count,
                       double area, double* out);
+
+}  // namespace kdm_runs
+
+namespace kdm::detail {
+using kdm_runs::glide_corners_run;
+using kdm_runs::glide_counts_run;
+
+/// Most points one block holds: their corners, 8 a point, fill one batch callback's call (kDensityBatch).
+inline constexpr std::size_t kGlideBlock = 16;
 
 /// The glide counts of points i < count (expected count expected[i] at stable position (x[i], y[i]) in a
 /// tile of side `side`, `area` the count per unit of density) into out[i], a block at a time:

@@ -5,7 +5,10 @@
 
 #include "run_clones.h"
 
-namespace kdm::detail {
+namespace kdm_runs {  // outside kdm: float_runs.h says why
+using namespace kdm;
+using namespace kdm::detail;
+
 namespace {
 
 /// Where the candidates fall among the texels (ImageSampler::texels, with 32-bit indices): the four
@@ -152,4 +155,4 @@ KDM_RUN_CLONES void image_classes_run(const TilePoint* from, std::size_t count, 
   for (std::uint32_t i = 0; i < m; ++i) cls[open[i]] = found[i];
 }
 
-}  // namespace kdm::detail
+}  // namespace kdm_runs

@@ -19,6 +19,14 @@ inline bool image_runs_fit(const DensityImageView& image) {
   return std::uint64_t(image.width) * std::uint64_t(image.height) < (std::uint64_t(1) << 31);
 }
 
+}  // namespace kdm::detail
+
+// Outside namespace kdm: GCC gives a target_clones function's ifunc default visibility whatever
+// -fvisibility says, and the shared library's version script exports kdm::* (run_clones.h).
+namespace kdm_runs {
+using namespace kdm;
+using namespace kdm::detail;
+
 /// Candidates from[0 … count) (count ≤ kImageBlock) of a tile at (wx, wy) of side S: their stable world
 /// positions into x[k], y[k] and the density of `sampler`'s image there into rho[k], as
 /// sampler.at(x[k], y[k]) reads it.
@@ -56,4 +64,12 @@ void image_classes_run(const TilePoint* from, std::size_t count, double wx, doub
                        const double* lo, const double* hi, const float* thresholds, double area_scale,
                        double area, double* x, double* y, double* rho, std::uint8_t* cls);
 
+}  // namespace kdm_runs
+
+namespace kdm::detail {
+using kdm_runs::image_classes_run;
+using kdm_runs::image_read_run;
+using kdm_runs::image_run;
+using kdm_runs::image_sum_classes_run;
+using kdm_runs::image_sums_run;
 }  // namespace kdm::detail

@@ -501,6 +501,10 @@ const char* kdm_version(void) {
   return kdm::version_string();
 }
 
+uint32_t kdm_version_number(void) {
+  return kdm::version_number();
+}
+
 uint32_t kdm_tileset_format_version(void) {
   return kdm::kTilesetFormatVersion;
 }

@@ -8,4 +8,8 @@ const char* version_string() {
   return KDM_VERSION_STRING;
 }
 
+std::uint32_t version_number() {
+  return KDM_VERSION_NUMBER;
+}
+
 }  // namespace kdm

@@ -159,6 +159,11 @@ int main(int argc, char** argv) {
     CHECK(info.handover_slack <= 16 && (info.subtiles_per_side > 0 || info.handover_slack == 0));
     CHECK(strstr(info.recipe, "base_points") != NULL && strlen(info.generator_version) > 0);
     CHECK(strchr(kdm_version(), '.') != NULL);
+    { /* the number is the string's parts */
+      unsigned major = 0, minor = 0, patch = 0;
+      CHECK(sscanf(kdm_version(), "%u.%u.%u", &major, &minor, &patch) == 3);
+      CHECK(kdm_version_number() == major * 10000 + minor * 100 + patch);
+    }
   }
 
   /* A density image: zero on the left half, 1 on the right half of [0, 2)^2, so no point has x < 0.9. */

@@ -6,13 +6,18 @@
  * (later fields keep their defaults) and writes only that many, so programs built against an older header
  * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest
  * (any larger size is taken: only one below the struct's first version is refused): a program that sets a
- * field newer than the library it runs with should check kdm_version(). The other structs (kdm_cursor,
+ * field newer than the library it runs with should check kdm_version_number(). The other structs (kdm_cursor,
  * kdm_class_density, kdm_joint_class_density, kdm_task_runner, kdm_point) carry no size: where one grows,
  * as kdm_class_density did in 0.4, callers are rebuilt with the new header (0.x minor versions may change
  * the ABI; the shared library's soname carries MAJOR.MINOR).
  *
  * Thread safety: a loaded kdm_tileset and a kdm_density_image are immutable; queries on them may run
- * concurrently. No function here throws; every failure is a status code. Queries allocate nothing. */
+ * concurrently. No function here throws; every failure is a status code. Queries allocate nothing.
+ *
+ * For bindings (Rust, C#, ctypes): kdm_status and kdm_problem_kind are C enums, int-sized on x86-64 (the
+ * platform kdm is tested on), and their lists grow from version to version: read them as int and take a
+ * value you do not know as a failure. Fields typed int (mode, flags, sizes)
+ * are C ints; there are no bitfields. */
 #ifndef KDM_RUNTIME_H
 #define KDM_RUNTIME_H
 
@@ -178,6 +183,9 @@ KDM_RUNTIME_API void kdm_set_tileset_allocator(void* (*allocate)(size_t bytes, s
 
 /* The library version, "MAJOR.MINOR.PATCH" (static string). */
 KDM_RUNTIME_API const char* kdm_version(void);
+/* The same as a number to compare, MAJOR * 10000 + MINOR * 100 + PATCH (0.5.0: 500): what a program that
+ * sets a struct's newer fields checks, as `if (kdm_version_number() >= 500)`. Added in 0.5. */
+KDM_RUNTIME_API uint32_t kdm_version_number(void);
 /* The newest tile-set format version this library reads and writes (it reads 2 and up). */
 KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
 

@@ -16,5 +16,7 @@ inline constexpr std::uint32_t kOldestTilesetFormatVersion = 2;
 
 /// The library version, "MAJOR.MINOR.PATCH". Thread-safe; returns a static string.
 KDM_RUNTIME_API const char* version_string();
+/// The same as a number to compare: MAJOR · 10000 + MINOR · 100 + PATCH (0.5.0: 500).
+KDM_RUNTIME_API std::uint32_t version_number();
 
 }  // namespace kdm
