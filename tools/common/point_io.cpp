@@ -63,8 +63,8 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
   if (!format.empty() && named != ext)
     for (const char* other : {".txt", ".csv", ".json", ".svg", ".png"})
       if (named == other) {
-        error = "--format " + ext.substr(1) + " would write " + ext.substr(1) + " into '" + path +
-                "', a " + named.substr(1) + " file name: name the file ." + ext.substr(1);
+        error = "--format " + ext.substr(1) + " would write " + ext.substr(1) + " into '" + path + "', a " +
+                named.substr(1) + " file name: name the file ." + ext.substr(1);
         return false;
       }
   std::error_code ec;
