@@ -198,6 +198,18 @@ TEST(Report, AnalyzeAggregatesSets) {
   EXPECT_NE(few.empty_circles_skipped.find("no circle was judged"), std::string::npos);
   EXPECT_NE(metrics_json(few, {"a"}).find("\"empty_circles_skipped\""), std::string::npos);
   EXPECT_EQ(metrics_json(few, {"a"}).find("\"empty_circles\":"), std::string::npos);
+  // Duplicates are counted and said; a periodogram that is constant on its rings (two points on one
+  // place) has no anisotropy, where rounding read -153 dB.
+  tools::PointSet twins;
+  twins.coords = {0.3, 0.3, 0.3, 0.3};
+  const AnalysisReport same = analyze({twins}, box);
+  EXPECT_EQ(same.coincident, 2u);
+  EXPECT_NE(format_summary(same).find("2 points lie on another"), std::string::npos);
+  EXPECT_NE(metrics_json(same, {"a"}).find("\"coincident_points\":2"), std::string::npos);
+  ASSERT_TRUE(same.has_spectrum);
+  EXPECT_TRUE(std::isnan(same.spectrum_stats.anisotropy_db));
+  o.tile_size = 0.25;
+  EXPECT_EQ(analyze(sets, o).coincident, 0u);
 }
 
 }  // namespace

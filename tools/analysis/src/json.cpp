@@ -137,6 +137,7 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
   w.key("nearest_neighbour");
   write_nn(w, r.nn);
   w.key("dmin_mean_over_sets").value(r.dmin_mean).key("dmin_per_set").value(r.dmin_per_set);
+  w.key("coincident_points").value(r.coincident);
   if (!r.spectrum_skipped.empty()) w.key("spectrum_skipped").value(r.spectrum_skipped);
   if (r.has_spectrum) {
     const SpectrumStats& st = r.spectrum_stats;

@@ -214,7 +214,7 @@ SpectrumStats spectrum_stats(const Periodogram& p) {
     if (f > 0.5 && f < 2.5 && count[r] > 1 && mean > 0) {
       const double c = static_cast<double>(count[r]);
       const double var = std::max(0.0, (sum2[r] - c * mean * mean) / (c - 1.0));
-      if (var > 0) {
+      if (var > 1e-9 * mean * mean) {  // below: rounding of a constant ring (coincident points), no angle
         aniso_sum += 10.0 * std::log10(var / (mean * mean));
         ++aniso_rings;
       }

@@ -66,6 +66,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     for (double d : nn.distance) {
       pooled.push_back(d / spacing);
       lo = std::min(lo, d);
+      r.coincident += d == 0;
     }
     r.dmin_per_set.push_back(lo / spacing);
     if (o.tile_size > 0) split_by_seam(s.coords, s.dim, nn, o.tile_size, seam, interior);
@@ -181,6 +182,9 @@ std::string format_summary(const AnalysisReport& r) {
   append(s, " %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
   append(s, "nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n",
          r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
+  if (r.coincident > 0)
+    append(s, "                   warning: %zu points lie on another (distance 0): holes and g(r) mislead\n",
+           r.coincident);
   if (!r.spectrum_skipped.empty()) append(s, "spectrum           skipped: %s\n", r.spectrum_skipped.c_str());
   if (r.has_spectrum) {
     const SpectrumStats& st = r.spectrum_stats;

@@ -50,6 +50,7 @@ struct AnalysisReport {
   NNStats nn;                        ///< pooled over sets, each normalised by its own spacing (spacing = 1)
   std::vector<double> dmin_per_set;  ///< δmin of each set
   double dmin_mean = 0;              ///< mean of dmin_per_set (nn.dmin is the worst)
+  std::size_t coincident = 0;  ///< points at distance 0 from another (duplicates): holes and g(r) mislead
   bool has_spectrum = false;
   std::string spectrum_skipped;  ///< why a 2D analysis has none (sets more than 10% apart in count), or ""
   Periodogram spectrum;          ///< set-averaged periodogram
