@@ -35,6 +35,13 @@ print(f"query: {len(bushes)} bushes on the hills")
 xy, kinds = tiles.positions((0, 0, 200, 200), scale=2, tile_size=32, classes=[0.1, 0.4])
 print(f"positions: {len(xy)} points, {np.count_nonzero(kinds == 0)} trees")
 
+# A painted map streamed chunk by chunk: prepared once (kdm.DensityMap), each chunk costs what its own
+# points do; the chunks hold exactly the whole region's points.
+forest = kdm.DensityMap(np.random.default_rng(1).random((256, 256)), rect=(0, 0, 200, 200))
+chunks = [tiles.positions((x, y, x + 50, y + 50), scale=2, tile_size=32, density=forest)
+          for x in range(0, 200, 50) for y in range(0, 200, 50)]
+print(f"chunks: {sum(len(c) for c in chunks)} points in 16 chunks of a painted map")
+
 # 3. Stippling a picture to PNG with the runtime's tiles, in grey and in colour (an ink per class).
 dots = kdm.stipple(str(here / "sphere.png"), points=10000, output=out / "sphere-dots.png")
 print(f"stipple: {len(dots)} dots -> {out / 'sphere-dots.png'}")
