@@ -27,6 +27,8 @@ def sample(
     gamma: float = ...,
     invert: bool = ...,
     classes: Optional[Sequence[_Density]] = ...,
+    sweeps: Optional[int] = ...,
+    coarse_sweeps: Optional[int] = ...,
 ) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]]: ...
 
 class QueryResult:

@@ -21,6 +21,8 @@ def sample(
     gamma: float = 1.0,
     invert: bool = False,
     classes: Optional[Sequence[Any]] = None,
+    sweeps: Optional[int] = None,
+    coarse_sweeps: Optional[int] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """Draw exactly `n` blue-noise points from the KDM model (the full sampler, `kdm sample`).
 
@@ -65,6 +67,11 @@ def sample(
         density, each later class is sampled around the earlier ones, then all are swept together at the
         sum (docs/multiclass.md).
 
+    sweeps, coarse_sweeps : int or None
+        Metropolis-Hastings sweeps on the finest level and on each level between the coarsest and the
+        finest, 0 to 100000 (``kdm sample --sweeps/--coarse-sweeps``; None: 30 and 15). More finest sweeps
+        with a lower temperature give a more ordered set (docs/quality.md: T = 0.2, 100 sweeps).
+
     Returns
     -------
     numpy.ndarray
@@ -82,16 +89,19 @@ def sample(
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
     threads = _checks.threads(threads)
     aspect = _checks.aspect(aspect)
+    sweeps = None if sweeps is None else _checks.integer("sweeps", sweeps, 0, 100000)
+    coarse_sweeps = None if coarse_sweeps is None else _checks.integer("coarse_sweeps", coarse_sweeps, 0, 100000)
+    more = dict(sweeps=sweeps, coarse_sweeps=coarse_sweeps)
     if classes is not None:
         if density is not None:
             raise ValueError("give either density or classes, not both")
         if dim != 2:
             raise ValueError("classes are sampled in 2-D: use dim=2")
         specs = _checks.class_specs(classes, gamma, invert)
-        return _kdm.sample_classes(n, specs, domain, temperature, seed, threads, aspect)
+        return _kdm.sample_classes(n, specs, domain, temperature, seed, threads, aspect, **more)
     if callable(density) and not isinstance(density, (np.ndarray, str)):
         if gamma != 1.0 or invert:
             raise ValueError("gamma and invert apply to image files only, and density is a function")
-        return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect)
+        return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect, **more)
     spec = _checks.sampler_density(density, gamma, invert)
-    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect)
+    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect, **more)

@@ -19,12 +19,18 @@ namespace {
 
 using tools::DensitySpec;
 
+/// MH sweeps on the finest level and on the levels between (kdm sample --sweeps, --coarse-sweeps); unset:
+/// the sampler's defaults.
+struct Sweeps {
+  std::optional<int> finest, coarse;
+};
+
 /// The options every sampling call shares, checked: `edged` densities (a picture, a ramp, a function) get
 /// a box unless `domain` says otherwise, as in kdm sample; `image_aspect` is the domain's width / height
 /// unless `aspect` is given.
 gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional<std::string>& domain,
                                     bool edged, double temperature, std::uint64_t seed, int threads,
-                                    std::optional<double> aspect, double image_aspect) {
+                                    std::optional<double> aspect, double image_aspect, const Sweeps& sweeps) {
   const std::string where = domain ? *domain : (edged ? "box" : "torus");
   if (where != "box" && where != "torus")
     throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
@@ -38,19 +44,22 @@ gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional
   o.seed = seed;
   o.threads = threads;
   o.progress = stop_on_signal;  // Ctrl-C stops the sampler at its next sweep
+  if (sweeps.finest) o.sweeps = *sweeps.finest;
+  if (sweeps.coarse) o.coarse_sweeps = *sweeps.coarse;
   return o;
 }
 
 py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
                            const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
-                           int threads, std::optional<double> aspect) {
+                           int threads, std::optional<double> aspect, std::optional<int> sweeps,
+                           std::optional<int> coarse_sweeps) {
   DensitySpec uniform;  // kdm sample's default, const:1
   const DensitySpec& spec = density ? *density : uniform;
   const bool image = spec.kind == DensitySpec::Kind::kImage;
   // As kdm sample: a ramp or a picture has edges that do not meet, so a box unless asked otherwise.
   const gen::SamplerOptions o =
       sampler_options(n, dim, domain, image || spec.kind == DensitySpec::Kind::kRamp, temperature, seed,
-                      threads, aspect, image ? double(spec.width) / spec.height : 1.0);
+                      threads, aspect, image ? double(spec.width) / spec.height : 1.0, {sweeps, coarse_sweeps});
   if (image && dim != 2) throw std::invalid_argument("image densities are 2D; use dim=2");
   const gen::Density target = tools::to_generator_density(spec);
   gen::SampleResult result;
@@ -67,10 +76,11 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
 /// not finite and >= 0, ends the call with that error once the sampler returns.
 py::array_t<double> sample_function(std::int64_t n, const py::object& function, int dim,
                                     const std::optional<std::string>& domain, double temperature,
-                                    std::uint64_t seed, int threads, std::optional<double> aspect) {
+                                    std::uint64_t seed, int threads, std::optional<double> aspect,
+                                    std::optional<int> sweeps, std::optional<int> coarse_sweeps) {
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
   const gen::SamplerOptions o =
-      sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0);
+      sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0, {sweeps, coarse_sweeps});
   PythonDensity function_density(function, dim);
   gen::SampleResult result;
   try {
@@ -88,7 +98,8 @@ py::array_t<double> sample_function(std::int64_t n, const py::object& function, 
 /// one's class.
 py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& specs,
                          const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
-                         int threads, std::optional<double> aspect) {
+                         int threads, std::optional<double> aspect, std::optional<int> sweeps,
+                         std::optional<int> coarse_sweeps) {
   if (specs.empty() || specs.size() > 8)
     throw std::invalid_argument("classes must hold 1 to 8 densities, got " + std::to_string(specs.size()));
   if (const auto [i, j] = tools::images_of_different_shapes(specs); j >= 0)
@@ -112,7 +123,8 @@ py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& 
   }
   const gen::SamplerOptions o =
       sampler_options(n, 2, domain, edged, temperature, seed, threads, aspect,
-                      first_image ? double(first_image->width) / first_image->height : 1.0);
+                      first_image ? double(first_image->width) / first_image->height : 1.0,
+                      {sweeps, coarse_sweeps});
   gen::ClassSample result;
   {
     py::gil_scoped_release release;
@@ -129,12 +141,15 @@ py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& 
 void bind_sampler(py::module_& m) {
   m.def("sample", &sample, py::arg("n"), py::arg("density").none(true), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
-        py::arg("aspect").none(true), "gen::sample as kdm sample runs it");
+        py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
+        py::arg("coarse_sweeps").none(true) = py::none(), "gen::sample as kdm sample runs it");
   m.def("sample_function", &sample_function, py::arg("n"), py::arg("function"), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
-        py::arg("aspect").none(true), "gen::sample of a Python function of the coordinates");
+        py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
+        py::arg("coarse_sweeps").none(true) = py::none(), "gen::sample of a Python function of the coordinates");
   m.def("sample_classes", &sample_classes, py::arg("n"), py::arg("specs"), py::arg("domain").none(true),
         py::arg("temperature"), py::arg("seed"), py::arg("threads"), py::arg("aspect").none(true),
+        py::arg("sweeps").none(true) = py::none(), py::arg("coarse_sweeps").none(true) = py::none(),
         "gen::sample_classes as kdm sample --class runs it");
   m.def("default_thread_count", &gen::default_thread_count);
 }
