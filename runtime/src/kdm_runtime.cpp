@@ -578,6 +578,16 @@ kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* poin
   return KDM_OK;
 }
 
+kdm_status kdm_key_threshold(const kdm_tileset* tileset, uint64_t key, int64_t near_tile_x,
+                             int64_t near_tile_y, double* threshold) {
+  if (!tileset || !threshold) return KDM_INVALID_ARGUMENT;
+  const double t = kdm::emission_threshold(
+      *tileset->set, kdm::point_id_of_key(*tileset->set, key, near_tile_x, near_tile_y));
+  if (t < 0) return KDM_INVALID_ARGUMENT;
+  *threshold = t;
+  return KDM_OK;
+}
+
 kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_tileset_info* info) {
   kdm_tileset_info v;
   if (!tileset || !read_grown(info, kInfoV1, v)) return KDM_INVALID_ARGUMENT;

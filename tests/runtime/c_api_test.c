@@ -133,6 +133,29 @@ int main(int argc, char** argv) {
     buffer[1].depth = 99;
     CHECK(kdm_point_threshold(builtin, &buffer[1], &t) == KDM_INVALID_ARGUMENT);
   }
+  /* A compact point's threshold from its key and a tile of the region: its point's, negative tiles too. */
+  {
+    kdm_query k = uniform_query();
+    kdm_point points[64];
+    float xy[128];
+    uint64_t keys[64];
+    kdm_cursor c1, c2;
+    size_t n1 = 0, n2 = 0, i;
+    double a = 0, b = 0;
+    k.x0 = -3.5, k.x1 = -2.9, k.y0 = -7.2, k.y1 = -6.6, k.origin_x = -3.5, k.origin_y = -7.2;
+    memset(&c1, 0, sizeof c1), memset(&c2, 0, sizeof c2);
+    CHECK(kdm_query_points(builtin, &k, points, 64, &n1, &c1, NULL) != KDM_INVALID_ARGUMENT);
+    CHECK(kdm_query_compact(builtin, &k, xy, keys, 64, &n2, &c2, NULL) != KDM_INVALID_ARGUMENT);
+    CHECK(n1 == n2 && n1 > 30);
+    for (i = 0; i < n1; ++i) {
+      CHECK(kdm_point_threshold(builtin, &points[i], &a) == KDM_OK);
+      CHECK(kdm_key_threshold(builtin, keys[i], -4, -8, &b) == KDM_OK && a == b);
+    }
+    CHECK(points[0].tile_x < 0 && points[0].tile_y < 0);
+    CHECK(kdm_key_threshold(NULL, keys[0], -4, -8, &b) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_key_threshold(builtin, keys[0], -4, -8, NULL) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_key_threshold(builtin, keys[0] | ((uint64_t)7 << 61), -4, -8, &b) == KDM_INVALID_ARGUMENT);
+  }
   CHECK(kdm_tileset_resident_bytes(loaded) == kdm_tileset_resident_bytes(builtin));
   CHECK(kdm_tileset_resident_bytes(loaded) > 1000000 && kdm_tileset_resident_bytes(NULL) == 0);
 

@@ -215,6 +215,32 @@ TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(problem.parameter, "image_sums");
 }
 
+// A move leaves the source empty: its views had gone on pointing into the texels it gave away, and a query
+// given it read freed memory.
+TEST(ClassImageSumsTest, AMoveLeavesTheSourceEmpty) {
+  SummedImages im;
+  ClassImageSums a;
+  ASSERT_EQ(a.build(im.pointers, 3), Status::kOk);
+  const float first = a.sum(2).values[5];
+  ClassImageSums b = std::move(a);
+  EXPECT_EQ(a.count(), 0u);  // NOLINT(bugprone-use-after-move): the state a move leaves is the point
+  EXPECT_EQ(b.count(), 3u);
+  EXPECT_EQ(b.sum(2).values[5], first);
+  ClassImageSums c;
+  c = std::move(b);
+  EXPECT_EQ(b.count(), 0u);  // NOLINT(bugprone-use-after-move)
+  EXPECT_EQ(c.sum(2).values[5], first);
+  ClassQueryParams q = im.query(0, 0, 4, 4, 100, QueryMode::kStable);
+  q.image_sums = &b;
+  std::vector<QueryPoint> out(16);
+  std::uint8_t cls[16];
+  std::size_t written = 0;
+  QueryProblem problem;
+  EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),
+            Status::kInvalidArgument);
+  EXPECT_STREQ(problem.parameter, "image_sums");
+}
+
 TEST(ClassImageSumsTest, QueriesAllocateNothing) {
   SummedImages im;
   testing::expect_class_queries_allocate_nothing(im.query(0, 0, 4, 4, 500, QueryMode::kStable));

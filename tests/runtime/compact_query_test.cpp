@@ -206,6 +206,28 @@ TEST(CompactQueryTest, KeysAreUniqueAndNameTheirPoint) {
   EXPECT_NE(point_key(id), point_key(PointId{-5, 7, 123, 1}));
 }
 
+// A key gives its id back (point_id_of_key), given a tile of the region, also for negative tiles, far
+// from the origin and past the top level: what fading a compact point by its threshold needs (its key's
+// bits alone named another tile for tile -3 and a threshold of 5.8 where the point's is 5.1).
+TEST(CompactQueryTest, AKeyGivesItsIdBackNearATileOfTheRegion) {
+  for (const double x0 : {-3e6 - 0.5, -7.3, 2.5e5}) {
+    for (const double scale : {2000.0, 3.1e6}) {  // the second past the top level: depth 1
+      QueryParams q = region(QueryMode::kSmooth);
+      q.x0 = x0, q.x1 = x0 + (scale > 1e6 ? 0.05 : 4), q.y0 = -2.2, q.y1 = q.y0 + (scale > 1e6 ? 0.05 : 4);
+      q.origin_x = q.x0, q.origin_y = q.y0, q.scale = scale;
+      const std::vector<QueryPoint> full = run_full(q);
+      ASSERT_GT(full.size(), 100u);
+      const std::int64_t near_x = std::int64_t(std::floor(q.x0)), near_y = std::int64_t(std::floor(q.y1));
+      bool deep = false;
+      for (const QueryPoint& p : full) {
+        ASSERT_EQ(point_id_of_key(Tileset::builtin(), point_key(p.id), near_x, near_y), p.id);
+        deep = deep || p.id.depth > 0;
+      }
+      EXPECT_EQ(deep, scale > 1e6);
+    }
+  }
+}
+
 TEST(CompactQueryTest, AllocatesNothing) {
   const QueryParams q = region(QueryMode::kSmooth);
   std::vector<float> xy(2 * 512);

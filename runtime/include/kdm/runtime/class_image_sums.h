@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "kdm/runtime/class_query.h"
@@ -23,14 +24,28 @@ class KDM_RUNTIME_API ClassImageSums {
   ClassImageSums() = default;
   ClassImageSums(const ClassImageSums&) = delete;
   ClassImageSums& operator=(const ClassImageSums&) = delete;
-  ClassImageSums(ClassImageSums&&) noexcept = default;
-  ClassImageSums& operator=(ClassImageSums&&) noexcept = default;
+  /// A move leaves `other` empty (count() 0, refused by a query), its views no longer into texels it gave.
+  ClassImageSums(ClassImageSums&& other) noexcept { *this = std::move(other); }
+  ClassImageSums& operator=(ClassImageSums&& other) noexcept {
+    if (this != &other) {
+      count_ = other.count_, texels_ = std::move(other.texels_);
+      for (std::uint32_t k = 0; k < kMaxQueryClasses; ++k) {
+        sums_[k] = other.sums_[k], mips_[k] = std::move(other.mips_[k]);
+        other.sums_[k] = DensityImageView{}, other.mips_[k].clear();
+      }
+      other.count_ = 0, other.texels_.clear();
+    }
+    return *this;
+  }
 
   /// Builds the sums of images[0 … count), class 0 first; each image's values are read (its mips are not
   /// needed). Sums are added in float, class by class, so sum(0) is images[0]'s texels exactly.
   /// Returns kOk, or kInvalidArgument (this left empty) with `problem` (optional) naming the fault in a
   /// static string: a count of 0 or more than kMaxQueryClasses, a null image or values, an image not on
-  /// images[0]'s grid (width, height and world rectangle), or one make_density_max_mip refuses.
+  /// images[0]'s grid (width, height and world rectangle), or one make_density_max_mip refuses. Its texels
+  /// come from the C++ allocator, not the tile-set allocator hooks (allocator.h): one float per texel and
+  /// class, and the mips; where that throws std::bad_alloc, so does build (the C API returns
+  /// KDM_OUT_OF_MEMORY).
   Status build(const DensityImageView* const* images, std::uint32_t count, const char** problem = nullptr);
 
   /// How many classes: 0 until built.

@@ -31,6 +31,31 @@ constexpr std::uint64_t point_key(const PointId& id) {
          std::uint64_t(id.depth) << (2 * kKeyTileBits + kKeyRankBits);
 }
 
+/// The id `key` stands for (point_key's inverse), for emission_threshold and the like: its tile is the one
+/// whose coordinates, modulo 2^21, are the key's and that lies nearest (near_tile_x, near_tile_y), given in
+/// tiles of side tile_size (depth 0; at depth d the point's tile coordinates are m^d times those, m =
+/// subtiles_per_side()). Any tile of the query's region serves as the near one, floor(x0 / tile_size) and
+/// floor(y0 / tile_size) say, as long as the region is under 2^20 tiles of the point's depth across.
+inline PointId point_id_of_key(const Tileset& tileset, std::uint64_t key, std::int64_t near_tile_x,
+                               std::int64_t near_tile_y) {
+  constexpr std::uint64_t tile_mask = (std::uint64_t(1) << kKeyTileBits) - 1;
+  constexpr std::int64_t half = std::int64_t(1) << (kKeyTileBits - 1);
+  PointId id;
+  id.rank = std::uint32_t(key >> (2 * kKeyTileBits)) & ((std::uint32_t(1) << kKeyRankBits) - 1);
+  id.depth = std::uint32_t(key >> (2 * kKeyTileBits + kKeyRankBits));
+  std::int64_t scale = 1;  // depth-0 tiles to the point's depth
+  for (std::uint32_t d = 0; d < id.depth; ++d) scale *= std::int64_t(tileset.data().subtiles_per_side());
+  auto unwrap = [&](std::uint64_t bits, std::int64_t near) {
+    near *= scale;  // the key's low bits, taken to the nearest tile congruent to them
+    std::int64_t delta = std::int64_t((bits - std::uint64_t(near)) & tile_mask);
+    if (delta >= half) delta -= 2 * half;
+    return near + delta;
+  };
+  id.tile_x = unwrap(key & tile_mask, near_tile_x);
+  id.tile_y = unwrap((key >> kKeyTileBits) & tile_mask, near_tile_y);
+  return id;
+}
+
 /// Where query_points_compact writes, caller-owned: `xy` is required (room for 2 · capacity floats), `keys`
 /// optional (null: no keys are written; else room for capacity keys).
 struct CompactPoints {

@@ -22,7 +22,8 @@ struct KDM_RUNTIME_API DensityImageView {
   const float* min_mip = nullptr;         ///< per 8×8 texel block minimum (optional: null means 0)
   int mip_width = 0, mip_height = 0;      ///< blocks of 8×8 texels: ceil(width / 8) × ceil(height / 8)
   /// The density at world position (x, y): bilinear, clamped at the edges (a NaN position reads the first
-  /// texel); 0 for an image without values or with a rectangle make_density_max_mip refuses.
+  /// texel, an infinite one the edge's: queries never ask for either; the C kdm_density_image_at returns 0
+  /// for both); 0 for an image without values or with a rectangle make_density_max_mip refuses.
   double at(double x, double y) const;
   /// Upper bound of the density over a world rectangle (from the max-mip, which must be set; exact bound,
   /// maybe loose).

@@ -222,6 +222,12 @@ KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_
    point the set does not have (a depth it does not reach, a rank past its tile's points). Added in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* point,
                                                double* threshold);
+/* The same for a point of the compact output known by its key (kdm::point_id_of_key): the key's tile is the
+   one nearest (near_tile_x, near_tile_y), in tiles of side tile_size, such as floor(x0 / tile_size) and
+   floor(y0 / tile_size) of the query's region (under 2^20 tiles across). Statuses as kdm_point_threshold's.
+   Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_key_threshold(const kdm_tileset* tileset, uint64_t key, int64_t near_tile_x,
+                                             int64_t near_tile_y, double* threshold);
 
 /* A density image over the world rectangle [x0, x1) x [y0, y1) (world units): `width` x `height` texels
  * of density (as kdm_query's `density`: multiplied by `scale`), row-major, row 0 at y0, bilinear between
