@@ -879,6 +879,24 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   expect_error("stipple " + image + " --frames 2000000000 --region 0,0,.5,.5" + out, "from 2 to 10000");
   expect_error("stipple " + image + " --frames 2147483648 --region 0,0,.5,.5" + out, "from 2 to 10000");
   expect_error("stipple " + image + " --frames 5" + out, "--region");
+  // A frame's printed region draws that frame again, though the first reach past the image; a zoom's end
+  // must lie in it, and a region anywhere must meet it.
+  const Outcome zoom =
+      kdm("stipple " + image + " --region 0.2,0.3,0.6,0.5 --frames 3 --width 200 -o '" + path("z.csv") + "'");
+  ASSERT_EQ(zoom.status, 0) << zoom.err;
+  const std::size_t at = zoom.err.find("region ") + 7;
+  const std::string first = zoom.err.substr(at, zoom.err.find(' ', at) - at);
+  EXPECT_EQ(first.rfind("-0.333", 0), 0u) << first;  // past the image's left side
+  ASSERT_EQ(
+      kdm("stipple " + image + " --region " + first + " --width 200 -o '" + path("again.csv") + "'").status,
+      0);
+  EXPECT_EQ(slurp(path("again.csv")), slurp(path("z_0000.csv")));
+  expect_error("stipple " + image + " --region " + first + " --frames 3" + out, "for --frames");
+  expect_error("stipple " + image + " --region 1.5,0,2,1" + out, "must meet the image");
+  // Sides equal within rounding (0.75 - 0.55, 0.55 - 0.35) zoom out to the image exactly.
+  const Outcome square = kdm(
+      "stipple " + image + " --region 0.55,0.35,0.75,0.55 --frames 2 --width 100 -o '" + path("s.csv") + "'");
+  EXPECT_NE(square.err.find("region 0,0,1,1 "), std::string::npos) << square.err;
   expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2 --mode stable" + out, "2× (");
   // Smooth mode descends into the built-in set's m × m subtiles, four depths deep: 2 · m^4 ×.
   const double m = kdm::Tileset::builtin().data().subtiles_per_side();

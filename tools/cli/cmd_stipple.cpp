@@ -37,12 +37,18 @@ struct StippleArgs {
   std::uint64_t seed = 1;
 };
 
-/// "x0,y0,x1,y1" in UV units (y up), inside [0, 1]².
-void parse_region(const std::string& text, double r[4]) {
+/// "x0,y0,x1,y1" in UV units (y up): meeting [0, 1]² for one picture (past the image is blank paper, as a
+/// zoom's first frames show, so a frame's printed region draws that frame again), inside it for a zoom's
+/// last frame.
+void parse_region(const std::string& text, bool zoom, double r[4]) {
   parse_rect(text, "--region", r);
-  if (!(r[0] >= 0 && r[1] >= 0 && r[2] <= 1 && r[3] <= 1))
-    throw CommandError("--region must be x0,y0,x1,y1 with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1, got '" +
-                       text + "'");
+  if (zoom && !(r[0] >= 0 && r[1] >= 0 && r[2] <= 1 && r[3] <= 1))
+    throw CommandError(
+        "--region must be x0,y0,x1,y1 with 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 for "
+        "--frames (where the zoom ends), got '" +
+        text + "'");
+  if (!(r[0] < 1 && r[1] < 1 && r[2] > 0 && r[3] > 0))
+    throw CommandError("--region must meet the image's square [0,1]², got '" + text + "'");
 }
 
 /// OUT.png -> OUT_0007.png (the frame number before the extension).
@@ -126,7 +132,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   const bool blank = specs.empty();  // a white image (a black one with --invert): no dots, not an error
   const double whole_dots = blank ? 0.0 : tools::stipple_dot_count(specs, double(a.points), a.scale);
   double region[4] = {0, 0, 1, 1};
-  if (!a.region.empty()) parse_region(a.region, region);
+  if (!a.region.empty()) parse_region(a.region, a.frames > 0, region);
   if (a.method == "full" && !a.region.empty())
     throw CommandError("--region needs --method tiles (the full sampler has no zoom)");
   Tileset storage;
@@ -263,15 +269,19 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("--method", a->method, "tiles: runtime + tile set (fast); full: the full KDM sampler")
       ->check(CLI::IsMember({"tiles", "full"}))
       ->capture_default_str();
-  cmd->add_option("--region", a->region,
-                  "x0,y0,x1,y1 in the image's UV square [0,1]² (y up): render that part at the same dot "
-                  "size with more dots, a zoom of 1 / its width; zoom at most 2× in stable mode, in smooth "
-                  "mode as deep as the tile set's "
-                  "subtiles go (2·m^4×: about 2·10^6 for 32×32 subtiles) (default: the whole image)");
+  cmd->add_option(
+      "--region", a->region,
+      "x0,y0,x1,y1 in the image's UV square [0,1]² (y up): render that part at the same dot "
+      "size with more dots, a zoom of 1 / its width (it may reach past the image, drawn as blank "
+      "paper, as a zoom's first frames do; not with --frames); zoom at most 2× in stable mode, in smooth "
+      "mode as deep as the tile set's "
+      "subtiles go (2·m^4×: about 2·10^6 for 32×32 subtiles) (default: the whole image)");
   cmd->add_option("--frames", a->frames,
                   "Zoom sequence of K numbered pictures from the whole image into --region (geometric "
                   "zoom, zoom-coherent; every picture has the region's shape, the first blank beside the "
-                  "image where the shapes differ; needs --method tiles; 0: one picture)")
+                  "image where the shapes differ; needs --method tiles; 0: one picture, else 2 to 10000; "
+                  "dots glide rather than boil where a frame zooms at most about 1.05x the one before: "
+                  "K = 1 + ln(zoom) / 0.05, 140 frames for 1,000x)")
       ->capture_default_str();
   cmd->add_option(
          "--fade", a->fade,

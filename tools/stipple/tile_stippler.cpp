@@ -39,7 +39,9 @@ void stipple_frame_region(const double region[4], int i, int k, double out[4]) {
     // Zoomed about the point of the region that lies in it as the region lies in the image; across the
     // image exactly where the region is the narrower way.
     const double fixed = size[j] < 1 ? region[j] / (1 - size[j]) : 0.5;
-    const bool across = size[j] == std::min(size[0], size[1]);
+    // Equal sides within rounding (0.75 - 0.55 against 0.55 - 0.35) count as equal: frame 0 is then the
+    // image exactly, not 1e-16 past it.
+    const bool across = size[j] <= std::min(size[0], size[1]) * (1 + 1e-12);
     whole[j] = across ? 0.0 : fixed + (region[j] - fixed) * first;
     whole[j + 2] = across ? 1.0 : whole[j] + size[j] * first;
   }
