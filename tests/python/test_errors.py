@@ -188,6 +188,8 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, r"points must be an \(n, 2\) or \(n, 3\) array", lambda: kdm.analyze(np.ones((5, 4)))),
     (ValueError, "must be a 2-D array", lambda: kdm.analyze(np.ones(5))),
     (TypeError, r"points must be an \(n, 2\) or \(n, 3\) array of points, got None", lambda: kdm.analyze(None)),
+    (ValueError, "sweeps must be >= 0, got -1", lambda: kdm.sample(10, sweeps=-1)),
+    (ValueError, "coarse_sweeps must be <= 100000", lambda: kdm.sample(10, coarse_sweeps=10**6)),
     (ValueError, "outside|inside", lambda: kdm.analyze(np.full((5, 2), 1.5))),
     (ValueError, r"outside the unit domain \(coordinate 1e\+300\)", lambda: kdm.analyze(np.full((5, 2), 1e300))),
     (ValueError, r"\(coordinate 1.0000001\); normalise points to \[0, 1\]",

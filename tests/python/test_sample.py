@@ -26,6 +26,8 @@ def test_same_bits_with_an_image_density(cli, tmp_path, gradient_png):
     (["--density", "radial:50", "--domain", "box"], dict(density="radial:50", domain="box")),
     (["--dim", "3", "--temperature", "0.3"], dict(dim=3, temperature=0.3)),
     (["--aspect", "2"], dict(aspect=2.0)),
+    (["--temperature", "0.2", "--sweeps", "100", "--coarse-sweeps", "5"],
+     dict(temperature=0.2, sweeps=100, coarse_sweeps=5)),
 ])
 def test_same_bits_for_other_arguments(cli, tmp_path, args, kwargs):
     out = tmp_path / "p.txt"
