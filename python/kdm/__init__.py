@@ -3,7 +3,8 @@
 - ``kdm.sample(n, density)``: exactly n points from the full sampler (``kdm sample``).
 - ``kdm.BlueNoise(d, seed=...)``: the same as a SciPy QMC engine (``scipy.stats.qmc.QMCEngine``).
 - ``kdm.Tileset.builtin().query(rect, scale=...)``: the runtime, points of any region in real time
-  (``kdm query``); ``kdm.bake(recipe)`` bakes tile sets.
+  (``kdm query``); ``kdm.DensityMap(array, rect)`` prepares a map once for many chunk queries;
+  ``kdm.bake(recipe)`` bakes tile sets.
 - ``kdm.stipple(image)``: an image as dots (``kdm stipple``), ``kdm.separate(image)`` its inks;
   ``kdm.analyze(points)``: point-set metrics (``kdm analyze``).
 
