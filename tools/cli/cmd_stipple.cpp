@@ -298,7 +298,7 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option(
          "--height", a->height_px,
          "Picture height in pixels instead of --width, 1 to 65536 (the width follows the picture's shape: "
-         "for tall images)")
+         "for tall images; default: unset, --width decides)")
       ->excludes(width);
   cmd->add_option(
       "--paper-width", a->paper_width,
