@@ -97,8 +97,9 @@ Status prepare_sums(const ClassQueryParams& p, ClassDensities& densities, QueryP
                     detail::Refusal& refuse) {
   using Kind = QueryProblem::Kind;
   const ClassImageSums& sums = *p.image_sums;
-  if (sums.count() != p.class_count || p.joint.densities || p.joint.batch_densities)
-    return refuse(Kind::kBadDensity, "image_sums");
+  if (sums.count() != p.class_count)  // value: the classes asked; limit: those the sums were built for
+    return refuse(Kind::kBadDensity, "image_sums", p.class_count, sums.count());
+  if (p.joint.densities || p.joint.batch_densities) return refuse(Kind::kBadDensity, "image_sums");
   for (std::uint32_t k = 0; k < p.class_count; ++k) {
     const DensityImageView& im = sums.sum(k);
     if (!detail::image_queryable(im) || !ImageSampler(&sums.sum(0)).same_grid(im))

@@ -202,6 +202,8 @@ TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
   EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),
             Status::kInvalidArgument);
   EXPECT_STREQ(problem.parameter, "image_sums");
+  EXPECT_EQ(problem.value, 2);  // the classes asked, and those the sums were built for
+  EXPECT_EQ(problem.limit, 3);
   q.class_count = 3;
   q.joint.densities = [](void*, double, double, double* v) { v[0] = v[1] = v[2] = 1; };
   EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),

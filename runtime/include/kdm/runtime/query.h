@@ -166,7 +166,9 @@ struct QueryProblem {
     kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
                         ///< >= 0; `value` holds it
     kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared,
-                        ///< or both callbacks are set; "density.kind" is not a QueryDensity::Kind
+                        ///< or both callbacks are set; "density.kind" is not a QueryDensity::Kind;
+                        ///< "image_sums" built for another count (`limit`; 0: empty) than the query's
+                        ///< classes (`value`), or beside a joint density
     kTooManyTiles,      ///< the region covers `value` tiles, more than `limit` (kMaxQueryTiles): split it
                         ///< (`parameter` "x0"; "tile_size" when they are too many to count: value inf)
     kDensityTooHigh,    ///< `value` expected points per tile exceed `limit` (query_density_limit):
