@@ -115,9 +115,11 @@ class DensityMap:
         As ``Tileset.query(density=...)`` takes it (not a callable: a function is read where it is asked).
     rect : (x0, y0, x1, y1)
         The world rectangle the map is stretched over (a query's ``density_rect``, which a query given a
-        DensityMap must not repeat). Needed for an array, image or test map; ignored for a constant.
+        DensityMap must not repeat; other image classes of that query are stretched over it too). Needed
+        for an array, image or test map; ignored for a constant.
     gamma, invert
-        How an image file's pixels become density.
+        How an image file's pixels become density (read once: a pickle holds the densities, not the
+        path).
     """
 
     def __init__(self, density: Any, rect: Optional[_Rect] = None, *, gamma: float = 1.0,
@@ -127,18 +129,33 @@ class DensityMap:
         spec = _checks.density_spec(density, gamma, invert)
         if spec is None:
             raise TypeError("density must be a number, a str or a 2-D array, got None")
-        if spec.kind != "const" and rect is None:
+        constant = spec.kind == "const"
+        if not constant and rect is None:
             raise ValueError("rect is needed: the world rectangle the map is stretched over")
-        self.rect = (0.0, 0.0, 1.0, 1.0) if rect is None else _checks.rect("rect", rect)
+        self._rect = None if constant else _checks.rect("rect", rect)
         self._spec = spec
-        self._ready = _kdm.PreparedDensity(spec, self.rect)
-        # What a pickle rebuilds it from: an array as the float32 values the map holds (a copy, so that
-        # changing the caller's array later changes neither).
-        kept = np.array(density, dtype=np.float32) if _checks.is_array(density) else density
-        self._args = (kept, None if rect is None else self.rect, gamma, invert)
+        self._ready = _kdm.PreparedDensity(spec, self._rect or (0.0, 0.0, 1.0, 1.0))
+
+    @property
+    def rect(self) -> Optional[Tuple[float, ...]]:
+        """The world rectangle the map is stretched over (None for a constant)."""
+        return self._rect
+
+    def at(self, x: Any, y: Any) -> np.ndarray:
+        """The density at world positions (arrays of x and y), as a query reads it: what fading objects in
+        by their thresholds needs (docs/runtime.md, "Fading objects in")."""
+        x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+        if x.shape != y.shape:
+            raise ValueError(f"x and y must have one shape, got {x.shape} and {y.shape}")
+        return self._ready.at(x.ravel(), y.ravel()).reshape(x.shape)
 
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
-        return (_density_map, self._args)
+        # The densities the map holds (an image file's as read, gamma applied), the text of a test map or
+        # the constant's value: never the path, whose file may change or be elsewhere where it is unpickled.
+        s = self._spec
+        density = s.values if s.kind == "image" else s.text if s.kind != "const" else self._ready.at(
+            np.zeros(1), np.zeros(1))[0]
+        return (_density_map, (density, self._rect, 1.0, False))
 
     @property
     def kind(self) -> str:
@@ -146,7 +163,7 @@ class DensityMap:
         return self._spec.kind
 
     def __repr__(self) -> str:
-        return f"kdm.DensityMap({self._spec!r}, rect={self.rect})"
+        return f"kdm.DensityMap({self._spec!r}, rect={self._rect})"
 
 
 def _density_map(density: Any, rect: Any, gamma: float, invert: bool) -> DensityMap:
@@ -539,6 +556,8 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
         callables.append(None)
         maxima.append(0.0)
     reshaped = _checks.number("gamma", gamma, 0.0, strict=True) != 1.0 or _checks.flag("invert", invert)
+    if reshaped and any(isinstance(d, DensityMap) for d in classes):
+        raise ValueError("gamma and invert are a DensityMap's own: give them to DensityMap()")
     files = [s for d, s in zip(classes, specs) if isinstance(d, (str, os.PathLike))]
     if reshaped and not any(s.kind == "image" for s in files):
         raise ValueError("gamma and invert apply to image files only, and no class is one")

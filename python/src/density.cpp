@@ -140,6 +140,16 @@ void bind_density(py::module_& m) {
       .def_readonly("width", &DensitySpec::width)
       .def_readonly("height", &DensitySpec::height)
       .def_readonly("text", &DensitySpec::text)
+      .def_property_readonly(
+          "values",
+          [](const DensitySpec& s) {  // an image's densities as from_values takes them: row 0 at the top
+            py::array_t<float> out({py::ssize_t(s.height), py::ssize_t(s.width)});
+            for (int y = 0; y < s.height; ++y)
+              std::copy_n(s.values.data() + std::size_t(s.height - 1 - y) * s.width, s.width,
+                          out.mutable_data(y, 0));
+            return out;
+          },
+          "An image's densities (float32, row 0 at the top); empty for other kinds")
       .def_property_readonly("max_value", &DensitySpec::max_value)
       .def_property_readonly("mean_value", &DensitySpec::mean_value)
       .def("__repr__", [](const DensitySpec& s) {

@@ -675,7 +675,24 @@ void bind_query(py::module_& m) {
   py::class_<PreparedDensity>(m, "PreparedDensity",
                               "A density spec stretched over a rectangle, prepared once for many queries")
       .def(py::init<std::shared_ptr<const tools::DensitySpec>, const Rect&>(), py::arg("spec"),
-           py::arg("rect"));
+           py::arg("rect"))
+      .def(
+          "at",
+          [](const PreparedDensity& d,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& x,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& y) {
+            if (x.size() != y.size()) throw std::invalid_argument("x and y must have the same length");
+            py::array_t<double> out(x.size());
+            const QueryDensity& q = d.density->density;
+            const double *px = x.data(), *py_ = y.data();
+            double* o = out.mutable_data();
+            for (py::ssize_t i = 0; i < x.size(); ++i)  // as a query reads it at a point
+              o[i] = q.kind == QueryDensity::Kind::kConstant ? q.constant
+                     : q.kind == QueryDensity::Kind::kImage  ? q.image->at(px[i], py_[i])
+                                                             : q.callback(q.user, px[i], py_[i]);
+            return out;
+          },
+          py::arg("x"), py::arg("y"), "The density at world positions, as a query reads it");
   m.def("query_classes", &query_classes, py::arg("tileset"), py::arg("rect"), py::arg("scale"),
         py::arg("specs"), py::arg("ready"), py::arg("callables"), py::arg("maxima"), py::arg("bounds"),
         py::arg("vectorized"), py::arg("density_rect").none(true), py::arg("tile_size"), py::arg("mode"),

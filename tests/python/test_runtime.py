@@ -921,3 +921,29 @@ def test_a_density_map_refuses_what_it_cannot_stand_for():
     with pytest.raises(ValueError, match="finite and >= 0"):
         kdm.DensityMap(np.full((4, 4), -1.0), (0, 0, 1, 1))
     assert len(t.query((0, 0, 10, 10), scale=5, density=kdm.DensityMap(2.0)).xy) > 100  # a constant: no rect
+
+
+def test_a_density_map_reads_as_queries_do_and_pickles_what_it_holds(tmp_path):
+    # at(): the density a query reads (fading by thresholds needs it), here against the bilinear texel
+    # centres of the array; a pickle holds the densities read, not an image's path, so a file changed or
+    # gone since gives the same map; rect is read-only, and a constant has none.
+    t = kdm.Tileset.builtin()
+    a = np.random.default_rng(3).random((30, 40))
+    m = kdm.DensityMap(a, (0, 0, 4, 3))
+    assert np.allclose(m.at([0.05, 3.95], [2.95, 0.05]), [a[0, 0], a[-1, -1]])
+    assert m.at(np.ones((2, 3)), np.ones((2, 3))).shape == (2, 3)
+    with pytest.raises(AttributeError):
+        m.rect = (0, 0, 1, 1)
+    image = tmp_path / "map.png"
+    image.write_bytes(SPHERE.read_bytes())
+    f = kdm.DensityMap(str(image), (0, 0, 10, 10), gamma=2)
+    pickled = pickle.dumps(f)
+    image.write_bytes(b"not a picture any more")
+    g = pickle.loads(pickled)
+    assert np.array_equal(t.query((0, 0, 10, 10), scale=50, density=f).xy,
+                          t.query((0, 0, 10, 10), scale=50, density=g).xy)
+    assert np.array_equal(f.at([2.5], [7.5]), g.at([2.5], [7.5]))
+    c = kdm.DensityMap(0.5, (5, 5, 0, 0))  # a constant's rect is ignored, as documented
+    assert c.rect is None and pickle.loads(pickle.dumps(c)).at([1.0], [2.0])[0] == 0.5
+    with pytest.raises(ValueError, match="DensityMap's own"):
+        t.query((0, 0, 10, 10), scale=1, classes=[f, 0.1], gamma=2)
