@@ -357,6 +357,22 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   ASSERT_NE(first_ink, std::string::npos);
   EXPECT_EQ(inks.find("<g id=\"ink-", first_ink + 1), std::string::npos);
   EXPECT_NE(inks.find("fill=\"#000000\"", first_ink), std::string::npos);
+  // A grey ramp with a photograph's colour noise (±3 levels per channel) is still grey: one black ink (it
+  // had six tinted near-black inks, and its darks came out light).
+  kdm::tools::RgbImage noisy(128, 64);
+  std::uint32_t lcg = 1;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x)
+      for (int k = 0; k < 3; ++k) {
+        lcg = lcg * 1664525u + 1013904223u;
+        const int level = 250 - 230 * x / 127 + int(lcg >> 29) - 3;
+        noisy.pixels[(y * 128 + x) * 3 + k] = static_cast<std::uint8_t>(std::clamp(level, 0, 255));
+      }
+  std::string noise_error;
+  ASSERT_TRUE(kdm::tools::write_png(path("noisy.png"), noisy, noise_error)) << noise_error;
+  const Outcome grey8 = kdm("stipple '" + path("noisy.png") + "' --colours 8 -o '" + path("noisy.svg") + "'");
+  ASSERT_EQ(grey8.status, 0) << grey8.err;
+  EXPECT_NE(grey8.err.find("classes 0 ink-0 #000000\n"), std::string::npos) << grey8.err;
   // Two flat halves, grey 128 and brown (150, 90, 50): each drawn in its own ink, in its own tone (within
   // 12 of 255 per channel; measured 1-4 off, where the clustered colours drew them 55-60 lighter).
   kdm::tools::RgbImage halves(64, 32);

@@ -155,6 +155,8 @@ int main(int argc, char** argv) {
     CHECK(kdm_key_threshold(NULL, keys[0], -4, -8, &b) == KDM_INVALID_ARGUMENT);
     CHECK(kdm_key_threshold(builtin, keys[0], -4, -8, NULL) == KDM_INVALID_ARGUMENT);
     CHECK(kdm_key_threshold(builtin, keys[0] | ((uint64_t)7 << 61), -4, -8, &b) == KDM_INVALID_ARGUMENT);
+    /* a near tile that cannot be scaled to the key's depth names no tile */
+    CHECK(kdm_key_threshold(builtin, (uint64_t)1 << 61, INT64_MAX, INT64_MIN, &b) == KDM_INVALID_ARGUMENT);
   }
   CHECK(kdm_tileset_resident_bytes(loaded) == kdm_tileset_resident_bytes(builtin));
   CHECK(kdm_tileset_resident_bytes(loaded) > 1000000 && kdm_tileset_resident_bytes(NULL) == 0);

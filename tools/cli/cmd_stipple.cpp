@@ -317,11 +317,12 @@ void add_stipple_command(CLI::App& app) {
       "--colours", a->colours,
       "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
       "removal), rgb (red, green, blue on black) or N (up to N = 2-8 inks: the image's main hues at full "
-      "strength, fewer if it has fewer, one black for a grey image); one "
-      "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink "
-      "(a layer per pen, empty for an ink no pixel uses), .csv a class column, the ink's number, least-used "
-      "ink first (but inks "
-      "under a tenth of all ink last), as the run prints them (default: black dots of the image's darkness)");
+      "strength, fewer if it has fewer or a hue holds under 1% of the ink, one black for a grey image); one "
+      "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink named as the "
+      "run prints it "
+      "(a layer per pen, empty for an ink no pixel uses), .csv a class column: the class number the run "
+      "prints before each ink's name and colour, least-used ink first (but inks under a tenth of all ink "
+      "last) (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
                   "set's endless tiling (another seed, other dots; one seed, the same dots in every region "

@@ -7,8 +7,10 @@
 // near the region (a chunk's corner, the camera), as float32 carries about 7 significant digits.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/query.h"
@@ -35,7 +37,9 @@ constexpr std::uint64_t point_key(const PointId& id) {
 /// whose coordinates, modulo 2^21, are the key's and that lies nearest (near_tile_x, near_tile_y), given in
 /// tiles of side tile_size (depth 0; at depth d the point's tile coordinates are m^d times those, m =
 /// subtiles_per_side()). Any tile of the query's region serves as the near one, floor(x0 / tile_size) and
-/// floor(y0 / tile_size) say, as long as the region is under 2^20 tiles of the point's depth across.
+/// floor(y0 / tile_size) say, as long as the region is under 2^20 tiles of the point's depth across. A near
+/// tile too far out to scale to the key's depth gives an id of no depth the set has (emission_threshold
+/// then refuses it).
 inline PointId point_id_of_key(const Tileset& tileset, std::uint64_t key, std::int64_t near_tile_x,
                                std::int64_t near_tile_y) {
   constexpr std::uint64_t tile_mask = (std::uint64_t(1) << kKeyTileBits) - 1;
@@ -44,8 +48,14 @@ inline PointId point_id_of_key(const Tileset& tileset, std::uint64_t key, std::i
   id.rank = std::uint32_t(key >> (2 * kKeyTileBits)) & ((std::uint32_t(1) << kKeyRankBits) - 1);
   id.depth = std::uint32_t(key >> (2 * kKeyTileBits + kKeyRankBits));
   std::int64_t scale = 1;  // depth-0 tiles to the point's depth
-  for (std::uint32_t d = 0; d < id.depth; ++d) scale *= std::int64_t(tileset.data().subtiles_per_side());
+  const std::int64_t m = std::max<std::int64_t>(1, tileset.data().subtiles_per_side());
+  for (std::uint32_t d = 0; d < id.depth && d <= kMaxQueryDepth; ++d) scale *= m;
+  // A near tile too far out to scale to the key's depth names no tile: a depth the set has not.
+  const std::int64_t reach = std::numeric_limits<std::int64_t>::max() / scale / 2;
+  if (near_tile_x > reach || near_tile_x < -reach || near_tile_y > reach || near_tile_y < -reach)
+    id.depth = std::numeric_limits<std::uint32_t>::max();
   auto unwrap = [&](std::uint64_t bits, std::int64_t near) {
+    near = near > reach ? reach : near < -reach ? -reach : near;
     near *= scale;  // the key's low bits, taken to the nearest tile congruent to them
     std::int64_t delta = std::int64_t((bits - std::uint64_t(near)) & tile_mask);
     if (delta >= half) delta -= 2 * half;

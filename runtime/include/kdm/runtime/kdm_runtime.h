@@ -5,7 +5,9 @@
  * caller sets to sizeof(the struct) as its header declares it. A newer library reads only that many bytes
  * (later fields keep their defaults) and writes only that many, so programs built against an older header
  * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest
- * (any larger size is taken: only one below the struct's first version is refused): a program that sets a
+ * (any larger size is taken: only one below the struct's first version is refused; the first versions end
+ * at kdm_query's `mode`, at kdm_tileset_info's `keyframes` and at the end of kdm_query_problem, whose
+ * fields have not grown): a program that sets a
  * field newer than the library it runs with should check kdm_version_number(). The other structs (kdm_cursor,
  * kdm_class_density, kdm_joint_class_density, kdm_task_runner, kdm_point) carry no size: where one grows,
  * as kdm_class_density did in 0.4, callers are rebuilt with the new header (0.x minor versions may change
@@ -264,7 +266,9 @@ KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kd
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);
 
-/* kdm_query_points into a compact output (kdm/runtime/compact_query.h): the same points in the same order,
+/* kdm_query_points into a compact output (kdm/runtime/compact_query.h): the same points in the same order
+ * (positions computed in float, within 2^-21 * (|position| + tile_size) of the records' doubles, not
+ * those doubles rounded: join the two outputs by key, not by position),
  * point i at xy[2i], xy[2i + 1] (floats, relative to the query's origin: keep it near the region) and, if
  * `keys` is not NULL, keys[i] = its 64-bit point key (tile x and y modulo 2^21, rank, depth; unique within
  * any region less than 2^21 tiles across). Statuses and resumption as kdm_query_points (a cursor serves
