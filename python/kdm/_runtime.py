@@ -239,7 +239,7 @@ class Tileset:
         glide_reach (tile sides)."""
         return self._handle.info
 
-    def thresholds(self, result: "QueryResult") -> np.ndarray:
+    def thresholds(self, result: Any, *, near_tile: Optional[Sequence[int]] = None) -> np.ndarray:
         """Each point's emission threshold: the expected count per tile above which it is emitted.
 
         A point of `result` (a QueryResult of this set) is present where its tile's expected count,
@@ -249,10 +249,19 @@ class Tileset:
         fraction f. For a result with classes, the count is that of the classes' summed density (the
         points of all classes are the one-class query's at their sum). Returns an (m,) float64 array.
         Raises TypeError for anything but a QueryResult and ValueError for a point this set does not
-        have (a result of another set).
+        have (a result of another set). `result` may also be the keys of ``positions(..., keys=True)``
+        with `near_tile`, a tile (tx, ty) of the query's region in tiles of its tile_size, such as
+        ``(floor(x0 / tile_size), floor(y0 / tile_size))``: a key names its tile modulo 2**21.
         """
+        if isinstance(result, np.ndarray) and result.dtype == np.uint64:
+            if near_tile is None:
+                raise ValueError("keys need near_tile: a tile (tx, ty) of the query's region")
+            tx, ty = (_checks.integer("near_tile", v, -2**62, 2**62) for v in near_tile)
+            return self._handle.key_thresholds(result, tx, ty)
         if not isinstance(result, QueryResult):
-            raise TypeError(f"result must be a kdm.QueryResult, got {type(result).__name__}")
+            raise TypeError(f"result must be a kdm.QueryResult or positions' keys, got {type(result).__name__}")
+        if near_tile is not None:
+            raise ValueError("near_tile is for keys only: a QueryResult holds its tiles")
         return self._handle.thresholds(result.tile, result.rank, result.points["depth"])
 
     def __repr__(self) -> str:

@@ -10,6 +10,7 @@
 #include "bindings.h"
 #include "image_io.h"
 #include "kdm/generator/bake.h"
+#include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset_format.h"
 #include "kdm/runtime/version.h"
@@ -159,6 +160,31 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
 }
 
 /// emission_threshold of every id given as tile (m × 2), rank and depth (m each).
+/// The thresholds of a compact output's points by their keys (point_id_of_key, near the tile given).
+py::array_t<double> key_thresholds(
+    const TilesetHandle& h, const py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>& keys,
+    std::int64_t near_x, std::int64_t near_y) {
+  if (keys.ndim() != 1)
+    throw std::invalid_argument("keys must be an (m,) array, as positions(keys=True) gives");
+  const py::ssize_t n = keys.size();
+  py::array_t<double> out(n);
+  const std::uint64_t* k = keys.data();
+  double* o = out.mutable_data();
+  py::ssize_t bad = -1;
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t i = 0; i < n && bad < 0; ++i) {
+      o[i] = emission_threshold(*h.set, point_id_of_key(*h.set, k[i], near_x, near_y));
+      if (o[i] < 0) bad = i;
+    }
+  }
+  if (bad >= 0)
+    throw std::invalid_argument("key " + std::to_string(bad) + " (" + std::to_string(k[bad]) +
+                                ") is not a point of this tile set near tile (" + std::to_string(near_x) +
+                                ", " + std::to_string(near_y) + ")");
+  return out;
+}
+
 py::array_t<double> thresholds(
     const TilesetHandle& h, const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& tile,
     const py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>& rank,
@@ -196,6 +222,7 @@ void bind_tileset(py::module_& m) {
       .def("to_bytes", &to_bytes)
       .def("save", &save, py::arg("path"))
       .def("thresholds", &thresholds, py::arg("tile"), py::arg("rank"), py::arg("depth"))
+      .def("key_thresholds", &key_thresholds, py::arg("keys"), py::arg("near_x"), py::arg("near_y"))
       .def_property_readonly("info", &info);
   m.def("bake", &bake, py::arg("recipe_text"), py::arg("threads"));
 }

@@ -475,17 +475,50 @@ kdm_status kdm_parallel_query_class_images_compact(kdm_parallel_query* parallel,
 
 kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
                                    kdm_class_images** out) {
-  if (!out) return KDM_INVALID_ARGUMENT;
+  return kdm_class_images_create_detail(images, count, out, nullptr, 0);
+}
+
+kdm_status kdm_class_images_create_detail(const kdm_density_image* const* images, uint32_t count,
+                                          kdm_class_images** out, char* detail, size_t detail_size) {
+  char why[512] = "";  // room for any two grids' numbers; cut to the caller's buffer below
+  const auto refuse = [&](kdm_status s) {  // the reason in the caller's buffer, cut to fit; nothing throws
+    if (detail && detail_size) {
+      const std::size_t n = std::min(std::strlen(why), detail_size - 1);
+      std::memcpy(detail, why, n);
+      detail[n] = '\0';
+    }
+    return s;
+  };
+  if (!out) return std::snprintf(why, sizeof why, "out is NULL"), refuse(KDM_INVALID_ARGUMENT);
   *out = nullptr;
-  if (!images || count < 1 || count > kdm::kMaxQueryClasses) return KDM_INVALID_ARGUMENT;
+  if (!images) return std::snprintf(why, sizeof why, "images is NULL"), refuse(KDM_INVALID_ARGUMENT);
+  if (count < 1 || count > kdm::kMaxQueryClasses)
+    return std::snprintf(why, sizeof why, "count is %u, not 1 to %u", unsigned(count),
+                         unsigned(kdm::kMaxQueryClasses)),
+           refuse(KDM_INVALID_ARGUMENT);
   const kdm::DensityImageView* views[kdm::kMaxQueryClasses];
   for (uint32_t k = 0; k < count; ++k) {
-    if (!images[k]) return KDM_INVALID_ARGUMENT;
+    if (!images[k])
+      return std::snprintf(why, sizeof why, "images[%u] is NULL", unsigned(k)), refuse(KDM_INVALID_ARGUMENT);
     views[k] = &images[k]->view;
+    const kdm::DensityImageView &a = *views[0], &b = *views[k];
+    if (b.width != a.width || b.height != a.height || b.x0 != a.x0 || b.y0 != a.y0 || b.x1 != a.x1 ||
+        b.y1 != a.y1)
+      return std::snprintf(
+                 why, sizeof why,
+                 "images[%u] is %d x %d texels over (%g, %g)-(%g, %g), not images[0]'s %d x %d over "
+                 "(%g, %g)-(%g, %g)",
+                 unsigned(k), b.width, b.height, b.x0, b.y0, b.x1, b.y1, a.width, a.height, a.x0, a.y0, a.x1,
+                 a.y1),
+             refuse(KDM_INVALID_ARGUMENT);
   }
   auto* handle = new (std::nothrow) kdm_class_images;
   if (!handle) return KDM_OUT_OF_MEMORY;
-  return hand_over(handle, unless_out_of_memory([&] { return handle->sums.build(views, count); }), out);
+  const char* problem = nullptr;
+  const kdm_status s = hand_over(
+      handle, unless_out_of_memory([&] { return handle->sums.build(views, count, &problem); }), out);
+  if (s == KDM_INVALID_ARGUMENT && problem) std::snprintf(why, sizeof why, "%s", problem);
+  return s == KDM_INVALID_ARGUMENT ? refuse(s) : s;
 }
 
 void kdm_class_images_free(kdm_class_images* images) {

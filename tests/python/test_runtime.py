@@ -947,3 +947,19 @@ def test_a_density_map_reads_as_queries_do_and_pickles_what_it_holds(tmp_path):
     assert c.rect is None and pickle.loads(pickle.dumps(c)).at([1.0], [2.0])[0] == 0.5
     with pytest.raises(ValueError, match="DensityMap's own"):
         t.query((0, 0, 10, 10), scale=1, classes=[f, 0.1], gamma=2)
+
+
+def test_thresholds_of_positions_keys_are_their_points_thresholds():
+    # positions(keys=True) carries keys, not tiles: given a tile of the region, their thresholds are those
+    # of the query's records, negative tiles and past the top level too (a key names its tile modulo 2**21).
+    t = kdm.Tileset.builtin()
+    for rect, scale in [((-7.3, -2.2, -3.1, 1.5), 800.0), ((-3.05, 4.0, -3.0, 4.05), 3.1e6)]:
+        kw = dict(scale=scale, tile_size=1, mode="smooth")
+        records = t.query(rect, **kw)
+        xy, keys = t.positions(rect, keys=True, **kw)
+        near = (math.floor(rect[0]), math.floor(rect[1]))
+        assert np.array_equal(t.thresholds(keys, near_tile=near), t.thresholds(records))
+    with pytest.raises(ValueError, match="keys need near_tile"):
+        t.thresholds(keys)
+    with pytest.raises(ValueError, match="near_tile is for keys only"):
+        t.thresholds(records, near_tile=(0, 0))

@@ -474,6 +474,18 @@ int main(int argc, char** argv) {
     CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 0, &class_images) ==
           KDM_INVALID_ARGUMENT);
     CHECK(kdm_class_images_create(NULL, 3, &class_images) == KDM_INVALID_ARGUMENT);
+    { /* _detail names the image and its grid against images[0]'s, cut to the buffer */
+      char why[200], short_why[12];
+      CHECK(kdm_class_images_create_detail((const kdm_density_image* const*)images, 3, &class_images, why,
+                                           sizeof why) == KDM_INVALID_ARGUMENT);
+      CHECK(strstr(why, "images[1] is 16 x 16 texels over (0, 0)-(3, 2)") != NULL);
+      CHECK(kdm_class_images_create_detail((const kdm_density_image* const*)images, 9, &class_images, why,
+                                           sizeof why) == KDM_INVALID_ARGUMENT);
+      CHECK(strcmp(why, "count is 9, not 1 to 8") == 0);
+      CHECK(kdm_class_images_create_detail((const kdm_density_image* const*)images, 3, &class_images,
+                                           short_why, sizeof short_why) == KDM_INVALID_ARGUMENT);
+      CHECK(strlen(short_why) == sizeof short_why - 1);
+    }
     images[1] = NULL;
     CHECK(kdm_class_images_create((const kdm_density_image* const*)images, 3, &class_images) ==
           KDM_INVALID_ARGUMENT);

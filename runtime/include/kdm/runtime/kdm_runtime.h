@@ -365,6 +365,11 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
 typedef struct kdm_class_images kdm_class_images;
 KDM_RUNTIME_API kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
                                                    kdm_class_images** out);
+/* The same, and on KDM_INVALID_ARGUMENT one line into `detail` (if not NULL, `detail_size` bytes with its
+ * terminating zero, cut to fit) saying which argument or image is at fault. Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_class_images_create_detail(const kdm_density_image* const* images,
+                                                          uint32_t count, kdm_class_images** out,
+                                                          char* detail, size_t detail_size);
 /* Frees the sums (NULL is ignored); no query may be using them. */
 KDM_RUNTIME_API void kdm_class_images_free(kdm_class_images* images);
 
