@@ -373,6 +373,7 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   const Outcome grey8 = kdm("stipple '" + path("noisy.png") + "' --colours 8 -o '" + path("noisy.svg") + "'");
   ASSERT_EQ(grey8.status, 0) << grey8.err;
   EXPECT_NE(grey8.err.find("classes 0 ink-0 #000000\n"), std::string::npos) << grey8.err;
+  EXPECT_NE(grey8.err.find("inks 1 of 8)"), std::string::npos) << grey8.err;
   // Two flat halves, grey 128 and brown (150, 90, 50): each drawn in its own ink, in its own tone (within
   // 12 of 255 per channel; measured 1-4 off, where the clustered colours drew them 55-60 lighter).
   kdm::tools::RgbImage halves(64, 32);

@@ -227,9 +227,12 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       style.blend = inks.blend;
     }
     char line[200], where[160];
+    // N inks: how many the image gave (a grey image one), and how many were asked for.
+    const bool counted = coloured && a.colours != "cmyk" && a.colours != "rgb";
+    const std::string scheme = counted ? std::to_string(inks.inks.size()) + " of " + a.colours : a.colours;
     std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s%s%s)", set.size(),
                   set.size() == 1 ? "" : "s", how.c_str(), coloured ? ", inks " : "",
-                  coloured ? a.colours.c_str() : "");
+                  coloured ? scheme.c_str() : "");
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
