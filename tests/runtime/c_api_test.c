@@ -56,6 +56,17 @@ static void ramp_bounds(void* user, double x0, double y0, double x1, double y1, 
   (void)user, (void)y0, (void)y1;
   *lo = 0.2 + 0.1 * x0, *hi = 0.2 + 0.1 * x1;
 }
+/* Bounds that record whether the library handed them NaN, and write nothing. */
+static int g_bounds_preset_nan = 1;
+static void silent_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  (void)user, (void)x0, (void)y0, (void)x1, (void)y1;
+  if (!(*lo != *lo && *hi != *hi)) g_bounds_preset_nan = 0;
+}
+/* What kdm_runtime.h tells a binding to do once its callback has failed: bounds of 0 everywhere. */
+static void given_up_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+  (void)user, (void)x0, (void)y0, (void)x1, (void)y1;
+  *lo = *hi = 0;
+}
 /* The ramp at n positions (density_batch_callback), counting its calls and values. */
 static long g_batch_calls = 0, g_batch_values = 0;
 static void ramp_batch(void* user, size_t n, const double* x, const double* y, double* out) {
@@ -94,6 +105,13 @@ int main(int argc, char** argv) {
   kdm_query_problem problem;
   const kdm_tileset* builtin = NULL;
   CHECK(argc == 2);
+  /* The layouts kdm_runtime.h states for bindings on LP64 platforms. */
+  if (sizeof(void*) == 8 && sizeof(long) == 8) {
+    CHECK(sizeof(kdm_point) == 40 && sizeof(kdm_query) == 144 && offsetof(kdm_query, mode) == 112);
+    CHECK(sizeof(kdm_cursor) == 56 && sizeof(kdm_query_problem) == 56);
+    CHECK(sizeof(kdm_tileset_info) == 144 && offsetof(kdm_tileset_info, keyframes) == 120);
+    CHECK(sizeof(kdm_class_density) == 56 && sizeof(kdm_joint_class_density) == 96);
+  }
   /* Freeing no set (or a loaded one) leaves the built-in set undecoded: nothing reaches the allocator. */
   kdm_set_tileset_allocator(hooked_allocate, hooked_deallocate, &g_hooked_bytes);
   kdm_tileset_free(NULL);
@@ -511,6 +529,18 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
     CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
     CHECK(g_ramp_calls < calls_without / 10); /* measured: a fortieth (tile and cell bounds) */
+    /* Bounds that write nothing are no bounds: the points and calls of none. */
+    q.density_bounds = silent_bounds, g_ramp_calls = 0;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
+    CHECK(a == b && memcmp(with, without, a * sizeof(kdm_point)) == 0);
+    CHECK(g_bounds_preset_nan && g_ramp_calls == calls_without);
+    /* A binding whose callback failed gives bounds of 0: the query ends without calling it again. */
+    q.density_bounds = given_up_bounds, g_ramp_calls = 0;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, with, 8192, &b, &cursor, NULL) == KDM_OK);
+    CHECK(b == 0 && g_ramp_calls == 0);
+    q.density_bounds = ramp_bounds;
     /* The ramp as a batch callback: the same points, the same values read, many a call. */
     {
       kdm_query_problem problem;
@@ -718,6 +748,22 @@ int main(int argc, char** argv) {
     fclose(f);
     CHECK(kdm_tileset_load_memory_detail(bytes, (size_t)size, &set, detail, sizeof detail) == KDM_OK);
     CHECK(set != NULL && detail[0] == '\0');
+    {
+      /* The set keeps nothing of the bytes: overwritten after the load, they change no point. */
+      static kdm_point before[4096], after[4096];
+      const kdm_query one = uniform_query();
+      kdm_cursor cursor;
+      size_t a = 0, b = 0;
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(set, &one, before, 4096, &a, &cursor, NULL) == KDM_OK && a > 1000);
+      memset(bytes, 0, (size_t)size);
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_points(set, &one, after, 4096, &b, &cursor, NULL) == KDM_OK);
+      CHECK(a == b && memcmp(before, after, a * sizeof(kdm_point)) == 0);
+      f = fopen(argv[1], "rb");
+      CHECK(f != NULL && fread(bytes, 1, (size_t)size, f) == (size_t)size);
+      fclose(f);
+    }
     kdm_tileset_free(set);
     CHECK(kdm_tileset_load_memory_detail(bytes, (size_t)size / 2, &set, detail, sizeof detail) != KDM_OK);
     CHECK(set == NULL && strlen(detail) > 0); /* the decoder's line: what is cut */

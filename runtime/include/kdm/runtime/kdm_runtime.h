@@ -6,8 +6,8 @@
  * (later fields keep their defaults) and writes only that many, so programs built against an older header
  * keep working. An older library given a larger struct_size reads the fields it knows and ignores the rest
  * (any larger size is taken: only one below the struct's first version is refused; the first versions end
- * at kdm_query's `mode`, at kdm_tileset_info's `keyframes` and at the end of kdm_query_problem, whose
- * fields have not grown): a program that sets a
+ * just before kdm_query's `mode`, at offsetof(kdm_query, mode), just before kdm_tileset_info's `keyframes`,
+ * and at the end of kdm_query_problem, whose fields have not grown): a program that sets a
  * field newer than the library it runs with should check kdm_version_number(). The other structs (kdm_cursor,
  * kdm_class_density, kdm_joint_class_density, kdm_task_runner, kdm_point) carry no size: where one grows,
  * as kdm_class_density did in 0.4, callers are rebuilt with the new header (0.x minor versions may change
@@ -19,7 +19,15 @@
  * For bindings (Rust, C#, ctypes): kdm_status and kdm_problem_kind are C enums, int-sized on x86-64 (the
  * platform kdm is tested on), and their lists grow from version to version: read them as int and take a
  * value you do not know as a failure. Fields typed int (mode, flags, sizes)
- * are C ints; there are no bitfields. */
+ * are C ints; there are no bitfields. Every struct has the C compiler's natural layout; on x86-64 (and any
+ * LP64 platform) sizeof is 40 for kdm_point, 144 for kdm_query (its first version 112), 56 for kdm_cursor
+ * (4 bytes of padding after `finished` and after `depth`), 56 for kdm_query_problem, 144 for
+ * kdm_tileset_info (its first version 120), 56 for kdm_class_density and 96 for kdm_joint_class_density
+ * (c_api_test checks these). Pointers a binding hands to the library must stay valid as long as each
+ * function's comment says it keeps them: the allocator hooks while any set loaded under them lives (the
+ * built-in set's: until the process ends), the callbacks and `user` for the call they are passed to.
+ * A callback cannot fail or stop a query: one that hits an error should record it, return 0 from then on
+ * (and lo = hi = 0 from density_bounds, which skips whole tiles), and the caller discards the result. */
 #ifndef KDM_RUNTIME_H
 #define KDM_RUNTIME_H
 
@@ -87,6 +95,7 @@ typedef struct kdm_query {
    * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
    * called only where emission is in doubt (kdm::QueryDensity::bounds). NaN bounds, and *lo > *hi, are
    * ignored; bounds that do not hold make points appear or vanish as if the density were *lo or *hi. */
+  /* *lo and *hi hold NaN when it is called: a callback that writes neither gives no bounds there. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback (set one of the two), the density at n positions at once,
    * out[i] at (x[i], y[i]), 1 <= n <= KDM_DENSITY_BATCH, for vectorised functions: a query gathers each
@@ -195,7 +204,8 @@ KDM_RUNTIME_API uint32_t kdm_tileset_format_version(void);
  * free with kdm_tileset_free, or NULL on failure: KDM_INVALID_ARGUMENT for a NULL `path` or `out` (or NULL
  * `data` with `size` > 0), KDM_IO_ERROR for a file that cannot be read, the format's statuses
  * (KDM_BAD_MAGIC ... KDM_INVALID_CONTENT) for a damaged or foreign one (KDM_TRUNCATED for one shorter than
- * its header, an empty buffer too), KDM_OUT_OF_MEMORY. */
+ * its header, an empty buffer too), KDM_OUT_OF_MEMORY. The set keeps nothing of `data`: it may be freed
+ * (or a managed buffer unpinned) once the call returns. */
 KDM_RUNTIME_API kdm_status kdm_tileset_load_file(const char* path, kdm_tileset** out);
 KDM_RUNTIME_API kdm_status kdm_tileset_load_memory(const void* data, size_t size, kdm_tileset** out);
 /* kdm_tileset_load_file, and on failure why in `detail` (if not NULL): one line ("No such file or
@@ -289,6 +299,7 @@ typedef struct kdm_class_density {
   /* Added in 0.4 (the struct grew: rebuild callers; arrays of it have a new stride): optional bounds of
    * the callback's density, as kdm_query's density_bounds; the union takes their sum, and a tile's
    * bounds settle most points' classes without a call. */
+  /* *lo and *hi hold NaN when it is called: a callback that writes neither gives no bounds there. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback, the density at n positions at once, as kdm_query's
    * density_batch_callback: a class query reads the classes where it would read their sum, up to
@@ -327,6 +338,7 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_compact(const kdm_tileset* tileset,
  * density_max is). Zero the struct before filling it. */
 typedef struct kdm_joint_class_density {
   void (*densities)(void* user, double x, double y, double* values);
+  /* *lo and *hi hold NaN when it is called: a callback that writes neither gives no bounds there. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   void* user;
   double density_max[KDM_MAX_CLASSES];
@@ -360,7 +372,10 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
  * kdm_query_points' at the images' summed texels, and in stable mode classes 0 ... k together exactly those
  * at the first k + 1 images' sum. KDM_INVALID_ARGUMENT for a NULL `out`, `images` or image, a count out of
  * range, images on different grids, or a sum that overflows a float; KDM_OUT_OF_MEMORY. The images may be
- * freed once it is built. Free it with
+ * freed once it is built. kdm_query_classes given the same images sums their bilinear values in double
+ * at every candidate instead: stable mode emits the same points, smooth mode the same ids at positions that
+ * may differ in their last bits (about 10^-8 of a tile side). `kdm query --class` uses these sums when every
+ * class is an image, all of one size, holding at most 2^20 texels in all. Free it with
  * kdm_class_images_free. Added in 0.4. */
 typedef struct kdm_class_images kdm_class_images;
 KDM_RUNTIME_API kdm_status kdm_class_images_create(const kdm_density_image* const* images, uint32_t count,
