@@ -96,6 +96,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         aspect=1 spaces them evenly in the unit square whatever the density's shape.
     temperature, domain, density, threads
         As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise;
+        for integration take the torus: small box sets are biased, as kdm.sample says;
         an array density is copied, and ``density`` returns that read-only copy);
         ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
         draws; ``random(n, workers=k)`` draws with k threads (-1: every core) as SciPy's engines do. A

@@ -44,7 +44,9 @@ def sample(
     dim : int
         2 or 3 (images and arrays are 2-D).
     domain : {"torus", "box"} or None
-        Periodic or bounded. None: a box for images, arrays and "ramp:R", a torus otherwise.
+        Periodic or bounded. None: a box for images, arrays and "ramp:R", a torus otherwise. For Monte
+        Carlo integration take the torus: box sets of up to a few hundred points are nearly the same
+        grid for every seed and bias integrals (docs/limits.md, "The full sampler in a box").
     temperature : float
         0 to 1000; 0.5 is the paper's look, lower is more ordered, 0 a deterministic descent, about
         300 white noise.
