@@ -12,6 +12,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/tileset_format.h"
@@ -78,6 +79,17 @@ bool closest_pair_flagged(const TilesetData& set, std::uint32_t level) {
     for (const Check& c : d.checks)
       flagged = flagged || (d.complete_level && c.name.find("closest pair") == 0 && !c.passed());
   return flagged;
+}
+
+// The report as print_report writes it.
+std::string printed(const Report& report) {
+  std::FILE* f = std::tmpfile();
+  print_report(report, f, false);
+  std::string text(static_cast<std::size_t>(std::ftell(f)), '\0');
+  std::rewind(f);
+  text.resize(std::fread(text.data(), 1, text.size(), f));
+  std::fclose(f);
+  return text;
 }
 
 TEST(GeneratorTest, EveryTileAndLevelMatchesTheFullSampler) {
@@ -171,6 +183,23 @@ TEST(GeneratorTest, VerifierFlagsAWhiteNoiseTile) {
   }
   EXPECT_FALSE(report.passed());
   EXPECT_GE(failing_tiles, 1u);
+  // Level 2's tiles are 22 spacings wide: a failure there is the recipe's, not a seed's luck.
+  EXPECT_EQ(printed(report).find("another seed"), std::string::npos);
+}
+
+// The same at level 0, whose tiles are a patch or two: the report says another seed usually passes.
+TEST(GeneratorTest, VerifierSuggestsAnotherSeedWhereOnlyTheCoarsestLevelsFail) {
+  TilesetData damaged = shipped();
+  Tile& tile = damaged.tiles[5];
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (std::uint32_t i = 0; i < tile.level_end[0]; ++i) tile.points[i] = TilePoint::from_unit(u(rng), u(rng));
+  VerifyOptions o = parts(true, false, false);
+  o.levels = {0};
+  o.reference_runs = 4;
+  const Report report = verify_tileset(damaged, o);
+  EXPECT_FALSE(report.passed());
+  EXPECT_NE(printed(report).find("another seed usually passes"), std::string::npos) << printed(report);
 }
 
 // A tile with the content of another tile whose NW corner has a different colour: its corner and edge

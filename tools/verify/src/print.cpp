@@ -124,9 +124,21 @@ void print_report(const Report& report, std::FILE* out, bool tables) {
     print_failures(k.checks, "gliding at " + std::to_string(int(k.points_per_tile)) + " points per tile",
                    out);
   const std::size_t failed = report.failed_checks();
-  if (failed)
+  if (failed) {
     std::fprintf(out, "%zu of %zu checks failed\n", failed, checks);
-  else
+    // At the coarsest levels one patch is most of a tile, and one drawn a little tight fails every tile
+    // that shows it: a draw's luck more than the recipe's, which another seed usually changes.
+    bool only_small = true;
+    for (const TileResult& t : report.tiles)
+      if (!t.passed() && std::sqrt(double(t.points) / 4) >= Bars{}.small_tile_spacings) only_small = false;
+    for (const DensityResult& d : report.densities) only_small = only_small && d.passed();
+    for (const KeyframeResult& k : report.keyframes) only_small = only_small && k.passed();
+    if (only_small)
+      std::fprintf(out,
+                   "every failure is at a level whose tiles are under %.0f point spacings wide, where a "
+                   "patch or two make a tile: another seed usually passes (docs/design.md §5)\n",
+                   Bars{}.small_tile_spacings);
+  } else
     std::fprintf(out, "all %zu checks passed\n", checks);
 }
 
