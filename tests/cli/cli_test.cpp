@@ -138,6 +138,41 @@ TEST_F(CliTest, SixteenBitImagesKeepTheirPrecision) {
   EXPECT_TRUE(fs::file_size(path("deep.svg")) > 0);
 }
 
+// A Radiance (.hdr) image of flat RGBE scanlines: each value as an 8-bit mantissa and a shared exponent.
+std::vector<unsigned char> radiance_hdr(int w, int h, const std::vector<float>& grey) {
+  std::string out =
+      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
+  for (const float v : grey) {
+    int e = 0;
+    const double m = std::frexp(v, &e);
+    const auto mantissa = static_cast<char>(static_cast<int>(m * 256));
+    out += std::string(3, mantissa) + static_cast<char>(e + 128);
+  }
+  return {out.begin(), out.end()};
+}
+
+TEST_F(CliTest, RadianceImagesKeepTheirDynamicRange) {
+  // 1 : 5,000, the paper's high-dynamic-range example, which 8 or 16 bits cannot hold.
+  std::vector<float> v(16 * 16);
+  for (int i = 0; i < 16 * 16; ++i) v[i] = i % 16 < 8 ? 3.0f : 3.0f / 5000;
+  write_bytes(path("range.hdr"), radiance_hdr(16, 16, v));
+  kdm::tools::GreyImage image;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("range.hdr"), image, error)) << error;
+  EXPECT_FLOAT_EQ(image.at(0, 0), 1.0f);                 // scaled by the brightest pixel
+  EXPECT_NEAR(image.at(15, 15) * 5000, 1.0, 1.0 / 128);  // an 8-bit mantissa's rounding
+  // Bright is dense with --invert: past the texel where the halves blend, the faint part holds 7/15 of
+  // 1/5000 of the bright part's density: about one point of 4,000.
+  const Outcome r =
+      kdm("sample --n 4000 --density '" + path("range.hdr") + "' --invert -o '" + path("r.txt") + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<kdm::tools::PointSet> sets;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("r.txt"), sets, error)) << error;
+  std::size_t faint = 0;
+  for (std::size_t i = 0; i < sets.at(0).size(); ++i) faint += sets[0].coords[2 * i] >= 9.0 / 16;
+  EXPECT_LE(faint, 4u);  // read as 8 bits the faint part would be 1/28 as dense: about 120 points
+}
+
 TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"

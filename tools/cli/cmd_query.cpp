@@ -198,8 +198,9 @@ void add_query_command(CLI::App& app) {
       cmd->add_option(
              "--density", a->density,
              "const:V (V >= 0), an image (density = 1 - luminance, 0.2126 R + 0.7152 G + 0.0722 B of the "
-             "file's values, alpha on white; dark = dense), or a test map ramp:R or radial:R (dynamic range "
-             "R), stretched over --density-rect (past it the edge texels go on)")
+             "file's values, alpha on white; dark = dense; a Radiance .hdr keeps its range, scaled by its "
+             "brightest pixel), or a test map ramp:R or radial:R (dynamic range R), stretched over "
+             "--density-rect (past it the edge texels go on)")
           ->capture_default_str();
   cmd->add_option(
          "--class", a->classes,

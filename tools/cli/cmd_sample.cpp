@@ -194,9 +194,11 @@ void add_sample_command(CLI::App& app) {
                   "lower = more ordered; 0 = deterministic descent; about 300 = white noise)")
       ->capture_default_str();
   add_seed_option(cmd, o.seed, "Random seed; the output depends on nothing else");
-  cmd->add_option("--density", args->density,
-                  "const:V, an image whose darkness is the density, or a test map: ramp:R (R^-x, dynamic "
-                  "range R) or radial:R (R^-(2r) around the centre)")
+  cmd->add_option(
+         "--density", args->density,
+         "const:V, an image whose darkness is the density (a Radiance .hdr keeps its range, scaled by "
+         "its brightest pixel: with --invert, bright is dense), or a test map: ramp:R (R^-x, dynamic "
+         "range R) or radial:R (R^-(2r) around the centre, 1/R past r = 0.5)")
       ->capture_default_str();
   cmd->add_option("--class", args->classes,
                   "Several classes (instead of --density): repeat it, one density each, highest priority "

@@ -481,7 +481,27 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
     image.pixels.resize(pixels * channels_of(image));
     return true;
   };
-  if (stbi_is_16_bit_from_memory(bytes, length)) {
+  if (stbi_is_hdr_from_memory(bytes, length)) {
+    // Radiance files hold linear values of any range: scaled by the largest (the brightest pixel's
+    // luminance, or channel for colour), so that a density keeps every ratio the file holds.
+    std::unique_ptr<float, void (*)(void*)> data(
+        stbi_loadf_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
+    if (!decoded(data.get())) return false;
+    if (!(channels == 3 || channels == 1)) {
+      error =
+          "cannot read image '" + name + "': a Radiance image of " + std::to_string(channels) + " channels";
+      return false;
+    }
+    double largest = 0;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const float* p = data.get() + i * channels;
+      const double value = std::is_same_v<Image, GreyImage> && channels == 3
+                               ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+                               : *std::max_element(p, p + channels);
+      if (value > largest && std::isfinite(value)) largest = value;
+    }
+    convert(data.get(), channels, largest > 0 ? static_cast<float>(largest) : 1.0f, image);
+  } else if (stbi_is_16_bit_from_memory(bytes, length)) {
     std::unique_ptr<stbi_us, void (*)(void*)> data(
         stbi_load_16_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;

@@ -43,8 +43,9 @@ struct RgbImage {
 /// an error naming the file, its size and this limit.
 inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
 
-/// Loads an image as luminance in [0, 1] (16-bit PNGs keep their precision; alpha is composited on white
-/// and kept; a JPEG is turned as its EXIF orientation says, as viewers show it).
+/// Loads an image as luminance in [0, 1] (16-bit PNGs keep their precision; a Radiance .hdr image its
+/// range, as linear values divided by its brightest pixel's; alpha is composited on white and kept; a
+/// JPEG is turned as its EXIF orientation says, as viewers show it).
 /// The file is read whole (at most 2 GiB); images of more than `max_pixels` pixels are refused from their
 /// header (see kMaxImagePixels), and so are inputs that would reach a known fault of the system's stb_image
 /// (tests/fuzz/crashes/README.md).
