@@ -48,8 +48,10 @@ def sample(
         Carlo integration take the torus: box sets of up to a few hundred points are nearly the same
         grid for every seed and bias integrals (docs/limits.md, "The full sampler in a box").
     temperature : float
-        0 to 1000; 0.5 is the paper's look, lower is more ordered, 0 a deterministic descent, about
-        300 white noise.
+        0 to 1000; 0.5 is the paper's look with the default sweeps, lower is more ordered down to about
+        0.1, 0 a deterministic descent, 100 and up near white noise (reached with sweeps=300). The
+        set is the chain after its sweeps, not at equilibrium: more sweeps order it further
+        (docs/design.md §2.1).
     seed : int
         0 to 2**64 - 1. The points depend on the arguments and the seed only, never on `threads`.
     threads : int

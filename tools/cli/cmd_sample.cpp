@@ -189,9 +189,11 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option(
       "--aspect", args->aspect,
       "Width/height of the domain (in 3D its x side over its y and z sides; default: the image's, or 1)");
-  cmd->add_option("--temperature,-T", o.temperature,
-                  "Temperature in the reference implementation's units, 0 to 1000 (0.5 = the paper's look; "
-                  "lower = more ordered; 0 = deterministic descent; about 300 = white noise)")
+  cmd->add_option(
+         "--temperature,-T", o.temperature,
+         "Temperature in the reference implementation's units, 0 to 1000 (0.5 = the paper's look with "
+         "the default --sweeps; lower = more ordered down to about 0.1; 0 = deterministic descent; "
+         "100 and up near white noise, reached with --sweeps 300)")
       ->capture_default_str();
   add_seed_option(cmd, o.seed, "Random seed; the output depends on nothing else");
   cmd->add_option(
@@ -211,7 +213,8 @@ void add_sample_command(CLI::App& app) {
   add_threads_option(cmd, o.threads, "output does not depend on it");
   cmd->add_option("--sweeps", o.sweeps,
                   "Metropolis-Hastings sweeps over all points on the finest level (where that is "
-                  "the only level, as for a few hundred points, at least 30: points start there at random)")
+                  "the only level, as for a few hundred points, at least 30: points start there at random); "
+                  "more keep ordering a set: δavg .872 at 30, .884 at 100, .897 at 1000 (T = 0.5)")
       ->capture_default_str();
   cmd->add_option("--coarse-sweeps", o.coarse_sweeps,
                   "Metropolis-Hastings sweeps on each level between the coarsest and the finest")
