@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -48,8 +49,10 @@ constexpr double kMoveBound = 0x1p-21;
 /// one set it was 5 d_hex where the largest is 2.
 Circle delaunay_circle(const std::vector<double>& xy, const std::vector<double>& moved, int i, int j, int k) {
   const Circle given = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
-  if (!std::isfinite(given.r)) return given;  // flat: a lattice row
   const Circle m = circumcircle(&moved[2 * i], &moved[2 * j], &moved[2 * k]);
+  // Flat as given (a row of a grid, one point a hair from the next across the torus's seam): the moved
+  // circle, or none if that is flat too (a box's hull).
+  if (!std::isfinite(given.r)) return m;
   return std::fabs(given.r - m.r) <= 8 * kMoveBound ? given : m;
 }
 
@@ -186,13 +189,37 @@ std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double b
   return circles;
 }
 
+/// The set's points with every coincident one after the first left out, in their order (the same vector
+/// when there are none). Coincident points have the empty circles of their position once; triangulated
+/// each, their zero-width triangles fail the torus's count of 2n circles, which then triangulated 25
+/// copies of the square (4,096 points and 2,000 duplicates: 3.9 s, against 0.03 s without them).
+std::vector<double> distinct_positions(const std::vector<double>& coords) {
+  const std::size_t n = coords.size() / 2;
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return std::tie(coords[2 * a], coords[2 * a + 1], a) < std::tie(coords[2 * b], coords[2 * b + 1], b);
+  });
+  std::vector<char> repeat(n, 0);
+  bool any = false;
+  for (std::size_t k = 1; k < n; ++k) {
+    const std::size_t a = order[k - 1], b = order[k];
+    if (coords[2 * a] == coords[2 * b] && coords[2 * a + 1] == coords[2 * b + 1]) repeat[b] = 1, any = true;
+  }
+  if (!any) return coords;
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!repeat[i]) out.insert(out.end(), {coords[2 * i], coords[2 * i + 1]});
+  return out;
+}
+
 SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, double mean_rho,
                      double max_rho) {
   SetCircles out;
-  const double spacing = hex_spacing(set.size());
+  const double spacing = hex_spacing(set.size());  // of all the points, coincident ones too
   const double edge_band = o.tile_size > 0 ? spacing : 0;
-  for (const Circle& c :
-       o.torus ? torus_circles(set.coords, spacing) : box_circles(set.coords, spacing, o.border)) {
+  const std::vector<double> xy = distinct_positions(set.coords);
+  for (const Circle& c : o.torus ? torus_circles(xy, spacing) : box_circles(xy, spacing, o.border)) {
     double local = spacing;
     if (o.density) {
       const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
