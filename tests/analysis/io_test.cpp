@@ -143,6 +143,127 @@ TEST(PointFiles, RejectsBadInput) {
   EXPECT_THROW(load_point_sets({}), InvalidInput);
 }
 
+/// The one set `text` (a file named `name`) reads as; empty with the failure recorded if it reads not.
+tools::PointSet read_one(const std::string& text, const std::string& name) {
+  std::vector<tools::PointSet> sets;
+  std::string error;
+  EXPECT_TRUE(tools::read_point_sets(write_temp(name, text), sets, error)) << name << ": " << error;
+  EXPECT_EQ(sets.size(), 1u) << name;
+  return sets.empty() ? tools::PointSet{} : sets.front();
+}
+
+// Other tools' CSV headers: the columns named x and y (and z, class or label), trimmed and in any case and
+// order, are read, and the others skipped whatever they hold; a header that names no x or y says so.
+TEST(PointFiles, CsvHeadersAreReadByTheirColumnNames) {
+  const std::vector<double> xy = {0.25, 0.5, 0.75, 0.125};
+  for (const char* text :
+       {"x, y\n0.25, 0.5\n0.75, 0.125\n", "X,Y\n0.25,0.5\n0.75,0.125\n", "y,x\n0.5,0.25\n0.125,0.75\n",
+        "id,x,y\np1,0.25,0.5\np2,0.75,0.125\n", "\"x\",\"y\",\"note\"\n0.25,0.5,a b\n0.75,0.125,\n",
+        "x y\n0.25 0.5\n0.75 0.125\n"}) {
+    SCOPED_TRACE(text);
+    const tools::PointSet set = read_one(text, "named.csv");
+    EXPECT_EQ(set.dim, 2);
+    EXPECT_EQ(set.coords, xy);
+    EXPECT_TRUE(set.classes.empty());
+  }
+  for (const char* text :
+       {"x,y,label\n0.25,0.5,1\n0.75,0.125,0\n", "Class,Y,X\n1,0.5,0.25\n0,0.125,0.75\n"}) {
+    const tools::PointSet set = read_one(text, "labelled.csv");
+    EXPECT_EQ(set.coords, xy) << text;
+    EXPECT_EQ(set.classes, (std::vector<std::uint8_t>{1, 0})) << text;
+  }
+  const tools::PointSet zyx = read_one("z,y,x\n0.1,0.5,0.25\n", "zyx.csv");
+  EXPECT_EQ(zyx.coords, (std::vector<double>{0.25, 0.5, 0.1}));
+  EXPECT_NE(read_error("a,b\n0.1,0.2\n", "ab.csv").find(":1: header 'a,b': expected columns named x and y"),
+            std::string::npos);
+  EXPECT_NE(read_error("x,X,y\n0.1,0.2,0.3\n", "twice.csv").find("names column x twice"), std::string::npos);
+  EXPECT_NE(read_error("x,y,z,class\n0.1,0.2,0.3,1\n", "zc.csv").find("classes are for 2D points"),
+            std::string::npos);
+  EXPECT_NE(read_error("id,x,y\n1,0.2\n", "short.csv").find(":2: expected 3 columns, found 2"),
+            std::string::npos);
+  EXPECT_NE(read_error("id,x,y\n1,0.2,abc\n", "bad.csv").find(":2: malformed number"), std::string::npos);
+  // A first line of numbers, "nan" among them, is a row, not a header.
+  EXPECT_NE(read_error("nan,0.5\n", "nan.csv").find(":1: non-finite"), std::string::npos);
+}
+
+// A labelled CSV without its header reads as 3D points: said in a warning when every z is 0 or 1, and in
+// the error when a class lies outside the unit square.
+TEST(PointFiles, AClassColumnWithoutAHeaderIsPointedOut) {
+  std::vector<std::string> warnings;
+  const std::vector<tools::PointSet> sets =
+      load_point_sets({write_temp("unlabelled.csv", "0.1,0.2,0\n0.3,0.4,1\n0.5,0.6,1\n")}, &warnings);
+  EXPECT_EQ(sets.front().dim, 3);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("the header line x,y,class"), std::string::npos) << warnings[0];
+  warnings.clear();
+  load_point_sets({write_temp("plain3d.txt", "0.1 0.2 0.3\n0.3 0.4 1\n")}, &warnings);
+  EXPECT_TRUE(warnings.empty());
+  try {
+    load_point_sets({write_temp("class2.csv", "0.1,0.2,0\n0.3,0.4,2\n")});
+    ADD_FAILURE() << "a class of 2 read as z";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("whole numbers only: a class column needs the header line x,y,class"),
+        std::string::npos)
+        << e.what();
+  }
+}
+
+/// A NumPy .npy file's bytes as np.save writes them: version 1.0, the header dict `dict` padded, then
+/// `data`.
+std::string npy(const std::string& dict, const std::string& data, int version = 1) {
+  std::string header = dict;
+  const std::size_t fixed = version == 1 ? 10 : 12;
+  while ((fixed + header.size() + 1) % 64) header += ' ';
+  header += '\n';
+  std::string out = std::string("\x93NUMPY", 6) + char(version) + char(0);
+  out += char(header.size() & 0xff), out += char(header.size() >> 8 & 0xff);
+  if (version != 1) out += std::string(2, '\0');
+  return out + header + data;
+}
+
+template <class T>
+std::string bytes_of(std::initializer_list<T> values) {  // little-endian, as this x86-64 machine stores them
+  std::string out;
+  for (T v : values) out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  return out;
+}
+
+// NumPy .npy files: little-endian float64 or float32, (n, 2) or (n, 3), in C or Fortran order; anything
+// else, a header promising more than the file holds and a header that is no dict literal, refused by name.
+TEST(PointFiles, NpyFilesRead) {
+  const std::string c2 = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }";
+  EXPECT_EQ(read_one(npy(c2, bytes_of<double>({0.25, 0.5, 0.75, 0.125})), "c.npy").coords,
+            (std::vector<double>{0.25, 0.5, 0.75, 0.125}));
+  const tools::PointSet f = read_one(npy("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }",
+                                         bytes_of<float>({0.25f, 0.75f, 0.5f, 0.125f, 0, 1})),
+                                     "f.npy");
+  EXPECT_EQ(f.dim, 3);
+  EXPECT_EQ(f.coords, (std::vector<double>{0.25, 0.5, 0, 0.75, 0.125, 1}));
+  EXPECT_EQ(read_one(npy(c2, bytes_of<double>({0.25, 0.5, 0.75, 0.125}), 2), "v2.npy").size(), 2u);
+  const std::string two = bytes_of<double>({0.25, 0.5, 0.75, 0.125});
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {npy("{'descr': '>f8', 'fortran_order': False, 'shape': (2, 2), }", two), "big-endian data ('>f8')"},
+      {npy("{'descr': '<i8', 'fortran_order': False, 'shape': (2, 2), }", two), "data of type '<i8'"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4,), }", two), "shape (4): expected (n, 2)"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 4), }", two), "shape (1, 4)"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (99999999999, 2), }", two),
+       "cut short: its header promises 199999999998 values"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }", two.substr(0, 31)), "cut short"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 2), }", ""), "holds no points"},
+      {npy("{'descr': '<f8', 'shape': (2, 2), }", two), "without descr, fortran_order or shape"},
+      {npy("__import__('os')", two), "no dictionary"},
+      {npy(c2, bytes_of<double>({0.25, std::nan(""), 0.75, 0.125})), "non-finite coordinate in row 1"},
+      {std::string("\x93NUMPY\x01\x00\xff\xff", 10), "cut short in its header"},
+      {std::string("\x93NUMPY\x02\x00\xff\xff\xff\x7f", 12), "a header of 2147483647 bytes"},
+      {std::string("\x93NUMPY\x07\x00", 8), "unknown format version 7"}};
+  for (const auto& [bytes, message] : refused) {
+    const std::string error = read_error(bytes, "bad.npy");
+    EXPECT_NE(error.find(message), std::string::npos) << error;
+    EXPECT_NE(error.find("bad.npy"), std::string::npos) << error;
+  }
+}
+
 TEST(Json, WriterEscapesAndNulls) {
   JsonWriter w;
   w.begin_object()

@@ -1,7 +1,9 @@
 // Fuzz target: read_point_sets, the reader of the point files `kdm analyze` takes (text, '#' lines between
-// sets, blanks or commas between coordinates, an optional CSV header), on arbitrary bytes. Checks: it
-// either fails with an error naming the file or returns at least one set, every set non-empty, all of one
-// dimension (2 or 3), with whole points of finite coordinates, and no more points than lines.
+// sets, blanks or commas between coordinates, an optional CSV header naming its columns; NumPy .npy), on
+// arbitrary bytes. Checks: it either fails with an error naming the file or returns at least one set,
+// every set non-empty, all of one dimension (2 or 3), with whole points of finite coordinates, no more
+// points than lines (text) or than the bytes hold (.npy, 4 bytes a coordinate at least), and labels, if
+// any, one a point.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -31,6 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   if (sets.empty()) fail();
+  const bool npy = text.rfind("\x93NUMPY", 0) == 0;
   const std::size_t lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
   std::size_t points = 0;
   for (const kdm::tools::PointSet& set : sets) {
@@ -38,8 +41,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (set.coords.empty() || set.coords.size() % set.dim != 0) fail();
     for (double c : set.coords)
       if (!std::isfinite(c)) fail();
+    if (!set.classes.empty() && (set.classes.size() != set.size() || set.dim != 2)) fail();
     points += set.size();
+    if (npy && set.coords.size() * 4 > size) fail();
   }
-  if (points > lines) fail();
+  if (npy ? sets.size() != 1 : points > lines) fail();
   return 0;
 }

@@ -145,6 +145,12 @@ def point_files():
     write("point_file", "bad.txt", "0.1 0.2\n0.3\n")
     write("point_file", "classes.csv", "x,y,class\n0.1,0.2,0\n0.3,0.4,2\n")
     write("point_file", "query.csv", "x,y,tile_x,tile_y,rank,level,class\n0.5,0.25,0,0,3,0,1\n")
+    write("point_file", "named_columns.csv", "id, Y ,X,label\n7,0.5,0.25,1\np2,0.75,0.125,0\n")
+    # np.save(f, np.array([[0.25, 0.5], [0.75, 0.125]])): version 1.0, its header padded to 64 bytes.
+    header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }"
+    header += " " * (64 - 10 - len(header) - 1) + "\n"
+    write("point_file", "two_points.npy", b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) +
+          header.encode() + struct.pack("<4d", 0.25, 0.5, 0.75, 0.125))
 
 
 def crashes():

@@ -133,7 +133,9 @@ void run_analyze(const AnalyzeArgs& args) {
       target = cli::to_generator_density(spec);
       o.density = tools::analysis_density(target);
     }
-    const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files);
+    std::vector<std::string> warnings;
+    const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files, &warnings);
+    for (const std::string& w : warnings) std::fprintf(stderr, "kdm: warning: %s\n", w.c_str());
     for (const std::string& file : args.files)
       if (const double aspect = sampled_aspect(file); aspect != 1)
         std::fprintf(stderr,

@@ -141,20 +141,255 @@ std::string excerpt(const std::string& line) {
 
 }  // namespace
 
+namespace {
+
+/// What a header line names: how many columns a row has, and which hold x, y, z and the class (-1: none).
+struct Header {
+  int columns = 0, x = -1, y = -1, z = -1, label = -1;
+};
+
+/// `line` cut into fields at commas, or where it has none at blanks and tabs; each trimmed of blanks, '\r'
+/// and enclosing quotes.
+std::vector<std::string> split_fields(const std::string& line) {
+  std::vector<std::string> fields;
+  const bool commas = line.find(',') != std::string::npos;
+  std::size_t at = 0;
+  while (at <= line.size()) {
+    std::size_t end = commas ? line.find(',', at) : line.find_first_of(" \t", at);
+    if (end == std::string::npos) end = line.size();
+    std::string f = line.substr(at, end - at);
+    const std::size_t a = f.find_first_not_of(" \t\r"), b = f.find_last_not_of(" \t\r");
+    f = a == std::string::npos ? "" : f.substr(a, b - a + 1);
+    if (f.size() >= 2 && (f.front() == '"' || f.front() == '\'') && f.back() == f.front())
+      f = f.substr(1, f.size() - 2);
+    if (commas || !f.empty()) fields.push_back(f);
+    at = end + 1;
+  }
+  return fields;
+}
+
+/// Whether `field` is a whole number such as strtod reads ("0.5", "nan", "inf"), blanks around it allowed.
+bool parse_number(const std::string& field, double& v) {
+  const char* p = field.c_str();
+  char* end = nullptr;
+  v = std::strtod(p, &end);
+  if (end == p) return false;
+  while (*end == ' ' || *end == '\t' || *end == '\r') ++end;
+  return end == p + field.size();
+}
+
+/// Whether a first line is a column header: printable text whose every field is a name (it starts with a
+/// letter or '_' and is no number such as "nan"), not a row of numbers or a binary file's first bytes.
+bool is_header(const std::string& head) {
+  for (char c : head)
+    if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r') return false;
+  for (const std::string& f : split_fields(head)) {
+    double v;
+    if (f.empty() || parse_number(f, v)) return false;
+    const unsigned char c = static_cast<unsigned char>(f[0]);
+    if (!std::isalpha(c) && c != '_') return false;
+  }
+  return true;
+}
+
+/// Reads a header's columns: x and y (and z, and the class as "class" or "label") by name, trimmed and in
+/// any case, in any order; other columns are skipped. False with `error` (no file or line) if it names
+/// no x or y, or a column twice.
+bool parse_header(const std::string& head, Header& h, std::string& error) {
+  const std::vector<std::string> fields = split_fields(head);
+  h.columns = static_cast<int>(fields.size());
+  for (int i = 0; i < h.columns; ++i) {
+    std::string name = fields[i];
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    int* column = name == "x"                          ? &h.x
+                  : name == "y"                        ? &h.y
+                  : name == "z"                        ? &h.z
+                  : name == "class" || name == "label" ? &h.label
+                                                       : nullptr;
+    if (!column) continue;
+    if (*column >= 0) {
+      error = "header '" + excerpt(head) + "' names column " + name + " twice";
+      return false;
+    }
+    *column = i;
+  }
+  if (h.x < 0 || h.y < 0) {
+    error = "header '" + excerpt(head) + "': expected columns named x and y (and z, class)";
+    return false;
+  }
+  if (h.z >= 0 && h.label >= 0) {
+    error = "header '" + excerpt(head) + "': classes are for 2D points, and z makes them 3D";
+    return false;
+  }
+  return true;
+}
+
+/// The first bytes of a NumPy .npy file (np.save).
+constexpr char kNpyMagic[] = "\x93NUMPY";
+
+/// Reads a NumPy .npy file's one set, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
+/// float32, in C or Fortran order. The header is untrusted: parsed as the few literals np.save writes, sizes
+/// bounded, and the data read as it comes (a header that promises more than the file holds allocates nothing
+/// of it).
+bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& sets, std::string& error) {
+  auto fail = [&](const std::string& what) {
+    error = path + ": NumPy .npy file: " + what;
+    return false;
+  };
+  std::streambuf* buffer = in.rdbuf();
+  auto read = [&](void* to, std::size_t n) {
+    return static_cast<std::size_t>(buffer->sgetn(static_cast<char*>(to), static_cast<std::streamsize>(n))) ==
+           n;
+  };
+  unsigned char pre[12];  // the magic (already read), the version, the header's length
+  if (!read(pre + 6, 2)) return fail("cut short in its header");
+  if (pre[6] < 1 || pre[6] > 3) return fail("unknown format version " + std::to_string(pre[6]));
+  const std::size_t length_bytes = pre[6] == 1 ? 2 : 4;
+  if (!read(pre + 8, length_bytes)) return fail("cut short in its header");
+  std::size_t header_length = 0;
+  for (std::size_t i = length_bytes; i-- > 0;) header_length = header_length << 8 | pre[8 + i];
+  constexpr std::size_t kMaxHeader = 1 << 16;  // np.save writes about 128 bytes
+  if (header_length > kMaxHeader)
+    return fail("a header of " + std::to_string(header_length) + " bytes (at most 65536)");
+  std::string header(header_length, '\0');
+  if (!read(header.data(), header_length)) return fail("cut short in its header");
+  // The header is a Python dict literal: {'descr': '<f8', 'fortran_order': False, 'shape': (n, 2), }
+  std::size_t at = 0;
+  auto skip = [&] {
+    while (at < header.size() && std::isspace(static_cast<unsigned char>(header[at]))) ++at;
+  };
+  auto take = [&](char c) {
+    skip();
+    if (at < header.size() && header[at] == c) return ++at, true;
+    return false;
+  };
+  auto quoted = [&](std::string& s) {
+    skip();
+    if (at >= header.size() || (header[at] != '\'' && header[at] != '"')) return false;
+    const std::size_t end = header.find(header[at], at + 1);
+    if (end == std::string::npos) return false;
+    s = header.substr(at + 1, end - at - 1), at = end + 1;
+    return true;
+  };
+  std::string descr;
+  int fortran = -1;
+  std::vector<std::uint64_t> shape;
+  bool has_shape = false;
+  if (!take('{')) return fail("a header that is no dictionary");
+  while (!take('}')) {
+    std::string key;
+    if (!quoted(key) || !take(':')) return fail("a malformed header");
+    skip();
+    if (key == "descr") {
+      if (!quoted(descr)) return fail("a malformed 'descr'");
+    } else if (key == "fortran_order") {
+      if (header.compare(at, 4, "True") == 0)
+        fortran = 1, at += 4;
+      else if (header.compare(at, 5, "False") == 0)
+        fortran = 0, at += 5;
+      else
+        return fail("a malformed 'fortran_order'");
+    } else if (key == "shape") {
+      if (!take('(')) return fail("a malformed 'shape'");
+      while (!take(')')) {
+        skip();
+        std::uint64_t v = 0;
+        const std::size_t from = at;
+        while (at < header.size() && std::isdigit(static_cast<unsigned char>(header[at])) && v < (1ull << 40))
+          v = v * 10 + static_cast<std::uint64_t>(header[at++] - '0');
+        if (at == from || v >= (1ull << 40) || shape.size() == 8) return fail("a malformed 'shape'");
+        shape.push_back(v);
+        if (!take(',') && (skip(), at >= header.size() || header[at] != ')'))
+          return fail("a malformed 'shape'");
+      }
+      has_shape = true;
+    } else {
+      return fail("an unknown header key '" + excerpt(key) + "'");
+    }
+    if (!take(',') && (skip(), at >= header.size() || header[at] != '}')) return fail("a malformed header");
+  }
+  if (descr.empty() || fortran < 0 || !has_shape)
+    return fail("a header without descr, fortran_order or shape");
+  std::size_t width = 0;
+  if (descr == "<f8")
+    width = 8;
+  else if (descr == "<f4")
+    width = 4;
+  else if (descr == ">f8" || descr == ">f4")
+    return fail("big-endian data ('" + descr + "'): save it as little-endian float64 (astype('<f8'))");
+  else
+    return fail("data of type '" + excerpt(descr) + "': expected float64 or float32 ('<f8' or '<f4')");
+  std::string dims;
+  for (std::size_t i = 0; i < shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(shape[i]);
+  if (shape.size() != 2 || (shape[1] != 2 && shape[1] != 3))
+    return fail("an array of shape (" + dims + "): expected (n, 2) or (n, 3) points");
+  const std::uint64_t n = shape[0], dim = shape[1], count = n * dim;
+  if (n == 0) {
+    error = "point file '" + path + "' holds no points";
+    return false;
+  }
+  PointSet set;
+  set.dim = static_cast<int>(dim);
+  set.coords.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(count, 1 << 20)));
+  unsigned char chunk[1 << 14];
+  for (std::uint64_t done = 0; done < count;) {
+    const std::size_t values =
+        static_cast<std::size_t>(std::min<std::uint64_t>(count - done, sizeof chunk / width));
+    if (!read(chunk, values * width))
+      return fail("cut short: its header promises " + std::to_string(count) + " values");
+    for (std::size_t k = 0; k < values; ++k) {
+      std::uint64_t bits = 0;  // little-endian, whatever this machine's order
+      for (std::size_t b = width; b-- > 0;) bits = bits << 8 | chunk[k * width + b];
+      double v;
+      if (width == 8) {
+        std::memcpy(&v, &bits, 8);
+      } else {
+        const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
+        float f;
+        std::memcpy(&f, &b32, 4);
+        v = f;
+      }
+      if (!std::isfinite(v))
+        return fail("a non-finite coordinate in row " +
+                    std::to_string((fortran ? (done + k) % n : (done + k) / dim) + 1));
+      set.coords.push_back(v);
+    }
+    done += values;
+  }
+  if (fortran) {  // column after column: interleave them
+    std::vector<double> rows(set.coords.size());
+    for (std::uint64_t i = 0; i < n; ++i)
+      for (std::uint64_t a = 0; a < dim; ++a) rows[i * dim + a] = set.coords[a * n + i];
+    set.coords.swap(rows);
+  }
+  sets.push_back(std::move(set));
+  return true;
+}
+
+}  // namespace
+
 bool read_point_sets(std::istream& in, const std::string& path, std::vector<PointSet>& sets,
                      std::string& error) {
   sets.clear();
+  if (in.rdbuf()->sgetc() == static_cast<unsigned char>(kNpyMagic[0])) {
+    char magic[6];
+    const std::streamsize got = in.rdbuf()->sgetn(magic, 6);
+    if (got == 6 && std::memcmp(magic, kNpyMagic, 6) == 0) return read_npy(in, path, sets, error);
+    error =
+        path + ":1: malformed number in '" + excerpt(std::string(magic, static_cast<std::size_t>(got))) + "'";
+    return false;
+  }
   PointSet current;
   int file_dim = 0;
   std::string line;
   int line_no = 0;
-  // Columns of a labelled CSV: which hold x, y and the class, and how many a line has.
-  int columns = 0, class_column = -1;
+  Header header;  // columns 0: no header, every field of a row a coordinate
   auto finish_set = [&] {
     if (!current.coords.empty()) sets.push_back(current);
     current.coords.clear(), current.classes.clear();
   };
   bool too_long = false;
+  std::vector<double> values;
   while (read_line(in, line, too_long)) {
     ++line_no;
     const auto first = line.find_first_not_of(" \t\r");
@@ -163,73 +398,73 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
       finish_set();
       continue;
     }
-    // The CSV files write_point_set produces start with a column header: skip it so they read back.
-    if (line_no == 1) {
-      std::string head = line.substr(first);
-      while (!head.empty() && (head.back() == '\r' || head.back() == ' ')) head.pop_back();
-      if (head == "x,y" || head == "x,y,z") continue;
-      if (head == "x,y,class") {
-        columns = 3, class_column = 2;
-        continue;
+    // A CSV file's column header (ours, kdm query's, another tool's): the columns named x, y, z and class.
+    if (line_no == 1 && is_header(line.substr(first))) {
+      std::string problem;
+      if (!parse_header(line.substr(first), header, problem)) {
+        error = path + ":1: " + problem;
+        return false;
       }
-      // kdm query's, with a depth column since 0.5 (earlier files have none).
-      // kdm query's: the class (several classes) and the depth (since 0.5) after the six columns.
-      if (head.rfind("x,y,tile_x,tile_y,rank,level", 0) == 0) {
-        const std::string rest = head.substr(28);
-        if (rest.empty() || rest == ",class" || rest == ",depth" || rest == ",class,depth") {
-          columns = 6 + int(std::count(rest.begin(), rest.end(), ','));
-          class_column = rest.rfind(",class", 0) == 0 ? 6 : -1;
-          continue;
-        }
-      }
+      continue;
     }
-    std::vector<double> values;
-    // To the line's end, not its first NUL: a NUL byte is malformed, not the end of the line.
-    const char* p = line.c_str() + first;
-    const char* const line_end = line.c_str() + line.size();
-    while (p < line_end) {
-      char* end = nullptr;
-      const double v = std::strtod(p, &end);
-      if (end == p) {
-        error = path + ":" + std::to_string(line_no) + ": malformed number in '" + excerpt(line) + "'";
+    values.clear();
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (header.columns) {  // the named columns; the others may hold anything
+      const std::vector<std::string> fields = split_fields(line.substr(first));
+      if (static_cast<int>(fields.size()) != header.columns) {
+        error = where + ": expected " + std::to_string(header.columns) + " columns, found " +
+                std::to_string(fields.size());
         return false;
       }
-      if (!std::isfinite(v)) {
-        const bool a_class = class_column >= 0 && static_cast<int>(values.size()) == class_column;
-        error = path + ":" + std::to_string(line_no) +
-                (a_class ? ": a class must be an integer 0 to 255" : ": non-finite coordinate");
-        return false;
-      }
-      values.push_back(v);
-      p = end;
-      while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') ++p;
-    }
-    if (columns) {  // a labelled or query CSV: x, y and the class
-      if (static_cast<int>(values.size()) != columns) {
-        error = path + ":" + std::to_string(line_no) + ": expected " + std::to_string(columns) +
-                " columns, found " + std::to_string(values.size());
-        return false;
-      }
-      if (class_column >= 0) {
-        const double c = values[class_column];
-        if (!(c >= 0 && c <= 255 && c == std::floor(c))) {
-          error = path + ":" + std::to_string(line_no) + ": a class must be an integer 0 to 255";
+      for (int column : {header.x, header.y, header.z, header.label}) {
+        if (column < 0) continue;
+        double v;
+        if (!parse_number(fields[column], v)) {
+          error = where + ": malformed number in '" + excerpt(line) + "'";
           return false;
         }
-        current.classes.push_back(static_cast<std::uint8_t>(c));
+        if (column == header.label) {
+          if (!(v >= 0 && v <= 255 && v == std::floor(v))) {
+            error = where + ": a class must be an integer 0 to 255";
+            return false;
+          }
+          current.classes.push_back(static_cast<std::uint8_t>(v));
+          continue;
+        }
+        if (!std::isfinite(v)) {
+          error = where + ": non-finite coordinate";
+          return false;
+        }
+        values.push_back(v);
       }
-      values.resize(2);
+    } else {
+      // To the line's end, not its first NUL: a NUL byte is malformed, not the end of the line.
+      const char* p = line.c_str() + first;
+      const char* const line_end = line.c_str() + line.size();
+      while (p < line_end) {
+        char* end = nullptr;
+        const double v = std::strtod(p, &end);
+        if (end == p) {
+          error = where + ": malformed number in '" + excerpt(line) + "'";
+          return false;
+        }
+        if (!std::isfinite(v)) {
+          error = where + ": non-finite coordinate";
+          return false;
+        }
+        values.push_back(v);
+        p = end;
+        while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r') ++p;
+      }
     }
     const int dim = static_cast<int>(values.size());
     if (dim != 2 && dim != 3) {
-      error = path + ":" + std::to_string(line_no) + ": expected 2 or 3 coordinates, found " +
-              std::to_string(dim);
+      error = where + ": expected 2 or 3 coordinates, found " + std::to_string(dim);
       return false;
     }
     if (file_dim == 0) file_dim = dim;
     if (dim != file_dim) {
-      error = path + ":" + std::to_string(line_no) + ": dimension changes from " + std::to_string(file_dim) +
-              " to " + std::to_string(dim);
+      error = where + ": dimension changes from " + std::to_string(file_dim) + " to " + std::to_string(dim);
       return false;
     }
     current.dim = dim;

@@ -1,9 +1,9 @@
 // Point-set text files as UTK and psa read and write them: '#' lines are comments, and a '#' line that
 // follows points separates one set from the next; every other line holds D coordinates in [0, 1)
-// (separated by blanks or commas; a first line "x,y" or "x,y,z" — the CSV header we write — is skipped).
-// Labelled points (several classes) are CSV files whose header is "x,y,class", or `kdm query`'s CSV
-// ("x,y,tile_x,tile_y,rank,level[,class],depth": the class for several classes; files without the depth
-// column too), of which x, y and class are read.
+// (separated by blanks or commas). A first line of column names is a CSV header: the columns named x and
+// y (and z; and class or label for labelled points, several classes), trimmed and in any case, in any
+// order, are read and the others skipped (kdm query's "x,y,tile_x,tile_y,rank,level[,class],depth" too).
+// A NumPy .npy file (np.save of an (n, 2) or (n, 3) float64 or float32 array) is read as one set.
 #pragma once
 
 #include <cstddef>
@@ -46,8 +46,8 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
 /// would end an XML comment) becomes "- -".
 std::string comment_safe(std::string line);
 
-/// Reads every set in `path` ("-": standard input). All sets must share one dimension (2 or 3);
-/// coordinates must be finite.
+/// Reads every set in `path` ("-": standard input), text or .npy (known by its first bytes). All sets must
+/// share one dimension (2 or 3); coordinates must be finite.
 /// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).
 bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::string& error);
 

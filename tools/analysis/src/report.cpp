@@ -13,24 +13,50 @@
 
 namespace kdm::analysis {
 
-std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths) {
+namespace {
+
+/// Whether every point's third coordinate is a whole number: a labelled file's class column, read as z
+/// because the file has no header naming it.
+bool whole_third_column(const tools::PointSet& set) {
+  if (set.dim != 3) return false;
+  for (std::size_t i = 2; i < set.coords.size(); i += 3)
+    if (set.coords[i] != std::floor(set.coords[i])) return false;
+  return true;
+}
+
+constexpr const char* kClassHeaderHint = "a class column needs the header line x,y,class";
+
+}  // namespace
+
+std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths,
+                                             std::vector<std::string>* warnings) {
   if (paths.empty()) throw InvalidInput("no point files given");
   std::vector<tools::PointSet> all;
   for (const std::string& path : paths) {
     std::vector<tools::PointSet> sets;
     std::string error;
     if (!tools::read_point_sets(path, sets, error)) throw InvalidInput(error);
+    bool whole = true;
     for (std::size_t k = 0; k < sets.size(); ++k) {
       if (!all.empty() && sets[k].dim != all.front().dim)
         throw InvalidInput(path + ": " + std::to_string(sets[k].dim) + "D points after " +
                            std::to_string(all.front().dim) + "D ones");
+      whole = whole && whole_third_column(sets[k]);
       try {
         validate_points(sets[k].coords, sets[k].dim);
       } catch (const InvalidInput& e) {
-        throw InvalidInput(path + " (set " + std::to_string(k + 1) + "): " + e.what());
+        const bool hint = whole_third_column(sets[k]);
+        throw InvalidInput(
+            path + " (set " + std::to_string(k + 1) + "): " + e.what() +
+            (hint ? std::string(" (its third column holds whole numbers only: ") + kClassHeaderHint + ")"
+                  : ""));
       }
       all.push_back(std::move(sets[k]));
     }
+    if (whole && warnings)
+      warnings->push_back(path +
+                          ": 3D points whose z is 0 or 1 in every one: if the third column is a class, " +
+                          kClassHeaderHint);
   }
   return all;
 }

@@ -21,9 +21,11 @@
 namespace kdm::analysis {
 
 /// Reads and concatenates the sets of every file in `paths` (in order). Throws InvalidInput with a one-line
-/// message for a missing/empty/malformed/non-finite file, mixed dimensions or points outside [0,1].
-/// Thread-safe (touches only the named files).
-std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths);
+/// message for a missing/empty/malformed/non-finite file, mixed dimensions or points outside [0,1]. With
+/// `warnings`, appends a line for what reads but is likely a mistake (a file of 3D points whose z are all
+/// 0 or 1: a class column without a header). Thread-safe (touches only the named files).
+std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths,
+                                             std::vector<std::string>* warnings = nullptr);
 
 struct AnalysisOptions {
   bool torus = true;             ///< periodic distances (else bounded box)
