@@ -333,5 +333,39 @@ TEST(Report, AnalyzeAggregatesSets) {
   EXPECT_EQ(analyze(sets, o).coincident, 0u);
 }
 
+// What cannot be measured reads n/a, not a figure: g(r) of two points far apart, the anisotropy below
+// f = 0.5; windows that expect more points than a set has are warned of; the distances used are named,
+// with the option for the other.
+TEST(Report, TheSummarySaysWhatCannotBeMeasured) {
+  tools::PointSet two;
+  two.coords = {0.1, 0.1, 0.6, 0.6};
+  AnalysisOptions o;
+  std::string s = format_summary(analyze({two}, o));
+  EXPECT_NE(s.find("g peak n/a (no pair within r"), std::string::npos) << s;
+  EXPECT_NE(s.find("torus distances (the set wraps around; --box for a bounded set)"), std::string::npos)
+      << s;
+  o.torus = false;
+  EXPECT_NE(format_summary(analyze({two}, o)).find("box distances (a bounded set; --torus"),
+            std::string::npos);
+  o.torus = true;
+  o.fmax = 0.5;
+  const tools::PointSet set = testing::uniform_set(4096, 5);
+  s = format_summary(analyze({set}, o));
+  EXPECT_NE(s.find("anisotropy n/a"), std::string::npos) << s;
+  EXPECT_EQ(s.find("nan"), std::string::npos) << s;
+  EXPECT_EQ(s.find("warning: no window"), std::string::npos) << s;
+  o.density = [](double, double) { return 1.0; };
+  o.min_expected = 5000;
+  const AnalysisReport r = analyze({set}, o);
+  EXPECT_EQ(r.density.windows, 1u);
+  s = format_summary(r);
+  EXPECT_NE(s.find("warning: no window expects 5000 points (--min-expected; a set has 4096)"),
+            std::string::npos)
+      << s;
+  EXPECT_NE(metrics_json(r, {"a"}).find("\"min_expected\":5000"), std::string::npos);
+  o.min_expected = 20;
+  EXPECT_EQ(format_summary(analyze({set}, o)).find("warning: no window"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace kdm::analysis

@@ -161,6 +161,17 @@ TEST(Tiling, PeriodicityRatioDetectsRepeatedTile) {
   // the transform's rounding (it read 1.9e27 from that), so the ratio is infinite; white noise has 24
   // exponential values over 192, whose ratio's log has sd ≈ 0.22: 5 sd allowed.
   EXPECT_EQ(r.lattice_ratio, HUGE_VAL);
+  EXPECT_EQ(r.lattice_frequencies, 24u);  // (i, j) in [-2, 2]² but 0: what tells JSON's null from NaN
+  // 4 points a tile, 4 × 4 tiles: the periodogram reaches |k| = 5, short of (4, 0)'s neighbour (5, 1).
+  tools::PointSet small;
+  for (int t = 0; t < 16; ++t)
+    for (std::size_t i = 0; i < 4; ++i)
+      small.coords.insert(small.coords.end(),
+                          {(t % 4 + tile.coords[2 * i]) / 4, (t / 4 + tile.coords[2 * i + 1]) / 4});
+  const Periodogram low = periodogram(small.coords, 2, 0.1);
+  const PeriodicityResult none = periodicity_ratio(low, spectrum_stats(low), 0.25);
+  EXPECT_EQ(none.lattice_frequencies, 0u);
+  EXPECT_TRUE(std::isnan(none.lattice_ratio));
   EXPECT_NEAR(std::log(rw.lattice_ratio), 0.0, 5 * 0.22);
 }
 

@@ -136,6 +136,7 @@ TEST(NearestNeighbour, SummaryAndQuantile) {
   ASSERT_EQ(st.histogram.size(), 4u);
   EXPECT_EQ(st.histogram[1], 1u);  // 0.5 ∈ [0.5, 1)
   EXPECT_EQ(st.histogram[3], 2u);  // 1.5 and the overflow 2.0
+  EXPECT_EQ(st.overflow, 1u);      // 2.0, at hist_max: counted apart too
   std::vector<double> v(100);
   for (int i = 0; i < 100; ++i) v[i] = 100 - i;
   EXPECT_DOUBLE_EQ(quantile(v, 0.01), 1.0);

@@ -119,7 +119,9 @@ void write_nn(JsonWriter& w, const NNStats& s) {
   w.key("count").value(s.count).key("dmin").value(s.dmin).key("davg").value(s.davg).key("nn1").value(s.nn1);
   w.key("dmax").value(s.dmax).key("histogram_max").value(s.hist_max).key("histogram").begin_array();
   for (std::size_t c : s.histogram) w.value(c);
-  w.end_array().end_object();
+  w.end_array();
+  // The last bin holds these too: every distance of histogram_max spacings or more.
+  w.key("histogram_overflow").value(s.overflow).end_object();
 }
 
 }  // namespace
@@ -178,7 +180,9 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
         .key("bias")
         .value(d.bias)
         .key("zero_density_points")
-        .value(d.zero_density);
+        .value(d.zero_density)
+        .key("min_expected")
+        .value(r.density_min_expected);
     w.key("bands").begin_array();
     for (const DensityBand& b : d.bands) {
       w.begin_object().key("rho_lo").value(b.lo).key("rho_hi").value(b.hi).key("expected").value(b.expected);
@@ -195,7 +199,9 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
         .key("lattice_frequencies")
         .value(r.periodicity.frequencies)
         .key("lattice_power_ratio")
-        .value(r.periodicity.lattice_ratio);
+        .value(r.periodicity.lattice_ratio)
+        .key("lattice_power_frequencies")
+        .value(r.periodicity.lattice_frequencies);
     w.key("seam");
     write_nn(w, r.seams.seam);
     w.key("interior");

@@ -116,6 +116,7 @@ NNStats summarise_nn(const std::vector<double>& distances, double spacing, int b
                                 ? s.histogram.size() - 1
                                 : static_cast<std::size_t>(std::max(0.0, b));
     ++s.histogram[bin];
+    s.overflow += v >= hist_max;
   }
   s.dmin = lo;
   s.dmax = hi;

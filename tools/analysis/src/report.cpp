@@ -170,6 +170,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
       r.density.bias = (count_sum - mu_sum) / mu_sum;
     }
     r.has_density = true;
+    r.density_min_expected = o.min_expected;
   }
 
   if (o.tile_size > 0) {
@@ -205,7 +206,11 @@ std::string format_summary(const AnalysisReport& r) {
   std::string s;
   append(s, "%zu set(s) of %zu", r.sets, r.points_min);
   if (r.points_max != r.points_min) append(s, "..%zu", r.points_max);
-  append(s, " %dD points, %s distances\n", r.dim, r.torus ? "torus" : "box");
+  // The default (torus) reads a bounded set as wrapping around: say which distances, and how to get the
+  // other.
+  append(s, " %dD points, %s\n", r.dim,
+         r.torus ? "torus distances (the set wraps around; --box for a bounded set)"
+                 : "box distances (a bounded set; --torus for one that wraps around)");
   append(s, "nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n",
          r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
   if (r.coincident > 0)
@@ -220,8 +225,12 @@ std::string format_summary(const AnalysisReport& r) {
       append(s, "lowP %.4f", st.low_p);
     else
       append(s, "lowP n/a (too few points)");
-    append(s, "  peak %.2f at f=%.3f  ν_eff %.3f  anisotropy %.1f dB\n", st.peak, st.peak_f, st.nu_eff,
-           st.anisotropy_db);
+    append(s, "  peak %.2f at f=%.3f  ν_eff %.3f", st.peak, st.peak_f, st.nu_eff);
+    // Anisotropy's rings lie in 0.5 < f < 2.5: none below --fmax 0.5.
+    if (std::isfinite(st.anisotropy_db))
+      append(s, "  anisotropy %.1f dB\n", st.anisotropy_db);
+    else
+      append(s, "  anisotropy n/a (no ring above f = 0.5)\n");
   }
   double gmax = 0, rpeak = 0;
   for (std::size_t b = 0; b < r.gr.g.size(); ++b)
@@ -229,7 +238,10 @@ std::string format_summary(const AnalysisReport& r) {
       gmax = r.gr.g[b];
       rpeak = r.gr.r[b];
     }
-  append(s, "pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  if (gmax > 0)
+    append(s, "pair correlation   g peak %.2f at r=%.2f (r ≤ %.1f)\n", gmax, rpeak, r.gr.r_max);
+  else  // a few points far apart: no pair within reach
+    append(s, "pair correlation   g peak n/a (no pair within r ≤ %.1f)\n", r.gr.r_max);
   if (!r.empty_circles_skipped.empty())
     append(s, "empty circles      skipped: %s\n", r.empty_circles_skipped.c_str());
   if (r.has_empty_circles) {
@@ -253,6 +265,11 @@ std::string format_summary(const AnalysisReport& r) {
         "density            %zu windows (μ≈%.1f)  RMS z %.3f  max|z| %.2f  bias %+.4f  in zero density %zu\n",
         r.density.windows, r.density.mean_expected, r.density.rms_z, r.density.max_abs_z, r.density.bias,
         r.density.zero_density);
+  if (r.has_density && r.density.mean_expected < r.density_min_expected)
+    append(s,
+           "                   warning: no window expects %g points (--min-expected; a set has %zu): one "
+           "window a set, whose z says nothing\n",
+           r.density_min_expected, r.points_min);
   if (r.has_density && r.density.bands.size() > 1) {
     append(s, "density bands      ρ/ρmax from        expected      points  count/target   ±1σ (Poisson)\n");
     for (const DensityBand& b : r.density.bands)

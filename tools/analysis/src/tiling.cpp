@@ -36,7 +36,7 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
       ++out.frequencies;
     }
   if (out.frequencies == 0) {
-    out.ratio = out.mean_power = out.mean_raps = std::numeric_limits<double>::quiet_NaN();
+    out.ratio = out.mean_power = out.mean_raps = out.lattice_ratio = std::numeric_limits<double>::quiet_NaN();
     return out;
   }
   out.mean_power = power / static_cast<double>(out.frequencies);
@@ -55,6 +55,7 @@ PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& s
         for (int dx = -1; dx <= 1; ++dx)
           if (dx || dy) off += p.at(kx + dx, ky + dy), ++off_count;
     }
+  out.lattice_frequencies = static_cast<std::size_t>(on_count);
   if (on_count == 0)
     out.lattice_ratio = std::nan("");
   else  // a strictly periodic set has no power off the lattice, bar the transform's rounding (1e-10 of S)

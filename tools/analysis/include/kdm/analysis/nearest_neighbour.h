@@ -34,6 +34,7 @@ struct NNStats {
   double dmax = 0;        ///< max NN distance / spacing
   double hist_max = 0;  ///< histogram covers [0, hist_max) in normalised units; last bin also counts overflow
   std::vector<std::size_t> histogram;
+  std::size_t overflow = 0;  ///< distances ≥ hist_max: counted in the histogram's last bin
 };
 
 /// Summarises `distances` (unit-domain lengths) divided by `spacing`. Empty input gives count 0 and NaN

@@ -63,6 +63,8 @@ struct AnalysisReport {
   EmptyCircles empty_circles;         ///< holes: radii in local d_hex (of the target density, if given)
   bool has_density = false;
   DensityAccuracy density;  ///< pooled: rms/max over all windows of all sets, summed counts
+  /// The windows' least expected count asked for: a set with fewer points has one window (z = 0).
+  double density_min_expected = 0;
   bool has_tiling = false;
   double tile_size = 0;
   PeriodicityResult periodicity;  ///< needs the spectrum (NaN ratio otherwise)

@@ -38,6 +38,9 @@ struct PeriodicityResult {
   /// when they lie outside the periodogram; infinite for a strictly periodic set (no power off the lattice
   /// beyond the transform's rounding).
   double lattice_ratio = 0;
+  /// The lattice frequencies lattice_ratio compares (0: NaN, none inside the periodogram), so that a JSON
+  /// null (non-finite) reads as infinite when there were some.
+  std::size_t lattice_frequencies = 0;
 };
 
 /// Periodicity ratio of a (set-averaged) periodogram `p` with radial statistics `stats` for tile side
