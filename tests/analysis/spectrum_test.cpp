@@ -7,6 +7,7 @@
 
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/periodogram.h"
+#include "kdm/analysis/plots.h"
 #include "test_sets.h"
 
 namespace kdm::analysis {
@@ -166,6 +167,25 @@ TEST(Periodogram, TorusHexLatticePeaksAtReciprocalLattice) {
   EXPECT_NEAR(st.peak_f, 30.0 / std::sqrt(n), 1e-12);
   EXPECT_NEAR(st.nu_eff, 29.0 / std::sqrt(n), 1e-12);  // every ring below 30 is exactly 0
   EXPECT_NEAR(st.low_p, 0.0, 1e-6);
+}
+
+// raps.png's value labels stay apart at any peak: at a peak of 100 (a lattice) a fixed step of 2 stacked
+// 56 labels into a black column beside the axis: ink in all 374 rows of the label column.
+TEST(Periodogram, RapsLabelsStayApartAtAnyPeak) {
+  for (const double peak : {1.5, 12.0, 100.0, 3000.0}) {
+    SpectrumStats st;
+    for (int r = 1; r <= 50; ++r) st.ring_f.push_back(r / 20.0), st.raps.push_back(r == 25 ? peak : 1.0);
+    const tools::RgbImage im = plot_raps(st, 2.5);
+    int inked = 0, rows = 0;
+    for (int y = 56; y < im.height - 70; ++y, ++rows)  // the plot's height; labels end 10 px left of it
+      for (int x = 0; x < 70; ++x)
+        if (im.pixels[(static_cast<std::size_t>(y) * im.width + x) * 3] < 128) {
+          ++inked;
+          break;
+        }
+    EXPECT_GT(inked, 0) << peak;
+    EXPECT_LT(inked, rows / 2) << "peak " << peak << ": " << inked << " of " << rows << " rows";
+  }
 }
 
 TEST(Periodogram, RejectsBadInput) {

@@ -112,7 +112,12 @@ tools::RgbImage plot_raps(const SpectrumStats& st, double fmax, int width_px, in
     std::snprintf(buf, sizeof buf, "%g", f);
     draw_text(im, x - text_width(buf, 2) / 2, top + ph + 10, buf, 2, black);
   }
-  const double ystep = ymax > 8 ? 2.0 : (ymax > 4 ? 1.0 : 0.5);
+  // At most 8 steps of 1, 2 or 5 × 10^k on any range: a fixed step of 2 drew the labels of a peak of 100
+  // (a lattice, clumps) on top of each other.
+  double ystep = 0.5;
+  for (double decade = 1; std::isfinite(ymax) && ymax / ystep > 8; decade *= 10)
+    for (double m : {1.0, 2.0, 5.0})
+      if (ymax / ystep > 8) ystep = m * decade;
   for (double v = 0; v <= ymax + 1e-9; v += ystep) {
     const int y = static_cast<int>(std::lround(Y(v)));
     fill_rect(im, left - 6, y, left, y + 1, black);
