@@ -676,6 +676,49 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   }
 }
 
+// kdm analyze -o - writes metrics.json (labelled points' classes.json inside, as "classes") to standard
+// output and the summary to standard error, and makes no directory "-"; several files say they are
+// pooled; a class column read as z is pointed out.
+TEST_F(CliTest, AnalyzeWritesJsonToStandardOutputAndSaysWhatItPooled) {
+  std::ofstream labelled(path("l.csv"));
+  labelled << "x,y,class\n";
+  for (int i = 0; i < 300; ++i)
+    labelled << (i * 0.618034) - std::floor(i * 0.618034) << ',' << (i + 0.5) / 300 << ',' << i % 2 << '\n';
+  labelled.close();
+  const Outcome r = kdm("analyze '" + path("l.csv") + "' --no-energy -o -", "cd '" + dir_.string() + "' &&");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("{\n  \"inputs\":", 0), 0u) << r.out.substr(0, 80);
+  EXPECT_NE(r.out.find("\"coincident_points\":0"), std::string::npos);
+  EXPECT_NE(r.out.find("\"classes\": {\"cross_class_closest\""), std::string::npos);
+  EXPECT_EQ(r.out.substr(r.out.size() - 4), "}\n}\n");  // one JSON document
+  EXPECT_EQ(r.out.find("nearest neighbour"), std::string::npos);
+  EXPECT_NE(r.err.find("nearest neighbour"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("class 1 alone"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "-"));
+  EXPECT_FALSE(fs::exists(dir_ / "points.png"));
+
+  const Outcome two = kdm("analyze '" + path("l.csv") + "' '" + path("l.csv") + "' --no-energy");
+  ASSERT_EQ(two.status, 0) << two.err;
+  EXPECT_EQ(two.out.rfind("2 files pooled into one report", 0), 0u) << two.out;
+  EXPECT_NE(two.out.find("2 set(s) of 300 2D points, torus distances (the set wraps around; --box"),
+            std::string::npos)
+      << two.out;
+  EXPECT_EQ(kdm("analyze '" + path("l.csv") + "' --no-energy").out.find("pooled"), std::string::npos);
+
+  std::ofstream(path("unnamed.csv")) << "0.1,0.2,0\n0.3,0.4,1\n0.5,0.7,1\n0.8,0.1,0\n";
+  const Outcome z = kdm("analyze '" + path("unnamed.csv") + "' --no-energy");
+  ASSERT_EQ(z.status, 0) << z.err;
+  EXPECT_NE(z.err.find("kdm: warning: " + path("unnamed.csv") + ": 3D points whose z is 0 or 1"),
+            std::string::npos)
+      << z.err;
+  std::ofstream(path("class2.csv")) << "0.1,0.2,0\n0.3,0.4,2\n";
+  expect_error("analyze '" + path("class2.csv") + "'", "a class column needs the header line x,y,class");
+  const Outcome help = kdm("analyze --help");
+  EXPECT_NE(help.out.find("pooled into one report"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("no density test"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("NumPy .npy"), std::string::npos) << help.out;
+}
+
 TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
   const Outcome r = kdm("--version");
   EXPECT_EQ(r.status, 0);

@@ -51,28 +51,35 @@ void save_png(const std::string& path, const tools::RgbImage& image) {
   if (!tools::write_png(path, image, error)) throw CommandError(error);
 }
 
-/// Labelled points (several classes): each class alone, as the whole set was analysed (printed, and, with
-/// a directory `dir`, in dir/classes.json with the closest pair of points of different classes).
-void analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
-                     const gen::Density& target, const AnalyzeArgs& args, const std::filesystem::path& dir) {
+/// Labelled points (several classes): each class alone, as the whole set was analysed (printed to `text`),
+/// and classes.json's text, with the closest pair of points of different classes.
+std::string analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
+                            const gen::Density& target, const AnalyzeArgs& args, std::FILE* text) {
   std::function<double(const std::vector<tools::PointSet>&)> energy;
   if (!args.no_energy)
     energy = [&](const std::vector<tools::PointSet>& subsets) {
       return tools::mean_energy_per_point(subsets, o.torus, target);
     };
   const analysis::ClassesReport report = analysis::analyze_classes(sets, o, energy);
-  std::printf("\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n",
-              report.classes.size() + report.too_small.size(), report.cross_class_closest);
+  std::fprintf(text, "\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n",
+               report.classes.size() + report.too_small.size(), report.cross_class_closest);
   for (std::uint8_t k : report.too_small)
-    std::printf("\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(k));
+    std::fprintf(text, "\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(k));
   for (std::size_t c = 0; c < report.classes.size(); ++c) {
-    std::printf("\nclass %u alone:\n", unsigned(report.classes[c]));
-    std::fputs(analysis::format_summary(report.reports[c]).c_str(), stdout);
+    std::fprintf(text, "\nclass %u alone:\n", unsigned(report.classes[c]));
+    std::fputs(analysis::format_summary(report.reports[c]).c_str(), text);
   }
-  std::string error;
-  if (!dir.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(),
-                                                     analysis::classes_json(report, args.files), error))
-    throw CommandError(error);
+  return analysis::classes_json(report, args.files);
+}
+
+/// metrics.json's text with classes.json's as its key "classes" (as kdm.analyze returns them): one JSON
+/// document for standard output.
+std::string with_classes(std::string metrics, const std::string& classes) {
+  const std::size_t end = metrics.rfind('}');
+  if (end == std::string::npos) return metrics;
+  std::string inner = classes;
+  while (!inner.empty() && (inner.back() == '\n' || inner.back() == ' ')) inner.pop_back();
+  return metrics.substr(0, end) + ",\n  \"classes\": " + inner + "\n}\n";
 }
 
 /// The aspect (width / height) a point file says its points were sampled in (`kdm sample --aspect` writes
@@ -144,26 +151,39 @@ void run_analyze(const AnalyzeArgs& args) {
                      file.c_str(), aspect);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
-    if (!args.output.empty()) prepare_output_directory(args.output);
+    // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
+    const bool to_stdout = args.output == tools::kStandardOutput;
+    std::FILE* text = to_stdout ? stderr : stdout;
+    if (!args.output.empty() && !to_stdout) prepare_output_directory(args.output);
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (!args.no_energy) {
       report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target);
       report.has_energy = true;
     }
-    std::fputs(analysis::format_summary(report).c_str(), stdout);
-    const std::filesystem::path dir(args.output);
-    if (args.output.empty()) {  // the summary alone
-      if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
+    if (args.files.size() > 1)  // not one report a file: the measures pool the sets of them all
+      std::fprintf(text, "%zu files pooled into one report (analyse them one at a time for one each)\n",
+                   args.files.size());
+    std::fputs(analysis::format_summary(report).c_str(), text);
+    const std::string classes =
+        sets.front().classes.empty() ? "" : analyze_classes(sets, o, target, args, text);
+    if (args.output.empty()) return;  // the summary alone
+    if (to_stdout) {
+      const std::string metrics = analysis::metrics_json(report, args.files);
+      const std::string json = classes.empty() ? metrics : with_classes(metrics, classes);
+      if (std::fwrite(json.data(), 1, json.size(), stdout) != json.size() || std::fflush(stdout) != 0)
+        throw CommandError("cannot write to standard output");
       return;
     }
-    if (!sets.front().classes.empty()) analyze_classes(sets, o, target, args, dir);
+    const std::filesystem::path dir(args.output);
+    std::string error;
+    if (!classes.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(), classes, error))
+      throw CommandError(error);
     save_png((dir / "points.png").string(), analysis::plot_points(sets.front()));
     if (report.has_spectrum) {
       save_png((dir / "spectrum.png").string(), analysis::plot_spectrum(report.spectrum));
       save_png((dir / "raps.png").string(), analysis::plot_raps(report.spectrum_stats, report.spectrum.fmax));
     }
     // Last: a metrics.json is there only when the pictures before it were written too.
-    std::string error;
     if (!tools::write_text_file_atomic((dir / "metrics.json").string(),
                                        analysis::metrics_json(report, args.files), error))
       throw CommandError(error);
@@ -182,14 +202,23 @@ void add_analyze_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("analyze", "Point-set metrics: NN distances, spectrum, g(r), density, tiling");
   cmd->add_option("files", args->files,
-                  "Point files: .txt (one point per line, sets separated by '#' lines) or .csv (x,y columns, "
-                  "and class for labelled points: each class is analysed alone too); - reads standard input")
+                  "Point files: text (one point per line, blanks or commas between coordinates, sets "
+                  "separated by '#' lines), CSV with a header naming columns x and y (and z, or class/label "
+                  "for labelled points: each class is analysed alone too; other columns are skipped), or "
+                  "NumPy .npy ((n, 2) or (n, 3) float64/float32); - reads standard input. Several files, "
+                  "and the sets in one, are pooled into one report")
       ->required();
-  cmd->add_flag("--torus", args->torus, "Periodic distances (default)");
-  cmd->add_flag("--box", args->box, "Bounded-box distances (g(r) with edge correction)");
-  cmd->add_option("--density", args->density,
-                  "Target density for the accuracy test and the per-band bias table: const:V, an image "
-                  "(dark = dense) or ramp:R / radial:R, as given to kdm sample (default: uniform)");
+  cmd->add_flag("--torus", args->torus,
+                "Periodic distances, for a set that wraps around (default; the summary's first line says "
+                "which were used)");
+  cmd->add_flag("--box", args->box,
+                "Bounded-box distances, for a set in a square with walls (most other tools' sets; g(r) with "
+                "edge correction)");
+  cmd->add_option(
+      "--density", args->density,
+      "Target density for the accuracy test and the per-band bias table: const:V, an image "
+      "(dark = dense) or ramp:R / radial:R, as given to kdm sample (default: none, no density test; "
+      "const:1 tests against a uniform density)");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
@@ -213,8 +242,9 @@ void add_analyze_command(CLI::App& app) {
   add_threads_option(cmd, args->threads, "results do not depend on it");
   cmd->add_option_function<std::string>(
       "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },
-      "Output directory (created if missing) for metrics.json and pictures (default: the "
-      "summary is only printed)");
+      "Output directory (created if missing) for metrics.json (classes.json for labelled points) and "
+      "pictures; - writes metrics.json (with classes.json's as \"classes\") to standard output and "
+      "the summary to standard error, no pictures (default: the summary is only printed)");
   cmd->callback([args] { run_analyze(*args); });
 }
 
