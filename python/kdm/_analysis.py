@@ -23,6 +23,14 @@ def _arrays(value: Any) -> Any:
     return value
 
 
+def _infinite_lattice(metrics: Dict[str, Any]) -> None:
+    """JSON has no infinity: a lattice power ratio written as null over lattice frequencies that were
+    compared is infinite (a strictly periodic set), not missing."""
+    tiling = metrics.get("tiling")
+    if tiling and np.isnan(tiling.get("lattice_power_ratio", 0.0)) and tiling.get("lattice_power_frequencies", 0):
+        tiling["lattice_power_ratio"] = np.inf
+
+
 def analyze(
     points: Any,
     *,
@@ -73,7 +81,8 @@ def analyze(
         each point's class, an (n,) array per set. Each class is then also analysed alone, as
         ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
         (``cross_class_closest`` in d_hex of all points, per class its "class" and "metrics", and in
-        "too_small" the classes present with fewer than 2 points in every set, which are not analysed).
+        "too_small", an integer array, the classes present with fewer than 2 points in every set, which
+        are not analysed).
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles
@@ -86,12 +95,16 @@ def analyze(
         empty_circles, pair_correlation, density, tiling, energy_per_point, seconds: those that apply;
         spectrum, empty_circles, density and tiling are 2-D measures, which a 3-D set does not get), with
         its lists of numbers (spectrum.raps_f, spectrum.raps, pair_correlation.r and .g, ...) as numpy
-        arrays. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
+        arrays, and its nulls as NaN, but tiling.lattice_power_ratio as inf for a strictly periodic set
+        (no power off the tile lattice; NaN when no lattice frequency lies in the spectrum). The nearest-
+        neighbour histogram's last bin counts every distance from histogram_max on (histogram_overflow of
+        them). A min_expected above a set's count leaves one window (z = 0) and warns. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
         their count): with ``box=True`` circles centred within two spacings of a side are left out.
     """
     # A list whose entries are 2-D (arrays or nested lists) is several sets; else it is one set's points.
     several = isinstance(points, (list, tuple)) and len(points) > 0
-    if several and all(_checks.is_array(p) and np.ndim(p) == 2 for p in points):
+    # An empty entry (np.empty((0, 2)), []) is one of several sets too, so that its error names it.
+    if several and all(_checks.is_array(p) and (np.ndim(p) == 2 or np.size(p) == 0) for p in points):
         raw, names = list(points), [f"points[{i}]" for i in range(len(points))]
     else:
         raw, names = [points], ["points"]
@@ -100,7 +113,15 @@ def analyze(
             raise TypeError(f"{name} must be an (n, 2) or (n, 3) array of points, got None")
         if _checks.is_array(p) and np.asarray(p).dtype == np.bool_:
             raise TypeError(f"{name} must hold coordinates, got booleans")
+        if _checks.is_array(p) and np.size(p) == 0:
+            raise ValueError(f"{name} holds no points: every set needs at least 2 points")
     sets = [_checks.array2d(name, p) for name, p in zip(names, raw)]
+    for name, s in zip(names, sets):
+        if s.shape[1] not in (2, 3):
+            hint = f" (transposed? {name}.T has shape {s.shape[::-1]})" if s.shape[0] in (2, 3) else ""
+            raise ValueError(f"{name} must be an (n, 2) or (n, 3) array of points, got shape {s.shape}{hint}")
+        if s.shape[0] < 2:
+            raise ValueError(f"{name} holds {s.shape[0]} point: every set needs at least 2 points")
     box = _checks.flag("box", box)
     function = None
     if callable(density) and not isinstance(density, (np.ndarray, str)):
@@ -132,6 +153,15 @@ def analyze(
     text, classes_text = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy, labels,
                                       min_expected, density_bands, holes_min_density)
     result = _arrays(json.loads(text))
+    _infinite_lattice(result)
+    density_result = result.get("density")
+    if density_result and density_result["mean_expected"] < min_expected:
+        warnings.warn(f"no density window expects min_expected={min_expected:g} points (a set has "
+                      f"{result['points_min']}): one window a set, whose z says nothing", stacklevel=2)
     if classes_text is not None:
         result["classes"] = _arrays(json.loads(classes_text))
+        for c in result["classes"]["classes"]:
+            _infinite_lattice(c["metrics"])
+        # Class labels, not measures: integers (an empty list too).
+        result["classes"]["too_small"] = np.asarray(result["classes"]["too_small"], dtype=np.int64)
     return result

@@ -205,7 +205,8 @@ def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient
         assert json.dumps(_lists(got[key]), sort_keys=True) == json.dumps(metrics[key], sort_keys=True), key
     lone = labels.copy()
     lone[0] = 7  # one point of its class: listed, not analysed
-    assert kdm.analyze(points, classes=lone, energy=False)["classes"]["too_small"].tolist() == [7]
+    too_small = kdm.analyze(points, classes=lone, energy=False)["classes"]["too_small"]
+    assert too_small.tolist() == [7] and too_small.dtype.kind == "i"  # labels, not measures
     with pytest.raises(ValueError, match="one array of labels per set"):
         kdm.analyze([points, points], classes=[labels])
     with pytest.raises(ValueError, match="must hold one label per point"):
@@ -415,6 +416,35 @@ def test_analyze_pools_sets_given_as_nested_lists_too():
     assert pooled["sets"] == 2
     assert pooled["nearest_neighbour"]["davg"] == kdm.analyze([a, b], energy=False, threads=1)["nearest_neighbour"]["davg"]
     assert kdm.analyze(a.tolist(), energy=False, threads=1)["sets"] == 1  # a list of points is one set
+
+
+def test_analyze_gives_inf_where_metrics_json_has_null_for_infinity():
+    # A tile repeated 4 x 4 has no power off the tile lattice: the lattice power ratio is infinite (null in
+    # metrics.json), not missing; with no lattice frequency in the spectrum (64 points reach |k| = 5, short
+    # of the neighbours of (4, 0)) it is NaN.
+    tile = np.random.default_rng(3).random((64, 2))
+    tiled = np.concatenate([(tile + [i, j]) / 4 for i in range(4) for j in range(4)])
+    tiling = kdm.analyze(tiled, tile_size=0.25, energy=False, threads=1)["tiling"]
+    assert tiling["lattice_power_ratio"] == np.inf and tiling["lattice_power_frequencies"] == 24
+    small = np.concatenate([(tile[:4] + [i, j]) / 4 for i in range(4) for j in range(4)])
+    low = kdm.analyze(small, tile_size=0.25, fmax=0.1, energy=False, threads=1)["tiling"]
+    assert np.isnan(low["lattice_power_ratio"])
+
+
+def test_analyze_names_the_shape_and_the_set_it_cannot_take():
+    rng = np.random.default_rng(4)
+    with pytest.raises(ValueError, match=r"got shape \(2, 10\) \(transposed\? points.T has shape \(10, 2\)\)"):
+        kdm.analyze(rng.random((2, 10)))
+    with pytest.raises(ValueError, match=r"got shape \(10, 4\)$"):
+        kdm.analyze(rng.random((10, 4)))
+    for empty in (np.empty((0, 2)), []):
+        with pytest.raises(ValueError, match=r"points\[1\] holds no points"):
+            kdm.analyze([rng.random((10, 2)), empty])
+    with pytest.raises(ValueError, match=r"points\[0\] holds 1 point"):
+        kdm.analyze([rng.random((1, 2)), rng.random((10, 2))])
+    points = rng.random((1000, 2))
+    with pytest.warns(UserWarning, match="no density window expects min_expected=2000"):
+        assert kdm.analyze(points, density=1.0, min_expected=2000, energy=False)["density"]["windows"] == 1
 
 
 def test_a_signal_stops_a_full_stipple_inside_its_call():
