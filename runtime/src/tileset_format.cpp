@@ -541,11 +541,13 @@ Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std:
   if (n == kFixedHeaderBytes && std::memcmp(bytes.data(), kMagic, 8) == 0) {
     const auto* h = reinterpret_cast<const std::uint8_t*>(bytes.data());
     const std::uint64_t header_size = get32(h + 12), payload_size = get64(h + 16);
-    if (header_size >= kFixedHeaderBytes && header_size <= kMaxTilesetHeaderBytes &&
-        payload_size <= ZSTD_compressBound(kMaxTilesetPayloadBytes)) {
+    if (header_size >= kFixedHeaderBytes && header_size <= kMaxTilesetHeaderBytes) {
       // The buffer grows with the bytes the file holds, not with what its unchecked header claims: a
-      // damaged 64-byte file must not allocate half a gigabyte.
-      const std::uint64_t wanted = header_size + payload_size + 1;
+      // damaged 64-byte file must not allocate half a gigabyte. A payload size past any payload's is read
+      // up to that bound, not stopped at the fixed header: the header checksum must see the whole header,
+      // so that the file is judged as decode_tileset judges its bytes in memory.
+      const std::uint64_t most = ZSTD_compressBound(kMaxTilesetPayloadBytes);
+      const std::uint64_t wanted = header_size + std::min(payload_size, most) + 1;
       std::uint64_t room = regular ? std::uint64_t(info.st_size) + 1 : std::uint64_t(1) << 16;
       while (n < wanted) {
         room = std::min(wanted, std::max(room, std::uint64_t(n) * 2));

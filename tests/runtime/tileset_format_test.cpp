@@ -668,5 +668,37 @@ TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
   std::remove(path.c_str());
 }
 
+// A file is judged as its bytes are in memory: a damaged size field (a payload size flipped far past any
+// payload's included) is a damaged header, not a file cut inside it.
+TEST(TilesetFormatTest, EveryHeaderBitFlipInAFileIsJudgedAsInMemory) {
+  const std::vector<std::uint8_t> bytes = encode(make_tileset());
+  const std::uint32_t header_size = get32(&bytes[12]);
+  const std::string path = testing::TempDir() + "/flipped.kdmt";
+  for (std::size_t bit = 0; bit < header_size * 8; ++bit) {
+    std::vector<std::uint8_t> damaged = bytes;
+    damaged[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
+    {
+      std::ofstream f(path, std::ios::binary | std::ios::trunc);
+      f.write(reinterpret_cast<const char*>(damaged.data()), static_cast<std::streamsize>(damaged.size()));
+    }
+    TilesetData loaded;
+    std::string in_file, in_memory;
+    const Status from_file = load_tileset(path, loaded, &in_file);
+    const Status from_memory = decode_tileset(damaged.data(), damaged.size(), loaded, &in_memory);
+    ASSERT_EQ(from_file, from_memory) << "bit " << bit << ": " << in_file << " / " << in_memory;
+    ASSERT_EQ(in_file, in_memory) << "bit " << bit;
+  }
+  std::vector<std::uint8_t> damaged = bytes;
+  damaged[20] ^= 1u << 4;  // payload size + 2^36
+  {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(damaged.data()), static_cast<std::streamsize>(damaged.size()));
+  }
+  Tileset handle;
+  std::string why;
+  EXPECT_EQ(Tileset::load_file(path, handle, &why), Status::kHeaderChecksumMismatch) << why;
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace kdm

@@ -292,9 +292,10 @@ KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, Tilese
                                       std::string* detail = nullptr);
 
 /// Reads the bytes of the tile-set file at `path` into `bytes`, for read_tileset_header and decode_tileset
-/// to judge: its fixed header, then no more than that header says the file holds, and one byte past it
-/// (an endless or huge input stops at its header). kIoError, with `detail`, when the path cannot be
-/// opened or read or is a directory; else kOk, whatever the bytes are.
+/// to judge: its fixed header, then no more than that header says the file holds (a payload size past any
+/// payload's: up to that bound), and one byte past it (an endless or huge input stops at its header or at
+/// that bound), so a file gives the statuses its bytes give in memory. kIoError, with `detail`, when the path
+/// cannot be opened or read or is a directory; else kOk, whatever the bytes are.
 KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<char>& bytes,
                                          std::string* detail = nullptr);
 
