@@ -331,6 +331,12 @@ def test_load_save_and_bake(tmp_path, tiny_tileset):
     kw = dict(scale=100, mode="smooth")
     assert same(loaded.query((0, 0, 3, 3), **kw), tiny_tileset.query((0, 0, 3, 3), **kw))
     assert kdm.bake(TINY_RECIPE, threads=1).info == info  # any thread count, the same set
+    damaged = bytearray(path.read_bytes())
+    damaged[20] ^= 1 << 4  # the payload size's high bytes: a damaged header, the file is whole
+    (tmp_path / "damaged.kdmt").write_bytes(damaged)
+    for load in (lambda: kdm.Tileset.load(tmp_path / "damaged.kdmt"), lambda: kdm.Tileset.from_bytes(damaged)):
+        with pytest.raises((OSError, ValueError), match="header checksum mismatch"):
+            load()
     with pytest.raises(ValueError, match="recipe_text gives no key"):  # not minutes of the defaults
         kdm.bake("# a comment only\n\n")
     with pytest.raises(ValueError, match="density too high|points per tile"):
