@@ -1,7 +1,8 @@
 // Fuzz target: BakeRecipe::parse (the text of a `kdm bake` recipe) on arbitrary bytes. Checks: it either
 // throws InvalidArgument with a message (any other exception escapes and is reported as a crash) or
-// returns a recipe whose every field lies in its documented range (at most 2^22 points per tile), whose
-// canonical text parses back to the same recipe, and whose level counts agree with it.
+// returns a recipe whose every field lies in its documented range (at most 2^22 points per tile), that
+// BakeRecipe::validate accepts, whose canonical text parses back to the same recipe, and whose level counts
+// agree with it.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -51,6 +52,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       (r.separation_push > 0 && !(r.separation > 0 && r.separation_push >= r.separation)) ||
       (r.keyframes_per_level == 0 && (r.glide_late > 0 || r.glide_consensus || r.glide_separation > 0)))
     fail();
+  try {
+    r.validate();  // what bake_tileset checks: the text's rules, on the fields
+  } catch (const kdm::gen::InvalidArgument&) {
+    fail();
+  }
   if (r.top_level_points() > (1u << 22)) fail();
   const auto counts = r.nominal_counts();
   if (counts.size() != r.levels || counts.back() != r.top_level_points()) fail();

@@ -189,6 +189,118 @@ BakeRecipe small_recipe() {
   return r;
 }
 
+// A recipe made in code is held to the text's rules before any work, with parse's messages less the line:
+// values out of range, and a key that tunes another given (here: off its default) without it.
+TEST(BakeTest, ARecipeMadeInCodeIsCheckedAsItsTextWouldBe) {
+  const auto validation = [](const BakeRecipe& r) -> std::string {
+    try {
+      r.validate();
+    } catch (const InvalidArgument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  struct Case {
+    const char* text;  // the same recipe as text
+    void (*edit)(BakeRecipe&);
+    const char* message;
+  };
+  const Case cases[] = {
+      {"levels 12\n", [](BakeRecipe& r) { r.levels = 12; },
+       "levels must be a whole number in [1, 10], got '12'"},
+      {"colours 17\n", [](BakeRecipe& r) { r.colours = 17; },
+       "colours must be a whole number in [1, 16], got '17'"},
+      {"colours 0\n", [](BakeRecipe& r) { r.colours = 0; },
+       "colours must be a whole number in [1, 16], got '0'"},
+      {"sweeps 0\n", [](BakeRecipe& r) { r.sweeps = 0; },
+       "sweeps must be a whole number in [1, 10000], got '0'"},
+      {"band 0.5\n", [](BakeRecipe& r) { r.band = 0.5; }, "band must be in (0, 0.5), got '0.5'"},
+      {"separation_push 0.5\n", [](BakeRecipe& r) { r.separation_push = 0.5; },
+       "separation_push needs separation"},
+      {"glide_sweeps 30\n", [](BakeRecipe& r) { r.glide_sweeps = 30; },
+       "glide_sweeps needs a glide track (keyframes)"},
+      {"handover_slack 2\n", [](BakeRecipe& r) { r.handover_slack = 2; },
+       "handover_slack needs handover_zone (a hand-over)"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    BakeRecipe r = small_recipe();
+    c.edit(r);
+    EXPECT_EQ(validation(r), std::string("recipe: ") + c.message);
+    EXPECT_EQ(refusal(c.text), std::string("recipe line 1: ") + c.message);
+    EXPECT_THROW(bake_tileset(r, 1), InvalidArgument);  // at once: levels 12 would bake for minutes
+  }
+  BakeRecipe nan = small_recipe();
+  nan.temperature = std::nan("");
+  EXPECT_EQ(validation(nan), "recipe: temperature must be in [0, 1000], got 'nan'");
+  // What parse accepts, validate accepts: the shipped recipe, and keys given at their defaults.
+  EXPECT_EQ(
+      validation(BakeRecipe::parse(read_file(std::string(KDM_SOURCE_DIR) + "/tilesets/default.recipe"))), "");
+  EXPECT_EQ(validation(BakeRecipe::parse("keyframes 2\nglide_sweeps 10\nseparation 0.3\nsplit_shared 0\n")),
+            "");
+  EXPECT_EQ(validation(small_recipe()), "");
+}
+
+// A refusal of keys that do not fit together names the line of the key at fault, and a key that tunes
+// another is refused without it even at 0; patches too narrow name their level and every remedy.
+TEST(BakeTest, RecipeRefusalsNameTheLineTheLevelAndTheRemedy) {
+  EXPECT_EQ(refusal("levels 2\n# push\nseparation_push 0.5\n"),
+            "recipe line 3: separation_push needs separation");
+  EXPECT_EQ(refusal("keyframes 2\nlevels 3\nhandover_slack 1\n"),
+            "recipe line 3: handover_slack needs handover_zone (a hand-over)");
+  EXPECT_EQ(refusal("separation 0.5\nseparation_push 0.3\n"),
+            "recipe line 2: separation_push 0.3 must be at least separation 0.5");
+  for (const char* text :
+       {"handover_level 0\n", "handover_slack 0\n", "split_shared 0\n", "glide_separation 0\n",
+        "separation_fill 0\n", "separation 0\nseparation_push 0\n", "keyframes 0\nglide_late 0\n"})
+    EXPECT_NE(refusal(text).find(" needs "), std::string::npos) << text << ": " << refusal(text);
+  // The stored recipe is normalised: keys at their defaults are left out.
+  const std::string stored =
+      BakeRecipe::parse("levels 2\nedge_gap 1.25\nseparation 0.3\nsplit_shared 0\n").to_text();
+  EXPECT_EQ(stored.find("edge_gap"), std::string::npos) << stored;
+  EXPECT_EQ(stored.find("split_shared"), std::string::npos) << stored;
+  EXPECT_NE(stored.find("separation 0.3\n"), std::string::npos) << stored;
+  EXPECT_EQ(
+      refusal("levels 2\nband 0.3\n"),
+      "recipe: base_points 32 with band 0.3, erosion 1.5 and edge_gap 1.25 leaves level 0's edge patches "
+      "narrower than half a point spacing (more base_points, a larger band, or a smaller erosion or "
+      "edge_gap, widens them)");
+  EXPECT_NE(refusal("levels 3\nerosion 3\n").find("leaves level 1's edge patches"), std::string::npos)
+      << refusal("levels 3\nerosion 3\n");
+}
+
+// A line that is not one 'key value' pair says what is wrong with it; lines end at LF, CR LF or CR; the
+// bytes of a tile set are named as such, and a recipe is told from other text.
+TEST(BakeTest, RecipeLinesSayWhatIsWrongWithThem) {
+  EXPECT_EQ(refusal("levels = 2\n"), "recipe line 1: '=' is not used: write 'levels 2'");
+  EXPECT_EQ(refusal("colours 1\nlevels=2\n"), "recipe line 2: '=' is not used: write 'levels 2'");
+  EXPECT_EQ(refusal("levels 2 3\n"),
+            "recipe line 1: 3 words: expected 'key value' (a comment starts with '#')");
+  EXPECT_EQ(refusal("levels\n"), "recipe line 1: 'levels' has no value: expected 'key value'");
+  EXPECT_EQ(
+      refusal("levels\xC2\xA0"
+              "2\n"),
+      "recipe line 1: a non-ASCII space (bytes C2 A0) is not a blank here: write the line with ASCII spaces");
+  EXPECT_NE(refusal("levels 2\xE3\x80\x80# ideographic\n").find("(bytes E3 80 80)"), std::string::npos);
+  const BakeRecipe mac = BakeRecipe::parse("levels 2\rcolours 1\r# a comment\rbase_points 64");
+  EXPECT_EQ(mac.levels, 2u);
+  EXPECT_EQ(mac.colours, 1u);
+  EXPECT_EQ(mac.base_points, 64u);
+  EXPECT_EQ(refusal("levels 2\rcolours 1\rlevels 3\r"), "recipe line 3: levels was already given on line 1");
+  EXPECT_EQ(refusal("levels 2\r\ncolours 1\r\n\r\nlevels 3\r\n"),
+            "recipe line 4: levels was already given on line 1");
+  EXPECT_TRUE(BakeRecipe::gives_any_key("# only\rlevels 2"));
+  EXPECT_FALSE(BakeRecipe::gives_any_key("# only\r\r  # comments\r"));
+  EXPECT_NE(refusal(std::string("KDMTILES\x07\0\0\0levels 2\n", 21)).find("this is a kdm tile-set file"),
+            std::string::npos);
+  EXPECT_TRUE(BakeRecipe::looks_like_recipe("# comment\n\nlevels 2 # two\n"));
+  EXPECT_TRUE(
+      BakeRecipe::looks_like_recipe(read_file(std::string(KDM_SOURCE_DIR) + "/tilesets/default.recipe")));
+  EXPECT_FALSE(BakeRecipe::looks_like_recipe("shopping list\n"));
+  EXPECT_FALSE(BakeRecipe::looks_like_recipe("levels\n"));
+  EXPECT_FALSE(BakeRecipe::looks_like_recipe(""));
+}
+
 TEST(BakeTest, DeterministicNestedCornerTiles) {
   const BakeRecipe r = small_recipe();
   const TilesetData a = bake_tileset(r, 1);

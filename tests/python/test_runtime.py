@@ -339,6 +339,10 @@ def test_load_save_and_bake(tmp_path, tiny_tileset):
             load()
     with pytest.raises(ValueError, match="recipe_text gives no key"):  # not minutes of the defaults
         kdm.bake("# a comment only\n\n")
+    with pytest.raises(ValueError, match="this is a kdm tile-set file"):  # a set's bytes read as text
+        kdm.bake(path.read_bytes().decode("latin-1"))
+    with pytest.raises(ValueError, match="recipe line 2: '=' is not used: write 'levels 2'"):
+        kdm.bake("colours 1\nlevels = 2\n")
     with pytest.raises(ValueError, match="density too high|points per tile"):
         loaded.query((0, 0, 1, 1), scale=129)
 

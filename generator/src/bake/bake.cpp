@@ -8,12 +8,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <type_traits>
+#include <vector>
 
 #include "bake/close_pairs.h"
 #include "bake/corner_layout.h"
@@ -65,31 +68,290 @@ std::string printable(const std::string& text) {
   return text.size() > 40 ? out + "..." : out;
 }
 
+/// How a key's value is checked against its [lo, hi].
+enum class Range { kWhole, kWithin, kOpen, kOffOrWithin };
+
+/// A numeric recipe key: its range, and its field read and written as a double (exact for every field).
+struct KeyRule {
+  const char* key;
+  Range range;
+  double lo, hi;
+  double (*get)(const BakeRecipe&);
+  void (*set)(BakeRecipe&, double);
+};
+
+template <auto Field>
+double get_field(const BakeRecipe& r) {
+  return static_cast<double>(r.*Field);
+}
+template <auto Field>
+void set_field(BakeRecipe& r, double v) {
+  using T = std::remove_reference_t<decltype(r.*Field)>;
+  r.*Field = static_cast<T>(v);
+}
+template <auto Field>
+constexpr KeyRule rule(const char* key, Range range, double lo, double hi) {
+  return {key, range, lo, hi, &get_field<Field>, &set_field<Field>};
+}
+
+// Every key but `seed` (any 64-bit value, read exactly, not through a double), with its range: parse checks
+// the text's values against them, validate a recipe's fields.
+const KeyRule kKeyRules[] = {
+    rule<&BakeRecipe::colours>("colours", Range::kWhole, 1, kMaxTileColours),
+    rule<&BakeRecipe::levels>("levels", Range::kWhole, 1, 10),
+    rule<&BakeRecipe::base_points>("base_points", Range::kWhole, 1, 1 << 16),
+    rule<&BakeRecipe::sweeps>("sweeps", Range::kWhole, 1, 10000),
+    rule<&BakeRecipe::band>("band", Range::kOpen, 0, 0.5),
+    rule<&BakeRecipe::erosion>("erosion", Range::kWithin, 0, 8),
+    rule<&BakeRecipe::edge_gap>("edge_gap", Range::kWithin, 0.5, 4),
+    rule<&BakeRecipe::rank_context>("rank_context", Range::kWhole, 0, 2),
+    rule<&BakeRecipe::min_distance>("min_distance", Range::kWithin, 0, 0.7),
+    rule<&BakeRecipe::separation>("separation", Range::kWithin, 0, 0.7),
+    rule<&BakeRecipe::separation_push>("separation_push", Range::kWithin, 0, 0.9),
+    rule<&BakeRecipe::split_shared>("split_shared", Range::kWhole, 0, 1),
+    rule<&BakeRecipe::separation_fill>("separation_fill", Range::kWhole, 0, 1),
+    rule<&BakeRecipe::separation_per_level>("separation_per_level", Range::kWhole, 0, 1),
+    rule<&BakeRecipe::fill_holes>("fill_holes", Range::kOffOrWithin, 0.5, 2),
+    rule<&BakeRecipe::glide_separation>("glide_separation", Range::kWithin, 0, 0.7),
+    rule<&BakeRecipe::keyframes_per_level>("keyframes", Range::kWhole, 0, 32),
+    rule<&BakeRecipe::handover_zone>("handover_zone", Range::kWhole, 0, 127),
+    rule<&BakeRecipe::handover_level>("handover_level", Range::kWhole, 0, 7),
+    rule<&BakeRecipe::handover_slack>("handover_slack", Range::kWhole, 0, kMaxHandoverSlack),
+    rule<&BakeRecipe::glide_consensus>("glide_consensus", Range::kWhole, 0, 1 << 22),
+    rule<&BakeRecipe::glide_corner_consensus>("glide_corner_consensus", Range::kWhole, 0, 1 << 22),
+    rule<&BakeRecipe::glide_late>("glide_late", Range::kWithin, 0, 0.95),
+    rule<&BakeRecipe::glide_sweeps>("glide_sweeps", Range::kWhole, 1, 1000),
+    rule<&BakeRecipe::temperature>("temperature", Range::kWithin, 0, kMaxTemperature),
+};
+
+const KeyRule* find_rule(const std::string& key) {
+  for (const KeyRule& k : kKeyRules)
+    if (key == k.key) return &k;
+  return nullptr;
+}
+
+/// Why `v` (as the recipe wrote it: `shown`) is no value for `k`'s key, or "" when it is one.
+std::string range_error(const KeyRule& k, double v, const std::string& shown) {
+  const std::string key = k.key, got = ", got '" + printable(shown) + "'";
+  switch (k.range) {
+    case Range::kWhole:
+      if (v != std::floor(v) || v < k.lo || v > k.hi)
+        return key + " must be a whole number in [" + std::to_string(std::int64_t(k.lo)) + ", " +
+               std::to_string(std::int64_t(k.hi)) + "]" + got;
+      break;
+    case Range::kWithin:
+      if (!(v >= k.lo && v <= k.hi))
+        return key + " must be in [" + shortest(k.lo) + ", " + shortest(k.hi) + "]" + got;
+      break;
+    case Range::kOpen:
+      if (!(v > k.lo && v < k.hi))
+        return key + " must be in (" + shortest(k.lo) + ", " + shortest(k.hi) + ")" + got;
+      break;
+    case Range::kOffOrWithin:
+      if (v != 0 && !(v >= k.lo && v <= k.hi))
+        return key + " must be 0 (off) or in [" + shortest(k.lo) + ", " + shortest(k.hi) + "]" + got;
+      break;
+  }
+  return "";
+}
+
+/// The lines of recipe text: a line ends at LF, CR LF or a lone CR (a file saved with classic Mac line
+/// ends would otherwise be one long line).
+std::vector<std::string> text_lines(const std::string& text) {
+  std::vector<std::string> lines(1);
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n' || text[i] == '\r') {
+      if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+      lines.emplace_back();
+    } else {
+      lines.back() += text[i];
+    }
+  }
+  if (lines.back().empty()) lines.pop_back();
+  return lines;
+}
+
+/// A line's words, split at ASCII blanks, after its comment.
+std::vector<std::string> words_of(const std::string& line) {
+  std::istringstream fields(line.substr(0, line.find('#')));
+  std::vector<std::string> words;
+  for (std::string word; fields >> word;) words.push_back(word);
+  return words;
+}
+
+/// The first Unicode space (no-break, em, ideographic, ...) in `line` as its UTF-8 bytes, e.g. "C2 A0", or
+/// "": text pasted from a document carries them, and they split nothing (a key and value would be one word).
+std::string non_ascii_space(const std::string& line) {
+  static const char* const kSpaces[] = {"\xC2\xA0",     "\xE1\x9A\x80", "\xE2\x80\xAF",
+                                        "\xE2\x81\x9F", "\xE3\x80\x80", "\xEF\xBB\xBF"};
+  std::size_t at = std::string::npos, length = 0;
+  const auto found = [&](std::size_t pos, std::size_t bytes) {
+    if (pos < at) at = pos, length = bytes;
+  };
+  for (const char* space : kSpaces) found(line.find(space), std::strlen(space));
+  for (unsigned c = 0x80; c <= 0x8A; ++c)  // U+2000..U+200A
+    found(line.find(std::string("\xE2\x80") + static_cast<char>(c)), 3);
+  if (at == std::string::npos) return "";
+  std::string bytes;
+  for (std::size_t i = 0; i < length; ++i) {
+    char hex[4];
+    std::snprintf(hex, sizeof hex, "%02X", static_cast<unsigned char>(line[at + i]));
+    bytes += (i ? " " : "") + std::string(hex);
+  }
+  return bytes;
+}
+
+/// Why a line that gives something is not one 'key value' pair, or "" when it is.
+std::string layout_error(const std::string& line, const std::vector<std::string>& words) {
+  const std::string code = line.substr(0, line.find('#'));
+  if (const std::string space = non_ascii_space(code); !space.empty())
+    return "a non-ASCII space (bytes " + space + ") is not a blank here: write the line with ASCII spaces";
+  if (code.find('=') != std::string::npos) {
+    std::string spaced = code;
+    std::replace(spaced.begin(), spaced.end(), '=', ' ');
+    const std::vector<std::string> parts = words_of(spaced);
+    return "'=' is not used: write '" +
+           (parts.size() == 2 ? printable(parts[0]) + " " + printable(parts[1]) : std::string("key value")) +
+           "'";
+  }
+  if (words.size() == 1) return "'" + printable(words[0]) + "' has no value: expected 'key value'";
+  if (words.size() > 2)
+    return std::to_string(words.size()) + " words: expected 'key value' (a comment starts with '#')";
+  return "";
+}
+
+/// The checks of a recipe's keys together (in the order a reader meets them). `lines` holds the line that
+/// gave each key when the recipe comes from text (errors then name the line of the key at fault), or is
+/// null for a recipe made in code, where a key counts as given when it differs from its default.
+void check_together(const BakeRecipe& r, const std::map<std::string, int>* lines) {
+  static const BakeRecipe kDefaults;
+  const auto given = [&](const char* key) {
+    if (lines) return lines->count(key) > 0;
+    const KeyRule* k = find_rule(key);
+    return k->get(r) != k->get(kDefaults);
+  };
+  const auto at = [&](const char* key) {
+    if (lines)
+      if (const auto it = lines->find(key); it != lines->end())
+        return "recipe line " + std::to_string(it->second) + ": ";
+    return std::string("recipe: ");
+  };
+  if (r.top_level_points() > (1u << 22))
+    throw InvalidArgument(at("levels") + "more than 2^22 points per tile");
+  if (make_keyframe_nominal(r.nominal_counts(), r.keyframes_per_level).size() > kMaxKeyframes)
+    throw InvalidArgument(at("keyframes") + "more than " + std::to_string(kMaxKeyframes) +
+                          " keyframes in all");
+  const std::vector<std::uint32_t> nominal = r.nominal_counts();
+  if (patch_widths(r.band, r.erosion, r.edge_gap, nominal).empty()) {
+    std::size_t level = 1;  // the first level whose patches are too narrow
+    while (!patch_widths(r.band, r.erosion, r.edge_gap, {nominal.begin(), nominal.begin() + level}).empty())
+      ++level;
+    char text[400];  // every term named, base_points too: a sparse coarsest level is the usual cause
+    std::snprintf(text, sizeof text,
+                  "recipe: base_points %u with band %g, erosion %g and edge_gap %g leaves level %zu's edge "
+                  "patches narrower than half a point spacing (more base_points, a larger band, or a smaller "
+                  "erosion or edge_gap, widens them)",
+                  unsigned(r.base_points), r.band, r.erosion, r.edge_gap, level - 1);
+    throw InvalidArgument(text);
+  }
+  // Keys that only tune another's pass: alone they would do nothing, silently. Refused when given at all,
+  // 0 included, so that a recipe never holds a line that does nothing.
+  const auto needs = [&](const char* key, bool parent_on, const char* parent) {
+    if (given(key) && !parent_on) throw InvalidArgument(at(key) + key + " needs " + parent);
+  };
+  needs("separation_push", r.separation > 0, "separation");
+  if (r.separation_push > 0 && r.separation_push < r.separation)
+    throw InvalidArgument(at("separation_push") + "separation_push " + shortest(r.separation_push) +
+                          " must be at least separation " + shortest(r.separation));
+  needs("separation_fill", r.separation_push > 0, "separation_push");
+  needs("separation_per_level", r.separation_push > 0, "separation_push");
+  needs("split_shared", r.separation > 0 || r.glide_separation > 0, "separation or glide_separation");
+  const bool track = r.keyframes_per_level > 0;
+  if (track && r.levels < 2)  // one level has no density between levels for a point to glide through
+    throw InvalidArgument(at("keyframes") +
+                          "keyframes need 2 or more levels (a glide track runs between levels)");
+  for (const char* key :
+       {"glide_sweeps", "glide_separation", "glide_consensus", "glide_corner_consensus", "glide_late"})
+    needs(key, track, "a glide track (keyframes)");
+  needs("handover_level", r.handover_zone > 0, "handover_zone (a hand-over)");
+  needs("handover_slack", r.handover_zone > 0, "handover_zone (a hand-over)");
+  if (r.handover_zone) {
+    const std::string zone_at = at("handover_zone");
+    if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
+      throw InvalidArgument(zone_at + "handover_zone needs 2 to 9 levels and a glide track (keyframes)");
+    if (r.handover_level + 1 >= r.levels)
+      throw InvalidArgument(at("handover_level") + "handover_level " + std::to_string(r.handover_level) +
+                            " must be below the top level (" + std::to_string(r.levels - 1) + ")");
+    const std::uint32_t m = 1u << (r.levels - 1 - r.handover_level);  // √(N_top / N_j)
+    // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side).
+    if (2 * r.handover_zone + 1 >= m) {
+      std::uint32_t levels = r.handover_level + 1;
+      while ((1u << (levels - 1 - r.handover_level)) <= 2 * r.handover_zone + 1) ++levels;
+      throw InvalidArgument(
+          zone_at + "handover_zone " + std::to_string(r.handover_zone) + " needs at least " +
+          std::to_string(levels) + " levels" +
+          (r.handover_level ? " with handover_level " + std::to_string(r.handover_level) : std::string()) +
+          ": " + std::to_string(r.levels) + " give " + std::to_string(m) +
+          " subtiles per side, and 2 * zone + 1 must be below that (a set without a hand-over has no "
+          "handover_zone line)");
+    }
+    TilesetShape shape;
+    const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal, r.keyframes_per_level);
+    shape.level_nominal.assign(nominal.begin(), nominal.end());
+    shape.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
+    shape.handover_level = r.handover_level, shape.handover_slack = r.handover_slack;
+    if (shape.handover_keyframe() + 1 < keyframes.size() &&
+        keyframes[shape.handover_keyframe()] > Tile::kMaxHandoverRank + 1) {
+      throw InvalidArgument(zone_at + "the hand-over keyframe holds " +
+                            std::to_string(keyframes[shape.handover_keyframe()]) +
+                            " points per subtile, more than a tile set's hand-over addresses (" +
+                            std::to_string(Tile::kMaxHandoverRank + 1) +
+                            "): fewer base_points, a lower handover_level or less handover_slack");
+    }
+    if (shape.handover_keyframe() + 1 >= keyframes.size()) {
+      // The most slack there is room for: the hand-over keyframe must lie below the top one.
+      const auto most = std::int64_t(keyframes.size()) - std::int64_t(shape.handover_keyframe()) +
+                        std::int64_t(r.handover_slack) - 2;
+      throw InvalidArgument((given("handover_slack") ? at("handover_slack") : zone_at) + "handover_slack " +
+                            std::to_string(r.handover_slack) +
+                            " puts the hand-over keyframe at or past the top one (" +
+                            (most >= 0 ? std::to_string(most) + " at most" : "more keyframes needed") + ")");
+    }
+  }
+}
+
 }  // namespace
 
 bool BakeRecipe::gives_any_key(const std::string& text) {
-  std::istringstream in(text);
-  std::string line, key;
-  while (std::getline(in, line))
-    if (std::istringstream(line.substr(0, line.find('#'))) >> key) return true;
+  for (const std::string& line : text_lines(text))
+    if (!words_of(line).empty()) return true;
+  return false;
+}
+
+bool BakeRecipe::looks_like_recipe(const std::string& text) {
+  for (const std::string& line : text_lines(text.substr(0, 4096))) {
+    const std::vector<std::string> words = words_of(line);
+    if (words.empty()) continue;
+    return words.size() == 2 && (words[0] == "seed" || find_rule(words[0]));
+  }
   return false;
 }
 
 BakeRecipe BakeRecipe::parse(const std::string& text) {
+  // Bytes of a baked set where its recipe belongs (arguments swapped, or a .kdmt read as text).
+  if (text.rfind("KDMTILES", 0) == 0)
+    throw InvalidArgument("recipe: this is a kdm tile-set file (it starts with KDMTILES), not a recipe");
   BakeRecipe r;
-  std::istringstream in(text);
-  std::string line;
   int line_no = 0;
   std::map<std::string, int> seen;  // key -> the line that gave it
-  while (std::getline(in, line)) {
+  for (std::string line : text_lines(text)) {
     ++line_no;
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
-    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
-    std::istringstream fields(line);
-    std::string key, value, extra;
-    if (!(fields >> key)) continue;
+    const std::vector<std::string> words = words_of(line);
+    if (words.empty()) continue;
     const std::string where = "recipe line " + std::to_string(line_no) + ": ";
-    if (!(fields >> value) || (fields >> extra)) throw InvalidArgument(where + "expected 'key value'");
+    if (const std::string why = layout_error(line, words); !why.empty()) throw InvalidArgument(where + why);
+    const std::string &key = words[0], &value = words[1];
     // A second value would silently win over the first: which one the author meant is not known.
     if (const auto [it, first] = seen.emplace(key, line_no); !first)
       throw InvalidArgument(where + key + " was already given on line " + std::to_string(it->second));
@@ -102,6 +364,8 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
                               printable(value) + "'");
       continue;
     }
+    const KeyRule* k = find_rule(key);
+    if (!k) throw InvalidArgument(where + "unknown key '" + printable(key) + "'");
     // Decimal numbers only: strtod also reads hexadecimal, "inf" and "nan", and stops at a NUL byte.
     if (value.find_first_not_of("0123456789+-.eE") != std::string::npos)
       throw InvalidArgument(where + "'" + printable(value) + "' is not a number");
@@ -112,155 +376,18 @@ BakeRecipe BakeRecipe::parse(const std::string& text) {
       throw InvalidArgument(where + "'" + printable(value) + "' is not a number");
     if (errno == ERANGE && std::fabs(v) > 1)
       throw InvalidArgument(where + key + " " + value + " is out of range");
-    auto whole = [&](double lo, double hi) {
-      if (v != std::floor(v) || v < lo || v > hi)
-        throw InvalidArgument(where + key + " must be a whole number in [" +
-                              std::to_string(std::int64_t(lo)) + ", " + std::to_string(std::int64_t(hi)) +
-                              "], got '" + printable(value) + "'");
-      return v;
-    };
-    auto within = [&](double lo, double hi) {  // a number in [lo, hi]
-      if (!(v >= lo && v <= hi))
-        throw InvalidArgument(where + key + " must be in [" + shortest(lo) + ", " + shortest(hi) +
-                              "], got '" + printable(value) + "'");
-      return v;
-    };
-    if (key == "colours")
-      r.colours = static_cast<std::uint32_t>(whole(1, kMaxTileColours));
-    else if (key == "levels")
-      r.levels = static_cast<std::uint32_t>(whole(1, 10));
-    else if (key == "base_points")
-      r.base_points = static_cast<std::uint32_t>(whole(1, 1 << 16));
-    else if (key == "sweeps")
-      r.sweeps = static_cast<int>(whole(1, 10000));
-    else if (key == "band") {
-      if (!(v > 0 && v < 0.5)) throw InvalidArgument(where + "band must be in (0, 0.5)");
-      r.band = v;
-    } else if (key == "erosion") {
-      r.erosion = within(0, 8);
-    } else if (key == "edge_gap") {
-      r.edge_gap = within(0.5, 4);
-    } else if (key == "rank_context") {
-      r.rank_context = static_cast<int>(whole(0, 2));
-    } else if (key == "min_distance") {
-      r.min_distance = within(0, 0.7);
-    } else if (key == "separation") {
-      r.separation = within(0, 0.7);
-    } else if (key == "separation_push") {
-      r.separation_push = within(0, 0.9);
-    } else if (key == "split_shared") {
-      r.split_shared = whole(0, 1) != 0;
-    } else if (key == "separation_fill") {
-      r.separation_fill = whole(0, 1) != 0;
-    } else if (key == "separation_per_level") {
-      r.separation_per_level = whole(0, 1) != 0;
-    } else if (key == "fill_holes") {
-      if (v != 0 && !(v >= 0.5 && v <= 2))
-        throw InvalidArgument(where + "fill_holes must be 0 (off) or in [0.5, 2]");
-      r.fill_holes = v;
-    } else if (key == "glide_separation") {
-      r.glide_separation = within(0, 0.7);
-    } else if (key == "keyframes") {
-      r.keyframes_per_level = static_cast<std::uint32_t>(whole(0, 32));
-    } else if (key == "handover_zone") {
-      r.handover_zone = static_cast<std::uint32_t>(whole(0, 127));
-    } else if (key == "handover_level") {
-      r.handover_level = static_cast<std::uint32_t>(whole(0, 7));
-    } else if (key == "handover_slack") {
-      r.handover_slack = static_cast<std::uint32_t>(whole(0, kMaxHandoverSlack));
-    } else if (key == "glide_consensus") {
-      r.glide_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
-    } else if (key == "glide_corner_consensus") {
-      r.glide_corner_consensus = static_cast<std::uint32_t>(whole(0, 1 << 22));
-    } else if (key == "glide_late") {
-      r.glide_late = within(0, 0.95);
-    } else if (key == "glide_sweeps") {
-      r.glide_sweeps = static_cast<int>(whole(1, 1000));
-    } else if (key == "temperature") {
-      r.temperature = within(0, kMaxTemperature);
-    } else {
-      throw InvalidArgument(where + "unknown key '" + printable(key) + "'");
-    }
+    if (const std::string why = range_error(*k, v, value); !why.empty()) throw InvalidArgument(where + why);
+    k->set(r, v);
   }
-  if (r.top_level_points() > (1u << 22)) throw InvalidArgument("recipe: more than 2^22 points per tile");
-  if (make_keyframe_nominal(r.nominal_counts(), r.keyframes_per_level).size() > kMaxKeyframes)
-    throw InvalidArgument("recipe: more than " + std::to_string(kMaxKeyframes) + " keyframes in all");
-  if (patch_widths(r.band, r.erosion, r.edge_gap, r.nominal_counts()).empty()) {
-    char text[300];  // every term named, base_points too: a sparse coarsest level is the usual cause
-    std::snprintf(text, sizeof text,
-                  "recipe: base_points %u with band %g, erosion %g and edge_gap %g leaves some level's edge "
-                  "patches narrower than half a point spacing (more base_points, or a smaller erosion or "
-                  "edge_gap, widens them)",
-                  unsigned(r.base_points), r.band, r.erosion, r.edge_gap);
-    throw InvalidArgument(text);
-  }
-  // Keys that only tune another's pass: alone they would do nothing, silently.
-  const auto needs = [&](const char* key, bool on, bool parent_on, const char* parent) {
-    if (on && !parent_on) throw InvalidArgument(std::string("recipe: ") + key + " needs " + parent);
-  };
-  needs("separation_push", r.separation_push > 0, r.separation > 0, "separation");
-  if (r.separation_push > 0 && r.separation_push < r.separation)
-    throw InvalidArgument("recipe: separation_push " + shortest(r.separation_push) +
-                          " must be at least separation " + shortest(r.separation));
-  needs("separation_fill", r.separation_fill, r.separation_push > 0, "separation_push");
-  needs("separation_per_level", r.separation_per_level, r.separation_push > 0, "separation_push");
-  needs("split_shared", r.split_shared, r.separation > 0 || r.glide_separation > 0,
-        "separation or glide_separation");
-  const bool track = r.keyframes_per_level > 0;
-  if (track && r.levels < 2)  // one level has no density between levels for a point to glide through
-    throw InvalidArgument("recipe: keyframes need 2 or more levels (a glide track runs between levels)");
-  needs("glide_sweeps", seen.count("glide_sweeps") > 0, track, "a glide track (keyframes)");
-  needs("glide_separation", r.glide_separation > 0, track, "a glide track (keyframes)");
-  needs("glide_consensus", r.glide_consensus > 0, track, "a glide track (keyframes)");
-  needs("glide_corner_consensus", r.glide_corner_consensus > 0, track, "a glide track (keyframes)");
-  needs("glide_late", r.glide_late > 0, track, "a glide track (keyframes)");
-  if (r.handover_level && !r.handover_zone)
-    throw InvalidArgument("recipe: handover_level needs handover_zone (a hand-over)");
-  if (r.handover_slack && !r.handover_zone)
-    throw InvalidArgument("recipe: handover_slack needs handover_zone (a hand-over)");
-  if (r.handover_zone) {
-    if (r.levels < 2 || r.levels > 9 || !r.keyframes_per_level)
-      throw InvalidArgument("recipe: handover_zone needs 2 to 9 levels and a glide track (keyframes)");
-    if (r.handover_level + 1 >= r.levels)
-      throw InvalidArgument("recipe: handover_level " + std::to_string(r.handover_level) +
-                            " must be below the top level (" + std::to_string(r.levels - 1) + ")");
-    const std::uint32_t m = 1u << (r.levels - 1 - r.handover_level);  // √(N_top / N_j)
-    // Subdivision: corner squares and edge bands must not meet (2 · zone + 1 < subtiles per side).
-    if (2 * r.handover_zone + 1 >= m) {
-      std::uint32_t levels = r.handover_level + 1;
-      while ((1u << (levels - 1 - r.handover_level)) <= 2 * r.handover_zone + 1) ++levels;
-      throw InvalidArgument(
-          "recipe: handover_zone " + std::to_string(r.handover_zone) + " needs at least " +
-          std::to_string(levels) + " levels" +
-          (r.handover_level ? " with handover_level " + std::to_string(r.handover_level) : std::string()) +
-          ": " + std::to_string(r.levels) + " give " + std::to_string(m) +
-          " subtiles per side, and 2 * zone + 1 must be below that (a set without a hand-over has no "
-          "handover_zone line)");
-    }
-    TilesetShape shape;
-    const std::vector<std::uint32_t> nominal = r.nominal_counts();
-    const std::vector<std::uint32_t> keyframes = make_keyframe_nominal(nominal, r.keyframes_per_level);
-    shape.level_nominal.assign(nominal.begin(), nominal.end());
-    shape.keyframe_nominal.assign(keyframes.begin(), keyframes.end());
-    shape.handover_level = r.handover_level, shape.handover_slack = r.handover_slack;
-    if (shape.handover_keyframe() + 1 < keyframes.size() &&
-        keyframes[shape.handover_keyframe()] > Tile::kMaxHandoverRank + 1) {
-      throw InvalidArgument("recipe: the hand-over keyframe holds " +
-                            std::to_string(keyframes[shape.handover_keyframe()]) +
-                            " points per subtile, more than a tile set's hand-over addresses (" +
-                            std::to_string(Tile::kMaxHandoverRank + 1) +
-                            "): fewer base_points, a lower handover_level or less handover_slack");
-    }
-    if (shape.handover_keyframe() + 1 >= keyframes.size()) {
-      // The most slack there is room for: the hand-over keyframe must lie below the top one.
-      const auto most = std::int64_t(keyframes.size()) - std::int64_t(shape.handover_keyframe()) +
-                        std::int64_t(r.handover_slack) - 2;
-      throw InvalidArgument("recipe: handover_slack " + std::to_string(r.handover_slack) +
-                            " puts the hand-over keyframe at or past the top one (" +
-                            (most >= 0 ? std::to_string(most) + " at most" : "more keyframes needed") + ")");
-    }
-  }
+  check_together(r, &seen);
   return r;
+}
+
+void BakeRecipe::validate() const {
+  for (const KeyRule& k : kKeyRules)
+    if (const std::string why = range_error(k, k.get(*this), shortest(k.get(*this))); !why.empty())
+      throw InvalidArgument("recipe: " + why);
+  check_together(*this, nullptr);
 }
 
 int BakeRecipe::sweeps_for(std::uint64_t level_points) const {
@@ -634,6 +761,7 @@ class Baker {
 
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads, const std::function<void(double)>& progress,
                          BakeReport* report) {
+  recipe.validate();  // a recipe made in code is held to parse's rules
   check_thread_count(threads);
   Baker baker(recipe, threads, progress);
   TilesetData set = baker.bake();

@@ -116,13 +116,22 @@ struct BakeRecipe {
   /// Needs handover_zone, and keyframes enough above N_j (an error names the most).
   std::uint32_t handover_slack = 0;
 
-  /// Parses recipe text. Throws InvalidArgument naming the line and problem (unknown key, bad value,
-  /// out-of-range count, patches that erode away).
+  /// Parses recipe text (lines end at LF, CR LF or CR). Throws InvalidArgument naming the line and problem
+  /// (a line that is not one 'key value' pair and why, unknown key, bad value, out-of-range count, a key
+  /// given without the key it tunes, patches that erode away), or the bytes of a tile-set file.
   static BakeRecipe parse(const std::string& text);
+  /// Throws InvalidArgument, with parse's message less the line, for a recipe parse would refuse: a value
+  /// out of its range, or keys that do not fit together (a key that tunes another counts as given when it
+  /// is not at its default). bake_tileset calls it first.
+  void validate() const;
   /// Whether `text` gives any key (a line with more than blanks and a comment). `kdm bake` and kdm.bake
   /// refuse a recipe that gives none: it is most likely the wrong file, and the defaults bake for minutes.
   static bool gives_any_key(const std::string& text);
-  /// The canonical text form (parse(to_text()) == *this).
+  /// Whether `text` looks like a recipe: its first line that gives something is a known key and a value
+  /// (`kdm info` and `kdm verify` say so when given one instead of a tile set).
+  static bool looks_like_recipe(const std::string& text);
+  /// The canonical text form (parse(to_text()) == *this), which a baked set stores: the keys that make
+  /// every set (seed to erosion) and the others only where they differ from their defaults.
   std::string to_text() const;
   /// MH sweeps for a level holding `level_points` points in all: `sweeps`, times 4096 / level_points
   /// (at most 64×) for small levels. They are cheap, and every finer level is built on them, so they get
@@ -141,10 +150,10 @@ struct BakeReport {
   std::size_t glide_split = 0, glide_removed = 0;  ///< after the glide track is relaxed
 };
 
-/// Bakes `recipe` (as BakeRecipe::parse checked it) on `threads` worker threads (0: default_thread_count());
-/// the file is the same for any count. `progress` (optional) receives the fraction done; `report`
-/// (optional) what the separation passes did. Throws InvalidArgument for a recipe whose values are in
-/// range but do not fit together (patches eroded too narrow, a context that leaves a patch no points).
+/// Bakes `recipe` on `threads` worker threads (0: default_thread_count()); the file is the same for any
+/// count. `progress` (optional) receives the fraction done; `report` (optional) what the separation passes
+/// did. Throws InvalidArgument, before any work, for a recipe BakeRecipe::validate refuses, and while
+/// baking for one that passes but leaves a patch no points (a context that holds them all).
 TilesetData bake_tileset(const BakeRecipe& recipe, int threads = 0,
                          const std::function<void(double)>& progress = {}, BakeReport* report = nullptr);
 
