@@ -719,6 +719,48 @@ TEST_F(CliTest, AnalyzeWritesJsonToStandardOutputAndSaysWhatItPooled) {
   EXPECT_NE(help.out.find("NumPy .npy"), std::string::npos) << help.out;
 }
 
+// '-' is standard input for a recipe and for a tile set; a recipe where a tile set belongs, and a set
+// where a recipe belongs, are named as such; a damaged size field is a damaged header, not a cut file.
+TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {
+  std::ofstream(path("r.recipe"))
+      << "# a first comment longer than the tile-set header's 64 fixed bytes, so "
+         "that a reader sees no key in them\nlevels 1\nbase_points 32\ncolours 1\n"
+         "sweeps 1\n";
+  const Outcome baked = kdm("bake - --threads 1 -o '" + path("r.kdmt") + "' < '" + path("r.recipe") + "'");
+  ASSERT_EQ(baked.status, 0) << baked.err;
+  const Outcome info = kdm("info - < '" + path("r.kdmt") + "'");
+  EXPECT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("(standard input) (" + std::to_string(fs::file_size(path("r.kdmt"))) + " bytes)"),
+            std::string::npos)
+      << info.out;
+  EXPECT_NE(info.out.find("  levels 1\n"), std::string::npos) << info.out;
+  const Outcome verified = kdm("verify - --runs 2 --no-seams < '" + path("r.kdmt") + "'");
+  EXPECT_EQ(verified.status, 0) << verified.out << verified.err;
+  EXPECT_NE(verified.out.find("checks passed"), std::string::npos) << verified.out;
+  for (const char* command : {"info", "verify"}) {
+    SCOPED_TRACE(command);
+    expect_error(
+        std::string(command) + " '" + path("r.recipe") + "'",
+        "bad magic) (file does not start with KDMTILES); it looks like a recipe: bake it with kdm bake '" +
+            path("r.recipe") + "' -o FILE.kdmt");
+  }
+  expect_error("info - < '" + path("r.recipe") + "'", "standard input: not a kdm tile set (bad magic)");
+  std::ofstream(path("notes.txt")) << "shopping list\n";  // not a recipe: no hint
+  const Outcome notes = kdm("info '" + path("notes.txt") + "'");
+  EXPECT_EQ(notes.err.find("looks like a recipe"), std::string::npos) << notes.err;
+  expect_error("bake - -o '" + path("x.kdmt") + "' < '" + path("r.kdmt") + "'",
+               "standard input is a tile-set file, not a recipe (its recipe: kdm info -)");
+  std::ofstream(path("eq.recipe")) << "levels = 2\n";
+  expect_error("bake '" + path("eq.recipe") + "' -o '" + path("x.kdmt") + "'",
+               "recipe line 1: '=' is not used: write 'levels 2'");
+  EXPECT_FALSE(fs::exists(path("x.kdmt")));
+  std::string damaged = slurp(path("r.kdmt"));
+  damaged[20] = static_cast<char>(damaged[20] ^ (1 << 4));  // the payload size's high bytes
+  std::ofstream(path("damaged.kdmt"), std::ios::binary) << damaged;
+  expect_error("info '" + path("damaged.kdmt") + "'",
+               "tile-set header checksum mismatch (header bytes are damaged)");
+}
+
 TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
   const Outcome r = kdm("--version");
   EXPECT_EQ(r.status, 0);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <memory>
 #include <sstream>
@@ -23,8 +24,22 @@
 namespace kdm::cli {
 namespace {
 
+/// How messages name an input: "standard input" for "-".
+std::string named(const std::string& path) {
+  return path == "-" ? std::string("standard input") : "'" + path + "'";
+}
+std::string recipe_named(const std::string& path) {
+  return path == "-" ? std::string("the recipe on standard input") : "recipe '" + path + "'";
+}
+/// `path` as a command line that reads it again would give it.
+std::string as_argument(const std::string& path) {
+  return path == "-" ? path : "'" + path + "'";
+}
+
 std::string read_text(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream file;
+  if (path != "-") file.open(path, std::ios::binary);
+  std::istream& in = path == "-" ? std::cin : file;
   if (!in) throw CommandError("cannot open recipe '" + path + "'");
   // A recipe is a few lines: reading stops past the header's cap for it, so an endless input (a device, a
   // pipe) or a directory fails instead of filling memory.
@@ -32,15 +47,15 @@ std::string read_text(const std::string& path) {
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) {
     std::error_code ec;
-    throw CommandError("cannot read recipe '" + path + "'" +
+    throw CommandError("cannot read " + recipe_named(path) +
                        (std::filesystem::is_directory(path, ec) ? ": it is a directory" : ""));
   }
   text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.compare(0, 8, "KDMTILES") == 0)  // the arguments swapped: a baked set where its recipe belongs
-    throw CommandError("'" + path + "' is a tile-set file, not a recipe (its recipe: kdm info '" + path +
-                       "')");
+  if (text.compare(0, 8, "KDMTILES") == 0)  // the arguments swapped: say how to see its recipe
+    throw CommandError(named(path) + " is a tile-set file, not a recipe (its recipe: kdm info " +
+                       as_argument(path) + ")");
   if (text.size() > kMaxTilesetHeaderBytes)
-    throw CommandError("recipe '" + path + "' is longer than " + std::to_string(kMaxTilesetHeaderBytes) +
+    throw CommandError(recipe_named(path) + " is longer than " + std::to_string(kMaxTilesetHeaderBytes) +
                        " bytes: not a recipe");
   return text;
 }
@@ -50,12 +65,12 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   try {
     const std::string text = read_text(recipe_path);
     if (!gen::BakeRecipe::gives_any_key(text))
-      throw CommandError("recipe '" + recipe_path +
-                         "' gives no key, only blank lines and comments (the "
+      throw CommandError(recipe_named(recipe_path) +
+                         " gives no key, only blank lines and comments (the "
                          "defaults alone bake for minutes: give at least one key, e.g. 'levels 6')");
     recipe = gen::BakeRecipe::parse(text);
   } catch (const gen::InvalidArgument& e) {
-    throw CommandError("'" + recipe_path + "': " + e.what());
+    throw CommandError(named(recipe_path) + ": " + e.what());
   }
   if (output == "-")  // a binary file, written atomically: never to a terminal or a pipe
     throw CommandError("-o -: a tile set is written to a file; name one, e.g. -o tiles.kdmt");
@@ -75,7 +90,7 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
     set = gen::bake_tileset(
         recipe, threads, [&bar](double f) { bar.update(f); }, &report);
   } catch (const gen::InvalidArgument& e) {  // the recipe's values, found while baking
-    throw CommandError("'" + recipe_path + "': " + e.what());
+    throw CommandError(named(recipe_path) + ": " + e.what());
   }
   bar.finish();
   const Status s = save_tileset(set, output, &detail);
@@ -107,16 +122,16 @@ std::string printable(const std::string& text) {
 
 void run_info(const std::string& path) {
   // The runtime answers what the file is: its header, then the set as queries would hold it.
-  std::vector<char> bytes;
+  const std::vector<char> bytes = read_tileset_input(path);
   TilesetHeader header;
   std::string detail;
-  Status s = read_tileset_file(path, bytes, &detail);
-  if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
+  Status s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
   Tileset loaded;
   if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), loaded, &detail);
-  if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  if (s != Status::kOk) throw tileset_error(path, s, detail, bytes);
   const TilesetData& set = loaded.data();
-  std::printf("file           %s (%zu bytes)\n", path.c_str(), bytes.size());
+  std::printf("file           %s (%zu bytes)\n", path == "-" ? "(standard input)" : path.c_str(),
+              bytes.size());
   const std::size_t resident = loaded.resident_bytes();
   std::printf("resident       %zu bytes (%.3g MiB) once loaded by the runtime\n", resident,
               double(resident) / (1 << 20));
@@ -164,18 +179,47 @@ void run_info(const std::string& path) {
 
 }  // namespace
 
+std::vector<char> read_tileset_input(const std::string& path) {
+  std::vector<char> bytes;
+  std::string detail;
+  // /dev/stdin: the runtime's reader, with its bounds on what it reads, reads standard input too.
+  if (const Status s = read_tileset_file(path == "-" ? "/dev/stdin" : path, bytes, &detail); s != Status::kOk)
+    throw CommandError(named(path) + ": " + status_message(s) + " (" + detail + ")");
+  return bytes;
+}
+
+CommandError tileset_error(const std::string& path, Status s, const std::string& detail,
+                           const std::vector<char>& bytes) {
+  std::string hint;
+  if (s == Status::kBadMagic) {
+    // The reader stops at the fixed header of a file without the magic: a recipe's first key line may lie
+    // past it, behind comments, so a named file is read again, a little further.
+    std::string start(bytes.begin(), bytes.end());
+    if (path != "-") {
+      std::ifstream in(path, std::ios::binary);
+      start.assign(4096, '\0');
+      in.read(start.data(), static_cast<std::streamsize>(start.size()));
+      start.resize(static_cast<std::size_t>(in.gcount()));
+    }
+    if (gen::BakeRecipe::looks_like_recipe(start))
+      hint = "; it looks like a recipe: bake it with kdm bake " + as_argument(path) + " -o FILE.kdmt";
+  }
+  return CommandError(named(path) + ": " + status_message(s) + " (" + detail + ")" + hint);
+}
+
 void add_tile_commands(CLI::App& app) {
   auto recipe = std::make_shared<std::string>();
   auto output = std::make_shared<std::string>();
   auto threads = std::make_shared<int>(0);
   CLI::App* bake =
       app.add_subcommand("bake", "Bake a tile set from a recipe (deterministic for any --threads)");
-  bake->add_option("recipe", *recipe,
-                   "Recipe file: 'key value' lines (seed, colours, levels, base_points, "
-                   "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
-                   "separation_push, split_shared, separation_fill, separation_per_level, fill_holes, "
-                   "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_corner_consensus, "
-                   "glide_late, handover_zone, handover_level, handover_slack)")
+  bake->add_option(
+          "recipe", *recipe,
+          "Recipe file ('-': standard input): 'key value' lines (seed, colours, levels, base_points, "
+          "temperature, sweeps, band, erosion, edge_gap, min_distance, rank_context, separation, "
+          "separation_push, split_shared, separation_fill, separation_per_level, fill_holes, "
+          "keyframes, glide_sweeps, glide_separation, glide_consensus, glide_corner_consensus, "
+          "glide_late, handover_zone, handover_level, handover_slack)")
       ->required();
   bake->add_option("-o,--output", *output, "Tile-set file to write (atomically)")->required();
   add_threads_option(bake, *threads, "the file does not depend on it");
@@ -184,7 +228,7 @@ void add_tile_commands(CLI::App& app) {
   auto info_path = std::make_shared<std::string>();
   CLI::App* info =
       app.add_subcommand("info", "Describe a tile-set file: header, recipe, tiles, levels, size");
-  info->add_option("file", *info_path, "Tile-set file")->required();
+  info->add_option("file", *info_path, "Tile-set file ('-': standard input)")->required();
   info->callback([=] { run_info(*info_path); });
 }
 

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <vector>
 
 #include "checked_options.h"
 #include "commands.h"
+#include "kdm/runtime/tileset_format.h"
 #include "kdm/verify/verify.h"
 #include "progress.h"
 
@@ -32,8 +34,9 @@ void run_verify(VerifyArgs args) {
     throw CommandError("--runs must be in [2, 1000]");
   TilesetData set;
   std::string detail;
-  const Status s = load_tileset(args.path, set, &detail);
-  if (s != Status::kOk) throw CommandError("'" + args.path + "': " + status_message(s) + " (" + detail + ")");
+  const std::vector<char> bytes = read_tileset_input(args.path);
+  const Status s = decode_tileset(bytes.data(), bytes.size(), set, &detail);
+  if (s != Status::kOk) throw tileset_error(args.path, s, detail, bytes);
   args.options.seams = !args.no_seams;
   args.options.direct_check = !args.no_direct;
   args.options.glide_track = !args.no_glide_track;
@@ -63,7 +66,7 @@ void add_verify_command(CLI::App& app) {
       "Judge every tile and level of a tile set against the full KDM sampler (the generator test); "
       "prints a table per level; exits 2 if any check fails, 1 if the file cannot be read or an option is "
       "wrong");
-  cmd->add_option("file", args->path, "Tile-set file")->required();
+  cmd->add_option("file", args->path, "Tile-set file ('-': standard input)")->required();
   cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (2 to 1000)")
       ->capture_default_str();
   cmd->add_option("--level", args->options.levels,

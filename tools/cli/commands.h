@@ -5,6 +5,9 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "kdm/runtime/status.h"
 
 namespace CLI {
 class App;
@@ -17,6 +20,14 @@ struct CommandError : std::runtime_error {
       : std::runtime_error(message), exit_status(status) {}
   int exit_status;  ///< 1, or what a command documents (kdm verify: 2 for a set that fails its checks)
 };
+
+/// The bytes of the tile-set file `path` ("-": standard input) as read_tileset_file reads them, or a
+/// CommandError when it cannot be read.
+std::vector<char> read_tileset_input(const std::string& path);
+/// The error for tile-set file `path` whose `bytes` the runtime refused with `s` and `detail`; for a recipe
+/// given instead, it says how to bake it.
+CommandError tileset_error(const std::string& path, Status s, const std::string& detail,
+                           const std::vector<char>& bytes);
 
 void add_sample_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
