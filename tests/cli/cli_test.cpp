@@ -173,6 +173,33 @@ TEST_F(CliTest, RadianceImagesKeepTheirDynamicRange) {
   EXPECT_LE(faint, 4u);  // read as 8 bits the faint part would be 1/28 as dense: about 120 points
 }
 
+// stb reads zeros past a Radiance file's end: every cut of a flat and a run-length file is refused, as are
+// the headers stb cannot read, by name.
+TEST_F(CliTest, RadianceImagesCutShortOrOtherwiseOrientedAreRefused) {
+  for (const char* name : {"flat.hdr", "rle.hdr"}) {
+    const std::string whole = slurp(std::string(KDM_SOURCE_DIR) + "/tests/fuzz/corpus/image/" + name);
+    kdm::tools::GreyImage image;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::load_grey_image_memory(whole.data(), whole.size(), image, error, name)) << error;
+    EXPECT_GT(image.at(0, 0), 0.0f);
+    for (std::size_t cut = whole.find("+X"); cut < whole.size(); ++cut) {
+      SCOPED_TRACE(std::string(name) + " cut at " + std::to_string(cut));
+      EXPECT_FALSE(kdm::tools::load_grey_image_memory(whole.data(), cut, image, error, name));
+      EXPECT_NE(error.find("cut short"), std::string::npos) << error;
+    }
+  }
+  const std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n";
+  const std::string flipped = header + "+Y 1 +X 1\n" + std::string(4, '\x80');
+  kdm::tools::GreyImage image;
+  std::string error;
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(flipped.data(), flipped.size(), image, error, "f.hdr"));
+  EXPECT_NE(error.find("only '-Y height +X width'"), std::string::npos) << error;
+  const std::string unformatted = "#?RADIANCE\n\n-Y 1 +X 1\n" + std::string(4, '\x80');
+  EXPECT_FALSE(
+      kdm::tools::load_grey_image_memory(unformatted.data(), unformatted.size(), image, error, "u.hdr"));
+  EXPECT_NE(error.find("FORMAT=32-bit_rle_rgbe"), std::string::npos) << error;
+}
+
 TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"

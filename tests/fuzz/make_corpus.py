@@ -82,6 +82,11 @@ def images():
     write("image", "rgb.bmp", bmp)
     tga = struct.pack("<BBBHHBHHHHBB", 0, 0, 3, 0, 0, 0, 0, 0, 2, 2, 8, 0) + bytes([0, 85, 170, 255])
     write("image", "grey.tga", tga)
+    # Radiance: flat RGBE pixels (narrow), and run-length scanlines (8 wide: one run and one dump per channel).
+    header = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n"
+    write("image", "flat.hdr", header + b"-Y 2 +X 2\n" + bytes([128, 128, 128, 129, 64, 0, 0, 120] * 2))
+    scanline = b"\x02\x02\x00\x08" + (bytes([132, 200]) + bytes([4, 1, 2, 3, 4])) * 3 + bytes([136, 130])
+    write("image", "rle.hdr", header + b"-Y 2 +X 8\n" + scanline * 2)
     # tiny.jpg with an EXIF segment after its SOI: big-endian TIFF, one entry, Orientation 6.
     with open(os.path.join(HERE, "image", "tiny.jpg"), "rb") as f:
         jpeg = f.read()

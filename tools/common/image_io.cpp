@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 
@@ -248,6 +250,54 @@ bool pnm_faults(const std::uint8_t* data, std::size_t size) {
   return h.max_value <= 65535 && h.pixel_bytes() > size - h.pixels_at;  // (stb refuses larger maxima)
 }
 
+// What is wrong with a Radiance (.hdr) file that stb would read anyway, or "": stb's reader takes zeros for
+// bytes past the end, so a file cut short gives a wrong density with no error, and the headers it does not
+// read (another orientation, no FORMAT line) it calls an unknown type. Walks the header and the scanlines
+// as stbi__hdr_load does.
+std::string radiance_fault(const std::uint8_t* data, std::size_t size) {
+  const std::string_view all(reinterpret_cast<const char*>(data), size);
+  if (all.rfind("#?RADIANCE\n", 0) != 0 && all.rfind("#?RGBE\n", 0) != 0) return "";
+  std::size_t pos = all.find('\n') + 1;
+  bool format = false;
+  for (;;) {  // header lines up to an empty one
+    const std::size_t end = all.find('\n', pos);
+    if (end == std::string_view::npos) return "a Radiance image cut short in its header";
+    const std::string_view line = all.substr(pos, end - pos);
+    pos = end + 1;
+    if (line.empty()) break;
+    format = format || line == "FORMAT=32-bit_rle_rgbe";
+  }
+  if (!format) return "a Radiance image without the line FORMAT=32-bit_rle_rgbe (the only format read)";
+  const std::size_t end = all.find('\n', pos);
+  if (end == std::string_view::npos) return "a Radiance image cut short in its size line";
+  const std::string_view line = all.substr(pos, end - pos);
+  long long h = 0, w = 0;
+  if (std::sscanf(std::string(line).c_str(), "-Y %lld +X %lld", &h, &w) != 2 || h <= 0 || w <= 0)
+    return "a Radiance image whose size line is '" + std::string(line.substr(0, 40)) +
+           "': only '-Y height +X width' (rows from the top, left to right) is read";
+  pos = end + 1;
+  const auto flat_from = [&](std::size_t at) {  // stb then reads the whole image as plain 4-byte pixels
+    return std::uint64_t(size - at) / 4 / std::uint64_t(w) < std::uint64_t(h);
+  };
+  if (w < 8 || w >= 32768) return flat_from(pos) ? "a Radiance image cut short in its pixels" : "";
+  for (long long j = 0; j < h; ++j) {
+    if (size - pos < 4) return "a Radiance image cut short in its pixels";
+    if (data[pos] != 2 || data[pos + 1] != 2 || (data[pos + 2] & 0x80))
+      return flat_from(pos) ? "a Radiance image cut short in its pixels" : "";
+    pos += 4;
+    for (int channel = 0; channel < 4; ++channel)
+      for (long long i = 0; i < w;) {
+        if (pos >= size) return "a Radiance image cut short in its pixels";
+        const int count = data[pos++], n = count > 128 ? count - 128 : count;
+        if (n == 0 || n > w - i) return "";  // bad run-length data: stb says so
+        pos += count > 128 ? 1 : std::size_t(n);
+        i += n;
+      }
+    if (pos > size) return "a Radiance image cut short in its pixels";
+  }
+  return "";
+}
+
 // The input stb would fault on, or nullptr.
 const char* stb_fault(const std::uint8_t* data, std::size_t size) {
   if (jpeg_faults(data, size)) return "corrupt JPEG (a Huffman table of more than 256 codes)";
@@ -432,6 +482,10 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
     return false;
   }
   if (const char* fault = stb_fault(bytes, size)) {
+    error = "cannot read image '" + name + "': " + fault;
+    return false;
+  }
+  if (const std::string fault = radiance_fault(bytes, size); !fault.empty()) {
     error = "cannot read image '" + name + "': " + fault;
     return false;
   }
