@@ -200,6 +200,14 @@ TEST(GeneratorTest, VerifierSuggestsAnotherSeedWhereOnlyTheCoarsestLevelsFail) {
   const Report report = verify_tileset(damaged, o);
   EXPECT_FALSE(report.passed());
   EXPECT_NE(printed(report).find("another seed usually passes"), std::string::npos) << printed(report);
+
+  // Bars of the caller's own, such as a largest hole no set meets, are not a seed's luck.
+  VerifyOptions strict = parts(false, false, true);
+  strict.levels = {0};
+  strict.holes = true, strict.bars.hole_largest = 0.01;
+  const Report holes = verify_tileset(shipped(), strict);
+  EXPECT_FALSE(holes.passed());
+  EXPECT_EQ(printed(holes).find("another seed"), std::string::npos) << printed(holes);
 }
 
 // A tile with the content of another tile whose NW corner has a different colour: its corner and edge
