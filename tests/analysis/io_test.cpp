@@ -159,7 +159,11 @@ TEST(PointFiles, CsvHeadersAreReadByTheirColumnNames) {
   for (const char* text :
        {"x, y\n0.25, 0.5\n0.75, 0.125\n", "X,Y\n0.25,0.5\n0.75,0.125\n", "y,x\n0.5,0.25\n0.125,0.75\n",
         "id,x,y\np1,0.25,0.5\np2,0.75,0.125\n", "\"x\",\"y\",\"note\"\n0.25,0.5,a b\n0.75,0.125,\n",
-        "x y\n0.25 0.5\n0.75 0.125\n"}) {
+        "x y\n0.25 0.5\n0.75 0.125\n",
+        // pandas' unnamed index column, a trailing comma, Excel's UTF-8 byte-order mark, a quoted comma
+        ",x,y\n0,0.25,0.5\n1,0.75,0.125\n", "x,y,\n0.25,0.5,\n0.75,0.125,\n",
+        "\xEF\xBB\xBFx,y\n0.25,0.5\n0.75,0.125\n",
+        "\"x\",\"y\",\"note, with comma\"\n0.25,0.5,\"a, b\"\n0.75,0.125,c\n"}) {
     SCOPED_TRACE(text);
     const tools::PointSet set = read_one(text, "named.csv");
     EXPECT_EQ(set.dim, 2);
@@ -177,6 +181,13 @@ TEST(PointFiles, CsvHeadersAreReadByTheirColumnNames) {
   EXPECT_NE(read_error("a,b\n0.1,0.2\n", "ab.csv").find(":1: header 'a,b': expected columns named x and y"),
             std::string::npos);
   EXPECT_NE(read_error("x,X,y\n0.1,0.2,0.3\n", "twice.csv").find("names column x twice"), std::string::npos);
+  EXPECT_NE(read_error("x,y,class,label\n0.1,0.2,0,1\n", "cl.csv").find("names the class twice"),
+            std::string::npos);
+  EXPECT_NE(read_error("x;y\n0.1;0.2\n", "semi.csv").find("not semicolons"), std::string::npos);
+  EXPECT_NE(read_error("x,y,class\n0.1,0.2,a\n", "letter.csv")
+                .find(":2: a class must be an integer 0 to 255, not 'a'"),
+            std::string::npos);
+  EXPECT_EQ(read_error(",\n0.1,0.2\n", "unnamed.csv").find("header"), std::string::npos);  // no name: a row
   EXPECT_NE(read_error("x,y,z,class\n0.1,0.2,0.3,1\n", "zc.csv").find("classes are for 2D points"),
             std::string::npos);
   EXPECT_NE(read_error("id,x,y\n1,0.2\n", "short.csv").find(":2: expected 3 columns, found 2"),
@@ -256,7 +267,8 @@ TEST(PointFiles, NpyFilesRead) {
       {npy(c2, bytes_of<double>({0.25, std::nan(""), 0.75, 0.125})), "non-finite coordinate in row 1"},
       {std::string("\x93NUMPY\x01\x00\xff\xff", 10), "cut short in its header"},
       {std::string("\x93NUMPY\x02\x00\xff\xff\xff\x7f", 12), "a header of 2147483647 bytes"},
-      {std::string("\x93NUMPY\x07\x00", 8), "unknown format version 7"}};
+      {std::string("\x93NUMPY\x07\x00", 8), "unknown format version 7"},
+      {std::string("\x93NUMPX\x01\x00", 8), "not a NumPy .npy file"}};
   for (const auto& [bytes, message] : refused) {
     const std::string error = read_error(bytes, "bad.npy");
     EXPECT_NE(error.find(message), std::string::npos) << error;

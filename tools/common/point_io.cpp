@@ -148,14 +148,20 @@ struct Header {
   int columns = 0, x = -1, y = -1, z = -1, label = -1;
 };
 
-/// `line` cut into fields at commas, or where it has none at blanks and tabs; each trimmed of blanks, '\r'
-/// and enclosing quotes.
+/// `line` cut into fields at commas (not those inside double quotes, as CSV writers quote them), or where
+/// it has none at blanks and tabs; each trimmed of blanks, '\r' and enclosing quotes.
 std::vector<std::string> split_fields(const std::string& line) {
   std::vector<std::string> fields;
   const bool commas = line.find(',') != std::string::npos;
   std::size_t at = 0;
   while (at <= line.size()) {
-    std::size_t end = commas ? line.find(',', at) : line.find_first_of(" \t", at);
+    std::size_t end = at;
+    if (commas) {
+      for (bool quoted = false; end < line.size() && (quoted || line[end] != ','); ++end)
+        if (line[end] == '"') quoted = !quoted;
+    } else {
+      end = line.find_first_of(" \t", at);
+    }
     if (end == std::string::npos) end = line.size();
     std::string f = line.substr(at, end - at);
     const std::size_t a = f.find_first_not_of(" \t\r"), b = f.find_last_not_of(" \t\r");
@@ -179,17 +185,21 @@ bool parse_number(const std::string& field, double& v) {
 }
 
 /// Whether a first line is a column header: printable text whose every field is a name (it starts with a
-/// letter or '_' and is no number such as "nan"), not a row of numbers or a binary file's first bytes.
+/// letter or '_' and is no number such as "nan") or empty (pandas' unnamed index column, a trailing
+/// comma), at least one a name; not a row of numbers or a binary file's first bytes.
 bool is_header(const std::string& head) {
   for (char c : head)
     if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r') return false;
+  bool named = false;
   for (const std::string& f : split_fields(head)) {
     double v;
-    if (f.empty() || parse_number(f, v)) return false;
+    if (f.empty()) continue;
+    if (parse_number(f, v)) return false;
     const unsigned char c = static_cast<unsigned char>(f[0]);
     if (!std::isalpha(c) && c != '_') return false;
+    named = true;
   }
-  return true;
+  return named;
 }
 
 /// Reads a header's columns: x and y (and z, and the class as "class" or "label") by name, trimmed and in
@@ -208,13 +218,18 @@ bool parse_header(const std::string& head, Header& h, std::string& error) {
                                                        : nullptr;
     if (!column) continue;
     if (*column >= 0) {
-      error = "header '" + excerpt(head) + "' names column " + name + " twice";
+      error = "header '" + excerpt(head) + "' names " +
+              (column == &h.label ? std::string("the class twice (class and label are one column)")
+                                  : "column " + name + " twice");
       return false;
     }
     *column = i;
   }
   if (h.x < 0 || h.y < 0) {
-    error = "header '" + excerpt(head) + "': expected columns named x and y (and z, class)";
+    error =
+        "header '" + excerpt(head) + "': expected columns named x and y (and z, class)" +
+        (head.find(';') != std::string::npos ? ", separated by commas, or by blanks and tabs, not semicolons"
+                                             : "");
     return false;
   }
   if (h.z >= 0 && h.label >= 0) {
@@ -375,8 +390,8 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
     char magic[6];
     const std::streamsize got = in.rdbuf()->sgetn(magic, 6);
     if (got == 6 && std::memcmp(magic, kNpyMagic, 6) == 0) return read_npy(in, path, sets, error);
-    error =
-        path + ":1: malformed number in '" + excerpt(std::string(magic, static_cast<std::size_t>(got))) + "'";
+    error = path + ": not a NumPy .npy file: it starts with '" +
+            excerpt(std::string(magic, static_cast<std::size_t>(got))) + "', not \\x93NUMPY";
     return false;
   }
   PointSet current;
@@ -392,6 +407,7 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
   std::vector<double> values;
   while (read_line(in, line, too_long)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos) continue;
     if (line[first] == '#') {
@@ -420,7 +436,9 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
         if (column < 0) continue;
         double v;
         if (!parse_number(fields[column], v)) {
-          error = where + ": malformed number in '" + excerpt(line) + "'";
+          error = where + (column == header.label ? ": a class must be an integer 0 to 255, not '" +
+                                                        excerpt(fields[column]) + "'"
+                                                  : ": malformed number in '" + excerpt(line) + "'");
           return false;
         }
         if (column == header.label) {
