@@ -40,6 +40,16 @@ TEST(PointFiles, ReadsSeveralSets) {
   EXPECT_DOUBLE_EQ(sets[1].coords[3], 0.8);
   const std::vector<tools::PointSet> all = load_point_sets({path, path});
   EXPECT_EQ(all.size(), 4u);
+  // Labelled and unlabelled files are refused together before any measure, naming the file.
+  const std::string labelled = write_temp("labelled.csv", "x,y,class\n0.1,0.2,0\n0.5,0.6,1\n");
+  try {
+    load_point_sets({labelled, path});
+    ADD_FAILURE() << "pooled labelled and unlabelled points";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(path + " (set 1): points without classes after labelled ones"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 /// `set` written to the temporary file `name` and read back: the one set it must hold.

@@ -41,6 +41,12 @@ std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& pat
       if (!all.empty() && sets[k].dim != all.front().dim)
         throw InvalidInput(path + ": " + std::to_string(sets[k].dim) + "D points after " +
                            std::to_string(all.front().dim) + "D ones");
+      // Classes are measured over every set pooled: one set without them leaves them meaningless.
+      if (!all.empty() && sets[k].classes.empty() != all.front().classes.empty())
+        throw InvalidInput(path + " (set " + std::to_string(k + 1) + "): " +
+                           (sets[k].classes.empty() ? "points without classes after labelled ones"
+                                                    : "labelled points after points without classes") +
+                           ": pool labelled files only with labelled ones");
       whole = whole && whole_third_column(sets[k]);
       try {
         validate_points(sets[k].coords, sets[k].dim);
