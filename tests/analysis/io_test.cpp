@@ -298,6 +298,11 @@ TEST(Json, WriterEscapesAndNulls) {
   w.key("t").value(true).end_object();
   EXPECT_EQ(w.str(), "{\n  \"a\\\"b\":null,\n  \"v\":[1.5,2],\n  \"s\":\"x\\ny\",\n  \"t\":true\n}\n");
   EXPECT_EQ(json_quote(std::string("\x01", 1)), "\"\\u0001\"");
+  // UTF-8 passes through; a byte of no character (a Latin-1 file name, a cut sequence) is written as \ufffd.
+  EXPECT_EQ(json_quote("lat\xC3\xA9 \xE2\x82\xAC"), "\"lat\xC3\xA9 \xE2\x82\xAC\"");
+  EXPECT_EQ(json_quote("lat\xE9.csv"), "\"lat\\ufffd.csv\"");
+  EXPECT_EQ(json_quote("\xE2\x82"), "\"\\ufffd\\ufffd\"");
+  EXPECT_EQ(json_quote("\xC0\xAF\xED\xA0\x80"), "\"\\ufffd\\ufffd\\ufffd\\ufffd\\ufffd\"");
 }
 
 TEST(Report, AnalyzeAggregatesSets) {

@@ -8,9 +8,36 @@
 
 namespace kdm::analysis {
 
+namespace {
+
+/// The length of the well-formed UTF-8 sequence at s[i] (RFC 3629: no overlong forms, no surrogates, at most
+/// U+10FFFF), or 0.
+std::size_t utf8_sequence(const std::string& s, std::size_t i) {
+  const auto at = [&](std::size_t k) { return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u; };
+  const unsigned c = at(i);
+  const std::size_t n = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c < 0xE0 ? 2 : 0;
+  if (n == 0 || c > 0xF4) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((at(i + k) & 0xC0) != 0x80) return 0;
+  const unsigned second = at(i + 1);
+  if ((c == 0xE0 && second < 0xA0) || (c == 0xED && second >= 0xA0) || (c == 0xF0 && second < 0x90) ||
+      (c == 0xF4 && second >= 0x90))
+    return 0;
+  return n;
+}
+
+}  // namespace
+
 std::string json_quote(const std::string& s) {
   std::string q = "\"";
-  for (unsigned char c : s) {
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x80) {  // JSON is UTF-8: a byte of no character (a Latin-1 file name) is written as \ufffd
+      const std::size_t n = utf8_sequence(s, i);
+      q += n ? s.substr(i, n) : "\\ufffd";
+      i += n ? n - 1 : 0;
+      continue;
+    }
     switch (c) {
       case '"':
         q += "\\\"";
@@ -33,7 +60,7 @@ std::string json_quote(const std::string& s) {
           std::snprintf(buf, sizeof buf, "\\u%04x", c);
           q += buf;
         } else {
-          q += static_cast<char>(c);  // UTF-8 passes through unchanged
+          q += static_cast<char>(c);
         }
     }
   }
