@@ -771,6 +771,8 @@ TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {
         "bad magic) (file does not start with KDMTILES); it looks like a recipe: bake it with kdm bake '" +
             path("r.recipe") + "' -o FILE.kdmt");
   }
+  expect_error("query --tileset '" + path("r.recipe") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
+               "it looks like a recipe: bake it with kdm bake");
   expect_error("info - < '" + path("r.recipe") + "'", "standard input: not a kdm tile set (bad magic)");
   std::ofstream(path("notes.txt")) << "shopping list\n";  // not a recipe: no hint
   const Outcome notes = kdm("info '" + path("notes.txt") + "'");

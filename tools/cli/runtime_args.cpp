@@ -39,7 +39,7 @@ const Tileset& tileset_for(const std::string& path, Tileset& storage) {
   }
   std::string detail;
   const Status s = Tileset::load_file(path, storage, &detail);
-  if (s != Status::kOk) throw CommandError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  if (s != Status::kOk) throw tileset_error(path, s, detail, {});
   return storage;
 }
 
