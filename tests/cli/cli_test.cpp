@@ -208,6 +208,11 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   expect_error("sample --n 100 --temperature nan" + out, "temperature");
   expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
   expect_error("sample --n 100 --temperature 1e4" + out, "temperature must be at most 1000");
+  // A 3D tube under 0.6 point spacings across stalled the sampler for minutes: refused at once.
+  expect_error("sample --dim 3 --aspect 30000" + out, "0.51 of a point spacing across");
+  expect_error("sample --dim 3 --n 1000 --aspect 7000" + out, "in 3D the sampler needs 0.6");
+  expect_error("sample --dim 3 --aspect 0.002" + out, "a short side of at least about 0.35");
+  EXPECT_EQ(kdm("sample --dim 3 --n 1000 --aspect 4000" + out).status, 0);
   const Outcome hot = kdm("sample --n 100 --temperature 1000" + out);  // the limit itself is taken
   EXPECT_EQ(hot.status, 0) << hot.err;
   expect_error("sample --n 100 --density const:0" + out, "const:V");  // all-zero density
