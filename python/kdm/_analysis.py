@@ -135,8 +135,9 @@ def analyze(
     threads = _checks.threads(threads)
     energy = _checks.flag("energy", energy)
     if sets[0].shape[1] == 3 and (spec is not None or function is not None or tile_size is not None):
-        warnings.warn("density and tiling diagnostics are 2D only; skipped", stacklevel=2)
-        spec, function, tile = None, None, 0.0
+        warnings.warn("density windows and tiling diagnostics are 2D only; skipped (a density still sets "
+                      "the energy, as kdm analyze's does)", stacklevel=2)
+        tile = 0.0
     min_expected = _checks.number("min_expected", min_expected, 0.0, strict=True)
     density_bands = _checks.integer("density_bands", density_bands, 1, 1000)
     holes_min_density = _checks.number("holes_min_density", holes_min_density, 0.0)

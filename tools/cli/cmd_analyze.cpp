@@ -150,7 +150,9 @@ void run_analyze(const AnalyzeArgs& args) {
                      "take its points in the unit square, so distances and the spectrum are stretched\n",
                      file.c_str(), aspect);
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
-      std::fprintf(stderr, "kdm: warning: density and tiling diagnostics are 2D only; skipped\n");
+      std::fprintf(stderr,
+                   "kdm: warning: density windows and tiling diagnostics are 2D only; skipped (a --density "
+                   "still sets the energy)\n");
     // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
     const bool to_stdout = args.output == tools::kStandardOutput;
     std::FILE* text = to_stdout ? stderr : stdout;
