@@ -293,6 +293,8 @@ def test_analyze_skips_the_2d_diagnostics_of_3d_points():
     with pytest.warns(UserWarning, match="2D only; skipped"):
         given = kdm.analyze(p, density="ramp:100", tile_size=0.5, threads=1)
     assert "tiling" not in given and "density" not in given
+    assert given["spectrum_skipped"].startswith("2D only") and "spectrum" not in given
+    assert given["empty_circles_skipped"].startswith("2D only")
     with pytest.warns(UserWarning, match="2D only"):
         function = kdm.analyze(p, density=lambda x, y, z: 100.0 ** -x, threads=1)
     assert given["energy_per_point"] == pytest.approx(function["energy_per_point"], rel=1e-6)

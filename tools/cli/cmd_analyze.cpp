@@ -201,8 +201,9 @@ void run_analyze(const AnalyzeArgs& args) {
 
 void add_analyze_command(CLI::App& app) {
   auto args = std::make_shared<AnalyzeArgs>();
-  CLI::App* cmd =
-      app.add_subcommand("analyze", "Point-set metrics: NN distances, spectrum, g(r), density, tiling");
+  CLI::App* cmd = app.add_subcommand("analyze",
+                                     "Point-set metrics: NN distances, spectrum, g(r), holes, density, "
+                                     "tiling (3D sets: NN distances, g(r) and the energy)");
   cmd->add_option("files", args->files,
                   "Point files: text (one point per line, blanks or commas between coordinates, sets "
                   "separated by '#' lines), CSV with a header naming columns x and y (and z, or class/label "

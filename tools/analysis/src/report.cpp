@@ -117,12 +117,15 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     r.spectrum = average_periodogram(sets, o.fmax, o.threads);
     r.spectrum_stats = spectrum_stats(r.spectrum);
     r.has_spectrum = true;
+  } else if (o.spectrum) {
+    r.spectrum_skipped = "2D only (3D sets get nearest neighbours, g(r) and the energy)";
   }
   checkpoint();
   r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
   checkpoint();
   if (r.dim == 2 && r.points_min < 3)
     r.empty_circles_skipped = "a set of fewer than 3 points has no triangle";
+  if (r.dim != 2) r.empty_circles_skipped = "2D only (no empty spheres)";
   if (r.dim == 2 && r.points_min >= 3) {
     EmptyCircleOptions eo;
     eo.torus = o.torus;
