@@ -29,7 +29,8 @@ class PythonDensity {
         const double v = value.cast<double>();
         if (std::isfinite(v) && v >= 0) return v;
         refused_ = "density returned " + std::to_string(v) + " at (" + std::to_string(u[0]) + ", " +
-                   std::to_string(u[1]) + "): values must be finite and >= 0";
+                   std::to_string(u[1]) + (dim_ == 3 ? ", " + std::to_string(u[2]) : "") +
+                   "): values must be finite and >= 0";
       } catch (py::error_already_set& e) {
         raised_ = std::make_unique<py::error_already_set>(std::move(e));
       } catch (const py::cast_error&) {

@@ -204,7 +204,7 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"
   expect_error("sample --n 4000000000" + out, "too large");  // beyond 2^31 points
-  expect_error("sample --n 100000000" + out, "limit");       // the grid would exceed max_grid_nodes
+  expect_error("sample --n 100000000" + out, "about 8.86e+06 points at most");  // over max_grid_nodes
   expect_error("sample --n 100 --temperature nan" + out, "temperature");
   expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
   expect_error("sample --n 100 --temperature 1e4" + out, "temperature must be at most 1000");

@@ -194,8 +194,10 @@ def test_a_function_density():
 
     with pytest.raises(KeyError, match="no density here"):  # the function's own exception
         kdm.sample(100, fails)
-    with pytest.raises(ValueError, match=r"density returned -1\.0+ at .*finite and >= 0"):
+    with pytest.raises(ValueError, match=r"density returned -1\.0+ at \([0-9.]+, [0-9.]+\): .*finite and >= 0"):
         kdm.sample(100, lambda x, y: -1.0)
+    with pytest.raises(ValueError, match=r"density returned -1\.0+ at \([0-9.]+, [0-9.]+, [0-9.]+\)"):
+        kdm.sample(100, lambda x, y, z: -1.0, dim=3)  # all three coordinates
     with pytest.raises(ValueError, match="density must return a number"):
         kdm.sample(100, lambda x, y: "dense")
     with pytest.raises(ValueError, match="zero everywhere"):

@@ -200,7 +200,8 @@ void add_sample_command(CLI::App& app) {
          "--density", args->density,
          "const:V, an image whose darkness is the density (a Radiance .hdr keeps its range, scaled by "
          "its brightest pixel: with --invert, bright is dense), or a test map: ramp:R (R^-x, dynamic "
-         "range R) or radial:R (R^-(2r) around the centre, 1/R past r = 0.5)")
+         "range R) or radial:R (R^-(2r) around the centre, 1/R past r = 0.5; both by x and y alone, so in 3D "
+         "a ramp along x and a cylinder along z)")
       ->capture_default_str();
   cmd->add_option("--class", args->classes,
                   "Several classes (instead of --density): repeat it, one density each, highest priority "

@@ -25,7 +25,7 @@ struct DensitySpec {
   bool analytic() const { return kind == Kind::kRamp || kind == Kind::kRadial; }
   /// The test maps at unit position (u, v) in [0, 1]²: ramp R^-u (1 at the left edge, 1/R at the right),
   /// radial R^-(r/0.5) with r the distance from the centre, 1/R beyond r = 0.5 (continuous across a
-  /// torus's edges). 1 for other kinds.
+  /// torus's edges). 1 for other kinds. A 3D sample reads them at (x, y): a ramp along x, a cylinder.
   double map_at(double u, double v) const;
   /// The largest value anywhere (1 for the test maps), and the mean over the unit square.
   double max_value() const;

@@ -211,7 +211,10 @@ Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
     if (fewest < 2) throw too_narrow(o);  // refining the grid only makes it larger: say what is wrong
     std::ostringstream s;
     s << "the density needs a computational grid of " << nodes << " nodes, more than the limit of "
-      << o.max_grid_nodes << " (ask for fewer points, a smaller dynamic range or a squarer domain)";
+      << o.max_grid_nodes << ": about " << std::setprecision(3)
+      << double(o.n) * double(o.max_grid_nodes) / nodes
+      << " points at most with this density and domain (ask for fewer points, a smaller dynamic range or "
+         "a squarer domain)";
     throw InvalidArgument(s.str());
   }
   Grid<D> g;
