@@ -200,6 +200,26 @@ TEST_F(CliTest, RadianceImagesCutShortOrOtherwiseOrientedAreRefused) {
   EXPECT_NE(error.find("FORMAT=32-bit_rle_rgbe"), std::string::npos) << error;
 }
 
+// .npy: an (n, d) float64 array of the same numbers as .txt holds, which kdm analyze reads back.
+TEST_F(CliTest, SampleWritesNumPyArrays) {
+  for (const int dim : {2, 3}) {
+    const std::string args = "sample --n 300 --dim " + std::to_string(dim) + " -o '";
+    ASSERT_EQ(kdm(args + path("p.npy") + "'").status, 0);
+    ASSERT_EQ(kdm(args + path("p.txt") + "'").status, 0);
+    std::vector<kdm::tools::PointSet> npy, txt;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::read_point_sets(path("p.npy"), npy, error)) << error;
+    ASSERT_TRUE(kdm::tools::read_point_sets(path("p.txt"), txt, error)) << error;
+    EXPECT_EQ(npy.at(0).dim, dim);
+    EXPECT_EQ(npy.at(0).coords, txt.at(0).coords);  // .txt's 17 digits give back every bit
+    const std::string bytes = slurp(path("p.npy"));
+    EXPECT_EQ(bytes.substr(0, 8), std::string("\x93NUMPY\x01\x00", 8));
+    EXPECT_EQ(bytes.size(), 128 + 300 * dim * 8u);  // the header padded to 64-byte alignment
+  }
+  expect_error("sample --n 100 --class const:1 --class const:2 -o '" + path("c.npy") + "'", "not .npy");
+  EXPECT_FALSE(fs::exists(path("c.npy")));
+}
+
 TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"

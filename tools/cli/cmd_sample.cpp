@@ -19,7 +19,7 @@
 namespace kdm::cli {
 namespace {
 
-const std::vector<const char*> kSampleFormats = {".txt", ".csv", ".svg", ".png"};
+const std::vector<const char*> kSampleFormats = {".txt", ".csv", ".npy", ".svg", ".png"};
 
 struct SampleArgs {
   gen::SamplerOptions options;
@@ -55,6 +55,8 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (args.classes.size() > 8)
     throw CommandError("--class given " + std::to_string(args.classes.size()) + " times; at most 8 classes");
   const bool classed = !args.classes.empty();
+  if (classed && format == ".npy")
+    throw CommandError("--class writes its classes to .csv (x,y,class) or pictures, not .npy");
   if (classed && args.options.n <= 0) throw CommandError("--class needs --n > 0 (the points of all classes)");
   if (classed && args.options.dim != 2) throw CommandError("--class samples 2D points: drop --dim 3");
   std::vector<tools::DensitySpec> specs;
@@ -235,9 +237,11 @@ void add_sample_command(CLI::App& app) {
                   "the output is the same")
       ->check(CLI::IsMember({4, 8, 16}))
       ->capture_default_str();
-  cmd->add_option("-o,--output", args->output,
-                  "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,z][,class]), .svg or .png; - for "
-                  "standard output (with --format)")
+  cmd->add_option(
+         "-o,--output", args->output,
+         "Output file: .txt (UTK/psa points in [0,1)), .csv (x,y[,z][,class]), .npy (NumPy: an (n, 2) or "
+         "(n, 3) float64 array; not with classes), .svg or .png; - for "
+         "standard output (with --format)")
       ->required();
   add_format_option(cmd, args->format, kSampleFormats);
   cmd->callback([args, cmd] {

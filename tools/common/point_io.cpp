@@ -61,7 +61,7 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
   // A file named for another format than --format gives it: its viewer would misread it.
   const std::string named = output_format(path);
   if (!format.empty() && named != ext)
-    for (const char* other : {".txt", ".csv", ".json", ".svg", ".png"})
+    for (const char* other : {".txt", ".csv", ".npy", ".json", ".svg", ".png"})
       if (named == other) {
         error = "--format " + ext.substr(1) + " would write " + ext.substr(1) + " into '" + path + "', a " +
                 named.substr(1) + " file name: name the file ." + ext.substr(1);
@@ -501,10 +501,43 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
   return true;
 }
 
+namespace {
+
+/// `set` as a NumPy .npy file (format 1.0): an (n, dim) little-endian float64 array in C order, as
+/// np.load reads it; the header padded with blanks so the data start at a multiple of 64 bytes.
+std::string npy_bytes(const PointSet& set) {
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(set.size()) +
+                     ", " + std::to_string(set.dim) + "), }";
+  const std::size_t unpadded = 10 + dict.size() + 1;
+  dict.append((64 - unpadded % 64) % 64, ' ');
+  dict += '\n';
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out += static_cast<char>(dict.size() & 0xFF);
+  out += static_cast<char>(dict.size() >> 8);
+  out += dict;
+  const std::size_t at = out.size();
+  out.resize(at + set.coords.size() * sizeof(double));
+  for (std::size_t i = 0; i < set.coords.size(); ++i) {  // little-endian whatever the host
+    std::uint64_t bits;
+    std::memcpy(&bits, &set.coords[i], sizeof bits);
+    for (int b = 0; b < 8; ++b) out[at + 8 * i + b] = static_cast<char>(bits >> (8 * b) & 0xFF);
+  }
+  return out;
+}
+
+}  // namespace
+
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
                      std::string& error, const std::string& format) {
   const bool csv = output_format(path, format) == ".csv";
   const bool labelled = !set.classes.empty();
+  if (output_format(path, format) == ".npy") {
+    if (labelled) {
+      error = "'" + path + "': points with classes are written as .csv (x,y,class)";
+      return false;
+    }
+    return write_text_file_atomic(path, npy_bytes(set), error);
+  }
   if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
     error = "'" + path + "': " +
             (set.dim != 2 ? std::string("points with classes are 2D only")

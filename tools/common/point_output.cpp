@@ -104,15 +104,16 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
                   const DrawStyle& style, const std::string& format) {
   std::string error;
   const std::string ext = output_format(path, format);
-  if (ext == ".txt" || ext == ".csv") {
+  if (ext == ".txt" || ext == ".csv" || ext == ".npy") {
     if (!write_point_set(path, points, header, error, ext)) throw std::runtime_error(error);
     return;
   }
   const bool png = ext == ".png", svg = ext == ".svg";
   if (!png && !svg)
-    throw std::invalid_argument("unknown output format for '" + path + "' (use .txt, .csv, .svg or .png)");
+    throw std::invalid_argument("unknown output format for '" + path +
+                                "' (use .txt, .csv, .npy, .svg or .png)");
   if (points.dim != 2)
-    throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt or .csv for 3D");
+    throw std::invalid_argument("pictures (.png, .svg) need 2D points; write .txt, .csv or .npy for 3D");
   const int w = std::max(1, style.width_px);
   const int h = check_picture_size(style.width_px, style.aspect, path, ext, style.height_px);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
