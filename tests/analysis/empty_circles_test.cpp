@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "empty_circles_copies.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/empty_circles.h"
 #include "test_sets.h"
@@ -78,6 +79,31 @@ TEST(EmptyCircles, WideHolesAndFewPointsAreTriangulatedWhole) {
     const double d = hex_spacing(s.size()), found = farthest_from_every_point(s, 200);
     EXPECT_GE(e.largest * d + 1e-12, found) << s.size() << " points";
     EXPECT_LE(e.largest * d, found + std::sqrt(0.5) / 200) << s.size() << " points";
+  }
+}
+
+// A torus set is copied only where a circle through the square may reach (beside its wide holes): the
+// same circles as copies in a margin widened until every circle lies in it, for sets whose holes are far
+// wider than their spacing (a steep ramp: its sparse side, a band, a cluster), lattices and a few points.
+TEST(EmptyCircles, CopiesAroundTheHolesFindTheCirclesOfAWholeMargin) {
+  std::vector<tools::PointSet> sets;
+  tools::PointSet ramp = uniform_set(3000, 4);  // density ∝ e^(-20 x): 5·10^8 from one side to the other
+  for (std::size_t p = 0; p < ramp.size(); ++p)
+    ramp.coords[2 * p] = -std::log1p(-ramp.coords[2 * p] * (1 - std::exp(-20.0))) / 20;
+  sets.push_back(ramp);
+  tools::PointSet band = uniform_set(2000, 1), cluster = uniform_set(1500, 2);
+  for (std::size_t p = 0; p < band.size(); ++p) band.coords[2 * p] = 0.25 + 0.5 * band.coords[2 * p];
+  for (double& v : cluster.coords) v = 0.4 + 0.1 * v;
+  sets.insert(sets.end(), {band, cluster, uniform_set(2000, 5), testing::jittered_grid(40, 6),
+                           torus_hex_lattice(26, 30)});
+  for (std::size_t n = 3; n <= 12; ++n) sets.push_back(uniform_set(n, 9));
+  for (const tools::PointSet& s : sets) {
+    std::vector<double> around = detail::torus_circumradii(s.coords, detail::TorusCopies::kAroundHoles);
+    std::vector<double> margin = detail::torus_circumradii(s.coords, detail::TorusCopies::kMargin);
+    EXPECT_EQ(around.size(), 2 * s.size()) << s.size() << " points";
+    std::sort(around.begin(), around.end());
+    std::sort(margin.begin(), margin.end());
+    EXPECT_EQ(around, margin) << s.size() << " points";
   }
 }
 

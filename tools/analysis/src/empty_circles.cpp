@@ -6,11 +6,14 @@
 #include "kdm/analysis/empty_circles.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <numeric>
+#include <queue>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -19,6 +22,7 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include "empty_circles_copies.h"
 #include "kdm/analysis/common.h"
 #include "parallel.h"
 
@@ -48,6 +52,13 @@ constexpr double kMoveBound = 0x1p-21;
 /// sides in the triangulation, and the given points' circle of such a sliver is no empty circle at all: in
 /// one set it was 5 d_hex where the largest is 2.
 Circle delaunay_circle(const std::vector<double>& xy, const std::vector<double>& moved, int i, int j, int k) {
+  // Corners in order of position, not as the triangulation lists them (which depends on what else was
+  // triangulated): the same triangle gives the same bits however the set was copied.
+  int v[3] = {i, j, k};
+  std::sort(v, v + 3, [&](int a, int b) {
+    return std::tie(xy[2 * a], xy[2 * a + 1]) < std::tie(xy[2 * b], xy[2 * b + 1]);
+  });
+  std::tie(i, j, k) = std::tie(v[0], v[1], v[2]);
   const Circle given = circumcircle(&xy[2 * i], &xy[2 * j], &xy[2 * k]);
   const Circle m = circumcircle(&moved[2 * i], &moved[2 * j], &moved[2 * k]);
   // Flat as given (a row of a grid, one point a hair from the next across the torus's seam): the moved
@@ -132,15 +143,37 @@ struct SetCircles {
   std::size_t over_085 = 0, over_100 = 0, over_085_near_edge = 0, near_edge_judged = 0;
 };
 
-/// The circumcircles of a torus set's Delaunay triangles, each once: in the copy that holds its lowest-
-/// numbered point itself (a rule of indices and whole shifts, so no rounding counts a triangle twice or
-/// never). The set is
-/// triangulated with its copies within a margin m of the square; a circle that lies within the copies is
-/// empty of every point, copies beyond the margin too: a Delaunay triangle of the torus. A torus of n
-/// points has 2n of them (Euler): fewer, or a circle past the copies, mean the margin was too narrow for
-/// some (a wide hole, or few points). It then grows and the set is triangulated again, up to m = 2: no
-/// empty circle of a torus is wider than √2/2, so none reaches farther than √2 past its lowest point.
-std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing) {
+/// The circumcircles of the Delaunay triangles of a torus set's n points and copies of them (`xy`: the points
+/// first, then the copies; `original`: the point each stands for) that count: each in the copy that holds
+/// its lowest-numbered point itself (a rule of indices and whole shifts, so no rounding counts a triangle
+/// twice or never). A circle that lies where every copy of every point is present is empty of every point:
+/// a Delaunay triangle of the torus. A torus of n points has 2n of them (Euler).
+std::vector<Circle> counted_circles(std::vector<double>& xy, const std::vector<std::size_t>& original,
+                                    std::size_t n) {
+  std::vector<Circle> circles;
+  delaunay(
+      xy,
+      [&](int i, int j, int k, const std::vector<double>& moved) {
+        const int v[3] = {i, j, k};
+        // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
+        // one translate of the triangle has the point itself there.
+        const int* first = std::min_element(v, v + 3, [&](int a, int b) {
+          return std::tie(original[a], xy[2 * a], xy[2 * a + 1]) <
+                 std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
+        });
+        if (std::size_t(*first) >= n) return;  // another copy's
+        const Circle c = delaunay_circle(xy, moved, i, j, k);
+        if (std::isfinite(c.r)) circles.push_back(c);  // else flat
+      },
+      &original);
+  return circles;
+}
+
+/// The circumcircles of a torus set's Delaunay triangles, each once, with the set's copies within a margin
+/// m of the square: fewer than 2n circles, or one past the copies, mean the margin was too narrow for some
+/// (a wide hole, or few points). It then grows and the set is triangulated again, up to m = 2: no empty
+/// circle of a torus is wider than √2/2, so none reaches farther than √2 past its lowest point.
+std::vector<Circle> torus_circles_by_margin(const std::vector<double>& coords, double spacing) {
   const std::size_t n = coords.size() / 2;
   for (double m = std::min(2.0, 4 * spacing);;) {
     std::vector<double> xy = coords;
@@ -154,28 +187,156 @@ std::vector<Circle> torus_circles(const std::vector<double>& coords, double spac
           if ((sx || sy) && x > -m && x < 1 + m && y > -m && y < 1 + m)
             xy.insert(xy.end(), {x, y}), original.push_back(i);
         }
-    std::vector<Circle> circles;
+    const std::vector<Circle> circles = counted_circles(xy, original, n);
     double reach = 0;  // how far the circles reach past the square
-    delaunay(
-        xy,
-        [&](int i, int j, int k, const std::vector<double>& moved) {
-          const int v[3] = {i, j, k};
-          // Lowest-numbered point first, and of two copies of it (a few points) the one lowest in x, then y:
-          // one translate of the triangle has the point itself there.
-          const int* first = std::min_element(v, v + 3, [&](int a, int b) {
-            return std::tie(original[a], xy[2 * a], xy[2 * a + 1]) <
-                   std::tie(original[b], xy[2 * b], xy[2 * b + 1]);
-          });
-          if (std::size_t(*first) >= n) return;  // another copy's
-          const Circle c = delaunay_circle(xy, moved, i, j, k);
-          if (!std::isfinite(c.r)) return;  // flat
-          circles.push_back(c);
-          reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
-        },
-        &original);
+    for (const Circle& c : circles)
+      reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
     if ((reach <= m && circles.size() == 2 * n) || m >= 2) return circles;
     m = std::min(2.0, std::max(2 * m, 1.01 * reach));
   }
+}
+
+/// Where a torus set's copies are needed: cells about a spacing wide over the square and around it, those
+/// that a Delaunay circle through a point of the square may cover. An empty circle centred in a cell d
+/// cells (centre to centre) from the nearest one holding a point is at most d + √2 cells wide. A margin as
+/// wide as the widest hole all round copied a steep ramp's dense side 25 times (10^5 points of ramp:1e9:
+/// 2.5 million points, 29 s and 1.6 GB); this copies it only beside the wide holes (0.16 million).
+class CopyRegion {
+ public:
+  CopyRegion(const std::vector<double>& coords, double spacing) {
+    g_ = std::clamp(static_cast<int>(1 / spacing), 1, 1024);
+    const std::size_t n = coords.size() / 2;
+    // For each cell, the cell holding a point nearest it (or nearly: Danielsson's propagation of nearest
+    // sites, in order of distance), as an offset in cells on the torus.
+    std::vector<std::array<int, 2>> site(std::size_t(g_) * g_, {kNone, kNone});
+    auto length2 = [](const std::array<int, 2>& o) { return double(o[0]) * o[0] + double(o[1]) * o[1]; };
+    using Entry = std::pair<double, std::size_t>;  // squared offset, cell
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t c = std::size_t(cell(coords[2 * i + 1])) * g_ + cell(coords[2 * i]);
+      if (site[c][0] == kNone) site[c] = {0, 0}, queue.push({0.0, c});
+    }
+    while (!queue.empty()) {
+      const auto [d2, q] = queue.top();
+      queue.pop();
+      if (d2 > length2(site[q])) continue;  // improved since
+      const int cx = int(q % g_), cy = int(q / g_);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const std::size_t c = std::size_t((cy + dy + g_) % g_) * g_ + (cx + dx + g_) % g_;
+          const std::array<int, 2> o = {site[q][0] - dx, site[q][1] - dy};
+          if (site[c][0] == kNone || length2(o) < length2(site[c])) site[c] = o, queue.push({length2(o), c});
+        }
+    }
+    // The widest circle centred in a cell, in cells: a point lies within the cells' centres' distance and
+    // two half diagonals; no empty circle of a torus is wider than √2/2. The slack covers the moves.
+    std::vector<double> widest(site.size());
+    for (std::size_t c = 0; c < site.size(); ++c)
+      widest[c] = std::min(std::sqrt(length2(site[c])) + std::sqrt(2.0), std::sqrt(0.5) * g_) + kSlack;
+    const int far = static_cast<int>(std::ceil(*std::max_element(widest.begin(), widest.end())));
+    // Cells up to `far` outside the square may centre a circle through a point in it, which may reach
+    // `far` cells further.
+    margin_ = 2 * far + 1;
+    side_ = g_ + 2 * margin_;
+    // reach: how many cells around a cell a circle centred in it or near may cover; spread from each
+    // cell that may centre a circle through the square to its neighbours, one less each step.
+    std::vector<int> reach(std::size_t(side_) * side_, -1);
+    for (int j = -margin_; j < g_ + margin_; ++j)
+      for (int i = -margin_; i < g_ + margin_; ++i) {
+        const double w = widest[std::size_t(wrap(j)) * g_ + wrap(i)];
+        const double dx = i < 0 ? -i - 1 : std::max(0, i - g_), dy = j < 0 ? -j - 1 : std::max(0, j - g_);
+        if (dx * dx + dy * dy <= w * w) reach[index(i, j)] = static_cast<int>(std::ceil(w));
+      }
+    for (int pass = 0; pass < 2; ++pass) {  // Rosenfeld and Pfaltz's two raster passes
+      const int step = pass ? -1 : 1;
+      for (int jj = 0; jj < side_; ++jj)
+        for (int ii = 0; ii < side_; ++ii) {
+          const int i = pass ? side_ - 1 - ii : ii, j = pass ? side_ - 1 - jj : jj;
+          int& r = reach[std::size_t(j) * side_ + i];
+          const int before[4][2] = {{-step, 0}, {-step, -step}, {0, -step}, {step, -step}};
+          for (const auto& b : before) {
+            const int bi = i + b[0], bj = j + b[1];
+            if (bi >= 0 && bi < side_ && bj >= 0 && bj < side_)
+              r = std::max(r, reach[std::size_t(bj) * side_ + bi] - 1);
+          }
+        }
+    }
+    // Cells left out, summed (their count in any rectangle of cells: contains()).
+    left_out_.assign(std::size_t(side_ + 1) * (side_ + 1), 0);
+    for (int j = 0; j < side_; ++j)
+      for (int i = 0; i < side_; ++i) {
+        const bool square = i >= margin_ && i < margin_ + g_ && j >= margin_ && j < margin_ + g_;
+        const std::size_t at = std::size_t(j + 1) * (side_ + 1) + (i + 1);
+        left_out_[at] = (!square && reach[std::size_t(j) * side_ + i] < 0) + left_out_[at - 1] +
+                        left_out_[at - side_ - 1] - left_out_[at - side_ - 2];
+      }
+  }
+
+  /// The points, then their copies in the region: `original` says which point each is.
+  void copies(const std::vector<double>& coords, std::vector<double>& xy,
+              std::vector<std::size_t>& original) const {
+    const std::size_t n = coords.size() / 2;
+    xy = coords;
+    original.resize(n);
+    std::iota(original.begin(), original.end(), std::size_t(0));
+    const int shifts = (margin_ + g_ - 1) / g_;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int cx = cell(coords[2 * i]), cy = cell(coords[2 * i + 1]);
+      for (int sx = -shifts; sx <= shifts; ++sx)
+        for (int sy = -shifts; sy <= shifts; ++sy)
+          if ((sx || sy) && !left_out(cx + sx * g_, cy + sy * g_, cx + sx * g_, cy + sy * g_))
+            xy.insert(xy.end(), {coords[2 * i] + sx, coords[2 * i + 1] + sy}), original.push_back(i);
+    }
+  }
+
+  /// Whether every cell a circle covers, widened by the slack, holds its copies.
+  bool contains(const Circle& c) const {
+    const double lo = -margin_, hi = g_ + margin_;
+    const double x0 = (c.x - c.r) * g_ - kSlack, x1 = (c.x + c.r) * g_ + kSlack;
+    const double y0 = (c.y - c.r) * g_ - kSlack, y1 = (c.y + c.r) * g_ + kSlack;
+    if (!(x0 >= lo && y0 >= lo && x1 < hi && y1 < hi)) return false;
+    return !left_out(int(std::floor(x0)), int(std::floor(y0)), int(std::floor(x1)), int(std::floor(y1)));
+  }
+
+ private:
+  int cell(double v) const { return std::min(g_ - 1, std::max(0, static_cast<int>(v * g_))); }
+  int wrap(int i) const { return ((i % g_) + g_) % g_; }
+  std::size_t index(int i, int j) const { return std::size_t(j + margin_) * side_ + (i + margin_); }
+  /// Whether a cell in [i0, i1] × [j0, j1] (cells of the plane, 0 to g − 1 the square's) is left out.
+  bool left_out(int i0, int j0, int i1, int j1) const {
+    if (i0 < -margin_ || j0 < -margin_ || i1 >= g_ + margin_ || j1 >= g_ + margin_) return true;
+    auto at = [&](int i, int j) { return left_out_[std::size_t(j + margin_) * (side_ + 1) + (i + margin_)]; };
+    return at(i1 + 1, j1 + 1) - at(i0, j1 + 1) - at(i1 + 1, j0) + at(i0, j0) > 0;
+  }
+
+  static constexpr int kNone = std::numeric_limits<int>::min();
+  /// Cells of slack (0.01 of a cell, at most 1024 cells to the side: 10^-5, ten moves and more) for the
+  /// moves of the points and the rounding of a point to its cell.
+  static constexpr double kSlack = 0.01;
+  int g_ = 1, margin_ = 0, side_ = 1;
+  std::vector<std::int64_t> left_out_;  // (side + 1)² prefix sums of the cells without copies
+};
+
+/// The circumcircles of a torus set's Delaunay triangles, each once, triangulated with the copies of
+/// CopyRegion; none if a circle does not lie where the copies are present or they are fewer than 2n (a
+/// flat triangle).
+std::vector<Circle> torus_circles_around_holes(const std::vector<double>& coords, double spacing) {
+  const std::size_t n = coords.size() / 2;
+  const CopyRegion region(coords, spacing);
+  std::vector<double> xy;
+  std::vector<std::size_t> original;
+  region.copies(coords, xy, original);
+  std::vector<Circle> circles = counted_circles(xy, original, n);
+  const auto inside = [&](const Circle& c) { return region.contains(c); };
+  if (circles.size() != 2 * n || !std::all_of(circles.begin(), circles.end(), inside)) circles.clear();
+  return circles;
+}
+
+/// The circumcircles of a torus set's Delaunay triangles, each once: with the copies around its holes, or
+/// failing that with a margin; both give the same circles.
+std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing) {
+  std::vector<Circle> circles = torus_circles_around_holes(coords, spacing);
+  return circles.empty() ? torus_circles_by_margin(coords, spacing) : circles;
 }
 
 /// The box set's circumcircles: those centred at least `border` spacings inside the square.
@@ -244,6 +405,19 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
 }
 
 }  // namespace
+
+namespace detail {
+
+std::vector<double> torus_circumradii(const std::vector<double>& coords, TorusCopies copies) {
+  const double spacing = hex_spacing(coords.size() / 2);
+  std::vector<double> radii;
+  for (const Circle& c : copies == TorusCopies::kAroundHoles ? torus_circles_around_holes(coords, spacing)
+                                                             : torus_circles_by_margin(coords, spacing))
+    radii.push_back(c.r);
+  return radii;
+}
+
+}  // namespace detail
 
 EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& o) {
   if (sets.empty()) throw InvalidInput("no point sets");
