@@ -98,7 +98,8 @@ def analyze(
         arrays, and its nulls as NaN, but tiling.lattice_power_ratio as inf for a strictly periodic set
         (no power off the tile lattice; NaN when no lattice frequency lies in the spectrum). The nearest-
         neighbour histogram's last bin counts every distance from histogram_max on (histogram_overflow of
-        them). A min_expected above a set's count leaves one window (z = 0) and warns. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
+        them). spectrum.nonuniform, present for a set that is not uniform, says why: its spectrum then
+        measures its density's variation, not blue-noise quality. A min_expected above a set's count leaves one window (z = 0) and warns. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
         their count): with ``box=True`` circles centred within two spacings of a side are left out.
     """
     # A list whose entries are 2-D (arrays or nested lists) is several sets; else it is one set's points.

@@ -394,5 +394,34 @@ TEST(Report, TheSummarySaysWhatCannotBeMeasured) {
   EXPECT_EQ(format_summary(analyze({set}, o)).find("warning: no window"), std::string::npos);
 }
 
+// The spectrum of a set that is not uniform measures its density, and the summary says so beside it: for
+// a target density that varies, or (with none given) windows whose counts vary far beyond Poisson. Its
+// numbers stay as they are; uniform sets, white noise too, get no note.
+TEST(Report, TheSpectrumOfANonUniformSetSaysWhatItMeasures) {
+  AnalysisOptions o;
+  o.fmax = 1;
+  const std::string note = "note: not a uniform set (";
+  for (const tools::PointSet& uniform : {testing::jittered_grid(64, 3), testing::uniform_set(4096, 4)}) {
+    const AnalysisReport r = analyze({uniform}, o);
+    EXPECT_TRUE(r.spectrum_nonuniform.empty()) << r.spectrum_nonuniform;
+    EXPECT_EQ(format_summary(r).find(note), std::string::npos);
+    EXPECT_EQ(metrics_json(r, {"a"}).find("\"nonuniform\""), std::string::npos);
+  }
+  tools::PointSet ramp = testing::uniform_set(4096, 5);  // density ∝ 1/√x
+  for (std::size_t p = 0; p < ramp.size(); ++p) ramp.coords[2 * p] *= ramp.coords[2 * p];
+  const AnalysisReport plain = analyze({ramp}, o);
+  EXPECT_NE(plain.spectrum_nonuniform.find("window counts vary far beyond Poisson"), std::string::npos)
+      << plain.spectrum_nonuniform;
+  const std::string summary = format_summary(plain);
+  const std::size_t next = summary.find('\n', summary.find("spectrum (f")) + 1;
+  EXPECT_EQ(summary.find(note), summary.find_first_not_of(' ', next)) << summary;  // the spectrum's next line
+  EXPECT_NE(metrics_json(plain, {"a"}).find("\"nonuniform\":\"window counts"), std::string::npos);
+  o.density = [](double x, double) { return 1 / std::sqrt(x + 1e-9); };
+  const AnalysisReport target = analyze({ramp}, o);
+  EXPECT_EQ(target.spectrum_nonuniform, "the target density is not constant");
+  EXPECT_EQ(target.spectrum_stats.low_p, plain.spectrum_stats.low_p);
+  EXPECT_EQ(target.spectrum_stats.peak, plain.spectrum_stats.peak);
+}
+
 }  // namespace
 }  // namespace kdm::analysis

@@ -26,6 +26,46 @@ bool whole_third_column(const tools::PointSet& set) {
 
 constexpr const char* kClassHeaderHint = "a class column needs the header line x,y,class";
 
+/// RMS z of window counts above which a set is not uniform: Poisson points give 1, blue noise well under.
+constexpr double kNonuniformRmsZ = 3;
+
+/// Why the sets are not uniform, or "": a target density that varies by more than 10% over the square,
+/// or windows of equal area whose counts vary far beyond Poisson (`uniform_rms_z`: their RMS z when the
+/// density test already counted them, else NaN). The spectrum of such a set measures its density.
+std::string nonuniform_reason(const std::vector<tools::PointSet>& sets, const AnalysisOptions& o,
+                              double uniform_rms_z) {
+  if (o.density) {
+    double lo = HUGE_VAL, hi = 0;
+    constexpr int kGrid = 64;
+    for (int j = 0; j < kGrid; ++j)
+      for (int i = 0; i < kGrid; ++i) {
+        const double v = o.density((i + 0.5) / kGrid, (j + 0.5) / kGrid);
+        lo = std::min(lo, v), hi = std::max(hi, v);
+      }
+    if (hi > 1.1 * lo) return "the target density is not constant";
+  }
+  double rms_z = uniform_rms_z;
+  if (!std::isfinite(rms_z)) {
+    DensityOptions dopt;
+    dopt.min_expected = o.min_expected;
+    dopt.bands = 1;
+    double z2 = 0, windows = 0;
+    for (const tools::PointSet& s : sets) {
+      const DensityAccuracy d = density_accuracy(
+          s.coords, 2, [](double, double) { return 1.0; }, dopt);
+      z2 += d.rms_z * d.rms_z * double(d.windows), windows += double(d.windows);
+    }
+    rms_z = windows > 0 ? std::sqrt(z2 / windows) : 0;
+  }
+  if (rms_z > kNonuniformRmsZ) {
+    char why[128];
+    std::snprintf(why, sizeof why,
+                  "window counts vary far beyond Poisson: RMS z %.1f against a uniform density", rms_z);
+    return why;
+  }
+  return "";
+}
+
 }  // namespace
 
 std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& paths,
@@ -182,6 +222,13 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     r.density_min_expected = o.min_expected;
   }
 
+  if (r.has_spectrum) {
+    checkpoint();
+    // The density test's windows are those of a uniform density when its target is constant.
+    const double rms_z = r.has_density && r.density.windows > 0 ? r.density.rms_z : std::nan("");
+    r.spectrum_nonuniform = nonuniform_reason(sets, o, rms_z);
+  }
+
   if (o.tile_size > 0) {
     r.has_tiling = true;
     r.tile_size = o.tile_size;
@@ -240,6 +287,11 @@ std::string format_summary(const AnalysisReport& r) {
       append(s, "  anisotropy %.1f dB\n", st.anisotropy_db);
     else
       append(s, "  anisotropy n/a (no ring above f = 0.5)\n");
+    if (!r.spectrum_nonuniform.empty())
+      append(s,
+             "                   note: not a uniform set (%s): the spectrum measures the density's own "
+             "variation, not blue-noise quality\n",
+             r.spectrum_nonuniform.c_str());
   }
   double gmax = 0, rpeak = 0;
   for (std::size_t b = 0; b < r.gr.g.size(); ++b)

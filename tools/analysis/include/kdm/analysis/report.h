@@ -57,6 +57,9 @@ struct AnalysisReport {
   std::string spectrum_skipped;  ///< why a 2D analysis has none (sets more than 10% apart in count), or ""
   Periodogram spectrum;          ///< set-averaged periodogram
   SpectrumStats spectrum_stats;
+  /// Why the set is not uniform (a target density that varies; window counts far beyond Poisson), or "":
+  /// then the spectrum's low frequencies measure the density's own variation, not blue-noise quality.
+  std::string spectrum_nonuniform;
   PairCorrelation gr;
   bool has_empty_circles = false;     ///< 2D sets of at least 3 points that span an area
   std::string empty_circles_skipped;  ///< why a 2D analysis has none (few or degenerate points), or ""
