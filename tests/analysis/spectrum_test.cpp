@@ -107,8 +107,19 @@ TEST(Periodogram, WhiteNoiseIsOne) {
   }
   EXPECT_NEAR(sum / weight, 1.0, 5 * std::sqrt(2.0 / (weight * 4.0)));
   EXPECT_EQ(st.nu_eff, 0.0);  // the first ring is not below 0.1
-  // Anisotropy: per ring var/mean² of the 4-set average ≈ 1/4 → about −6 dB.
+  // Anisotropy: per ring var/mean² of the 4-set average ≈ 1/4 → about −6 dB, on every ring of many k (one
+  // above f = 0.5 holds at least 200, half of them independent: the ratio's sd is under 0.2 of it, and
+  // 3 dB is a factor 2); the figure is their mean over 0.5 < f < 2.5.
   EXPECT_NEAR(st.anisotropy_db, 10 * std::log10(1.0 / 4), 0.5);
+  ASSERT_EQ(st.ring_anisotropy_db.size(), st.raps.size());
+  double in_range = 0;
+  int rings = 0;
+  for (std::size_t r = 0; r < st.raps.size(); ++r)
+    if (st.ring_f[r] > 0.5 && st.ring_f[r] < 2.5) {
+      EXPECT_NEAR(st.ring_anisotropy_db[r], 10 * std::log10(1.0 / 4), 3.0) << "ring " << r + 1;
+      in_range += st.ring_anisotropy_db[r], ++rings;
+    }
+  EXPECT_NEAR(in_range / rings, st.anisotropy_db, 1e-12);
 }
 
 TEST(Periodogram, JitteredGridMatchesSincFormula) {
@@ -167,6 +178,11 @@ TEST(Periodogram, TorusHexLatticePeaksAtReciprocalLattice) {
   EXPECT_NEAR(st.peak_f, 30.0 / std::sqrt(n), 1e-12);
   EXPECT_NEAR(st.nu_eff, 29.0 / std::sqrt(n), 1e-12);  // every ring below 30 is exactly 0
   EXPECT_NEAR(st.low_p, 0.0, 1e-6);
+  // All of ring 30's power lies on its six lattice frequencies: var/mean² = K/6 − 1 of its K (about 190)
+  // bins, some 15 dB, where an isotropic set's one ring reads about 0 dB.
+  const double ring30 = st.ring_anisotropy_db[29];
+  EXPECT_NEAR(ring30, 10 * std::log10(st.ring_size[29] / 6.0 - 1), 0.1);
+  EXPECT_GT(ring30, 10);
 }
 
 // raps.png's value labels stay apart at any peak: at a peak of 100 (a lattice) a fixed step of 2 stacked

@@ -468,3 +468,17 @@ def test_a_signal_stops_an_analysis_between_its_measures():
     points = np.random.default_rng(3).random((150_000, 2))
     call = lambda: kdm.analyze(points, energy=False, threads=1)  # noqa: E731
     assert interrupted("analyze", call, 0.3) == ["c_exception"]
+
+
+def test_anisotropy_by_ring_finds_a_lattice_and_not_the_sampler():
+    # A square lattice holds its peak ring's power on four of its some 400 frequencies (about 20 dB); the
+    # full sampler's peak ring is isotropic, near 0 dB for one set (its sd there is about 1 dB).
+    m = 64
+    lattice = (np.stack(np.meshgrid(np.arange(m), np.arange(m)), -1).reshape(-1, 2) + 0.5) / m
+    grid = kdm.analyze(lattice, energy=False, threads=1)["spectrum"]
+    blue = kdm.analyze(kdm.sample(m * m, seed=3, threads=1), energy=False, threads=1)["spectrum"]
+    for s in (grid, blue):
+        assert isinstance(s["anisotropy_db_by_ring"], np.ndarray)
+        assert len(s["anisotropy_db_by_ring"]) == len(s["raps_f"])
+    assert grid["anisotropy_db_by_ring"][np.argmax(grid["raps"])] > 15
+    assert abs(blue["anisotropy_db_by_ring"][np.argmax(blue["raps"])]) < 3

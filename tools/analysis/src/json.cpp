@@ -180,6 +180,7 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
     w.key("low_p").value(st.low_p).key("peak").value(st.peak).key("peak_f").value(st.peak_f);
     w.key("nu_eff").value(st.nu_eff).key("anisotropy_db").value(st.anisotropy_db);
     w.key("raps_f").value(st.ring_f).key("raps").value(st.raps);
+    w.key("anisotropy_db_by_ring").value(st.ring_anisotropy_db);
     if (!r.spectrum_nonuniform.empty()) w.key("nonuniform").value(r.spectrum_nonuniform);
     w.end_object();
   }

@@ -211,13 +211,17 @@ SpectrumStats spectrum_stats(const Periodogram& p) {
     }
     below = below && mean < 0.1;
     if (below) st.nu_eff = f;
-    if (f > 0.5 && f < 2.5 && count[r] > 1 && mean > 0) {
+    double ring_db = std::numeric_limits<double>::quiet_NaN();
+    if (count[r] > 1 && mean > 0) {
       const double c = static_cast<double>(count[r]);
       const double var = std::max(0.0, (sum2[r] - c * mean * mean) / (c - 1.0));
-      if (var > 1e-9 * mean * mean) {  // below: rounding of a constant ring (coincident points), no angle
-        aniso_sum += 10.0 * std::log10(var / (mean * mean));
-        ++aniso_rings;
-      }
+      // below: rounding of a constant ring (coincident points), no angle
+      if (var > 1e-9 * mean * mean) ring_db = 10.0 * std::log10(var / (mean * mean));
+    }
+    st.ring_anisotropy_db.push_back(ring_db);
+    if (f > 0.5 && f < 2.5 && std::isfinite(ring_db)) {
+      aniso_sum += ring_db;
+      ++aniso_rings;
     }
   }
   st.anisotropy_db = aniso_rings ? aniso_sum / aniso_rings : std::numeric_limits<double>::quiet_NaN();

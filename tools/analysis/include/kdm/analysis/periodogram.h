@@ -48,6 +48,9 @@ struct SpectrumStats {
   std::vector<double> ring_f;          ///< f of rings r = 1..ring_max (index r−1)
   std::vector<double> raps;            ///< RAPS of those rings
   std::vector<std::size_t> ring_size;  ///< number of integer k in each ring
+  /// 10·log10(var/mean²) of each ring (NaN for a ring of one k, zero power or a constant one); an isotropic
+  /// spectrum reads about 0 dB for one set (−10·log10(m) for m), a lattice far above at its peak.
+  std::vector<double> ring_anisotropy_db;
   double low_p = 0;  ///< mean P over all k with 0 < f < 0.5; NaN where none lies there (4 points or fewer)
   double peak = 0, peak_f = 0;  ///< max RAPS and its f
   double nu_eff = 0;            ///< 0 when the first ring already has RAPS ≥ 0.1
