@@ -170,6 +170,7 @@ TEST(ImageLimit, FuzzerFoundImagesAreRefusedCleanly) {
   } cases[] = {{"jpeg_huffman_overflow.jpg", "Huffman table of more than 256 codes"},
                {"jpeg_no_huffman_tables.jpg", ""},
                {"png_chunk_past_end.png", "ends inside a chunk"},
+               {"hdr_run_of_length_zero.hdr", "a run of length 0"},
                {"pnm_header_overflow.pgm", "header number too large"},
                {"pnm_pixels_cut_short.pgm", "pixels cut short"}};
   for (const auto& c : cases) {

@@ -177,6 +177,9 @@ def crashes():
     write("image", "pnm_header_overflow.pgm", b"P5 99999999999 1 255\n\0", root)
     # 64x64 pixels announced, 10 given: stb returns the other 4086 uninitialised.
     write("image", "pnm_pixels_cut_short.pgm", b"P5 64 64 255\n" + b"\x80" * 10, root)
+    # A run-length scanline with a run of length 0 (fuzzer-found): stb 2.27 reads on in place forever.
+    write("image", "hdr_run_of_length_zero.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 8\n" +
+          bytes([2, 2, 0, 8, 4, 180, 0, 240, 0, 0]), root)
     # query_points never returns (runtime/src/query.cpp): x in [0, 5e-324) with tiles of side 255/64 covers
     # no tile column (x1 / tile_size underflows to 0, so ceil = floor), the tile count is 0 x 2.5e14 = 0
     # and passes kMaxQueryTiles, and the loop walks 2.5e14 empty rows without examining a candidate.

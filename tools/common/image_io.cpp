@@ -289,7 +289,10 @@ std::string radiance_fault(const std::uint8_t* data, std::size_t size) {
       for (long long i = 0; i < w;) {
         if (pos >= size) return "a Radiance image cut short in its pixels";
         const int count = data[pos++], n = count > 128 ? count - 128 : count;
-        if (n == 0 || n > w - i) return "";  // bad run-length data: stb says so
+        // stb 2.27 never leaves a run of length 0 (it reads on in place); a longer run than the
+        // scanline's rest it refuses itself.
+        if (n == 0) return "corrupt Radiance image (a run of length 0)";
+        if (n > w - i) return "";
         pos += count > 128 ? 1 : std::size_t(n);
         i += n;
       }
