@@ -59,6 +59,37 @@ TEST(PairCorrelation, LatticeHasNoPairsBelowItsSpacing) {
   EXPECT_GT(peak, 5.0);  // all six neighbours fall in one narrow bin
 }
 
+// Points on one another are counted as one position with its multiplicity: the same g(r) as counting
+// every ordered pair (brute force here), up to the order of the sums.
+TEST(PairCorrelation, PointsOnOneAnotherCountEveryPair) {
+  for (bool torus : {true, false}) {
+    tools::PointSet s = uniform_set(400, 21);
+    for (int copies = 1; copies <= 40; ++copies)  // groups of 2 to 41 points
+      for (int a = 0; a < 2; ++a) s.coords.push_back(s.coords[copies * 2 + a]);
+    for (int k = 0; k < 30; ++k) s.coords.insert(s.coords.end(), {0.25, 0.75});
+    const int bins = 20;
+    const PairCorrelation g = pair_correlation({s}, torus, 3.0, bins);
+    const double r_abs = g.r_max * g.spacing, n = static_cast<double>(s.size());
+    std::vector<double> hist(bins, 0.0);
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        if (i == j) continue;
+        const double dx = axis_delta(s.coords[2 * i], s.coords[2 * j], torus),
+                     dy = axis_delta(s.coords[2 * i + 1], s.coords[2 * j + 1], torus);
+        const double d = std::hypot(dx, dy);
+        if (d < r_abs)
+          hist[std::min(bins - 1, static_cast<int>(d / (r_abs / bins)))] +=
+              torus ? 1.0 : 1.0 / ((1 - std::abs(dx)) * (1 - std::abs(dy)));
+      }
+    for (int b = 0; b < bins; ++b) {
+      const double r0 = r_abs * b / bins, r1 = r_abs * (b + 1) / bins;
+      EXPECT_NEAR(g.g[b], hist[b] / (n * (n - 1) * kPi * (r1 * r1 - r0 * r0)), 1e-9 * (1 + g.g[b]))
+          << "bin " << b << " torus " << torus;
+    }
+    EXPECT_GT(g.g[0], 10.0);  // the groups' pairs at distance 0 (25.7 here; a uniform set's bin is about 1)
+  }
+}
+
 double uniform(double, double) {
   return 1.0;
 }

@@ -16,8 +16,14 @@ namespace {
 using testing::torus_hex_lattice;
 using testing::uniform_set;
 
-void brute_force_check(int dim, bool torus, std::size_t n, unsigned seed) {
-  const tools::PointSet s = uniform_set(n, seed, dim);
+// `copies`: every 7th point is repeated this many times more, at its very position, the copies spread
+// through the set (groups the search answers without comparing their members).
+void brute_force_check(int dim, bool torus, std::size_t n, unsigned seed, std::size_t copies = 0) {
+  tools::PointSet s = uniform_set(n, seed, dim);
+  for (std::size_t c = 0; c < copies; ++c)
+    for (std::size_t i = 0; i < n; i += 7)
+      for (int a = 0; a < dim; ++a) s.coords.push_back(s.coords[i * dim + a]);
+  n = s.size();
   const NearestNeighbours nn = nearest_neighbours(s.coords, dim, torus, 2);
   for (std::size_t i = 0; i < n; ++i) {
     double best = std::numeric_limits<double>::infinity();
@@ -43,6 +49,13 @@ TEST(NearestNeighbour, CellListMatchesBruteForce) {
   brute_force_check(3, false, 500, 4);
   brute_force_check(2, true, 5, 5);  // grid of one cell: wrap-around visits it repeatedly
   brute_force_check(3, false, 3, 6);
+}
+
+TEST(NearestNeighbour, PointsOnOneAnotherMatchBruteForce) {
+  brute_force_check(2, true, 300, 7, 1);
+  brute_force_check(2, false, 300, 8, 3);
+  brute_force_check(3, true, 200, 9, 2);
+  brute_force_check(3, false, 200, 10, 1);
 }
 
 // The closest pair of different classes, against brute force, on the torus and in the box, with classes

@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "cell_grid.h"
+#include "coincident.h"
 #include "kdm/analysis/common.h"
 #include "parallel.h"
 
@@ -19,6 +20,9 @@ NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim,
   const std::size_t n = coords.size() / dim;
   if (n < 2) throw InvalidInput("nearest-neighbour statistics need at least 2 points");
   const detail::CellGrid grid(coords, dim, 2.0, dim == 2 ? 2048 : 160);
+  // A point that stands on another has it as its nearest (the smallest such index, as the search's ties
+  // pick): no search, which within a large group would compare every pair.
+  const std::vector<std::size_t> partner = detail::distinct_positions(coords, dim).partner;
   const int g = grid.g;
   NearestNeighbours out;
   out.dim = dim;
@@ -31,6 +35,10 @@ NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim,
     const std::size_t i0 = static_cast<std::size_t>(ci * chunk);
     const std::size_t i1 = std::min(n, i0 + static_cast<std::size_t>(chunk));
     for (std::size_t i = i0; i < i1; ++i) {
+      if (partner[i] != n) {
+        out.index[i] = partner[i];  // distance and offset 0, as assigned
+        continue;
+      }
       const double* p = &coords[i * dim];
       int home[3] = {0, 0, 0};
       for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a]);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "cell_grid.h"
+#include "coincident.h"
 #include "kdm/analysis/common.h"
 #include "parallel.h"
 
@@ -19,9 +20,13 @@ double ball_volume(int dim, double r) {
   return dim == 2 ? kPi * r * r : 4.0 / 3.0 * kPi * r * r * r;
 }
 
-// Adds the weighted pair histogram of one set (distances in unit lengths, bins of width `width`).
-void pair_histogram(const std::vector<double>& coords, int dim, bool torus, double r_abs, int bins,
+// Adds the weighted pair histogram of one set (distances in unit lengths, bins of width `width`). Points at
+// one position are counted as one with their multiplicity, so a group costs what one point does.
+void pair_histogram(const std::vector<double>& points, int dim, bool torus, double r_abs, int bins,
                     int threads, std::vector<double>& hist) {
+  const detail::DistinctPositions distinct = detail::distinct_positions(points, dim);
+  const std::vector<double>& coords = distinct.any_coincident ? distinct.coords : points;
+  const auto weight = [&](std::size_t i) { return distinct.any_coincident ? distinct.multiplicity[i] : 1.0; };
   const std::size_t n = coords.size() / dim;
   const int g_cells = std::max(1, static_cast<int>(std::floor(1.0 / r_abs)));
   const detail::CellGrid grid(coords, dim, 1.0, std::min(g_cells, dim == 2 ? 4096 : 256));
@@ -35,6 +40,8 @@ void pair_histogram(const std::vector<double>& coords, int dim, bool torus, doub
     std::vector<std::size_t> cells;
     for (std::size_t i = ci * chunk; i < std::min(n, static_cast<std::size_t>((ci + 1) * chunk)); ++i) {
       const double* p = &coords[i * dim];
+      const double w = weight(i);
+      h[0] += w * (w - 1);  // the ordered pairs of the points standing at p, at distance 0
       int home[3] = {0, 0, 0};
       for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a]);
       cells.clear();
@@ -70,7 +77,7 @@ void pair_histogram(const std::vector<double>& coords, int dim, bool torus, doub
           const double d = std::sqrt(d2);
           if (d >= r_abs) continue;
           const int b = std::min(bins - 1, static_cast<int>(d / width));
-          h[b] += torus ? 1.0 : 1.0 / cover;
+          h[b] += w * weight(j) * (torus ? 1.0 : 1.0 / cover);
         }
     }
   });
