@@ -64,7 +64,9 @@ int main(void) {
     status = kdm_query_classes_joint_compact(tiles, &q, &joint, 3, xy, NULL, classes, 4096, &written, &cursor,
                                              &problem);
     if (status != KDM_OK && status != KDM_BUFFER_FULL) {
-      fprintf(stderr, "query: %s (%s)\n", kdm_status_message(status), problem.parameter);
+      char why[256];
+      kdm_query_problem_describe(&problem, why, sizeof why);
+      fprintf(stderr, "query: %s: %s\n", kdm_status_message(status), why);
       return 1;
     }
     for (i = 0; i < written; ++i) ++counts[classes[i]];

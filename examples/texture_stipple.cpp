@@ -370,9 +370,11 @@ int main(int argc, char** argv) {
             "texture_stipple: frame %d: the tile set serves at most %g points per tile, this frame needs "
             "%.0f: use a tile set with a hand-over to subtiles (--tileset)\n",
             k, problem.limit, problem.value);
-      else
-        std::fprintf(stderr, "texture_stipple: frame %d: query refused: %s (%s)\n", k,
-                     kdm::query_problem_message(problem.kind), problem.parameter);
+      else {
+        char why[256];
+        kdm::describe_query_problem(problem, why, sizeof why);
+        std::fprintf(stderr, "texture_stipple: frame %d: query refused: %s\n", k, why);
+      }
       return 1;
     }
 

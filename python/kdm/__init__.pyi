@@ -152,6 +152,7 @@ def stipple(
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],
+    classes: Optional[Union[npt.ArrayLike, Sequence[npt.ArrayLike]]] = ...,
     *,
     box: bool = ...,
     density: Union[_Density, _Function] = ...,
@@ -161,7 +162,6 @@ def analyze(
     energy: bool = ...,
     gamma: float = ...,
     invert: bool = ...,
-    classes: Optional[Union[npt.ArrayLike, Sequence[npt.ArrayLike]]] = ...,
     min_expected: float = ...,
     density_bands: int = ...,
     holes_min_density: float = ...,

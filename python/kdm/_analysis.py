@@ -33,6 +33,7 @@ def _infinite_lattice(metrics: Dict[str, Any]) -> None:
 
 def analyze(
     points: Any,
+    classes: Any = None,
     *,
     box: bool = False,
     density: Any = None,
@@ -42,7 +43,6 @@ def analyze(
     energy: bool = True,
     gamma: float = 1.0,
     invert: bool = False,
-    classes: Any = None,
     min_expected: float = 20.0,
     density_bands: int = 10,
     holes_min_density: float = 0.0,
@@ -58,6 +58,14 @@ def analyze(
         "spectrum_skipped" says so).
         Distances are those of the unit square (cube): a set drawn for a non-square domain is judged
         squeezed (docs/limits.md, "Analysing point sets").
+    classes : array or list of arrays, optional
+        Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them,
+        so ``kdm.analyze(*kdm.sample(n, classes=...))`` works):
+        each point's class, an (n,) array per set. Each class is then also analysed alone, as
+        ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
+        (``cross_class_closest`` in d_hex of all points, per class its "class" and "metrics", and in
+        "too_small", an integer array, the classes present with fewer than 2 points in every set, which
+        are not analysed).
     box : bool
         Bounded-box distances instead of periodic (torus) ones.
     density : None, float, str, 2-D array or callable
@@ -76,13 +84,6 @@ def analyze(
         Worker threads (0: the default count); the results do not depend on it.
     energy : bool
         Compute E/n under the KDM model (``energy_per_point``).
-    classes : array or list of arrays, optional
-        Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them):
-        each point's class, an (n,) array per set. Each class is then also analysed alone, as
-        ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
-        (``cross_class_closest`` in d_hex of all points, per class its "class" and "metrics", and in
-        "too_small", an integer array, the classes present with fewer than 2 points in every set, which
-        are not analysed).
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles

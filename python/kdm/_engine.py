@@ -78,7 +78,9 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     sampler's order (kdm.sample: a prefix of a set is a patch of the domain). An engine pickles and
     copies (a process pool's workers get it): its density is read again where it is unpickled, so an
     image file must be there too. A copy goes on from the same state, so workers given copies draw the
-    same sets: give each its own seed (``np.random.SeedSequence(s).spawn(k)``).
+    same sets: give each its own seed (``np.random.SeedSequence(s).spawn(k)``). As everywhere in kdm, a
+    count or dimension that is not an integer (``random(2.0)``) raises TypeError, a value out of range
+    ValueError: catch both where SciPy's engines are given values a user typed.
 
     Parameters
     ----------
@@ -95,7 +97,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
         aspect=1 spaces them evenly in the unit square whatever the density's shape.
     temperature, domain, density, threads
-        As kdm.sample takes them (domain None: a box for images, arrays and "ramp:R", a torus otherwise;
+        As kdm.sample takes them (domain None: a box for images, arrays, callables and "ramp:R", a
+        torus for a uniform density and "radial:R";
         for integration take the torus: small box sets are biased, as kdm.sample says;
         an array density is copied, and ``density`` returns that read-only copy);
         ``random(n)`` returns what ``kdm.sample(n, density, dim=d, seed=s, ...)`` does for the seed s it
@@ -152,7 +155,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             return
         spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
         if self.d != 2 and spec is not None and spec.kind == "image":
-            raise ValueError("image densities are 2D; use d=2")  # now, not at the first draw
+            raise ValueError("image and array densities are 2-D; use d=2")  # now, not at the first draw
         if _checks.is_array(value):  # what is drawn from: later changes to the caller's array are not
             value = np.array(value, dtype=np.float64)
             value.flags.writeable = False

@@ -26,7 +26,7 @@ namespace kdm::python {
 namespace {
 
 /// A refused query's parameters as Python's keyword arguments.
-constexpr tools::ParameterNames kKeywordNames{"scale=", "tile_size=", "origin="};
+constexpr QueryParameterNames kKeywordNames{"scale=", "tile_size=", "origin="};
 
 using Rect = std::array<double, 4>;
 

@@ -60,7 +60,7 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
   const gen::SamplerOptions o =
       sampler_options(n, dim, domain, image || spec.kind == DensitySpec::Kind::kRamp, temperature, seed,
                       threads, aspect, image ? double(spec.width) / spec.height : 1.0, {sweeps, coarse_sweeps});
-  if (image && dim != 2) throw std::invalid_argument("image densities are 2D; use dim=2");
+  if (image && dim != 2) throw std::invalid_argument("image and array densities are 2-D; use dim=2");
   const gen::Density target = tools::to_generator_density(spec);
   gen::SampleResult result;
   {

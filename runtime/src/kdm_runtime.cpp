@@ -788,4 +788,18 @@ const char* kdm_problem_message(kdm_problem_kind kind) {
   return kdm::query_problem_message(static_cast<kdm::QueryProblem::Kind>(static_cast<int>(kind)));
 }
 
+size_t kdm_query_problem_describe(const kdm_query_problem* problem, char* text, size_t size) {
+  kdm::QueryProblem p;
+  if (!problem || problem->struct_size < kProblemV1) {
+    p.kind = kdm::QueryProblem::Kind::kMissingArgument, p.parameter = "problem";
+  } else {
+    p.kind = static_cast<kdm::QueryProblem::Kind>(static_cast<int>(problem->kind));
+    p.parameter = problem->parameter ? problem->parameter : "";
+    p.value = problem->value, p.limit = problem->limit;
+    p.largest_valid = problem->largest_valid, p.largest_tile_size = problem->largest_tile_size;
+  }
+  return kdm::describe_query_problem(
+      p, text, size, kdm::QueryParameterNames{"scale", "tile_size", "origin (origin_x, origin_y)"});
+}
+
 }  // extern "C"

@@ -577,43 +577,6 @@ double emission_threshold(const Tileset& tileset, const PointId& id) {
   return id.rank < thresholds.size() ? double(thresholds[id.rank]) : -1;
 }
 
-const char* query_problem_message(QueryProblem::Kind kind) {
-  switch (kind) {
-    case QueryProblem::Kind::kNone:
-      return "no problem";
-    case QueryProblem::Kind::kMissingArgument:
-      return "a required argument is null or empty (the tile set, an output), or a parallel query's "
-             "scratch was not made";
-    case QueryProblem::Kind::kNotFinite:
-      return "a parameter is not a finite number";
-    case QueryProblem::Kind::kNotPositive:
-      return "a parameter must be greater than 0 (or, for a struct_size, at least the limit)";
-    case QueryProblem::Kind::kNegative:
-      return "a parameter must not be negative";
-    case QueryProblem::Kind::kBadDensity:
-      return "the density's image (with its max-mip), callback or image sums are missing or do not fit the "
-             "query "
-             "(or both callbacks are set)";
-    case QueryProblem::Kind::kTooManyTiles:
-      return "the region covers more tiles than one query may (split it)";
-    case QueryProblem::Kind::kDensityTooHigh:
-      return "the density asks for more points per tile than the tile set serves in this mode (stable mode "
-             "stops at its top level, smooth mode at its depth cap)";
-    case QueryProblem::Kind::kCursorMismatch:
-      return "the cursor was started by a query with other parameters or on another tile set, or is damaged";
-    case QueryProblem::Kind::kBadMode:
-      return "the mode is neither stable nor smooth";
-    case QueryProblem::Kind::kBadClassCount:
-      return "a query needs between 1 and 8 classes";
-    case QueryProblem::Kind::kKeysUnsupported:
-      return "the tile set's tiles hold more points than a 64-bit point key can number";
-    case QueryProblem::Kind::kTooFarFromOrigin:
-      return "the region lies too far from the origin (the world's, or the query's for its output) for its "
-             "points to keep their places";
-  }
-  return "unknown problem";
-}
-
 std::uint64_t query_fingerprint(const QueryParams& q) {
   detail::Fingerprint f(0x6b646d71756572ull);  // "kdmquer"
   for (double v : {q.x0, q.y0, q.x1, q.y1, q.origin_x, q.origin_y, q.tile_size, q.scale, q.density.constant,

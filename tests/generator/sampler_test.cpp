@@ -208,6 +208,19 @@ TEST(SamplerTest, RejectsBadOptionsWithClearErrors) {
   o = options_for(100, Domain::kTorus);
   o.vector_lanes = 3;  // 16, 8 or 4 only
   EXPECT_THROW(sample(o), InvalidArgument);
+  // Enumerations cast from other numbers: a domain of 7 had sampled a box, numerics of 7 run as kFast.
+  o = options_for(100, Domain::kTorus);
+  o.domain = static_cast<Domain>(7);
+  EXPECT_THROW(sample(o), InvalidArgument);
+  o = options_for(100, Domain::kTorus);
+  o.numerics = static_cast<Numerics>(7);
+  EXPECT_THROW(sample(o), InvalidArgument);
+  try {
+    sample(o, Density::from_values(-1, 4, {}));
+    ADD_FAILURE() << "a density image of width -1 was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("-1 x 4"), std::string::npos) << e.what();
+  }
   o = options_for(100, Domain::kTorus);
   Density negative_size;
   negative_size.function = [](const double*) { return 1.0; };

@@ -35,4 +35,19 @@ if cmake --build "$work/build" >"$work/unverified.log" 2>&1; then echo "a set fa
 grep -q "failed [0-9]* check" "$work/unverified.log" || { echo "verification did not say why:"; cat "$work/unverified.log"; exit 1; }
 if [ -e "$baked.baking" ]; then echo "the failed verification left $baked.baking behind"; exit 1; fi
 if cmake --build "$work/build" >/dev/null 2>&1; then echo "the build after a failed verification passed"; exit 1; fi
+# The sampler through pkg-config, for C++ builds without CMake.
+pc_dir=$(dirname "$(find "$prefix" -name kdm-generator.pc | head -n 1)")
+cat >"$work/pc_generator.cpp" <<'CPP'
+#include <cstdio>
+#include <kdm/generator/sampler.h>
+int main() {
+  kdm::gen::SamplerOptions o;
+  o.n = 100;
+  std::printf("pkg-config sampler %zu points\n", kdm::gen::sample(o).size());
+}
+CPP
+# shellcheck disable=SC2046  # the flags are words
+c++ -std=c++17 -o "$work/pc_generator" "$work/pc_generator.cpp" $(PKG_CONFIG_PATH="$pc_dir" pkg-config --cflags --libs kdm-generator)
+LD_LIBRARY_PATH="$(PKG_CONFIG_PATH="$pc_dir" pkg-config --variable=libdir kdm-generator)" "$work/pc_generator" |
+  grep -q "pkg-config sampler 100 points" || { echo "the sampler through pkg-config did not run"; exit 1; }
 echo "consumer ok"

@@ -94,7 +94,7 @@ def test_engine_options():
         kdm.BlueNoise(2, density=0.0)
     with pytest.raises(TypeError):
         kdm.BlueNoise(2.0)
-    with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
+    with pytest.raises(ValueError, match="image and array densities are 2-D; use d=2"):
         kdm.BlueNoise(3, density=np.ones((4, 4)))
     e.threads = 10**9  # set after __init__: checked at the draw
     with pytest.raises(ValueError, match="threads must be"):
@@ -110,7 +110,7 @@ def test_engine_options():
     with pytest.raises(ValueError, match="'const:0' is zero everywhere"):  # when set, not at the draw
         e.density = "const:0"
     e3 = kdm.BlueNoise(3, seed=1)
-    with pytest.raises(ValueError, match="image densities are 2D; use d=2"):
+    with pytest.raises(ValueError, match="image and array densities are 2-D; use d=2"):
         e3.density = np.ones((4, 4))
     # Checked at construction, not at the first draw, as kdm.sample checks them.
     with pytest.raises(ValueError, match="temperature must be at most 1000"):

@@ -59,7 +59,7 @@ def raises(kind, match, call, *args, **kwargs):
     (TypeError, "invert must be True or False", dict(n=10, density="const:1", invert="yes")),
     (ValueError, "const:V needs a finite V >= 0", dict(n=10, density="const:x")),
     (ValueError, r"ramp:R needs a dynamic range R in \[1, 1e9\]", dict(n=10, density="ramp:0.5")),
-    (ValueError, "image densities are 2D", dict(n=10, density=np.ones((2, 2)), dim=3)),
+    (ValueError, "image and array densities are 2-D", dict(n=10, density=np.ones((2, 2)), dim=3)),
 ])
 def test_sample_refusals(kind, match, kwargs):
     raises(kind, match, kdm.sample, **kwargs)

@@ -300,6 +300,17 @@ int main(int argc, char** argv) {
     CHECK(problem.limit == 32768 && fabs(problem.largest_valid - 32768) < 1e-6);
     CHECK(fabs(problem.largest_tile_size - sqrt(0.32768)) < 1e-9);
     CHECK(strlen(kdm_problem_message(problem.kind)) > 0);
+    {
+      /* The problem in one line, with the advice that fits; cut to the buffer, its length as snprintf's. */
+      char line[300], cut[12];
+      const size_t length = kdm_query_problem_describe(&problem, line, sizeof line);
+      CHECK(length == strlen(line) && strstr(line, "100000 points per tile") &&
+            strstr(line, "at most 32768") && strstr(line, "use scale 32768 or less, or tile_size 0.572433"));
+      CHECK(kdm_query_problem_describe(&problem, cut, sizeof cut) == length && strlen(cut) == sizeof cut - 1 &&
+            strncmp(cut, line, sizeof cut - 1) == 0);
+      CHECK(kdm_query_problem_describe(&problem, NULL, 0) == length);
+      CHECK(kdm_query_problem_describe(NULL, line, sizeof line) > 0 && strstr(line, "'problem'"));
+    }
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(strcmp(problem.parameter, "query.struct_size") == 0);

@@ -27,6 +27,6 @@ inline QueryMode parse_mode(const std::string& text) {
 void parse_rect(const std::string& text, const char* option, double r[4]);
 
 /// How refusals name the query's parameters on the command line.
-inline constexpr tools::ParameterNames kCommandLineNames{"--scale", "--tile-size", nullptr};
+inline constexpr QueryParameterNames kCommandLineNames{"--scale", "--tile-size", nullptr};
 
 }  // namespace kdm::cli

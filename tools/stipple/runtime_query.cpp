@@ -8,82 +8,9 @@
 #include <stdexcept>
 
 namespace kdm::tools {
-namespace {
-
-/// `v` (> 0) to six significant digits, rounded down: advice of "X or less" must itself be accepted.
-std::string six_digits_down(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  if (std::strtod(text, nullptr) <= v) return text;
-  const double unit = std::pow(10.0, std::floor(std::log10(v)) - 5);
-  for (double w = std::floor(v / unit) * unit;; w -= unit) {
-    std::snprintf(text, sizeof text, "%.6g", w);
-    if (std::strtod(text, nullptr) <= v) return text;
-  }
-}
-
-}  // namespace
-
-std::string describe(const QueryProblem& p, const ParameterNames& names) {
-  // The parameter as the caller spells it ("--tile-size", "tile_size"), not as QueryParams does.
-  std::string shown = p.parameter ? p.parameter : "";
-  if (shown == "scale" || shown == "tile_size") {
-    shown = shown == "scale" ? names.scale : names.tile_size;
-    if (!shown.empty() && shown.back() == '=') shown.pop_back();
-  }
+std::string describe(const QueryProblem& p, const QueryParameterNames& names) {
   char text[400];
-  switch (p.kind) {
-    case QueryProblem::Kind::kDensityTooHigh: {
-      // Only advice that can be followed: a scale or tile size that fits and is still > 0.
-      char scale[120] = "", tile[120] = "";
-      if (p.largest_valid > 0)
-        std::snprintf(scale, sizeof scale, "%s %s or less", names.scale,
-                      six_digits_down(p.largest_valid).c_str());
-      if (p.largest_tile_size > 0)
-        std::snprintf(tile, sizeof tile, "%s %s or less", names.tile_size,
-                      six_digits_down(p.largest_tile_size).c_str());
-      std::snprintf(text, sizeof text, "%s: %.6g points per tile where it serves at most %.0f; use %s%s%s",
-                    query_problem_message(p.kind), p.value, p.limit, scale, *scale && *tile ? ", or " : "",
-                    *scale || *tile ? tile : "a lower density");
-      break;
-    }
-    case QueryProblem::Kind::kTooManyTiles:
-      std::snprintf(text, sizeof text, "%s: %.6g tiles, at most %.0f; use a larger %s or a smaller region",
-                    query_problem_message(p.kind), p.value, p.limit, names.tile_size);
-      break;
-    case QueryProblem::Kind::kTooFarFromOrigin:
-      // "origin_x" / "origin_y": the output's numbers are too coarse, not the world's.
-      if (std::strncmp(p.parameter, "origin", 6) == 0 && names.origin)
-        std::snprintf(
-            text, sizeof text,
-            "the region lies too far from the query's origin ('%s') for the output to keep its points "
-            "apart: %.6g from it, at most %.6g for this density; use an %s nearer the region, or ask "
-            "for fewer points per unit area",
-            p.parameter, p.value, p.limit, names.origin);
-      else
-        std::snprintf(
-            text, sizeof text,
-            "the region lies too far from the world origin for doubles to place its points: %.6g from "
-            "it, at most %.6g for this density and region; keep the world's coordinates nearer its "
-            "origin (move the origin), or ask for fewer points per unit area",
-            p.value, p.limit);
-      break;
-    case QueryProblem::Kind::kNotPositive:  // the runtime's message also speaks of the C API's struct_size
-      std::snprintf(text, sizeof text, "'%s' must be > 0, got %.6g", shown.c_str(), p.value);
-      break;
-    case QueryProblem::Kind::kNegative:
-      std::snprintf(text, sizeof text, "'%s' must be >= 0, got %.6g", shown.c_str(), p.value);
-      break;
-    case QueryProblem::Kind::kNotFinite:
-      if (!std::isfinite(p.value)) {  // the kind also covers places too far out for a finite value
-        std::snprintf(text, sizeof text, "'%s' is not a finite number (%g)", shown.c_str(), p.value);
-        break;
-      }
-      [[fallthrough]];
-    default:
-      std::snprintf(text, sizeof text, "%s ('%s' = %.6g)", query_problem_message(p.kind), shown.c_str(),
-                    p.value);
-  }
+  describe_query_problem(p, text, sizeof text, names);
   return text;
 }
 
@@ -138,7 +65,7 @@ double upper_bound(const QueryDensity& d, const QueryParams& q) {
 /// The one rule of every collecting query: chunks of 2^16 points, at most kMaxCollectedPoints, refusals
 /// as describe()'s line.
 template <class T, class Step>
-void collect(std::vector<T>& out, std::size_t per_point, const ParameterNames& names, Step&& step) {
+void collect(std::vector<T>& out, std::size_t per_point, const QueryParameterNames& names, Step&& step) {
   out.clear();
   QueryCursor cursor;
   for (std::size_t m = 0;;) {
@@ -160,7 +87,7 @@ void collect(std::vector<T>& out, std::size_t per_point, const ParameterNames& n
 /// one per point.
 template <class T, class Step>
 void collect_classes(std::vector<T>& out, std::size_t per_point, std::vector<std::uint8_t>& classes,
-                     const ParameterNames& names, Step&& step) {
+                     const QueryParameterNames& names, Step&& step) {
   classes.clear();
   collect(out, per_point, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
@@ -194,7 +121,7 @@ double points_at_least(const Tileset& tileset, const ClassQueryParams& params) {
 
 namespace {
 
-void check_collectable(double least, const ParameterNames& names) {
+void check_collectable(double least, const QueryParameterNames& names) {
   // 5% of margin for the tiles' own counts around the density.
   if (!(least > 1.05 * double(kMaxCollectedPoints))) return;
   char text[200];
@@ -208,7 +135,8 @@ void check_collectable(double least, const ParameterNames& names) {
 
 }  // namespace
 
-void check_before_collecting(const Tileset& tileset, const QueryParams& params, const ParameterNames& names) {
+void check_before_collecting(const Tileset& tileset, const QueryParams& params,
+                             const QueryParameterNames& names) {
   // A call with no room checks the parameters and stops at the first point.
   std::size_t written = 0;
   QueryCursor cursor;
@@ -219,7 +147,7 @@ void check_before_collecting(const Tileset& tileset, const QueryParams& params, 
 }
 
 void check_before_collecting(const Tileset& tileset, const ClassQueryParams& params,
-                             const ParameterNames& names) {
+                             const QueryParameterNames& names) {
   std::size_t written = 0;
   QueryCursor cursor;
   QueryProblem problem;
@@ -230,7 +158,7 @@ void check_before_collecting(const Tileset& tileset, const ClassQueryParams& par
 }
 
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
-               const ParameterNames& names) {
+               const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
   collect(out, 1, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
@@ -240,7 +168,7 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
 }
 
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
-                  const ParameterNames& names) {
+                  const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
   collect(xy, 2, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
@@ -251,7 +179,7 @@ void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector
 }
 
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
-                  std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+                  std::vector<std::uint8_t>& classes, const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
   collect_classes(xy, 2, classes, names,
                   [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
@@ -263,7 +191,7 @@ void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::v
 }
 
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
-               std::vector<std::uint8_t>& classes, const ParameterNames& names) {
+               std::vector<std::uint8_t>& classes, const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
   collect_classes(out, 1, classes, names,
                   [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,

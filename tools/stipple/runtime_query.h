@@ -17,16 +17,8 @@ namespace kdm::tools {
 /// Most points one such query collects (2^25, 1 GiB as QueryPoint) before it gives up.
 inline constexpr std::size_t kMaxCollectedPoints = std::size_t(1) << 25;
 
-/// How a caller names the parameters a refusal suggests changing (`--scale` on the command line,
-/// `scale=` in Python).
-struct ParameterNames {
-  const char* scale = "scale";
-  const char* tile_size = "tile_size";
-  const char* origin = "origin";  ///< null where the caller cannot set one (the world origin is the query's)
-};
-
-/// A refused query's problem in one line: which parameter, which limit, what works.
-std::string describe(const QueryProblem& problem, const ParameterNames& names = {});
+/// A refused query's problem in one line (describe_query_problem's).
+std::string describe(const QueryProblem& problem, const QueryParameterNames& names = {});
 
 /// A lower bound of how many points a query of `params` emits: its density times scale over its region
 /// (exact for a constant; an image's min-mip over 64 × 64 blocks of the region, 0 where its maximum could
@@ -40,25 +32,25 @@ double points_at_least(const Tileset& tileset, const ClassQueryParams& params);
 /// refuses (std::invalid_argument with describe()'s line), then a count (points_at_least) clearly past
 /// kMaxCollectedPoints (std::length_error), so that such a query fails at once, not after seconds.
 void check_before_collecting(const Tileset& tileset, const QueryParams& params,
-                             const ParameterNames& names = {});
+                             const QueryParameterNames& names = {});
 void check_before_collecting(const Tileset& tileset, const ClassQueryParams& params,
-                             const ParameterNames& names = {});
+                             const QueryParameterNames& names = {});
 
 /// Runs a query to completion into `out` (replaced). Throws std::invalid_argument with describe()'s line
 /// on bad parameters, std::length_error when more than kMaxCollectedPoints points would be emitted (before
 /// querying where check_before_collecting can tell).
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
-               const ParameterNames& names = {});
+               const QueryParameterNames& names = {});
 /// The same into the compact output (compact_query.h): positions only, `xy` (replaced) holding x, y
 /// pairs relative to the query origin, as fast as the runtime writes them.
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
-                  const ParameterNames& names = {});
+                  const QueryParameterNames& names = {});
 /// The same for several classes: `classes` (replaced) receives each point's class.
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
-               std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
+               std::vector<std::uint8_t>& classes, const QueryParameterNames& names = {});
 /// The same into the compact output: x, y pairs and each point's class.
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
-                  std::vector<std::uint8_t>& classes, const ParameterNames& names = {});
+                  std::vector<std::uint8_t>& classes, const QueryParameterNames& names = {});
 
 /// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
 /// point set normalised to it: [0, 1) on both axes.

@@ -229,6 +229,12 @@ void validate_options(const SamplerOptions& o) {
   if (o.dim != 2 && o.dim != 3) throw InvalidArgument("dimension must be 2 or 3");
   if (o.n < 0) throw InvalidArgument("point count must be > 0 (or 0 with a grid resolution > 0)");
   check_thread_count(o.threads);
+  if (o.domain != Domain::kTorus && o.domain != Domain::kBox)
+    throw InvalidArgument("domain must be Domain::kTorus or Domain::kBox, got " +
+                          std::to_string(static_cast<int>(o.domain)));
+  if (o.numerics != Numerics::kFast && o.numerics != Numerics::kOriginal)
+    throw InvalidArgument("numerics must be Numerics::kFast or Numerics::kOriginal, got " +
+                          std::to_string(static_cast<int>(o.numerics)));
   if (o.vector_lanes != 16 && o.vector_lanes != 8 && o.vector_lanes != 4)
     throw InvalidArgument("vector_lanes must be 16, 8 or 4, got " + std::to_string(o.vector_lanes));
   if (o.n == 0 && o.resolution <= 0)
@@ -392,7 +398,9 @@ Density Density::constant(double value) {
 }
 
 Density Density::from_values(int width, int height, std::vector<float> values) {
-  if (width <= 0 || height <= 0) throw InvalidArgument("density image is empty");
+  if (width <= 0 || height <= 0)
+    throw InvalidArgument("density image must be at least 1 x 1 values, got " + std::to_string(width) +
+                          " x " + std::to_string(height));
   if (values.size() != static_cast<std::size_t>(width) * height)
     throw InvalidArgument("density image has the wrong number of values");
   bool any = false;

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "kdm/generator/sampler.h"  // InvalidArgument, default_thread_count
 #include "kdm/runtime/tileset_format.h"
 
 namespace kdm::gen {
@@ -32,7 +33,10 @@ inline constexpr double kFirstEdgeGap = 1.25;
 
 /// Everything that determines a baked tile set; `kdm bake` reads it from a small text file of
 /// "key value" lines ('#' starts a comment). Baking the same recipe with the same kdm version gives
-/// the same bytes, for any thread count.
+/// the same bytes, for any thread count. Each key's range, and which keys need which, are listed in
+/// docs/design.md §3 ("Ranges, as the parser checks them"); parse() and validate() name the key at fault.
+/// Small sets are refused by their patches rather than a count: with the default band, erosion and
+/// edge_gap, base_points below 28.
 struct BakeRecipe {
   std::uint64_t seed = 1;
   std::uint32_t colours = 2;       ///< corner colours C: C^4 tiles

@@ -21,7 +21,7 @@ inline constexpr int kUnionSweeps = 30;
 
 /// sample_classes' labelled points.
 struct ClassSample {
-  int dim = 2;                        ///< 2: classes are sampled in the plane
+  int dim = 2;                        ///< SamplerOptions::dim: 2 or 3
   std::vector<double> points;         ///< n * dim coordinates in [0, 1), class 0's points first
   std::vector<std::uint8_t> classes;  ///< each point's class
   std::vector<std::int64_t> counts;   ///< points per class

@@ -26,7 +26,9 @@ struct InvalidArgument : std::invalid_argument {
 /// before it and a ripple of density behind (docs/design.md §2.3, measured there).
 enum class Domain { kTorus, kBox };
 
-/// Relative target density at normalised position u in [0, 1)^dim. Must return a finite value >= 0.
+/// Relative target density at normalised position u in [0, 1)^dim. Must return a finite value >= 0. It is
+/// read at the computational grid's nodes only (a few per point spacing): a bad value there is refused
+/// with its position, one on a strip narrower than a node falls between them unseen.
 /// Called only during the setup of sample(), from one thread at a time unless Density::thread_safe. An
 /// exception it throws ends sample() with that exception.
 using DensityFunction = std::function<double(const double* u)>;
@@ -198,7 +200,7 @@ struct SampleResult {
   int dim = 2;                 ///< as SamplerOptions::dim
   std::vector<double> points;  ///< n * dim coordinates, normalised to [0, 1) on every axis
   SampleReport report;
-  std::size_t size() const { return points.size() / dim; }
+  std::size_t size() const { return points.size() / static_cast<std::size_t>(dim); }
 };
 
 /// The threads sample() and bake_tileset() use when given 0: the first number in OMP_NUM_THREADS if it is

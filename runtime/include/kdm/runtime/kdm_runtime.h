@@ -467,6 +467,12 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_class_images_compact(
 /* A static English description of `status` / of a problem kind ("unknown ..." for a value not listed). */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);
+/* `problem` (as a refused query filled it) in one line for a log: the field at fault, the limit it broke
+ * and what would be accepted ("... 409600 points per tile where it serves at most 32768; use scale 0.08 or
+ * less, or tile_size 18.1019 or less"). Writes at most `size` bytes into `text`, its NUL included (cut to
+ * fit; nothing with size 0), and returns the whole line's length without the NUL, as snprintf does; a NULL
+ * or too short problem is described as such. Allocates nothing. Added in 0.5. */
+KDM_RUNTIME_API size_t kdm_query_problem_describe(const kdm_query_problem* problem, char* text, size_t size);
 
 #ifdef __cplusplus
 }

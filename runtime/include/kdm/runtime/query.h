@@ -218,6 +218,22 @@ KDM_RUNTIME_API double emission_threshold(const Tileset& tileset, const PointId&
 /// A short English description of a problem kind (static storage).
 KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
 
+/// How a caller names the parameters a refusal's advice speaks of (`--scale` on a command line, `scale=`
+/// in Python); a name ending in '=' is shown without it where it names the parameter at fault.
+struct QueryParameterNames {
+  const char* scale = "scale";
+  const char* tile_size = "tile_size";
+  const char* origin = "origin";  ///< null where the caller cannot set one (the world origin is the query's)
+};
+
+/// `problem` in one line for a log or an error message: the parameter at fault, the limit it broke and
+/// what would be accepted ("... 409600 points per tile where it serves at most 32768; use scale 0.08 or
+/// less, or tile_size 18.1019 or less"). Writes at most `size` bytes of it into `text`, NUL included (cut
+/// to fit; nothing with size 0), and returns the whole line's length without the NUL, as snprintf does.
+/// Allocates nothing.
+KDM_RUNTIME_API std::size_t describe_query_problem(const QueryProblem& problem, char* text, std::size_t size,
+                                                   const QueryParameterNames& names = {});
+
 /// A hash of every field of `params` (their bits, and the image and callback pointers): the identity a
 /// cursor keeps of the call that started it.
 KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
