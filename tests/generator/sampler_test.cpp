@@ -395,6 +395,35 @@ TEST(SamplerTest, MoreThanTheGridCanHoldIsRefusedByName) {
   EXPECT_THROW(sample(o), InvalidArgument);  // beyond the 2^31 point cap
 }
 
+// The count a refusal names fits, and is not far below the most that do: for an image whose one dark
+// pixel the grid resolves better the finer it gets (a stipple of one black pixel: 20,000 points were
+// told "about 2,500 at most", 2,000 then "about 836").
+TEST(SamplerTest, TheCountAGridLimitNamesFits) {
+  std::vector<float> values(32 * 32, 1e-3f);
+  values[17 * 32 + 9] = 1;
+  const Density spot = Density::from_values(32, 32, values);
+  SamplerOptions o = options_for(20000, Domain::kBox);
+  o.max_grid_nodes = 1 << 20;
+  const auto named = [&](std::int64_t n) -> std::int64_t {
+    o.n = n;
+    try {
+      sample(o, spot);
+      return -1;
+    } catch (const InvalidArgument& e) {
+      const std::string what = e.what();
+      const std::size_t at = what.find("about ");
+      EXPECT_NE(at, std::string::npos) << what;
+      return at == std::string::npos ? 0 : std::atoll(what.c_str() + at + 6);
+    }
+  };
+  const std::int64_t most = named(20000);
+  ASSERT_GT(most, 0);
+  EXPECT_EQ(named(most), -1);  // fits
+  EXPECT_EQ(named(most / 2 * 2), -1);
+  EXPECT_GT(named(most + most / 4), 0);  // a quarter more does not: the estimate is within 25%
+  EXPECT_EQ(named(4 * most), most);      // the same figure from any count asked
+}
+
 // A domain whose short side would be one grid node wide is refused (its points bunched up: 300 at aspect
 // 5000 all in the left half); one just inside the limit (two nodes) covers both of its sides. An extreme
 // aspect ratio is refused before its grid's size overflows an int.

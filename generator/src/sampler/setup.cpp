@@ -195,24 +195,39 @@ InvalidArgument too_thin(const SamplerOptions& o, double sides) {
   return InvalidArgument(s.str());
 }
 
+/// The dims (in double: an extreme aspect ratio overflows an int) and pyramid levels of the finest grid
+/// with about `shortest` nodes along the domain's shortest side; returns their product.
 template <int D>
-Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels) {
+double grid_dims(const SamplerOptions& o, double shortest, int& levels, double (&dims)[D]) {
   double min_extent = o.extent[0];
   for (int k = 1; k < D; ++k) min_extent = std::min(min_extent, o.extent[k]);
   levels = 1;
   while (shortest / std::ldexp(1.0, levels) >= o.coarsest_grid) ++levels;
   const double unit = std::ldexp(1.0, levels - 1);
-  double dims[D], nodes = 1, fewest = 0;  // in double first: an extreme aspect ratio overflows an int
+  double nodes = 1;
   for (int k = 0; k < D; ++k) {
     dims[k] = unit * std::max(1.0, std::round(shortest * o.extent[k] / min_extent / unit));
-    nodes *= dims[k], fewest = k ? std::min(fewest, dims[k]) : dims[k];
+    nodes *= dims[k];
   }
+  return nodes;
+}
+
+/// The finest grid for `shortest` (grid_dims). Past max_grid_nodes it is refused, saying how many points
+/// fit: `most_points()`, or where that is NaN (nothing known of the density's peak) the count scaled by
+/// the nodes, which a density whose peak the grid resolves better as it grows overestimates.
+template <int D, class MostPoints>
+Grid<D> make_grid(const SamplerOptions& o, double shortest, int& levels, MostPoints most_points) {
+  double dims[D];
+  const double nodes = grid_dims<D>(o, shortest, levels, dims);
+  double fewest = dims[0];
+  for (int k = 1; k < D; ++k) fewest = std::min(fewest, dims[k]);
   if (!(nodes <= double(o.max_grid_nodes))) {
     if (fewest < 2) throw too_narrow(o);  // refining the grid only makes it larger: say what is wrong
+    double most = most_points();
+    if (std::isnan(most)) most = double(o.n) * double(o.max_grid_nodes) / nodes;
     std::ostringstream s;
     s << "the density needs a computational grid of " << nodes << " nodes, more than the limit of "
-      << o.max_grid_nodes << ": about " << std::setprecision(3)
-      << double(o.n) * double(o.max_grid_nodes) / nodes
+      << o.max_grid_nodes << ": about " << std::setprecision(3) << most
       << " points at most with this density and domain (ask for fewer points, a smaller dynamic range or "
          "a squarer domain)";
     throw InvalidArgument(s.str());
@@ -296,11 +311,35 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
       if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
       peak_over_mean = mx / (sum / p.size());
     }
-    const double total = double(o.n) + double(o.fixed_points.size() / D);
-    double shortest =
-        std::pow(total * setup.mass_per_point * peak_over_mean / (o.peak_density * aspect_product), 1.0 / D);
+    const double fixed = double(o.fixed_points.size() / D), total = double(o.n) + fixed;
+    const auto shortest_for = [&](double points, double peak_ratio) {
+      return std::pow(points * setup.mass_per_point * peak_ratio / (o.peak_density * aspect_product),
+                      1.0 / D);
+    };
+    double shortest = shortest_for(total, peak_over_mean);
+    // An image's peak over its mean is known from its values, whatever the grid resolves of it: the
+    // largest count whose grid (at the image's full peak) fits, with the refinement's margin.
+    const auto most_points = [&] {
+      if (!density.image) return std::nan("");
+      double sum = 0, mx = 0;
+      for (float v : density.image->values) sum += v, mx = std::max<double>(mx, v);
+      const double ratio = mx / (sum / double(density.image->values.size()));
+      const auto fits = [&](double points) {
+        double dims[D];
+        int grid_levels = 0;
+        return grid_dims<D>(o, std::max(1.0, shortest_for(points, ratio) * 1.03), grid_levels, dims) <=
+               double(o.max_grid_nodes);
+      };
+      double lo = std::floor(total), hi = lo + 1;  // lo: the largest count known to fit (0 if none)
+      while (lo >= 1 && !fits(lo)) hi = lo, lo = std::floor(lo * 0.9);
+      while (hi - lo > 1) {  // the same figure whatever count was asked
+        const double mid = std::floor((lo + hi) / 2);
+        (fits(mid) ? lo : hi) = mid;
+      }
+      return std::max(0.0, lo - fixed);
+    };
     for (int attempt = 0;; ++attempt) {
-      grid = make_grid<D>(o, std::max(1.0, shortest), levels);
+      grid = make_grid<D>(o, std::max(1.0, shortest), levels, most_points);
       rho = sample_density<D>(grid, density, threads);
       double sum = 0, mx = 0;
       if (!density.function)
@@ -328,7 +367,7 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     }
   } else {
     if (o.resolution < 2) throw InvalidArgument("grid resolution must be at least 2 nodes");
-    grid = make_grid<D>(o, o.resolution, levels);
+    grid = make_grid<D>(o, o.resolution, levels, [] { return std::nan(""); });
     rho = sample_density<D>(grid, density, threads);
     const double mx = *std::max_element(rho.begin(), rho.end());
     if (!(mx > 0)) throw InvalidArgument("density is zero everywhere");
