@@ -117,5 +117,35 @@ TEST(MultiClassTest, ConstantsWithValuesSetTheShares) {
   EXPECT_EQ(sample(o, Density::constant(5)).points, sample(o).points);  // alone, only its shape matters
 }
 
+// A class never lies where its own density is zero: class 1 (the left half only) was sampled at the sum
+// with class 0 (everywhere) fixed, so it filled class 0's gaps on the right too, and the joint sweeps moved
+// points by the sum alone; such a point takes the class whose density is there. Counts follow the classes.
+TEST(MultiClassTest, NoClassWhereItsDensityIsZero) {
+  SamplerOptions o;
+  o.n = 4000;
+  o.seed = 3;
+  o.threads = 1;
+  o.domain = Domain::kBox;
+  std::vector<float> left(64 * 64, 0.0f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 32; ++x) left[std::size_t(y) * 64 + x] = 1.0f;
+  const std::vector<Density> densities = {Density::from_values(1, 1, {1.0f}),
+                                          Density::from_values(64, 64, left)};
+  const ClassSample s = sample_classes(o, densities);
+  ASSERT_EQ(s.size(), 4000u);
+  std::int64_t counted[2] = {0, 0}, stray = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    ++counted[s.classes[i]];
+    if (s.classes[i] == 1 && s.points[2 * i] > 33.0 / 64) ++stray;  // past the interpolated edge
+    if (i > 0) {
+      ASSERT_LE(s.classes[i - 1], s.classes[i]);  // class 0's points first
+    }
+  }
+  EXPECT_EQ(stray, 0);
+  EXPECT_EQ(counted[0], s.counts[0]);
+  EXPECT_EQ(counted[1], s.counts[1]);
+  EXPECT_NEAR(double(s.counts[1]), 4000.0 / 3, 4000.0 / 3 * 0.05);  // its share, give or take the moved
+}
+
 }  // namespace
 }  // namespace kdm::gen

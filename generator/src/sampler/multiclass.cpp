@@ -1,6 +1,7 @@
 // Several classes by constrained KDM sampling, one class at a time; see kdm/generator/multiclass.h.
 #include "kdm/generator/multiclass.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -131,6 +132,44 @@ ClassSample sample_classes(const SamplerOptions& options, const std::vector<Dens
     SampleResult r = sample(o, sum_of_densities(densities));
     result.points = std::move(r.points);
     result.reports.push_back(std::move(r.report));
+  }
+  // A class's points where its own density is zero go to the class of the largest density there. Class k
+  // fills in around the earlier classes at their summed density, so it takes a gap they left where its
+  // own density is zero, and the joint sweeps move every point by the sum: cyan dots in a black area.
+  if (densities.size() > 1) {
+    const auto value = [&](std::size_t k, const double* u) {
+      return densities[k].function ? densities[k].function(u) : 1.0;
+    };
+    bool moved = false;
+    for (std::size_t i = 0; i < result.classes.size(); ++i) {
+      const double* u = &result.points[i * std::size_t(options.dim)];
+      const std::size_t own = result.classes[i];
+      if (value(own, u) > 0) continue;
+      std::size_t best = own;
+      double best_value = 0;
+      for (std::size_t k = 0; k < densities.size(); ++k) {
+        const double v = value(k, u);
+        if (v > best_value) best = k, best_value = v;
+      }
+      if (best == own) continue;  // no class has density here (the sum's edge): it keeps its class
+      --result.counts[own], ++result.counts[best];
+      result.classes[i] = static_cast<std::uint8_t>(best);
+      moved = true;
+    }
+    if (moved) {  // class 0's points first again, each class's in their order
+      const std::size_t dim = std::size_t(options.dim);
+      std::vector<std::size_t> order(result.classes.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(),
+                       [&](std::size_t a, std::size_t b) { return result.classes[a] < result.classes[b]; });
+      std::vector<double> points(result.points.size());
+      std::vector<std::uint8_t> classes(result.classes.size());
+      for (std::size_t i = 0; i < order.size(); ++i) {
+        classes[i] = result.classes[order[i]];
+        std::copy_n(&result.points[order[i] * dim], dim, &points[i * dim]);
+      }
+      result.points = std::move(points), result.classes = std::move(classes);
+    }
   }
   return result;
 }
