@@ -322,9 +322,9 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   const std::string sphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
   ASSERT_EQ(kdm("stipple " + coffee + " --colours cmyk --points 8000 -o '" + path("c.svg") + "'").status, 0);
   const std::string svg = slurp(path("c.svg"));
-  // Inkscape layers, one per pen in the printing order whatever the classes' order; the paper one of its own.
-  std::size_t previous = svg.find("<g id=\"paper\" inkscape:groupmode=\"layer\" inkscape:label=\"paper\">");
-  EXPECT_NE(previous, std::string::npos);
+  // Inkscape layers, one per pen in the printing order whatever the classes' order; white paper none.
+  EXPECT_EQ(svg.find("<g id=\"paper\""), std::string::npos);
+  std::size_t previous = 0;
   for (const std::string ink : {"cyan", "magenta", "yellow", "black"}) {
     const std::size_t at =
         svg.find("<g id=\"" + ink + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + ink);
@@ -372,7 +372,7 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   ASSERT_TRUE(kdm::tools::write_png(path("noisy.png"), noisy, noise_error)) << noise_error;
   const Outcome grey8 = kdm("stipple '" + path("noisy.png") + "' --colours 8 -o '" + path("noisy.svg") + "'");
   ASSERT_EQ(grey8.status, 0) << grey8.err;
-  EXPECT_NE(grey8.err.find("classes 0 ink-0 #000000\n"), std::string::npos) << grey8.err;
+  EXPECT_NE(grey8.err.find("classes 0 ink-0-black #000000\n"), std::string::npos) << grey8.err;
   EXPECT_NE(grey8.err.find("inks 1 of 8)"), std::string::npos) << grey8.err;
   // Two flat halves, grey 128 and brown (150, 90, 50): each drawn in its own ink, in its own tone (within
   // 12 of 255 per channel; measured 1-4 off, where the clustered colours drew them 55-60 lighter).
@@ -412,7 +412,8 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   EXPECT_NEAR(double(rows), 8000, 80);  // the dots of all inks together
   for (std::size_t c : counts) EXPECT_GT(c, 100u);
   ASSERT_EQ(kdm("stipple " + coffee + " --colours rgb --points 2000 -o '" + path("rgb.svg") + "'").status, 0);
-  EXPECT_NE(slurp(path("rgb.svg")).find("fill=\"#000000\"/>"), std::string::npos);  // black paper
+  EXPECT_NE(slurp(path("rgb.svg")).find("fill=\"#000000\" stroke=\"none\"/>"),
+            std::string::npos);  // black paper
   // Printed at a size: the SVG's width and height in the unit given, the drawing in its pixels inside.
   ASSERT_EQ(
       kdm("stipple " + coffee + " --points 2000 --width 600 --paper-width 150mm -o '" + path("p.svg") + "'")
@@ -446,6 +447,236 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   EXPECT_LT(inks_seen[0], inks_seen[2]);  // the ink that covers least (of those over a tenth) first
   EXPECT_GT(inks_seen[2], 0u);
   expect_error("stipple " + coffee + " --colours cmyk --invert -o '" + path("x.png") + "'", "--invert");
+}
+
+// The artist's test picture, 150 x 100: cyan, magenta and yellow faces over the top half, a gradient
+// (R = x, G = y, B = 1 - x) below, pure red and pure black strips at the bottom.
+kdm::tools::RgbImage ink_picture() {
+  kdm::tools::RgbImage image(150, 100);
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 150; ++x) {
+      const double u = x / 150.0, v = y / 100.0;
+      double rgb[3] = {u, v, 1 - u};
+      const double faces[3][3] = {{0, 1, 1}, {1, 0, 1}, {1, 1, 0}};
+      if (v < 0.5) std::copy(faces[std::min(2, int(u * 3))], faces[std::min(2, int(u * 3))] + 3, rgb);
+      if (v > 0.8) std::fill(rgb, rgb + 3, 0.0), rgb[0] = u < 0.5 ? 1 : 0;
+      for (int k = 0; k < 3; ++k)
+        image.pixels[(std::size_t(y) * 150 + x) * 3 + k] =
+            static_cast<std::uint8_t>(std::lround(rgb[k] * 255));
+    }
+  return image;
+}
+
+// Each class's dots in a .csv (x, y), by class number.
+std::map<int, std::vector<std::pair<double, double>>> csv_classes(const std::string& text) {
+  std::map<int, std::vector<std::pair<double, double>>> classes;
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    double x = 0, y = 0;
+    int k = 0;
+    if (std::sscanf(line.c_str(), "%lf,%lf,%d", &x, &y, &k) == 3) classes[k].push_back({x, y});
+  }
+  return classes;
+}
+
+// --colours N: the inks are the picture's own colours (black where it has black, its saturated colours),
+// and each pixel's colour is split over them, so that the picture's colours come back, gradients by dots
+// of several inks. It chose a brown and no red or black, drew black #0f2000 and the gradient as flat
+// patches of one ink each (blocks off by up to 67 of 255; now 28).
+TEST_F(CliTest, StippleNInksDrawThePicturesColours) {
+  std::string error;
+  const kdm::tools::RgbImage image = ink_picture();
+  ASSERT_TRUE(kdm::tools::write_png(path("c.png"), image, error)) << error;
+  const Outcome six = kdm("stipple '" + path("c.png") + "' --colours 6 --points 20000 --width 600 -o '" +
+                          path("n6.png") + "'");
+  ASSERT_EQ(six.status, 0) << six.err;
+  for (const char* ink :
+       {"black #000000", "red #ff0000", "cyan #00ffff", "magenta #ff00ff", "yellow #ffff00"})
+    EXPECT_NE(six.err.find(ink), std::string::npos) << ink << "\n" << six.err;
+  // Blocks of 1/12 of the width: each one's mean colour in the picture against the image's.
+  kdm::tools::ColourImage drawn;
+  ASSERT_TRUE(kdm::tools::load_colour_image(path("n6.png"), drawn, error)) << error;
+  ASSERT_EQ(drawn.width, 600);
+  double worst = 0, sum = 0;
+  int blocks = 0;
+  for (int by = 0; by < 8; ++by)
+    for (int bx = 0; bx < 12; ++bx, ++blocks) {
+      double want[3] = {}, got[3] = {};
+      for (int y = by * 100 / 8; y < (by + 1) * 100 / 8; ++y)
+        for (int x = bx * 150 / 12; x < (bx + 1) * 150 / 12; ++x)
+          for (int k = 0; k < 3; ++k) want[k] += image.pixels[(std::size_t(y) * 150 + x) * 3 + k];
+      for (int y = by * 400 / 8; y < (by + 1) * 400 / 8; ++y)
+        for (int x = bx * 600 / 12; x < (bx + 1) * 600 / 12; ++x)
+          for (int k = 0; k < 3; ++k) got[k] += drawn.pixels[(std::size_t(y) * 600 + x) * 3 + k] * 255;
+      double off = 0;
+      for (int k = 0; k < 3; ++k)
+        off = std::max(off, std::abs(want[k] / (12.5 * 12.5) - got[k] / (50.0 * 50.0)));
+      worst = std::max(worst, off), sum += off;
+    }
+  EXPECT_LT(worst, 45) << "mean " << sum / blocks;
+  EXPECT_LT(sum / blocks, 25);
+  // The gradient by several inks: in each of 10 windows along it, at least two inks hold a tenth of its dots.
+  ASSERT_EQ(
+      kdm("stipple '" + path("c.png") + "' --colours 6 --points 20000 -o '" + path("n6.csv") + "'").status,
+      0);
+  const auto classes = csv_classes(slurp(path("n6.csv")));
+  int mixed = 0;
+  for (int w = 0; w < 10; ++w) {
+    std::map<int, int> counts;
+    int all = 0;
+    for (const auto& [k, dots] : classes)
+      for (const auto& [x, y] : dots)
+        if (x >= w / 10.0 && x < (w + 1) / 10.0 && y > 0.22 && y < 0.48) ++counts[k], ++all;
+    int inks = 0;
+    for (const auto& [k, n] : counts) inks += n >= 0.1 * all;
+    mixed += inks >= 2;
+  }
+  EXPECT_GE(mixed, 9);
+  // Four inks: black stays black.
+  const Outcome four = kdm("stipple '" + path("c.png") + "' --colours 4 -o '" + path("n4.csv") + "'");
+  ASSERT_EQ(four.status, 0) << four.err;
+  EXPECT_NE(four.err.find("black #000000"), std::string::npos) << four.err;
+}
+
+// The user's own pens as inks, split as N inks are; the printed list, the .svg's layers and the .csv's
+// classes one numbering that names each ink and its colour.
+TEST_F(CliTest, StipplePensAsInksOneNumbering) {
+  std::string error;
+  ASSERT_TRUE(kdm::tools::write_png(path("c.png"), ink_picture(), error)) << error;
+  const std::string pens = " --colours '#e00000,#0000aa,#000000,#00aa00' --points 6000 ";
+  const Outcome run = kdm("stipple '" + path("c.png") + "'" + pens + "-o '" + path("p.svg") + "'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  ASSERT_EQ(kdm("stipple '" + path("c.png") + "'" + pens + "-o '" + path("p.csv") + "'").status, 0);
+  EXPECT_NE(run.err.find("inks 4 of 4 given"), std::string::npos) << run.err;
+  const std::string svg = slurp(path("p.svg"));
+  const auto classes = csv_classes(slurp(path("p.csv")));
+  ASSERT_EQ(classes.size(), 4u);
+  std::set<std::string> colours;
+  for (const auto& [k, dots] : classes) {
+    // "K ink-K-word #rrggbb" printed; the layer of that name holds class K's dots, in that colour.
+    const std::string key = std::to_string(k) + " ink-" + std::to_string(k) + "-";
+    const std::size_t at = run.err.find(key);
+    ASSERT_NE(at, std::string::npos) << key << "\n" << run.err;
+    const std::size_t hash = run.err.find(" #", at);
+    const std::string name = run.err.substr(at + key.size() - 6, hash - (at + key.size() - 6));
+    const std::string hex = run.err.substr(hash + 1, 7);
+    colours.insert(hex);
+    const std::size_t layer = svg.find("<g id=\"" + name + "\"");
+    ASSERT_NE(layer, std::string::npos) << name;
+    const std::string group = svg.substr(layer, svg.find("</g>", layer) - layer);
+    EXPECT_NE(group.find("fill=\"" + hex + "\""), std::string::npos) << name;
+    std::size_t circles = 0;
+    for (std::size_t c = group.find("<circle"); c != std::string::npos; c = group.find("<circle", c + 1))
+      ++circles;
+    EXPECT_EQ(circles, dots.size()) << name;
+  }
+  EXPECT_EQ(colours, (std::set<std::string>{"#e00000", "#0000aa", "#000000", "#00aa00"}));
+  EXPECT_NE(run.err.find("ink-0-"), std::string::npos);
+  EXPECT_NE(svg.find("-black\""), std::string::npos);
+  for (const char* bad : {"'#e00000,#12345'", "'#e00000,,#000000'", "'#ffffff'", "'#000000,#000000'",
+                          "'#000000,#111111,#222222,#333333,#444444,#555555,#666666,#777777,#888888'"})
+    expect_error("stipple '" + path("c.png") + "' --colours " + bad + " -o '" + path("x.png") + "'", "ink");
+}
+
+// SVG dots in plotting order: each layer's dots as a pen would draw them, each the nearest left (travel was
+// about 16 times a greedy order's, the dots coming in the tiles' order), every dot inside the picture,
+// and no paper rectangle for a plotter to trace as a frame (other paper in a layer AxiDraw skips).
+TEST_F(CliTest, StippleSvgInPlottingOrder) {
+  std::string error;
+  ASSERT_TRUE(kdm::tools::write_png(path("c.png"), ink_picture(), error)) << error;
+  const Outcome run = kdm("stipple '" + path("c.png") + "' --colours cmyk --points 20000 --width 600 -o '" +
+                          path("p.svg") + "'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const std::string svg = slurp(path("p.svg"));
+  EXPECT_EQ(svg.find("<rect"), std::string::npos);
+  std::size_t layers = 0;
+  for (std::size_t at = svg.find("<g id="); at != std::string::npos;
+       at = svg.find("<g id=", at + 1), ++layers) {
+    const std::string group = svg.substr(at, svg.find("</g>", at) - at);
+    double travel = 0, px = 0, py = 0;
+    std::size_t dots = 0;
+    for (std::size_t c = group.find("<circle"); c != std::string::npos; c = group.find("<circle", c + 1)) {
+      double x = 0, y = 0, r = 0;
+      ASSERT_EQ(std::sscanf(group.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
+      EXPECT_TRUE(x - r >= -1e-3 && x + r <= 600 + 1e-3 && y - r >= -1e-3 && y + r <= 400 + 1e-3)
+          << x << "," << y;
+      if (dots++) travel += std::hypot(x - px, y - py);
+      px = x, py = y;
+    }
+    // A greedy order's travel is about 1.1 sqrt(n A) for n blue-noise dots over an area A of the picture.
+    if (dots > 100) {
+      EXPECT_LT(travel, 1.5 * std::sqrt(double(dots) * 600 * 400)) << group.substr(0, 80);
+    }
+  }
+  EXPECT_EQ(layers, 4u);
+  // rgb's black paper: a rectangle in a layer whose name starts with % (not plotted), no stroke.
+  ASSERT_EQ(
+      kdm("stipple '" + path("c.png") + "' --colours rgb --points 2000 -o '" + path("r.svg") + "'").status,
+      0);
+  EXPECT_NE(slurp(path("r.svg"))
+                .find("inkscape:label=\"% paper (not plotted)\"><rect width=\"100%\" "
+                      "height=\"100%\" fill=\"#000000\" stroke=\"none\"/>"),
+            std::string::npos);
+}
+
+// --method full with inks: a class never lands where its own ink is zero (cyan dots in a black area came
+// from the sampler's classes filling one another's gaps at their summed density).
+TEST_F(CliTest, StippleFullInksOnlyWhereTheirInkIs) {
+  kdm::tools::RgbImage image(90, 60);
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 90; ++x) {
+      const std::uint8_t black[3] = {0, 0, 0}, cyan[3] = {0, 255, 255}, yellow[3] = {255, 255, 0};
+      const std::uint8_t* rgb = y < 20 ? yellow : x < 45 ? black : cyan;
+      std::copy(rgb, rgb + 3, &image.pixels[(std::size_t(y) * 90 + x) * 3]);
+    }
+  std::string error;
+  ASSERT_TRUE(kdm::tools::write_png(path("kc.png"), image, error)) << error;
+  const Outcome run = kdm("stipple '" + path("kc.png") + "' --method full --colours cmyk --points 6000 -o '" +
+                          path("f.csv") + "'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  ASSERT_NE(run.err.find("classes 0 black #000000, 1 cyan #00aeef, 2 yellow #fff200"), std::string::npos)
+      << run.err;
+  const auto classes = csv_classes(slurp(path("f.csv")));
+  std::size_t counted = 0;
+  for (const auto& [k, dots] : classes)
+    for (const auto& [u, v] : dots) {
+      const double x = u * 90, y = (1 - v) * 60;  // pixels, y down; two pixels in from each area's edge
+      const int area = y < 18 ? 2 : y > 22 && x < 43 ? 0 : y > 22 && x > 47 ? 1 : -1;  // its one ink
+      if (area < 0) continue;
+      EXPECT_EQ(k, area) << u << "," << v;
+      ++counted;
+    }
+  EXPECT_GT(counted, 5000u);
+}
+
+// Small frictions of kdm stipple: the help says what --region, --invert and --format allow; a transparent
+// image is said to be transparent, not white; a format kdm does not read is named, with those it reads.
+TEST_F(CliTest, StippleSaysWhatItTakes) {
+  const Outcome help = kdm("stipple --help");
+  ASSERT_EQ(help.status, 0);
+  std::string words;  // the help's words on one line, whatever its wrapping
+  std::istringstream in(help.out);
+  for (std::string word; in >> word;) words += word + " ";
+  for (const char* said :
+       {"needs --method tiles; zoom", "not with --colours", "-o x.png --format svg is refused",
+        "#rrggbb,#rrggbb", "drawing order", "AxiDraw skips"})
+    EXPECT_NE(words.find(said), std::string::npos) << said;
+  std::vector<std::uint16_t> clear(16 * 16 * 2, 0);  // grey and alpha, all 0
+  write_bytes(path("clear.png"), grey_png(16, 16, 8, clear, 2));
+  for (const char* colours : {"", " --colours 3"}) {
+    const Outcome none = kdm("stipple '" + path("clear.png") + "'" + colours + " -o '" + path("n.svg") + "'");
+    ASSERT_EQ(none.status, 0) << none.err;
+    EXPECT_NE(none.err.find("(it is all transparent)"), std::string::npos) << none.err;
+    EXPECT_EQ(none.err.find("white"), std::string::npos) << none.err;
+  }
+  std::ofstream(path("x.tif"), std::ios::binary) << std::string("II*\0\x08\0\0\0\0\0\0\0", 12);
+  std::ofstream(path("x.webp"), std::ios::binary)
+      << std::string("RIFF\x1a\0\0\0WEBPVP8 \0\0\0\0\0\0\0\0", 24);
+  expect_error("stipple '" + path("x.tif") + "' -o '" + path("x.png") + "'", "a TIFF image");
+  expect_error("stipple '" + path("x.webp") + "' --colours 3 -o '" + path("x.png") + "'",
+               "a WebP image, a format kdm does not read (it reads PNG, JPEG");
 }
 
 // kdm sample --class: exact counts per class by the densities' integrals, a class column in .csv.

@@ -79,11 +79,14 @@ CLI::Option* add_format_option(CLI::App* cmd, std::string& format,
   std::string names;
   for (std::size_t i = 0; i < extensions.size(); ++i)
     names += (i ? ", " : "") + std::string(extensions[i] + 1);
-  return cmd->add_option("--format", format,
-                         "The output's format (" + names +
-                             "; default: -o's extension): -o - writes to standard output, as in `-o - "
-                             "--format " +
-                             std::string(extensions[0] + 1) + " | …`");
+  return cmd->add_option(
+      "--format", format,
+      "The output's format (" + names +
+          "; default: -o's extension): -o - writes to standard output, as in `-o - "
+          "--format " +
+          std::string(extensions[0] + 1) +
+          " | …`; it does not override a file name of "
+          "another format's extension (-o x.png --format svg is refused: name the file .svg)");
 }
 
 }  // namespace kdm::cli

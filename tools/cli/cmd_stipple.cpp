@@ -141,12 +141,20 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       tools::stipple_zoom(region) > tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
   std::unique_ptr<tools::TileStippler> stippler;
-  if (blank)
-    std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s: no dots\n", a.image.c_str(),
-                 coloured   ? " in any colour"
-                 : a.invert ? ""
-                            : " (it is all white)");
-  else if (a.method != "full") {
+  if (blank) {
+    // Said as the image is: every pixel transparent (paper), or white.
+    tools::ColourImage probe;
+    std::string unread;
+    const bool transparent =
+        tools::load_colour_image(a.image, probe, unread) && !probe.alpha.empty() &&
+        std::all_of(probe.alpha.begin(), probe.alpha.end(), [](float alpha) { return alpha == 0; });
+    std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s%s: no dots\n", a.image.c_str(),
+                 coloured ? " in any colour" : "",
+                 transparent            ? " (it is all transparent)"
+                 : coloured || a.invert ? ""
+                                        : " (it is all white)");
+  }
+  if (!blank && a.method != "full") {
     stippler = std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale,
                                                      parse_mode(a.mode), a.seed);
   }
@@ -229,7 +237,12 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     char line[200], where[160];
     // N inks: how many the image gave (a grey image one), and how many were asked for.
     const bool counted = coloured && a.colours != "cmyk" && a.colours != "rgb";
-    const std::string scheme = counted ? std::to_string(inks.inks.size()) + " of " + a.colours : a.colours;
+    const bool listed = a.colours.find_first_of("#,") != std::string::npos;  // the user's pens
+    const std::string scheme =
+        !counted
+            ? a.colours
+            : std::to_string(inks.inks.size()) + " of " +
+                  (listed ? std::to_string(inks.inks.size() + inks.unused.size()) + " given" : a.colours);
     std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s%s%s)", set.size(),
                   set.size() == 1 ? "" : "s", how.c_str(), coloured ? ", inks " : "",
                   coloured ? scheme.c_str() : "");
@@ -257,7 +270,10 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
                   "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...; - for standard "
-                  "output (with --format)")
+                  "output (with --format). For pen plotters, .svg has an Inkscape layer per ink, its dots in "
+                  "drawing order (each the nearest not yet drawn: short pen travel) and inside the picture's "
+                  "edge; white paper is no element (nothing to trace as a frame), other paper (rgb's black) "
+                  "a layer '% paper (not plotted)' that AxiDraw skips: hide it in other plotter software")
       ->required();
   add_format_option(cmd, a->format, kStippleFormats);
   add_count_option(
@@ -276,8 +292,8 @@ void add_stipple_command(CLI::App& app) {
       "--region", a->region,
       "x0,y0,x1,y1 in the image's UV square [0,1]² (y up): render that part at the same dot "
       "size with more dots, a zoom of 1 / its width (it may reach past the image, drawn as blank "
-      "paper, as a zoom's first frames do; not with --frames); zoom at most 2× in stable mode, in smooth "
-      "mode as deep as the tile set's "
+      "paper, as a zoom's first frames do; not with --frames); needs --method tiles; zoom at most 2× in "
+      "stable mode, in smooth mode as deep as the tile set's "
       "subtiles go (2·m^4×: about 2·10^6 for 32×32 subtiles) (default: the whole image)");
   cmd->add_option("--frames", a->frames,
                   "Zoom sequence of K numbered pictures from the whole image into --region (geometric "
@@ -315,16 +331,18 @@ void add_stipple_command(CLI::App& app) {
       "keeps the image's tone)");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
-  cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas)");
+  cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas); not with --colours");
   cmd->add_option(
       "--colours", a->colours,
-      "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour "
-      "removal), rgb (red, green, blue on black) or N (up to N = 2-8 inks: the image's main hues at full "
-      "strength, fewer if it has fewer or a hue holds under 1% of the ink, one black for a grey image); one "
-      "class of dots per ink, all inks together one blue-noise set; .svg has a group per ink named as the "
-      "run prints it "
-      "(a layer per pen, empty for an ink no pixel uses), .csv a class column: the class number the run "
-      "prints before each ink's name and colour, least-used ink first (but inks under a tenth of all ink "
+      "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour removal), rgb "
+      "(red, green, blue on black), N (up to N = 2-8 inks chosen for the image: its own colours at full "
+      "strength, black where it has black, fewer if fewer draw it as well or an ink would hold under 1% of "
+      "the ink; one black for a grey image) or your pens as '#rrggbb,#rrggbb,...' (1 to 8). With N inks or "
+      "pens each pixel's colour is split over them (the mix of inks side by side nearest its colour: a "
+      "gradient is drawn by mixing dots of several inks). One class of dots per ink, all inks together one "
+      "blue-noise set; the run prints each class number with its ink's name and colour; .svg has a layer "
+      "per ink named as printed (with N inks or pens ink-K-colour, K the class number; an empty layer for "
+      "an ink no pixel uses), .csv a class column; least-used ink first (but inks under a tenth of all ink "
       "last) (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
@@ -341,7 +359,7 @@ void add_stipple_command(CLI::App& app) {
   cmd->callback([a, cmd] {
     const bool scale_given = cmd->get_option("--scale")->count() > 0;
     if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())
-      throw CommandError("--colours must be cmyk, rgb or a count of inks (2-8), got ''");
+      throw CommandError("--colours must be cmyk, rgb, a count of inks (2-8) or inks as #rrggbb,..., got ''");
     // Given empty or 0, these read as unset: say so rather than draw at the default size.
     if (cmd->get_option("--height")->count() > 0 && a->height_px < 1)
       throw CommandError("--height must be 1 to 65536 pixels");

@@ -314,6 +314,24 @@ std::string stb_reason() {
   return reason ? reason : "unknown format";
 }
 
+// Why stb read no header: a format it does not read named, with the ones it does; else its reason.
+std::string unread_format(const std::uint8_t* bytes, std::size_t size) {
+  const auto starts = [&](const char* magic, std::size_t at = 0) {
+    const std::size_t n = std::strlen(magic);
+    return size >= at + n && std::memcmp(bytes + at, magic, n) == 0;
+  };
+  const char* kind = starts("II*") || (starts("MM") && size >= 4 && bytes[2] == 0 && bytes[3] == 42) ? "TIFF"
+                     : starts("RIFF") && starts("WEBP", 8)                                           ? "WebP"
+                     : starts("ftyp", 4)                              ? "HEIF/AVIF"
+                     : starts("\xff\x0a") || starts("\0\0\0\x0cJXL ") ? "JPEG XL"
+                                                                      : nullptr;
+  const std::string reason = stb_reason();
+  if (!kind && reason != "unknown image type") return reason;
+  return std::string(kind ? "a " + std::string(kind) + " image, a format" : "not a format") +
+         " kdm does not read (it reads PNG, JPEG, BMP, GIF, TGA, PSD, HDR, PIC and PGM/PPM): convert it to "
+         "PNG";
+}
+
 // Luminance of `channels`-channel samples of full scale `full`, composited on white paper. The samples are
 // converted to float and divided first, as kdm always did, so that outputs stay bit for bit the same.
 template <class Sample>
@@ -505,7 +523,7 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
     if (png_size(bytes, size, pw, ph) && pw * ph > max_pixels) {
       w = int(std::min<std::uint64_t>(pw, INT32_MAX)), h = int(std::min<std::uint64_t>(ph, INT32_MAX));
     } else {
-      error = "cannot read image '" + name + "': " + stb_reason();
+      error = "cannot read image '" + name + "': " + unread_format(bytes, size);
       return false;
     }
   }

@@ -29,6 +29,80 @@ std::string number(double v) {
 
 }  // namespace
 
+std::vector<std::size_t> plotting_order(const std::vector<double>& xy) {
+  const std::size_t n = xy.size() / 2;
+  std::vector<std::size_t> order;
+  order.reserve(n);
+  if (n == 0) return order;
+  // A grid of about two points a cell over the points' bounding box; each cell's points in a list.
+  double lo[2] = {xy[0], xy[1]}, hi[2] = {xy[0], xy[1]};
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 2; ++a)
+      lo[a] = std::min(lo[a], xy[2 * i + a]), hi[a] = std::max(hi[a], xy[2 * i + a]);
+  const double w = std::max(hi[0] - lo[0], 1e-300), h = std::max(hi[1] - lo[1], 1e-300);
+  const double cell = std::max(std::sqrt(w * h / (0.5 * double(n))), std::max(w, h) / 4096);
+  const int gx = std::max(1, std::min(4096, int(w / cell) + 1)),
+            gy = std::max(1, std::min(4096, int(h / cell) + 1));
+  const auto cell_of = [&](std::size_t i, int a) {
+    const int g = a ? gy : gx;
+    return std::clamp(int((xy[2 * i + a] - lo[a]) / cell), 0, g - 1);
+  };
+  std::vector<std::size_t> start(std::size_t(gx) * gy + 1, 0), items(n);
+  for (std::size_t i = 0; i < n; ++i) ++start[std::size_t(cell_of(i, 1)) * gx + cell_of(i, 0) + 1];
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) items[fill[std::size_t(cell_of(i, 1)) * gx + cell_of(i, 0)]++] = i;
+  }
+  std::vector<std::size_t> alive(start.size() - 1);  // points left per cell, kept at the front of its list
+  for (std::size_t c = 0; c < alive.size(); ++c) alive[c] = start[c + 1] - start[c];
+  std::vector<std::size_t> where(n);  // each point's place in `items`
+  for (std::size_t k = 0; k < n; ++k) where[items[k]] = k;
+  const auto take = [&](std::size_t i) {
+    const std::size_t c = std::size_t(cell_of(i, 1)) * gx + cell_of(i, 0);
+    const std::size_t last = start[c] + --alive[c], at = where[i];
+    std::swap(items[at], items[last]);
+    where[items[at]] = at, where[items[last]] = last;
+    order.push_back(i);
+  };
+  // From the point nearest the bounding box's corner at the origin (the top left of a picture), each time
+  // to the nearest point left: rings of cells around the current one until no closer point can lie
+  // farther out.
+  std::size_t current = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (xy[2 * i] + xy[2 * i + 1] < xy[2 * current] + xy[2 * current + 1]) current = i;
+  take(current);
+  while (order.size() < n) {
+    const int cx = cell_of(current, 0), cy = cell_of(current, 1);
+    std::size_t best = n;
+    double best_d = HUGE_VAL;
+    for (int r = 0;; ++r) {
+      // Every point in ring r or beyond is at least (r - 1) cells away.
+      if (best < n && best_d <= (double(r) - 1) * (r - 1) * cell * cell) break;
+      if (cx - r < 0 && cy - r < 0 && cx + r >= gx && cy + r >= gy) break;
+      const auto visit = [&](int x, int y) {
+        const std::size_t c = std::size_t(y) * gx + x;
+        for (std::size_t k = start[c]; k < start[c] + alive[c]; ++k) {
+          const std::size_t j = items[k];
+          const double dx = xy[2 * j] - xy[2 * current], dy = xy[2 * j + 1] - xy[2 * current + 1];
+          const double d = dx * dx + dy * dy;
+          if (d < best_d || (d == best_d && j < best)) best = j, best_d = d;
+        }
+      };
+      for (int y = std::max(0, cy - r); y <= std::min(gy - 1, cy + r); ++y)
+        if (y == cy - r || y == cy + r) {
+          for (int x = std::max(0, cx - r); x <= std::min(gx - 1, cx + r); ++x) visit(x, y);
+        } else {
+          if (cx - r >= 0) visit(cx - r, y);
+          if (cx + r < gx) visit(cx + r, y);
+        }
+    }
+    take(best);
+    current = best;
+  }
+  return order;
+}
+
 std::string Ink::hex() const {
   char text[8];
   std::snprintf(text, sizeof text, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
@@ -154,8 +228,10 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     return;
   }
   std::ostringstream out;
-  // Each group an Inkscape layer, so that plotter software draws a layer per pen; the paper is a layer of
-  // its own, to hide before plotting (a plotter would trace its outline).
+  // Each group an Inkscape layer, so that plotter software draws a layer per pen. White paper is no
+  // element at all (a plotter would trace a rectangle's outline as a frame); paper of another colour is a
+  // rectangle in a layer of its own whose name starts with % (AxiDraw's mark for a layer it does not plot;
+  // hide it in other plotter software).
   std::string width = std::to_string(w), height = std::to_string(h);
   if (!style.paper_width.empty()) {  // the same drawing, printed at a size: a plotter's or printer's units
     check_paper_width(style.paper_width);
@@ -168,26 +244,45 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     std::snprintf(text, sizeof text, "%.10g%s", value * h / w, unit.c_str());
     height = text;
   }
-  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
-         "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
-      << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << w << ' ' << h << "\">\n";
-  for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
-  const auto layer = [&](const std::string& name) {
-    return "<g id=\"" + name + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + name + "\"";
-  };
   Ink paper;
   std::copy(style.background, style.background + 3, paper.rgb);
-  out << layer("paper") << "><rect width=\"100%\" height=\"100%\" fill=\"" << paper.hex() << "\"/></g>\n";
+  const bool white = paper.hex() == "#ffffff";
+  out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
+         "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
+      << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << w << ' ' << h << "\""
+      << (white ? "" : " style=\"background-color:" + paper.hex() + "\"") << ">\n";
+  for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
+  const auto layer = [&](const std::string& name, const std::string& label) {
+    return "<g id=\"" + name + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + label + "\"";
+  };
+  if (!white)
+    out << layer("paper", "% paper (not plotted)") << "><rect width=\"100%\" height=\"100%\" fill=\""
+        << paper.hex() << "\" stroke=\"none\"/></g>\n";
   out.precision(6);
+  std::vector<double> xy;  // a layer's dot centres in the picture's pixels, each inside the picture
+  std::vector<double> radii;
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
                                                         : "";
-    out << layer(classed ? inks[k].name : "points") << " fill=\"" << inks[k].hex() << "\"" << blend << ">\n";
+    const std::string name = classed ? inks[k].name : "points";
+    out << layer(name, name) << " fill=\"" << inks[k].hex() << "\"" << blend << ">\n";
+    xy.clear(), radii.clear();
     for (std::size_t i = 0; i < points.size(); ++i)
-      if ((!classed || (*style.classes)[i] == k) && radius(i) > 0)
-        out << "<circle cx=\"" << points.coords[2 * i] * w << "\" cy=\"" << (1 - points.coords[2 * i + 1]) * h
-            << "\" r=\"" << radius(i) << "\"/>\n";
+      if ((!classed || (*style.classes)[i] == k) && radius(i) > 0) {
+        // A dot that would cross the picture's edge is moved in to touch it (a plotter draws no further
+        // than the paper; a dot wider than the picture is centred).
+        const double ri = radius(i);
+        const auto inside = [ri](double v, double side) {
+          return 2 * ri >= side ? side / 2 : std::clamp(v, ri, side - ri);
+        };
+        xy.push_back(inside(points.coords[2 * i] * w, w));
+        xy.push_back(inside((1 - points.coords[2 * i + 1]) * h, h));
+        radii.push_back(ri);
+      }
+    // In plotting order: each dot the nearest of those left to the one before (plotting_order).
+    for (const std::size_t i : plotting_order(xy))
+      out << "<circle cx=\"" << xy[2 * i] << "\" cy=\"" << xy[2 * i + 1] << "\" r=\"" << radii[i] << "\"/>\n";
     out << "</g>\n";
   }
   out << "</svg>\n";

@@ -42,6 +42,11 @@ struct DrawStyle {
   std::string paper_width;
 };
 
+/// An order of the points `xy` (x, y pairs) for a pen plotter's short travel: from the point nearest the
+/// bounding box's low corner, each time to the nearest point not yet drawn (greedy nearest neighbour on a
+/// grid; ties to the lower index: the same order every run). SVG pictures write each layer's dots so.
+std::vector<std::size_t> plotting_order(const std::vector<double>& xy);
+
 /// Checks `text` as DrawStyle::paper_width takes it; throws std::invalid_argument naming the problem.
 void check_paper_width(const std::string& text);
 

@@ -35,10 +35,16 @@ struct ColourSeparation {
 /// - "cmyk": cyan, magenta, yellow and black on white paper, black by full under-colour removal
 ///   (K = 1 − max(R, G, B), C = (1 − R − K) / (1 − K), …);
 /// - "rgb": red, green and blue dots on black paper, each channel's intensity its density;
-/// - "N" (2 … 8): up to N inks on white paper, the image's hues clustered (spherical k-means of the
-///   pixels' absorbances 1 − rgb, deterministic; fewer inks where the image holds fewer hues, one for a
-///   grey image), each ink its hue at full strength (its strongest channel 0), each pixel drawn by the ink
-///   of the nearest hue with the coverage that gives its absorbance (least squares, at most 1).
+/// - "N" (2 … 8): up to N inks on white paper chosen for the image: among its own colours at full
+///   strength (strongest channel 0; a near-grey one black), greedily and then by swaps, the inks whose
+///   splits (below) draw the image's colours with the least squared error; fewer where more would not lower
+///   it by 1% of the blank paper's, none under 1% of the coverage (one black ink for a grey image);
+/// - "#rrggbb,#rrggbb,…" (1 … 8): the user's own inks (pens) as given.
+/// With N inks or a list, each pixel's colour is split over the inks: the coverages c_i ≥ 0, Σ c_i ≤ 1 (dots
+/// side by side) whose Σ c_i (1 − ink_i) is nearest its absorbance 1 − rgb (least squares with a small
+/// ridge, so the split changes smoothly with the colour and a gradient is drawn by dots of several inks;
+/// traces under 1% dropped), near-greys as greys. Such inks are named by their class number and colour,
+/// "ink-0-red", after the ordering below, the unused after the used; their layers come in that order.
 /// Each density is the coverage raised to `gamma` (> 0). The inks come in order of increasing mean coverage
 /// (a later class's tone carries the earlier classes' count errors, the more the smaller its share), except
 /// that inks under a tenth of the total coverage come last, most covering first (a sparse class early in
