@@ -76,11 +76,12 @@ def stipple(
         pc or px), the height in proportion (``kdm stipple --paper-width``). None: `width` pixels.
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
-    colours : {"cmyk", "rgb"}, int or None
+    colours : {"cmyk", "rgb"}, int, str of pens or None
         A colour stipple of the image, a file or an array (``kdm stipple --colours``): "cmyk" (black by under-colour
-        removal), "rgb" (light on black) or a number of inks, 2 to 8: the image's main hues at full
-        strength (fewer if it has fewer; one black ink for a grey image), each pixel drawn by the ink of
-        its hue; one class of dots per ink, all of them one blue-noise set.
+        removal), "rgb" (light on black), a number of inks, 2 to 8 (chosen among the image's own colours,
+        the set whose mixes draw it best; fewer if fewer do as well, one black ink for a grey image), or
+        your own pens as "#e00000,#0000aa,#000000" (1 to 8); each pixel's colour is split over the inks;
+        one class of dots per ink, all of them one blue-noise set.
     fade : float
         For method "tiles", in the picture written to `output`: a dot's area grows from 0 where it
         appears to full once the density there is this fraction higher (``kdm stipple --fade``), so

@@ -171,7 +171,7 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, "needs method='tiles'", lambda: kdm.stipple(SPHERE, method="full", region=(0, 0, 1, 1))),
     (ValueError, "width must be <= 65536", lambda: kdm.stipple(SPHERE, width=10**6)),
     (ValueError, "dot_size must be >= 0", lambda: kdm.stipple(SPHERE, dot_size=-1)),
-    (ValueError, "^colours must be cmyk, rgb or a number of inks", lambda: kdm.stipple(SPHERE, colours="9")),
+    (ValueError, "^colours must be cmyk, rgb, a number of inks", lambda: kdm.stipple(SPHERE, colours="9")),
     (ValueError, "unknown output format", lambda: kdm.stipple(SPHERE, points=100, output="x.gif")),
     (ValueError, "luminances in", lambda: kdm.stipple(np.full((4, 4), 2.0))),
     (ValueError, r"luminances in \[0, 1\], got 1e\+300 \(8-bit", lambda: kdm.stipple(np.full((4, 4), 1e300))),
