@@ -518,7 +518,10 @@ struct Driver {
       chain.splat_all(particles, threads);
     }
     if (!coarsest && !relaxing && options.n > 0) fix_count_level(chain, level);
-    if (level == 0 && !relaxing && !fixed.empty()) separate_from_fixed(chain);
+    // kOriginal keeps its first start: a recipe bakes the same tiles in every version (the baker parts
+    // close pairs itself, bake/close_pairs.h).
+    if (level == 0 && !relaxing && !fixed.empty() && options.numerics == Numerics::kFast)
+      separate_from_fixed(chain);
 
     // Freeze wide kernels; bound the rest (a support constraint that keeps footprints small). Kernels not
     // yet relaxed get twice the width: a split's children are crowded and would stay so if frozen at birth.
