@@ -138,6 +138,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       tools::DrawStyle style;
       style.width_px = width;
       style.paper_width = paper_width;
+      style.dots_inside = true;  // for pen plotters, as kdm stipple
       style.height_px = height;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
       style.dot_radius_px = dot_size > 0 ? dot_size

@@ -149,6 +149,35 @@ TEST_F(CliTest, QueryPicturesOfSliversAreRefused) {
   ASSERT_EQ(kdm("query --rect 0,0,1000,1 --scale 1 -o '" + path("long.png") + "'").status, 0);
 }
 
+// A query's SVG holds its points where they are, those by the rect's sides too (the stippler's pen-plotter
+// pictures move dots inward; a query's were moved up to 2 pixels with them).
+TEST_F(CliTest, QuerySvgKeepsEveryPointWhereItIs) {
+  const std::string args = "query --rect 0,0,2,2 --scale 300 -o '";
+  ASSERT_EQ(kdm(args + path("q.csv") + "' --normalised").status, 0);
+  ASSERT_EQ(kdm(args + path("q.svg") + "'").status, 0);
+  std::vector<std::pair<double, double>> from_csv, from_svg;  // in the pixels of a 1024² picture
+  std::istringstream csv(slurp(path("q.csv")));
+  std::string row;
+  std::getline(csv, row);  // the header
+  double x = 0, y = 0, r = 0;
+  while (std::getline(csv, row) && std::sscanf(row.c_str(), "%lf,%lf", &x, &y) == 2)
+    from_csv.emplace_back(x * 1024, (1 - y) * 1024);
+  const std::string svg = slurp(path("q.svg"));
+  for (std::size_t c = svg.find("<circle"); c != std::string::npos; c = svg.find("<circle", c + 1)) {
+    ASSERT_EQ(std::sscanf(svg.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
+    from_svg.emplace_back(x, y);
+  }
+  ASSERT_GT(from_csv.size(), 1000u);
+  ASSERT_EQ(from_svg.size(), from_csv.size());
+  std::size_t moved = 0;  // SVG points with no point of the CSV within the six digits it writes
+  for (const auto& p : from_svg) {
+    bool found = false;
+    for (const auto& q : from_csv) found = found || std::hypot(p.first - q.first, p.second - q.second) < 0.01;
+    moved += !found;
+  }
+  EXPECT_EQ(moved, 0u);
+}
+
 // Past the top level ranks repeat in the subtiles: the depth column makes every id unique (without it,
 // 261 of 401,662 points shared (tile_x, tile_y, rank) with another point over 2 × 2 units).
 TEST_F(CliTest, QueryIdsPastTheTopLevelAreUniqueWithTheirDepth) {

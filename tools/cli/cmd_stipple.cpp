@@ -228,6 +228,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
     style.dot_radius_px = dot_radius;
     style.paper_width = a.paper_width;
+    style.dots_inside = true;  // for pen plotters
     if (coloured) {
       if (set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left: a one-class query
       style.classes = &set.classes, style.inks = inks.layers();

@@ -259,7 +259,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     out << layer("paper", "% paper (not plotted)") << "><rect width=\"100%\" height=\"100%\" fill=\""
         << paper.hex() << "\" stroke=\"none\"/></g>\n";
   out.precision(6);
-  std::vector<double> xy;  // a layer's dot centres in the picture's pixels, each inside the picture
+  std::vector<double> xy;  // a layer's dot centres in the picture's pixels
   std::vector<double> radii;
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
@@ -270,10 +270,9 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     xy.clear(), radii.clear();
     for (std::size_t i = 0; i < points.size(); ++i)
       if ((!classed || (*style.classes)[i] == k) && radius(i) > 0) {
-        // A dot that would cross the picture's edge is moved in to touch it (a plotter draws no further
-        // than the paper; a dot wider than the picture is centred).
         const double ri = radius(i);
-        const auto inside = [ri](double v, double side) {
+        const auto inside = [&](double v, double side) {
+          if (!style.dots_inside) return v;
           return 2 * ri >= side ? side / 2 : std::clamp(v, ri, side - ri);
         };
         xy.push_back(inside(points.coords[2 * i] * w, w));
