@@ -254,7 +254,7 @@ Vec<D> Chain<D>::gradient(const Particle<D>& p, Scratch& scratch) {
 }
 
 template <int D>
-bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached) {
+bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached, int cell) {
   const double w = p.weight();
   const double rho_old = rho_at(p.x);
   if (!(rho_old > 0)) return false;  // a massless kernel has nothing to relax
@@ -294,6 +294,12 @@ bool Chain<D>::update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprin
   Vec<D> x_new;
   for (int k = 0; k < D; ++k) x_new[k] = p.x[k] + step[k];
   if (!grid().canonical(x_new)) return reject();
+  // A point stays in its checkerboard cell for the sweep (a support constraint, symmetric like the others):
+  // the sweep's order, cell by cell, is then the same for every state it can reach, so each update's
+  // invariance of P carries over to the sweep. Let points cross and the order depends on where they are:
+  // the cells updated first lost points near their borders to the cells updated after (5% of the density
+  // within a node of each border, at 256 points; docs/design.md §2.2).
+  if (cell >= 0 && board_.cell_of(x_new) != cell) return reject();
   const double rho_new = rho_at(x_new);
   if (!(rho_new > 0)) return reject();
   const double sigma_new = sigma_for(rho_new, w, scratch);
@@ -347,9 +353,23 @@ void Chain<D>::sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys
   }
   // The sweeps run on a copy in cell order, so consecutive updates read consecutive particles, and it
   // stays in that order between sweeps (resort()), so each thread keeps its band's particles.
+  // Every sweep moves the cells by an offset drawn from its keys alone, never from the points: points do
+  // not cross cell borders within a sweep (update()), and borders that never moved would be walls.
+  auto place_cells = [&](int s) {
+    const std::uint64_t sweep_index = static_cast<std::uint64_t>(keys.first_index + s * keys.index_step);
+    Rng rng(keys.seed, 0x43454C4C53ull /* "CELLS" */, static_cast<std::uint64_t>(keys.level), sweep_index, 0);
+    Vec<D> offset{};
+    for (int k = 0; k < D; ++k)
+      offset[k] = board_.cells_per_axis()[k] > 1 ? rng.uniform() * board_.cell_width()[k] : 0.0;
+    board_.set_offset(offset);
+  };
+  place_cells(0);
   board_.sort(particles, nthreads, local_);
   for (int s = 0; s < count; ++s) {
-    if (s > 0) board_.resort(local_, nthreads);
+    if (s > 0) {
+      place_cells(s);
+      board_.resort(local_, nthreads);
+    }
     sweep(keys.seed, keys.level, keys.first_index + s * keys.index_step, nthreads, caching, counters);
     if (after_sweep) after_sweep();
   }
@@ -363,6 +383,7 @@ void Chain<D>::sweep(std::uint64_t seed, int level, int sweep_index, int nthread
                      ChainCounters& counters) {
   const std::vector<int>& order = board_.order();
   std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
+  const bool confined = board_.cell_count() > 1;  // one cell: no border to cross
   FootprintCache<D>& cache = *cache_;
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =
@@ -397,7 +418,7 @@ void Chain<D>::sweep(std::uint64_t seed, int level, int sweep_index, int nthread
         }
         const int j = order[t];
         Rng rng = Rng::from_key(sweep_key, static_cast<std::uint64_t>(j));
-        acc += update(local_[t], rng, s, caching ? &cache[j] : nullptr) ? 1 : 0;
+        acc += update(local_[t], rng, s, caching ? &cache[j] : nullptr, confined ? c : -1) ? 1 : 0;
       }
       accepted_in_cell[c] = acc;
     };
@@ -419,13 +440,18 @@ typename Chain<D>::CellBlock Chain<D>::cell_block(int cell, int updates) const {
   const Grid<D>& g = grid();
   const std::array<int, D>& ncell = board_.cells_per_axis();
   const std::array<double, D>& width = board_.cell_width();
+  const Vec<D>& offset = board_.offset();
   CellBlock b;
   for (int k = 0, rest = cell; k < D; ++k) {
     const int at = rest % ncell[k];
     rest /= ncell[k];
-    b.lo[k] = std::max<std::int64_t>(0, static_cast<std::int64_t>(at * width[k]) - kCellBlockMargin);
-    b.hi[k] = std::min<std::int64_t>(g.dims[k] - 1,
-                                     static_cast<std::int64_t>((at + 1) * width[k]) + kCellBlockMargin);
+    // The cell's nodes (a box's first cell starts at its wall), those past a torus's seam left out: a
+    // prefetch, so fetching less changes no result.
+    const double start = at == 0 && !g.torus ? 0.0 : at * width[k] + offset[k];
+    b.lo[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>(start) - kCellBlockMargin, 0, g.dims[k] - 1);
+    b.hi[k] = std::clamp<std::int64_t>(
+        static_cast<std::int64_t>((at + 1) * width[k] + offset[k]) + kCellBlockMargin, b.lo[k],
+        g.dims[k] - 1);
     b.at[k] = b.lo[k];
   }
   b.lines_per_row = (b.hi[0] - b.lo[0] + 1 + 15) / 16 + 1;  // 16 floats a line; the ends may straddle lines

@@ -96,8 +96,10 @@ class Chain {
 
   /// One MH-corrected Langevin update of p (whose kernel is in R). `rng` drives only this update.
   /// `cached` (optional) is p's own footprint cache: read when it holds p's footprint, and left holding
-  /// the footprint at p's position afterwards. Returns true when the proposal was accepted.
-  bool update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached = nullptr);
+  /// the footprint at p's position afterwards. `cell` (sweeps() only; -1: none): proposals leaving that cell
+  /// of the sweep's checkerboard are rejected. Returns true when the proposal was accepted.
+  bool update(Particle<D>& p, Rng& rng, Scratch& scratch, CachedFootprint<D>* cached = nullptr,
+              int cell = -1);
 
   /// Where a run of sweeps takes its random numbers: sweep s draws from the stream of (seed, level,
   /// first_index + s * index_step).

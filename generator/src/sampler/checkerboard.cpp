@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "kdm/runtime/check.h"
 #include "platform/huge_pages.h"
@@ -12,7 +13,10 @@ namespace kdm::gen {
 template <int D>
 void Checkerboard<D>::layout(const Grid<D>& g, double reach) {
   total_cells_ = 1;
+  offset_ = {};
+  torus_ = g.torus;
   for (int k = 0; k < D; ++k) {
+    extent_[k] = g.dims[k];
     // Wider cells where the grid has room for at least 8 along the axis: each colour then touches less
     // of the grid through its cells' borders (the residual is streamed once per colour).
     int c = static_cast<int>(std::min(1e9, std::floor(g.dims[k] / std::max(2 * reach, 64.0))));
@@ -38,7 +42,9 @@ template <int D>
 int Checkerboard<D>::cell_of(const Vec<D>& x) const {
   int id = 0, mul = 1;
   for (int k = 0; k < D; ++k) {
-    const int c = std::clamp(static_cast<int>(x[k] / width_[k]), 0, ncell_[k] - 1);
+    double u = x[k] - offset_[k];
+    if (torus_ && u < 0) u += extent_[k];  // the cell the offset moves across the torus's seam
+    const int c = std::clamp(static_cast<int>(u / width_[k]), 0, ncell_[k] - 1);
     id += c * mul;
     mul *= ncell_[k];
   }
@@ -120,9 +126,8 @@ void Checkerboard<D>::sort(const std::vector<Particle<D>>& particles, int thread
 template <int D>
 void Checkerboard<D>::resort(std::vector<Particle<D>>& sorted, int threads) {
   // The counting sort of sort(), over the current order instead of particle index. A cell then receives
-  // its particles ordered by (old cell, index): the ones that stayed, in index order, and those that
-  // arrived from each neighbour, in index order too; an insertion sort per cell merges them, which costs
-  // little since few particles change cells in a sweep.
+  // its particles ordered by (old cell, index): a few runs each in index order (the cells move between
+  // sweeps, so a cell may take a share of each neighbour's), which a sort per cell puts in index order.
   KDM_CHECK(sorted.size() == order_.size());
   const std::int64_t n = static_cast<std::int64_t>(sorted.size());
   const int runs = std::max(1, threads);
@@ -153,16 +158,16 @@ void Checkerboard<D>::resort(std::vector<Particle<D>>& sorted, int threads) {
   for_each_part(runs, parallel, [&](int run, int) {
     std::int64_t lo, hi;
     run_range(total_cells_, run, runs, lo, hi);
+    std::vector<std::pair<int, Particle<D>>> cell;
     for (std::int64_t c = lo; c < hi; ++c) {
       const int first = first_in_cell_[c], end = first_in_cell_[c + 1];
-      for (int t = first + 1; t < end; ++t) {
-        if (order_[t - 1] < order_[t]) continue;
-        const int index = order_[t];
-        const Particle<D> p = sorted[t];
-        int u = t;
-        for (; u > first && order_[u - 1] > index; --u) order_[u] = order_[u - 1], sorted[u] = sorted[u - 1];
-        order_[u] = index, sorted[u] = p;
-      }
+      int t = first + 1;
+      while (t < end && order_[t - 1] < order_[t]) ++t;
+      if (t >= end) continue;
+      cell.clear();
+      for (int u = first; u < end; ++u) cell.emplace_back(order_[u], sorted[u]);
+      std::sort(cell.begin(), cell.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (int u = first; u < end; ++u) order_[u] = cell[u - first].first, sorted[u] = cell[u - first].second;
     }
   });
 }

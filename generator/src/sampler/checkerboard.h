@@ -24,6 +24,16 @@ class Checkerboard {
   /// their centre. Depends on the grid and the reach only.
   void layout(const Grid<D>& g, double reach);
 
+  /// Moves every cell boundary by `offset[k]` nodes along axis k (0 <= offset[k] < cell_width()[k]; layout()
+  /// sets 0). On a torus the cells wrap; in a box the first cell grows by the offset and the last one
+  /// shrinks, which keeps every two cells of one colour a whole cell apart. A sweep draws a new offset
+  /// independent of the points (Chain::sweeps), so no boundary stays in one place.
+  void set_offset(const Vec<D>& offset) { offset_ = offset; }
+  const Vec<D>& offset() const { return offset_; }
+
+  /// The cell holding x (canonical), for the layout and offset in force.
+  int cell_of(const Vec<D>& x) const;
+
   /// Sorts the active particles by cell, ascending index within each cell, and copies them in that order
   /// into `sorted` (resized to fit). Uses up to `threads` threads; the order does not depend on how
   /// many. Not thread-safe (call from one thread).
@@ -47,7 +57,6 @@ class Checkerboard {
   const std::vector<int>& order() const { return order_; }
 
  private:
-  int cell_of(const Vec<D>& x) const;
   // Turns each run's counts per cell (in run_slots_) into its first place in each cell, runs in order
   // within a cell; sets first_in_cell_. Returns the number of places.
   int place_runs(int runs, std::size_t stride);
@@ -55,6 +64,9 @@ class Checkerboard {
 
   std::array<int, D> ncell_{};
   std::array<double, D> width_{};
+  Vec<D> offset_{};
+  std::array<double, D> extent_{};  // the grid's side along each axis
+  bool torus_ = true;
   int total_cells_ = 0;
   std::array<std::vector<int>, (1 << D)> cells_by_colour_;
   std::vector<int> first_in_cell_, order_;
