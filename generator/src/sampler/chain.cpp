@@ -356,6 +356,7 @@ void Chain<D>::sweeps(std::vector<Particle<D>>& particles, const SweepKeys& keys
   // Every sweep moves the cells by an offset drawn from its keys alone, never from the points: points do
   // not cross cell borders within a sweep (update()), and borders that never moved would be walls.
   auto place_cells = [&](int s) {
+    if (!params_.moving_cells) return;
     const std::uint64_t sweep_index = static_cast<std::uint64_t>(keys.first_index + s * keys.index_step);
     Rng rng(keys.seed, 0x43454C4C53ull /* "CELLS" */, static_cast<std::uint64_t>(keys.level), sweep_index, 0);
     Vec<D> offset{};
@@ -383,7 +384,7 @@ void Chain<D>::sweep(std::uint64_t seed, int level, int sweep_index, int nthread
                      ChainCounters& counters) {
   const std::vector<int>& order = board_.order();
   std::vector<std::uint64_t> accepted_in_cell(board_.cell_count(), 0);
-  const bool confined = board_.cell_count() > 1;  // one cell: no border to cross
+  const bool confined = params_.moving_cells && board_.cell_count() > 1;  // one cell: no border to cross
   FootprintCache<D>& cache = *cache_;
   // Every update's stream shares the key of (seed, level, sweep); the point index completes it.
   const std::uint64_t sweep_key =

@@ -35,7 +35,10 @@ struct ChainParams {
   double max_step = 1e30;       ///< proposals moving farther than this along any axis are rejected
   bool box_muller = false;      ///< normal deviates by Rng::normal_box_muller() instead of the ziggurat
   bool four_lane_sums = false;  ///< Numerics::kOriginal's sums (lanes.h) instead of per-lane sums
-  int vector_lanes = 16;        ///< the widest passes (lanes_wide.h) the CPU has, up to this many lanes
+  /// Sweeps keep each point in its checkerboard cell and move the cells every sweep (Chain::sweeps), so
+  /// that no cell border biases the density; false: Numerics::kOriginal's fixed cells, which points cross.
+  bool moving_cells = true;
+  int vector_lanes = 16;  ///< the widest passes (lanes_wide.h) the CPU has, up to this many lanes
   std::size_t cache_bytes = std::size_t(256) << 20;  ///< budget of the footprint cache (CachedFootprint)
 };
 

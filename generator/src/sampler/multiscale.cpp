@@ -90,6 +90,7 @@ struct Driver {
     params.metropolis = o.metropolis;
     params.box_muller = o.numerics == Numerics::kOriginal;
     params.four_lane_sums = o.numerics == Numerics::kOriginal;
+    params.moving_cells = o.numerics == Numerics::kFast;  // kOriginal: a recipe bakes the same tiles
     params.vector_lanes = o.vector_lanes;
     params.cache_bytes = o.footprint_cache_bytes;
   }

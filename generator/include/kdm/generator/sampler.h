@@ -75,13 +75,17 @@ struct Density {
 
 /// The sampler's arithmetic (see SamplerOptions::numerics). Each gives the same bits on every machine and
 /// for every thread count; the two differ from each other in their random stream and last bits, so the same
-/// seed gives different (equally good) point sets.
+/// seed gives different point sets.
 enum class Numerics {
   /// The default and the fastest: Langevin noise from a ziggurat, and energy and gradient sums kept per
   /// vector lane, so the update passes run sixteen lanes wide on CPUs with AVX-512 with the same result.
+  /// Its sweeps keep points in moving cells (no density bias at cell borders) and constrained runs start
+  /// new points clear of the fixed ones (docs/design.md §2.7, §2.8).
   kFast,
-  /// kdm's first versions: Box–Muller noise and four-lane sums. Tile baking (bake.h) and `kdm verify` keep
-  /// it, so a recipe bakes the same tiles in every version.
+  /// kdm's first versions: Box–Muller noise, four-lane sums, fixed cells that points cross (a few percent
+  /// more density on one side of each cell border, within half a grid node) and the first start of
+  /// constrained runs. Tile baking (bake.h) and `kdm verify` keep it, so a recipe bakes the same tiles in
+  /// every version.
   kOriginal,
 };
 
