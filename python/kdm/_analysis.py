@@ -63,7 +63,8 @@ def analyze(
         so ``kdm.analyze(*kdm.sample(n, classes=...))`` works):
         each point's class, an (n,) array per set. Each class is then also analysed alone, as
         ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
-        (``cross_class_closest`` in d_hex of all points, per class its "class" and "metrics", and in
+        (``cross_class_closest`` in d_hex of all points, local ones where `density` is given, per
+        class its "class" and "metrics", and in
         "too_small", an integer array, the classes present with fewer than 2 points in every set, which
         are not analysed).
     box : bool

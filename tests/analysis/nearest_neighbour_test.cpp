@@ -7,6 +7,7 @@
 
 #include "kdm/analysis/classes.h"
 #include "kdm/analysis/common.h"
+#include "kdm/analysis/density.h"
 #include "kdm/analysis/nearest_neighbour.h"
 #include "test_sets.h"
 
@@ -77,6 +78,30 @@ TEST(NearestNeighbour, CrossClassClosestPairMatchesBruteForce) {
         }
       EXPECT_DOUBLE_EQ(cross_class_closest(s, torus), best / hex_spacing(s.size())) << torus << rare;
     }
+  // With a target density, in local spacings: each pair's distance over d_hex scaled by √(mean ρ / ρ) at
+  // its midpoint, among the pairs within two local spacings of either point.
+  const DensityFunction ramp = [](double x, double) { return 0.2 + x; };  // mean 0.7
+  for (bool torus : {false, true}) {
+    tools::PointSet s = uniform_set(1500, 21);
+    for (std::size_t i = 0; i < s.size(); ++i) s.classes.push_back(static_cast<std::uint8_t>(i % 3));
+    const double spacing = hex_spacing(s.size());
+    const auto local = [&](double x, double y) { return spacing * std::sqrt(0.7 / ramp(x, y)); };
+    double best = HUGE_VAL;
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (std::size_t j = i + 1; j < s.size(); ++j) {
+        if (s.classes[i] == s.classes[j]) continue;
+        double dx = s.coords[2 * j] - s.coords[2 * i], dy = s.coords[2 * j + 1] - s.coords[2 * i + 1];
+        if (torus) dx -= std::round(dx), dy -= std::round(dy);
+        const double d = std::hypot(dx, dy);
+        if (d > 2 * local(s.coords[2 * i], 0) && d > 2 * local(s.coords[2 * j], 0)) continue;
+        double mx = s.coords[2 * i] + dx / 2;
+        if (torus) mx -= std::floor(mx);
+        best = std::min(best, d / local(mx, 0));
+      }
+    // The ramp's mean over density_scale's 256² grid is 0.7 to rounding: the same up to 1e-12.
+    EXPECT_NEAR(cross_class_closest(s, torus, ramp), best, 1e-9) << torus;
+    EXPECT_NE(cross_class_closest(s, torus, ramp), cross_class_closest(s, torus)) << torus;
+  }
   tools::PointSet one = uniform_set(10, 1);
   one.classes.assign(10, 4);
   EXPECT_TRUE(std::isnan(cross_class_closest(one, true)));

@@ -204,7 +204,9 @@ def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient
     for key in ("density", "empty_circles"):
         assert json.dumps(_lists(got[key]), sort_keys=True) == json.dumps(metrics[key], sort_keys=True), key
     unpacked = kdm.analyze(*kdm.sample(3000, seed=5, classes=[1, 2, 4], threads=1), energy=False)
-    assert unpacked["classes"]["cross_class_closest"] == expected["cross_class_closest"]  # sample's tuple
+    plain = kdm.analyze(points, classes=labels, energy=False)["classes"]["cross_class_closest"]
+    assert unpacked["classes"]["cross_class_closest"] == plain  # sample's tuple, unpacked
+    assert plain != got["classes"]["cross_class_closest"]  # with a density: in local spacings
     lone = labels.copy()
     lone[0] = 7  # one point of its class: listed, not analysed
     too_small = kdm.analyze(points, classes=lone, energy=False)["classes"]["too_small"]

@@ -61,8 +61,9 @@ std::string analyze_classes(const std::vector<tools::PointSet>& sets, const anal
       return tools::mean_energy_per_point(subsets, o.torus, target);
     };
   const analysis::ClassesReport report = analysis::analyze_classes(sets, o, energy);
-  std::fprintf(text, "\nclasses: %zu; closest pair of different classes: %.4f d_hex of all points\n",
-               report.classes.size() + report.too_small.size(), report.cross_class_closest);
+  std::fprintf(text, "\nclasses: %zu; closest pair of different classes: %.4f %s\n",
+               report.classes.size() + report.too_small.size(), report.cross_class_closest,
+               o.density ? "local d_hex of all points (of --density)" : "d_hex of all points");
   for (std::uint8_t k : report.too_small)
     std::fprintf(text, "\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(k));
   for (std::size_t c = 0; c < report.classes.size(); ++c) {

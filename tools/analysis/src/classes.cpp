@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "kdm/analysis/common.h"
+#include "kdm/analysis/density.h"
 #include "kdm/analysis/json.h"
 
 namespace kdm::analysis {
@@ -26,7 +27,72 @@ tools::PointSet class_subset(const tools::PointSet& set, std::uint8_t k) {
   return subset;
 }
 
-double cross_class_closest(const tools::PointSet& set, bool torus) {
+namespace {
+
+/// The closest pair of different classes in local spacings: each pair's distance over d_hex of the set's
+/// count scaled by √(mean ρ / ρ) at its midpoint, every point looking up to two of its own local spacings
+/// away (a pair farther apart than that is no close pair where either stands). Work ∝ n, as a sparse
+/// region's wider reach meets fewer points.
+double local_cross_class_closest(const tools::PointSet& set, bool torus, const DensityFunction& density) {
+  const std::size_t n = set.size();
+  const double spacing = hex_spacing(n), mean = density_scale(density).first;
+  if (!(mean > 0)) throw InvalidInput("the target density is zero everywhere");
+  const int cells = std::clamp(static_cast<int>(1 / (2 * spacing)), 1, 4096);
+  const double h = 1.0 / cells;
+  auto cell_of = [&](double v) { return std::min(cells - 1, std::max(0, static_cast<int>(v * cells))); };
+  std::vector<std::size_t> start(std::size_t(cells) * cells + 1, 0), order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    ++start[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i]) + 1];
+  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    order[fill[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i])]++] = i;
+  auto local = [&](double x, double y) {
+    const double rho = density(x, y);
+    return rho > 0 ? spacing * std::sqrt(mean / rho) : std::numeric_limits<double>::infinity();
+  };
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = set.coords[2 * i], y = set.coords[2 * i + 1];
+    const double reach = std::min(2 * local(x, y), torus ? 0.5 : 1.5);
+    if (!std::isfinite(reach)) continue;  // a point where ρ = 0: no local spacing
+    const int rings = std::min(cells, static_cast<int>(std::ceil(reach / h)));
+    const int cx = cell_of(x), cy = cell_of(y);
+    for (int dy = -rings; dy <= rings; ++dy)
+      for (int dx = -rings; dx <= rings; ++dx) {
+        int gx = cx + dx, gy = cy + dy;
+        if (torus) {
+          if (std::abs(dx) > cells / 2 || std::abs(dy) > cells / 2) continue;  // reached the other way
+          gx = (gx % cells + cells) % cells, gy = (gy % cells + cells) % cells;
+        } else if (gx < 0 || gy < 0 || gx >= cells || gy >= cells) {
+          continue;
+        }
+        const std::size_t c = std::size_t(gy) * cells + gx;
+        for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
+          const std::size_t j = order[k];
+          if (set.classes[j] == set.classes[i]) continue;
+          double ddx = set.coords[2 * j] - x, ddy = set.coords[2 * j + 1] - y;
+          if (torus) ddx -= std::round(ddx), ddy -= std::round(ddy);
+          const double d = std::hypot(ddx, ddy);
+          if (d > reach) continue;
+          double mx = x + ddx / 2, my = y + ddy / 2;
+          if (torus) mx -= std::floor(mx), my -= std::floor(my);
+          best = std::min(best, d / local(mx, my));
+        }
+      }
+  }
+  return best;
+}
+
+}  // namespace
+
+double cross_class_closest(const tools::PointSet& set, bool torus, const DensityFunction& density) {
+  if (density) {
+    if (set.dim != 2 || set.classes.size() != set.size())
+      throw InvalidInput("the cross-class closest pair needs 2D points with a class each");
+    if (classes_present(set).size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    return local_cross_class_closest(set, torus, density);
+  }
   const std::size_t n = set.size();
   if (set.dim != 2 || set.classes.size() != n)
     throw InvalidInput("the cross-class closest pair needs 2D points with a class each");
@@ -80,12 +146,13 @@ ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const An
   for (const tools::PointSet& set : sets) {
     if (set.classes.size() != set.size())
       throw InvalidInput("every set of labelled points needs its classes");
-    closest = std::min(closest, cross_class_closest(set, options.torus));
+    closest = std::min(closest, cross_class_closest(set, options.torus, options.density));
     for (std::uint8_t k : classes_present(set))
       if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
   }
   std::sort(present.begin(), present.end());
-  out.cross_class_closest = closest < HUGE_VAL ? closest : std::nan("");  // no set has two classes
+  // NaN: no set has two classes (with a density: none within two local spacings of each other)
+  out.cross_class_closest = closest < HUGE_VAL ? closest : std::nan("");
   for (std::uint8_t k : present) {
     std::vector<tools::PointSet> subsets;
     for (const tools::PointSet& set : sets) {

@@ -149,4 +149,15 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
   return out;
 }
 
+std::pair<double, double> density_scale(const DensityFunction& rho) {
+  constexpr int kGrid = 256;
+  double sum = 0, largest = 0;
+  for (int j = 0; j < kGrid; ++j)
+    for (int i = 0; i < kGrid; ++i) {
+      const double v = std::max(0.0, rho((i + 0.5) / kGrid, (j + 0.5) / kGrid));
+      sum += v, largest = std::max(largest, v);
+    }
+  return {sum / (kGrid * kGrid), largest};
+}
+
 }  // namespace kdm::analysis

@@ -125,18 +125,6 @@ void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::siz
     throw InvalidInput("the Delaunay triangulation failed (Qhull error " + std::to_string(failed) + ")");
 }
 
-/// Mean and largest ρ over the unit square on a 256² grid (the scale radii are normalised by).
-std::pair<double, double> density_scale(const DensityFunction& rho) {
-  constexpr int kGrid = 256;
-  double sum = 0, largest = 0;
-  for (int j = 0; j < kGrid; ++j)
-    for (int i = 0; i < kGrid; ++i) {
-      const double v = std::max(0.0, rho((i + 0.5) / kGrid, (j + 0.5) / kGrid));
-      sum += v, largest = std::max(largest, v);
-    }
-  return {sum / (kGrid * kGrid), largest};
-}
-
 /// One set's judged circles: their radii in local d_hex and the counts empty_circles pools.
 struct SetCircles {
   std::vector<double> radii;

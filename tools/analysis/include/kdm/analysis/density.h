@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace kdm::analysis {
@@ -53,5 +54,9 @@ struct DensityAccuracy {
 /// Thread-safe if `density` is.
 DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, const DensityFunction& density,
                                  const DensityOptions& options = {});
+
+/// Mean and largest ρ over the unit square, sampled on a 256² grid: the scale local spacings are taken
+/// from (d_hex of the set's count where ρ is its mean, scaled by √(mean ρ / ρ) elsewhere).
+std::pair<double, double> density_scale(const DensityFunction& rho);
 
 }  // namespace kdm::analysis
