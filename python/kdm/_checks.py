@@ -219,7 +219,10 @@ def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str 
     if isinstance(density, numbers.Real) and not isinstance(density, (bool, np.bool_)):
         return _kdm.DensitySpec.constant(number(name, density, 0.0))
     if is_array(density):
-        return _kdm.DensitySpec.from_values(array2d(name, density))
+        try:
+            return _kdm.DensitySpec.from_values(array2d(name, density))
+        except ValueError as e:  # the C++ side's messages do not know the name
+            raise ValueError(str(e) if name == "density" or str(e).startswith(name) else f"{name}: {e}") from None
     kinds = ([] if one_of_several else ["None"]) + ["a number", "a str (const:V, ramp:R, radial:R or an image "
                                                     "path)", "a 2-D array"] + (["a callable"] if callable_ok else [])
     raise TypeError(f"{name} must be {', '.join(kinds[:-1])} or {kinds[-1]}, got {type(density).__name__}")

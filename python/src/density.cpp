@@ -57,7 +57,10 @@ DensitySpec from_values(const Array& a) {
     if (!(a.data()[i] >= 0 && a.data()[i] <= FLT_MAX))  // kept as floats, as images are
       throw std::invalid_argument(
           "density array values must be finite and >= 0, at most 3.4e38 (kept as floats), got " +
-          shown(a.data()[i]));
+          shown(a.data()[i]) +
+          (a.ndim() == 2
+               ? " at [" + std::to_string(i / a.shape(1)) + ", " + std::to_string(i % a.shape(1)) + "]"
+               : std::string()));
   return flipped(a, "density array", [](double v) { return v; });
 }
 
