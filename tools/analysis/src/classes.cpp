@@ -29,6 +29,32 @@ tools::PointSet class_subset(const tools::PointSet& set, std::uint8_t k) {
 
 namespace {
 
+/// The set's points by square cell about two spacings wide (a counting sort): cell (gx, gy) holds
+/// order[start[gy · cells + gx] … start[gy · cells + gx + 1]).
+struct CellList {
+  int cells = 1;
+  std::vector<std::size_t> start, order;
+  int cell_of(double v) const { return std::min(cells - 1, std::max(0, static_cast<int>(v * cells))); }
+  /// The cell at (gx, gy), wrapped on a torus; -1 past a box's side.
+  std::ptrdiff_t at(int gx, int gy, bool torus) const {
+    if (torus) gx = (gx % cells + cells) % cells, gy = (gy % cells + cells) % cells;
+    if (gx < 0 || gy < 0 || gx >= cells || gy >= cells) return -1;
+    return std::ptrdiff_t(gy) * cells + gx;
+  }
+  CellList(const tools::PointSet& set, double spacing)
+      : cells(std::clamp(static_cast<int>(1 / (2 * spacing)), 1, 4096)),
+        start(std::size_t(cells) * cells + 1, 0),
+        order(set.size()) {
+    const auto cell = [&](std::size_t i) {
+      return std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i]);
+    };
+    for (std::size_t i = 0; i < set.size(); ++i) ++start[cell(i) + 1];
+    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < set.size(); ++i) order[fill[cell(i)]++] = i;
+  }
+};
+
 /// The closest pair of different classes in local spacings: each pair's distance over d_hex of the set's
 /// count scaled by √(mean ρ / ρ) at its midpoint, every point looking up to two of its own local spacings
 /// away (a pair farther apart than that is no close pair where either stands). Work ∝ n, as a sparse
@@ -37,16 +63,11 @@ double local_cross_class_closest(const tools::PointSet& set, bool torus, const D
   const std::size_t n = set.size();
   const double spacing = hex_spacing(n), mean = density_scale(density).first;
   if (!(mean > 0)) throw InvalidInput("the target density is zero everywhere");
-  const int cells = std::clamp(static_cast<int>(1 / (2 * spacing)), 1, 4096);
+  const CellList list(set, spacing);
+  const int cells = list.cells;
   const double h = 1.0 / cells;
-  auto cell_of = [&](double v) { return std::min(cells - 1, std::max(0, static_cast<int>(v * cells))); };
-  std::vector<std::size_t> start(std::size_t(cells) * cells + 1, 0), order(n);
-  for (std::size_t i = 0; i < n; ++i)
-    ++start[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i]) + 1];
-  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    order[fill[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i])]++] = i;
+  const auto cell_of = [&](double v) { return list.cell_of(v); };
+  const std::vector<std::size_t>&start = list.start, &order = list.order;
   auto local = [&](double x, double y) {
     const double rho = density(x, y);
     return rho > 0 ? spacing * std::sqrt(mean / rho) : std::numeric_limits<double>::infinity();
@@ -60,14 +81,10 @@ double local_cross_class_closest(const tools::PointSet& set, bool torus, const D
     const int cx = cell_of(x), cy = cell_of(y);
     for (int dy = -rings; dy <= rings; ++dy)
       for (int dx = -rings; dx <= rings; ++dx) {
-        int gx = cx + dx, gy = cy + dy;
-        if (torus) {
-          if (std::abs(dx) > cells / 2 || std::abs(dy) > cells / 2) continue;  // reached the other way
-          gx = (gx % cells + cells) % cells, gy = (gy % cells + cells) % cells;
-        } else if (gx < 0 || gy < 0 || gx >= cells || gy >= cells) {
-          continue;
-        }
-        const std::size_t c = std::size_t(gy) * cells + gx;
+        if (torus && (std::abs(dx) > cells / 2 || std::abs(dy) > cells / 2))
+          continue;  // reached the other way
+        const std::ptrdiff_t c = list.at(cx + dx, cy + dy, torus);
+        if (c < 0) continue;
         for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
           const std::size_t j = order[k];
           if (set.classes[j] == set.classes[i]) continue;
@@ -100,16 +117,11 @@ double cross_class_closest(const tools::PointSet& set, bool torus, const Density
   // Cells about two spacings wide; each point looks through rings of cells around its own until the ring
   // lies farther than the closest pair found so far.
   const double spacing = hex_spacing(n);
-  const int cells = std::clamp(static_cast<int>(1 / (2 * spacing)), 1, 4096);
+  const CellList list(set, spacing);
+  const int cells = list.cells;
   const double h = 1.0 / cells;
-  auto cell_of = [&](double v) { return std::min(cells - 1, std::max(0, static_cast<int>(v * cells))); };
-  std::vector<std::size_t> start(std::size_t(cells) * cells + 1, 0), order(n);
-  for (std::size_t i = 0; i < n; ++i)
-    ++start[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i]) + 1];
-  for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (std::size_t i = 0; i < n; ++i)
-    order[fill[std::size_t(cell_of(set.coords[2 * i + 1])) * cells + cell_of(set.coords[2 * i])]++] = i;
+  const auto cell_of = [&](double v) { return list.cell_of(v); };
+  const std::vector<std::size_t>&start = list.start, &order = list.order;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     const double x = set.coords[2 * i], y = set.coords[2 * i + 1];
@@ -118,14 +130,9 @@ double cross_class_closest(const tools::PointSet& set, bool torus, const Density
       for (int dy = -ring; dy <= ring; ++dy)
         for (int dx = -ring; dx <= ring; ++dx) {
           if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
-          int gx = cx + dx, gy = cy + dy;
-          if (torus) {
-            if (ring > cells / 2) continue;  // every cell is already within reach on the torus
-            gx = (gx % cells + cells) % cells, gy = (gy % cells + cells) % cells;
-          } else if (gx < 0 || gy < 0 || gx >= cells || gy >= cells) {
-            continue;
-          }
-          const std::size_t c = std::size_t(gy) * cells + gx;
+          if (torus && ring > cells / 2) continue;  // every cell is already within reach on the torus
+          const std::ptrdiff_t c = list.at(cx + dx, cy + dy, torus);
+          if (c < 0) continue;
           for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
             const std::size_t j = order[k];
             if (set.classes[j] == set.classes[i]) continue;
