@@ -706,6 +706,14 @@ TEST_F(CliTest, StippleSaysWhatItTakes) {
   expect_error("stipple '" + path("x.tif") + "' -o '" + path("x.png") + "'", "a TIFF image");
   expect_error("stipple '" + path("x.webp") + "' --colours 3 -o '" + path("x.png") + "'",
                "a WebP image, a format kdm does not read (it reads PNG, JPEG");
+  std::ofstream(path("x.jxl"), std::ios::binary) << std::string("\0\0\0\x0cJXL \x0d\x0a\x87\x0a", 12);
+  expect_error("stipple '" + path("x.jxl") + "' -o '" + path("x.png") + "'", "a JPEG XL image");
+  // Bytes of no format are not named as one (a magic with NULs had matched every file as JPEG XL).
+  std::ofstream(path("junk.png"), std::ios::binary) << "hello, these are no picture's bytes";
+  const Outcome junk = kdm("stipple '" + path("junk.png") + "' -o '" + path("x.png") + "'");
+  EXPECT_NE(junk.status, 0);
+  EXPECT_EQ(junk.err.find("JPEG XL"), std::string::npos) << junk.err;
+  EXPECT_NE(junk.err.find("cannot read image"), std::string::npos) << junk.err;
 }
 
 // kdm sample --class: exact counts per class by the densities' integrals, a class column in .csv.

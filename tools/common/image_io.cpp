@@ -316,8 +316,8 @@ std::string stb_reason() {
 
 // Why stb read no header: a format it does not read named, with the ones it does; else its reason.
 std::string unread_format(const std::uint8_t* bytes, std::size_t size) {
-  const auto starts = [&](const char* magic, std::size_t at = 0) {
-    const std::size_t n = std::strlen(magic);
+  const auto starts = [&](const auto& magic, std::size_t at = 0) {  // a literal: its bytes, NULs too
+    const std::size_t n = sizeof magic - 1;
     return size >= at + n && std::memcmp(bytes + at, magic, n) == 0;
   };
   const char* kind = starts("II*") || (starts("MM") && size >= 4 && bytes[2] == 0 && bytes[3] == 42) ? "TIFF"
