@@ -135,7 +135,7 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
     (ValueError, r"would emit at least 2e\+10 points, more than 2\^25; lower the scale \(scale=\)",
      dict(rect=(0, 0, 2000, 2000), scale=20000, density=np.full((4, 4), 0.25))),
     # A query's values are densities (the sampler's only a shape, scaled into float32's range).
-    (ValueError, r"at most 3\.4e38 \(kept as floats\), got 1e\+308$", dict(density=np.full((2, 2), 1e308))),
+    (ValueError, r"at most 3\.4e38 \(kept as floats\), got 1e\+308 at \[0, 0\]$", dict(density=np.full((2, 2), 1e308))),
     (TypeError, "density must be None, a number, .* 2-D array or a callable, got object", dict(density=object())),
     (TypeError, r"classes\[0\] must be a number, .* 2-D array or a callable, got bool", dict(classes=[True])),
     (ValueError, "image files only, and no density is given", dict(gamma=2)),
