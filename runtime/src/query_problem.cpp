@@ -44,7 +44,7 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kNotFinite:
       return "a parameter is not a finite number";
     case QueryProblem::Kind::kNotPositive:
-      return "a parameter must be greater than 0 (or, for a struct_size, at least the limit)";
+      return "a parameter must be greater than 0 (a C struct's struct_size: at least the limit)";
     case QueryProblem::Kind::kNegative:
       return "a parameter must not be negative";
     case QueryProblem::Kind::kBadDensity:
@@ -114,7 +114,7 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
                    "from it, at most %.6g for this density and region; keep the world's coordinates nearer "
                    "its origin (move the origin), or ask for fewer points per unit area",
                    p.value, p.limit);
-    case QueryProblem::Kind::kNotPositive:  // the kind's text also speaks of the C API's struct_size
+    case QueryProblem::Kind::kNotPositive:  // the kind's text speaks of the C API's struct_size too
       return print(text, size, "'%s' must be > 0, got %.6g", shown, p.value);
     case QueryProblem::Kind::kNegative:
       return print(text, size, "'%s' must be >= 0, got %.6g", shown, p.value);
