@@ -40,7 +40,9 @@ def stipple(
         An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored):
         luminance (rows, columns) as floats in [0, 1], uint8 or uint16; or colour (rows, columns, 3 or 4),
         RGB(A), made luminance as a file is (0.2126 R + 0.7152 G + 0.0722 B, composited on white). The
-        image spans [0, width/height] x [0, 1]. An image with no ink gives no dots.
+        image spans [0, width/height] x [0, 1]. An image with no ink gives no dots. A file of up to
+        16384 x 16384 pixels is averaged down as it is read to what its dots need (as ``kdm stipple``
+        reads it: docs/limits.md, "Large pictures"); an array is used as it is.
     points : int
         Dots over the whole image (ignored when `scale` is given).
     scale : float or None
@@ -104,7 +106,7 @@ def stipple(
                 os.stat(label)
             except OSError as e:
                 raise type(e)(f"cannot read image '{label}': {e.strerror}") from None
-        spec = _kdm.DensitySpec.parse(label, gamma, invert)
+        spec = None  # read below, at the size its dots need
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
         label, image = "array", _checks.pil_pixels(image)
@@ -154,6 +156,8 @@ def stipple(
     if paper_width == "":
         raise ValueError("paper_width must be a number and a unit ('180mm', '7.5in'), got ''")
     handle = tileset._handle if tileset is not None else None
+    if spec is None:
+        spec = _kdm.stipple_density(label, gamma, invert, points, scale, region)
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
         colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height,

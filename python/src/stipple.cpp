@@ -26,12 +26,15 @@ using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>
 /// A colour image for the separation: from `rgb` ((rows, columns, 3) in [0, 1], composited on white, row 0
 /// at the top) and its `alpha` when given (kdm._checks.colour made them as load_colour_image reads a file),
 /// else read from the file `label`.
+/// A file is read as kdm stipple reads it: `kept` averages a large picture down (tools::KeptPixels).
 tools::ColourImage colour_image(const std::string& label, const std::optional<FloatArray>& rgb,
-                                const std::optional<FloatArray>& alpha) {
+                                const std::optional<FloatArray>& alpha, const tools::KeptPixels& kept = {}) {
   tools::ColourImage image;
   if (!rgb) {
     std::string error;
-    if (!tools::load_colour_image(label, image, error)) throw FileError(error);
+    if (!tools::load_colour_image(label, image, error,
+                                  kept ? tools::kMaxStipplePixels : tools::kMaxImagePixels, kept))
+      throw FileError(error);
     return image;
   }
   if (rgb->ndim() != 3 || rgb->shape(2) != 3 ||
@@ -41,6 +44,29 @@ tools::ColourImage colour_image(const std::string& label, const std::optional<Fl
   image.pixels.assign(rgb->data(), rgb->data() + rgb->size());
   if (alpha) image.alpha.assign(alpha->data(), alpha->data() + alpha->size());
   return image;
+}
+
+/// The deepest zoom a stipple of `region` draws (tools::stipple_zoom; 1 for none or one refused later).
+double region_zoom(const std::optional<Region>& region) {
+  if (!region) return 1;
+  const double width = (*region)[2] - (*region)[0];
+  return std::isfinite(width) && width > 0 ? tools::stipple_zoom(region->data()) : 1;
+}
+
+/// The image file `path` as kdm stipple reads its one ink (a large picture averaged down for the dots that
+/// `points` or `scale` and `region` ask for, tools::stipple_kept_pixels).
+DensitySpec stipple_density(const std::string& path, double gamma, bool invert, std::int64_t points,
+                            double scale, std::optional<Region> region) {
+  const tools::KeptPixels kept = tools::stipple_kept_pixels(scale > 0 ? 0.0 : double(points),
+                                                            scale > 0 ? scale : 0.0, region_zoom(region));
+  py::gil_scoped_release release;  // an image is read and decoded
+  try {
+    return tools::parse_density_spec(path, gamma, invert, tools::kMaxStipplePixels, kept);
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // an image that cannot be read
+    throw FileError(e.what());
+  }
 }
 
 py::object stipple(const DensitySpec& spec, const std::string& label, std::int64_t points, double scale,
@@ -88,7 +114,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   tools::ColourSeparation inks;
   std::vector<const DensitySpec*> specs = {&spec};
   if (colours) {
-    const tools::ColourImage image = colour_image(label, rgb, alpha);
+    const tools::ColourImage image =
+        colour_image(label, rgb, alpha,
+                     tools::stipple_kept_pixels(scale > 0 ? 0.0 : double(points), scale > 0 ? scale : 0.0,
+                                                region_zoom(region)));
     py::gil_scoped_release release;  // a clustering of every pixel: seconds for a large photograph
     inks = tools::separate_colours(image, *colours, gamma);
     specs.clear();
@@ -195,6 +224,9 @@ py::tuple separate(const std::string& path, const std::string& colours, double g
 }  // namespace
 
 void bind_stipple(py::module_& m) {
+  m.def("stipple_density", &stipple_density, py::arg("path"), py::arg("gamma"), py::arg("invert"),
+        py::arg("points"), py::arg("scale"), py::arg("region").none(true),
+        "An image file's one ink as kdm stipple reads it (a large picture averaged down for its dots)");
   m.def("separate", &separate, py::arg("path"), py::arg("colours"), py::arg("gamma"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
         "The inks of an image file as kdm stipple --colours separates them (channels, names)");

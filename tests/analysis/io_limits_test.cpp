@@ -172,7 +172,8 @@ TEST(ImageLimit, FuzzerFoundImagesAreRefusedCleanly) {
                {"png_chunk_past_end.png", "ends inside a chunk"},
                {"hdr_run_of_length_zero.hdr", "a run of length 0"},
                {"pnm_header_overflow.pgm", "header number too large"},
-               {"pnm_pixels_cut_short.pgm", "pixels cut short"}};
+               {"pnm_pixels_cut_short.pgm", "pixels cut short"},
+               {"bmp_pixels_inside_header.bmp", "its pixels start inside its header"}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.file);
     const std::vector<std::uint8_t> bytes = read_bytes(dir + c.file);

@@ -99,19 +99,8 @@ inline void chunk(std::vector<std::uint8_t>& png, const char type[5], const std:
   put32(png, crc32(&png[start], png.size() - start));
 }
 
-// A greyscale PNG of `depth` bits (8 or 16), with alpha when `channels` is 2 (grey, alpha per pixel);
-// `samples` row-major, top row first.
-inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int depth,
-                                          const std::vector<std::uint16_t>& samples, int channels = 1) {
-  std::vector<std::uint8_t> raw;  // filter byte 0 per row, then big-endian samples
-  for (std::uint32_t y = 0; y < h; ++y) {
-    raw.push_back(0);
-    for (std::uint32_t x = 0; x < w * channels; ++x) {
-      const std::uint16_t v = samples[y * w * channels + x];
-      if (depth == 16) raw.push_back(static_cast<std::uint8_t>(v >> 8));
-      raw.push_back(static_cast<std::uint8_t>(v));
-    }
-  }
+// `raw` as a zlib stream of stored (uncompressed) blocks, as a PNG's IDAT holds it.
+inline std::vector<std::uint8_t> zlib_stored(const std::vector<std::uint8_t>& raw) {
   std::vector<std::uint8_t> z = {0x78, 0x01};  // zlib header, then stored blocks of up to 65535 bytes
   std::size_t at = 0;
   do {
@@ -125,6 +114,23 @@ inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int 
   std::uint32_t a = 1, b = 0;  // Adler-32
   for (std::uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
   put32(z, (b << 16) | a);
+  return z;
+}
+
+// A greyscale PNG of `depth` bits (8 or 16), with alpha when `channels` is 2 (grey, alpha per pixel);
+// `samples` row-major, top row first.
+inline std::vector<std::uint8_t> grey_png(std::uint32_t w, std::uint32_t h, int depth,
+                                          const std::vector<std::uint16_t>& samples, int channels = 1) {
+  std::vector<std::uint8_t> raw;  // filter byte 0 per row, then big-endian samples
+  for (std::uint32_t y = 0; y < h; ++y) {
+    raw.push_back(0);
+    for (std::uint32_t x = 0; x < w * channels; ++x) {
+      const std::uint16_t v = samples[y * w * channels + x];
+      if (depth == 16) raw.push_back(static_cast<std::uint8_t>(v >> 8));
+      raw.push_back(static_cast<std::uint8_t>(v));
+    }
+  }
+  const std::vector<std::uint8_t> z = zlib_stored(raw);
   std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::vector<std::uint8_t> ihdr;
   put32(ihdr, w);

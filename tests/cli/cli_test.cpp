@@ -38,6 +38,126 @@ TEST_F(CliTest, TheTestEncoderWritesImagesTheLoaderReads) {
   EXPECT_FLOAT_EQ(image.at(10, 5), 40.0f / 255.0f);
 }
 
+TEST_F(CliTest, LoadersAverageALargePictureDownToTheKeptPixels) {
+  // 90 × 60 grey + alpha, no two neighbours alike, so that any misplaced box shows.
+  const int w = 90, h = 60;
+  std::vector<std::uint16_t> samples(std::size_t(w) * h * 2);
+  for (int i = 0; i < w * h; ++i) {
+    samples[2 * i] = static_cast<std::uint16_t>((i * 37 + i / w * 11) % 256);
+    samples[2 * i + 1] = static_cast<std::uint16_t>(255 - (i * 53) % 128);
+  }
+  write_bytes(path("boxes.png"), grey_png(w, h, 8, samples, 2));
+  std::string error;
+  kdm::tools::GreyImage full, same, thirds, fifths;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("boxes.png"), full, error)) << error;
+  const auto keep = [](std::uint64_t n) { return [n](int, int) { return n; }; };
+  // As many pixels as it has, or more: every pixel, bit for bit.
+  ASSERT_TRUE(
+      kdm::tools::load_grey_image(path("boxes.png"), same, error, kdm::tools::kMaxImagePixels, keep(w * h)));
+  EXPECT_EQ(same.pixels, full.pixels);
+  EXPECT_EQ(same.alpha, full.alpha);
+  // A ninth: each kept pixel is the mean of a 3 × 3 box (composited on paper), and so is its alpha.
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("boxes.png"), thirds, error, kdm::tools::kMaxImagePixels,
+                                          keep(w * h / 9)));
+  ASSERT_EQ(thirds.width, 30);
+  ASSERT_EQ(thirds.height, 20);
+  ASSERT_EQ(thirds.alpha.size(), 600u);
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 30; ++x) {
+      double grey = 0, alpha = 0;
+      for (int v = 0; v < 3; ++v)
+        for (int u = 0; u < 3; ++u) {
+          grey += full.at(3 * x + u, 3 * y + v) / 9.0;
+          alpha += full.alpha[std::size_t(3 * y + v) * w + 3 * x + u] / 9.0;
+        }
+      EXPECT_NEAR(thirds.at(x, y), grey, 1e-6) << x << "," << y;
+      EXPECT_NEAR(thirds.alpha[std::size_t(y) * 30 + x], alpha, 1e-6) << x << "," << y;
+    }
+  // Boxes of 2.5 pixels split pixels between two kept ones: the picture's tone stays, and the kept
+  // pixels' columns still hold the picture's columns in order (the left third's mean is the left third's).
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("boxes.png"), fifths, error, kdm::tools::kMaxImagePixels,
+                                          keep(w * h * 4 / 25)));
+  ASSERT_EQ(fifths.width, 36);
+  ASSERT_EQ(fifths.height, 24);
+  const auto mean = [](const kdm::tools::GreyImage& image, int x0, int x1) {
+    double sum = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = x0; x < x1; ++x) sum += image.at(x, y);
+    return sum / (double(x1 - x0) * image.height);
+  };
+  EXPECT_NEAR(mean(fifths, 0, 36), mean(full, 0, 90), 1e-6);
+  EXPECT_NEAR(mean(fifths, 0, 12), mean(full, 0, 30), 1e-6);
+  // In colour too: a grey picture's three channels are its luminance.
+  kdm::tools::ColourImage colour;
+  ASSERT_TRUE(kdm::tools::load_colour_image(path("boxes.png"), colour, error, kdm::tools::kMaxImagePixels,
+                                            keep(w * h / 9)));
+  ASSERT_EQ(colour.width, 30);
+  for (std::size_t i = 0; i < thirds.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(colour.pixels[3 * i + c], thirds.pixels[i], 1e-6);
+  // A keep of 0 still keeps a pixel.
+  ASSERT_TRUE(
+      kdm::tools::load_grey_image(path("boxes.png"), same, error, kdm::tools::kMaxImagePixels, keep(0)));
+  EXPECT_EQ(same.width * same.height, 1);
+  EXPECT_NEAR(same.pixels[0], mean(full, 0, 90), 1e-6);
+}
+
+TEST_F(CliTest, PicturesWhoseDecodingPassesTwoGibibytesAreRefusedByName) {
+  // A Radiance picture of 16,384 × 8,193 (just over 2^27 pixels, within a stipple's 2^28): stb decodes it
+  // as four floats a pixel (3 channels, room for a fourth), more bytes than its int counts. Each scanline
+  // holds runs of one value per channel, so the file is small.
+  const int w = 16384, h = 8193;
+  std::string file =
+      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
+  std::string line = {2, 2, char(w >> 8), char(w & 255)};
+  for (int channel = 0; channel < 4; ++channel) {
+    for (int run = 0; run < w / 127; ++run) line += {char(128 + 127), char(channel == 3 ? 128 : 100)};
+    line += {char(128 + w % 127), char(channel == 3 ? 128 : 100)};
+  }
+  for (int y = 0; y < h; ++y) file += line;
+  write_bytes(path("wide.hdr"), std::vector<std::uint8_t>(file.begin(), file.end()));
+  kdm::tools::GreyImage image;
+  std::string error;
+  EXPECT_FALSE(kdm::tools::load_grey_image(path("wide.hdr"), image, error, std::uint64_t(1) << 28));
+  EXPECT_NE(error.find("16384x8193 pixels of 32 bits: decoding it takes more than 2 GiB"), std::string::npos)
+      << error;
+  expect_error("stipple '" + path("wide.hdr") + "' -o '" + path("w.svg") + "'", "more than 2 GiB");
+}
+
+// Fills stack the loader's callees will use with a grey, so that a read of uninitialised stack shows.
+__attribute__((noinline)) void dirty_stack() {
+  volatile std::uint8_t junk[1 << 18];
+  for (std::size_t i = 0; i < sizeof junk; ++i) junk[i] = 0x80;
+}
+
+TEST_F(CliTest, PaletteIndicesPastThePaletteAreBlack) {
+  // A 4 × 1 palette PNG of 2 bits a pixel whose PLTE holds two entries (both white), its pixels the
+  // indices 0, 1, 2 and 3; and the same as a 4-bit BMP. stb reads entries 2 and 3 from its own
+  // uninitialised stack: kdm gives it a palette filled up with black.
+  std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  chunk(png, "IHDR", {0, 0, 0, 4, 0, 0, 0, 1, 2, 3, 0, 0, 0});
+  chunk(png, "PLTE", {255, 255, 255, 255, 255, 255});
+  chunk(png, "IDAT", zlib_stored({0, 0x1B}));
+  chunk(png, "IEND", {});
+  write_bytes(path("palette.png"), png);
+  std::vector<std::uint8_t> bmp = {'B', 'M', 70, 0, 0, 0, 0, 0, 0, 0, 62, 0, 0, 0,         // pixels at 62
+                                   40,  0,   0,  0, 4, 0, 0, 0, 1, 0, 0,  0, 1, 0, 4, 0};  // 4 × 1, 4 bits
+  bmp.resize(14 + 40, 0);                                                                  // no compression
+  bmp.insert(bmp.end(), {255, 255, 255, 0, 255, 255, 255, 0});                             // two entries
+  bmp.insert(bmp.end(), {0x01, 0x23, 0, 0});                                               // a row
+  write_bytes(path("palette.bmp"), bmp);
+  for (const char* name : {"palette.png", "palette.bmp"}) {
+    SCOPED_TRACE(name);
+    for (int round = 0; round < 2; ++round) {
+      kdm::tools::GreyImage image;
+      std::string error;
+      dirty_stack();
+      ASSERT_TRUE(kdm::tools::load_grey_image(path(name), image, error)) << error;
+      ASSERT_EQ(image.pixels.size(), 4u);
+      EXPECT_EQ(image.pixels, (std::vector<float>{1, 1, 0, 0}));
+    }
+  }
+}
+
 TEST_F(CliTest, BadImagesGiveOneLineErrors) {
   const std::vector<std::uint8_t> good = ramp_png();
   write_bytes(path("empty0x0.png"), grey_png(0, 0, 8, {}));  // IHDR says 0×0

@@ -4,7 +4,8 @@
 // from the last byte) for the sampler (Density::from_values) and the runtime (make_density_max_mip).
 // The pixel limit is lowered to kFuzzMaxPixels so that each input stays cheap; the limit's logic is the
 // same. Checks: an accepted image is non-empty, within the limit, with width·height values in [0, 1];
-// a refused one has an error naming the image; the density is accepted by the runtime, and its max-mip
+// a refused one has an error naming the image; read averaged down (as kdm stipple reads a large picture)
+// it keeps its size rule, its range and its mean; the density is accepted by the runtime, and its max-mip
 // bounds the density at sample points; the sampler's density is finite and >= 0 there.
 #include <algorithm>
 #include <cmath>
@@ -40,6 +41,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (image.pixels.size() != std::size_t(w) * std::size_t(h)) fail();
   for (float v : image.pixels)
     if (!(v >= 0 && v <= 1)) fail();
+
+  // Averaged down as kdm stipple reads a large picture: the kept size, values in [0, 1], the same mean
+  // (every pixel weighs its area in the kept ones: equal up to float rounding).
+  const std::uint8_t share = data[size - 1] % 7 + 1;
+  kdm::tools::GreyImage kept;
+  const auto keep = [share](int width, int height) {
+    return std::uint64_t(width) * height / (share * share);
+  };
+  if (!kdm::tools::load_grey_image_memory(data, size, kept, error, "fuzz.png", kFuzzMaxPixels, keep)) fail();
+  if (kept.width < 1 || kept.height < 1 || kept.width > w || kept.height > h) fail();
+  if (kept.pixels.size() != std::size_t(kept.width) * std::size_t(kept.height)) fail();
+  double mean = 0, kept_mean = 0;
+  for (float v : image.pixels) mean += v;
+  for (float v : kept.pixels) {
+    if (!(v >= 0 && v <= 1)) fail();
+    kept_mean += v;
+  }
+  if (!(std::fabs(mean / image.pixels.size() - kept_mean / kept.pixels.size()) < 1e-4)) fail();
 
   // As tools/cli/density_arg.cpp: density = tone^gamma, tone = darkness (or brightness with --invert).
   const std::uint8_t last = data[size - 1];

@@ -177,6 +177,16 @@ def crashes():
     write("image", "pnm_header_overflow.pgm", b"P5 99999999999 1 255\n\0", root)
     # 64x64 pixels announced, 10 given: stb returns the other 4086 uninitialised.
     write("image", "pnm_pixels_cut_short.pgm", b"P5 64 64 255\n" + b"\x80" * 10, root)
+    # A 2-bit palette PNG whose PLTE holds 3 entries and whose pixels use index 3 (fuzzer-found): stb reads
+    # the entry from its uninitialised stack, so the picture differed from one decode to the next.
+    write("image", "png_index_past_palette.png", bytes.fromhex(
+        "89504e470d0a1a0a0000000d494844520000000400000002020300000002c695f000000009504c5445800000ffffff8040"
+        "2059e4f73c0000000274524e51ff00e5b7304a0000000c4944415478da6394647e000000e500ac242342fa000030004945"
+        "4e44ae426082"), root)
+    # A 4-bit BMP cut short whose pixel offset is 0, inside its header (fuzzer-found): stb counts a negative
+    # palette, reads none, and draws every pixel from its uninitialised stack.
+    write("image", "bmp_pixels_inside_header.bmp",
+          bytes.fromhex("424d4600002f003d003600000000280000002b00000011000000010004"), root)
     # A run-length scanline with a run of length 0 (fuzzer-found): stb 2.27 reads on in place forever.
     write("image", "hdr_run_of_length_zero.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 8\n" +
           bytes([2, 2, 0, 8, 4, 180, 0, 240, 0, 0]), root)

@@ -486,3 +486,21 @@ def test_anisotropy_by_ring_finds_a_lattice_and_not_the_sampler():
         assert len(s["anisotropy_db_by_ring"]) == len(s["raps_f"])
     assert grid["anisotropy_db_by_ring"][np.argmax(grid["raps"])] > 15
     assert abs(blue["anisotropy_db_by_ring"][np.argmax(blue["raps"])]) < 3
+
+
+def test_stipple_reads_a_picture_past_the_density_limit_at_the_size_its_dots_need(cli, tmp_path):
+    # 8,400 x 8,200 pixels, more than the 2^26 a density may have: a stipple averages it down as it reads
+    # it (here to 2^24 pixels, about 4,140 x 4,050), so only the decoder holds every pixel.
+    grey = np.full((8200, 8400), 255, np.uint8)
+    grey[:, :4200] = 0  # the left half black
+    big = tmp_path / "big.png"
+    write_png(big, grey)
+    dots = kdm.stipple(str(big), points=4000, mode="stable")
+    # Measured: 3,974-4,005 dots over seeds 1-3; stable mode between levels keeps counts within a few percent.
+    assert abs(len(dots) - 4000) < 120
+    # Every dot on the black half, but for the kept pixels (1/4,140 wide) the edge shares with the white.
+    assert dots[:, 0].max() < 0.5 + 2 / 4140 and dots[:, 0].min() >= 0
+    cli("stipple", big, "--points", 4000, "--mode", "stable", "-o", tmp_path / "cli.txt")
+    assert np.array_equal(read_txt(tmp_path / "cli.txt"), dots)
+    with pytest.raises(OSError, match="more than the limit of 67108864 pixels"):
+        kdm.sample(100, density=str(big))

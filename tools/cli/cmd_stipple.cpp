@@ -96,6 +96,11 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     }
   }
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
+  double region[4] = {0, 0, 1, 1};
+  if (!a.region.empty()) parse_region(a.region, a.frames > 0, region);
+  // A large picture is averaged down to what its dots can show, at the deepest zoom drawn.
+  const tools::KeptPixels kept = tools::stipple_kept_pixels(
+      scale_given ? 0.0 : double(a.points), scale_given ? a.scale : 0.0, tools::stipple_zoom(region));
   // One ink (the image's darkness), or with --colours the image separated into several.
   tools::ColourSeparation inks;
   double aspect = 1;  // world: [0, aspect] × [0, 1]
@@ -106,7 +111,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (!named && !std::filesystem::exists(a.image, missing))
       throw CommandError("cannot read image '" + a.image +
                          "': " + (missing ? missing.message() : std::string(std::strerror(ENOENT))));
-    inks.channels.push_back(parse_density(a.image, a.gamma, a.invert));
+    inks.channels.push_back(parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept));
     inks.inks = tools::class_inks(1);
     const tools::DensitySpec& spec = inks.channels.front();
     if (spec.kind != tools::DensitySpec::Kind::kImage)
@@ -117,7 +122,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
     tools::ColourImage image;
     std::string error;
-    if (!tools::load_colour_image(a.image, image, error)) throw CommandError(error);
+    if (!tools::load_colour_image(a.image, image, error, tools::kMaxStipplePixels, kept))
+      throw CommandError(error);
     check_gamma(a.gamma);
     try {
       inks = tools::separate_colours(image, a.colours, a.gamma);
@@ -131,8 +137,6 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   for (const tools::DensitySpec& channel : inks.channels) specs.push_back(&channel);
   const bool blank = specs.empty();  // a white image (a black one with --invert): no dots, not an error
   const double whole_dots = blank ? 0.0 : tools::stipple_dot_count(specs, double(a.points), a.scale);
-  double region[4] = {0, 0, 1, 1};
-  if (!a.region.empty()) parse_region(a.region, a.frames > 0, region);
   if (a.method == "full" && !a.region.empty())
     throw CommandError("--region needs --method tiles (the full sampler has no zoom)");
   Tileset storage;
@@ -146,7 +150,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     tools::ColourImage probe;
     std::string unread;
     const bool transparent =
-        tools::load_colour_image(a.image, probe, unread) && !probe.alpha.empty() &&
+        tools::load_colour_image(a.image, probe, unread, tools::kMaxStipplePixels, kept) &&
+        !probe.alpha.empty() &&
         std::all_of(probe.alpha.begin(), probe.alpha.end(), [](float alpha) { return alpha == 0; });
     std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s%s: no dots\n", a.image.c_str(),
                  coloured ? " in any colour" : "",
@@ -264,9 +269,12 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
 void add_stipple_command(CLI::App& app) {
   auto a = std::make_shared<StippleArgs>();
   CLI::App* cmd = app.add_subcommand("stipple", "Stipple an image: darkness becomes dot density");
-  cmd->add_option("image", a->image,
-                  "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
-                  "density; transparent pixels are paper")
+  cmd->add_option(
+         "image", a->image,
+         "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
+         "density; transparent pixels are paper. Up to 16384x16384 pixels: a picture larger than its dots "
+         "need (about 4096x4096, or 64 pixels per dot, times the zoom squared) is averaged down as it "
+         "is read")
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "

@@ -16,10 +16,11 @@ void check_gamma(double gamma) {
   throw CommandError(text);
 }
 
-tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert) {
+tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert, std::uint64_t max_pixels,
+                                 const tools::KeptPixels& kept) {
   check_gamma(gamma);
   try {
-    return tools::parse_density_spec(text, gamma, invert);
+    return tools::parse_density_spec(text, gamma, invert, max_pixels, kept);
   } catch (const std::exception& e) {  // a bad value, or an image that cannot be read
     throw CommandError(e.what());
   }

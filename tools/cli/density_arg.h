@@ -11,7 +11,10 @@
 namespace kdm::cli {
 
 /// Parses --density (see tools::parse_density_spec). Throws CommandError naming the problem.
-tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert);
+/// Images: refused over `max_pixels`, averaged down to what `kept` keeps (tools::KeptPixels).
+tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert,
+                                 std::uint64_t max_pixels = tools::kMaxImagePixels,
+                                 const tools::KeptPixels& kept = {});
 
 /// --gamma as every command takes it: a finite number > 0, else a CommandError naming the option.
 void check_gamma(double gamma);

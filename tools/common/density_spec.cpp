@@ -60,7 +60,8 @@ double parse_number(const std::string& text) {
 
 }  // namespace
 
-DensitySpec parse_density_spec(const std::string& text, double gamma, bool invert) {
+DensitySpec parse_density_spec(const std::string& text, double gamma, bool invert, std::uint64_t max_pixels,
+                               const KeptPixels& kept) {
   DensitySpec spec;
   spec.text = text;
   if (!(std::isfinite(gamma) && gamma > 0)) throw std::invalid_argument("gamma must be a finite number > 0");
@@ -88,7 +89,7 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
                              "': no such file (a density is a picture, const:V, ramp:R or radial:R)");
   GreyImage image;
   std::string error;
-  if (!load_grey_image(text, image, error)) throw std::runtime_error(error);
+  if (!load_grey_image(text, image, error, max_pixels, kept)) throw std::runtime_error(error);
   // Densities keep row 0 at the bottom (y up); the picture's row 0 is its top: flipped here, once.
   spec.kind = DensitySpec::Kind::kImage;
   spec.width = image.width, spec.height = image.height, spec.inverted = invert;

@@ -4,10 +4,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "image_io.h"
 
 namespace kdm::tools {
 
@@ -36,7 +39,10 @@ struct DensitySpec {
 /// that cannot be read (std::runtime_error, naming the file). Messages are one line.
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
 /// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance.
-DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false);
+/// An image of more than `max_pixels` pixels is refused; `kept`, if given, averages a larger picture
+/// down as it is read (KeptPixels; the average is of luminance, before `gamma`).
+DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false,
+                               std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
 
 /// Densities that share one domain (the classes of a query or a sample) stretch each image over all of it:
 /// images whose sides differ in ratio (by more than 1%) would be stretched differently, while images of one

@@ -301,11 +301,83 @@ std::string radiance_fault(const std::uint8_t* data, std::size_t size) {
   return "";
 }
 
+// A BMP of 1, 4 or 8 bits a pixel: its palette as stb_image counts it from the pixels' offset (the count
+// for the 12-byte header reads four fewer entries than the file holds, and can be negative).
+struct BmpPalette {
+  int bits = 0;
+  std::int64_t offset = 0, header = 0, entry = 0, entries = 0;  // entries 0: no palette BMP
+};
+
+BmpPalette bmp_palette(const std::uint8_t* data, std::size_t size) {
+  BmpPalette bmp;
+  if (size < 2 || data[0] != 'B' || data[1] != 'M') return bmp;
+  const auto byte = [&](std::size_t at) { return at < size ? std::uint32_t(data[at]) : 0u; };  // as stb reads
+  const auto le32 = [&](std::size_t at) {
+    return byte(at) | byte(at + 1) << 8 | byte(at + 2) << 16 | byte(at + 3) << 24;
+  };
+  bmp.offset = std::int32_t(le32(10)), bmp.header = le32(14);
+  if (bmp.header != 12 && bmp.header != 40 && bmp.header != 56 && bmp.header != 108 && bmp.header != 124)
+    return bmp;
+  bmp.bits = int(bmp.header == 12 ? byte(24) | byte(25) << 8 : byte(28) | byte(29) << 8);
+  if ((bmp.bits != 1 && bmp.bits != 4 && bmp.bits != 8) || bmp.offset < 0) return bmp;
+  bmp.entry = bmp.header == 12 ? 3 : 4;
+  bmp.entries = bmp.header == 12 ? (bmp.offset - 14 - 24) / 3 : (bmp.offset - 14 - bmp.header) >> 2;
+  return bmp;
+}
+
+// stb_image reads a palette entry past a file's palette (a PNG's PLTE, a BMP's colour table) from its own
+// uninitialised stack, so a corrupt file would decode differently each time. Such a file is decoded from
+// a copy in `padded` whose palette is filled up with black entries, as libpng reads an index past the
+// palette. Returns false when the file needs no copy.
+bool pad_palette(const std::uint8_t* data, std::size_t size, std::vector<std::uint8_t>& padded) {
+  static const std::uint8_t kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  const auto be32 = [data](std::size_t at) {
+    return std::uint32_t(data[at]) << 24 | std::uint32_t(data[at + 1]) << 16 |
+           std::uint32_t(data[at + 2]) << 8 | data[at + 3];
+  };
+  if (size >= 26 && std::memcmp(data, kPng, 8) == 0 && std::memcmp(data + 12, "IHDR", 4) == 0 &&
+      data[25] == 3) {
+    for (std::size_t pos = 8; size - pos >= 12;) {  // a palette image: its PLTE chunk (stb reads one)
+      const std::uint32_t length = be32(pos);
+      if (length > size - pos - 12) return false;  // cut short: refused elsewhere, or read as zeros
+      if (std::memcmp(data + pos + 4, "IDAT", 4) == 0) return false;
+      if (std::memcmp(data + pos + 4, "PLTE", 4) == 0) {
+        if (length % 3 != 0 || length >= 768) return false;  // stb refuses the first; the second is whole
+        padded.assign(data, data + pos);
+        for (int shift = 24; shift >= 0; shift -= 8) padded.push_back(std::uint8_t(768 >> shift));
+        padded.insert(padded.end(), data + pos + 4, data + pos + 8 + length);
+        padded.resize(padded.size() + 768 - length, 0);
+        padded.insert(padded.end(), 4, 0);  // the CRC, which stb does not check
+        padded.insert(padded.end(), data + pos + 12 + length, data + size);
+        return true;
+      }
+      pos += 12 + std::size_t(length);
+    }
+    return false;
+  }
+  if (const BmpPalette bmp = bmp_palette(data, size); bmp.entries > 0) {
+    const std::int64_t end = 14 + bmp.header + bmp.entries * bmp.entry;  // where stb stops reading it
+    const std::int64_t needed = std::int64_t(1) << bmp.bits;
+    if (bmp.entries >= needed || end > std::int64_t(size)) return false;
+    const std::int64_t added = (needed - bmp.entries) * bmp.entry;
+    if (bmp.offset + added > INT32_MAX) return false;
+    padded.assign(data, data + end);
+    padded.resize(padded.size() + std::size_t(added), 0);
+    padded.insert(padded.end(), data + end, data + size);
+    const auto moved = std::uint32_t(bmp.offset + added);
+    for (int i = 0; i < 4; ++i) padded[10 + i] = std::uint8_t(moved >> (8 * i));
+    return true;
+  }
+  return false;
+}
+
 // The input stb would fault on, or nullptr.
 const char* stb_fault(const std::uint8_t* data, std::size_t size) {
   if (jpeg_faults(data, size)) return "corrupt JPEG (a Huffman table of more than 256 codes)";
   if (png_truncated(data, size)) return "corrupt PNG (cut short: it ends inside a chunk or before IEND)";
   if (pnm_faults(data, size)) return "corrupt PGM/PPM (a header number too large, or pixels cut short)";
+  // stb would read no palette and draw every pixel from its uninitialised stack.
+  if (bmp_palette(data, size).entries < 0) return "corrupt BMP (its pixels start inside its header)";
   return nullptr;
 }
 
@@ -396,6 +468,83 @@ void convert(const Sample* data, int channels, float full, Image& image) {
     to_rgb(data, channels, full, image.pixels);
   image.alpha.resize(image.pixels.size() / channels_of(image));
   to_alpha(data, channels, full, image.alpha);
+}
+
+// One axis of an area-weighted reduction of n source pixels to m <= n: source pixel i, covering [i, i + 1),
+// gives `share[i]` of itself to kept pixel `first[i]`, which covers [j n / m, (j + 1) n / m), and the rest
+// to the next one (a kept pixel is at least a source pixel wide, so a source pixel meets at most two).
+struct BoxAxis {
+  std::vector<int> first;
+  std::vector<double> share;
+  BoxAxis(int n, int m) : first(std::size_t(n)), share(std::size_t(n)) {
+    const double step = double(n) / m;
+    for (int i = 0; i < n; ++i) {
+      const int j = std::min(m - 1, static_cast<int>(i / step));
+      first[std::size_t(i)] = j;
+      share[std::size_t(i)] = j + 1 < m ? std::clamp((j + 1) * step - i, 0.0, 1.0) : 1.0;
+    }
+  }
+};
+
+// `convert` into `kw` × `kh` pixels that average the picture's `w` × `h`: a row is converted at a time
+// (values composited as `convert` does them, so averages keep the tone on paper) and summed into the kept
+// rows it meets, so that no full-size copy of floats is made.
+template <class Sample, class Image>
+void convert_reduced(const Sample* data, int channels, float full, int w, int h, int kw, int kh,
+                     Image& image) {
+  const std::size_t c = channels_of(image), stride = c + 1;  // the values, then alpha, per kept pixel
+  const bool has_alpha = channels == 2 || channels == 4;
+  const BoxAxis ax(w, kw), ay(h, kh);
+  Image row;
+  row.pixels.resize(std::size_t(w) * c);
+  std::vector<double> sums[2] = {std::vector<double>(std::size_t(kw) * stride),
+                                 std::vector<double>(std::size_t(kw) * stride)};
+  image.pixels.assign(std::size_t(kw) * kh * c, 0.0f);
+  image.alpha.assign(has_alpha ? std::size_t(kw) * kh : 0, 0.0f);
+  const double area = double(w) / kw * (double(h) / kh);
+  const auto flush = [&](int j) {  // kept row j is whole
+    std::vector<double>& sum = sums[j & 1];
+    for (std::size_t x = 0; x < std::size_t(kw); ++x) {
+      const std::size_t at = std::size_t(j) * kw + x;
+      for (std::size_t k = 0; k < c; ++k)
+        image.pixels[at * c + k] = static_cast<float>(std::clamp(sum[x * stride + k] / area, 0.0, 1.0));
+      if (has_alpha) image.alpha[at] = static_cast<float>(std::clamp(sum[x * stride + c] / area, 0.0, 1.0));
+    }
+    std::fill(sum.begin(), sum.end(), 0.0);
+  };
+  int flushed = 0;
+  for (int y = 0; y < h; ++y) {
+    convert(data + std::size_t(y) * w * channels, channels, full, row);
+    const int j = ay.first[std::size_t(y)];
+    while (flushed < j) flush(flushed++);
+    for (int dy = 0; dy < 2 && j + dy < kh; ++dy) {
+      const double wy = dy == 0 ? ay.share[std::size_t(y)] : 1.0 - ay.share[std::size_t(y)];
+      if (wy <= 0) continue;
+      std::vector<double>& sum = sums[(j + dy) & 1];
+      for (std::size_t x = 0; x < std::size_t(w); ++x) {
+        const std::size_t i = std::size_t(ax.first[x]);
+        const double share = ax.share[x];
+        for (std::size_t dx = 0; dx < 2 && i + dx < std::size_t(kw); ++dx) {
+          const double weight = wy * (dx == 0 ? share : 1.0 - share);
+          if (weight <= 0) continue;
+          double* to = &sum[(i + dx) * stride];
+          for (std::size_t k = 0; k < c; ++k) to[k] += weight * row.pixels[x * c + k];
+          to[c] += weight * (has_alpha ? row.alpha[x] : 1.0f);
+        }
+      }
+    }
+  }
+  while (flushed < kh) flush(flushed++);
+}
+
+// The size `kept` asks a `w` × `h` picture to be kept at: the same shape, each side at least 1.
+std::pair<int, int> kept_size(int w, int h, const KeptPixels& kept) {
+  const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+  const std::uint64_t keep = kept ? kept(w, h) : pixels;
+  if (keep >= pixels) return {w, h};
+  const double factor = std::sqrt(double(pixels) / double(std::max<std::uint64_t>(keep, 1)));
+  return {std::clamp(static_cast<int>(std::lround(w / factor)), 1, w),
+          std::clamp(static_cast<int>(std::lround(h / factor)), 1, h)};
 }
 
 /// Whether every PGM/PPM sample is at most the file's maxval (else `error`: the file is corrupt).
@@ -493,7 +642,7 @@ void apply_orientation(Image& image, int orientation) {
 // read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
 template <class Image>
 bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& name,
-                std::uint64_t max_pixels, Image& out, std::string& error) {
+                std::uint64_t max_pixels, Image& out, std::string& error, const KeptPixels& kept = {}) {
   if (size == 0) {
     error = "cannot read image '" + name + "': the file is empty";
     return false;
@@ -509,6 +658,14 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   if (const std::string fault = radiance_fault(bytes, size); !fault.empty()) {
     error = "cannot read image '" + name + "': " + fault;
     return false;
+  }
+  std::vector<std::uint8_t> padded;
+  if (pad_palette(bytes, size, padded)) {
+    if (padded.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+      error = "cannot read image '" + name + "': larger than 2 GiB";
+      return false;
+    }
+    bytes = padded.data(), size = padded.size();
   }
   // stb reads PGM/PPM samples as they are, whatever the file's maxval: full scale is the maxval here.
   const PnmHeader pnm = pnm_header(bytes, size);
@@ -541,7 +698,21 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
         ": scale it down (a density needs no more pixels than the dots it places)";
     return false;
   }
+  // stb counts its buffer's bytes in an int: said here, not as its "too large" (a PNG's tRNS may add alpha).
+  const bool hdr = stbi_is_hdr_from_memory(bytes, length) != 0;
+  const int sample_bytes = hdr ? 4 : stbi_is_16_bit_from_memory(bytes, length) ? 2 : 1;
+  const std::uint64_t buffer = pixels * std::uint64_t(std::min(4, header_channels + 1)) * sample_bytes;
+  if (buffer > std::uint64_t(std::numeric_limits<int>::max())) {
+    error = "image '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) + " pixels of " +
+            std::to_string(8 * sample_bytes) + " bits: decoding it takes more than 2 GiB; scale it down" +
+            (hdr                 ? ""
+             : sample_bytes == 2 ? " or convert it to 8 bits"
+                                 : "");
+    return false;
+  }
   int lw = 0, lh = 0, channels = 0;
+  const std::pair<int, int> kept_wh = kept_size(w, h, kept);  // not a binding: lambdas capture these
+  const int kw = kept_wh.first, kh = kept_wh.second;
   Image image;
   // The decoder must return the header's size, so that the limit holds for what is kept.
   auto decoded = [&](const void* data) {
@@ -553,10 +724,16 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
       error = "cannot read image '" + name + "': its header and its pixels disagree";
       return false;
     }
-    image.pixels.resize(pixels * channels_of(image));
+    if (kw == w && kh == h) image.pixels.resize(pixels * channels_of(image));
     return true;
   };
-  if (stbi_is_hdr_from_memory(bytes, length)) {
+  const auto convert_kept = [&](const auto* data, float full) {
+    if (kw == w && kh == h)
+      convert(data, channels, full, image);
+    else
+      convert_reduced(data, channels, full, w, h, kw, kh, image);
+  };
+  if (hdr) {
     // Radiance files hold linear values of any range: scaled by the largest (the brightest pixel's
     // luminance, or channel for colour), so that a density keeps every ratio the file holds.
     std::unique_ptr<float, void (*)(void*)> data(
@@ -575,7 +752,7 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
                                : *std::max_element(p, p + channels);
       if (value > largest && std::isfinite(value)) largest = value;
     }
-    convert(data.get(), channels, largest > 0 ? static_cast<float>(largest) : 1.0f, image);
+    convert_kept(data.get(), largest > 0 ? static_cast<float>(largest) : 1.0f);
   } else if (stbi_is_16_bit_from_memory(bytes, length)) {
     std::unique_ptr<stbi_us, void (*)(void*)> data(
         stbi_load_16_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
@@ -586,16 +763,16 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
         data.get()[i] =
             static_cast<stbi_us>(bytes[pnm.pixels_at + 2 * i] << 8 | bytes[pnm.pixels_at + 2 * i + 1]);
     if (pnm.pnm && !samples_within(data.get(), pixels * channels, pnm.max_value, name, error)) return false;
-    convert(data.get(), channels, pnm.pnm ? float(pnm.max_value) : 65535.0f, image);
+    convert_kept(data.get(), pnm.pnm ? float(pnm.max_value) : 65535.0f);
   } else {
     std::unique_ptr<stbi_uc, void (*)(void*)> data(
         stbi_load_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
     if (pnm.pnm && !samples_within(data.get(), pixels * channels, pnm.max_value, name, error)) return false;
-    convert(data.get(), channels, pnm.pnm ? float(pnm.max_value) : 255.0f, image);
+    convert_kept(data.get(), pnm.pnm ? float(pnm.max_value) : 255.0f);
   }
-  image.width = w;
-  image.height = h;
+  image.width = kw;
+  image.height = kh;
   apply_orientation(image, jpeg_orientation(bytes, size));  // as a photo is seen, not as it is stored
   out = std::move(image);
   return true;
@@ -606,7 +783,8 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
 namespace {
 
 template <class Image>
-bool load_image_file(const std::string& path, Image& out, std::string& error, std::uint64_t max_pixels) {
+bool load_image_file(const std::string& path, Image& out, std::string& error, std::uint64_t max_pixels,
+                     const KeptPixels& kept) {
   // Read whole, once: the checks and the decoder see the same bytes, whatever happens to the file.
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) {
@@ -648,23 +826,24 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
-  return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error);
+  return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error, kept);
 }
 
 }  // namespace
 
-bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels) {
-  return load_image_file(path, out, error, max_pixels);
+bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels,
+                     const KeptPixels& kept) {
+  return load_image_file(path, out, error, max_pixels, kept);
 }
 
 bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
-                       std::uint64_t max_pixels) {
-  return load_image_file(path, out, error, max_pixels);
+                       std::uint64_t max_pixels, const KeptPixels& kept) {
+  return load_image_file(path, out, error, max_pixels, kept);
 }
 
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
-                            const std::string& name, std::uint64_t max_pixels) {
-  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error);
+                            const std::string& name, std::uint64_t max_pixels, const KeptPixels& kept) {
+  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error, kept);
 }
 
 bool write_png(const std::string& path, const RgbImage& image, std::string& error) {

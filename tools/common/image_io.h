@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,13 @@ struct RgbImage {
 /// an error naming the file, its size and this limit.
 inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
 
+/// How many pixels a loader keeps of an image stored as `width` × `height` pixels. Fewer than width ·
+/// height make it average the picture down as it converts it (area-weighted boxes, to about that many
+/// pixels in the same shape, every side at least 1), so that no full-size copy of floats is made; the
+/// tone of every region larger than a kept pixel stays. Empty, or a count not below width · height:
+/// every pixel, bit for bit as without it.
+using KeptPixels = std::function<std::uint64_t(int width, int height)>;
+
 /// Loads an image as luminance in [0, 1] (16-bit PNGs keep their precision; a Radiance .hdr image its
 /// range, as linear values divided by its brightest pixel's; alpha is composited on white and kept; a
 /// JPEG is turned as its EXIF orientation says, as viewers show it).
@@ -50,17 +58,18 @@ inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
 /// header (see kMaxImagePixels), and so are inputs that would reach a known fault of the system's stb_image
 /// (tests/fuzz/crashes/README.md).
 /// Returns false and sets `error` to a one-line message naming the file and the problem.
+/// `kept`, if given, averages a large picture down while it is converted (KeptPixels).
 bool load_grey_image(const std::string& path, GreyImage& out, std::string& error,
-                     std::uint64_t max_pixels = kMaxImagePixels);
+                     std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
 
 /// The same as red, green and blue (alpha composited on white; a grey image gives three equal channels).
 bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
-                       std::uint64_t max_pixels = kMaxImagePixels);
+                       std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
 /// The same as load_grey_image for an image file's bytes in memory; `name` stands for the file in error
 /// messages.
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
                             const std::string& name = "image in memory",
-                            std::uint64_t max_pixels = kMaxImagePixels);
+                            std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
 
 /// Writes `image` as PNG atomically (temporary file, then rename). Returns false with `error` set on failure.
 bool write_png(const std::string& path, const RgbImage& image, std::string& error);

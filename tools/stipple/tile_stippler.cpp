@@ -27,6 +27,15 @@ double between_keyframes(const Tileset& tileset, double count) {
 constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
+KeptPixels stipple_kept_pixels(double points, double scale, double zoom) {
+  return [=](int width, int height) {
+    const double aspect = double(std::max(width, height)) / std::min(width, height);
+    const double dots = points > 0 ? 4 * points : scale * aspect;  // 16 kept pixels a dot, or 64 a mean one
+    const double kept = std::max(double(1 << 24), 16 * dots) * std::max(1.0, zoom) * std::max(1.0, zoom);
+    return kept >= double(kMaxStipplePixels) ? kMaxStipplePixels : static_cast<std::uint64_t>(kept);
+  };
+}
+
 double stipple_zoom(const double uv[4]) {
   return 1 / (uv[2] - uv[0]);
 }

@@ -18,6 +18,18 @@ namespace kdm::tools {
 /// The tile size leaves room for this many times more dots per axis than the whole image shows.
 inline constexpr double kStippleZoomRoom = 2;
 
+/// The largest picture a stipple reads, in pixels (16384 × 16384; other commands keep kMaxImagePixels):
+/// it is averaged down as it is read (stipple_kept_pixels), so only the decoder holds every pixel, 1 to 8
+/// bytes each (8-bit grey to 16-bit RGBA).
+inline constexpr std::uint64_t kMaxStipplePixels = std::uint64_t(1) << 28;
+
+/// How many of a picture's pixels a stipple keeps (KeptPixels): max(2^24, 64 · points) · zoom², or with
+/// `scale` (points 0) max(2^24, 16 · scale · aspect) · zoom² (aspect: the longer side over the shorter),
+/// `zoom` being the deepest zoom drawn (stipple_zoom, at least 1). A dot's spacing then spans about four
+/// kept pixels where the picture is darkest (with `scale`; with `points`, on a picture at least a
+/// sixteenth dark), and no picture up to 4096 × 4096 is averaged.
+KeptPixels stipple_kept_pixels(double points, double scale, double zoom);
+
 /// Dots over a whole image of `inks` (one or more images of one size, over [0, aspect] × [0, 1]): `points`
 /// when > 0, else `scale` dots per unit area at full darkness, scale · aspect · the inks' summed mean.
 double stipple_dot_count(const std::vector<const DensitySpec*>& inks, double points, double scale);
