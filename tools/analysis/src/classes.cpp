@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/density.h"
@@ -145,21 +147,95 @@ double cross_class_closest(const tools::PointSet& set, bool torus, const Density
   return best / spacing;
 }
 
+DensityFunction summed_density(const std::vector<DensityFunction>& densities) {
+  if (densities.empty()) return {};
+  return [densities](double x, double y) {
+    double sum = 0;
+    for (const DensityFunction& d : densities)
+      if (d) sum += d(x, y);
+    return sum;
+  };
+}
+
+namespace {
+
+/// Each class's share of the points as its density's integral predicts it, against its count over `sets`;
+/// checks the densities (one per class the labels run to, finite, >= 0, not zero where a class has points).
+std::vector<ClassShare> class_shares(const std::vector<tools::PointSet>& sets,
+                                     const std::vector<DensityFunction>& densities) {
+  std::size_t labels = 0;  // largest label + 1
+  for (const tools::PointSet& set : sets)
+    for (std::uint8_t k : set.classes) labels = std::max(labels, std::size_t(k) + 1);
+  if (labels == 0) throw InvalidInput("class densities given, but the sets hold no points");
+  if (densities.size() != labels)
+    throw InvalidInput(std::to_string(densities.size()) +
+                       " class densities given, but the points' classes run 0 to " +
+                       std::to_string(labels - 1) + " (" + std::to_string(labels) +
+                       " classes): give one density per class, class 0 first");
+  std::vector<ClassShare> shares(labels);
+  double total = 0;
+  std::vector<double> mean(labels);
+  for (std::size_t k = 0; k < labels; ++k) {
+    const std::string name = "class " + std::to_string(k) + "'s density";
+    if (!densities[k]) throw InvalidInput(name + " is empty");
+    // density_scale clamps what it reads; a density the windows would refuse is named here by class.
+    constexpr int kProbe = 64;
+    for (int j = 0; j < kProbe; ++j)
+      for (int i = 0; i < kProbe; ++i) {
+        const double v = densities[k]((i + 0.5) / kProbe, (j + 0.5) / kProbe);
+        if (!std::isfinite(v) || v < 0) throw InvalidInput(name + " is negative or not finite");
+      }
+    mean[k] = density_scale(densities[k]).first;
+    total += mean[k];
+    shares[k].cls = static_cast<std::uint8_t>(k);
+  }
+  if (!(total > 0)) throw InvalidInput("every class density is zero everywhere");
+  for (const tools::PointSet& set : sets)
+    for (std::uint8_t k : set.classes) ++shares[k].count;
+  for (std::size_t k = 0; k < labels; ++k) {
+    ClassShare& s = shares[k];
+    if (!(mean[k] > 0) && s.count > 0)
+      throw InvalidInput("class " + std::to_string(k) + "'s density is zero everywhere, but the class has " +
+                         std::to_string(s.count) + " points");
+    s.share = mean[k] / total;
+    double variance = 0;
+    for (const tools::PointSet& set : sets) {
+      const double n = static_cast<double>(set.size());
+      s.expected += n * s.share;
+      variance += n * s.share * (1 - s.share);
+    }
+    s.sd = std::sqrt(variance);
+    // sd = 0: a share of 0 (no points, checked above) or 1 (every point, the others having none).
+    s.z = s.sd > 0 ? (static_cast<double>(s.count) - s.expected) / s.sd : 0.0;
+  }
+  return shares;
+}
+
+}  // namespace
+
 ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
-                              const std::function<double(const std::vector<tools::PointSet>&)>& energy) {
+                              const ClassEnergy& energy,
+                              const std::vector<DensityFunction>& class_densities) {
   ClassesReport out;
+  for (const tools::PointSet& set : sets)
+    if (set.classes.size() != set.size())
+      throw InvalidInput("every set of labelled points needs its classes");
+  const bool own = !class_densities.empty();
+  if (own) out.shares = class_shares(sets, class_densities);
+  // The closest pair of different classes: in local spacings of the classes' summed density, if they have
+  // their own.
+  const DensityFunction pair_density = own ? summed_density(class_densities) : options.density;
   double closest = HUGE_VAL;
   std::vector<std::uint8_t> present;
   for (const tools::PointSet& set : sets) {
-    if (set.classes.size() != set.size())
-      throw InvalidInput("every set of labelled points needs its classes");
-    closest = std::min(closest, cross_class_closest(set, options.torus, options.density));
+    closest = std::min(closest, cross_class_closest(set, options.torus, pair_density));
     for (std::uint8_t k : classes_present(set))
       if (std::find(present.begin(), present.end(), k) == present.end()) present.push_back(k);
   }
   std::sort(present.begin(), present.end());
   // NaN: no set has two classes (with a density: none within two local spacings of each other)
   out.cross_class_closest = closest < HUGE_VAL ? closest : std::nan("");
+  AnalysisOptions class_options = options;
   for (std::uint8_t k : present) {
     std::vector<tools::PointSet> subsets;
     for (const tools::PointSet& set : sets) {
@@ -170,12 +246,27 @@ ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const An
       out.too_small.push_back(k);
       continue;
     }
-    AnalysisReport report = analyze(subsets, options);
-    if (energy) report.energy_per_point = energy(subsets), report.has_energy = true;
+    if (own) class_options.density = class_densities[k];
+    AnalysisReport report = analyze(subsets, class_options);
+    if (energy) report.energy_per_point = energy(k, subsets), report.has_energy = true;
     out.classes.push_back(k);
     out.reports.push_back(std::move(report));
   }
   return out;
+}
+
+std::string format_class_shares(const ClassesReport& report) {
+  if (report.shares.empty()) return "";
+  std::string s =
+      "class counts against their densities' shares (± binomial sd; a sampler that fixes counts: |z| << 1)\n";
+  for (const ClassShare& c : report.shares) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "  class %-3u %10zu points  expected %12.1f ± %-8.1f share %.4f  z %+.2f\n",
+                  unsigned(c.cls), c.count, c.expected, c.sd, c.share, c.z);
+    s += line;
+  }
+  return s;
 }
 
 std::string classes_json(const ClassesReport& report, const std::vector<std::string>& inputs) {
@@ -188,7 +279,24 @@ std::string classes_json(const ClassesReport& report, const std::vector<std::str
   json += "], \"too_small\": [";  // present, but with fewer than 2 points in every set: not analysed
   for (std::size_t c = 0; c < report.too_small.size(); ++c)
     json += std::string(c ? ", " : "") + std::to_string(report.too_small[c]);
-  return json + "]}\n";
+  json += "]";
+  if (!report.shares.empty()) {  // only with class densities: the output without them is unchanged
+    const auto number = [](double v) {
+      JsonWriter w;
+      w.value(v);
+      return w.str();
+    };
+    json += ", \"shares\": [";
+    for (std::size_t c = 0; c < report.shares.size(); ++c) {
+      const ClassShare& s = report.shares[c];
+      json += std::string(c ? ", " : "") + "{\"class\": " + std::to_string(s.cls) +
+              ", \"share\": " + number(s.share) + ", \"count\": " + std::to_string(s.count) +
+              ", \"expected\": " + number(s.expected) + ", \"sd\": " + number(s.sd) +
+              ", \"z\": " + number(s.z) + "}";
+    }
+    json += "]";
+  }
+  return json + "}\n";
 }
 
 }  // namespace kdm::analysis
