@@ -891,6 +891,68 @@ TEST_F(CliTest, AnalyzeWritesJsonToStandardOutputAndSaysWhatItPooled) {
   EXPECT_NE(help.out.find("NumPy .npy"), std::string::npos) << help.out;
 }
 
+/// Every number after `key` ("rms_z", "z") in a JSON text, in order.
+std::vector<double> json_numbers(const std::string& json, const std::string& key) {
+  std::vector<double> out;
+  const std::string quoted = "\"" + key + "\":";
+  for (std::size_t at = json.find(quoted); at != std::string::npos; at = json.find(quoted, at + 1))
+    out.push_back(std::strtod(json.c_str() + at + quoted.size(), nullptr));
+  return out;
+}
+
+// --class-density: each class of a labelled set against its own density, the whole set against their
+// sum, the classes' counts against their shares; refusals name the numbers.
+TEST_F(CliTest, AnalyzeJudgesEachClassAgainstItsOwnDensity) {
+  const std::string file = "'" + path("c.csv") + "'";
+  ASSERT_EQ(kdm("sample --n 2000 --class const:1 --class ramp:20 --seed 3 -o " + file).status, 0);
+  const std::string own = " --class-density const:1 --class-density ramp:20";
+  const Outcome r = kdm("analyze " + file + own + " --no-energy -o -");
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The whole set's, then class 0's and class 1's. Seeds 1..6: class 1's RMS z 0.24–0.42 against its
+  // ramp, 4.31–4.40 against one uniform --density (as every class was judged before); bars between.
+  const std::vector<double> z = json_numbers(r.out, "rms_z");
+  ASSERT_EQ(z.size(), 3u) << r.out;
+  for (double v : z) EXPECT_LT(v, 0.7);
+  const Outcome uniform = kdm("analyze " + file + " --density const:1 --no-energy -o -");
+  ASSERT_EQ(json_numbers(uniform.out, "rms_z").size(), 3u) << uniform.err;
+  EXPECT_GT(json_numbers(uniform.out, "rms_z")[2], 2.5);
+  EXPECT_NE(r.err.find("all classes together, against the sum of the --class-density densities"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("class 1 alone, against --class-density ramp:20:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(of the --class-density sum)"), std::string::npos) << r.err;
+  // Shares: the sampler splits its points by the same integrals (|z| ≪ 1); const:3 for class 0 predicts
+  // more of them than it has (z about −22 at this split; binomial sd about 20 points).
+  const std::vector<double> shares = json_numbers(r.out, "z");
+  ASSERT_EQ(shares.size(), 2u) << r.out;
+  for (double v : shares) EXPECT_LT(std::abs(v), 0.5);
+  const Outcome scaled =
+      kdm("analyze " + file + " --class-density const:3 --class-density ramp:20 --no-energy -o -");
+  ASSERT_EQ(json_numbers(scaled.out, "z").size(), 2u) << scaled.err;
+  EXPECT_LT(json_numbers(scaled.out, "z")[0], -10);
+  // With --density too, that judges the whole set alone (seeds 1..6: RMS z 1.12–1.17 against const:1,
+  // 0.20–0.26 against the sum); the classes keep theirs.
+  const Outcome both = kdm("analyze " + file + own + " --density const:1 --no-energy -o -");
+  ASSERT_EQ(json_numbers(both.out, "rms_z").size(), 3u) << both.err;
+  EXPECT_GT(json_numbers(both.out, "rms_z")[0], 0.7);
+  EXPECT_LT(json_numbers(both.out, "rms_z")[2], 0.7);
+  EXPECT_NE(both.err.find("all classes together, against --density"), std::string::npos) << both.err;
+  // Without --class-density nothing about shares is written.
+  EXPECT_EQ(uniform.out.find("shares"), std::string::npos);
+
+  expect_error("analyze " + file + " --class-density const:1",
+               "1 --class-density given, but the points' classes run 0 to 1 (2 classes)");
+  expect_error("analyze " + file + own + " --class-density const:1",
+               "3 --class-density given, but the points' classes run 0 to 1 (2 classes)");
+  expect_error("analyze " + file + " --class-density const:1 --class-density nothing:2",
+               "--class-density for class 1: density 'nothing:2'");
+  expect_error("analyze " + file + " --class-density const:0 --class-density ramp:20",
+               "class 0's density is zero everywhere, but the class has");
+  ASSERT_EQ(kdm("sample --n 200 -o '" + path("u.txt") + "'").status, 0);
+  expect_error("analyze '" + path("u.txt") + "'" + own, "--class-density needs labelled points");
+  EXPECT_NE(kdm("analyze --help").out.find("--class-density"), std::string::npos);
+}
+
 // '-' is standard input for a recipe and for a tile set; a recipe where a tile set belongs, and a set
 // where a recipe belongs, are named as such; a damaged size field is a damaged header, not a cut file.
 TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/plots.h"
 #include "kdm/analysis/report.h"
+#include "kdm/generator/multiclass.h"
 #include "kdm/generator/sampler.h"
 #include "sampler_density.h"
 
@@ -33,6 +35,7 @@ struct AnalyzeArgs {
   std::vector<std::string> files;
   bool torus = false, box = false;
   std::string density;
+  std::vector<std::string> class_densities;  ///< --class-density, repeated: one per class, class 0 first
   double gamma = 1;
   bool invert = false;
   bool no_energy = false;
@@ -51,23 +54,40 @@ void save_png(const std::string& path, const tools::RgbImage& image) {
   if (!tools::write_png(path, image, error)) throw CommandError(error);
 }
 
+/// The classes' own densities (--class-density), as the analysis and the energy take them.
+struct ClassTargets {
+  std::vector<gen::Density> densities;  ///< as kdm sample --class has them: constants keep their values
+  std::vector<analysis::DensityFunction> functions;
+};
+
 /// Labelled points (several classes): each class alone, as the whole set was analysed (printed to `text`),
-/// and classes.json's text, with the closest pair of points of different classes.
+/// and classes.json's text, with the closest pair of points of different classes; with class densities,
+/// each class against its own, and the classes' counts against their shares.
 std::string analyze_classes(const std::vector<tools::PointSet>& sets, const analysis::AnalysisOptions& o,
-                            const gen::Density& target, const AnalyzeArgs& args, std::FILE* text) {
-  std::function<double(const std::vector<tools::PointSet>&)> energy;
+                            const gen::Density& target, const ClassTargets& own, const AnalyzeArgs& args,
+                            std::FILE* text) {
+  analysis::ClassEnergy energy;
   if (!args.no_energy)
-    energy = [&](const std::vector<tools::PointSet>& subsets) {
-      return tools::mean_energy_per_point(subsets, o.torus, target);
+    energy = [&](std::uint8_t k, const std::vector<tools::PointSet>& subsets) {
+      return tools::mean_energy_per_point(subsets, o.torus,
+                                          own.densities.empty() ? target : own.densities[k]);
     };
-  const analysis::ClassesReport report = analysis::analyze_classes(sets, o, energy);
+  const analysis::ClassesReport report = analysis::analyze_classes(sets, o, energy, own.functions);
   std::fprintf(text, "\nclasses: %zu; closest pair of different classes: %.4f %s\n",
                report.classes.size() + report.too_small.size(), report.cross_class_closest,
-               o.density ? "local d_hex of all points (of --density)" : "d_hex of all points");
+               !own.functions.empty() ? "local d_hex of all points (of the --class-density sum)"
+               : o.density            ? "local d_hex of all points (of --density)"
+                                      : "d_hex of all points");
+  std::fputs(analysis::format_class_shares(report).c_str(), text);
   for (std::uint8_t k : report.too_small)
     std::fprintf(text, "\nclass %u alone: fewer than 2 points in every set, not analysed\n", unsigned(k));
   for (std::size_t c = 0; c < report.classes.size(); ++c) {
-    std::fprintf(text, "\nclass %u alone:\n", unsigned(report.classes[c]));
+    const unsigned k = report.classes[c];
+    if (own.functions.empty())
+      std::fprintf(text, "\nclass %u alone:\n", k);
+    else
+      std::fprintf(text, "\nclass %u alone, against --class-density %s:\n", k,
+                   args.class_densities[k].c_str());
     std::fputs(analysis::format_summary(report.reports[c]).c_str(), text);
   }
   return analysis::classes_json(report, args.files);
@@ -134,16 +154,50 @@ void run_analyze(const AnalyzeArgs& args) {
   try {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
     gen::Density target = gen::Density::constant();
-    if (args.density.empty()) check_image_options({}, args.gamma, args.invert);  // refused as sample does
+    std::vector<tools::DensitySpec> specs;  // --density's, then each --class-density's
+    if (!args.density.empty()) specs.push_back(parse_density(args.density, args.gamma, args.invert));
+    for (std::size_t k = 0; k < args.class_densities.size(); ++k) try {
+        specs.push_back(parse_density(args.class_densities[k], args.gamma, args.invert));
+      } catch (const CommandError& e) {
+        throw CommandError("--class-density for class " + std::to_string(k) + ": " + e.what());
+      }
+    std::vector<const tools::DensitySpec*> given;
+    for (const tools::DensitySpec& s : specs) given.push_back(&s);
+    check_image_options(given, args.gamma, args.invert);  // refused as sample does
     if (!args.density.empty()) {
-      const tools::DensitySpec spec = parse_density(args.density, args.gamma, args.invert);
-      check_image_options({&spec}, args.gamma, args.invert);
-      target = cli::to_generator_density(spec);
+      target = cli::to_generator_density(specs.front());
       o.density = tools::analysis_density(target);
     }
+    ClassTargets own;
+    const std::size_t first_class = args.density.empty() ? 0 : 1;
+    bool any = false;
+    for (std::size_t k = first_class; k < specs.size(); ++k) {
+      own.densities.push_back(cli::to_class_density(specs[k]));  // its scale sets the class's share
+      own.functions.push_back(tools::analysis_density(own.densities.back()));
+      any = any || specs[k].max_value() > 0;
+    }
+    if (!own.densities.empty() && !any) throw CommandError("every --class-density is zero everywhere");
     std::vector<std::string> warnings;
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files, &warnings);
     for (const std::string& w : warnings) std::fprintf(stderr, "kdm: warning: %s\n", w.c_str());
+    if (!own.densities.empty()) {
+      if (sets.front().classes.empty())
+        throw CommandError(
+            "--class-density needs labelled points (a class column, with the header line "
+            "x,y,class), and the points have no classes");
+      std::size_t labels = 0;  // largest label + 1
+      for (const tools::PointSet& set : sets)
+        for (std::uint8_t k : set.classes) labels = std::max(labels, std::size_t(k) + 1);
+      if (labels != own.densities.size())
+        throw CommandError(std::to_string(own.densities.size()) +
+                           " --class-density given, but the points' classes run 0 to " +
+                           std::to_string(labels - 1) + " (" + std::to_string(labels) +
+                           " classes): give one per class, class 0 first");
+      if (args.density.empty()) {  // the whole set against the classes' summed density
+        target = gen::sum_of_densities(own.densities);
+        o.density = tools::analysis_density(target);
+      }
+    }
     for (const std::string& file : args.files)
       if (const double aspect = sampled_aspect(file); aspect != 1)
         std::fprintf(stderr,
@@ -166,9 +220,12 @@ void run_analyze(const AnalyzeArgs& args) {
     if (args.files.size() > 1)  // not one report a file: the measures pool the sets of them all
       std::fprintf(text, "%zu files pooled into one report (analyse them one at a time for one each)\n",
                    args.files.size());
+    if (!own.densities.empty())
+      std::fprintf(text, "all classes together, against %s\n",
+                   args.density.empty() ? "the sum of the --class-density densities" : "--density");
     std::fputs(analysis::format_summary(report).c_str(), text);
     const std::string classes =
-        sets.front().classes.empty() ? "" : analyze_classes(sets, o, target, args, text);
+        sets.front().classes.empty() ? "" : analyze_classes(sets, o, target, own, args, text);
     if (args.output.empty()) return;  // the summary alone
     if (to_stdout) {
       const std::string metrics = analysis::metrics_json(report, args.files);
@@ -222,7 +279,17 @@ void add_analyze_command(CLI::App& app) {
       "--density", args->density,
       "Target density for the accuracy test and the per-band bias table: const:V, an image "
       "(dark = dense) or ramp:R / radial:R, as given to kdm sample (default: none, no density test; "
-      "const:1 tests against a uniform density)");
+      "const:1 tests against a uniform density). With --class-density it judges the whole set only "
+      "(default there: the sum of the class densities); each class keeps its own");
+  cmd->add_option(
+      "--class-density", args->class_densities,
+      "Labelled points: repeat it, one target density per class, class 0 first, as many as the classes "
+      "run (any form --density takes; the --class list given to kdm sample --class). Each class alone "
+      "is judged against its own (density test, bands, holes in its local spacings), the whole set "
+      "against their sum, and the closest pair of different classes in local spacings of the sum. Only "
+      "each density's shape matters to its class's test; their integrals together predict each class's "
+      "share of the points, which the summary and classes.json (\"shares\") compare with its count "
+      "(z against a binomial sd)");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
