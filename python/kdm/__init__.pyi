@@ -156,6 +156,7 @@ def analyze(
     *,
     box: bool = ...,
     density: Union[_Density, _Function] = ...,
+    class_densities: Optional[Sequence[Union[_Density, _Function]]] = ...,
     tile_size: Optional[float] = ...,
     fmax: float = ...,
     threads: int = ...,

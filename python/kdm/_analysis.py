@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import json
 import warnings
-from typing import Any, Dict, Optional
+import numbers
+import os
+from typing import Any, Dict, List, Optional
 
 import numpy as np
 
@@ -31,12 +33,39 @@ def _infinite_lattice(metrics: Dict[str, Any]) -> None:
         tiling["lattice_power_ratio"] = np.inf
 
 
+def _class_densities(class_densities: Any, gamma: Any, invert: Any) -> List[Any]:
+    """class_densities as the C++ side takes them: each a _kdm.DensitySpec or a callable (`gamma` and
+    `invert` reshape image files' tones; the caller checks that some density is one)."""
+    if isinstance(class_densities, np.ndarray) and class_densities.ndim == 1:  # constants, one per class
+        class_densities = [float(v) for v in class_densities]
+    if isinstance(class_densities, (str, bytes, numbers.Real, np.ndarray)) or not isinstance(
+            class_densities, (list, tuple)):
+        raise TypeError("class_densities must be a list of densities, one per class, got "
+                        f"{type(class_densities).__name__}")
+    out: List[Any] = []
+    for k, d in enumerate(class_densities):
+        name = f"class_densities[{k}]"
+        if callable(d) and not isinstance(d, (np.ndarray, str)):
+            out.append(d)
+            continue
+        text = isinstance(d, (str, os.PathLike))
+        spec = _checks.density_spec(d, gamma if text else 1.0, invert if text else False, name,
+                                    one_of_several=True, callable_ok=True)
+        if spec is None:
+            raise TypeError(f"{name} must be a number, a str, a 2-D array or a callable, got None")
+        out.append(spec)
+    if not any(callable(d) and not isinstance(d, _kdm.DensitySpec) or d.max_value > 0 for d in out):
+        raise ValueError("class_densities: every density is zero everywhere")
+    return out
+
+
 def analyze(
     points: Any,
     classes: Any = None,
     *,
     box: bool = False,
     density: Any = None,
+    class_densities: Any = None,
     tile_size: Optional[float] = None,
     fmax: float = 2.5,
     threads: int = 0,
@@ -73,7 +102,18 @@ def analyze(
         The target density, as kdm.sample takes it (default: uniform): for the density accuracy test,
         and the local spacing empty circles are measured in. A callable ``f(x, y)`` of coordinates in
         [0, 1] is called point by point (its exception, or a value that is not finite and >= 0, is
-        raised).
+        raised). With `class_densities` it judges the whole set only (default there: their sum).
+    class_densities : list, optional
+        With `classes`: one target density per class, class 0 first, as many as the labels run (largest
+        label + 1; the list given to ``kdm.sample(classes=...)``), each anything `density` takes (a
+        number, str, 2-D array or callable), as ``kdm analyze --class-density``. Each class alone is
+        judged against its own (density test, bands, empty circles in its local spacings), the whole set
+        against their sum unless `density` is given, and the closest pair of different classes is in local
+        spacings of the sum. Only each density's shape matters to its class's test; their integrals
+        together predict each class's share of the points: the result's "classes" then holds "shares", per
+        class its "class", predicted "share", observed "count", "expected" count, binomial "sd" and "z"
+        (a sampler that gives a class the wrong count shows a large z). ValueError for a count that does
+        not match the labels, or a class with points whose density is zero everywhere.
     gamma, invert
         How an image file's pixels become density, as kdm.sample takes them.
     tile_size : float or None
@@ -127,7 +167,22 @@ def analyze(
             raise ValueError(f"{name} holds {s.shape[0]} point: every set needs at least 2 points")
     box = _checks.flag("box", box)
     function = None
-    if callable(density) and not isinstance(density, (np.ndarray, str)):
+    if class_densities is not None and classes is None:
+        raise ValueError("class_densities needs classes (each point's class)")
+    own = [] if class_densities is None else _class_densities(class_densities, gamma, invert)
+    if own:  # gamma and invert reshape any image file among the densities (and must find one)
+        text = isinstance(density, (str, os.PathLike))
+        if callable(density) and not isinstance(density, (np.ndarray, str)):
+            function, spec = density, None
+        else:
+            spec = None if density is None else _checks.sampler_density(
+                density, gamma if text else 1.0, invert if text else False)
+        reshaped = _checks.number("gamma", gamma, 0.0, strict=True) != 1.0 or _checks.flag("invert", invert)
+        images = [d for d, given in zip(own + [spec], list(class_densities) + [density])
+                  if isinstance(d, _kdm.DensitySpec) and d.kind == "image" and isinstance(given, (str, os.PathLike))]
+        if reshaped and not images:
+            raise ValueError("gamma and invert apply to image files only, and no density given is one")
+    elif callable(density) and not isinstance(density, (np.ndarray, str)):
         if gamma != 1.0 or invert:
             raise ValueError("gamma and invert apply to image files only, and density is a function")
         function, spec = density, None
@@ -154,8 +209,13 @@ def analyze(
             if a.ndim != 1 or a.dtype.kind not in "iu" or (a.size and (a.min() < 0 or a.max() > 255)):
                 raise ValueError(f"classes[{k}] must be an (n,) array of integer labels 0 to 255")
             labels.append(np.ascontiguousarray(a, dtype=np.uint8))
+    if own:
+        runs = 1 + max(int(a.max()) if a.size else -1 for a in labels)
+        if runs != len(own):
+            raise ValueError(f"class_densities holds {len(own)} densit{'y' if len(own) == 1 else 'ies'}, but the classes run 0 to {runs - 1} "
+                             f"({runs} classes): give one per class, class 0 first")
     text, classes_text = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy, labels,
-                                      min_expected, density_bands, holes_min_density)
+                                      min_expected, density_bands, holes_min_density, own)
     result = _arrays(json.loads(text))
     _infinite_lattice(result)
     density_result = result.get("density")

@@ -10,6 +10,7 @@
 #include "kdm/analysis/classes.h"
 #include "kdm/analysis/json.h"
 #include "kdm/analysis/report.h"
+#include "kdm/generator/multiclass.h"
 #include "python_density.h"
 #include "sampler_density.h"
 
@@ -31,11 +32,14 @@ tools::PointSet to_point_set(const Array& a) {
 using Labels = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
 
 /// metrics.json's text, and with `labels` (one array per set, or none) classes.json's (else None). The
-/// target density is `density`, or `function` of the coordinates (PythonDensity), or uniform.
+/// target density is `density`, or `function` of the coordinates (PythonDensity), or uniform; with
+/// `class_densities` (each a DensitySpec or a function; one per class, or none) each class is judged
+/// against its own, and the whole set against their sum unless a target density is given.
 py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::string>& names, bool box,
                   const tools::DensitySpec* density, const py::object& function, double tile_size,
                   double fmax, int threads, bool energy, const std::vector<Labels>& labels,
-                  double min_expected, int density_bands, double holes_min_density) {
+                  double min_expected, int density_bands, double holes_min_density,
+                  const std::vector<py::object>& class_densities) {
   check_number("fmax", fmax, 0, true);
   check_number("min_expected", min_expected, 0, true);
   if (density_bands < 1 || density_bands > 1000)
@@ -45,6 +49,8 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
                                 std::to_string(holes_min_density));
   if (!labels.empty() && labels.size() != arrays.size())
     throw std::invalid_argument("classes must hold one array of labels per set");
+  if (!class_densities.empty() && labels.empty())
+    throw std::invalid_argument("class_densities needs classes (each point's class)");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   if (!std::isfinite(tile_size)) throw std::invalid_argument("tile_size must be a finite number");
   analysis::AnalysisOptions o;
@@ -77,28 +83,59 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     target = function_density->density();
   }
   if (density || function_density) o.density = tools::analysis_density(target);
+  std::vector<gen::Density> own;  // the classes' densities; constants keep their values (their shares)
+  std::vector<analysis::DensityFunction> own_functions;
+  std::vector<std::unique_ptr<PythonDensity>> class_functions;
+  for (std::size_t k = 0; k < class_densities.size(); ++k) {
+    const py::object& d = class_densities[k];
+    if (py::isinstance<tools::DensitySpec>(d)) {
+      try {
+        own.push_back(tools::to_class_density(d.cast<const tools::DensitySpec&>()));
+      } catch (const std::exception& e) {
+        throw std::invalid_argument("class_densities[" + std::to_string(k) + "]: " + e.what());
+      }
+    } else {
+      class_functions.push_back(std::make_unique<PythonDensity>(d, 2));
+      own.push_back(class_functions.back()->density());
+    }
+    own_functions.push_back(tools::analysis_density(own.back()));
+  }
+  // The whole set against the classes' summed density, unless the caller named its own target.
+  if (!own.empty() && !o.density)
+    target = gen::sum_of_densities(own), o.density = tools::analysis_density(target);
+  const auto failed = [&] {
+    if (function_density && function_density->failed()) return true;
+    for (const auto& f : class_functions)
+      if (f->failed()) return true;
+    return false;
+  };
   std::string metrics, classes;
   try {
     py::gil_scoped_release release;
-    auto energy_of = [&](const std::vector<tools::PointSet>& of) {
+    auto energy_of = [&](const std::vector<tools::PointSet>& of, const gen::Density& under) {
       try {
-        return tools::mean_energy_per_point(of, o.torus, target, threads);
+        return tools::mean_energy_per_point(of, o.torus, under, threads);
       } catch (const gen::InvalidArgument& e) {
         throw std::invalid_argument(std::string("energy: ") + e.what());
       }
     };
     analysis::AnalysisReport report = analysis::analyze(sets, o);
-    if (energy) report.energy_per_point = energy_of(sets), report.has_energy = true;
+    if (energy) report.energy_per_point = energy_of(sets, target), report.has_energy = true;
     metrics = analysis::metrics_json(report, names);
     if (!labels.empty()) {
-      std::function<double(const std::vector<tools::PointSet>&)> class_energy;
-      if (energy) class_energy = energy_of;
-      classes = analysis::classes_json(analysis::analyze_classes(sets, o, class_energy), names);
+      analysis::ClassEnergy class_energy;
+      if (energy)
+        class_energy = [&](std::uint8_t k, const std::vector<tools::PointSet>& of) {
+          return energy_of(of, own.empty() ? target : own[k]);
+        };
+      classes =
+          analysis::classes_json(analysis::analyze_classes(sets, o, class_energy, own_functions), names);
     }
   } catch (...) {
-    if (!function_density || !function_density->failed()) throw;  // else its failure is the cause
+    if (!failed()) throw;  // else a density function's failure is the cause
   }
   if (function_density) function_density->rethrow();
+  for (const auto& f : class_functions) f->rethrow();
   return py::make_tuple(metrics, labels.empty() ? py::object(py::none()) : py::object(py::str(classes)));
 }
 
@@ -108,7 +145,7 @@ void bind_analysis(py::module_& m) {
   m.def("analyze", &analyze, py::arg("sets"), py::arg("names"), py::arg("box"), py::arg("density").none(true),
         py::arg("function").none(true), py::arg("tile_size"), py::arg("fmax"), py::arg("threads"),
         py::arg("energy"), py::arg("labels"), py::arg("min_expected"), py::arg("density_bands"),
-        py::arg("holes_min_density"),
+        py::arg("holes_min_density"), py::arg("class_densities"),
         "kdm analyze's metrics.json (and classes.json) for point sets in memory");
 }
 

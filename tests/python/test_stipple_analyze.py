@@ -221,6 +221,59 @@ def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient
         kdm.analyze(points, density_bands=1001)
 
 
+def test_analyze_class_densities_as_the_command_line(cli, tmp_path):
+    # Each class against its own density, the whole set against their sum, and the counts against the
+    # densities' shares: what kdm analyze --class-density writes to classes.json.
+    points, labels = kdm.sample(2000, seed=3, classes=[1, "ramp:20"], threads=1)
+    path = tmp_path / "c.csv"
+    np.savetxt(path, np.column_stack([points, labels]), fmt=["%.17g", "%.17g", "%d"], delimiter=",",
+               header="x,y,class", comments="")
+    cli("analyze", path, "--no-energy", "--class-density", "const:1", "--class-density", "ramp:20",
+        "-o", tmp_path / "out")
+    expected = json.loads((tmp_path / "out" / "classes.json").read_text())
+    metrics = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    got = kdm.analyze(points, labels, class_densities=[1, "ramp:20"], energy=False)
+    assert json.dumps(_lists(got["density"]), sort_keys=True) == json.dumps(metrics["density"], sort_keys=True)
+    assert got["classes"]["cross_class_closest"] == expected["cross_class_closest"]
+    assert [s["class"] for s in got["classes"]["shares"]] == [0, 1]
+    assert json.dumps(got["classes"]["shares"], sort_keys=True) == json.dumps(expected["shares"], sort_keys=True)
+    for mine, theirs in zip(got["classes"]["classes"], expected["classes"]):
+        for key in ("density", "empty_circles"):
+            assert json.dumps(_lists(mine["metrics"][key]), sort_keys=True) == json.dumps(
+                theirs["metrics"][key], sort_keys=True), key
+    # Seeds 1..6 (the command line's test): class 1's RMS z 0.24-0.42 against its ramp, 4.3-4.4 against
+    # one uniform density for every class; the sampler's counts are its shares to the rounding (|z| < 0.1).
+    ramp_class = got["classes"]["classes"][1]["metrics"]["density"]["rms_z"]
+    uniform = kdm.analyze(points, labels, density=1, energy=False)["classes"]["classes"][1]
+    assert ramp_class < 0.7 < 2.5 < uniform["metrics"]["density"]["rms_z"]
+    assert all(abs(s["z"]) < 0.5 for s in got["classes"]["shares"])
+    assert "shares" not in kdm.analyze(points, labels, energy=False)["classes"]
+
+    # Any form density= takes; callables too. A scale the sampler did not have shows in the shares alone.
+    few, few_labels = kdm.sample(1000, seed=1, classes=[1, 3], threads=1)
+    for densities in ([1, 3], [lambda x, y: 1.0, lambda x, y: 3.0], [np.ones((2, 2)), "const:3"]):
+        shares = kdm.analyze(few, few_labels, class_densities=densities, energy=False)["classes"]["shares"]
+        assert [s["count"] for s in shares] == [250, 750] and all(abs(s["z"]) < 0.5 for s in shares), densities
+    wrong = kdm.analyze(few, few_labels, class_densities=[1, 1], energy=False)["classes"]
+    assert wrong["shares"][0]["z"] < -10  # 250 points where 500 are expected, sd 15.8
+    assert wrong["classes"][1]["metrics"]["density"]["rms_z"] < 0.7  # the shape is right
+
+    with pytest.raises(ValueError, match=r"holds 1 density, but the classes run 0 to 1 \(2 classes\)"):
+        kdm.analyze(few, few_labels, class_densities=[1])
+    with pytest.raises(ValueError, match=r"holds 3 densities, but the classes run 0 to 1 \(2 classes\)"):
+        kdm.analyze(few, few_labels, class_densities=[1, 2, 3])
+    with pytest.raises(ValueError, match="class_densities needs classes"):
+        kdm.analyze(few, class_densities=[1, 3])
+    with pytest.raises(ValueError, match="class 0's density is zero everywhere, but the class has 250 points"):
+        kdm.analyze(few, few_labels, class_densities=[0, 3])
+    with pytest.raises(TypeError, match="class_densities must be a list"):
+        kdm.analyze(few, few_labels, class_densities="const:1")
+    with pytest.raises(TypeError, match=r"class_densities\[1\] must be"):
+        kdm.analyze(few, few_labels, class_densities=[1, None])
+    with pytest.raises(ValueError, match="values must be finite and >= 0"):
+        kdm.analyze(few, few_labels, class_densities=[1, lambda x, y: -1.0], energy=False)
+
+
 def _lists(value):
     """The dict back with its arrays as lists, NaN as null, as metrics.json holds them."""
     if isinstance(value, dict):
