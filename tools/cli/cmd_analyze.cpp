@@ -283,13 +283,13 @@ void add_analyze_command(CLI::App& app) {
       "(default there: the sum of the class densities); each class keeps its own");
   cmd->add_option(
       "--class-density", args->class_densities,
-      "Labelled points: repeat it, one target density per class, class 0 first, as many as the classes "
-      "run (any form --density takes; the --class list given to kdm sample --class). Each class alone "
+      "Labelled points: repeat it, one target density per class, class 0 first, up to the largest class "
+      "in the file (any form --density takes: the densities given to kdm sample --class). Each class alone "
       "is judged against its own (density test, bands, holes in its local spacings), the whole set "
       "against their sum, and the closest pair of different classes in local spacings of the sum. Only "
       "each density's shape matters to its class's test; their integrals together predict each class's "
       "share of the points, which the summary and classes.json (\"shares\") compare with its count "
-      "(z against a binomial sd)");
+      "(z against a binomial sd); by default none, every class against --density as the whole set");
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness (as in kdm sample)")
       ->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense (as in kdm sample)");
