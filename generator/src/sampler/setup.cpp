@@ -46,6 +46,20 @@ inline double image_value(const DensityImage& image, const PixelLerp& x, const P
          y.t * ((1 - x.t) * at(x.lo, y.hi) + x.t * at(x.hi, y.hi));
 }
 
+/// A volume density between eight voxels: Density::from_volume()'s function, the bilinear image_value()
+/// of the two slices around u_z blended along z.
+inline double volume_value(const DensityVolume& v, const PixelLerp& x, const PixelLerp& y,
+                           const PixelLerp& z) {
+  auto at = [&](int col, int row, int slice) {
+    return double(v.values[(std::size_t(slice) * v.height + row) * v.width + col]);
+  };
+  auto slice = [&](int k) {
+    return (1 - y.t) * ((1 - x.t) * at(x.lo, y.lo, k) + x.t * at(x.hi, y.lo, k)) +
+           y.t * ((1 - x.t) * at(x.lo, y.hi, k) + x.t * at(x.hi, y.hi, k));
+  };
+  return (1 - z.t) * slice(z.lo) + z.t * slice(z.hi);
+}
+
 /// Samples the density at every node of `grid` (averaging supersamples where the source is finer), on up
 /// to `threads` threads when the density may be called concurrently. Throws InvalidArgument naming the
 /// first node (in storage order) where the density is not finite or negative, whatever the thread count.
@@ -284,6 +298,10 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
   validate_options(o);
   if (D == 3 && density.image)  // its values hold no z: 3D wants a function of (x, y, z)
     throw InvalidArgument("an image density (from_values) is 2D: sample it with dim 2, or give a function");
+  if (D == 2 && density.volume)  // a volume's third axis would be read at u_z = 0 only
+    throw InvalidArgument("a volume density (from_volume) is 3D: sample it with dim 3");
+  if (density.volume && !density.function)
+    throw InvalidArgument("a volume density needs its function (from_volume sets it)");
   for (int k = 0; k < 3; ++k)
     if (density.native_resolution[k] < 0)
       throw InvalidArgument("density native_resolution must be >= 0 (0: unknown), got " +
@@ -461,6 +479,45 @@ Density Density::from_values(int width, int height, std::vector<float> values) {
   d.image = image;
   d.function = [image](const double* u) {
     return image_value(*image, PixelLerp(u[0], image->width), PixelLerp(u[1], image->height));
+  };
+  return d;
+}
+
+Density Density::from_volume(int width, int height, int depth, std::vector<float> values) {
+  if (width <= 0 || height <= 0 || depth <= 0)
+    throw InvalidArgument("density volume must be at least 1 x 1 x 1 values, got " + std::to_string(width) +
+                          " x " + std::to_string(height) + " x " + std::to_string(depth));
+  // Three ints multiply past 2^64: no vector holds that many, so such sizes are wrong, not merely large.
+  const std::size_t slice = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (slice > values.max_size() / static_cast<std::size_t>(depth))
+    throw InvalidArgument("density volume of " + std::to_string(width) + " x " + std::to_string(height) +
+                          " x " + std::to_string(depth) + " values is too large to index");
+  if (values.size() != slice * static_cast<std::size_t>(depth))
+    throw InvalidArgument("density volume has the wrong number of values: " + std::to_string(values.size()) +
+                          " for " + std::to_string(width) + " x " + std::to_string(height) + " x " +
+                          std::to_string(depth));
+  bool any = false;
+  for (float v : values) {
+    if (!std::isfinite(v))
+      throw InvalidArgument("density volume holds a value that is not finite or exceeds a float (3.4e38)");
+    if (v < 0) throw InvalidArgument("density volume holds a negative value");
+    any |= v > 0;
+  }
+  if (!any) throw InvalidArgument("density volume is zero everywhere");
+  Density d;
+  d.thread_safe = true;  // the function below only reads its shared, immutable values
+  d.native_resolution[0] = width;
+  d.native_resolution[1] = height;
+  d.native_resolution[2] = depth;
+  auto volume = std::make_shared<DensityVolume>();
+  volume->width = width;
+  volume->height = height;
+  volume->depth = depth;
+  volume->values = std::move(values);
+  d.volume = volume;
+  d.function = [volume](const double* u) {
+    return volume_value(*volume, PixelLerp(u[0], volume->width), PixelLerp(u[1], volume->height),
+                        PixelLerp(u[2], volume->depth));
   };
   return d;
 }

@@ -41,6 +41,14 @@ struct DensityImage {
   std::vector<float> values;  ///< finite and >= 0, row by row
 };
 
+/// A 3D density given as `width`×`height`×`depth` values, in DensityImage's convention along a third axis:
+/// x fastest, then y (row 0 at the bottom, u_y near 0), then z (slice 0 at u_z near 0), so value (x, y, z)
+/// is values[(z · height + y) · width + x], centred at ((x + ½) / width, (y + ½) / height, (z + ½) / depth).
+struct DensityVolume {
+  int width = 0, height = 0, depth = 0;
+  std::vector<float> values;  ///< finite and >= 0, slice by slice, each row by row
+};
+
 /// The range a density function's peak must lie in: the sampler keeps densities as floats. Densities
 /// outside it are refused; only the shape matters, so scale them by a constant.
 inline constexpr double kMinDensityPeak = 1e-30, kMaxDensityValue = 1e30;
@@ -61,6 +69,10 @@ struct Density {
   /// the same result as calling `function` at each node but without a call per node. Leave it empty for a
   /// density of your own; if you change `function`, reset it.
   std::shared_ptr<const DensityImage> image;
+  /// Set by from_volume() to the values `function` interpolates: a 3D density, which sample() refuses with
+  /// dim 2. sample() calls `function` at each node (on several threads, as thread_safe is set): with a
+  /// 64³ volume that is a few per cent of a 3D run (docs/design.md §2.1). If you change `function`, reset it.
+  std::shared_ptr<const DensityVolume> volume;
 
   /// The uniform density (no function): 1 everywhere.
   static Density constant() { return {}; }
@@ -71,6 +83,13 @@ struct Density {
   /// interpolated. Values must be finite and >= 0, and not all zero. Throws InvalidArgument otherwise.
   /// 2D only: sample() refuses it with dim 3.
   static Density from_values(int width, int height, std::vector<float> values);
+  /// A 3D density from `width`×`height`×`depth` values laid out as DensityVolume says (x fastest, row 0 at
+  /// the bottom, slice 0 at u_z near 0), trilinearly interpolated between voxel centres and clamped at the
+  /// faces. Sets native_resolution to the three sizes, so a grid coarser than the volume averages several
+  /// samples per node. Sizes must be > 0 with a product that fits in memory's index range, and values
+  /// finite, >= 0 and not all zero; throws InvalidArgument otherwise. 3D only: sample() refuses it with
+  /// dim 2. The sides of the domain are SamplerOptions::extent's, whatever the volume's shape.
+  static Density from_volume(int width, int height, int depth, std::vector<float> values);
 };
 
 /// The sampler's arithmetic (see SamplerOptions::numerics). Each gives the same bits on every machine and
