@@ -340,6 +340,139 @@ TEST_F(CliTest, SampleWritesNumPyArrays) {
   EXPECT_FALSE(fs::exists(path("c.npy")));
 }
 
+/// `values` (depth × height × width, in numpy's C order) as np.save writes a 3-D array of `descr` ('<f8',
+/// '<f4' or '|u1'); `shape` overrides the header's shape.
+std::string npy_volume(const std::vector<double>& values, int depth, int height, int width,
+                       const std::string& descr = "<f4", const std::string& shape = "") {
+  const std::string dims =
+      shape.empty() ? std::to_string(depth) + ", " + std::to_string(height) + ", " + std::to_string(width)
+                    : shape;
+  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': (" + dims + "), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  for (double v : values) {
+    if (descr == "<f8") {
+      bytes.append(reinterpret_cast<const char*>(&v), 8);  // x86-64: little-endian already
+    } else if (descr == "<f4") {
+      const float f = static_cast<float>(v);
+      bytes.append(reinterpret_cast<const char*>(&f), 4);
+    } else {
+      bytes += static_cast<char>(static_cast<unsigned char>(v));
+    }
+  }
+  return bytes;
+}
+
+/// The fraction of a 3D point file's points with coordinate `axis` below 1/2.
+double fraction_below_half(const std::string& file, int axis) {
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  EXPECT_TRUE(kdm::tools::read_point_sets(file, sets, error)) << error;
+  if (sets.empty() || sets[0].dim != 3) return -1;
+  std::size_t below = 0;
+  for (std::size_t i = 0; i < sets[0].size(); ++i) below += sets[0].coords[3 * i + axis] < 0.5;
+  return double(below) / double(sets[0].size());
+}
+
+// kdm sample --dim 3 --density vol.npy: a (depth, height, width) array, slice 0 at z near 0 and each
+// slice's row 0 at the top (y near 1). An 8³ volume 4× denser in its first 4 slices puts 0.78125 of the
+// points below z = 1/2 (the linear fall from 4 to 1 between the two middle voxel centres; measured
+// 0.7768-0.7800 at 4,000 points in a cube over seeds 1-8, sd 0.0009: tests/generator/sampler_test.cpp;
+// bound ±0.008),
+// one 4× denser in its first 4 rows as many above y = 1/2. float64, float32 and uint8 give the same bits.
+TEST_F(CliTest, SampleReadsNumPyVolumes) {
+  const int s = 8;
+  std::vector<double> by_slice(s * s * s, 1.0), by_row(s * s * s, 1.0);
+  for (int z = 0; z < s; ++z)
+    for (int row = 0; row < s; ++row)
+      for (int x = 0; x < s; ++x) {
+        if (z < s / 2) by_slice[(z * s + row) * s + x] = 4;
+        if (row < s / 2) by_row[(z * s + row) * s + x] = 4;
+      }
+  std::ofstream(path("z.npy"), std::ios::binary) << npy_volume(by_slice, s, s, s);
+  std::ofstream(path("y.npy"), std::ios::binary) << npy_volume(by_row, s, s, s, "<f8");
+  std::ofstream(path("y8.npy"), std::ios::binary) << npy_volume(by_row, s, s, s, "|u1");
+  const std::string run = "sample --dim 3 --n 4000 --threads 2 --density '";
+  ASSERT_EQ(kdm(run + path("z.npy") + "' -o '" + path("z.txt") + "'").status, 0);
+  ASSERT_EQ(kdm(run + path("y.npy") + "' -o '" + path("y.txt") + "'").status, 0);
+  const Outcome bytes = kdm(run + path("y8.npy") + "' -o '" + path("y8.txt") + "'");
+  ASSERT_EQ(bytes.status, 0) << bytes.err;
+  const double expected = (4 * 7.0 / 16 + 3.25 / 16) / 2.5;
+  EXPECT_NEAR(fraction_below_half(path("z.txt"), 2), expected, 0.008);
+  EXPECT_NEAR(1 - fraction_below_half(path("y.txt"), 1), expected, 0.008);
+  auto points = [](const std::string& text) { return text.substr(text.find("\n0")); };  // past the header
+  EXPECT_EQ(points(slurp(path("y.txt"))), points(slurp(path("y8.txt"))));
+  // The domain is a box with the volume's voxel counts as sides, as --aspect W:H:D gives it.
+  std::ofstream(path("flat.npy"), std::ios::binary)
+      << npy_volume(std::vector<double>(2 * 4 * 8, 1.0), 2, 4, 8);
+  ASSERT_EQ(
+      kdm("sample --dim 3 --n 500 --density '" + path("flat.npy") + "' -o '" + path("f.txt") + "'").status,
+      0);
+  ASSERT_EQ(kdm("sample --dim 3 --n 500 --domain box --aspect 8:4:2 -o '" + path("a.txt") + "'").status, 0);
+  EXPECT_EQ(points(slurp(path("f.txt"))), points(slurp(path("a.txt"))));
+  EXPECT_NE(slurp(path("f.txt")).find("domain box, sides 8:4:2"), std::string::npos) << slurp(path("f.txt"));
+}
+
+// --aspect X:Y:Z sets a 3D domain's three sides; one number keeps its meaning (x over y and z).
+TEST_F(CliTest, SampleTakesThreeSides) {
+  const std::string run = "sample --dim 3 --n 600 -o '";
+  ASSERT_EQ(kdm(run + path("one.txt") + "' --aspect 2").status, 0);
+  ASSERT_EQ(kdm(run + path("three.txt") + "' --aspect 2:1:1").status, 0);
+  ASSERT_EQ(kdm(run + path("scaled.txt") + "' --aspect 4:2:2").status, 0);
+  ASSERT_EQ(kdm(run + path("other.txt") + "' --aspect 1:2:4").status, 0);
+  auto points = [&](const std::string& name) {
+    const std::string text = slurp(path(name));
+    return text.substr(text.find("\n0"));
+  };
+  EXPECT_EQ(points("one.txt"), points("three.txt"));
+  EXPECT_EQ(points("one.txt"), points("scaled.txt"));  // only the ratios count
+  EXPECT_NE(points("one.txt"), points("other.txt"));
+  EXPECT_NE(slurp(path("other.txt")).find(", sides 1:2:4"), std::string::npos);
+  EXPECT_NE(slurp(path("one.txt")).find(", aspect 2\n"), std::string::npos);
+}
+
+TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
+  const std::string out = " -o '" + path("x.txt") + "'";
+  std::ofstream(path("v.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 1.0), 2, 2, 2);
+  std::ofstream(path("flat.npy"), std::ios::binary)
+      << npy_volume(std::vector<double>(4, 1.0), 0, 0, 0, "<f4", "2, 2");
+  std::vector<double> bad(8, 1.0);
+  bad[5] = -2;  // [1, 0, 1]
+  std::ofstream(path("neg.npy"), std::ios::binary) << npy_volume(bad, 2, 2, 2, "<f8");
+  bad[5] = std::nan("");
+  std::ofstream(path("nan.npy"), std::ios::binary) << npy_volume(bad, 2, 2, 2, "<f8");
+  std::ofstream(path("zero.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 0.0), 2, 2, 2);
+  std::ofstream(path("i2.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, "<i2");
+  std::ofstream(path("short.npy"), std::ios::binary) << npy_volume(std::vector<double>(7, 1.0), 2, 2, 2);
+  const std::string v = " --density '" + path("v.npy") + "'";
+  expect_error("sample --n 100 --dim 3 --density '" + path("flat.npy") + "'" + out,
+               "a 2-D array of shape (2, 2)");
+  expect_error("sample --n 100" + v + out, "is a 3-D array (2, 2, 2): sample it with --dim 3");
+  expect_error("sample --n 100 --dim 3 --density '" + path("neg.npy") + "'" + out,
+               "a value of -2.000000 at [1, 0, 1]");
+  expect_error("sample --n 100 --dim 3 --density '" + path("nan.npy") + "'" + out,
+               "at [1, 0, 1]: densities must be finite");
+  expect_error("sample --n 100 --dim 3 --density '" + path("zero.npy") + "'" + out, "zero everywhere");
+  expect_error("sample --n 100 --dim 3 --density '" + path("i2.npy") + "'" + out,
+               "expected float64, float32 or uint8");
+  expect_error("sample --n 100 --dim 3 --density '" + path("short.npy") + "'" + out, "cut short");
+  expect_error("sample --n 100 --dim 3 --gamma 2" + v + out, "--gamma and --invert apply to images only");
+  expect_error("sample --n 100 --class '" + path("v.npy") + "'" + out, "3-D volume");
+  expect_error("query --rect 0,0,1,1" + v + " -o '" + path("x.csv") + "'", "only the full sampler takes it");
+  ASSERT_EQ(kdm("sample --n 100" + out).status, 0);
+  expect_error("analyze '" + path("x.txt") + "'" + v, "is a 3-D volume, and the points are 2D");
+  expect_error("sample --n 100 --dim 3 --aspect 1:2" + out, "one number or three sides X:Y:Z, got 2");
+  expect_error("sample --n 100 --dim 3 --aspect 1:0:2" + out, "three sides X:Y:Z each > 0; got '1:0:2'");
+  expect_error("sample --n 100 --dim 3 --aspect 1:x:2" + out, "got '1:x:2'");
+  expect_error("sample --n 100 --dim 3 --aspect 1::2" + out, "got '1::2'");
+  expect_error("sample --n 100 --aspect 1:2:3" + out, "add --dim 3");
+  expect_error("sample --n 100 --aspect nan" + out, "--aspect must be a number > 0");
+}
+
 TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"

@@ -164,6 +164,7 @@ void run_analyze(const AnalyzeArgs& args) {
     std::vector<const tools::DensitySpec*> given;
     for (const tools::DensitySpec& s : specs) given.push_back(&s);
     check_image_options(given, args.gamma, args.invert);  // refused as sample does
+    const bool volume = !args.density.empty() && specs.front().kind == tools::DensitySpec::Kind::kVolume;
     if (!args.density.empty()) {
       target = cli::to_generator_density(specs.front());
       o.density = tools::analysis_density(target);
@@ -180,6 +181,8 @@ void run_analyze(const AnalyzeArgs& args) {
     std::vector<std::string> warnings;
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files, &warnings);
     for (const std::string& w : warnings) std::fprintf(stderr, "kdm: warning: %s\n", w.c_str());
+    if (volume && sets.front().dim != 3)
+      throw CommandError("--density '" + args.density + "' is a 3-D volume, and the points are 2D");
     if (!own.densities.empty()) {
       if (sets.front().classes.empty())
         throw CommandError(

@@ -1,8 +1,10 @@
 // `kdm sample`: the full KDM sampler from the command line.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,7 +29,7 @@ struct SampleArgs {
   std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
   std::string domain;                // empty: box for images and ramps, torus otherwise
   std::string output, format;
-  double aspect = 0;  // 0: from the image, or 1
+  std::string aspect;  // empty: from the image or volume, or 1
   double gamma = 1;
   bool invert = false;
   bool unadjusted = false;
@@ -35,6 +37,34 @@ struct SampleArgs {
   int width_px = 1024;
   double dot_radius = 0;
 };
+
+/// --aspect: one number, the x side over the others, or in 3D three sides X:Y:Z (their ratios count).
+/// Returns the sides (one for a single number); throws CommandError for anything else.
+std::vector<double> parse_aspect(const std::string& text, int dim) {
+  std::vector<double> sides;
+  std::size_t from = 0;
+  for (;;) {
+    const std::size_t colon = text.find(':', from);
+    const std::string part = text.substr(from, colon == std::string::npos ? std::string::npos : colon - from);
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
+      throw CommandError(
+          "--aspect must be a number > 0 (the x side over the others) or, with --dim 3, three "
+          "sides X:Y:Z each > 0; got '" +
+          text + "'");
+    sides.push_back(v);
+    if (colon == std::string::npos) break;
+    from = colon + 1;
+  }
+  if (sides.size() == 3 && dim != 3)
+    throw CommandError(
+        "--aspect X:Y:Z sets a 3D domain's sides: add --dim 3, or give one number (width/height)");
+  if (sides.size() != 1 && sides.size() != 3)
+    throw CommandError("--aspect takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
+                       " in '" + text + "'");
+  return sides;
+}
 
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   const std::string format =
@@ -44,8 +74,8 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
   if (args.options.n < 0) throw CommandError("--n must be >= 0 (0: use --resolution)");
   if (args.options.resolution < 0) throw CommandError("--resolution must be >= 0");
-  if (aspect_given && !(args.aspect > 0 && std::isfinite(args.aspect)))
-    throw CommandError("--aspect must be a number > 0");
+  const std::vector<double> sides =
+      aspect_given ? parse_aspect(args.aspect, args.options.dim) : std::vector<double>{};
   if (!(args.width_px >= 1 && args.width_px <= 65536))
     throw CommandError("--width must be 1 to 65536 pixels");
   if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
@@ -69,29 +99,40 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   check_class_images(class_specs);
   check_image_options(class_specs, args.gamma, args.invert);
   bool image = false, edged = false;
+  const tools::DensitySpec* volume = nullptr;
   for (const tools::DensitySpec& s : specs) {
     image = image || s.kind == tools::DensitySpec::Kind::kImage;
-    // A ramp or a picture has edges that do not meet: a box, unless asked otherwise.
-    edged = edged || s.kind == tools::DensitySpec::Kind::kImage || s.kind == tools::DensitySpec::Kind::kRamp;
+    if (s.kind == tools::DensitySpec::Kind::kVolume) volume = &s;
+    // A ramp, a picture or a volume has edges that do not meet: a box, unless asked otherwise.
+    edged = edged || s.kind == tools::DensitySpec::Kind::kImage ||
+            s.kind == tools::DensitySpec::Kind::kRamp || s.kind == tools::DensitySpec::Kind::kVolume;
   }
+  if (volume && classed)
+    throw CommandError("--class samples 2D points, and '" + volume->text + "' is a 3-D volume");
+  if (volume && args.options.dim == 2)
+    throw CommandError("density '" + volume->text + "' is a 3-D array (" + std::to_string(volume->depth) +
+                       ", " + std::to_string(volume->height) + ", " + std::to_string(volume->width) +
+                       "): sample it with --dim 3");
   gen::SamplerOptions o = args.options;
   const std::string domain = args.domain.empty() ? (edged ? "box" : "torus") : args.domain;
   o.domain = domain == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
-  double aspect = args.aspect;
+  // The domain's sides: --aspect's, else an image's width / height, a volume's voxel counts, or a cube.
+  double aspect = sides.empty() ? 1 : sides[0];
+  double extent[3] = {aspect, 1, 1};
+  if (sides.size() == 3) std::copy(sides.begin(), sides.end(), extent);
   if (!aspect_given) {
-    aspect = 1;
     for (const tools::DensitySpec& s : specs)
       if (s.kind == tools::DensitySpec::Kind::kImage) {
-        aspect = double(s.width) / s.height;
+        aspect = extent[0] = double(s.width) / s.height;
         break;
       }
+    if (volume) extent[0] = volume->width, extent[1] = volume->height, extent[2] = volume->depth;
   }
   if (image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
   std::vector<gen::Density> densities;
   for (const tools::DensitySpec& s : specs)
     densities.push_back(classed ? to_class_density(s) : to_generator_density(s));
-  o.extent[0] = aspect;
-  o.extent[1] = 1;
+  std::copy(extent, extent + 3, o.extent);
   o.metropolis = !args.unadjusted;
   if (args.unadjusted)
     std::fprintf(stderr, "kdm: warning: --unadjusted skips the Metropolis-Hastings test; output is biased\n");
@@ -136,7 +177,11 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     for (const std::string& c : args.classes) what += " " + c;
   }
   std::string shape;  // kdm analyze warns of it: it measures in the unit square
-  if (aspect != 1) {
+  if (o.dim == 3 && (extent[1] != 1 || extent[2] != 1)) {
+    char text[96];  // three sides of their own (not the x side over the other two, which aspect says)
+    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
+    shape = text;
+  } else if (aspect != 1) {
     char text[40];
     std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
     shape = text;
@@ -145,7 +190,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   tools::DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;
-  style.aspect = aspect;
+  style.aspect = extent[0] / extent[1];  // pictures show x and y
   if (classed) style.classes = &set.classes, style.inks = tools::class_inks(specs.size());
   tools::write_points(args.output, set, header, style, format);
   std::fprintf(stderr, "%s, %.3f s -> %s\n", line, r.seconds,
@@ -190,7 +235,9 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option(
       "--aspect", args->aspect,
-      "Width/height of the domain (in 3D its x side over its y and z sides; default: the image's, or 1)");
+      "Width/height of the domain (in 3D its x side over its y and z sides), or in 3D its three "
+      "sides X:Y:Z (relative lengths, e.g. 2:1:0.5); default: the image's, a volume's voxel counts "
+      "W:H:D, or 1");
   cmd->add_option(
          "--temperature,-T", o.temperature,
          "Temperature in the reference implementation's units, 0 to 1000 (0.5 = the paper's look with "
@@ -203,7 +250,10 @@ void add_sample_command(CLI::App& app) {
          "const:V, an image whose darkness is the density (a Radiance .hdr keeps its range, scaled by "
          "its brightest pixel: with --invert, bright is dense), or a test map: ramp:R (R^-x, dynamic "
          "range R) or radial:R (R^-(2r) around the centre, 1/R past r = 0.5; both by x and y alone, so in 3D "
-         "a ramp along x and a cylinder along z)")
+         "a ramp along x and a cylinder along z); with --dim 3 also a NumPy .npy volume: a 3-D array "
+         "(depth, height, width) of float64, float32 or uint8 densities, trilinear between voxels, "
+         "stretched over the domain: [k] is the slice at z = (k + 0.5) / depth, each slice as a picture, "
+         "row 0 at the top (y near 1), the last axis x")
       ->capture_default_str();
   cmd->add_option("--class", args->classes,
                   "Several classes (instead of --density): repeat it, one density each, highest priority "

@@ -114,6 +114,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     inks.channels.push_back(parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept));
     inks.inks = tools::class_inks(1);
     const tools::DensitySpec& spec = inks.channels.front();
+    if (spec.kind == tools::DensitySpec::Kind::kVolume)
+      throw CommandError("kdm stipple needs an image, and '" + a.image +
+                         "' is a 3-D volume (kdm sample --dim 3)");
     if (spec.kind != tools::DensitySpec::Kind::kImage)
       throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
     aspect = double(spec.width) / spec.height;

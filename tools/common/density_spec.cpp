@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include "image_io.h"
+#include "point_io.h"
 
 namespace kdm::tools {
 
@@ -22,7 +25,7 @@ double DensitySpec::map_at(double u, double v) const {
 
 double DensitySpec::max_value() const {
   if (kind == Kind::kConstant) return constant;
-  if (kind == Kind::kImage)
+  if (kind == Kind::kImage || kind == Kind::kVolume)
     return values.empty() ? 0.0 : double(*std::max_element(values.begin(), values.end()));
   return 1;
 }
@@ -31,7 +34,8 @@ double DensitySpec::mean_value() const {
   switch (kind) {
     case Kind::kConstant:
       return constant;
-    case Kind::kImage: {
+    case Kind::kImage:
+    case Kind::kVolume: {
       double sum = 0;
       for (float v : values) sum += v;
       return values.empty() ? 0.0 : sum / double(values.size());
@@ -56,6 +60,86 @@ double parse_number(const std::string& text) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   return !text.empty() && *end == '\0' && std::isfinite(v) ? v : std::nan("");
+}
+
+/// A 3-D NumPy array of densities as a kVolume spec (parse_density_spec says which); throws
+/// std::runtime_error naming the file and the problem.
+DensitySpec read_volume(const std::string& path, std::istream& in) {
+  auto fail = [&](const std::string& what) {
+    return std::runtime_error("density '" + path + "': NumPy .npy file: " + what);
+  };
+  std::streambuf& buffer = *in.rdbuf();
+  char magic[6];
+  buffer.sgetn(magic, 6);
+  NpyHeader h;
+  std::string what;
+  if (!read_npy_header(buffer, h, what)) throw fail(what);
+  std::size_t bytes = 0;
+  if (h.descr == "<f8")
+    bytes = 8;
+  else if (h.descr == "<f4")
+    bytes = 4;
+  else if (h.descr == "|u1")
+    bytes = 1;
+  else
+    throw fail("data of type '" + h.descr + "': expected float64, float32 or uint8 ('<f8', '<f4' or '|u1')");
+  std::string dims;
+  for (std::size_t i = 0; i < h.shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(h.shape[i]);
+  if (h.shape.size() == 2)
+    throw fail("a 2-D array of shape (" + dims +
+               "): a .npy density is a volume for --dim 3, of shape (depth, height, width); a 2-D density is "
+               "a picture");
+  if (h.shape.size() != 3)
+    throw fail("an array of shape (" + dims + "): expected a 3-D array (depth, height, width)");
+  const std::uint64_t d = h.shape[0], rows = h.shape[1], cols = h.shape[2];
+  if (d == 0 || rows == 0 || cols == 0) throw fail("an empty array of shape (" + dims + ")");
+  if (d > kMaxImagePixels || rows > kMaxImagePixels || cols > kMaxImagePixels ||
+      d * rows * cols > kMaxImagePixels)
+    throw fail("an array of shape (" + dims + "): more than 2^26 values (the image size limit)");
+  DensitySpec spec;
+  spec.kind = DensitySpec::Kind::kVolume;
+  spec.text = path;
+  spec.width = static_cast<int>(cols), spec.height = static_cast<int>(rows), spec.depth = static_cast<int>(d);
+  const std::uint64_t count = d * rows * cols;
+  spec.values.resize(static_cast<std::size_t>(count));
+  unsigned char chunk[1 << 14];
+  for (std::uint64_t done = 0; done < count;) {
+    const std::uint64_t n = std::min<std::uint64_t>(count - done, sizeof chunk / bytes);
+    if (static_cast<std::uint64_t>(buffer.sgetn(reinterpret_cast<char*>(chunk),
+                                                static_cast<std::streamsize>(n * bytes))) != n * bytes)
+      throw fail("cut short: its header promises " + std::to_string(count) + " values");
+    for (std::uint64_t k = 0; k < n; ++k) {
+      std::uint64_t bits = 0;  // little-endian, whatever this machine's order
+      for (std::size_t b = bytes; b-- > 0;) bits = bits << 8 | chunk[k * bytes + b];
+      double v;
+      if (bytes == 8) {
+        std::memcpy(&v, &bits, 8);
+      } else if (bytes == 4) {
+        const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
+        float f;
+        std::memcpy(&f, &b32, 4);
+        v = f;
+      } else {
+        v = double(bits);
+      }
+      // The element's numpy index [slice, row, column], in either order.
+      const std::uint64_t at = done + k;
+      std::uint64_t z, row, col;
+      if (h.fortran)
+        z = at % d, row = at / d % rows, col = at / (d * rows);
+      else
+        col = at % cols, row = at / cols % rows, z = at / (cols * rows);
+      if (!(std::isfinite(v) && v >= 0 && v <= 3.4028234663852886e38))
+        throw fail("a value of " + std::to_string(v) + " at [" + std::to_string(z) + ", " +
+                   std::to_string(row) + ", " + std::to_string(col) +
+                   "]: densities must be finite and >= 0, at most 3.4e38");
+      // Rows are stored top first, as in a picture; kdm keeps row 0 at the bottom.
+      spec.values[static_cast<std::size_t>((z * rows + (rows - 1 - row)) * cols + col)] =
+          static_cast<float>(v);
+    }
+    done += n;
+  }
+  return spec;
 }
 
 }  // namespace
@@ -85,8 +169,21 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   }
   std::error_code missing;
   if (!std::filesystem::exists(text, missing))  // a misspelt map more often than a missing picture
-    throw std::runtime_error("density '" + text +
-                             "': no such file (a density is a picture, const:V, ramp:R or radial:R)");
+    throw std::runtime_error(
+        "density '" + text +
+        "': no such file (a density is a picture, const:V, ramp:R, radial:R or a .npy volume)");
+  if (std::filesystem::is_regular_file(text, missing)) {  // a directory is refused by the image loader
+    std::ifstream file(text, std::ios::binary);
+    char magic[6] = {};
+    if (file && file.rdbuf()->sgetn(magic, 6) == 6 && std::memcmp(magic, "\x93NUMPY", 6) == 0) {
+      if (gamma != 1 || invert)  // they reshape a picture's tones; a volume holds densities
+        throw std::invalid_argument(
+            "density '" + text +
+            "' is a NumPy volume of densities: --gamma and --invert apply to images only");
+      file.seekg(0);
+      return read_volume(text, file);
+    }
+  }
   GreyImage image;
   std::string error;
   if (!load_grey_image(text, image, error, max_pixels, kept)) throw std::runtime_error(error);

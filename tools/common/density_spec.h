@@ -1,6 +1,7 @@
-// A density as a user names it ("const:V", the test maps "ramp:R" and "radial:R", or an image whose
-// darkness is the density), parsed once into a neutral description: the full sampler's commands convert it
-// for the generator, the runtime's commands for a query, and neither needs the other's headers.
+// A density as a user names it ("const:V", the test maps "ramp:R" and "radial:R", an image whose
+// darkness is the density, or a 3-D NumPy array of densities for 3D samples), parsed once into a neutral
+// description: the full sampler's commands convert it for the generator, the runtime's commands for a query,
+// and neither needs the other's headers.
 #pragma once
 
 #include <cstddef>
@@ -15,16 +16,19 @@
 namespace kdm::tools {
 
 struct DensitySpec {
-  enum class Kind { kConstant, kRamp, kRadial, kImage };
+  enum class Kind { kConstant, kRamp, kRadial, kImage, kVolume };
   Kind kind = Kind::kConstant;
   double constant = 1;        ///< kConstant: the value (>= 0)
   double range = 1;           ///< kRamp, kRadial: the dynamic range R (in [1, 1e9])
-  int width = 0, height = 0;  ///< kImage: its size in pixels
-  std::vector<float> values;  ///< kImage: density per pixel (finite, >= 0), row 0 at the bottom
-  bool inverted = false;      ///< kImage: luminance is the density (else darkness)
-  std::string text;           ///< what it was parsed from (for messages)
+  int width = 0, height = 0;  ///< kImage, kVolume: its size in pixels (voxels)
+  int depth = 0;              ///< kVolume: its slices along z
+  /// kImage: density per pixel (finite, >= 0), row 0 at the bottom. kVolume: per voxel, as
+  /// gen::DensityVolume lays them out (x fastest, row 0 at the bottom, slice 0 at z near 0).
+  std::vector<float> values;
+  bool inverted = false;  ///< kImage: luminance is the density (else darkness)
+  std::string text;       ///< what it was parsed from (for messages)
 
-  /// Whether the density is a function of position (the test maps), not a constant or an image.
+  /// Whether the density is a function of position (the test maps), not a constant, image or volume.
   bool analytic() const { return kind == Kind::kRamp || kind == Kind::kRadial; }
   /// The test maps at unit position (u, v) in [0, 1]²: ramp R^-u (1 at the left edge, 1/R at the right),
   /// radial R^-(r/0.5) with r the distance from the centre, 1/R beyond r = 0.5 (continuous across a
@@ -38,7 +42,12 @@ struct DensitySpec {
 /// A density that does not parse: a malformed or out-of-range value (std::invalid_argument), or an image
 /// that cannot be read (std::runtime_error, naming the file). Messages are one line.
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
-/// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance.
+/// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance. A
+/// NumPy .npy file (known by its first bytes) is a kVolume: a 3-D array of shape (depth, height, width) of
+/// little-endian float64, float32 or uint8 densities (finite, >= 0; uint8 as its values 0 ... 255), in C or
+/// Fortran order, at most kMaxImagePixels values: array[k] is slice k along z (k = 0 at z near 0), each
+/// slice a picture's rows, row 0 at the top (y near 1), as 2-D density arrays in Python. Other shapes and
+/// types are refused, naming the file.
 /// An image of more than `max_pixels` pixels is refused; `kept`, if given, averages a larger picture
 /// down as it is read (KeptPixels; the average is of luminance, before `gamma`).
 DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false,

@@ -239,19 +239,14 @@ bool parse_header(const std::string& head, Header& h, std::string& error) {
   return true;
 }
 
-/// The first bytes of a NumPy .npy file (np.save).
-constexpr char kNpyMagic[] = "\x93NUMPY";
+}  // namespace
 
-/// Reads a NumPy .npy file's one set, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
-/// float32, in C or Fortran order. The header is untrusted: parsed as the few literals np.save writes, sizes
-/// bounded, and the data read as it comes (a header that promises more than the file holds allocates nothing
-/// of it).
-bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& sets, std::string& error) {
-  auto fail = [&](const std::string& what) {
-    error = path + ": NumPy .npy file: " + what;
+bool read_npy_header(std::streambuf& in, NpyHeader& out, std::string& what) {
+  auto fail = [&](const std::string& problem) {
+    what = problem;
     return false;
   };
-  std::streambuf* buffer = in.rdbuf();
+  std::streambuf* buffer = &in;
   auto read = [&](void* to, std::size_t n) {
     return static_cast<std::size_t>(buffer->sgetn(static_cast<char*>(to), static_cast<std::streamsize>(n))) ==
            n;
@@ -288,7 +283,8 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
   };
   std::string descr;
   int fortran = -1;
-  std::vector<std::uint64_t> shape;
+  std::vector<std::uint64_t>& shape = out.shape;
+  shape.clear();
   bool has_shape = false;
   if (!take('{')) return fail("a header that is no dictionary");
   while (!take('}')) {
@@ -325,6 +321,35 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
   }
   if (descr.empty() || fortran < 0 || !has_shape)
     return fail("a header without descr, fortran_order or shape");
+  out.descr = descr;
+  out.fortran = fortran == 1;
+  return true;
+}
+
+namespace {
+
+/// The first bytes of a NumPy .npy file (np.save).
+constexpr char kNpyMagic[] = "\x93NUMPY";
+
+/// Reads a NumPy .npy file's one set, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
+/// float32, in C or Fortran order. The header is untrusted (read_npy_header), and the data read as it comes
+/// (a header that promises more than the file holds allocates nothing of it).
+bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& sets, std::string& error) {
+  auto fail = [&](const std::string& what) {
+    error = path + ": NumPy .npy file: " + what;
+    return false;
+  };
+  std::streambuf* buffer = in.rdbuf();
+  auto read = [&](void* to, std::size_t n) {
+    return static_cast<std::size_t>(buffer->sgetn(static_cast<char*>(to), static_cast<std::streamsize>(n))) ==
+           n;
+  };
+  NpyHeader h;
+  std::string what;
+  if (!read_npy_header(*buffer, h, what)) return fail(what);
+  const std::string& descr = h.descr;
+  const int fortran = h.fortran ? 1 : 0;
+  const std::vector<std::uint64_t>& shape = h.shape;
   std::size_t width = 0;
   if (descr == "<f8")
     width = 8;

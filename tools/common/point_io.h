@@ -55,6 +55,18 @@ bool read_point_sets(const std::string& path, std::vector<PointSet>& sets, std::
 bool read_point_sets(std::istream& in, const std::string& name, std::vector<PointSet>& sets,
                      std::string& error);
 
+/// A NumPy .npy file's header (np.save): its element type ('<f8', '|u1', ...), order and shape.
+struct NpyHeader {
+  std::string descr;
+  bool fortran = false;              ///< column-major data (np.asfortranarray, a transposed array)
+  std::vector<std::uint64_t> shape;  ///< at most 8 axes, each under 2^40
+};
+
+/// Reads a .npy header from `in`, whose six-byte magic ("\x93NUMPY") has been read: the version, the length
+/// and the dict np.save writes. The header is untrusted: parsed as the few literals np.save writes, sizes
+/// bounded. Returns false with `what` naming the problem ("cut short in its header", "a malformed 'shape'").
+bool read_npy_header(std::streambuf& in, NpyHeader& header, std::string& what);
+
 /// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
 /// or as CSV when its format (output_format(path, format)) is ".csv" (with a class column for labelled
 /// points, which only CSV carries: false with `error` for a labelled set and another format). Atomic

@@ -23,6 +23,12 @@ gen::Density to_generator_density(const DensitySpec& spec) {
       d.thread_safe = true;
       return d;
     }
+    case Kind::kVolume:
+      try {
+        return gen::Density::from_volume(spec.width, spec.height, spec.depth, spec.values);
+      } catch (const gen::InvalidArgument& e) {
+        throw std::invalid_argument("volume '" + spec.text + "': " + e.what());
+      }
     case Kind::kImage:
       break;
   }
@@ -52,7 +58,7 @@ gen::Density to_class_density(const DensitySpec& spec) {
 std::function<double(double, double)> analysis_density(const gen::Density& density) {
   if (!density.function) return [](double, double) { return 1.0; };
   return [f = density.function](double x, double y) {
-    const double u[2] = {x, y};
+    const double u[3] = {x, y, 0.5};  // a third coordinate for a volume's function, though 2D sets refuse it
     return f(u);
   };
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 namespace kdm::tools {
 
@@ -27,6 +28,9 @@ SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
       density.user = this;
       density.callback_max = 1;
       return;
+    case Kind::kVolume:
+      throw std::invalid_argument("density '" + spec.text +
+                                  "' is a 3-D volume: only the full sampler takes it (kdm sample --dim 3)");
     case Kind::kImage:
       break;
   }
