@@ -16,14 +16,14 @@ _Function = Callable[[float, float], float]
 
 def sample(
     n: int,
-    density: Union[_Density, Callable[..., float]] = ...,
+    density: Union[_Density, Callable[..., float]] = ...,  # a 3-D array (depth, height, width) with dim=3
     *,
     dim: int = ...,
     domain: Optional[str] = ...,
     temperature: float = ...,
     seed: int = ...,
     threads: int = ...,
-    aspect: Optional[float] = ...,
+    aspect: Union[None, float, Tuple[float, float, float]] = ...,  # in 3-D also the three sides (x, y, z)
     gamma: float = ...,
     invert: bool = ...,
     classes: Optional[Sequence[_Density]] = ...,

@@ -56,6 +56,22 @@ def aspect(value: Any) -> Optional[float]:
     return None if value is None else number("aspect", value, 0.0, strict=True)
 
 
+def aspect_or_sides(value: Any, dim: int) -> Tuple[Optional[float], Optional[Tuple[float, float, float]]]:
+    """kdm.sample's aspect: None, one number (the x side over the others), or in 3-D three sides (x, y, z),
+    each finite and > 0 (their ratios count). Returns (number or None, sides or None)."""
+    if value is None or isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+        return aspect(value), None
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+        raise TypeError(f"aspect must be a number or a sequence of three sides (x, y, z), got {type(value).__name__}")
+    values = list(value)
+    if len(values) != 3:
+        raise ValueError(f"aspect must be a number or three sides (x, y, z), got {len(values)} values")
+    if dim != 3:
+        raise ValueError("aspect=(x, y, z) sets a 3-D domain's sides: use dim=3, or give one number (width / height)")
+    sides = tuple(number(f"aspect[{k}]", v, 0.0, strict=True) for k, v in enumerate(values))
+    return None, sides  # type: ignore[return-value]
+
+
 def threads(value: Any) -> int:
     """A worker-thread count: 0 for the default (OMP_NUM_THREADS, else the CPUs this process may use), at
     most _kdm.MAX_THREADS (256) as on the command line."""
@@ -228,8 +244,35 @@ def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str 
     raise TypeError(f"{name} must be {', '.join(kinds[:-1])} or {kinds[-1]}, got {type(density).__name__}")
 
 
+def array3d(name: str, value: Any) -> np.ndarray:
+    """A 3-D array of numbers (depth, height, width) as C-contiguous float64."""
+    a = _real_array(name, value)
+    if a.ndim != 3:
+        raise ValueError(f"{name} must be a 3-D array (depth, height, width), got shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _scaled_into_floats(values: np.ndarray) -> np.ndarray:
+    """Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled into it
+    rather than flushed to 0 or infinity; bad values are left for the C++ side to name."""
+    if values.size and np.all(np.isfinite(values)) and float(np.min(values)) >= 0:
+        top = float(np.max(values))
+        if top > 0 and not 1e-30 <= top <= 1e30:
+            return values / top
+    return values
+
+
 def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:
-    """density_spec() for the full sampler, which needs something to sample."""
+    """density_spec() for the full sampler, which needs something to sample. A 3-D array is a volume
+    (depth, height, width) for dim=3."""
+    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim == 3:
+        if number("gamma", gamma, 0.0, strict=True) != 1.0 or flag("invert", invert):
+            raise ValueError("gamma and invert apply to image files only (an array or a number is the density)")
+        spec = _kdm.DensitySpec.from_volume(_scaled_into_floats(array3d(name, density)))
+        if not spec.max_value > 0:
+            raise ValueError(f"{name}: an array that is zero everywhere has nothing to sample (it needs some "
+                             "density > 0)")
+        return spec
     if is_array(density) and not isinstance(density, (str, bytes)):
         # Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled
         # into it rather than flushed to 0 or infinity.

@@ -17,7 +17,7 @@ def sample(
     temperature: float = 0.5,
     seed: int = 1,
     threads: int = 0,
-    aspect: Optional[float] = None,
+    aspect: Union[None, float, Sequence[float]] = None,
     gamma: float = 1.0,
     invert: bool = False,
     classes: Optional[Sequence[Any]] = None,
@@ -32,7 +32,7 @@ def sample(
         The number of points, 1 to 2**31. The sampler's grid (at most 2**27 nodes) holds about 8 million
         points in 2-D and 3 million in 3-D (fewer with a wide density range or a long domain); more raise
         ValueError saying so.
-    density : None, float, str, 2-D array or callable
+    density : None, float, str, 2-D or 3-D array, or callable
         The target density (only its shape matters: the sampler scales it to `n` points). None or a
         number > 0: uniform. A callable ``f(x, y)`` (``f(x, y, z)`` with dim=3) of coordinates in
         [0, 1) returning a number >= 0: called once per node of the sampler's grid (one Python call each;
@@ -42,11 +42,15 @@ def sample(
         ``kdm sample --density`` accepts, "const:V", the test maps
         "ramp:R" and "radial:R", or an image file whose darkness (to the power `gamma`; its luminance with
         `invert`) is the density. A 2-D array: density values (finite, >= 0, not all zero), stretched over
-        the domain, with row 0 at the TOP, as pictures are stored (and as an image file is read).
+        the domain, with row 0 at the TOP, as pictures are stored (and as an image file is read). A 3-D
+        array of shape (depth, height, width), with dim=3: a volume of densities, trilinear between voxel
+        centres, stretched over the domain; ``a[k]`` is the slice at z = (k + 0.5) / depth (slice 0 at
+        z near 0), each slice laid out as a 2-D array (row 0 at the top, y near 1; the last axis is x),
+        as ``kdm sample --dim 3 --density vol.npy`` reads ``np.save("vol.npy", a)``.
     dim : int
-        2 or 3 (images and arrays are 2-D).
+        2 or 3 (images and 2-D arrays are 2-D, 3-D arrays 3-D).
     domain : {"torus", "box"} or None
-        Periodic or bounded. None: a box for images, arrays, callables and "ramp:R", a torus for None,
+        Periodic or bounded. None: a box for images, arrays, volumes, callables and "ramp:R", a torus for None,
         a number, "const:V" and "radial:R". For Monte
         Carlo integration take the torus: box sets of up to a few hundred points are nearly the same
         grid for every seed and bias integrals (docs/limits.md, "The full sampler in a box").
@@ -59,10 +63,11 @@ def sample(
         0 to 2**64 - 1. The points depend on the arguments and the seed only, never on `threads`.
     threads : int
         Worker threads; 0: OMP_NUM_THREADS if set, else the CPUs this process may use.
-    aspect : float or None
+    aspect : float, (x, y, z) or None
         Width / height of the domain (in 3-D, its x side over its y and z sides, as ``kdm sample
-        --aspect``); None: the image's or array's, else 1. Points are normalised to [0, 1) on every axis
-        whatever the aspect.
+        --aspect``); in 3-D also three sides ``(x, y, z)``, relative lengths each > 0 (``--aspect X:Y:Z``);
+        None: the image's or 2-D array's width / height, a 3-D array's (width, height, depth), else 1.
+        Points are normalised to [0, 1) on every axis whatever the aspect.
     gamma, invert
         How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
     classes : sequence of densities, optional
@@ -96,7 +101,7 @@ def sample(
     temperature = _checks.temperature(temperature)
     seed = _checks.integer("seed", seed, 0, 2**64 - 1)
     threads = _checks.threads(threads)
-    aspect = _checks.aspect(aspect)
+    aspect, sides = _checks.aspect_or_sides(aspect, dim)
     sweeps = None if sweeps is None else _checks.integer("sweeps", sweeps, 0, 100000)
     coarse_sweeps = None if coarse_sweeps is None else _checks.integer("coarse_sweeps", coarse_sweeps, 0, 100000)
     more = dict(sweeps=sweeps, coarse_sweeps=coarse_sweeps)
@@ -110,6 +115,13 @@ def sample(
     if callable(density) and not isinstance(density, (np.ndarray, str)):
         if gamma != 1.0 or invert:
             raise ValueError("gamma and invert apply to image files only, and density is a function")
-        return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect, **more)
+        return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect, sides=sides,
+                                    **more)
     spec = _checks.sampler_density(density, gamma, invert)
-    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect, **more)
+    if spec is not None and spec.kind == "volume" and dim != 3:
+        raise ValueError(f"density: a 3-D array of shape ({spec.depth}, {spec.height}, {spec.width}) is a volume "
+                         "(depth, height, width): use dim=3")
+    if spec is not None and spec.kind == "image" and dim == 3:
+        raise ValueError("image and array densities are 2-D; use dim=2 (a 3-D density is an array of shape "
+                         "(depth, height, width))")
+    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect, sides=sides, **more)

@@ -64,6 +64,37 @@ DensitySpec from_values(const Array& a) {
   return flipped(a, "density array", [](double v) { return v; });
 }
 
+/// A 3-D array (depth, height, width) of densities as a kVolume spec: slice k at z near 0 for k = 0, each
+/// slice's rows flipped as a 2-D array's are (row 0 at the top).
+DensitySpec from_volume(const py::array_t<double, py::array::c_style | py::array::forcecast>& a) {
+  if (a.ndim() != 3)
+    throw std::invalid_argument("a density volume must be a 3-D array (depth, height, width), got " +
+                                std::to_string(a.ndim()) + " dimensions");
+  const std::uint64_t d = std::uint64_t(a.shape(0)), rows = std::uint64_t(a.shape(1)),
+                      cols = std::uint64_t(a.shape(2));
+  if (d < 1 || rows < 1 || cols < 1) throw std::invalid_argument("density volume is empty");
+  if (d * rows * cols > tools::kMaxImagePixels)
+    throw std::invalid_argument("density volume has more than 2^26 values (the image size limit)");
+  const double* in = a.data();
+  for (std::uint64_t i = 0; i < d * rows * cols; ++i)
+    if (!(in[i] >= 0 && in[i] <= FLT_MAX))  // kept as floats, as images are
+      throw std::invalid_argument(
+          "density volume values must be finite and >= 0, at most 3.4e38 (kept as floats), got " +
+          shown(in[i]) + " at [" + std::to_string(i / (rows * cols)) + ", " +
+          std::to_string(i / cols % rows) + ", " + std::to_string(i % cols) + "]");
+  DensitySpec spec;
+  spec.kind = DensitySpec::Kind::kVolume;
+  spec.text = "array";
+  spec.width = static_cast<int>(cols), spec.height = static_cast<int>(rows), spec.depth = static_cast<int>(d);
+  spec.values.resize(static_cast<std::size_t>(d * rows * cols));
+  for (std::uint64_t z = 0; z < d; ++z)
+    for (std::uint64_t y = 0; y < rows; ++y)
+      for (std::uint64_t x = 0; x < cols; ++x)
+        spec.values[static_cast<std::size_t>((z * rows + y) * cols + x)] =
+            static_cast<float>(in[(z * rows + (rows - 1 - y)) * cols + x]);
+  return spec;
+}
+
 /// As tools::parse_density_spec reads a picture: darkness (or luminance, inverted) to the power gamma.
 DensitySpec from_luminance(const Array& a, double gamma, bool invert) {
   check_number("gamma", gamma, 0, true);
@@ -112,6 +143,8 @@ const char* kind_name(const DensitySpec& s) {
       return "ramp";
     case DensitySpec::Kind::kRadial:
       return "radial";
+    case DensitySpec::Kind::kVolume:
+      return "volume";
     case DensitySpec::Kind::kImage:
       break;
   }
@@ -137,11 +170,16 @@ void bind_density(py::module_& m) {
           py::arg("value"))
       .def_static("from_values", &from_values, py::arg("values"),
                   "Densities (finite, >= 0), row 0 at the top")
+      .def_static(
+          "from_volume", &from_volume, py::arg("values"),
+          "Densities (finite, >= 0) of shape (depth, height, width): slice 0 at z near 0, each slice's "
+          "row 0 at the top")
       .def_static("from_luminance", &from_luminance, py::arg("values"), py::arg("gamma") = 1.0,
                   py::arg("invert") = false, "Luminances in [0, 1], row 0 at the top, read as a picture")
       .def_property_readonly("kind", &kind_name)
       .def_readonly("width", &DensitySpec::width)
       .def_readonly("height", &DensitySpec::height)
+      .def_readonly("depth", &DensitySpec::depth)
       .def_readonly("text", &DensitySpec::text)
       .def_property_readonly(
           "values",

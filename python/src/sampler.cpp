@@ -1,6 +1,7 @@
 // kdm._kdm.sample: the full KDM sampler (gen::sample) with `kdm sample`'s defaults and density conversion,
 // so the same arguments give the same bits as the command line, returned as a numpy array it owns.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -25,12 +26,16 @@ struct Sweeps {
   std::optional<int> finest, coarse;
 };
 
+/// A 3D domain's three sides (kdm sample --aspect X:Y:Z); unset: `aspect` or the density's shape.
+using Sides = std::optional<std::array<double, 3>>;
+
 /// The options every sampling call shares, checked: `edged` densities (a picture, a ramp, a function) get
 /// a box unless `domain` says otherwise, as in kdm sample; `image_aspect` is the domain's width / height
-/// unless `aspect` is given.
+/// unless `aspect` or `sides` is given (sides: 3D only, each finite and > 0, checked by the caller too).
 gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional<std::string>& domain,
                                     bool edged, double temperature, std::uint64_t seed, int threads,
-                                    std::optional<double> aspect, double image_aspect, const Sweeps& sweeps) {
+                                    std::optional<double> aspect, double image_aspect, const Sweeps& sweeps,
+                                    const Sides& sides = std::nullopt) {
   const std::string where = domain ? *domain : (edged ? "box" : "torus");
   if (where != "box" && where != "torus")
     throw std::invalid_argument("domain must be 'torus' or 'box', got '" + where + "'");
@@ -40,6 +45,13 @@ gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional
   o.domain = where == "box" ? gen::Domain::kBox : gen::Domain::kTorus;
   o.extent[0] = aspect ? *aspect : image_aspect;
   o.extent[1] = 1;
+  if (sides) {
+    if (dim != 3) throw std::invalid_argument("aspect=(x, y, z) sets a 3-D domain's sides: use dim=3");
+    for (double side : *sides)
+      if (!(std::isfinite(side) && side > 0))
+        throw std::invalid_argument("aspect sides must be finite and > 0, got " + std::to_string(side));
+    std::copy(sides->begin(), sides->end(), o.extent);
+  }
   o.temperature = temperature;
   o.seed = seed;
   o.threads = threads;
@@ -52,14 +64,19 @@ gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional
 py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
                            const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
                            int threads, std::optional<double> aspect, std::optional<int> sweeps,
-                           std::optional<int> coarse_sweeps) {
+                           std::optional<int> coarse_sweeps, const Sides& sides) {
   DensitySpec uniform;  // kdm sample's default, const:1
   const DensitySpec& spec = density ? *density : uniform;
-  const bool image = spec.kind == DensitySpec::Kind::kImage;
-  // As kdm sample: a ramp or a picture has edges that do not meet, so a box unless asked otherwise.
-  const gen::SamplerOptions o =
-      sampler_options(n, dim, domain, image || spec.kind == DensitySpec::Kind::kRamp, temperature, seed,
-                      threads, aspect, image ? double(spec.width) / spec.height : 1.0, {sweeps, coarse_sweeps});
+  const bool image = spec.kind == DensitySpec::Kind::kImage, volume = spec.kind == DensitySpec::Kind::kVolume;
+  if (volume && dim != 3)
+    throw std::invalid_argument("a 3-D density array (depth, height, width) is a volume: use dim=3");
+  // As kdm sample: a ramp, a picture or a volume has edges that do not meet, so a box unless asked otherwise;
+  // a volume's domain has its voxel counts as sides unless `aspect` says otherwise.
+  Sides shape = sides;
+  if (volume && !sides && !aspect) shape = {{double(spec.width), double(spec.height), double(spec.depth)}};
+  const gen::SamplerOptions o = sampler_options(
+      n, dim, domain, image || volume || spec.kind == DensitySpec::Kind::kRamp, temperature, seed, threads,
+      aspect, image ? double(spec.width) / spec.height : 1.0, {sweeps, coarse_sweeps}, shape);
   if (image && dim != 2) throw std::invalid_argument("image and array densities are 2-D; use dim=2");
   const gen::Density target = tools::to_generator_density(spec);
   gen::SampleResult result;
@@ -77,10 +94,11 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
 py::array_t<double> sample_function(std::int64_t n, const py::object& function, int dim,
                                     const std::optional<std::string>& domain, double temperature,
                                     std::uint64_t seed, int threads, std::optional<double> aspect,
-                                    std::optional<int> sweeps, std::optional<int> coarse_sweeps) {
+                                    std::optional<int> sweeps, std::optional<int> coarse_sweeps,
+                                    const Sides& sides) {
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
-  const gen::SamplerOptions o =
-      sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0, {sweeps, coarse_sweeps});
+  const gen::SamplerOptions o = sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0,
+                                                {sweeps, coarse_sweeps}, sides);
   PythonDensity function_density(function, dim);
   gen::SampleResult result;
   try {
@@ -121,10 +139,9 @@ py::tuple sample_classes(std::int64_t n, const std::vector<const DensitySpec*>& 
       throw std::invalid_argument("classes[" + std::to_string(densities.size()) + "]: " + e.what());
     }
   }
-  const gen::SamplerOptions o =
-      sampler_options(n, 2, domain, edged, temperature, seed, threads, aspect,
-                      first_image ? double(first_image->width) / first_image->height : 1.0,
-                      {sweeps, coarse_sweeps});
+  const gen::SamplerOptions o = sampler_options(
+      n, 2, domain, edged, temperature, seed, threads, aspect,
+      first_image ? double(first_image->width) / first_image->height : 1.0, {sweeps, coarse_sweeps});
   gen::ClassSample result;
   {
     py::gil_scoped_release release;
@@ -142,11 +159,13 @@ void bind_sampler(py::module_& m) {
   m.def("sample", &sample, py::arg("n"), py::arg("density").none(true), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
-        py::arg("coarse_sweeps").none(true) = py::none(), "gen::sample as kdm sample runs it");
+        py::arg("coarse_sweeps").none(true) = py::none(), py::arg("sides").none(true) = py::none(),
+        "gen::sample as kdm sample runs it");
   m.def("sample_function", &sample_function, py::arg("n"), py::arg("function"), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
-        py::arg("coarse_sweeps").none(true) = py::none(), "gen::sample of a Python function of the coordinates");
+        py::arg("coarse_sweeps").none(true) = py::none(), py::arg("sides").none(true) = py::none(),
+        "gen::sample of a Python function of the coordinates");
   m.def("sample_classes", &sample_classes, py::arg("n"), py::arg("specs"), py::arg("domain").none(true),
         py::arg("temperature"), py::arg("seed"), py::arg("threads"), py::arg("aspect").none(true),
         py::arg("sweeps").none(true) = py::none(), py::arg("coarse_sweeps").none(true) = py::none(),
