@@ -104,16 +104,17 @@ def analyze(
         [0, 1] is called point by point (its exception, or a value that is not finite and >= 0, is
         raised). With `class_densities` it judges the whole set only (default there: their sum).
     class_densities : list, optional
-        With `classes`: one target density per class, class 0 first, as many as the labels run (largest
-        label + 1; the list given to ``kdm.sample(classes=...)``), each anything `density` takes (a
+        With `classes`: one target density per class, class 0 first, at least as many as the labels run
+        (largest label + 1; the list given to ``kdm.sample(classes=...)``, whose classes of density 0 have
+        no points), each anything `density` takes (a
         number, str, 2-D array or callable), as ``kdm analyze --class-density``. Each class alone is
         judged against its own (density test, bands, empty circles in its local spacings), the whole set
         against their sum unless `density` is given, and the closest pair of different classes is in local
         spacings of the sum. Only each density's shape matters to its class's test; their integrals
         together predict each class's share of the points: the result's "classes" then holds "shares", per
         class its "class", predicted "share", observed "count", "expected" count, binomial "sd" and "z"
-        (a sampler that gives a class the wrong count shows a large z). ValueError for a count that does
-        not match the labels, or a class with points whose density is zero everywhere.
+        (a sampler that gives a class the wrong count shows a large z). ValueError for fewer densities
+        than the labels run to, or a class with points whose density is zero everywhere.
     gamma, invert
         How an image file's pixels become density, as kdm.sample takes them.
     tile_size : float or None

@@ -273,6 +273,9 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
             raise ValueError(f"{name}: an array that is zero everywhere has nothing to sample (it needs some "
                              "density > 0)")
         return spec
+    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim > 3:
+        raise ValueError(f"{name} must be a 2-D array (rows, columns), or with dim=3 a 3-D array (depth, "
+                         f"height, width), got shape {np.shape(density)}")
     if is_array(density) and not isinstance(density, (str, bytes)):
         # Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled
         # into it rather than flushed to 0 or infinity.

@@ -167,7 +167,12 @@ TEST(AnalysisClassesTest, ClassDensitiesInJsonEnergyAndRefusals) {
   };
   EXPECT_NE(message(set, {kUniform}).find("1 class densities given, but the points' classes run 0 to 1 (2 "),
             std::string::npos);
-  EXPECT_NE(message(set, {kUniform, kRamp, kRamp}).find("3 class densities"), std::string::npos);
+  // A class after the last label holds no points (a sampled class of density 0): counted, not refused.
+  const ClassesReport trailing = analyze_classes({set}, o, {}, {kUniform, kRamp, zero});
+  ASSERT_EQ(trailing.shares.size(), 3u);
+  EXPECT_EQ(trailing.shares[2].count, 0u);
+  EXPECT_EQ(trailing.shares[2].z, 0);
+  EXPECT_EQ(trailing.shares[1].count, own.shares[1].count);
   EXPECT_NE(message(set, {kUniform, zero}).find("class 1's density is zero everywhere, but the class has"),
             std::string::npos);
   EXPECT_NE(message(gap, {zero, zero, zero}).find("every class density is zero"), std::string::npos);

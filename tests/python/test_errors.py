@@ -35,6 +35,8 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, "must be a 2-D array", dict(n=10, density=np.ones(5))),
     (ValueError, r"a 3-D array .* is a volume .*: use dim=3", dict(n=10, density=np.ones((2, 2, 2)))),
     (ValueError, "density volume is empty", dict(n=10, dim=3, density=np.ones((0, 2, 2)))),
+    (ValueError, r"or with dim=3 a 3-D array \(depth, height, width\), got shape \(2, 3, 4, 5\)",
+     dict(n=10, dim=3, density=np.ones((2, 3, 4, 5)))),
     (ValueError, "density array is empty", dict(n=10, density=np.ones((0, 4)))),
     (ValueError, "finite and >= 0", dict(n=10, density=np.array([[1.0, NAN]]))),
     (ValueError, "finite and >= 0", dict(n=10, density=np.array([[1.0, -2.0]]))),

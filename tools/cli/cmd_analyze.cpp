@@ -103,15 +103,23 @@ std::string with_classes(std::string metrics, const std::string& classes) {
   return metrics.substr(0, end) + ",\n  \"classes\": " + inner + "\n}\n";
 }
 
-/// The aspect (width / height) a point file says its points were sampled in (`kdm sample --aspect` writes
-/// ", aspect A" in its header lines), or 1.
-double sampled_aspect(const std::string& path) {
+/// The shape of the domain a point file says its points were sampled in, when not a square or cube
+/// (`kdm sample --aspect` writes ", aspect A" or ", sides X:Y:Z" in its header lines), else "".
+std::string sampled_shape(const std::string& path) {
   std::ifstream in(path);
   std::string line;
-  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i)
-    if (const std::size_t at = line.find(", aspect "); at != std::string::npos)
-      return std::atof(line.c_str() + at + 9);
-  return 1;
+  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i) {
+    if (const std::size_t at = line.find(", aspect "); at != std::string::npos) {
+      const double aspect = std::atof(line.c_str() + at + 9);
+      if (aspect == 1) return "";
+      char text[80];
+      std::snprintf(text, sizeof text, "aspect %g (width / height)", aspect);
+      return text;
+    }
+    if (const std::size_t at = line.find(", sides "); at != std::string::npos)
+      return "sides " + line.substr(at + 8, line.find_first_of(",\n", at + 8) - (at + 8));
+  }
+  return "";
 }
 
 /// Creates `output` as analyze's directory (it receives metrics.json and pictures), or says why it cannot.
@@ -188,25 +196,25 @@ void run_analyze(const AnalyzeArgs& args) {
         throw CommandError(
             "--class-density needs labelled points (a class column, with the header line "
             "x,y,class), and the points have no classes");
-      std::size_t labels = 0;  // largest label + 1
-      for (const tools::PointSet& set : sets)
-        for (std::uint8_t k : set.classes) labels = std::max(labels, std::size_t(k) + 1);
-      if (labels != own.densities.size())
-        throw CommandError(std::to_string(own.densities.size()) +
-                           " --class-density given, but the points' classes run 0 to " +
-                           std::to_string(labels - 1) + " (" + std::to_string(labels) +
-                           " classes): give one per class, class 0 first");
+      try {  // refused before anything is printed
+        analysis::class_shares(sets, own.functions);
+      } catch (const analysis::InvalidInput& e) {
+        std::string why = e.what();  // said in the option's name
+        if (const std::size_t at = why.find(" class densities given"); at != std::string::npos)
+          why.replace(at, 16, " --class-density");
+        throw CommandError(why);
+      }
       if (args.density.empty()) {  // the whole set against the classes' summed density
         target = gen::sum_of_densities(own.densities);
         o.density = tools::analysis_density(target);
       }
     }
     for (const std::string& file : args.files)
-      if (const double aspect = sampled_aspect(file); aspect != 1)
+      if (const std::string shape = sampled_shape(file); !shape.empty())
         std::fprintf(stderr,
-                     "kdm: warning: %s was sampled in a domain of aspect %g (width / height); the measures "
-                     "take its points in the unit square, so distances and the spectrum are stretched\n",
-                     file.c_str(), aspect);
+                     "kdm: warning: %s was sampled in a domain of %s; the measures take its points in the "
+                     "unit square (cube), so distances and the spectrum are stretched\n",
+                     file.c_str(), shape.c_str());
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr,
                    "kdm: warning: density windows and tiling diagnostics are 2D only; skipped (a --density "
@@ -286,8 +294,9 @@ void add_analyze_command(CLI::App& app) {
       "(default there: the sum of the class densities); each class keeps its own");
   cmd->add_option(
       "--class-density", args->class_densities,
-      "Labelled points: repeat it, one target density per class, class 0 first, up to the largest class "
-      "in the file (any form --density takes: the densities given to kdm sample --class). Each class alone "
+      "Labelled points: repeat it, one target density per class, class 0 first, at least up to the "
+      "largest class in the file (any form --density takes: the densities given to kdm sample --class). Each "
+      "class alone "
       "is judged against its own (density test, bands, holes in its local spacings), the whole set "
       "against their sum, and the closest pair of different classes in local spacings of the sum. Only "
       "each density's shape matters to its class's test; their integrals together predict each class's "

@@ -157,25 +157,22 @@ DensityFunction summed_density(const std::vector<DensityFunction>& densities) {
   };
 }
 
-namespace {
-
-/// Each class's share of the points as its density's integral predicts it, against its count over `sets`;
-/// checks the densities (one per class the labels run to, finite, >= 0, not zero where a class has points).
 std::vector<ClassShare> class_shares(const std::vector<tools::PointSet>& sets,
                                      const std::vector<DensityFunction>& densities) {
   std::size_t labels = 0;  // largest label + 1
   for (const tools::PointSet& set : sets)
     for (std::uint8_t k : set.classes) labels = std::max(labels, std::size_t(k) + 1);
   if (labels == 0) throw InvalidInput("class densities given, but the sets hold no points");
-  if (densities.size() != labels)
+  if (densities.size() < labels)  // more: classes after the last label hold no points (a density of 0)
     throw InvalidInput(std::to_string(densities.size()) +
                        " class densities given, but the points' classes run 0 to " +
                        std::to_string(labels - 1) + " (" + std::to_string(labels) +
                        " classes): give one density per class, class 0 first");
-  std::vector<ClassShare> shares(labels);
+  const std::size_t classes = densities.size();
+  std::vector<ClassShare> shares(classes);
   double total = 0;
-  std::vector<double> mean(labels);
-  for (std::size_t k = 0; k < labels; ++k) {
+  std::vector<double> mean(classes);
+  for (std::size_t k = 0; k < classes; ++k) {
     const std::string name = "class " + std::to_string(k) + "'s density";
     if (!densities[k]) throw InvalidInput(name + " is empty");
     // density_scale clamps what it reads; a density the windows would refuse is named here by class.
@@ -192,7 +189,7 @@ std::vector<ClassShare> class_shares(const std::vector<tools::PointSet>& sets,
   if (!(total > 0)) throw InvalidInput("every class density is zero everywhere");
   for (const tools::PointSet& set : sets)
     for (std::uint8_t k : set.classes) ++shares[k].count;
-  for (std::size_t k = 0; k < labels; ++k) {
+  for (std::size_t k = 0; k < classes; ++k) {
     ClassShare& s = shares[k];
     if (!(mean[k] > 0) && s.count > 0)
       throw InvalidInput("class " + std::to_string(k) + "'s density is zero everywhere, but the class has " +
@@ -210,8 +207,6 @@ std::vector<ClassShare> class_shares(const std::vector<tools::PointSet>& sets,
   }
   return shares;
 }
-
-}  // namespace
 
 ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
                               const ClassEnergy& energy,

@@ -40,6 +40,15 @@ struct ClassShare {
   double z = 0;  ///< (count − expected) / sd; 0 when sd = 0 (then count = expected)
 };
 
+/// Each class's count over `sets` against the share of the points its density's integral predicts
+/// (ClassShare), one per density: `densities` hold one per class, class 0 first, at least as many as the
+/// labels run (largest label + 1; classes after it have no points, as a sampled class of density 0).
+/// Throws InvalidInput for fewer densities, an empty one, one negative or not finite, a class with points
+/// whose density is zero everywhere, or densities all zero: the checks analyze_classes makes, for a caller
+/// that wants them before it measures anything.
+std::vector<ClassShare> class_shares(const std::vector<tools::PointSet>& sets,
+                                     const std::vector<DensityFunction>& densities);
+
 /// Labelled sets analysed class by class: each class alone as the whole sets are (analyze), and the
 /// closest pair of points of different classes over the sets.
 struct ClassesReport {
@@ -62,8 +71,8 @@ DensityFunction summed_density(const std::vector<DensityFunction>& densities);
 /// Each class of `sets` (every set labelled; else InvalidInput) alone, under `options`; `energy`, if set,
 /// gives each class's E/n from its subsets.
 ///
-/// `class_densities` (optional): one target density per class, class 0 first, as many as the labels run
-/// (largest label + 1 over all sets; classes between without points may have any density, 0 too). Each
+/// `class_densities` (optional): one target density per class, class 0 first, at least as many as the
+/// labels run (largest label + 1 over all sets; classes without points may have any density, 0 too). Each
 /// class is then judged against its own density instead of options.density: density windows, per-band
 /// bias, empty circles in local spacings of its density, the spectrum's non-uniform note. Only each
 /// density's shape matters there (the windows are normalised to the class's count); their scales together
@@ -71,7 +80,7 @@ DensityFunction summed_density(const std::vector<DensityFunction>& densities);
 /// (kdm sample --class: const:1 and const:2 give a third and two thirds). The closest pair of different
 /// classes is then in local spacings of their sum (summed_density). The union itself is the caller's
 /// analyze(): its target is options.density if the caller chose one, else summed_density(class_densities).
-/// Throws InvalidInput for a count of densities that does not match the labels, an empty density, one
+/// Throws InvalidInput for fewer densities than the labels run to, an empty density, one
 /// that is negative or not finite, a class with points whose density is zero everywhere, or densities
 /// all zero.
 ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
