@@ -233,6 +233,18 @@ def test_volume_array_same_bits_as_kdm_sample_npy(cli, tmp_path):
     assert np.array_equal(kdm.sample(800, counts, dim=3), read_txt(tmp_path / "u8.txt"))
 
 
+def test_a_2d_npy_density_is_the_array_kdm_sample_takes(cli, tmp_path):
+    # A 2-D .npy is a picture's densities, row 0 at the top, as a 2-D array in Python: the same bits, in
+    # any layout, and its shape sets the domain's aspect as an image's does.
+    a = np.ones((6, 12)) * np.linspace(1, 3, 12)
+    a[:3] *= 2  # the top rows denser
+    for name, array in [("c", a), ("fortran", np.asfortranarray(a)), ("u8", (a * 40).astype(np.uint8))]:
+        np.save(tmp_path / f"{name}.npy", array)
+        cli("sample", "--n", 900, "--seed", 3, "--density", tmp_path / f"{name}.npy", "-o", tmp_path / f"{name}.txt")
+        assert np.array_equal(kdm.sample(900, array, seed=3), read_txt(tmp_path / f"{name}.txt")), name
+    assert "aspect 2" in (tmp_path / "c.txt").read_text().splitlines()[1]
+
+
 def test_volume_axes_are_z_rows_from_the_top_and_x():
     # a[k] is the slice at z = (k + 0.5) / depth; each slice's row 0 at the top (y near 1), as 2-D arrays;
     # the last axis is x. 4x denser in the first half of an axis of 8 voxels: 0.78125 of the points in that

@@ -62,9 +62,9 @@ double parse_number(const std::string& text) {
   return !text.empty() && *end == '\0' && std::isfinite(v) ? v : std::nan("");
 }
 
-/// A 3-D NumPy array of densities as a kVolume spec (parse_density_spec says which); throws
-/// std::runtime_error naming the file and the problem.
-DensitySpec read_volume(const std::string& path, std::istream& in) {
+/// A NumPy array of densities: 2-D as a kImage spec, 3-D as a kVolume one (parse_density_spec says which);
+/// throws std::runtime_error naming the file and the problem.
+DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   auto fail = [&](const std::string& what) {
     return std::runtime_error("density '" + path + "': NumPy .npy file: " + what);
   };
@@ -85,21 +85,20 @@ DensitySpec read_volume(const std::string& path, std::istream& in) {
     throw fail("data of type '" + h.descr + "': expected float64, float32 or uint8 ('<f8', '<f4' or '|u1')");
   std::string dims;
   for (std::size_t i = 0; i < h.shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(h.shape[i]);
-  if (h.shape.size() == 2)
-    throw fail("a 2-D array of shape (" + dims +
-               "): a .npy density is a volume for --dim 3, of shape (depth, height, width); a 2-D density is "
-               "a picture");
-  if (h.shape.size() != 3)
-    throw fail("an array of shape (" + dims + "): expected a 3-D array (depth, height, width)");
-  const std::uint64_t d = h.shape[0], rows = h.shape[1], cols = h.shape[2];
+  if (h.shape.size() != 2 && h.shape.size() != 3)
+    throw fail("an array of shape (" + dims +
+               "): expected a 2-D array (rows, columns) or, for --dim 3, a 3-D one (depth, height, width)");
+  const bool flat = h.shape.size() == 2;  // a picture's densities: one slice
+  const std::uint64_t d = flat ? 1 : h.shape[0], rows = h.shape[flat ? 0 : 1], cols = h.shape[flat ? 1 : 2];
   if (d == 0 || rows == 0 || cols == 0) throw fail("an empty array of shape (" + dims + ")");
   if (d > kMaxImagePixels || rows > kMaxImagePixels || cols > kMaxImagePixels ||
       d * rows * cols > kMaxImagePixels)
     throw fail("an array of shape (" + dims + "): more than 2^26 values (the image size limit)");
   DensitySpec spec;
-  spec.kind = DensitySpec::Kind::kVolume;
+  spec.kind = flat ? DensitySpec::Kind::kImage : DensitySpec::Kind::kVolume;
   spec.text = path;
-  spec.width = static_cast<int>(cols), spec.height = static_cast<int>(rows), spec.depth = static_cast<int>(d);
+  spec.width = static_cast<int>(cols), spec.height = static_cast<int>(rows);
+  if (!flat) spec.depth = static_cast<int>(d);
   const std::uint64_t count = d * rows * cols;
   spec.values.resize(static_cast<std::size_t>(count));
   unsigned char chunk[1 << 14];
@@ -130,7 +129,7 @@ DensitySpec read_volume(const std::string& path, std::istream& in) {
       else
         col = at % cols, row = at / cols % rows, z = at / (cols * rows);
       if (!(std::isfinite(v) && v >= 0 && v <= 3.4028234663852886e38))
-        throw fail("a value of " + std::to_string(v) + " at [" + std::to_string(z) + ", " +
+        throw fail("a value of " + std::to_string(v) + " at [" + (flat ? "" : std::to_string(z) + ", ") +
                    std::to_string(row) + ", " + std::to_string(col) +
                    "]: densities must be finite and >= 0, at most 3.4e38");
       // Rows are stored top first, as in a picture; kdm keeps row 0 at the bottom.
@@ -171,7 +170,7 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   if (!std::filesystem::exists(text, missing))  // a misspelt map more often than a missing picture
     throw std::runtime_error(
         "density '" + text +
-        "': no such file (a density is a picture, const:V, ramp:R, radial:R or a .npy volume)");
+        "': no such file (a density is a picture, const:V, ramp:R, radial:R or a .npy array)");
   if (std::filesystem::is_regular_file(text, missing)) {  // a directory is refused by the image loader
     std::ifstream file(text, std::ios::binary);
     char magic[6] = {};
@@ -179,9 +178,9 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
       if (gamma != 1 || invert)  // they reshape a picture's tones; a volume holds densities
         throw std::invalid_argument(
             "density '" + text +
-            "' is a NumPy volume of densities: --gamma and --invert apply to images only");
+            "' is a NumPy array of densities: --gamma and --invert apply to images only");
       file.seekg(0);
-      return read_volume(text, file);
+      return read_npy_density(text, file);
     }
   }
   GreyImage image;
