@@ -446,7 +446,7 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   bad[5] = std::nan("");
   std::ofstream(path("nan.npy"), std::ios::binary) << npy_volume(bad, 2, 2, 2, "<f8");
   std::ofstream(path("zero.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 0.0), 2, 2, 2);
-  std::ofstream(path("i2.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, "<i2");
+  std::ofstream(path("i2.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, ">f4");  // big-endian
   std::ofstream(path("short.npy"), std::ios::binary) << npy_volume(std::vector<double>(7, 1.0), 2, 2, 2);
   const std::string v = " --density '" + path("v.npy") + "'";
   expect_error("sample --n 100 --dim 3 --density '" + path("flat.npy") + "'" + out, "image densities are 2D");
@@ -457,7 +457,7 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
                "at [1, 0, 1]: densities must be finite");
   expect_error("sample --n 100 --dim 3 --density '" + path("zero.npy") + "'" + out, "zero everywhere");
   expect_error("sample --n 100 --dim 3 --density '" + path("i2.npy") + "'" + out,
-               "expected float64, float32 or uint8");
+               "data of type '>f4': expected little-endian real numbers");
   expect_error("sample --n 100 --dim 3 --density '" + path("short.npy") + "'" + out, "cut short");
   expect_error("sample --n 100 --dim 3 --gamma 2" + v + out, "--gamma and --invert apply to images only");
   expect_error("sample --n 100 --class '" + path("v.npy") + "'" + out, "3-D volume");

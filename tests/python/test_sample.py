@@ -238,7 +238,9 @@ def test_a_2d_npy_density_is_the_array_kdm_sample_takes(cli, tmp_path):
     # any layout, and its shape sets the domain's aspect as an image's does.
     a = np.ones((6, 12)) * np.linspace(1, 3, 12)
     a[:3] *= 2  # the top rows denser
-    for name, array in [("c", a), ("fortran", np.asfortranarray(a)), ("u8", (a * 40).astype(np.uint8))]:
+    for name, array in [("c", a), ("fortran", np.asfortranarray(a)), ("u8", (a * 40).astype(np.uint8)),
+                        ("i16", (a * 400).astype(np.int16)), ("i64", (a * 4e9).astype(np.int64)),
+                        ("f16", a.astype(np.float16)), ("bool", a > 3)]:
         np.save(tmp_path / f"{name}.npy", array)
         cli("sample", "--n", 900, "--seed", 3, "--density", tmp_path / f"{name}.npy", "-o", tmp_path / f"{name}.txt")
         assert np.array_equal(kdm.sample(900, array, seed=3), read_txt(tmp_path / f"{name}.txt")), name

@@ -250,8 +250,9 @@ void add_sample_command(CLI::App& app) {
          "const:V, an image whose darkness is the density (a Radiance .hdr keeps its range, scaled by "
          "its brightest pixel: with --invert, bright is dense), or a test map: ramp:R (R^-x, dynamic "
          "range R) or radial:R (R^-(2r) around the centre, 1/R past r = 0.5; both by x and y alone, so in 3D "
-         "a ramp along x and a cylinder along z), or a NumPy .npy array of float64, float32 or uint8 "
-         "densities: 2-D (rows, columns) as a picture's, row 0 at the top (y near 1), the last axis x; with "
+         "a ramp along x and a cylinder along z), or a NumPy .npy array of densities (floats, integers "
+         "as their values, or bools): 2-D (rows, columns) as a picture's, row 0 at the top (y near 1), the "
+         "last axis x; with "
          "--dim 3 a 3-D volume (depth, height, width), trilinear between voxels, stretched over the domain: "
          "[k] is the slice at z = (k + 0.5) / depth, each slice as a 2-D array")
       ->capture_default_str();

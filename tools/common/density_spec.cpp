@@ -74,15 +74,17 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   NpyHeader h;
   std::string what;
   if (!read_npy_header(buffer, h, what)) throw fail(what);
-  std::size_t bytes = 0;
-  if (h.descr == "<f8")
-    bytes = 8;
-  else if (h.descr == "<f4")
-    bytes = 4;
-  else if (h.descr == "|u1")
-    bytes = 1;
-  else
-    throw fail("data of type '" + h.descr + "': expected float64, float32 or uint8 ('<f8', '<f4' or '|u1')");
+  // Little-endian (or single-byte) reals as numpy writes them: float16/32/64, (u)int8 to 64, bool.
+  const char kind = h.descr.size() == 3 ? h.descr[1] : 0;
+  const std::size_t bytes = h.descr.size() == 3 ? std::size_t(h.descr[2] - '0') : 0;
+  const bool order = h.descr[0] == '<' || (h.descr[0] == '|' && bytes == 1);
+  const bool sized =
+      kind == 'f'   ? bytes == 2 || bytes == 4 || bytes == 8
+      : kind == 'b' ? bytes == 1
+                    : (kind == 'u' || kind == 'i') && (bytes == 1 || bytes == 2 || bytes == 4 || bytes == 8);
+  if (!order || !sized)
+    throw fail("data of type '" + h.descr +
+               "': expected little-endian real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool)");
   std::string dims;
   for (std::size_t i = 0; i < h.shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(h.shape[i]);
   if (h.shape.size() != 2 && h.shape.size() != 3)
@@ -111,15 +113,24 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
       std::uint64_t bits = 0;  // little-endian, whatever this machine's order
       for (std::size_t b = bytes; b-- > 0;) bits = bits << 8 | chunk[k * bytes + b];
       double v;
-      if (bytes == 8) {
+      if (kind == 'f' && bytes == 8) {
         std::memcpy(&v, &bits, 8);
-      } else if (bytes == 4) {
+      } else if (kind == 'f' && bytes == 4) {
         const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
         float f;
         std::memcpy(&f, &b32, 4);
         v = f;
+      } else if (kind == 'f') {  // IEEE half: sign, 5 exponent bits, 10 mantissa bits
+        const int exponent = int(bits >> 10 & 31), mantissa = int(bits & 1023);
+        v = exponent == 31  ? (mantissa ? std::nan("") : HUGE_VAL)
+            : exponent == 0 ? std::ldexp(mantissa, -24)
+                            : std::ldexp(1024 + mantissa, exponent - 25);
+        if (bits >> 15 & 1) v = -v;
+      } else if (kind == 'i') {  // two's complement of `bytes` bytes
+        const unsigned shift = unsigned(64 - 8 * bytes);
+        v = double(static_cast<std::int64_t>(bits << shift) >> shift);
       } else {
-        v = double(bits);
+        v = double(kind == 'b' ? bits != 0 : bits);
       }
       // The element's numpy index [slice, row, column], in either order.
       const std::uint64_t at = done + k;

@@ -43,8 +43,8 @@ struct DensitySpec {
 /// that cannot be read (std::runtime_error, naming the file). Messages are one line.
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
 /// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance. A
-/// NumPy .npy file (known by its first bytes) holds little-endian float64, float32 or uint8 densities
-/// (finite, >= 0; uint8 as its values 0 ... 255), in C or Fortran order, at most kMaxImagePixels values: a
+/// NumPy .npy file (known by its first bytes) holds little-endian real densities (float16, 32 or 64,
+/// integers of 8 to 64 bits as their values, bool as 0 and 1; finite, >= 0), in C or Fortran order, at most kMaxImagePixels values: a
 /// 2-D array (rows, columns) is a kImage, row 0 at the top (y near 1), as 2-D density arrays in Python; a
 /// 3-D one (depth, height, width) a kVolume, array[k] slice k along z (k = 0 at z near 0), each slice as a
 /// 2-D array. Other shapes and types are refused, naming the file.
