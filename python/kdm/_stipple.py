@@ -40,8 +40,9 @@ def stipple(
         An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored):
         luminance (rows, columns) as floats in [0, 1], uint8 or uint16; or colour (rows, columns, 3 or 4),
         RGB(A), made luminance as a file is (0.2126 R + 0.7152 G + 0.0722 B, composited on white). The
-        image spans [0, width/height] x [0, 1]. An image with no ink gives no dots. A file of up to
-        16384 x 16384 pixels is averaged down as it is read to what its dots need (as ``kdm stipple``
+        image is stretched over [0, width/height] x [0, 1] in the tiling's units (`scale` counts dots
+        per unit area there); the dots come back normalised (Returns). An image with no ink gives no dots.
+        A file of up to 2^28 pixels (16384 x 16384) is averaged down as it is read to what its dots need (as ``kdm stipple``
         reads it: docs/limits.md, "Large pictures"); an array is used as it is.
     points : int
         Dots over the whole image (ignored when `scale` is given).

@@ -32,7 +32,8 @@ void check_shape(const Array& a, const char* what, int& width, int& height) {
                                 std::to_string(a.ndim()) + " dimensions");
   if (a.shape(0) < 1 || a.shape(1) < 1) throw std::invalid_argument(std::string(what) + " is empty");
   if (std::uint64_t(a.shape(0)) * std::uint64_t(a.shape(1)) > tools::kMaxImagePixels)
-    throw std::invalid_argument(std::string(what) + " has more than 2^26 values (the image size limit)");
+    throw std::invalid_argument(std::string(what) + " has more than 2^26 pixels (the image size limit; " +
+                                "kdm.stipple reads a larger picture from its file, averaged down)");
   height = static_cast<int>(a.shape(0)), width = static_cast<int>(a.shape(1));
 }
 

@@ -102,10 +102,10 @@ TEST_F(CliTest, LoadersAverageALargePictureDownToTheKeptPixels) {
 }
 
 TEST_F(CliTest, PicturesWhoseDecodingPassesTwoGibibytesAreRefusedByName) {
-  // A Radiance picture of 16,384 × 8,193 (just over 2^27 pixels, within a stipple's 2^28): stb decodes it
-  // as four floats a pixel (3 channels, room for a fourth), more bytes than its int counts. Each scanline
-  // holds runs of one value per channel, so the file is small.
-  const int w = 16384, h = 8193;
+  // A Radiance picture of 16,384 × 10,923 (within a stipple's 2^28 pixels): stb decodes it as three floats
+  // a pixel, 2^31 bytes and more, past what its int counts. Each scanline holds runs of one value per
+  // channel, so the file is small.
+  const int w = 16384, h = 10923;
   std::string file =
       "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
   std::string line = {2, 2, char(w >> 8), char(w & 255)};
@@ -118,9 +118,10 @@ TEST_F(CliTest, PicturesWhoseDecodingPassesTwoGibibytesAreRefusedByName) {
   kdm::tools::GreyImage image;
   std::string error;
   EXPECT_FALSE(kdm::tools::load_grey_image(path("wide.hdr"), image, error, std::uint64_t(1) << 28));
-  EXPECT_NE(error.find("16384x8193 pixels of 32 bits: decoding it takes more than 2 GiB"), std::string::npos)
+  EXPECT_NE(error.find("16384x10923 pixels of 3 channels of 32 bits: decoding it takes 2 GiB or more"),
+            std::string::npos)
       << error;
-  expect_error("stipple '" + path("wide.hdr") + "' -o '" + path("w.svg") + "'", "more than 2 GiB");
+  expect_error("stipple '" + path("wide.hdr") + "' -o '" + path("w.svg") + "'", "2 GiB or more");
 }
 
 // Fills stack the loader's callees will use with a grey, so that a read of uninitialised stack shows.
@@ -156,6 +157,34 @@ TEST_F(CliTest, PaletteIndicesPastThePaletteAreBlack) {
       EXPECT_EQ(image.pixels, (std::vector<float>{1, 1, 0, 0}));
     }
   }
+}
+
+TEST_F(CliTest, TopDownBmpsAreReadAsBottomUpOnes) {
+  // A 2 × 2 24-bit BMP stored bottom row first (a positive height), and the same picture stored top row
+  // first (a negative height): one picture, black at the top left.
+  const auto bmp = [](int height, const std::vector<std::uint8_t>& rows) {
+    std::vector<std::uint8_t> b = {'B', 'M', 70, 0, 0, 0, 0, 0, 0, 0, 54, 0, 0, 0, 40, 0, 0, 0, 2, 0, 0, 0};
+    for (int i = 0; i < 4; ++i) b.push_back(std::uint8_t(std::uint32_t(height) >> (8 * i)));
+    b.insert(b.end(), {1, 0, 24, 0});
+    b.resize(54, 0);
+    b.insert(b.end(), rows.begin(), rows.end());
+    return b;
+  };
+  const std::vector<std::uint8_t> top = {0, 0, 0, 255, 255, 255, 0, 0},
+                                  bottom = {255, 255, 255, 128, 128, 128, 0, 0};
+  std::vector<std::uint8_t> up = bottom, down = top;
+  up.insert(up.end(), top.begin(), top.end());
+  down.insert(down.end(), bottom.begin(), bottom.end());
+  write_bytes(path("up.bmp"), bmp(2, up));
+  write_bytes(path("down.bmp"), bmp(-2, down));
+  kdm::tools::GreyImage a, b;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("up.bmp"), a, error)) << error;
+  ASSERT_TRUE(kdm::tools::load_grey_image(path("down.bmp"), b, error)) << error;
+  ASSERT_EQ(b.height, 2);
+  EXPECT_EQ(a.pixels, b.pixels);
+  EXPECT_EQ(b.at(0, 0), 0.0f);
+  EXPECT_NEAR(b.at(1, 1), 128.0f / 255, 1e-6);
 }
 
 TEST_F(CliTest, BadImagesGiveOneLineErrors) {

@@ -177,6 +177,21 @@ bool png_truncated(const std::uint8_t* data, std::size_t size) {
   return true;  // no IEND: stb decodes nothing without one
 }
 
+// Whether a PNG holds a chunk of `type` before its first IDAT (false for anything else).
+bool png_has_chunk(const std::uint8_t* data, std::size_t size, const char type[4]) {
+  static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  if (size < 8 || std::memcmp(data, kSignature, 8) != 0) return false;
+  for (std::size_t pos = 8; size - pos >= 8;) {
+    const std::uint32_t length = std::uint32_t(data[pos]) << 24 | std::uint32_t(data[pos + 1]) << 16 |
+                                 std::uint32_t(data[pos + 2]) << 8 | data[pos + 3];
+    if (std::memcmp(data + pos + 4, type, 4) == 0) return true;
+    if (std::memcmp(data + pos + 4, "IDAT", 4) == 0 || length > size - pos - 8) return false;
+    pos += 12 + std::size_t(length);
+    if (pos > size) return false;
+  }
+  return false;
+}
+
 // A PNG's size from its IHDR chunk (the first), or false: stb refuses to read even the header of a PNG
 // whose pixels would pass 2^30 bytes, and its reason then names no size.
 bool png_size(const std::uint8_t* data, std::size_t size, std::uint64_t& w, std::uint64_t& h) {
@@ -684,6 +699,9 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
       return false;
     }
   }
+  // A BMP stored top row first says so by a negative height (stb reads it so, and says it so here).
+  if (size >= 2 && bytes[0] == 'B' && bytes[1] == 'M' && h < 0 && h != std::numeric_limits<int>::min())
+    h = -h;
   if (w <= 0 || h <= 0) {
     error = "image '" + name + "' is empty or has a corrupt header";
     return false;
@@ -698,13 +716,15 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
         ": scale it down (a density needs no more pixels than the dots it places)";
     return false;
   }
-  // stb counts its buffer's bytes in an int: said here, not as its "too large" (a PNG's tRNS may add alpha).
+  // stb counts its buffer's bytes in an int: said here, not as its "too large" (a PNG's tRNS adds alpha).
   const bool hdr = stbi_is_hdr_from_memory(bytes, length) != 0;
   const int sample_bytes = hdr ? 4 : stbi_is_16_bit_from_memory(bytes, length) ? 2 : 1;
-  const std::uint64_t buffer = pixels * std::uint64_t(std::min(4, header_channels + 1)) * sample_bytes;
+  const int decoded_channels = std::min(4, header_channels + (png_has_chunk(bytes, size, "tRNS") ? 1 : 0));
+  const std::uint64_t buffer = pixels * std::uint64_t(decoded_channels) * std::uint64_t(sample_bytes);
   if (buffer > std::uint64_t(std::numeric_limits<int>::max())) {
     error = "image '" + name + "' is " + std::to_string(w) + "x" + std::to_string(h) + " pixels of " +
-            std::to_string(8 * sample_bytes) + " bits: decoding it takes more than 2 GiB; scale it down" +
+            std::to_string(decoded_channels) + " channels of " + std::to_string(8 * sample_bytes) +
+            " bits: decoding it takes 2 GiB or more; scale it down" +
             (hdr                 ? ""
              : sample_bytes == 2 ? " or convert it to 8 bits"
                                  : "");

@@ -32,7 +32,8 @@ KeptPixels stipple_kept_pixels(double points, double scale, double zoom) {
     const double aspect = double(std::max(width, height)) / std::min(width, height);
     const double dots = points > 0 ? 4 * points : scale * aspect;  // 16 kept pixels a dot, or 64 a mean one
     const double kept = std::max(double(1 << 24), 16 * dots) * std::max(1.0, zoom) * std::max(1.0, zoom);
-    return kept >= double(kMaxStipplePixels) ? kMaxStipplePixels : static_cast<std::uint64_t>(kept);
+    // At most what a density may hold: a deep zoom into a huge picture would keep every pixel of it.
+    return kept >= double(kMaxImagePixels) ? kMaxImagePixels : static_cast<std::uint64_t>(kept);
   };
 }
 

@@ -25,9 +25,9 @@ inline constexpr std::uint64_t kMaxStipplePixels = std::uint64_t(1) << 28;
 
 /// How many of a picture's pixels a stipple keeps (KeptPixels): max(2^24, 64 · points) · zoom², or with
 /// `scale` (points 0) max(2^24, 16 · scale · aspect) · zoom² (aspect: the longer side over the shorter),
-/// `zoom` being the deepest zoom drawn (stipple_zoom, at least 1). A dot's spacing then spans about four
-/// kept pixels where the picture is darkest (with `scale`; with `points`, on a picture at least a
-/// sixteenth dark), and no picture up to 4096 × 4096 is averaged.
+/// `zoom` being the deepest zoom drawn (stipple_zoom, at least 1), and at most kMaxImagePixels. A dot's
+/// spacing then spans about four kept pixels where the picture is darkest (with `scale`; with `points`,
+/// on a picture at least a sixteenth dark), and no picture up to 4096 × 4096 is averaged.
 KeptPixels stipple_kept_pixels(double points, double scale, double zoom);
 
 /// Dots over a whole image of `inks` (one or more images of one size, over [0, aspect] × [0, 1]): `points`
