@@ -215,6 +215,11 @@ ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const An
   for (const tools::PointSet& set : sets)
     if (set.classes.size() != set.size())
       throw InvalidInput("every set of labelled points needs its classes");
+  // The closest pair of different classes is searched in the unit square's cells and lengths.
+  if (!sets.empty() && !unit_sides(unit_measure_sides(options.extent, sets.front().dim)))
+    throw InvalidInput(
+        "labelled points (classes) are analysed in the unit square only: give them the aspect 1 (the "
+        "whole set's measures are stretched then)");
   const bool own = !class_densities.empty();
   if (own) out.shares = class_shares(sets, class_densities);
   // The closest pair of different classes: in local spacings of the classes' summed density, if they have

@@ -2,6 +2,7 @@
 // nearest-neighbour spacing (sqrt(2)/n)^(1/3) on the unit cube) and input validation shared by every metric.
 #include "kdm/analysis/common.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +25,24 @@ double reference_spacing(int dim, std::size_t n) {
   if (dim == 2) return hex_spacing(n);
   if (dim == 3) return fcc_spacing(n);
   throw InvalidInput("dimension must be 2 or 3, got " + std::to_string(dim));
+}
+
+Sides unit_measure_sides(const double* extent, int dim) {
+  if (dim != 2 && dim != 3) throw InvalidInput("dimension must be 2 or 3, got " + std::to_string(dim));
+  double lo = HUGE_VAL, hi = 0, product = 1;
+  for (int a = 0; a < dim; ++a) {
+    if (!(extent[a] > 0) || !std::isfinite(extent[a]))
+      throw InvalidInput("the domain's sides must be positive finite numbers, got " +
+                         std::to_string(extent[a]) + " for " + "xyz"[a]);
+    lo = std::min(lo, extent[a]), hi = std::max(hi, extent[a]), product *= extent[a];
+  }
+  // Past this a set of any size has under a spacing across the short side: nothing to measure there.
+  if (hi > 1e4 * lo) throw InvalidInput("the domain's sides are more than 10^4 apart");
+  Sides sides = kUnitSides;
+  if (hi == lo) return sides;  // exactly the unit square (cube), whatever the common length
+  const double scale = dim == 2 ? std::sqrt(product) : std::cbrt(product);
+  for (int a = 0; a < dim; ++a) sides[a] = extent[a] / scale;
+  return sides;
 }
 
 void validate_points(const std::vector<double>& coords, int dim) {

@@ -19,8 +19,8 @@ struct Window {
 };
 
 struct Sat {
-  int r;
-  std::vector<double> s;  // (r+1)² prefix sums
+  int r;                  // raster cells along x
+  std::vector<double> s;  // (ry+1)(r+1) prefix sums
   double mass(int x0, int y0, int x1, int y1) const {
     auto at = [&](int x, int y) { return s[static_cast<std::size_t>(y) * (r + 1) + x]; };
     return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);
@@ -72,23 +72,30 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
     const double side = std::sqrt(options.min_expected / std::max(1.0, total));
     r = std::clamp(static_cast<int>(std::ceil(8.0 / side)), 256, 4096);
   }
-  Sat sat{r, std::vector<double>(static_cast<std::size_t>(r + 1) * (r + 1), 0.0)};
-  for (int y = 0; y < r; ++y)
-    for (int x = 0; x < r; ++x) {
-      const double v = density((x + 0.5) / r, (y + 0.5) / r);
+  // A rectangle's raster has cells square in its lengths (r along a unit side), so windows split along
+  // its longer sides are about square there too.
+  const double lx = options.sides[0], ly = options.sides[1];
+  if (!(lx > 0 && ly > 0 && std::isfinite(lx) && std::isfinite(ly)))
+    throw InvalidInput("the domain's sides must be positive finite numbers");
+  const int rx = lx == 1 ? r : std::clamp(static_cast<int>(std::lround(r * lx)), 1, 1 << 16);
+  const int ry = ly == 1 ? r : std::clamp(static_cast<int>(std::lround(r * ly)), 1, 1 << 16);
+  Sat sat{rx, std::vector<double>(static_cast<std::size_t>(rx + 1) * (ry + 1), 0.0)};
+  for (int y = 0; y < ry; ++y)
+    for (int x = 0; x < rx; ++x) {
+      const double v = density((x + 0.5) / rx, (y + 0.5) / ry);
       if (!std::isfinite(v) || v < 0) throw InvalidInput("target density is negative or not finite");
-      const std::size_t i = static_cast<std::size_t>(y + 1) * (r + 1) + (x + 1);
-      sat.s[i] = v + sat.s[i - 1] + sat.s[i - (r + 1)] - sat.s[i - (r + 1) - 1];
+      const std::size_t i = static_cast<std::size_t>(y + 1) * (rx + 1) + (x + 1);
+      sat.s[i] = v + sat.s[i - 1] + sat.s[i - (rx + 1)] - sat.s[i - (rx + 1) - 1];
     }
-  const double integral = sat.mass(0, 0, r, r);
+  const double integral = sat.mass(0, 0, rx, ry);
   if (!(integral > 0)) throw InvalidInput("target density is zero everywhere");
   const double scale = total / integral;  // raster mass → expected count
-  std::vector<double> cell_rho(static_cast<std::size_t>(r) * r);
+  std::vector<double> cell_rho(static_cast<std::size_t>(rx) * ry);
   double rho_min = std::numeric_limits<double>::infinity(), rho_max = 0;
-  for (int y = 0; y < r; ++y)
-    for (int x = 0; x < r; ++x) {
+  for (int y = 0; y < ry; ++y)
+    for (int x = 0; x < rx; ++x) {
       const double v = sat.mass(x, y, x + 1, y + 1);
-      cell_rho[static_cast<std::size_t>(y) * r + x] = v;
+      cell_rho[static_cast<std::size_t>(y) * rx + x] = v;
       if (v > 0) rho_min = std::min(rho_min, v), rho_max = std::max(rho_max, v);
     }
   const int band_count = rho_max > rho_min * 1.01 ? options.bands : 1;
@@ -111,21 +118,23 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
       out.bands[static_cast<std::size_t>(cell_band[i])].expected += cell_rho[i] * scale;
     }
   std::vector<Window> windows;
-  split(sat, Window{0, 0, r, r}, scale, options.min_expected, windows);
-  std::vector<int> label(static_cast<std::size_t>(r) * r, 0);
+  split(sat, Window{0, 0, rx, ry}, scale, options.min_expected, windows);
+  std::vector<int> label(static_cast<std::size_t>(rx) * ry, 0);
   for (std::size_t k = 0; k < windows.size(); ++k)
     for (int y = windows[k].y0; y < windows[k].y1; ++y)
-      for (int x = windows[k].x0; x < windows[k].x1; ++x) label[static_cast<std::size_t>(y) * r + x] = int(k);
+      for (int x = windows[k].x0; x < windows[k].x1; ++x)
+        label[static_cast<std::size_t>(y) * rx + x] = int(k);
   std::vector<double> counts(windows.size(), 0.0);
   out.points = n;
   for (std::size_t i = 0; i < n; ++i) {
     const double x = coords[2 * i], y = coords[2 * i + 1];
-    const int cx = std::min(r - 1, static_cast<int>(x * r)), cy = std::min(r - 1, static_cast<int>(y * r));
+    const int cx = std::min(rx - 1, static_cast<int>(x * rx)),
+              cy = std::min(ry - 1, static_cast<int>(y * ry));
     if (density(x, y) == 0) {  // counted apart: such points are misplaced, not part of any window's count
       ++out.zero_density;
       continue;
     }
-    const std::size_t cell = static_cast<std::size_t>(cy) * r + cx;
+    const std::size_t cell = static_cast<std::size_t>(cy) * rx + cx;
     counts[label[cell]] += 1;
     if (cell_band[cell] >= 0) out.bands[static_cast<std::size_t>(cell_band[cell])].count += 1;
   }

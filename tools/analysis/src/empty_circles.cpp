@@ -158,29 +158,32 @@ std::vector<Circle> counted_circles(std::vector<double>& xy, const std::vector<s
 }
 
 /// The circumcircles of a torus set's Delaunay triangles, each once, with the set's copies within a margin
-/// m of the square: fewer than 2n circles, or one past the copies, mean the margin was too narrow for some
-/// (a wide hole, or few points). It then grows and the set is triangulated again, up to m = 2: no empty
-/// circle of a torus is wider than √2/2, so none reaches farther than √2 past its lowest point.
-std::vector<Circle> torus_circles_by_margin(const std::vector<double>& coords, double spacing) {
+/// m of the square (or of the lx × ly rectangle, `coords` in its lengths): fewer than 2n circles, or one
+/// past the copies, mean the margin was too narrow for some (a wide hole, or few points). It then grows
+/// and the set is triangulated again, up to m = 2·max(lx, ly): no empty circle of a torus is wider than
+/// half its diagonal, so none reaches farther than the diagonal past its lowest point.
+std::vector<Circle> torus_circles_by_margin(const std::vector<double>& coords, double spacing, double lx = 1,
+                                            double ly = 1) {
   const std::size_t n = coords.size() / 2;
-  for (double m = std::min(2.0, 4 * spacing);;) {
+  const double cap = 2 * std::max(lx, ly);
+  for (double m = std::min(cap, 4 * spacing);;) {
     std::vector<double> xy = coords;
     std::vector<std::size_t> original;  // the point each copy stands for
     for (std::size_t i = 0; i < n; ++i) original.push_back(i);
-    const int shifts = static_cast<int>(std::ceil(m));
+    const int shifts_x = static_cast<int>(std::ceil(m / lx)), shifts_y = static_cast<int>(std::ceil(m / ly));
     for (std::size_t i = 0; i < n; ++i)
-      for (int sx = -shifts; sx <= shifts; ++sx)
-        for (int sy = -shifts; sy <= shifts; ++sy) {
-          const double x = coords[2 * i] + sx, y = coords[2 * i + 1] + sy;
-          if ((sx || sy) && x > -m && x < 1 + m && y > -m && y < 1 + m)
+      for (int sx = -shifts_x; sx <= shifts_x; ++sx)
+        for (int sy = -shifts_y; sy <= shifts_y; ++sy) {
+          const double x = coords[2 * i] + sx * lx, y = coords[2 * i + 1] + sy * ly;
+          if ((sx || sy) && x > -m && x < lx + m && y > -m && y < ly + m)
             xy.insert(xy.end(), {x, y}), original.push_back(i);
         }
     const std::vector<Circle> circles = counted_circles(xy, original, n);
     double reach = 0;  // how far the circles reach past the square
     for (const Circle& c : circles)
-      reach = std::max({reach, c.r - c.x, c.x + c.r - 1, c.r - c.y, c.y + c.r - 1});
-    if ((reach <= m && circles.size() == 2 * n) || m >= 2) return circles;
-    m = std::min(2.0, std::max(2 * m, 1.01 * reach));
+      reach = std::max({reach, c.r - c.x, c.x + c.r - lx, c.r - c.y, c.y + c.r - ly});
+    if ((reach <= m && circles.size() == 2 * n) || m >= cap) return circles;
+    m = std::min(cap, std::max(2 * m, 1.01 * reach));
   }
 }
 
@@ -321,19 +324,23 @@ std::vector<Circle> torus_circles_around_holes(const std::vector<double>& coords
 }
 
 /// The circumcircles of a torus set's Delaunay triangles, each once: with the copies around its holes, or
-/// failing that with a margin; both give the same circles.
-std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing) {
+/// failing that with a margin; both give the same circles. A rectangle (`sides` not the unit square's,
+/// `coords` in its lengths) takes the margin: CopyRegion's cells are the square's.
+std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing, const Sides& sides) {
+  if (!unit_sides(sides)) return torus_circles_by_margin(coords, spacing, sides[0], sides[1]);
   std::vector<Circle> circles = torus_circles_around_holes(coords, spacing);
   return circles.empty() ? torus_circles_by_margin(coords, spacing) : circles;
 }
 
-/// The box set's circumcircles: those centred at least `border` spacings inside the square.
-std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double border) {
+/// The box set's circumcircles: those centred at least `border` spacings inside the square (the lx × ly
+/// rectangle, `xy` in its lengths).
+std::vector<Circle> box_circles(std::vector<double> xy, double spacing, double border, double lx = 1,
+                                double ly = 1) {
   std::vector<Circle> circles;
   const double m = border * spacing;
   delaunay(xy, [&](int i, int j, int k, const std::vector<double>& moved) {
     const Circle c = delaunay_circle(xy, moved, i, j, k);
-    if (std::isfinite(c.r) && c.x >= m && c.x <= 1 - m && c.y >= m && c.y <= 1 - m) circles.push_back(c);
+    if (std::isfinite(c.r) && c.x >= m && c.x <= lx - m && c.y >= m && c.y <= ly - m) circles.push_back(c);
   });
   return circles;
 }
@@ -367,11 +374,17 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
   SetCircles out;
   const double spacing = hex_spacing(set.size());  // of all the points, coincident ones too
   const double edge_band = o.tile_size > 0 ? spacing : 0;
-  const std::vector<double> xy = distinct_positions(set.coords);
-  for (const Circle& c : o.torus ? torus_circles(xy, spacing) : box_circles(xy, spacing, o.border)) {
+  const double lx = o.sides[0], ly = o.sides[1];
+  const bool square = lx == 1 && ly == 1;
+  std::vector<double> xy = distinct_positions(set.coords);
+  if (!square)  // triangulated in the rectangle's own lengths: a Delaunay triangulation is no affine map's
+    for (std::size_t i = 0; i < xy.size(); i += 2) xy[i] *= lx, xy[i + 1] *= ly;
+  for (const Circle& c :
+       o.torus ? torus_circles(xy, spacing, o.sides) : box_circles(xy, spacing, o.border, lx, ly)) {
     double local = spacing;
     if (o.density) {
-      const double rho = o.density(std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0));
+      const double u = square ? c.x : c.x / lx, v = square ? c.y : c.y / ly;  // the density's coordinates
+      const double rho = o.density(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0));
       if (!(rho > 0) || rho < o.min_relative_density * max_rho) continue;
       local = spacing * std::sqrt(mean_rho / rho);
     }
@@ -413,6 +426,10 @@ EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const Empty
       o.density ? density_scale(o.density) : std::pair<double, double>(1, 1);
   const double mean_rho = scale.first, max_rho = scale.second;
   if (o.density && !(mean_rho > 0)) throw InvalidInput("the target density is zero everywhere");
+  if (!(o.sides[0] > 0 && o.sides[1] > 0 && std::isfinite(o.sides[0]) && std::isfinite(o.sides[1])))
+    throw InvalidInput("the domain's sides must be positive finite numbers");
+  if (o.tile_size > 0 && !unit_sides(o.sides))
+    throw InvalidInput("tile edges are those of square tiles of the unit square, not of a rectangle");
   EmptyCircles out;
   for (const tools::PointSet& set : sets) {
     if (set.dim != 2) throw InvalidInput("empty circles are 2D only");

@@ -160,6 +160,8 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
   for (const std::string& s : inputs) w.value(s);
   w.end_array();
   w.key("dim").value(r.dim).key("domain").value(r.torus ? "torus" : "box");
+  if (!unit_sides(r.sides))  // the unit square's document stays as it was
+    w.key("sides").value(std::vector<double>(r.sides.begin(), r.sides.begin() + r.dim));
   w.key("sets").value(r.sets).key("points_min").value(r.points_min).key("points_max").value(r.points_max);
   w.key("points_mean").value(r.points_mean);
   w.key("spacing_unit").value(r.dim == 2 ? "d_hex = sqrt(2/(sqrt(3) n))" : "fcc = (sqrt(2)/n)^(1/3)");

@@ -15,15 +15,16 @@
 
 namespace kdm::analysis {
 
-NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads) {
+NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads,
+                                     const Sides& sides) {
   validate_points(coords, dim);
   const std::size_t n = coords.size() / dim;
   if (n < 2) throw InvalidInput("nearest-neighbour statistics need at least 2 points");
-  const detail::CellGrid grid(coords, dim, 2.0, dim == 2 ? 2048 : 160);
+  const int max_cells[3] = {dim == 2 ? 2048 : 160, dim == 2 ? 2048 : 160, 160};
+  const detail::CellGrid grid(coords, dim, 2.0, max_cells, sides);
   // A point that stands on another has it as its nearest (the smallest such index, as the search's ties
   // pick): no search, which within a large group would compare every pair.
   const std::vector<std::size_t> partner = detail::distinct_positions(coords, dim).partner;
-  const int g = grid.g;
   NearestNeighbours out;
   out.dim = dim;
   out.distance.assign(n, 0.0);
@@ -41,13 +42,14 @@ NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim,
       }
       const double* p = &coords[i * dim];
       int home[3] = {0, 0, 0};
-      for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a]);
+      for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a], a);
       double best = std::numeric_limits<double>::infinity();
       std::size_t best_j = i;
       auto visit = [&](const int* off) {
         int c[3] = {0, 0, 0};
         for (int a = 0; a < dim; ++a) {
           int v = home[a] + off[a];
+          const int g = grid.g[a];
           if (torus) {
             v %= g;
             if (v < 0) v += g;
@@ -62,7 +64,7 @@ NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim,
           if (j == i) continue;
           double d2 = 0;
           for (int a = 0; a < dim; ++a) {
-            const double d = axis_delta(p[a], coords[j * dim + a], torus);
+            const double d = axis_delta(p[a], coords[j * dim + a], torus, sides[a]);
             d2 += d * d;
           }
           if (d2 < best || (d2 == best && j < best_j)) {
@@ -81,13 +83,14 @@ NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim,
               visit(off);
             }
         const double reach = r * grid.h;
+        const int g = *std::max_element(grid.g, grid.g + dim);
         const bool covered = torus ? 2 * r + 1 >= g : r >= g;
         if (covered || best <= reach * reach) break;
       }
       out.distance[i] = std::sqrt(best);
       out.index[i] = best_j;
       for (int a = 0; a < dim; ++a)
-        out.offset[i * dim + a] = axis_delta(p[a], coords[best_j * dim + a], torus);
+        out.offset[i * dim + a] = axis_delta(p[a], coords[best_j * dim + a], torus, sides[a]);
     }
   });
   return out;
@@ -133,8 +136,8 @@ NNStats summarise_nn(const std::vector<double>& distances, double spacing, int b
   return s;
 }
 
-NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads) {
-  const NearestNeighbours nn = nearest_neighbours(coords, dim, torus, threads);
+NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads, const Sides& sides) {
+  const NearestNeighbours nn = nearest_neighbours(coords, dim, torus, threads, sides);
   return summarise_nn(nn.distance, reference_spacing(dim, nn.distance.size()));
 }
 

@@ -22,15 +22,17 @@ double ball_volume(int dim, double r) {
 
 // Adds the weighted pair histogram of one set (distances in unit lengths, bins of width `width`). Points at
 // one position are counted as one with their multiplicity, so a group costs what one point does.
-void pair_histogram(const std::vector<double>& points, int dim, bool torus, double r_abs, int bins,
-                    int threads, std::vector<double>& hist) {
+void pair_histogram(const std::vector<double>& points, int dim, bool torus, const Sides& sides, double r_abs,
+                    int bins, int threads, std::vector<double>& hist) {
   const detail::DistinctPositions distinct = detail::distinct_positions(points, dim);
   const std::vector<double>& coords = distinct.any_coincident ? distinct.coords : points;
   const auto weight = [&](std::size_t i) { return distinct.any_coincident ? distinct.multiplicity[i] : 1.0; };
   const std::size_t n = coords.size() / dim;
-  const int g_cells = std::max(1, static_cast<int>(std::floor(1.0 / r_abs)));
-  const detail::CellGrid grid(coords, dim, 1.0, std::min(g_cells, dim == 2 ? 4096 : 256));
-  const int g = grid.g;  // cell side ≥ r_abs: neighbours lie in the 3^dim surrounding cells
+  int max_cells[3];  // cell sides ≥ r_abs: neighbours lie in the 3^dim surrounding cells
+  for (int a = 0; a < 3; ++a)
+    max_cells[a] =
+        std::min(std::max(1, static_cast<int>(std::floor(sides[a] / r_abs))), dim == 2 ? 4096 : 256);
+  const detail::CellGrid grid(coords, dim, 1.0, max_cells, sides);
   const double width = r_abs / bins;
   const int workers = detail::worker_count(threads, static_cast<std::ptrdiff_t>(n));
   std::vector<std::vector<double>> local(workers, std::vector<double>(bins, 0.0));
@@ -43,7 +45,7 @@ void pair_histogram(const std::vector<double>& points, int dim, bool torus, doub
       const double w = weight(i);
       h[0] += w * (w - 1);  // the ordered pairs of the points standing at p, at distance 0
       int home[3] = {0, 0, 0};
-      for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a]);
+      for (int a = 0; a < dim; ++a) home[a] = grid.axis_cell(p[a], a);
       cells.clear();
       const int rz = dim == 3 ? 1 : 0;
       for (int dz = -rz; dz <= rz; ++dz)
@@ -54,6 +56,7 @@ void pair_histogram(const std::vector<double>& points, int dim, bool torus, doub
             bool inside = true;
             for (int a = 0; a < dim; ++a) {
               int v = home[a] + off[a];
+              const int g = grid.g[a];
               if (torus)
                 v = ((v % g) + g) % g;
               else if (v < 0 || v >= g)
@@ -70,9 +73,10 @@ void pair_histogram(const std::vector<double>& points, int dim, bool torus, doub
           if (j == i) continue;
           double d2 = 0, cover = 1;
           for (int a = 0; a < dim; ++a) {
-            const double d = axis_delta(p[a], coords[j * dim + a], torus);
-            d2 += d * d;
-            cover *= 1.0 - std::abs(d);
+            const double d = axis_delta(p[a], coords[j * dim + a], torus);  // normalised
+            const double along = sides[a] == 1 ? d : d * sides[a];
+            d2 += along * along;
+            cover *= 1.0 - std::abs(d);  // the share of the box a translate by d keeps, in any lengths
           }
           const double d = std::sqrt(d2);
           if (d >= r_abs) continue;
@@ -88,7 +92,7 @@ void pair_histogram(const std::vector<double>& points, int dim, bool torus, doub
 }  // namespace
 
 PairCorrelation pair_correlation(const std::vector<tools::PointSet>& sets, bool torus, double r_max, int bins,
-                                 int threads) {
+                                 int threads, const Sides& sides) {
   if (sets.empty()) throw InvalidInput("no point sets to analyse");
   if (bins < 1 || !(r_max > 0)) throw InvalidInput("pair correlation needs bins >= 1 and r_max > 0");
   const int dim = sets[0].dim;
@@ -101,11 +105,12 @@ PairCorrelation pair_correlation(const std::vector<tools::PointSet>& sets, bool 
   }
   PairCorrelation out;
   out.spacing = reference_spacing(dim, static_cast<std::size_t>(std::llround(total / sets.size())));
-  out.r_max = std::min(r_max, 0.5 / out.spacing);
+  const double shortest = *std::min_element(sides.begin(), sides.begin() + dim);
+  out.r_max = std::min(r_max, 0.5 * shortest / out.spacing);
   const double r_abs = out.r_max * out.spacing;
   std::vector<double> hist(bins, 0.0), expected(bins, 0.0);
   for (const tools::PointSet& s : sets) {
-    pair_histogram(s.coords, dim, torus, r_abs, bins, threads, hist);
+    pair_histogram(s.coords, dim, torus, sides, r_abs, bins, threads, hist);
     const double pairs = static_cast<double>(s.size()) * static_cast<double>(s.size() - 1);
     for (int b = 0; b < bins; ++b)
       expected[b] += pairs * (ball_volume(dim, r_abs * (b + 1) / bins) - ball_volume(dim, r_abs * b / bins));

@@ -37,67 +37,87 @@ int fft_size(int at_least) {
   }
 }
 
-// Adds |S(k)|²/n of one set to `acc` ((2kmax+1)² grid, disc |k| ≤ kmax; NaN outside it).
-void accumulate_set(const std::vector<double>& coords, int kmax, int threads, std::vector<double>& acc) {
+// One axis of the oversampled grid: `modes` integer frequencies (−half..half), the grid's side m, and the
+// width τ of the Gaussian exp(−d²/(4τ)) (d in normalised units) chosen for the oversampling.
+struct Axis {
+  int half = 0, modes = 1, m = 1;
+  double tau = 0;
+  explicit Axis(int half_width) : half(half_width), modes(2 * half_width + 1), m(fft_size(2 * modes)) {
+    const double ratio = double(m) / modes;
+    tau = kSpread / (4 * kPi * ratio * (ratio - 0.5) * double(modes) * modes);
+  }
+  // The Gaussian's weights at the 2·kSpread grid points about v, and their (wrapped) indices.
+  void weights(double v, double* out, int* index) const {
+    const int c = static_cast<int>(std::floor(v * m));
+    for (int t = 0; t < 2 * kSpread; ++t) {
+      const int g = c - kSpread + 1 + t;
+      const double d = v - double(g) / m;
+      out[t] = std::exp(-d * d / (4 * tau));
+      index[t] = ((g % m) + m) % m;
+    }
+  }
+  // The Gaussian's coefficient at frequency k divided out: √(4πτ)·exp(−4π²τk²), and the FFT's sum over m
+  // grid points stands for m times the integral.
+  double deconvolve(int k) const {
+    return std::exp(4 * kPi * kPi * tau * double(k) * k) / (m * std::sqrt(4 * kPi * tau));
+  }
+};
+
+// Adds |S(k)|²/n of one set to `p.power` (grid kx ∈ [−kx_max, kx_max], ky likewise; NaN outside the disc
+// |k| ≤ kmax). S is taken at integer (kx, ky) of the normalised coordinates: on a rectangle of sides
+// lx × ly those are the frequencies (kx/lx, ky/ly) of the points in its own lengths.
+void accumulate_set(const std::vector<double>& coords, Periodogram& p, int threads) {
   const std::size_t n = coords.size() / 2;
-  const int modes = 2 * kmax + 1;
-  const int m = fft_size(2 * modes);  // the oversampled grid's side
-  const double ratio = double(m) / modes;
-  // The Gaussian exp(−d²/(4τ)) (d in units of the unit square), its width chosen for the oversampling.
-  const double tau = kSpread / (4 * kPi * ratio * (ratio - 0.5) * double(modes) * modes);
-  std::vector<double> grid(std::size_t(m) * std::size_t(m), 0.0);  // row y, column x
+  const Axis ax(p.kx_max), ay(p.ky_max);
+  std::vector<double> grid(std::size_t(ay.m) * std::size_t(ax.m), 0.0);  // row y, column x
   {
     constexpr int w = 2 * kSpread;
     double wx[w], wy[w];
     int ix[w], iy[w];
-    const auto weights = [&](double v, double* out, int* index) {
-      const int c = static_cast<int>(std::floor(v * m));
-      for (int t = 0; t < w; ++t) {
-        const int g = c - kSpread + 1 + t;
-        const double d = v - double(g) / m;
-        out[t] = std::exp(-d * d / (4 * tau));
-        index[t] = ((g % m) + m) % m;
-      }
-    };
     for (std::size_t j = 0; j < n; ++j) {  // in order: the sums do not depend on threads
-      weights(coords[2 * j], wx, ix);
-      weights(coords[2 * j + 1], wy, iy);
+      ax.weights(coords[2 * j], wx, ix);
+      ay.weights(coords[2 * j + 1], wy, iy);
       for (int ty = 0; ty < w; ++ty) {
-        double* row = grid.data() + std::size_t(iy[ty]) * m;
+        double* row = grid.data() + std::size_t(iy[ty]) * ax.m;
         for (int tx = 0; tx < w; ++tx) row[ix[tx]] += wy[ty] * wx[tx];
       }
     }
   }
-  // Rows: kx ∈ [0, kmax] of each (the other half plane is the mirror image: P(−k) = P(k)).
-  const int kx_count = kmax + 1;
-  std::vector<std::complex<double>> half(std::size_t(m) * kx_count);
-  const int workers = detail::worker_count(threads, m);
+  // Rows: kx ∈ [0, kx_max] of each (the other half plane is the mirror image: P(−k) = P(k)).
+  const int kx_count = p.kx_max + 1;
+  std::vector<std::complex<double>> half(std::size_t(ay.m) * kx_count);
+  const int workers = detail::worker_count(threads, ay.m);
   std::vector<Eigen::FFT<double>> ffts(workers);
-  std::vector<std::vector<double>> row_in(workers, std::vector<double>(m));
-  std::vector<std::vector<std::complex<double>>> out(workers, std::vector<std::complex<double>>(m));
-  detail::parallel_for(m, workers, [&](std::ptrdiff_t y, int t) {
-    std::copy_n(grid.data() + y * m, m, row_in[t].data());
+  std::vector<std::vector<double>> row_in(workers, std::vector<double>(ax.m));
+  std::vector<std::vector<std::complex<double>>> out(workers, std::vector<std::complex<double>>(ax.m));
+  detail::parallel_for(ay.m, workers, [&](std::ptrdiff_t y, int t) {
+    std::copy_n(grid.data() + y * ax.m, ax.m, row_in[t].data());
     ffts[t].fwd(out[t], row_in[t]);
     std::copy_n(out[t].data(), kx_count, half.data() + y * kx_count);
   });
   std::vector<double>().swap(grid);
-  // Columns, then the Gaussian divided out: its coefficients are √(4πτ)·exp(−4π²τk²) per axis, and the
-  // FFT's sum over m grid points stands for m times the integral.
-  const int side = 2 * kmax + 1;
+  // Columns, then the Gaussian divided out.
+  const int width = p.width();
   const double inv_n = 1.0 / static_cast<double>(n), nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::vector<std::complex<double>>> column(workers, std::vector<std::complex<double>>(m));
-  std::vector<double> deconvolve(kx_count);
-  for (int k = 0; k <= kmax; ++k)
-    deconvolve[k] = std::exp(4 * kPi * kPi * tau * double(k) * k) / (m * std::sqrt(4 * kPi * tau));
+  const bool square = p.lx == 1 && p.ly == 1;
+  const double k2max = double(p.kmax) * p.kmax;
+  std::vector<std::vector<std::complex<double>>> column(workers, std::vector<std::complex<double>>(ay.m));
+  std::vector<std::vector<std::complex<double>>> column_out(workers, std::vector<std::complex<double>>(ay.m));
+  std::vector<double> deconvolve_x(kx_count), deconvolve_y(p.ky_max + 1);
+  for (int k = 0; k <= p.kx_max; ++k) deconvolve_x[k] = ax.deconvolve(k);
+  for (int k = 0; k <= p.ky_max; ++k) deconvolve_y[k] = ay.deconvolve(k);
   detail::parallel_for(kx_count, workers, [&](std::ptrdiff_t kx, int t) {
-    for (int y = 0; y < m; ++y) column[t][y] = half[std::size_t(y) * kx_count + kx];
-    ffts[t].fwd(out[t], column[t]);
-    for (int ky = -kmax; ky <= kmax; ++ky) {
-      const bool inside = kx * kx + ky * ky <= std::ptrdiff_t(kmax) * kmax;
-      const std::complex<double> s = out[t][(ky + m) % m] * (deconvolve[kx] * deconvolve[std::abs(ky)]);
-      const double p = inside ? std::norm(s) * inv_n : nan;
-      acc[static_cast<std::size_t>(ky + kmax) * side + (kx + kmax)] += p;
-      if (kx > 0) acc[static_cast<std::size_t>(kmax - ky) * side + (kmax - kx)] += p;
+    for (int y = 0; y < ay.m; ++y) column[t][y] = half[std::size_t(y) * kx_count + kx];
+    ffts[t].fwd(column_out[t], column[t]);
+    for (int ky = -p.ky_max; ky <= p.ky_max; ++ky) {
+      const double fx = double(kx) / p.lx, fy = double(ky) / p.ly;
+      const bool inside =
+          square ? kx * kx + ky * ky <= std::ptrdiff_t(p.kmax) * p.kmax : fx * fx + fy * fy <= k2max;
+      const std::complex<double> s =
+          column_out[t][(ky + ay.m) % ay.m] * (deconvolve_x[kx] * deconvolve_y[std::abs(ky)]);
+      const double v = inside ? std::norm(s) * inv_n : nan;
+      p.power[static_cast<std::size_t>(ky + p.ky_max) * width + (kx + p.kx_max)] += v;
+      if (kx > 0) p.power[static_cast<std::size_t>(p.ky_max - ky) * width + (p.kx_max - kx)] += v;
     }
   });
 }
@@ -115,7 +135,7 @@ int Periodogram::ring_max() const {
 
 namespace {
 
-Periodogram make_grid(double mean_n, double fmax) {
+Periodogram make_grid(double mean_n, double fmax, const Sides& sides) {
   if (!(fmax > 0) || !std::isfinite(fmax)) throw InvalidInput("fmax must be a positive number");
   Periodogram p;
   p.n = mean_n;
@@ -130,20 +150,26 @@ Periodogram make_grid(double mean_n, double fmax) {
     throw InvalidInput(text);
   }
   p.kmax = static_cast<int>(kmax);
-  p.power.assign(static_cast<std::size_t>(p.side()) * p.side(), 0.0);
+  p.lx = sides[0], p.ly = sides[1];
+  // The disc |k| ≤ kmax reaches kmax·lx integer steps along x (an exact kmax on the square).
+  p.kx_max = p.lx == 1 ? p.kmax : static_cast<int>(std::ceil(kmax * p.lx));
+  p.ky_max = p.ly == 1 ? p.kmax : static_cast<int>(std::ceil(kmax * p.ly));
+  p.power.assign(static_cast<std::size_t>(p.width()) * p.height(), 0.0);
   return p;
 }
 
 }  // namespace
 
-Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads) {
+Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads,
+                        const Sides& sides) {
   tools::PointSet s;
   s.dim = dim;
   s.coords = coords;
-  return average_periodogram({s}, fmax, threads);
+  return average_periodogram({s}, fmax, threads, sides);
 }
 
-Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads) {
+Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads,
+                                const Sides& sides) {
   if (sets.empty()) throw InvalidInput("no point sets to analyse");
   double total = 0;
   std::size_t fewest = sets.front().size(), most = fewest;
@@ -159,8 +185,8 @@ Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double
   if (double(most) > 1.1 * double(fewest))
     throw InvalidInput("the spectrum pools sets of about one size: these hold " + std::to_string(fewest) +
                        " to " + std::to_string(most) + " points (more than 10% apart); analyse them apart");
-  Periodogram p = make_grid(total / static_cast<double>(sets.size()), fmax);
-  for (const tools::PointSet& s : sets) accumulate_set(s.coords, p.kmax, threads, p.power);
+  Periodogram p = make_grid(total / static_cast<double>(sets.size()), fmax, sides);
+  for (const tools::PointSet& s : sets) accumulate_set(s.coords, p, threads);
   for (double& v : p.power) v /= static_cast<double>(sets.size());
   p.sets = static_cast<int>(sets.size());
   return p;
@@ -180,10 +206,11 @@ SpectrumStats spectrum_stats(const Periodogram& p) {
   const double k_low = 0.5 * std::sqrt(p.n);
   double low_sum = 0;
   std::size_t low_count = 0;
-  for (int ky = -p.kmax; ky <= p.kmax; ++ky)
-    for (int kx = -p.kmax; kx <= p.kmax; ++kx) {
+  const bool square = p.lx == 1 && p.ly == 1;
+  for (int ky = -p.ky_max; ky <= p.ky_max; ++ky)
+    for (int kx = -p.kx_max; kx <= p.kx_max; ++kx) {
       if (kx == 0 && ky == 0) continue;
-      const double kn = std::hypot(kx, ky);
+      const double kn = square ? std::hypot(kx, ky) : std::hypot(kx / p.lx, ky / p.ly);
       const double v = p.at(kx, ky);
       if (kn < k_low) {
         low_sum += v;

@@ -64,28 +64,34 @@ void draw_text(tools::RgbImage& image, int x, int y, const char* text, int scale
   }
 }
 
-tools::RgbImage plot_points(const tools::PointSet& set, int size_px) {
-  tools::RgbImage im(size_px, size_px, 255);
+tools::RgbImage plot_points(const tools::PointSet& set, int size_px, const Sides& sides) {
+  const bool square = sides[0] == sides[1];
+  const double longer = std::max(sides[0], sides[1]);
+  const int w = square ? size_px : std::max(1, static_cast<int>(std::lround(size_px * sides[0] / longer)));
+  const int h = square ? size_px : std::max(1, static_cast<int>(std::lround(size_px * sides[1] / longer)));
+  tools::RgbImage im(w, h, 255);
   const std::uint8_t black[3] = {0, 0, 0};
   const std::size_t n = set.size();
-  const double r = std::max(0.6, 0.22 * size_px / std::sqrt(std::max<std::size_t>(1, n)));
+  // Dots scale with the spacing: size_px over the unit square's side, the longer side's pixels over its.
+  const double unit_px = square ? size_px : size_px / longer;
+  const double r = std::max(0.6, 0.22 * unit_px / std::sqrt(std::max<std::size_t>(1, n)));
   for (std::size_t i = 0; i < n; ++i)
-    tools::draw_disc(im, set.coords[i * set.dim] * size_px, (1.0 - set.coords[i * set.dim + 1]) * size_px, r,
-                     black);
+    tools::draw_disc(im, set.coords[i * set.dim] * w, (1.0 - set.coords[i * set.dim + 1]) * h, r, black);
   return im;
 }
 
 tools::RgbImage plot_spectrum(const Periodogram& p, int min_size_px) {
-  const int side = p.side();
+  // A rectangle's grid is as wide as its lattice: one square pixel block per frequency.
+  const int side = std::max(p.width(), p.height());
   const int s = std::max(1, (min_size_px + side - 1) / side);
-  tools::RgbImage im(side * s, side * s, 0);
-  for (int ky = -p.kmax; ky <= p.kmax; ++ky)
-    for (int kx = -p.kmax; kx <= p.kmax; ++kx) {
+  tools::RgbImage im(p.width() * s, p.height() * s, 0);
+  for (int ky = -p.ky_max; ky <= p.ky_max; ++ky)
+    for (int kx = -p.kx_max; kx <= p.kx_max; ++kx) {
       const double v = std::log10(std::max(1e-12, p.at(kx, ky)));
       const double t = std::clamp((v + 1.5) / 2.5, 0.0, 1.0);
       const std::uint8_t g = static_cast<std::uint8_t>(std::lround(255 * t));
       const std::uint8_t rgb[3] = {g, g, g};
-      const int px = (kx + p.kmax) * s, py = (p.kmax - ky) * s;
+      const int px = (kx + p.kx_max) * s, py = (p.ky_max - ky) * s;
       fill_rect(im, px, py, px + s, py + s, rgb);
     }
   return im;

@@ -33,7 +33,7 @@ constexpr double kNonuniformRmsZ = 3;
 /// or windows of equal area whose counts vary far beyond Poisson (`uniform_rms_z`: their RMS z when the
 /// density test already counted them, else NaN). The spectrum of such a set measures its density.
 std::string nonuniform_reason(const std::vector<tools::PointSet>& sets, const AnalysisOptions& o,
-                              double uniform_rms_z) {
+                              const Sides& sides, double uniform_rms_z) {
   if (o.density) {
     double lo = HUGE_VAL, hi = 0;
     constexpr int kGrid = 64;
@@ -49,6 +49,7 @@ std::string nonuniform_reason(const std::vector<tools::PointSet>& sets, const An
     DensityOptions dopt;
     dopt.min_expected = o.min_expected;
     dopt.bands = 1;
+    dopt.sides = sides;
     double z2 = 0, windows = 0;
     for (const tools::PointSet& s : sets) {
       const DensityAccuracy d = density_accuracy(
@@ -124,7 +125,13 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     total += static_cast<double>(s.size());
   }
   r.points_mean = total / static_cast<double>(sets.size());
+  r.sides = unit_measure_sides(o.extent, r.dim);
+  const Sides& sides = r.sides;
   if (o.tile_size > 0) tiles_per_axis(o.tile_size);  // validate options before the expensive parts
+  if (o.tile_size > 0 && !unit_sides(sides))
+    throw InvalidInput(
+        "tiling diagnostics take square tiles of the unit square: leave out the tile size for "
+        "a set drawn in a rectangle");
 
   const auto checkpoint = [&] {
     if (o.checkpoint) o.checkpoint();
@@ -132,7 +139,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
   std::vector<double> pooled, seam, interior;
   for (const tools::PointSet& s : sets) {
     checkpoint();
-    const NearestNeighbours nn = nearest_neighbours(s.coords, s.dim, o.torus, o.threads);
+    const NearestNeighbours nn = nearest_neighbours(s.coords, s.dim, o.torus, o.threads, sides);
     const double spacing = reference_spacing(s.dim, s.size());
     double lo = nn.distance.front();
     for (double d : nn.distance) {
@@ -154,14 +161,14 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     r.spectrum_skipped = "sets of " + std::to_string(r.points_min) + " to " + std::to_string(r.points_max) +
                          " points (more than 10% apart) have no common frequency axis: analyse them apart";
   } else if (o.spectrum && r.dim == 2) {
-    r.spectrum = average_periodogram(sets, o.fmax, o.threads);
+    r.spectrum = average_periodogram(sets, o.fmax, o.threads, sides);
     r.spectrum_stats = spectrum_stats(r.spectrum);
     r.has_spectrum = true;
   } else if (o.spectrum) {
     r.spectrum_skipped = "2D only (3D sets get nearest neighbours, g(r) and the energy)";
   }
   checkpoint();
-  r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads);
+  r.gr = pair_correlation(sets, o.torus, o.gr_rmax, o.gr_bins, o.threads, sides);
   checkpoint();
   if (r.dim == 2 && r.points_min < 3)
     r.empty_circles_skipped = "a set of fewer than 3 points has no triangle";
@@ -173,6 +180,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     eo.tile_size = o.tile_size;
     eo.min_relative_density = o.holes_min_density;
     eo.threads = o.threads;
+    eo.sides = sides;
     try {  // the other measures stand without them
       r.empty_circles = empty_circles(sets, eo);
       r.has_empty_circles = r.empty_circles.triangles > 0;
@@ -192,6 +200,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     DensityOptions dopt;
     dopt.min_expected = o.min_expected;
     dopt.bands = o.density_bands;
+    dopt.sides = sides;
     double z2 = 0, mu_sum = 0, count_sum = 0;  // pooled over all windows of all sets
     for (const tools::PointSet& s : sets) {
       checkpoint();
@@ -226,7 +235,7 @@ AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisO
     checkpoint();
     // The density test's windows are those of a uniform density when its target is constant.
     const double rms_z = r.has_density && r.density.windows > 0 ? r.density.rms_z : std::nan("");
-    r.spectrum_nonuniform = nonuniform_reason(sets, o, rms_z);
+    r.spectrum_nonuniform = nonuniform_reason(sets, o, sides, rms_z);
   }
 
   if (o.tile_size > 0) {
@@ -267,6 +276,15 @@ std::string format_summary(const AnalysisReport& r) {
   append(s, " %dD points, %s\n", r.dim,
          r.torus ? "torus distances (the set wraps around; --box for a bounded set)"
                  : "box distances (a bounded set; --torus for one that wraps around)");
+  if (!unit_sides(r.sides)) {  // the unit square's summary stays as it was
+    if (r.dim == 2)
+      append(s,
+             "domain             %.4g × %.4g rectangle (aspect %.4g, unit area): distances in its lengths\n",
+             r.sides[0], r.sides[1], r.sides[0] / r.sides[1]);
+    else
+      append(s, "domain             %.4g × %.4g × %.4g box (unit volume): distances in its lengths\n",
+             r.sides[0], r.sides[1], r.sides[2]);
+  }
   append(s, "nearest neighbour  δmin %.3f (mean over sets %.3f)  δavg %.3f  NN1%% %.3f  (units of %s)\n",
          r.nn.dmin, r.dmin_mean, r.nn.davg, r.nn.nn1, r.dim == 2 ? "d_hex" : "FCC spacing");
   if (r.coincident > 0)

@@ -23,6 +23,8 @@ int tiles_per_axis(double tile_size) {
 
 PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& stats, double tile_size) {
   const int t = tiles_per_axis(tile_size);
+  if (p.lx != 1 || p.ly != 1)
+    throw InvalidInput("tiling diagnostics take square tiles of the unit square, not a rectangle's spectrum");
   PeriodicityResult out;
   double power = 0, raps = 0;
   const int rmax = static_cast<int>(stats.raps.size());

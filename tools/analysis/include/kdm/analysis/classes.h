@@ -80,9 +80,9 @@ DensityFunction summed_density(const std::vector<DensityFunction>& densities);
 /// (kdm sample --class: const:1 and const:2 give a third and two thirds). The closest pair of different
 /// classes is then in local spacings of their sum (summed_density). The union itself is the caller's
 /// analyze(): its target is options.density if the caller chose one, else summed_density(class_densities).
-/// Throws InvalidInput for fewer densities than the labels run to, an empty density, one
-/// that is negative or not finite, a class with points whose density is zero everywhere, or densities
-/// all zero.
+/// Throws InvalidInput for fewer densities than the labels run to, an empty density, one that is negative
+/// or not finite, a class with points whose density is zero everywhere, densities all zero, or
+/// options.extent other than a square's (cube's).
 ClassesReport analyze_classes(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options,
                               const ClassEnergy& energy = {},
                               const std::vector<DensityFunction>& class_densities = {});

@@ -3,6 +3,7 @@
 // minimum-image displacement used for periodic (torus) distances.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <stdexcept>
 #include <vector>
@@ -11,7 +12,14 @@ namespace kdm::analysis {
 
 // Points are passed as interleaved coordinates `const std::vector<double>& coords` (x0 y0 x1 y1 ... or
 // x0 y0 z0 ...), `dim` (2 or 3) per point, normalised to the unit square/cube [0,1)^dim. A flag `torus`
-// selects periodic (minimum-image) distances; otherwise the domain is a bounded box.
+// selects periodic (minimum-image) distances; otherwise the domain is a bounded box. A set drawn in a
+// rectangle (box) has its points normalised all the same; `Sides` then say the domain's side lengths,
+// scaled to unit area (volume), and every distance is measured in them.
+
+/// Side lengths of the domain, x y z, in units where it has area (2D) or volume (3D) 1: {1, 1, 1} is the
+/// unit square (cube); a 2:1 rectangle is {√2, 1/√2, 1}. A coordinate v ∈ [0, 1] lies at v · side.
+using Sides = std::array<double, 3>;
+inline constexpr Sides kUnitSides = {1, 1, 1};
 
 /// Thrown for invalid input (wrong dimension, coordinates outside [0,1], non-finite values, too few points).
 struct InvalidInput : std::invalid_argument {
@@ -34,6 +42,17 @@ double reference_spacing(int dim, std::size_t n);
 /// Thread-safe (reads only).
 void validate_points(const std::vector<double>& coords, int dim);
 
+/// The sides of a domain of relative side lengths `extent` (x y z; only the first `dim` are read) scaled to
+/// unit area (2D) or volume (3D): extent {2, 1} gives {√2, 1/√2}; all-equal sides give exactly 1 each.
+/// Throws InvalidInput for a side that is not a positive finite number, or sides more than 10^4 apart.
+/// Thread-safe (pure).
+Sides unit_measure_sides(const double* extent, int dim);
+
+/// Whether `sides` are the unit square's (cube's): every one exactly 1.
+inline bool unit_sides(const Sides& sides) {
+  return sides[0] == 1 && sides[1] == 1 && sides[2] == 1;
+}
+
 /// Component of the displacement b − a along one axis; on the torus the minimum image in [−1/2, 1/2].
 inline double axis_delta(double a, double b, bool torus) {
   double d = b - a;
@@ -44,6 +63,12 @@ inline double axis_delta(double a, double b, bool torus) {
       d += 1.0;
   }
   return d;
+}
+
+/// axis_delta in the domain's lengths: the normalised displacement times the axis's `side` (a period of
+/// `side` on the torus). A side of 1 gives axis_delta's bits.
+inline double axis_delta(double a, double b, bool torus, double side) {
+  return axis_delta(a, b, torus) * side;
 }
 
 }  // namespace kdm::analysis

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "kdm/analysis/common.h"
+
 namespace kdm::analysis {
 
 /// Target density ρ(x, y) ≥ 0 on [0,1]² (x right, y up; any scale — it is normalised). Must be a pure
@@ -22,6 +24,9 @@ struct DensityOptions {
   double min_expected = 20;  ///< every window has expected count μ ≥ this (unless the whole set has fewer)
   double expected_total = 0;  ///< expected total count; 0 = the set's own point count
   int raster = 0;             ///< density raster per axis; 0 = automatic (≥ 8 cells per window side)
+  /// The domain's sides (common.h): a rectangle gets a raster of cells square in its lengths (`raster`
+  /// along a side of 1) and windows about square there. Only x and y are read.
+  Sides sides = kUnitSides;
   /// Bands of equal width in log ρ between the sparsest non-zero raster cell and the densest (one band
   /// when they differ by less than 1%).
   int bands = 10;
@@ -48,9 +53,9 @@ struct DensityAccuracy {
   std::vector<DensityBand> bands;  ///< sparsest first
 };
 
-/// Measures one 2D set (interleaved x y in [0,1]²) against `density`. Throws InvalidInput for invalid
-/// points, dim ≠ 2, a density that is negative, non-finite or zero everywhere, min_expected ≤ 0 or
-/// bands < 1.
+/// Measures one 2D set (interleaved x y in [0,1]²; `density` takes the same normalised coordinates) against
+/// `density`. Throws InvalidInput for invalid points, dim ≠ 2, a density that is negative, non-finite or zero
+/// everywhere, min_expected ≤ 0, bands < 1 or sides that are not positive.
 /// Thread-safe if `density` is.
 DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, const DensityFunction& density,
                                  const DensityOptions& options = {});

@@ -24,6 +24,9 @@ struct EmptyCircleOptions {
   /// count, scaled by √(mean ρ / ρ(centre))); circles centred where ρ = 0 are left out. Empty: uniform.
   DensityFunction density;
   double tile_size = 0;  ///< > 0: also count the large circles centred within one spacing of a tile edge
+  /// The domain's sides (common.h; only x and y are read): a rectangle's set is triangulated in its own
+  /// lengths, its torus copies shifted by them, a box's border kept inside them. Tiles need the square.
+  Sides sides = kUnitSides;
   /// With a density: judge only circles centred where ρ is at least this fraction of its largest value
   /// (e.g. 0.5: the dark half of a stippled picture).
   double min_relative_density = 0;
@@ -54,8 +57,8 @@ struct EmptyCircles {
 };
 
 /// Empty circles pooled over `sets` (2D, each of at least 3 points, in [0,1]²; each normalised by its own
-/// count). Throws DegenerateSet for a set that spans no area, InvalidInput for other input. O(n log n)
-/// (Qhull's Delaunay triangulation).
+/// count). Throws DegenerateSet for a set that spans no area, InvalidInput for other input (tile_size with
+/// a rectangle's sides too). O(n log n) (Qhull's Delaunay triangulation).
 EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const EmptyCircleOptions& options = {});
 
 }  // namespace kdm::analysis

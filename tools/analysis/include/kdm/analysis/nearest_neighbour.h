@@ -6,11 +6,14 @@
 #include <cstddef>
 #include <vector>
 
+#include "kdm/analysis/common.h"
+
 namespace kdm::analysis {
 
-/// Per-point nearest neighbours. distance[i] is in unit-domain lengths (not normalised); index[i] is the
-/// neighbour's point index; offset[i*dim + a] is the displacement to that neighbour along axis a (the
-/// minimum image on the torus), so the link can be located (e.g. whether it crosses a tile edge).
+/// Per-point nearest neighbours. distance[i] is in unit-domain lengths (not normalised; the domain's, of
+/// unit area or volume, for other sides); index[i] is the neighbour's point index; offset[i*dim + a] is the
+/// displacement to that neighbour along axis a in the same lengths (the minimum image on the torus), so the
+/// link can be located (e.g. whether it crosses a tile edge).
 struct NearestNeighbours {
   int dim = 2;
   std::vector<double> distance;
@@ -20,9 +23,11 @@ struct NearestNeighbours {
 
 /// Finds every point's nearest other point. `coords`: interleaved, `dim` ∈ {2,3}, in [0,1]^dim; `torus`:
 /// periodic distances. Ties go to the lowest index. Needs n ≥ 2 (throws InvalidInput otherwise, and for
-/// invalid coordinates). `threads`: 0 = gen::default_thread_count(). Thread-safe (no shared state); result
+/// invalid coordinates). `threads`: 0 = gen::default_thread_count(). `sides`: the domain's (common.h; the
+/// unit square's by default), as unit_measure_sides gives them. Thread-safe (no shared state); result
 /// independent of the thread count.
-NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
+NearestNeighbours nearest_neighbours(const std::vector<double>& coords, int dim, bool torus, int threads = 0,
+                                     const Sides& sides = kUnitSides);
 
 /// Summary of NN distances, normalised by the reference spacing.
 struct NNStats {
@@ -43,7 +48,8 @@ NNStats summarise_nn(const std::vector<double>& distances, double spacing, int b
                      double hist_max = 1.5);
 
 /// nearest_neighbours + summarise_nn with spacing = reference_spacing(dim, n).
-NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads = 0);
+NNStats nn_stats(const std::vector<double>& coords, int dim, bool torus, int threads = 0,
+                 const Sides& sides = kUnitSides);
 
 /// The q-quantile (q in [0,1]) of `values` by the nearest-rank rule (value of rank ceil(q·m), ≥ 1).
 /// Returns NaN for empty input. Thread-safe (works on a copy).

@@ -3,29 +3,37 @@
 //   RAPS = mean of P over rings of width one integer step in |k| (ring r holds r − ½ ≤ |k| < r + ½, f =
 //   r/√n), lowP = mean P over 0 < f < 0.5, peak height/position of RAPS, ν_eff = largest f with RAPS < 0.1 on
 //   every ring in (0, f], anisotropy (dB) = mean over rings 0.5 < f < 2.5 of 10·log10(var/mean²).
-// P is exact for periodic (torus) sets; for box sets it includes the square window's leakage.
+// P is exact for periodic (torus) sets; for box sets it includes the square window's leakage. A set drawn in
+// a rectangle of sides lx × ly (unit area) is measured on its reciprocal lattice k = (kx/lx, ky/ly): |k| and
+// f = |k|/√n keep their meaning, rings hold about as many k as on the square.
 // S(k) is a non-uniform FFT (Gaussian gridding; relative error about 1e-10).
 #pragma once
 
 #include <cstddef>
 #include <vector>
 
+#include "kdm/analysis/common.h"
 #include "point_io.h"
 
 namespace kdm::analysis {
 
-/// A (set-averaged) periodogram on the integer grid kx, ky ∈ [−kmax, kmax].
+/// A (set-averaged) periodogram on the integer grid kx ∈ [−kx_max, kx_max], ky ∈ [−ky_max, ky_max]: the
+/// frequency (kx/lx, ky/ly); on the unit square kx_max = ky_max = kmax and lx = ly = 1.
 struct Periodogram {
-  int kmax = 0;     ///< grid half-width (integer frequencies)
-  double n = 0;     ///< points per set (mean over the sets) — defines f = |k| / sqrt(n)
-  int sets = 0;     ///< number of sets averaged
-  double fmax = 0;  ///< requested normalised frequency limit; rings are complete up to it
-  /// (2kmax+1)² values, row-major: index (ky+kmax)(2kmax+1) + (kx+kmax). Only the disc |k| ≤ kmax is
-  /// computed; the corners outside it hold NaN.
+  int kmax = 0;           ///< largest |k| computed (frequencies of the domain of unit area)
+  int kx_max = 0;         ///< grid half-width along x (integer steps: ceil(kmax · lx))
+  int ky_max = 0;         ///< grid half-width along y
+  double lx = 1, ly = 1;  ///< the domain's sides (unit area; common.h's Sides)
+  double n = 0;           ///< points per set (mean over the sets) — defines f = |k| / sqrt(n)
+  int sets = 0;           ///< number of sets averaged
+  double fmax = 0;        ///< requested normalised frequency limit; rings are complete up to it
+  /// width() · height() values, row-major: index (ky+ky_max)·width() + (kx+kx_max). Only the disc |k| ≤
+  /// kmax is computed; the corners outside it hold NaN.
   std::vector<double> power;
-  int side() const { return 2 * kmax + 1; }
+  int width() const { return 2 * kx_max + 1; }
+  int height() const { return 2 * ky_max + 1; }
   double at(int kx, int ky) const {
-    return power[static_cast<std::size_t>(ky + kmax) * side() + static_cast<std::size_t>(kx + kmax)];
+    return power[static_cast<std::size_t>(ky + ky_max) * width() + static_cast<std::size_t>(kx + kx_max)];
   }
   double frequency(double k_norm) const;  ///< |k| → f = |k| / sqrt(n)
   int ring_max() const;                   ///< last complete ring: floor(fmax · sqrt(n)), ≤ kmax − 1
@@ -33,15 +41,18 @@ struct Periodogram {
 
 /// Periodogram of one 2D set up to normalised frequency `fmax`, and 0.5 at least, lowP's (kmax =
 /// ceil(max(fmax, 0.5)·√n) + 1). `coords`
-/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). Cost O(n + kmax² log kmax),
-/// memory about 200 · kmax² bytes. Throws InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no
-/// shared state); the result does not depend on the thread count (fixed summation order). A time for
-/// scale: docs/design.md §6.
-Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0);
+/// interleaved x y in [0,1]². `threads`: 0 = gen::default_thread_count(). `sides`: the domain's (common.h;
+/// the unit square's by default). Cost O(n + kmax² log kmax), memory about 200 · kmax² bytes. Throws
+/// InvalidInput for dim ≠ 2, empty or invalid input. Thread-safe (no shared state); the result does not
+/// depend on the thread count (fixed summation order). A time for scale: docs/design.md §6.
+Periodogram periodogram(const std::vector<double>& coords, int dim, double fmax, int threads = 0,
+                        const Sides& sides = kUnitSides);
 
-/// Mean periodogram of several 2D sets (all on the grid of the mean point count). Throws InvalidInput for an
-/// empty list, 3D sets, invalid points or counts more than 10% apart. Thread-safe.
-Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads = 0);
+/// Mean periodogram of several 2D sets (all on the grid of the mean point count) in a domain of `sides`.
+/// Throws InvalidInput for an empty list, 3D sets, invalid points or counts more than 10% apart.
+/// Thread-safe.
+Periodogram average_periodogram(const std::vector<tools::PointSet>& sets, double fmax, int threads = 0,
+                                const Sides& sides = kUnitSides);
 
 /// Radial statistics of a periodogram (see the file comment for definitions).
 struct SpectrumStats {

@@ -4,16 +4,18 @@
 #pragma once
 
 #include "image_io.h"
+#include "kdm/analysis/common.h"
 #include "kdm/analysis/periodogram.h"
 #include "point_io.h"
 
 namespace kdm::analysis {
 
-/// Dots of `set` (x right, y up; 3D sets show x, y) on a white `size_px` square. Thread-safe.
-tools::RgbImage plot_points(const tools::PointSet& set, int size_px = 1024);
+/// Dots of `set` (x right, y up; 3D sets show x, y) on a white `size_px` square, or a rectangle of the
+/// domain's shape `sides` (common.h) whose longer side is `size_px`. Thread-safe.
+tools::RgbImage plot_points(const tools::PointSet& set, int size_px = 1024, const Sides& sides = kUnitSides);
 
 /// log10 P(k) mapped from [−1.5, 1] to black…white, k = 0 at the centre, ky up, each k an s×s block with
-/// s chosen so the picture is about `min_size_px` wide. Thread-safe.
+/// s chosen so the picture is about `min_size_px` wide (a rectangle's grid: its longer side). Thread-safe.
 tools::RgbImage plot_spectrum(const Periodogram& p, int min_size_px = 640);
 
 /// RAPS against f with axes, ticks, labels and a dashed line at 1. Thread-safe.

@@ -38,7 +38,11 @@ struct AnalysisOptions {
   int density_bands = 10;        ///< bands of the per-band bias table (equal steps in log ρ)
   double tile_size = 0;          ///< tile side for the tiling diagnostics (0: skip)
   double holes_min_density = 0;  ///< empty circles: only where ρ ≥ this fraction of its largest value
-  int threads = 0;               ///< worker threads, 0 = gen::default_thread_count()
+  /// Relative side lengths x y z of the domain the points were drawn in (as gen::SamplerOptions::extent;
+  /// the first `dim` are read): the normalised points are measured in that box scaled to unit area
+  /// (volume), common.h's unit_measure_sides. Tiling diagnostics and classes need equal sides.
+  double extent[3] = {1, 1, 1};
+  int threads = 0;  ///< worker threads, 0 = gen::default_thread_count()
   /// Called from the calling thread between the measures and the sets (optional): an exception it throws
   /// stops the analysis there (Python's Ctrl-C).
   std::function<void()> checkpoint;
@@ -47,6 +51,7 @@ struct AnalysisOptions {
 struct AnalysisReport {
   int dim = 2;
   bool torus = true;
+  Sides sides = kUnitSides;  ///< the domain the sets were measured in (unit area or volume)
   std::size_t sets = 0, points_min = 0, points_max = 0;
   double points_mean = 0;
   NNStats nn;                        ///< pooled over sets, each normalised by its own spacing (spacing = 1)
@@ -81,7 +86,8 @@ struct AnalysisReport {
 };
 
 /// Runs the analysis. Throws InvalidInput for an empty list, mixed dimensions, invalid points, sets with
-/// fewer than 2 points, or invalid options. Thread-safe (no shared state).
+/// fewer than 2 points, or invalid options (among them sides that are not positive finite numbers, and a
+/// tile size with unequal sides). Thread-safe (no shared state).
 AnalysisReport analyze(const std::vector<tools::PointSet>& sets, const AnalysisOptions& options);
 
 /// A one-screen human-readable summary of `report` (several lines, '\n'-terminated). Thread-safe.

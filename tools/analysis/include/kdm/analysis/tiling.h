@@ -44,7 +44,8 @@ struct PeriodicityResult {
 };
 
 /// Periodicity ratio of a (set-averaged) periodogram `p` with radial statistics `stats` for tile side
-/// `tile_size` (unit-domain lengths). Thread-safe (pure).
+/// `tile_size` (unit-domain lengths). Throws InvalidInput for a rectangle's periodogram (lx ≠ 1). Thread-safe
+/// (pure).
 PeriodicityResult periodicity_ratio(const Periodogram& p, const SpectrumStats& stats, double tile_size);
 
 /// Two-sample Kolmogorov–Smirnov test.
