@@ -826,15 +826,25 @@ TEST_F(CliTest, AnalyzeReportsTheBiasOfEveryDensityBand) {
 
 }  // namespace
 
-// The analysis measures in the unit square: a set sampled in a wider domain is measured stretched, and
-// kdm analyze says so (from the aspect kdm sample writes in its header); a square one draws no warning.
+// A set sampled in a wider domain is measured in it, and kdm analyze says so (from the aspect or sides kdm
+// sample writes in its header); a square or cube draws no such line, nor a warning of stretched measures.
 TEST_F(CliTest, AnalyzeWarnsOfASetSampledInAnotherShape) {
   for (const std::string aspect : {"2", "1"}) {
     ASSERT_EQ(kdm("sample --n 200 --aspect " + aspect + " -o '" + path("s.txt") + "'").status, 0);
     const Outcome r = kdm("analyze '" + path("s.txt") + "' --no-energy");
     ASSERT_EQ(r.status, 0) << r.err;
-    const bool warned = r.err.find("sampled in a domain of aspect 2 (width / height)") != std::string::npos;
-    EXPECT_EQ(warned, aspect == "2") << r.err;
+    EXPECT_EQ(r.out.find("domain from the file header: aspect 2") != std::string::npos, aspect == "2")
+        << r.out;
+    EXPECT_EQ(r.err.find("stretched"), std::string::npos) << r.err;
+  }
+  // A 3D box of three sides of its own, and a cube given as three equal sides.
+  for (const std::string sides : {"2:1:0.5", "1:1:1"}) {
+    ASSERT_EQ(kdm("sample --dim 3 --n 300 --aspect " + sides + " -o '" + path("v.txt") + "'").status, 0);
+    const Outcome r = kdm("analyze '" + path("v.txt") + "' --no-energy");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("domain from the file header: sides 2:1:0.5") != std::string::npos,
+              sides == "2:1:0.5")
+        << r.out;
   }
   // A 3D box of three sides of its own, and a cube given as three equal sides.
   for (const std::string sides : {"2:1:0.5", "1:1:1"}) {

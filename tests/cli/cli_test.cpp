@@ -1061,6 +1061,53 @@ std::vector<double> json_numbers(const std::string& json, const std::string& key
   return out;
 }
 
+// A set kdm sample drew 2:1 is measured in its rectangle (its header says the shape), and says so; --aspect
+// overrides it (1: the unit square, where it reads squeezed); files of different shapes are refused.
+TEST_F(CliTest, AnalyzeMeasuresASetInTheDomainItWasDrawnIn) {
+  const std::string wide = "'" + path("wide.txt") + "'", square = "'" + path("square.txt") + "'";
+  ASSERT_EQ(kdm("sample --n 2000 --aspect 2 --seed 4 -o " + wide).status, 0);
+  ASSERT_EQ(kdm("sample --n 2000 --seed 4 -o " + square).status, 0);
+  const Outcome own = kdm("analyze " + wide + " --no-energy -o -");
+  ASSERT_EQ(own.status, 0) << own.err;
+  EXPECT_NE(own.err.find("domain from the file header: aspect 2"), std::string::npos) << own.err;
+  EXPECT_NE(own.err.find("1.414 × 0.7071 rectangle (aspect 2"), std::string::npos) << own.err;
+  EXPECT_NE(own.out.find("\"sides\":[1.414213562,0.7071067812]"), std::string::npos)
+      << own.out.substr(0, 400);
+  const Outcome forced = kdm("analyze " + wide + " --aspect 1 --no-energy -o -");
+  ASSERT_EQ(forced.status, 0) << forced.err;
+  EXPECT_NE(forced.err.find("was sampled with aspect 2; measured with --aspect 1"), std::string::npos)
+      << forced.err;
+  EXPECT_EQ(forced.out.find("\"sides\""), std::string::npos);
+  const Outcome flat = kdm("analyze " + square + " --no-energy -o -");
+  ASSERT_EQ(flat.status, 0) << flat.err;
+  EXPECT_EQ(flat.err.find("domain"), std::string::npos) << flat.err;  // the square's summary as it was
+  // δavg (the first "davg"): the rectangle's reads as the square set's, the squeezed one far below (the
+  // sampler's 2,000-point sets spread by about 0.003 between seeds).
+  const double in_rectangle = json_numbers(own.out, "davg").at(0),
+               in_square = json_numbers(flat.out, "davg").at(0),
+               squeezed = json_numbers(forced.out, "davg").at(0);
+  EXPECT_NEAR(in_rectangle, in_square, 0.02);
+  EXPECT_LT(squeezed, in_square - 0.1);
+  const Outcome given = kdm("analyze " + square + " --aspect 2 --no-energy");
+  ASSERT_EQ(given.status, 0) << given.err;
+  EXPECT_NE(given.out.find("domain from --aspect: aspect 2"), std::string::npos) << given.out;
+
+  expect_error("analyze " + wide + " " + square, "sampled in different domains");
+  EXPECT_EQ(kdm("analyze " + wide + " " + square + " --aspect 2 --no-energy").status, 0);
+  expect_error("analyze " + wide + " --tile-size 0.25", "square tiles of the unit square");
+  expect_error("analyze " + wide + " --aspect 2:1:1", "the points are 2D");
+  expect_error("analyze " + wide + " --aspect 0", "--aspect must be a number > 0");
+  expect_error("analyze " + wide + " --aspect 1:2", "one number or three sides X:Y:Z, got 2");
+
+  // 3D: the box's three sides from the header.
+  const std::string box = "'" + path("box.txt") + "'";
+  ASSERT_EQ(kdm("sample --dim 3 --n 1000 --aspect 2:1:0.5 --seed 4 -o " + box).status, 0);
+  const Outcome boxed = kdm("analyze " + box + " --no-energy");
+  ASSERT_EQ(boxed.status, 0) << boxed.err;
+  EXPECT_NE(boxed.out.find("domain from the file header: sides 2:1:0.5"), std::string::npos) << boxed.out;
+  EXPECT_NE(boxed.out.find("2 × 1 × 0.5 box"), std::string::npos) << boxed.out;
+}
+
 // --class-density: each class of a labelled set against its own density, the whole set against their
 // sum, the classes' counts against their shares; refusals name the numbers.
 TEST_F(CliTest, AnalyzeJudgesEachClassAgainstItsOwnDensity) {

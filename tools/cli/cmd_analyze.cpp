@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -45,6 +46,7 @@ struct AnalyzeArgs {
   int density_bands = 10;
   double holes_min_density = 0;
   int threads = 0;
+  std::string aspect;  ///< --aspect: empty, the files' headers say the shape
   std::string output;
   bool tile_size_given = false, output_given = false;  // 0 and "" given are mistakes, not the defaults
 };
@@ -103,23 +105,96 @@ std::string with_classes(std::string metrics, const std::string& classes) {
   return metrics.substr(0, end) + ",\n  \"classes\": " + inner + "\n}\n";
 }
 
-/// The shape of the domain a point file says its points were sampled in, when not a square or cube
-/// (`kdm sample --aspect` writes ", aspect A" or ", sides X:Y:Z" in its header lines), else "".
-std::string sampled_shape(const std::string& path) {
+/// A domain's relative sides x y z (gen::SamplerOptions::extent) and how the summary names them.
+struct Shape {
+  double extent[3] = {1, 1, 1};
+  std::string text;  ///< "aspect 2" or "sides 2:1:0.5"; "" for a square or cube
+  int numbers = 1;   ///< as given: one (an aspect) or three (sides)
+  bool square() const { return extent[0] == extent[1] && extent[1] == extent[2]; }
+  bool same(const Shape& o) const {
+    return extent[0] == o.extent[0] && extent[1] == o.extent[1] && extent[2] == o.extent[2];
+  }
+};
+
+/// Parses one number A (x side over the others) or three sides X:Y:Z, each > 0 and finite, as kdm sample
+/// --aspect takes them; `what` names the source in the error. Throws CommandError.
+Shape parse_shape(const std::string& text, const std::string& what) {
+  std::vector<double> sides;
+  for (std::size_t from = 0;;) {
+    const std::size_t colon = text.find(':', from);
+    const std::string part = text.substr(from, colon == std::string::npos ? std::string::npos : colon - from);
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
+      throw CommandError(
+          what + " must be a number > 0 (width / height) or three sides X:Y:Z each > 0, got '" + text + "'");
+    sides.push_back(v);
+    if (colon == std::string::npos) break;
+    from = colon + 1;
+  }
+  if (sides.size() != 1 && sides.size() != 3)
+    throw CommandError(what + " takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
+                       " in '" + text + "'");
+  Shape shape;
+  shape.numbers = int(sides.size());
+  shape.extent[0] = sides[0];
+  if (sides.size() == 3) std::copy(sides.begin(), sides.end(), shape.extent);
+  char buffer[96];
+  if (sides.size() == 3)
+    std::snprintf(buffer, sizeof buffer, "sides %g:%g:%g", sides[0], sides[1], sides[2]);
+  else
+    std::snprintf(buffer, sizeof buffer, "aspect %g", sides[0]);
+  if (!shape.square()) shape.text = buffer;
+  return shape;
+}
+
+/// The shape of the domain a point file says its points were sampled in (`kdm sample --aspect` writes
+/// ", aspect A" or ", sides X:Y:Z" in its header lines): a square or cube when it says none (a file of
+/// other tools, a .npy, standard input).
+Shape sampled_shape(const std::string& path) {
   std::ifstream in(path);
   std::string line;
-  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i) {
-    if (const std::size_t at = line.find(", aspect "); at != std::string::npos) {
-      const double aspect = std::atof(line.c_str() + at + 9);
-      if (aspect == 1) return "";
-      char text[80];
-      std::snprintf(text, sizeof text, "aspect %g (width / height)", aspect);
-      return text;
-    }
-    if (const std::size_t at = line.find(", sides "); at != std::string::npos)
-      return "sides " + line.substr(at + 8, line.find_first_of(",\n", at + 8) - (at + 8));
+  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i)
+    for (const char* key : {", aspect ", ", sides "})
+      if (const std::size_t at = line.find(key); at != std::string::npos) {
+        const std::size_t from = at + std::string(key).size();
+        return parse_shape(line.substr(from, line.find_first_of(", \r", from) - from),
+                           path + ": the header's " + std::string(key + 2, std::strlen(key) - 3));
+      }
+  return {};
+}
+
+/// The shape the files are measured in: --aspect's, else their headers' (all alike: pooled sets share one
+/// domain). Says on `text` which it took when that is not the square. Throws CommandError.
+Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text) {
+  std::vector<Shape> read;
+  for (const std::string& file : args.files) read.push_back(sampled_shape(file));
+  if (!args.aspect.empty()) {
+    const Shape given = parse_shape(args.aspect, "--aspect");
+    if (dim == 2 && given.numbers == 3)
+      throw CommandError(
+          "--aspect X:Y:Z gives a 3D domain's sides, and the points are 2D: give one number "
+          "(width / height)");
+    if (!given.square()) std::fprintf(text, "domain from --aspect: %s\n", given.text.c_str());
+    for (std::size_t f = 0; f < read.size(); ++f)
+      if (!read[f].same(given) && !(read[f].square() && given.square()))
+        std::fprintf(text, "%s was sampled with %s; measured with --aspect %s\n", args.files[f].c_str(),
+                     read[f].square() ? "a square" : read[f].text.c_str(), args.aspect.c_str());
+    return given;
   }
-  return "";
+  for (std::size_t f = 1; f < read.size(); ++f)
+    if (!read[f].same(read[0]))
+      throw CommandError("the files were sampled in different domains (" + args.files[0] + ": " +
+                         (read[0].square() ? "square" : read[0].text) + ", " + args.files[f] + ": " +
+                         (read[f].square() ? "square" : read[f].text) +
+                         "): their sets pool into one report, so analyse them apart, or give --aspect to "
+                         "measure them all in one");
+  if (!read[0].square())
+    std::fprintf(text,
+                 "domain from the file header%s: %s (--aspect overrides; --aspect 1 measures in the "
+                 "unit square)\n",
+                 read.size() > 1 ? "s" : "", read[0].text.c_str());
+  return read[0];
 }
 
 /// Creates `output` as analyze's directory (it receives metrics.json and pictures), or says why it cannot.
@@ -209,12 +284,6 @@ void run_analyze(const AnalyzeArgs& args) {
         o.density = tools::analysis_density(target);
       }
     }
-    for (const std::string& file : args.files)
-      if (const std::string shape = sampled_shape(file); !shape.empty())
-        std::fprintf(stderr,
-                     "kdm: warning: %s was sampled in a domain of %s; the measures take its points in the "
-                     "unit square (cube), so distances and the spectrum are stretched\n",
-                     file.c_str(), shape.c_str());
     if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
       std::fprintf(stderr,
                    "kdm: warning: density windows and tiling diagnostics are 2D only; skipped (a --density "
@@ -222,10 +291,24 @@ void run_analyze(const AnalyzeArgs& args) {
     // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
     const bool to_stdout = args.output == tools::kStandardOutput;
     std::FILE* text = to_stdout ? stderr : stdout;
+    const Shape shape = measured_shape(args, sets.front().dim, text);
+    std::copy(shape.extent, shape.extent + 3, o.extent);
+    if (!shape.square() && args.tile_size != 0)
+      throw CommandError(
+          "--tile-size: tiling diagnostics take square tiles of the unit square, and the "
+          "points were drawn in a domain of " +
+          shape.text +
+          " (--aspect 1 measures them in "
+          "the unit square)");
+    if (!shape.square() && !sets.front().classes.empty())
+      throw CommandError(
+          "labelled points are analysed in the unit square only, and these were drawn in a "
+          "domain of " +
+          shape.text + ": give --aspect 1 (the measures are stretched then)");
     if (!args.output.empty() && !to_stdout) prepare_output_directory(args.output);
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (!args.no_energy) {
-      report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target);
+      report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target, 0, o.extent);
       report.has_energy = true;
     }
     if (args.files.size() > 1)  // not one report a file: the measures pool the sets of them all
@@ -249,7 +332,7 @@ void run_analyze(const AnalyzeArgs& args) {
     std::string error;
     if (!classes.empty() && !tools::write_text_file_atomic((dir / "classes.json").string(), classes, error))
       throw CommandError(error);
-    save_png((dir / "points.png").string(), analysis::plot_points(sets.front()));
+    save_png((dir / "points.png").string(), analysis::plot_points(sets.front(), 1024, report.sides));
     if (report.has_spectrum) {
       save_png((dir / "spectrum.png").string(), analysis::plot_spectrum(report.spectrum));
       save_png((dir / "raps.png").string(), analysis::plot_raps(report.spectrum_stats, report.spectrum.fmax));
@@ -322,6 +405,11 @@ void add_analyze_command(CLI::App& app) {
                   "Bands of the per-band bias table: the points where the target density lies in each "
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
+  cmd->add_option("--aspect", args->aspect,
+                  "The domain the points were drawn in: width/height (in 3D the x side over the others), or "
+                  "three sides X:Y:Z; they are measured in it, scaled to unit area (volume). Default: what "
+                  "the files' headers say (kdm sample --aspect writes it), else the unit square (cube); 1 "
+                  "forces the square");
   add_threads_option(cmd, args->threads, "results do not depend on it");
   cmd->add_option_function<std::string>(
       "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },

@@ -64,13 +64,14 @@ std::function<double(double, double)> analysis_density(const gen::Density& densi
 }
 
 double mean_energy_per_point(const std::vector<PointSet>& sets, bool torus, const gen::Density& density,
-                             int threads) {
+                             int threads, const double* extent) {
   double sum = 0;
   for (const PointSet& set : sets) {
     gen::SamplerOptions o;
     o.dim = set.dim;
     o.domain = torus ? gen::Domain::kTorus : gen::Domain::kBox;
     o.threads = threads;
+    if (extent) std::copy(extent, extent + 3, o.extent);
     std::vector<double> coords = set.coords;
     for (double& c : coords) c = std::min(c, std::nextafter(1.0, 0.0));  // writers may round up to 1
     sum += gen::energy_per_point(o, density, coords);

@@ -26,8 +26,9 @@ gen::Density to_class_density(const DensitySpec& spec);
 std::function<double(double, double)> analysis_density(const gen::Density& density);
 
 /// E/n of each set under the KDM model for its own count, domain and density, averaged over the sets
-/// (gen::energy_per_point). Throws gen::InvalidArgument for sets the model cannot take.
+/// (gen::energy_per_point). `extent`: the domain's relative sides x y z (gen::SamplerOptions::extent;
+/// null: a square or cube). Throws gen::InvalidArgument for sets the model cannot take.
 double mean_energy_per_point(const std::vector<PointSet>& sets, bool torus, const gen::Density& density,
-                             int threads = 0);
+                             int threads = 0, const double* extent = nullptr);
 
 }  // namespace kdm::tools
