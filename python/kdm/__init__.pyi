@@ -166,6 +166,7 @@ def analyze(
     min_expected: float = ...,
     density_bands: int = ...,
     holes_min_density: float = ...,
+    aspect: Union[None, float, Tuple[float, float, float]] = ...,  # the domain's shape, as kdm.sample's
 ) -> Dict[str, Any]: ...
 
 class BlueNoise:

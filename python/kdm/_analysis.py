@@ -5,7 +5,7 @@ import json
 import warnings
 import numbers
 import os
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -75,6 +75,7 @@ def analyze(
     min_expected: float = 20.0,
     density_bands: int = 10,
     holes_min_density: float = 0.0,
+    aspect: Any = None,
 ) -> Dict[str, Any]:
     """Measure point sets as ``kdm analyze`` does, returning what it writes to metrics.json.
 
@@ -85,8 +86,8 @@ def analyze(
         lists) of one dimension: statistics are pooled over them, as over the sets of one file; sets more
         than 10% apart in count get no spectrum (their frequencies would not line up: the result's
         "spectrum_skipped" says so).
-        Distances are those of the unit square (cube): a set drawn for a non-square domain is judged
-        squeezed (docs/limits.md, "Analysing point sets").
+        Distances are those of the unit square (cube), or with `aspect` of the domain the set was drawn
+        in.
     classes : array or list of arrays, optional
         Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them,
         so ``kdm.analyze(*kdm.sample(n, classes=...))`` works):
@@ -126,6 +127,14 @@ def analyze(
         Worker threads (0: the default count); the results do not depend on it.
     energy : bool
         Compute E/n under the KDM model (``energy_per_point``).
+    aspect : float, (x, y, z) or None
+        The domain the points were drawn in, as ``kdm.sample(aspect=...)`` takes it: width / height (in
+        3-D the x side over the others), or in 3-D three sides ``(x, y, z)``. The normalised points are
+        measured in that box scaled to unit area (volume): spacings, nearest neighbours, g(r), holes,
+        density windows and the spectrum (on the rectangle's own frequencies) are the domain's; the
+        result's "sides" gives its sides. None or 1: the unit square (cube). ValueError for a side that is
+        not > 0, or with `tile_size` or `classes` (square tiles and the classes' closest pair need the
+        square); TypeError for a value that is no number or sequence.
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles
@@ -200,6 +209,16 @@ def analyze(
     min_expected = _checks.number("min_expected", min_expected, 0.0, strict=True)
     density_bands = _checks.integer("density_bands", density_bands, 1, 1000)
     holes_min_density = _checks.number("holes_min_density", holes_min_density, 0.0)
+    if sets[0].shape[1] == 2 and isinstance(aspect, (Sequence, np.ndarray)) and not isinstance(aspect, (str, bytes)):
+        raise ValueError("aspect=(x, y, z) gives a 3-D domain's sides, and the points are 2-D: give one number "
+                         "(width / height)")
+    one, sides = _checks.aspect_or_sides(aspect, sets[0].shape[1])
+    extent = list(sides) if sides is not None else [1.0 if one is None else one, 1.0, 1.0]
+    if extent[0] != extent[1] or extent[1] != extent[2]:
+        if tile is not None and tile > 0:
+            raise ValueError("tile_size takes square tiles of the unit square, and aspect gives another domain")
+        if classes is not None:
+            raise ValueError("labelled points (classes) are analysed in the unit square only: leave out aspect")
     labels = []
     if classes is not None:
         given = list(classes) if several and isinstance(classes, (list, tuple)) else [classes]
@@ -216,7 +235,7 @@ def analyze(
             raise ValueError(f"class_densities holds {len(own)} densit{'y' if len(own) == 1 else 'ies'}, but the classes run 0 to {runs - 1} "
                              f"({runs} classes): give one per class, class 0 first")
     text, classes_text = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy, labels,
-                                      min_expected, density_bands, holes_min_density, own)
+                                      min_expected, density_bands, holes_min_density, own, extent)
     result = _arrays(json.loads(text))
     _infinite_lattice(result)
     density_result = result.get("density")

@@ -1,5 +1,6 @@
 // kdm._kdm.analyze: the point-set analysis as `kdm analyze` runs it (tools/cli/cmd_analyze.cpp), returned as
 // the text of the metrics.json it would write, which the Python side parses.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -39,7 +40,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
                   const tools::DensitySpec* density, const py::object& function, double tile_size,
                   double fmax, int threads, bool energy, const std::vector<Labels>& labels,
                   double min_expected, int density_bands, double holes_min_density,
-                  const std::vector<py::object>& class_densities) {
+                  const std::vector<py::object>& class_densities, const std::vector<double>& extent) {
   check_number("fmax", fmax, 0, true);
   check_number("min_expected", min_expected, 0, true);
   if (density_bands < 1 || density_bands > 1000)
@@ -53,6 +54,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     throw std::invalid_argument("class_densities needs classes (each point's class)");
   if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default count)");
   if (!std::isfinite(tile_size)) throw std::invalid_argument("tile_size must be a finite number");
+  if (extent.size() != 3) throw std::invalid_argument("extent must hold three sides");
   analysis::AnalysisOptions o;
   o.torus = !box;
   o.fmax = fmax;
@@ -61,6 +63,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
   o.min_expected = min_expected;
   o.density_bands = density_bands;
   o.holes_min_density = holes_min_density;
+  std::copy(extent.begin(), extent.end(), o.extent);
   o.checkpoint = [] { stop_on_signal(0); };                 // Ctrl-C stops it between its measures
   if (tile_size != 0) analysis::tiles_per_axis(tile_size);  // 1 / tile_size an integer
   std::vector<tools::PointSet> sets;
@@ -114,7 +117,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     py::gil_scoped_release release;
     auto energy_of = [&](const std::vector<tools::PointSet>& of, const gen::Density& under) {
       try {
-        return tools::mean_energy_per_point(of, o.torus, under, threads);
+        return tools::mean_energy_per_point(of, o.torus, under, threads, o.extent);
       } catch (const gen::InvalidArgument& e) {
         throw std::invalid_argument(std::string("energy: ") + e.what());
       }
@@ -145,7 +148,7 @@ void bind_analysis(py::module_& m) {
   m.def("analyze", &analyze, py::arg("sets"), py::arg("names"), py::arg("box"), py::arg("density").none(true),
         py::arg("function").none(true), py::arg("tile_size"), py::arg("fmax"), py::arg("threads"),
         py::arg("energy"), py::arg("labels"), py::arg("min_expected"), py::arg("density_bands"),
-        py::arg("holes_min_density"), py::arg("class_densities"),
+        py::arg("holes_min_density"), py::arg("class_densities"), py::arg("extent"),
         "kdm analyze's metrics.json (and classes.json) for point sets in memory");
 }
 
