@@ -4,11 +4,14 @@
 // against the direct sum, and a sampler's 2:1 set against its square sets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
 #include <vector>
 
+#include "empty_circles_copies.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/empty_circles.h"
 #include "kdm/analysis/nearest_neighbour.h"
@@ -104,6 +107,38 @@ TEST(Domain, ASquareSetRepeatedOnATwoToOneTorusMeasuresAsTheSquare) {
   EXPECT_NEAR(b.gr.r_max, a.gr.r_max, 1e-12);
   const double pairs = (2.0 * 500 - 1) / (2.0 * 499);
   for (std::size_t k = 0; k < a.gr.g.size(); ++k) EXPECT_NEAR(b.gr.g[k] * pairs, a.gr.g[k], 1e-9) << k;
+}
+
+// A rectangle's torus is copied only where a circle through it may reach, as the square's: the same
+// circles as copies in a widening margin, for a steep ramp (along either side), a cluster, uniform points
+// and a few points, on a 2:1 and a 1:5 rectangle.
+TEST(Domain, RectangleCopiesAroundTheHolesFindTheCirclesOfAWholeMargin) {
+  std::vector<tools::PointSet> sets;
+  tools::PointSet ramp = uniform_set(500, 4), across = uniform_set(500, 5);  // density ∝ e^(-20 x)
+  for (std::size_t p = 0; p < ramp.size(); ++p) {
+    ramp.coords[2 * p] = -std::log1p(-ramp.coords[2 * p] * (1 - std::exp(-20.0))) / 20;
+    across.coords[2 * p + 1] = -std::log1p(-across.coords[2 * p + 1] * (1 - std::exp(-20.0))) / 20;
+  }
+  tools::PointSet cluster = uniform_set(400, 2);
+  for (double& v : cluster.coords) v = 0.4 + 0.1 * v;
+  sets.insert(sets.end(), {ramp, across, cluster, uniform_set(800, 6)});
+  for (std::size_t n = 3; n <= 8; ++n) sets.push_back(uniform_set(n, 9));
+  const std::array<double, 3> shapes[2] = {{2, 1, 1}, {1, 5, 1}};
+  for (const std::array<double, 3>& shape : shapes) {
+    const Sides sides = unit_measure_sides(shape.data(), 2);
+    for (tools::PointSet s : sets) {
+      for (std::size_t i = 0; i < s.coords.size(); i += 2)
+        s.coords[i] *= sides[0], s.coords[i + 1] *= sides[1];
+      std::vector<double> around =
+          detail::torus_circumradii(s.coords, detail::TorusCopies::kAroundHoles, sides[0], sides[1]);
+      std::vector<double> margin =
+          detail::torus_circumradii(s.coords, detail::TorusCopies::kMargin, sides[0], sides[1]);
+      EXPECT_EQ(around.size(), 2 * s.size()) << s.size() << " points, sides " << sides[0];
+      std::sort(around.begin(), around.end());
+      std::sort(margin.begin(), margin.end());
+      EXPECT_EQ(around, margin) << s.size() << " points, sides " << sides[0];
+    }
+  }
 }
 
 // A box set on a rectangle: every judged circle is centred two spacings inside its sides, the long one

@@ -192,74 +192,89 @@ std::vector<Circle> torus_circles_by_margin(const std::vector<double>& coords, d
 /// cells (centre to centre) from the nearest one holding a point is at most d + √2 cells wide. A margin as
 /// wide as the widest hole all round copied a steep ramp's dense side 25 times (10^5 points of ramp:1e9:
 /// 2.5 million points, 29 s and 1.6 GB); this copies it only beside the wide holes (0.16 million).
+/// A rectangle lx × ly (`coords` in its lengths) has gx × gy cells, not quite square: lengths are then
+/// in units of the shorter cell side h (a cell is ax × ay of them), and reaches in whole cells are counted
+/// as if every cell were h wide, which can only copy more. The square's cells are exactly as they were.
 class CopyRegion {
  public:
-  CopyRegion(const std::vector<double>& coords, double spacing) {
-    g_ = std::clamp(static_cast<int>(1 / spacing), 1, 1024);
+  CopyRegion(const std::vector<double>& coords, double spacing, double lx = 1, double ly = 1)
+      : lx_(lx), ly_(ly) {
+    gx_ = std::clamp(static_cast<int>(lx / spacing), 1, 1024);
+    gy_ = std::clamp(static_cast<int>(ly / spacing), 1, 1024);
+    const bool square = lx == 1 && ly == 1;
+    const double cx_side = lx / gx_, cy_side = ly / gy_, h = std::min(cx_side, cy_side);
+    const double ax = square ? 1.0 : cx_side / h, ay = square ? 1.0 : cy_side / h;
     const std::size_t n = coords.size() / 2;
     // For each cell, the cell holding a point nearest it (or nearly: Danielsson's propagation of nearest
-    // sites, in order of distance), as an offset in cells on the torus.
-    std::vector<std::array<int, 2>> site(std::size_t(g_) * g_, {kNone, kNone});
-    auto length2 = [](const std::array<int, 2>& o) { return double(o[0]) * o[0] + double(o[1]) * o[1]; };
+    // sites, in order of distance), as an offset in cells on the torus. Any cell holding a point bounds
+    // the circles centred in a cell, the nearest best.
+    std::vector<std::array<int, 2>> site(std::size_t(gx_) * gy_, {kNone, kNone});
+    auto length2 = [&](const std::array<int, 2>& o) {
+      return double(o[0]) * ax * (double(o[0]) * ax) + double(o[1]) * ay * (double(o[1]) * ay);
+    };
     using Entry = std::pair<double, std::size_t>;  // squared offset, cell
     std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
     for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t c = std::size_t(cell(coords[2 * i + 1])) * g_ + cell(coords[2 * i]);
+      const std::size_t c = std::size_t(cell_y(coords[2 * i + 1])) * gx_ + cell_x(coords[2 * i]);
       if (site[c][0] == kNone) site[c] = {0, 0}, queue.push({0.0, c});
     }
     while (!queue.empty()) {
       const auto [d2, q] = queue.top();
       queue.pop();
       if (d2 > length2(site[q])) continue;  // improved since
-      const int cx = int(q % g_), cy = int(q / g_);
+      const int cx = int(q % gx_), cy = int(q / gx_);
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          const std::size_t c = std::size_t((cy + dy + g_) % g_) * g_ + (cx + dx + g_) % g_;
+          const std::size_t c = std::size_t((cy + dy + gy_) % gy_) * gx_ + (cx + dx + gx_) % gx_;
           const std::array<int, 2> o = {site[q][0] - dx, site[q][1] - dy};
           if (site[c][0] == kNone || length2(o) < length2(site[c])) site[c] = o, queue.push({length2(o), c});
         }
     }
     // The widest circle centred in a cell, in cells: a point lies within the cells' centres' distance and
-    // two half diagonals; no empty circle of a torus is wider than √2/2. The slack covers the moves.
+    // two half diagonals; no empty circle of a torus is wider than half its diagonal. The slack covers the
+    // moves.
+    const double diagonal = square ? std::sqrt(2.0) : std::hypot(ax, ay);
+    const double widest_torus = square ? std::sqrt(0.5) * gx_ : 0.5 * std::hypot(lx, ly) / h;
     std::vector<double> widest(site.size());
     for (std::size_t c = 0; c < site.size(); ++c)
-      widest[c] = std::min(std::sqrt(length2(site[c])) + std::sqrt(2.0), std::sqrt(0.5) * g_) + kSlack;
+      widest[c] = std::min(std::sqrt(length2(site[c])) + diagonal, widest_torus) + kSlack;
     const int far = static_cast<int>(std::ceil(*std::max_element(widest.begin(), widest.end())));
     // Cells up to `far` outside the square may centre a circle through a point in it, which may reach
     // `far` cells further.
     margin_ = 2 * far + 1;
-    side_ = g_ + 2 * margin_;
+    side_x_ = gx_ + 2 * margin_, side_y_ = gy_ + 2 * margin_;
     // reach: how many cells around a cell a circle centred in it or near may cover; spread from each
     // cell that may centre a circle through the square to its neighbours, one less each step.
-    std::vector<int> reach(std::size_t(side_) * side_, -1);
-    for (int j = -margin_; j < g_ + margin_; ++j)
-      for (int i = -margin_; i < g_ + margin_; ++i) {
-        const double w = widest[std::size_t(wrap(j)) * g_ + wrap(i)];
-        const double dx = i < 0 ? -i - 1 : std::max(0, i - g_), dy = j < 0 ? -j - 1 : std::max(0, j - g_);
+    std::vector<int> reach(std::size_t(side_x_) * side_y_, -1);
+    for (int j = -margin_; j < gy_ + margin_; ++j)
+      for (int i = -margin_; i < gx_ + margin_; ++i) {
+        const double w = widest[std::size_t(wrap(j, gy_)) * gx_ + wrap(i, gx_)];
+        const double dx = (i < 0 ? -i - 1 : std::max(0, i - gx_)) * ax,
+                     dy = (j < 0 ? -j - 1 : std::max(0, j - gy_)) * ay;
         if (dx * dx + dy * dy <= w * w) reach[index(i, j)] = static_cast<int>(std::ceil(w));
       }
     for (int pass = 0; pass < 2; ++pass) {  // Rosenfeld and Pfaltz's two raster passes
       const int step = pass ? -1 : 1;
-      for (int jj = 0; jj < side_; ++jj)
-        for (int ii = 0; ii < side_; ++ii) {
-          const int i = pass ? side_ - 1 - ii : ii, j = pass ? side_ - 1 - jj : jj;
-          int& r = reach[std::size_t(j) * side_ + i];
+      for (int jj = 0; jj < side_y_; ++jj)
+        for (int ii = 0; ii < side_x_; ++ii) {
+          const int i = pass ? side_x_ - 1 - ii : ii, j = pass ? side_y_ - 1 - jj : jj;
+          int& r = reach[std::size_t(j) * side_x_ + i];
           const int before[4][2] = {{-step, 0}, {-step, -step}, {0, -step}, {step, -step}};
           for (const auto& b : before) {
             const int bi = i + b[0], bj = j + b[1];
-            if (bi >= 0 && bi < side_ && bj >= 0 && bj < side_)
-              r = std::max(r, reach[std::size_t(bj) * side_ + bi] - 1);
+            if (bi >= 0 && bi < side_x_ && bj >= 0 && bj < side_y_)
+              r = std::max(r, reach[std::size_t(bj) * side_x_ + bi] - 1);
           }
         }
     }
     // Cells left out, summed (their count in any rectangle of cells: contains()).
-    left_out_.assign(std::size_t(side_ + 1) * (side_ + 1), 0);
-    for (int j = 0; j < side_; ++j)
-      for (int i = 0; i < side_; ++i) {
-        const bool square = i >= margin_ && i < margin_ + g_ && j >= margin_ && j < margin_ + g_;
-        const std::size_t at = std::size_t(j + 1) * (side_ + 1) + (i + 1);
-        left_out_[at] = (!square && reach[std::size_t(j) * side_ + i] < 0) + left_out_[at - 1] +
-                        left_out_[at - side_ - 1] - left_out_[at - side_ - 2];
+    left_out_.assign(std::size_t(side_x_ + 1) * (side_y_ + 1), 0);
+    for (int j = 0; j < side_y_; ++j)
+      for (int i = 0; i < side_x_; ++i) {
+        const bool inside = i >= margin_ && i < margin_ + gx_ && j >= margin_ && j < margin_ + gy_;
+        const std::size_t at = std::size_t(j + 1) * (side_x_ + 1) + (i + 1);
+        left_out_[at] = (!inside && reach[std::size_t(j) * side_x_ + i] < 0) + left_out_[at - 1] +
+                        left_out_[at - side_x_ - 1] - left_out_[at - side_x_ - 2];
       }
   }
 
@@ -270,33 +285,36 @@ class CopyRegion {
     xy = coords;
     original.resize(n);
     std::iota(original.begin(), original.end(), std::size_t(0));
-    const int shifts = (margin_ + g_ - 1) / g_;
+    const int shifts_x = (margin_ + gx_ - 1) / gx_, shifts_y = (margin_ + gy_ - 1) / gy_;
     for (std::size_t i = 0; i < n; ++i) {
-      const int cx = cell(coords[2 * i]), cy = cell(coords[2 * i + 1]);
-      for (int sx = -shifts; sx <= shifts; ++sx)
-        for (int sy = -shifts; sy <= shifts; ++sy)
-          if ((sx || sy) && !left_out(cx + sx * g_, cy + sy * g_, cx + sx * g_, cy + sy * g_))
-            xy.insert(xy.end(), {coords[2 * i] + sx, coords[2 * i + 1] + sy}), original.push_back(i);
+      const int cx = cell_x(coords[2 * i]), cy = cell_y(coords[2 * i + 1]);
+      for (int sx = -shifts_x; sx <= shifts_x; ++sx)
+        for (int sy = -shifts_y; sy <= shifts_y; ++sy)
+          if ((sx || sy) && !left_out(cx + sx * gx_, cy + sy * gy_, cx + sx * gx_, cy + sy * gy_))
+            xy.insert(xy.end(), {coords[2 * i] + sx * lx_, coords[2 * i + 1] + sy * ly_}),
+                original.push_back(i);
     }
   }
 
   /// Whether every cell a circle covers, widened by the slack, holds its copies.
   bool contains(const Circle& c) const {
-    const double lo = -margin_, hi = g_ + margin_;
-    const double x0 = (c.x - c.r) * g_ - kSlack, x1 = (c.x + c.r) * g_ + kSlack;
-    const double y0 = (c.y - c.r) * g_ - kSlack, y1 = (c.y + c.r) * g_ + kSlack;
-    if (!(x0 >= lo && y0 >= lo && x1 < hi && y1 < hi)) return false;
+    const double x0 = (c.x - c.r) / lx_ * gx_ - kSlack, x1 = (c.x + c.r) / lx_ * gx_ + kSlack;
+    const double y0 = (c.y - c.r) / ly_ * gy_ - kSlack, y1 = (c.y + c.r) / ly_ * gy_ + kSlack;
+    if (!(x0 >= -margin_ && y0 >= -margin_ && x1 < gx_ + margin_ && y1 < gy_ + margin_)) return false;
     return !left_out(int(std::floor(x0)), int(std::floor(y0)), int(std::floor(x1)), int(std::floor(y1)));
   }
 
  private:
-  int cell(double v) const { return std::min(g_ - 1, std::max(0, static_cast<int>(v * g_))); }
-  int wrap(int i) const { return ((i % g_) + g_) % g_; }
-  std::size_t index(int i, int j) const { return std::size_t(j + margin_) * side_ + (i + margin_); }
+  int cell_x(double v) const { return std::min(gx_ - 1, std::max(0, static_cast<int>(v / lx_ * gx_))); }
+  int cell_y(double v) const { return std::min(gy_ - 1, std::max(0, static_cast<int>(v / ly_ * gy_))); }
+  static int wrap(int i, int g) { return ((i % g) + g) % g; }
+  std::size_t index(int i, int j) const { return std::size_t(j + margin_) * side_x_ + (i + margin_); }
   /// Whether a cell in [i0, i1] × [j0, j1] (cells of the plane, 0 to g − 1 the square's) is left out.
   bool left_out(int i0, int j0, int i1, int j1) const {
-    if (i0 < -margin_ || j0 < -margin_ || i1 >= g_ + margin_ || j1 >= g_ + margin_) return true;
-    auto at = [&](int i, int j) { return left_out_[std::size_t(j + margin_) * (side_ + 1) + (i + margin_)]; };
+    if (i0 < -margin_ || j0 < -margin_ || i1 >= gx_ + margin_ || j1 >= gy_ + margin_) return true;
+    auto at = [&](int i, int j) {
+      return left_out_[std::size_t(j + margin_) * (side_x_ + 1) + (i + margin_)];
+    };
     return at(i1 + 1, j1 + 1) - at(i0, j1 + 1) - at(i1 + 1, j0) + at(i0, j0) > 0;
   }
 
@@ -304,16 +322,18 @@ class CopyRegion {
   /// Cells of slack (0.01 of a cell, at most 1024 cells to the side: 10^-5, ten moves and more) for the
   /// moves of the points and the rounding of a point to its cell.
   static constexpr double kSlack = 0.01;
-  int g_ = 1, margin_ = 0, side_ = 1;
-  std::vector<std::int64_t> left_out_;  // (side + 1)² prefix sums of the cells without copies
+  double lx_ = 1, ly_ = 1;
+  int gx_ = 1, gy_ = 1, margin_ = 0, side_x_ = 1, side_y_ = 1;
+  std::vector<std::int64_t> left_out_;  // (side_x + 1)(side_y + 1) prefix sums of the cells without copies
 };
 
 /// The circumcircles of a torus set's Delaunay triangles, each once, triangulated with the copies of
 /// CopyRegion; none if a circle does not lie where the copies are present or they are fewer than 2n (a
 /// flat triangle).
-std::vector<Circle> torus_circles_around_holes(const std::vector<double>& coords, double spacing) {
+std::vector<Circle> torus_circles_around_holes(const std::vector<double>& coords, double spacing,
+                                               double lx = 1, double ly = 1) {
   const std::size_t n = coords.size() / 2;
-  const CopyRegion region(coords, spacing);
+  const CopyRegion region(coords, spacing, lx, ly);
   std::vector<double> xy;
   std::vector<std::size_t> original;
   region.copies(coords, xy, original);
@@ -324,12 +344,11 @@ std::vector<Circle> torus_circles_around_holes(const std::vector<double>& coords
 }
 
 /// The circumcircles of a torus set's Delaunay triangles, each once: with the copies around its holes, or
-/// failing that with a margin; both give the same circles. A rectangle (`sides` not the unit square's,
-/// `coords` in its lengths) takes the margin: CopyRegion's cells are the square's.
+/// failing that with a margin; both give the same circles. A rectangle's `coords` are in its lengths
+/// (`sides`, common.h).
 std::vector<Circle> torus_circles(const std::vector<double>& coords, double spacing, const Sides& sides) {
-  if (!unit_sides(sides)) return torus_circles_by_margin(coords, spacing, sides[0], sides[1]);
-  std::vector<Circle> circles = torus_circles_around_holes(coords, spacing);
-  return circles.empty() ? torus_circles_by_margin(coords, spacing) : circles;
+  std::vector<Circle> circles = torus_circles_around_holes(coords, spacing, sides[0], sides[1]);
+  return circles.empty() ? torus_circles_by_margin(coords, spacing, sides[0], sides[1]) : circles;
 }
 
 /// The box set's circumcircles: those centred at least `border` spacings inside the square (the lx × ly
@@ -409,11 +428,13 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
 
 namespace detail {
 
-std::vector<double> torus_circumradii(const std::vector<double>& coords, TorusCopies copies) {
+std::vector<double> torus_circumradii(const std::vector<double>& coords, TorusCopies copies, double lx,
+                                      double ly) {
   const double spacing = hex_spacing(coords.size() / 2);
   std::vector<double> radii;
-  for (const Circle& c : copies == TorusCopies::kAroundHoles ? torus_circles_around_holes(coords, spacing)
-                                                             : torus_circles_by_margin(coords, spacing))
+  for (const Circle& c : copies == TorusCopies::kAroundHoles
+                             ? torus_circles_around_holes(coords, spacing, lx, ly)
+                             : torus_circles_by_margin(coords, spacing, lx, ly))
     radii.push_back(c.r);
   return radii;
 }

@@ -12,7 +12,9 @@ enum class TorusCopies {
 };
 
 /// The circumradii of a torus set's (distinct, 2D, interleaved) Delaunay triangles, each once, in the order
-/// found. kAroundHoles returns none where empty_circles falls back to kMargin (a flat triangle).
-std::vector<double> torus_circumradii(const std::vector<double>& coords, TorusCopies copies);
+/// found. kAroundHoles returns none where empty_circles falls back to kMargin (a flat triangle). A torus of
+/// sides lx × ly takes `coords` in its lengths.
+std::vector<double> torus_circumradii(const std::vector<double>& coords, TorusCopies copies, double lx = 1,
+                                      double ly = 1);
 
 }  // namespace kdm::analysis::detail
