@@ -108,8 +108,9 @@ std::string with_classes(std::string metrics, const std::string& classes) {
 /// A domain's relative sides x y z (gen::SamplerOptions::extent) and how the summary names them.
 struct Shape {
   double extent[3] = {1, 1, 1};
-  std::string text;  ///< "aspect 2" or "sides 2:1:0.5"; "" for a square or cube
-  int numbers = 1;   ///< as given: one (an aspect) or three (sides)
+  std::string text;    ///< "aspect 2" or "sides 2:1:0.5"; "" for a square or cube
+  int numbers = 1;     ///< as given: one (an aspect) or three (sides)
+  bool named = false;  ///< a file's header named it (else the file says nothing: taken as a square)
   bool square() const { return extent[0] == extent[1] && extent[1] == extent[2]; }
   bool same(const Shape& o) const {
     return extent[0] == o.extent[0] && extent[1] == o.extent[1] && extent[2] == o.extent[2];
@@ -158,8 +159,10 @@ Shape sampled_shape(const std::string& path) {
     for (const char* key : {", aspect ", ", sides "})
       if (const std::size_t at = line.find(key); at != std::string::npos) {
         const std::size_t from = at + std::string(key).size();
-        return parse_shape(line.substr(from, line.find_first_of(", \r", from) - from),
-                           path + ": the header's " + std::string(key + 2, std::strlen(key) - 3));
+        Shape shape = parse_shape(line.substr(from, line.find_first_of(", \r", from) - from),
+                                  path + ": the header's " + std::string(key + 2, std::strlen(key) - 3));
+        shape.named = true;
+        return shape;
       }
   return {};
 }
@@ -177,9 +180,9 @@ Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text) {
           "(width / height)");
     if (!given.square()) std::fprintf(text, "domain from --aspect: %s\n", given.text.c_str());
     for (std::size_t f = 0; f < read.size(); ++f)
-      if (!read[f].same(given) && !(read[f].square() && given.square()))
+      if (read[f].named && !read[f].same(given) && !(read[f].square() && given.square()))
         std::fprintf(text, "%s was sampled with %s; measured with --aspect %s\n", args.files[f].c_str(),
-                     read[f].square() ? "a square" : read[f].text.c_str(), args.aspect.c_str());
+                     read[f].square() ? "equal sides" : read[f].text.c_str(), args.aspect.c_str());
     return given;
   }
   for (std::size_t f = 1; f < read.size(); ++f)
@@ -295,11 +298,11 @@ void run_analyze(const AnalyzeArgs& args) {
     std::copy(shape.extent, shape.extent + 3, o.extent);
     if (!shape.square() && args.tile_size != 0)
       throw CommandError(
-          "--tile-size: tiling diagnostics take square tiles of the unit square, and the "
-          "points were drawn in a domain of " +
+          "--tile-size: tiling diagnostics take square tiles of the unit square, and the points "
+          "were drawn in a domain of " +
           shape.text +
-          " (--aspect 1 measures them in "
-          "the unit square)");
+          " (--aspect 1 measures them in the unit "
+          "square)");
     if (!shape.square() && !sets.front().classes.empty())
       throw CommandError(
           "labelled points are analysed in the unit square only, and these were drawn in a "
@@ -407,9 +410,9 @@ void add_analyze_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--aspect", args->aspect,
                   "The domain the points were drawn in: width/height (in 3D the x side over the others), or "
-                  "three sides X:Y:Z; they are measured in it, scaled to unit area (volume). Default: what "
-                  "the files' headers say (kdm sample --aspect writes it), else the unit square (cube); 1 "
-                  "forces the square");
+                  "three sides X:Y:Z; they are measured in it, scaled to unit area (volume); 1 forces the "
+                  "square (default: what the files' headers say, as kdm sample --aspect writes it, else the "
+                  "unit square or cube)");
   add_threads_option(cmd, args->threads, "results do not depend on it");
   cmd->add_option_function<std::string>(
       "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },
