@@ -67,7 +67,8 @@ def sample(
         Width / height of the domain (in 3-D, its x side over its y and z sides, as ``kdm sample
         --aspect``); in 3-D also three sides ``(x, y, z)``, relative lengths each > 0 (``--aspect X:Y:Z``);
         None: the image's or 2-D array's width / height, a 3-D array's (width, height, depth), else 1.
-        Points are normalised to [0, 1) on every axis whatever the aspect.
+        Points are normalised to [0, 1) on every axis whatever the aspect: give ``kdm.analyze`` the same
+        aspect to measure them in their domain.
     gamma, invert
         How an image file's pixels become density (as ``kdm sample --gamma/--invert``).
     classes : sequence of densities, optional
