@@ -846,12 +846,4 @@ TEST_F(CliTest, AnalyzeWarnsOfASetSampledInAnotherShape) {
               sides == "2:1:0.5")
         << r.out;
   }
-  // A 3D box of three sides of its own, and a cube given as three equal sides.
-  for (const std::string sides : {"2:1:0.5", "1:1:1"}) {
-    ASSERT_EQ(kdm("sample --dim 3 --n 300 --aspect " + sides + " -o '" + path("v.txt") + "'").status, 0);
-    const Outcome r = kdm("analyze '" + path("v.txt") + "' --no-energy");
-    ASSERT_EQ(r.status, 0) << r.err;
-    const bool warned = r.err.find("sampled in a domain of sides 2:1:0.5;") != std::string::npos;
-    EXPECT_EQ(warned, sides == "2:1:0.5") << r.err;
-  }
 }
