@@ -240,6 +240,33 @@ inline constexpr int kMaxThreads = 256;
 /// Draws one point set from the KDM model. Throws InvalidArgument on bad options or density.
 SampleResult sample(const SamplerOptions& options, const Density& density = Density::constant());
 
+/// The most sets one sample_sets() call takes, and the most points (sets × n) it returns in all: 2^27
+/// points are 2 GiB of coordinates in 2D, 3 GiB in 3D. Ask for more in several calls.
+inline constexpr std::int64_t kMaxSampleSets = std::int64_t(1) << 20;
+inline constexpr std::int64_t kMaxSampleSetPoints = std::int64_t(1) << 27;
+
+/// Many independent point sets of one kind at once, for Monte Carlo work that wants a small set per pixel
+/// or per frame: set k is bit for bit what sample() returns for `options` with seed `seeds[k]`, for every
+/// thread count. The sets run in parallel, one per thread of up to options.threads (0:
+/// default_thread_count()), each on one thread (a set of up to a few thousand points runs its sweeps on one
+/// thread anyway), so on c cores a batch of small sets runs about c times as many sets per second as sample()
+/// calls do; when there are fewer sets than threads each set shares out the rest. The model (the density
+/// sampled on the grids, which does not depend on the seed) is built once for all sets: a density function is
+/// called as for one sample() call, from the calling thread, not once per set. options.n must be > 0 (with a
+/// `resolution` the count could differ between sets); options.seed is not used. options.progress, if set, is
+/// called from the calling thread only, with the fraction of all sets done; an exception it throws ends the
+/// call with that exception once the running sets stop at their next sweep. Each report's model_seconds is
+/// the shared model's build, which its `seconds` leaves out. Throws InvalidArgument as sample() does, and for
+/// no seeds, more than kMaxSampleSets of them, or more than kMaxSampleSetPoints points in all.
+std::vector<SampleResult> sample_sets(const SamplerOptions& options, const Density& density,
+                                      const std::vector<std::uint64_t>& seeds);
+
+/// sample_sets() writing into caller-owned memory: set k's n · dim coordinates (as SampleResult::points)
+/// go to points[k · n · dim ...], so `points` must hold seeds.size() · n · dim doubles (n: options.n, or
+/// the count of initial_points). Returns each set's report. Throws as sample_sets() does, before writing.
+std::vector<SampleReport> sample_sets(const SamplerOptions& options, const Density& density,
+                                      const std::vector<std::uint64_t>& seeds, double* points);
+
 /// E / n of `points` (normalised coordinates) under the model sample() would use for the same count,
 /// domain and density: the energy of eq. 3 on the finest grid. Lets any point set (tiles, other
 /// samplers) be compared with full-sampler runs on one scale. Throws InvalidArgument on bad input.
