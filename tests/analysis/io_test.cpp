@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 #include "kdm/analysis/json.h"
@@ -262,6 +263,15 @@ TEST(PointFiles, NpyFilesRead) {
   EXPECT_EQ(f.dim, 3);
   EXPECT_EQ(f.coords, (std::vector<double>{0.25, 0.5, 0, 0.75, 0.125, 1}));
   EXPECT_EQ(read_one(npy(c2, bytes_of<double>({0.25, 0.5, 0.75, 0.125}), 2), "v2.npy").size(), 2u);
+  // (sets, n, dim), as kdm sample --sets writes it: that many sets.
+  std::istringstream several(npy("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 1, 2), }",
+                                 bytes_of<double>({0.25, 0.5, 0.75, 0.125, 0, 0.5})));
+  std::vector<tools::PointSet> sets;
+  std::string read_failure;
+  ASSERT_TRUE(tools::read_point_sets(several, "s.npy", sets, read_failure)) << read_failure;
+  ASSERT_EQ(sets.size(), 3u);
+  EXPECT_EQ(sets[1].coords, (std::vector<double>{0.75, 0.125}));
+  EXPECT_EQ(sets[2].coords, (std::vector<double>{0, 0.5}));
   const std::string two = bytes_of<double>({0.25, 0.5, 0.75, 0.125});
   const std::vector<std::pair<std::string, std::string>> refused = {
       {npy("{'descr': '>f8', 'fortran_order': False, 'shape': (2, 2), }", two), "big-endian data ('>f8')"},
@@ -275,6 +285,11 @@ TEST(PointFiles, NpyFilesRead) {
       {npy("{'descr': '<f8', 'shape': (2, 2), }", two), "without descr, fortran_order or shape"},
       {npy("__import__('os')", two), "no dictionary"},
       {npy(c2, bytes_of<double>({0.25, std::nan(""), 0.75, 0.125})), "non-finite coordinate in row 1"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 1, 2), }",
+           bytes_of<double>({0.25, 0.5, 0.75, std::nan("")})),
+       "non-finite coordinate in row 1 of set 2"},
+      {npy("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 1, 2), }", two), "save it in C order"},
+      {npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 1, 4), }", two), "shape (2, 1, 4)"},
       {std::string("\x93NUMPY\x01\x00\xff\xff", 10), "cut short in its header"},
       {std::string("\x93NUMPY\x02\x00\xff\xff\xff\x7f", 12), "a header of 2147483647 bytes"},
       {std::string("\x93NUMPY\x07\x00", 8), "unknown format version 7"},

@@ -369,6 +369,45 @@ TEST_F(CliTest, SampleWritesNumPyArrays) {
   EXPECT_FALSE(fs::exists(path("c.npy")));
 }
 
+// --sets K: K sets in one file, each the set --sets 1 writes for its seed (--seed, --seed + 1, ...), read
+// back as K sets from .txt ('#' lines between them) and from .npy (a (K, n, dim) array), whatever the
+// thread count; what several sets cannot be is refused before any sampling.
+TEST_F(CliTest, SampleWritesSeveralSets) {
+  for (const int dim : {2, 3}) {
+    const std::string d = " --dim " + std::to_string(dim);
+    ASSERT_EQ(kdm("sample --n 40 --sets 3 --seed 11 --threads 1" + d + " -o '" + path("s.txt") + "'").status,
+              0);
+    ASSERT_EQ(kdm("sample --n 40 --sets 3 --seed 11 --threads 2" + d + " -o '" + path("s.npy") + "'").status,
+              0);
+    std::vector<kdm::tools::PointSet> txt, npy, one;
+    std::string error;
+    ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), txt, error)) << error;
+    ASSERT_TRUE(kdm::tools::read_point_sets(path("s.npy"), npy, error)) << error;
+    ASSERT_EQ(txt.size(), 3u);
+    ASSERT_EQ(npy.size(), 3u);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(
+          kdm("sample --n 40 --seed " + std::to_string(11 + k) + d + " -o '" + path("one.txt") + "'").status,
+          0);
+      ASSERT_TRUE(kdm::tools::read_point_sets(path("one.txt"), one, error)) << error;
+      EXPECT_EQ(txt[k].dim, dim);
+      EXPECT_EQ(txt[k].coords, one.at(0).coords) << "set " << k;
+      EXPECT_EQ(npy[k].coords, one.at(0).coords) << "set " << k;
+    }
+    EXPECT_EQ(slurp(path("s.npy")).size(), 128 + 3 * 40 * dim * 8u);
+  }
+  const std::string o = " -o '" + path("x.txt") + "'";
+  expect_error("sample --n 16 --sets 0" + o, "--sets must be 1 to");
+  expect_error("sample --n 16 --sets 1048577" + o, "--sets must be 1 to");
+  expect_error("sample --n 1000 --sets 1048576" + o, "points in all");
+  expect_error("sample --n 0 --resolution 64 --sets 2" + o, "--sets needs --n > 0");
+  expect_error("sample --n 16 --sets 2 -o '" + path("x.csv") + "'", "not .csv");
+  expect_error("sample --n 16 --sets 2 -o '" + path("x.png") + "'", "not .png");
+  expect_error("sample --n 16 --sets 2 --class const:1 --class const:2" + o, "drop --class");
+  expect_error("sample --n 16 --sets 3 --seed 18446744073709551614" + o, "past the largest seed");
+  EXPECT_FALSE(fs::exists(path("x.txt")));
+}
+
 /// `values` (depth × height × width, in numpy's C order) as np.save writes a 3-D array of `descr` ('<f8',
 /// '<f4' or '|u1'); `shape` overrides the header's shape.
 std::string npy_volume(const std::vector<double>& values, int depth, int height, int width,

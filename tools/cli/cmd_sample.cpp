@@ -2,10 +2,13 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -36,6 +39,7 @@ struct SampleArgs {
   bool timing = false;
   int width_px = 1024;
   double dot_radius = 0;
+  std::int64_t sets = 1;  ///< --sets: point sets, seeds --seed, --seed + 1, ...
 };
 
 /// --aspect: one number, the x side over the others, or in 3D three sides X:Y:Z (their ratios count).
@@ -66,6 +70,84 @@ std::vector<double> parse_aspect(const std::string& text, int dim) {
   return sides;
 }
 
+/// --sets: refuses, before any sampling, what several sets cannot be (a count from --resolution, classes,
+/// a picture or CSV file, seeds past 2^64 - 1). Sizes past sample_sets()'s bounds it refuses itself.
+void check_sets(const SampleArgs& args, const std::string& format, bool classed) {
+  if (args.sets < 1 || args.sets > gen::kMaxSampleSets)
+    throw CommandError("--sets must be 1 to " + std::to_string(gen::kMaxSampleSets) + ", got " +
+                       std::to_string(args.sets));
+  if (args.sets == 1) return;
+  if (args.options.n <= 0) throw CommandError("--sets needs --n > 0: every set has that many points");
+  if (classed) throw CommandError("--sets draws one class: drop --class, or --sets");
+  if (format != ".txt" && format != ".npy")
+    throw CommandError(
+        "--sets writes .txt (sets separated by '#' lines, as kdm analyze reads them) or .npy " +
+        std::string("(a (sets, n, dim) array), not ") + format);
+  if (args.options.seed > std::numeric_limits<std::uint64_t>::max() - std::uint64_t(args.sets - 1))
+    throw CommandError("--seed " + std::to_string(args.options.seed) + " with --sets " +
+                       std::to_string(args.sets) + " runs past the largest seed, 2^64 - 1");
+}
+
+/// kdm sample --sets K: K sets with seeds --seed, --seed + 1, ... (gen::sample_sets), each the points
+/// `kdm sample --seed S` writes for its seed S, in one file.
+void run_sets(const SampleArgs& args, const gen::SamplerOptions& o, const gen::Density& density,
+              const std::string& format, const std::string& domain, const double extent[3], double aspect,
+              ProgressBar& bar) {
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(args.sets));
+  for (std::size_t k = 0; k < seeds.size(); ++k) seeds[k] = o.seed + k;
+  std::vector<gen::SampleResult> results;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    results = gen::sample_sets(o, density, seeds);
+  } catch (const gen::InvalidArgument& e) {
+    throw CommandError(e.what());
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  bar.finish();
+  std::vector<tools::PointSet> sets(results.size());
+  std::vector<std::string> set_headers;
+  std::uint64_t proposals = 0, accepted = 0;
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    sets[k].dim = results[k].dim;
+    sets[k].coords = std::move(results[k].points);
+    proposals += results[k].report.proposals, accepted += results[k].report.accepted;
+    char set_line[96];
+    std::snprintf(set_line, sizeof set_line, "set %zu, seed %llu, acceptance %.3f", k,
+                  static_cast<unsigned long long>(seeds[k]), results[k].report.acceptance_rate());
+    set_headers.push_back(set_line);
+  }
+  const double acceptance = proposals ? double(accepted) / double(proposals) : 0.0;
+  char line[256];
+  std::snprintf(
+      line, sizeof line,
+      "kdm sample: %lld sets of %lld points, T=%g (model %.4g), seeds %llu to %llu, acceptance %.3f",
+      static_cast<long long>(args.sets), static_cast<long long>(o.n), o.temperature,
+      results.front().report.model_temperature, static_cast<unsigned long long>(seeds.front()),
+      static_cast<unsigned long long>(seeds.back()), acceptance);
+  std::string shape;
+  if (o.dim == 3 && (extent[1] != 1 || extent[2] != 1)) {
+    char text[96];
+    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
+    shape = text;
+  } else if (aspect != 1) {
+    char text[40];
+    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
+    shape = text;
+  }
+  std::string error;
+  if (!tools::write_point_sets(args.output, sets,
+                               {line, "density " + args.density + ", domain " + domain + shape}, set_headers,
+                               error, format))
+    throw std::runtime_error(error);
+  std::fprintf(stderr, "%s, %.3f s -> %s\n", line, seconds,
+               args.output == tools::kStandardOutput ? "standard output" : args.output.c_str());
+  if (args.timing)
+    std::printf("sets %lld points_per_set %lld seconds %.4f sets_per_second %.1f threads %d\n",
+                static_cast<long long>(args.sets), static_cast<long long>(o.n), seconds,
+                double(args.sets) / std::max(1e-9, seconds),
+                o.threads > 0 ? o.threads : gen::default_thread_count());
+}
+
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   const std::string format =
       check_output_option(args.output, kSampleFormats, args.format);  // before sampling
@@ -89,6 +171,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     throw CommandError("--class writes its classes to .csv (x,y,class) or pictures, not .npy");
   if (classed && args.options.n <= 0) throw CommandError("--class needs --n > 0 (the points of all classes)");
   if (classed && args.options.dim != 2) throw CommandError("--class samples 2D points: drop --dim 3");
+  check_sets(args, format, classed);
   std::vector<tools::DensitySpec> specs;
   for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density}) {
     tools::refuse_writing_over(text, args.output, "density image");  // a picture written over its input
@@ -138,6 +221,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     std::fprintf(stderr, "kdm: warning: --unadjusted skips the Metropolis-Hastings test; output is biased\n");
   ProgressBar bar("sampling");
   o.progress = [&bar](double f) { bar.update(f); };
+  if (args.sets > 1) return run_sets(args, o, densities.front(), format, domain, extent, aspect, bar);
   gen::SampleResult result;
   tools::PointSet set;
   try {
@@ -265,6 +349,13 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--gamma", args->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", args->invert, "Bright image areas are dense instead of dark ones");
   add_threads_option(cmd, o.threads, "output does not depend on it");
+  add_count_option(
+      cmd, "--sets", args->sets,
+      "Point sets to draw, 1 to 1048576, with seeds --seed, --seed + 1, ... (each set the points "
+      "--sets 1 writes for its seed), run a set per thread: many small sets for Monte Carlo "
+      "work; written to .txt with a '#' line before each set (as kdm analyze reads several "
+      "sets) or to .npy as a (sets, n, dim) array; needs --n, at most 2^27 points in all")
+      ->capture_default_str();
   cmd->add_option("--sweeps", o.sweeps,
                   "Metropolis-Hastings sweeps over all points on the finest level (where that is "
                   "the only level, as for a few hundred points, at least 30: points start there at random); "

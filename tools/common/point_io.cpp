@@ -331,9 +331,10 @@ namespace {
 /// The first bytes of a NumPy .npy file (np.save).
 constexpr char kNpyMagic[] = "\x93NUMPY";
 
-/// Reads a NumPy .npy file's one set, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
-/// float32, in C or Fortran order. The header is untrusted (read_npy_header), and the data read as it comes
-/// (a header that promises more than the file holds allocates nothing of it).
+/// Reads a NumPy .npy file's sets, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
+/// float32, in C or Fortran order, is one set; a (sets, n, 2) or (sets, n, 3) array in C order (kdm sample
+/// --sets) is that many. The header is untrusted (read_npy_header), and the data read as it comes (a header
+/// that promises more than the file holds allocates nothing of it).
 bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& sets, std::string& error) {
   auto fail = [&](const std::string& what) {
     error = path + ": NumPy .npy file: " + what;
@@ -361,16 +362,21 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
     return fail("data of type '" + excerpt(descr) + "': expected float64 or float32 ('<f8' or '<f4')");
   std::string dims;
   for (std::size_t i = 0; i < shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(shape[i]);
-  if (shape.size() != 2 || (shape[1] != 2 && shape[1] != 3))
-    return fail("an array of shape (" + dims + "): expected (n, 2) or (n, 3) points");
-  const std::uint64_t n = shape[0], dim = shape[1], count = n * dim;
-  if (n == 0) {
+  const bool several = shape.size() == 3;  // (sets, n, dim)
+  if ((shape.size() != 2 && !several) || (shape.back() != 2 && shape.back() != 3))
+    return fail("an array of shape (" + dims + "): expected (n, 2) or (n, 3) points, or (sets, n, 2) or " +
+                "(sets, n, 3)");
+  if (several && fortran)
+    return fail("a (sets, n, dim) array in Fortran order: save it in C order (np.ascontiguousarray)");
+  const std::uint64_t n = shape[shape.size() - 2], dim = shape.back(), per_set = n * dim;
+  const std::uint64_t count = several ? shape[0] * per_set : per_set;  // each axis < 2^40: no overflow
+  if (count == 0) {
     error = "point file '" + path + "' holds no points";
     return false;
   }
   PointSet set;
   set.dim = static_cast<int>(dim);
-  set.coords.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(count, 1 << 20)));
+  set.coords.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(per_set, 1 << 20)));
   unsigned char chunk[1 << 14];
   for (std::uint64_t done = 0; done < count;) {
     const std::size_t values =
@@ -389,13 +395,22 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
         std::memcpy(&f, &b32, 4);
         v = f;
       }
-      if (!std::isfinite(v))
+      if (!std::isfinite(v)) {
+        const std::uint64_t at = done + k;
         return fail("a non-finite coordinate in row " +
-                    std::to_string((fortran ? (done + k) % n : (done + k) / dim) + 1));
+                    std::to_string((fortran ? at % n : at % per_set / dim) + 1) +
+                    (several ? " of set " + std::to_string(at / per_set + 1) : std::string()));
+      }
       set.coords.push_back(v);
+      if (several && set.coords.size() == per_set) {
+        sets.push_back(std::move(set));
+        set = PointSet{};
+        set.dim = static_cast<int>(dim);
+      }
     }
     done += values;
   }
+  if (several) return true;
   if (fortran) {  // column after column: interleave them
     std::vector<double> rows(set.coords.size());
     for (std::uint64_t i = 0; i < n; ++i)
@@ -528,11 +543,14 @@ bool read_point_sets(std::istream& in, const std::string& path, std::vector<Poin
 
 namespace {
 
-/// `set` as a NumPy .npy file (format 1.0): an (n, dim) little-endian float64 array in C order, as
-/// np.load reads it; the header padded with blanks so the data start at a multiple of 64 bytes.
-std::string npy_bytes(const PointSet& set) {
-  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(set.size()) +
-                     ", " + std::to_string(set.dim) + "), }";
+/// `sets` as a NumPy .npy file (format 1.0): one set an (n, dim) little-endian float64 array in C order,
+/// several (all of one size) a (sets, n, dim) one, as np.load reads them; the header padded with blanks so
+/// the data start at a multiple of 64 bytes.
+std::string npy_bytes(const std::vector<const PointSet*>& sets) {
+  const PointSet& first = *sets.front();
+  const std::string shape = (sets.size() > 1 ? std::to_string(sets.size()) + ", " : std::string()) +
+                            std::to_string(first.size()) + ", " + std::to_string(first.dim);
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + shape + "), }";
   const std::size_t unpadded = 10 + dict.size() + 1;
   dict.append((64 - unpadded % 64) % 64, ' ');
   dict += '\n';
@@ -540,14 +558,31 @@ std::string npy_bytes(const PointSet& set) {
   out += static_cast<char>(dict.size() & 0xFF);
   out += static_cast<char>(dict.size() >> 8);
   out += dict;
-  const std::size_t at = out.size();
-  out.resize(at + set.coords.size() * sizeof(double));
-  for (std::size_t i = 0; i < set.coords.size(); ++i) {  // little-endian whatever the host
-    std::uint64_t bits;
-    std::memcpy(&bits, &set.coords[i], sizeof bits);
-    for (int b = 0; b < 8; ++b) out[at + 8 * i + b] = static_cast<char>(bits >> (8 * b) & 0xFF);
+  for (const PointSet* set : sets) {
+    const std::size_t at = out.size();
+    out.resize(at + set->coords.size() * sizeof(double));
+    for (std::size_t i = 0; i < set->coords.size(); ++i) {  // little-endian whatever the host
+      std::uint64_t bits;
+      std::memcpy(&bits, &set->coords[i], sizeof bits);
+      for (int b = 0; b < 8; ++b) out[at + 8 * i + b] = static_cast<char>(bits >> (8 * b) & 0xFF);
+    }
   }
   return out;
+}
+
+/// Appends `set`'s points as text, one point per line, separated by `sep`.
+void append_points(std::string& out, const PointSet& set, char sep) {
+  char number[32];
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    for (int k = 0; k < set.dim; ++k) {
+      if (k) out += sep;
+      const auto written = std::to_chars(number, number + sizeof number, set.coords[i * set.dim + k],
+                                         std::chars_format::general, 17);
+      out.append(number, written.ptr);
+    }
+    if (!set.classes.empty()) out += ',' + std::to_string(set.classes[i]);
+    out += '\n';
+  }
 }
 
 }  // namespace
@@ -561,7 +596,7 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
       error = "'" + path + "': points with classes are written as .csv (x,y,class)";
       return false;
     }
-    return write_text_file_atomic(path, npy_bytes(set), error);
+    return write_text_file_atomic(path, npy_bytes({&set}), error);
   }
   if (labelled && (!csv || set.dim != 2 || set.classes.size() != set.size())) {
     error = "'" + path + "': " +
@@ -579,17 +614,41 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
   } else {
     for (const std::string& h : header) out += "# " + comment_safe(h) + '\n';
   }
-  const char sep = csv ? ',' : ' ';
-  char number[32];
-  for (std::size_t i = 0; i < set.size(); ++i) {
-    for (int k = 0; k < set.dim; ++k) {
-      if (k) out += sep;
-      const auto written = std::to_chars(number, number + sizeof number, set.coords[i * set.dim + k],
-                                         std::chars_format::general, 17);
-      out.append(number, written.ptr);
+  append_points(out, set, csv ? ',' : ' ');
+  return write_text_file_atomic(path, out, error);
+}
+
+bool write_point_sets(const std::string& path, const std::vector<PointSet>& sets,
+                      const std::vector<std::string>& header, const std::vector<std::string>& set_headers,
+                      std::string& error, const std::string& format) {
+  const std::string ext = output_format(path, format);
+  if (ext != ".txt" && ext != ".npy") {
+    error = "'" + path + "': several point sets are written as .txt (sets separated by '#' lines) or .npy " +
+            "(a (sets, n, dim) array), not " + (ext.empty() ? std::string("a file without extension") : ext);
+    return false;
+  }
+  if (sets.empty() || set_headers.size() != sets.size()) {
+    error = "'" + path + "': no point sets, or not one header line per set";
+    return false;
+  }
+  for (const PointSet& set : sets)
+    if (!set.classes.empty() || set.size() != sets.front().size() || set.dim != sets.front().dim ||
+        set.size() == 0) {
+      error = "'" + path + "': point sets written together must be unlabelled, not empty, of one size and " +
+              "dimension";
+      return false;
     }
-    if (labelled) out += ',' + std::to_string(set.classes[i]);
-    out += '\n';
+  if (ext == ".npy") {
+    std::vector<const PointSet*> all;
+    for (const PointSet& set : sets) all.push_back(&set);
+    return write_text_file_atomic(path, npy_bytes(all), error);
+  }
+  std::string out;
+  out.reserve(64 + (header.size() + sets.size()) * 80 + sets.size() * sets.front().coords.size() * 25);
+  for (const std::string& h : header) out += "# " + comment_safe(h) + '\n';
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    out += "# " + comment_safe(set_headers[k]) + '\n';
+    append_points(out, sets[k], ' ');
   }
   return write_text_file_atomic(path, out, error);
 }

@@ -3,7 +3,8 @@
 // (separated by blanks or commas). A first line of column names is a CSV header: the columns named x and
 // y (and z; and class or label for labelled points, several classes), trimmed and in any case, in any
 // order, are read and the others skipped (kdm query's "x,y,tile_x,tile_y,rank,level[,class],depth" too).
-// A NumPy .npy file (np.save of an (n, 2) or (n, 3) float64 or float32 array) is read as one set.
+// A NumPy .npy file (np.save of an (n, 2) or (n, 3) float64 or float32 array) is read as one set, one of
+// shape (sets, n, 2) or (sets, n, 3) (C order) as that many sets.
 #pragma once
 
 #include <cstddef>
@@ -73,5 +74,14 @@ bool read_npy_header(std::streambuf& in, NpyHeader& header, std::string& what);
 /// (temporary file, then rename); kStandardOutput writes to standard output.
 bool write_point_set(const std::string& path, const PointSet& set, const std::vector<std::string>& header,
                      std::string& error, const std::string& format = "");
+
+/// Writes several unlabelled sets of one size and dimension (kdm sample --sets): as text, the `header`
+/// lines, then for each set a '#' line from set_headers[k] (one per set) and its points, so that
+/// read_point_sets() reads them back as separate sets; as .npy (output_format(path, format)), a (sets, n,
+/// dim) float64 array (one set: (n, dim), as write_point_set). Other formats, labelled or unequal sets:
+/// false with `error` naming the problem. Atomic; kStandardOutput writes to standard output.
+bool write_point_sets(const std::string& path, const std::vector<PointSet>& sets,
+                      const std::vector<std::string>& header, const std::vector<std::string>& set_headers,
+                      std::string& error, const std::string& format = "");
 
 }  // namespace kdm::tools
