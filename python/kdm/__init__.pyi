@@ -29,6 +29,7 @@ def sample(
     classes: Optional[Sequence[_Density]] = ...,
     sweeps: Optional[int] = ...,
     coarse_sweeps: Optional[int] = ...,
+    sets: Optional[int] = ...,  # (sets, n, dim) for seeds seed, seed + 1, ...
 ) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]]: ...
 
 class QueryResult:

@@ -23,6 +23,7 @@ def sample(
     classes: Optional[Sequence[Any]] = None,
     sweeps: Optional[int] = None,
     coarse_sweeps: Optional[int] = None,
+    sets: Optional[int] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """Draw exactly `n` blue-noise points from the KDM model (the full sampler, `kdm sample`).
 
@@ -85,6 +86,14 @@ def sample(
         finest, 0 to 100000 (``kdm sample --sweeps/--coarse-sweeps``; None: 30 and 15). A set of
         up to about 256 points has one level, which runs at least 30. More finest sweeps
         with a lower temperature give a more ordered set (docs/quality.md: T = 0.2, 100 sweeps).
+    sets : int or None
+        Many independent sets at once (Monte Carlo: a set per pixel or per frame), as ``kdm sample
+        --sets``: 1 to 2**20 sets of `n` points each, at most 2**27 points in all, drawn with the seeds
+        ``seed, seed + 1, ..., seed + sets - 1`` (their last at most 2**64 - 1); set k is exactly
+        ``kdm.sample(n, ..., seed=seed + k)``. The sets run in parallel, one per thread (a small set runs
+        on one thread anyway), with the GIL released: on two cores about twice the sets per second of a
+        loop of calls (docs/design.md §2.9). A callable density is called as for one set. Not with
+        `classes`. None: one set, returned as (n, dim).
 
     Returns
     -------
@@ -93,7 +102,8 @@ def sample(
         in the sampler's order, cell by cell of its grid, so neighbouring rows are neighbouring points: a
         prefix ``x[:k]`` is a patch of the domain, not a thinner set (for k points, sample k; for a random
         subset, index by ``rng.permutation(n)[:k]``). With `classes`: ``(points, labels)``, the points
-        (n, 2) class 0's first and labels (n,) uint8 each point's class.
+        (n, 2) class 0's first and labels (n,) uint8 each point's class. With `sets`: (sets, n, dim),
+        ``x[k]`` the set of seed ``seed + k``.
     """
     n = _checks.integer("n", n, 1, 2**31)
     dim = _checks.integer("dim", dim, 2, 3)
@@ -106,7 +116,13 @@ def sample(
     sweeps = None if sweeps is None else _checks.integer("sweeps", sweeps, 0, 100000)
     coarse_sweeps = None if coarse_sweeps is None else _checks.integer("coarse_sweeps", coarse_sweeps, 0, 100000)
     more = dict(sweeps=sweeps, coarse_sweeps=coarse_sweeps)
+    if sets is not None:
+        sets = _checks.integer("sets", sets, 1, 2**20)
+        if seed + sets - 1 > 2**64 - 1:
+            raise ValueError(f"seed {seed} with sets={sets} runs past the largest seed, 2**64 - 1")
     if classes is not None:
+        if sets is not None:
+            raise ValueError("sets draws one class: give density, not classes")
         if density is not None:
             raise ValueError("give either density or classes, not both")
         if dim != 2:
@@ -117,7 +133,7 @@ def sample(
         if gamma != 1.0 or invert:
             raise ValueError("gamma and invert apply to image files only, and density is a function")
         return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect, sides=sides,
-                                    **more)
+                                    sets=sets, **more)
     spec = _checks.sampler_density(density, gamma, invert)
     if spec is not None and spec.kind == "volume" and dim != 3:
         raise ValueError(f"density: a 3-D array of shape ({spec.depth}, {spec.height}, {spec.width}) is a volume "
@@ -125,4 +141,4 @@ def sample(
     if spec is not None and spec.kind == "image" and dim == 3:
         raise ValueError("image and array densities are 2-D; use dim=2 (a 3-D density is an array of shape "
                          "(depth, height, width))")
-    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect, sides=sides, **more)
+    return _kdm.sample(n, spec, dim, domain, temperature, seed, threads, aspect, sides=sides, sets=sets, **more)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -61,10 +62,36 @@ gen::SamplerOptions sampler_options(std::int64_t n, int dim, const std::optional
   return o;
 }
 
-py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
-                           const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
-                           int threads, std::optional<double> aspect, std::optional<int> sweeps,
-                           std::optional<int> coarse_sweeps, const Sides& sides) {
+/// gen::sample_sets with seeds o.seed, o.seed + 1, ..., o.seed + sets - 1, into a new (sets, n, dim) array:
+/// the sizes checked before the array is made, the GIL released while the sets run.
+py::array_t<double> sample_sets(const gen::SamplerOptions& o, const gen::Density& density,
+                                std::int64_t sets) {
+  if (sets < 1 || sets > gen::kMaxSampleSets)
+    throw std::invalid_argument("sets must be 1 to " + std::to_string(gen::kMaxSampleSets) + ", got " +
+                                std::to_string(sets));
+  if (o.n > gen::kMaxSampleSetPoints / sets)
+    throw std::invalid_argument(std::to_string(sets) + " sets of " + std::to_string(o.n) + " points are " +
+                                std::to_string(sets * o.n) + " points in all, more than the " +
+                                std::to_string(gen::kMaxSampleSetPoints) +
+                                " one call returns: ask for fewer");
+  if (o.seed > std::numeric_limits<std::uint64_t>::max() - std::uint64_t(sets - 1))
+    throw std::invalid_argument("seed " + std::to_string(o.seed) + " with sets=" + std::to_string(sets) +
+                                " runs past the largest seed, 2**64 - 1");
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(sets));
+  for (std::size_t k = 0; k < seeds.size(); ++k) seeds[k] = o.seed + k;
+  py::array_t<double> points({py::ssize_t(sets), py::ssize_t(o.n), py::ssize_t(o.dim)});
+  double* data = points.mutable_data();
+  {
+    py::gil_scoped_release release;
+    gen::sample_sets(o, density, seeds, data);
+  }
+  return points;
+}
+
+py::object sample(std::int64_t n, const DensitySpec* density, int dim,
+                  const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
+                  int threads, std::optional<double> aspect, std::optional<int> sweeps,
+                  std::optional<int> coarse_sweeps, const Sides& sides, std::optional<std::int64_t> sets) {
   DensitySpec uniform;  // kdm sample's default, const:1
   const DensitySpec& spec = density ? *density : uniform;
   const bool image = spec.kind == DensitySpec::Kind::kImage, volume = spec.kind == DensitySpec::Kind::kVolume;
@@ -79,6 +106,7 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
       aspect, image ? double(spec.width) / spec.height : 1.0, {sweeps, coarse_sweeps}, shape);
   if (image && dim != 2) throw std::invalid_argument("image and array densities are 2-D; use dim=2");
   const gen::Density target = tools::to_generator_density(spec);
+  if (sets) return sample_sets(o, target, *sets);
   gen::SampleResult result;
   {
     py::gil_scoped_release release;
@@ -91,15 +119,25 @@ py::array_t<double> sample(std::int64_t n, const DensitySpec* density, int dim,
 /// gen::sample of a Python function of the point's coordinates: called once per node of the sampler's
 /// grid, on one thread, with the GIL taken for each call. The first exception it raises, or value that is
 /// not finite and >= 0, ends the call with that error once the sampler returns.
-py::array_t<double> sample_function(std::int64_t n, const py::object& function, int dim,
-                                    const std::optional<std::string>& domain, double temperature,
-                                    std::uint64_t seed, int threads, std::optional<double> aspect,
-                                    std::optional<int> sweeps, std::optional<int> coarse_sweeps,
-                                    const Sides& sides) {
+py::object sample_function(std::int64_t n, const py::object& function, int dim,
+                           const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
+                           int threads, std::optional<double> aspect, std::optional<int> sweeps,
+                           std::optional<int> coarse_sweeps, const Sides& sides,
+                           std::optional<std::int64_t> sets) {
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
   const gen::SamplerOptions o = sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0,
                                                 {sweeps, coarse_sweeps}, sides);
   PythonDensity function_density(function, dim);
+  if (sets) {
+    py::object points;
+    try {
+      points = sample_sets(o, function_density.density(), *sets);
+    } catch (...) {
+      if (!function_density.failed()) throw;
+    }
+    function_density.rethrow();
+    return points;
+  }
   gen::SampleResult result;
   try {
     py::gil_scoped_release release;
@@ -160,12 +198,14 @@ void bind_sampler(py::module_& m) {
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
         py::arg("coarse_sweeps").none(true) = py::none(), py::arg("sides").none(true) = py::none(),
-        "gen::sample as kdm sample runs it");
+        py::arg("sets").none(true) = py::none(),
+        "gen::sample as kdm sample runs it; with sets, gen::sample_sets for seeds seed, seed + 1, ...");
   m.def("sample_function", &sample_function, py::arg("n"), py::arg("function"), py::arg("dim"),
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
         py::arg("coarse_sweeps").none(true) = py::none(), py::arg("sides").none(true) = py::none(),
-        "gen::sample of a Python function of the coordinates");
+        py::arg("sets").none(true) = py::none(),
+        "gen::sample of a Python function of the coordinates (with sets, gen::sample_sets)");
   m.def("sample_classes", &sample_classes, py::arg("n"), py::arg("specs"), py::arg("domain").none(true),
         py::arg("temperature"), py::arg("seed"), py::arg("threads"), py::arg("aspect").none(true),
         py::arg("sweeps").none(true) = py::none(), py::arg("coarse_sweeps").none(true) = py::none(),

@@ -274,3 +274,48 @@ def test_three_sides():
 def test_three_sides_same_bits_as_kdm_sample(cli, tmp_path):
     cli("sample", "--n", 700, "--dim", 3, "--aspect", "1:2:4", "--seed", 3, "-o", tmp_path / "s.txt")
     assert np.array_equal(kdm.sample(700, dim=3, aspect=(1, 2, 4), seed=3), read_txt(tmp_path / "s.txt"))
+
+
+def test_sets_are_the_single_calls_with_consecutive_seeds(cli, tmp_path):
+    # sets=K: a (K, n, dim) array whose set k is kdm.sample(n, seed=seed + k), bit for bit, on any thread
+    # count, for a uniform, an image-like array and a function density, and as kdm sample --sets writes it.
+    batch = kdm.sample(16, seed=5, sets=4, threads=2)
+    assert batch.shape == (4, 16, 2) and batch.dtype == np.float64 and batch.flags.c_contiguous
+    for k in range(4):
+        assert np.array_equal(batch[k], kdm.sample(16, seed=5 + k, threads=1))
+    assert np.array_equal(batch, kdm.sample(16, seed=5, sets=4, threads=1))
+    assert not np.array_equal(batch[0], batch[1])
+    assert kdm.sample(16, sets=1).shape == (1, 16, 2)
+    cube = kdm.sample(30, dim=3, seed=2, sets=3)
+    assert cube.shape == (3, 30, 3) and np.array_equal(cube[2], kdm.sample(30, dim=3, seed=4))
+    image = np.outer(np.linspace(1, 3, 8), np.ones(8))
+    assert np.array_equal(kdm.sample(100, image, seed=9, sets=2)[1], kdm.sample(100, image, seed=10))
+    calls = []
+
+    def ramp(x, y):
+        calls.append(x)
+        return 1.0 + x
+
+    one = kdm.sample(100, ramp, seed=3)
+    per_set = len(calls)
+    both = kdm.sample(100, ramp, seed=2, sets=2)
+    assert np.array_equal(both[1], one)
+    assert len(calls) == 2 * per_set  # the density is read once for all the sets
+    out = tmp_path / "sets.npy"
+    cli("sample", "--n", 16, "--seed", 5, "--sets", 4, "-o", out)
+    assert np.array_equal(np.load(out), batch)
+
+
+@pytest.mark.parametrize("kwargs,error,match", [
+    (dict(sets=0), ValueError, "sets must be >= 1"),
+    (dict(sets=2**20 + 1), ValueError, "sets must be <="),
+    (dict(sets=2.0), TypeError, "sets must be an integer"),
+    (dict(n=1000, sets=2**20), ValueError, "points in all"),
+    (dict(seed=2**64 - 2, sets=3), ValueError, "past the largest seed"),
+    (dict(classes=[1, 2], sets=2), ValueError, "not classes"),
+])
+def test_sets_refusals(kwargs, error, match):
+    args = dict(n=16)
+    args.update(kwargs)
+    with pytest.raises(error, match=match):
+        kdm.sample(args.pop("n"), **args)
