@@ -102,6 +102,68 @@ BENCHMARK(BM_TwoThreadsOverOne)->Arg(16384)->Iterations(31)->ArgName("n")->Unit(
 BENCHMARK(BM_TwoThreadsOverOne)->Arg(65536)->Iterations(15)->ArgName("n")->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TwoThreadsOverOne)->Arg(262144)->Iterations(7)->ArgName("n")->Unit(benchmark::kMillisecond);
 
+// Many small sets (Monte Carlo: a set per pixel or per frame), uniform torus, on two threads: rounds of
+// `sets` sample() calls one after another, one sample_sets() call with the same seeds (the same points),
+// and two std::threads side by side each making half the sample() calls on one thread. A set this small
+// runs its sweeps on one thread, so the batch's gain is running a set per thread. Counters, medians over
+// the rounds: single_sets_per_second and batch_sets_per_second; speedup, their ratio, with its quartiles;
+// ceiling = t_single / t_side_by_side, what this machine gives two threads that share nothing (on a shared
+// machine, how much of the second core was there); efficiency = t_side_by_side / t_batch.
+static void BM_SmallSets(benchmark::State& state) {
+  kdm::gen::SamplerOptions o;
+  o.n = state.range(0);
+  o.threads = 2;
+  const int sets = static_cast<int>(state.range(1));
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(sets));
+  std::uint64_t next_seed = 1;
+  auto time = [](auto&& work) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  auto calls = [&seeds](kdm::gen::SamplerOptions options, std::size_t from, std::size_t step) {
+    for (std::size_t k = from; k < seeds.size(); k += step) {
+      options.seed = seeds[k];
+      benchmark::DoNotOptimize(kdm::gen::sample(options).points.data());
+    }
+  };
+  benchmark::DoNotOptimize(
+      kdm::gen::sample_sets(o, kdm::gen::Density::constant(), {1, 2}).data());  // warm-up
+  std::vector<double> single, batch, side_by_side, ratio, ceiling, efficiency;
+  for (auto _ : state) {
+    for (auto& s : seeds) s = next_seed++;
+    single.push_back(time([&] { calls(o, 0, 1); }));
+    batch.push_back(time([&] {
+      benchmark::DoNotOptimize(kdm::gen::sample_sets(o, kdm::gen::Density::constant(), seeds).data());
+    }));
+    side_by_side.push_back(time([&] {
+      kdm::gen::SamplerOptions one = o;
+      one.threads = 1;
+      std::thread second([&] { calls(one, 1, 2); });
+      calls(one, 0, 2);
+      second.join();
+    }));
+    ratio.push_back(single.back() / batch.back());
+    ceiling.push_back(single.back() / side_by_side.back());
+    efficiency.push_back(side_by_side.back() / batch.back());
+  }
+  state.counters["single_sets_per_second"] = sets / quantile(single, 0.5);
+  state.counters["batch_sets_per_second"] = sets / quantile(batch, 0.5);
+  state.counters["speedup"] = quantile(ratio, 0.5);
+  state.counters["speedup_q1"] = quantile(ratio, 0.25);
+  state.counters["speedup_q3"] = quantile(ratio, 0.75);
+  state.counters["ceiling"] = quantile(ceiling, 0.5);
+  state.counters["efficiency"] = quantile(efficiency, 0.5);
+}
+BENCHMARK(BM_SmallSets)
+    ->Args({16, 256})
+    ->Args({64, 64})
+    ->Args({256, 16})
+    ->Args({1024, 4})
+    ->ArgNames({"n", "sets"})
+    ->Iterations(9)
+    ->Unit(benchmark::kMillisecond);
+
 // Linear in n: rounds of n = 16,384 then n = 262,144 on one thread, back to back. Counters: ratio, the
 // median of t(262,144)/t(16,384) over the rounds (18 or less is the target; 16 would be exactly linear),
 // with its quartiles.
