@@ -306,6 +306,12 @@ def test_sets_are_the_single_calls_with_consecutive_seeds(cli, tmp_path):
     assert np.array_equal(np.load(out), batch)
 
 
+def test_a_signal_stops_the_sets_inside_their_call():
+    # The calling thread checks for signals between its set's sweeps and the other threads' sets stop at
+    # their next sweep: 1,000 sets of 2,000 points take about 15 s; the alarm comes after 0.2 s.
+    assert interrupted("sample", lambda: kdm.sample(2000, sets=1000, threads=2), 0.2) == ["c_exception"]
+
+
 @pytest.mark.parametrize("kwargs,error,match", [
     (dict(sets=0), ValueError, "sets must be >= 1"),
     (dict(sets=2**20 + 1), ValueError, "sets must be <="),

@@ -359,12 +359,14 @@ void add_analyze_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("analyze",
                                      "Point-set metrics: NN distances, spectrum, g(r), holes, density, "
                                      "tiling (3D sets: NN distances, g(r) and the energy)");
-  cmd->add_option("files", args->files,
-                  "Point files: text (one point per line, blanks or commas between coordinates, sets "
-                  "separated by '#' lines), CSV with a header naming columns x and y (and z, or class/label "
-                  "for labelled points: each class is analysed alone too; other columns are skipped), or "
-                  "NumPy .npy ((n, 2) or (n, 3) float64/float32); - reads standard input. Several files, "
-                  "and the sets in one, are pooled into one report")
+  cmd->add_option(
+         "files", args->files,
+         "Point files: text (one point per line, blanks or commas between coordinates, sets "
+         "separated by '#' lines), CSV with a header naming columns x and y (and z, or class/label "
+         "for labelled points: each class is analysed alone too; other columns are skipped), or "
+         "NumPy .npy ((n, 2) or (n, 3) float64/float32, or (sets, n, 2) or (sets, n, 3) as kdm sample "
+         "--sets writes); - reads standard input. Several files, "
+         "and the sets in one, are pooled into one report")
       ->required();
   cmd->add_flag("--torus", args->torus,
                 "Periodic distances, for a set that wraps around (default; the summary's first line says "
