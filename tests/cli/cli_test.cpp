@@ -1145,6 +1145,16 @@ TEST_F(CliTest, AnalyzeMeasuresASetInTheDomainItWasDrawnIn) {
   ASSERT_EQ(boxed.status, 0) << boxed.err;
   EXPECT_NE(boxed.out.find("domain from the file header: sides 2:1:0.5"), std::string::npos) << boxed.out;
   EXPECT_NE(boxed.out.find("2 × 1 × 0.5 box"), std::string::npos) << boxed.out;
+  EXPECT_NE(boxed.out.find("--aspect 1 measures in the unit cube"), std::string::npos) << boxed.out;
+  // The same sides in other numbers are the same box, not an override.
+  const Outcome same = kdm("analyze " + box + " --aspect 4:2:1 --no-energy");
+  EXPECT_EQ(same.out.find("measured with --aspect"), std::string::npos) << same.out;
+
+  // Standard input's header tells its shape too (kdm sample ... -o - | kdm analyze -).
+  const Outcome piped = kdm("analyze - --no-energy -o - <" + wide);
+  ASSERT_EQ(piped.status, 0) << piped.err;
+  EXPECT_NE(piped.err.find("domain from the file header: aspect 2"), std::string::npos) << piped.err;
+  EXPECT_EQ(json_numbers(piped.out, "davg").at(0), in_rectangle);
 }
 
 // --class-density: each class of a labelled set against its own density, the whole set against their

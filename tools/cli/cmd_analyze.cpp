@@ -10,7 +10,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <iterator>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -112,8 +115,11 @@ struct Shape {
   int numbers = 1;     ///< as given: one (an aspect) or three (sides)
   bool named = false;  ///< a file's header named it (else the file says nothing: taken as a square)
   bool square() const { return extent[0] == extent[1] && extent[1] == extent[2]; }
-  bool same(const Shape& o) const {
-    return extent[0] == o.extent[0] && extent[1] == o.extent[1] && extent[2] == o.extent[2];
+  bool same(const Shape& o) const {  // only the sides' ratios count: 4:2:1 is 2:1:0.5
+    for (int i = 1; i < 3; ++i)
+      if (std::fabs(extent[i] / extent[0] - o.extent[i] / o.extent[0]) > 1e-12 * (extent[i] / extent[0]))
+        return false;
+    return true;
   }
 };
 
@@ -149,11 +155,36 @@ Shape parse_shape(const std::string& text, const std::string& what) {
   return shape;
 }
 
+/// Standard input read whole before the points are (they are then read from this copy), so that its
+/// header lines tell its domain as a file's do.
+class BufferedStandardInput {
+ public:
+  BufferedStandardInput()
+      : bytes_(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()),
+        copy_(bytes_),
+        old_(std::cin.rdbuf(copy_.rdbuf())) {}
+  ~BufferedStandardInput() { std::cin.rdbuf(old_); }
+  BufferedStandardInput(const BufferedStandardInput&) = delete;
+  BufferedStandardInput& operator=(const BufferedStandardInput&) = delete;
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+  std::istringstream copy_;
+  std::streambuf* old_;
+};
+
 /// The shape of the domain a point file says its points were sampled in (`kdm sample --aspect` writes
 /// ", aspect A" or ", sides X:Y:Z" in its header lines): a square or cube when it says none (a file of
-/// other tools, a .npy, standard input).
-Shape sampled_shape(const std::string& path) {
-  std::ifstream in(path);
+/// other tools, a .npy). "-" is standard input, whose bytes are `standard_input`.
+Shape sampled_shape(const std::string& path, const std::string& standard_input) {
+  std::ifstream file;
+  std::istringstream piped;
+  if (path == "-")
+    piped.str(standard_input.substr(0, 4096));  // the header lines lie in the first few
+  else
+    file.open(path);
+  std::istream& in = path == "-" ? static_cast<std::istream&>(piped) : file;
   std::string line;
   for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i)
     for (const char* key : {", aspect ", ", sides "})
@@ -169,9 +200,9 @@ Shape sampled_shape(const std::string& path) {
 
 /// The shape the files are measured in: --aspect's, else their headers' (all alike: pooled sets share one
 /// domain). Says on `text` which it took when that is not the square. Throws CommandError.
-Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text) {
+Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text, const std::string& standard_input) {
   std::vector<Shape> read;
-  for (const std::string& file : args.files) read.push_back(sampled_shape(file));
+  for (const std::string& file : args.files) read.push_back(sampled_shape(file, standard_input));
   if (!args.aspect.empty()) {
     const Shape given = parse_shape(args.aspect, "--aspect");
     if (dim == 2 && given.numbers == 3)
@@ -195,8 +226,8 @@ Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text) {
   if (!read[0].square())
     std::fprintf(text,
                  "domain from the file header%s: %s (--aspect overrides; --aspect 1 measures in the "
-                 "unit square)\n",
-                 read.size() > 1 ? "s" : "", read[0].text.c_str());
+                 "unit %s)\n",
+                 read.size() > 1 ? "s" : "", read[0].text.c_str(), dim == 3 ? "cube" : "square");
   return read[0];
 }
 
@@ -265,6 +296,9 @@ void run_analyze(const AnalyzeArgs& args) {
     }
     if (!own.densities.empty() && !any) throw CommandError("every --class-density is zero everywhere");
     std::vector<std::string> warnings;
+    std::unique_ptr<BufferedStandardInput> piped;
+    if (std::find(args.files.begin(), args.files.end(), "-") != args.files.end())
+      piped = std::make_unique<BufferedStandardInput>();
     const std::vector<tools::PointSet> sets = analysis::load_point_sets(args.files, &warnings);
     for (const std::string& w : warnings) std::fprintf(stderr, "kdm: warning: %s\n", w.c_str());
     if (volume && sets.front().dim != 3)
@@ -294,7 +328,7 @@ void run_analyze(const AnalyzeArgs& args) {
     // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
     const bool to_stdout = args.output == tools::kStandardOutput;
     std::FILE* text = to_stdout ? stderr : stdout;
-    const Shape shape = measured_shape(args, sets.front().dim, text);
+    const Shape shape = measured_shape(args, sets.front().dim, text, piped ? piped->bytes() : std::string());
     std::copy(shape.extent, shape.extent + 3, o.extent);
     if (!shape.square() && args.tile_size != 0)
       throw CommandError(
