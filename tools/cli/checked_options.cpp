@@ -89,4 +89,26 @@ CLI::Option* add_format_option(CLI::App* cmd, std::string& format,
           "another format's extension (-o x.png --format svg is refused: name the file .svg)");
 }
 
+std::vector<double> parse_sides(const std::string& text, const std::string& what) {
+  std::vector<double> sides;
+  for (std::size_t from = 0;;) {
+    const std::size_t colon = text.find(':', from);
+    const std::string part = text.substr(from, colon == std::string::npos ? std::string::npos : colon - from);
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
+      throw CommandError(what +
+                         " must be a number > 0 (the x side over the others) or three sides X:Y:Z each > 0; "
+                         "got '" +
+                         text + "'");
+    sides.push_back(v);
+    if (colon == std::string::npos) break;
+    from = colon + 1;
+  }
+  if (sides.size() != 1 && sides.size() != 3)
+    throw CommandError(what + " takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
+                       " in '" + text + "'");
+  return sides;
+}
+
 }  // namespace kdm::cli

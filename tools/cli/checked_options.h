@@ -25,6 +25,11 @@ CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::stri
 CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,
                               const std::string& description);
 
+/// A domain's shape as --aspect gives it (kdm sample, kdm analyze): one number A, the x side over the others,
+/// or three sides X:Y:Z, each > 0 and finite. Returns the one or three numbers; `what` names the source in
+/// the error ("--aspect", a file's header). Throws CommandError.
+std::vector<double> parse_sides(const std::string& text, const std::string& what);
+
 /// Refuses, before any long work, an output path that write would refuse later: a format (`format`, the
 /// --format option, else the path's extension) not among `extensions` (".csv", ".png", …), a directory, a
 /// directory that does not exist, or "-" (standard output) without a format. Throws CommandError.

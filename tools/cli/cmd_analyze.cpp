@@ -123,25 +123,9 @@ struct Shape {
   }
 };
 
-/// Parses one number A (x side over the others) or three sides X:Y:Z, each > 0 and finite, as kdm sample
-/// --aspect takes them; `what` names the source in the error. Throws CommandError.
+/// The shape --aspect or a file's header gives (parse_sides); `what` names the source in the error.
 Shape parse_shape(const std::string& text, const std::string& what) {
-  std::vector<double> sides;
-  for (std::size_t from = 0;;) {
-    const std::size_t colon = text.find(':', from);
-    const std::string part = text.substr(from, colon == std::string::npos ? std::string::npos : colon - from);
-    char* end = nullptr;
-    const double v = std::strtod(part.c_str(), &end);
-    if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
-      throw CommandError(
-          what + " must be a number > 0 (width / height) or three sides X:Y:Z each > 0, got '" + text + "'");
-    sides.push_back(v);
-    if (colon == std::string::npos) break;
-    from = colon + 1;
-  }
-  if (sides.size() != 1 && sides.size() != 3)
-    throw CommandError(what + " takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
-                       " in '" + text + "'");
+  const std::vector<double> sides = parse_sides(text, what);
   Shape shape;
   shape.numbers = int(sides.size());
   shape.extent[0] = sides[0];

@@ -45,29 +45,24 @@ struct SampleArgs {
 /// --aspect: one number, the x side over the others, or in 3D three sides X:Y:Z (their ratios count).
 /// Returns the sides (one for a single number); throws CommandError for anything else.
 std::vector<double> parse_aspect(const std::string& text, int dim) {
-  std::vector<double> sides;
-  std::size_t from = 0;
-  for (;;) {
-    const std::size_t colon = text.find(':', from);
-    const std::string part = text.substr(from, colon == std::string::npos ? std::string::npos : colon - from);
-    char* end = nullptr;
-    const double v = std::strtod(part.c_str(), &end);
-    if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
-      throw CommandError(
-          "--aspect must be a number > 0 (the x side over the others) or, with --dim 3, three "
-          "sides X:Y:Z each > 0; got '" +
-          text + "'");
-    sides.push_back(v);
-    if (colon == std::string::npos) break;
-    from = colon + 1;
-  }
+  const std::vector<double> sides = parse_sides(text, "--aspect");
   if (sides.size() == 3 && dim != 3)
     throw CommandError(
         "--aspect X:Y:Z sets a 3D domain's sides: add --dim 3, or give one number (width/height)");
-  if (sides.size() != 1 && sides.size() != 3)
-    throw CommandError("--aspect takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
-                       " in '" + text + "'");
   return sides;
+}
+
+/// The header's words for a domain that is not a square or cube, which kdm analyze reads back: ", sides
+/// X:Y:Z" for a 3D box of sides of its own, ", aspect A" for the x side over the others, else "".
+std::string shape_header(int dim, const double extent[3], double aspect) {
+  char text[96];
+  if (dim == 3 && (extent[1] != 1 || extent[2] != 1))
+    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
+  else if (aspect != 1)
+    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
+  else
+    return "";
+  return text;
 }
 
 /// --sets: refuses, before any sampling, what several sets cannot be (a count from --resolution, classes,
@@ -124,16 +119,7 @@ void run_sets(const SampleArgs& args, const gen::SamplerOptions& o, const gen::D
       static_cast<long long>(args.sets), static_cast<long long>(o.n), o.temperature,
       results.front().report.model_temperature, static_cast<unsigned long long>(seeds.front()),
       static_cast<unsigned long long>(seeds.back()), acceptance);
-  std::string shape;
-  if (o.dim == 3 && (extent[1] != 1 || extent[2] != 1)) {
-    char text[96];
-    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
-    shape = text;
-  } else if (aspect != 1) {
-    char text[40];
-    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
-    shape = text;
-  }
+  const std::string shape = shape_header(o.dim, extent, aspect);
   std::string error;
   if (!tools::write_point_sets(args.output, sets,
                                {line, "density " + args.density + ", domain " + domain + shape}, set_headers,
@@ -260,16 +246,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     what = "classes";
     for (const std::string& c : args.classes) what += " " + c;
   }
-  std::string shape;  // kdm analyze warns of it: it measures in the unit square
-  if (o.dim == 3 && (extent[1] != 1 || extent[2] != 1)) {
-    char text[96];  // three sides of their own (not the x side over the other two, which aspect says)
-    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
-    shape = text;
-  } else if (aspect != 1) {
-    char text[40];
-    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
-    shape = text;
-  }
+  const std::string shape = shape_header(o.dim, extent, aspect);  // kdm analyze measures in it
   std::vector<std::string> header = {line, what + ", domain " + domain + shape};
   tools::DrawStyle style;
   style.width_px = args.width_px;

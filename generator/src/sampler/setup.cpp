@@ -454,20 +454,29 @@ Density Density::constant(double value) {
   return d;
 }
 
+namespace {
+
+// A density's values: finite, >= 0 and not all zero, else InvalidArgument naming `what`.
+void check_density_values(const std::vector<float>& values, const std::string& what) {
+  bool any = false;
+  for (float v : values) {
+    if (!std::isfinite(v))
+      throw InvalidArgument(what + " holds a value that is not finite or exceeds a float (3.4e38)");
+    if (v < 0) throw InvalidArgument(what + " holds a negative value");
+    any |= v > 0;
+  }
+  if (!any) throw InvalidArgument(what + " is zero everywhere");
+}
+
+}  // namespace
+
 Density Density::from_values(int width, int height, std::vector<float> values) {
   if (width <= 0 || height <= 0)
     throw InvalidArgument("density image must be at least 1 x 1 values, got " + std::to_string(width) +
                           " x " + std::to_string(height));
   if (values.size() != static_cast<std::size_t>(width) * height)
     throw InvalidArgument("density image has the wrong number of values");
-  bool any = false;
-  for (float v : values) {
-    if (!std::isfinite(v))
-      throw InvalidArgument("density image holds a value that is not finite or exceeds a float (3.4e38)");
-    if (v < 0) throw InvalidArgument("density image holds a negative value");
-    any |= v > 0;
-  }
-  if (!any) throw InvalidArgument("density image is zero everywhere");
+  check_density_values(values, "density image");
   Density d;
   d.thread_safe = true;  // the function below only reads its shared, immutable values
   d.native_resolution[0] = width;
@@ -496,14 +505,7 @@ Density Density::from_volume(int width, int height, int depth, std::vector<float
     throw InvalidArgument("density volume has the wrong number of values: " + std::to_string(values.size()) +
                           " for " + std::to_string(width) + " x " + std::to_string(height) + " x " +
                           std::to_string(depth));
-  bool any = false;
-  for (float v : values) {
-    if (!std::isfinite(v))
-      throw InvalidArgument("density volume holds a value that is not finite or exceeds a float (3.4e38)");
-    if (v < 0) throw InvalidArgument("density volume holds a negative value");
-    any |= v > 0;
-  }
-  if (!any) throw InvalidArgument("density volume is zero everywhere");
+  check_density_values(values, "density volume");
   Density d;
   d.thread_safe = true;  // the function below only reads its shared, immutable values
   d.native_resolution[0] = width;
