@@ -2,8 +2,8 @@
 // sets, blanks or commas between coordinates, an optional CSV header naming its columns; NumPy .npy), on
 // arbitrary bytes. Checks: it either fails with an error naming the file or returns at least one set,
 // every set non-empty, all of one dimension (2 or 3), with whole points of finite coordinates, no more
-// points than lines (text) or than the bytes hold (.npy, 4 bytes a coordinate at least), and labels, if
-// any, one a point.
+// points than lines (text) or than the bytes hold (.npy, 4 bytes a coordinate at least; its sets, one or
+// a (sets, n, dim) array's, of one size), and labels, if any, one a point.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -45,6 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     points += set.size();
     if (npy && set.coords.size() * 4 > size) fail();
   }
-  if (npy ? sets.size() != 1 : points > lines) fail();
+  if (!npy && points > lines) fail();
+  for (const kdm::tools::PointSet& set : sets)  // .npy: one set, or a (sets, n, dim) array's K of one size
+    if (npy && set.size() != sets[0].size()) fail();
   return 0;
 }
