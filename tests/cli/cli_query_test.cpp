@@ -607,6 +607,13 @@ TEST_F(CliTest, StipplePensAsInksOneNumbering) {
   for (const char* bad : {"'#e00000,#12345'", "'#e00000,,#000000'", "'#ffffff'", "'#000000,#000000'",
                           "'#000000,#111111,#222222,#333333,#444444,#555555,#666666,#777777,#888888'"})
     expect_error("stipple '" + path("c.png") + "' --colours " + bad + " -o '" + path("x.png") + "'", "ink");
+  // Spaces around the pens, as a list is typed, change nothing.
+  ASSERT_EQ(
+      kdm("stipple '" + path("c.png") +
+          "' --colours ' #e00000, #0000aa,#000000 ,\t#00aa00' --points 6000 -o '" + path("spaced.csv") + "'")
+          .status,
+      0);
+  EXPECT_EQ(slurp(path("spaced.csv")), slurp(path("p.csv")));
 }
 
 // SVG dots in plotting order: each layer's dots as a pen would draw them, each the nearest left (travel was

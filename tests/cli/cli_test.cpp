@@ -1042,6 +1042,8 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   expect_error("query --tileset '" + path("dir.png") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
                "is a directory");
   expect_error("bake '" + path("dir.png") + "' -o '" + path("d.kdmt") + "'", "cannot read recipe");
+  expect_error("bake '" + path("absent.recipe") + "' -o '" + path("d.kdmt") + "'",
+               "cannot open recipe '" + path("absent.recipe") + "': No such file or directory");
   if (fs::exists("/dev/zero")) {
     expect_error("info /dev/zero", "bad magic");
     expect_error("bake /dev/zero -o '" + path("z.kdmt") + "'", "not a recipe");
@@ -1237,7 +1239,7 @@ TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {
     SCOPED_TRACE(command);
     expect_error(
         std::string(command) + " '" + path("r.recipe") + "'",
-        "bad magic) (file does not start with KDMTILES); it looks like a recipe: bake it with kdm bake '" +
+        "bad magic): file does not start with KDMTILES; it looks like a recipe: bake it with kdm bake '" +
             path("r.recipe") + "' -o FILE.kdmt");
   }
   expect_error("query --tileset '" + path("r.recipe") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
@@ -1256,7 +1258,7 @@ TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {
   damaged[20] = static_cast<char>(damaged[20] ^ (1 << 4));  // the payload size's high bytes
   std::ofstream(path("damaged.kdmt"), std::ios::binary) << damaged;
   expect_error("info '" + path("damaged.kdmt") + "'",
-               "tile-set header checksum mismatch (header bytes are damaged)");
+               "tile-set header checksum mismatch: header bytes are damaged");
 }
 
 TEST_F(CliTest, VersionNamesTheLibraryAndTheFormat) {
@@ -1602,4 +1604,33 @@ TEST_F(CliTest, OutputsGoIntoPipesAndABakeKeepsItsRecipe) {
 
   expect_error("bake '" + path("r.recipe") + "' -o '" + path("r.recipe") + "'", "is the recipe");
   EXPECT_EQ(slurp(path("r.recipe")), "levels 1\ncolours 1\nsweeps 2\n");
+}
+
+// A set baked without a glide track: smooth mode gives its stable positions, and both commands that query
+// it say so (points right, only not gliding); without a hand-over its zoom stops at its top level, and a
+// deeper --region is refused for that reason, not for how deep subtiles go.
+TEST_F(CliTest, ASetWithoutGlideTrackOrHandOverIsSaidToBeOne) {
+  std::ofstream(path("r.recipe")) << "levels 2\nbase_points 32\ncolours 1\nkeyframes 0\nsweeps 1\n";
+  ASSERT_EQ(kdm("bake '" + path("r.recipe") + "' -o '" + path("r.kdmt") + "'").status, 0);
+  const std::string set = " --tileset '" + path("r.kdmt") + "' ";
+  const std::string sphere = "stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'" + set;
+  const char* warning = "warning: the tile set has no glide track: smooth mode gives stable positions";
+  const Outcome query =
+      kdm("query" + set + "--rect 0,0,2,2 --scale 40 --mode smooth -o '" + path("q.csv") + "'");
+  ASSERT_EQ(query.status, 0) << query.err;
+  EXPECT_NE(query.err.find(std::string("kdm query: ") + warning), std::string::npos) << query.err;
+  const Outcome smooth = kdm(sphere + "--points 2000 -o '" + path("s.csv") + "'");
+  ASSERT_EQ(smooth.status, 0) << smooth.err;
+  EXPECT_NE(smooth.err.find(std::string("kdm stipple: ") + warning), std::string::npos) << smooth.err;
+  const Outcome stable = kdm(sphere + "--points 2000 --mode stable -o '" + path("t.csv") + "'");
+  ASSERT_EQ(stable.status, 0) << stable.err;
+  EXPECT_EQ(stable.err.find("warning"), std::string::npos) << stable.err;
+  EXPECT_EQ(slurp(path("s.csv")), slurp(path("t.csv")));  // stable positions, as said
+  expect_error(
+      sphere + "--region 0.4,0.4,0.6,0.6 -o '" + path("z.csv") + "'",
+      "--region zooms more than 2× (the tile set has no hand-over to subtiles, so smooth mode stops");
+  // The built-in set has one: its smooth limit is the subtiles' depth.
+  expect_error("stipple '" + std::string(KDM_SOURCE_DIR) +
+                   "/examples/sphere.png' --region 0,0,1e-9,1e-9 -o '" + path("z.csv") + "'",
+               "(smooth mode: as deep as the tile set's subtiles go)");
 }

@@ -127,10 +127,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   q.glide_together = a.glide_together;
   if (a.glide_together && q.mode != QueryMode::kSmooth)  // stable points never glide: said, not refused
     std::fprintf(stderr, "kdm query: warning: --glide-together applies to --mode smooth only; ignored\n");
-  if (q.mode == QueryMode::kSmooth && !tiles.has_glide_track())  // the runtime's rule, said
-    std::fprintf(stderr,
-                 "kdm query: warning: the tile set has no glide track: smooth mode gives stable "
-                 "positions (bake it with keyframes)\n");
+  warn_without_glide_track("kdm query", tiles, q.mode);
   // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;

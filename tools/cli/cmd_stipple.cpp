@@ -147,6 +147,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.method != "full" &&  // before any frame
       tools::stipple_zoom(region) > tools::max_stipple_zoom(tiles, parse_mode(a.mode)) * (1 + 1e-9))
     throw CommandError(tools::stipple_zoom_error("--region", tiles, parse_mode(a.mode)));
+  if (a.method != "full") warn_without_glide_track("kdm stipple", tiles, parse_mode(a.mode));
   std::unique_ptr<tools::TileStippler> stippler;
   if (blank) {
     // Said as the image is: every pixel transparent (paper), or white.
@@ -354,8 +355,10 @@ void add_stipple_command(CLI::App& app) {
       "gradient is drawn by mixing dots of several inks). One class of dots per ink, all inks together one "
       "blue-noise set; the run prints each class number with its ink's name and colour; .svg has a layer "
       "per ink named as printed (with N inks or pens ink-K-colour, K the class number; an empty layer for "
-      "an ink no pixel uses), .csv a class column; least-used ink first (but inks under a tenth of all ink "
-      "last) (default: black dots of the image's darkness)");
+      "an ink no pixel uses), in class order, but for cmyk and rgb in their fixed printing order (cyan, "
+      "magenta, yellow, black; red, green, blue) so a plotter's pens stay put whatever the image; .csv a "
+      "class column; classes: least-used ink first (but inks under a tenth of all ink last), pens may be "
+      "separated by ', ' (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
                   "set's endless tiling (another seed, other dots; one seed, the same dots in every region "

@@ -2,8 +2,10 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -40,7 +42,7 @@ std::string read_text(const std::string& path) {
   std::ifstream file;
   if (path != "-") file.open(path, std::ios::binary);
   std::istream& in = path == "-" ? std::cin : file;
-  if (!in) throw CommandError("cannot open recipe '" + path + "'");
+  if (!in) throw CommandError("cannot open recipe '" + path + "': " + std::strerror(errno));
   // A recipe is a few lines: reading stops past the header's cap for it, so an endless input (a device, a
   // pipe) or a directory fails instead of filling memory.
   std::string text(kMaxTilesetHeaderBytes + 1, '\0');
@@ -184,7 +186,7 @@ std::vector<char> read_tileset_input(const std::string& path) {
   std::string detail;
   // /dev/stdin: the runtime's reader, with its bounds on what it reads, reads standard input too.
   if (const Status s = read_tileset_file(path == "-" ? "/dev/stdin" : path, bytes, &detail); s != Status::kOk)
-    throw CommandError(named(path) + ": " + status_message(s) + " (" + detail + ")");
+    throw CommandError(named(path) + ": " + status_message(s) + ": " + detail);
   return bytes;
 }
 
@@ -204,7 +206,7 @@ CommandError tileset_error(const std::string& path, Status s, const std::string&
     if (gen::BakeRecipe::looks_like_recipe(start))
       hint = "; it looks like a recipe: bake it with kdm bake " + as_argument(path) + " -o FILE.kdmt";
   }
-  return CommandError(named(path) + ": " + status_message(s) + " (" + detail + ")" + hint);
+  return CommandError(named(path) + ": " + status_message(s) + ": " + detail + hint);
 }
 
 void add_tile_commands(CLI::App& app) {

@@ -43,4 +43,12 @@ const Tileset& tileset_for(const std::string& path, Tileset& storage) {
   return storage;
 }
 
+void warn_without_glide_track(const char* command, const Tileset& tiles, QueryMode mode) {
+  if (mode == QueryMode::kSmooth && !tiles.has_glide_track())
+    std::fprintf(stderr,
+                 "%s: warning: the tile set has no glide track: smooth mode gives stable positions (bake it "
+                 "with keyframes)\n",
+                 command);
+}
+
 }  // namespace kdm::cli

@@ -22,6 +22,10 @@ inline QueryMode parse_mode(const std::string& text) {
   return text == "smooth" ? QueryMode::kSmooth : QueryMode::kStable;
 }
 
+/// Warns on standard error, as `command`, that smooth mode gives stable positions when `tiles` has no glide
+/// track (the runtime's rule, said rather than refused: the points are still right, only not gliding).
+void warn_without_glide_track(const char* command, const Tileset& tiles, QueryMode mode);
+
 /// Parses `text`, the value of `option` (named in errors), as "x0,y0,x1,y1": four finite numbers with
 /// x0 < x1 and y0 < y1. Throws CommandError.
 void parse_rect(const std::string& text, const char* option, double r[4]);

@@ -337,7 +337,8 @@ std::string colour_word(const std::uint8_t rgb[3]) {
   return lo > 0.45 ? "pink" : "magenta";
 }
 
-/// An ink list "#e00000,#0000aa,#000000" (each #rrggbb or rrggbb, 1 to 8 of them) as absorbances; throws
+/// An ink list "#e00000,#0000aa,#000000" (each #rrggbb or rrggbb, 1 to 8 of them, spaces around each
+/// allowed) as absorbances; throws
 /// std::invalid_argument naming the bad part.
 std::vector<Vec3> parse_palette(const std::string& scheme) {
   std::vector<Vec3> inks;
@@ -345,6 +346,10 @@ std::vector<Vec3> parse_palette(const std::string& scheme) {
   while (true) {
     const std::size_t comma = scheme.find(',', start);
     std::string item = scheme.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    // Spaces around an ink are allowed, as a list typed "#e00000, #0000aa" has them.
+    const auto space = [](char ch) { return std::isspace(static_cast<unsigned char>(ch)) != 0; };
+    item.erase(item.begin(), std::find_if_not(item.begin(), item.end(), space));
+    item.erase(std::find_if_not(item.rbegin(), item.rend(), space).base(), item.end());
     if (!item.empty() && item[0] == '#') item.erase(0, 1);
     const bool hex = item.size() == 6 && std::all_of(item.begin(), item.end(), [](char ch) {
                        return std::isxdigit(static_cast<unsigned char>(ch)) != 0;

@@ -97,12 +97,16 @@ double max_stipple_zoom(const Tileset& tileset, QueryMode mode) {
 }
 
 std::string stipple_zoom_error(const char* what, const Tileset& tileset, QueryMode mode) {
-  char text[200];
+  char text[320];
+  const bool deep = tileset.data().handover_zone > 0 && tileset.has_glide_track();
   std::snprintf(text, sizeof text, "%s zooms more than %.6g× (%s)", what, max_stipple_zoom(tileset, mode),
-                mode == QueryMode::kSmooth
+                mode != QueryMode::kSmooth
+                    ? "stable mode: the image's darkest tone is placed a zoom of 2 below the tile set's top "
+                      "level, and stable points cannot go past it; smooth mode zooms on"
+                : deep
                     ? "smooth mode: as deep as the tile set's subtiles go"
-                    : "stable mode: the image's darkest tone is placed a zoom of 2 below the tile set's top "
-                      "level, and stable points cannot go past it; smooth mode zooms on");
+                    : "the tile set has no hand-over to subtiles, so smooth mode stops at its top level as "
+                      "stable mode does; the built-in set zooms on");
   return text;
 }
 
