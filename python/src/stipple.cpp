@@ -177,12 +177,14 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
         style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);
       }
-      char line[200], where[160];
+      char line[200];
       std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s)", set.size(), set.size() == 1 ? "" : "s",
                     method == "full" ? "full KDM sampler" : "runtime tiles");
-      std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
       try {
-        tools::write_points(*output, set, {line, "image " + label, where}, style);
+        std::vector<std::string> header = {line, "image " + label};
+        for (std::string& more : tools::stipple_region_header(uv.data(), style.aspect))
+          header.push_back(std::move(more));
+        tools::write_points(*output, set, header, style);
       } catch (const std::invalid_argument&) {
         throw;
       } catch (const std::runtime_error& e) {

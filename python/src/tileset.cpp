@@ -56,7 +56,7 @@ TilesetHandle load(const std::string& path) {
     if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
-  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + ": " + detail);
   return with_bytes({std::move(set), header.format_version}, bytes);
 }
 
@@ -73,7 +73,7 @@ TilesetHandle from_bytes(const py::bytes& data) {
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
   if (s != Status::kOk)
-    throw std::invalid_argument(std::string("data: ") + status_message(s) + " (" + detail + ")");
+    throw std::invalid_argument(std::string("data: ") + status_message(s) + ": " + detail);
   return with_bytes({std::move(set), header.format_version}, bytes);
 }
 
@@ -88,7 +88,7 @@ const std::vector<std::uint8_t>& encoded_bytes(const TilesetHandle& h) {
     const Status s = encode_tileset(h.set->data(), e.bytes, &detail);
     if (s != Status::kOk) {
       e.bytes.clear();
-      throw std::runtime_error(std::string("tile set: ") + status_message(s) + " (" + detail + ")");
+      throw std::runtime_error(std::string("tile set: ") + status_message(s) + ": " + detail);
     }
   }
   return e.bytes;
@@ -110,7 +110,7 @@ void save(const TilesetHandle& h, const std::string& path) {
     if (!tools::write_text_file_atomic(path, std::string(bytes.begin(), bytes.end()), error))
       s = Status::kIoError, detail = error;
   }
-  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + " (" + detail + ")");
+  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + ": " + detail);
 }
 
 py::dict info(const TilesetHandle& h) {
@@ -154,7 +154,7 @@ TilesetHandle bake(const std::string& recipe_text, int threads) {
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
   if (s != Status::kOk)
-    throw std::runtime_error(std::string("baked set: ") + status_message(s) + " (" + detail + ")");
+    throw std::runtime_error(std::string("baked set: ") + status_message(s) + ": " + detail);
   const std::uint32_t version = tileset_format_version_for(set->data());
   return with_bytes({std::move(set), version}, bytes);
 }

@@ -1159,6 +1159,52 @@ TEST_F(CliTest, AnalyzeMeasuresASetInTheDomainItWasDrawnIn) {
   EXPECT_EQ(json_numbers(piped.out, "davg").at(0), in_rectangle);
 }
 
+// A bounded set is measured as one: kdm sample --domain box, kdm query and kdm stipple say "domain box" in
+// their .txt headers, and kdm analyze takes box distances from it (torus ones would join points across the
+// walls), said in the summary; --torus overrides; a box and a torus file
+// are not pooled.
+TEST_F(CliTest, AnalyzeMeasuresABoundedSetAsOneFromItsHeader) {
+  const std::string box = "'" + path("box.txt") + "'", torus = "'" + path("torus.txt") + "'";
+  ASSERT_EQ(kdm("sample --n 2000 --domain box --seed 4 -o " + box).status, 0);
+  ASSERT_EQ(kdm("sample --n 2000 --seed 4 -o " + torus).status, 0);
+  EXPECT_NE(slurp(path("box.txt")).find("# density const:1, domain box\n"), std::string::npos);
+  const Outcome own = kdm("analyze " + box + " --no-energy -o -");
+  ASSERT_EQ(own.status, 0) << own.err;
+  EXPECT_NE(own.err.find("domain from the file header: a bounded box (--torus overrides)"), std::string::npos)
+      << own.err;
+  EXPECT_NE(own.out.find("\"domain\":\"box\""), std::string::npos) << own.out.substr(0, 300);
+  const Outcome flagged = kdm("analyze " + box + " --box --no-energy -o -");
+  EXPECT_EQ(json_numbers(own.out, "davg").at(0), json_numbers(flagged.out, "davg").at(0));
+  const Outcome forced = kdm("analyze " + box + " --torus --no-energy -o -");
+  ASSERT_EQ(forced.status, 0) << forced.err;
+  EXPECT_NE(forced.out.find("\"domain\":\"torus\""), std::string::npos);
+  // A torus distance is never longer than the box's, and a box sample's points are not kept apart across
+  // its walls: measured as a torus, points by the walls find nearer neighbours there.
+  EXPECT_LT(json_numbers(forced.out, "davg").at(0), json_numbers(own.out, "davg").at(0));
+  expect_error("analyze " + box + " " + torus, "sampled in different domains (a box and a torus)");
+  EXPECT_EQ(kdm("analyze " + box + " " + torus + " --box --no-energy").status, 0);
+
+  // A query's and a stipple's points: a box in their rectangle's shape.
+  ASSERT_EQ(kdm("query --rect 0,0,4,2 --scale 300 -o '" + path("q.txt") + "'").status, 0);
+  EXPECT_NE(slurp(path("q.txt")).find("# coordinates normalised to the rect, domain box, aspect 2\n"),
+            std::string::npos);
+  const Outcome query = kdm("analyze '" + path("q.txt") + "' --no-energy");
+  ASSERT_EQ(query.status, 0) << query.err;
+  EXPECT_NE(query.out.find("a bounded box"), std::string::npos) << query.out;
+  EXPECT_NE(query.out.find("rectangle (aspect 2"), std::string::npos) << query.out;
+  ASSERT_EQ(kdm("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/coffee.png' --points 3000 -o '" +
+                path("s.txt") + "'")
+                .status,
+            0);
+  const Outcome stipple = kdm("analyze '" + path("s.txt") + "' --no-energy");
+  ASSERT_EQ(stipple.status, 0) << stipple.err;
+  EXPECT_NE(stipple.out.find("a bounded box"), std::string::npos) << stipple.out;
+  EXPECT_NE(stipple.out.find("rectangle (aspect 1.5"), std::string::npos) << stipple.out;
+  // Standard input's header as a file's.
+  const Outcome piped = kdm("analyze - --no-energy <" + box);
+  EXPECT_NE(piped.out.find("a bounded box"), std::string::npos) << piped.out;
+}
+
 // --class-density: each class of a labelled set against its own density, the whole set against their
 // sum, the classes' counts against their shares; refusals name the numbers.
 TEST_F(CliTest, AnalyzeJudgesEachClassAgainstItsOwnDensity) {

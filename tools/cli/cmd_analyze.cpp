@@ -158,35 +158,58 @@ class BufferedStandardInput {
   std::streambuf* old_;
 };
 
-/// The shape of the domain a point file says its points were sampled in (`kdm sample --aspect` writes
-/// ", aspect A" or ", sides X:Y:Z" in its header lines): a square or cube when it says none (a file of
-/// other tools, a .npy). "-" is standard input, whose bytes are `standard_input`.
-Shape sampled_shape(const std::string& path, const std::string& standard_input) {
+/// A file's domain as its header lines name it (domain_header.h): its shape, a square or cube when they say
+/// none (a file of other tools, a .npy), and whether it wraps around ("" when unsaid). "-" is standard
+/// input, whose bytes are `standard_input`.
+struct SampledDomain {
+  Shape shape;
+  std::string domain;  ///< "box", "torus" or ""
+};
+
+SampledDomain sampled_domain(const std::string& path, const std::string& standard_input) {
   std::ifstream file;
   std::istringstream piped;
   if (path == "-")
     piped.str(standard_input.substr(0, 4096));  // the header lines lie in the first few
   else
     file.open(path);
-  std::istream& in = path == "-" ? static_cast<std::istream&>(piped) : file;
-  std::string line;
-  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i)
-    for (const char* key : {", aspect ", ", sides "})
-      if (const std::size_t at = line.find(key); at != std::string::npos) {
-        const std::size_t from = at + std::string(key).size();
-        Shape shape = parse_shape(line.substr(from, line.find_first_of(", \r", from) - from),
-                                  path + ": the header's " + std::string(key + 2, std::strlen(key) - 3));
-        shape.named = true;
-        return shape;
-      }
-  return {};
+  const tools::DomainHeader header =
+      tools::read_domain_header(path == "-" ? static_cast<std::istream&>(piped) : file);
+  SampledDomain read;
+  read.domain = header.domain;
+  if (!header.shape_key.empty()) {
+    read.shape = parse_shape(header.shape_text, path + ": the header's " + header.shape_key);
+    read.shape.named = true;
+  }
+  return read;
+}
+
+/// Whether the files are measured as wrapping around: --torus or --box, else what their headers say (all
+/// alike: pooled sets share one domain), else a torus. Says on `text` when a header chose a box (a torus,
+/// the default, goes unsaid). Throws CommandError.
+bool measured_torus(const AnalyzeArgs& args, const std::vector<SampledDomain>& read, std::FILE* text) {
+  if (args.torus || args.box) return args.torus;
+  std::string said;
+  for (std::size_t f = 0; f < read.size(); ++f) {
+    if (read[f].domain.empty()) continue;
+    if (!said.empty() && read[f].domain != said)
+      throw CommandError(
+          "the files were sampled in different domains (a box and a torus): their sets pool "
+          "into one report, so analyse them apart, or give --box or --torus");
+    said = read[f].domain;
+  }
+  if (said != "box") return true;
+  std::fprintf(text, "domain from the file header%s: a bounded box (--torus overrides)\n",
+               read.size() > 1 ? "s" : "");
+  return false;
 }
 
 /// The shape the files are measured in: --aspect's, else their headers' (all alike: pooled sets share one
 /// domain). Says on `text` which it took when that is not the square. Throws CommandError.
-Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text, const std::string& standard_input) {
+Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text,
+                     const std::vector<SampledDomain>& domains) {
   std::vector<Shape> read;
-  for (const std::string& file : args.files) read.push_back(sampled_shape(file, standard_input));
+  for (const SampledDomain& d : domains) read.push_back(d.shape);
   if (!args.aspect.empty()) {
     const Shape given = parse_shape(args.aspect, "--aspect");
     if (dim == 2 && given.numbers == 3)
@@ -241,7 +264,6 @@ void run_analyze(const AnalyzeArgs& args) {
   if (args.output_given && args.output.empty())
     throw CommandError("-o names no directory (leave it out to print the summary only)");
   analysis::AnalysisOptions o;
-  o.torus = !args.box;
   o.fmax = args.fmax;
   o.min_expected = args.min_expected;
   if (args.density_bands < 1 || args.density_bands > 1000)
@@ -312,7 +334,11 @@ void run_analyze(const AnalyzeArgs& args) {
     // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
     const bool to_stdout = args.output == tools::kStandardOutput;
     std::FILE* text = to_stdout ? stderr : stdout;
-    const Shape shape = measured_shape(args, sets.front().dim, text, piped ? piped->bytes() : std::string());
+    std::vector<SampledDomain> domains;
+    for (const std::string& file : args.files)
+      domains.push_back(sampled_domain(file, piped ? piped->bytes() : std::string()));
+    o.torus = measured_torus(args, domains, text);
+    const Shape shape = measured_shape(args, sets.front().dim, text, domains);
     std::copy(shape.extent, shape.extent + 3, o.extent);
     if (!shape.square() && args.tile_size != 0)
       throw CommandError(
@@ -387,8 +413,9 @@ void add_analyze_command(CLI::App& app) {
          "and the sets in one, are pooled into one report")
       ->required();
   cmd->add_flag("--torus", args->torus,
-                "Periodic distances, for a set that wraps around (default; the summary's first line says "
-                "which were used)");
+                "Periodic distances, for a set that wraps around (default, unless the files' headers say "
+                "\"domain box\", as kdm query and stipple and a bounded kdm sample write it; the summary's "
+                "first line says which were used)");
   cmd->add_flag("--box", args->box,
                 "Bounded-box distances, for a set in a square with walls (most other tools' sets; g(r) with "
                 "edge correction)");

@@ -176,8 +176,10 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     style.width_px =
         style.aspect >= 1 ? 1024 : static_cast<int>(std::max(1.0, std::round(1024 * style.aspect)));
     if (classed) style.classes = &classes, style.inks = tools::class_inks(densities.size());
-    tools::write_points(a.output, tools::normalise_to_rect(points, r),
-                        {line, "coordinates normalised to the rect"}, style, format);
+    tools::write_points(
+        a.output, tools::normalise_to_rect(points, r),
+        {line, "coordinates normalised to the rect, " + tools::domain_header(false, 2, nullptr, aspect)},
+        style, format);
   }
   const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   std::fprintf(stderr, "%s queried in %.4f s, written in %.3f s -> %s\n", line, seconds, writing,

@@ -52,19 +52,6 @@ std::vector<double> parse_aspect(const std::string& text, int dim) {
   return sides;
 }
 
-/// The header's words for a domain that is not a square or cube, which kdm analyze reads back: ", sides
-/// X:Y:Z" for a 3D box of sides of its own, ", aspect A" for the x side over the others, else "".
-std::string shape_header(int dim, const double extent[3], double aspect) {
-  char text[96];
-  if (dim == 3 && (extent[1] != 1 || extent[2] != 1))
-    std::snprintf(text, sizeof text, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
-  else if (aspect != 1)
-    std::snprintf(text, sizeof text, ", aspect %.17g", aspect);
-  else
-    return "";
-  return text;
-}
-
 /// --sets: refuses, before any sampling, what several sets cannot be (a count from --resolution, classes,
 /// a picture or CSV file, seeds past 2^64 - 1). Sizes past sample_sets()'s bounds it refuses itself.
 void check_sets(const SampleArgs& args, const std::string& format, bool classed) {
@@ -119,11 +106,11 @@ void run_sets(const SampleArgs& args, const gen::SamplerOptions& o, const gen::D
       static_cast<long long>(args.sets), static_cast<long long>(o.n), o.temperature,
       results.front().report.model_temperature, static_cast<unsigned long long>(seeds.front()),
       static_cast<unsigned long long>(seeds.back()), acceptance);
-  const std::string shape = shape_header(o.dim, extent, aspect);
   std::string error;
   if (!tools::write_point_sets(args.output, sets,
-                               {line, "density " + args.density + ", domain " + domain + shape}, set_headers,
-                               error, format))
+                               {line, "density " + args.density + ", " +
+                                          tools::domain_header(domain == "torus", o.dim, extent, aspect)},
+                               set_headers, error, format))
     throw std::runtime_error(error);
   std::fprintf(stderr, "%s, %.3f s -> %s\n", line, seconds,
                args.output == tools::kStandardOutput ? "standard output" : args.output.c_str());
@@ -246,8 +233,9 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
     what = "classes";
     for (const std::string& c : args.classes) what += " " + c;
   }
-  const std::string shape = shape_header(o.dim, extent, aspect);  // kdm analyze measures in it
-  std::vector<std::string> header = {line, what + ", domain " + domain + shape};
+  // kdm analyze measures in the domain the header names.
+  std::vector<std::string> header = {
+      line, what + ", " + tools::domain_header(domain == "torus", o.dim, extent, aspect)};
   tools::DrawStyle style;
   style.width_px = args.width_px;
   style.dot_radius_px = args.dot_radius;

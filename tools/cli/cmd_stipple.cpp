@@ -259,7 +259,10 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
-    tools::write_points(path, set, {line, "image " + a.image, where}, style, format);
+    std::vector<std::string> header = {line, "image " + a.image};
+    for (std::string& more : tools::stipple_region_header(uv, style.aspect))
+      header.push_back(std::move(more));
+    tools::write_points(path, set, header, style, format);
     const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     // A frame's region is said too: a .csv frame has no header to hold it.
     std::fprintf(stderr, "%s%s%s placed in %.3f s, written in %.3f s -> %s\n", line, a.frames > 0 ? ", " : "",

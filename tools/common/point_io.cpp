@@ -653,4 +653,39 @@ bool write_point_sets(const std::string& path, const std::vector<PointSet>& sets
   return write_text_file_atomic(path, out, error);
 }
 
+std::string domain_header(bool torus, int dim, const double* extent, double aspect) {
+  std::string text = torus ? "domain torus" : "domain box";
+  char shape[96];
+  if (dim == 3 && extent && (extent[1] != 1 || extent[2] != 1))
+    std::snprintf(shape, sizeof shape, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
+  else if (aspect != 1)
+    std::snprintf(shape, sizeof shape, ", aspect %.17g", aspect);
+  else
+    return text;
+  return text + shape;
+}
+
+DomainHeader read_domain_header(std::istream& in) {
+  DomainHeader header;
+  // A word after `key` up to the next ',' or space, from any of the lines.
+  auto word_after = [](const std::string& line, const std::string& key, std::string& word) {
+    const std::size_t at = line.find(key);
+    if (at == std::string::npos || !word.empty()) return;
+    const std::size_t from = at + key.size();
+    word = line.substr(from, line.find_first_of(", \r", from) - from);
+  };
+  std::string line;
+  for (int i = 0; i < 4 && std::getline(in, line) && line.rfind('#', 0) == 0; ++i) {
+    // "domain" follows a comma or opens the line's text ("# density ramp:4, domain box").
+    for (const char* key : {", domain ", "# domain "}) word_after(line, key, header.domain);
+    for (const char* key : {"aspect", "sides"})
+      if (header.shape_key.empty()) {
+        word_after(line, std::string(", ") + key + " ", header.shape_text);
+        if (!header.shape_text.empty()) header.shape_key = key;
+      }
+  }
+  if (header.domain != "box" && header.domain != "torus") header.domain.clear();
+  return header;
+}
+
 }  // namespace kdm::tools

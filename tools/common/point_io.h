@@ -47,6 +47,23 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
 /// would end an XML comment) becomes "- -".
 std::string comment_safe(std::string line);
 
+/// The header's words for the domain a point file's points lie in, which kdm analyze reads back
+/// (read_domain_header): "domain box" or "domain torus" (`torus`: it wraps around), then ", sides X:Y:Z"
+/// for a 3D box of its own sides `extent` (`dim` 3), else ", aspect A" for a width over height `aspect`
+/// other than 1. `extent` may be null for 2D.
+std::string domain_header(bool torus, int dim, const double* extent, double aspect);
+
+/// What a point file's first header lines ('#' lines, at most 4) say of its domain; each field "" when
+/// unsaid.
+struct DomainHeader {
+  std::string domain;      ///< "box" or "torus"
+  std::string shape_key;   ///< "aspect" or "sides"
+  std::string shape_text;  ///< "2" or "2:1:0.5", as written
+};
+
+/// Reads the header lines at the start of `in` (a point file, or the first bytes of one).
+DomainHeader read_domain_header(std::istream& in);
+
 /// Reads every set in `path` ("-": standard input), text or .npy (known by its first bytes). All sets must
 /// share one dimension (2 or 3); coordinates must be finite.
 /// Returns false with `error` naming the file, line and problem (empty file, malformed or non-finite value).

@@ -44,6 +44,11 @@ std::int64_t full_stipple_count(double whole_dots, double scale);
 double stipple_dot_radius(double whole_dots, int width_px, double aspect,
                           const std::vector<const DensitySpec*>& inks);
 
+/// A stipple's header lines after its image's: the "region x0,y0,x1,y1" drawn (of the image's UV square),
+/// then its picture's domain, a box of width over height `aspect` (domain_header), where kdm analyze
+/// measures the dots.
+std::vector<std::string> stipple_region_header(const double uv[4], double aspect);
+
 /// The most a region may zoom into an image with `tileset` in `mode`: kStippleZoomRoom, times m^4 in
 /// smooth mode with a set that hands over to m×m subtiles past its top level (query_density_limit).
 double max_stipple_zoom(const Tileset& tileset, QueryMode mode);
