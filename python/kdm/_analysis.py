@@ -102,8 +102,9 @@ def analyze(
     density : None, float, str, 2-D array or callable
         The target density, as kdm.sample takes it (default: uniform): for the density accuracy test,
         and the local spacing empty circles are measured in. A callable ``f(x, y)`` of coordinates in
-        [0, 1] is called point by point (its exception, or a value that is not finite and >= 0, is
-        raised). With `class_densities` it judges the whole set only (default there: their sum).
+        [0, 1] is called point by point (its exception is raised, and as kdm.sample says it, TypeError
+        for a value that is no real number, ValueError for one that is not finite and >= 0). With
+        `class_densities` it judges the whole set only (default there: their sum).
     class_densities : list, optional
         With `classes`: one target density per class, class 0 first, at least as many as the labels run
         (largest label + 1; the list given to ``kdm.sample(classes=...)``, whose classes of density 0 have

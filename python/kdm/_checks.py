@@ -252,23 +252,27 @@ def array3d(name: str, value: Any) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
-def _scaled_into_floats(values: np.ndarray) -> np.ndarray:
-    """Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled into it
-    rather than flushed to 0 or infinity; bad values are left for the C++ side to name."""
-    if values.size and np.all(np.isfinite(values)) and float(np.min(values)) >= 0:
-        top = float(np.max(values))
-        if top > 0 and not 1e-30 <= top <= 1e30:
-            return values / top
-    return values
+def _shape_of_density(name: str, values: np.ndarray) -> np.ndarray:
+    """The sampler's array of densities, of which only the shape matters: every value finite and >= 0, at any
+    scale. Values past float32's range (the C++ side's) are divided by the largest, rather than flushed to
+    0 or infinity; those within it are kept as they are."""
+    bad = ~(np.isfinite(values) & (values >= 0))
+    if bad.any():
+        at = np.unravel_index(int(np.argmax(bad)), values.shape)
+        what = "volume" if values.ndim == 3 else "array"
+        raise ValueError(f"{name} {what} values must be finite and >= 0 (at any scale: only their shape matters), "
+                         f"got {float(values[at]):.6g} at [{', '.join(str(int(i)) for i in at)}]")
+    top = float(np.max(values)) if values.size else 0.0
+    return values / top if top > 0 and not 1e-30 <= top <= 1e30 else values
 
 
 def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:
     """density_spec() for the full sampler, which needs something to sample. A 3-D array is a volume
-    (depth, height, width) for dim=3."""
+    (depth, height, width) for dim=3. An array's values may have any scale (_shape_of_density)."""
     if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim == 3:
         if number("gamma", gamma, 0.0, strict=True) != 1.0 or flag("invert", invert):
             raise ValueError("gamma and invert apply to image files only (an array or a number is the density)")
-        spec = _kdm.DensitySpec.from_volume(_scaled_into_floats(array3d(name, density)))
+        spec = _kdm.DensitySpec.from_volume(_shape_of_density(name, array3d(name, density)))
         if not spec.max_value > 0:
             raise ValueError(f"{name}: an array that is zero everywhere has nothing to sample (it needs some "
                              "density > 0)")
@@ -276,14 +280,8 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
     if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim > 3:
         raise ValueError(f"{name} must be a 2-D array (rows, columns), or with dim=3 a 3-D array (depth, "
                          f"height, width), got shape {np.shape(density)}")
-    if is_array(density) and not isinstance(density, (str, bytes)):
-        # Only the shape matters to the sampler: values past float32's range (the C++ side's) are scaled
-        # into it rather than flushed to 0 or infinity.
-        values = array2d(name, density)
-        if values.size and np.all(np.isfinite(values)) and float(np.min(values)) >= 0:  # else refused as it is
-            top = float(np.max(values))
-            if top > 0 and not 1e-30 <= top <= 1e30:
-                density = values / top
+    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim == 2:
+        density = _shape_of_density(name, array2d(name, density))
     spec = density_spec(density, gamma, invert, name)
     if spec is not None and not spec.max_value > 0:  # now, not at the first draw
         if spec.text in ("array", "number"):

@@ -305,8 +305,9 @@ class Tileset:
             either of the last two stretched over `density_rect` (default: `rect`; fix it to query parts
             of one region), bilinear between texel centres, its edge texels going on past it. Or a
             callable f(x, y) -> float of world coordinates, called for every candidate point (with the
-            GIL held; an exception it raises is raised here once the query ends, and a value that is
-            not finite and >= 0 raises ValueError), which needs `density_max` (> 0), a true upper bound of
+            GIL held; an exception it raises is raised here once the query ends, a value that is no
+            real number TypeError and one that is not finite and >= 0 ValueError, each naming the
+            point), which needs `density_max` (> 0), a true upper bound of
             its values (a larger one raises ValueError; smooth mode also reads up to twice the glide's
             reach, ``info["glide_reach"]`` tile sides, outside `rect`). Or a DensityMap, a map prepared once
             with its rectangle: for a map queried chunk by chunk, whose array would otherwise be

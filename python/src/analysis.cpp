@@ -98,7 +98,8 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
         throw std::invalid_argument("class_densities[" + std::to_string(k) + "]: " + e.what());
       }
     } else {
-      class_functions.push_back(std::make_unique<PythonDensity>(d, 2));
+      class_functions.push_back(
+          std::make_unique<PythonDensity>(d, 2, "class_densities[" + std::to_string(k) + "]"));
       own.push_back(class_functions.back()->density());
     }
     own_functions.push_back(tools::analysis_density(own.back()));

@@ -594,7 +594,7 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
       if (!(maxima[k] >= 0 && maxima[k] < std::numeric_limits<double>::infinity()))
         throw std::invalid_argument(name + ": a callable's density_max must be finite and >= 0");
       prepared.callables.push_back(
-          std::make_unique<CallableDensity>(callables[k], maxima[k], bounds[k], vectorized));
+          std::make_unique<CallableDensity>(callables[k], maxima[k], bounds[k], vectorized, name));
       q.classes[k] = prepared.callables.back()->density;
       threads = 0;  // Python functions run one at a time (the GIL): one query
       continue;

@@ -2,65 +2,69 @@
 #include "query_density.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <limits>
+#include <new>
 #include <stdexcept>
 #include <string>
+
+#include "density_value.h"
 
 namespace kdm::python {
 namespace {
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", v);
-  return text;
-}
-
 /// A density value from Python: the C++ query counts a bad one as 0 and one above its bound as the bound
 /// (too few points there); from Python either is a bug in the callable or its density_max, said so. A
 /// value within rounding of the bound (10^-9 of it) passes: a maximum computed another way may differ so.
-double checked_value(double v, double x, double y, double max_value) {
-  if (!(v >= 0 && v < std::numeric_limits<double>::infinity()))
-    throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
-                            number(y) + "): a density must be finite and >= 0");
+double checked_value(double v, const std::string& name, double x, double y, double max_value) {
+  const double at[2] = {x, y};
+  finite_density(v, name, at, 2);
   if (v > max_value * (1 + 1e-9))
-    throw std::domain_error("density callable returned " + number(v) + " at (" + number(x) + ", " +
-                            number(y) + "), above density_max " + number(max_value) +
+    throw std::domain_error(name + " callable returned " + number_text(v) + " at " + point_text(at, 2) +
+                            ", above density_max " + number_text(max_value) +
                             ": density_max must bound every value (smooth mode also reads up to a glide's "
                             "reach outside the rect)");
   return v;
 }
 
-/// Raises TypeError (as error_already_set) naming what a density callable returned instead of numbers.
-[[noreturn]] void not_numbers(const py::handle& value, const char* what) {
-  PyErr_Format(PyExc_TypeError, "density callable returned %s, not %s", Py_TYPE(value.ptr())->tp_name, what);
-  throw py::error_already_set();
-}
-
 /// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all.
-void read_values(const py::object& value, std::size_t n, const double* x, const double* y, double max_value,
-                 double* out) {
+/// Anything but real numbers is a TypeError naming what came back and the first position, as
+/// density_value says it for one value.
+void read_values(const py::object& value, const std::string& name, std::size_t n, const double* x,
+                 const double* y, double max_value, double* out) {
   using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  const auto wrong_type = [&](const std::string& what) {
+    const double first[2] = {n ? x[0] : 0, n ? y[0] : 0};
+    throw py::type_error(name + " callable returned " + what + " for " + std::to_string(n) +
+                         " positions from " + point_text(first, 2) +
+                         ": a vectorized density must return an array of real numbers");
+  };
+  const std::string type = py::str(py::type::handle_of(value).attr("__name__"));
   // Cast to double, None would become NaN and a complex number lose its imaginary part.
-  if (value.is_none()) not_numbers(value, "an array of numbers");
-  if (const py::array raw = py::array::ensure(value); raw && raw.dtype().kind() == 'c')
-    not_numbers(value, "real numbers (its dtype is complex)");
-  const Array v = Array::ensure(value);
-  if (!v) throw std::invalid_argument("a vectorized density callable must return an array of numbers");
+  if (value.is_none() || PyComplex_Check(value.ptr())) wrong_type(type);
+  const py::array raw = py::array::ensure(value);
+  if (!raw) wrong_type(type);
+  const char kind = raw.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+    wrong_type(py::isinstance<py::array>(value) ? type + " of dtype " + std::string(py::str(raw.dtype()))
+                                                : type);
+  const Array v = Array::ensure(raw);  // real numbers as float64: fails only where memory runs out
+  if (!v) throw std::bad_alloc();
   const bool one = v.ndim() == 0 || (v.ndim() == 1 && v.shape(0) == 1);
   if (!one && !(v.ndim() == 1 && std::size_t(v.shape(0)) == n)) {
     std::string shape;
     for (py::ssize_t k = 0; k < v.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(v.shape(k));
-    throw std::invalid_argument("vectorized density callable returned shape (" + shape + ") for " +
-                                std::to_string(n) + " positions: it must return one value per position");
+    throw std::invalid_argument(name + " callable returned shape (" + shape + ") for " + std::to_string(n) +
+                                " positions: a vectorized density must return one value per position");
   }
   const double* values = v.data();
-  for (std::size_t i = 0; i < n; ++i) out[i] = checked_value(values[one ? 0 : i], x[i], y[i], max_value);
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = checked_value(values[one ? 0 : i], name, x[i], y[i], max_value);
 }
 
 /// Runs `call` (which talks to Python) with the GIL held, unless an earlier call failed: true if it
-/// returned. Its first exception is kept in `d` for rethrow(), as itself or as a ValueError (a bad value,
-/// shape or pair) or RuntimeError (a failed conversion inside pybind11), and later calls are skipped.
+/// returned. Its first exception is kept in `d` for rethrow(), as itself, as density_value's TypeError or
+/// ValueError, as a ValueError (a bad value, shape or pair) or RuntimeError (a failed conversion inside
+/// pybind11), and later calls are skipped.
 template <class Call>
 bool guarded(CallableDensity& d, Call&& call) {
   if (d.failed.load(std::memory_order_relaxed)) return false;
@@ -70,6 +74,9 @@ bool guarded(CallableDensity& d, Call&& call) {
     return true;
   } catch (py::error_already_set& e) {
     d.error.emplace(std::move(e));
+  } catch (const py::builtin_exception& e) {  // density_value's TypeError or ValueError
+    e.set_error();
+    d.error.emplace();
   } catch (const std::domain_error& e) {
     PyErr_SetString(PyExc_ValueError, e.what());
     d.error.emplace();
@@ -86,8 +93,9 @@ bool guarded(CallableDensity& d, Call&& call) {
 
 }  // namespace
 
-CallableDensity::CallableDensity(py::object f, double max_value, py::object bounds, bool vectorized)
-    : function(std::move(f)), bounds_function(std::move(bounds)) {
+CallableDensity::CallableDensity(py::object f, double max_value, py::object bounds, bool vectorized,
+                                 std::string argument)
+    : function(std::move(f)), bounds_function(std::move(bounds)), name(std::move(argument)) {
   density.kind = QueryDensity::Kind::kCallback;
   density.callback_max = max_value;
   density.user = this;
@@ -97,7 +105,7 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
       const bool read = guarded(d, [&] {
         const py::array_t<double> xs(py::ssize_t(n), x),
             ys(py::ssize_t(n), y);  // copies the callable may keep
-        read_values(d.function(xs, ys), n, x, y, d.density.callback_max, out);
+        read_values(d.function(xs, ys), d.name, n, x, y, d.density.callback_max, out);
       });
       if (!read) std::fill(out, out + n, 0.0);
     };
@@ -106,14 +114,9 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
       CallableDensity& d = *static_cast<CallableDensity*>(user);
       double v = 0;
       guarded(d, [&] {
-        const py::object value = d.function(x, y);
-        const double got = PyFloat_AsDouble(value.ptr());  // any number, numpy's too
-        if (got == -1 && PyErr_Occurred()) {
-          if (!PyErr_ExceptionMatches(PyExc_TypeError)) throw py::error_already_set();
-          PyErr_Clear();
-          not_numbers(value, "a number");
-        }
-        v = checked_value(got, x, y, d.density.callback_max);
+        const double at[2] = {x, y};
+        const double got = density_value(d.function(x, y), d.name, at, 2);
+        v = checked_value(got, d.name, x, y, d.density.callback_max);
       });
       return v;
     };
@@ -134,8 +137,9 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
         throw std::invalid_argument("density_bounds must return two numbers (lo, hi)");
       }
       if (!(l >= 0 && l <= h))
-        throw std::invalid_argument("density_bounds returned (" + number(l) + ", " + number(h) + ") for (" +
-                                    number(x0) + ", " + number(y0) + ", " + number(x1) + ", " + number(y1) +
+        throw std::invalid_argument("density_bounds returned (" + number_text(l) + ", " + number_text(h) +
+                                    ") for (" + number_text(x0) + ", " + number_text(y0) + ", " +
+                                    number_text(x1) + ", " + number_text(y1) +
                                     "): bounds must satisfy 0 <= lo <= hi");
       *lo = l, *hi = h;
     });

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "bindings.h"
@@ -21,14 +22,16 @@ using tools::SpecDensity;  // as `kdm query` builds it (tools/stipple/spec_densi
 /// The query runs with the GIL released; each call takes it back. The first exception f raises is kept (later
 /// calls return 0 at once) for rethrow() to raise once the query is over, so it reaches the caller as itself.
 /// `bounds`, if not None, is a callable (x0, y0, x1, y1) -> (lo, hi) bounding the density over a rectangle
-/// (QueryDensity::bounds).
+/// (QueryDensity::bounds). `name` is the argument it came as ("density", "classes[1]"), for the messages.
 struct CallableDensity {
-  CallableDensity(py::object function, double max_value, py::object bounds, bool vectorized);
+  CallableDensity(py::object function, double max_value, py::object bounds, bool vectorized,
+                  std::string name = "density");
   /// Raises the kept exception, if any. Call with the GIL held.
   void rethrow();
 
   QueryDensity density;
   py::object function, bounds_function;
+  std::string name;
   std::atomic<bool> failed{false};
   std::optional<py::error_already_set> error;
 };

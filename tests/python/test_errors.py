@@ -2,6 +2,7 @@
 or written), with one clear line, and never crash the interpreter: explicit cases, then random ones."""
 import inspect
 import math
+import re
 import subprocess
 
 import numpy as np
@@ -161,6 +162,77 @@ def test_query_refusals(kind, match, kwargs):
     args = dict(rect=(0, 0, 1, 1), scale=100)
     args.update(kwargs)
     raises(kind, match, TILES.query, args.pop("rect"), **args)
+
+
+# What a density callable may return wrongly: a wrong type is a TypeError naming it, a bad value a
+# ValueError; in kdm.sample, kdm.analyze and queries alike, each naming the point it was called at.
+NOT_NUMBERS = [
+    (None, "NoneType"), ("a", "str"), (1 + 1j, "complex"), (np.complex64(1), "complex64"),
+    (np.array([1.0, 2.0]), r"ndarray of shape \(2,\)"), ([1.0], "list"),
+]
+POINT = r"\(-?[0-9.e+-]+, -?[0-9.e+-]+\)"  # (x, y)
+POINT3 = r"\(-?[0-9.e+-]+, -?[0-9.e+-]+, -?[0-9.e+-]+\)"  # (x, y, z)
+
+
+@pytest.mark.parametrize("value,name", NOT_NUMBERS)
+def test_a_density_callable_returning_no_number_is_a_type_error(value, name):
+    points = kdm.sample(300, threads=1)
+    said = rf"^density callable returned {name} at {POINT}: a density must be a real number$"
+    raises(TypeError, said, kdm.sample, 200, lambda x, y: value)
+    raises(TypeError, said, kdm.analyze, points, density=lambda x, y: value, energy=False)
+    raises(TypeError, said, TILES.query, (0, 0, 1, 1), scale=100, density=lambda x, y: value, density_max=1)
+    raises(TypeError, said, kdm.BlueNoise(2, seed=1, density=lambda x, y: value).random, 100)
+    raises(TypeError, rf"^density callable returned {name} at {POINT3}: a density must be a real number$",
+           kdm.sample, 200, lambda x, y, z: value, dim=3)
+    raises(TypeError, rf"^class_densities\[1\] callable returned {name} at {POINT}:", kdm.analyze, points,
+           np.arange(300) % 2, class_densities=[1.0, lambda x, y: value], energy=False)
+    raises(TypeError, rf"^classes\[0\] callable returned {name} at {POINT}:", TILES.query, (0, 0, 1, 1),
+           scale=100, classes=[lambda x, y: value], density_max=1)
+
+
+@pytest.mark.parametrize("value", [NAN, INF, -0.5, 10**400])
+def test_a_density_callable_returning_no_density_is_a_value_error(value):
+    shown = {NAN: "nan", INF: "inf", -0.5: "-0.5", 10**400: "inf"}[value]
+    said = rf"^density callable returned {shown} at {POINT}: a density must be finite and >= 0$"
+    raises(ValueError, said, kdm.sample, 200, lambda x, y: value)
+    raises(ValueError, said, kdm.analyze, kdm.sample(300), density=lambda x, y: value, energy=False)
+    raises(ValueError, said, TILES.query, (0, 0, 1, 1), scale=100, density=lambda x, y: value, density_max=1)
+
+
+def test_a_density_callable_may_return_any_real_number():
+    # Python and numpy numbers, and a 0-d array (what numpy reductions may give): the same points as a float.
+    points = kdm.sample(200, lambda x, y: 1.0 + x, seed=3, threads=1)
+    for kind in (np.float32, np.float64, lambda v: np.array(v)):
+        assert np.array_equal(kdm.sample(200, lambda x, y: kind(1.0 + x), seed=3, threads=1), points)
+    ones = kdm.sample(200, lambda x, y: 1.0, seed=3, threads=1)
+    for one in (1, np.int64(1), True, np.uint8(1)):
+        assert np.array_equal(kdm.sample(200, lambda x, y: one, seed=3, threads=1), ones)
+
+
+def test_a_vectorized_density_callable_returning_no_numbers_is_a_type_error():
+    for value, name in [(None, "NoneType"), (np.array(["a"] * 2), "ndarray of dtype <U1"), (1j, "complex")]:
+        raises(TypeError, rf"^density callable returned {name} for \d+ positions from {POINT}: a vectorized "
+               "density must return an array of real numbers$", TILES.query, (0, 0, 1, 1), scale=100,
+               density=lambda x, y: value, density_max=1, vectorized=True)
+
+
+def test_density_arrays_and_callables_say_the_range_they_take():
+    # The sampler takes an array at any scale (only its shape matters: it is scaled into float32's range);
+    # a callable's values are kept as floats as they come, so its peak must lie in 1e-30 ... 1e30.
+    ramp = np.tile(np.linspace(1.0, 4.0, 8), (6, 1))
+    for scale in (1e-300, 1e300):
+        scaled = ramp * scale
+        assert np.array_equal(kdm.sample(300, scaled, seed=2, threads=1),
+                              kdm.sample(300, scaled / scaled.max(), seed=2, threads=1))
+    ramp[1, 2] = NAN
+    raises(ValueError, r"^density array values must be finite and >= 0 \(at any scale: only their shape "
+           r"matters\), got nan at \[1, 2\]$", kdm.sample, 10, ramp)
+    raises(ValueError, r"^density volume values must be finite and >= 0 \(at any scale: .*\), got inf at "
+           r"\[0, 0, 1\]$", kdm.sample, 10, np.array([[[1.0, INF]]]), dim=3)
+    for peak, fix in ((1e35, "divide"), (1e-35, "multiply")):
+        raises(ValueError, re.escape(f"density peaks at {peak:.3g}, outside 1e-30 ... 1e+30 (kept as floats); "
+                                     f"only its shape matters, so {fix} it by a constant"),
+               kdm.sample, 100, lambda x, y: peak)
 
 
 def test_gamma_reshapes_an_image_file_or_is_refused():

@@ -270,7 +270,8 @@ def test_analyze_class_densities_as_the_command_line(cli, tmp_path):
         kdm.analyze(few, few_labels, class_densities="const:1")
     with pytest.raises(TypeError, match=r"class_densities\[1\] must be"):
         kdm.analyze(few, few_labels, class_densities=[1, None])
-    with pytest.raises(ValueError, match="values must be finite and >= 0"):
+    with pytest.raises(ValueError, match=r"class_densities\[1\] callable returned -1 at \(.*\): a density must be "
+                                         "finite and >= 0"):
         kdm.analyze(few, few_labels, class_densities=[1, lambda x, y: -1.0], energy=False)
 
 
@@ -317,7 +318,7 @@ def test_analyze_takes_a_function_as_the_density(gradient_png):
     # Its failures are raised as kdm.sample raises them.
     with pytest.raises(ZeroDivisionError):
         kdm.analyze(points, density=lambda x, y: 1 / 0, energy=False)
-    with pytest.raises(ValueError, match="density returned nan"):
+    with pytest.raises(ValueError, match="density callable returned nan"):
         kdm.analyze(points, density=lambda x, y: float("nan"), energy=False)
     with pytest.raises(ValueError, match="gamma and invert apply to image files only"):
         kdm.analyze(points, density=ramp, invert=True)
