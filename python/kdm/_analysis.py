@@ -59,6 +59,24 @@ def _class_densities(class_densities: Any, gamma: Any, invert: Any) -> List[Any]
     return out
 
 
+def _labels(name: str, value: Any) -> np.ndarray:
+    """One set's class labels as uint8. Labels are integers, as kdm.sample returns them: a float array is
+    refused (TypeError) even where its values are whole, as a float count is everywhere in kdm, so that a
+    density or a coordinate passed by mistake is never read as classes."""
+    try:
+        a = np.asarray(value)
+    except ValueError as e:  # ragged nested lists
+        raise ValueError(f"{name} must be an (n,) array of integer labels 0 to 255: {e}") from None
+    if a.dtype.kind not in "iu":
+        whole = a.dtype.kind == "f" and a.size and np.all(np.isfinite(a)) and np.all(a == np.round(a))
+        hint = " (whole numbers as floats: convert them with .astype(int))" if whole else ""
+        raise TypeError(f"{name} must be an (n,) array of integer labels 0 to 255, got dtype {a.dtype}{hint}")
+    if a.ndim != 1 or (a.size and (a.min() < 0 or a.max() > 255)):
+        raise ValueError(f"{name} must be an (n,) array of integer labels 0 to 255" + (
+            f", got shape {a.shape}" if a.ndim != 1 else f", got {a.min()} to {a.max()}"))
+    return np.ascontiguousarray(a, dtype=np.uint8)
+
+
 def analyze(
     points: Any,
     classes: Any = None,
@@ -91,8 +109,10 @@ def analyze(
     classes : array or list of arrays, optional
         Labelled points (several classes, as ``kdm.sample(classes=...)`` or a class query returns them,
         so ``kdm.analyze(*kdm.sample(n, classes=...))`` works):
-        each point's class, an (n,) array per set. Each class is then also analysed alone, as
-        ``kdm analyze`` does a labelled file: the result's "classes" holds classes.json
+        each point's class, an (n,) array of integers 0 to 255 per set (a float array is a TypeError,
+        whole numbers too: ``labels.astype(int)``; a label out of range a ValueError). Each class is then
+        also analysed alone, as ``kdm analyze`` does a labelled file: the result's "classes" holds
+        classes.json
         (``cross_class_closest`` in d_hex of all points, local ones where `density` is given, per
         class its "class" and "metrics", and in
         "too_small", an integer array, the classes present with fewer than 2 points in every set, which
@@ -222,14 +242,12 @@ def analyze(
             raise ValueError("labelled points (classes) are analysed in the unit square only: leave out aspect")
     labels = []
     if classes is not None:
-        given = list(classes) if several and isinstance(classes, (list, tuple)) else [classes]
+        listed = several and isinstance(classes, (list, tuple))
+        given = list(classes) if listed else [classes]
         if len(given) != len(sets):
             raise ValueError(f"classes must hold one array of labels per set ({len(sets)}), got {len(given)}")
         for k, c in enumerate(given):
-            a = np.asarray(c)
-            if a.ndim != 1 or a.dtype.kind not in "iu" or (a.size and (a.min() < 0 or a.max() > 255)):
-                raise ValueError(f"classes[{k}] must be an (n,) array of integer labels 0 to 255")
-            labels.append(np.ascontiguousarray(a, dtype=np.uint8))
+            labels.append(_labels(f"classes[{k}]" if listed else "classes", c))
     if own:
         runs = 1 + max(int(a.max()) if a.size else -1 for a in labels)
         if runs != len(own):

@@ -215,8 +215,19 @@ def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient
         kdm.analyze([points, points], classes=[labels])
     with pytest.raises(ValueError, match="must hold one label per point"):
         kdm.analyze(points, classes=labels[:-1])
-    with pytest.raises(ValueError, match="integer labels 0 to 255"):
-        kdm.analyze(points, classes=labels + 0.5)
+    # Labels are integers: a float array is a TypeError, whole numbers too (said how to convert them).
+    with pytest.raises(TypeError, match=r"classes must be an \(n,\) array of integer labels 0 to 255, got dtype "
+                                        r"float64$"):
+        kdm.analyze(points, labels + 0.5)
+    with pytest.raises(TypeError, match=r"got dtype float64 \(whole numbers as floats: convert them with "
+                                        r"\.astype\(int\)\)$"):
+        kdm.analyze(points, labels.astype(np.float64))
+    with pytest.raises(TypeError, match=r"classes\[1\] must be .* got dtype bool$"):
+        kdm.analyze([points, points], [labels, labels > 0])
+    with pytest.raises(ValueError, match=r"integer labels 0 to 255, got -1 to 1$"):
+        kdm.analyze(points, labels.astype(np.int64) - 1)
+    with pytest.raises(ValueError, match=r"integer labels 0 to 255, got shape \(1, \d+\)$"):
+        kdm.analyze(points, labels[None])
     with pytest.raises(ValueError, match="density_bands must be <= 1000"):
         kdm.analyze(points, density_bands=1001)
 
