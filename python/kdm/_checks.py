@@ -56,9 +56,11 @@ def aspect(value: Any) -> Optional[float]:
     return None if value is None else number("aspect", value, 0.0, strict=True)
 
 
-def aspect_or_sides(value: Any, dim: int) -> Tuple[Optional[float], Optional[Tuple[float, float, float]]]:
+def aspect_or_sides(value: Any, dim: int, dim_name: str = "dim"
+                    ) -> Tuple[Optional[float], Optional[Tuple[float, float, float]]]:
     """kdm.sample's aspect: None, one number (the x side over the others), or in 3-D three sides (x, y, z),
-    each finite and > 0 (their ratios count). Returns (number or None, sides or None)."""
+    each finite and > 0 (their ratios count). Returns (number or None, sides or None). `dim_name` is the
+    caller's name for the dimension (kdm.sample's dim, BlueNoise's d), for the messages."""
     if value is None or isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
         return aspect(value), None
     if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
@@ -67,7 +69,8 @@ def aspect_or_sides(value: Any, dim: int) -> Tuple[Optional[float], Optional[Tup
     if len(values) != 3:
         raise ValueError(f"aspect must be a number or three sides (x, y, z), got {len(values)} values")
     if dim != 3:
-        raise ValueError("aspect=(x, y, z) sets a 3-D domain's sides: use dim=3, or give one number (width / height)")
+        raise ValueError(f"aspect=(x, y, z) sets a 3-D domain's sides: use {dim_name}=3, or give one number "
+                         "(width / height)")
     sides = tuple(number(f"aspect[{k}]", v, 0.0, strict=True) for k, v in enumerate(values))
     return None, sides  # type: ignore[return-value]
 

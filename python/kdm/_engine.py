@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import copy
 import numbers
-from typing import Any, Optional
+from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -77,8 +77,10 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d, in the
     sampler's order (kdm.sample: a prefix of a set is a patch of the domain). An engine pickles and
     copies (a process pool's workers get it): its density is read again where it is unpickled, so an
-    image file must be there too. A copy goes on from the same state, so workers given copies draw the
-    same sets: give each its own seed (``np.random.SeedSequence(s).spawn(k)``). As everywhere in kdm, a
+    image file must be there too. A copy (``copy.copy``, ``copy.deepcopy`` or a pickle) is an engine of
+    its own, its generator a copy at the same state: it draws the sets the original would draw next, so
+    workers given copies draw the same sets: give each its own seed (``np.random.SeedSequence(s).spawn(k)``).
+    As everywhere in kdm, a
     count or dimension that is not an integer (``random(2.0)``) raises TypeError, a value out of range
     ValueError: catch both where SciPy's engines are given values a user typed.
 
@@ -92,10 +94,12 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         fresh entropy (kept, so that reset() replays it too); a Generator is used as it is (and replayed
         from a copy by reset()). Unlike
         ``kdm.sample``, whose default seed is 1, two engines made without one draw different sets.
-    aspect : float or None
-        Width / height of the domain the points are spaced evenly in, as kdm.sample takes it (None: the
-        density array's or image's, else 1); the points are normalised to [0, 1)^2 whatever it is, so
-        aspect=1 spaces them evenly in the unit square whatever the density's shape.
+    aspect : float, (x, y, z) or None
+        The domain the points are spaced evenly in, as kdm.sample takes it for dimension d: width / height
+        (with d=3 the x side over the y and z sides), or with d=3 three sides ``(x, y, z)``; None: the
+        density array's, volume's or image's shape, else 1. The points are normalised to [0, 1)^d whatever
+        it is, as a QMC engine's are (and kdm.sample's): scale them by the sides to place them in the box.
+        So aspect=1 spaces them evenly in the unit square (cube) whatever the density's shape.
     temperature, domain, density, threads
         As kdm.sample takes them (domain None: a box for images, arrays, callables and "ramp:R", a
         torus for a uniform density and "radial:R";
@@ -117,7 +121,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         domain: Optional[str] = None,
         density: Any = None,
         threads: int = 0,
-        aspect: Optional[float] = None,
+        aspect: Union[None, float, Sequence[float]] = None,
     ) -> None:
         d = _checks.integer("d", d, 2, 3)
         if rng is not None:  # SciPy 1.15's name for it
@@ -141,7 +145,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
         self.threads = _checks.threads(threads)
         self.density = density
-        self.aspect = _checks.aspect(aspect)
+        one, sides = _checks.aspect_or_sides(aspect, d, "d")  # refused now, not at the first draw
+        self.aspect = one if sides is None else sides
 
     @property
     def density(self) -> Any:
@@ -156,10 +161,21 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
         if self.d != 2 and spec is not None and spec.kind == "image":
             raise ValueError("image and array densities are 2-D; use d=2")  # now, not at the first draw
+        if self.d != 3 and spec is not None and spec.kind == "volume":
+            raise ValueError(f"density: a 3-D array of shape ({spec.depth}, {spec.height}, {spec.width}) is a "
+                             "volume (depth, height, width): use d=3")
         if _checks.is_array(value):  # what is drawn from: later changes to the caller's array are not
             value = np.array(value, dtype=np.float64)
             value.flags.writeable = False
         self._density, self._spec = value, spec
+
+    def __copy__(self) -> "BlueNoise":
+        # A shallow copy would share the generator, and each engine's draws would advance the other's.
+        twin = type(self).__new__(type(self))
+        twin.__dict__.update(self.__dict__)
+        twin.rng = copy.deepcopy(self.rng)
+        twin.rng_seed = copy.deepcopy(self.rng_seed)
+        return twin
 
     def __getstate__(self) -> dict:
         state = self.__dict__.copy()
@@ -207,14 +223,15 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         threads = _checks.threads(threads)
         temperature = _checks.temperature(self.temperature)
         domain = None if self.domain is None else _checks.choice("domain", self.domain, ("torus", "box"))
-        aspect = _checks.aspect(self.aspect)
+        aspect, sides = _checks.aspect_or_sides(self.aspect, self.d, "d")
         state = copy.deepcopy(self.rng.bit_generator.state if hasattr(self.rng, "bit_generator")
                               else self.rng.get_state())
         seed = self._draw_seed()
         try:
             if callable(self._spec):
-                return _kdm.sample_function(n, self._spec, self.d, domain, temperature, seed, threads, aspect)
-            return _kdm.sample(n, self._spec, self.d, domain, temperature, seed, threads, aspect)
+                return _kdm.sample_function(n, self._spec, self.d, domain, temperature, seed, threads, aspect,
+                                            sides=sides)
+            return _kdm.sample(n, self._spec, self.d, domain, temperature, seed, threads, aspect, sides=sides)
         except BaseException:  # a refused or interrupted draw uses no seed: the next is the one it was
             if hasattr(self.rng, "bit_generator"):
                 self.rng.bit_generator.state = state

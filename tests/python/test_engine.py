@@ -140,6 +140,49 @@ def test_an_engine_pickles_and_copies():
             assert np.array_equal(twin.random(300), e.random(300)), density
 
 
+def test_a_shallow_copy_is_an_engine_of_its_own():
+    import copy
+    for seed in (7, np.random.default_rng(7), np.random.RandomState(7)):
+        e = kdm.BlueNoise(2, seed=seed, threads=1)
+        e.random(50)
+        twin = copy.copy(e)
+        assert twin.rng is not e.rng
+        # The same state: the twin draws what the engine draws next, and each draw advances only its own.
+        first = twin.random(200)
+        assert np.array_equal(first, e.random(200))
+        assert np.array_equal(twin.random(200), e.random(200))
+        assert np.array_equal(twin.reset().random(200), e.reset().random(200))
+
+
+def test_the_density_and_aspect_forms_of_kdm_sample_for_d():
+    # A volume needs d=3, named as the engine names it.
+    with pytest.raises(ValueError, match=r"a 3-D array of shape \(4, 4, 4\) is a volume .*: use d=3$"):
+        kdm.BlueNoise(d=2, density=np.ones((4, 4, 4)))
+    volume = np.ones((4, 5, 6))
+    volume[:2] = 3.0
+    engine = kdm.BlueNoise(d=3, seed=2, density=volume, threads=1)
+    drawn = int(np.random.default_rng(2).integers(0, 2**63, dtype=np.int64))
+    assert np.array_equal(engine.random(300), kdm.sample(300, volume, dim=3, seed=drawn, threads=1))
+    # Three sides with d=3, as kdm.sample(dim=3) takes them: its points, in [0, 1)^3 as kdm.sample's.
+    for density in (None, lambda x, y, z: 1.0 + z):
+        engine = kdm.BlueNoise(d=3, seed=2, aspect=(1, 2, 3), density=density, threads=1)
+        assert engine.aspect == (1.0, 2.0, 3.0)
+        points = engine.random(400)
+        assert np.array_equal(points, kdm.sample(400, density, dim=3, seed=drawn, aspect=(1, 2, 3), threads=1))
+        assert points.min() >= 0 and points.max() < 1
+        assert not np.array_equal(points, kdm.BlueNoise(d=3, seed=2, density=density, threads=1).random(400))
+    with pytest.raises(ValueError, match=r"aspect=\(x, y, z\) sets a 3-D domain's sides: use d=3"):
+        kdm.BlueNoise(d=2, aspect=(1, 2, 3))
+    with pytest.raises(ValueError, match=r"aspect\[1\] must be > 0"):
+        kdm.BlueNoise(d=3, aspect=(1, 0, 3))
+    with pytest.raises(TypeError, match="aspect must be a number or a sequence of three sides"):
+        kdm.BlueNoise(d=3, aspect="1:2:3")
+    engine = kdm.BlueNoise(d=3, seed=2)
+    engine.aspect = (1, 2)  # set after __init__: checked at the draw
+    with pytest.raises(ValueError, match="got 2 values"):
+        engine.random(10)
+
+
 def test_aspect_spaces_points_evenly_in_the_unit_square():
     # A 10 x 40 array of ones is a uniform density 4 times wider than tall: by default the points are spaced
     # evenly in that shape and squeezed into [0, 1)^2 (anisotropic there, as kdm.sample's are); aspect=1
