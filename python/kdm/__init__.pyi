@@ -4,6 +4,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
+from scipy.stats.qmc import QMCEngine as _QMCEngine  # type: ignore[import]
 
 __version__: str
 __all__: list[str]
@@ -170,28 +171,34 @@ def analyze(
     aspect: Union[None, float, Tuple[float, float, float]] = ...,  # the domain's shape, as kdm.sample's
 ) -> Dict[str, Any]: ...
 
-class BlueNoise:
+_Seed = Union[None, int, np.random.Generator, np.random.RandomState, np.random.SeedSequence, np.random.BitGenerator]
+_Aspect = Union[None, float, Tuple[float, float, float]]  # the three sides (x, y, z) with d=3
+
+# At runtime BlueNoise derives from SciPy's QMCEngine where SciPy is installed (else from a base of the same
+# interface, kdm._engine._Engine).
+class BlueNoise(_QMCEngine):
     d: int
-    rng: np.random.Generator
+    rng: Union[np.random.Generator, np.random.RandomState]
     rng_seed: Any
     num_generated: int
     temperature: float
     domain: Optional[str]
-    density: _Density
+    density: Union[_Density, Callable[..., float]]
     threads: int
-    aspect: Optional[float]
+    aspect: _Aspect
     def __init__(
         self,
         d: int = ...,
         *,
-        seed: Union[None, int, np.random.Generator] = ...,
-        rng: Union[None, int, np.random.Generator] = ...,
+        seed: _Seed = ...,
+        rng: _Seed = ...,
         temperature: float = ...,
         domain: Optional[str] = ...,
-        density: _Density = ...,
+        density: Union[_Density, Callable[..., float]] = ...,
         threads: int = ...,
-        aspect: Optional[float] = ...,
+        aspect: _Aspect = ...,
     ) -> None: ...
+    def __copy__(self) -> BlueNoise: ...
     def random(self, n: int = ..., *, workers: int = ...) -> npt.NDArray[np.float64]: ...
     def reset(self) -> BlueNoise: ...
     def fast_forward(self, n: int) -> BlueNoise: ...
