@@ -148,8 +148,8 @@ def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
     channel count (1 for a 2-D array)."""
     a = _real_array(name, value)
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] in (1, 2, 3, 4))):
-        raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, 3 or 4) "
-                         f"of colour, got shape {a.shape}")
+        raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, k): k = 1 "
+                         f"grey, 2 grey and alpha, 3 or 4 colour (RGB, RGBA), got shape {a.shape}")
     full = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(a.dtype)
     if full is None and a.dtype.kind != "f":
         raise ValueError(f"{name}: integer arrays must be uint8 (0-255) or uint16 (0-65535), got {a.dtype}")

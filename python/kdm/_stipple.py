@@ -37,9 +37,10 @@ def stipple(
     Parameters
     ----------
     image : str, os.PathLike, array or PIL image
-        An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored):
-        luminance (rows, columns) as floats in [0, 1], uint8 or uint16; or colour (rows, columns, 3 or 4),
-        RGB(A), made luminance as a file is (0.2126 R + 0.7152 G + 0.0722 B, composited on white). The
+        An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored), its
+        samples floats in [0, 1], uint8 or uint16: luminance (rows, columns) or (rows, columns, 1); grey and
+        alpha (rows, columns, 2); or colour (rows, columns, 3 or 4), RGB(A), made luminance as a file is
+        (0.2126 R + 0.7152 G + 0.0722 B); an alpha channel composites the image on white paper. The
         image is stretched over [0, width/height] x [0, 1] in the tiling's units (`scale` counts dots
         per unit area there); the dots come back normalised (Returns). An image with no ink gives no dots.
         A file of up to 2^28 pixels (16384 x 16384) is averaged down as it is read to what its dots need (as ``kdm stipple``
@@ -66,7 +67,8 @@ def stipple(
     tileset : Tileset, str, os.PathLike or None
         For method "tiles": a set, or a tile-set file to load (default: the built-in set).
     output : str, os.PathLike or None
-        Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does.
+        Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does
+        (another extension, .npy too, is a ValueError: the dots are returned as an array).
     width, dot_size
         The picture's width in pixels (None: 1024, or what `height` makes it), and the dot radius in pixels (None: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the

@@ -84,7 +84,15 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     throw std::invalid_argument("mode must be 'stable' or 'smooth', got '" + mode + "'");
   if (!(width >= 1 && width <= 65536)) throw std::invalid_argument("width must be 1 to 65536 pixels");
   if (!(height >= 0 && height <= 65536)) throw std::invalid_argument("height must be 1 to 65536 pixels");
-  if (output) tools::refuse_writing_over(label, *output, "input image");
+  if (output) {
+    tools::refuse_writing_over(label, *output, "input image");
+    const std::string format = tools::output_format(*output);
+    if (std::none_of(tools::kStippleFormats.begin(), tools::kStippleFormats.end(), [&](const char* e) {
+          return format == e;
+        }))  // as kdm stipple -o says it, before the dots
+      throw std::invalid_argument("unknown output format for '" + *output + "' (use " +
+                                  tools::extension_list(tools::kStippleFormats) + ")");
+  }
   if (!paper_width.empty()) {
     if (!output || tools::output_format(*output) != ".svg")
       throw std::invalid_argument("paper_width sizes an SVG for print: give output a .svg file");

@@ -266,7 +266,8 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, r"got 255 \(8-bit pixels: pass them as uint8", lambda: kdm.stipple(np.full((4, 4), 255.0))),
     (ValueError, "integer arrays must be uint8", lambda: kdm.stipple(np.zeros((4, 4), dtype=np.int64))),
     (ValueError, r"values must be in \[0, 1\] \(8-bit pixels", lambda: kdm.stipple(np.full((4, 4, 3), 2.0))),
-    (ValueError, r"or \(rows, columns, 3 or 4\) of colour", lambda: kdm.stipple(np.zeros((4, 4, 5)))),
+    (ValueError, r"or \(rows, columns, k\): k = 1 grey, 2 grey and alpha, 3 or 4 colour \(RGB, RGBA\), got "
+     r"shape \(4, 4, 5\)", lambda: kdm.stipple(np.zeros((4, 4, 5)))),
     (ValueError, "stipple needs an image", lambda: kdm.stipple("const:1")),
     (TypeError, "image must be a path or an array", lambda: kdm.stipple(3)),
     (ValueError, "names a file: give its text", lambda: kdm.bake(str(SPHERE))),

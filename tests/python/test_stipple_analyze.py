@@ -131,6 +131,44 @@ def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
                                   kdm.stipple(grey, points=2000))  # 257 v / 65535 = v / 255, rounded alike
 
 
+def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
+    # (rows, columns, 2): grey and alpha, composited on white paper as an LA picture file is read; and
+    # (rows, columns, 1) is grey alone.
+    from PIL import Image
+
+    grey = np.asarray(Image.open(SPHERE))
+    alpha = np.tile(np.linspace(0, 255, grey.shape[1]).astype(np.uint8), (grey.shape[0], 1))
+    la = np.stack([grey, alpha], axis=2)
+    Image.fromarray(la, "LA").save(tmp_path / "la.png")
+    from_file = kdm.stipple(str(tmp_path / "la.png"), points=2000)
+    np.testing.assert_array_equal(kdm.stipple(la, points=2000), from_file)
+    np.testing.assert_array_equal(kdm.stipple(la / 255.0, points=2000), kdm.stipple(la, points=2000))
+    assert not np.array_equal(from_file, kdm.stipple(grey, points=2000))  # the alpha counts
+    for a, b in zip(kdm.stipple(la, points=2000, colours="cmyk"),
+                    kdm.stipple(str(tmp_path / "la.png"), points=2000, colours="cmyk")):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(kdm.stipple(grey[..., None], points=2000), kdm.stipple(grey, points=2000))
+
+
+def test_stipple_writes_the_formats_kdm_stipple_writes_and_names_them(cli, tmp_path):
+    import os
+    import subprocess
+    for ext in ("png", "svg", "txt", "csv"):
+        kdm.stipple(str(SPHERE), points=300, output=tmp_path / f"dots.{ext}")
+        assert (tmp_path / f"dots.{ext}").stat().st_size > 0
+    # Anything else, .npy too (the dots come back as an array), is refused in the command line's words,
+    # before any dot is placed.
+    for ext in ("npy", "gif"):
+        done = subprocess.run([os.environ["KDM_CLI"], "stipple", str(SPHERE), "-o", str(tmp_path / f"x.{ext}")],
+                              capture_output=True, text=True)
+        said = done.stderr.strip().removeprefix("kdm: error: ")
+        assert done.returncode != 0 and said.endswith("(use .png, .svg, .txt or .csv)"), said
+        with pytest.raises(ValueError) as info:
+            kdm.stipple(str(SPHERE), points=300, output=tmp_path / f"x.{ext}")
+        assert str(info.value) == said
+    assert not list(tmp_path.glob("x.*"))
+
+
 def test_stipple_of_a_blank_image_has_no_dots(tmp_path):
     # As kdm stipple: an empty picture, not an error (a blank frame of an animation).
     assert kdm.stipple(np.ones((6, 9))).shape == (0, 2)

@@ -24,7 +24,7 @@
 namespace kdm::cli {
 namespace {
 
-const std::vector<const char*> kStippleFormats = {".png", ".svg", ".txt", ".csv"};
+using tools::kStippleFormats;  // kdm.stipple writes the same
 
 struct StippleArgs {
   std::string image, output, format, method = "tiles", region, tileset, mode = "smooth", colours, paper_width;

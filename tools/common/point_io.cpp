@@ -37,16 +37,22 @@ std::string output_format(const std::string& path, const std::string& format) {
   return ext;
 }
 
+std::string extension_list(const std::vector<const char*>& extensions) {
+  std::string list;
+  for (std::size_t i = 0; i < extensions.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + std::string(extensions[i]);
+  return list;
+}
+
 bool check_output_path(const std::string& path, const std::vector<const char*>& extensions,
                        std::string& error, const std::string& format) {
   const std::string ext = output_format(path, format);
   bool known = false;
-  std::string list, names;
+  const std::string list = extension_list(extensions);
+  std::string names;
   for (std::size_t i = 0; i < extensions.size(); ++i) {
     known = known || ext == extensions[i];
-    const char* sep = i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ";
-    list += sep + std::string(extensions[i]);
-    names += sep + std::string(extensions[i] + 1);
+    names += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + std::string(extensions[i] + 1);
   }
   if (path == kStandardOutput && format.empty()) {
     error = "'-' (standard output) needs --format: " + names;

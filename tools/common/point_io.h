@@ -36,6 +36,9 @@ inline constexpr const char* kStandardOutput = "-";
 /// ".csv"), else the path's own extension; "" when neither names one.
 std::string output_format(const std::string& path, const std::string& format = "");
 
+/// `extensions` as a choice in a message: ".png, .svg, .txt or .csv".
+std::string extension_list(const std::vector<const char*>& extensions);
+
 /// Checks, before any long work, that `path` can be written as one of `extensions` (a list such as
 /// {".csv", ".png"}): its format (output_format(path, format)) is one of them, it is not a directory,
 /// and its directory exists. kStandardOutput needs `format`. Returns false with `error` naming the path

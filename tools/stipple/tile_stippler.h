@@ -15,6 +15,9 @@
 
 namespace kdm::tools {
 
+/// The files a stipple is written to (`kdm stipple -o`, kdm.stipple's output): pictures and point files.
+inline const std::vector<const char*> kStippleFormats = {".png", ".svg", ".txt", ".csv"};
+
 /// The tile size leaves room for this many times more dots per axis than the whole image shows.
 inline constexpr double kStippleZoomRoom = 2;
 
