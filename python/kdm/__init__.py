@@ -9,7 +9,8 @@
   ``kdm.analyze(points)``: point-set metrics (``kdm analyze``).
 
 Arrays in are converted to float64 as needed; 2-D density and image arrays have row 0 at the top, as
-pictures are stored. Wrong types raise TypeError, bad values ValueError, unreadable files OSError. The
+pictures are stored. Wrong types raise TypeError, bad values ValueError, unreadable files OSError (as
+open() raises it: FileNotFoundError for a missing file, IsADirectoryError for a directory). The
 C++ work runs with the GIL released, so Python threads sample and query in parallel; Ctrl-C stops a long
 sample, bake, analysis or full stipple within its current step.
 """

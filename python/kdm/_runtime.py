@@ -196,7 +196,8 @@ class Tileset:
 
     @classmethod
     def load(cls, path: Any) -> "Tileset":
-        """Loads and validates a .kdmt file. Raises OSError (the command line's message) if it cannot."""
+        """Loads and validates a .kdmt file. Raises OSError (the command line's message) if it cannot:
+        FileNotFoundError for a missing file, IsADirectoryError for a directory, as open() raises them."""
         return cls(_kdm.Tileset.load(_checks.path("path", path)))
 
     @classmethod

@@ -22,10 +22,18 @@ namespace kdm::python {
 namespace py = pybind11;
 
 /// A file that cannot be read or written: raised as OSError (pybind11 would make a std::runtime_error a
-/// RuntimeError). The message is the command line's one line.
+/// RuntimeError), or as the subclass of OSError that `error_number` names, as Python's open() raises it
+/// (ENOENT: FileNotFoundError). The message is the command line's one line.
 struct FileError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit FileError(const std::string& message, int error = 0)
+      : std::runtime_error(message), error_number(error) {}
+  int error_number;  ///< an errno value, or 0 for a plain OSError
 };
+
+/// A FileError for the file `path` that could not be read: with the errno of why, where the file system
+/// tells it (a missing file, a directory, no permission), so that `except FileNotFoundError` catches a
+/// missing file as it does for open().
+FileError read_error(const std::string& path, const std::string& message);
 
 /// A long call's progress callback: raises a pending signal's exception (Ctrl-C's KeyboardInterrupt) in
 /// the call, which then stops at its next step instead of running to its end. Takes the GIL.

@@ -119,7 +119,7 @@ DensitySpec parse(const std::string& text, double gamma, bool invert) {
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // an image that cannot be read
-    throw FileError(e.what());
+    throw read_error(text, e.what());
   }
 }
 
@@ -132,7 +132,7 @@ py::array_t<float> load_luminance(const std::string& path) {
     py::gil_scoped_release release;
     ok = tools::load_grey_image(path, image, error);
   }
-  if (!ok) throw FileError(error);
+  if (!ok) throw read_error(path, error);
   return owning_array(std::move(image.pixels), {image.height, image.width});
 }
 

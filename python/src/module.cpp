@@ -1,5 +1,9 @@
 // The compiled half of the Python package: kdm._kdm. The public functions, their defaults and their
 // docstrings are in python/kdm/*.py, which check argument types and call what is bound here.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 
@@ -17,6 +21,18 @@ void check_number(const char* name, double value, double min, bool strict) {
   throw std::invalid_argument(text);
 }
 
+FileError read_error(const std::string& path, const std::string& message) {
+  struct stat info;
+  int error = 0;
+  if (::stat(path.c_str(), &info) != 0)
+    error = errno;
+  else if (S_ISDIR(info.st_mode))
+    error = EISDIR;
+  else if (::access(path.c_str(), R_OK) != 0)
+    error = errno;
+  return FileError(message, error);
+}
+
 }  // namespace kdm::python
 
 PYBIND11_MODULE(_kdm, m) {
@@ -29,7 +45,13 @@ PYBIND11_MODULE(_kdm, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const FileError& e) {
-      PyErr_SetString(PyExc_OSError, e.what());
+      // OSError(errno, ...) is the subclass that errno names; raised with kdm's message alone.
+      PyObject* type = PyExc_OSError;
+      const py::object probe = py::reinterpret_steal<py::object>(
+          e.error_number ? PyObject_CallFunction(PyExc_OSError, "is", e.error_number, "") : nullptr);
+      if (probe) type = reinterpret_cast<PyObject*>(Py_TYPE(probe.ptr()));
+      PyErr_Clear();  // a failed probe leaves OSError itself
+      PyErr_SetString(type, e.what());
     }
   });
   bind_density(m);

@@ -34,7 +34,7 @@ tools::ColourImage colour_image(const std::string& label, const std::optional<Fl
     std::string error;
     if (!tools::load_colour_image(label, image, error,
                                   kept ? tools::kMaxStipplePixels : tools::kMaxImagePixels, kept))
-      throw FileError(error);
+      throw read_error(label, error);
     return image;
   }
   if (rgb->ndim() != 3 || rgb->shape(2) != 3 ||
@@ -65,7 +65,7 @@ DensitySpec stipple_density(const std::string& path, double gamma, bool invert, 
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // an image that cannot be read
-    throw FileError(e.what());
+    throw read_error(path, e.what());
   }
 }
 

@@ -56,7 +56,7 @@ TilesetHandle load(const std::string& path) {
     if (s == Status::kOk) s = read_tileset_header(bytes.data(), bytes.size(), header, &detail);
     if (s == Status::kOk) s = Tileset::load_memory(bytes.data(), bytes.size(), *set, &detail);
   }
-  if (s != Status::kOk) throw FileError("'" + path + "': " + status_message(s) + ": " + detail);
+  if (s != Status::kOk) throw read_error(path, "'" + path + "': " + status_message(s) + ": " + detail);
   return with_bytes({std::move(set), header.format_version}, bytes);
 }
 

@@ -109,12 +109,24 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
             TILES.query((0, 0, 1, 1), scale=10, density=str(path))
     damaged = tmp_path / "damaged.kdmt"
     damaged.write_bytes(b"KDMT" + bytes(100))
-    for path in (tmp_path / "missing.kdmt", damaged, tmp_path):  # a directory too
+    # The subclass of OSError that open() raises for a missing file or a directory; OSError for a damaged one.
+    for path, kind in ((tmp_path / "missing.kdmt", FileNotFoundError), (damaged, OSError),
+                       (tmp_path, IsADirectoryError)):
         message = cli_message(kdm_cli, "query", "--tileset", path, "--rect", "0,0,1,1",
                               "-o", tmp_path / "x.csv")
         with pytest.raises(OSError) as info:
             kdm.Tileset.load(path)
-        assert str(info.value) == message
+        assert str(info.value) == message and type(info.value) is kind
+        with pytest.raises(kind):
+            kdm.stipple(SPHERE, points=100, tileset=path)
+    # A missing image file too, wherever it is read.
+    for call in (lambda: kdm.sample(10, str(missing)), lambda: kdm.stipple(missing),
+                 lambda: kdm.stipple(missing, colours="cmyk"), lambda: kdm.separate(missing),
+                 lambda: TILES.query((0, 0, 1, 1), scale=10, density=str(missing)),
+                 lambda: kdm.analyze(kdm.sample(50), density=str(missing))):
+        with pytest.raises(FileNotFoundError):
+            call()
+    assert type(pytest.raises(OSError, kdm.sample, 10, str(not_an_image)).value) is OSError
     with pytest.raises(OSError, match="cannot|No such|directory"):
         kdm.stipple(SPHERE, points=100, output=tmp_path / "no" / "such" / "dir" / "x.png")
     with pytest.raises(OSError):
