@@ -239,7 +239,8 @@ std::string handover_problem(const TilesetData& set) {
   if (h + 1 >= set.keyframe_nominal.size()) return "the hand-over keyframe is the top one";
   std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe h, per tile
   for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], h);
-  std::vector<std::uint32_t> type(std::size_t(m) * m), first(std::size_t(m) * m + 1);
+  std::vector<std::uint32_t> type(std::size_t(m) * m);
+  std::vector<std::uint64_t> first(std::size_t(m) * m + 1);  // m² · 2^32 points would wrap 32 bits
   std::vector<char> taken;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
@@ -251,7 +252,10 @@ std::string handover_problem(const TilesetData& set) {
       type[j] = std::uint32_t(set.subtile_index(t, j % m, j / m));
       first[j + 1] = first[j] + present[type[j]];
     }
-    taken.assign(first.back(), 0);
+    // Before `taken` is sized by the subtiles' points (m² times a tile's): a forged count costs nothing.
+    if (tile.handover.size() + tile.appearing.size() != first.back())
+      return name + " leaves some of its subtiles' points out of the hand-over";
+    taken.assign(static_cast<std::size_t>(first.back()), 0);
     const auto take = [&](std::uint32_t j, std::uint32_t q) -> std::string {
       if (q >= present[type[j]])
         return name + " names rank " + std::to_string(q) + " of subtile " + std::to_string(j) +
@@ -272,8 +276,6 @@ std::string handover_problem(const TilesetData& set) {
       if ((v >> 16) >= m * m) return name + " has an appearing sub-point outside its subtiles";
       if (std::string problem = take(v >> 16, v & 0xFFFF); !problem.empty()) return problem;
     }
-    if (tile.handover.size() + tile.appearing.size() != first.back())
-      return name + " leaves some of its subtiles' points out of the hand-over";
   }
   return {};
 }

@@ -700,5 +700,35 @@ TEST(TilesetFormatTest, EveryHeaderBitFlipInAFileIsJudgedAsInMemory) {
   std::remove(path.c_str());
 }
 
+// A hand-over onto 256 × 256 subtiles of a tile of 70,001 points names 4.6 × 10^9 sub-points, past 32
+// bits: the check counts them in 64 bits and compares the count with the tile's tables before it sizes
+// anything by it (a 32-bit count wrapped to 2.9 × 10^8 and the check wrote far past that many bytes).
+TEST(TilesetFormatTest, AHandOverOfMoreSubPointsThan32BitsCountIsRefusedBeforeItsScratch) {
+  const std::uint32_t points = 70001;
+  const std::string body = body_bytes([&](auto& ar) {
+    ar(std::uint32_t(1), std::uint32_t(2), std::uint32_t(1));  // one colour, two levels, one tile
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), std::uint32_t(65536));  // m = 256
+    ar(cereal::make_size_tag(cereal::size_type(3)), std::uint32_t(2), std::uint32_t(4), std::uint32_t(65536));
+    ar(std::uint32_t(1));  // the hand-over zone (format 5)
+    ar(cereal::make_size_tag(cereal::size_type(2)), std::uint32_t(1), points);
+    ar(cereal::make_size_tag(cereal::size_type(2 * points)));
+    for (std::uint32_t i = 0; i < 2 * points; ++i) ar(std::uint16_t(i % 2 ? 238 << 8 : 72 << 8));
+    ar(cereal::make_size_tag(cereal::size_type(points)));
+    for (std::uint32_t i = 0; i < points; ++i) ar(std::uint16_t(0));  // every point present at keyframe 1
+    ar(cereal::make_size_tag(cereal::size_type(6 * points)));         // three keyframes' offsets, none moves
+    for (std::uint32_t i = 0; i < 6 * points; ++i) ar(std::uint8_t(0));
+    ar(cereal::make_size_tag(cereal::size_type(points)));
+    for (std::uint32_t i = 0; i < points; ++i) ar(std::uint16_t(12));  // rank 0 of its own subtile
+    ar(cereal::make_size_tag(cereal::size_type(0)));
+  });
+  std::vector<std::uint8_t> file = encode(make_tileset(1, 2, 1, /*glide=*/false));
+  put32(&file[8], 5);
+  file = with_body(file, body);
+  TilesetData out;
+  std::string why;
+  EXPECT_EQ(decode_tileset(file.data(), file.size(), out, &why), Status::kInvalidContent);
+  EXPECT_EQ(why, "tile 0 leaves some of its subtiles' points out of the hand-over");
+}
+
 }  // namespace
 }  // namespace kdm
