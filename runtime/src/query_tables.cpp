@@ -13,13 +13,12 @@ namespace kdm::detail {
 
 QueryTables::QueryTables(const TilesetData& set) {
   // Thresholds once per load, so the query loop compares instead of interpolating.
-  const std::vector<std::vector<float>> coarsest = coarsest_level_thresholds(set);
   thresholds.assign(set.tiles.size(), {});
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) thresholds[t].resize(set.tiles[t].points.size());
+  coarsest_level_thresholds_into(set, thresholds);
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
     TilesetArray<float>& out = thresholds[t];
-    out.assign(coarsest[t].begin(), coarsest[t].end());
-    out.resize(tile.points.size());
     for (std::uint32_t k = 1, i = tile.level_end[0]; k < set.levels; ++k)
       for (; i < tile.level_end[k]; ++i) out[i] = set.emission_threshold(k, tile.keys[i]);
   }

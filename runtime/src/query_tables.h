@@ -26,6 +26,10 @@ inline constexpr double kEdgeSlack = 8;
 /// QueryTables::cell_ranks cuts a tile into 2^kIndexCellBits × 2^kIndexCellBits cells.
 inline constexpr std::uint32_t kIndexCellBits = 5, kIndexCells = 1u << kIndexCellBits;
 
+/// coarsest_level_thresholds (tileset_format.h) into `out`, whose tiles' arrays already hold at least
+/// their coarsest level's ranks (the rest is left as it is): no scratch outside the tile-set allocator.
+void coarsest_level_thresholds_into(const TilesetData& set, TilesetArray<TilesetArray<float>>& out);
+
 struct QueryTables {
   /// Per tile, its points' emission thresholds (TilesetShape::emission_threshold), non-decreasing.
   TilesetArray<TilesetArray<float>> thresholds;

@@ -1,8 +1,12 @@
 // Reading and writing kdm tile sets (format described in kdm/runtime/tileset.h). The reader treats its
 // input as untrusted: it checks magic, version, sizes, both checksums and the reader caps before it
-// allocates, decompresses into a buffer of the stated size only, parses counts against the bytes left,
-// and validates the structure it built.
+// allocates, parses the body as zstd decompresses it (never holding it whole, so a small file that
+// decompresses to hundreds of megabytes costs only zstd's window), parses counts against the bytes the
+// header says are left, and validates the structure it built. What it allocates goes through the
+// tile-set allocator (allocator.h), zstd's memory included.
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_createDCtx_advanced: zstd's memory through the tile-set allocator
 #include <zstd.h>
+#include <zstd_errors.h>
 
 #include <algorithm>
 #include <cereal/archives/portable_binary.hpp>
@@ -18,12 +22,14 @@
 #include <sstream>
 #include <streambuf>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include <sys/stat.h>
 
 #include "crc32.h"
 #include "kdm/runtime/tileset_format.h"
+#include "query_tables.h"
 
 namespace kdm {
 namespace {
@@ -65,14 +71,113 @@ std::uint32_t header_crc(const std::uint8_t* header, std::size_t size) {
   return detail::crc32(header + kFixedHeaderBytes, size - kFixedHeaderBytes, crc);
 }
 
-/// A read-only streambuf over memory that can say how many bytes are left.
-class MemoryBuffer : public std::streambuf {
+/// zstd's memory from the tile-set allocator's hooks (operator new without them). zstd frees by address
+/// alone, so each block carries its size in front.
+constexpr std::size_t kBlockPrefix = alignof(std::max_align_t);
+void* zstd_allocate(void* opaque, std::size_t size) {
+  const auto& hooks = *static_cast<const AllocatorHooks*>(opaque);
+  if (size > SIZE_MAX - kBlockPrefix) return nullptr;
+  const std::size_t bytes = size + kBlockPrefix;
+  void* p =
+      hooks.allocate ? hooks.allocate(bytes, kBlockPrefix, hooks.user) : ::operator new(bytes, std::nothrow);
+  if (!p) return nullptr;
+  std::memcpy(p, &bytes, sizeof bytes);
+  return static_cast<char*>(p) + kBlockPrefix;
+}
+void zstd_free(void* opaque, void* address) {
+  if (!address) return;
+  const auto& hooks = *static_cast<const AllocatorHooks*>(opaque);
+  void* p = static_cast<char*>(address) - kBlockPrefix;
+  std::size_t bytes = 0;
+  std::memcpy(&bytes, p, sizeof bytes);
+  if (hooks.deallocate)
+    hooks.deallocate(p, bytes, kBlockPrefix, hooks.user);
+  else
+    ::operator delete(p);
+}
+
+/// The body as zstd decompresses the payload, a chunk at a time: the parser reads it as a stream, so only
+/// zstd's window (at most the body's size) and one chunk are held. It never gives more than the header's
+/// body size B, and remaining() is what is left of B, the bound every count is checked against.
+class ZstdBody : public std::streambuf {
  public:
-  MemoryBuffer(const char* data, std::size_t size) {
-    char* p = const_cast<char*>(data);  // never written through: this buffer has no put area
-    setg(p, p, p + size);
+  ZstdBody(ZSTD_DCtx* zstd, const void* payload, std::size_t payload_size, std::uint64_t body_size)
+      : zstd_(zstd), in_{payload, payload_size, 0}, body_(body_size) {}
+  /// The chunk buffer (zstd's block, or the whole body if smaller), through the tile-set allocator
+  /// (throws std::bad_alloc when refused).
+  void allocate_chunk() {
+    chunk_.resize(static_cast<std::size_t>(
+        std::max<std::uint64_t>(1, std::min<std::uint64_t>(body_, ZSTD_DStreamOutSize()))));
   }
-  std::size_t remaining() const { return static_cast<std::size_t>(egptr() - gptr()); }
+  std::uint64_t remaining() const { return body_ - (produced_ - std::uint64_t(egptr() - gptr())); }
+  /// zstd's error code, where it failed (0 if it did not).
+  std::size_t error() const { return error_; }
+  /// After the whole body was read: whether the frame ends there (else error() says why, or it is longer).
+  bool finish() {
+    if (gptr() != egptr() || produced_ != body_) return false;
+    char extra;
+    while (!ended_) {
+      ZSTD_outBuffer out{&extra, 1, 0};
+      const std::size_t before = in_.pos, r = ZSTD_decompressStream(zstd_, &out, &in_);
+      if (ZSTD_isError(r)) return error_ = r, false;
+      if (out.pos) return false;                      // more than B bytes
+      if (r != 0 && in_.pos == before) return false;  // no progress: the frame is cut short
+      ended_ = r == 0;
+    }
+    return in_.pos == in_.size;
+  }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    const std::size_t n = fill(chunk_.data(), chunk_.size());
+    if (n == 0) return traits_type::eof();
+    setg(chunk_.data(), chunk_.data(), chunk_.data() + n);
+    return traits_type::to_int_type(*gptr());
+  }
+  /// Large reads (a tile's arrays) are decompressed straight into the destination.
+  std::streamsize xsgetn(char* s, std::streamsize n) override {
+    std::streamsize done = 0;
+    while (done < n) {
+      if (gptr() == egptr() && std::size_t(n - done) >= chunk_.size()) {
+        const std::size_t got = fill(s + done, std::size_t(n - done));
+        if (got == 0) break;
+        done += std::streamsize(got);
+        continue;
+      }
+      if (gptr() == egptr() && traits_type::eq_int_type(underflow(), traits_type::eof())) break;
+      const std::streamsize k = std::min<std::streamsize>(n - done, egptr() - gptr());
+      std::memcpy(s + done, gptr(), std::size_t(k));
+      gbump(static_cast<int>(k));
+      done += k;
+    }
+    return done;
+  }
+
+ private:
+  /// Decompresses at most `size` bytes, and never past B, into `out`: how many (0 at B, or where zstd
+  /// failed or stopped making progress).
+  std::size_t fill(char* out, std::size_t size) {
+    ZSTD_outBuffer o{out, static_cast<std::size_t>(std::min<std::uint64_t>(size, body_ - produced_)), 0};
+    while (o.pos == 0 && o.size > 0 && error_ == 0 && !ended_) {
+      const std::size_t before = in_.pos, r = ZSTD_decompressStream(zstd_, &o, &in_);
+      if (ZSTD_isError(r))
+        error_ = r;
+      else if (r == 0)
+        ended_ = true;  // short of B if nothing came (zstd checks the frame's size itself too)
+      else if (o.pos == 0 && in_.pos == before)
+        break;  // no progress: the frame is cut short
+    }
+    produced_ += o.pos;
+    return o.pos;
+  }
+
+  ZSTD_DCtx* zstd_;
+  ZSTD_inBuffer in_;
+  std::uint64_t body_, produced_ = 0;
+  std::size_t error_ = 0;
+  bool ended_ = false;  // zstd has said the frame is complete
+  TilesetArray<char> chunk_;
 };
 
 using InputArchive = cereal::PortableBinaryInputArchive;
@@ -84,15 +189,20 @@ void save_array(cereal::PortableBinaryOutputArchive& ar, const Array& v) {
   ar(cereal::binary_data(const_cast<T*>(v.data()), v.size() * sizeof(T)));
 }
 
-template <class Array>
-void load_array(InputArchive& ar, const MemoryBuffer& buffer, Array& v) {
-  using T = typename Array::value_type;
+/// An array's size tag, checked against the bytes left of the body's stated size: a count larger than
+/// they hold cannot be genuine, and is refused before anything is allocated for it.
+cereal::size_type load_count(InputArchive& ar, const ZstdBody& body, std::size_t element_bytes) {
   cereal::size_type n = 0;
   ar(cereal::make_size_tag(n));
-  // A count larger than the bytes left cannot be genuine: refuse before allocating.
-  if (n > buffer.remaining() / sizeof(T))
+  if (n > body.remaining() / element_bytes)
     throw ContentError("an array claims " + std::to_string(n) + " elements, more than the payload holds");
-  v.resize(static_cast<std::size_t>(n));
+  return n;
+}
+
+template <class Array>
+void load_array(InputArchive& ar, const ZstdBody& body, Array& v) {
+  using T = typename Array::value_type;
+  v.resize(static_cast<std::size_t>(load_count(ar, body, sizeof(T))));
   ar(cereal::binary_data(v.data(), v.size() * sizeof(T)));
 }
 
@@ -114,20 +224,24 @@ std::vector<Value> glide_differences(const TilesetData& set, const Tile& tile,
   }
   return v;
 }
-template <class Value>
-void glide_sums(const TilesetData& set, const Tile& tile, std::vector<Value>& v) {
+template <class Array>
+void glide_sums(const TilesetData& set, const Tile& tile, Array& v) {
+  using Value = typename Array::value_type;
+  using Unsigned = std::make_unsigned_t<Value>;  // sums mod 2^bits, as the differences were taken
   std::size_t at = 0;
   for (std::size_t g = 0; g < set.keyframe_nominal.size(); ++g) {
     const std::size_t n = 2 * std::size_t(set.offsets_at_keyframe(tile, g));
     const std::size_t before = g ? 2 * std::size_t(set.offsets_at_keyframe(tile, g - 1)) : 0;
-    for (std::size_t i = 0; i < before; ++i) v[at + i] = static_cast<Value>(v[at + i] + v[at - before + i]);
+    for (std::size_t i = 0; i < before; ++i)
+      v[at + i] =
+          static_cast<Value>(static_cast<Unsigned>(Unsigned(v[at + i]) + Unsigned(v[at - before + i])));
     at += n;
   }
 }
 
 /// Format 3's glide offsets (16-bit differences, in 1/65536 tile sides) into tile.glide's 8-bit units,
 /// rounded and clamped: format 3 sets keep their glide track to within a 64th of a spacing.
-void glide_from_format3(const TilesetData& set, std::vector<std::uint16_t>& stored, Tile& tile) {
+void glide_from_format3(const TilesetData& set, TilesetArray<std::uint16_t>& stored, Tile& tile) {
   glide_sums(set, tile, stored);
   tile.glide.resize(stored.size());
   std::size_t at = 0;
@@ -178,49 +292,86 @@ std::vector<std::uint8_t> serialise_body(const TilesetData& set) {
   return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
 }
 
-void parse_body(const char* body, std::size_t size, std::uint32_t version, TilesetData& set,
-                std::vector<std::vector<std::uint16_t>>& glide16,
-                std::vector<std::vector<std::uint8_t>>& glide) {
+/// Parses the body from `body` into `set`: format 3's glide offsets into `glide16` (tile.glide only sized),
+/// later formats' into tile.glide as stored (differences: glide_sums once the set is validated).
+void parse_body(ZstdBody& body, std::uint32_t version, TilesetData& set,
+                TilesetArray<TilesetArray<std::uint16_t>>& glide16) {
   // cereal's endianness flag: 1 little-, 0 big-endian; cereal itself would take anything else as "other".
-  if (size == 0 || (body[0] != 0 && body[0] != 1)) throw ContentError("bad byte-order flag");
-  MemoryBuffer buffer(body, size);
-  std::istream stream(&buffer);
+  const auto flag = body.sgetc();
+  if (flag != 0 && flag != 1) throw ContentError("bad byte-order flag");
+  std::istream stream(&body);
   InputArchive ar(stream);
   std::uint32_t tile_count = 0;
   ar(set.colours, set.levels, tile_count);
-  load_array(ar, buffer, set.level_nominal);
+  load_array(ar, body, set.level_nominal);
   const bool gliding = version >= 3, handover = version >= 5;
-  if (gliding) load_array(ar, buffer, set.keyframe_nominal);
+  if (gliding) load_array(ar, body, set.keyframe_nominal);
   if (handover) ar(set.handover_zone);
   if (version >= 6) ar(set.handover_level);
   if (version >= 7) ar(set.handover_slack);
   // Every tile takes at least three size tags (8 bytes each), which bounds the count by the bytes left.
-  if (tile_count > buffer.remaining() / (handover ? 48 : gliding ? 32 : 24))
+  if (tile_count > body.remaining() / (handover ? 48 : gliding ? 32 : 24))
     throw ContentError("tile count exceeds the payload");
   set.tiles.resize(tile_count);
-  std::vector<std::uint16_t> xy;
-  for (Tile& tile : set.tiles) {
-    load_array(ar, buffer, tile.level_end);
-    load_array(ar, buffer, xy);
-    if (xy.size() % 2) throw ContentError("a tile has an odd number of coordinates");
-    tile.points.resize(xy.size() / 2);
-    for (std::size_t i = 0; i < tile.points.size(); ++i) tile.points[i] = {xy[2 * i], xy[2 * i + 1]};
-    load_array(ar, buffer, tile.keys);
+  if (version == 3) glide16.resize(tile_count);
+  static_assert(sizeof(TilePoint) == 2 * sizeof(std::uint16_t) && std::is_standard_layout_v<TilePoint>,
+                "a tile's points are its stored (x, y) pairs");
+  for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+    Tile& tile = set.tiles[t];
+    load_array(ar, body, tile.level_end);
+    const cereal::size_type xy = load_count(ar, body, sizeof(std::uint16_t));
+    if (xy % 2) throw ContentError("a tile has an odd number of coordinates");
+    tile.points.resize(static_cast<std::size_t>(xy / 2));
+    ar(cereal::binary_data(reinterpret_cast<std::uint16_t*>(tile.points.data()), xy * sizeof(std::uint16_t)));
+    load_array(ar, body, tile.keys);
     if (version == 3) {
-      glide16.emplace_back();
-      load_array(ar, buffer, glide16.back());
-      tile.glide.resize(glide16.back().size());  // the size for validation; the values after it
+      load_array(ar, body, glide16[t]);
+      tile.glide.resize(glide16[t].size());  // the size for validation; the values after it
     } else if (gliding) {
-      glide.emplace_back();
-      load_array(ar, buffer, glide.back());
-      tile.glide.resize(glide.back().size());
+      load_array(ar, body, tile.glide);
     }
     if (handover) {
-      load_array(ar, buffer, tile.handover);
-      load_array(ar, buffer, tile.appearing);
+      load_array(ar, body, tile.handover);
+      load_array(ar, body, tile.appearing);
     }
   }
-  if (buffer.remaining() != 0) throw ContentError("payload has bytes after the last tile");
+  if (body.remaining() != 0) throw ContentError("payload has bytes after the last tile");
+}
+
+/// Decompresses the payload (one zstd frame of `body_size` bytes, checked) and parses it into `set` as one
+/// stream: kOk, or kInvalidContent, kDecompressionFailed (zstd's failure explains whatever the parser made
+/// of the bytes it did not get) or kOutOfMemory, with `detail`.
+Status read_body(const std::uint8_t* payload, std::size_t payload_size, std::uint64_t body_size,
+                 std::uint32_t version, TilesetData& set, TilesetArray<TilesetArray<std::uint16_t>>& glide16,
+                 std::string* detail) {
+  AllocatorHooks hooks = tileset_allocator();
+  const ZSTD_customMem memory{zstd_allocate, zstd_free, &hooks};
+  const std::unique_ptr<ZSTD_DCtx, std::size_t (*)(ZSTD_DCtx*)> zstd(ZSTD_createDCtx_advanced(memory),
+                                                                     ZSTD_freeDCtx);
+  if (!zstd) return fail(Status::kOutOfMemory, detail, "payload: no memory to decompress it");
+  // Any window, as a decoder of the whole frame at once takes: zstd's buffer is at most the body's size.
+  ZSTD_DCtx_setParameter(zstd.get(), ZSTD_d_windowLogMax, ZSTD_WINDOWLOG_MAX);
+  ZstdBody body(zstd.get(), payload, payload_size, body_size);
+  Status status = Status::kOk;
+  std::string problem;
+  try {
+    body.allocate_chunk();
+    parse_body(body, version, set, glide16);
+    if (!body.finish())
+      status = Status::kDecompressionFailed, problem = "payload: the frame does not end at the stated size";
+  } catch (const std::bad_alloc&) {  // not damage
+    status = Status::kOutOfMemory, problem = "payload: an allocation failed";
+  } catch (const cereal::Exception&) {  // its own words ("Failed to read 8 bytes ...") say less than these
+    status = Status::kInvalidContent, problem = "payload: its records end before their stated sizes";
+  } catch (const std::exception& e) {
+    status = Status::kInvalidContent, problem = std::string("payload: ") + e.what();
+  }
+  if (body.error()) {
+    if (ZSTD_getErrorCode(body.error()) == ZSTD_error_memory_allocation)
+      return fail(Status::kOutOfMemory, detail, "payload: no memory to decompress it");
+    return fail(Status::kDecompressionFailed, detail, ZSTD_getErrorName(body.error()));
+  }
+  return status == Status::kOk ? status : fail(status, detail, problem);
 }
 
 /// The first problem of a set's hand-over tables (empty if none): every point of a tile glides onto its own
@@ -237,11 +388,11 @@ std::string handover_problem(const TilesetData& set) {
            std::to_string(kMaxHandoverSlack);
   const std::size_t h = set.handover_keyframe();
   if (h + 1 >= set.keyframe_nominal.size()) return "the hand-over keyframe is the top one";
-  std::vector<std::uint32_t> present(set.tiles.size());  // points at keyframe h, per tile
+  TilesetArray<std::uint32_t> present(set.tiles.size());  // points at keyframe h, per tile
   for (std::size_t t = 0; t < set.tiles.size(); ++t) present[t] = set.points_at_keyframe(set.tiles[t], h);
-  std::vector<std::uint32_t> type(std::size_t(m) * m);
-  std::vector<std::uint64_t> first(std::size_t(m) * m + 1);  // m² · 2^32 points would wrap 32 bits
-  std::vector<char> taken;
+  TilesetArray<std::uint32_t> type(std::size_t(m) * m);
+  TilesetArray<std::uint64_t> first(std::size_t(m) * m + 1);  // m² · 2^32 points would wrap 32 bits
+  TilesetArray<char> taken;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
     const std::string name = "tile " + std::to_string(t);
@@ -287,18 +438,22 @@ std::uint32_t tileset_format_version_for(const TilesetShape& set) {
   return !set.handover_zone ? 4 : set.handover_slack ? 7 : set.handover_level ? 6 : 5;
 }
 
-std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set) {
-  std::vector<std::vector<float>> out(set.tiles.size());
+namespace {
+
+/// coarsest_level_thresholds into `out`, whose tiles' arrays already hold at least their coarsest level's
+/// ranks; its scratch through the tile-set allocator.
+template <class Thresholds>
+void coarsest_thresholds_into(const TilesetData& set, Thresholds& out) {
   struct Coarsest {
     float threshold;
     std::uint32_t tie;  // how many earlier ranks of its tile have the same threshold
     std::uint32_t tile, rank;
   };
-  std::vector<Coarsest> coarsest;
+  TilesetArray<Coarsest> coarsest;
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
-    out[t].resize(tile.level_end.empty() ? 0 : tile.level_end[0]);
-    for (std::uint32_t i = 0; i < out[t].size(); ++i) {
+    const std::uint32_t count = tile.level_end.empty() ? 0 : tile.level_end[0];
+    for (std::uint32_t i = 0; i < count; ++i) {
       const float threshold = set.emission_threshold(0, tile.keys[i]);
       const bool tied = i > 0 && coarsest.back().threshold == threshold;
       coarsest.push_back({threshold, tied ? coarsest.back().tie + 1 : 0, static_cast<std::uint32_t>(t), i});
@@ -311,7 +466,20 @@ std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set
   const double step = double(set.level_nominal[0]) / double(coarsest.size());
   for (std::size_t i = 0; i < coarsest.size(); ++i)
     out[coarsest[i].tile][coarsest[i].rank] = static_cast<float>((double(i) + 0.5) * step);
+}
+
+}  // namespace
+
+std::vector<std::vector<float>> coarsest_level_thresholds(const TilesetData& set) {
+  std::vector<std::vector<float>> out(set.tiles.size());
+  for (std::size_t t = 0; t < set.tiles.size(); ++t)
+    out[t].resize(set.tiles[t].level_end.empty() ? 0 : set.tiles[t].level_end[0]);
+  coarsest_thresholds_into(set, out);
   return out;
+}
+
+void detail::coarsest_level_thresholds_into(const TilesetData& set, TilesetArray<TilesetArray<float>>& out) {
+  coarsest_thresholds_into(set, out);
 }
 
 Status validate_tileset(const TilesetData& set, std::string* detail) {
@@ -365,7 +533,13 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
                  " glide offsets, its keyframes need " + std::to_string(2 * present));
   }
   if (set.handover_zone) {
-    if (const std::string problem = handover_problem(set); !problem.empty()) return bad(problem);
+    std::string problem;
+    try {
+      problem = handover_problem(set);
+    } catch (const std::bad_alloc&) {  // its scratch, refused by the tile-set allocator
+      return fail(Status::kOutOfMemory, detail, "no memory to check the hand-over");
+    }
+    if (!problem.empty()) return bad(problem);
   } else {
     if (set.handover_level) return bad("a hand-over level in a set without a hand-over");
     if (set.handover_slack) return bad("a hand-over slack in a set without a hand-over");
@@ -496,40 +670,30 @@ Status decode_tileset(const void* data, std::size_t size, TilesetData& out, std:
   if (frame == ZSTD_CONTENTSIZE_ERROR || frame == ZSTD_CONTENTSIZE_UNKNOWN || frame != body_size ||
       ZSTD_findFrameCompressedSize(payload, payload_size) != payload_size)  // one frame, nothing after it
     return fail(Status::kDecompressionFailed, detail, "payload is not one zstd frame of the stated size");
-  // Not zero-filled first: zstd writes every byte (5 MB for the built-in set, a fifth of its load time).
-  const std::unique_ptr<char[]> body(new (std::nothrow) char[static_cast<std::size_t>(body_size)]);
-  if (!body) return fail(Status::kOutOfMemory, detail, "payload: no memory to decompress it into");
-  const std::size_t unpacked = ZSTD_decompress(body.get(), body_size, payload, payload_size);
-  if (ZSTD_isError(unpacked) || unpacked != body_size)
-    return fail(Status::kDecompressionFailed, detail,
-                ZSTD_isError(unpacked) ? ZSTD_getErrorName(unpacked) : "short frame");
   TilesetData set;
-  std::vector<std::vector<std::uint16_t>> glide16;  // stored glide offsets per tile: format 3's
-  std::vector<std::vector<std::uint8_t>> glide;     // and format 4's (glide_differences)
-  try {
-    parse_body(body.get(), body_size, version, set, glide16, glide);
-  } catch (const std::bad_alloc&) {  // not damage
-    return fail(Status::kOutOfMemory, detail, "payload: an allocation failed");
-  } catch (const cereal::Exception&) {  // its own words ("Failed to read 8 bytes ...") say less than these
-    return fail(Status::kInvalidContent, detail, "payload: its records end before their stated sizes");
-  } catch (const std::exception& e) {
-    return fail(Status::kInvalidContent, detail, std::string("payload: ") + e.what());
-  }
+  TilesetArray<TilesetArray<std::uint16_t>> glide16;  // format 3's stored glide offsets, per tile
+  if (const Status s = read_body(payload, static_cast<std::size_t>(payload_size), body_size, version, set,
+                                 glide16, detail);
+      s != Status::kOk)
+    return s;
   if (set.colours != header.colours || set.levels != header.levels)
     return fail(Status::kInvalidContent, detail, "payload disagrees with the header");
   if (const Status s = validate_tileset(set, detail); s != Status::kOk) return s;
-  for (std::size_t t = 0; t < glide16.size(); ++t) glide_from_format3(set, glide16[t], set.tiles[t]);
-  for (std::size_t t = 0; t < glide.size(); ++t) {
-    glide_sums(set, set.tiles[t], glide[t]);
-    std::copy(glide[t].begin(), glide[t].end(), set.tiles[t].glide.begin());  // two's complement bytes
-  }
+  if (version == 3)
+    for (std::size_t t = 0; t < glide16.size(); ++t) glide_from_format3(set, glide16[t], set.tiles[t]);
+  else
+    for (Tile& tile : set.tiles) glide_sums(set, tile, tile.glide);  // two's complement bytes
   set.recipe = std::move(header.recipe);
   set.generator_version = std::move(header.generator_version);
   out = std::move(set);
   return Status::kOk;
 }
 
-Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std::string* detail) {
+namespace {
+
+/// read_tileset_file into any vector of char (the loader's: through the tile-set allocator).
+template <class Bytes>
+Status read_file_into(const std::string& path, Bytes& bytes, std::string* detail) {
   bytes.clear();
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) return fail(Status::kIoError, detail, "cannot open '" + path + "': " + std::strerror(errno));
@@ -565,10 +729,20 @@ Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std:
   return Status::kOk;
 }
 
+}  // namespace
+
+Status read_tileset_file(const std::string& path, std::vector<char>& bytes, std::string* detail) {
+  return read_file_into(path, bytes, detail);
+}
+
 Status load_tileset(const std::string& path, TilesetData& out, std::string* detail) {
   out = TilesetData{};
-  std::vector<char> bytes;
-  if (const Status s = read_tileset_file(path, bytes, detail); s != Status::kOk) return s;
+  TilesetArray<char> bytes;  // as large as the file: the tile-set allocator's too
+  try {
+    if (const Status s = read_file_into(path, bytes, detail); s != Status::kOk) return s;
+  } catch (const std::bad_alloc&) {
+    return fail(Status::kOutOfMemory, detail, "no memory to read '" + path + "' into");
+  }
   return decode_tileset(bytes.data(), bytes.size(), out, detail);
 }
 

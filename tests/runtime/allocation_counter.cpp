@@ -12,6 +12,7 @@
 
 namespace {
 std::atomic<long> g_allocations{0};
+std::atomic<std::size_t> g_largest{0};
 }  // namespace
 
 // Every replaceable form that allocates with malloc is replaced, so that no form left to the library
@@ -19,6 +20,9 @@ std::atomic<long> g_allocations{0};
 namespace {
 void* counted_malloc(std::size_t size) noexcept {
   ++g_allocations;
+  for (std::size_t largest = g_largest.load();
+       size > largest && !g_largest.compare_exchange_weak(largest, size);) {
+  }
   return std::malloc(size ? size : 1);
 }
 }  // namespace
@@ -58,4 +62,12 @@ void operator delete[](void* p, const std::nothrow_t&) noexcept {
 
 long kdm::testing::allocations() {
   return g_allocations.load();
+}
+
+std::size_t kdm::testing::largest_allocation() {
+  return g_largest.load();
+}
+
+void kdm::testing::reset_largest_allocation() {
+  g_largest.store(0);
 }

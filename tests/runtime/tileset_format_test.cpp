@@ -1,6 +1,7 @@
 // The tile-set file format on untrusted input (meshoptimizer style: cut at every length, flip bits,
 // craft hostile counts behind valid checksums) and its round trip.
 #include <gtest/gtest.h>
+#define ZSTD_STATIC_LINKING_ONLY  // ZSTD_getFrameHeader: the window a bomb's frame asks for
 #include <zstd.h>
 
 #include <algorithm>
@@ -12,11 +13,14 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <tuple>
 
+#include "allocation_counter.h"
 #include "crc32.h"
+#include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/query.h"
 #include "kdm/runtime/tileset.h"
 #include "query_tables.h"
@@ -84,21 +88,26 @@ void put64(std::uint8_t* p, std::uint64_t v) {
   for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
-// Rewrites `file`'s payload with `body` (compressed) and fixes every size and checksum, as a hostile
-// writer who knows the format would.
-std::vector<std::uint8_t> with_body(std::vector<std::uint8_t> file, const std::string& body,
-                                    std::uint64_t claimed_body_size = 0) {
+// Rewrites `file`'s payload with `payload` (a zstd frame of `body_size` bytes) and fixes every size and
+// checksum, as a hostile writer who knows the format would.
+std::vector<std::uint8_t> with_payload(std::vector<std::uint8_t> file,
+                                       const std::vector<std::uint8_t>& payload, std::uint64_t body_size) {
   const std::uint32_t header_size = get32(&file[12]);
-  std::vector<std::uint8_t> payload(ZSTD_compressBound(body.size()));
-  payload.resize(ZSTD_compress(payload.data(), payload.size(), body.data(), body.size(), 3));
   file.resize(header_size);
   put64(&file[16], payload.size());
-  put64(&file[24], claimed_body_size ? claimed_body_size : body.size());
+  put64(&file[24], body_size);
   put32(&file[32], detail::crc32(payload.data(), payload.size()));
   put32(&file[60], 0);
   put32(&file[60], detail::crc32(file.data(), file.size()));
   file.insert(file.end(), payload.begin(), payload.end());
   return file;
+}
+// The same with `body` compressed (its size claimed to be `claimed_body_size` if not 0).
+std::vector<std::uint8_t> with_body(std::vector<std::uint8_t> file, const std::string& body,
+                                    std::uint64_t claimed_body_size = 0) {
+  std::vector<std::uint8_t> payload(ZSTD_compressBound(body.size()));
+  payload.resize(ZSTD_compress(payload.data(), payload.size(), body.data(), body.size(), 3));
+  return with_payload(std::move(file), payload, claimed_body_size ? claimed_body_size : body.size());
 }
 
 TEST(TilesetFormatTest, RoundTripIsExact) {
@@ -112,7 +121,7 @@ TEST(TilesetFormatTest, RoundTripIsExact) {
   const std::vector<std::uint8_t> bytes = encode(set);
   ASSERT_EQ(decode_tileset(bytes.data(), bytes.size(), back), Status::kOk);
   EXPECT_EQ(back, set);
-  const std::string path = testing::TempDir() + "/roundtrip.kdmt";
+  const std::string path = ::testing::TempDir() + "/roundtrip.kdmt";
   ASSERT_EQ(save_tileset(set, path), Status::kOk);
   TilesetData loaded;
   ASSERT_EQ(load_tileset(path, loaded), Status::kOk);
@@ -406,9 +415,9 @@ TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
   EXPECT_EQ(save_tileset(set, "/nonexistent-dir/x.kdmt"), Status::kIoError);
   // A path that cannot take the set is found before any work (check_tileset_path), named in the detail.
   std::string detail;
-  EXPECT_EQ(check_tileset_path(testing::TempDir(), &detail), Status::kIoError);
+  EXPECT_EQ(check_tileset_path(::testing::TempDir(), &detail), Status::kIoError);
   EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
-  EXPECT_EQ(save_tileset(set, testing::TempDir(), &detail), Status::kIoError);
+  EXPECT_EQ(save_tileset(set, ::testing::TempDir(), &detail), Status::kIoError);
   EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
   EXPECT_EQ(check_tileset_path("", &detail), Status::kIoError);
   EXPECT_EQ(check_tileset_path("/nonexistent-dir/x.kdmt", &detail), Status::kIoError);
@@ -416,9 +425,9 @@ TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
       detail.find("cannot write '/nonexistent-dir/x.kdmt': directory '/nonexistent-dir' does not exist"),
       std::string::npos)
       << detail;
-  EXPECT_EQ(check_tileset_path(testing::TempDir() + "/fresh.kdmt"), Status::kOk);
-  EXPECT_FALSE(std::ifstream(testing::TempDir() + "/fresh.kdmt.partial").good());  // removed again
-  const std::string path = testing::TempDir() + "/atomic.kdmt";
+  EXPECT_EQ(check_tileset_path(::testing::TempDir() + "/fresh.kdmt"), Status::kOk);
+  EXPECT_FALSE(std::ifstream(::testing::TempDir() + "/fresh.kdmt.partial").good());  // removed again
+  const std::string path = ::testing::TempDir() + "/atomic.kdmt";
   { std::ofstream(path) << "old contents"; }
   ASSERT_EQ(save_tileset(set, path), Status::kOk);
   TilesetData loaded;
@@ -429,8 +438,8 @@ TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {
   EXPECT_EQ(load_tileset(path, loaded), Status::kIoError);
   // Through a symbolic link the set replaces the link's target; the link stays a link.
   namespace fs = std::filesystem;
-  const fs::path target = fs::path(testing::TempDir()) / "target.kdmt",
-                 link = fs::path(testing::TempDir()) / "link.kdmt";
+  const fs::path target = fs::path(::testing::TempDir()) / "target.kdmt",
+                 link = fs::path(::testing::TempDir()) / "link.kdmt";
   fs::remove(target), fs::remove(link);
   { std::ofstream(target) << "old contents"; }
   fs::create_symlink(target, link);
@@ -519,7 +528,7 @@ TEST(TilesetFormatTest, AHeaderPastTheCapIsTooLargeNotDamaged) {
   const std::uint32_t fixed = 64, long_recipe = 2u << 20, version_size = get32(&file[52]);
   std::vector<std::uint8_t> big(file.begin(), file.begin() + fixed);  // the fixed header (format doc §2)
   put32(&big[12], fixed + long_recipe + version_size), put32(&big[48], long_recipe);
-  const std::string path = testing::TempDir() + "/long_recipe.kdmt";
+  const std::string path = ::testing::TempDir() + "/long_recipe.kdmt";
   {
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(big.data()), static_cast<std::streamsize>(big.size()));
@@ -627,17 +636,17 @@ TEST(TilesetAllocatorTest, TheTileSetsArraysGoThroughTheHook) {
 TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
   TilesetData loaded;
   std::string detail;
-  EXPECT_EQ(load_tileset(testing::TempDir(), loaded, &detail), Status::kIoError);
+  EXPECT_EQ(load_tileset(::testing::TempDir(), loaded, &detail), Status::kIoError);
   EXPECT_NE(detail.find("is a directory"), std::string::npos) << detail;
   Tileset handle;
-  EXPECT_EQ(Tileset::load_file(testing::TempDir(), handle), Status::kIoError);
+  EXPECT_EQ(Tileset::load_file(::testing::TempDir(), handle), Status::kIoError);
   if (std::ifstream("/dev/zero").good()) {
     EXPECT_EQ(load_tileset("/dev/zero", loaded), Status::kBadMagic);
   }
 
   std::vector<std::uint8_t> bytes;
   ASSERT_EQ(encode_tileset(make_tileset(), bytes), Status::kOk);
-  const std::string path = testing::TempDir() + "/cut.kdmt";
+  const std::string path = ::testing::TempDir() + "/cut.kdmt";
   auto load_bytes = [&](std::size_t size, const std::string& tail) {
     {
       std::ofstream f(path, std::ios::binary | std::ios::trunc);
@@ -673,7 +682,7 @@ TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
 TEST(TilesetFormatTest, EveryHeaderBitFlipInAFileIsJudgedAsInMemory) {
   const std::vector<std::uint8_t> bytes = encode(make_tileset());
   const std::uint32_t header_size = get32(&bytes[12]);
-  const std::string path = testing::TempDir() + "/flipped.kdmt";
+  const std::string path = ::testing::TempDir() + "/flipped.kdmt";
   for (std::size_t bit = 0; bit < header_size * 8; ++bit) {
     std::vector<std::uint8_t> damaged = bytes;
     damaged[bit / 8] ^= static_cast<std::uint8_t>(1u << (bit % 8));
@@ -698,6 +707,151 @@ TEST(TilesetFormatTest, EveryHeaderBitFlipInAFileIsJudgedAsInMemory) {
   std::string why;
   EXPECT_EQ(Tileset::load_file(path, handle, &why), Status::kHeaderChecksumMismatch) << why;
   std::remove(path.c_str());
+}
+
+// An engine's heap with a budget, as one that bounds what a set it did not bake may cost: it refuses a
+// request that would take its live bytes past the budget, and records what it was asked.
+struct BudgetHeap {
+  std::size_t budget = 0, live = 0, peak = 0, allocations = 0, frees = 0, largest_refused = 0;
+};
+void* budget_allocate(std::size_t bytes, std::size_t, void* user) {
+  auto* heap = static_cast<BudgetHeap*>(user);
+  if (bytes > heap->budget - heap->live) {
+    heap->largest_refused = std::max(heap->largest_refused, bytes);
+    return nullptr;
+  }
+  heap->live += bytes, heap->peak = std::max(heap->peak, heap->live), ++heap->allocations;
+  return std::malloc(bytes ? bytes : 1);
+}
+void budget_deallocate(void* p, std::size_t bytes, std::size_t, void* user) {
+  auto* heap = static_cast<BudgetHeap*>(user);
+  heap->live -= bytes, ++heap->frees;
+  std::free(p);
+}
+
+std::vector<std::uint8_t> shipped_set() {
+  std::ifstream in(std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt", std::ios::binary);
+  return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A decompression bomb: a valid header, both checksums right, and a zstd frame of `zeros` zero bytes
+// (streamed in, level 3 with level 19's 8 MiB window, as `zstd -19` writes a large input) where a set of one
+// tile needs a few hundred bytes.
+std::vector<std::uint8_t> decompression_bomb(std::uint64_t zeros) {
+  const std::unique_ptr<ZSTD_CCtx, std::size_t (*)(ZSTD_CCtx*)> z(ZSTD_createCCtx(), ZSTD_freeCCtx);
+  ZSTD_CCtx_setParameter(z.get(), ZSTD_c_compressionLevel, 3);
+  ZSTD_CCtx_setParameter(z.get(), ZSTD_c_windowLog, 23);
+  ZSTD_CCtx_setPledgedSrcSize(z.get(), zeros);  // the frame states its size, as the format requires
+  const std::vector<char> chunk(1 << 20, 0);
+  std::vector<std::uint8_t> payload, out(ZSTD_CStreamOutSize());
+  for (std::uint64_t left = zeros; left > 0;) {
+    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left, chunk.size()));
+    left -= n;
+    ZSTD_inBuffer in{chunk.data(), n, 0};
+    const ZSTD_EndDirective mode = left ? ZSTD_e_continue : ZSTD_e_end;
+    for (std::size_t pending = 1; in.pos < in.size || (mode == ZSTD_e_end && pending);) {
+      ZSTD_outBuffer o{out.data(), out.size(), 0};
+      pending = ZSTD_compressStream2(z.get(), &o, &in, mode);
+      EXPECT_FALSE(ZSTD_isError(pending));
+      if (ZSTD_isError(pending)) return {};
+      payload.insert(payload.end(), out.begin(), out.begin() + std::ptrdiff_t(o.pos));
+    }
+  }
+  return with_payload(encode(make_tileset(1, 2)), payload, zeros);
+}
+
+// The bomb is a 13 KB file that would decompress to 400 MiB. The loader reads the body as zstd
+// decompresses it, so the bomb costs zstd's window (its 8 MiB, through the tile-set allocator) and is
+// refused once the parser finds the tile set ends where 400 MiB of body go on; and a heap whose budget is
+// below the window is asked for it and refuses it: out of memory, nothing touched, nothing leaked.
+TEST(TilesetAllocatorTest, ADecompressionBombCostsItsWindowAndABudgetRefusesIt) {
+  const std::uint64_t body = 400ull << 20;
+  const std::vector<std::uint8_t> bomb = decompression_bomb(body);
+  ASSERT_GT(bomb.size(), 64u);
+  ASSERT_LT(bomb.size(), 64u << 10);
+  TilesetHeader header;
+  ASSERT_EQ(read_tileset_header(bomb.data(), bomb.size(), header), Status::kOk);
+  ASSERT_EQ(header.decompressed_bytes, body);
+  ZSTD_frameHeader frame;
+  ASSERT_EQ(ZSTD_getFrameHeader(&frame, bomb.data() + header.header_bytes, header.payload_bytes), 0u);
+  ASSERT_EQ(frame.frameContentSize, body);
+  const std::size_t window = static_cast<std::size_t>(frame.windowSize);
+  ASSERT_EQ(window, std::size_t(8) << 20);
+
+  BudgetHeap heap;
+  heap.budget = std::size_t(4) << 20;  // below the window
+  set_tileset_allocator({budget_allocate, budget_deallocate, &heap});
+  Tileset loaded;
+  std::string why;
+  EXPECT_EQ(Tileset::load_memory(bomb.data(), bomb.size(), loaded, &why), Status::kOutOfMemory) << why;
+  EXPECT_EQ(why, "payload: no memory to decompress it");
+  EXPECT_GE(heap.largest_refused, window);  // the decompression buffer was asked of the hook
+  EXPECT_LT(heap.largest_refused, window + (std::size_t(1) << 20));
+  EXPECT_EQ(heap.live, 0u);
+  EXPECT_EQ(heap.allocations, heap.frees);
+  EXPECT_TRUE(loaded.empty());
+  // The C API's hooks are the same ones, and so is its status.
+  kdm_tileset* handle = nullptr;
+  char detail[256] = "";
+  EXPECT_EQ(kdm_tileset_load_memory_detail(bomb.data(), bomb.size(), &handle, detail, sizeof detail),
+            KDM_OUT_OF_MEMORY);
+  EXPECT_EQ(handle, nullptr);
+  EXPECT_NE(std::strstr(detail, "no memory to decompress"), nullptr) << detail;
+  EXPECT_EQ(heap.live, 0u);
+
+  // A budget the shipped set loads in (with its file: kdm_runtime.h's figures) takes the bomb's window,
+  // and the bomb is refused for its content after a few chunks, not after 400 MiB.
+  heap = BudgetHeap{};
+  heap.budget = std::size_t(64) << 20;
+  const std::vector<std::uint8_t> shipped = shipped_set();
+  EXPECT_EQ(Tileset::load_memory(shipped.data(), shipped.size(), loaded), Status::kOk);
+  loaded = Tileset{};
+  heap.peak = 0;
+  EXPECT_EQ(Tileset::load_memory(bomb.data(), bomb.size(), loaded, &why), Status::kInvalidContent);
+  EXPECT_EQ(why, "payload: payload has bytes after the last tile");
+  EXPECT_GE(heap.peak, window);
+  EXPECT_LT(heap.peak, window + (std::size_t(1) << 20));
+  EXPECT_EQ(heap.live, 0u);
+  set_tileset_allocator({});
+
+  // Without hooks the same: operator new serves zstd, and is never asked for more than the window.
+  testing::reset_largest_allocation();
+  EXPECT_EQ(Tileset::load_memory(bomb.data(), bomb.size(), loaded), Status::kInvalidContent);
+  EXPECT_LT(testing::largest_allocation(), window + (std::size_t(1) << 20));
+}
+
+// What a load of the shipped set takes at its peak, all of it through the hooks but small things (texts,
+// a stream object): from memory the set's arrays and zstd's window while they fill, from its file the
+// file's bytes too (kdm_runtime.h and allocator.h give these figures).
+TEST(TilesetAllocatorTest, ALoadsSizeableAllocationsAllGoThroughTheHooks) {
+  const std::vector<std::uint8_t> shipped = shipped_set();
+  BudgetHeap heap;
+  heap.budget = ~std::size_t(0);
+  set_tileset_allocator({budget_allocate, budget_deallocate, &heap});
+  testing::reset_largest_allocation();
+  {
+    Tileset loaded;
+    ASSERT_EQ(Tileset::load_memory(shipped.data(), shipped.size(), loaded), Status::kOk);
+    const std::size_t set = heap.live;  // the loaded set's arrays
+    EXPECT_LT(testing::largest_allocation(), std::size_t(64) << 10);
+    const std::size_t window = std::size_t(8) << 20;  // the shipped set's frame's, zstd's buffer
+    EXPECT_GT(heap.peak, set);
+    EXPECT_LT(heap.peak, set + window);
+    std::printf("from memory: the set's arrays %zu bytes, peak through the hooks %zu\n", set, heap.peak);
+  }
+  EXPECT_EQ(heap.live, 0u);
+  heap.peak = 0;
+  {
+    Tileset loaded;
+    ASSERT_EQ(Tileset::load_file(std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt", loaded),
+              Status::kOk);
+    EXPECT_LT(testing::largest_allocation(), std::size_t(64) << 10);
+    EXPECT_GT(heap.peak, heap.live + shipped.size());
+    std::printf("from its file: peak through the hooks %zu\n", heap.peak);
+  }
+  EXPECT_EQ(heap.live, 0u);
+  EXPECT_EQ(heap.allocations, heap.frees);
+  set_tileset_allocator({});
 }
 
 // A hand-over onto 256 × 256 subtiles of a tile of 70,001 points names 4.6 × 10^9 sub-points, past 32

@@ -270,7 +270,8 @@ KDM_RUNTIME_API std::vector<std::vector<float>> coarsest_level_thresholds(const 
 /// Checks the structural invariants above (colour and level caps, tile count, level tables, nominal
 /// counts, one key per point, keys sorted within each level, keyframes increasing up to the top level,
 /// one glide offset pair per point present at each keyframe).
-/// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem.
+/// Returns kOk or kInvalidContent with `detail` (optional) naming the first problem; kOutOfMemory when the
+/// tile-set allocator refuses the hand-over check's scratch.
 KDM_RUNTIME_API Status validate_tileset(const TilesetData& set, std::string* detail = nullptr);
 
 /// The format version encode_tileset writes `set` in: the oldest that holds it, so that older readers keep
@@ -285,9 +286,12 @@ KDM_RUNTIME_API Status encode_tileset(const TilesetData& set, std::vector<std::u
                                       std::string* detail = nullptr);
 
 /// Decodes a tile set from `size` bytes at `data` (untrusted input: every size, count and checksum is
-/// checked before use; nothing is allocated beyond the caps). Returns kOk, read_tileset_header's
-/// statuses, kPayloadChecksumMismatch, kDecompressionFailed, kInvalidContent (validate_tileset's, or a
-/// payload that does not parse) or kOutOfMemory, with `detail` (optional). On failure `out` is left empty.
+/// checked before use; nothing is allocated beyond the caps). The body is parsed as zstd decompresses it,
+/// a chunk at a time, and never held whole: what a decode holds besides the set's arrays is zstd's window
+/// (the frame's, at most the body's size), all of it through the tile-set allocator (allocator.h).
+/// Returns kOk, read_tileset_header's statuses, kPayloadChecksumMismatch, kDecompressionFailed,
+/// kInvalidContent (validate_tileset's, or a payload that does not parse) or kOutOfMemory (the allocator
+/// refused a request), with `detail` (optional). On failure `out` is left empty.
 KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, TilesetData& out,
                                       std::string* detail = nullptr);
 
@@ -299,8 +303,8 @@ KDM_RUNTIME_API Status decode_tileset(const void* data, std::size_t size, Tilese
 KDM_RUNTIME_API Status read_tileset_file(const std::string& path, std::vector<char>& bytes,
                                          std::string* detail = nullptr);
 
-/// Reads (read_tileset_file) and decodes the file at `path`: read_tileset_file's and decode_tileset's
-/// statuses.
+/// Reads (read_tileset_file, into memory from the tile-set allocator) and decodes the file at `path`:
+/// read_tileset_file's and decode_tileset's statuses, and kOutOfMemory where the file's bytes are refused.
 KDM_RUNTIME_API Status load_tileset(const std::string& path, TilesetData& out, std::string* detail = nullptr);
 
 /// Whether a tile set can be saved at `path`: not a directory, and its temporary file (`path` + ".partial")
