@@ -185,7 +185,7 @@ kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
 
 static_assert(static_cast<int>(kdm::Status::kOutOfMemory) == KDM_OUT_OF_MEMORY, "one code for running out");
 static_assert(KDM_DENSITY_BATCH == kdm::kDensityBatch, "the C and C++ batch sizes agree");
-static_assert(static_cast<int>(kdm::QueryProblem::Kind::kTooFarFromOrigin) == KDM_PROBLEM_TOO_FAR_FROM_ORIGIN,
+static_assert(static_cast<int>(kdm::QueryProblem::Kind::kRunnerIncomplete) == KDM_PROBLEM_RUNNER_INCOMPLETE,
               "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
 
 // C's names for class k's density fields (kdm_class_density's, not kdm::QueryDensity's) and the joint
@@ -790,8 +790,11 @@ const char* kdm_problem_message(kdm_problem_kind kind) {
 
 size_t kdm_query_problem_describe(const kdm_query_problem* problem, char* text, size_t size) {
   kdm::QueryProblem p;
-  if (!problem || problem->struct_size < kProblemV1) {
+  if (!problem) {
     p.kind = kdm::QueryProblem::Kind::kMissingArgument, p.parameter = "problem";
+  } else if (problem->struct_size < kProblemV1) {  // as a short query.struct_size is told
+    p.kind = kdm::QueryProblem::Kind::kNotPositive, p.parameter = "problem.struct_size";
+    p.value = static_cast<double>(problem->struct_size), p.limit = static_cast<double>(kProblemV1);
   } else {
     p.kind = static_cast<kdm::QueryProblem::Kind>(static_cast<int>(problem->kind));
     p.parameter = problem->parameter ? problem->parameter : "";

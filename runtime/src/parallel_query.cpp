@@ -451,7 +451,11 @@ Status ParallelQuery::run_into(const Tileset& tileset, const QueryParams& q, con
     return Status::kInvalidArgument;
   }
   // A runner that returned without running its tasks left units unclaimed: an error, not an empty region.
-  if (job.next.load() < job.units) return refuse(QueryProblem::Kind::kMissingArgument, "runner.run");
+  if (const std::size_t taken = job.next.load(); taken < job.units) {
+    refuse(QueryProblem::Kind::kRunnerIncomplete, "runner.run");
+    p.value = double(taken), p.limit = double(job.units);
+    return Status::kInvalidArgument;
+  }
   const std::size_t total = job.end.load();
   if (written) *written = std::min(total, capacity);
   if (needed) *needed = total;

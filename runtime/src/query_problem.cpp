@@ -67,6 +67,8 @@ const char* query_problem_message(QueryProblem::Kind kind) {
     case QueryProblem::Kind::kTooFarFromOrigin:
       return "the region lies too far from the origin (the world's, or the query's for its output) for its "
              "points to keep their places";
+    case QueryProblem::Kind::kRunnerIncomplete:
+      return "a parallel query's task runner returned before its tasks had done the query";
   }
   return "unknown problem";
 }
@@ -114,10 +116,32 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
                    "from it, at most %.6g for this density and region; keep the world's coordinates nearer "
                    "its origin (move the origin), or ask for fewer points per unit area",
                    p.value, p.limit);
-    case QueryProblem::Kind::kNotPositive:  // the kind's text speaks of the C API's struct_size too
+    case QueryProblem::Kind::kNotPositive:  // a C struct's struct_size has a limit, its first version's size
+      if (p.limit > 0)
+        return print(text, size, "'%s' must be at least %.6g, got %.6g", shown, p.limit, p.value);
       return print(text, size, "'%s' must be > 0, got %.6g", shown, p.value);
     case QueryProblem::Kind::kNegative:
       return print(text, size, "'%s' must be >= 0, got %.6g", shown, p.value);
+    case QueryProblem::Kind::kKeysUnsupported:
+      return print(text, size, "%s: its tiles hold %.0f points, a key numbers at most %.0f; ask for no '%s'",
+                   query_problem_message(p.kind), p.value, p.limit, shown);
+    case QueryProblem::Kind::kBadDensity:
+      if (std::strcmp(parameter, "image_sums") == 0 && p.value > 0)  // built for another class count
+        return print(text, size, "'%s' holds the sums of %.6g classes, the query has %.6g", shown, p.limit,
+                     p.value);
+      break;
+    case QueryProblem::Kind::kMissingArgument:  // a null has no value to show
+      return print(text, size, "%s: '%s'", query_problem_message(p.kind), shown);
+    case QueryProblem::Kind::kRunnerIncomplete: {
+      const char* rule =
+          "a runner must call the tasks it is given and return once those it started have returned";
+      if (p.value == 0)
+        return print(text, size, "the task runner ('%s') returned without running any task: %s", shown, rule);
+      return print(text, size,
+                   "the task runner ('%s') returned before its tasks had done the query (%.6g of %.6g units "
+                   "taken): %s",
+                   shown, p.value, p.limit, rule);
+    }
     case QueryProblem::Kind::kNotFinite:
       if (!std::isfinite(p.value))  // the kind also covers places too far out for a finite value
         return print(text, size, "'%s' is not a finite number (%g)", shown, p.value);

@@ -173,12 +173,18 @@ int main(void) {
   CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "parallel") == 0);
   CHECK(kdm_parallel_query_compact(parallel, NULL, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==
         KDM_INVALID_ARGUMENT);
-  CHECK(strcmp(problem.parameter, "runner.run") == 0);
+  CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "runner.run") == 0);
   { /* a runner that returns without running its tasks: an error, not an empty region */
     const kdm_task_runner idle = {run_nothing, NULL};
     CHECK(kdm_parallel_query_compact(parallel, &idle, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==
           KDM_INVALID_ARGUMENT);
-    CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "runner.run") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_RUNNER_INCOMPLETE && strcmp(problem.parameter, "runner.run") == 0);
+    CHECK(problem.value == 0 && problem.limit >= 1);
+    {
+      char line[300];
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      CHECK(strstr(line, "returned without running any task") && !strstr(line, "null"));
+    }
   }
   q.scale = -1;
   CHECK(kdm_parallel_query_compact(parallel, &in_turn, builtin, &q, xy[0], NULL, 16, &n[0], NULL, &problem) ==

@@ -306,14 +306,36 @@ int main(int argc, char** argv) {
       const size_t length = kdm_query_problem_describe(&problem, line, sizeof line);
       CHECK(length == strlen(line) && strstr(line, "100000 points per tile") &&
             strstr(line, "at most 32768") && strstr(line, "use scale 32768 or less, or tile_size 0.572433"));
-      CHECK(kdm_query_problem_describe(&problem, cut, sizeof cut) == length && strlen(cut) == sizeof cut - 1 &&
-            strncmp(cut, line, sizeof cut - 1) == 0);
+      CHECK(kdm_query_problem_describe(&problem, cut, sizeof cut) == length &&
+            strlen(cut) == sizeof cut - 1 && strncmp(cut, line, sizeof cut - 1) == 0);
       CHECK(kdm_query_problem_describe(&problem, NULL, 0) == length);
       CHECK(kdm_query_problem_describe(NULL, line, sizeof line) > 0 && strstr(line, "'problem'"));
     }
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
-    CHECK(strcmp(problem.parameter, "query.struct_size") == 0);
+    CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && strcmp(problem.parameter, "query.struct_size") == 0);
+    CHECK(problem.value == offsetof(kdm_query, mode) - 8 && problem.limit == offsetof(kdm_query, mode));
+    {
+      /* Said with its limit, the first version's size, not as "must be > 0". */
+      char line[200], expected[200];
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      snprintf(expected, sizeof expected, "'query.struct_size' must be at least %zu, got %zu",
+               offsetof(kdm_query, mode), offsetof(kdm_query, mode) - 8);
+      CHECK(strcmp(line, expected) == 0);
+      q.struct_size = 8;
+      CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      snprintf(expected, sizeof expected, "'query.struct_size' must be at least %zu, got 8",
+               offsetof(kdm_query, mode));
+      CHECK(strcmp(line, expected) == 0);
+      /* A problem struct too short to be read is told the same way. */
+      kdm_query_problem short_problem = problem;
+      short_problem.struct_size = 8;
+      kdm_query_problem_describe(&short_problem, line, sizeof line);
+      snprintf(expected, sizeof expected, "'problem.struct_size' must be at least %zu, got 8",
+               sizeof(kdm_query_problem));
+      CHECK(strcmp(line, expected) == 0);
+    }
     q = uniform_query();
     q.x0 = 1e15, q.x1 = 1e15 + 1; /* a double's step there is 1/8: points would fall together */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);

@@ -204,6 +204,9 @@ TEST(ClassImageSumsTest, BadInputIsRefusedByName) {
   EXPECT_STREQ(problem.parameter, "image_sums");
   EXPECT_EQ(problem.value, 2);  // the classes asked, and those the sums were built for
   EXPECT_EQ(problem.limit, 3);
+  char line[200];
+  describe_query_problem(problem, line, sizeof line);
+  EXPECT_STREQ(line, "'image_sums' holds the sums of 3 classes, the query has 2");
   q.class_count = 3;
   q.joint.densities = [](void*, double, double, double* v) { v[0] = v[1] = v[2] = 1; };
   EXPECT_EQ(query_classes(Tileset::builtin(), q, out.data(), cls, 16, &written, nullptr, &problem),

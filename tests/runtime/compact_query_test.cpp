@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "allocation_counter.h"
@@ -343,6 +345,14 @@ TEST(CompactQueryTest, RefusesKeysForTilesTooLargeToNumber) {
   EXPECT_EQ(why.kind, QueryProblem::Kind::kKeysUnsupported);
   EXPECT_STREQ(why.parameter, "out.keys");
   EXPECT_EQ(why.value, double(count));
+  char line[300];  // the count and the limit, not the count as if it were the keys' value
+  describe_query_problem(why, line, sizeof line);
+  EXPECT_NE(
+      std::strstr(line, (": its tiles hold " + std::to_string(count) + " points, a key numbers at most " +
+                         std::to_string(std::uint64_t(why.limit)) + "; ask for no 'out.keys'")
+                            .c_str()),
+      nullptr)
+      << line;
   // Positions alone need no key.
   EXPECT_EQ(query_points_compact(large, q, {xy.data(), nullptr}, 256, &written, &cursor, &why), Status::kOk);
   EXPECT_GT(written, 50u);

@@ -247,6 +247,21 @@ TEST(ParallelQueryTest, RefusesByName) {
   EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, TaskRunner{}, nullptr, &why),
             Status::kInvalidArgument);
   EXPECT_STREQ(why.parameter, "runner.run");
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kMissingArgument);
+  // A runner that returns without running a task: said as what happened, not as a null argument.
+  TaskRunner idle;
+  idle.run = [](void*, void (*)(void*, std::size_t), void*, std::size_t) {};
+  EXPECT_EQ(pq.run(Tileset::builtin(), q, out.data(), 16, &written, idle, nullptr, &why),
+            Status::kInvalidArgument);
+  EXPECT_EQ(why.kind, QueryProblem::Kind::kRunnerIncomplete);
+  EXPECT_STREQ(why.parameter, "runner.run");
+  EXPECT_EQ(why.value, 0);
+  EXPECT_GE(why.limit, 1);  // the units it left
+  char line[300];
+  describe_query_problem(why, line, sizeof line);
+  EXPECT_NE(std::strstr(line, "the task runner ('runner.run') returned without running any task"), nullptr)
+      << line;
+  EXPECT_EQ(std::strstr(line, "null"), nullptr) << line;
   EXPECT_EQ(pq.run(Tileset::builtin(), q, static_cast<QueryPoint*>(nullptr), 16, &written,
                    sequential_runner(), nullptr, &why),
             Status::kInvalidArgument);

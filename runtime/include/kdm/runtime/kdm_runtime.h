@@ -125,9 +125,8 @@ typedef struct kdm_cursor {
 /* Why kdm_query_points returned KDM_INVALID_ARGUMENT (mirrors kdm::QueryProblem). */
 typedef enum kdm_problem_kind {
   KDM_PROBLEM_NONE = 0,
-  KDM_PROBLEM_MISSING_ARGUMENT =
-      1,                      /* `parameter` is NULL (or the tile set is empty; "runner.run": ran no task) */
-  KDM_PROBLEM_NOT_FINITE = 2, /* `parameter` is NaN or infinite; `value` holds it */
+  KDM_PROBLEM_MISSING_ARGUMENT = 1,  /* `parameter` is NULL (or the tile set is empty) */
+  KDM_PROBLEM_NOT_FINITE = 2,        /* `parameter` is NaN or infinite; `value` holds it */
   KDM_PROBLEM_NOT_POSITIVE = 3,      /* `parameter` must be > 0 ("query.struct_size": at least `limit`) */
   KDM_PROBLEM_NEGATIVE = 4,          /* `parameter` must be >= 0 */
   KDM_PROBLEM_BAD_DENSITY = 5,       /* the density image or callback is missing, or both callbacks are set */
@@ -139,10 +138,13 @@ typedef enum kdm_problem_kind {
   KDM_PROBLEM_BAD_CLASS_COUNT = 10,  /* kdm_query_classes: `value` classes, not 1 ... KDM_MAX_CLASSES */
   KDM_PROBLEM_KEYS_UNSUPPORTED = 11, /* kdm_query_compact: keys asked of a set whose tiles hold `value`
                                         points, more than a key's ranks (`limit`) */
-  KDM_PROBLEM_TOO_FAR_FROM_ORIGIN = 12 /* the region lies `value` from the world origin ("x0", "y0"),
-                                          farther than `limit`, where doubles cannot place its points; or
-                                          from the query's origin ("origin_x", "origin_y"), where the
-                                          output's doubles or floats cannot keep its densest points apart */
+  KDM_PROBLEM_TOO_FAR_FROM_ORIGIN = 12, /* the region lies `value` from the world origin ("x0", "y0"),
+                                           farther than `limit`, where doubles cannot place its points; or
+                                           from the query's origin ("origin_x", "origin_y"), where the
+                                           output's doubles or floats cannot keep its densest points apart */
+  KDM_PROBLEM_RUNNER_INCOMPLETE = 13    /* a parallel query's runner ("runner.run") returned before its tasks
+                                           had done the query: `value` of its `limit` units were taken (0: it
+                                           ran no task). Added in 0.5 */
 } kdm_problem_kind;
 
 typedef struct kdm_query_problem {
@@ -437,8 +439,9 @@ KDM_RUNTIME_API void kdm_parallel_query_free(kdm_parallel_query* parallel);
  * (if not NULL) the count: KDM_OK when all fit; KDM_BUFFER_FULL when there were more (out holds the first
  * `capacity`, *needed, if not NULL, the full count: call again with room for it; capacity 0 and a NULL out
  * only count; with `needed` NULL the run stops soon after the buffer is full); KDM_INVALID_ARGUMENT as
- * kdm_query_points refuses the query, or for a NULL parallel query
- * ("parallel") or runner or runner->run ("runner.run"). Allocates nothing. */
+ * kdm_query_points refuses the query, for a NULL parallel query ("parallel") or runner or runner->run
+ * ("runner.run", KDM_PROBLEM_MISSING_ARGUMENT), or a runner that returned before its tasks had done the
+ * query (KDM_PROBLEM_RUNNER_INCOMPLETE). Allocates nothing. */
 KDM_RUNTIME_API kdm_status kdm_parallel_query_points(kdm_parallel_query* parallel,
                                                      const kdm_task_runner* runner,
                                                      const kdm_tileset* tileset, const kdm_query* query,

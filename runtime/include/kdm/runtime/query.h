@@ -161,10 +161,10 @@ struct QueryCursor {
 struct QueryProblem {
   enum class Kind : int {
     kNone = 0,          ///< no problem
-    kMissingArgument,   ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty (a
-                        ///< parallel query's "runner.run": or it returned without running its tasks)
+    kMissingArgument,   ///< `parameter` ("written", "cursor", "out", "tileset") is null or empty
     kNotFinite,         ///< `parameter` is NaN or infinite; `value` holds it
-    kNotPositive,       ///< `parameter` ("tile_size") must be > 0; `value` holds it
+    kNotPositive,       ///< `parameter` ("tile_size") must be > 0; `value` holds it (a C struct's
+                        ///< "query.struct_size": at least `limit`, its first version's size)
     kNegative,          ///< `parameter` ("scale", "density.constant", "density.callback_max") must be
                         ///< >= 0; `value` holds it
     kBadDensity,        ///< `parameter` ("density.image", "density.callback") is missing or not prepared,
@@ -191,6 +191,8 @@ struct QueryProblem {
                         ///< step (a double's, or a compact output's float) is over a 16th (a float's: a
                         ///< quarter) of the densest points' spacing, or a float's reaches a tile: set
                         ///< the origin nearer the region
+    kRunnerIncomplete,  ///< a parallel query's task runner ("runner.run") returned before its tasks had
+                        ///< done the query: `value` of its `limit` units were taken (0: it ran no task)
   };
   Kind kind = Kind::kNone;
   const char* parameter = "";    ///< the QueryParams field (or argument) at fault; static storage
