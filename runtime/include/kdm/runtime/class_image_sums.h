@@ -18,7 +18,12 @@ namespace kdm {
 /// with its mips. Set ClassQueryParams::image_sums to it: the class query then runs as the one-class
 /// query at sum(count - 1) runs (exactly that query's points, in stable mode classes 0 … k together
 /// exactly the one-class query at sum(k)), where classes given image by image read every image at every
-/// candidate. Built once, shared read-only; it owns its texels, so it moves but does not copy.
+/// candidate. Against those, which sum the images' values in double, stable mode emits the same points
+/// (their classes too, but for a threshold within rounding of a density); smooth mode the same ids at
+/// positions that may differ in their last bits, under 3 · 10^-7 of a tile side (at most 1.5 · 10^-7 measured
+/// over 11 million points, tile sides 0.25 to 4, 4 to 4 · 10^5 points per tile; most at 10 to 200, where a
+/// glide is fastest against the count). Built once, shared read-only; it owns its texels, so it moves but
+/// does not copy.
 class KDM_RUNTIME_API ClassImageSums {
  public:
   ClassImageSums() = default;

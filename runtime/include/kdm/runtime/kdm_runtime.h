@@ -382,7 +382,9 @@ KDM_RUNTIME_API kdm_status kdm_query_classes_joint_compact(const kdm_tileset* ti
  * range, images on different grids, or a sum that overflows a float; KDM_OUT_OF_MEMORY. The images may be
  * freed once it is built. kdm_query_classes given the same images sums their bilinear values in double
  * at every candidate instead: stable mode emits the same points, smooth mode the same ids at positions that
- * may differ in their last bits (about 10^-8 of a tile side). `kdm query --class` uses these sums when every
+ * may differ in their last bits: under 3 * 10^-7 of a tile side (at most 1.5 * 10^-7 measured over 11 million
+ * points, tile sides 0.25 to 4, 4 to 4 * 10^5 points per tile; most at 10 to 200, where a glide is fastest
+ * against the count; ClassImageSumsTest checks). `kdm query --class` uses these sums when every
  * class is an image, all of one size, holding at most 2^20 texels in all. Free it with
  * kdm_class_images_free. Added in 0.4. */
 typedef struct kdm_class_images kdm_class_images;
