@@ -86,6 +86,38 @@ TEST(MultiClassTest, VaryingDensitiesSplitByTheirIntegrals) {
   EXPECT_NEAR(mean / double(c.size() / 2), 1.0 / 3, 0.03);
 }
 
+// Classes with batch functions (alone, or beside a function and a constant) give the same points as the
+// same classes read node by node: the class means and summed densities read through the batches.
+TEST(MultiClassTest, BatchDensitiesGiveTheSameBitsAsTheirFunctions) {
+  const DensityFunction ramp = [](const double* u) { return 0.1 + u[0] * u[1]; };
+  const DensityFunction wave = [](const double* u) { return 1.1 + std::sin(7 * u[0]); };
+  int batch_calls = 0;
+  const auto batched = [&](const DensityFunction& f) {
+    Density d;
+    d.function = f;
+    d.batch = [f, &batch_calls](const double* u, std::size_t count, double* out) {
+      ++batch_calls;
+      for (std::size_t i = 0; i < count; ++i) out[i] = f(u + 2 * i);
+    };
+    return d;
+  };
+  Density plain_ramp, plain_wave;
+  plain_ramp.function = ramp, plain_wave.function = wave;
+  SamplerOptions o;
+  o.n = 3000;
+  o.seed = 4;
+  o.domain = Domain::kBox;
+  const ClassSample a = sample_classes(o, {plain_ramp, plain_wave, Density::constant(0.5)});
+  const ClassSample b = sample_classes(o, {batched(ramp), plain_wave, Density::constant(0.5)});
+  const ClassSample c = sample_classes(o, {batched(ramp), batched(wave), Density::constant(0.5)});
+  EXPECT_GT(batch_calls, 0);
+  EXPECT_EQ(a.counts, b.counts);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.classes, b.classes);
+  EXPECT_EQ(a.points, c.points);
+  EXPECT_EQ(a.classes, c.classes);
+}
+
 TEST(MultiClassTest, BadInputIsRefused) {
   SamplerOptions o;
   o.n = 100;

@@ -382,6 +382,105 @@ TEST(SamplerTest, DensitySamplingOnThreadsKeepsItsErrorsAndItsContract) {
   EXPECT_EQ(most.load(), 1);
 }
 
+/// `f` as a batch density: its function, and a batch that calls it at each position of a run, counting
+/// the runs and the positions read.
+struct Batched {
+  Density density;
+  std::shared_ptr<std::int64_t> calls = std::make_shared<std::int64_t>(0),
+                                positions = std::make_shared<std::int64_t>(0);
+  Batched(const DensityFunction& f, int dim) {
+    density.function = f;
+    density.batch = [f, dim, calls = calls, positions = positions](const double* u, std::size_t count,
+                                                                   double* out) {
+      ++*calls, *positions += std::int64_t(count);
+      EXPECT_LE(count, kDensityBatch);
+      for (std::size_t i = 0; i < count; ++i) out[i] = f(u + i * dim);
+    };
+  }
+};
+
+// A batch density reads the same positions as its function node by node and gives the same points bit for
+// bit, in 2D and 3D, with subsamples per node, in runs of up to kDensityBatch positions.
+TEST(SamplerTest, BatchDensitiesGiveTheSameBitsAsTheirFunction) {
+  const auto density_in = [](int dim) -> DensityFunction {
+    return [dim](const double* u) {
+      return 0.2 + u[0] * u[0] + 0.5 * std::sin(5 * u[1]) * std::sin(5 * u[1]) + (dim == 3 ? u[2] : 0.0);
+    };
+  };
+  struct Case {
+    int dim;
+    std::int64_t n;
+    int native;  // > the finest grid: subsamples per node
+  };
+  for (const Case c : {Case{2, 6000, 0}, Case{2, 300, 400}, Case{3, 3000, 0}}) {
+    const DensityFunction f = density_in(c.dim);
+    SamplerOptions o = options_for(c.n, Domain::kBox, 5);
+    o.dim = c.dim;
+    o.threads = 2;
+    std::int64_t per_node_calls = 0;
+    Density per_node;
+    per_node.function = [&](const double* u) {
+      ++per_node_calls;
+      return f(u);
+    };
+    Batched batched(f, c.dim);
+    for (int k = 0; k < c.dim; ++k)
+      per_node.native_resolution[k] = batched.density.native_resolution[k] = c.native;
+    const SampleResult a = sample(o, per_node), b = sample(o, batched.density);
+    const std::string what = std::to_string(c.dim) + "D, n = " + std::to_string(c.n);
+    EXPECT_EQ(a.points, b.points) << what;
+    EXPECT_EQ(*batched.positions, per_node_calls) << what;
+    std::int64_t nodes = 0;  // the grids read: the probe's, then at least the finest
+    for (const LevelReport& level : b.report.levels)
+      nodes = std::max<std::int64_t>(
+          nodes, std::int64_t(level.grid[0]) * level.grid[1] * (c.dim == 3 ? level.grid[2] : 1));
+    EXPECT_GE(*batched.calls, 2) << what;
+    // Full runs of whole nodes, and one shorter run per grid read (the probe, then a few tries at most).
+    EXPECT_LE(*batched.calls, *batched.positions / std::int64_t(kDensityBatch / 2) + 8) << what;
+    EXPECT_GE(*batched.positions, nodes) << what;
+    if (c.native) {
+      EXPECT_GT(*batched.positions, nodes + 4096) << what << ": no subsamples";
+    }
+  }
+}
+
+// A bad value in a batch is refused naming the first bad node's position, in the words of a function's
+// refusal; a batch without its function is refused.
+TEST(SamplerTest, BatchDensitiesRefuseBadValuesByPosition) {
+  const SamplerOptions o = options_for(20000, Domain::kBox, 2);
+  for (const double bad : {std::nan(""), -1.0}) {
+    const DensityFunction holes = [bad](const double* u) {
+      const bool low = u[0] > 0.7 && u[1] > 0.2 && u[1] < 0.25, high = u[0] < 0.1 && u[1] > 0.8;
+      return low || high ? bad : 1.0;
+    };
+    std::string per_node, batch;
+    Density d;
+    d.function = holes;
+    try {
+      sample(o, d);
+    } catch (const InvalidArgument& e) {
+      per_node = e.what();
+    }
+    try {
+      sample(o, Batched(holes, 2).density);
+    } catch (const InvalidArgument& e) {
+      batch = e.what();
+    }
+    EXPECT_EQ(batch, per_node);
+    EXPECT_NE(batch.find(std::isnan(bad) ? "density is not finite at (0.7" : "density is negative at (0.7"),
+              std::string::npos)
+        << batch;
+  }
+  Density alone = Batched([](const double*) { return 1.0; }, 2).density;
+  alone.function = nullptr;
+  try {
+    sample(o, alone);
+    ADD_FAILURE() << "a batch without its function was taken";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("batch function needs its function"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SamplerTest, MoreThanTheGridCanHoldIsRefusedByName) {
   // 1000 points need about 16 grid nodes each (kernel mass / peak density), far over a 4096-node limit;
   // the guard must fire before anything of that size is allocated, and say which limit it hit.

@@ -10,7 +10,7 @@ namespace kdm::gen {
 namespace {
 
 /// The mean of `density` over the unit domain: an image's mean value, a function's mean over a grid of
-/// 256² (2D) or 64³ (3D) midpoints, 1 for a constant.
+/// 256² (2D) or 64³ (3D) midpoints (through its batch function when it has one), 1 for a constant.
 double mean_of(const Density& density, int dim) {
   if (density.image) {
     double sum = 0;
@@ -19,16 +19,27 @@ double mean_of(const Density& density, int dim) {
   }
   if (!density.function) return 1;
   const int side = dim == 2 ? 256 : 64;
-  double sum = 0, u[3] = {0, 0, 0};
-  std::int64_t count = 0;
+  const std::size_t count = std::size_t(side) * side * (dim == 3 ? side : 1);
+  std::vector<double> u, values(count);
+  if (density.batch) u.reserve(count * std::size_t(dim));
+  double at[3] = {0, 0, 0};
+  std::size_t i = 0;
   for (int z = 0; z < (dim == 3 ? side : 1); ++z)
     for (int y = 0; y < side; ++y)
-      for (int x = 0; x < side; ++x) {
-        u[0] = (x + 0.5) / side, u[1] = (y + 0.5) / side, u[2] = (z + 0.5) / side;
-        const double v = density.function(u);
-        if (!std::isfinite(v) || v < 0) throw InvalidArgument("a class's density is negative or not finite");
-        sum += v, ++count;
+      for (int x = 0; x < side; ++x, ++i) {
+        at[0] = (x + 0.5) / side, at[1] = (y + 0.5) / side, at[2] = (z + 0.5) / side;
+        if (density.batch)
+          u.insert(u.end(), at, at + dim);
+        else
+          values[i] = density.function(at);
       }
+  for (std::size_t first = 0; density.batch && first < count; first += kDensityBatch)
+    density.batch(&u[first * std::size_t(dim)], std::min(kDensityBatch, count - first), &values[first]);
+  double sum = 0;
+  for (double v : values) {
+    if (!std::isfinite(v) || v < 0) throw InvalidArgument("a class's density is negative or not finite");
+    sum += v;
+  }
   return sum / double(count);
 }
 
@@ -60,7 +71,7 @@ std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std:
   return counts;
 }
 
-Density sum_of_densities(const std::vector<Density>& densities) {
+Density sum_of_densities(const std::vector<Density>& densities, int dim) {
   bool all_constant = true, images = true;
   int width = 0, height = 0;
   for (const Density& d : densities) {
@@ -89,6 +100,23 @@ Density sum_of_densities(const std::vector<Density>& densities) {
     for (const Density& d : *parts) s += d.function ? d.function(u) : 1.0;
     return s;
   };
+  const bool batch =
+      std::any_of(densities.begin(), densities.end(), [](const Density& d) { return bool(d.batch); });
+  if (!batch) return sum;
+  // Each part's batch, or its function at each position: the same sums, added in the same order.
+  sum.thread_safe = false;  // read through the batch on one thread anyway
+  sum.batch = [parts, dim](const double* u, std::size_t count, double* out) {
+    std::fill(out, out + count, 0.0);
+    std::vector<double> values(count);
+    for (const Density& d : *parts) {
+      if (d.batch)
+        d.batch(u, count, values.data());
+      else
+        for (std::size_t i = 0; i < count; ++i)
+          values[i] = d.function ? d.function(u + i * std::size_t(dim)) : 1.0;
+      for (std::size_t i = 0; i < count; ++i) out[i] += values[i];
+    }
+  };
   return sum;
 }
 
@@ -116,7 +144,7 @@ ClassSample sample_classes(const SamplerOptions& options, const std::vector<Dens
       o.progress = [&options, k, total = densities.size()](double f) {
         options.progress((double(k) + f) / double(total));
       };
-    SampleResult r = sample(o, prefix.size() == 1 ? prefix.front() : sum_of_densities(prefix));
+    SampleResult r = sample(o, prefix.size() == 1 ? prefix.front() : sum_of_densities(prefix, options.dim));
     result.points.insert(result.points.end(), r.points.begin(), r.points.end());
     result.classes.insert(result.classes.end(), r.size(), static_cast<std::uint8_t>(k));
     result.reports.push_back(std::move(r.report));
@@ -129,7 +157,7 @@ ClassSample sample_classes(const SamplerOptions& options, const std::vector<Dens
     o.sweeps = union_sweeps;
     o.burn_in_sweeps = 0;
     o.progress = nullptr;
-    SampleResult r = sample(o, sum_of_densities(densities));
+    SampleResult r = sample(o, sum_of_densities(densities, options.dim));
     result.points = std::move(r.points);
     result.reports.push_back(std::move(r.report));
   }

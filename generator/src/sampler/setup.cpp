@@ -61,8 +61,9 @@ inline double volume_value(const DensityVolume& v, const PixelLerp& x, const Pix
 }
 
 /// Samples the density at every node of `grid` (averaging supersamples where the source is finer), on up
-/// to `threads` threads when the density may be called concurrently. Throws InvalidArgument naming the
-/// first node (in storage order) where the density is not finite or negative, whatever the thread count.
+/// to `threads` threads when the density may be called concurrently, or through Density::batch (one
+/// thread). Throws InvalidArgument naming the first node (in storage order) where the density is not
+/// finite or negative, whatever the thread count.
 template <int D>
 std::vector<float> sample_function(const Grid<D>& grid, const Density& density, int threads) {
   std::vector<float> rho = vector_on_huge_pages<float>(static_cast<std::size_t>(grid.size()), 0.0f);
@@ -72,49 +73,89 @@ std::vector<float> sample_function(const Grid<D>& grid, const Density& density, 
     sub[k] = std::clamp((density.native_resolution[k] + grid.dims[k] - 1) / std::max(1, grid.dims[k]), 1, 8);
     subsamples *= sub[k];
   }
-  // Rows along the first axis, cut into one stretch per part; each part stops at its first bad node.
-  const std::int64_t rows = grid.size() / grid.dims[0];
-  const int parts = density.thread_safe && grid.size() >= (1 << 16) ? std::max(1, threads) : 1;
-  std::vector<std::int64_t> bad_node(static_cast<std::size_t>(parts), grid.size());
-  std::vector<std::string> bad_message(static_cast<std::size_t>(parts));
-  std::vector<double> part_peak(static_cast<std::size_t>(parts), 0.0);
-  for_each_part(parts, parts > 1, [&](int part, int) {
-    for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
-      std::array<int, D> node{};
-      std::int64_t higher_axes = row;
-      for (int k = 1; k < D; ++k) {
-        node[k] = static_cast<int>(higher_axes % grid.dims[k]);
-        higher_axes /= grid.dims[k];
+  // Subsample s of `node`: the one formula of both paths below, so they read the same positions.
+  const auto position = [&](const std::array<int, D>& node, int s, double* u) {
+    int rest = s;
+    for (int k = 0; k < D; ++k) {
+      const int j = rest % sub[k];
+      rest /= sub[k];
+      u[k] = (node[k] + (j + 0.5) / sub[k]) / grid.dims[k];
+    }
+  };
+  // The node of `row` (all axes but the first) and column x.
+  const auto node_at = [&](std::int64_t row, int x) {
+    std::array<int, D> node{};
+    node[0] = x;
+    for (int k = 1; k < D; ++k) {
+      node[k] = static_cast<int>(row % grid.dims[k]);
+      row /= grid.dims[k];
+    }
+    return node;
+  };
+  const auto refusal = [](double v, const double* u) {
+    return std::string(std::isfinite(v) ? "density is negative at " : "density is not finite at ") +
+           format_position<D>(u);
+  };
+  double peak = 0;
+  if (density.batch) {
+    // Runs of whole nodes, kDensityBatch positions at most (a node has at most 8^3 subsamples).
+    const std::int64_t run = std::int64_t(kDensityBatch) / subsamples;
+    std::vector<double> u(static_cast<std::size_t>(run * subsamples * D));
+    std::vector<double> values(static_cast<std::size_t>(run * subsamples));
+    for (std::int64_t first = 0; first < grid.size(); first += run) {
+      const std::int64_t nodes = std::min(run, grid.size() - first);
+      for (std::int64_t i = 0; i < nodes; ++i) {
+        const std::array<int, D> node =
+            node_at((first + i) / grid.dims[0], static_cast<int>((first + i) % grid.dims[0]));
+        for (int s = 0; s < subsamples; ++s)
+          position(node, s, &u[static_cast<std::size_t>((i * subsamples + s) * D)]);
       }
-      for (node[0] = 0; node[0] < grid.dims[0]; ++node[0]) {
+      density.batch(u.data(), static_cast<std::size_t>(nodes * subsamples), values.data());
+      for (std::int64_t i = 0; i < nodes; ++i) {
         double sum = 0;
         for (int s = 0; s < subsamples; ++s) {
-          double u[3] = {0, 0, 0};
-          int rest = s;
-          for (int k = 0; k < D; ++k) {
-            const int j = rest % sub[k];
-            rest /= sub[k];
-            u[k] = (node[k] + (j + 0.5) / sub[k]) / grid.dims[k];
-          }
-          const double v = density.function(u);
-          if (!std::isfinite(v) || v < 0) {
-            bad_node[part] = row * grid.dims[0] + node[0];
-            bad_message[part] =
-                std::string(std::isfinite(v) ? "density is negative at " : "density is not finite at ") +
-                format_position<D>(u);
-            return;
-          }
+          const std::size_t at = static_cast<std::size_t>(i * subsamples + s);
+          const double v = values[at];
+          if (!std::isfinite(v) || v < 0) throw InvalidArgument(refusal(v, &u[at * D]));
           sum += v;
         }
-        part_peak[part] = std::max(part_peak[part], sum / subsamples);
-        rho[static_cast<std::size_t>(row * grid.dims[0] + node[0])] = static_cast<float>(sum / subsamples);
+        peak = std::max(peak, sum / subsamples);
+        rho[static_cast<std::size_t>(first + i)] = static_cast<float>(sum / subsamples);
       }
     }
-  });
-  const auto first_bad = std::min_element(bad_node.begin(), bad_node.end());
-  if (*first_bad < grid.size()) throw InvalidArgument(bad_message[first_bad - bad_node.begin()]);
+  } else {
+    // Rows along the first axis, cut into one stretch per part; each part stops at its first bad node.
+    const std::int64_t rows = grid.size() / grid.dims[0];
+    const int parts = density.thread_safe && grid.size() >= (1 << 16) ? std::max(1, threads) : 1;
+    std::vector<std::int64_t> bad_node(static_cast<std::size_t>(parts), grid.size());
+    std::vector<std::string> bad_message(static_cast<std::size_t>(parts));
+    std::vector<double> part_peak(static_cast<std::size_t>(parts), 0.0);
+    for_each_part(parts, parts > 1, [&](int part, int) {
+      for (std::int64_t row = rows * part / parts; row < rows * (part + 1) / parts; ++row) {
+        for (int x = 0; x < grid.dims[0]; ++x) {
+          const std::array<int, D> node = node_at(row, x);
+          double sum = 0;
+          for (int s = 0; s < subsamples; ++s) {
+            double u[3] = {0, 0, 0};
+            position(node, s, u);
+            const double v = density.function(u);
+            if (!std::isfinite(v) || v < 0) {
+              bad_node[part] = row * grid.dims[0] + x;
+              bad_message[part] = refusal(v, u);
+              return;
+            }
+            sum += v;
+          }
+          part_peak[part] = std::max(part_peak[part], sum / subsamples);
+          rho[static_cast<std::size_t>(row * grid.dims[0] + x)] = static_cast<float>(sum / subsamples);
+        }
+      }
+    });
+    const auto first_bad = std::min_element(bad_node.begin(), bad_node.end());
+    if (*first_bad < grid.size()) throw InvalidArgument(bad_message[first_bad - bad_node.begin()]);
+    peak = *std::max_element(part_peak.begin(), part_peak.end());
+  }
   // Nodes keep floats: a density far outside their range would become infinite or zero.
-  const double peak = *std::max_element(part_peak.begin(), part_peak.end());
   if (peak > kMaxDensityValue || (peak > 0 && peak < kMinDensityPeak)) {
     char text[200];
     std::snprintf(text, sizeof text,
@@ -302,6 +343,9 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     throw InvalidArgument("a volume density (from_volume) is 3D: sample it with dim 3");
   if (density.volume && !density.function)
     throw InvalidArgument("a volume density needs its function (from_volume sets it)");
+  if (density.batch && !density.function)
+    throw InvalidArgument(
+        "a density's batch function needs its function too (the same density point by point)");
   for (int k = 0; k < 3; ++k)
     if (density.native_resolution[k] < 0)
       throw InvalidArgument("density native_resolution must be >= 0 (0: unknown), got " +

@@ -36,8 +36,8 @@ std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std:
                                        std::int64_t n);
 
 /// The sum of densities (an image when all of them are images of one size or constants, else a function
-/// calling each).
-Density sum_of_densities(const std::vector<Density>& densities);
+/// calling each, with a batch function when any of them has one: positions of `dim` coordinates, 2 or 3).
+Density sum_of_densities(const std::vector<Density>& densities, int dim = 2);
 
 /// Samples options.n points (> 0) in 1 … 8 classes of `densities` (highest priority first), each class's
 /// count from class_counts, every run seeded from options.seed and the class, then `union_sweeps` MH

@@ -6,6 +6,7 @@
 // `threads` worker threads of its own.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -33,6 +34,15 @@ enum class Domain { kTorus, kBox };
 /// exception it throws ends sample() with that exception.
 using DensityFunction = std::function<double(const double* u)>;
 
+/// The same density at `count` positions in one call: u holds them one after another, dim coordinates each
+/// (x, y[, z] of the first, then the second's: no third one in 2D), and out receives their `count` values,
+/// each what DensityFunction gives at that position. For a density whose calls cost more than its arithmetic
+/// (one in another language): see Density::batch.
+using DensityBatchFunction = std::function<void(const double* u, std::size_t count, double* out)>;
+
+/// The most positions sample() passes to Density::batch in one call.
+inline constexpr std::size_t kDensityBatch = std::size_t(1) << 16;
+
 /// A density given as `width`×`height` values, row 0 at the bottom (u_y near 0): kdm's one row
 /// convention, the runtime's too (kdm::DensityImageView); picture files, stored top row first, are
 /// flipped once when they are read.
@@ -57,6 +67,14 @@ inline constexpr double kMinDensityPeak = 1e-30, kMaxDensityValue = 1e30;
 /// peak must lie within kMinDensityPeak ... kMaxDensityValue.
 struct Density {
   DensityFunction function;  ///< empty means constant
+  /// Optional, with `function` (sample() refuses it alone): the same density on many positions a call.
+  /// When set, sample() reads its grids through it instead of calling `function` at each node: a run of
+  /// whole nodes (every subsample of each) at a time, up to kDensityBatch positions a call, in storage
+  /// order, from one thread whatever thread_safe says. Its values are checked as `function`'s are (the
+  /// first bad one refused with its position) and give the same points bit for bit as `function` giving
+  /// the same values. sample_classes() (multiclass.h) reads class means and summed densities through it
+  /// too, and calls `function` once per point to check each point's class at the end.
+  DensityBatchFunction batch;
   /// For densities sampled from an image: its size in pixels per axis. When the computational grid is
   /// coarser than this, each grid node averages several samples so no image detail aliases. 0: unknown;
   /// negative values are refused.
