@@ -31,6 +31,7 @@ def sample(
     sweeps: Optional[int] = ...,
     coarse_sweeps: Optional[int] = ...,
     sets: Optional[int] = ...,  # (sets, n, dim) for seeds seed, seed + 1, ...
+    vectorized: bool = ...,  # density f takes coordinate arrays and returns an array
 ) -> Union[npt.NDArray[np.float64], Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]]: ...
 
 class QueryResult:
@@ -186,6 +187,7 @@ class BlueNoise(_QMCEngine):
     density: Union[_Density, Callable[..., float]]
     threads: int
     aspect: _Aspect
+    vectorized: bool
     def __init__(
         self,
         d: int = ...,
@@ -197,6 +199,7 @@ class BlueNoise(_QMCEngine):
         density: Union[_Density, Callable[..., float]] = ...,
         threads: int = ...,
         aspect: _Aspect = ...,
+        vectorized: bool = ...,  # density f takes coordinate arrays and returns an array
     ) -> None: ...
     def __copy__(self) -> BlueNoise: ...
     def random(self, n: int = ..., *, workers: int = ...) -> npt.NDArray[np.float64]: ...

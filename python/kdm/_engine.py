@@ -100,7 +100,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         density array's, volume's or image's shape, else 1. The points are normalised to [0, 1)^d whatever
         it is, as a QMC engine's are (and kdm.sample's): scale them by the sides to place them in the box.
         So aspect=1 spaces them evenly in the unit square (cube) whatever the density's shape.
-    temperature, domain, density, threads
+    temperature, domain, density, threads, vectorized
         As kdm.sample takes them (domain None: a box for images, arrays, callables and "ramp:R", a
         torus for a uniform density and "radial:R";
         for integration take the torus: small box sets are biased, as kdm.sample says;
@@ -122,6 +122,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         density: Any = None,
         threads: int = 0,
         aspect: Union[None, float, Sequence[float]] = None,
+        vectorized: bool = False,
     ) -> None:
         d = _checks.integer("d", d, 2, 3)
         if rng is not None:  # SciPy 1.15's name for it
@@ -145,6 +146,8 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         self.domain = None if domain is None else _checks.choice("domain", domain, ("torus", "box"))
         self.threads = _checks.threads(threads)
         self.density = density
+        self.vectorized = _checks.flag("vectorized", vectorized)
+        self._check_vectorized()
         one, sides = _checks.aspect_or_sides(aspect, d, "d")  # refused now, not at the first draw
         self.aspect = one if sides is None else sides
 
@@ -168,6 +171,12 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
             value = np.array(value, dtype=np.float64)
             value.flags.writeable = False
         self._density, self._spec = value, spec
+
+    def _check_vectorized(self) -> bool:
+        vectorized = _checks.flag("vectorized", self.vectorized)
+        if vectorized and not callable(self._spec):
+            raise ValueError("vectorized is for a callable density only")
+        return vectorized
 
     def __copy__(self) -> "BlueNoise":
         # A shallow copy would share the generator, and each engine's draws would advance the other's.
@@ -224,13 +233,14 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         temperature = _checks.temperature(self.temperature)
         domain = None if self.domain is None else _checks.choice("domain", self.domain, ("torus", "box"))
         aspect, sides = _checks.aspect_or_sides(self.aspect, self.d, "d")
+        vectorized = self._check_vectorized()
         state = copy.deepcopy(self.rng.bit_generator.state if hasattr(self.rng, "bit_generator")
                               else self.rng.get_state())
         seed = self._draw_seed()
         try:
             if callable(self._spec):
                 return _kdm.sample_function(n, self._spec, self.d, domain, temperature, seed, threads, aspect,
-                                            sides=sides)
+                                            sides=sides, vectorized=vectorized)
             return _kdm.sample(n, self._spec, self.d, domain, temperature, seed, threads, aspect, sides=sides)
         except BaseException:  # a refused or interrupted draw uses no seed: the next is the one it was
             if hasattr(self.rng, "bit_generator"):

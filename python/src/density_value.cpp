@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <new>
 
 namespace kdm::python {
 namespace {
@@ -35,6 +36,38 @@ double finite_density(double v, const std::string& name, const double* point, in
   if (v >= 0 && v < std::numeric_limits<double>::infinity()) return v;
   throw py::value_error(name + " callable returned " + number_text(v) + " at " + point_text(point, dim) +
                         ": a density must be finite and >= 0");
+}
+
+py::array_t<double, py::array::c_style | py::array::forcecast> density_values(const py::handle& value,
+                                                                              const std::string& name,
+                                                                              std::size_t n,
+                                                                              const double* first, int dim) {
+  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  const auto wrong_type = [&](const std::string& what) {
+    const double none[3] = {0, 0, 0};
+    throw py::type_error(name + " callable returned " + what + " for " + std::to_string(n) +
+                         " positions from " + point_text(n ? first : none, dim) +
+                         ": a vectorized density must return an array of real numbers");
+  };
+  const std::string type = type_name(value);
+  // Cast to double, None would become NaN and a complex number lose its imaginary part.
+  if (value.is_none() || PyComplex_Check(value.ptr())) wrong_type(type);
+  const py::array raw = py::array::ensure(value);
+  if (!raw) wrong_type(type);
+  const char kind = raw.dtype().kind();
+  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+    wrong_type(py::isinstance<py::array>(value) ? type + " of dtype " + std::string(py::str(raw.dtype()))
+                                                : type);
+  const Array v = Array::ensure(raw);  // real numbers as float64: fails only where memory runs out
+  if (!v) throw std::bad_alloc();
+  const bool one = v.ndim() == 0 || (v.ndim() == 1 && v.shape(0) == 1);
+  if (!one && !(v.ndim() == 1 && std::size_t(v.shape(0)) == n)) {
+    std::string shape;
+    for (py::ssize_t k = 0; k < v.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(v.shape(k));
+    throw py::value_error(name + " callable returned shape (" + shape + ") for " + std::to_string(n) +
+                          " positions: a vectorized density must return one value per position");
+  }
+  return v;
 }
 
 double density_value(const py::handle& value, const std::string& name, const double* point, int dim) {

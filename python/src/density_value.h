@@ -3,6 +3,7 @@
 // callable and the point it was called at.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "bindings.h"
@@ -15,6 +16,15 @@ namespace kdm::python {
 /// exception raised while converting it (its own __float__'s) is left set, as py::error_already_set.
 /// The GIL must be held.
 double density_value(const py::handle& value, const std::string& name, const double* point, int dim);
+
+/// What a vectorized callable `name` returned for `n` positions (the first at `first`, `dim` coordinates), as
+/// float64 values: n of them, or one for all. Throws py::type_error for anything but an array of real
+/// numbers (or one real number), naming what came back and the first position, and py::value_error for
+/// another shape; the values themselves are the caller's to check. The GIL must be held.
+py::array_t<double, py::array::c_style | py::array::forcecast> density_values(const py::handle& value,
+                                                                              const std::string& name,
+                                                                              std::size_t n,
+                                                                              const double* first, int dim);
 
 /// `v` if it is finite and >= 0, else py::value_error in density_value's words.
 double finite_density(double v, const std::string& name, const double* point, int dim);

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -26,36 +25,13 @@ double checked_value(double v, const std::string& name, double x, double y, doub
   return v;
 }
 
-/// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all.
-/// Anything but real numbers is a TypeError naming what came back and the first position, as
-/// density_value says it for one value.
+/// The values a vectorized callable returned for n positions into out[0 … n): n of them, or one for all,
+/// each checked as checked_value checks one.
 void read_values(const py::object& value, const std::string& name, std::size_t n, const double* x,
                  const double* y, double max_value, double* out) {
-  using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  const auto wrong_type = [&](const std::string& what) {
-    const double first[2] = {n ? x[0] : 0, n ? y[0] : 0};
-    throw py::type_error(name + " callable returned " + what + " for " + std::to_string(n) +
-                         " positions from " + point_text(first, 2) +
-                         ": a vectorized density must return an array of real numbers");
-  };
-  const std::string type = py::str(py::type::handle_of(value).attr("__name__"));
-  // Cast to double, None would become NaN and a complex number lose its imaginary part.
-  if (value.is_none() || PyComplex_Check(value.ptr())) wrong_type(type);
-  const py::array raw = py::array::ensure(value);
-  if (!raw) wrong_type(type);
-  const char kind = raw.dtype().kind();
-  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
-    wrong_type(py::isinstance<py::array>(value) ? type + " of dtype " + std::string(py::str(raw.dtype()))
-                                                : type);
-  const Array v = Array::ensure(raw);  // real numbers as float64: fails only where memory runs out
-  if (!v) throw std::bad_alloc();
-  const bool one = v.ndim() == 0 || (v.ndim() == 1 && v.shape(0) == 1);
-  if (!one && !(v.ndim() == 1 && std::size_t(v.shape(0)) == n)) {
-    std::string shape;
-    for (py::ssize_t k = 0; k < v.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(v.shape(k));
-    throw std::invalid_argument(name + " callable returned shape (" + shape + ") for " + std::to_string(n) +
-                                " positions: a vectorized density must return one value per position");
-  }
+  const double first[2] = {n ? x[0] : 0, n ? y[0] : 0};
+  const auto v = density_values(value, name, n, first, 2);
+  const bool one = v.size() == 1 && n != 1;
   const double* values = v.data();
   for (std::size_t i = 0; i < n; ++i)
     out[i] = checked_value(values[one ? 0 : i], name, x[i], y[i], max_value);

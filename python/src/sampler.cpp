@@ -117,17 +117,18 @@ py::object sample(std::int64_t n, const DensitySpec* density, int dim,
 }
 
 /// gen::sample of a Python function of the point's coordinates: called once per node of the sampler's
-/// grid, on one thread, with the GIL taken for each call. The first exception it raises, or value that is
+/// grid, on one thread, with the GIL taken for each call, or `vectorized` once per run of nodes (up to
+/// gen::kDensityBatch positions) on coordinate arrays. The first exception it raises, or value that is
 /// not finite and >= 0, ends the call with that error once the sampler returns.
 py::object sample_function(std::int64_t n, const py::object& function, int dim,
                            const std::optional<std::string>& domain, double temperature, std::uint64_t seed,
                            int threads, std::optional<double> aspect, std::optional<int> sweeps,
                            std::optional<int> coarse_sweeps, const Sides& sides,
-                           std::optional<std::int64_t> sets) {
+                           std::optional<std::int64_t> sets, bool vectorized) {
   // A function's edges do not meet in general: a box unless asked otherwise, as for a ramp or a picture.
   const gen::SamplerOptions o = sampler_options(n, dim, domain, true, temperature, seed, threads, aspect, 1.0,
                                                 {sweeps, coarse_sweeps}, sides);
-  PythonDensity function_density(function, dim);
+  PythonDensity function_density(function, dim, "density", vectorized);
   if (sets) {
     py::object points;
     try {
@@ -204,8 +205,9 @@ void bind_sampler(py::module_& m) {
         py::arg("domain").none(true), py::arg("temperature"), py::arg("seed"), py::arg("threads"),
         py::arg("aspect").none(true), py::arg("sweeps").none(true) = py::none(),
         py::arg("coarse_sweeps").none(true) = py::none(), py::arg("sides").none(true) = py::none(),
-        py::arg("sets").none(true) = py::none(),
-        "gen::sample of a Python function of the coordinates (with sets, gen::sample_sets)");
+        py::arg("sets").none(true) = py::none(), py::arg("vectorized") = false,
+        "gen::sample of a Python function of the coordinates (with sets, gen::sample_sets), vectorized: "
+        "of coordinate arrays");
   m.def("sample_classes", &sample_classes, py::arg("n"), py::arg("specs"), py::arg("domain").none(true),
         py::arg("temperature"), py::arg("seed"), py::arg("threads"), py::arg("aspect").none(true),
         py::arg("sweeps").none(true) = py::none(), py::arg("coarse_sweeps").none(true) = py::none(),

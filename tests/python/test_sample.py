@@ -207,6 +207,71 @@ def test_a_function_density():
         kdm.sample(100, ramp, gamma=2.0)
 
 
+def test_a_vectorized_density_gives_the_scalar_ones_points_in_a_few_calls():
+    # Arithmetic only (+, *): numpy on arrays and Python on floats give the same values, so the same points.
+    calls = []
+
+    def ramp(x, y):
+        calls.append(len(x))
+        return 0.1 + x * y + x * x * (1.0 - y)
+
+    scalar = kdm.sample(20000, lambda x, y: 0.1 + x * y + x * x * (1.0 - y), seed=3, threads=1)
+    assert np.array_equal(kdm.sample(20000, ramp, seed=3, threads=2, vectorized=True), scalar)
+    # About 16 nodes per point (more here: the grid follows the peak) and 65,536 positions a call at most.
+    assert 2 <= len(calls) <= 20 and max(calls) <= 65536 and sum(calls) > 10 * 20000, calls
+
+    def blob(x, y, z):
+        return 0.2 + x * (1.0 - x) * y + z * z
+
+    scalar3 = kdm.sample(3000, lambda x, y, z: 0.2 + x * (1.0 - x) * y + z * z, dim=3, seed=4)
+    assert np.array_equal(kdm.sample(3000, blob, dim=3, seed=4, vectorized=True), scalar3)
+    assert np.array_equal(kdm.sample(500, lambda x, y: 2.0, vectorized=True), kdm.sample(500, lambda x, y: 2.0))
+    sets = kdm.sample(300, ramp, seed=5, sets=2, vectorized=True)  # sets read the density through it too
+    assert np.array_equal(sets[1], kdm.sample(300, ramp, seed=6, vectorized=True))
+    engine = kdm.BlueNoise(2, seed=4, density=ramp, threads=1, vectorized=True)
+    drawn = int(np.random.default_rng(4).integers(0, 2**63, dtype=np.int64))
+    assert np.array_equal(engine.random(500), kdm.sample(500, ramp, seed=drawn, threads=1, vectorized=True))
+
+
+def test_a_vectorized_density_refuses_wrong_returns_by_position():
+    point = r"\([0-9.e-]+, [0-9.e-]+\)"
+    with pytest.raises(ValueError, match=r"density callable returned shape \(3\) for \d+ positions: a vectorized "
+                                         "density must return one value per position"):
+        kdm.sample(100, lambda x, y: np.ones(3), vectorized=True)
+    with pytest.raises(ValueError, match=r"returned shape \(\d+, 2\) for \d+ positions"):
+        kdm.sample(100, lambda x, y: np.stack([x, y], axis=1), vectorized=True)
+    with pytest.raises(TypeError, match=r"density callable returned str for \d+ positions from " + point +
+                                        ": a vectorized density must return an array of real numbers"):
+        kdm.sample(100, lambda x, y: "dense", vectorized=True)
+    with pytest.raises(TypeError, match=r"returned ndarray of dtype complex128 for"):
+        kdm.sample(100, lambda x, y: x + 1j, vectorized=True)
+    with pytest.raises(TypeError, match=r"returned NoneType for"):
+        kdm.sample(100, lambda x, y: None, vectorized=True)
+
+    def hole(x, y):  # NaN in one patch, named by its first position
+        return np.where((x > 0.7) & (y > 0.2) & (y < 0.25), np.nan, 1.0)
+
+    with pytest.raises(ValueError, match=r"density callable returned nan at \(0\.7[0-9.e-]*, 0\.2[0-9.e-]*\): a density "
+                                         "must be finite and >= 0"):
+        kdm.sample(2000, hole, vectorized=True)
+    with pytest.raises(ValueError, match=r"density callable returned -1 at \([0-9.e-]+, [0-9.e-]+, [0-9.e-]+\)"):
+        kdm.sample(100, lambda x, y, z: -np.ones_like(x), dim=3, vectorized=True)
+
+    def fails(x, y):
+        raise KeyError("no density here")
+
+    with pytest.raises(KeyError, match="no density here"):  # the function's own exception
+        kdm.sample(100, fails, vectorized=True)
+    with pytest.raises(ValueError, match="vectorized is for a callable density only"):
+        kdm.sample(100, 2.0, vectorized=True)
+    with pytest.raises(ValueError, match="vectorized is for a callable density only"):
+        kdm.sample(100, classes=[1, 2], vectorized=True)
+    with pytest.raises(ValueError, match="vectorized is for a callable density only"):
+        kdm.BlueNoise(2, density=np.ones((4, 4)), vectorized=True)
+    with pytest.raises(TypeError, match="vectorized must be True or False"):
+        kdm.sample(100, lambda x, y: x, vectorized="yes")
+
+
 def _half_dense_volume(depth=8, height=8, width=8, axis=0):
     """A (depth, height, width) volume 4x denser in the first half of numpy axis `axis`."""
     v = np.ones((depth, height, width))
