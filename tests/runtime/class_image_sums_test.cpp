@@ -36,6 +36,14 @@ struct SummedImages : testing::ThreeImages {
     q.image_sums = &sums;
     return q;
   }
+  /// `q` with the images given one by one instead of their sums.
+  ClassQueryParams one_by_one(const ClassQueryParams& q) const {
+    ClassQueryParams images = q;
+    images.image_sums = nullptr;
+    for (int k = 0; k < 3; ++k)
+      images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &views[k];
+    return images;
+  }
 };
 
 /// The one-class query at sum k's image over q's region.
@@ -111,11 +119,7 @@ TEST(ClassImageSumsTest, ClassesFollowTheImagesGivenOneByOne) {
   SummedImages im;
   for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
     const ClassQueryParams sums = im.query(-0.4, 0.3, 4.3, 4.6, 900, mode);
-    ClassQueryParams images = sums;
-    images.image_sums = nullptr;
-    for (int k = 0; k < 3; ++k)
-      images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &im.views[k];
-    const testing::Points a = testing::run_classes(sums), b = testing::run_classes(images);
+    const testing::Points a = testing::run_classes(sums), b = testing::run_classes(im.one_by_one(sums));
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
     for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
@@ -142,11 +146,7 @@ TEST(ClassImageSumsTest, SmoothPositionsDifferFromTheImagesGivenOneByOneInTheirL
         const double scale = per_tile / (tile * tile), side = std::min(3.8, std::sqrt(20000 / (3 * scale)));
         ClassQueryParams sums = im.query(0.1, 0.1, 0.1 + side, 0.1 + side, scale, QueryMode::kSmooth);
         sums.query.tile_size = tile, sums.query.glide_together = together;
-        ClassQueryParams images = sums;
-        images.image_sums = nullptr;
-        for (int k = 0; k < 3; ++k)
-          images.classes[k].kind = QueryDensity::Kind::kImage, images.classes[k].image = &im.views[k];
-        const testing::Points a = testing::run_classes(sums), b = testing::run_classes(images);
+        const testing::Points a = testing::run_classes(sums), b = testing::run_classes(im.one_by_one(sums));
         ASSERT_EQ(a.size(), b.size());
         for (auto i = a.begin(), j = b.begin(); i != a.end(); ++i, ++j) {
           ASSERT_TRUE(i->first == j->first);
