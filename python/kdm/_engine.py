@@ -1,7 +1,10 @@
 """kdm.BlueNoise: the full sampler as a SciPy quasi-Monte Carlo engine (scipy.stats.qmc.QMCEngine).
 
-Code written for ``qmc.PoissonDisk(d=2, seed=rng)`` switches by changing that line to
-``kdm.BlueNoise(d=2, seed=rng)``. Without SciPy the class has the same interface on a small base of its own.
+Code written for ``qmc.PoissonDisk(d=2, seed=rng)`` through the engine interface (``random``, ``reset``,
+``fast_forward``, ``integers``) switches by changing that line to ``kdm.BlueNoise(d=2, seed=rng)``;
+PoissonDisk's own ``radius``, ``hypersphere``, ``ncandidates``, ``optimization`` and ``fill_space`` have no
+counterpart (the count is ``random``'s n). Without SciPy the class has the same interface on a small base
+of its own.
 """
 from __future__ import annotations
 
