@@ -103,14 +103,22 @@ CallableDensity::CallableDensity(py::object f, double max_value, py::object boun
     *lo = *hi = std::numeric_limits<double>::quiet_NaN();  // no bounds, unless the call gives them
     guarded(d, [&] {
       const py::object got = d.bounds_function(x0, y0, x1, y1);
-      if (!py::isinstance<py::sequence>(got) || py::len(got) != 2)
-        throw std::invalid_argument("density_bounds must return (lo, hi)");
+      // A wrong type is a TypeError naming what came back, as a density's own value is (density_value.h).
+      const auto type_name = [](const py::handle& o) {
+        return std::string(py::str(py::type::of(o).attr("__name__")));
+      };
+      if (!py::isinstance<py::sequence>(got) || py::isinstance<py::str>(got))
+        throw py::type_error("density_bounds must return a pair (lo, hi), got " + type_name(got));
+      if (py::len(got) != 2)
+        throw std::invalid_argument("density_bounds must return a pair (lo, hi), got " +
+                                    std::to_string(py::len(got)) + " values");
       const py::sequence pair = got.cast<py::sequence>();
       double l, h;
       try {
         l = pair[0].cast<double>(), h = pair[1].cast<double>();
       } catch (const py::cast_error&) {
-        throw std::invalid_argument("density_bounds must return two numbers (lo, hi)");
+        throw py::type_error("density_bounds must return two real numbers (lo, hi), got (" +
+                             type_name(pair[0]) + ", " + type_name(pair[1]) + ")");
       }
       if (!(l >= 0 && l <= h))
         throw std::invalid_argument("density_bounds returned (" + number_text(l) + ", " + number_text(h) +

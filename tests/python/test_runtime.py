@@ -64,6 +64,18 @@ def test_same_bits_with_an_image_density(cli, tmp_path, gradient_png):
     assert same(a, r)
 
 
+@pytest.mark.parametrize("bounds, error, message", [
+    (None, TypeError, r"must return a pair \(lo, hi\), got NoneType"),
+    ("ab", TypeError, r"must return a pair \(lo, hi\), got str"),
+    ((0.0, "x"), TypeError, r"two real numbers \(lo, hi\), got \(float, str\)"),
+    ((0.0, 1.0, 2.0), ValueError, r"must return a pair \(lo, hi\), got 3 values"),
+])
+def test_density_bounds_of_the_wrong_type_or_length_are_named(bounds, error, message):
+    with pytest.raises(error, match=message):
+        BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x, y: 1.0, density_max=1.0,
+                      density_bounds=lambda *r: bounds)
+
+
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
 def test_partitions_concatenate_to_the_whole(mode):
     density = np.random.default_rng(3).random((16, 16))
