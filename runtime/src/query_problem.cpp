@@ -85,6 +85,8 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
   const std::size_t len = std::strlen(shown);
   if (len > 0 && shown[len - 1] == '=' && spelled != parameter) shown[len - 1] = 0;
   switch (p.kind) {
+    case QueryProblem::Kind::kNone:  // nothing refused: no parameter to name
+      return print(text, size, "%s", query_problem_message(p.kind));
     case QueryProblem::Kind::kDensityTooHigh: {
       // Only advice that can be followed: a scale or tile size that fits and is still > 0.
       char scale[120] = "", tile[120] = "", number[40];

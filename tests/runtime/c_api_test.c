@@ -310,6 +310,14 @@ int main(int argc, char** argv) {
             strlen(cut) == sizeof cut - 1 && strncmp(cut, line, sizeof cut - 1) == 0);
       CHECK(kdm_query_problem_describe(&problem, NULL, 0) == length);
       CHECK(kdm_query_problem_describe(NULL, line, sizeof line) > 0 && strstr(line, "'problem'"));
+      /* A query that is taken clears the problem, which then names no parameter. */
+      kdm_cursor fresh;
+      memset(&fresh, 0, sizeof fresh);
+      q = uniform_query();
+      CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &fresh, &problem) == KDM_BUFFER_FULL);
+      CHECK(problem.kind == KDM_PROBLEM_NONE);
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      CHECK(strcmp(line, "no problem") == 0);
     }
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
