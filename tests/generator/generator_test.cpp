@@ -153,6 +153,27 @@ TEST(GeneratorTest, VerifierFlagsAJumpInTheGlidingTrack) {
   for (const KeyframeResult& k : report.keyframes)
     for (const Check& c : k.checks) flagged = flagged || (c.name == "motion p99" && !c.passed());
   EXPECT_TRUE(flagged);
+  // A few rows of the track, as a draw's luck fails them: no word of the recipe's glide.
+  EXPECT_EQ(printed(report).find("the glide track fails"), std::string::npos) << printed(report);
+}
+
+// Every tile's glide offsets below 128 points per tile replaced by random ones: most of the track fails,
+// which is the recipe's glide (too few keyframes do the like), not a seed's draw at small tiles.
+TEST(GeneratorTest, VerifierBlamesTheRecipeWhereMostOfTheGlideTrackFails) {
+  TilesetData damaged = shipped();
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> offset(-60, 60);
+  for (Tile& tile : damaged.tiles)
+    for (std::int8_t& v : tile.glide) v = static_cast<std::int8_t>(offset(rng));
+  VerifyOptions o = keyframes_only();
+  o.levels = {0};
+  o.holes = false;
+  const Report report = verify_tileset(damaged, o);
+  std::size_t failed = 0;
+  for (const KeyframeResult& k : report.keyframes) failed += !k.passed();
+  ASSERT_GT(failed * 4, report.keyframes.size()) << printed(report);
+  EXPECT_NE(printed(report).find("the glide track fails at"), std::string::npos) << printed(report);
+  EXPECT_EQ(printed(report).find("another seed"), std::string::npos) << printed(report);
 }
 
 // A tile whose points of one level are replaced by uniformly random ones: the statistics and the direct

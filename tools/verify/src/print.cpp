@@ -140,8 +140,21 @@ void print_report(const Report& report, std::FILE* out, bool tables) {
       only_small = only_small && (t.passed() || small(t.checks, t.points / 4.0));
     for (const DensityResult& d : report.densities)
       only_small = only_small && (d.passed() || small(d.checks, d.points_per_tile));
-    for (const KeyframeResult& k : report.keyframes)
+    // A draw's luck fails a few rows of the glide track; most of it failing is the recipe's glide
+    // (too few keyframes: 8 at 2 levels fail 14 of 17 rows, seeds 1-8 at the shipped 24 at most 4 of 49).
+    std::size_t glide_failed = 0;
+    for (const KeyframeResult& k : report.keyframes) {
+      glide_failed += !k.passed();
       only_small = only_small && (k.passed() || small(k.checks, k.points_per_tile));
+    }
+    const std::size_t glide_rows = report.keyframes.size();
+    if (glide_failed * 4 > glide_rows) {
+      only_small = false;
+      std::fprintf(out,
+                   "the glide track fails at %zu of its %zu rows: its recipe, not a seed's draw (fewer "
+                   "keyframes give each interval more motion; the shipped recipe's 24 per level pass)\n",
+                   glide_failed, glide_rows);
+    }
     if (only_small)
       std::fprintf(out,
                    "every failure is at a density whose tiles are under %.0f point spacings wide, where a "
