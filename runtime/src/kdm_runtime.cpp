@@ -720,6 +720,14 @@ kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query, 
                    });
 }
 
+kdm_status kdm_count_points(const kdm_tileset* tileset, const kdm_query* query, size_t* count,
+                            kdm_cursor* cursor, kdm_query_problem* problem) {
+  return run_query(tileset, query, count, cursor, problem,
+                   [&](const kdm::QueryParams& q, kdm::QueryCursor* k, kdm::QueryProblem* why) {
+                     return kdm::count_points(*tileset->set, q, count, k, why);
+                   });
+}
+
 kdm_status kdm_query_compact(const kdm_tileset* tileset, const kdm_query* query, float* xy, uint64_t* keys,
                              size_t capacity, size_t* written, kdm_cursor* cursor,
                              kdm_query_problem* problem) {

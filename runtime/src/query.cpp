@@ -434,6 +434,21 @@ Status detail::query_points_counted(const Tileset& tileset, const QueryParams& q
                     examined, run);
 }
 
+Status count_points(const Tileset& tileset, const QueryParams& q, std::size_t* count, QueryCursor* cursor,
+                    QueryProblem* problem) {
+  detail::Refusal refuse(problem);
+  if (!count) return refuse(QueryProblem::Kind::kMissingArgument, "count");
+  // A counting cursor's fingerprint differs from a query's, so that one is never resumed as the other.
+  constexpr std::uint64_t kCounting = 0x636f756e74696e67;  // "counting"
+  const bool started = cursor && cursor->started;
+  if (started) cursor->fingerprint ^= kCounting;
+  std::uint64_t examined = 0;
+  const Status s = query_into(tileset, q, detail::CountSink{}, true, "out",
+                              std::numeric_limits<std::size_t>::max(), count, cursor, refuse, examined, {});
+  if (cursor && cursor->started) cursor->fingerprint ^= kCounting;
+  return s;
+}
+
 Status detail::count_points(const Tileset& tileset, const QueryParams& q, std::size_t* count,
                             QueryCursor* cursor, const TileRun& run) {
   detail::Refusal refuse(nullptr);

@@ -128,6 +128,25 @@ int main(int argc, char** argv) {
   {
     const size_t a = count_points(builtin, &q, 64), b = count_points(loaded, &q, 5);
     CHECK(a > 1000 && a == b); /* same set from the file and built in; resumed buffers lose nothing */
+    {
+      /* kdm_count_points counts what the query writes, with a cursor of its own. */
+      kdm_cursor cursor;
+      kdm_query_problem problem;
+      size_t counted = 0, total = 0;
+      kdm_status s;
+      memset(&cursor, 0, sizeof cursor);
+      problem.struct_size = sizeof problem;
+      while ((s = kdm_count_points(builtin, &q, &counted, &cursor, &problem)) == KDM_BUFFER_FULL)
+        total += counted;
+      CHECK(s == KDM_OK && total + counted == a);
+      CHECK(kdm_query_points(builtin, &q, NULL, 0, &counted, &cursor, &problem) == KDM_INVALID_ARGUMENT &&
+            problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_count_points(builtin, &q, NULL, &cursor, &problem) == KDM_INVALID_ARGUMENT &&
+            problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "count") == 0);
+      CHECK(kdm_count_points(NULL, &q, &counted, &cursor, &problem) == KDM_INVALID_ARGUMENT &&
+            strcmp(problem.parameter, "tileset") == 0 && counted == 0);
+    }
   }
   /* Every point's threshold lies below its tile's expected count (500 here), and an id the set does not
    * have, or a NULL argument, is refused. */

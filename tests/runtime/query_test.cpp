@@ -926,6 +926,66 @@ TEST_P(ModeTest, QueriesDoNotAllocate) {
   EXPECT_EQ(testing::allocations(), before);
 }
 
+// count_points gives the number query_points writes, for every kind of density and in both modes, allocating
+// nothing; its cursor and a query's are not interchangeable.
+TEST_P(ModeTest, CountPointsGivesTheQuerysCount) {
+  static const DensityImageView image = [] {
+    static std::vector<float> texels(64 * 64), mips;
+    for (int i = 0; i < 64 * 64; ++i) texels[i] = float((i % 64) * (i / 64)) / (63.0f * 63.0f);
+    DensityImageView v;
+    v.width = v.height = 64;
+    v.x0 = -1.5, v.y0 = -1.0, v.x1 = 2.5, v.y1 = 3.0;
+    v.values = texels.data();
+    EXPECT_EQ(make_density_max_mip(v, mips), Status::kOk);
+    return v;
+  }();
+  std::vector<QueryParams> cases(3, region(-1.3, -0.7, 2.1, 2.6, 700, GetParam()));
+  cases[1].density.kind = QueryDensity::Kind::kImage, cases[1].density.image = &image;
+  cases[2].density.kind = QueryDensity::Kind::kCallback, cases[2].density.callback_max = 1;
+  cases[2].density.callback = [](void*, double x, double y) { return 0.5 + 0.5 * std::sin(2 * x + y); };
+  for (const QueryParams& q : cases) {
+    const std::size_t expected = testing::run_query(q).size();
+    ASSERT_GT(expected, 1000u);
+    const long before = testing::allocations();
+    QueryCursor cursor;
+    std::size_t count = 0, total = 0;
+    Status s;
+    while ((s = count_points(Tileset::builtin(), q, &count, &cursor)) == Status::kBufferFull) total += count;
+    total += count;
+    EXPECT_EQ(testing::allocations(), before);
+    EXPECT_EQ(s, Status::kOk);
+    EXPECT_EQ(total, expected) << "density kind " << int(q.density.kind);
+
+    // The finished counting cursor is refused by query_points, as a query's cursor is by count_points.
+    std::vector<QueryPoint> out(16);
+    std::size_t written = 0;
+    QueryProblem problem;
+    EXPECT_EQ(query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &cursor, &problem),
+              Status::kInvalidArgument);
+    EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+    QueryCursor query_cursor;
+    ASSERT_EQ(query_points(Tileset::builtin(), q, out.data(), out.size(), &written, &query_cursor),
+              Status::kBufferFull);
+    const QueryCursor kept = query_cursor;
+    EXPECT_EQ(count_points(Tileset::builtin(), q, &count, &query_cursor, &problem), Status::kInvalidArgument);
+    EXPECT_EQ(problem.kind, QueryProblem::Kind::kCursorMismatch);
+    EXPECT_EQ(count, 0u);
+    EXPECT_EQ(std::memcmp(&kept, &query_cursor, sizeof kept), 0) << "a refused call leaves the cursor";
+  }
+  QueryCursor cursor;
+  QueryProblem problem;
+  EXPECT_EQ(count_points(Tileset::builtin(), cases[0], nullptr, &cursor, &problem), Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kMissingArgument);
+  EXPECT_STREQ(problem.parameter, "count");
+  QueryParams bad = cases[0];
+  bad.tile_size = -1;
+  std::size_t count = 7;
+  EXPECT_EQ(count_points(Tileset::builtin(), bad, &count, &cursor, &problem), Status::kInvalidArgument);
+  EXPECT_EQ(problem.kind, QueryProblem::Kind::kNotPositive);
+  EXPECT_STREQ(problem.parameter, "tile_size");
+  EXPECT_EQ(count, 0u);
+}
+
 TEST(QueryTest, SmallChunksFindEveryPointThatGlidesIn) {
   // Smooth mode with a varying density: a chunk's cells are visited one after another, each in rank order,
   // and a point's reach narrows with its rank, so each cell must start from the widest reach again. Points

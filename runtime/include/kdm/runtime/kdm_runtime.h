@@ -283,6 +283,12 @@ KDM_RUNTIME_API double kdm_density_image_at(const kdm_density_image* image, doub
 KDM_RUNTIME_API kdm_status kdm_query_points(const kdm_tileset* tileset, const kdm_query* query,
                                             kdm_point* out, size_t capacity, size_t* written,
                                             kdm_cursor* cursor, kdm_query_problem* problem);
+/* How many points kdm_query_points would write, into *count, writing none (kdm::count_points): KDM_OK;
+ * KDM_BUFFER_FULL after 2^24 candidates, with the count so far: call again with the same cursor and query
+ * and add; KDM_INVALID_ARGUMENT as kdm_query_points refuses (a NULL `count` too), with `problem`. A
+ * counting cursor is one of its own: kdm_query_points refuses it, and this a query's. Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_count_points(const kdm_tileset* tileset, const kdm_query* query, size_t* count,
+                                            kdm_cursor* cursor, kdm_query_problem* problem);
 
 /* kdm_query_points into a compact output (kdm/runtime/compact_query.h): the same points in the same order
  * (positions computed in float, within 2^-21 * (|position| + tile_size) of the records' doubles, not

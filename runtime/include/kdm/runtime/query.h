@@ -259,9 +259,19 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// (kTooFarFromOrigin), or a cursor started with other params. Capacity 0 (`out` may then be null) only
 /// checks the query: kInvalidArgument, or kBufferFull at its first point with the cursor unmoved (so a
 /// loop resuming while kBufferFull must give room for a point), or kOk for a region without points; to
-/// count a region, ParallelQuery::run with capacity 0. No allocation.
+/// count a region, count_points (one thread) or ParallelQuery::run with capacity 0. No allocation.
 KDM_RUNTIME_API Status query_points(const Tileset& tileset, const QueryParams& params, QueryPoint* out,
                                     std::size_t capacity, std::size_t* written, QueryCursor* cursor,
                                     QueryProblem* problem = nullptr);
+
+/// How many points query_points would write for `params`, into `*count`, writing none: to size a buffer
+/// before the query. Whole tiles of a constant density cost nothing to count, other tiles what their
+/// query does. Returns kOk with the count; kBufferFull after kMaxQueryCandidates candidates, with the
+/// count so far: call again with the same cursor and params and add; kInvalidArgument where query_points
+/// refuses the params (`count` null: kMissingArgument), with `problem` (optional) saying why. A counting
+/// cursor is one of its own: query_points refuses it (kCursorMismatch), and count_points a query's. No
+/// allocation.
+KDM_RUNTIME_API Status count_points(const Tileset& tileset, const QueryParams& params, std::size_t* count,
+                                    QueryCursor* cursor, QueryProblem* problem = nullptr);
 
 }  // namespace kdm
