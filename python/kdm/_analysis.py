@@ -118,7 +118,11 @@ def analyze(
         "too_small", an integer array, the classes present with fewer than 2 points in every set, which
         are not analysed).
     box : bool
-        Bounded-box distances instead of periodic (torus) ones.
+        Bounded-box distances instead of periodic (torus) ones. An array carries no domain, unlike a
+        ``.txt`` file whose header ``kdm analyze`` reads: give ``box=True`` for a bounded set
+        (``kdm.stipple``'s dots, a query's points normalised to its rectangle, a sample in a box: of an
+        image, array or callable, or ``domain="box"``) and `aspect` for its shape; else it is measured as
+        a torus of the unit square.
     density : None, float, str, 2-D array or callable
         The target density, as kdm.sample takes it (default: uniform): for the density accuracy test,
         and the local spacing empty circles are measured in. A callable ``f(x, y)`` of coordinates in

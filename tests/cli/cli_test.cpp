@@ -1205,6 +1205,40 @@ TEST_F(CliTest, AnalyzeMeasuresABoundedSetAsOneFromItsHeader) {
   EXPECT_NE(piped.out.find("a bounded box"), std::string::npos) << piped.out;
 }
 
+// A file without a domain header (CSV, .npy: a box sample, query or stipple among them) is measured as a
+// square torus by default: analyze says so on standard error once, and not when --box, --torus or a .txt
+// header settles it.
+TEST_F(CliTest, AnalyzeNotesAFileWithoutADomainHeader) {
+  const std::string csv = "'" + path("box.csv") + "'", txt = "'" + path("box.txt") + "'";
+  ASSERT_EQ(kdm("sample --n 1000 --domain box --aspect 1.5 --seed 4 -o " + csv).status, 0);
+  ASSERT_EQ(kdm("sample --n 1000 --domain box --aspect 1.5 --seed 4 -o " + txt).status, 0);
+  EXPECT_EQ(slurp(path("box.csv")).rfind("x,y\n", 0), 0u);  // plain CSV, no comment lines
+  const std::string note = "kdm: note: " + path("box.csv") + " has no domain header";
+  const Outcome plain = kdm("analyze " + csv + " --no-energy");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_NE(plain.err.find(note), std::string::npos) << plain.err;
+  EXPECT_EQ(plain.err.find("kdm: note:"), plain.err.rfind("kdm: note:")) << plain.err;  // once
+  for (const char* said : {"measured as a torus in the unit square", "--box for a bounded set",
+                           "--aspect for its shape", "--torus to keep the torus"})
+    EXPECT_NE(plain.err.find(said), std::string::npos) << said << "\n" << plain.err;
+  EXPECT_EQ(plain.out.find("kdm: note:"), std::string::npos) << plain.out;  // the summary stays clean
+  // With the shape given, the note names the domain alone.
+  const Outcome shaped = kdm("analyze " + csv + " --aspect 1.5 --no-energy");
+  ASSERT_EQ(shaped.status, 0) << shaped.err;
+  EXPECT_NE(shaped.err.find(note), std::string::npos) << shaped.err;
+  EXPECT_EQ(shaped.err.find("--aspect for its shape"), std::string::npos) << shaped.err;
+  EXPECT_EQ(shaped.err.find("unit square"), std::string::npos) << shaped.err;
+  for (const std::string& settled : {csv + " --box", csv + " --torus", txt}) {
+    const Outcome r = kdm("analyze " + settled + " --no-energy");
+    ASSERT_EQ(r.status, 0) << settled << "\n" << r.err;
+    EXPECT_EQ(r.err.find("kdm: note:"), std::string::npos) << settled << "\n" << r.err;
+  }
+  // Standard input without a header, and a refusal: the error stays its one line.
+  const Outcome piped = kdm("analyze - --no-energy <" + csv);
+  EXPECT_NE(piped.err.find("kdm: note: standard input has no domain header"), std::string::npos) << piped.err;
+  expect_error("analyze " + csv + " --aspect 1.5 --tile-size 0.25", "square tiles of the unit square");
+}
+
 // --class-density: each class of a labelled set against its own density, the whole set against their
 // sum, the classes' counts against their shares; refusals name the numbers.
 TEST_F(CliTest, AnalyzeJudgesEachClassAgainstItsOwnDensity) {

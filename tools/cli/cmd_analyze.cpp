@@ -204,6 +204,30 @@ bool measured_torus(const AnalyzeArgs& args, const std::vector<SampledDomain>& r
   return false;
 }
 
+/// Says on standard error (a note, the summary's first line says it too) when the files' domain is the
+/// default one because no header named it: CSV and .npy files, a bounded stipple's or query's among them,
+/// carry none, and a torus measures a bounded set wrongly. Names the unknown shape too where it is unknown.
+void note_unsaid_domain(const AnalyzeArgs& args, const std::vector<SampledDomain>& read, int dim) {
+  if (args.torus || args.box) return;
+  bool shape_known = !args.aspect.empty();
+  for (const SampledDomain& d : read) {
+    if (!d.domain.empty()) return;
+    shape_known = shape_known || d.shape.named;
+  }
+  const std::string which = read.size() > 1        ? "the files have"
+                            : args.files[0] == "-" ? "standard input has"
+                                                   : args.files[0] + " has";
+  std::fprintf(stderr,
+               "kdm: note: %s no domain header (kdm's .txt files carry one; CSV and .npy files none): "
+               "measured as a torus%s; give --box for a bounded set (a stipple, a query, a box sample)%s, or "
+               "--torus to keep the torus\n",
+               which.c_str(),
+               shape_known ? ""
+               : dim == 3  ? " in the unit cube"
+                           : " in the unit square",
+               shape_known ? "" : " and --aspect for its shape");
+}
+
 /// The shape the files are measured in: --aspect's, else their headers' (all alike: pooled sets share one
 /// domain). Says on `text` which it took when that is not the square. Throws CommandError.
 Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text,
@@ -358,6 +382,7 @@ void run_analyze(const AnalyzeArgs& args) {
       report.energy_per_point = tools::mean_energy_per_point(sets, o.torus, target, 0, o.extent);
       report.has_energy = true;
     }
+    note_unsaid_domain(args, domains, sets.front().dim);  // after the analysis: an error stays one line
     if (args.files.size() > 1)  // not one report a file: the measures pool the sets of them all
       std::fprintf(text, "%zu files pooled into one report (analyse them one at a time for one each)\n",
                    args.files.size());
@@ -414,11 +439,11 @@ void add_analyze_command(CLI::App& app) {
       ->required();
   cmd->add_flag("--torus", args->torus,
                 "Periodic distances, for a set that wraps around (default, unless the files' headers say "
-                "\"domain box\", as kdm query and stipple and a bounded kdm sample write it; the summary's "
-                "first line says which were used)");
+                "\"domain box\", as the .txt files of kdm query and stipple and a bounded kdm sample do; CSV "
+                "and .npy files carry no header; the summary's first line says which were used)");
   cmd->add_flag("--box", args->box,
-                "Bounded-box distances, for a set in a square with walls (most other tools' sets; g(r) with "
-                "edge correction)");
+                "Bounded-box distances, for a set in a square with walls (most other tools' sets, and kdm "
+                "stipple's, query's or a bounded sample's as CSV or .npy; g(r) with edge correction)");
   cmd->add_option(
       "--density", args->density,
       "Target density for the accuracy test and the per-band bias table: const:V, an image "
@@ -455,11 +480,12 @@ void add_analyze_command(CLI::App& app) {
                   "Bands of the per-band bias table: the points where the target density lies in each "
                   "band (equal steps in log density) against the count it should get")
       ->capture_default_str();
-  cmd->add_option("--aspect", args->aspect,
-                  "The domain the points were drawn in: width/height (in 3D the x side over the others), or "
-                  "three sides X:Y:Z; they are measured in it, scaled to unit area (volume); 1 forces the "
-                  "square (default: what the files' headers say, as kdm sample --aspect writes it, else the "
-                  "unit square or cube)");
+  cmd->add_option(
+      "--aspect", args->aspect,
+      "The domain the points were drawn in: width/height (in 3D the x side over the others), or "
+      "three sides X:Y:Z; they are measured in it, scaled to unit area (volume); 1 forces the "
+      "square (default: what the files' .txt headers say, as kdm sample --aspect, query and stipple "
+      "write it; else, as for CSV and .npy files, the unit square or cube)");
   add_threads_option(cmd, args->threads, "results do not depend on it");
   cmd->add_option_function<std::string>(
       "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },
