@@ -225,6 +225,10 @@ TEST_F(CliTest, QueryWritesJsonAndAcceptsAZeroDensity) {
     EXPECT_NEAR(x, (wx - 1) / 2, 1e-12) << row;
     EXPECT_NEAR(y, wy - 1, 1e-12) << row;
   }
+  // World units are refused by kdm analyze, naming the option that writes them normalised.
+  expect_error("analyze '" + path("w.csv") + "' --no-energy", "outside the unit domain");
+  expect_error("analyze '" + path("w.csv") + "' --no-energy", "give it --normalised");
+  EXPECT_EQ(kdm("analyze '" + path("n.csv") + "' --box --aspect 2 --no-energy").status, 0);
   // Options an output would silently drop are refused: --normalised where the output always is, and
   // classes where it has no column for them.
   expect_error("query --rect 1,1,3,2 --normalised -o '" + path("n.png") + "'", "--normalised is for .csv");

@@ -93,10 +93,15 @@ std::vector<tools::PointSet> load_point_sets(const std::vector<std::string>& pat
         validate_points(sets[k].coords, sets[k].dim);
       } catch (const InvalidInput& e) {
         const bool hint = whole_third_column(sets[k]);
+        // Finite coordinates past [0, 1] are most likely world units, as kdm query writes .csv.
+        const bool finite = std::all_of(sets[k].coords.begin(), sets[k].coords.end(),
+                                        [](double v) { return std::isfinite(v); });
         throw InvalidInput(
             path + " (set " + std::to_string(k + 1) + "): " + e.what() +
-            (hint ? std::string(" (its third column holds whole numbers only: ") + kClassHeaderHint + ")"
-                  : ""));
+            (hint     ? std::string(" (its third column holds whole numbers only: ") + kClassHeaderHint + ")"
+             : finite ? std::string(" (kdm query writes world units to .csv: give it --normalised, "
+                                    "or write .txt)")
+                      : ""));
       }
       all.push_back(std::move(sets[k]));
     }
