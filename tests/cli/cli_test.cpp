@@ -1380,6 +1380,44 @@ TEST_F(CliTest, HelpDescribesEveryOption) {
   }
 }
 
+// Every density a NumPy .npy array can give says so in its command's help, and the command reads one.
+TEST_F(CliTest, HelpNamesNpyWhereADensityReadsOne) {
+  std::vector<double> values(4 * 6);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = i % 6 < 3 ? 4 : 1;  // dense on the left
+  std::ofstream(path("d.npy"), std::ios::binary) << npy_volume(values, 1, 4, 6, "<f8", "4, 6");
+  const std::string d = " '" + path("d.npy") + "'";
+  struct Case {
+    const char *sub, *option;
+    std::string run;
+  };
+  for (const Case& c :
+       {Case{"query", "--density",
+             "query --rect 0,0,2,1 --scale 400 --density" + d + " -o '" + path("q.txt") + "'"},
+        Case{"sample", "--density", "sample --n 400 --density" + d + " -o '" + path("s.txt") + "'"},
+        Case{"stipple", "image", "stipple" + d + " --points 400 -o '" + path("p.txt") + "'"},
+        Case{"analyze", "--density", "analyze '" + path("s.txt") + "' --no-energy --density" + d}}) {
+    const Outcome run = kdm(c.run);
+    EXPECT_EQ(run.status, 0) << c.run << "\n" << run.err;
+    std::istringstream lines(kdm(std::string(c.sub) + " --help").out);
+    std::string help;  // the option's line, and the lines its text wraps onto
+    for (std::string line; std::getline(lines, line);)
+      if (line.rfind(std::string("  ") + c.option + " ", 0) == 0 ||
+          (!help.empty() && line.rfind("      ", 0) == 0))
+        help += line;
+      else if (!help.empty())
+        break;
+    EXPECT_NE(help.find("NumPy .npy"), std::string::npos)
+        << "kdm " << c.sub << " --help, " << c.option << ": " << help;
+  }
+  // The query's points follow the array: four times as dense on its left half.
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("q.txt"), sets, error)) << error;
+  std::size_t left = 0;
+  for (std::size_t i = 0; i < sets.at(0).size(); ++i) left += sets[0].coords[2 * i] < 0.5;
+  EXPECT_GT(left, 3 * (sets[0].size() - left)) << left << " of " << sets[0].size();
+}
+
 // Reads a frame written by `stipple --frames`: its points in image UV and its rectangle (from the header).
 struct Frame {
   double region[4] = {0, 0, 0, 0};

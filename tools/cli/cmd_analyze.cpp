@@ -447,8 +447,9 @@ void add_analyze_command(CLI::App& app) {
   cmd->add_option(
       "--density", args->density,
       "Target density for the accuracy test and the per-band bias table: const:V, an image "
-      "(dark = dense) or ramp:R / radial:R, as given to kdm sample (default: none, no density test; "
-      "const:1 tests against a uniform density). With --class-density it judges the whole set only "
+      "(dark = dense), ramp:R / radial:R or a NumPy .npy array, as given to kdm sample (default: none, no "
+      "density test; const:1 tests against a uniform density). With --class-density it judges the whole "
+      "set only "
       "(default there: the sum of the class densities); each class keeps its own");
   cmd->add_option(
       "--class-density", args->class_densities,

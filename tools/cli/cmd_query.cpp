@@ -198,7 +198,8 @@ void add_query_command(CLI::App& app) {
              "--density", a->density,
              "const:V (V >= 0), an image (density = 1 - luminance, 0.2126 R + 0.7152 G + 0.0722 B of the "
              "file's values, alpha on white; dark = dense; a Radiance .hdr keeps its range, scaled by its "
-             "brightest pixel), or a test map ramp:R or radial:R (dynamic range R), stretched over "
+             "brightest pixel), a test map ramp:R or radial:R (dynamic range R), or a NumPy .npy 2-D array "
+             "of densities (rows, columns; row 0 at the top, as kdm sample takes it), stretched over "
              "--density-rect (past it the edge texels go on)")
           ->capture_default_str();
   cmd->add_option(

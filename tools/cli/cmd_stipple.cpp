@@ -279,9 +279,10 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option(
          "image", a->image,
          "Image (8/16-bit PNG, JPEG turned as its EXIF orientation says, ...); darkness is the dot "
-         "density; transparent pixels are paper. Up to 2^28 pixels in all (16384x16384): a picture larger "
-         "than its dots need (about 4096x4096, or 64 pixels per dot, times the zoom squared; at most "
-         "2^26) is averaged down as it is read")
+         "density; transparent pixels are paper. A NumPy .npy 2-D array of densities (rows, columns; row 0 "
+         "at the top, as kdm sample takes it) is the density itself (not with --colours). Up to 2^28 pixels "
+         "in all (16384x16384): a picture larger than its dots need (about 4096x4096, or 64 pixels per dot, "
+         "times the zoom squared; at most 2^26) is averaged down as it is read")
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
