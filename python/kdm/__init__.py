@@ -14,7 +14,7 @@ open() raises it: FileNotFoundError for a missing file, IsADirectoryError for a 
 C++ work runs with the GIL released, so Python threads sample and query in parallel; Ctrl-C stops a long
 sample, bake, analysis or full stipple within its current step.
 """
-from typing import Any as _Any
+from typing import Any as _Any, List as _List
 
 from . import _kdm
 from ._analysis import analyze
@@ -39,3 +39,8 @@ def __getattr__(name: str) -> _Any:
         globals()["BlueNoise"] = BlueNoise
         return BlueNoise
     raise AttributeError(f"module 'kdm' has no attribute {name!r}")
+
+
+def __dir__() -> _List[str]:
+    # The names loaded on first use (__getattr__) are listed before they are loaded, without loading them.
+    return sorted(set(globals()) | set(__all__))

@@ -41,6 +41,16 @@ def test_import_does_not_load_scipy():
     assert done.stdout.strip() == "False"
 
 
+def test_dir_lists_every_public_name_without_loading_it():
+    # A fresh interpreter: BlueNoise is loaded on first use, and dir() lists it before that.
+    code = ("import sys, kdm; names = dir(kdm); "
+            "print(sorted(set(kdm.__all__) - set(names)), 'kdm._engine' in sys.modules, 'scipy' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[] False False"
+    assert "BlueNoise" in dir(kdm) and "sample" in dir(kdm) and "_kdm" in dir(kdm)
+
+
 def test_the_example_runs(tmp_path):
     from conftest import SOURCE_DIR
     done = subprocess.run([sys.executable, str(SOURCE_DIR / "examples" / "python_example.py"), str(tmp_path)],
