@@ -1,6 +1,6 @@
 # Type hints of the kdm package (the implementation is kdm/*.py over the compiled kdm._kdm).
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -57,6 +57,7 @@ class QueryResult:
         classes: Optional[npt.NDArray[np.uint8]] = ...,
     ) -> None: ...
     def __len__(self) -> int: ...
+    def __iter__(self) -> Iterator[QueryResult]: ...
 
 class DensityMap:
     @property

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -47,7 +47,9 @@ class QueryResult:
         as a dict key or to join with positions' keys; thresholds() needs the result itself.
 
     ``r[i]``, ``r[a:b]``, ``r[mask]`` and ``r[indices]`` give a new QueryResult of those points (copied);
-    a result pickles its points alone, not the buffer a reused ``out`` left behind it.
+    an integer past either end (``-len(r) <= i < len(r)``, as numpy's) is an IndexError. Iterating
+    yields ``r[0]``, ``r[1]``, ...: one-point QueryResults (slow for many points; the arrays are the bulk
+    route). A result pickles its points alone, not the buffer a reused ``out`` left behind it.
     """
 
     __slots__ = ("points", "xy", "tile", "rank", "level", "classes", "_storage")
@@ -76,7 +78,10 @@ class QueryResult:
 
     def __getitem__(self, index: Any) -> "QueryResult":
         if isinstance(index, numbers.Integral):
-            index = slice(index, index + 1 if index != -1 else None)  # a one-point result
+            m, i = len(self), int(index)
+            if not -m <= i < m:  # as numpy's (an empty result instead would never end iteration)
+                raise IndexError(f"index {i} is out of range for a QueryResult of {m} points")
+            index = slice(i % m, i % m + 1)  # a one-point result
         return QueryResult._of(self.points[index].copy(), self.level[index],
                                None if self.classes is None else self.classes[index])
 
@@ -98,6 +103,9 @@ class QueryResult:
 
     def __len__(self) -> int:
         return len(self.xy)
+
+    def __iter__(self) -> Iterator["QueryResult"]:
+        return (self[i] for i in range(len(self)))
 
     def __repr__(self) -> str:
         return f"<kdm.QueryResult: {len(self)} points>"

@@ -396,6 +396,22 @@ def test_the_shipped_file_loads_as_the_builtin_set(tmp_path):
     assert pickle.loads(pickle.dumps(shipped)).to_bytes() == data
 
 
+def test_result_index_past_either_end_is_an_index_error_and_iteration_ends():
+    r = kdm.Tileset.builtin().query((0, 0, 1, 1), scale=100)
+    m = len(r)
+    assert m > 10
+    for i in (m, m + 5, -m - 1, 10**20):  # as numpy's: not an empty result, on which iteration never ends
+        with pytest.raises(IndexError, match="out of range"):
+            r[i]
+        with pytest.raises(IndexError):
+            r.rank[i]
+    assert r[-m].rank[0] == r.rank[0] and r[m - 1].rank[0] == r.rank[-1] and r[np.int64(-2)].rank[0] == r.rank[-2]
+    items = list(r)  # one-point results, in order
+    assert len(items) == m and all(isinstance(p, kdm.QueryResult) and len(p) == 1 for p in items)
+    assert np.array_equal(np.concatenate([p.xy for p in items]), r.xy)
+    assert list(r[:0]) == []
+
+
 def test_results_index_key_and_pickle_their_own_points():
     tiles = kdm.Tileset.builtin()
     # Past the top level and left of the origin too: keys hold the depth, and a negative tile's low bits.
