@@ -151,7 +151,8 @@ class DensityMap:
 
     def at(self, x: Any, y: Any) -> np.ndarray:
         """The density at world positions (arrays of x and y), as a query reads it: what fading objects in
-        by their thresholds needs (docs/runtime.md, "Fading objects in")."""
+        by their thresholds needs (docs/runtime.md, "Fading objects in"). 0 where x or y is NaN or
+        infinite (no position: as the C kdm_density_image_at)."""
         x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
         if x.shape != y.shape:
             raise ValueError(f"x and y must have one shape, got {x.shape} and {y.shape}")

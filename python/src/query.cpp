@@ -725,10 +725,12 @@ void bind_query(py::module_& m) {
             const QueryDensity& q = d.density->density;
             const double *px = x.data(), *py_ = y.data();
             double* o = out.mutable_data();
-            for (py::ssize_t i = 0; i < x.size(); ++i)  // as a query reads it at a point
-              o[i] = q.kind == QueryDensity::Kind::kConstant ? q.constant
-                     : q.kind == QueryDensity::Kind::kImage  ? q.image->at(px[i], py_[i])
-                                                             : q.callback(q.user, px[i], py_[i]);
+            // As a query reads it at a point; 0 at no position (NaN, infinite), as kdm_density_image_at.
+            for (py::ssize_t i = 0; i < x.size(); ++i)
+              o[i] = !(std::isfinite(px[i]) && std::isfinite(py_[i])) ? 0.0
+                     : q.kind == QueryDensity::Kind::kConstant        ? q.constant
+                     : q.kind == QueryDensity::Kind::kImage           ? q.image->at(px[i], py_[i])
+                                                                      : q.callback(q.user, px[i], py_[i]);
             return out;
           },
           py::arg("x"), py::arg("y"), "The density at world positions, as a query reads it");

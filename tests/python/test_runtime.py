@@ -995,6 +995,16 @@ def test_a_density_map_reads_as_queries_do_and_pickles_what_it_holds(tmp_path):
         t.query((0, 0, 10, 10), scale=1, classes=[f, 0.1], gamma=2)
 
 
+def test_a_density_map_at_no_position_is_zero_as_in_c():
+    # kdm_density_image_at's rule: a NaN or infinite coordinate has density 0 (not the first or the edge
+    # texel's, which the clamped bilinear read would give), whatever the map's kind.
+    for m in (kdm.DensityMap(np.ones((2, 2)), (0, 0, 1, 1)), kdm.DensityMap(2.0), kdm.DensityMap("ramp:4", (0, 0, 1, 1))):
+        assert m.at(0.5, 0.5) > 0
+        bad = [np.nan, np.inf, -np.inf, 0.5, 0.5, 0.5]
+        assert np.array_equal(m.at(bad, bad[::-1]), [0.0] * 6), m
+    assert kdm.DensityMap(np.ones((2, 2)), (0, 0, 1, 1)).at(float("nan"), 0.5) == 0
+
+
 def test_thresholds_of_positions_keys_are_their_points_thresholds():
     # positions(keys=True) carries keys, not tiles: given a tile of the region, their thresholds are those
     # of the query's records, negative tiles and past the top level too (a key names its tile modulo 2**21).
