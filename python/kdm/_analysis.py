@@ -36,6 +36,7 @@ def _infinite_lattice(metrics: Dict[str, Any]) -> None:
 def _class_densities(class_densities: Any, gamma: Any, invert: Any) -> List[Any]:
     """class_densities as the C++ side takes them: each a _kdm.DensitySpec or a callable (`gamma` and
     `invert` reshape image files' tones; the caller checks that some density is one)."""
+    _checks.unmasked("class_densities", class_densities, "class_densities.filled(0), no density where it is masked")
     if isinstance(class_densities, np.ndarray) and class_densities.ndim == 1:  # constants, one per class
         class_densities = [float(v) for v in class_densities]
     if isinstance(class_densities, (str, bytes, numbers.Real, np.ndarray)) or not isinstance(
@@ -193,7 +194,8 @@ def analyze(
             raise TypeError(f"{name} must hold coordinates, got booleans")
         if _checks.is_array(p) and np.size(p) == 0:
             raise ValueError(f"{name} holds no points: every set needs at least 2 points")
-    sets = [_checks.array2d(name, p) for name, p in zip(names, raw)]
+    sets = [_checks.array2d(name, p, f"np.ma.compress_rows({name}), its points without a masked coordinate")
+            for name, p in zip(names, raw)]
     for name, s in zip(names, sets):
         if s.shape[1] not in (2, 3):
             hint = f" (transposed? {name}.T has shape {s.shape[::-1]})" if s.shape[0] in (2, 3) else ""

@@ -122,8 +122,19 @@ def rect(name: str, value: Any, allow_empty: bool = False) -> Tuple[float, ...]:
     return r
 
 
-def _real_array(name: str, value: Any) -> np.ndarray:
-    """`value` as a numpy array of real numbers (bool, integer or float), else ValueError or TypeError."""
+def unmasked(name: str, value: Any, fill: str) -> None:
+    """Refuses a numpy masked array (TypeError): np.asarray drops its mask, so its masked entries would be
+    read as whatever values they hide. `fill` says what to pass instead."""
+    if isinstance(value, np.ma.MaskedArray):
+        raise TypeError(f"{name} is a masked array, and kdm would ignore its mask (reading the values it hides): "
+                        f"pass {fill}")
+
+
+def _real_array(name: str, value: Any, fill: Optional[str] = None) -> np.ndarray:
+    """`value` as a numpy array of real numbers (bool, integer or float), else ValueError or TypeError.
+    A masked array is refused (unmasked()); `fill` says what to pass instead (default: the density's
+    .filled(0))."""
+    unmasked(name, value, fill or f"{name}.filled(0), no density where it is masked")
     try:
         a = np.asarray(value)
     except ValueError as e:  # ragged nested lists
@@ -135,18 +146,23 @@ def _real_array(name: str, value: Any) -> np.ndarray:
     return a
 
 
-def array2d(name: str, value: Any) -> np.ndarray:
-    """A 2-D array of numbers as C-contiguous float64 (copied only when it is not that already)."""
-    a = _real_array(name, value)
+def array2d(name: str, value: Any, fill: Optional[str] = None) -> np.ndarray:
+    """A 2-D array of numbers as C-contiguous float64 (copied only when it is not that already); `fill` as
+    _real_array's."""
+    a = _real_array(name, value, fill)
     if a.ndim != 2:
         raise ValueError(f"{name} must be a 2-D array (rows, columns), got shape {a.shape}")
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
+# What a masked image should be filled with: paper.
+_PAPER = "image.filled(white) (1.0 for floats, 255 for uint8, 65535 for uint16): no ink where it is masked"
+
+
 def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
     """An image array as float32 samples in [0, 1] (uint8 and uint16 divided by 255 and 65535) and its
     channel count (1 for a 2-D array)."""
-    a = _real_array(name, value)
+    a = _real_array(name, value, _PAPER)
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] in (1, 2, 3, 4))):
         raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, k): k = 1 "
                          f"grey, 2 grey and alpha, 3 or 4 colour (RGB, RGBA), got shape {a.shape}")
@@ -162,6 +178,7 @@ def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
 def colour(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     """An image array as load_colour_image reads a file: (rows, columns, 3) float32 red, green and blue
     composited on white (grey: three equal channels), and its alpha (rows, columns) or None."""
+    unmasked(name, value, _PAPER)
     p, channels = _samples(name, np.asarray(value) if hasattr(value, "__array_interface__") else value)
     alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else None
     colour = p[..., :1].repeat(3, axis=2) if channels < 3 else p[..., :3]
@@ -175,6 +192,7 @@ def luminance(name: str, value: Any) -> np.ndarray:
     are; uint8 and uint16 divided by 255 and 65535; (rows, columns, 3 or 4) RGB(A), or 2 (grey and alpha),
     to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in float32 as kdm reads files (the same
     densities as the file's pixels). A PIL image is an array too."""
+    unmasked(name, value, _PAPER)
     a = np.asarray(value) if is_array(value) or hasattr(value, "__array_interface__") else value
     if getattr(a, "ndim", 0) == 2 and getattr(a, "dtype", None) is not None and a.dtype.kind == "f":
         return np.ascontiguousarray(a, dtype=np.float64)  # luminance as given (checked in [0, 1] after)
@@ -297,6 +315,7 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
 
 def class_specs(classes: Any, gamma: Any, invert: Any) -> list:
     """The full sampler's classes: 1 to 8 densities (numbers, str or 2-D arrays), as _kdm.DensitySpec."""
+    unmasked("classes", classes, "classes.filled(0), no density where it is masked")
     if isinstance(classes, np.ndarray) and classes.ndim == 1:  # constant densities, one per class
         classes = [float(v) for v in classes]
     if isinstance(classes, (str, bytes, numbers.Real)) or not isinstance(classes, Sequence):

@@ -334,6 +334,28 @@ def cheap_calls():
     return calls
 
 
+def test_masked_arrays_are_refused_saying_what_to_pass():
+    # np.asarray drops a mask: the values it hides would be read as densities, pixels or points.
+    mask = [[1, 0], [0, 0]]
+    density = np.ma.masked_array(np.ones((2, 2)), mask)
+    fill = r"is a masked array, and kdm would ignore its mask .*: pass density.filled\(0\)"
+    for call in (lambda: kdm.sample(10, density), lambda: kdm.sample(10, np.ma.masked_array(np.ones((2, 2, 2))), dim=3),
+                 lambda: kdm.DensityMap(density, (0, 0, 1, 1)), lambda: TILES.query((0, 0, 1, 1), scale=10, density=density),
+                 lambda: kdm.analyze(kdm.sample(50, seed=1), density=density, energy=False)):
+        raises(TypeError, fill, call)
+    raises(TypeError, r"classes\[1\] is a masked array.*classes\[1\].filled\(0\)",
+           lambda: kdm.sample(10, classes=[1.0, density]))
+    raises(TypeError, r"classes is a masked array", lambda: kdm.sample(10, classes=np.ma.masked_array([1.0, 2.0], [1, 0])))
+    raises(TypeError, r"class_densities is a masked array", lambda: kdm.analyze(
+        kdm.sample(50, seed=1), np.arange(50) % 2, class_densities=np.ma.masked_array([1.0, 2.0], [1, 0])))
+    image = np.ma.masked_array(np.full((2, 2), 0.5), mask)
+    for call in (lambda: kdm.stipple(image), lambda: kdm.separate(np.ma.masked_array(np.ones((2, 2, 3))))):
+        raises(TypeError, r"image is a masked array.*image.filled\(white\)", call)
+    raises(TypeError, r"points is a masked array.*np.ma.compress_rows\(points\)",
+           lambda: kdm.analyze(np.ma.masked_array(np.random.default_rng(1).random((10, 2)))))
+    assert len(kdm.sample(10, density.filled(0), seed=1)) == 10  # as suggested
+
+
 def test_random_bad_arguments_never_crash():
     rng = np.random.default_rng(2024)
     outcomes = {"ok": 0, "refused": 0}
