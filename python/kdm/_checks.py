@@ -167,8 +167,10 @@ def _samples(name: str, value: Any) -> Tuple[np.ndarray, int]:
         raise ValueError(f"{name} must be a 2-D array (rows, columns) of luminance, or (rows, columns, k): k = 1 "
                          f"grey, 2 grey and alpha, 3 or 4 colour (RGB, RGBA), got shape {a.shape}")
     full = {np.dtype(np.uint8): 255, np.dtype(np.uint16): 65535}.get(a.dtype)
-    if full is None and a.dtype.kind != "f":
-        raise ValueError(f"{name}: integer arrays must be uint8 (0-255) or uint16 (0-65535), got {a.dtype}")
+    if full is None and a.dtype.kind != "f":  # int64, say, has no white: 8-bit levels or 0 and 1?
+        plain = " (as a list of Python ints makes)" if a.dtype == np.dtype(int) else ""
+        raise ValueError(f"{name}: integer arrays must be uint8 (0-255) or uint16 (0-65535), got {a.dtype}{plain}: "
+                         f"pass 8-bit levels as np.asarray({name}, np.uint8), or luminances as floats in [0, 1]")
     p = a.astype(np.float32) / np.float32(full or 1)
     if full is None and not (np.isfinite(p).all() and p.min(initial=0) >= 0 and p.max(initial=0) <= 1):
         raise ValueError(f"{name}: values must be in [0, 1] (8-bit pixels: pass them as uint8, or divide by 255)")

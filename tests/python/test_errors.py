@@ -277,6 +277,8 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, r"luminances in \[0, 1\], got 1e\+300 \(8-bit", lambda: kdm.stipple(np.full((4, 4), 1e300))),
     (ValueError, r"got 255 \(8-bit pixels: pass them as uint8", lambda: kdm.stipple(np.full((4, 4), 255.0))),
     (ValueError, "integer arrays must be uint8", lambda: kdm.stipple(np.zeros((4, 4), dtype=np.int64))),
+    (ValueError, r"got int64 \(as a list of Python ints makes\): pass 8-bit levels as np.asarray\(image, "
+     r"np.uint8\), or luminances as floats in \[0, 1\]", lambda: kdm.stipple([[0, 0], [0, 0]])),
     (ValueError, r"values must be in \[0, 1\] \(8-bit pixels", lambda: kdm.stipple(np.full((4, 4, 3), 2.0))),
     (ValueError, r"or \(rows, columns, k\): k = 1 grey, 2 grey and alpha, 3 or 4 colour \(RGB, RGBA\), got "
      r"shape \(4, 4, 5\)", lambda: kdm.stipple(np.zeros((4, 4, 5)))),
