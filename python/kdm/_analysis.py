@@ -164,7 +164,9 @@ def analyze(
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles
-        count only where the density is at least that fraction of its largest value.
+        count only where the density is at least that fraction of its largest value. The last two need a
+        density (`density` or `class_densities`): without one, another value than the default is a
+        ValueError.
 
     Returns
     -------
@@ -236,6 +238,10 @@ def analyze(
     min_expected = _checks.number("min_expected", min_expected, 0.0, strict=True)
     density_bands = _checks.integer("density_bands", density_bands, 1, 1000)
     holes_min_density = _checks.number("holes_min_density", holes_min_density, 0.0)
+    if spec is None and function is None and not own:  # they would do nothing: refused, as gamma is
+        idle = "holes_min_density" if holes_min_density != 0 else "density_bands" if density_bands != 10 else None
+        if idle:
+            raise ValueError(f"{idle} applies with a density (density or class_densities), and none is given")
     if sets[0].shape[1] == 2 and isinstance(aspect, (Sequence, np.ndarray)) and not isinstance(aspect, (str, bytes)):
         raise ValueError("aspect=(x, y, z) gives a 3-D domain's sides, and the points are 2-D: give one number "
                          "(width / height)")

@@ -833,6 +833,15 @@ TEST_F(CliTest, AnalyzeReportsTheBiasOfEveryDensityBand) {
   expect_error("sample -n 100 --density ramp:0.5 -o '" + path("z.txt") + "'", "[1, 1e9]");
   expect_error("sample -n 100 --density radial: -o '" + path("z.txt") + "'", "dynamic range");
   expect_error("analyze '" + path("ramp.txt") + "' --density-bands 0 -o '" + path("m") + "'", "1 to 1000");
+  // Without a density the bands and the holes' density floor would do nothing: refused, as --gamma is.
+  expect_error("analyze '" + path("ramp.txt") + "' --density-bands 5",
+               "--density-bands applies with a density (--density or --class-density), and none is given");
+  expect_error("analyze '" + path("ramp.txt") + "' --holes-min-density 0.5", "--holes-min-density applies");
+  const Outcome floor =
+      kdm("analyze '" + path("ramp.txt") + "' --box --density ramp:100 --holes-min-density 0.5 --no-energy");
+  EXPECT_EQ(floor.status, 0) << floor.err;
+  // --min-expected also sizes the uniformity check's windows (the spectrum's "nonuniform"): taken alone.
+  EXPECT_EQ(kdm("analyze '" + path("ramp.txt") + "' --min-expected 50 --no-energy").status, 0);
 }
 
 }  // namespace

@@ -371,6 +371,13 @@ def test_analyze_takes_a_function_as_the_density(gradient_png):
         kdm.analyze(points, density=lambda x, y: float("nan"), energy=False)
     with pytest.raises(ValueError, match="gamma and invert apply to image files only"):
         kdm.analyze(points, density=ramp, invert=True)
+    # The bands and the holes' density floor need a density: without one they would do nothing.
+    for option in (dict(holes_min_density=0.5), dict(density_bands=5)):
+        with pytest.raises(ValueError, match=f"{next(iter(option))} applies with a density"):
+            kdm.analyze(points, energy=False, **option)
+    floor = kdm.analyze(points, box=True, density=ramp, holes_min_density=0.5, density_bands=5, energy=False)
+    assert len(floor["density"]["bands"]) == 5
+    kdm.analyze(points, energy=False, min_expected=50)  # also the uniformity check's windows: taken alone
 
 
 def test_stipple_never_writes_over_its_image(tmp_path):

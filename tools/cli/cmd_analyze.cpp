@@ -296,6 +296,14 @@ void run_analyze(const AnalyzeArgs& args) {
   if (!(args.holes_min_density >= 0 && args.holes_min_density <= 1))
     throw CommandError("--holes-min-density must be in [0, 1]");
   o.holes_min_density = args.holes_min_density;
+  // Without a density these would do nothing: refused, as --gamma is.
+  const analysis::AnalysisOptions defaults;
+  const char* idle = args.holes_min_density != defaults.holes_min_density ? "--holes-min-density"
+                     : args.density_bands != defaults.density_bands       ? "--density-bands"
+                                                                          : nullptr;
+  if (idle && args.density.empty() && args.class_densities.empty())
+    throw CommandError(std::string(idle) +
+                       " applies with a density (--density or --class-density), and none is given");
   o.tile_size = args.tile_size;
   o.threads = args.threads;
   try {
@@ -478,8 +486,8 @@ void add_analyze_command(CLI::App& app) {
                   "its largest value (0.5: the dark half of a picture)")
       ->capture_default_str();
   cmd->add_option("--density-bands", args->density_bands,
-                  "Bands of the per-band bias table: the points where the target density lies in each "
-                  "band (equal steps in log density) against the count it should get")
+                  "With --density: bands of the per-band bias table, the points where the target density "
+                  "lies in each band (equal steps in log density) against the count it should get")
       ->capture_default_str();
   cmd->add_option(
       "--aspect", args->aspect,
