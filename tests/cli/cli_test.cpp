@@ -545,6 +545,8 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"
   expect_error("sample --n 4000000000" + out, "too large");  // beyond 2^31 points
   expect_error("sample --n 100000000" + out, "about 8.86e+06 points at most");  // over max_grid_nodes
+  // Over max_grid_nodes by resolution: the largest resolution that fits, not "about 0 points at most".
+  expect_error("sample --n 0 --resolution 100000" + out, "a resolution of at most 1");
   expect_error("sample --n 100 --temperature nan" + out, "temperature");
   expect_error("sample --n 100 --temperature -0.5" + out, "temperature");
   expect_error("sample --n 100 --temperature 1e4" + out, "temperature must be at most 1000");

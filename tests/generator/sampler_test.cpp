@@ -525,6 +525,39 @@ TEST(SamplerTest, TheCountAGridLimitNamesFits) {
   EXPECT_EQ(named(4 * most), most);      // the same figure from any count asked
 }
 
+// A resolution past the grid limit is refused naming the largest resolution that fits (as a count names a
+// count: not "0 points at most", the count a resolution leaves unasked), and that one is sampled.
+TEST(SamplerTest, TheResolutionAGridLimitNamesFits) {
+  SamplerOptions o = options_for(0, Domain::kTorus);
+  o.max_grid_nodes = 1 << 14;
+  const auto named = [&](int resolution) -> int {
+    o.resolution = resolution;
+    try {
+      sample(o);
+      return -1;
+    } catch (const InvalidArgument& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find("points"), std::string::npos) << what;
+      const std::size_t at = what.find("at most ");
+      EXPECT_NE(at, std::string::npos) << what;
+      return at == std::string::npos ? 0 : std::atoi(what.c_str() + at + 8);
+    }
+  };
+  const int most = named(100000);
+  ASSERT_GE(most, 2);
+  EXPECT_EQ(named(most), -1);        // fits
+  EXPECT_GT(named(most + 1), 0);     // the largest: one more does not
+  EXPECT_EQ(named(4 * most), most);  // the same figure from any resolution asked
+  o.extent[0] = 1e6;                 // too long a domain for even the smallest grid
+  o.resolution = 2;
+  try {
+    sample(o);
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("no resolution fits"), std::string::npos) << e.what();
+  }
+}
+
 // A domain whose short side would be one grid node wide is refused (its points bunched up: 300 at aspect
 // 5000 all in the left half); one just inside the limit (two nodes) covers both of its sides. An extreme
 // aspect ratio is refused before its grid's size overflows an int.

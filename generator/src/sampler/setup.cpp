@@ -429,6 +429,29 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
     }
   } else {
     if (o.resolution < 2) throw InvalidArgument("grid resolution must be at least 2 nodes");
+    const auto fits = [&](double resolution) {
+      double dims[D];
+      int grid_levels = 0;
+      return grid_dims<D>(o, resolution, grid_levels, dims) <= double(o.max_grid_nodes);
+    };
+    if (!fits(o.resolution)) {  // make_grid's refusal speaks of a count of points, which none asked for
+      double lo = 1, hi = o.resolution;  // lo: the largest resolution known to fit (1 if none does)
+      while (hi - lo > 1) {
+        const double mid = std::floor((lo + hi) / 2);
+        (fits(mid) ? lo : hi) = mid;
+      }
+      double dims[D];
+      int grid_levels = 0;
+      std::ostringstream s;
+      s << "grid resolution " << o.resolution << " needs a computational grid of "
+        << grid_dims<D>(o, o.resolution, grid_levels, dims) << " nodes, more than the limit of "
+        << o.max_grid_nodes << ": ";
+      if (lo >= 2)
+        s << "a resolution of at most " << lo << " fits this domain (ask for a smaller one)";
+      else
+        s << "no resolution fits this domain (ask for a squarer one)";
+      throw InvalidArgument(s.str());
+    }
     grid = make_grid<D>(o, o.resolution, levels, [] { return std::nan(""); });
     rho = sample_density<D>(grid, density, threads);
     const double mx = *std::max_element(rho.begin(), rho.end());
