@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -409,7 +410,7 @@ TEST_F(CliTest, SampleWritesSeveralSets) {
 }
 
 /// `values` (depth × height × width, in numpy's C order) as np.save writes a 3-D array of `descr` ('<f8',
-/// '<f4' or '|u1'); `shape` overrides the header's shape.
+/// '<f4', big-endian '>f8' or '>f4', or '|u1'); `shape` overrides the header's shape.
 std::string npy_volume(const std::vector<double>& values, int depth, int height, int width,
                        const std::string& descr = "<f4", const std::string& shape = "") {
   const std::string dims =
@@ -423,14 +424,16 @@ std::string npy_volume(const std::vector<double>& values, int depth, int height,
   bytes += static_cast<char>(header.size() >> 8);
   bytes += header;
   for (double v : values) {
-    if (descr == "<f8") {
+    const std::size_t at = bytes.size();
+    if (descr.substr(1) == "f8") {
       bytes.append(reinterpret_cast<const char*>(&v), 8);  // x86-64: little-endian already
-    } else if (descr == "<f4") {
+    } else if (descr.substr(1) == "f4") {
       const float f = static_cast<float>(v);
       bytes.append(reinterpret_cast<const char*>(&f), 4);
     } else {
       bytes += static_cast<char>(static_cast<unsigned char>(v));
     }
+    if (descr[0] == '>') std::reverse(bytes.begin() + std::ptrdiff_t(at), bytes.end());
   }
   return bytes;
 }
@@ -451,7 +454,8 @@ double fraction_below_half(const std::string& file, int axis) {
 // points below z = 1/2 (the linear fall from 4 to 1 between the two middle voxel centres; measured
 // 0.7768-0.7800 at 4,000 points in a cube over seeds 1-8, sd 0.0009: tests/generator/sampler_test.cpp;
 // bound ±0.008),
-// one 4× denser in its first 4 rows as many above y = 1/2. float64, float32 and uint8 give the same bits.
+// one 4× denser in its first 4 rows as many above y = 1/2. float64, float32 and uint8 give the same bits,
+// and so does big-endian float64.
 TEST_F(CliTest, SampleReadsNumPyVolumes) {
   const int s = 8;
   std::vector<double> by_slice(s * s * s, 1.0), by_row(s * s * s, 1.0);
@@ -464,6 +468,7 @@ TEST_F(CliTest, SampleReadsNumPyVolumes) {
   std::ofstream(path("z.npy"), std::ios::binary) << npy_volume(by_slice, s, s, s);
   std::ofstream(path("y.npy"), std::ios::binary) << npy_volume(by_row, s, s, s, "<f8");
   std::ofstream(path("y8.npy"), std::ios::binary) << npy_volume(by_row, s, s, s, "|u1");
+  std::ofstream(path("yb.npy"), std::ios::binary) << npy_volume(by_row, s, s, s, ">f8");
   const std::string run = "sample --dim 3 --n 4000 --threads 2 --density '";
   ASSERT_EQ(kdm(run + path("z.npy") + "' -o '" + path("z.txt") + "'").status, 0);
   ASSERT_EQ(kdm(run + path("y.npy") + "' -o '" + path("y.txt") + "'").status, 0);
@@ -474,6 +479,9 @@ TEST_F(CliTest, SampleReadsNumPyVolumes) {
   EXPECT_NEAR(1 - fraction_below_half(path("y.txt"), 1), expected, 0.008);
   auto points = [](const std::string& text) { return text.substr(text.find("\n0")); };  // past the header
   EXPECT_EQ(points(slurp(path("y.txt"))), points(slurp(path("y8.txt"))));
+  const Outcome big = kdm(run + path("yb.npy") + "' -o '" + path("yb.txt") + "'");
+  ASSERT_EQ(big.status, 0) << big.err;
+  EXPECT_EQ(points(slurp(path("y.txt"))), points(slurp(path("yb.txt"))));
   // The domain is a box with the volume's voxel counts as sides, as --aspect W:H:D gives it.
   std::ofstream(path("flat.npy"), std::ios::binary)
       << npy_volume(std::vector<double>(2 * 4 * 8, 1.0), 2, 4, 8);
@@ -514,7 +522,7 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   bad[5] = std::nan("");
   std::ofstream(path("nan.npy"), std::ios::binary) << npy_volume(bad, 2, 2, 2, "<f8");
   std::ofstream(path("zero.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 0.0), 2, 2, 2);
-  std::ofstream(path("i2.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, ">f4");  // big-endian
+  std::ofstream(path("c.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, "<c8");  // complex
   std::ofstream(path("short.npy"), std::ios::binary) << npy_volume(std::vector<double>(7, 1.0), 2, 2, 2);
   const std::string v = " --density '" + path("v.npy") + "'";
   expect_error("sample --n 100 --dim 3 --density '" + path("flat.npy") + "'" + out, "image densities are 2D");
@@ -524,8 +532,10 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   expect_error("sample --n 100 --dim 3 --density '" + path("nan.npy") + "'" + out,
                "at [1, 0, 1]: densities must be finite");
   expect_error("sample --n 100 --dim 3 --density '" + path("zero.npy") + "'" + out, "zero everywhere");
-  expect_error("sample --n 100 --dim 3 --density '" + path("i2.npy") + "'" + out,
-               "data of type '>f4': expected little-endian real numbers");
+  expect_error(
+      "sample --n 100 --dim 3 --density '" + path("c.npy") + "'" + out,
+      "data of type '<c8': expected real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool; "
+      "either byte order)");
   expect_error("sample --n 100 --dim 3 --density '" + path("short.npy") + "'" + out, "cut short");
   expect_error("sample --n 100 --dim 3 --gamma 2" + v + out, "--gamma and --invert apply to images only");
   expect_error("sample --n 100 --class '" + path("v.npy") + "'" + out, "3-D volume");

@@ -74,17 +74,13 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   NpyHeader h;
   std::string what;
   if (!read_npy_header(buffer, h, what)) throw fail(what);
-  // Little-endian (or single-byte) reals as numpy writes them: float16/32/64, (u)int8 to 64, bool.
-  const char kind = h.descr.size() == 3 ? h.descr[1] : 0;
-  const std::size_t bytes = h.descr.size() == 3 ? std::size_t(h.descr[2] - '0') : 0;
-  const bool order = h.descr[0] == '<' || (h.descr[0] == '|' && bytes == 1);
-  const bool sized =
-      kind == 'f'   ? bytes == 2 || bytes == 4 || bytes == 8
-      : kind == 'b' ? bytes == 1
-                    : (kind == 'u' || kind == 'i') && (bytes == 1 || bytes == 2 || bytes == 4 || bytes == 8);
-  if (!order || !sized)
+  // Reals as numpy writes them, in either byte order: float16/32/64, (u)int8 to 64, bool.
+  NpyScalar type;
+  if (!parse_npy_scalar(h.descr, type))
     throw fail("data of type '" + h.descr +
-               "': expected little-endian real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool)");
+               "': expected real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool; either byte "
+               "order)");
+  const std::size_t bytes = type.bytes;
   std::string dims;
   for (std::size_t i = 0; i < h.shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(h.shape[i]);
   if (h.shape.size() != 2 && h.shape.size() != 3)
@@ -110,28 +106,7 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
                                                 static_cast<std::streamsize>(n * bytes))) != n * bytes)
       throw fail("cut short: its header promises " + std::to_string(count) + " values");
     for (std::uint64_t k = 0; k < n; ++k) {
-      std::uint64_t bits = 0;  // little-endian, whatever this machine's order
-      for (std::size_t b = bytes; b-- > 0;) bits = bits << 8 | chunk[k * bytes + b];
-      double v;
-      if (kind == 'f' && bytes == 8) {
-        std::memcpy(&v, &bits, 8);
-      } else if (kind == 'f' && bytes == 4) {
-        const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
-        float f;
-        std::memcpy(&f, &b32, 4);
-        v = f;
-      } else if (kind == 'f') {  // IEEE half: sign, 5 exponent bits, 10 mantissa bits
-        const int exponent = int(bits >> 10 & 31), mantissa = int(bits & 1023);
-        v = exponent == 31  ? (mantissa ? std::nan("") : HUGE_VAL)
-            : exponent == 0 ? std::ldexp(mantissa, -24)
-                            : std::ldexp(1024 + mantissa, exponent - 25);
-        if (bits >> 15 & 1) v = -v;
-      } else if (kind == 'i') {  // two's complement of `bytes` bytes
-        const unsigned shift = unsigned(64 - 8 * bytes);
-        v = double(static_cast<std::int64_t>(bits << shift) >> shift);
-      } else {
-        v = double(kind == 'b' ? bits != 0 : bits);
-      }
+      const double v = npy_scalar_value(chunk + k * bytes, type);
       // The element's numpy index [slice, row, column], in either order.
       const std::uint64_t at = done + k;
       std::uint64_t z, row, col;

@@ -332,15 +332,59 @@ bool read_npy_header(std::streambuf& in, NpyHeader& out, std::string& what) {
   return true;
 }
 
+bool parse_npy_scalar(const std::string& descr, NpyScalar& type) {
+  if (descr.size() != 3) return false;
+  const char order = descr[0], kind = descr[1];
+  const std::size_t bytes = descr[2] >= '1' && descr[2] <= '8' ? std::size_t(descr[2] - '0') : 0;
+  // '|' (no order) only for single bytes, as numpy writes them; '<' and '>' for any size.
+  if (!(order == '<' || order == '>' || (order == '|' && bytes == 1))) return false;
+  const bool sized =
+      kind == 'f'   ? bytes == 2 || bytes == 4 || bytes == 8
+      : kind == 'b' ? bytes == 1
+                    : (kind == 'u' || kind == 'i') && (bytes == 1 || bytes == 2 || bytes == 4 || bytes == 8);
+  if (!sized) return false;
+  type.kind = kind, type.bytes = bytes, type.big_endian = order == '>';
+  return true;
+}
+
+double npy_scalar_value(const unsigned char* p, const NpyScalar& type) {
+  const std::size_t bytes = type.bytes;
+  std::uint64_t bits = 0;  // the number's bits, whatever this machine's order
+  for (std::size_t b = 0; b < bytes; ++b) bits = bits << 8 | p[type.big_endian ? b : bytes - 1 - b];
+  if (type.kind == 'f' && bytes == 8) {
+    double v;
+    std::memcpy(&v, &bits, 8);
+    return v;
+  }
+  if (type.kind == 'f' && bytes == 4) {
+    const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
+    float f;
+    std::memcpy(&f, &b32, 4);
+    return f;
+  }
+  if (type.kind == 'f') {  // IEEE half: sign, 5 exponent bits, 10 mantissa bits
+    const int exponent = int(bits >> 10 & 31), mantissa = int(bits & 1023);
+    const double v = exponent == 31  ? (mantissa ? std::nan("") : HUGE_VAL)
+                     : exponent == 0 ? std::ldexp(mantissa, -24)
+                                     : std::ldexp(1024 + mantissa, exponent - 25);
+    return bits >> 15 & 1 ? -v : v;
+  }
+  if (type.kind == 'i') {  // two's complement of `bytes` bytes
+    const unsigned shift = unsigned(64 - 8 * bytes);
+    return double(static_cast<std::int64_t>(bits << shift) >> shift);
+  }
+  return double(type.kind == 'b' ? bits != 0 : bits);
+}
+
 namespace {
 
 /// The first bytes of a NumPy .npy file (np.save).
 constexpr char kNpyMagic[] = "\x93NUMPY";
 
-/// Reads a NumPy .npy file's sets, after its magic: an (n, 2) or (n, 3) array of little-endian float64 or
-/// float32, in C or Fortran order, is one set; a (sets, n, 2) or (sets, n, 3) array in C order (kdm sample
-/// --sets) is that many. The header is untrusted (read_npy_header), and the data read as it comes (a header
-/// that promises more than the file holds allocates nothing of it).
+/// Reads a NumPy .npy file's sets, after its magic: an (n, 2) or (n, 3) array of float64 or float32 (either
+/// byte order), in C or Fortran order, is one set; a (sets, n, 2) or (sets, n, 3) array in C order
+/// (kdm sample --sets) is that many. The header is untrusted (read_npy_header), and the data read as it comes
+/// (a header that promises more than the file holds allocates nothing of it).
 bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& sets, std::string& error) {
   auto fail = [&](const std::string& what) {
     error = path + ": NumPy .npy file: " + what;
@@ -357,15 +401,11 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
   const std::string& descr = h.descr;
   const int fortran = h.fortran ? 1 : 0;
   const std::vector<std::uint64_t>& shape = h.shape;
-  std::size_t width = 0;
-  if (descr == "<f8")
-    width = 8;
-  else if (descr == "<f4")
-    width = 4;
-  else if (descr == ">f8" || descr == ">f4")
-    return fail("big-endian data ('" + descr + "'): save it as little-endian float64 (astype('<f8'))");
-  else
-    return fail("data of type '" + excerpt(descr) + "': expected float64 or float32 ('<f8' or '<f4')");
+  NpyScalar type;
+  if (!parse_npy_scalar(descr, type) || type.kind != 'f' || type.bytes < 4)
+    return fail("data of type '" + excerpt(descr) +
+                "': expected float64 or float32 ('<f8' or '<f4', or big-endian '>f8' or '>f4')");
+  const std::size_t width = type.bytes;
   std::string dims;
   for (std::size_t i = 0; i < shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(shape[i]);
   const bool several = shape.size() == 3;  // (sets, n, dim)
@@ -390,17 +430,7 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
     if (!read(chunk, values * width))
       return fail("cut short: its header promises " + std::to_string(count) + " values");
     for (std::size_t k = 0; k < values; ++k) {
-      std::uint64_t bits = 0;  // little-endian, whatever this machine's order
-      for (std::size_t b = width; b-- > 0;) bits = bits << 8 | chunk[k * width + b];
-      double v;
-      if (width == 8) {
-        std::memcpy(&v, &bits, 8);
-      } else {
-        const std::uint32_t b32 = static_cast<std::uint32_t>(bits);
-        float f;
-        std::memcpy(&f, &b32, 4);
-        v = f;
-      }
+      const double v = npy_scalar_value(chunk + k * width, type);
       if (!std::isfinite(v)) {
         const std::uint64_t at = done + k;
         return fail("a non-finite coordinate in row " +

@@ -88,6 +88,20 @@ struct NpyHeader {
 /// bounded. Returns false with `what` naming the problem ("cut short in its header", "a malformed 'shape'").
 bool read_npy_header(std::streambuf& in, NpyHeader& header, std::string& what);
 
+/// A .npy element type kdm reads (NpyHeader::descr): a real number in either byte order, as np.save writes
+/// it ('<f8', '>f4', '|u1', '|b1').
+struct NpyScalar {
+  char kind = 0;          ///< 'f' float, 'i' signed integer, 'u' unsigned integer, 'b' bool
+  std::size_t bytes = 0;  ///< float 2, 4 or 8; integer 1, 2, 4 or 8; bool 1
+  bool big_endian = false;
+};
+
+/// Parses `descr` into `type`; false for anything else (complex numbers, strings, records, datetimes).
+bool parse_npy_scalar(const std::string& descr, NpyScalar& type);
+
+/// The value of the element of `type` at `bytes` (as stored in the file), whatever this machine's order.
+double npy_scalar_value(const unsigned char* bytes, const NpyScalar& type);
+
 /// Writes `set` as text ('#' header lines from `header`, one point per line, 17 significant digits),
 /// or as CSV when its format (output_format(path, format)) is ".csv" (with a class column for labelled
 /// points, which only CSV carries: false with `error` for a labelled set and another format). Atomic
