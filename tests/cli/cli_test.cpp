@@ -532,6 +532,14 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   expect_error("sample --n 100 --dim 3 --density '" + path("nan.npy") + "'" + out,
                "at [1, 0, 1]: densities must be finite");
   expect_error("sample --n 100 --dim 3 --density '" + path("zero.npy") + "'" + out, "zero everywhere");
+  // A 2-D array of zeros is an array, not a picture: no talk of white images and ink.
+  std::ofstream(path("zero2.npy"), std::ios::binary)
+      << npy_volume(std::vector<double>(4, 0.0), 0, 0, 0, "<f4", "2, 2");
+  const std::string zeros = "sample --n 100 --density '" + path("zero2.npy") + "'" + out;
+  expect_error(zeros, "array '" + path("zero2.npy") + "': its densities are zero everywhere");
+  const std::string said = kdm(zeros).err, why = said.substr(std::min(said.size(), said.find("zero2.npy'")));
+  EXPECT_EQ(said.find("image '"), std::string::npos) << said;
+  EXPECT_EQ(why.find("ink"), std::string::npos) << said;
   expect_error(
       "sample --n 100 --dim 3 --density '" + path("c.npy") + "'" + out,
       "data of type '<c8': expected real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool; "

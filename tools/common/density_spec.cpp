@@ -94,6 +94,7 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
     throw fail("an array of shape (" + dims + "): more than 2^26 values (the image size limit)");
   DensitySpec spec;
   spec.kind = flat ? DensitySpec::Kind::kImage : DensitySpec::Kind::kVolume;
+  spec.array = true;
   spec.text = path;
   spec.width = static_cast<int>(cols), spec.height = static_cast<int>(rows);
   if (!flat) spec.depth = static_cast<int>(d);

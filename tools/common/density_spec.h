@@ -26,6 +26,7 @@ struct DensitySpec {
   /// gen::DensityVolume lays them out (x fastest, row 0 at the bottom, slice 0 at z near 0).
   std::vector<float> values;
   bool inverted = false;  ///< kImage: luminance is the density (else darkness)
+  bool array = false;     ///< kImage, kVolume: read from a NumPy .npy array of densities (not a picture)
   std::string text;       ///< what it was parsed from (for messages)
 
   /// Whether the density is a function of position (the test maps), not a constant, image or volume.

@@ -36,6 +36,11 @@ gen::Density to_generator_density(const DensitySpec& spec) {
     return gen::Density::from_values(spec.width, spec.height, spec.values);
   } catch (const gen::InvalidArgument& e) {
     const bool blank = std::string(e.what()).find("zero everywhere") != std::string::npos;
+    if (spec.array)  // numbers, not a picture's ink
+      throw std::invalid_argument("array '" + spec.text + "': " +
+                                  (blank ? "its densities are zero everywhere: nothing to sample (it needs "
+                                           "some density > 0)"
+                                         : e.what()));
     throw std::invalid_argument("image '" + spec.text + "': " + e.what() +
                                 (blank && !spec.inverted ? " (an all-white image has no ink)" : ""));
   }
