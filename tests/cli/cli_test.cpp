@@ -1057,6 +1057,11 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
     EXPECT_NE(slurp(path("a/metrics.json")).find("\"empty_circles_skipped\""), std::string::npos);
   }
   expect_error("verify '" + path("a/metrics.json") + "' --runs 1001", "--runs must be in [2, 1000]");
+  // --level is refused by name, as --runs is, not by the parser's "Could not convert".
+  expect_error("verify '" + path("a/metrics.json") + "' --level -1",
+               "--level must be a level number >= 0 (the first is 0), got -1");
+  expect_error("verify '" + path("a/metrics.json") + "' --level 5000000000",
+               "--level 5000000000 is not in the tile set");
   // A directory or an endless device where a tile set or a recipe belongs fails at once, saying so.
   expect_error("info '" + path("dir.png") + "'", "is a directory, not a tile set file");
   expect_error("query --tileset '" + path("dir.png") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",

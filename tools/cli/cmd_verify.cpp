@@ -3,8 +3,11 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "checked_options.h"
@@ -20,6 +23,7 @@ struct VerifyArgs {
   std::string path;
   verify::VerifyOptions options;
   bool no_seams = false, no_direct = false, no_glide_track = false, quiet = false;
+  std::vector<std::int64_t> levels;  ///< --level, signed: -1 is refused by name, not by CLI11's conversion
 };
 
 void run_verify(VerifyArgs args) {
@@ -32,6 +36,14 @@ void run_verify(VerifyArgs args) {
     throw CommandError("--handover-rows must be in [1, 1000]");
   if (args.options.reference_runs < 2 || args.options.reference_runs > 1000)
     throw CommandError("--runs must be in [2, 1000]");
+  for (const std::int64_t level : args.levels) {
+    if (level < 0)
+      throw CommandError("--level must be a level number >= 0 (the first is 0), got " +
+                         std::to_string(level));
+    if (level > std::numeric_limits<std::uint32_t>::max())
+      throw CommandError("--level " + std::to_string(level) + " is not in the tile set");
+    args.options.levels.push_back(static_cast<std::uint32_t>(level));
+  }
   TilesetData set;
   std::string detail;
   const std::vector<char> bytes = read_tileset_input(args.path);
@@ -69,7 +81,7 @@ void add_verify_command(CLI::App& app) {
   cmd->add_option("file", args->path, "Tile-set file ('-': standard input)")->required();
   cmd->add_option("--runs", args->options.reference_runs, "Full-sampler reference runs per level (2 to 1000)")
       ->capture_default_str();
-  cmd->add_option("--level", args->options.levels,
+  cmd->add_option("--level", args->levels,
                   "Judge only these levels and the keyframes within them (repeatable; default: all)");
   cmd->add_option("--spectrum-budget", args->options.spectrum_budget,
                   "Largest tile torus (points) whose spectra (lowP, RAPS) are computed (default: every one)")
