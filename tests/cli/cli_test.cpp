@@ -1747,6 +1747,15 @@ TEST_F(CliTest, OutputsGoIntoPipesAndABakeKeepsItsRecipe) {
 
   expect_error("bake '" + path("r.recipe") + "' -o '" + path("r.recipe") + "'", "is the recipe");
   EXPECT_EQ(slurp(path("r.recipe")), "levels 1\ncolours 1\nsweeps 2\n");
+  // A name of another format gets its tile set, with a warning; a .kdmt name (above) none.
+  EXPECT_EQ(b.err.find("warning"), std::string::npos) << b.err;
+  const Outcome txt = kdm("bake '" + path("r.recipe") + "' --threads 1 -o '" + path("r.txt") + "'");
+  ASSERT_EQ(txt.status, 0) << txt.err;
+  EXPECT_NE(txt.err.find("kdm bake: warning: '" + path("r.txt") + "' receives a tile set"), std::string::npos)
+      << txt.err;
+  const std::string written = slurp(path("r.txt"));
+  kdm::Tileset baked;
+  EXPECT_EQ(kdm::Tileset::load_memory(written.data(), written.size(), baked), kdm::Status::kOk);
 }
 
 // A set baked without a glide track: smooth mode gives its stable positions, and both commands that query

@@ -20,6 +20,7 @@
 #include "kdm/generator/bake.h"
 #include "kdm/generator/sampler.h"
 #include "kdm/runtime/tileset.h"
+#include "point_io.h"
 #include "point_output.h"
 #include "progress.h"
 
@@ -84,6 +85,11 @@ void run_bake(const std::string& recipe_path, const std::string& output, int thr
   std::string detail;
   if (const Status s = check_tileset_path(output, &detail); s != Status::kOk)  // before minutes of baking
     throw CommandError(std::string(status_message(s)) + ": " + detail);
+  // Said before the minutes of baking: a .txt or .png name expects what the other commands write there.
+  if (const std::string ext = tools::output_format(output); !ext.empty() && ext != ".kdmt")
+    std::fprintf(stderr,
+                 "kdm bake: warning: '%s' receives a tile set (binary, as .kdmt files), not a %s file\n",
+                 output.c_str(), ext.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("baking");
   gen::BakeReport report;
