@@ -792,6 +792,13 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   EXPECT_NE(thousand.err.find("1000 points"), std::string::npos) << thousand.err;
   expect_error("sample --n 10", "--output");
   expect_error("sample --n 10 --aspect -1" + out, "--aspect");
+  // W:H is the shape W / H; in 3D it is refused, where one number or X:Y:Z says which sides.
+  ASSERT_EQ(kdm("sample --n 200 --aspect 3:2 -o '" + path("wh.txt") + "'").status, 0);
+  ASSERT_EQ(kdm("sample --n 200 --aspect 1.5 -o '" + path("a.txt") + "'").status, 0);
+  EXPECT_EQ(slurp(path("wh.txt")), slurp(path("a.txt")));
+  expect_error("sample --dim 3 --n 10 --aspect 2:1" + out, "--aspect W:H is a 2D domain's shape");
+  expect_error("sample --n 10 --aspect 1:2:3:4" + out,
+               "one number, two sides W:H or three sides X:Y:Z, got 4");
   expect_error("sample --n 10 --width 0 -o '" + path("x.png") + "'", "--width");
   expect_error("sample --n 2000 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
   expect_error("stipple --frames 2x a.png" + out, "--frames");

@@ -98,16 +98,17 @@ std::vector<double> parse_sides(const std::string& text, const std::string& what
     const double v = std::strtod(part.c_str(), &end);
     if (part.empty() || *end != '\0' || !(v > 0 && std::isfinite(v)))
       throw CommandError(what +
-                         " must be a number > 0 (the x side over the others) or three sides X:Y:Z each > 0; "
-                         "got '" +
+                         " must be a number > 0 (the x side over the others), two sides W:H or three sides "
+                         "X:Y:Z, each > 0; got '" +
                          text + "'");
     sides.push_back(v);
     if (colon == std::string::npos) break;
     from = colon + 1;
   }
+  if (sides.size() == 2) return {sides[0] / sides[1]};  // W:H, as a picture's shape is often written
   if (sides.size() != 1 && sides.size() != 3)
-    throw CommandError(what + " takes one number or three sides X:Y:Z, got " + std::to_string(sides.size()) +
-                       " in '" + text + "'");
+    throw CommandError(what + " takes one number, two sides W:H or three sides X:Y:Z, got " +
+                       std::to_string(sides.size()) + " in '" + text + "'");
   return sides;
 }
 

@@ -26,7 +26,8 @@ CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int6
                               const std::string& description);
 
 /// A domain's shape as --aspect gives it (kdm sample, kdm analyze): one number A, the x side over the others,
-/// or three sides X:Y:Z, each > 0 and finite. Returns the one or three numbers; `what` names the source in
+/// two sides W:H (A = W / H), or three sides X:Y:Z, each > 0 and finite. Returns the one (for W:H, W / H)
+/// or three numbers; `what` names the source in
 /// the error ("--aspect", a file's header). Throws CommandError.
 std::vector<double> parse_sides(const std::string& text, const std::string& what);
 

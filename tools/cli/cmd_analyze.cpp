@@ -491,8 +491,9 @@ void add_analyze_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option(
       "--aspect", args->aspect,
-      "The domain the points were drawn in: width/height (in 3D the x side over the others), or "
-      "three sides X:Y:Z; they are measured in it, scaled to unit area (volume); 1 forces the "
+      "The domain the points were drawn in: width/height as a number or W:H (in 3D the x side over "
+      "the others), or three sides X:Y:Z; they are measured in it, scaled to unit area (volume); 1 forces "
+      "the "
       "square (default: what the files' .txt headers say, as kdm sample --aspect, query and stipple "
       "write it; else, as for CSV and .npy files, the unit square or cube)");
   add_threads_option(cmd, args->threads, "results do not depend on it");

@@ -46,6 +46,10 @@ struct SampleArgs {
 /// Returns the sides (one for a single number); throws CommandError for anything else.
 std::vector<double> parse_aspect(const std::string& text, int dim) {
   const std::vector<double> sides = parse_sides(text, "--aspect");
+  if (dim == 3 && std::count(text.begin(), text.end(), ':') == 1)
+    throw CommandError(
+        "--aspect W:H is a 2D domain's shape: in 3D give three sides X:Y:Z, or one number (the "
+        "x side over the others)");
   if (sides.size() == 3 && dim != 3)
     throw CommandError(
         "--aspect X:Y:Z sets a 3D domain's sides: add --dim 3, or give one number (width/height)");
@@ -284,7 +288,8 @@ void add_sample_command(CLI::App& app) {
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option(
       "--aspect", args->aspect,
-      "Width/height of the domain (in 3D its x side over its y and z sides), or in 3D its three "
+      "Width/height of the domain, as a number or W:H (in 3D one number is its x side over its y and "
+      "z sides), or in 3D its three "
       "sides X:Y:Z (relative lengths, e.g. 2:1:0.5); default: the image's, a volume's voxel counts "
       "W:H:D, or 1");
   cmd->add_option(
