@@ -189,20 +189,23 @@ def colour(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     return np.ascontiguousarray(rgb), None if alpha is None else np.ascontiguousarray(alpha)
 
 
-def luminance(name: str, value: Any) -> np.ndarray:
-    """An image array as luminance in [0, 1], 2-D float64, as an image file is read: float values as they
-    are; uint8 and uint16 divided by 255 and 65535; (rows, columns, 3 or 4) RGB(A), or 2 (grey and alpha),
-    to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in float32 as kdm reads files (the same
-    densities as the file's pixels). A PIL image is an array too."""
+def luminance(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+    """An image array as load_grey_image reads a file: (luminance in [0, 1], 2-D float64; its alpha, 2-D
+    float64, or None). Float values as they are; uint8 and uint16 divided by 255 and 65535; (rows, columns,
+    3 or 4) RGB(A), or 2 (grey and alpha), to 0.2126 R + 0.7152 G + 0.0722 B composited on white paper, in
+    float32 as kdm reads files (the same densities as the file's pixels; with the alpha, inverted ones on
+    black paper too). A PIL image is an array too."""
     unmasked(name, value, _PAPER)
     a = np.asarray(value) if is_array(value) or hasattr(value, "__array_interface__") else value
     if getattr(a, "ndim", 0) == 2 and getattr(a, "dtype", None) is not None and a.dtype.kind == "f":
-        return np.ascontiguousarray(a, dtype=np.float64)  # luminance as given (checked in [0, 1] after)
+        return np.ascontiguousarray(a, dtype=np.float64), None  # luminance as given (checked in [0, 1] after)
     p, channels = _samples(name, a)
     lum = p[..., 0] if channels < 3 else (np.float32(0.2126) * p[..., 0] + np.float32(0.7152) * p[..., 1]
                                           + np.float32(0.0722) * p[..., 2])
-    alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else np.float32(1)
-    return np.ascontiguousarray(np.clip(lum * alpha + (np.float32(1) - alpha), 0, 1), dtype=np.float64)
+    alpha = p[..., 1] if channels == 2 else p[..., 3] if channels == 4 else None
+    a = np.float32(1) if alpha is None else alpha
+    grey = np.ascontiguousarray(np.clip(lum * a + (np.float32(1) - a), 0, 1), dtype=np.float64)
+    return grey, None if alpha is None else np.ascontiguousarray(alpha, dtype=np.float64)
 
 
 def pil_pixels(value: Any) -> Any:

@@ -40,7 +40,8 @@ def stipple(
         An image file (PNG, JPEG, ...), or an array with row 0 at the TOP (as pictures are stored), its
         samples floats in [0, 1], uint8 or uint16: luminance (rows, columns) or (rows, columns, 1); grey and
         alpha (rows, columns, 2); or colour (rows, columns, 3 or 4), RGB(A), made luminance as a file is
-        (0.2126 R + 0.7152 G + 0.0722 B); an alpha channel composites the image on white paper. The
+        (0.2126 R + 0.7152 G + 0.0722 B); an alpha channel lays the image on paper, white (black with
+        `invert`: transparent pixels get no dots either way), as a file with alpha is read. The
         image is stretched over [0, width/height] x [0, 1] in the tiling's units (`scale` counts dots
         per unit area there); the dots come back normalised (Returns). An image with no ink gives no dots.
         A file of up to 2^28 pixels (16384 x 16384) is averaged down as it is read to what its dots need (as ``kdm stipple``
@@ -113,7 +114,8 @@ def stipple(
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
         label, image = "array", _checks.pil_pixels(image)
-        spec = _kdm.DensitySpec.from_luminance(_checks.luminance("image", image), gamma, invert)
+        grey, alpha = _checks.luminance("image", image)
+        spec = _kdm.DensitySpec.from_luminance(grey, gamma, invert, alpha)
         rgb, alpha = _checks.colour("image", image) if colours is not None else (None, None)
     else:
         raise TypeError(f"image must be a path or an array (luminance or colour), got {type(image).__name__}")

@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "bindings.h"
@@ -37,7 +38,8 @@ void check_shape(const Array& a, const char* what, int& width, int& height) {
   height = static_cast<int>(a.shape(0)), width = static_cast<int>(a.shape(1));
 }
 
-/// A kImage spec of `a`'s size with row y of the spec taken from row height - 1 - y of `a`, through `f`.
+/// A kImage spec of `a`'s size with row y of the spec taken from row height - 1 - y of `a`: `f(i)` of the
+/// index i of a's element.
 template <class F>
 DensitySpec flipped(const Array& a, const char* what, F f) {
   DensitySpec spec;
@@ -45,11 +47,10 @@ DensitySpec flipped(const Array& a, const char* what, F f) {
   spec.text = "array";
   check_shape(a, what, spec.width, spec.height);
   spec.values.resize(std::size_t(spec.width) * spec.height);
-  const double* in = a.data();
   for (int y = 0; y < spec.height; ++y)
     for (int x = 0; x < spec.width; ++x)
       spec.values[std::size_t(y) * spec.width + x] =
-          static_cast<float>(f(in[std::size_t(spec.height - 1 - y) * spec.width + x]));
+          static_cast<float>(f(std::size_t(spec.height - 1 - y) * spec.width + x));
   return spec;
 }
 
@@ -62,7 +63,7 @@ DensitySpec from_values(const Array& a) {
           (a.ndim() == 2
                ? " at [" + std::to_string(i / a.shape(1)) + ", " + std::to_string(i % a.shape(1)) + "]"
                : std::string()));
-  return flipped(a, "density array", [](double v) { return v; });
+  return flipped(a, "density array", [&a](std::size_t i) { return a.data()[i]; });
 }
 
 /// A 3-D array (depth, height, width) of densities as a kVolume spec: slice k at z near 0 for k = 0, each
@@ -96,17 +97,25 @@ DensitySpec from_volume(const py::array_t<double, py::array::c_style | py::array
   return spec;
 }
 
-/// As tools::parse_density_spec reads a picture: darkness (or luminance, inverted) to the power gamma.
-DensitySpec from_luminance(const Array& a, double gamma, bool invert) {
+/// As tools::parse_density_spec reads a picture: darkness (or luminance, inverted) to the power gamma, by
+/// tools::picture_tone. `a` is composited on white, as GreyImage's pixels; `alpha`, if given, their coverage.
+DensitySpec from_luminance(const Array& a, double gamma, bool invert, const std::optional<Array>& alpha) {
   check_number("gamma", gamma, 0, true);
   for (py::ssize_t i = 0; i < a.size(); ++i)
     if (!(a.data()[i] >= 0 && a.data()[i] <= 1))
       throw std::invalid_argument(
           "image array values must be luminances in [0, 1], got " + shown(a.data()[i]) +
           (a.data()[i] > 1 ? " (8-bit pixels: pass them as uint8, or divide by 255)" : ""));
-  DensitySpec spec = flipped(a, "image array", [gamma, invert](double grey) {
-    const double tone = invert ? grey : 1.0 - grey;
-    return std::pow(std::max(0.0, tone), gamma);
+  if (alpha) {
+    if (alpha->ndim() != a.ndim() || !std::equal(a.shape(), a.shape() + a.ndim(), alpha->shape()))
+      throw std::invalid_argument("an image array's alpha must have its shape (rows, columns)");
+    for (py::ssize_t i = 0; i < alpha->size(); ++i)
+      if (!(alpha->data()[i] >= 0 && alpha->data()[i] <= 1))
+        throw std::invalid_argument("image array alpha values must be in [0, 1], got " +
+                                    shown(alpha->data()[i]));
+  }
+  DensitySpec spec = flipped(a, "image array", [&](std::size_t i) {
+    return std::pow(tools::picture_tone(a.data()[i], alpha ? alpha->data()[i] : 1.0, invert), gamma);
   });
   spec.inverted = invert;
   return spec;
@@ -176,7 +185,9 @@ void bind_density(py::module_& m) {
           "Densities (finite, >= 0) of shape (depth, height, width): slice 0 at z near 0, each slice's "
           "row 0 at the top")
       .def_static("from_luminance", &from_luminance, py::arg("values"), py::arg("gamma") = 1.0,
-                  py::arg("invert") = false, "Luminances in [0, 1], row 0 at the top, read as a picture")
+                  py::arg("invert") = false, py::arg("alpha").none(true) = py::none(),
+                  "Luminances in [0, 1] composited on white, row 0 at the top, and their alpha (None: "
+                  "opaque), read as a picture")
       .def_property_readonly("kind", &kind_name)
       .def_readonly("width", &DensitySpec::width)
       .def_readonly("height", &DensitySpec::height)

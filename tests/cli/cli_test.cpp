@@ -1639,6 +1639,39 @@ TEST_F(CliTest, StippleLeavesTransparentPixelsEmpty) {
   expect_error("stipple '" + path("half.png") + "' --colours cmyk -o '" + path("c.txt") + "'", ".csv");
 }
 
+// Inverted, the tone is the luminance on black paper, transparent black: black at any opacity has no ink
+// (the composited grey's float rounding once left invisible dots where opacity was not 1/2), and white
+// at opacity a has a tone of a, so that dots follow the opacity.
+TEST_F(CliTest, StippleInvertedLaysTransparencyOnBlack) {
+  std::vector<std::uint16_t> black, black64, white;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 256; ++x) {
+      black.insert(black.end(), {0, std::uint16_t(x)});
+      black64.insert(black64.end(), {0, 64});
+      white.insert(white.end(), {255, std::uint16_t(x)});
+    }
+  for (const auto& [name, samples] : {std::pair{"black.png", black}, std::pair{"black64.png", black64}}) {
+    SCOPED_TRACE(name);
+    write_bytes(path(name), grey_png(256, 8, 8, samples, 2));
+    const Outcome o = kdm("stipple '" + path(name) + "' --points 4000 --invert -o '" + path("b.csv") + "'");
+    ASSERT_EQ(o.status, 0) << o.err;
+    EXPECT_NE(o.err.find("has no ink"), std::string::npos) << o.err;
+    const std::string csv = slurp(path("b.csv"));
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1) << csv.substr(0, 200);  // the header alone
+  }
+  write_bytes(path("white.png"), grey_png(256, 8, 8, white, 2));
+  const Outcome o =
+      kdm("stipple '" + path("white.png") + "' --points 4000 --invert -o '" + path("w.txt") + "'");
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  ASSERT_TRUE(kdm::tools::read_point_sets(path("w.txt"), sets, error)) << error;
+  std::size_t left = 0, right = 0;  // mean opacity 1/4 and 3/4
+  for (std::size_t i = 0; i < sets.at(0).size(); ++i) (sets[0].coords[2 * i] < 0.5 ? left : right) += 1;
+  EXPECT_NEAR(double(left + right), 4000.0, 200.0);
+  EXPECT_NEAR(double(right) / double(left), 3.0, 0.3) << left << " " << right;
+}
+
 TEST_F(CliTest, StippleFramesRejectBadCounts) {
   const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
   const std::string out = " -o '" + path("z.png") + "'";

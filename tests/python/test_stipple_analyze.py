@@ -150,6 +150,26 @@ def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
     np.testing.assert_array_equal(kdm.stipple(grey[..., None], points=2000), kdm.stipple(grey, points=2000))
 
 
+def test_stipple_inverts_an_array_with_alpha_as_kdm_stipple_inverts_its_file(cli, tmp_path):
+    # Inverted, transparent is black paper: an RGBA or grey-and-alpha array gives the dots `kdm stipple
+    # --invert` gives for its file, bit for bit (not its clear parts, laid on white, as bright dots).
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(SPHERE.parent / "coffee.png"))
+    grey = np.asarray(Image.open(SPHERE))
+    ramp = lambda a: np.tile(np.linspace(0, 255, a.shape[1]).astype(np.uint8), (a.shape[0], 1))
+    for name, pixels in (("rgba.png", np.dstack([rgb, ramp(rgb)])), ("la.png", np.dstack([grey, ramp(grey)]))):
+        Image.fromarray(pixels).save(tmp_path / name)
+        cli("stipple", tmp_path / name, "--points", 3000, "--invert", "--gamma", 1.5, "-o", tmp_path / "cli.txt")
+        dots = kdm.stipple(pixels, points=3000, invert=True, gamma=1.5)
+        np.testing.assert_array_equal(dots, read_txt(tmp_path / "cli.txt"))
+        assert not np.array_equal(dots, kdm.stipple(pixels[..., :-1], points=3000, invert=True, gamma=1.5))
+    # Black at part opacity has no light to draw, at any opacity.
+    black = np.zeros((64, 64, 4), np.uint8)
+    black[..., 3] = 64
+    assert kdm.stipple(black, points=4000, invert=True).shape == (0, 2)
+
+
 def test_stipple_writes_the_formats_kdm_stipple_writes_and_names_them(cli, tmp_path):
     import os
     import subprocess

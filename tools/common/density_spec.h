@@ -43,16 +43,23 @@ struct DensitySpec {
 /// A density that does not parse: a malformed or out-of-range value (std::invalid_argument), or an image
 /// that cannot be read (std::runtime_error, naming the file). Messages are one line.
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
-/// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance. A
-/// NumPy .npy file (known by its first bytes) holds real densities of either byte order (float16, 32 or 64,
-/// integers of 8 to 64 bits as their values, bool as 0 and 1; finite, >= 0), in C or Fortran order, at most
-/// kMaxImagePixels values: a 2-D array (rows, columns) is a kImage, row 0 at the top (y near 1), as 2-D
-/// density arrays in Python; a 3-D one (depth, height, width) a kVolume, array[k] slice k along z (k = 0 at z
-/// near 0), each slice as a 2-D array. Other shapes and types are refused, naming the file. An image of more
-/// than `max_pixels` pixels is refused; `kept`, if given, averages a larger picture down as it is read
-/// (KeptPixels; the average is of luminance, before `gamma`).
+/// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance (on
+/// black paper: picture_tone). A NumPy .npy file (known by its first bytes) holds real densities of either
+/// byte order (float16, 32 or 64, integers of 8 to 64 bits as their values, bool as 0 and 1; finite, >= 0),
+/// in C or Fortran order, at most kMaxImagePixels values: a 2-D array (rows, columns) is a kImage, row 0 at
+/// the top (y near 1), as 2-D density arrays in Python; a 3-D one (depth, height, width) a kVolume, array[k]
+/// slice k along z (k = 0 at z near 0), each slice as a 2-D array. Other shapes and types are refused,
+/// naming the file. An image of more than `max_pixels` pixels is refused; `kept`, if given, averages a larger
+/// picture down as it is read (KeptPixels; the average is of luminance, before `gamma`).
 DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false,
                                std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
+
+/// A picture's tone at a pixel, before gamma: its darkness 1 − grey, or with `invert` its luminance on black
+/// paper, grey − (1 − alpha). `grey` is composited on white (GreyImage) and `alpha` its coverage (1 where
+/// opaque): transparent is paper, white for dark dots and black for inverted ones. Every reader of a
+/// picture's tone (a file, a colour's channel, a Python array) takes it from here, so that they agree bit
+/// for bit. Never negative; a tone under 2^-20, float rounding rather than ink, is 0.
+double picture_tone(double grey, double alpha, bool invert);
 
 /// Densities that share one domain (the classes of a query or a sample) stretch each image over all of it:
 /// images whose sides differ in ratio (by more than 1%) would be stretched differently, while images of one

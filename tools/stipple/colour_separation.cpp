@@ -408,10 +408,10 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   } else if (scheme == "rgb") {
     for (int c = 0; c < 3; ++c) {
       const char* names[3] = {"red", "green", "blue"};
-      // Light on black paper: transparent is black (the colour on white less 1 − alpha).
+      // Light on black paper: each channel's tone as an inverted picture's (transparent is black).
       s.channels.push_back(channel(image, gamma, names[c], [c, &image](const float* p) {
         const std::size_t i = std::size_t(p - image.pixels.data()) / 3;
-        return double(p[c]) - (image.alpha.empty() ? 0.0 : 1.0 - image.alpha[i]);
+        return picture_tone(p[c], image.alpha.empty() ? 1.0 : image.alpha[i], true);
       }));
     }
     s.inks = {ink(255, 0, 0, "red", 0), ink(0, 255, 0, "green", 1), ink(0, 0, 255, "blue", 2)};
