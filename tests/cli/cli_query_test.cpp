@@ -640,8 +640,7 @@ TEST_F(CliTest, StippleSvgInPlottingOrder) {
     for (std::size_t c = group.find("<circle"); c != std::string::npos; c = group.find("<circle", c + 1)) {
       double x = 0, y = 0, r = 0;
       ASSERT_EQ(std::sscanf(group.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
-      EXPECT_TRUE(x - r >= -1e-3 && x + r <= 600 + 1e-3 && y - r >= -1e-3 && y + r <= 400 + 1e-3)
-          << x << "," << y;
+      EXPECT_TRUE(x - r >= 0 && x + r <= 600 && y - r >= 0 && y + r <= 400) << x << "," << y;
       if (dots++) travel += std::hypot(x - px, y - py);
       px = x, py = y;
     }
@@ -659,6 +658,32 @@ TEST_F(CliTest, StippleSvgInPlottingOrder) {
                 .find("inkscape:label=\"% paper (not plotted)\"><rect width=\"100%\" "
                       "height=\"100%\" fill=\"#000000\" stroke=\"none\"/>"),
             std::string::npos);
+}
+
+// Every SVG dot lies within the picture as its numbers are printed: rounding a centre next to the edge to
+// 6 digits once carried its circle past the edge by thousandths of a pixel (a dark picture, dots all along
+// its edges, at widths whose coordinates keep 1 or 2 decimals).
+TEST_F(CliTest, StippleSvgDotsStayInsideAsPrinted) {
+  write_bytes(path("black.png"), grey_png(8, 8, 8, std::vector<std::uint16_t>(64, 0)));
+  for (const int width : {1000, 1500, 2048, 777}) {
+    SCOPED_TRACE(width);
+    const Outcome run = kdm("stipple '" + path("black.png") + "' --points 20000 --width " +
+                            std::to_string(width) + " -o '" + path("b.svg") + "'");
+    ASSERT_EQ(run.status, 0) << run.err;
+    const std::string svg = slurp(path("b.svg"));
+    double w = 0, h = 0;
+    ASSERT_EQ(std::sscanf(svg.c_str() + svg.find("viewBox="), "viewBox=\"0 0 %lf %lf\"", &w, &h), 2);
+    std::size_t dots = 0, edge = 0;
+    for (std::size_t c = svg.find("<circle"); c != std::string::npos;
+         c = svg.find("<circle", c + 1), ++dots) {
+      double x = 0, y = 0, r = 0;
+      ASSERT_EQ(std::sscanf(svg.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
+      EXPECT_TRUE(x - r >= 0 && x + r <= w && y - r >= 0 && y + r <= h) << x << "," << y << " r " << r;
+      edge += x + r > w - 0.05 || y + r > h - 0.05;
+    }
+    EXPECT_GT(dots, 19000u);
+    EXPECT_GT(edge, 10u);  // dots that touch the right or bottom edge (to the printed digits)
+  }
 }
 
 // --method full with inks: a class never lands where its own ink is zero (cyan dots in a black area came

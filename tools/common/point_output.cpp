@@ -27,6 +27,24 @@ std::string number(double v) {
   return text;
 }
 
+/// An SVG circle's number as the picture prints it (6 significant digits), read back.
+double as_printed(double v) {
+  return std::strtod(number(v).c_str(), nullptr);
+}
+
+/// A dot's centre `v` (in [r, side − r]) such that the printed circle, centre and radius as a reader
+/// parses them, lies within [0, side]: rounding to 6 digits could carry it past the edge by thousandths of
+/// a pixel, so there it is moved in by the last printed digit while it does. Other centres are kept.
+double printed_inside(double v, double side, double printed_r) {
+  double p = as_printed(v);
+  if (p - printed_r >= 0 && p + printed_r <= side) return v;
+  for (int step = 0; step < 4 && p > 0 && (p - printed_r < 0 || p + printed_r > side); ++step) {
+    const double digit = std::pow(10.0, std::floor(std::log10(p)) - 5);
+    p = as_printed(p - printed_r < 0 ? p + digit : p - digit);
+  }
+  return p;
+}
+
 }  // namespace
 
 std::vector<std::size_t> plotting_order(const std::vector<double>& xy) {
@@ -258,7 +276,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   if (!white)
     out << layer("paper", "% paper (not plotted)") << "><rect width=\"100%\" height=\"100%\" fill=\""
         << paper.hex() << "\" stroke=\"none\"/></g>\n";
-  out.precision(6);
+  out.precision(6);        // as number() prints
   std::vector<double> xy;  // a layer's dot centres in the picture's pixels
   std::vector<double> radii;
   for (const std::size_t k : order) {
@@ -273,7 +291,8 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
         const double ri = radius(i);
         const auto inside = [&](double v, double side) {
           if (!style.dots_inside) return v;
-          return 2 * ri >= side ? side / 2 : std::clamp(v, ri, side - ri);
+          return 2 * ri >= side ? side / 2
+                                : printed_inside(std::clamp(v, ri, side - ri), side, as_printed(ri));
         };
         xy.push_back(inside(points.coords[2 * i] * w, w));
         xy.push_back(inside((1 - points.coords[2 * i + 1]) * h, h));

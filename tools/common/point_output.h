@@ -40,8 +40,9 @@ struct DrawStyle {
   /// SVG only: the printed width, a number > 0 and a unit (mm, cm, in, pt, pc or px: "180mm"), the height
   /// in proportion; empty: width_px pixels. The drawing keeps its pixel coordinates (viewBox).
   std::string paper_width;
-  /// SVG only: a dot that would cross the picture's edge is moved in to touch it (a pen plotter draws no
-  /// further than the paper; a dot wider than the picture is centred). Off: every dot at its point.
+  /// SVG only: a dot that would cross the picture's edge is moved in to touch it, its numbers as printed
+  /// (a pen plotter draws no further than the paper; a dot wider than the picture is centred). Off: every
+  /// dot at its point.
   bool dots_inside = false;
 };
 
