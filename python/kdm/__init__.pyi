@@ -131,7 +131,7 @@ class Tileset:
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
 def zoom_regions(region: Sequence[float], frames: int) -> npt.NDArray[np.float64]: ...
 def separate(
-    image: _Path, *, colours: Union[str, int] = ..., gamma: float = ...
+    image: _Path, *, colours: Union[str, int, Sequence[str]] = ..., gamma: float = ...
 ) -> Tuple[npt.NDArray[np.float32], List[str]]: ...
 def stipple(
     image: Union[_Path, npt.ArrayLike],
@@ -149,7 +149,7 @@ def stipple(
     width: Optional[int] = ...,
     dot_size: Optional[float] = ...,
     threads: int = ...,
-    colours: Union[str, int, None] = ...,
+    colours: Union[str, int, Sequence[str], None] = ...,
     fade: float = ...,
     paper_width: Optional[str] = ...,
     height: Optional[int] = ...,

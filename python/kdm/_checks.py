@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import re
 from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
@@ -187,6 +188,30 @@ def colour(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     a = np.float32(1) if alpha is None else alpha[..., None]
     rgb = np.clip(colour * a + (np.float32(1) - a), 0, 1).astype(np.float32)
     return np.ascontiguousarray(rgb), None if alpha is None else np.ascontiguousarray(alpha)
+
+
+_PENS = re.compile(r"\s*#?[0-9a-fA-F]{6}\s*")
+
+
+def colour_scheme(value: Any) -> str:
+    """colours as `kdm stipple --colours` takes them: "cmyk", "rgb", a number of inks (an int too), or pens as
+    one str "#e00000,#0000aa" or a list or tuple of them, each "#rrggbb" or "rrggbb" (joined into that str)."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_)):
+        return str(int(value))
+    if isinstance(value, (list, tuple)):
+        if not value:
+            raise ValueError("colours is an empty list: give 1 to 8 pens, as ['#e00000', '#0000aa']")
+        for k, pen in enumerate(value):
+            if not isinstance(pen, str):
+                raise TypeError(f"colours[{k}] must be a pen as a str ('#e00000'), got {type(pen).__name__}")
+            if not _PENS.fullmatch(pen):  # said here: joined, '3' would be read as a number of inks
+                raise ValueError(f"colours[{k}] must be a pen as #rrggbb ('#e00000'), got {pen!r}")
+        # Each with its '#', so that one pen alone is read as a pen, as in a list of several.
+        return ",".join("#" + pen.strip().lstrip("#") for pen in value)
+    if not isinstance(value, str):
+        raise TypeError("colours must be 'cmyk', 'rgb', a number of inks (2 to 8), or pens as a str "
+                        f"('#e00000,#0000aa') or a list of them (['#e00000', '#0000aa']), got {type(value).__name__}")
+    return value
 
 
 def luminance(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:

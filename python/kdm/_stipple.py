@@ -1,7 +1,6 @@
 """kdm.stipple: an image as dots, as `kdm stipple` draws it (one picture; no zoom sequence); kdm.separate: its inks."""
 from __future__ import annotations
 
-import numbers
 import os
 from typing import Any, List, Optional, Sequence, Tuple
 
@@ -82,12 +81,13 @@ def stipple(
         pc or px), the height in proportion (``kdm stipple --paper-width``). None: `width` pixels.
     threads : int
         For method "full": worker threads (0: the default count); the dots do not depend on it.
-    colours : {"cmyk", "rgb"}, int, str of pens or None
+    colours : {"cmyk", "rgb"}, int, str or list of pens, or None
         A colour stipple of the image, a file or an array (``kdm stipple --colours``): "cmyk" (black by under-colour
         removal), "rgb" (light on black), a number of inks, 2 to 8 (chosen among the image's own colours,
         the set whose mixes draw it best; fewer if fewer do as well, one black ink for a grey image), or
-        your own pens as "#e00000,#0000aa,#000000" (1 to 8); each pixel's colour is split over the inks;
-        one class of dots per ink, all of them one blue-noise set.
+        your own pens as "#e00000,#0000aa,#000000" or a list or tuple of them, ["#e00000", "#0000aa"]
+        (1 to 8); each pixel's colour is split over the inks; one class of dots per ink, all of them one
+        blue-noise set.
     fade : float
         For method "tiles", in the picture written to `output`: a dot's area grows from 0 where it
         appears to full once the density there is this fraction higher (``kdm stipple --fade``), so
@@ -152,10 +152,7 @@ def stipple(
     if colours is not None:
         if invert:
             raise ValueError("invert does not apply to colours (each ink has its own channel)")
-        if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
-            colours = str(int(colours))
-        if not isinstance(colours, str):
-            raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
+        colours = _checks.colour_scheme(colours)
     if paper_width is not None and not isinstance(paper_width, str):
         raise TypeError(f"paper_width must be a str such as '180mm', got {type(paper_width).__name__}")
     if paper_width == "":
@@ -202,9 +199,6 @@ def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[
     else:  # an array or a PIL image, as stipple() takes it
         label, (rgb, alpha) = "array", _checks.colour("image", _checks.pil_pixels(image))
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
-    if isinstance(colours, numbers.Integral) and not isinstance(colours, bool):
-        colours = str(int(colours))
-    if not isinstance(colours, str):
-        raise TypeError(f"colours must be 'cmyk', 'rgb' or a number of inks, got {type(colours).__name__}")
+    colours = _checks.colour_scheme(colours)
     channels, inks = _kdm.separate(label, colours, gamma, rgb, alpha)
     return channels, list(inks)

@@ -483,6 +483,19 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
     assert len(dots) > 150 and set(classes) == {0} and inks == ["black"]
 
 
+def test_stipple_takes_pens_as_a_list(tmp_path):
+    # A list or tuple of pens is the comma-separated str `kdm stipple --colours` takes, in stipple() and
+    # separate(); a pen alone in a list is a pen, '#' or not.
+    coffee = str(SPHERE.parent / "coffee.png")
+    as_text = kdm.stipple(coffee, points=2000, colours="#ff0000,#000000")
+    for pens in (["#ff0000", "#000000"], ("#ff0000", " 000000")):
+        for a, b in zip(kdm.stipple(coffee, points=2000, colours=pens), as_text):
+            np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(kdm.separate(coffee, colours=["#ff0000", "#000000"])[0],
+                                  kdm.separate(coffee, colours="#ff0000,#000000")[0])
+    assert kdm.stipple(coffee, points=500, colours=["000000"])[2] == ["ink-0-black"]
+
+
 def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
     # A white image in rgb is all light: dots, as the command line gives (no grey "no ink" refusal).
     white = tmp_path / "white.png"
