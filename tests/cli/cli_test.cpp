@@ -550,8 +550,8 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   expect_error("query --rect 0,0,1,1" + v + " -o '" + path("x.csv") + "'", "only the full sampler takes it");
   ASSERT_EQ(kdm("sample --n 100" + out).status, 0);
   expect_error("analyze '" + path("x.txt") + "'" + v, "is a 3-D volume, and the points are 2D");
-  expect_error("sample --n 100 --dim 3 --aspect 1:2" + out, "one number or three sides X:Y:Z, got 2");
-  expect_error("sample --n 100 --dim 3 --aspect 1:0:2" + out, "three sides X:Y:Z each > 0; got '1:0:2'");
+  expect_error("sample --n 100 --dim 3 --aspect 1:2" + out, "--aspect W:H is a 2D domain's shape");
+  expect_error("sample --n 100 --dim 3 --aspect 1:0:2" + out, "three sides X:Y:Z, each > 0; got '1:0:2'");
   expect_error("sample --n 100 --dim 3 --aspect 1:x:2" + out, "got '1:x:2'");
   expect_error("sample --n 100 --dim 3 --aspect 1::2" + out, "got '1::2'");
   expect_error("sample --n 100 --aspect 1:2:3" + out, "add --dim 3");
@@ -1170,7 +1170,11 @@ TEST_F(CliTest, AnalyzeMeasuresASetInTheDomainItWasDrawnIn) {
   expect_error("analyze " + wide + " --tile-size 0.25", "square tiles of the unit square");
   expect_error("analyze " + wide + " --aspect 2:1:1", "the points are 2D");
   expect_error("analyze " + wide + " --aspect 0", "--aspect must be a number > 0");
-  expect_error("analyze " + wide + " --aspect 1:2", "one number or three sides X:Y:Z, got 2");
+  expect_error("analyze " + wide + " --aspect 1:2:3:4", "two sides W:H or three sides X:Y:Z, got 4");
+  // W:H is the number W / H.
+  const Outcome colon = kdm("analyze " + wide + " --aspect 4:2 --no-energy");
+  ASSERT_EQ(colon.status, 0) << colon.err;
+  EXPECT_NE(colon.out.find("domain from --aspect: aspect 2"), std::string::npos) << colon.out;
 
   // 3D: the box's three sides from the header.
   const std::string box = "'" + path("box.txt") + "'";

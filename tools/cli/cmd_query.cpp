@@ -142,7 +142,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
         "kdm query: warning: at most %.3g points per tile; below 1 a tile's expected count rounds to "
         "steps of 1/%zu of a point (use a larger --tile-size)\n",
         per_tile, tiles.data().tiles.size());
-  else if (per_tile < coarsest && densest > 0 && a.scale > 0)
+  else if (per_tile < coarsest && densest > 0 && a.scale > 0 && a.tile_size > 0)
     std::fprintf(stderr,
                  "kdm query: warning: at most %.3g points per tile, under the tile set's coarsest level "
                  "(%.0f): a tile then gives part of that level, less even (use a --tile-size of at least "
