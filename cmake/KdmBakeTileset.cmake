@@ -5,11 +5,15 @@
 # bakes it again whenever the recipe or kdm changes.
 #   OUTPUT   the tile-set file to write; a relative path is taken from the current binary directory.
 #   RECIPE   the recipe file; a relative path is taken from the current source directory.
-#   TARGET   a custom target, built by default, that makes OUTPUT; other targets may add_dependencies on
-#            it. Without it, name OUTPUT among a target's sources (or in another custom command's DEPENDS).
+#   TARGET   the custom target, built by default, that bakes OUTPUT. It alone runs the bake: a target that
+#            reads OUTPUT depends on it (add_dependencies(<target> TARGET), or TARGET beside OUTPUT in a
+#            custom command's DEPENDS). Naming OUTPUT among the sources of targets that do not depend on it
+#            lets a Makefile build run the bake in each at once, into the same file. Without TARGET an
+#            internal target, built by default, bakes it.
 #   EMBED    a static library of that name holding the set's bytes, for a program that carries its set
 #            inside it: link it, `#include "<name>.h"` and pass `<name>, <name>_size` to
-#            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier.
+#            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier. The
+#            library depends on the target that bakes OUTPUT.
 #            Compiling the bytes as an array costs the compiler time and memory: for a set the size of the
 #            built-in one (14 MB), a 71 MB source, 24 s and 2.4 GB in g++; load such a set from its file.
 #   THREADS  baking and verifying threads (0, the default, takes every core). The file does not depend on it.
@@ -61,6 +65,18 @@ function(kdm_bake_tileset)
   if(NOT EXISTS "${recipe}" OR IS_DIRECTORY "${recipe}")
     message(FATAL_ERROR "kdm_bake_tileset: RECIPE '${recipe}' is not a file")
   endif()
+  # One target owns each bake (CMake's rule for a custom command's output): two would run it at once.
+  get_property(baked GLOBAL PROPERTY KDM_BAKED_TILESETS)
+  if(output IN_LIST baked)
+    message(FATAL_ERROR "kdm_bake_tileset: OUTPUT '${output}' is baked by another kdm_bake_tileset already")
+  endif()
+  set_property(GLOBAL APPEND PROPERTY KDM_BAKED_TILESETS "${output}")
+  if(arg_TARGET)
+    set(owner ${arg_TARGET})
+  else()
+    file(RELATIVE_PATH owner "${CMAKE_BINARY_DIR}" "${output}")
+    string(MAKE_C_IDENTIFIER "kdm_bake_${owner}" owner)
+  endif()
   get_filename_component(output_dir "${output}" DIRECTORY)
   set(scratch "${output}.baking")
   set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
@@ -77,9 +93,7 @@ function(kdm_bake_tileset)
                      DEPENDS "${recipe}" "$<TARGET_FILE:kdm::kdm>" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake"
                      COMMENT "Baking tile set ${output} from ${recipe}"
                      VERBATIM)
-  if(arg_TARGET)
-    add_custom_target(${arg_TARGET} ALL DEPENDS "${output}")
-  endif()
+  add_custom_target(${owner} ALL DEPENDS "${output}")
   if(arg_EMBED)
     set(include_dir "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}")
     file(WRITE "${include_dir}/${arg_EMBED}.h.tmp"
@@ -107,6 +121,7 @@ function(kdm_bake_tileset)
                        COMMENT "Embedding tile set ${output} as ${arg_EMBED}"
                        VERBATIM)
     add_library(${arg_EMBED} STATIC "${source}")
+    add_dependencies(${arg_EMBED} ${owner})  # so that its own copy of the bake's rule finds OUTPUT made
     target_include_directories(${arg_EMBED} PUBLIC "$<BUILD_INTERFACE:${include_dir}>")
   endif()
 endfunction()

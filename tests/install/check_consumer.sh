@@ -1,7 +1,8 @@
 #!/bin/sh
 # Builds and runs the find_package consumer (consumer/) against an installed kdm at PREFIX, in WORK, and
 # checks its build-time bake (kdm_bake_tileset): a second build bakes nothing, a changed recipe is baked
-# again, and a recipe that cannot be baked, or whose set fails verification, fails the build.
+# again, and a recipe that cannot be baked, or whose set fails verification, fails the build. Then each
+# of the bake's patterns in a parallel Makefile build (embed_consumer/).
 # Usage: check_consumer.sh PREFIX WORK
 set -eu
 prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
@@ -35,6 +36,32 @@ if cmake --build "$work/build" >"$work/unverified.log" 2>&1; then echo "a set fa
 grep -q "failed [0-9]* check" "$work/unverified.log" || { echo "verification did not say why:"; cat "$work/unverified.log"; exit 1; }
 if [ -e "$baked.baking" ]; then echo "the failed verification left $baked.baking behind"; exit 1; fi
 if cmake --build "$work/build" >/dev/null 2>&1; then echo "the build after a failed verification passed"; exit 1; fi
+# A project of C alone in each of kdm_bake_tileset's patterns, with Makefiles on two jobs: each set is
+# baked once, by the one target that owns its bake, and each embedded set is its file's bytes.
+mkdir -p "$work/embed"
+cp -R "$here/embed_consumer" "$work/embed/src"
+cp "$here/consumer/small.recipe" "$work/embed/src/"
+cmake -S "$work/embed/src" -B "$work/embed/build" -G "Unix Makefiles" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/embed/build" -j2 >"$work/embed/build.log" 2>&1 || { cat "$work/embed/build.log"; exit 1; }
+for set in a b c; do
+  bakes=$(grep -c "Baking tile set .*/$set\.kdmt from" "$work/embed/build.log" || true)
+  [ "$bakes" = 1 ] || { echo "$set.kdmt was baked $bakes times:"; cat "$work/embed/build.log"; exit 1; }
+done
+"$work/embed/build/embedded_a" >/dev/null
+"$work/embed/build/embedded_b" >/dev/null
+cmp "$work/embed/build/c.kdmt" "$work/embed/build/c_copy.kdmt"
+# Two bakes of one file would race: the second is refused.
+mkdir -p "$work/twice"
+cp "$here/consumer/small.recipe" "$work/twice/"
+printf '%s\n' 'cmake_minimum_required(VERSION 3.20)' 'project(twice LANGUAGES C)' \
+  'find_package(kdm 0.5 REQUIRED COMPONENTS tool)' \
+  'kdm_bake_tileset(OUTPUT a.kdmt RECIPE small.recipe TARGET first)' \
+  'kdm_bake_tileset(OUTPUT a.kdmt RECIPE small.recipe TARGET second)' >"$work/twice/CMakeLists.txt"
+if cmake -S "$work/twice" -B "$work/twice/build" -DCMAKE_PREFIX_PATH="$prefix" >"$work/twice.log" 2>&1; then
+  echo "a second bake of one OUTPUT was configured"; exit 1
+fi
+tr -s ' \n' ' ' <"$work/twice.log" | grep -q "is baked by another kdm_bake_tileset" || { echo "the second bake was not named:"; cat "$work/twice.log"; exit 1; }
 # The sampler through pkg-config, for C++ builds without CMake.
 pc_dir=$(dirname "$(find "$prefix" -name kdm-generator.pc | head -n 1)")
 cat >"$work/pc_generator.cpp" <<'CPP'
