@@ -96,8 +96,10 @@ function(kdm_bake_tileset)
   add_custom_target(${owner} ALL DEPENDS "${output}")
   if(arg_EMBED)
     set(include_dir "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}")
+    # C89 comments only: a C90 project includes the header too. A path cannot end the comment early.
+    string(REPLACE "*/" "* /" named "${output}, baked from ${recipe}")
     file(WRITE "${include_dir}/${arg_EMBED}.h.tmp"
-      "// The bytes of ${output}, baked from ${recipe} (kdm_bake_tileset). Generated: do not edit.\n"
+      "/* The bytes of ${named} (kdm_bake_tileset). Generated: do not edit. */\n"
       "#pragma once\n#include <stddef.h>\n"
       "#ifdef __cplusplus\nextern \"C\" {\n#endif\n"
       "extern const unsigned char ${arg_EMBED}[];\nextern const size_t ${arg_EMBED}_size;\n"

@@ -33,8 +33,9 @@ function(kdm_write_embedded_source input output symbol)
       "alignas(16) const unsigned char ${symbol}[] = {\n")
     set(size_type "std::size_t")
   endif()
+  string(REPLACE "*/" "* /" named "${input}")  # a path cannot end the comment early
   file(WRITE ${output}.tmp
-    "/* Generated from ${input} by cmake/KdmEmbed.cmake. Do not edit. */\n" "${head}" "${bytes}\n};\n"
+    "/* Generated from ${named} by cmake/KdmEmbed.cmake. Do not edit. */\n" "${head}" "${bytes}\n};\n"
     "const ${size_type} ${symbol}_size = ${size};\n")
   if("ALWAYS" IN_LIST ARGN)
     file(RENAME ${output}.tmp ${output})
