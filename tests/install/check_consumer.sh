@@ -2,7 +2,8 @@
 # Builds and runs the find_package consumer (consumer/) against an installed kdm at PREFIX, in WORK, and
 # checks its build-time bake (kdm_bake_tileset): a second build bakes nothing, a changed recipe is baked
 # again, and a recipe that cannot be baked, or whose set fails verification, fails the build. Then each
-# of the bake's patterns in a parallel Makefile build (embed_consumer/).
+# of the bake's patterns in a parallel Makefile build (embed_consumer/), and a bake by a project of no
+# language through the tool component alone (tool_consumer/).
 # Usage: check_consumer.sh PREFIX WORK
 set -eu
 prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
@@ -51,6 +52,11 @@ done
 "$work/embed/build/embedded_a" >/dev/null
 "$work/embed/build/embedded_b" >/dev/null
 cmp "$work/embed/build/c.kdmt" "$work/embed/build/c_copy.kdmt"
+# A project of no language bakes through the tool component alone.
+cmake -S "$here/tool_consumer" -B "$work/tool" -DCMAKE_PREFIX_PATH="$prefix" >"$work/tool.log" 2>&1 ||
+  { cat "$work/tool.log"; exit 1; }
+cmake --build "$work/tool" >/dev/null
+[ -s "$work/tool/small.kdmt" ] || { echo "the tool component alone baked nothing"; exit 1; }
 # Two bakes of one file would race: the second is refused.
 mkdir -p "$work/twice"
 cp "$here/consumer/small.recipe" "$work/twice/"
