@@ -98,14 +98,19 @@ function(kdm_bake_tileset)
     set(include_dir "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}")
     # C89 comments only: a C90 project includes the header too. A path cannot end the comment early.
     string(REPLACE "*/" "* /" named "${output}, baked from ${recipe}")
-    file(WRITE "${include_dir}/${arg_EMBED}.h.tmp"
+    string(CONCAT header
       "/* The bytes of ${named} (kdm_bake_tileset). Generated: do not edit. */\n"
       "#pragma once\n#include <stddef.h>\n"
       "#ifdef __cplusplus\nextern \"C\" {\n#endif\n"
       "extern const unsigned char ${arg_EMBED}[];\nextern const size_t ${arg_EMBED}_size;\n"
       "#ifdef __cplusplus\n}\n#endif\n")
-    file(COPY_FILE "${include_dir}/${arg_EMBED}.h.tmp" "${include_dir}/${arg_EMBED}.h" ONLY_IF_DIFFERENT)
-    file(REMOVE "${include_dir}/${arg_EMBED}.h.tmp")
+    set(old_header "")
+    if(EXISTS "${include_dir}/${arg_EMBED}.h")
+      file(READ "${include_dir}/${arg_EMBED}.h" old_header)
+    endif()
+    if(NOT old_header STREQUAL header)  # written only where it changes: its includers are not rebuilt
+      file(WRITE "${include_dir}/${arg_EMBED}.h" "${header}")
+    endif()
     # The source is C and C++ alike: compiled as C++ where the project has it, else as C.
     get_property(languages GLOBAL PROPERTY ENABLED_LANGUAGES)
     if("CXX" IN_LIST languages)
