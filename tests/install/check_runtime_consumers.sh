@@ -1,7 +1,8 @@
 #!/bin/sh
 # Builds and runs the runtime-only consumers against an installed kdm at PREFIX, in WORK: through
-# find_package(kdm COMPONENTS runtime) and through pkg-config, C and C++ (-fno-exceptions -fno-rtti), and
-# a project of C alone (which, where the command line is installed, embeds a set it bakes).
+# find_package(kdm COMPONENTS runtime) and through pkg-config, C and C++ (-fno-exceptions -fno-rtti), also
+# linked fully static where the runtime is static, and a project of C alone (which, where the command line
+# is installed, embeds a set it bakes).
 # Usage: check_runtime_consumers.sh PREFIX WORK
 set -eu
 prefix=$1 work=$2 here=$(cd "$(dirname "$0")" && pwd)
@@ -11,6 +12,17 @@ cmake -S "$here/runtime_consumer" -B "$work/cmake" -DCMAKE_PREFIX_PATH="$prefix"
 cmake --build "$work/cmake" >/dev/null
 "$work/cmake/runtime_c" "$tiles"
 "$work/cmake/runtime_cpp"
+# A static runtime links into a fully static program through CMake too (with zstd's static library).
+if [ -n "$(find "$prefix" -name libkdm_runtime.a)" ]; then
+  cmake -S "$here/runtime_consumer" -B "$work/cmake_static" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_EXE_LINKER_FLAGS=-static >/dev/null
+  cmake --build "$work/cmake_static" >/dev/null
+  "$work/cmake_static/runtime_c" "$tiles"
+  "$work/cmake_static/runtime_cpp"
+fi
+if grep -F -q 'LINK_ONLY:>' "$(find "$prefix" -name kdmRuntimeTargets.cmake)"; then
+  echo "kdm::runtime's exported link interface has an empty entry"; exit 1
+fi
 cmake -S "$here/runtime_c_consumer" -B "$work/cmake_c" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/cmake_c" >/dev/null
 "$work/cmake_c/runtime_c_only"
