@@ -12,8 +12,8 @@
 #            internal target, built by default, bakes it.
 #   EMBED    a static library of that name holding the set's bytes, for a program that carries its set
 #            inside it: link it, `#include "<name>.h"` and pass `<name>, <name>_size` to
-#            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier. The
-#            library depends on the target that bakes OUTPUT.
+#            kdm::Tileset::load_memory (or kdm_tileset_load_memory). The name must be a C identifier, and
+#            not a C or C++ keyword. The library depends on the target that bakes OUTPUT.
 #            Compiling the bytes as an array costs the compiler time and memory: for a set the size of the
 #            built-in one (14 MB), a 71 MB source, 24 s and 2.4 GB in g++; load such a set from its file.
 #   THREADS  baking and verifying threads (0, the default, takes every core). The file does not depend on it.
@@ -58,6 +58,21 @@ function(kdm_bake_tileset)
   endforeach()
   if(arg_EMBED AND NOT arg_EMBED MATCHES "^[A-Za-z_][A-Za-z0-9_]*$")
     message(FATAL_ERROR "kdm_bake_tileset: EMBED '${arg_EMBED}' is not a C identifier")
+  endif()
+  # Keywords of C (to C23) and C++ (to C++20) look like identifiers but cannot name the array.
+  set(keywords
+      _Alignas _Alignof _Atomic _BitInt _Bool _Complex _Decimal128 _Decimal32 _Decimal64 _Generic _Imaginary
+      _Noreturn _Static_assert _Thread_local alignas alignof and and_eq asm auto bitand bitor bool break case
+      catch char char16_t char32_t char8_t class co_await co_return co_yield compl concept const const_cast
+      consteval constexpr constinit continue decltype default delete do double dynamic_cast else enum
+      explicit export extern false float for friend goto if inline int long mutable namespace new noexcept
+      not not_eq nullptr operator or or_eq private protected public register reinterpret_cast requires
+      restrict return short signed sizeof static static_assert static_cast struct switch template this
+      thread_local throw true try typedef typeid typename typeof typeof_unqual union unsigned using virtual
+      void volatile wchar_t while xor xor_eq)
+  if(arg_EMBED IN_LIST keywords)
+    message(FATAL_ERROR "kdm_bake_tileset: EMBED '${arg_EMBED}' is a C or C++ keyword, which cannot name "
+                        "the embedded array; choose another name")
   endif()
 
   get_filename_component(recipe "${arg_RECIPE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")

@@ -57,6 +57,20 @@ cmake -S "$here/tool_consumer" -B "$work/tool" -DCMAKE_PREFIX_PATH="$prefix" >"$
   { cat "$work/tool.log"; exit 1; }
 cmake --build "$work/tool" >/dev/null
 [ -s "$work/tool/small.kdmt" ] || { echo "the tool component alone baked nothing"; exit 1; }
+# A C or C++ keyword cannot name an embedded set: refused at configure time, by name.
+for keyword in int class; do
+  mkdir -p "$work/keyword_$keyword"
+  cp "$here/consumer/small.recipe" "$work/keyword_$keyword/"
+  printf '%s\n' 'cmake_minimum_required(VERSION 3.20)' 'project(keyword LANGUAGES C)' \
+    'find_package(kdm 0.5 REQUIRED COMPONENTS tool)' \
+    "kdm_bake_tileset(OUTPUT a.kdmt RECIPE small.recipe EMBED $keyword)" >"$work/keyword_$keyword/CMakeLists.txt"
+  if cmake -S "$work/keyword_$keyword" -B "$work/keyword_$keyword/build" -DCMAKE_PREFIX_PATH="$prefix" \
+    >"$work/keyword_$keyword.log" 2>&1; then
+    echo "EMBED $keyword was configured"; exit 1
+  fi
+  tr -s ' \n' ' ' <"$work/keyword_$keyword.log" | grep -q "EMBED '$keyword' is a C or C++ keyword" ||
+    { echo "EMBED $keyword was not refused by name:"; cat "$work/keyword_$keyword.log"; exit 1; }
+done
 # Two bakes of one file would race: the second is refused.
 mkdir -p "$work/twice"
 cp "$here/consumer/small.recipe" "$work/twice/"
