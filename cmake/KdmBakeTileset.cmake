@@ -21,8 +21,10 @@
 #            check fails.
 #   VERIFY_ARGS  more `kdm verify` options (needs VERIFY), e.g. the design's bars for holes, which verify
 #            only reports by default: VERIFY_ARGS --hole-largest 1.0 --holes-per-1e5 10.
-# The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed:
-# a failed or interrupted step leaves OUTPUT as it was, older than the recipe, so the next build tries again.
+# The bake writes a scratch file beside OUTPUT and renames it into place only once every step has passed,
+# and only if its bytes differ from OUTPUT's: a failed or interrupted step leaves OUTPUT as it was and the
+# next build tries again, and a bake that gives the same set (a touched recipe, a new comment) leaves OUTPUT
+# untouched, so that nothing built from it (EMBED's library, its users) is built again.
 function(kdm_bake_tileset)
   cmake_parse_arguments(PARSE_ARGV 0 arg "VERIFY" "OUTPUT;RECIPE;TARGET;EMBED;THREADS" "VERIFY_ARGS")
   if(arg_UNPARSED_ARGUMENTS)
@@ -94,21 +96,30 @@ function(kdm_bake_tileset)
   endif()
   get_filename_component(output_dir "${output}" DIRECTORY)
   set(scratch "${output}.baking")
-  set(steps COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}"
-            COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS})
+  # The bake's own output is a stamp, OUTPUT its byproduct: a bake that gives the same bytes leaves OUTPUT,
+  # and its time, as they were (KdmBakeStep.cmake), and Ninja and Make then rebuild nothing from it.
+  set(stamp "${CMAKE_CURRENT_BINARY_DIR}/kdm_baked/${owner}.stamp")
+  set(step_args "-DKDM_BAKE_SCRATCH=${scratch}" "-DKDM_BAKE_OUTPUT=${output}" "-DKDM_BAKE_STAMP=${stamp}")
   if(arg_VERIFY)
     list(JOIN arg_VERIFY_ARGS "|" verify_args)  # one word through the command line: '|' for ';'
-    list(APPEND steps COMMAND "${CMAKE_COMMAND}" "-DKDM_VERIFY_KDM=$<TARGET_FILE:kdm::kdm>"
-                              "-DKDM_VERIFY_FILE=${scratch}" "-DKDM_VERIFY_THREADS=${arg_THREADS}"
-                              "-DKDM_VERIFY_ARGS=${verify_args}"
-                              -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake")
+    list(APPEND step_args "-DKDM_VERIFY_KDM=$<TARGET_FILE:kdm::kdm>" "-DKDM_VERIFY_THREADS=${arg_THREADS}"
+                          "-DKDM_VERIFY_ARGS=${verify_args}")
   endif()
-  list(APPEND steps COMMAND "${CMAKE_COMMAND}" -E rename "${scratch}" "${output}")
-  add_custom_command(OUTPUT "${output}" ${steps}
-                     DEPENDS "${recipe}" "$<TARGET_FILE:kdm::kdm>" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmVerifyStep.cmake"
+  set(depends "${recipe}" "$<TARGET_FILE:kdm::kdm>" "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmBakeStep.cmake")
+  if(CMAKE_GENERATOR MATCHES "Make")
+    # Make knows no rule for a byproduct: this one makes a missing OUTPUT look new, so the stamp, which
+    # depends on it, is remade and OUTPUT baked again (Ninja does so for a missing byproduct itself).
+    add_custom_command(OUTPUT "${output}" COMMAND "${CMAKE_COMMAND}" -E true VERBATIM)
+    list(APPEND depends "${output}")
+  endif()
+  add_custom_command(OUTPUT "${stamp}" BYPRODUCTS "${output}"
+                     COMMAND "${CMAKE_COMMAND}" -E make_directory "${output_dir}" "${CMAKE_CURRENT_BINARY_DIR}/kdm_baked"
+                     COMMAND kdm::kdm bake "${recipe}" -o "${scratch}" --threads ${arg_THREADS}
+                     COMMAND "${CMAKE_COMMAND}" ${step_args} -P "${CMAKE_CURRENT_FUNCTION_LIST_DIR}/KdmBakeStep.cmake"
+                     DEPENDS ${depends}
                      COMMENT "Baking tile set ${output} from ${recipe}"
                      VERBATIM)
-  add_custom_target(${owner} ALL DEPENDS "${output}")
+  add_custom_target(${owner} ALL DEPENDS "${stamp}")
   if(arg_EMBED)
     set(include_dir "${CMAKE_CURRENT_BINARY_DIR}/kdm_embedded/${arg_EMBED}")
     # C89 comments only: a C90 project includes the header too. A path cannot end the comment early.

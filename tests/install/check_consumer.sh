@@ -52,6 +52,23 @@ done
 "$work/embed/build/embedded_a" >/dev/null
 "$work/embed/build/embedded_b" >/dev/null
 cmp "$work/embed/build/c.kdmt" "$work/embed/build/c_copy.kdmt"
+# A touched recipe, and a new comment in it, bake the same bytes again: the set keeps its time, and
+# nothing built from it is built again.
+before=$(ls -l --time-style=full-iso "$work/embed/build/a.kdmt" "$work/embed/build/embedded_a")
+for edit in "touch" "echo '# a comment' >>"; do
+  eval "$edit \"\$work/embed/src/small.recipe\""
+  cmake --build "$work/embed/build" -j2 >"$work/embed/again.log" 2>&1 || { cat "$work/embed/again.log"; exit 1; }
+  grep -q "Baking tile set .*/a\.kdmt from" "$work/embed/again.log" || { echo "$edit: the recipe was not baked again"; exit 1; }
+  if grep -q -e "Embedding" -e "Linking" "$work/embed/again.log"; then
+    echo "$edit: the same set was embedded or linked again:"; cat "$work/embed/again.log"; exit 1
+  fi
+  [ "$(ls -l --time-style=full-iso "$work/embed/build/a.kdmt" "$work/embed/build/embedded_a")" = "$before" ] ||
+    { echo "$edit: the same set, or its program, has a new time"; exit 1; }
+done
+# A removed set is baked again.
+rm "$work/embed/build/a.kdmt"
+cmake --build "$work/embed/build" -j2 >"$work/embed/removed.log" 2>&1 || { cat "$work/embed/removed.log"; exit 1; }
+"$work/embed/build/embedded_a" >/dev/null
 # A project of no language bakes through the tool component alone.
 cmake -S "$here/tool_consumer" -B "$work/tool" -DCMAKE_PREFIX_PATH="$prefix" >"$work/tool.log" 2>&1 ||
   { cat "$work/tool.log"; exit 1; }
