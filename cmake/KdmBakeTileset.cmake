@@ -95,7 +95,7 @@ function(kdm_bake_tileset)
     string(MAKE_C_IDENTIFIER "kdm_bake_${owner}" owner)
   endif()
   get_filename_component(output_dir "${output}" DIRECTORY)
-  set(scratch "${output}.baking")
+  set(scratch "${output}.baking.kdmt")  # a tile set's extension, of which kdm bake does not warn
   # The bake's own output is a stamp, OUTPUT its byproduct: a bake that gives the same bytes leaves OUTPUT,
   # and its time, as they were (KdmBakeStep.cmake), and Ninja and Make then rebuild nothing from it.
   set(stamp "${CMAKE_CURRENT_BINARY_DIR}/kdm_baked/${owner}.stamp")

@@ -35,7 +35,7 @@ grep -q "levels" "$work/bad.log" || { echo "the refused bake did not say why:"; 
 printf 'colours 1\nlevels 2\nbase_points 32\ntemperature 50\n' >"$work/src/small.recipe"
 if cmake --build "$work/build" >"$work/unverified.log" 2>&1; then echo "a set failing verification was built"; exit 1; fi
 grep -q "failed [0-9]* check" "$work/unverified.log" || { echo "verification did not say why:"; cat "$work/unverified.log"; exit 1; }
-if [ -e "$baked.baking" ]; then echo "the failed verification left $baked.baking behind"; exit 1; fi
+if [ -e "$baked.baking.kdmt" ]; then echo "the failed verification left $baked.baking.kdmt behind"; exit 1; fi
 if cmake --build "$work/build" >/dev/null 2>&1; then echo "the build after a failed verification passed"; exit 1; fi
 # A project of C alone in each of kdm_bake_tileset's patterns, with Makefiles on two jobs: each set is
 # baked once, by the one target that owns its bake, and each embedded set is its file's bytes.
@@ -45,6 +45,7 @@ cp "$here/consumer/small.recipe" "$work/embed/src/"
 cmake -S "$work/embed/src" -B "$work/embed/build" -G "Unix Makefiles" -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/embed/build" -j2 >"$work/embed/build.log" 2>&1 || { cat "$work/embed/build.log"; exit 1; }
+if grep "kdm bake: warning" "$work/embed/build.log"; then echo "the bake warned"; exit 1; fi
 for set in a b c; do
   bakes=$(grep -c "Baking tile set .*/$set\.kdmt from" "$work/embed/build.log" || true)
   [ "$bakes" = 1 ] || { echo "$set.kdmt was baked $bakes times:"; cat "$work/embed/build.log"; exit 1; }
