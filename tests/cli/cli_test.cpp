@@ -511,6 +511,37 @@ TEST_F(CliTest, SampleTakesThreeSides) {
   EXPECT_NE(slurp(path("one.txt")).find(", aspect 2\n"), std::string::npos);
 }
 
+// Only a density's shape matters: a .npy array of any scale, values far below or above a float's range too,
+// samples as the array divided by its largest value (all 1e-200 is not zero everywhere).
+TEST_F(CliTest, SampleTakesNumPyDensitiesAtAnyScale) {
+  std::vector<double> values(2 * 3 * 4);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 1 + double(i % 5);
+  auto points = [&](const std::string& name) {
+    const std::string text = slurp(path(name));
+    return text.substr(text.find("\n0"));
+  };
+  for (const char* dim : {"2", "3"}) {
+    const bool flat = dim[0] == '2';
+    const std::string shape = flat ? "6, 4" : "";
+    // Values times 2^k over their largest (5 times 2^k) are exactly the values over 5, at any k.
+    auto scaled = [&](int k) {
+      std::vector<double> out = values;
+      for (double& v : out) v = k ? std::ldexp(v, k) : v / 5;
+      return out;
+    };
+    std::ofstream(path("unit.npy"), std::ios::binary) << npy_volume(scaled(0), 2, 3, 4, "<f8", shape);
+    const std::string run = std::string("sample --n 300 --seed 2 --dim ") + dim + " --density '";
+    const Outcome unit = kdm(run + path("unit.npy") + "' -o '" + path("unit.txt") + "'");
+    ASSERT_EQ(unit.status, 0) << unit.err;
+    for (int scale : {-660, -116, 116, 996}) {  // about 1e-199, 1e-35, 1e35, 1e300
+      std::ofstream(path("s.npy"), std::ios::binary) << npy_volume(scaled(scale), 2, 3, 4, "<f8", shape);
+      const Outcome got = kdm(run + path("s.npy") + "' -o '" + path("s.txt") + "'");
+      ASSERT_EQ(got.status, 0) << dim << " " << scale << ": " << got.err;
+      EXPECT_EQ(points("s.txt"), points("unit.txt")) << dim << " " << scale;
+    }
+  }
+}
+
 TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   const std::string out = " -o '" + path("x.txt") + "'";
   std::ofstream(path("v.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 1.0), 2, 2, 2);

@@ -313,6 +313,21 @@ def test_a_2d_npy_density_is_the_array_kdm_sample_takes(cli, tmp_path):
     assert "aspect 2" in (tmp_path / "c.txt").read_text().splitlines()[1]
 
 
+def test_npy_density_at_any_scale_same_bits_as_the_array(cli, tmp_path):
+    # Only a density's shape matters: kdm sample scales a .npy array as kdm.sample scales the array (values
+    # far below or above float32's range too), for the same bits; all 1e-200 is not zero everywhere.
+    flat = np.ones((6, 12)) * np.linspace(1, 3, 12)
+    volume = _half_dense_volume(4, 6, 8) * np.linspace(1, 2, 8)
+    for scale in [1e-200, 1e35, 1e300]:
+        for name, array, dim in [("flat", flat * scale, 2), ("volume", volume * scale, 3),
+                                 ("even", np.full((4, 4, 4), scale), 3)]:
+            np.save(tmp_path / f"{name}.npy", array)
+            cli("sample", "--n", 700, "--dim", dim, "--seed", 4, "--density", tmp_path / f"{name}.npy", "-o",
+                tmp_path / f"{name}.txt")
+            assert np.array_equal(kdm.sample(700, array, dim=dim, seed=4), read_txt(tmp_path / f"{name}.txt")), \
+                (name, scale)
+
+
 def test_volume_axes_are_z_rows_from_the_top_and_x():
     # a[k] is the slice at z = (k + 0.5) / depth; each slice's row 0 at the top (y near 1), as 2-D arrays;
     # the last axis is x. 4x denser in the first half of an axis of 8 voxels: 0.78125 of the points in that

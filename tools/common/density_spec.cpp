@@ -108,31 +108,41 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   if (!flat) spec.depth = static_cast<int>(d);
   const std::uint64_t count = d * rows * cols;
   spec.values.resize(static_cast<std::size_t>(count));
-  unsigned char chunk[1 << 14];
-  for (std::uint64_t done = 0; done < count;) {
-    const std::uint64_t n = std::min<std::uint64_t>(count - done, sizeof chunk / bytes);
-    if (static_cast<std::uint64_t>(buffer.sgetn(reinterpret_cast<char*>(chunk),
-                                                static_cast<std::streamsize>(n * bytes))) != n * bytes)
-      throw fail("cut short: its header promises " + std::to_string(count) + " values");
-    for (std::uint64_t k = 0; k < n; ++k) {
-      const double v = npy_scalar_value(chunk + k * bytes, type);
-      // The element's numpy index [slice, row, column], in either order.
-      const std::uint64_t at = done + k;
-      std::uint64_t z, row, col;
-      if (h.fortran)
-        z = at % d, row = at / d % rows, col = at / (d * rows);
-      else
-        col = at % cols, row = at / cols % rows, z = at / (cols * rows);
-      if (!(std::isfinite(v) && v >= 0 && v <= 3.4028234663852886e38))
-        throw fail("a value of " + std::to_string(v) + " at [" + (flat ? "" : std::to_string(z) + ", ") +
-                   std::to_string(row) + ", " + std::to_string(col) +
-                   "]: densities must be finite and >= 0, at most 3.4e38");
-      // Rows are stored top first, as in a picture; kdm keeps row 0 at the bottom.
-      spec.values[static_cast<std::size_t>((z * rows + (rows - 1 - row)) * cols + col)] =
-          static_cast<float>(v);
+  // Calls f(value, index into spec.values) for every element from the data's start, in file order.
+  const std::streampos data = buffer.pubseekoff(0, std::ios::cur, std::ios::in);
+  auto each = [&](auto f) {
+    if (buffer.pubseekpos(data, std::ios::in) != data) throw fail("cannot read its data");
+    unsigned char chunk[1 << 14];
+    for (std::uint64_t done = 0; done < count;) {
+      const std::uint64_t n = std::min<std::uint64_t>(count - done, sizeof chunk / bytes);
+      if (static_cast<std::uint64_t>(buffer.sgetn(reinterpret_cast<char*>(chunk),
+                                                  static_cast<std::streamsize>(n * bytes))) != n * bytes)
+        throw fail("cut short: its header promises " + std::to_string(count) + " values");
+      for (std::uint64_t k = 0; k < n; ++k) {
+        // The element's numpy index [slice, row, column], in either order.
+        const std::uint64_t at = done + k;
+        std::uint64_t z, row, col;
+        if (h.fortran)
+          z = at % d, row = at / d % rows, col = at / (d * rows);
+        else
+          col = at % cols, row = at / cols % rows, z = at / (cols * rows);
+        const double v = npy_scalar_value(chunk + k * bytes, type);
+        if (!(std::isfinite(v) && v >= 0))
+          throw fail("a value of " + std::to_string(v) + " at [" + (flat ? "" : std::to_string(z) + ", ") +
+                     std::to_string(row) + ", " + std::to_string(col) +
+                     "]: densities must be finite and >= 0");
+        // Rows are stored top first, as in a picture; kdm keeps row 0 at the bottom.
+        f(v, static_cast<std::size_t>((z * rows + (rows - 1 - row)) * cols + col));
+      }
+      done += n;
     }
-    done += n;
-  }
+  };
+  double top = 0;
+  each([&](double v, std::size_t) { top = std::max(top, v); });
+  // Only the shape matters: values whose largest is outside the sampler's range (1e-30 ... 1e30) are divided
+  // by it in float64 before they become floats, as kdm.sample does with an array (the same bits).
+  const double divisor = top > 0 && !(top >= 1e-30 && top <= 1e30) ? top : 1;
+  each([&](double v, std::size_t i) { spec.values[i] = static_cast<float>(v / divisor); });
   return spec;
 }
 

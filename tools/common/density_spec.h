@@ -45,7 +45,8 @@ struct DensitySpec {
 /// `text` is "const:V" (V finite, >= 0), "ramp:R" or "radial:R" (R in [1, 1e9]), or a path to an image:
 /// darkness (1 − luminance) raised to `gamma` (finite, > 0) is the density; `invert` uses luminance (on
 /// black paper: picture_tone). A NumPy .npy file (known by its first bytes) holds real densities of either
-/// byte order (float16, 32 or 64, integers of 8 to 64 bits as their values, bool as 0 and 1; finite, >= 0),
+/// byte order (float16, 32 or 64, integers of 8 to 64 bits as their values, bool as 0 and 1; finite, >= 0,
+/// at any scale: when the largest is outside 1e-30 ... 1e30 all are divided by it, as kdm.sample does),
 /// in C or Fortran order, at most kMaxImagePixels values: a 2-D array (rows, columns) is a kImage, row 0 at
 /// the top (y near 1), as 2-D density arrays in Python; a 3-D one (depth, height, width) a kVolume, array[k]
 /// slice k along z (k = 0 at z near 0), each slice as a 2-D array. Other shapes and types are refused,
