@@ -5,6 +5,7 @@ anything reaches the C++ libraries (which check again, so nothing a caller passe
 """
 from __future__ import annotations
 
+import inspect
 import math
 import numbers
 import os
@@ -131,15 +132,16 @@ def unmasked(name: str, value: Any, fill: str) -> None:
                         f"pass {fill}")
 
 
-def _real_array(name: str, value: Any, fill: Optional[str] = None) -> np.ndarray:
+def _real_array(name: str, value: Any, fill: Optional[str] = None,
+                shapes: str = "a 2-D array (rows, columns)") -> np.ndarray:
     """`value` as a numpy array of real numbers (bool, integer or float), else ValueError or TypeError.
     A masked array is refused (unmasked()); `fill` says what to pass instead (default: the density's
-    .filled(0))."""
+    .filled(0)); `shapes` what a ragged one should have been."""
     unmasked(name, value, fill or f"{name}.filled(0), no density where it is masked")
     try:
         a = np.asarray(value)
     except ValueError as e:  # ragged nested lists
-        raise ValueError(f"{name} must be a 2-D array (rows, columns): {e}") from None
+        raise ValueError(f"{name} must be {shapes}: {e}") from None
     except Exception as e:  # an object whose __array__ fails
         raise TypeError(f"{name} must be a 2-D array of numbers: {e}") from None
     if a.dtype.kind not in "biuf":
@@ -317,10 +319,17 @@ def _shape_of_density(name: str, values: np.ndarray) -> np.ndarray:
     return values / top if top > 0 and not 1e-30 <= top <= 1e30 else values
 
 
-def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density") -> Any:
+def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density",
+                    dim: Optional[int] = None) -> Any:
     """density_spec() for the full sampler, which needs something to sample. A 3-D array is a volume
-    (depth, height, width) for dim=3. An array's values may have any scale (_shape_of_density)."""
-    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim == 3:
+    (depth, height, width) for dim=3. An array's values may have any scale (_shape_of_density). `dim`,
+    if known, is the sample's (for messages)."""
+    ndim = 0
+    if is_array(density) and not isinstance(density, (str, bytes)):
+        shapes = {2: "a 2-D array (rows, columns)", 3: "with dim=3 a 3-D array (depth, height, width)"}.get(
+            dim, "a 2-D array (rows, columns), or with dim=3 a 3-D array (depth, height, width)")
+        ndim = _real_array(name, density, shapes=shapes).ndim
+    if ndim == 3:
         if number("gamma", gamma, 0.0, strict=True) != 1.0 or flag("invert", invert):
             raise ValueError("gamma and invert apply to image files only (an array or a number is the density)")
         spec = _kdm.DensitySpec.from_volume(_shape_of_density(name, array3d(name, density)))
@@ -328,10 +337,10 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
             raise ValueError(f"{name}: an array that is zero everywhere has nothing to sample (it needs some "
                              "density > 0)")
         return spec
-    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim > 3:
+    if ndim > 3:
         raise ValueError(f"{name} must be a 2-D array (rows, columns), or with dim=3 a 3-D array (depth, "
                          f"height, width), got shape {np.shape(density)}")
-    if is_array(density) and not isinstance(density, (str, bytes)) and _real_array(name, density).ndim == 2:
+    if ndim == 2:
         density = _shape_of_density(name, array2d(name, density))
     spec = density_spec(density, gamma, invert, name)
     if spec is not None and not spec.max_value > 0:  # now, not at the first draw
@@ -341,6 +350,21 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
         ink = "; an all-white image has no ink" if spec.kind == "image" else ""
         raise ValueError(f"{name} {spec.text!r} is zero everywhere: nothing to sample{ink}")
     return spec
+
+
+def density_function(name: str, f: Any, dim: int, dim_name: str = "dim") -> None:
+    """Refuses (TypeError) a callable density that cannot take `dim` coordinates, f(x, y) or f(x, y, z), by
+    its signature before any call: a TypeError raised inside a callable that takes them stays its own."""
+    try:
+        signature = inspect.signature(f)
+    except (TypeError, ValueError):  # some builtins have none to read: their calls will tell
+        return
+    try:
+        signature.bind(*([0.0] * dim))
+    except TypeError:
+        call = "f(x, y, z)" if dim == 3 else "f(x, y)"
+        raise TypeError(f"{name}: with {dim_name}={dim} the density is called as {call}, with {dim} "
+                        f"coordinates, but this callable takes {signature}") from None
 
 
 def class_specs(classes: Any, gamma: Any, invert: Any) -> list:

@@ -162,9 +162,10 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     @density.setter
     def density(self, value: Any) -> None:
         if callable(value) and not isinstance(value, (np.ndarray, str)):  # called at each draw
+            _checks.density_function("density", value, self.d, "d")
             self._density = self._spec = value
             return
-        spec = _checks.sampler_density(value, 1.0, False)  # read once, refused now if bad
+        spec = _checks.sampler_density(value, 1.0, False, dim=self.d)  # read once, refused now if bad
         if self.d != 2 and spec is not None and spec.kind == "image":
             raise ValueError("image and array densities are 2-D; use d=2")  # now, not at the first draw
         if self.d != 3 and spec is not None and spec.kind == "volume":

@@ -158,9 +158,10 @@ def sample(
     if callable(density) and not isinstance(density, (np.ndarray, str)):
         if gamma != 1.0 or invert:
             raise ValueError("gamma and invert apply to image files only, and density is a function")
+        _checks.density_function("density", density, dim)
         return _kdm.sample_function(n, density, dim, domain, temperature, seed, threads, aspect, sides=sides,
                                     sets=sets, vectorized=vectorized, **more)
-    spec = _checks.sampler_density(density, gamma, invert)
+    spec = _checks.sampler_density(density, gamma, invert, dim=dim)
     if spec is not None and spec.kind == "volume" and dim != 3:
         raise ValueError(f"density: a 3-D array of shape ({spec.depth}, {spec.height}, {spec.width}) is a volume "
                          "(depth, height, width): use dim=3")

@@ -556,7 +556,8 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   std::ofstream(path("c.npy"), std::ios::binary) << npy_volume({}, 2, 2, 2, "<c8");  // complex
   std::ofstream(path("short.npy"), std::ios::binary) << npy_volume(std::vector<double>(7, 1.0), 2, 2, 2);
   const std::string v = " --density '" + path("v.npy") + "'";
-  expect_error("sample --n 100 --dim 3 --density '" + path("flat.npy") + "'" + out, "image densities are 2D");
+  expect_error("sample --n 100 --dim 3 --density '" + path("flat.npy") + "'" + out,
+               "density '" + path("flat.npy") + "' is a 2-D array (2, 2): drop --dim 3, or give a 3-D array");
   expect_error("sample --n 100" + v + out, "is a 3-D array (2, 2, 2): sample it with --dim 3");
   expect_error("sample --n 100 --dim 3 --density '" + path("neg.npy") + "'" + out,
                "a value of -2.000000 at [1, 0, 1]");
@@ -583,6 +584,10 @@ TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   expect_error("analyze '" + path("x.txt") + "'" + v, "is a 3-D volume, and the points are 2D");
   expect_error("sample --n 100 --dim 3 --aspect 1:2" + out, "--aspect W:H is a 2D domain's shape");
   expect_error("sample --n 100 --dim 3 --aspect 1:0:2" + out, "three sides X:Y:Z, each > 0; got '1:0:2'");
+  expect_error(
+      "sample --n 100 --dim 3 --aspect 2:1:0" + out,
+      "one number > 0 (the x side over the others) or, in 3D, three sides X:Y:Z, each > 0; got '2:1:0'");
+  EXPECT_EQ(kdm("sample --n 100 --dim 3 --aspect 2:1:0" + out).err.find("W:H"), std::string::npos);
   expect_error("sample --n 100 --dim 3 --aspect 1:x:2" + out, "got '1:x:2'");
   expect_error("sample --n 100 --dim 3 --aspect 1::2" + out, "got '1::2'");
   expect_error("sample --n 100 --aspect 1:2:3" + out, "add --dim 3");

@@ -77,9 +77,23 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, r"aspect\[2\] must be a finite number", dict(n=10, dim=3, aspect=(1, 1, NAN))),
     (TypeError, "aspect must be a number or a sequence of three sides", dict(n=10, dim=3, aspect="1:2:3")),
     (ValueError, r"aspect=\(x, y, z\) sets a 3-D domain's sides", dict(n=10, density=lambda x, y: 1.0, aspect=(1, 2, 3))),
+    (ValueError, r"density must be with dim=3 a 3-D array \(depth, height, width\): ",
+     dict(n=10, dim=3, density=[[[1, 2], [3]]])),
+    (TypeError, r"with dim=3 the density is called as f\(x, y, z\), with 3 coordinates, but this callable "
+     r"takes \(x, y\)", dict(n=10, dim=3, density=lambda x, y: 1.0)),
+    (TypeError, r"with dim=2 the density is called as f\(x, y\)", dict(n=10, density=lambda x, y, z: 1.0)),
 ])
 def test_sample_refusals(kind, match, kwargs):
     raises(kind, match, kdm.sample, **kwargs)
+
+
+def test_a_type_error_inside_a_density_callable_is_its_own():
+    # The callable takes f(x, y, z): its own TypeError is not mistaken for a wrong number of coordinates.
+    def density(x, y, z):
+        return len(x)  # a float has no len()
+    raises(TypeError, "has no len", kdm.sample, 10, density, dim=3)
+    raises(TypeError, r"with d=3 the density is called as f\(x, y, z\)", kdm.BlueNoise, d=3,
+           density=lambda x, y: 1.0)
 
 
 def cli_message(cli_path, *args):

@@ -45,7 +45,16 @@ struct SampleArgs {
 /// --aspect: one number, the x side over the others, or in 3D three sides X:Y:Z (their ratios count).
 /// Returns the sides (one for a single number); throws CommandError for anything else.
 std::vector<double> parse_aspect(const std::string& text, int dim) {
-  const std::vector<double> sides = parse_sides(text, "--aspect");
+  std::vector<double> sides;
+  try {
+    sides = parse_sides(text, "--aspect");
+  } catch (const CommandError&) {
+    if (dim != 3) throw;
+    throw CommandError(
+        "--aspect must be one number > 0 (the x side over the others) or, in 3D, three sides "
+        "X:Y:Z, each > 0; got '" +
+        text + "'");
+  }
   if (dim == 3 && std::count(text.begin(), text.end(), ':') == 1)
     throw CommandError(
         "--aspect W:H is a 2D domain's shape: in 3D give three sides X:Y:Z, or one number (the "
@@ -158,10 +167,10 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   for (const tools::DensitySpec& s : specs) class_specs.push_back(&s);
   check_class_images(class_specs);
   check_image_options(class_specs, args.gamma, args.invert);
-  bool image = false, edged = false;
-  const tools::DensitySpec* volume = nullptr;
+  bool edged = false;
+  const tools::DensitySpec *image = nullptr, *volume = nullptr;
   for (const tools::DensitySpec& s : specs) {
-    image = image || s.kind == tools::DensitySpec::Kind::kImage;
+    if (s.kind == tools::DensitySpec::Kind::kImage && !image) image = &s;
     if (s.kind == tools::DensitySpec::Kind::kVolume) volume = &s;
     // A ramp, a picture or a volume has edges that do not meet: a box, unless asked otherwise.
     edged = edged || s.kind == tools::DensitySpec::Kind::kImage ||
@@ -188,7 +197,12 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
       }
     if (volume) extent[0] = volume->width, extent[1] = volume->height, extent[2] = volume->depth;
   }
-  if (image && o.dim != 2) throw CommandError("image densities are 2D; drop --dim 3");
+  if (image && o.dim != 2)
+    throw CommandError(image->array
+                           ? "density '" + image->text + "' is a 2-D array (" +
+                                 std::to_string(image->height) + ", " + std::to_string(image->width) +
+                                 "): drop --dim 3, or give a 3-D array (depth, height, width)"
+                           : std::string("image densities are 2D; drop --dim 3"));
   std::vector<gen::Density> densities;
   for (const tools::DensitySpec& s : specs)
     densities.push_back(classed ? to_class_density(s) : to_generator_density(s));
