@@ -5,12 +5,13 @@ anything reaches the C++ libraries (which check again, so nothing a caller passe
 """
 from __future__ import annotations
 
+import functools
 import inspect
 import math
 import numbers
 import os
 import re
-from typing import Any, Optional, Sequence, Tuple
+from typing import Any, Callable, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -350,6 +351,20 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
         ink = "; an all-white image has no ink" if spec.kind == "image" else ""
         raise ValueError(f"{name} {spec.text!r} is zero everywhere: nothing to sample{ink}")
     return spec
+
+
+def other_name(wrong: str, right: str, why: str) -> Callable:
+    """A decorator that refuses the keyword `wrong` (TypeError) saying to use `right` instead: kdm.sample's
+    dim= and kdm.BlueNoise's d= (SciPy's name) are each the other's mistake, and Python's own refusal does
+    not say which to use."""
+    def wrap(f: Callable) -> Callable:
+        @functools.wraps(f)
+        def checked(*args: Any, **kwargs: Any) -> Any:
+            if wrong in kwargs:
+                raise TypeError(f"{f.__qualname__.split('.')[0]}() takes {right}=, not {wrong}= ({why})")
+            return f(*args, **kwargs)
+        return checked
+    return wrap
 
 
 def density_function(name: str, f: Any, dim: int, dim_name: str = "dim") -> None:

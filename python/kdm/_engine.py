@@ -114,6 +114,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
         blue noise already.
     """
 
+    @_checks.other_name("dim", "d", "SciPy's name for the dimension; dim= is kdm.sample's")
     def __init__(
         self,
         d: int = 2,

@@ -8,6 +8,7 @@ import numpy as np
 from . import _checks, _kdm
 
 
+@_checks.other_name("d", "dim", "d= is kdm.BlueNoise's, SciPy's name")
 def sample(
     n: int,
     density: Any = None,

@@ -96,6 +96,12 @@ def test_a_type_error_inside_a_density_callable_is_its_own():
            density=lambda x, y: 1.0)
 
 
+def test_the_dimension_keyword_of_the_other_interface_says_which_to_use():
+    raises(TypeError, r"sample\(\) takes dim=, not d=", kdm.sample, 10, d=3)
+    raises(TypeError, r"BlueNoise\(\) takes d=, not dim=", kdm.BlueNoise, dim=3)
+    assert "dim" in inspect.signature(kdm.sample).parameters  # the wrapper keeps the signature
+
+
 def cli_message(cli_path, *args):
     done = subprocess.run([cli_path, *map(str, args)], capture_output=True, text=True)
     assert done.returncode == 1
