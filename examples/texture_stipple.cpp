@@ -278,13 +278,6 @@ int main(int argc, char** argv) {
   }
   if (out_dir.empty()) return usage("-o DIR is required");
   const int frames = int(frames_arg), size = int(size_arg);
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec)
-    return std::fprintf(stderr, "texture_stipple: cannot create '%s': %s\n", out_dir.c_str(),
-                        ec.message().c_str()),
-           1;
-
   kdm::Tileset loaded;
   if (!tileset_path.empty()) {
     std::string detail;
@@ -295,6 +288,13 @@ int main(int argc, char** argv) {
              1;
   }
   const kdm::Tileset& tileset = tileset_path.empty() ? kdm::Tileset::builtin() : loaded;
+  // The folder only once the inputs load: a refused run leaves nothing behind.
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec)
+    return std::fprintf(stderr, "texture_stipple: cannot create '%s': %s\n", out_dir.c_str(),
+                        ec.message().c_str()),
+           1;
 
   // The path: straight down onto a point just beside a checker edge, the eye's distance to the surface
   // shrinking geometrically from 4 radii to 1/25 (the surface below 100× larger), so every frame zooms by
