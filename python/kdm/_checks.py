@@ -327,7 +327,7 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
     if known, is the sample's (for messages)."""
     ndim = 0
     if is_array(density) and not isinstance(density, (str, bytes)):
-        shapes = {2: "a 2-D array (rows, columns)", 3: "with dim=3 a 3-D array (depth, height, width)"}.get(
+        shapes = {2: "a 2-D array (rows, columns)", 3: "a 3-D array (depth, height, width) for 3-D points"}.get(
             dim, "a 2-D array (rows, columns), or with dim=3 a 3-D array (depth, height, width)")
         ndim = _real_array(name, density, shapes=shapes).ndim
     if ndim == 3:

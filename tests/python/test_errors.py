@@ -77,7 +77,7 @@ def raises(kind, match, call, *args, **kwargs):
     (ValueError, r"aspect\[2\] must be a finite number", dict(n=10, dim=3, aspect=(1, 1, NAN))),
     (TypeError, "aspect must be a number or a sequence of three sides", dict(n=10, dim=3, aspect="1:2:3")),
     (ValueError, r"aspect=\(x, y, z\) sets a 3-D domain's sides", dict(n=10, density=lambda x, y: 1.0, aspect=(1, 2, 3))),
-    (ValueError, r"density must be with dim=3 a 3-D array \(depth, height, width\): ",
+    (ValueError, r"density must be a 3-D array \(depth, height, width\) for 3-D points: ",
      dict(n=10, dim=3, density=[[[1, 2], [3]]])),
     (TypeError, r"with dim=3 the density is called as f\(x, y, z\), with 3 coordinates, but this callable "
      r"takes \(x, y\)", dict(n=10, dim=3, density=lambda x, y: 1.0)),
