@@ -30,6 +30,14 @@ namespace {
 
 using namespace kdm_cli_test;
 
+/// The first point set of `file` (empty, with a test failure, if it does not read).
+kdm::tools::PointSet first_set(const std::string& file) {
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  EXPECT_TRUE(kdm::tools::read_point_sets(file, sets, error) && !sets.empty()) << file << ": " << error;
+  return sets.empty() ? kdm::tools::PointSet{} : sets[0];
+}
+
 TEST_F(CliTest, TheTestEncoderWritesImagesTheLoaderReads) {
   write_bytes(path("ramp.png"), ramp_png());
   kdm::tools::GreyImage image;
@@ -261,16 +269,12 @@ TEST_F(CliTest, OneByOneImageIsAConstantDensity) {
   const Outcome sampled =
       kdm("sample --n 300 --density '" + path("grey.png") + "' -o '" + path("s.txt") + "'");
   ASSERT_EQ(sampled.status, 0) << sampled.err;
-  std::vector<kdm::tools::PointSet> sets;
-  std::string error;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
-  EXPECT_EQ(sets.at(0).size(), 300u);  // exact count, as for any density
+  EXPECT_EQ(first_set(path("s.txt")).size(), 300u);  // exact count, as for any density
   const Outcome stippled = kdm("stipple '" + path("grey.png") + "' --points 2000 -o '" + path("t.txt") + "'");
   ASSERT_EQ(stippled.status, 0) << stippled.err;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("t.txt"), sets, error)) << error;
   // The runtime's count for a uniform density over many tiles is the expectation up to the rounding of
   // partly covered edge tiles; 5% is several times that for 2000 dots.
-  EXPECT_NEAR(double(sets.at(0).size()), 2000.0, 100.0);
+  EXPECT_NEAR(double(first_set(path("t.txt")).size()), 2000.0, 100.0);
 }
 
 TEST_F(CliTest, SixteenBitImagesKeepTheirPrecision) {
@@ -316,10 +320,9 @@ TEST_F(CliTest, RadianceImagesKeepTheirDynamicRange) {
   const Outcome r =
       kdm("sample --n 4000 --density '" + path("range.hdr") + "' --invert -o '" + path("r.txt") + "'");
   ASSERT_EQ(r.status, 0) << r.err;
-  std::vector<kdm::tools::PointSet> sets;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("r.txt"), sets, error)) << error;
+  const kdm::tools::PointSet set = first_set(path("r.txt"));
   std::size_t faint = 0;
-  for (std::size_t i = 0; i < sets.at(0).size(); ++i) faint += sets[0].coords[2 * i] >= 9.0 / 16;
+  for (std::size_t i = 0; i < set.size(); ++i) faint += set.coords[2 * i] >= 9.0 / 16;
   EXPECT_LE(faint, 4u);  // read as 8 bits the faint part would be 1/28 as dense: about 120 points
 }
 
@@ -627,10 +630,7 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   EXPECT_EQ(zero.status, 1);
   EXPECT_NE(zero.err.find("needs V > 0 here (zero everywhere"), std::string::npos) << zero.err;
   EXPECT_EQ(zero.err.find("sampler"), std::string::npos) << zero.err;
-  std::vector<kdm::tools::PointSet> sets;
-  std::string error;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
-  EXPECT_EQ(sets.at(0).size(), 1u);
+  EXPECT_EQ(first_set(path("s.txt")).size(), 1u);
 }
 
 // --timing: the throughput line, the model's time, then one line per level (coarsest first, grids doubling)
@@ -1022,13 +1022,10 @@ TEST_F(CliTest, StippleScaleIsChecked) {
   EXPECT_FALSE(fs::exists(path("s.txt")));
   // --scale decides, not --points' default, and counts dots at full darkness: both methods place about
   // scale · mean darkness, the image's mean darkness 0.624 (the runtime's count is within 1% here).
-  std::vector<kdm::tools::PointSet> sets;
-  std::string error;
   std::size_t counts[2] = {};
   for (int full = 0; full < 2; ++full) {
     ASSERT_EQ(kdm(stipple + "5000" + (full ? " --method full" : "")).status, 0);
-    ASSERT_TRUE(kdm::tools::read_point_sets(path("s.txt"), sets, error)) << error;
-    counts[full] = sets.at(0).size();
+    counts[full] = first_set(path("s.txt")).size();
   }
   const double expected = 5000 * (1 - (0 + 64 + 128 + 192) / (4 * 255.0));
   EXPECT_NEAR(counts[0], expected, 0.02 * expected);
@@ -1482,12 +1479,10 @@ TEST_F(CliTest, HelpNamesNpyWhereADensityReadsOne) {
         << "kdm " << c.sub << " --help, " << c.option << ": " << help;
   }
   // The query's points follow the array: four times as dense on its left half.
-  std::vector<kdm::tools::PointSet> sets;
-  std::string error;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("q.txt"), sets, error)) << error;
+  const kdm::tools::PointSet set = first_set(path("q.txt"));
   std::size_t left = 0;
-  for (std::size_t i = 0; i < sets.at(0).size(); ++i) left += sets[0].coords[2 * i] < 0.5;
-  EXPECT_GT(left, 3 * (sets[0].size() - left)) << left << " of " << sets[0].size();
+  for (std::size_t i = 0; i < set.size(); ++i) left += set.coords[2 * i] < 0.5;
+  EXPECT_GT(left, 3 * (set.size() - left)) << left << " of " << set.size();
 }
 
 // Reads a frame written by `stipple --frames`: its points in image UV and its rectangle (from the header).
@@ -1625,10 +1620,7 @@ TEST_F(CliTest, StippleRegionsOfAnyShapeKeepTheDotDensity) {
     const Outcome r = kdm("stipple '" + path("grey.png") + "' --points 2000 --region " + region + " -o '" +
                           path("r.txt") + "'");
     EXPECT_EQ(r.status, 0) << r.err;
-    std::vector<kdm::tools::PointSet> sets;
-    std::string error;
-    EXPECT_TRUE(kdm::tools::read_point_sets(path("r.txt"), sets, error)) << error;
-    return sets.empty() ? 0.0 : double(sets[0].size());
+    return double(first_set(path("r.txt")).size());
   };
   EXPECT_NEAR(dots("0,0,0.25,1"), 8000.0, 400.0);  // 4× the density over a quarter of the image
   EXPECT_NEAR(dots("0,0,1,0.25"), 500.0, 25.0);    // the whole image's size, a quarter as tall
@@ -1667,12 +1659,10 @@ TEST_F(CliTest, StippleLeavesTransparentPixelsEmpty) {
     const Outcome r =
         kdm("stipple '" + path("half.png") + "' --points 2000" + invert + " -o '" + path("h.txt") + "'");
     ASSERT_EQ(r.status, 0) << r.err;
-    std::vector<kdm::tools::PointSet> sets;
-    std::string error;
-    ASSERT_TRUE(kdm::tools::read_point_sets(path("h.txt"), sets, error)) << error;
-    ASSERT_GT(sets.at(0).size(), 1500u);
+    const kdm::tools::PointSet set = first_set(path("h.txt"));
+    ASSERT_GT(set.size(), 1500u);
     std::size_t right = 0;  // past the last opaque texel's centre, where bilinear reaches zero
-    for (std::size_t i = 0; i < sets[0].size(); ++i) right += sets[0].coords[2 * i] > 4.5 / 8;
+    for (std::size_t i = 0; i < set.size(); ++i) right += set.coords[2 * i] > 4.5 / 8;
     EXPECT_EQ(right, 0u);
   }
   expect_error("stipple '" + path("half.png") + "' -o '" + path("half.png") + "'", "is the input image");
@@ -1703,11 +1693,9 @@ TEST_F(CliTest, StippleInvertedLaysTransparencyOnBlack) {
   const Outcome o =
       kdm("stipple '" + path("white.png") + "' --points 4000 --invert -o '" + path("w.txt") + "'");
   ASSERT_EQ(o.status, 0) << o.err;
-  std::vector<kdm::tools::PointSet> sets;
-  std::string error;
-  ASSERT_TRUE(kdm::tools::read_point_sets(path("w.txt"), sets, error)) << error;
+  const kdm::tools::PointSet set = first_set(path("w.txt"));
   std::size_t left = 0, right = 0;  // mean opacity 1/4 and 3/4
-  for (std::size_t i = 0; i < sets.at(0).size(); ++i) (sets[0].coords[2 * i] < 0.5 ? left : right) += 1;
+  for (std::size_t i = 0; i < set.size(); ++i) (set.coords[2 * i] < 0.5 ? left : right) += 1;
   EXPECT_NEAR(double(left + right), 4000.0, 200.0);
   EXPECT_NEAR(double(right) / double(left), 3.0, 0.3) << left << " " << right;
 }
