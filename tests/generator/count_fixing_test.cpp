@@ -44,22 +44,17 @@ std::vector<Particle<D>> random_kernels(Chain<D>& chain, int count, std::uint64_
   return particles;
 }
 
-// The rule of remove_surplus(), stated directly: among the kernels no heavier than the surplus (all of
-// them if none is), the first of lowest cost, with every cost worked out again before each choice.
+// The rule of remove_surplus(), stated directly: the first of lowest cost per unit of weight, however
+// heavy, with every cost worked out again before each choice.
 template <int D>
 std::int64_t remove_with_fresh_costs(Chain<D>& chain, std::vector<Particle<D>>& particles, double n,
                                      double& w) {
   std::int64_t removed = 0;
   for (typename Chain<D>::Scratch scratch; w > n && !particles.empty(); ++removed) {
-    std::vector<std::pair<double, std::size_t>> light, all;  // (cost, index): pairs order ties by index
-    for (std::size_t j = 0; j < particles.size(); ++j) {
-      const double cost = chain.energy_change_if_removed(particles[j], scratch) / particles[j].weight();
-      all.emplace_back(cost, j);
-      if (particles[j].weight() <= w - n) light.emplace_back(cost, j);
-    }
-    const std::size_t best =
-        std::min_element(light.empty() ? all.begin() : light.begin(), light.empty() ? all.end() : light.end())
-            ->second;
+    std::vector<std::pair<double, std::size_t>> all;  // (cost, index): pairs order ties by index
+    for (std::size_t j = 0; j < particles.size(); ++j)
+      all.emplace_back(chain.energy_change_if_removed(particles[j], scratch) / particles[j].weight(), j);
+    const std::size_t best = std::min_element(all.begin(), all.end())->second;
     chain.splat(particles[best], -1.0f, scratch);
     w -= particles[best].weight();
     particles.erase(particles.begin() + static_cast<std::ptrdiff_t>(best));
@@ -116,6 +111,29 @@ TEST(CountFixingTest, KeptCostsSeeNeighboursAcrossTheTorusSeam) {
   for (const Particle<2>& p : particles) seam_pair += p.x[1] == 10, middle_pair += p.x[1] == 30;
   EXPECT_EQ(seam_pair, 1);
   EXPECT_EQ(middle_pair, 1);
+}
+
+// Light kernels each on its own spot and two heavy ones stacked on one, with a surplus lighter than a
+// heavy kernel: one of the stacked pair is the cheapest removal per unit of weight, and taking it leaves
+// every light kernel. Kept to kernels that fit the surplus, removal took three light kernels instead,
+// which is how the faint side of a sharp step lost its points.
+TEST(CountFixingTest, RemovesAHeavyKernelWhenItIsTheCheapest) {
+  const DensityGrid<2> density = varying_density<2>(48, true, false);
+  Chain<2> chain(density, ChainParams{});
+  Chain<2>::Scratch scratch;
+  std::vector<Particle<2>> particles;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) particles.push_back({Vec<2>{3.0 + 12 * x, 3.0 + 12 * y}, 0});
+  for (int j = 0; j < 2; ++j) particles.push_back({Vec<2>{9.0, 9.0}, 1});  // weight 4 each
+  for (const Particle<2>& p : particles) chain.splat(p, 1.0f, scratch);
+  double w = total_weight(particles);
+  ASSERT_EQ(w, 24);
+  EXPECT_EQ(remove_surplus(chain, particles, 21.5, w), 1);
+  EXPECT_EQ(w, 20);
+  int light = 0, heavy = 0;
+  for (const Particle<2>& p : particles) (p.splits ? heavy : light) += 1;
+  EXPECT_EQ(light, 16);
+  EXPECT_EQ(heavy, 1);
 }
 
 TEST(CountFixingTest, KeptCostsChooseAsFreshCostsOnABox) {

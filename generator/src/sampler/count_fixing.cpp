@@ -68,7 +68,6 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
   // Removed kernels stay in place (gone) until the end, so indices, which break ties, keep their order.
   std::vector<double> cost(count), slack(count), reach(count), weight(count);
   std::vector<char> stale(count, 0), gone(count, 0);
-  std::array<std::int64_t, 256> left_with_splits{};  // kernels left of each weight 2^(D·splits)
   auto work_out = [&](std::size_t j) {
     cost[j] = chain.energy_change_if_removed(particles[j], scratch) / weight[j];
     stale[j] = 0;
@@ -82,16 +81,14 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
     const bool massless = !(chain.rho_at(particles[j].x) > 0);  // no footprint: its cost is always 0
     slack[j] = massless ? 0 : 2 * removal_rounding_bound(scratch.old_fp, max_abs_r) / weight[j] * (1 + 1e-6);
     reach[j] = kCut * chain.sigma_at(particles[j]) + 1;
-    ++left_with_splits[particles[j].splits];
   }
   std::vector<std::pair<double, std::size_t>> floors;  // (floor, index) of stale candidates
   std::int64_t removed = 0;
   std::size_t last = count;  // the kernel the last round removed
   for (std::int64_t left = static_cast<std::int64_t>(count); w > n && left > 0; --left) {
-    // Among the kernels no heavier than the surplus (all of them if none is), the first of lowest cost.
-    bool any_light = false;
-    for (int s = 0; s < 256; ++s) any_light |= left_with_splits[s] > 0 && std::ldexp(1.0, D * s) <= w - n;
-    const double heaviest = any_light ? w - n : std::numeric_limits<double>::infinity();
+    // The first of lowest cost, heavier than the surplus or not (the caller adds back what a heavy one
+    // takes too many): kept to kernels that fit the surplus, the last removals would take a sharp step's
+    // light faint kernels by the dozen where one dense kernel costs less (docs/design.md §2.5).
     std::size_t best = count;
     auto below_best = [&](double floor, std::size_t j) {
       return best == count || floor < cost[best] || (floor == cost[best] && j < best);
@@ -100,7 +97,7 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
     if (last < count) mark_overlapping<D>(chain.grid(), centres, reach, last, stale);
     floors.clear();
     for (std::size_t j = 0; j < count; ++j) {
-      if (gone[j] || weight[j] > heaviest) continue;
+      if (gone[j]) continue;
       if (!stale[j]) {
         if (below_best(cost[j], j)) best = j;
       } else if (below_best(cost[j] - slack[j], j)) {
@@ -116,7 +113,6 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
     chain.splat(particles[best], -1.0f, scratch);
     w -= weight[best];
     gone[best] = 1;
-    --left_with_splits[particles[best].splits];
     ++removed;
     last = best;
   }

@@ -12,8 +12,9 @@
 namespace kdm::gen {
 
 /// Removes kernels from `particles` (every one of them in `chain`'s R) while their total weight `w` exceeds
-/// `n`: each time the one whose removal raises E least per unit of weight, preferring kernels no heavier
-/// than the surplus; ties go to the lowest index. Takes each removed kernel out of R and lowers `w`.
+/// `n`: each time the one whose removal raises E least per unit of weight, however heavy (`w` may end
+/// below `n`: the caller adds kernels back); ties go to the lowest index. Takes each removed kernel out of
+/// R and lowers `w`.
 /// Returns how many were removed. Chooses exactly what working out every cost before each choice would,
 /// but works out again only the costs that a removal changed and that might now be the lowest.
 /// Not thread-safe (one chain, one thread).
@@ -26,9 +27,9 @@ std::int64_t remove_surplus(Chain<D>& chain, std::vector<Particle<D>>& particles
 template <int D>
 double removal_rounding_bound(const Footprint<D>& fp, double max_abs_r);
 
-/// remove_surplus() as kdm's first versions did it, kept for Numerics::kOriginal: every cost worked out
-/// again after each removal by taking the kernel out of R and putting it back, which may change R's last
-/// bits and so the choices after.
+/// remove_surplus() as kdm's first versions did it, kept for Numerics::kOriginal: kernels no heavier than
+/// the surplus preferred, and every cost worked out again after each removal by taking the kernel out of R
+/// and putting it back, which may change R's last bits and so the choices after.
 template <int D>
 std::int64_t remove_surplus_as_first_versions(Chain<D>& chain, std::vector<Particle<D>>& particles, double n,
                                               double& w);
