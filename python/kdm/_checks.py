@@ -262,6 +262,14 @@ def is_array(value: Any) -> bool:
     return isinstance(value, (np.ndarray, list, tuple)) or hasattr(value, "__array__")
 
 
+def scalar_if_0d(value: Any) -> Any:
+    """A 0-d array of a real number as that number: np.asarray(0.5) is the density 0.5, as np.float32(0.5)
+    is. Anything else as it is."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "fiu":
+        return value.item()
+    return value
+
+
 def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str = "density",
                  one_of_several: bool = False, callable_ok: bool = False) -> Any:
     """A density as the C++ side takes it (_kdm.DensitySpec), or None for None.
@@ -272,6 +280,7 @@ def density_spec(density: Any, gamma: Any = 1.0, invert: Any = False, name: str 
     is refused (they would be ignored), unless `one_of_several` (the caller checks the densities together:
     then None is no density either). `callable_ok`: the caller takes callables too (the TypeError says so).
     """
+    density = scalar_if_0d(density)
     gamma = number("gamma", gamma, 0.0, strict=True)
     invert = flag("invert", invert)
     reshaped = gamma != 1.0 or invert
@@ -325,6 +334,7 @@ def sampler_density(density: Any, gamma: Any, invert: Any, name: str = "density"
     """density_spec() for the full sampler, which needs something to sample. A 3-D array is a volume
     (depth, height, width) for dim=3. An array's values may have any scale (_shape_of_density). `dim`,
     if known, is the sample's (for messages)."""
+    density = scalar_if_0d(density)
     ndim = 0
     if is_array(density) and not isinstance(density, (str, bytes)):
         shapes = {2: "a 2-D array (rows, columns)", 3: "a 3-D array (depth, height, width) for 3-D points"}.get(

@@ -153,6 +153,26 @@ def test_unreadable_files_raise_oserror_with_the_cli_message(cli, tmp_path, tiny
         tiny_tileset.save(tmp_path / "no" / "such" / "x.kdmt")  # (the built-in set takes 30 s to encode)
 
 
+def test_a_npy_file_of_bad_values_is_a_value_error_and_a_cut_one_an_os_error(tmp_path):
+    # The same array in memory raises ValueError: a file that reads but holds no density is bad values.
+    values = np.ones((4, 4))
+    values[1, 2] = NAN
+    bad = tmp_path / "nan.npy"
+    np.save(bad, values)
+    wrong_shape = tmp_path / "flat.npy"
+    np.save(wrong_shape, np.ones(5))
+    cut = tmp_path / "cut.npy"
+    np.save(cut, np.ones((64, 64)))
+    cut.write_bytes(cut.read_bytes()[:200])
+    calls = (lambda p: kdm.sample(10, str(p)), lambda p: TILES.query((0, 0, 1, 1), scale=10, density=str(p)),
+             lambda p: kdm.DensityMap(str(p), rect=(0, 0, 1, 1)))
+    for call in calls:
+        raises(ValueError, r"nan\.npy.*a value of nan at \[1, 2\]: densities must be finite", call, bad)
+        raises(ValueError, r"an array of shape \(5\)", call, wrong_shape)
+        with pytest.raises(OSError, match="cut short"):
+            call(cut)
+
+
 @pytest.mark.parametrize("kind,match,kwargs", [
     (ValueError, "density_rect is empty or inverted",
      dict(density=np.ones((4, 4)), density_rect=(0, 0, 0, 1))),

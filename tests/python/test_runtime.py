@@ -212,6 +212,18 @@ def test_positions_refuse_an_origin_where_floats_lose_the_tiles():
     assert len(xy) > 9000 and len(np.unique(xy, axis=0)) == len(xy)
 
 
+def test_a_0d_array_is_the_number_it_holds():
+    # np.asarray(0.5) turns up wherever a pipeline normalises its inputs; np.float32(0.5) was taken already.
+    rect = (0, 0, 3, 2)
+    assert same(BUILTIN.query(rect, scale=300, density=np.asarray(0.5)),
+                BUILTIN.query(rect, scale=300, density=0.5))
+    assert same(BUILTIN.query(rect, scale=300, classes=[np.asarray(0.3), np.asarray(2)]),
+                BUILTIN.query(rect, scale=300, classes=[0.3, 2.0]))
+    assert np.array_equal(kdm.sample(50, np.asarray(0.5), seed=3), kdm.sample(50, 0.5, seed=3))
+    with pytest.raises(ValueError, match="density must be >= 0"):
+        BUILTIN.query(rect, scale=300, density=np.asarray(-1.0))
+
+
 @pytest.mark.parametrize("bounds", [(math.nan, 1.0), (2.0, 1.0), (-1.0, 1.0), (0.0, math.nan)])
 def test_density_bounds_that_are_no_bounds_are_an_error(bounds):
     with pytest.raises(ValueError, match=r"density_bounds returned .*0 <= lo <= hi"):

@@ -71,10 +71,15 @@ double parse_number(const std::string& text) {
 }
 
 /// A NumPy array of densities: 2-D as a kImage spec, 3-D as a kVolume one (parse_density_spec says which);
-/// throws std::runtime_error naming the file and the problem.
+/// throws naming the file and the problem: std::runtime_error for a file it cannot read (a header it
+/// cannot parse, data cut short), std::invalid_argument for an array that is no density (its type, shape
+/// or values), as for the same array given in memory.
 DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   auto fail = [&](const std::string& what) {
     return std::runtime_error("density '" + path + "': NumPy .npy file: " + what);
+  };
+  auto bad = [&](const std::string& what) {
+    return std::invalid_argument("density '" + path + "': NumPy .npy file: " + what);
   };
   std::streambuf& buffer = *in.rdbuf();
   char magic[6];
@@ -85,21 +90,21 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   // Reals as numpy writes them, in either byte order: float16/32/64, (u)int8 to 64, bool.
   NpyScalar type;
   if (!parse_npy_scalar(h.descr, type))
-    throw fail("data of type '" + h.descr +
-               "': expected real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool; either byte "
-               "order)");
+    throw bad("data of type '" + h.descr +
+              "': expected real numbers (float16, 32 or 64, integers of 8 to 64 bits, bool; either byte "
+              "order)");
   const std::size_t bytes = type.bytes;
   std::string dims;
   for (std::size_t i = 0; i < h.shape.size(); ++i) dims += (i ? ", " : "") + std::to_string(h.shape[i]);
   if (h.shape.size() != 2 && h.shape.size() != 3)
-    throw fail("an array of shape (" + dims +
-               "): expected a 2-D array (rows, columns) or, for --dim 3, a 3-D one (depth, height, width)");
+    throw bad("an array of shape (" + dims +
+              "): expected a 2-D array (rows, columns) or, for --dim 3, a 3-D one (depth, height, width)");
   const bool flat = h.shape.size() == 2;  // a picture's densities: one slice
   const std::uint64_t d = flat ? 1 : h.shape[0], rows = h.shape[flat ? 0 : 1], cols = h.shape[flat ? 1 : 2];
-  if (d == 0 || rows == 0 || cols == 0) throw fail("an empty array of shape (" + dims + ")");
+  if (d == 0 || rows == 0 || cols == 0) throw bad("an empty array of shape (" + dims + ")");
   if (d > kMaxImagePixels || rows > kMaxImagePixels || cols > kMaxImagePixels ||
       d * rows * cols > kMaxImagePixels)
-    throw fail("an array of shape (" + dims + "): more than 2^26 values (the image size limit)");
+    throw bad("an array of shape (" + dims + "): more than 2^26 values (the image size limit)");
   DensitySpec spec;
   spec.kind = flat ? DensitySpec::Kind::kImage : DensitySpec::Kind::kVolume;
   spec.array = true;
@@ -128,9 +133,9 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
           col = at % cols, row = at / cols % rows, z = at / (cols * rows);
         const double v = npy_scalar_value(chunk + k * bytes, type);
         if (!(std::isfinite(v) && v >= 0))
-          throw fail("a value of " + std::to_string(v) + " at [" + (flat ? "" : std::to_string(z) + ", ") +
-                     std::to_string(row) + ", " + std::to_string(col) +
-                     "]: densities must be finite and >= 0");
+          throw bad("a value of " + std::to_string(v) + " at [" + (flat ? "" : std::to_string(z) + ", ") +
+                    std::to_string(row) + ", " + std::to_string(col) +
+                    "]: densities must be finite and >= 0");
         // Rows are stored top first, as in a picture; kdm keeps row 0 at the bottom.
         f(v, static_cast<std::size_t>((z * rows + (rows - 1 - row)) * cols + col));
       }
