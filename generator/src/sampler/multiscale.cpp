@@ -14,6 +14,7 @@
 #include "sampler/count_balance.h"
 #include "sampler/count_fixing.h"
 #include "sampler/setup.h"
+#include "sampler/support_pieces.h"
 
 namespace kdm::gen {
 namespace {
@@ -519,6 +520,11 @@ struct Driver {
       chain.splat_all(particles, threads);
     }
     if (!coarsest && !relaxing && options.n > 0) fix_count_level(chain, level);
+    // Pieces of the support that zero density parts: kernels cannot move between them, so whole ones are
+    // moved for them (support_pieces.h). With the count balance, which the first versions lacked.
+    if (!relaxing && options.n > 0 && options.count_balance && fixed.empty() &&
+        options.numerics == Numerics::kFast)
+      report.moved_between_pieces += balance_pieces<D>(chain, particles, support_pieces<D>(density));
     // kOriginal keeps its first start: a recipe bakes the same tiles in every version (the baker parts
     // close pairs itself, bake/close_pairs.h).
     if (level == 0 && !relaxing && !fixed.empty() && options.numerics == Numerics::kFast)

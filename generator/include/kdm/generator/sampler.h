@@ -228,6 +228,9 @@ struct SampleReport {
   double energy_per_point = 0;   ///< E / n at the end, finest grid
   std::int64_t inserted_for_exact_count = 0;  ///< points added so that exactly n come out
   std::int64_t removed_for_exact_count = 0;   ///< points removed so that exactly n come out
+  /// Kernels moved from one piece of the density's support to another (pieces that zero density parts),
+  /// so that each piece gets its share: over all levels.
+  std::int64_t moved_between_pieces = 0;
   /// Varying densities: Σ|count − target| / n on a coarse grid before and after the refined points'
   /// large-scale counts were balanced for the finest sweeps (0 when no balance ran).
   double count_mismatch_before = 0, count_mismatch_after = 0;
