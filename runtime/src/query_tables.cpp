@@ -194,7 +194,8 @@ void QueryTables::index_edges(const TilesetData& set) {
       }
       edge_start[5 * t + side + 1] = static_cast<std::uint32_t>(out.size());
     }
-    out.shrink_to_fit();
+    // To its size by a copy: shrink_to_fit may swallow the allocator's refusal (it is only a request).
+    TilesetArray<std::uint32_t>(out.begin(), out.end(), out.get_allocator()).swap(out);
   }
 }
 

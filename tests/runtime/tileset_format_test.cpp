@@ -631,6 +631,43 @@ TEST(TilesetAllocatorTest, TheTileSetsArraysGoThroughTheHook) {
   EXPECT_EQ(heap.allocations, heap.frees);
 }
 
+struct RefusingHeap {
+  std::size_t refuse = 0;  ///< the allocation to refuse, counting from 1 (0: none)
+  std::size_t calls = 0, live = 0;
+};
+void* refusing_allocate(std::size_t bytes, std::size_t, void* user) {
+  auto* heap = static_cast<RefusingHeap*>(user);
+  if (++heap->calls == heap->refuse) return nullptr;
+  heap->live += bytes;
+  return std::malloc(bytes ? bytes : 1);
+}
+void refusing_deallocate(void* p, std::size_t bytes, std::size_t, void* user) {
+  static_cast<RefusingHeap*>(user)->live -= bytes;
+  std::free(p);
+}
+
+// Whichever allocation of a load the hook refuses, the load fails as out of memory and leaves nothing
+// allocated: none is optional (a shrink of an array that swallowed its refusal let the load succeed).
+TEST(TilesetAllocatorTest, EveryRefusedAllocationOfALoadFailsIt) {
+  const std::vector<std::uint8_t> bytes = encode(make_tileset());
+  RefusingHeap heap;
+  set_tileset_allocator({refusing_allocate, refusing_deallocate, &heap});
+  {
+    Tileset loaded;
+    ASSERT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), loaded), Status::kOk);
+  }
+  const std::size_t allocations = heap.calls;
+  ASSERT_GT(allocations, 20u);
+  for (std::size_t n = 1; n <= allocations; ++n) {
+    heap.refuse = n, heap.calls = 0;
+    Tileset loaded;
+    EXPECT_EQ(Tileset::load_memory(bytes.data(), bytes.size(), loaded), Status::kOutOfMemory) << n;
+    EXPECT_TRUE(loaded.empty()) << n;
+    EXPECT_EQ(heap.live, 0u) << n;
+  }
+  set_tileset_allocator({});
+}
+
 // A path that holds no tile set fails at once with a reason: a directory, an endless device, a file cut
 // short or with bytes after its payload. The loader reads no more than the header says the file holds.
 TEST(TilesetFormatTest, LoadingAFileThatIsNoTilesetFailsAtItsHeader) {
