@@ -287,7 +287,9 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
   kdm::ClassQueryParams q;
   kdm_status status = KDM_INVALID_ARGUMENT;
   if (!read_query(tileset, query, cursor, written, q.query, why)) {
-  } else if (source.kind == ClassSource::kJoint    ? !(joint && (joint->densities || joint->batch_densities))
+  } else if (source.kind == ClassSource::kJoint && joint && !joint->densities && !joint->batch_densities) {
+    why.kind = kdm::QueryProblem::Kind::kBadDensity, why.parameter = "joint.densities";  // no function set
+  } else if (source.kind == ClassSource::kJoint    ? !joint
              : source.kind == ClassSource::kImages ? !source.images
                                                    : !classes) {
     why.kind = kdm::QueryProblem::Kind::kMissingArgument;

@@ -131,7 +131,11 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
       if (std::strcmp(parameter, "image_sums") == 0 && p.value > 0)  // built for another class count
         return print(text, size, "'%s' holds the sums of %.6g classes, the query has %.6g", shown, p.limit,
                      p.value);
+      if (!std::strstr(parameter, "kind"))  // a function or image missing or doubled: no number to show
+        return print(text, size, "%s ('%s')", query_problem_message(p.kind), shown);
       break;
+    case QueryProblem::Kind::kCursorMismatch:
+      return print(text, size, "%s ('%s')", query_problem_message(p.kind), shown);
     case QueryProblem::Kind::kMissingArgument:  // a null has no value to show
       return print(text, size, "%s: '%s'", query_problem_message(p.kind), shown);
     case QueryProblem::Kind::kRunnerIncomplete: {

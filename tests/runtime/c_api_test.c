@@ -402,6 +402,11 @@ int main(int argc, char** argv) {
     q.x1 = 3;
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH && written == 0);
+    {
+      char line[512]; /* a cursor has no number to show */
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      CHECK(strstr(line, "('cursor')") != NULL && strstr(line, "= ") == NULL);
+    }
     q.x1 = 0.5, q.y1 = 0.5, q.scale = 20;
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_OK &&
@@ -712,7 +717,18 @@ int main(int argc, char** argv) {
         CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
                                       &problem) == KDM_INVALID_ARGUMENT &&
               strcmp(problem.parameter, "joint.batch_densities") == 0);
+        {
+          char line[512];
+          kdm_query_problem_describe(&problem, line, sizeof line);
+          CHECK(strstr(line, "('joint.batch_densities')") != NULL && strstr(line, "= ") == NULL);
+        }
         joint.batch_densities = NULL;
+        /* Neither function: the density is missing, not the argument. */
+        joint.densities = NULL;
+        CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, with, with_classes, 8192, &b, &cursor,
+                                      &problem) == KDM_INVALID_ARGUMENT &&
+              problem.kind == KDM_PROBLEM_BAD_DENSITY && strcmp(problem.parameter, "joint.densities") == 0);
+        joint.densities = two_ramps;
         /* Refused by name: no joint density, a bad maximum. */
         memset(&cursor, 0, sizeof cursor);
         CHECK(kdm_query_classes_joint(builtin, &q, NULL, 2, with, with_classes, 8192, &b, &cursor,

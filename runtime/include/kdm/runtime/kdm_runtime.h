@@ -364,9 +364,9 @@ typedef struct kdm_joint_class_density {
 
 /* kdm_query_classes and kdm_query_classes_compact with the classes' densities from one call: the same
  * points and classes as separate callbacks giving the same values, one call per candidate instead of one
- * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` or neither of its two density functions
- * ("joint"), both of them ("joint.batch_densities") and a bad density_max ("joint.density_max[k]"). Added
- * in 0.4. */
+ * per class. KDM_INVALID_ARGUMENT also for a NULL `joint` ("joint", KDM_PROBLEM_MISSING_ARGUMENT),
+ * neither of its two density functions ("joint.densities") or both of them ("joint.batch_densities", both
+ * KDM_PROBLEM_BAD_DENSITY) and a bad density_max ("joint.density_max[k]"). Added in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_query_classes_joint(const kdm_tileset* tileset, const kdm_query* query,
                                                    const kdm_joint_class_density* joint, uint32_t class_count,
                                                    kdm_point* out, uint8_t* out_classes, size_t capacity,
