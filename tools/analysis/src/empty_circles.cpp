@@ -402,7 +402,10 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
        o.torus ? torus_circles(xy, spacing, o.sides) : box_circles(xy, spacing, o.border, lx, ly)) {
     double local = spacing;
     if (o.density) {
-      const double u = square ? c.x : c.x / lx, v = square ? c.y : c.y / ly;  // the density's coordinates
+      double u = square ? c.x : c.x / lx, v = square ? c.y : c.y / ly;  // the density's coordinates
+      if (o.torus) {  // a triangle across the seam is counted once, its centre perhaps past the edge
+        u -= std::floor(u), v -= std::floor(v);
+      }
       const double rho = o.density(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0));
       if (!(rho > 0) || rho < o.min_relative_density * max_rho) continue;
       local = spacing * std::sqrt(mean_rho / rho);
