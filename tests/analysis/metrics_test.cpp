@@ -134,6 +134,23 @@ TEST(Density, NonUniformTargetIsMatched) {
   EXPECT_GT(density_accuracy(c, 2, uniform).rms_z, 3.0);
 }
 
+// Bands span the density's own range: zero cells stay zero (from the summed-area table's differences they
+// came out as 1e-15-sized residue and set the lowest band, eight of ten bands then empty), so a target
+// of 0, 0.01 to 0.51 and 1 has bands from about 0.01 to 1.
+TEST(Density, BandsSpanTheDensitysOwnRange) {
+  // The zero cells last, after the table's sums have grown: a difference of large sums leaves residue.
+  const auto steps = [](double x, double y) { return x > 0.5 || y > 0.5 ? 0.0 : x < 0.25 ? 1.0 : 0.01 + y; };
+  std::vector<double> c;
+  for (int i = 0; i < 64; ++i)
+    for (int j = 0; j < 64; ++j) c.push_back(0.25 * (i + 0.5) / 64), c.push_back(0.5 * (j + 0.5) / 64);
+  const DensityAccuracy d = density_accuracy(c, 2, steps);
+  ASSERT_EQ(d.bands.size(), 10u);
+  EXPECT_GE(d.bands.front().lo, 0.01);  // the lowest raster cell's 0.01 + y, y its centre (under 0.003)
+  EXPECT_LT(d.bands.front().lo, 0.013);
+  EXPECT_NEAR(d.bands.back().hi, 1.0, 1e-9);
+  EXPECT_GT(d.bands.front().expected, 0.0);  // the 0.01 cells, in the first band
+}
+
 TEST(Density, StratifiedSetIsFarBelowPoisson) {
   const tools::PointSet p = jittered_grid(64, 9);
   const DensityAccuracy d = density_accuracy(p.coords, 2, uniform);

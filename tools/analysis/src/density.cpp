@@ -80,24 +80,23 @@ DensityAccuracy density_accuracy(const std::vector<double>& coords, int dim, con
   const int rx = lx == 1 ? r : std::clamp(static_cast<int>(std::lround(r * lx)), 1, 1 << 16);
   const int ry = ly == 1 ? r : std::clamp(static_cast<int>(std::lround(r * ly)), 1, 1 << 16);
   Sat sat{rx, std::vector<double>(static_cast<std::size_t>(rx + 1) * (ry + 1), 0.0)};
+  // Each cell's value as the density gave it: from the table's differences a zero cell came out as
+  // rounding residue (7e-15 of the peak), which set the bands' log range.
+  std::vector<double> cell_rho(static_cast<std::size_t>(rx) * ry);
   for (int y = 0; y < ry; ++y)
     for (int x = 0; x < rx; ++x) {
       const double v = density((x + 0.5) / rx, (y + 0.5) / ry);
       if (!std::isfinite(v) || v < 0) throw InvalidInput("target density is negative or not finite");
+      cell_rho[static_cast<std::size_t>(y) * rx + x] = v;
       const std::size_t i = static_cast<std::size_t>(y + 1) * (rx + 1) + (x + 1);
       sat.s[i] = v + sat.s[i - 1] + sat.s[i - (rx + 1)] - sat.s[i - (rx + 1) - 1];
     }
   const double integral = sat.mass(0, 0, rx, ry);
   if (!(integral > 0)) throw InvalidInput("target density is zero everywhere");
   const double scale = total / integral;  // raster mass → expected count
-  std::vector<double> cell_rho(static_cast<std::size_t>(rx) * ry);
   double rho_min = std::numeric_limits<double>::infinity(), rho_max = 0;
-  for (int y = 0; y < ry; ++y)
-    for (int x = 0; x < rx; ++x) {
-      const double v = sat.mass(x, y, x + 1, y + 1);
-      cell_rho[static_cast<std::size_t>(y) * rx + x] = v;
-      if (v > 0) rho_min = std::min(rho_min, v), rho_max = std::max(rho_max, v);
-    }
+  for (double v : cell_rho)
+    if (v > 0) rho_min = std::min(rho_min, v), rho_max = std::max(rho_max, v);
   const int band_count = rho_max > rho_min * 1.01 ? options.bands : 1;
   const double log_span = std::log(rho_max / rho_min);
   auto band_of = [&](double v) {  // v > 0

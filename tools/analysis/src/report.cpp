@@ -357,8 +357,12 @@ std::string format_summary(const AnalysisReport& r) {
   if (r.has_density && r.density.bands.size() > 1) {
     append(s, "density bands      ρ/ρmax from        expected      points  count/target   ±1σ (Poisson)\n");
     for (const DensityBand& b : r.density.bands)
-      append(s, "                   %.3g–%-10.3g %10.1f  %10.0f  %12.4f  %8.4f\n", b.lo, b.hi, b.expected,
-             b.count, 1 + b.bias(), b.expected > 0 ? 1 / std::sqrt(b.expected) : 0.0);
+      if (b.expected < 1)  // a ratio to less than a point says nothing (a picture's faint fringe)
+        append(s, "                   %.3g–%-10.3g %10.1f  %10.0f  %12s  %8s\n", b.lo, b.hi, b.expected,
+               b.count, "-", "-");
+      else
+        append(s, "                   %.3g–%-10.3g %10.1f  %10.0f  %12.4f  %8.4f\n", b.lo, b.hi, b.expected,
+               b.count, 1 + b.bias(), 1 / std::sqrt(b.expected));
   }
   if (r.has_tiling) {
     append(
