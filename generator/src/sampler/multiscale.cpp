@@ -140,20 +140,31 @@ struct Driver {
                                           : remove_surplus(chain, particles, n, w);
     const Grid<D>& g = chain.grid();
     const int max_splits = static_cast<int>(setup.levels.size()) - 1;
+    // kFast adds kernels of the weight their node asks for while one fits what is left of n, lighter ones
+    // only for the last remainder, and one a node: lighter kernels among heavier ones (the excess of a
+    // heavy kernel's removal made up at its own dense nodes) hid in their wide neighbours' footprints and
+    // refined into clumps of stacked points. The first versions' rule otherwise (tile baking keeps its bits).
+    const bool fast = options.numerics == Numerics::kFast;
+    std::vector<char> added(fast ? static_cast<std::size_t>(g.size()) : 0, 0);
     while (w < n) {
       double best_gain = std::numeric_limits<double>::infinity();
       Particle<D> best;
-      for (std::int64_t node = 0; node < g.size(); ++node) {
-        const double rho = chain.density().rho[node];
-        if (!(rho > 0)) continue;
-        Particle<D> p;
-        p.x = node_centre(g, node);
-        p.splits = static_cast<std::uint8_t>(splits_within<D>(rho, max_splits, n - w));
-        if (w + p.weight() > n) continue;
-        const double gain = chain.energy_change_if_added(p, scratch) / p.weight();
-        if (gain < best_gain) best_gain = gain, best = p;
+      std::int64_t best_node = -1;
+      for (int pass = fast ? 0 : 1; pass < 2 && best_node < 0; ++pass) {  // 0: whole kernels only
+        for (std::int64_t node = 0; node < g.size(); ++node) {
+          const double rho = chain.density().rho[node];
+          if (!(rho > 0) || (fast && added[static_cast<std::size_t>(node)])) continue;
+          Particle<D> p;
+          p.x = node_centre(g, node);
+          p.splits = static_cast<std::uint8_t>(pass == 0 ? splits_for<D>(rho, max_splits)
+                                                         : splits_within<D>(rho, max_splits, n - w));
+          if (w + p.weight() > n) continue;
+          const double gain = chain.energy_change_if_added(p, scratch) / p.weight();
+          if (gain < best_gain) best_gain = gain, best = p, best_node = node;
+        }
       }
-      if (best_gain == std::numeric_limits<double>::infinity()) break;
+      if (best_node < 0) break;
+      if (fast) added[static_cast<std::size_t>(best_node)] = 1;
       chain.splat(best, 1.0f, scratch);
       particles.push_back(best);
       w += best.weight();
