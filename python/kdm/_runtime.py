@@ -184,8 +184,10 @@ class Tileset:
     """A loaded, immutable tile set: the runtime's source of points for any region and density.
 
     Get one with Tileset.builtin(), Tileset.load(path), Tileset.from_bytes(data) or kdm.bake(recipe).
-    Any number of threads may query one at once. It pickles (as its file's bytes; the built-in set as
-    itself), and copies are the set itself: it never changes.
+    Any number of threads may query one at once. It pickles (as its file's bytes, 14 MB for a set the size
+    of the built-in one; the built-in set as itself, 79 bytes), and copies are the set itself: it never
+    changes. For a process pool, load a set from a file once in each worker (the pool's initializer)
+    rather than sending it with every task.
     """
 
     __slots__ = ("_handle",)
