@@ -95,6 +95,21 @@ TEST(ExtremeDensityTest, FaintEndOfASteepRampHasNoClumps) {
   }
 }
 
+/// The share of a density's integral inside a region, by the midpoint rule on a 1000² grid.
+template <class Inside>
+double share_inside(const Density& d, Inside inside) {
+  double part = 0, whole = 0;
+  const int m = 1000;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double u[2] = {(i + 0.5) / m, (j + 0.5) / m};
+      const double v = d.function(u);
+      whole += v;
+      if (inside(u[0], u[1])) part += v;
+    }
+  return part / whole;
+}
+
 /// The smallest distance between points of `xy` inside the square [lo, hi)², by cells of side `cell`.
 double closest_pair_inside(const std::vector<double>& xy, double lo, double hi, double cell) {
   const int side = static_cast<int>((hi - lo) / cell) + 1;
@@ -128,17 +143,8 @@ TEST(ExtremeDensityTest, TheFaintSideOfASharpStepKeepsItsPoints) {
     for (int x = 70; x < 100; ++x) values[y * 100 + x] += 1.0f;
   const Density d = Density::from_values(100, 100, values);
   auto faint = [](double x, double y) { return !(x >= 0.7 && y >= 0.7); };
-  double faint_mass = 0, mass = 0;  // the interpolated density's integral, by the midpoint rule
-  const int m = 1000;
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      const double u[2] = {(i + 0.5) / m, (j + 0.5) / m};
-      const double v = d.function(u);
-      mass += v;
-      if (faint(u[0], u[1])) faint_mass += v;
-    }
   const int n = 40000;
-  const double expected = n * faint_mass / mass;
+  const double expected = n * share_inside(d, faint);
   for (std::uint64_t seed : {2, 4}) {
     const SampleResult r = sample(options_for(n, Domain::kTorus, seed), d);
     int count = 0;
@@ -170,17 +176,8 @@ TEST(ExtremeDensityTest, ASmallPieceOfTheSupportGetsItsShare) {
       if (inside(x, y, 0.25, 0.5, 0.2) || inside(x, y, 0.8, 0.8, 0.03)) values[row * 200 + col] = 1;
     }
   const Density d = Density::from_values(200, 200, values);
-  double small_mass = 0, mass = 0;  // the interpolated density's integral, by the midpoint rule
-  const int m = 1000;
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      const double u[2] = {(i + 0.5) / m, (j + 0.5) / m};
-      const double v = d.function(u);
-      mass += v;
-      if (u[0] > 0.6) small_mass += v;
-    }
   const int n = 10000;
-  const double share = n * small_mass / mass;
+  const double share = n * share_inside(d, [](double x, double) { return x > 0.6; });
   for (std::uint64_t seed : {1, 2}) {
     const SampleResult r = sample(options_for(n, Domain::kTorus, seed), d);
     int count = 0;
