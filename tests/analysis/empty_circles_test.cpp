@@ -43,8 +43,14 @@ TEST(EmptyCircles, AHexagonalLatticeHasNoHoleAndAMissingPointIsOne) {
   EXPECT_EQ(full.over_085, 0u);
   // Equilateral triangles of side a have circumradius a/√3; a = 1/cols here.
   EXPECT_NEAR(full.largest, (1.0 / cols) / std::sqrt(3.0) / hex_spacing(s.size()), 0.02);
+  const double gone_x = s.coords[2 * 300], gone_y = s.coords[2 * 300 + 1];
   s.coords.erase(s.coords.begin() + 2 * 300, s.coords.begin() + 2 * 301);  // one point gone
   const EmptyCircles holed = empty_circles({s});
+  // Pooled after the whole lattice, the largest is the second set's, centred where the point was.
+  const EmptyCircles both = empty_circles({torus_hex_lattice(cols, rows), s});
+  EXPECT_EQ(both.largest_set, 1u);
+  EXPECT_LT(std::hypot(axis_delta(both.largest_x, gone_x, true), axis_delta(both.largest_y, gone_y, true)),
+            0.2 * hex_spacing(s.size()));
   EXPECT_GE(holed.over_085, 1u);
   EXPECT_EQ(holed.over_100, 0u);  // its six neighbours lie at a ≈ 0.99 d_hex
   EXPECT_GT(holed.largest, 0.95);

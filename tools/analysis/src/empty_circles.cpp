@@ -128,6 +128,7 @@ void delaunay(std::vector<double>& xy, Visit&& visit, const std::vector<std::siz
 /// One set's judged circles: their radii in local d_hex and the counts empty_circles pools.
 struct SetCircles {
   std::vector<double> radii;
+  double largest = -1, largest_x = 0, largest_y = 0;  ///< the largest radius and its centre, normalised
   std::size_t over_085 = 0, over_100 = 0, over_085_near_edge = 0, near_edge_judged = 0;
 };
 
@@ -401,17 +402,18 @@ SetCircles judge_set(const tools::PointSet& set, const EmptyCircleOptions& o, do
   for (const Circle& c :
        o.torus ? torus_circles(xy, spacing, o.sides) : box_circles(xy, spacing, o.border, lx, ly)) {
     double local = spacing;
+    double u = square ? c.x : c.x / lx, v = square ? c.y : c.y / ly;  // normalised, as the density reads
+    if (o.torus) {  // a triangle across the seam is counted once, its centre perhaps past the edge
+      u -= std::floor(u), v -= std::floor(v);
+    }
     if (o.density) {
-      double u = square ? c.x : c.x / lx, v = square ? c.y : c.y / ly;  // the density's coordinates
-      if (o.torus) {  // a triangle across the seam is counted once, its centre perhaps past the edge
-        u -= std::floor(u), v -= std::floor(v);
-      }
       const double rho = o.density(std::clamp(u, 0.0, 1.0), std::clamp(v, 0.0, 1.0));
       if (!(rho > 0) || rho < o.min_relative_density * max_rho) continue;
       local = spacing * std::sqrt(mean_rho / rho);
     }
     const double r = c.r / local;
     out.radii.push_back(r);
+    if (r > out.largest) out.largest = r, out.largest_x = u, out.largest_y = v;
     bool near_edge = false;
     if (edge_band > 0) {
       auto gap = [&](double v) {
@@ -480,7 +482,11 @@ EmptyCircles empty_circles(const std::vector<tools::PointSet>& sets, const Empty
   }
   std::vector<double> radii;
   std::size_t near_edge_judged = 0;
-  for (const SetCircles& c : per_set) {
+  double largest = -1;
+  for (std::size_t k = 0; k < per_set.size(); ++k) {
+    const SetCircles& c = per_set[k];
+    if (c.largest > largest)
+      largest = c.largest, out.largest_set = k, out.largest_x = c.largest_x, out.largest_y = c.largest_y;
     radii.insert(radii.end(), c.radii.begin(), c.radii.end());
     out.over_085 += c.over_085, out.over_100 += c.over_100, out.over_085_near_edge += c.over_085_near_edge;
     near_edge_judged += c.near_edge_judged;

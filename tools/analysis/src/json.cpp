@@ -193,6 +193,8 @@ std::string metrics_json(const AnalysisReport& r, const std::vector<std::string>
     const EmptyCircles& e = r.empty_circles;
     w.key("empty_circles").begin_object();
     w.key("triangles").value(e.triangles).key("largest").value(e.largest).key("p999").value(e.p999);
+    w.key("largest_set").value(e.largest_set).key("largest_x").value(e.largest_x);
+    w.key("largest_y").value(e.largest_y);
     w.key("over_085").value(e.over_085).key("over_100").value(e.over_100);
     w.key("over_085_per_1e5").value(e.over_085_per_1e5()).key("over_100_per_1e5").value(e.over_100_per_1e5());
     if (r.has_tiling)

@@ -337,6 +337,12 @@ std::string format_summary(const AnalysisReport& r) {
         "(Delaunay, local d_hex%s)\n",
         e.largest, e.p999, e.over_085, e.over_085_per_1e5(), e.over_100, e.over_100_per_1e5(),
         r.torus ? "" : ", away from the border");
+    if (e.triangles > 0) {
+      char where[64] = "";
+      if (r.sets > 1) std::snprintf(where, sizeof where, " of set %zu", e.largest_set + 1);
+      append(s, "                   the largest centred at (%.4f, %.4f)%s\n", e.largest_x, e.largest_y,
+             where);
+    }
     if (r.has_tiling && e.over_085 > 0)
       append(s,
              "                   of those > 0.85, %.0f%% within one spacing of a tile edge (%.0f%% of all "

@@ -41,9 +41,13 @@ struct DegenerateSet : InvalidInput {
 };
 
 struct EmptyCircles {
-  std::size_t points = 0;                  ///< points of the sets, pooled
-  std::size_t triangles = 0;               ///< Delaunay triangles judged
-  double largest = 0;                      ///< largest circumradius / local d_hex
+  std::size_t points = 0;     ///< points of the sets, pooled
+  std::size_t triangles = 0;  ///< Delaunay triangles judged
+  double largest = 0;         ///< largest circumradius / local d_hex
+  /// Where the largest is: its set (0-based, in the order given) and its centre in the set's coordinates
+  /// ([0, 1), wrapped on a torus).
+  std::size_t largest_set = 0;
+  double largest_x = 0, largest_y = 0;
   double p999 = 0;                         ///< its 99.9th percentile (nearest rank) over the judged triangles
   std::size_t over_085 = 0, over_100 = 0;  ///< triangles with a radius above 0.85 and 1.0 local d_hex
   std::size_t over_085_near_edge = 0;      ///< of over_085, centred within one spacing of a tile edge
