@@ -592,14 +592,20 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
     return prefix ? fail(Status::kTruncated, detail, "file ends inside the magic number")
                   : fail(Status::kBadMagic, detail, "file does not start with KDMTILES");
   }
-  if (size < 12) return fail(Status::kTruncated, detail, "file ends inside the header");
+  // Byte counts say how much is missing: a download cut short, or a file still being written.
+  auto cut_header = [&](const char* part, std::uint64_t need) {
+    return fail(Status::kTruncated, detail,
+                "file ends inside the header: it has " + std::to_string(size) + " bytes of the " + part +
+                    "'s " + std::to_string(need));
+  };
+  if (size < 12) return cut_header("fixed header", kFixedHeaderBytes);
   const std::uint32_t version = get32(p + 8);
   if (version < kOldestTilesetFormatVersion || version > kTilesetFormatVersion)
     return fail(Status::kUnsupportedVersion, detail,
                 "format version " + std::to_string(version) + ", this reader supports " +
                     std::to_string(kOldestTilesetFormatVersion) + " to " +
                     std::to_string(kTilesetFormatVersion));
-  if (size < kFixedHeaderBytes) return fail(Status::kTruncated, detail, "file ends inside the header");
+  if (size < kFixedHeaderBytes) return cut_header("fixed header", kFixedHeaderBytes);
   const std::uint32_t header_size = get32(p + 12);
   if (header_size < kFixedHeaderBytes)
     return fail(Status::kHeaderChecksumMismatch, detail, "header size field is implausible (damaged header)");
@@ -617,7 +623,7 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
     const std::uint64_t text_sizes = std::uint64_t(get32(p + 48)) + get32(p + 52);
     return text_sizes + kFixedHeaderBytes != header_size
                ? fail(Status::kHeaderChecksumMismatch, detail, "header size field is damaged")
-               : fail(Status::kTruncated, detail, "file ends inside the header");
+               : cut_header("header", header_size);
   }
   if (header_crc(p, header_size) != get32(p + kHeaderCrcOffset))
     return fail(Status::kHeaderChecksumMismatch, detail, "header bytes are damaged");
@@ -627,9 +633,13 @@ Status read_tileset_header(const void* data, std::size_t size, TilesetHeader& ou
   if (recipe_size + version_size + kFixedHeaderBytes != header_size)
     return fail(Status::kInvalidContent, detail, "header text sizes do not add up to the header size");
   if (payload_size > size - header_size)
-    return fail(Status::kTruncated, detail, "file ends inside the payload");
+    return fail(Status::kTruncated, detail,
+                "file ends inside the payload: it has " + std::to_string(size) + " bytes, the " +
+                    std::to_string(header_size) + "-byte header and " + std::to_string(payload_size) +
+                    "-byte payload need " + std::to_string(header_size + payload_size));
   if (payload_size < size - header_size)
-    return fail(Status::kTrailingBytes, detail, "bytes follow the payload");
+    return fail(Status::kTrailingBytes, detail,  // how many is unknown: the file reader stops at one past
+                "bytes follow the payload, which ends at byte " + std::to_string(header_size + payload_size));
   if (body_size > kMaxTilesetPayloadBytes)
     return fail(Status::kTooLarge, detail, "payload decompresses to " + std::to_string(body_size) + " bytes");
   // Each count named: a reader of a damaged file learns which one.

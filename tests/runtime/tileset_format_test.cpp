@@ -138,8 +138,13 @@ TEST(TilesetFormatTest, EveryTruncationIsRejectedAsTruncated) {
 
 TEST(TilesetFormatTest, TrailingBytesAreRejected) {
   std::vector<std::uint8_t> bytes = encode(make_tileset());
+  const std::size_t end = bytes.size();
   bytes.push_back(0);
   EXPECT_EQ(decode(bytes, bytes.size()), Status::kTrailingBytes);
+  TilesetData out;
+  std::string why;
+  EXPECT_EQ(decode_tileset(bytes.data(), bytes.size(), out, &why), Status::kTrailingBytes);
+  EXPECT_NE(why.find("ends at byte " + std::to_string(end)), std::string::npos) << why;
 }
 
 TEST(TilesetFormatTest, EveryHeaderBitFlipIsRejected) {
@@ -497,8 +502,18 @@ TEST(TilesetFormatTest, TheHeaderDescribesTheFileAndIsValidatedAlone) {
   EXPECT_GT(h.decompressed_bytes, h.payload_bytes / 2);
   const std::size_t header_bytes = h.header_bytes;
   for (std::size_t len = 0; len < bytes.size(); ++len) {
-    ASSERT_EQ(read_tileset_header(bytes.data(), len, h), Status::kTruncated) << "cut at " << len;
+    std::string why;
+    ASSERT_EQ(read_tileset_header(bytes.data(), len, h, &why), Status::kTruncated) << "cut at " << len;
     EXPECT_EQ(h.format_version, 0u);  // left empty
+    // Past the magic number the detail says how many bytes the file has and how many it needs.
+    if (len >= 8) {
+      const std::string has = "it has " + std::to_string(len) + " bytes";
+      const std::string needs = len < 64             ? "fixed header's 64"
+                                : len < header_bytes ? "header's " + std::to_string(header_bytes)
+                                                     : "need " + std::to_string(bytes.size());
+      EXPECT_NE(why.find(has), std::string::npos) << "cut at " << len << ": " << why;
+      EXPECT_NE(why.find(needs), std::string::npos) << "cut at " << len << ": " << why;
+    }
   }
   std::vector<std::uint8_t> damaged = bytes;
   damaged[header_bytes + 3] ^= 1;  // the payload: the header does not look at it
