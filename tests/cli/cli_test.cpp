@@ -1393,6 +1393,16 @@ TEST_F(CliTest, RecipesAndTileSetsComeFromStandardInputAndAreToldApart) {
   }
   expect_error("query --tileset '" + path("r.recipe") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
                "it looks like a recipe: bake it with kdm bake");
+  // kdm query reads its tile set from standard input as info and verify do: the same points as the file.
+  const std::string query = " --rect 0,0,4,4 --scale 30 --format csv -o -";
+  const Outcome piped = kdm("query --tileset -" + query + " < '" + path("r.kdmt") + "'");
+  ASSERT_EQ(piped.status, 0) << piped.err;
+  EXPECT_GT(std::count(piped.out.begin(), piped.out.end(), '\n'), 100) << piped.out;
+  EXPECT_EQ(piped.out, kdm("query --tileset '" + path("r.kdmt") + "'" + query).out);
+  expect_error("query --tileset -" + query + " < '" + path("r.recipe") + "'",
+               "standard input: not a kdm tile set (bad magic)");
+  expect_error("verify '" + path("r.kdmt") + "' --spectrum-budget -1",
+               "--spectrum-budget must be a point count >= 0 (0: no spectra), got -1");
   expect_error("info - < '" + path("r.recipe") + "'", "standard input: not a kdm tile set (bad magic)");
   std::ofstream(path("notes.txt")) << "shopping list\n";  // not a recipe: no hint
   const Outcome notes = kdm("info '" + path("notes.txt") + "'");

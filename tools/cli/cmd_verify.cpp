@@ -24,6 +24,7 @@ struct VerifyArgs {
   verify::VerifyOptions options;
   bool no_seams = false, no_direct = false, no_glide_track = false, quiet = false;
   std::vector<std::int64_t> levels;  ///< --level, signed: -1 is refused by name, not by CLI11's conversion
+  std::int64_t spectrum_budget = std::int64_t(1) << 30;  ///< signed for the same reason
 };
 
 void run_verify(VerifyArgs args) {
@@ -36,6 +37,10 @@ void run_verify(VerifyArgs args) {
     throw CommandError("--handover-rows must be in [1, 1000]");
   if (args.options.reference_runs < 2 || args.options.reference_runs > 1000)
     throw CommandError("--runs must be in [2, 1000]");
+  if (args.spectrum_budget < 0)
+    throw CommandError("--spectrum-budget must be a point count >= 0 (0: no spectra), got " +
+                       std::to_string(args.spectrum_budget));
+  args.options.spectrum_budget = static_cast<std::size_t>(args.spectrum_budget);
   for (const std::int64_t level : args.levels) {
     if (level < 0)
       throw CommandError("--level must be a level number >= 0 (the first is 0), got " +
@@ -83,9 +88,9 @@ void add_verify_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--level", args->levels,
                   "Judge only these levels and the keyframes within them (repeatable; default: all)");
-  cmd->add_option("--spectrum-budget", args->options.spectrum_budget,
-                  "Largest tile torus (points) whose spectra (lowP, RAPS) are computed (default: every one)")
-      ->capture_default_str();
+  add_count_option(
+      cmd, "--spectrum-budget", args->spectrum_budget,
+      "Largest tile torus (points) whose spectra (lowP, RAPS) are computed (default: every one)");
   cmd->add_flag("--no-seams", args->no_seams, "Skip the seam and in-between-density checks");
   cmd->add_flag("--no-direct", args->no_direct, "Skip the direct check (tiles freed for 15 sweeps)");
   cmd->add_flag("--no-glide-track", args->no_glide_track, "Skip the glide track's keyframes (smooth mode)");

@@ -38,7 +38,7 @@ const Tileset& tileset_for(const std::string& path, Tileset& storage) {
     return builtin;
   }
   std::string detail;
-  const Status s = Tileset::load_file(path, storage, &detail);
+  const Status s = Tileset::load_file(path == "-" ? "/dev/stdin" : path, storage, &detail);
   if (s != Status::kOk) throw tileset_error(path, s, detail, {});
   return storage;
 }
