@@ -144,13 +144,17 @@ struct Driver {
     // only for the last remainder, and one a node: lighter kernels among heavier ones (the excess of a
     // heavy kernel's removal made up at its own dense nodes) hid in their wide neighbours' footprints and
     // refined into clumps of stacked points. The first versions' rule otherwise (tile baking keeps its bits).
+    // Nor, while a node elsewhere can take one, where a kernel's least weight (one point) passes the
+    // node's mass 2^D-fold: once no node lacks mass, a kernel raises E least per unit weight where it is
+    // widest, and a 1:10^6 ramp's faintest column took one a node (a row of points along its far wall).
     const bool fast = options.numerics == Numerics::kFast;
     std::vector<char> added(fast ? static_cast<std::size_t>(g.size()) : 0, 0);
     while (w < n) {
       double best_gain = std::numeric_limits<double>::infinity();
       Particle<D> best;
       std::int64_t best_node = -1;
-      for (int pass = fast ? 0 : 1; pass < 2 && best_node < 0; ++pass) {  // 0: whole kernels only
+      // 0: whole kernels where they fit their node's mass; 1: lighter ones there; 2: lighter ones anywhere
+      for (int pass = fast ? 0 : 2; pass < 3 && best_node < 0; ++pass) {
         for (std::int64_t node = 0; node < g.size(); ++node) {
           const double rho = chain.density().rho[node];
           if (!(rho > 0) || (fast && added[static_cast<std::size_t>(node)])) continue;
@@ -158,7 +162,7 @@ struct Driver {
           p.x = node_centre(g, node);
           p.splits = static_cast<std::uint8_t>(pass == 0 ? splits_for<D>(rho, max_splits)
                                                          : splits_within<D>(rho, max_splits, n - w));
-          if (w + p.weight() > n) continue;
+          if (w + p.weight() > n || (pass < 2 && p.weight() > std::ldexp(rho, D))) continue;
           const double gain = chain.energy_change_if_added(p, scratch) / p.weight();
           if (gain < best_gain) best_gain = gain, best = p, best_node = node;
         }
