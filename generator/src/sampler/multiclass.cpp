@@ -52,6 +52,35 @@ std::uint64_t class_seed(std::uint64_t seed, std::size_t k) {
   return z ^ (z >> 31);
 }
 
+/// For each stray (a point relabelled from class from[j] to its present class c because from[j]'s density
+/// is zero there), relabels the nearest point of class c where from[j]'s density is positive as from[j]:
+/// every class ends with the count it was sampled with. A class with no such point left keeps the loss
+/// (`counts` follow the labels). Distances are plain (a box's; on a torus the nearest may be across the
+/// seam and a nearer one across it missed, which changes which point swaps, not the counts).
+template <class Value>
+void give_back_counts(ClassSample& s, const std::vector<std::size_t>& strays,
+                      const std::vector<std::uint8_t>& from, const Value& value) {
+  const std::size_t dim = std::size_t(s.dim);
+  std::vector<char> taken(s.classes.size(), 0);
+  for (std::size_t i : strays) taken[i] = 1;  // its class is the density's there already
+  for (std::size_t j = 0; j < strays.size(); ++j) {
+    const std::size_t c = s.classes[strays[j]], lost = from[j];
+    const double* p = &s.points[strays[j] * dim];
+    std::size_t best = s.classes.size();
+    double best_d2 = HUGE_VAL;
+    for (std::size_t i = 0; i < s.classes.size(); ++i) {
+      if (s.classes[i] != c || taken[i]) continue;
+      const double* q = &s.points[i * dim];
+      double d2 = 0;
+      for (std::size_t a = 0; a < dim; ++a) d2 += (p[a] - q[a]) * (p[a] - q[a]);
+      if (d2 < best_d2 && value(lost, q) > 0) best_d2 = d2, best = i;
+    }
+    --s.counts[lost], ++s.counts[c];
+    if (best == s.classes.size()) continue;
+    s.classes[best] = static_cast<std::uint8_t>(lost), taken[best] = 1;
+    --s.counts[c], ++s.counts[lost];
+  }
+}
 }  // namespace
 
 std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std::vector<Density>& densities,
@@ -164,13 +193,17 @@ ClassSample sample_classes(const SamplerOptions& options, const std::vector<Dens
   // A class's points where its own density is zero go to the class of the largest density there. Class k
   // fills in around the earlier classes at their summed density, so it takes a gap they left where its
   // own density is zero, and the joint sweeps move every point by the sum: cyan dots in a black area.
+  // Each such point's new class then gives its original class back the nearest of its own points where
+  // that class's density is positive, so that every class keeps its count.
   if (densities.size() > 1) {
     const auto value = [&](std::size_t k, const double* u) {
       return densities[k].function ? densities[k].function(u) : 1.0;
     };
-    bool moved = false;
+    const std::size_t dim = std::size_t(options.dim);
+    std::vector<std::size_t> strays;
+    std::vector<std::uint8_t> from;
     for (std::size_t i = 0; i < result.classes.size(); ++i) {
-      const double* u = &result.points[i * std::size_t(options.dim)];
+      const double* u = &result.points[i * dim];
       const std::size_t own = result.classes[i];
       if (value(own, u) > 0) continue;
       std::size_t best = own;
@@ -180,12 +213,12 @@ ClassSample sample_classes(const SamplerOptions& options, const std::vector<Dens
         if (v > best_value) best = k, best_value = v;
       }
       if (best == own) continue;  // no class has density here (the sum's edge): it keeps its class
-      --result.counts[own], ++result.counts[best];
       result.classes[i] = static_cast<std::uint8_t>(best);
-      moved = true;
+      strays.push_back(i), from.push_back(static_cast<std::uint8_t>(own));
     }
+    const bool moved = !strays.empty();
+    give_back_counts(result, strays, from, value);
     if (moved) {  // class 0's points first again, each class's in their order
-      const std::size_t dim = std::size_t(options.dim);
       std::vector<std::size_t> order(result.classes.size());
       for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
       std::stable_sort(order.begin(), order.end(),

@@ -43,8 +43,9 @@ Density sum_of_densities(const std::vector<Density>& densities, int dim = 2);
 /// count from class_counts, every run seeded from options.seed and the class, then `union_sweeps` MH
 /// sweeps of all points together at the summed density (0: none; classes keep their points). A point
 /// where its class's density is zero then takes the class of the largest density there (a class never
-/// lies where its density is zero; `counts` follow), so the counts can differ from class_counts' by the
-/// few points that fill another class's gaps.
+/// lies where its density is zero), and gives its old class back the nearest point of its new one where
+/// the old class's density is positive: the counts stay class_counts' (`counts` follow the labels, should
+/// a class have no such point to take back).
 /// Constrained-sampling and relaxation options (fixed_points, initial_points) must be empty. Seeded,
 /// thread-independent as sample(). Throws InvalidArgument on bad options or densities.
 ClassSample sample_classes(const SamplerOptions& options, const std::vector<Density>& densities,
