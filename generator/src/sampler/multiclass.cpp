@@ -55,32 +55,85 @@ std::uint64_t class_seed(std::uint64_t seed, std::size_t k) {
 /// For each stray (a point relabelled from class from[j] to its present class c because from[j]'s density
 /// is zero there), relabels the nearest point of class c where from[j]'s density is positive as from[j]:
 /// every class ends with the count it was sampled with. A class with no such point left keeps the loss
-/// (`counts` follow the labels). Distances are plain (a box's; on a torus the nearest may be across the
-/// seam and a nearer one across it missed, which changes which point swaps, not the counts).
+/// (`counts` follow the labels). Distances are plain (a torus's nearest point across its seam may be
+/// passed over, which changes which point swaps, not the counts). Points are bucketed on a grid of about
+/// four a cell and searched shell by shell outwards.
 template <class Value>
 void give_back_counts(ClassSample& s, const std::vector<std::size_t>& strays,
                       const std::vector<std::uint8_t>& from, const Value& value) {
-  const std::size_t dim = std::size_t(s.dim);
-  std::vector<char> taken(s.classes.size(), 0);
+  if (strays.empty()) return;
+  const int dim = s.dim;
+  const std::size_t n = s.classes.size();
+  double lo[3] = {0, 0, 0}, cell[3] = {1, 1, 1};
+  int side = std::max(1, static_cast<int>(std::pow(double(n) / 4, 1.0 / dim)));
+  for (int a = 0; a < dim; ++a) {
+    double low = HUGE_VAL, high = -HUGE_VAL;
+    for (std::size_t i = 0; i < n; ++i)
+      low = std::min(low, s.points[i * dim + a]), high = std::max(high, s.points[i * dim + a]);
+    lo[a] = low, cell[a] = std::max((high - low) / side, 1e-300);
+  }
+  const auto coordinate = [&](std::size_t i, int a) {
+    return std::clamp(static_cast<int>((s.points[i * dim + a] - lo[a]) / cell[a]), 0, side - 1);
+  };
+  std::size_t cells = 1;
+  for (int a = 0; a < dim; ++a) cells *= std::size_t(side);
+  std::vector<std::size_t> first(cells + 1, 0), members(n);
+  const auto cell_of = [&](std::size_t i) {
+    std::size_t c = 0;
+    for (int a = dim - 1; a >= 0; --a) c = c * std::size_t(side) + std::size_t(coordinate(i, a));
+    return c;
+  };
+  for (std::size_t i = 0; i < n; ++i) ++first[cell_of(i) + 1];
+  for (std::size_t c = 0; c < cells; ++c) first[c + 1] += first[c];
+  std::vector<std::size_t> next(first.begin(), first.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) members[next[cell_of(i)]++] = i;
+
+  std::vector<char> taken(n, 0);
   for (std::size_t i : strays) taken[i] = 1;  // its class is the density's there already
+  const double finest = *std::min_element(cell, cell + dim);
   for (std::size_t j = 0; j < strays.size(); ++j) {
-    const std::size_t c = s.classes[strays[j]], lost = from[j];
-    const double* p = &s.points[strays[j] * dim];
-    std::size_t best = s.classes.size();
+    const std::size_t p = strays[j], c = s.classes[p], lost = from[j];
+    int centre[3] = {0, 0, 0};
+    for (int a = 0; a < dim; ++a) centre[a] = coordinate(p, a);
+    std::size_t best = n;
     double best_d2 = HUGE_VAL;
-    for (std::size_t i = 0; i < s.classes.size(); ++i) {
-      if (s.classes[i] != c || taken[i]) continue;
-      const double* q = &s.points[i * dim];
-      double d2 = 0;
-      for (std::size_t a = 0; a < dim; ++a) d2 += (p[a] - q[a]) * (p[a] - q[a]);
-      if (d2 < best_d2 && value(lost, q) > 0) best_d2 = d2, best = i;
+    for (int r = 0; r <= side; ++r) {
+      // The cells at Chebyshev distance r from the centre: none nearer than (r - 1) cells.
+      const int span = 2 * r + 1;
+      std::size_t count = 1;
+      for (int a = 0; a < dim; ++a) count *= std::size_t(span);
+      for (std::size_t k = 0; k < count; ++k) {
+        int at[3] = {0, 0, 0};
+        bool shell = false, inside = true;
+        std::size_t rest = k, index = 0;
+        for (int a = 0; a < dim; ++a) {
+          const int offset = static_cast<int>(rest % std::size_t(span)) - r;
+          rest /= std::size_t(span);
+          shell = shell || std::abs(offset) == r;
+          at[a] = centre[a] + offset;
+          inside = inside && at[a] >= 0 && at[a] < side;
+        }
+        if (!shell || !inside) continue;
+        for (int a = dim - 1; a >= 0; --a) index = index * std::size_t(side) + std::size_t(at[a]);
+        for (std::size_t m = first[index]; m < first[index + 1]; ++m) {
+          const std::size_t i = members[m];
+          if (s.classes[i] != c || taken[i]) continue;
+          double d2 = 0;
+          for (int a = 0; a < dim; ++a)
+            d2 += (s.points[p * dim + a] - s.points[i * dim + a]) *
+                  (s.points[p * dim + a] - s.points[i * dim + a]);
+          if (d2 < best_d2 && value(lost, &s.points[i * dim]) > 0) best_d2 = d2, best = i;
+        }
+      }
+      if (best < n && std::sqrt(best_d2) <= r * finest) break;  // the next shell lies further
     }
     --s.counts[lost], ++s.counts[c];
-    if (best == s.classes.size()) continue;
+    if (best == n) continue;
     s.classes[best] = static_cast<std::uint8_t>(lost), taken[best] = 1;
     --s.counts[c], ++s.counts[lost];
   }
 }
+
 }  // namespace
 
 std::vector<std::int64_t> class_counts(const SamplerOptions& options, const std::vector<Density>& densities,
