@@ -284,6 +284,16 @@ TEST(GeneratorTest, VerifierFlagsNearCoincidentPoints) {
   ASSERT_GT(moved, 0u);
   EXPECT_FALSE(closest_pair_flagged(shipped(), level));  // 512 points per tile and below: no close pair
   EXPECT_TRUE(closest_pair_flagged(damaged, level));
+  // Verify's default bar (0.1 d_hex) fails a pair 0.05 apart, as a damaged file's points on one spot.
+  tile.points[moved] =
+      TilePoint::from_unit(tile.points[moved].unit_x() - 0.05 * spacing, tile.points[moved].unit_y());
+  VerifyOptions o = parts(false, false, true);
+  o.levels = {level};
+  ASSERT_EQ(o.bars.closest_pair, Bars{}.closest_pair);
+  bool flagged = false;
+  for (const DensityResult& d : verify_tileset(damaged, o).densities)
+    for (const Check& c : d.checks) flagged = flagged || (c.name.find("closest pair") == 0 && !c.passed());
+  EXPECT_TRUE(flagged);
 }
 
 // Two tiles that can meet across an edge, though no tile's 2×2 torus puts one above the other: the last
