@@ -91,8 +91,7 @@ def test_stipple_an_array_as_the_picture():
 
 def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
     # uint8 and uint16 luminance, RGB(A) and PIL images: the same dots as the file they came from.
-    from PIL import Image
-
+    Image = pytest.importorskip("PIL.Image")
     coffee = SPHERE.parent / "coffee.png"
     rgb = np.asarray(Image.open(coffee))
     assert rgb.dtype == np.uint8 and rgb.shape[2] == 3
@@ -134,8 +133,7 @@ def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
 def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
     # (rows, columns, 2): grey and alpha, composited on white paper as an LA picture file is read; and
     # (rows, columns, 1) is grey alone.
-    from PIL import Image
-
+    Image = pytest.importorskip("PIL.Image")
     grey = np.asarray(Image.open(SPHERE))
     alpha = np.tile(np.linspace(0, 255, grey.shape[1]).astype(np.uint8), (grey.shape[0], 1))
     la = np.stack([grey, alpha], axis=2)
@@ -153,8 +151,7 @@ def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
 def test_stipple_inverts_an_array_with_alpha_as_kdm_stipple_inverts_its_file(cli, tmp_path):
     # Inverted, transparent is black paper: an RGBA or grey-and-alpha array gives the dots `kdm stipple
     # --invert` gives for its file, bit for bit (not its clear parts, laid on white, as bright dots).
-    from PIL import Image
-
+    Image = pytest.importorskip("PIL.Image")
     rgb = np.asarray(Image.open(SPHERE.parent / "coffee.png"))
     grey = np.asarray(Image.open(SPHERE))
     ramp = lambda a: np.tile(np.linspace(0, 255, a.shape[1]).astype(np.uint8), (a.shape[0], 1))
@@ -199,8 +196,7 @@ def test_stipple_of_a_blank_image_has_no_dots(tmp_path):
     assert dots.shape == (0, 2) and classes.shape == (0,) and inks == []
     assert "<circle" not in (tmp_path / "w.svg").read_text()
     kdm.stipple(np.ones((6, 9)), output=tmp_path / "w.png", width=90)
-    from PIL import Image
-
+    Image = pytest.importorskip("PIL.Image")
     assert np.asarray(Image.open(tmp_path / "w.png")).min() == 255
 
 
