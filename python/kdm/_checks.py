@@ -238,24 +238,43 @@ def luminance(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
 
 def pil_pixels(value: Any) -> Any:
     """A PIL image as the array of pixels luminance() and colour() read, as an image file of it is read: grey,
-    grey and alpha, RGB and RGBA as they are (16-bit grey too); a palette, CMYK, YCbCr and the other modes
-    converted to RGB, or RGBA where they hold transparency. Anything else is returned as it is."""
+    grey and alpha, RGB and RGBA as they are (16-bit grey too); grey and RGB with a transparent colour
+    (info["transparency"], a PNG's tRNS) with an alpha, 0 at that colour; a palette, CMYK, YCbCr and the
+    other modes converted to RGB, or RGBA where they hold transparency. Anything else is returned as it is."""
     mode = getattr(value, "mode", None)
     if not isinstance(mode, str) or not hasattr(value, "convert") or not hasattr(value, "info"):
         return value
-    if mode in ("L", "LA", "RGB", "RGBA", "I;16", "I;16L", "I;16B"):
+    key = value.info.get("transparency")
+    if mode in ("LA", "RGBA") or mode in ("L", "RGB", "I;16", "I;16L", "I;16B") and key is None:
         return value
     if mode == "1":
-        return value.convert("L")
+        if key is None:
+            return value.convert("L")
+        a = np.asarray(value)
+        return _keyed(a.astype(np.uint8) * np.uint8(255), a == bool(key))
     if mode == "I":  # how Pillow opens some 16-bit grey files: 32-bit integers holding 0 .. 65535
         a = np.asarray(value)
         if a.size and (a.min() < 0 or a.max() > 65535):
             raise ValueError("a PIL image of mode 'I' must hold 16-bit grey levels 0 to 65535")
-        return a.astype(np.uint16)
+        return a.astype(np.uint16) if key is None else _keyed(a.astype(np.uint16), a == key)
+    if mode in ("L", "I;16", "I;16L", "I;16B"):  # with a key: Pillow's convert("LA") ignores a 16-bit one
+        a = np.asarray(value).astype(np.uint8 if mode == "L" else np.uint16)
+        return _keyed(a, a == key)
+    if mode == "RGB":
+        a = np.asarray(value)
+        return _keyed(a, (a == np.asarray(key)).all(axis=2))
     if mode == "F":
         raise ValueError("a PIL image of mode 'F' has no set range: give an array of luminances in [0, 1]")
     transparent = "A" in mode or "a" in mode or "transparency" in value.info
     return value.convert("RGBA" if transparent else "RGB")
+
+
+def _keyed(pixels: np.ndarray, transparent: np.ndarray) -> np.ndarray:
+    """Grey (rows, columns) or RGB (rows, columns, 3) pixels with an alpha channel appended: 0 where
+    `transparent`, full (255 or 65535 by the pixels' dtype) elsewhere."""
+    full = np.iinfo(pixels.dtype).max
+    alpha = np.where(transparent, 0, full).astype(pixels.dtype)
+    return np.dstack([pixels, alpha])
 
 
 def is_array(value: Any) -> bool:

@@ -130,6 +130,44 @@ def test_stipple_takes_arrays_as_an_image_file_is_read(tmp_path):
                                   kdm.stipple(grey, points=2000))  # 257 v / 65535 = v / 255, rounded alike
 
 
+def test_stipple_takes_a_pil_images_transparent_colour_as_its_file_does(tmp_path):
+    # Grey and RGB pictures with a transparent colour (a PNG's tRNS; Pillow's info["transparency"]): the
+    # pixels of that colour are paper, as the file's are, on white and inverted on black, in colour too.
+    Image = pytest.importorskip("PIL.Image")
+    import struct
+    import zlib
+
+    def png(path, pixels, bits, colour_type, key):
+        raw = b"".join(b"\x00" + row.astype(">u2" if bits == 16 else "u1").tobytes() for row in pixels)
+        chunk = lambda kind, data: (struct.pack(">I", len(data)) + kind + data
+                                    + struct.pack(">I", zlib.crc32(kind + data)))
+        size = struct.pack(">IIBBBBB", pixels.shape[1], pixels.shape[0], bits, colour_type, 0, 0, 0)
+        key = struct.pack(f">{len(key)}H", *key)  # tRNS: the transparent grey level or RGB, 16 bits each
+        path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", size) + chunk(b"tRNS", key)
+                         + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+        return path
+
+    grey = np.asarray(Image.open(SPHERE))
+    keyed = grey.copy()
+    keyed[:, : grey.shape[1] // 2] = 0  # the left half black, the transparent colour: paper, no dots
+    rgb = np.asarray(Image.open(SPHERE.parent / "coffee.png")).copy()
+    rgb[:, : rgb.shape[1] // 2] = (0, 0, 0)
+    files = [png(tmp_path / "grey.png", keyed, 8, 0, (0,)), png(tmp_path / "rgb.png", rgb, 8, 2, (0, 0, 0)),
+             png(tmp_path / "grey16.png", keyed.astype(np.uint16) * 257, 16, 0, (0,))]
+    for path in files:
+        picture = Image.open(path)
+        assert "transparency" in picture.info and picture.mode in ("L", "RGB", "I", "I;16"), picture.mode
+        dots = kdm.stipple(picture, points=3000)
+        np.testing.assert_array_equal(dots, kdm.stipple(str(path), points=3000))
+        assert len(dots) > 2000 and (dots[:, 0] < 0.5).mean() < 0.01, path.name  # not the black half's
+        np.testing.assert_array_equal(kdm.stipple(picture, points=3000, invert=True),
+                                      kdm.stipple(str(path), points=3000, invert=True))
+        for a, b in zip(kdm.stipple(picture, points=3000, colours="cmyk"),
+                        kdm.stipple(str(path), points=3000, colours="cmyk")):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(kdm.separate(picture)[0], kdm.separate(str(path))[0])
+
+
 def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
     # (rows, columns, 2): grey and alpha, composited on white paper as an LA picture file is read; and
     # (rows, columns, 1) is grey alone.
