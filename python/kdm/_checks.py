@@ -236,6 +236,21 @@ def luminance(name: str, value: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     return grey, None if alpha is None else np.ascontiguousarray(alpha, dtype=np.float64)
 
 
+def image_size(value: Any) -> None:
+    """Refuses an image array or PIL image of more pixels than kdm takes (ValueError, the C++ side's rule and
+    words), from its shape alone: before anything converts or copies it (gigabytes for a large one)."""
+    size = getattr(value, "size", None)
+    if isinstance(size, tuple) and len(size) == 2 and hasattr(value, "mode"):  # PIL: (width, height)
+        rows, columns = size[1], size[0]
+    else:
+        shape = getattr(value, "shape", None)
+        if not isinstance(shape, tuple) or len(shape) < 2:
+            return  # a list is converted to see its shape; a bad shape is refused after
+        rows, columns = shape[0], shape[1]
+    if isinstance(rows, numbers.Integral) and isinstance(columns, numbers.Integral):
+        _kdm.check_image_size("image array", int(rows), int(columns))
+
+
 def pil_pixels(value: Any) -> Any:
     """A PIL image as the array of pixels luminance() and colour() read, as an image file of it is read: grey,
     grey and alpha, RGB and RGBA as they are (16-bit grey too); grey and RGB with a transparent colour

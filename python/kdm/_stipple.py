@@ -113,6 +113,7 @@ def stipple(
         spec = None  # read below, at the size its dots need
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
+        _checks.image_size(image)
         label, image = "array", _checks.pil_pixels(image)
         grey, alpha = _checks.luminance("image", image)
         spec = _kdm.DensitySpec.from_luminance(grey, gamma, invert, alpha)
@@ -197,6 +198,7 @@ def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[
     if isinstance(image, (str, os.PathLike)):
         label, rgb, alpha = _checks.path("image", image), None, None
     else:  # an array or a PIL image, as stipple() takes it
+        _checks.image_size(image)
         label, (rgb, alpha) = "array", _checks.colour("image", _checks.pil_pixels(image))
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     colours = _checks.colour_scheme(colours)

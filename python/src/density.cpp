@@ -26,15 +26,21 @@ std::string shown(double v) {
   return text;
 }
 
+/// An image of `rows` × `columns` pixels, checked: no larger than the images the command line reads.
+/// Python checks an array's shape by it too, before converting the array.
+void check_image_size(const std::string& what, py::ssize_t rows, py::ssize_t columns) {
+  if (rows > 0 && columns > 0 && std::uint64_t(rows) * std::uint64_t(columns) > tools::kMaxImagePixels)
+    throw std::invalid_argument(what + " has more than 2^26 pixels (the image size limit; " +
+                                "kdm.stipple reads a larger picture from its file, averaged down)");
+}
+
 /// The array's size, checked: 2-D, not empty, no larger than the images the command line reads.
 void check_shape(const Array& a, const char* what, int& width, int& height) {
   if (a.ndim() != 2)
     throw std::invalid_argument(std::string(what) + " must be a 2-D array (rows, columns), got " +
                                 std::to_string(a.ndim()) + " dimensions");
   if (a.shape(0) < 1 || a.shape(1) < 1) throw std::invalid_argument(std::string(what) + " is empty");
-  if (std::uint64_t(a.shape(0)) * std::uint64_t(a.shape(1)) > tools::kMaxImagePixels)
-    throw std::invalid_argument(std::string(what) + " has more than 2^26 pixels (the image size limit; " +
-                                "kdm.stipple reads a larger picture from its file, averaged down)");
+  check_image_size(what, a.shape(0), a.shape(1));
   height = static_cast<int>(a.shape(0)), width = static_cast<int>(a.shape(1));
 }
 
@@ -208,6 +214,9 @@ void bind_density(py::module_& m) {
       .def("__repr__", [](const DensitySpec& s) {
         return "<DensitySpec " + std::string(kind_name(s)) + " " + s.text + ">";
       });
+  m.def(
+      "check_image_size", &check_image_size, py::arg("what"), py::arg("rows"), py::arg("columns"),
+      "Raises ValueError for an image of more pixels than kdm takes (2^26), as the arrays' conversion does");
   m.def("load_luminance", &load_luminance, py::arg("path"),
         "A picture file as luminance in [0, 1] (float32, row 0 at the top)");
 }

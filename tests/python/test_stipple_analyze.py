@@ -683,6 +683,26 @@ def test_stipple_reads_a_picture_past_the_density_limit_at_the_size_its_dots_nee
         kdm.sample(100, density=str(big))
 
 
+def test_an_image_array_past_the_size_limit_is_refused_before_it_is_converted():
+    # 8,193 x 8,193 pixels, past the 2^26 an array may have: refused from its shape, before the float
+    # copies a conversion makes (over a gigabyte for this one). A broadcast scalar holds no pixels itself.
+    import tracemalloc
+
+    grey = np.broadcast_to(np.uint8(0), (8193, 8193))
+    calls = [lambda: kdm.stipple(grey), lambda: kdm.stipple(grey[..., None], colours="cmyk"),
+             lambda: kdm.stipple(np.broadcast_to(0.5, (8193, 8193))),
+             lambda: kdm.separate(np.broadcast_to(np.uint8(0), (8193, 8193, 3)))]
+    for call in calls:
+        tracemalloc.start()
+        try:
+            with pytest.raises(ValueError, match=r"^image array has more than 2\^26 pixels \(the image size limit"):
+                call()
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert peak < 1 << 20, peak
+
+
 def test_analyze_measures_a_set_in_the_domain_it_was_drawn_in(cli, tmp_path):
     # kdm.sample(aspect=2)'s set measured with aspect=2 reads as its square sets do (δavg spreads by about
     # 0.003 between seeds at 2,000 points); measured as a unit square it is squeezed. As kdm analyze does.
