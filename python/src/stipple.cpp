@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
@@ -185,11 +184,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
         style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);
       }
-      char line[200];
-      std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s)", set.size(), set.size() == 1 ? "" : "s",
-                    method == "full" ? "full KDM sampler" : "runtime tiles");
+      const std::string how = blank ? "no ink" : method == "full" ? "full KDM sampler" : "runtime tiles";
       try {
-        std::vector<std::string> header = {line, "image " + label};
+        std::vector<std::string> header = {
+            tools::stipple_summary(set.size(), how, colours.value_or(""), inks), "image " + label};
         for (std::string& more : tools::stipple_region_header(uv.data(), style.aspect))
           header.push_back(std::move(more));
         tools::write_points(*output, set, header, style);

@@ -517,6 +517,23 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
     assert len(dots) > 150 and set(classes) == {0} and inks == ["black"]
 
 
+def test_stipple_writes_the_header_kdm_stipple_writes_in_colour(cli, tmp_path):
+    # The same SVG as `kdm stipple --colours`, its first comment naming the inks; a blank image's too.
+    coffee = str(SPHERE.parent / "coffee.png")
+    white = tmp_path / "white.png"
+    write_png(white, np.full((6, 9), 255))
+    for image, colours, said in ((coffee, "cmyk", "inks cmyk"), (coffee, "3", "inks 3 of 3"),
+                                 (coffee, "#ff0000,#000000,#00ff00", "of 3 given"), (str(white), "cmyk", "no ink")):
+        cli("stipple", image, "--colours", colours, "--points", 2000, "-o", tmp_path / "cli.svg")
+        kdm.stipple(image, colours=colours, points=2000, output=tmp_path / "py.svg")
+        svg = (tmp_path / "py.svg").read_text()
+        assert svg == (tmp_path / "cli.svg").read_text()
+        assert said in svg.splitlines()[1], svg.splitlines()[1]
+    cli("stipple", white, "--points", 2000, "-o", tmp_path / "cli.svg")
+    kdm.stipple(white, points=2000, output=tmp_path / "py.svg")
+    assert (tmp_path / "py.svg").read_text() == (tmp_path / "cli.svg").read_text()
+
+
 def test_stipple_takes_pens_as_a_list(tmp_path):
     # A list or tuple of pens is the comma-separated str `kdm stipple --colours` takes, in stipple() and
     # separate(); a pen alone in a list is a pen, '#' or not.

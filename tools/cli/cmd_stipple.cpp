@@ -244,18 +244,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       std::copy(inks.background, inks.background + 3, style.background);
       style.blend = inks.blend;
     }
-    char line[200], where[160];
-    // N inks: how many the image gave (a grey image one), and how many were asked for.
-    const bool counted = coloured && a.colours != "cmyk" && a.colours != "rgb";
-    const bool listed = a.colours.find_first_of("#,") != std::string::npos;  // the user's pens
-    const std::string scheme =
-        !counted
-            ? a.colours
-            : std::to_string(inks.inks.size()) + " of " +
-                  (listed ? std::to_string(inks.inks.size() + inks.unused.size()) + " given" : a.colours);
-    std::snprintf(line, sizeof line, "kdm stipple: %zu dot%s (%s%s%s)", set.size(),
-                  set.size() == 1 ? "" : "s", how.c_str(), coloured ? ", inks " : "",
-                  coloured ? scheme.c_str() : "");
+    char where[160];
+    const std::string line = tools::stipple_summary(set.size(), how, a.colours, inks);
     std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
@@ -265,8 +255,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     tools::write_points(path, set, header, style, format);
     const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     // A frame's region is said too: a .csv frame has no header to hold it.
-    std::fprintf(stderr, "%s%s%s placed in %.3f s, written in %.3f s -> %s\n", line, a.frames > 0 ? ", " : "",
-                 a.frames > 0 ? where : "", seconds, writing,
+    std::fprintf(stderr, "%s%s%s placed in %.3f s, written in %.3f s -> %s\n", line.c_str(),
+                 a.frames > 0 ? ", " : "", a.frames > 0 ? where : "", seconds, writing,
                  path == tools::kStandardOutput ? "standard output" : path.c_str());
   }
 }

@@ -504,4 +504,17 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   return sorted;
 }
 
+std::string stipple_summary(std::size_t dots, const std::string& how, const std::string& scheme,
+                            const ColourSeparation& inks) {
+  std::string inked;
+  if (scheme == "cmyk" || scheme == "rgb") {
+    inked = ", inks " + scheme;
+  } else if (!scheme.empty()) {
+    const bool listed = scheme.find_first_of("#,") != std::string::npos;  // the user's pens
+    inked = ", inks " + std::to_string(inks.inks.size()) + " of " +
+            (listed ? std::to_string(inks.inks.size() + inks.unused.size()) + " given" : scheme);
+  }
+  return "kdm stipple: " + std::to_string(dots) + " dot" + (dots == 1 ? "" : "s") + " (" + how + inked + ")";
+}
+
 }  // namespace kdm::tools

@@ -52,4 +52,11 @@ struct ColourSeparation {
 /// unused). Throws std::invalid_argument naming the problem for another scheme.
 ColourSeparation separate_colours(const ColourImage& image, const std::string& scheme, double gamma);
 
+/// A stipple's first header line, as kdm stipple and kdm.stipple write it: "kdm stipple: N dots (HOW)",
+/// HOW how they were placed; with a colour `scheme` (--colours as given; empty: one ink) ", inks SCHEME"
+/// after HOW, cmyk and rgb as named, a count or pens as "K of N" (the K inks the image uses of the N asked
+/// for or given).
+std::string stipple_summary(std::size_t dots, const std::string& how, const std::string& scheme,
+                            const ColourSeparation& inks);
+
 }  // namespace kdm::tools
