@@ -45,6 +45,13 @@ def stipple(
         per unit area there); the dots come back normalised (Returns). An image with no ink gives no dots.
         A file of up to 2^28 pixels (16384 x 16384) is averaged down as it is read to what its dots need (as ``kdm stipple``
         reads it: docs/limits.md, "Large pictures"); an array is used as it is.
+        A path to a NumPy .npy file is read as ``kdm stipple`` reads one: not as a picture but as the density
+        itself, a 2-D array (row 0 at the top) of values >= 0 at any scale, the larger the denser (1 dense,
+        0 no dots); `gamma`, `invert` and `colours` are refused with it. An array is a picture instead: its
+        luminance is the paper's (1, 255 or 65535 white: no dots; 0 black: the densest); with
+        ``invert=True`` its values are the density (to the power `gamma`), so an array `d` of values in
+        [0, 1] with ``invert=True`` gives the dots of a .npy file of `d` (scale densities into [0, 1]
+        first: ``d / d.max()``).
     points : int
         Dots over the whole image (ignored when `scale` is given).
     scale : float or None
@@ -60,7 +67,8 @@ def stipple(
         1 / its width, at most 2x in stable mode; in smooth mode with a tile set that hands over to m x m
         subtiles past its top level, 2 * m**4 x. None: the whole image.
     gamma, invert
-        Darkness ** gamma is the density; invert: luminance instead of darkness.
+        Darkness ** gamma is the density; invert: luminance instead of darkness (an array's values as the
+        density: see `image`).
     seed : int
         Method "full": the sampler's seed. Method "tiles": where the image lies in the tile set's endless
         tiling (another seed, other dots; one seed, the same dots in every region).
