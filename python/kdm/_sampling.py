@@ -51,9 +51,11 @@ def sample(
         `vectorized`, a handful of calls on arrays instead. A str: what
         ``kdm sample --density`` accepts, "const:V", the test maps "ramp:R" and "radial:R", or an image
         file whose darkness (to the power `gamma`; its luminance with `invert`) is the density. A 2-D
-        array: density values (finite, >= 0, not all zero; at any scale, as only the shape matters: an
-        array whose largest value lies outside 1e-30 ... 1e30 is divided by it first), stretched over the
-        domain, with row 0 at the TOP, as pictures are stored (and as an image file is read). A 3-D array
+        array: density values (finite, >= 0, not all zero; at any scale: the scale does not change the
+        points' distribution, but one that is not a power of two rounds the values differently, so the
+        points differ; an array whose largest value lies outside 1e-30 ... 1e30 is divided by it first),
+        stretched over the domain, with row 0 at the TOP, as pictures are stored (and as an image file is
+        read). A 3-D array
         of shape (depth, height, width), with dim=3: a volume of densities (values as a 2-D array's),
         trilinear between voxel centres, stretched over the domain; ``a[k]`` is the slice at
         z = (k + 0.5) / depth (slice 0 at z near 0), each slice laid out as a 2-D array (row 0 at the top,
