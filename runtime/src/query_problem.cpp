@@ -152,9 +152,10 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
       if (!std::isfinite(p.value))  // the kind also covers places too far out for a finite value
         return print(text, size, "'%s' is not a finite number (%g)", shown, p.value);
       break;
-    default:
-      break;
+    default:  // a kind this library does not know (a C caller's number): the number, not a blank field
+      return print(text, size, "%s (kind %d)", query_problem_message(p.kind), static_cast<int>(p.kind));
   }
+  if (!*shown) return print(text, size, "%s", query_problem_message(p.kind));
   return print(text, size, "%s ('%s' = %.6g)", query_problem_message(p.kind), shown, p.value);
 }
 

@@ -337,6 +337,11 @@ int main(int argc, char** argv) {
       CHECK(problem.kind == KDM_PROBLEM_NONE);
       kdm_query_problem_describe(&problem, line, sizeof line);
       CHECK(strcmp(line, "no problem") == 0);
+      /* A kind this library does not know is told by its number, not as a blank field. */
+      kdm_query_problem unknown = problem;
+      unknown.kind = (kdm_problem_kind)42;
+      kdm_query_problem_describe(&unknown, line, sizeof line);
+      CHECK(strcmp(line, "unknown problem (kind 42)") == 0);
     }
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
