@@ -147,7 +147,7 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (!(args.width_px >= 1 && args.width_px <= 65536))
     throw CommandError("--width must be 1 to 65536 pixels");
   if (!(args.dot_radius >= 0 && std::isfinite(args.dot_radius)))
-    throw CommandError("--dot-size must be >= 0");
+    throw CommandError("--dot-size must be a finite number >= 0");
   if (density_given && !args.classes.empty())
     throw CommandError("give either --density or --class (one per class), not both");
   if (args.classes.size() > 8)

@@ -95,7 +95,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       throw CommandError(std::string("--paper-width ") + e.what());
     }
   }
-  if (!(a.dot_size >= 0 && std::isfinite(a.dot_size))) throw CommandError("--dot-size must be >= 0");
+  if (!(a.dot_size >= 0 && std::isfinite(a.dot_size)))
+    throw CommandError("--dot-size must be a finite number >= 0");
   double region[4] = {0, 0, 1, 1};
   if (!a.region.empty()) parse_region(a.region, a.frames > 0, region);
   // A large picture is averaged down to what its dots can show, at the deepest zoom drawn.
