@@ -28,4 +28,21 @@ TEST_F(CliTest, StippleDotSizeMustBeAFiniteNumber) {
   }
 }
 
+// Header numbers are the shortest that read back: a 4:5 picture's aspect is 0.8, not 0.80000000000000004.
+TEST_F(CliTest, StippleHeadersPrintTheShortestNumbers) {
+  write_bytes(path("portrait.png"), grey_png(40, 50, 8, std::vector<std::uint16_t>(40 * 50, 100)));
+  const std::string image = " '" + path("portrait.png") + "' --points 500";
+  for (const std::string format : {"txt", "svg"}) {
+    const Outcome run = kdm("stipple" + image + " -o '" + path("s." + format) + "'");
+    ASSERT_EQ(run.status, 0) << run.err;
+    const std::string text = slurp(path("s." + format));
+    EXPECT_NE(text.find(format == "txt" ? "# domain box, aspect 0.8\n" : "<!-- domain box, aspect 0.8 -->"),
+              std::string::npos)
+        << text.substr(0, 400);
+  }
+  const Outcome zoom = kdm("stipple" + image + " --region 0.1,0.3,0.7,0.9 -o '" + path("z.txt") + "'");
+  ASSERT_EQ(zoom.status, 0) << zoom.err;
+  EXPECT_NE(slurp(path("z.txt")).find("# region 0.1,0.3,0.7,0.9\n"), std::string::npos);
+}
+
 }  // namespace

@@ -245,9 +245,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       std::copy(inks.background, inks.background + 3, style.background);
       style.blend = inks.blend;
     }
-    char where[160];
     const std::string line = tools::stipple_summary(set.size(), how, a.colours, inks);
-    std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
+    const std::string where = tools::stipple_region_text(uv);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<std::string> header = {line, "image " + a.image};
@@ -257,7 +256,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     const double writing = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     // A frame's region is said too: a .csv frame has no header to hold it.
     std::fprintf(stderr, "%s%s%s placed in %.3f s, written in %.3f s -> %s\n", line.c_str(),
-                 a.frames > 0 ? ", " : "", a.frames > 0 ? where : "", seconds, writing,
+                 a.frames > 0 ? ", " : "", a.frames > 0 ? where.c_str() : "", seconds, writing,
                  path == tools::kStandardOutput ? "standard output" : path.c_str());
   }
 }

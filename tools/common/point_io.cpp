@@ -689,16 +689,18 @@ bool write_point_sets(const std::string& path, const std::vector<PointSet>& sets
   return write_text_file_atomic(path, out, error);
 }
 
+std::string shortest(double v) {
+  char text[32];
+  const std::to_chars_result end = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, end.ptr);
+}
+
 std::string domain_header(bool torus, int dim, const double* extent, double aspect) {
-  std::string text = torus ? "domain torus" : "domain box";
-  char shape[96];
+  const std::string text = torus ? "domain torus" : "domain box";
   if (dim == 3 && extent && (extent[1] != 1 || extent[2] != 1))
-    std::snprintf(shape, sizeof shape, ", sides %.17g:%.17g:%.17g", extent[0], extent[1], extent[2]);
-  else if (aspect != 1)
-    std::snprintf(shape, sizeof shape, ", aspect %.17g", aspect);
-  else
-    return text;
-  return text + shape;
+    return text + ", sides " + shortest(extent[0]) + ":" + shortest(extent[1]) + ":" + shortest(extent[2]);
+  if (aspect != 1) return text + ", aspect " + shortest(aspect);
+  return text;
 }
 
 DomainHeader read_domain_header(std::istream& in) {

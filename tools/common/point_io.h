@@ -50,6 +50,9 @@ bool check_output_path(const std::string& path, const std::vector<const char*>& 
 /// would end an XML comment) becomes "- -".
 std::string comment_safe(std::string line);
 
+/// The shortest text that reads back as `v` (std::to_chars): "0.8", not %.17g's 0.80000000000000004.
+std::string shortest(double v);
+
 /// The header's words for the domain a point file's points lie in, which kdm analyze reads back
 /// (read_domain_header): "domain box" or "domain torus" (`torus`: it wraps around), then ", sides X:Y:Z"
 /// for a 3D box of its own sides `extent` (`dim` 3), else ", aspect A" for a width over height `aspect`

@@ -92,10 +92,12 @@ double stipple_dot_radius(double whole_dots, int width_px, double aspect,
   return std::sqrt(coverage * pixels / (kPi * std::max(1.0, whole_dots)));
 }
 
+std::string stipple_region_text(const double uv[4]) {
+  return "region " + shortest(uv[0]) + "," + shortest(uv[1]) + "," + shortest(uv[2]) + "," + shortest(uv[3]);
+}
+
 std::vector<std::string> stipple_region_header(const double uv[4], double aspect) {
-  char where[160];
-  std::snprintf(where, sizeof where, "region %.17g,%.17g,%.17g,%.17g", uv[0], uv[1], uv[2], uv[3]);
-  return {where, domain_header(false, 2, nullptr, aspect)};
+  return {stipple_region_text(uv), domain_header(false, 2, nullptr, aspect)};
 }
 
 double max_stipple_zoom(const Tileset& tileset, QueryMode mode) {

@@ -47,6 +47,9 @@ std::int64_t full_stipple_count(double whole_dots, double scale);
 double stipple_dot_radius(double whole_dots, int width_px, double aspect,
                           const std::vector<const DensitySpec*>& inks);
 
+/// "region x0,y0,x1,y1" for the UV rectangle `uv`, each number the shortest that reads back as it.
+std::string stipple_region_text(const double uv[4]);
+
 /// A stipple's header lines after its image's: the "region x0,y0,x1,y1" drawn (of the image's UV square),
 /// then its picture's domain, a box of width over height `aspect` (domain_header), where kdm analyze
 /// measures the dots.
