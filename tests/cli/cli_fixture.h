@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -147,6 +148,19 @@ inline void write_bytes(const std::string& path, const std::vector<std::uint8_t>
   std::ofstream f(path, std::ios::binary);
   f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   ASSERT_TRUE(f.good()) << path;
+}
+
+// A Radiance (.hdr) image of flat RGBE scanlines: each value as an 8-bit mantissa and a shared exponent.
+inline std::vector<std::uint8_t> radiance_hdr(int w, int h, const std::vector<float>& grey) {
+  std::string out =
+      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
+  for (const float v : grey) {
+    int e = 0;
+    const double m = std::frexp(v, &e);
+    const auto mantissa = static_cast<char>(static_cast<int>(m * 256));
+    out += std::string(3, mantissa) + static_cast<char>(e + 128);
+  }
+  return {out.begin(), out.end()};
 }
 
 // A 64×64 8-bit horizontal ramp: a valid image to cut and damage.

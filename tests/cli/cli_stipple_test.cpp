@@ -15,6 +15,12 @@ namespace {
 
 using namespace kdm_cli_test;
 
+/// The dots of a stipple's .csv (its lines after the header).
+std::size_t csv_dots(const std::string& text) {
+  const std::size_t lines = std::size_t(std::count(text.begin(), text.end(), '\n'));
+  return lines > 0 ? lines - 1 : 0;
+}
+
 const std::string kSphere = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
 
 // A dot size that is no number is refused as one, not as a negative number.
@@ -43,6 +49,36 @@ TEST_F(CliTest, StippleHeadersPrintTheShortestNumbers) {
   const Outcome zoom = kdm("stipple" + image + " --region 0.1,0.3,0.7,0.9 -o '" + path("z.txt") + "'");
   ASSERT_EQ(zoom.status, 0) << zoom.err;
   EXPECT_NE(slurp(path("z.txt")).find("# region 0.1,0.3,0.7,0.9\n"), std::string::npos);
+}
+
+// An HDR picture's brightest pixel is white unless --white says which luminance is: a strip at 100 on a
+// background of 0.5 left the background at 1/200 of white, stippled as black.
+TEST_F(CliTest, StippleWhiteSetsAnHdrPicturesWhite) {
+  const int w = 32, h = 16;
+  std::vector<float> v(w * h, 0.5f);
+  for (int y = 0; y < h; ++y) v[y * w] = v[y * w + 1] = 100.0f;  // 2 of 32 columns
+  write_bytes(path("spec.hdr"), radiance_hdr(w, h, v));
+  const double black = 2000 * double(w) / h;  // --scale 2000: dots per unit area at full darkness
+  const std::string run = "stipple '" + path("spec.hdr") + "' --scale 2000 -o '" + path("s.csv") + "'";
+  for (const char* colours : {"", " --colours cmyk"}) {
+    SCOPED_TRACE(colours);
+    Outcome r = kdm(run + colours);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NEAR(double(csv_dots(slurp(path("s.csv")))), black * 30 / 32, 0.05 * black) << "as before";
+    r = kdm(run + colours + " --white 1");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NEAR(double(csv_dots(slurp(path("s.csv")))), black * 0.5 * 30 / 32, 0.05 * black);
+  }
+  // Brighter than --white is white: the strip gets no dots at --white 50 either.
+  ASSERT_EQ(kdm(run + " --white 50").status, 0);
+  EXPECT_NEAR(double(csv_dots(slurp(path("s.csv")))), black * 0.99 * 30 / 32, 0.05 * black);
+  expect_error(run + " --white 0", "--white must be a finite number > 0");
+  expect_error(run + " --white nan", "--white must be a finite number > 0");
+  expect_error("stipple " + kSphere + " --white 1 -o '" + path("s.csv") + "'",
+               "--white sets the luminance that is white in a Radiance .hdr picture");
+  const Outcome help = kdm("stipple --help");
+  EXPECT_NE(help.out.find("--white"), std::string::npos);
+  EXPECT_NE(help.out.find("brightest pixel is white"), std::string::npos);
 }
 
 }  // namespace

@@ -292,19 +292,6 @@ TEST_F(CliTest, SixteenBitImagesKeepTheirPrecision) {
   EXPECT_TRUE(fs::file_size(path("deep.svg")) > 0);
 }
 
-// A Radiance (.hdr) image of flat RGBE scanlines: each value as an 8-bit mantissa and a shared exponent.
-std::vector<unsigned char> radiance_hdr(int w, int h, const std::vector<float>& grey) {
-  std::string out =
-      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
-  for (const float v : grey) {
-    int e = 0;
-    const double m = std::frexp(v, &e);
-    const auto mantissa = static_cast<char>(static_cast<int>(m * 256));
-    out += std::string(3, mantissa) + static_cast<char>(e + 128);
-  }
-  return {out.begin(), out.end()};
-}
-
 TEST_F(CliTest, RadianceImagesKeepTheirDynamicRange) {
   // 1 : 5,000, the paper's high-dynamic-range example, which 8 or 16 bits cannot hold.
   std::vector<float> v(16 * 16);

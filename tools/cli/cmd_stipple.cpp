@@ -30,6 +30,7 @@ struct StippleArgs {
   std::string image, output, format, method = "tiles", region, tileset, mode = "smooth", colours, paper_width;
   std::int64_t points = 20000;
   double scale = 0, gamma = 1, dot_size = 0, fade = 0;
+  double white = 0;  // a Radiance picture's luminance that is white; 0: its brightest pixel's
   bool invert = false;
   int width_px = 1024, height_px = 0;
   std::int64_t frames = 0;  // wide, so that any count is refused by name, not by the option's parser
@@ -49,6 +50,14 @@ void parse_region(const std::string& text, bool zoom, double r[4]) {
         text + "'");
   if (!(r[0] < 1 && r[1] < 1 && r[2] > 0 && r[3] > 0))
     throw CommandError("--region must meet the image's square [0,1]², got '" + text + "'");
+}
+
+/// The first `n` bytes of the file `path` (fewer for a shorter file, none for one that does not open).
+std::string first_bytes(const std::string& path, std::size_t n) {
+  std::string bytes(n, '\0');
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+  bytes.resize(file ? std::fread(bytes.data(), 1, n, file.get()) : 0);
+  return bytes;
 }
 
 /// OUT.png -> OUT_0007.png (the frame number before the extension).
@@ -95,6 +104,13 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       throw CommandError(std::string("--paper-width ") + e.what());
     }
   }
+  if (a.white > 0) {  // given (checked as it was read)
+    const std::string start = first_bytes(a.image, 16);
+    // (An empty or missing file is left to the loader to name.)
+    if (!start.empty() && !tools::is_radiance(start.data(), start.size()))
+      throw CommandError("--white sets the luminance that is white in a Radiance .hdr picture, and '" +
+                         a.image + "' is none (its white is already its format's)");
+  }
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size)))
     throw CommandError("--dot-size must be a finite number >= 0");
   double region[4] = {0, 0, 1, 1};
@@ -112,7 +128,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (!named && !std::filesystem::exists(a.image, missing))
       throw CommandError("cannot read image '" + a.image +
                          "': " + (missing ? missing.message() : std::string(std::strerror(ENOENT))));
-    inks.channels.push_back(parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept));
+    inks.channels.push_back(
+        parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept, a.white));
     inks.inks = tools::class_inks(1);
     const tools::DensitySpec& spec = inks.channels.front();
     if (spec.kind == tools::DensitySpec::Kind::kVolume)
@@ -126,7 +143,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
     tools::ColourImage image;
     std::string error;
-    if (!tools::load_colour_image(a.image, image, error, tools::kMaxStipplePixels, kept))
+    if (!tools::load_colour_image(a.image, image, error, tools::kMaxStipplePixels, kept, a.white))
       throw CommandError(error);
     check_gamma(a.gamma);
     try {
@@ -339,6 +356,11 @@ void add_stipple_command(CLI::App& app) {
       "Dot radius in pixels (default, or 0: the size at which the whole image's dots cover as much of "
       "the picture as the image's mean darkness, with --colours the inks' summed coverage: the picture "
       "keeps the image's tone)");
+  cmd->add_option(
+      "--white", a->white,
+      "Radiance .hdr pictures: the luminance (0.2126 R + 0.7152 G + 0.0722 B of the file's linear "
+      "values) that is white paper; brighter is white too (default: an HDR picture's brightest "
+      "pixel is white, so one small highlight darkens the rest)");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to darkness (> 1 lightens mid-tones)")
       ->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright areas get the dots (default: dark areas); not with --colours");
@@ -378,6 +400,9 @@ void add_stipple_command(CLI::App& app) {
       throw CommandError("--height must be 1 to 65536 pixels");
     if (cmd->get_option("--paper-width")->count() > 0 && a->paper_width.empty())
       throw CommandError("--paper-width must be a number and a unit (180mm, 7.5in), got ''");
+    if (cmd->get_option("--white")->count() > 0 && !(a->white > 0 && std::isfinite(a->white)))
+      throw CommandError("--white must be a finite number > 0 (the luminance that is white), got " +
+                         tools::shortest(a->white));
     if (scale_given) a->points = 0;
     if (a->method == "full")  // options the full sampler would ignore
       for (const char* tiles_only : {"--mode", "--tileset"})

@@ -17,10 +17,10 @@ void check_gamma(double gamma) {
 }
 
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert, std::uint64_t max_pixels,
-                                 const tools::KeptPixels& kept) {
+                                 const tools::KeptPixels& kept, double white) {
   check_gamma(gamma);
   try {
-    return tools::parse_density_spec(text, gamma, invert, max_pixels, kept);
+    return tools::parse_density_spec(text, gamma, invert, max_pixels, kept, white);
   } catch (const std::exception& e) {  // a bad value, or an image that cannot be read
     throw CommandError(e.what());
   }

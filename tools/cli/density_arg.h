@@ -11,10 +11,11 @@
 namespace kdm::cli {
 
 /// Parses --density (see tools::parse_density_spec). Throws CommandError naming the problem.
-/// Images: refused over `max_pixels`, averaged down to what `kept` keeps (tools::KeptPixels).
+/// Images: refused over `max_pixels`, averaged down to what `kept` keeps (tools::KeptPixels); a Radiance
+/// picture's luminance `white` is white (0: its brightest pixel's).
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert,
                                  std::uint64_t max_pixels = tools::kMaxImagePixels,
-                                 const tools::KeptPixels& kept = {});
+                                 const tools::KeptPixels& kept = {}, double white = 0);
 
 /// --gamma as every command takes it: a finite number > 0, else a CommandError naming the option.
 void check_gamma(double gamma);

@@ -154,7 +154,7 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
 }  // namespace
 
 DensitySpec parse_density_spec(const std::string& text, double gamma, bool invert, std::uint64_t max_pixels,
-                               const KeptPixels& kept) {
+                               const KeptPixels& kept, double white) {
   DensitySpec spec;
   spec.text = text;
   if (!(std::isfinite(gamma) && gamma > 0)) throw std::invalid_argument("gamma must be a finite number > 0");
@@ -195,7 +195,7 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   }
   GreyImage image;
   std::string error;
-  if (!load_grey_image(text, image, error, max_pixels, kept)) throw std::runtime_error(error);
+  if (!load_grey_image(text, image, error, max_pixels, kept, white)) throw std::runtime_error(error);
   // Densities keep row 0 at the bottom (y up); the picture's row 0 is its top: flipped here, once.
   spec.kind = DensitySpec::Kind::kImage;
   spec.width = image.width, spec.height = image.height, spec.inverted = invert;

@@ -51,9 +51,11 @@ struct DensitySpec {
 /// the top (y near 1), as 2-D density arrays in Python; a 3-D one (depth, height, width) a kVolume, array[k]
 /// slice k along z (k = 0 at z near 0), each slice as a 2-D array. Other shapes and types are refused,
 /// naming the file. An image of more than `max_pixels` pixels is refused; `kept`, if given, averages a larger
-/// picture down as it is read (KeptPixels; the average is of luminance, before `gamma`).
+/// picture down as it is read (KeptPixels; the average is of luminance, before `gamma`). `white` > 0 is the
+/// luminance of a Radiance .hdr picture that is white (load_grey_image; 0: its brightest pixel's).
 DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool invert = false,
-                               std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
+                               std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
+                               double white = 0);
 
 /// A picture's tone at a pixel, before gamma: its darkness 1 − grey, or with `invert` its luminance on black
 /// paper, grey − (1 − alpha). `grey` is composited on white (GreyImage) and `alpha` its coverage (1 where

@@ -271,7 +271,7 @@ bool pnm_faults(const std::uint8_t* data, std::size_t size) {
 // as stbi__hdr_load does.
 std::string radiance_fault(const std::uint8_t* data, std::size_t size) {
   const std::string_view all(reinterpret_cast<const char*>(data), size);
-  if (all.rfind("#?RADIANCE\n", 0) != 0 && all.rfind("#?RGBE\n", 0) != 0) return "";
+  if (!is_radiance(data, size)) return "";
   std::size_t pos = all.find('\n') + 1;
   bool format = false;
   for (;;) {  // header lines up to an empty one
@@ -657,7 +657,8 @@ void apply_orientation(Image& image, int orientation) {
 // read (its size; nothing is allocated) and refused over `max_pixels`; only then are the pixels decoded.
 template <class Image>
 bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& name,
-                std::uint64_t max_pixels, Image& out, std::string& error, const KeptPixels& kept = {}) {
+                std::uint64_t max_pixels, Image& out, std::string& error, const KeptPixels& kept,
+                double white) {
   if (size == 0) {
     error = "cannot read image '" + name + "': the file is empty";
     return false;
@@ -754,8 +755,9 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
       convert_reduced(data, channels, full, w, h, kw, kh, image);
   };
   if (hdr) {
-    // Radiance files hold linear values of any range: scaled by the largest (the brightest pixel's
-    // luminance, or channel for colour), so that a density keeps every ratio the file holds.
+    // Radiance files hold linear values of any range: scaled by `white`, or else by the largest (the
+    // brightest pixel's luminance, or channel for colour), so that a density keeps every ratio the file
+    // holds; a brighter pixel than `white` is clipped to white.
     std::unique_ptr<float, void (*)(void*)> data(
         stbi_loadf_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
@@ -772,7 +774,7 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
                                : *std::max_element(p, p + channels);
       if (value > largest && std::isfinite(value)) largest = value;
     }
-    convert_kept(data.get(), largest > 0 ? static_cast<float>(largest) : 1.0f);
+    convert_kept(data.get(), static_cast<float>(white > 0 ? white : largest > 0 ? largest : 1.0));
   } else if (stbi_is_16_bit_from_memory(bytes, length)) {
     std::unique_ptr<stbi_us, void (*)(void*)> data(
         stbi_load_16_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
@@ -804,7 +806,7 @@ namespace {
 
 template <class Image>
 bool load_image_file(const std::string& path, Image& out, std::string& error, std::uint64_t max_pixels,
-                     const KeptPixels& kept) {
+                     const KeptPixels& kept, double white) {
   // Read whole, once: the checks and the decoder see the same bytes, whatever happens to the file.
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) {
@@ -846,24 +848,30 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
-  return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error, kept);
+  return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error, kept, white);
 }
 
 }  // namespace
 
 bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels,
-                     const KeptPixels& kept) {
-  return load_image_file(path, out, error, max_pixels, kept);
+                     const KeptPixels& kept, double white) {
+  return load_image_file(path, out, error, max_pixels, kept, white);
 }
 
 bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
-                       std::uint64_t max_pixels, const KeptPixels& kept) {
-  return load_image_file(path, out, error, max_pixels, kept);
+                       std::uint64_t max_pixels, const KeptPixels& kept, double white) {
+  return load_image_file(path, out, error, max_pixels, kept, white);
 }
 
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
-                            const std::string& name, std::uint64_t max_pixels, const KeptPixels& kept) {
-  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error, kept);
+                            const std::string& name, std::uint64_t max_pixels, const KeptPixels& kept,
+                            double white) {
+  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error, kept, white);
+}
+
+bool is_radiance(const void* data, std::size_t size) {
+  const std::string_view start(static_cast<const char*>(data), size);
+  return start.rfind("#?RADIANCE\n", 0) == 0 || start.rfind("#?RGBE\n", 0) == 0;
 }
 
 bool write_png(const std::string& path, const RgbImage& image, std::string& error) {

@@ -52,24 +52,32 @@ inline constexpr std::uint64_t kMaxImagePixels = std::uint64_t(1) << 26;
 using KeptPixels = std::function<std::uint64_t(int width, int height)>;
 
 /// Loads an image as luminance in [0, 1] (16-bit PNGs keep their precision; a Radiance .hdr image its
-/// range, as linear values divided by its brightest pixel's; alpha is composited on white and kept; a
-/// JPEG is turned as its EXIF orientation says, as viewers show it).
+/// range, as linear values divided by `white` (brighter ones clipped to 1), or when `white` is 0 by its
+/// brightest pixel's; alpha is composited on white and kept; a JPEG is turned as its EXIF orientation
+/// says, as viewers show it).
 /// The file is read whole (at most 2 GiB); images of more than `max_pixels` pixels are refused from their
 /// header (see kMaxImagePixels), and so are inputs that would reach a known fault of the system's stb_image
 /// (tests/fuzz/crashes/README.md).
 /// Returns false and sets `error` to a one-line message naming the file and the problem.
 /// `kept`, if given, averages a large picture down while it is converted (KeptPixels).
 bool load_grey_image(const std::string& path, GreyImage& out, std::string& error,
-                     std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
+                     std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
+                     double white = 0);
 
-/// The same as red, green and blue (alpha composited on white; a grey image gives three equal channels).
+/// The same as red, green and blue (alpha composited on white; a grey image gives three equal channels; a
+/// Radiance image's channels divided by `white`, or when it is 0 by the largest).
 bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
-                       std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
+                       std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
+                       double white = 0);
 /// The same as load_grey_image for an image file's bytes in memory; `name` stands for the file in error
 /// messages.
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
                             const std::string& name = "image in memory",
-                            std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {});
+                            std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
+                            double white = 0);
+
+/// Whether `data` begins as a Radiance (.hdr) image does ("#?RADIANCE" or "#?RGBE" and a line break).
+bool is_radiance(const void* data, std::size_t size);
 
 /// Writes `image` as PNG atomically (temporary file, then rename). Returns false with `error` set on failure.
 bool write_png(const std::string& path, const RgbImage& image, std::string& error);
