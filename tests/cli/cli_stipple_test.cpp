@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,76 @@ TEST_F(CliTest, StippleWhiteSetsAnHdrPicturesWhite) {
   const Outcome help = kdm("stipple --help");
   EXPECT_NE(help.out.find("--white"), std::string::npos);
   EXPECT_NE(help.out.find("brightest pixel is white"), std::string::npos);
+}
+
+/// A NumPy .npy file of a 2-D float64 array (rows, columns), row-major.
+std::string npy_2d(const std::vector<double>& values, int rows, int cols) {
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
+                       std::to_string(cols) + "), }";
+  header += std::string(63 - (10 + header.size()) % 64, ' ') + "\n";  // to a multiple of 64 bytes
+  std::string out = std::string("\x93NUMPY\x01\x00", 8);
+  out += char(header.size() & 0xFF), out += char(header.size() >> 8);
+  out += header;
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return out;
+}
+
+// "-" reads the image from standard input, as the README says every input does: a picture, an HDR one or
+// a .npy array, told apart by their first bytes, the same dots as from the file; "-o -" is then no
+// output over the input. Densities of kdm query and sample read it too; standard input is read once.
+TEST_F(CliTest, StippleAndDensitiesReadStandardInput) {
+  std::vector<std::uint16_t> ramp(48 * 32);
+  std::vector<double> array(48 * 32);
+  std::vector<float> light(48 * 32);
+  for (std::size_t i = 0; i < ramp.size(); ++i) {
+    ramp[i] = std::uint16_t(255 * (i % 48) / 47);
+    array[i] = 1 - (i % 48) / 47.0;
+    light[i] = 0.02f * float(1 + i % 48);
+  }
+  write_bytes(path("ramp.png"), grey_png(48, 32, 8, ramp));
+  std::ofstream(path("ramp.npy"), std::ios::binary) << npy_2d(array, 32, 48);
+  write_bytes(path("ramp.hdr"), radiance_hdr(48, 32, light));
+  for (const std::string name : {"ramp.png", "ramp.npy", "ramp.hdr"}) {
+    SCOPED_TRACE(name);
+    const std::string white = name == "ramp.hdr" ? " --white 0.5" : "";
+    const Outcome file =
+        kdm("stipple '" + path(name) + "'" + white + " --points 2000 -o '" + path("f.csv") + "'");
+    ASSERT_EQ(file.status, 0) << file.err;
+    const Outcome piped =
+        kdm("stipple -" + white + " --points 2000 -o '" + path("p.csv") + "' < '" + path(name) + "'");
+    ASSERT_EQ(piped.status, 0) << piped.err;
+    EXPECT_EQ(slurp(path("p.csv")), slurp(path("f.csv")));
+    EXPECT_GT(csv_dots(slurp(path("p.csv"))), 1000u);
+    const std::string rect = " --rect 0,0,1.5,1 --scale 2000 -o '" + path("q.csv") + "'";
+    ASSERT_EQ(kdm("query --density '" + path(name) + "'" + rect).status, 0);
+    const std::string from_file = slurp(path("q.csv"));
+    const Outcome query = kdm("query --density -" + rect + " < '" + path(name) + "'");
+    ASSERT_EQ(query.status, 0) << query.err;
+    EXPECT_EQ(slurp(path("q.csv")), from_file);
+    const std::string sample = " --n 300 -o '" + path("s.csv") + "'";
+    ASSERT_EQ(kdm("sample --density '" + path(name) + "'" + sample).status, 0);
+    const std::string sampled = slurp(path("s.csv"));
+    const Outcome piped_sample = kdm("sample --density -" + sample + " < '" + path(name) + "'");
+    ASSERT_EQ(piped_sample.status, 0) << piped_sample.err;
+    EXPECT_EQ(slurp(path("s.csv")), sampled);
+  }
+  // To standard output, in colour, and the header says where the image came from.
+  const Outcome png = kdm("stipple - --points 500 -o - --format png < '" + path("ramp.png") + "'");
+  ASSERT_EQ(png.status, 0) << png.err;
+  EXPECT_EQ(png.out.substr(0, 4), "\x89PNG");
+  const Outcome txt =
+      kdm("stipple - --points 500 --colours cmyk -o - --format svg < '" + path("ramp.png") + "'");
+  ASSERT_EQ(txt.status, 0) << txt.err;
+  EXPECT_NE(txt.out.find("image - (standard input)"), std::string::npos);
+  // Nothing, no image, or two inputs from the one standard input: said.
+  expect_error("stipple - -o '" + path("x.csv") + "' < /dev/null",
+               "'-' reads standard input, and it is empty");
+  expect_error("stipple - -o '" + path("x.csv") + "' < '" + path("f.csv") + "'",
+               "cannot read image 'standard input'");
+  expect_error("stipple - --tileset - -o '" + path("x.csv") + "' < '" + path("ramp.png") + "'",
+               "standard input is read once: '-' given to the image and to --tileset");
+  expect_error("sample --n 10 --class - --class - -o '" + path("x.csv") + "' < '" + path("ramp.png") + "'",
+               "standard input is read once");
 }
 
 }  // namespace

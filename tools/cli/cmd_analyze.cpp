@@ -310,6 +310,11 @@ void run_analyze(const AnalyzeArgs& args) {
     if (args.tile_size != 0) analysis::tiles_per_axis(args.tile_size);
     gen::Density target = gen::Density::constant();
     std::vector<tools::DensitySpec> specs;  // --density's, then each --class-density's
+    std::vector<std::pair<std::string, std::string>> inputs = {{"--density", args.density}};
+    for (const std::string& text : args.class_densities) inputs.emplace_back("--class-density", text);
+    if (std::find(args.files.begin(), args.files.end(), "-") != args.files.end())
+      inputs.emplace_back("the points", "-");
+    check_one_standard_input(inputs);
     if (!args.density.empty()) specs.push_back(parse_density(args.density, args.gamma, args.invert));
     for (std::size_t k = 0; k < args.class_densities.size(); ++k) try {
         specs.push_back(parse_density(args.class_densities[k], args.gamma, args.invert));

@@ -96,6 +96,10 @@ void run_query_command(const QueryArgs& a, bool density_given) {
                        std::to_string(kMaxQueryClasses) + " classes");
   // One density per class (--density alone is one class); specs and densities stay put (queries point in).
   std::vector<std::unique_ptr<tools::DensitySpec>> specs;
+  std::vector<std::pair<std::string, std::string>> inputs = {{"--tileset", a.tileset}};
+  for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes)
+    inputs.emplace_back(a.classes.empty() ? "--density" : "--class", text);
+  check_one_standard_input(inputs);
   for (const std::string& text : a.classes.empty() ? std::vector<std::string>{a.density} : a.classes) {
     tools::refuse_writing_over(text, a.output, "density image");  // a picture written over its input
     specs.push_back(std::make_unique<tools::DensitySpec>(parse_density(text, a.gamma, a.invert)));
@@ -208,7 +212,8 @@ void add_query_command(CLI::App& app) {
              "file's values, alpha on white; dark = dense; a Radiance .hdr keeps its range, scaled by its "
              "brightest pixel), a test map ramp:R or radial:R (dynamic range R), or a NumPy .npy 2-D array "
              "of densities (rows, columns; row 0 at the top, as kdm sample takes it), stretched over "
-             "--density-rect (past it the edge texels go on)")
+             "--density-rect (past it the edge texels go on); '-' reads the image or array from standard "
+             "input")
           ->capture_default_str();
   cmd->add_option(
          "--class", a->classes,

@@ -159,6 +159,10 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   if (classed && args.options.dim != 2) throw CommandError("--class samples 2D points: drop --dim 3");
   check_sets(args, format, classed);
   std::vector<tools::DensitySpec> specs;
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density})
+    inputs.emplace_back(classed ? "--class" : "--density", text);
+  check_one_standard_input(inputs);
   for (const std::string& text : classed ? args.classes : std::vector<std::string>{args.density}) {
     tools::refuse_writing_over(text, args.output, "density image");  // a picture written over its input
     specs.push_back(parse_density(text, args.gamma, args.invert));
@@ -322,7 +326,8 @@ void add_sample_command(CLI::App& app) {
          "as their values, or bools): 2-D (rows, columns) as a picture's, row 0 at the top (y near 1), the "
          "last axis x; with "
          "--dim 3 a 3-D volume (depth, height, width), trilinear between voxels, stretched over the domain: "
-         "[k] is the slice at z = (k + 0.5) / depth, each slice as a 2-D array")
+         "[k] is the slice at z = (k + 0.5) / depth, each slice as a 2-D array; '-' reads the image or array "
+         "from standard input")
       ->capture_default_str();
   cmd->add_option("--class", args->classes,
                   "Several classes (instead of --density): repeat it, one density each, highest priority "

@@ -104,12 +104,20 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       throw CommandError(std::string("--paper-width ") + e.what());
     }
   }
-  if (a.white > 0) {  // given (checked as it was read)
-    const std::string start = first_bytes(a.image, 16);
+  check_one_standard_input({{"the image", a.image}, {"--tileset", a.tileset}});
+  // "-": the image piped in, read once (the loaders below read these bytes).
+  const bool piped = a.image == "-";
+  const std::vector<std::uint8_t> piped_bytes = piped ? standard_input_bytes() : std::vector<std::uint8_t>{};
+  const std::string named = piped ? kStandardInputName : a.image;  // in messages
+  if (a.white > 0) {                                               // given (checked as it was read)
+    const std::string start =
+        piped ? std::string(piped_bytes.begin(),
+                            piped_bytes.begin() + std::min<std::size_t>(16, piped_bytes.size()))
+              : first_bytes(a.image, 16);
     // (An empty or missing file is left to the loader to name.)
     if (!start.empty() && !tools::is_radiance(start.data(), start.size()))
       throw CommandError("--white sets the luminance that is white in a Radiance .hdr picture, and '" +
-                         a.image + "' is none (its white is already its format's)");
+                         named + "' is none (its white is already its format's)");
   }
   if (!(a.dot_size >= 0 && std::isfinite(a.dot_size)))
     throw CommandError("--dot-size must be a finite number >= 0");
@@ -118,22 +126,38 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   // A large picture is averaged down to what its dots can show, at the deepest zoom drawn.
   const tools::KeptPixels kept = tools::stipple_kept_pixels(
       scale_given ? 0.0 : double(a.points), scale_given ? a.scale : 0.0, tools::stipple_zoom(region));
+  const auto load_colours = [&](tools::ColourImage& image, std::string& error) {
+    return piped ? tools::load_colour_image_memory(piped_bytes.data(), piped_bytes.size(), image, error,
+                                                   named, tools::kMaxStipplePixels, kept, a.white)
+                 : tools::load_colour_image(a.image, image, error, tools::kMaxStipplePixels, kept, a.white);
+  };
   // One ink (the image's darkness), or with --colours the image separated into several.
   tools::ColourSeparation inks;
   double aspect = 1;  // world: [0, aspect] × [0, 1]
   if (a.colours.empty()) {
-    const bool named = a.image.rfind("const:", 0) == 0 || a.image.rfind("ramp:", 0) == 0 ||
-                       a.image.rfind("radial:", 0) == 0;  // refused below: stipple needs an image
+    const bool named_map = a.image.rfind("const:", 0) == 0 || a.image.rfind("ramp:", 0) == 0 ||
+                           a.image.rfind("radial:", 0) == 0;  // refused below: stipple needs an image
     std::error_code missing;  // said as --colours' loader says it, not "a density is a picture, const:V, …"
-    if (!named && !std::filesystem::exists(a.image, missing))
+    if (!named_map && !piped && !std::filesystem::exists(a.image, missing))
       throw CommandError("cannot read image '" + a.image +
                          "': " + (missing ? missing.message() : std::string(std::strerror(ENOENT))));
-    inks.channels.push_back(
-        parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept, a.white));
+    if (piped) {
+      check_gamma(a.gamma);
+      try {
+        inks.channels.push_back(tools::parse_density_bytes(piped_bytes.data(), piped_bytes.size(), named,
+                                                           a.gamma, a.invert, tools::kMaxStipplePixels, kept,
+                                                           a.white));
+      } catch (const std::exception& e) {  // a bad value, or an image that cannot be read
+        throw CommandError(e.what());
+      }
+    } else {
+      inks.channels.push_back(
+          parse_density(a.image, a.gamma, a.invert, tools::kMaxStipplePixels, kept, a.white));
+    }
     inks.inks = tools::class_inks(1);
     const tools::DensitySpec& spec = inks.channels.front();
     if (spec.kind == tools::DensitySpec::Kind::kVolume)
-      throw CommandError("kdm stipple needs an image, and '" + a.image +
+      throw CommandError("kdm stipple needs an image, and '" + named +
                          "' is a 3-D volume (kdm sample --dim 3)");
     if (spec.kind != tools::DensitySpec::Kind::kImage)
       throw CommandError("kdm stipple needs an image; for a constant density use kdm sample");
@@ -143,8 +167,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
     tools::ColourImage image;
     std::string error;
-    if (!tools::load_colour_image(a.image, image, error, tools::kMaxStipplePixels, kept, a.white))
-      throw CommandError(error);
+    if (!load_colours(image, error)) throw CommandError(error);
     check_gamma(a.gamma);
     try {
       inks = tools::separate_colours(image, a.colours, a.gamma);
@@ -172,10 +195,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     tools::ColourImage probe;
     std::string unread;
     const bool transparent =
-        tools::load_colour_image(a.image, probe, unread, tools::kMaxStipplePixels, kept) &&
-        !probe.alpha.empty() &&
+        load_colours(probe, unread) && !probe.alpha.empty() &&
         std::all_of(probe.alpha.begin(), probe.alpha.end(), [](float alpha) { return alpha == 0; });
-    std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s%s: no dots\n", a.image.c_str(),
+    std::fprintf(stderr, "kdm stipple: image '%s' has no ink%s%s: no dots\n", named.c_str(),
                  coloured ? " in any colour" : "",
                  transparent            ? " (it is all transparent)"
                  : coloured || a.invert ? ""
@@ -266,7 +288,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     const std::string where = tools::stipple_region_text(uv);
     const std::string path = a.frames > 0 ? frame_path(a.output, i) : a.output;
     const auto t1 = std::chrono::steady_clock::now();
-    std::vector<std::string> header = {line, "image " + a.image};
+    std::vector<std::string> header = {line, "image " + (piped ? "- (" + named + ")" : a.image)};
     for (std::string& more : tools::stipple_region_header(uv, style.aspect))
       header.push_back(std::move(more));
     tools::write_points(path, set, header, style, format);
@@ -289,7 +311,7 @@ void add_stipple_command(CLI::App& app) {
          "density; transparent pixels are paper. A NumPy .npy 2-D array of densities (rows, columns; row 0 "
          "at the top, as kdm sample takes it) is the density itself (not with --colours). Up to 2^28 pixels "
          "in all (16384x16384): a picture larger than its dots need (about 4096x4096, or 64 pixels per dot, "
-         "times the zoom squared; at most 2^26) is averaged down as it is read")
+         "times the zoom squared; at most 2^26) is averaged down as it is read. '-': standard input")
       ->required();
   cmd->add_option("-o,--output", a->output,
                   "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "

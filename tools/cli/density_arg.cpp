@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <unistd.h>
+
 #include "commands.h"
 
 namespace kdm::cli {
@@ -16,10 +18,36 @@ void check_gamma(double gamma) {
   throw CommandError(text);
 }
 
+std::vector<std::uint8_t> standard_input_bytes() {
+  if (isatty(STDIN_FILENO))
+    throw CommandError("'-' reads standard input, and it is a terminal: pipe the input into kdm (< file)");
+  std::vector<std::uint8_t> bytes;
+  std::string error;
+  if (!tools::read_standard_input(bytes, error)) throw CommandError(error);
+  if (bytes.empty()) throw CommandError("'-' reads standard input, and it is empty");
+  return bytes;
+}
+
+void check_one_standard_input(const std::vector<std::pair<std::string, std::string>>& inputs) {
+  std::string first;
+  for (const auto& [option, value] : inputs) {
+    if (value != "-") continue;
+    if (!first.empty())
+      throw CommandError("standard input is read once: '-' given to " + first + " and to " + option +
+                         " (write one of them to a file)");
+    first = option;
+  }
+}
+
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert, std::uint64_t max_pixels,
                                  const tools::KeptPixels& kept, double white) {
   check_gamma(gamma);
   try {
+    if (text == "-") {
+      const std::vector<std::uint8_t> bytes = standard_input_bytes();
+      return tools::parse_density_bytes(bytes.data(), bytes.size(), kStandardInputName, gamma, invert,
+                                        max_pixels, kept, white);
+    }
     return tools::parse_density_spec(text, gamma, invert, max_pixels, kept, white);
   } catch (const std::exception& e) {  // a bad value, or an image that cannot be read
     throw CommandError(e.what());

@@ -3,14 +3,28 @@
 // with runtime_args.h.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "density_spec.h"
 
 namespace kdm::cli {
 
-/// Parses --density (see tools::parse_density_spec). Throws CommandError naming the problem.
+/// How messages name the input "-".
+inline constexpr const char* kStandardInputName = "standard input";
+
+/// Standard input read whole, for an input given as "-" (tools::read_standard_input). Throws CommandError
+/// when it is a terminal, empty or cannot be read.
+std::vector<std::uint8_t> standard_input_bytes();
+
+/// Throws CommandError when more than one of `inputs` (an option's name, its value) is "-": standard input
+/// is read once.
+void check_one_standard_input(const std::vector<std::pair<std::string, std::string>>& inputs);
+
+/// Parses --density (see tools::parse_density_spec; "-": standard input, an image or a .npy array told
+/// apart by its first bytes). Throws CommandError naming the problem.
 /// Images: refused over `max_pixels`, averaged down to what `kept` keeps (tools::KeptPixels); a Radiance
 /// picture's luminance `white` is white (0: its brightest pixel's).
 tools::DensitySpec parse_density(const std::string& text, double gamma, bool invert,

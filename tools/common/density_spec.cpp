@@ -70,6 +70,31 @@ double parse_number(const std::string& text) {
   return !text.empty() && *end == '\0' && std::isfinite(v) ? v : std::nan("");
 }
 
+/// Bytes in memory as a seekable stream buffer (read_npy_density seeks back to read the data twice).
+class MemoryBuffer : public std::streambuf {
+ public:
+  MemoryBuffer(const char* data, std::size_t size) {
+    char* begin = const_cast<char*>(data);  // only ever read
+    setg(begin, begin, begin + size);
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+    const off_type from = dir == std::ios_base::beg   ? 0
+                          : dir == std::ios_base::cur ? gptr() - eback()
+                                                      : egptr() - eback();
+    if (off < -from || off > (egptr() - eback()) - from) return pos_type(off_type(-1));
+    setg(eback(), eback() + from + off, egptr());
+    return pos_type(from + off);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+};
+
+/// A picture's densities: its tone (picture_tone) to the power `gamma`, row 0 at the bottom.
+DensitySpec image_density(const GreyImage& image, const std::string& text, double gamma, bool invert);
+
 /// A NumPy array of densities: 2-D as a kImage spec, 3-D as a kVolume one (parse_density_spec says which);
 /// throws naming the file and the problem: std::runtime_error for a file it cannot read (a header it
 /// cannot parse, data cut short), std::invalid_argument for an array that is no density (its type, shape
@@ -196,6 +221,32 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
   GreyImage image;
   std::string error;
   if (!load_grey_image(text, image, error, max_pixels, kept, white)) throw std::runtime_error(error);
+  return image_density(image, text, gamma, invert);
+}
+
+DensitySpec parse_density_bytes(const void* data, std::size_t size, const std::string& name, double gamma,
+                                bool invert, std::uint64_t max_pixels, const KeptPixels& kept, double white) {
+  if (!(std::isfinite(gamma) && gamma > 0)) throw std::invalid_argument("gamma must be a finite number > 0");
+  if (size >= 6 && std::memcmp(data, "\x93NUMPY", 6) == 0) {
+    if (gamma != 1 || invert)
+      throw std::invalid_argument(
+          "density '" + name + "' is a NumPy array of densities: --gamma and --invert apply to images only");
+    MemoryBuffer buffer(static_cast<const char*>(data), size);
+    std::istream in(&buffer);
+    return read_npy_density(name, in);
+  }
+  GreyImage image;
+  std::string error;
+  if (!load_grey_image_memory(data, size, image, error, name, max_pixels, kept, white))
+    throw std::runtime_error(error);
+  return image_density(image, name, gamma, invert);
+}
+
+namespace {
+
+DensitySpec image_density(const GreyImage& image, const std::string& text, double gamma, bool invert) {
+  DensitySpec spec;
+  spec.text = text;
   // Densities keep row 0 at the bottom (y up); the picture's row 0 is its top: flipped here, once.
   spec.kind = DensitySpec::Kind::kImage;
   spec.width = image.width, spec.height = image.height, spec.inverted = invert;
@@ -209,6 +260,8 @@ DensitySpec parse_density_spec(const std::string& text, double gamma, bool inver
     }
   return spec;
 }
+
+}  // namespace
 
 std::pair<int, int> images_of_different_shapes(const std::vector<const DensitySpec*>& specs) {
   int first = -1;

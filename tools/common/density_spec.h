@@ -57,6 +57,12 @@ DensitySpec parse_density_spec(const std::string& text, double gamma = 1, bool i
                                std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
                                double white = 0);
 
+/// parse_density_spec of an image or .npy file's bytes in memory (standard input read whole, say), told apart
+/// by their first bytes as a file's are; `name` stands for the file in messages.
+DensitySpec parse_density_bytes(const void* data, std::size_t size, const std::string& name, double gamma = 1,
+                                bool invert = false, std::uint64_t max_pixels = kMaxImagePixels,
+                                const KeptPixels& kept = {}, double white = 0);
+
 /// A picture's tone at a pixel, before gamma: its darkness 1 − grey, or with `invert` its luminance on black
 /// paper, grey − (1 − alpha). `grey` is composited on white (GreyImage) and `alpha` its coverage (1 where
 /// opaque): transparent is paper, white for dark dots and black for inverted ones. Every reader of a

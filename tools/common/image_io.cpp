@@ -804,6 +804,48 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
 
 namespace {
 
+/// Reads `file` whole into `bytes` (at most 2 GiB, stb's byte count), `name` standing for it in messages.
+bool read_whole(std::FILE* file, const std::string& name, std::vector<std::uint8_t>& bytes,
+                std::string& error) {
+  struct stat info {};  // a directory opens, and then reads as an error or as a huge size
+  const bool stated = fstat(fileno(file), &info) == 0;
+  if (stated && S_ISDIR(info.st_mode)) {
+    error = "cannot read image '" + name + "': it is a directory";
+    return false;
+  }
+  const auto too_large = [&] {
+    error = "cannot read image '" + name + "': larger than 2 GiB";
+    return false;
+  };
+  constexpr auto kMaxBytes = static_cast<std::size_t>(std::numeric_limits<int>::max());  // stb's byte count
+  bytes.clear();
+  if (std::fseek(file, 0, SEEK_END) == 0) {  // a regular file: its size up front
+    const long size = std::ftell(file);
+    if (size > 0 && static_cast<std::size_t>(size) > kMaxBytes) return too_large();
+    if (size > 0) bytes.reserve(static_cast<std::size_t>(size));
+    std::rewind(file);
+  }
+  std::uint8_t chunk[1 << 16];
+  for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, file)) > 0;) {
+    if (bytes.size() + n > kMaxBytes) return too_large();
+    bytes.insert(bytes.end(), chunk, chunk + n);
+    // A device or a pipe has no size to check up front: /dev/zero would be read to 2 GiB. Its first
+    // 64 KiB must begin an image stb_image knows (or a NumPy array of densities, for standard input).
+    int w, h, channels;
+    if (bytes.size() == n && stated && !S_ISREG(info.st_mode) &&
+        !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &channels) &&
+        !(n >= 6 && std::memcmp(bytes.data(), "\x93NUMPY", 6) == 0)) {
+      error = "cannot read image '" + name + "': not a file, and its first bytes are no image header";
+      return false;
+    }
+  }
+  if (std::ferror(file)) {
+    error = "cannot read image '" + name + "': " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
 template <class Image>
 bool load_image_file(const std::string& path, Image& out, std::string& error, std::uint64_t max_pixels,
                      const KeptPixels& kept, double white) {
@@ -813,45 +855,16 @@ bool load_image_file(const std::string& path, Image& out, std::string& error, st
     error = "cannot read image '" + path + "': " + std::strerror(errno);
     return false;
   }
-  struct stat info {};  // a directory opens, and then reads as an error or as a huge size
-  const bool stated = fstat(fileno(file.get()), &info) == 0;
-  if (stated && S_ISDIR(info.st_mode)) {
-    error = "cannot read image '" + path + "': it is a directory";
-    return false;
-  }
-  const auto too_large = [&] {
-    error = "cannot read image '" + path + "': larger than 2 GiB";
-    return false;
-  };
-  constexpr auto kMaxBytes = static_cast<std::size_t>(std::numeric_limits<int>::max());  // stb's byte count
   std::vector<std::uint8_t> bytes;
-  if (std::fseek(file.get(), 0, SEEK_END) == 0) {  // a regular file: its size up front
-    const long size = std::ftell(file.get());
-    if (size > 0 && static_cast<std::size_t>(size) > kMaxBytes) return too_large();
-    if (size > 0) bytes.reserve(static_cast<std::size_t>(size));
-    std::rewind(file.get());
-  }
-  std::uint8_t chunk[1 << 16];
-  for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, file.get())) > 0;) {
-    if (bytes.size() + n > kMaxBytes) return too_large();
-    bytes.insert(bytes.end(), chunk, chunk + n);
-    // A device or a pipe has no size to check up front: /dev/zero would be read to 2 GiB. Its first
-    // 64 KiB must begin an image stb_image knows.
-    int w, h, channels;
-    if (bytes.size() == n && stated && !S_ISREG(info.st_mode) &&
-        !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &w, &h, &channels)) {
-      error = "cannot read image '" + path + "': not a file, and its first bytes are no image header";
-      return false;
-    }
-  }
-  if (std::ferror(file.get())) {
-    error = "cannot read image '" + path + "': " + std::strerror(errno);
-    return false;
-  }
+  if (!read_whole(file.get(), path, bytes, error)) return false;
   return load_image(bytes.data(), bytes.size(), path, max_pixels, out, error, kept, white);
 }
 
 }  // namespace
+
+bool read_standard_input(std::vector<std::uint8_t>& bytes, std::string& error) {
+  return read_whole(stdin, "standard input", bytes, error);
+}
 
 bool load_grey_image(const std::string& path, GreyImage& out, std::string& error, std::uint64_t max_pixels,
                      const KeptPixels& kept, double white) {
@@ -866,6 +879,12 @@ bool load_colour_image(const std::string& path, ColourImage& out, std::string& e
 bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, std::string& error,
                             const std::string& name, std::uint64_t max_pixels, const KeptPixels& kept,
                             double white) {
+  return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error, kept, white);
+}
+
+bool load_colour_image_memory(const void* data, std::size_t size, ColourImage& out, std::string& error,
+                              const std::string& name, std::uint64_t max_pixels, const KeptPixels& kept,
+                              double white) {
   return load_image(static_cast<const std::uint8_t*>(data), size, name, max_pixels, out, error, kept, white);
 }
 

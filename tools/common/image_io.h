@@ -76,6 +76,17 @@ bool load_grey_image_memory(const void* data, std::size_t size, GreyImage& out, 
                             std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
                             double white = 0);
 
+/// The same as load_colour_image for an image file's bytes in memory.
+bool load_colour_image_memory(const void* data, std::size_t size, ColourImage& out, std::string& error,
+                              const std::string& name = "image in memory",
+                              std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
+                              double white = 0);
+
+/// Reads all of standard input into `bytes`, as the loaders read a file (at most 2 GiB; a pipe whose first
+/// 64 KiB begin no image header, nor a NumPy array's, is refused there, not read to its end). Returns false
+/// with `error` set ("standard input" named as the image) when it cannot.
+bool read_standard_input(std::vector<std::uint8_t>& bytes, std::string& error);
+
 /// Whether `data` begins as a Radiance (.hdr) image does ("#?RADIANCE" or "#?RGBE" and a line break).
 bool is_radiance(const void* data, std::size_t size);
 

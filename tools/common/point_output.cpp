@@ -143,6 +143,7 @@ std::vector<Ink> class_inks(std::size_t count) {
 }
 
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what) {
+  if (input == "-") return;  // standard input: no file to write over, and "-o -" is standard output
   std::error_code unknown;
   if (output == input || std::filesystem::equivalent(input, output, unknown))
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");

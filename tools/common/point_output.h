@@ -55,7 +55,8 @@ std::vector<std::size_t> plotting_order(const std::vector<double>& xy);
 void check_paper_width(const std::string& text);
 
 /// Throws std::invalid_argument when `output` names the file `input` (the same path, or a link to it),
-/// `what` saying what the input is ("input image"): a result written over what it came from.
+/// `what` saying what the input is ("input image"): a result written over what it came from. An `input` of
+/// "-" (standard input) is no file.
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
 /// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path` (in
