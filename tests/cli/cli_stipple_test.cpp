@@ -152,4 +152,14 @@ TEST_F(CliTest, StippleAndDensitiesReadStandardInput) {
                "standard input is read once");
 }
 
+// A .npy array is one ink's density: --colours, which separates a picture's colours, says so by name.
+TEST_F(CliTest, StippleColoursRefuseANumPyArrayByName) {
+  std::ofstream(path("d.npy"), std::ios::binary) << npy_2d(std::vector<double>(6, 0.5), 2, 3);
+  expect_error("stipple '" + path("d.npy") + "' --colours cmyk -o '" + path("x.csv") + "'",
+               "'" + path("d.npy") + "' is a NumPy array of densities: stipple it without --colours");
+  expect_error("stipple - --colours 3 -o '" + path("x.csv") + "' < '" + path("d.npy") + "'",
+               "is a NumPy array of densities");
+  ASSERT_EQ(kdm("stipple '" + path("d.npy") + "' -o '" + path("x.csv") + "'").status, 0);
+}
+
 }  // namespace

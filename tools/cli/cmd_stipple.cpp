@@ -165,6 +165,14 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     if (!(spec.max_value() > 0)) inks.channels.clear();  // no ink: an empty picture, below
   } else {
     if (a.invert) throw CommandError("--invert does not apply to --colours (each ink has its own channel)");
+    // An array of densities has no colours to separate: said so, not as an image of no known type.
+    const std::string start =
+        piped ? std::string(piped_bytes.begin(),
+                            piped_bytes.begin() + std::min<std::size_t>(6, piped_bytes.size()))
+              : first_bytes(a.image, 6);
+    if (start == "\x93NUMPY")
+      throw CommandError("--colours separates a picture's colours, and '" + named +
+                         "' is a NumPy array of densities: stipple it without --colours");
     tools::ColourImage image;
     std::string error;
     if (!load_colours(image, error)) throw CommandError(error);
