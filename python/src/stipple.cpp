@@ -149,9 +149,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
     throw std::invalid_argument(
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
   if (height > 0)  // the width follows the picture's shape (kdm stipple --height)
-    width = int(std::clamp(std::lround(height * aspect * (uv[2] - uv[0]) / (uv[3] - uv[1])), 1L, 65536L));
+    width = int(std::clamp(std::lround(height * aspect * (uv[2] - uv[0]) / (uv[3] - uv[1])), 1L, 1L << 30));
   if (output && picture())
-    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output, "", height);
+    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output, "", height, "width",
+                              "height");
   tools::PointSet set;
   {
     py::gil_scoped_release release;

@@ -162,4 +162,26 @@ TEST_F(CliTest, StippleColoursRefuseANumPyArrayByName) {
   ASSERT_EQ(kdm("stipple '" + path("d.npy") + "' -o '" + path("x.csv") + "'").status, 0);
 }
 
+// Every picture's sides are 1 to 65536 pixels, an SVG's too (a 3 x 3,000 image at the default width was an
+// SVG 1,024,000 pixels high); the message names the option that gets out of it.
+TEST_F(CliTest, StipplePictureSidesStayWithinTheirRange) {
+  write_bytes(path("tall.png"), grey_png(3, 3000, 8, std::vector<std::uint16_t>(3 * 3000, 100)));
+  write_bytes(path("wide.png"), grey_png(3000, 3, 8, std::vector<std::uint16_t>(3 * 3000, 100)));
+  for (const char* format : {"svg", "png"}) {
+    SCOPED_TRACE(format);
+    const std::string out = " -o '" + path(std::string("s.") + format) + "'";
+    expect_error("stipple '" + path("tall.png") + "'" + out,
+                 "a picture of 1024x1024000 pixels is too tall (sides 1 to 65536 pixels); give --height");
+    // The width that --height gives a wide image was cut to 65536, squeezing the picture.
+    expect_error("stipple '" + path("wide.png") + "' --height 100" + out,
+                 "a picture of 100000x100 pixels is too wide (sides 1 to 65536 pixels); lower --height");
+    const Outcome fits = kdm("stipple '" + path("tall.png") + "' --height 30000" + out);
+    ASSERT_EQ(fits.status, 0) << fits.err;
+  }
+  EXPECT_NE(slurp(path("s.svg")).find("width=\"30\" height=\"30000\""), std::string::npos);
+  // kdm sample has no --height: its way out is a lower --width, said before the points are placed.
+  expect_error("sample -n 100 --aspect 0.01 -o '" + path("s.svg") + "'",
+               "a picture of 1024x102400 pixels is too tall (sides 1 to 65536 pixels); lower --width");
+}
+
 }  // namespace

@@ -823,7 +823,7 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   expect_error("sample --n 10 --aspect 1:2:3:4" + out,
                "one number, two sides W:H or three sides X:Y:Z, got 4");
   expect_error("sample --n 10 --width 0 -o '" + path("x.png") + "'", "--width");
-  expect_error("sample --n 2000 --aspect 0.0001 -o '" + path("x.png") + "'", "too large");  // 1024×10^7 px
+  expect_error("sample --n 2000 --aspect 0.0001 -o '" + path("x.png") + "'", "too tall");  // 1024×10^7 px
   expect_error("stipple --frames 2x a.png" + out, "--frames");
   expect_error("query --rect 0,0,1" + out, "--rect");
   // An option that needs a value, followed by another option: named as such, not read as its value.
@@ -918,7 +918,8 @@ TEST_F(CliTest, ZeroPaddedIntegersAreDecimal) {
 // high): --height sizes it instead, the width following its shape.
 TEST_F(CliTest, StippleHeightSizesATallPicture) {
   write_bytes(path("strip.png"), grey_png(3, 4000, 8, std::vector<std::uint16_t>(3 * 4000, 100)));
-  expect_error("stipple '" + path("strip.png") + "' -o '" + path("s.png") + "'", "lower the width");
+  expect_error("stipple '" + path("strip.png") + "' -o '" + path("s.png") + "'",
+               "give --height (the width follows its shape) or lower --width");
   const Outcome run = kdm("stipple '" + path("strip.png") + "' --height 2000 -o '" + path("s.png") + "'");
   ASSERT_EQ(run.status, 0) << run.err;
   kdm::tools::GreyImage picture;
@@ -1733,7 +1734,7 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   expect_error("stipple " + image + " --frames 5 --region 0,0,1e-7,1e-7" + out, deepest);
   expect_error("stipple " + image + " --frames 5 --region 0,0,.5,.5 --method full" + out, "--method tiles");
   // A picture too large is said before any dot is placed (a sliver of the image at the default width).
-  expect_error("stipple " + image + " --region 0.499,0,0.5,1" + out, "pixels is too large");
+  expect_error("stipple " + image + " --region 0.499,0,0.5,1" + out, "pixels is too tall");
   // Options of the tiles alone, which the full sampler would ignore.
   expect_error("stipple " + image + " --method full --mode stable" + out, "--mode applies to --method tiles");
   expect_error("stipple " + image + " --method full --tileset '" + std::string(KDM_SOURCE_DIR) +

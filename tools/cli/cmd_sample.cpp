@@ -211,6 +211,11 @@ void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   for (const tools::DensitySpec& s : specs)
     densities.push_back(classed ? to_class_density(s) : to_generator_density(s));
   std::copy(extent, extent + 3, o.extent);
+  if (o.dim == 2 && (format == ".png" || format == ".svg")) try {  // said before the points are placed
+      tools::check_picture_size(args.width_px, extent[0] / extent[1], args.output, format, 0, "--width");
+    } catch (const std::invalid_argument& e) {
+      throw CommandError(e.what());
+    }
   o.metropolis = !args.unadjusted;
   if (args.unadjusted)
     std::fprintf(stderr, "kdm: warning: --unadjusted skips the Metropolis-Hastings test; output is biased\n");

@@ -227,7 +227,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   // --height sizes a tall picture (a strip 3 pixels wide and 4,000 high has no --width that fits).
   const double picture_aspect = aspect * (region[2] - region[0]) / (region[3] - region[1]);
   const int width_px =
-      a.height_px > 0 ? int(std::clamp(std::lround(a.height_px * picture_aspect), 1L, 65536L)) : a.width_px;
+      a.height_px > 0 ? int(std::clamp(std::lround(a.height_px * picture_aspect), 1L, 1L << 30)) : a.width_px;
   if (format == ".png" || format == ".svg")
     for (int i = 0; i < frames; ++i) {  // each frame's picture, before any dot is placed
       double uv[4];
@@ -237,7 +237,7 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
         std::copy(region, region + 4, uv);
       try {
         tools::check_picture_size(width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output, format,
-                                  a.height_px);
+                                  a.height_px, "--width", "--height");
       } catch (const std::invalid_argument& e) {
         throw CommandError(e.what());
       }
@@ -369,7 +369,8 @@ void add_stipple_command(CLI::App& app) {
   CLI::Option* width =
       cmd->add_option(
              "--width", a->width_px,
-             "Picture width in pixels (.png/.svg), 1 to 65536; a PNG holds at most 2^28 pixels in all")
+             "Picture width in pixels (.png/.svg), 1 to 65536; the height, from the picture's shape, is 1 "
+             "to 65536 too (size a tall picture by --height), and a PNG holds at most 2^28 pixels in all")
           ->capture_default_str();
   cmd->add_option(
          "--height", a->height_px,

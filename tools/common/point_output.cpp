@@ -150,20 +150,24 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
 }
 
 int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format,
-                       int height_px) {
+                       int height_px, const std::string& width_option, const std::string& height_option) {
   const int w = std::max(1, width_px);
   const double h = height_px > 0 ? height_px : std::max(1.0, std::round(w / aspect));  // the picture's shape
-  const auto refuse = [&](const char* limit) {
-    throw std::invalid_argument("a picture of " + std::to_string(w) + "x" +
-                                std::to_string(std::llround(std::min(h, 1e18))) + " pixels is too large (" +
-                                limit + "); lower the width" + (height_px > 0 ? " or height" : ""));
-  };
-  if (output_format(path, format) !=
-      ".png") {  // an SVG's size is two numbers: only the height's int is a limit
-    if (!(h <= double(1 << 30))) refuse("limit 2^30 pixels high");
-  } else if (!(double(w) * h <= double(1 << 28))) {  // 768 MiB of RGB and 512 of coverage: refuse, not die
-    refuse("limit 2^28 pixels");
-  }
+  const std::string size =
+      "a picture of " + std::to_string(w) + "x" + std::to_string(std::llround(std::min(h, 1e18))) + " pixels";
+  // The way out: lower the side that was given, or size a tall picture by its height where one can.
+  const std::string lower = "lower " + (height_px > 0 ? height_option : width_option);
+  if (!(h <= kMaxPictureSide))
+    throw std::invalid_argument(
+        size + " is too tall (sides 1 to 65536 pixels); " +
+        (height_px > 0 || height_option.empty()
+             ? lower
+             : "give " + height_option + " (the width follows its shape) or " + lower));
+  if (w > kMaxPictureSide)
+    throw std::invalid_argument(size + " is too wide (sides 1 to 65536 pixels); " + lower);
+  // 768 MiB of RGB and 512 of coverage: refused, not died of. (An SVG's size is two numbers.)
+  if (output_format(path, format) == ".png" && !(double(w) * h <= double(1 << 28)))
+    throw std::invalid_argument(size + " is too large (limit 2^28 pixels); " + lower);
   return static_cast<int>(h);
 }
 

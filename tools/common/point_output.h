@@ -59,12 +59,17 @@ void check_paper_width(const std::string& text);
 /// "-" (standard input) is no file.
 void refuse_writing_over(const std::string& input, const std::string& output, const std::string& what);
 
+/// The longest side of a picture, in pixels.
+inline constexpr int kMaxPictureSide = 65536;
+
 /// The height in pixels of a picture `width_px` wide of `aspect` (width / height) written to `path` (in
-/// `format`, output_format's), or `height_px` if > 0; throws std::invalid_argument, naming the size, for a
-/// PNG past 2^28 pixels or an SVG past 2^30 pixels high (write_points checks it; a caller that computes
-/// points for a picture checks it first).
+/// `format`, output_format's), or `height_px` if > 0 (`width_px` then the width that shape rounds to);
+/// throws std::invalid_argument, naming the size and the way out (the caller's `width_option`, or its
+/// `height_option` where it has one), for a side past kMaxPictureSide or a PNG past 2^28 pixels
+/// (write_points checks it; a caller that computes points for a picture checks it first).
 int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format = "",
-                       int height_px = 0);
+                       int height_px = 0, const std::string& width_option = "the width",
+                       const std::string& height_option = "");
 
 /// Writes `points` (normalised [0,1)^dim, y up) to `path` (kStandardOutput: standard output) in `format`
 /// (".txt", ".csv", ".svg", ".png"; by default the path's extension). Throws std::invalid_argument on an
