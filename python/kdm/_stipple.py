@@ -80,7 +80,8 @@ def stipple(
     width, dot_size
         The picture's width in pixels (None: 1024, or what `height` makes it), and the dot radius in pixels (None: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
-        inks' summed coverage, so that the picture keeps the image's tone).
+        inks' summed coverage, so that the picture keeps the image's tone), at most a quarter of the
+        picture's shorter side.
     height : int or None
         The picture's height in pixels instead of `width` (which then follows the picture's shape), 1
         to 65536: for tall images (``kdm stipple --height``).

@@ -150,9 +150,17 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
         tools::stipple_zoom_error("region", given ? *given : builtin_tileset(), query_mode));
   if (height > 0)  // the width follows the picture's shape (kdm stipple --height)
     width = int(std::clamp(std::lround(height * aspect * (uv[2] - uv[0]) / (uv[3] - uv[1])), 1L, 1L << 30));
-  if (output && picture())
-    tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), *output, "", height, "width",
-                              "height");
+  double largest_dot = HUGE_VAL;  // pixels, as kdm stipple --dot-size takes them
+  if (output && picture()) {
+    const int drawn_height = tools::check_picture_size(width, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]),
+                                                       *output, "", height, "width", "height");
+    largest_dot = tools::max_dot_radius(width, drawn_height);
+    if (dot_size > largest_dot)
+      throw std::invalid_argument("dot_size " + tools::shortest(dot_size) +
+                                  " is more than a quarter of the " + std::to_string(width) + "x" +
+                                  std::to_string(drawn_height) + " picture's shorter side: at most " +
+                                  tools::shortest(largest_dot) + " pixels");
+  }
   tools::PointSet set;
   {
     py::gil_scoped_release release;
@@ -178,9 +186,10 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       style.dots_inside = true;  // for pen plotters, as kdm stipple
       style.height_px = height;
       style.aspect = aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]);
-      style.dot_radius_px = dot_size > 0 ? dot_size
-                            : blank      ? 1.0
-                                         : tools::stipple_dot_radius(whole_dots, width, aspect, specs);
+      style.dot_radius_px =
+          dot_size > 0 ? dot_size
+          : blank      ? 1.0
+                       : std::min(tools::stipple_dot_radius(whole_dots, width, aspect, specs), largest_dot);
       if (colours) {
         style.classes = &set.classes, style.inks = inks.layers(), style.blend = inks.blend;
         std::copy(inks.background, inks.background + 3, style.background);

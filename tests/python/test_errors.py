@@ -311,6 +311,8 @@ def test_gamma_reshapes_an_image_file_or_is_refused():
     (ValueError, "needs method='tiles'", lambda: kdm.stipple(SPHERE, method="full", region=(0, 0, 1, 1))),
     (ValueError, "width must be <= 65536", lambda: kdm.stipple(SPHERE, width=10**6)),
     (ValueError, "dot_size must be >= 0", lambda: kdm.stipple(SPHERE, dot_size=-1)),
+    (ValueError, "dot_size 120 is more than a quarter of the 200x200 picture's shorter side: at most 50 pixels",
+     lambda: kdm.stipple(SPHERE, points=100, width=200, dot_size=120, output="never.svg")),
     (ValueError, "^colours must be cmyk, rgb, a number of inks", lambda: kdm.stipple(SPHERE, colours="9")),
     (TypeError, r"^colours must be 'cmyk', 'rgb', a number of inks \(2 to 8\), or pens as a str \('#e00000,#0000aa'\) "
      r"or a list of them \(\['#e00000', '#0000aa'\]\), got set", lambda: kdm.stipple(SPHERE, colours={"#ff0000"})),

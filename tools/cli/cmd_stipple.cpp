@@ -228,6 +228,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   const double picture_aspect = aspect * (region[2] - region[0]) / (region[3] - region[1]);
   const int width_px =
       a.height_px > 0 ? int(std::clamp(std::lround(a.height_px * picture_aspect), 1L, 1L << 30)) : a.width_px;
+  double largest_dot = HUGE_VAL;  // pixels: a quarter of the pictures' shorter side
+  std::string picture;            // "WxH", for the message
   if (format == ".png" || format == ".svg")
     for (int i = 0; i < frames; ++i) {  // each frame's picture, before any dot is placed
       double uv[4];
@@ -236,12 +238,22 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       else
         std::copy(region, region + 4, uv);
       try {
-        tools::check_picture_size(width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]), a.output, format,
-                                  a.height_px, "--width", "--height");
+        const int height = tools::check_picture_size(width_px, aspect * (uv[2] - uv[0]) / (uv[3] - uv[1]),
+                                                     a.output, format, a.height_px, "--width", "--height");
+        if (tools::max_dot_radius(width_px, height) < largest_dot) {
+          largest_dot = tools::max_dot_radius(width_px, height);
+          picture = std::to_string(width_px) + "x" + std::to_string(height);
+        }
       } catch (const std::invalid_argument& e) {
         throw CommandError(e.what());
       }
     }
+  // Larger dots would be moved in from the edge by more than the picture can spare (an SVG of a few dots
+  // drew them all at its centre), and only blacken it.
+  if (a.dot_size > largest_dot)
+    throw CommandError("--dot-size " + tools::shortest(a.dot_size) + " is more than a quarter of the " +
+                       picture + " picture's shorter side: at most " + tools::shortest(largest_dot) +
+                       " pixels");
   double dot_radius = a.dot_size;  // pixels; fixed by the whole image's dot count, so zoomed dots keep it
   for (int i = 0; i < frames; ++i) {
     double uv[4];
@@ -278,7 +290,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (dot_radius <= 0)
-      dot_radius = blank ? 1.0 : tools::stipple_dot_radius(whole_dots, width_px, aspect, specs);
+      dot_radius =
+          blank ? 1.0 : std::min(tools::stipple_dot_radius(whole_dots, width_px, aspect, specs), largest_dot);
     tools::DrawStyle style;
     style.width_px = width_px;
     style.height_px = a.height_px;
@@ -384,9 +397,9 @@ void add_stipple_command(CLI::App& app) {
       "share of it (default: --width pixels)");
   cmd->add_option(
       "--dot-size", a->dot_size,
-      "Dot radius in pixels (default, or 0: the size at which the whole image's dots cover as much of "
-      "the picture as the image's mean darkness, with --colours the inks' summed coverage: the picture "
-      "keeps the image's tone)");
+      "Dot radius in pixels, at most a quarter of the picture's shorter side (default, or 0: the size at "
+      "which the whole image's dots cover as much of the picture as the image's mean darkness, with "
+      "--colours the inks' summed coverage: the picture keeps the image's tone)");
   cmd->add_option(
       "--white", a->white,
       "Radiance .hdr pictures: the luminance (0.2126 R + 0.7152 G + 0.0722 B of the file's linear "

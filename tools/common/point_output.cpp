@@ -149,6 +149,10 @@ void refuse_writing_over(const std::string& input, const std::string& output, co
     throw std::invalid_argument("the output '" + output + "' is the " + what + ": write another file");
 }
 
+double max_dot_radius(int width_px, int height_px) {
+  return std::min(width_px, height_px) / 4.0;
+}
+
 int check_picture_size(int width_px, double aspect, const std::string& path, const std::string& format,
                        int height_px, const std::string& width_option, const std::string& height_option) {
   const int w = std::max(1, width_px);
@@ -214,6 +218,10 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   const int w = std::max(1, style.width_px);
   const int h = check_picture_size(style.width_px, style.aspect, path, ext, style.height_px);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
+  if (svg && style.dots_inside && !(r <= max_dot_radius(w, h)))  // the dots would crowd into the middle
+    throw std::invalid_argument("a dot radius of " + number(r) + " pixels is more than a quarter of the " +
+                                std::to_string(w) + "x" + std::to_string(h) + " picture's shorter side (" +
+                                number(max_dot_radius(w, h)) + " pixels)");
   // A dot wider than the picture only blackens it, and painting large dots costs their area each.
   if (!(r <= std::max(w, h)))
     throw std::invalid_argument("a dot size of " + number(r) + " pixels is larger than the " +
@@ -284,6 +292,11 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   out.precision(6);        // as number() prints
   std::vector<double> xy;  // a layer's dot centres in the picture's pixels
   std::vector<double> radii;
+  // Clamping each centre into [r, side − r] lined the edge with the dots within r of it; one shrink of all
+  // keeps the blue noise's spacing there too (a fraction of a percent at the usual dot sizes).
+  double largest = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) largest = std::max(largest, radius(i));
+  const double shrink = 1 - 2 * largest / std::min(w, h);
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
@@ -296,8 +309,8 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
         const double ri = radius(i);
         const auto inside = [&](double v, double side) {
           if (!style.dots_inside) return v;
-          return 2 * ri >= side ? side / 2
-                                : printed_inside(std::clamp(v, ri, side - ri), side, as_printed(ri));
+          const double drawn_in = side / 2 + (v - side / 2) * shrink;  // (a point past [0, 1] clamped)
+          return printed_inside(std::clamp(drawn_in, ri, side - ri), side, as_printed(ri));
         };
         xy.push_back(inside(points.coords[2 * i] * w, w));
         xy.push_back(inside((1 - points.coords[2 * i + 1]) * h, h));

@@ -40,11 +40,16 @@ struct DrawStyle {
   /// SVG only: the printed width, a number > 0 and a unit (mm, cm, in, pt, pc or px: "180mm"), the height
   /// in proportion; empty: width_px pixels. The drawing keeps its pixel coordinates (viewBox).
   std::string paper_width;
-  /// SVG only: a dot that would cross the picture's edge is moved in to touch it, its numbers as printed
-  /// (a pen plotter draws no further than the paper; a dot wider than the picture is centred). Off: every
-  /// dot at its point.
+  /// SVG only: every whole circle inside the picture's edge, its numbers as printed (a pen plotter draws
+  /// no further than the paper): the dots' centres are drawn towards the picture's centre by one factor,
+  /// 1 − 2R / the shorter side (R the largest dot's radius, at most max_dot_radius), which keeps their
+  /// spacing even up to the edge. Off: every dot at its point.
   bool dots_inside = false;
 };
+
+/// The largest dot radius a picture of `width_px` × `height_px` draws inside its edge (DrawStyle::
+/// dots_inside): a quarter of its shorter side, in pixels.
+double max_dot_radius(int width_px, int height_px);
 
 /// An order of the points `xy` (x, y pairs) for a pen plotter's short travel: from the point nearest the
 /// bounding box's low corner, each time to the nearest point not yet drawn (greedy nearest neighbour on a
