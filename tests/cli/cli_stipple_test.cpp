@@ -260,4 +260,35 @@ TEST_F(CliTest, StippleRefusesDotsTooLargeForThePicture) {
   EXPECT_EQ(kdm(run + " --dot-size 120 -o '" + path("s.csv") + "'").status, 0);
 }
 
+// A tile set of a narrow density range (2 levels: 1:4) places a picture's light tones under its coarsest
+// level, where they come out clumpy: said once, as kdm query says it of a tile size too small. The
+// built-in set (1:1024) serves the examples' tones, and says nothing.
+TEST_F(CliTest, StippleSaysWhenTheTileSetServesLightTonesUnevenly) {
+  std::ofstream(path("small.recipe")) << "seed 3\nlevels 2\nbase_points 32\nsweeps 10\nkeyframes 4\n";
+  ASSERT_EQ(kdm("bake '" + path("small.recipe") + "' -o '" + path("small.kdmt") + "'").status, 0);
+  std::vector<std::uint16_t> ramp(64 * 32);
+  for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = std::uint16_t(255 * (i % 64) / 63);
+  write_bytes(path("ramp.png"), grey_png(64, 32, 8, ramp));
+  const std::string out = " -o '" + path("s.csv") + "'";
+  const Outcome small =
+      kdm("stipple '" + path("ramp.png") + "' --tileset '" + path("small.kdmt") + "'" + out);
+  ASSERT_EQ(small.status, 0) << small.err;
+  const std::string said = "than the tile set's coarsest level holds (32), and come out clumpy there";
+  EXPECT_NE(small.err.find(said), std::string::npos) << small.err;
+  EXPECT_NE(small.err.find("a tile set of more levels"), std::string::npos) << small.err;
+  std::size_t warnings = 0;
+  for (std::size_t at = small.err.find("warning"); at != std::string::npos;
+       at = small.err.find("warning", at + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 1u) << small.err;
+  for (const char* example : {"sphere.png", "coffee.png"}) {
+    const Outcome builtin =
+        kdm("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/" + example + "'" + out);
+    ASSERT_EQ(builtin.status, 0) << builtin.err;
+    EXPECT_EQ(builtin.err.find("warning"), std::string::npos) << example << ": " << builtin.err;
+  }
+  const Outcome ramp_builtin = kdm("stipple '" + path("ramp.png") + "'" + out);
+  EXPECT_EQ(ramp_builtin.err.find("warning"), std::string::npos) << ramp_builtin.err;
+}
+
 }  // namespace

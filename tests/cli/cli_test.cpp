@@ -1842,7 +1842,7 @@ TEST_F(CliTest, ASetWithoutGlideTrackOrHandOverIsSaidToBeOne) {
   EXPECT_NE(smooth.err.find(std::string("kdm stipple: ") + warning), std::string::npos) << smooth.err;
   const Outcome stable = kdm(sphere + "--points 2000 --mode stable -o '" + path("t.csv") + "'");
   ASSERT_EQ(stable.status, 0) << stable.err;
-  EXPECT_EQ(stable.err.find("warning"), std::string::npos) << stable.err;
+  EXPECT_EQ(stable.err.find(warning), std::string::npos) << stable.err;
   EXPECT_EQ(slurp(path("s.csv")), slurp(path("t.csv")));  // stable positions, as said
   expect_error(
       sphere + "--region 0.4,0.4,0.6,0.6 -o '" + path("z.csv") + "'",

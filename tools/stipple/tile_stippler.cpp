@@ -181,6 +181,27 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   read_images_by_sums(classes, sums_, HUGE_VAL);  // built once for every frame
 }
 
+TileStippler::ThinTones TileStippler::thin_tones(double zoom) const {
+  ThinTones thin;
+  thin.coarsest = tiles_.data().level_nominal.empty() ? 0 : tiles_.data().level_nominal[0];
+  thin.fewest = HUGE_VAL;
+  const double per_tile = scale_ * zoom * zoom * tile_size_ * tile_size_;  // per unit of density
+  const std::vector<float>& first = densities_.front()->spec.values;
+  double all = 0, under = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    double density = 0;
+    for (const auto& d : densities_) density += d->spec.values[i];
+    if (!(density > 0)) continue;
+    all += density;
+    if (density * per_tile < thin.coarsest) {
+      under += density;
+      thin.fewest = std::min(thin.fewest, density * per_tile);
+    }
+  }
+  thin.share = all > 0 ? under / all : 0;
+  return thin;
+}
+
 ClassQueryParams TileStippler::class_params(const QueryParams& q) const {
   ClassQueryParams cq;
   cq.query = q;

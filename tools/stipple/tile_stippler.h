@@ -98,6 +98,16 @@ class TileStippler {
   PointSet render(const double uv[4], double fade = 0) const;
   double aspect() const { return aspect_; }
 
+  /// The image's tones that the tile set serves unevenly at `zoom` (stipple_zoom): those that ask fewer
+  /// points per tile than its coarsest level holds, where a tile gives only part of that level (a set of
+  /// few levels, of a narrow density range, places the image's light tones there).
+  struct ThinTones {
+    double share = 0;     ///< of the dots (the inks' density summed over the image), in [0, 1]
+    double fewest = 0;    ///< points per tile that the lightest inked pixel asks
+    double coarsest = 0;  ///< the set's coarsest level's points per tile
+  };
+  ThinTones thin_tones(double zoom) const;
+
  private:
   ClassQueryParams class_params(const QueryParams& q) const;  ///< the inks' query over q
   PointSet with_sizes(const QueryParams& q, const double rect[4], double fade) const;
