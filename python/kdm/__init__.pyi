@@ -131,7 +131,11 @@ class Tileset:
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
 def zoom_regions(region: Sequence[float], frames: int) -> npt.NDArray[np.float64]: ...
 def separate(
-    image: _Path, *, colours: Union[str, int, Sequence[str]] = ..., gamma: float = ...
+    image: _Path,
+    *,
+    colours: Union[str, int, Sequence[str]] = ...,
+    gamma: float = ...,
+    white: Optional[float] = ...,
 ) -> Tuple[npt.NDArray[np.float32], List[str]]: ...
 def stipple(
     image: Union[_Path, npt.ArrayLike],
@@ -153,6 +157,7 @@ def stipple(
     fade: float = ...,
     paper_width: Optional[str] = ...,
     height: Optional[int] = ...,
+    white: Optional[float] = ...,
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],

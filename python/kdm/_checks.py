@@ -54,6 +54,25 @@ def temperature(value: Any) -> float:
     return value
 
 
+def white(value: Any, file: bool) -> float:
+    """A Radiance picture's luminance that is white, as `kdm stipple --white` takes it: None (0: its brightest
+    pixel's) or finite and > 0, for an image `file` (the C++ side refuses one that is no Radiance picture)."""
+    if value is None:
+        return 0.0
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError(f"white must be a number, got {type(value).__name__}")
+    try:
+        white = float(value)
+    except OverflowError:  # an int past a double's range
+        white = math.inf
+    if not (white > 0 and math.isfinite(white)):
+        raise ValueError(f"white must be a finite number > 0 (the luminance that is white), got {white:g}")
+    if not file:
+        raise ValueError("white sets the luminance that is white in a Radiance .hdr picture, and an array or PIL "
+                         "image is none (its white is already its type's: 1.0, 255 or 65535)")
+    return white
+
+
 def aspect(value: Any) -> Optional[float]:
     """A domain's width / height (in 3-D, its x side over its y and z sides), or None."""
     return None if value is None else number("aspect", value, 0.0, strict=True)

@@ -30,6 +30,7 @@ def stipple(
     fade: float = 0.0,
     paper_width: Optional[str] = None,
     height: Optional[int] = None,
+    white: Optional[float] = None,
 ) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
@@ -103,6 +104,9 @@ def stipple(
         that the dots of a zoom sequence grow in instead of popping up; it lightens the picture by about
         1 - ln(1 + fade) / fade (28% at 1, 61% at 5: the sphere, measured). 0 (off) to 10. The same dots
         are returned (to float precision).
+    white : float or None
+        For a Radiance .hdr file: the luminance that is white paper, brighter clipped to white (``kdm stipple
+        --white``). None: its brightest pixel's. Refused for other images.
 
     Returns
     -------
@@ -114,6 +118,7 @@ def stipple(
     invert = _checks.flag("invert", invert)
     if isinstance(image, (str, os.PathLike)):
         label = _checks.path("image", image)
+        white = _checks.white(white, True)
         if not label.startswith(("const:", "ramp:", "radial:")):
             try:  # said as colours' loader says it, not "a density is a picture, const:V, ..."
                 os.stat(label)
@@ -122,6 +127,7 @@ def stipple(
         spec = None  # read below, at the size its dots need
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too
+        white = _checks.white(white, False)
         _checks.image_size(image)
         label, image = "array", _checks.pil_pixels(image)
         grey, alpha = _checks.luminance("image", image)
@@ -169,10 +175,10 @@ def stipple(
         raise ValueError("paper_width must be a number and a unit ('180mm', '7.5in'), got ''")
     handle = tileset._handle if tileset is not None else None
     if spec is None:
-        spec = _kdm.stipple_density(label, gamma, invert, points, scale, region)
+        spec = _kdm.stipple_density(label, gamma, invert, points, scale, region, white)
     return _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
-        colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height,
+        colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height, white,
     )
 
 
@@ -195,7 +201,9 @@ def zoom_regions(region: Sequence[float], frames: int) -> np.ndarray:
     return _kdm.zoom_regions(r, frames)
 
 
-def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[np.ndarray, List[str]]:
+def separate(
+    image: Any, *, colours: Any = "cmyk", gamma: float = 1.0, white: Optional[float] = None
+) -> Tuple[np.ndarray, List[str]]:
     """The inks of an image (a file, an array or a PIL image) as ``stipple(image, colours=...)`` separates
     them, to preview or measure.
 
@@ -203,13 +211,16 @@ def separate(image: Any, *, colours: Any = "cmyk", gamma: float = 1.0) -> Tuple[
     (its coverage raised to `gamma`), row 0 at the top as in the picture; inks the inks' names, in class
     order: the inks of least coverage first (a later class's tone carries the earlier classes' count
     errors, the more the smaller its share), except that inks under a tenth of the total coverage come last.
+    `white`: for a Radiance .hdr file, the luminance that is white, as in stipple().
     """
     if isinstance(image, (str, os.PathLike)):
         label, rgb, alpha = _checks.path("image", image), None, None
+        white = _checks.white(white, True)
     else:  # an array or a PIL image, as stipple() takes it
+        white = _checks.white(white, False)
         _checks.image_size(image)
         label, (rgb, alpha) = "array", _checks.colour("image", _checks.pil_pixels(image))
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     colours = _checks.colour_scheme(colours)
-    channels, inks = _kdm.separate(label, colours, gamma, rgb, alpha)
+    channels, inks = _kdm.separate(label, colours, gamma, rgb, alpha, white)
     return channels, list(inks)

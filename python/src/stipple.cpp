@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,17 +23,35 @@ using tools::DensitySpec;
 using Region = std::array<double, 4>;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
+/// Refuses `white` (> 0: given) for the file `path` unless it is a Radiance picture, as kdm stipple --white
+/// does; an empty or missing file is left to the loader to name.
+void check_white(const std::string& path, double white) {
+  check_number("white", white, 0, false);  // 0: not given
+  if (white == 0) return;
+  char start[16];
+  std::size_t size = 0;
+  if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
+    size = std::fread(start, 1, sizeof start, file);
+    std::fclose(file);
+  }
+  if (size > 0 && !tools::is_radiance(start, size))
+    throw std::invalid_argument("white sets the luminance that is white in a Radiance .hdr picture, and '" +
+                                path + "' is none (its white is already its format's)");
+}
+
 /// A colour image for the separation: from `rgb` ((rows, columns, 3) in [0, 1], composited on white, row 0
 /// at the top) and its `alpha` when given (kdm._checks.colour made them as load_colour_image reads a file),
-/// else read from the file `label`.
+/// else read from the file `label`, a Radiance picture's luminance `white` being white (0: its largest).
 /// A file is read as kdm stipple reads it: `kept` averages a large picture down (tools::KeptPixels).
 tools::ColourImage colour_image(const std::string& label, const std::optional<FloatArray>& rgb,
-                                const std::optional<FloatArray>& alpha, const tools::KeptPixels& kept = {}) {
+                                const std::optional<FloatArray>& alpha, double white,
+                                const tools::KeptPixels& kept = {}) {
   tools::ColourImage image;
   if (!rgb) {
+    check_white(label, white);
     std::string error;
     if (!tools::load_colour_image(label, image, error,
-                                  kept ? tools::kMaxStipplePixels : tools::kMaxImagePixels, kept))
+                                  kept ? tools::kMaxStipplePixels : tools::kMaxImagePixels, kept, white))
       throw read_error(label, error);
     return image;
   }
@@ -53,14 +72,16 @@ double region_zoom(const std::optional<Region>& region) {
 }
 
 /// The image file `path` as kdm stipple reads its one ink (a large picture averaged down for the dots that
-/// `points` or `scale` and `region` ask for, tools::stipple_kept_pixels).
+/// `points` or `scale` and `region` ask for, tools::stipple_kept_pixels; a Radiance picture's luminance
+/// `white` is white, 0: its brightest pixel's).
 DensitySpec stipple_density(const std::string& path, double gamma, bool invert, std::int64_t points,
-                            double scale, std::optional<Region> region) {
+                            double scale, std::optional<Region> region, double white) {
+  check_white(path, white);
   const tools::KeptPixels kept = tools::stipple_kept_pixels(scale > 0 ? 0.0 : double(points),
                                                             scale > 0 ? scale : 0.0, region_zoom(region));
   py::gil_scoped_release release;  // an image is read and decoded
   try {
-    return tools::parse_density_spec(path, gamma, invert, tools::kMaxStipplePixels, kept);
+    return tools::parse_density_spec(path, gamma, invert, tools::kMaxStipplePixels, kept, white);
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // an image that cannot be read
@@ -73,7 +94,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                    std::uint64_t seed, const TilesetHandle* tileset, std::optional<std::string> output,
                    int width, double dot_size, int threads, std::optional<std::string> colours, double gamma,
                    double fade, std::optional<FloatArray> rgb, std::optional<FloatArray> alpha,
-                   const std::string& paper_width, int height) {
+                   const std::string& paper_width, int height, double white) {
   if (scale > 0) points = 0;  // as kdm stipple: --scale overrides --points
   if (points <= 0 && !(scale > 0 && std::isfinite(scale)))
     throw std::invalid_argument("give points > 0 or a finite scale > 0");
@@ -122,7 +143,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   std::vector<const DensitySpec*> specs = {&spec};
   if (colours) {
     const tools::ColourImage image =
-        colour_image(label, rgb, alpha,
+        colour_image(label, rgb, alpha, white,
                      tools::stipple_kept_pixels(scale > 0 ? 0.0 : double(points), scale > 0 ? scale : 0.0,
                                                 region_zoom(region)));
     py::gil_scoped_release release;  // a clustering of every pixel: seconds for a large photograph
@@ -219,9 +240,9 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
 /// The inks of an image file as kdm stipple --colours separates them: (k, height, width) float32 densities,
 /// row 0 at the top as in the picture, and the inks' names, in class order.
 py::tuple separate(const std::string& path, const std::string& colours, double gamma,
-                   std::optional<FloatArray> rgb, std::optional<FloatArray> alpha) {
+                   std::optional<FloatArray> rgb, std::optional<FloatArray> alpha, double white) {
   check_number("gamma", gamma, 0, true);
-  const tools::ColourImage image = colour_image(path, rgb, alpha);
+  const tools::ColourImage image = colour_image(path, rgb, alpha, white);
   tools::ColourSeparation inks;
   {
     py::gil_scoped_release release;
@@ -243,10 +264,11 @@ py::tuple separate(const std::string& path, const std::string& colours, double g
 
 void bind_stipple(py::module_& m) {
   m.def("stipple_density", &stipple_density, py::arg("path"), py::arg("gamma"), py::arg("invert"),
-        py::arg("points"), py::arg("scale"), py::arg("region").none(true),
+        py::arg("points"), py::arg("scale"), py::arg("region").none(true), py::arg("white") = 0.0,
         "An image file's one ink as kdm stipple reads it (a large picture averaged down for its dots)");
   m.def("separate", &separate, py::arg("path"), py::arg("colours"), py::arg("gamma"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
+        py::arg("white") = 0.0,
         "The inks of an image file as kdm stipple --colours separates them (channels, names)");
   m.def(
       "zoom_regions",
@@ -262,7 +284,7 @@ void bind_stipple(py::module_& m) {
         py::arg("tileset").none(true), py::arg("output").none(true), py::arg("width"), py::arg("dot_size"),
         py::arg("threads"), py::arg("colours").none(true), py::arg("gamma"), py::arg("fade"),
         py::arg("rgb").none(true) = py::none(), py::arg("alpha").none(true) = py::none(),
-        py::arg("paper_width") = std::string(), py::arg("height") = 0,
+        py::arg("paper_width") = std::string(), py::arg("height") = 0, py::arg("white") = 0.0,
         "One picture of kdm stipple (with colours: the dots, their inks and the inks' names)");
 }
 

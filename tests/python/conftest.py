@@ -91,6 +91,16 @@ def write_png(path, grey):
     Path(path).write_bytes(b"\x89PNG\r\n\x1a\n" + body)
 
 
+def write_hdr(path, grey):
+    """A Radiance .hdr picture of `grey` (rows of values > 0, row 0 at the top) in flat RGBE scanlines: each
+    value as an 8-bit mantissa (exact for values of 8 significant bits) and a shared exponent."""
+    grey = np.asarray(grey, dtype=np.float64)
+    mantissa, exponent = np.frexp(grey)
+    rgbe = np.stack([(mantissa * 256).astype(np.uint8)] * 3 + [(exponent + 128).astype(np.uint8)], axis=-1)
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {grey.shape[0]} +X {grey.shape[1]}\n".encode()
+    Path(path).write_bytes(header + rgbe.tobytes())
+
+
 @pytest.fixture(scope="session")
 def gradient_png(tmp_path_factory):
     """A 60 x 40 picture, dark at the top left and light at the bottom right, with some texture: not

@@ -456,6 +456,9 @@ def test_the_compiled_layer_checks_too():
         lambda: _kdm.query(handle, (0, 0, 1, 1), 10, None, lambda x, y: 1, None, INF, 1, "stable", (0, 0)),
         lambda: _kdm.stipple(spec, "x", 10, 0, "tiles", "smooth", None, 1, None, None, 64, 0, 0),
         lambda: _kdm.stipple(spec, "x", 0, NAN, "tiles", "smooth", None, 1, None, None, 64, 0, 0),
+        lambda: _kdm.stipple_density(str(SPHERE), 1.0, False, 100, 0.0, None, NAN),
+        lambda: _kdm.stipple_density(str(SPHERE), 1.0, False, 100, 0.0, None, 1.0),  # white, for a PNG
+        lambda: _kdm.separate(str(SPHERE), "cmyk", 1.0, None, None, -1.0),
         lambda: _kdm.analyze([np.ones((4, 2)) * 0.5], ["a"], False, None, NAN, 2.5, 0, False),
         lambda: _kdm.analyze([], [], False, None, 0, 2.5, 0, False),
         lambda: _kdm.bake("levels 0\n", 0),

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import kdm
-from conftest import SPHERE, interrupted, read_txt, write_png
+from conftest import SPHERE, interrupted, read_txt, write_hdr, write_png
 
 
 def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
@@ -552,6 +552,45 @@ def test_stipple_writes_the_header_kdm_stipple_writes_in_colour(cli, tmp_path):
     cli("stipple", white, "--points", 2000, "-o", tmp_path / "cli.svg")
     kdm.stipple(white, points=2000, output=tmp_path / "py.svg")
     assert (tmp_path / "py.svg").read_text() == (tmp_path / "cli.svg").read_text()
+
+
+def test_stipple_white_sets_an_hdr_pictures_white_as_kdm_stipple_does(cli, tmp_path):
+    # A strip at 100 on a background of 0.5: by default the strip is white and the background 1/200 of it,
+    # nearly black; with white=1 the background is half-tone and the strip, brighter, white.
+    grey = np.full((16, 32), 0.5)
+    grey[:, :2] = 100.0
+    hdr = tmp_path / "strip.hdr"
+    write_hdr(hdr, grey)
+    black = 2000 * 32 / 16  # scale 2000: dots per unit area at full darkness, over a 2 x 1 image
+    assert len(kdm.stipple(hdr, scale=2000)) == pytest.approx(black * 30 / 32, abs=0.05 * black)
+    half = kdm.stipple(hdr, scale=2000, white=1, output=tmp_path / "py.txt")
+    assert len(half) == pytest.approx(black * 0.5 * 30 / 32, abs=0.05 * black)
+    assert half[:, 0].min() >= 1.5 / 32  # none on the strip (white up to its last pixel's centre)
+    cli("stipple", hdr, "--scale", 2000, "--white", 1, "-o", tmp_path / "cli.txt")
+    assert (tmp_path / "py.txt").read_bytes() == (tmp_path / "cli.txt").read_bytes()
+    assert np.array_equal(half, read_txt(tmp_path / "cli.txt"))
+    # In colour too (the colour loader), and the inks' separation.
+    cli("stipple", hdr, "--scale", 2000, "--white", 1, "--colours", "cmyk", "-o", tmp_path / "cli.csv")
+    dots, classes, _ = kdm.stipple(hdr, scale=2000, white=1, colours="cmyk")
+    rows = np.loadtxt(tmp_path / "cli.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(rows[:, :2], dots) and np.array_equal(rows[:, 2], classes)
+    assert len(dots) == pytest.approx(black * 0.5 * 30 / 32, abs=0.05 * black)
+    channels, inks = kdm.separate(hdr, white=1)
+    assert inks == ["black"] and np.allclose(channels[0, :, 2:], 0.5, atol=0.01) and not channels[0, :, :2].any()
+    assert np.allclose(kdm.separate(hdr)[0][0, :, 2:], 0.995, atol=0.01)
+    # Refused, as kdm stipple --white refuses them.
+    for bad in (0, -1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match=r"white must be a finite number > 0 \(the luminance that is white\)"):
+            kdm.stipple(hdr, white=bad)
+    for bad in ("1", True, [1.0]):
+        with pytest.raises(TypeError, match="white must be a number"):
+            kdm.stipple(hdr, white=bad)
+    for call in (kdm.stipple, kdm.separate):
+        with pytest.raises(ValueError, match=r"white sets the luminance that is white in a Radiance \.hdr picture, "
+                                             r"and '.*sphere\.png' is none"):
+            call(SPHERE, white=1)
+        with pytest.raises(ValueError, match="white sets the luminance .* an array or PIL image is none"):
+            call(np.full((4, 4, 3), 0.5), white=1)
 
 
 def test_stipple_takes_pens_as_a_list(tmp_path):
