@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,36 @@ TEST_F(CliTest, StippleWhiteSetsAnHdrPicturesWhite) {
   const Outcome help = kdm("stipple --help");
   EXPECT_NE(help.out.find("--white"), std::string::npos);
   EXPECT_NE(help.out.find("brightest pixel is white"), std::string::npos);
+}
+
+// In colour too an HDR picture's white is its brightest pixel's luminance: a grey 0.5 beside a red strip
+// of (4, 0, 0) (luminance 0.85) draws the grey's black ink as the grey reading draws its dots. Its
+// brightest channel, 4, made that grey 0.875 dark (0.41 in grey).
+TEST_F(CliTest, StippleColourHdrWhiteIsTheBrightestPixelsLuminance) {
+  const int w = 32, h = 16;
+  std::vector<float> v(w * h, 0.5f);
+  for (int y = 0; y < h; ++y) v[y * w] = v[y * w + 1] = 4.0f;
+  std::vector<std::uint8_t> hdr = radiance_hdr(w, h, v);
+  const std::size_t pixels_at = hdr.size() - 4 * v.size();
+  for (int y = 0; y < h; ++y)
+    for (int x : {0, 1}) hdr[pixels_at + 4 * (y * w + x) + 1] = hdr[pixels_at + 4 * (y * w + x) + 2] = 0;
+  write_bytes(path("red.hdr"), hdr);
+  const std::string run = "stipple '" + path("red.hdr") + "' --scale 2000 -o '" + path("s.csv") + "'";
+  ASSERT_EQ(kdm(run).status, 0);
+  const double grey = double(csv_dots(slurp(path("s.csv"))));
+  const double expected = 2000 * double(w) / h * (1 - 0.5 / (0.2126 * 4)) * 30 / 32;
+  EXPECT_NEAR(grey, expected, 0.05 * expected);
+  ASSERT_EQ(kdm(run + " --colours cmyk").status, 0);
+  // The grey's ink, black, holds most dots (inks are numbered by coverage): the strip is drawn in others.
+  std::map<std::string, std::size_t> per_ink;
+  const std::string text = slurp(path("s.csv"));
+  for (std::size_t at = text.find('\n'); at != std::string::npos && at + 1 < text.size();
+       at = text.find('\n', at + 1))
+    ++per_ink[text.substr(text.rfind(',', text.find('\n', at + 1)) + 1,
+                          text.find('\n', at + 1) - text.rfind(',', text.find('\n', at + 1)) - 1)];
+  std::size_t black = 0;
+  for (const auto& [ink, count] : per_ink) black = std::max(black, count);
+  EXPECT_NEAR(double(black), grey, 0.05 * grey);
 }
 
 /// A NumPy .npy file of a 2-D float64 array (rows, columns), row-major.
@@ -200,10 +231,11 @@ std::vector<Circle> svg_circles(const std::string& svg, double& w, double& h) {
   return circles;
 }
 
-// A plotter's SVG keeps whole circles inside the picture's edge by drawing every centre in by one factor,
-// not by moving the dots within a radius of the edge onto a line there, which lined the border with
-// crowded dots: on a flat grey, 4-8% of the dots within a spacing of the edge had a neighbour nearer than
-// 0.6 d_hex (seeds 1-3), against about 1.3% inside.
+// A plotter's SVG keeps whole circles inside the picture's edge by mapping each axis of the centres onto
+// [R, side - R], not by moving the dots within a radius of the edge onto a line there, which lined the
+// border with crowded dots: on a flat grey, 4-8% of the dots within a spacing of the edge had a neighbour
+// nearer than 0.6 d_hex (seeds 1-3), against about 1.3% inside. Per axis: one factor for both, from the
+// shorter side, left a 20:1 strip's ends blank over 24% of its width.
 TEST_F(CliTest, StippleSvgDotsKeepTheirSpacingAtTheEdge) {
   write_bytes(path("grey.png"), grey_png(64, 64, 8, std::vector<std::uint16_t>(64 * 64, 128)));
   for (int seed = 1; seed <= 3; ++seed) {
@@ -234,6 +266,21 @@ TEST_F(CliTest, StippleSvgDotsKeepTheirSpacingAtTheEdge) {
         << crowded_edge << " of " << edge << " at the edge, " << crowded_inside << " of " << inside
         << " inside";
   }
+}
+
+TEST_F(CliTest, StippleSvgDotsFillALongPictureToItsEnds) {
+  write_bytes(path("strip.png"), grey_png(200, 10, 8, std::vector<std::uint16_t>(200 * 10, 128)));
+  const Outcome run =
+      kdm("stipple '" + path("strip.png") + "' --points 2000 --width 2000 -o '" + path("s.svg") + "'");
+  ASSERT_EQ(run.status, 0) << run.err;
+  double w = 0, h = 0;
+  const std::vector<Circle> dots = svg_circles(slurp(path("s.svg")), w, h);
+  ASSERT_GT(dots.size(), 1900u);
+  double left = w, right = 0;
+  for (const Circle& c : dots) left = std::min(left, c.x - c.r), right = std::max(right, c.x + c.r);
+  const double spacing = std::sqrt(w * h / double(dots.size()));
+  EXPECT_LE(left, spacing) << "blank at the left end";  // one factor left 76 px of 2000 here
+  EXPECT_GE(right, w - spacing) << "blank at the right end";
 }
 
 // A dot larger than a quarter of the picture's shorter side is refused by --dot-size's name, in every
@@ -289,6 +336,14 @@ TEST_F(CliTest, StippleSaysWhenTheTileSetServesLightTonesUnevenly) {
   }
   const Outcome ramp_builtin = kdm("stipple '" + path("ramp.png") + "'" + out);
   EXPECT_EQ(ramp_builtin.err.find("warning"), std::string::npos) << ramp_builtin.err;
+  // A flat tone whose count rounds to the coarsest level's own is no thin tone ("as few as 32 ... (32)").
+  write_bytes(path("flat.png"), grey_png(64, 64, 8, std::vector<std::uint16_t>(64 * 64, 128)));
+  for (const char* points : {"2000", "3000"}) {
+    const Outcome flat = kdm("stipple '" + path("flat.png") + "' --points " + points + " --tileset '" +
+                             path("small.kdmt") + "'" + out);
+    ASSERT_EQ(flat.status, 0) << flat.err;
+    EXPECT_EQ(flat.err.find("clumpy"), std::string::npos) << points << ": " << flat.err;
+  }
 }
 
 }  // namespace

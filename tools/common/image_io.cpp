@@ -755,9 +755,10 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
       convert_reduced(data, channels, full, w, h, kw, kh, image);
   };
   if (hdr) {
-    // Radiance files hold linear values of any range: scaled by `white`, or else by the largest (the
-    // brightest pixel's luminance, or channel for colour), so that a density keeps every ratio the file
-    // holds; a brighter pixel than `white` is clipped to white.
+    // Radiance files hold linear values of any range: scaled by `white`, or else by the brightest pixel's
+    // luminance, so that a density keeps every ratio the file holds and a colour picture the tones of its
+    // grey reading (its brightest channel made a grey 0.5 beside a red of 4 near black); a brighter pixel
+    // or channel than `white` is clipped to white.
     std::unique_ptr<float, void (*)(void*)> data(
         stbi_loadf_from_memory(bytes, length, &lw, &lh, &channels, 0), stbi_image_free);
     if (!decoded(data.get())) return false;
@@ -769,9 +770,7 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
     double largest = 0;
     for (std::size_t i = 0; i < pixels; ++i) {
       const float* p = data.get() + i * channels;
-      const double value = std::is_same_v<Image, GreyImage> && channels == 3
-                               ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-                               : *std::max_element(p, p + channels);
+      const double value = channels == 3 ? 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] : p[0];
       if (value > largest && std::isfinite(value)) largest = value;
     }
     convert_kept(data.get(), static_cast<float>(white > 0 ? white : largest > 0 ? largest : 1.0));

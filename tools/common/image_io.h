@@ -65,7 +65,8 @@ bool load_grey_image(const std::string& path, GreyImage& out, std::string& error
                      double white = 0);
 
 /// The same as red, green and blue (alpha composited on white; a grey image gives three equal channels; a
-/// Radiance image's channels divided by `white`, or when it is 0 by the largest).
+/// Radiance image's channels divided by `white`, or when it is 0 by its brightest pixel's luminance, and
+/// clipped to 1).
 bool load_colour_image(const std::string& path, ColourImage& out, std::string& error,
                        std::uint64_t max_pixels = kMaxImagePixels, const KeptPixels& kept = {},
                        double white = 0);

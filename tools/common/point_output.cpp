@@ -292,11 +292,11 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   out.precision(6);        // as number() prints
   std::vector<double> xy;  // a layer's dot centres in the picture's pixels
   std::vector<double> radii;
-  // Clamping each centre into [r, side − r] lined the edge with the dots within r of it; one shrink of all
-  // keeps the blue noise's spacing there too (a fraction of a percent at the usual dot sizes).
+  // Clamping each centre into [r, side − r] lined the edge with the dots within r of it; mapping each axis
+  // onto [R, side − R] (R the largest radius) keeps the blue noise's spacing there too. Per axis, not one
+  // factor for both, which left a long picture's ends blank (a 20:1 strip lost a quarter of its width).
   double largest = 0;
   for (std::size_t i = 0; i < points.size(); ++i) largest = std::max(largest, radius(i));
-  const double shrink = 1 - 2 * largest / std::min(w, h);
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
@@ -309,7 +309,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
         const double ri = radius(i);
         const auto inside = [&](double v, double side) {
           if (!style.dots_inside) return v;
-          const double drawn_in = side / 2 + (v - side / 2) * shrink;  // (a point past [0, 1] clamped)
+          const double drawn_in = largest + v * (1 - 2 * largest / side);  // (a point past [0, 1] clamped)
           return printed_inside(std::clamp(drawn_in, ri, side - ri), side, as_printed(ri));
         };
         xy.push_back(inside(points.coords[2 * i] * w, w));

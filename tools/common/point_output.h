@@ -41,9 +41,9 @@ struct DrawStyle {
   /// in proportion; empty: width_px pixels. The drawing keeps its pixel coordinates (viewBox).
   std::string paper_width;
   /// SVG only: every whole circle inside the picture's edge, its numbers as printed (a pen plotter draws
-  /// no further than the paper): the dots' centres are drawn towards the picture's centre by one factor,
-  /// 1 − 2R / the shorter side (R the largest dot's radius, at most max_dot_radius), which keeps their
-  /// spacing even up to the edge. Off: every dot at its point.
+  /// no further than the paper): each axis of the dots' centres is mapped from [0, side] onto [R, side −
+  /// R] (R the largest dot's radius, at most max_dot_radius), which keeps their spacing even up to the
+  /// edge and leaves a margin of R on every side. Off: every dot at its point.
   bool dots_inside = false;
 };
 

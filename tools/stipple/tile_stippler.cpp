@@ -193,7 +193,7 @@ TileStippler::ThinTones TileStippler::thin_tones(double zoom) const {
     for (const auto& d : densities_) density += d->spec.values[i];
     if (!(density > 0)) continue;
     all += density;
-    if (density * per_tile < thin.coarsest) {
+    if (density * per_tile < thin.coarsest * (1 - 1e-3)) {  // not a tone that rounds to the level itself
       under += density;
       thin.fewest = std::min(thin.fewest, density * per_tile);
     }
