@@ -124,6 +124,11 @@ def stipple(
                 os.stat(label)
             except OSError as e:
                 raise type(e)(f"cannot read image '{label}': {e.strerror}") from None
+            if colours is not None:  # as kdm stipple --colours says it, not as an image of no known type
+                with open(label, "rb") as f:
+                    if f.read(6) == b"\x93NUMPY":
+                        raise ValueError(
+                            f"'{label}' is a NumPy array of densities: stipple it without colours")
         spec = None  # read below, at the size its dots need
         rgb = alpha = None
     elif _checks.is_array(image) or hasattr(image, "__array_interface__"):  # a PIL image too

@@ -101,7 +101,7 @@ def test_stipple_reads_a_npy_path_as_the_density_and_an_array_as_luminance(cli, 
     np.testing.assert_array_equal(kdm.stipple(density, points=3000, invert=True), from_path)
     # Measured: mean x 0.66 and 0.42 (deterministic; the density alone would give 2/3, its darkness 0.42).
     assert from_path[:, 0].mean() > 0.6 and kdm.stipple(density, points=3000)[:, 0].mean() < 0.45
-    for given in (dict(invert=True), dict(gamma=2.0)):
+    for given in (dict(invert=True), dict(gamma=2.0), dict(colours="cmyk")):
         with pytest.raises(ValueError, match="NumPy array of densities"):
             kdm.stipple(tmp_path / "d.npy", points=300, **given)
     said = " ".join(kdm.stipple.__doc__.split())
