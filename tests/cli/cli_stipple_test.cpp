@@ -151,18 +151,16 @@ TEST_F(CliTest, StippleAndDensitiesReadStandardInput) {
     ASSERT_EQ(piped.status, 0) << piped.err;
     EXPECT_EQ(slurp(path("p.csv")), slurp(path("f.csv")));
     EXPECT_GT(csv_dots(slurp(path("p.csv"))), 1000u);
-    const std::string rect = " --rect 0,0,1.5,1 --scale 2000 -o '" + path("q.csv") + "'";
-    ASSERT_EQ(kdm("query --density '" + path(name) + "'" + rect).status, 0);
-    const std::string from_file = slurp(path("q.csv"));
-    const Outcome query = kdm("query --density -" + rect + " < '" + path(name) + "'");
-    ASSERT_EQ(query.status, 0) << query.err;
-    EXPECT_EQ(slurp(path("q.csv")), from_file);
-    const std::string sample = " --n 300 -o '" + path("s.csv") + "'";
-    ASSERT_EQ(kdm("sample --density '" + path(name) + "'" + sample).status, 0);
-    const std::string sampled = slurp(path("s.csv"));
-    const Outcome piped_sample = kdm("sample --density -" + sample + " < '" + path(name) + "'");
-    ASSERT_EQ(piped_sample.status, 0) << piped_sample.err;
-    EXPECT_EQ(slurp(path("s.csv")), sampled);
+    // The command with --density NAME, then with --density - fed NAME: the same output file.
+    const auto same_piped = [&](const std::string& command, const std::string& rest, const std::string& out) {
+      ASSERT_EQ(kdm(command + " --density '" + path(name) + "'" + rest).status, 0);
+      const std::string from_file = slurp(path(out));
+      const Outcome from_pipe = kdm(command + " --density -" + rest + " < '" + path(name) + "'");
+      ASSERT_EQ(from_pipe.status, 0) << from_pipe.err;
+      EXPECT_EQ(slurp(path(out)), from_file) << command;
+    };
+    same_piped("query", " --rect 0,0,1.5,1 --scale 2000 -o '" + path("q.csv") + "'", "q.csv");
+    same_piped("sample", " --n 300 -o '" + path("s.csv") + "'", "s.csv");
   }
   // To standard output, in colour, and the header says where the image came from.
   const Outcome png = kdm("stipple - --points 500 -o - --format png < '" + path("ramp.png") + "'");

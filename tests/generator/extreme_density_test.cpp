@@ -23,6 +23,13 @@ SamplerOptions options_for(std::int64_t n, Domain domain, std::uint64_t seed) {
   return o;
 }
 
+/// The ramp R^-x across the unit square: 1 at x = 0, 1/R at x = 1.
+Density steep_ramp(double R) {
+  Density d;
+  d.function = [=](const double* u) { return std::pow(R, -u[0]); };
+  return d;
+}
+
 bool in_square(double x, double y, double x0, double y0, double side) {
   return x >= x0 && x < x0 + side && y >= y0 && y < y0 + side;
 }
@@ -67,9 +74,7 @@ std::vector<double> spacing_ratios(const SampleResult& r, double R, bool torus) 
 // 20,000. Now none.
 TEST(ExtremeDensityTest, NoRepeatedPointsOnSteepRamps) {
   for (const auto& [R, n] : {std::pair{1e7, 2000}, std::pair{1e9, 20000}}) {
-    Density d;
-    d.function = [R = R](const double* u) { return std::pow(R, -u[0]); };
-    const SampleResult r = sample(options_for(n, Domain::kTorus, 1), d);
+    const SampleResult r = sample(options_for(n, Domain::kTorus, 1), steep_ramp(R));
     const analysis::NearestNeighbours nn = analysis::nearest_neighbours(r.points, 2, true, 1);
     int repeated = 0;
     for (double dist : nn.distance) repeated += dist < 1e-9;
@@ -84,8 +89,7 @@ TEST(ExtremeDensityTest, NoRepeatedPointsOnSteepRamps) {
 // whose median ratio here is 0.94). 15 is three times the worst measured.
 TEST(ExtremeDensityTest, FaintEndOfASteepRampHasNoClumps) {
   const double R = 1e7;
-  Density d;
-  d.function = [=](const double* u) { return std::pow(R, -u[0]); };
+  const Density d = steep_ramp(R);
   for (std::uint64_t seed : {3, 4}) {
     const SampleResult r = sample(options_for(20000, Domain::kBox, seed), d);
     int clumped = 0;
@@ -101,8 +105,7 @@ TEST(ExtremeDensityTest, FaintEndOfASteepRampHasNoClumps) {
 // wall. Now 0 or 1 there at those seeds; 3 allows the odd point and fails the row.
 TEST(ExtremeDensityTest, TheFaintEndOfARampGetsNoRowOfPointsToMakeUpTheCount) {
   const double R = 1e6;
-  Density d;
-  d.function = [=](const double* u) { return std::pow(R, -u[0]); };
+  const Density d = steep_ramp(R);
   for (std::uint64_t seed : {1, 4}) {
     const SampleResult r = sample(options_for(20000, Domain::kBox, seed), d);
     int last_tenth = 0;
