@@ -37,6 +37,16 @@ struct kdm_class_images {
 
 namespace {
 
+// A C caller may hand any int in an enum; in C++ loading one outside the enumerators' range is
+// undefined, so the value is read as the int it is.
+template <typename Enum>
+int enum_as_int(const Enum& value) {
+  static_assert(sizeof(Enum) == sizeof(int), "C enums are int-sized here");
+  int number;
+  std::memcpy(&number, &value, sizeof number);
+  return number;
+}
+
 kdm_status to_c(kdm::Status s) {
   return static_cast<kdm_status>(static_cast<int>(s));
 }
@@ -791,11 +801,11 @@ kdm_status kdm_query_class_images_compact(const kdm_tileset* tileset, const kdm_
 }
 
 const char* kdm_status_message(kdm_status status) {
-  return kdm::status_message(static_cast<kdm::Status>(static_cast<int>(status)));
+  return kdm::status_message(static_cast<kdm::Status>(enum_as_int(status)));
 }
 
 const char* kdm_problem_message(kdm_problem_kind kind) {
-  return kdm::query_problem_message(static_cast<kdm::QueryProblem::Kind>(static_cast<int>(kind)));
+  return kdm::query_problem_message(static_cast<kdm::QueryProblem::Kind>(enum_as_int(kind)));
 }
 
 size_t kdm_query_problem_describe(const kdm_query_problem* problem, char* text, size_t size) {
@@ -806,7 +816,7 @@ size_t kdm_query_problem_describe(const kdm_query_problem* problem, char* text, 
     p.kind = kdm::QueryProblem::Kind::kNotPositive, p.parameter = "problem.struct_size";
     p.value = static_cast<double>(problem->struct_size), p.limit = static_cast<double>(kProblemV1);
   } else {
-    p.kind = static_cast<kdm::QueryProblem::Kind>(static_cast<int>(problem->kind));
+    p.kind = static_cast<kdm::QueryProblem::Kind>(enum_as_int(problem->kind));
     p.parameter = problem->parameter ? problem->parameter : "";
     p.value = problem->value, p.limit = problem->limit;
     p.largest_valid = problem->largest_valid, p.largest_tile_size = problem->largest_tile_size;

@@ -342,6 +342,8 @@ int main(int argc, char** argv) {
       unknown.kind = (kdm_problem_kind)42;
       kdm_query_problem_describe(&unknown, line, sizeof line);
       CHECK(strcmp(line, "unknown problem (kind 42)") == 0);
+      CHECK(strcmp(kdm_problem_message((kdm_problem_kind)42), "unknown problem") == 0);
+      CHECK(strcmp(kdm_status_message((kdm_status)42), "unknown status") == 0);
     }
     q.struct_size = offsetof(kdm_query, mode) - 8; /* older than the first struct with struct_size */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
