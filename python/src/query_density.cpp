@@ -7,17 +7,18 @@
 #include <string>
 
 #include "density_value.h"
+#include "kdm/runtime/density_check.h"
 
 namespace kdm::python {
 namespace {
 
 /// A density value from Python: the C++ query counts a bad one as 0 and one above its bound as the bound
-/// (too few points there); from Python either is a bug in the callable or its density_max, said so. A
-/// value within rounding of the bound (10^-9 of it) passes: a maximum computed another way may differ so.
+/// (too few points there); from Python either is a bug in the callable or its density_max, said so, by the
+/// rule a kdm::DensityCheck applies in C and C++.
 double checked_value(double v, const std::string& name, double x, double y, double max_value) {
   const double at[2] = {x, y};
   finite_density(v, name, at, 2);
-  if (v > max_value * (1 + 1e-9))
+  if (!density_value_fits(v, max_value))
     throw std::domain_error(name + " callable returned " + number_text(v) + " at " + point_text(at, 2) +
                             ", above density_max " + number_text(max_value) +
                             ": density_max must bound every value (smooth mode also reads up to a glide's "

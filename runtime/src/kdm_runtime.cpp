@@ -14,6 +14,7 @@
 #include "kdm/runtime/class_image_sums.h"
 #include "kdm/runtime/class_query.h"
 #include "kdm/runtime/compact_query.h"
+#include "kdm/runtime/density_check.h"
 #include "kdm/runtime/kdm_runtime.h"
 #include "kdm/runtime/parallel_query.h"
 #include "kdm/runtime/query.h"
@@ -29,6 +30,10 @@ struct kdm_density_image {
 
 struct kdm_parallel_query {
   kdm::ParallelQuery parallel;
+};
+
+struct kdm_density_check {
+  kdm::DensityCheck check;
 };
 
 struct kdm_class_images {
@@ -798,6 +803,70 @@ kdm_status kdm_query_class_images_compact(const kdm_tileset* tileset, const kdm_
   return class_compact(tileset, query, ClassSource{ClassSource::kImages, nullptr, nullptr, images},
                        images ? images->sums.count() : 0, xy, keys, out_classes, capacity, written, cursor,
                        problem);
+}
+
+kdm_status kdm_density_check_create(kdm_density_check** out) {
+  if (!out) return KDM_INVALID_ARGUMENT;
+  *out = new (std::nothrow) kdm_density_check;
+  return *out ? KDM_OK : KDM_OUT_OF_MEMORY;
+}
+
+void kdm_density_check_free(kdm_density_check* check) {
+  delete check;
+}
+
+kdm_status kdm_density_check_wrap_query(kdm_density_check* check, kdm_query* query) {
+  if (!check || !query || query->struct_size < kQueryV1) return KDM_INVALID_ARGUMENT;
+  const bool bounds =
+      query->struct_size >= offsetof(kdm_query, density_bounds) + sizeof query->density_bounds;
+  const bool batch = query->struct_size >=
+                     offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback;
+  kdm::QueryDensity d = to_density(query->density, query->density_callback, query->user, query->density_max,
+                                   query->density_image);
+  if (batch)
+    with_batch_callback(d, query->density_batch_callback, query->user, query->density_max,
+                        query->density_image);
+  if (d.kind != kdm::QueryDensity::Kind::kCallback) return KDM_OK;
+  if (bounds) d.bounds = query->density_bounds;
+  const kdm::QueryDensity wrapped = check->check.wrap(d);
+  query->density_callback = wrapped.callback, query->user = wrapped.user;
+  if (bounds) query->density_bounds = wrapped.bounds;
+  if (batch) query->density_batch_callback = wrapped.batch_callback;
+  return KDM_OK;
+}
+
+kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_density* density) {
+  if (!check || !density) return KDM_INVALID_ARGUMENT;
+  kdm::QueryDensity d = to_density(density->density, density->density_callback, density->user,
+                                   density->density_max, density->density_image);
+  with_batch_callback(d, density->density_batch_callback, density->user, density->density_max,
+                      density->density_image);
+  if (d.kind != kdm::QueryDensity::Kind::kCallback) return KDM_OK;
+  d.bounds = density->density_bounds;
+  const kdm::QueryDensity wrapped = check->check.wrap(d);
+  density->density_callback = wrapped.callback, density->user = wrapped.user;
+  density->density_bounds = wrapped.bounds, density->density_batch_callback = wrapped.batch_callback;
+  return KDM_OK;
+}
+
+int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y) {
+  kdm::DensityFinding f;
+  if (!check || !check->check.failed(&f)) return 0;
+  if (value) *value = f.value;
+  if (x) *x = f.x;
+  if (y) *y = f.y;
+  return 1;
+}
+
+size_t kdm_density_check_describe(const kdm_density_check* check, char* text, size_t size) {
+  if (check) return check->check.describe(text, size);
+  const char line[] = "no density check ('check' is NULL)";
+  if (size) std::snprintf(text, size, "%s", line);
+  return sizeof line - 1;
+}
+
+void kdm_density_check_reset(kdm_density_check* check) {
+  if (check) check->check.reset();
 }
 
 const char* kdm_status_message(kdm_status status) {

@@ -91,6 +91,16 @@ static void two_ramp_bounds(void* user, double x0, double y0, double x1, double 
   lo[1] = lo[0], hi[1] = hi[0];
 }
 
+/* 0.5, or `bad` (user) from x = 1.5 on; in a batch, too. */
+static double flawed(void* user, double x, double y) {
+  (void)y;
+  return x >= 1.5 ? *(const double*)user : 0.5;
+}
+static void flawed_batch(void* user, size_t n, const double* x, const double* y, double* out) {
+  size_t i;
+  for (i = 0; i < n; ++i) out[i] = flawed(user, x[i], y[i]);
+}
+
 static kdm_query uniform_query(void) {
   kdm_query q;
   memset(&q, 0, sizeof q);
@@ -422,6 +432,58 @@ int main(int argc, char** argv) {
     q.x0 = 1, q.x1 = 1.5;
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
+  }
+  /* A density check: the same points where the values fit; the first bad value and where it was read. */
+  {
+    static kdm_point bare[4096], checked[4096];
+    kdm_density_check* check = NULL;
+    kdm_class_density density;
+    kdm_cursor cursor;
+    size_t n_bare = 0, n_checked = 0;
+    double bad = 0.5, value = 0, x = 0, y = 0;
+    char line[160];
+    CHECK(kdm_density_check_create(NULL) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_check_create(&check) == KDM_OK && check != NULL);
+    q = uniform_query();
+    q.density_callback = flawed, q.user = &bad, q.density_max = 1;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, bare, 4096, &n_bare, &cursor, NULL) == KDM_OK);
+    CHECK(kdm_density_check_wrap_query(check, &q) == KDM_OK && q.user == (void*)check);
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, checked, 4096, &n_checked, &cursor, NULL) == KDM_OK);
+    CHECK(n_bare > 300 && n_bare == n_checked && memcmp(bare, checked, n_bare * sizeof(kdm_point)) == 0);
+    CHECK(kdm_density_check_failed(check, &value, &x, &y) == 0);
+    kdm_density_check_describe(check, line, sizeof line);
+    CHECK(strcmp(line, "no bad density value") == 0);
+    bad = NAN; /* the same wrapped query, now with a flaw */
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, checked, 4096, &n_checked, &cursor, NULL) == KDM_OK);
+    CHECK(kdm_density_check_failed(check, &value, &x, &y) == 1 && value != value && x >= 1.5 && x < 2);
+    CHECK(kdm_density_check_describe(check, line, sizeof line) == strlen(line));
+    CHECK(strstr(line, "density callback returned nan at (") == line);
+    kdm_density_check_reset(check);
+    CHECK(kdm_density_check_failed(check, NULL, NULL, NULL) == 0);
+    /* A class's batch callback above its bound. */
+    memset(&density, 0, sizeof density);
+    bad = 3;
+    density.density_batch_callback = flawed_batch, density.user = &bad, density.density_max = 1;
+    CHECK(kdm_density_check_wrap_class(check, &density) == KDM_OK && density.user == (void*)check);
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_classes(builtin, &q, &density, 1, bare, (uint8_t*)checked, 4096, &n_checked, &cursor,
+                            NULL) == KDM_OK);
+    CHECK(kdm_density_check_failed(check, &value, NULL, NULL) == 1 && value == 3);
+    kdm_density_check_describe(check, line, sizeof line);
+    CHECK(strstr(line, "above its bound callback_max 1") != NULL);
+    /* Constants are left alone; NULL arguments are refused or told. */
+    q = uniform_query();
+    CHECK(kdm_density_check_wrap_query(check, &q) == KDM_OK && q.user == NULL && q.density_callback == NULL);
+    CHECK(kdm_density_check_wrap_query(NULL, &q) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_check_wrap_query(check, NULL) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_check_wrap_class(check, NULL) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_density_check_failed(NULL, &value, &x, &y) == 0);
+    CHECK(kdm_density_check_describe(NULL, line, sizeof line) == strlen(line) && strstr(line, "NULL"));
+    kdm_density_check_free(check);
+    kdm_density_check_free(NULL);
   }
   /* Several classes: class 0 is the one-class query at its density, the union the one at the sum. */
   {

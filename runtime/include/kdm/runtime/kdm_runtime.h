@@ -481,6 +481,34 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_class_images_compact(
     const kdm_query* query, const kdm_class_images* images, float* xy, uint64_t* keys, uint8_t* out_classes,
     size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
 
+/* A debugging aid for density callbacks (kdm::DensityCheck). A query counts a callback's NaN, infinite and
+ * negative values as 0 and treats values above density_max as density_max, so a bug in a density function
+ * or its bound shows only as missing points. A check routes one density's callbacks through itself and
+ * records the first value that is not finite, >= 0 and <= density_max, with the position it was read at.
+ * It costs a comparison and an extra call per value read; the points are unchanged wherever the values fit.
+ * Thread-safe (parallel queries may use it). Added in 0.5. */
+typedef struct kdm_density_check kdm_density_check;
+
+/* A new check into *out: KDM_OK, KDM_INVALID_ARGUMENT for a NULL `out`, KDM_OUT_OF_MEMORY. */
+KDM_RUNTIME_API kdm_status kdm_density_check_create(kdm_density_check** out);
+/* Frees the check (NULL is ignored); no query may be using a density it wraps. */
+KDM_RUNTIME_API void kdm_density_check_free(kdm_density_check* check);
+/* Routes `query`'s density_callback, density_batch_callback and density_bounds through `check`: query->user
+ * becomes the check, which keeps the originals (wrapping again replaces them: one check per density). A
+ * query whose density is not a callback (a constant, or an image, which takes precedence) is left as it
+ * is. KDM_OK, or KDM_INVALID_ARGUMENT for a NULL argument or a query->struct_size older than the first. */
+KDM_RUNTIME_API kdm_status kdm_density_check_wrap_query(kdm_density_check* check, kdm_query* query);
+/* The same for one class's density of kdm_query_classes (one check per class). */
+KDM_RUNTIME_API kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_density* density);
+/* 1 once a value that does not fit was read, with the first one's value and position in *value, *x, *y
+ * (each optional); 0 otherwise (and for a NULL check). */
+KDM_RUNTIME_API int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y);
+/* The finding in one line ("density callback returned nan at (2.5, 7)", "... returned 3 at (1, 1), above
+ * its bound callback_max 2", or "no bad density value"), as kdm_query_problem_describe writes its line. */
+KDM_RUNTIME_API size_t kdm_density_check_describe(const kdm_density_check* check, char* text, size_t size);
+/* Forgets the finding (not while a query using the check runs). */
+KDM_RUNTIME_API void kdm_density_check_reset(kdm_density_check* check);
+
 /* A static English description of `status` / of a problem kind ("unknown ..." for a value not listed). */
 KDM_RUNTIME_API const char* kdm_status_message(kdm_status status);
 KDM_RUNTIME_API const char* kdm_problem_message(kdm_problem_kind kind);

@@ -1,0 +1,177 @@
+// DensityCheck: a wrapped callback density gives the same points as the bare one, and the first value a
+// query reads that is NaN, infinite, negative or above callback_max is recorded with where it was read.
+#include "kdm/runtime/density_check.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "kdm/runtime/class_query.h"
+#include "kdm/runtime/parallel_query.h"
+#include "run_query.h"
+
+namespace kdm {
+namespace {
+
+using testing::run_query;
+using testing::same_bits;
+
+// 0.25 + x/8, with a flaw right of x = `bad_from` where it returns `bad` instead; bounded by 1.25 up to
+// x = 8, past the region's right side by more than smooth mode's reads reach (they reach 6.27 there).
+struct Ramp {
+  double bad_from = std::numeric_limits<double>::infinity();
+  double bad = 0;
+  int bounds_calls = 0;
+  double value(double x) const { return x >= bad_from ? bad : 0.25 + x / 8; }
+  static double at(void* self, double x, double) { return static_cast<Ramp*>(self)->value(x); }
+  static void batch(void* self, std::size_t n, const double* x, const double*, double* out) {
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<Ramp*>(self)->value(x[i]);
+  }
+  static void bounds(void* self, double x0, double, double x1, double, double* lo, double* hi) {
+    ++static_cast<Ramp*>(self)->bounds_calls;  // only one thread queries where this is counted
+    *lo = 0.25 + x0 / 8, *hi = 0.25 + x1 / 8;
+  }
+};
+
+QueryParams ramp_query(Ramp& ramp, QueryMode mode) {
+  QueryParams q;
+  q.x0 = 0, q.y0 = 0, q.x1 = 6, q.y1 = 4, q.scale = 2048, q.mode = mode;
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = &Ramp::at, q.density.user = &ramp, q.density.callback_max = 1.25;
+  return q;
+}
+
+TEST(DensityCheckTest, AWrappedDensityThatFitsGivesTheSamePointsAndNoFinding) {
+  for (const QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+    Ramp ramp;
+    QueryParams q = ramp_query(ramp, mode);
+    const std::vector<QueryPoint> bare = run_query(q);
+    DensityCheck check;
+    q.density = check.wrap(q.density);
+    const std::vector<QueryPoint> checked = run_query(q);
+    EXPECT_GT(bare.size(), 10000u);
+    EXPECT_TRUE(same_bits(bare, checked));
+    EXPECT_FALSE(check.failed());
+    char line[64];
+    check.describe(line, sizeof line);
+    EXPECT_STREQ(line, "no bad density value");
+  }
+}
+
+TEST(DensityCheckTest, TheFirstBadValueIsRecordedWithItsPosition) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double bad : {nan, inf, -0.5, 1.5}) {
+    for (const bool batch : {false, true}) {
+      Ramp ramp;
+      ramp.bad_from = 5, ramp.bad = bad;
+      QueryParams q = ramp_query(ramp, QueryMode::kStable);
+      if (batch) q.density.callback = nullptr, q.density.batch_callback = &Ramp::batch;
+      DensityCheck check;
+      q.density = check.wrap(q.density);
+      run_query(q);
+      DensityFinding f;
+      ASSERT_TRUE(check.failed(&f)) << bad << (batch ? " batch" : "");
+      EXPECT_TRUE(std::isnan(bad) ? std::isnan(f.value) : f.value == bad);
+      EXPECT_GE(f.x, 5);  // read where the flaw is, inside the region
+      EXPECT_LT(f.x, 6);
+      EXPECT_GE(f.y, 0);
+      EXPECT_LT(f.y, 4);
+      EXPECT_EQ(f.limit, 1.25);
+      char line[160];
+      const std::size_t length = check.describe(line, sizeof line);
+      EXPECT_EQ(length, std::string(line).size());
+      EXPECT_EQ(std::string(line).rfind("density callback returned ", 0), 0u) << line;
+      EXPECT_EQ(std::string(line).find("above its bound callback_max 1.25") != std::string::npos, bad == 1.5)
+          << line;
+      check.reset();
+      EXPECT_FALSE(check.failed());
+    }
+  }
+}
+
+TEST(DensityCheckTest, AValueWithinRoundingOfTheBoundFits) {
+  EXPECT_TRUE(density_value_fits(1 + 1e-12, 1));
+  EXPECT_FALSE(density_value_fits(1 + 1e-6, 1));
+  EXPECT_TRUE(density_value_fits(0, 1));
+  EXPECT_FALSE(density_value_fits(-0.0001, 1));
+  EXPECT_FALSE(density_value_fits(std::numeric_limits<double>::quiet_NaN(), 1));
+}
+
+TEST(DensityCheckTest, BoundsReachTheWrappedDensityWithItsOwnUser) {
+  Ramp ramp;
+  QueryParams q = ramp_query(ramp, QueryMode::kStable);
+  q.density.bounds = &Ramp::bounds;
+  const std::vector<QueryPoint> bare = run_query(q);
+  const int bare_calls = ramp.bounds_calls;
+  DensityCheck check;
+  q.density = check.wrap(q.density);
+  EXPECT_TRUE(same_bits(bare, run_query(q)));
+  EXPECT_GT(bare_calls, 0);
+  EXPECT_EQ(ramp.bounds_calls, 2 * bare_calls);
+}
+
+TEST(DensityCheckTest, AConstantOrImageDensityIsLeftAsItIs) {
+  DensityCheck check;
+  QueryDensity constant;
+  constant.constant = 0.5;
+  const QueryDensity same = check.wrap(constant);
+  EXPECT_EQ(same.kind, QueryDensity::Kind::kConstant);
+  EXPECT_EQ(same.constant, 0.5);
+  EXPECT_EQ(same.user, nullptr);
+}
+
+TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
+  Ramp good, flawed;
+  flawed.bad_from = 3, flawed.bad = -1;
+  DensityCheck good_check, flawed_check;
+  ClassQueryParams c;
+  c.query = ramp_query(good, QueryMode::kStable);
+  c.class_count = 2;
+  c.classes[0] = good_check.wrap(c.query.density);
+  c.classes[1] = flawed_check.wrap(ramp_query(flawed, QueryMode::kStable).density);
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  std::size_t written = 0;
+  QueryCursor cursor;
+  ASSERT_EQ(query_classes(Tileset::builtin(), c, out.data(), classes.data(), out.size(), &written, &cursor),
+            Status::kOk);
+  EXPECT_FALSE(good_check.failed());
+  DensityFinding f;
+  ASSERT_TRUE(flawed_check.failed(&f));
+  EXPECT_EQ(f.value, -1);
+  EXPECT_GE(f.x, 3);
+
+  // Two workers read the flawed density at once: one finding, whole.
+  ParallelQuery parallel;
+  ASSERT_EQ(parallel.init(2), Status::kOk);
+  DensityCheck check;
+  QueryParams q = ramp_query(flawed, QueryMode::kSmooth);
+  q.density = check.wrap(q.density);
+  ASSERT_EQ(parallel.run(Tileset::builtin(), q, out.data(), out.size(), &written, std_thread_runner()),
+            Status::kOk);
+  ASSERT_TRUE(check.failed(&f));
+  EXPECT_EQ(f.value, -1);
+  EXPECT_GE(f.x, 3);
+  EXPECT_EQ(f.limit, 1.25);
+}
+
+TEST(DensityCheckTest, DescribeCutsToTheBufferAndCountsTheWholeLine) {
+  Ramp ramp;
+  ramp.bad_from = 1, ramp.bad = 2;
+  QueryParams q = ramp_query(ramp, QueryMode::kStable);
+  DensityCheck check;
+  q.density = check.wrap(q.density);
+  run_query(q);
+  char whole[160], cut[12] = "untouched";
+  const std::size_t length = check.describe(whole, sizeof whole);
+  EXPECT_EQ(check.describe(nullptr, 0), length);
+  EXPECT_EQ(check.describe(cut, sizeof cut), length);
+  EXPECT_EQ(std::string(cut), std::string(whole, sizeof cut - 1));
+}
+
+}  // namespace
+}  // namespace kdm
