@@ -74,7 +74,9 @@ def stipple(
         Method "full": the sampler's seed. Method "tiles": where the image lies in the tile set's endless
         tiling (another seed, other dots; one seed, the same dots in every region).
     tileset : Tileset, str, os.PathLike or None
-        For method "tiles": a set, or a tile-set file to load (default: the built-in set).
+        For method "tiles": a set, or a tile-set file to load (default: the built-in set). When 1% or
+        more of the dots lie where the picture asks fewer points per tile than the set's coarsest level
+        holds (a set of few levels), they come out clumpy there: a UserWarning says so, as kdm stipple does.
     output : str, os.PathLike or None
         Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does
         (another extension, .npy too, is a ValueError: the dots are returned as an array).

@@ -183,6 +183,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                                   tools::shortest(largest_dot) + " pixels");
   }
   tools::PointSet set;
+  std::string thin;  // warned of once the GIL is back
   {
     py::gil_scoped_release release;
     const Tileset& tiles = given ? *given : builtin_tileset();
@@ -197,6 +198,8 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
                     : tools::stipple_full(spec, count, aspect, seed, threads, stop_on_signal);
     } else {
       const tools::TileStippler stippler(specs, tiles, double(points), scale, query_mode, seed);
+      thin = tools::TileStippler::thin_tones_warning(stippler.thin_tones(tools::stipple_zoom(uv.data())),
+                                                     "gamma", given && given != &builtin_tileset());
       set = stippler.render(uv.data(), fade);
     }
     if (colours && set.classes.empty()) set.classes.assign(set.size(), 0);  // one ink left
@@ -229,6 +232,8 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
       }
     }
   }
+  // Level 2: the warning names the line that called kdm.stipple.
+  if (!thin.empty() && PyErr_WarnEx(PyExc_UserWarning, thin.c_str(), 2) < 0) throw py::error_already_set();
   const auto count = static_cast<py::ssize_t>(set.size());
   py::array_t<double> dots = owning_array(std::move(set.coords), {count, py::ssize_t(2)});
   if (!colours) return std::move(dots);

@@ -1,5 +1,6 @@
 """kdm.stipple and kdm.analyze: what `kdm stipple` draws and what `kdm analyze` measures."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -258,6 +259,7 @@ def test_stipple_of_a_blank_image_has_no_dots(tmp_path):
     assert np.asarray(Image.open(tmp_path / "w.png")).min() == 255
 
 
+@pytest.mark.filterwarnings("ignore:.*coarsest level holds")  # the tiny set's, tested below
 def test_stipple_scale_region_mode_and_tileset(tiny_tileset, tmp_path):
     whole = kdm.stipple(str(SPHERE), scale=8000)
     part = kdm.stipple(str(SPHERE), scale=8000, region=(0.25, 0.25, 0.75, 0.75))
@@ -278,6 +280,20 @@ def test_stipple_scale_region_mode_and_tileset(tiny_tileset, tmp_path):
         kdm.stipple(str(SPHERE), scale=1e-9, method="full")
     with pytest.raises(ValueError, match="more than the full sampler's 2\\^31"):
         kdm.stipple(str(SPHERE), scale=1e300, method="full")
+
+
+def test_stipple_warns_where_a_tile_set_serves_light_tones_unevenly(tiny_tileset):
+    # As kdm stipple warns: a set of 2 levels (1:4) places a ramp's light tones under its coarsest level;
+    # the built-in set (1:1024) serves them and says nothing.
+    ramp = np.tile(np.linspace(0, 1, 64), (32, 1))
+    with pytest.warns(UserWarning, match=r"coarsest level holds \(32\), and come out clumpy") as said:
+        dots = kdm.stipple(ramp, tileset=tiny_tileset)
+    assert len(said) == 1 and "a tile set of more levels" in str(said[0].message)
+    assert "gamma below 1" in str(said[0].message) and said[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(kdm.stipple(ramp)) > 1000
+    assert len(dots) > 1000
 
 
 def test_analyze_gives_metrics_json(cli, tmp_path):

@@ -215,24 +215,15 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     stippler = std::make_unique<tools::TileStippler>(specs, tiles, double(a.points), a.scale,
                                                      parse_mode(a.mode), a.seed);
     // As kdm query says a tile size too small: tones under the set's coarsest level come out clumpy.
-    // Said for the least zoomed picture (deeper ones ask more points per tile), when they hold 1% of
-    // the dots or more (a few pale pixels' dots are not seen as clumps).
+    // Said for the least zoomed picture (deeper ones ask more points per tile).
     double first[4];
     if (a.frames > 0)
       tools::stipple_frame_region(region, 0, int(a.frames), first);
     else
       std::copy(region, region + 4, first);
-    const tools::TileStippler::ThinTones thin = stippler->thin_tones(tools::stipple_zoom(first));
-    if (thin.share >= 0.01)
-      std::fprintf(
-          stderr,
-          "kdm stipple: warning: %.0f%% of the dots lie where the picture asks fewer points per tile "
-          "(as few as %.3g) than the tile set's coarsest level holds (%.0f), and come out clumpy "
-          "there: %s--gamma below 1 raises those tones\n",
-          std::max(1.0, std::floor(100 * thin.share)), thin.fewest, thin.coarsest,
-          a.tileset.empty() ? ""
-                            : "a tile set of more levels (a wider density range, as the built-in "
-                              "set's 1:1024) serves them evenly, or ");
+    const std::string thin = tools::TileStippler::thin_tones_warning(
+        stippler->thin_tones(tools::stipple_zoom(first)), "--gamma", !a.tileset.empty());
+    if (!thin.empty()) std::fprintf(stderr, "kdm stipple: warning: %s\n", thin.c_str());
   }
   if (coloured && !blank) {  // which ink each class number of a .csv is, and its colour (a plotter's pen)
     std::string names;

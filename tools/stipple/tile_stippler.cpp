@@ -202,6 +202,22 @@ TileStippler::ThinTones TileStippler::thin_tones(double zoom) const {
   return thin;
 }
 
+std::string TileStippler::thin_tones_warning(const ThinTones& thin, const char* gamma, bool custom_set) {
+  if (!(thin.share >= 0.01)) return "";
+  char line[400];
+  std::snprintf(
+      line, sizeof line,
+      "%.0f%% of the dots lie where the picture asks fewer points per tile (as few as %.3g) than the "
+      "tile set's coarsest level holds (%.0f), and come out clumpy there: %s%s below 1 raises those "
+      "tones",
+      std::max(1.0, std::floor(100 * thin.share)), thin.fewest, thin.coarsest,
+      custom_set ? "a tile set of more levels (a wider density range, as the built-in set's 1:1024) "
+                   "serves them evenly, or "
+                 : "",
+      gamma);
+  return line;
+}
+
 ClassQueryParams TileStippler::class_params(const QueryParams& q) const {
   ClassQueryParams cq;
   cq.query = q;

@@ -107,6 +107,10 @@ class TileStippler {
     double coarsest = 0;  ///< the set's coarsest level's points per tile
   };
   ThinTones thin_tones(double zoom) const;
+  /// The warning for thin_tones' result, without a prefix, or "" when they hold under 1% of the dots (a
+  /// few pale pixels' dots are not seen as clumps). `gamma` names the option that raises tones
+  /// ("--gamma", "gamma="); `custom_set` adds that a set of more levels serves them.
+  static std::string thin_tones_warning(const ThinTones& thin, const char* gamma, bool custom_set);
 
  private:
   ClassQueryParams class_params(const QueryParams& q) const;  ///< the inks' query over q
