@@ -18,23 +18,42 @@ const char* shortest(double v, char (&text)[32]) {
 
 }  // namespace
 
-QueryDensity DensityCheck::wrap(const QueryDensity& density) {
-  if (density.kind != QueryDensity::Kind::kCallback) return density;
-  inner_ = density;
-  QueryDensity wrapped = density;
-  wrapped.user = this;
-  wrapped.callback = density.callback ? &DensityCheck::call : nullptr;
-  wrapped.batch_callback = density.batch_callback ? &DensityCheck::call_batch : nullptr;
-  wrapped.bounds = density.bounds ? &DensityCheck::call_bounds : nullptr;
-  return wrapped;
+bool DensityCheck::routes(const QueryDensity& density) const {
+  return density.user == this && (!density.callback || density.callback == &DensityCheck::call) &&
+         (!density.batch_callback || density.batch_callback == &DensityCheck::call_batch);
+}
+
+Status DensityCheck::wrap(QueryDensity* density) {
+  if (!density) return Status::kInvalidArgument;
+  if (density->kind != QueryDensity::Kind::kCallback) return Status::kOk;
+  if (routes(*density)) {  // wrapped already: only its bound may have changed
+    inner_.callback_max = density->callback_max;
+    return Status::kOk;
+  }
+  const bool same = density->callback == inner_.callback &&
+                    density->batch_callback == inner_.batch_callback && density->bounds == inner_.bounds &&
+                    density->user == inner_.user;
+  if (wrapping_ && !same) return Status::kInvalidArgument;
+  inner_ = *density, wrapping_ = true;
+  density->user = this;
+  density->callback = inner_.callback ? &DensityCheck::call : nullptr;
+  density->batch_callback = inner_.batch_callback ? &DensityCheck::call_batch : nullptr;
+  density->bounds = inner_.bounds ? &DensityCheck::call_bounds : nullptr;
+  return Status::kOk;
+}
+
+void DensityCheck::record(const DensityFinding& finding) {
+  int none = 0;  // the first finding is kept: later threads' leave it alone
+  if (!state_.compare_exchange_strong(none, 1, std::memory_order_acq_rel)) return;
+  finding_ = finding;
+  state_.store(2, std::memory_order_release);
 }
 
 void DensityCheck::check(double value, double x, double y) {
   if (density_value_fits(value, inner_.callback_max)) return;
-  int none = 0;  // the first finding is kept: later threads' leave it alone
-  if (!state_.compare_exchange_strong(none, 1, std::memory_order_acq_rel)) return;
-  finding_ = DensityFinding{value, x, y, inner_.callback_max};
-  state_.store(2, std::memory_order_release);
+  DensityFinding f;
+  f.value = value, f.x = x, f.y = y, f.limit = inner_.callback_max;
+  record(f);
 }
 
 double DensityCheck::call(void* user, double x, double y) {
@@ -52,8 +71,31 @@ void DensityCheck::call_batch(void* user, std::size_t n, const double* x, const 
 
 void DensityCheck::call_bounds(void* user, double x0, double y0, double x1, double y1, double* lo,
                                double* hi) {
-  const auto* self = static_cast<const DensityCheck*>(user);
-  self->inner_.bounds(self->inner_.user, x0, y0, x1, y1, lo, hi);
+  auto* self = static_cast<DensityCheck*>(user);
+  const QueryDensity& d = self->inner_;
+  d.bounds(d.user, x0, y0, x1, y1, lo, hi);
+  if (!(*lo <= *hi)) return;  // NaN or crossed bounds: the query ignores them
+  // The density at the rectangle's corners, edge middles and centre must lie within them.
+  double x[9], y[9], v[9];
+  for (int i = 0; i < 9; ++i) {
+    x[i] = i % 3 == 0 ? x0 : i % 3 == 1 ? 0.5 * (x0 + x1) : x1;
+    y[i] = i / 3 == 0 ? y0 : i / 3 == 1 ? 0.5 * (y0 + y1) : y1;
+  }
+  if (d.callback)
+    for (int i = 0; i < 9; ++i) v[i] = d.callback(d.user, x[i], y[i]);
+  else
+    d.batch_callback(d.user, 9, x, y, v);
+  for (int i = 0; i < 9; ++i) {
+    self->check(v[i], x[i], y[i]);
+    if (!(v[i] < *lo * (1 - 1e-9) || v[i] > *hi * (1 + 1e-9)) || !density_value_fits(v[i], HUGE_VAL))
+      continue;
+    DensityFinding f;
+    f.kind = DensityFinding::Kind::kBounds;
+    f.value = v[i], f.x = x[i], f.y = y[i], f.limit = d.callback_max, f.lo = *lo, f.hi = *hi;
+    f.rect[0] = x0, f.rect[1] = y0, f.rect[2] = x1, f.rect[3] = y1;
+    self->record(f);
+    return;
+  }
 }
 
 bool DensityCheck::failed(DensityFinding* finding) const {
@@ -64,22 +106,30 @@ bool DensityCheck::failed(DensityFinding* finding) const {
 
 std::size_t DensityCheck::describe(char* text, std::size_t size) const {
   DensityFinding f;
-  char line[200], value[32], x[32], y[32], limit[32];
+  char line[320], n0[32], n1[32], n2[32], n3[32], n4[32], n5[32], n6[32], n7[32], n8[32];
   int n;
   if (!failed(&f)) {
     n = std::snprintf(line, sizeof line, "no bad density value");
+  } else if (f.kind == DensityFinding::Kind::kBounds) {
+    n = std::snprintf(
+        line, sizeof line,
+        "density bounds gave [%s, %s] over (%s, %s) to (%s, %s), but the density is %s at (%s, %s)",
+        shortest(f.lo, n0), shortest(f.hi, n1), shortest(f.rect[0], n2), shortest(f.rect[1], n3),
+        shortest(f.rect[2], n4), shortest(f.rect[3], n5), shortest(f.value, n6), shortest(f.x, n7),
+        shortest(f.y, n8));
   } else {
-    n = std::snprintf(line, sizeof line, "density callback returned %s at (%s, %s)", shortest(f.value, value),
-                      shortest(f.x, x), shortest(f.y, y));
+    n = std::snprintf(line, sizeof line, "density callback returned %s at (%s, %s)", shortest(f.value, n0),
+                      shortest(f.x, n1), shortest(f.y, n2));
     if (f.value > f.limit && f.value < HUGE_VAL && n > 0 && std::size_t(n) < sizeof line)
       n += std::snprintf(line + n, sizeof line - std::size_t(n), ", above its bound callback_max %s",
-                         shortest(f.limit, limit));
+                         shortest(f.limit, n3));
   }
   if (size) std::snprintf(text, size, "%s", line);
   return n > 0 ? std::size_t(n) : 0;
 }
 
 void DensityCheck::reset() {
+  wrapping_ = false;
   state_.store(0, std::memory_order_release);
 }
 

@@ -181,6 +181,14 @@ bool unset_callback_bound(const kdm::QueryDensity& d, const char* name, kdm::Que
   return true;
 }
 
+/// Bounds given with neither a callback to bound nor an image: the density would silently be the struct's
+/// constant, most often a zeroed struct's 0. Refused as `name`, the callback missing (C++ names the kind).
+bool bounds_without_callback(const kdm::QueryDensity& d, const char* name, kdm::QueryProblem& why) {
+  if (!d.bounds || d.kind != kdm::QueryDensity::Kind::kConstant) return false;
+  why.kind = kdm::QueryProblem::Kind::kBadDensity, why.parameter = name;
+  return true;
+}
+
 /// kdm_point and QueryPoint share their layout: queries write straight into the caller's buffer.
 kdm::QueryPoint* as_points(kdm_point* out) {
   static_assert(sizeof(kdm_point) == sizeof(kdm::QueryPoint), "kdm_point mirrors QueryPoint");
@@ -275,7 +283,8 @@ kdm_status run_query(const kdm_tileset* tileset, const kdm_query* query, size_t*
         offsetof(kdm_query, density_batch_callback) + sizeof query->density_batch_callback)
       with_batch_callback(q.density, query->density_batch_callback, query->user, query->density_max,
                           query->density_image);
-    if (!unset_callback_bound(q.density, "density_max", why))
+    if (!unset_callback_bound(q.density, "density_max", why) &&
+        !bounds_without_callback(q.density, "density_callback", why))
       status = with_cursor(cursor, [&](kdm::QueryCursor* k) { return run(q, k, &why); });
   }
   report(why, problem);
@@ -322,7 +331,8 @@ kdm_status run_class_query(const kdm_tileset* tileset, const kdm_query* query, c
       q.classes[k] = to_density(c.density, c.density_callback, c.user, c.density_max, c.density_image);
       q.classes[k].bounds = c.density_bounds;
       with_batch_callback(q.classes[k], c.density_batch_callback, c.user, c.density_max, c.density_image);
-      unset = unset_callback_bound(q.classes[k], kClassDensityNames[1][k], why);
+      unset = unset_callback_bound(q.classes[k], kClassDensityNames[1][k], why) ||
+              bounds_without_callback(q.classes[k], kClassDensityNames[3][k], why);
     }
     if (source.kind == ClassSource::kImages) q.image_sums = &source.images->sums;
     if (source.kind == ClassSource::kJoint) {
@@ -828,11 +838,11 @@ kdm_status kdm_density_check_wrap_query(kdm_density_check* check, kdm_query* que
                         query->density_image);
   if (d.kind != kdm::QueryDensity::Kind::kCallback) return KDM_OK;
   if (bounds) d.bounds = query->density_bounds;
-  const kdm::QueryDensity wrapped = check->check.wrap(d);
-  query->density_callback = wrapped.callback, query->user = wrapped.user;
-  if (bounds) query->density_bounds = wrapped.bounds;
-  if (batch) query->density_batch_callback = wrapped.batch_callback;
-  return KDM_OK;
+  const kdm::Status status = check->check.wrap(&d);
+  query->density_callback = d.callback, query->user = d.user;
+  if (bounds) query->density_bounds = d.bounds;
+  if (batch) query->density_batch_callback = d.batch_callback;
+  return to_c(status);
 }
 
 kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_density* density) {
@@ -843,10 +853,10 @@ kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_dens
                       density->density_image);
   if (d.kind != kdm::QueryDensity::Kind::kCallback) return KDM_OK;
   d.bounds = density->density_bounds;
-  const kdm::QueryDensity wrapped = check->check.wrap(d);
-  density->density_callback = wrapped.callback, density->user = wrapped.user;
-  density->density_bounds = wrapped.bounds, density->density_batch_callback = wrapped.batch_callback;
-  return KDM_OK;
+  const kdm::Status status = check->check.wrap(&d);
+  density->density_callback = d.callback, density->user = d.user;
+  density->density_bounds = d.bounds, density->density_batch_callback = d.batch_callback;
+  return to_c(status);
 }
 
 int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y) {

@@ -152,6 +152,9 @@ std::size_t describe_query_problem(const QueryProblem& p, char* text, std::size_
       if (!std::isfinite(p.value))  // the kind also covers places too far out for a finite value
         return print(text, size, "'%s' is not a finite number (%g)", shown, p.value);
       break;
+    case QueryProblem::Kind::kBadMode:
+    case QueryProblem::Kind::kBadClassCount:
+      break;  // the value refused, below
     default:  // a kind this library does not know (a C caller's number): the number, not a blank field
       return print(text, size, "%s (kind %d)", query_problem_message(p.kind), static_cast<int>(p.kind));
   }

@@ -398,10 +398,19 @@ int main(int argc, char** argv) {
     q.density_max = -1; /* "must be > 0" too, not "must not be negative", which would allow the 0 above */
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_NOT_POSITIVE && problem.value == -1);
+    q = uniform_query(); /* bounds with nothing to bound: not silently the constant (0 when zeroed) */
+    q.density = 0, q.density_bounds = ramp_bounds, q.density_max = 1;
+    CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_BAD_DENSITY && strcmp(problem.parameter, "density_callback") == 0);
     q = uniform_query();
     q.mode = 7;
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_BAD_MODE && strcmp(problem.parameter, "mode") == 0);
+    { /* the mode's value is told, not the problem kind's number */
+      char line[160];
+      kdm_query_problem_describe(&problem, line, sizeof line);
+      CHECK(strstr(line, "('mode' = 7)") != NULL && strstr(line, "kind") == NULL);
+    }
     q.struct_size = offsetof(kdm_query, mode); /* a caller built before `mode`: stable, whatever follows */
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, NULL, 0, &written, &cursor, &problem) == KDM_BUFFER_FULL);
@@ -449,6 +458,7 @@ int main(int argc, char** argv) {
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, bare, 4096, &n_bare, &cursor, NULL) == KDM_OK);
     CHECK(kdm_density_check_wrap_query(check, &q) == KDM_OK && q.user == (void*)check);
+    CHECK(kdm_density_check_wrap_query(check, &q) == KDM_OK && q.user == (void*)check); /* no 2nd layer */
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_points(builtin, &q, checked, 4096, &n_checked, &cursor, NULL) == KDM_OK);
     CHECK(n_bare > 300 && n_bare == n_checked && memcmp(bare, checked, n_bare * sizeof(kdm_point)) == 0);
@@ -468,6 +478,13 @@ int main(int argc, char** argv) {
     bad = 3;
     density.density_batch_callback = flawed_batch, density.user = &bad, density.density_max = 1;
     CHECK(kdm_density_check_wrap_class(check, &density) == KDM_OK && density.user == (void*)check);
+    { /* another density through the same check is refused, and left as it was */
+      kdm_class_density other;
+      memset(&other, 0, sizeof other);
+      other.density_callback = flawed, other.user = &bad, other.density_max = 1;
+      CHECK(kdm_density_check_wrap_class(check, &other) == KDM_INVALID_ARGUMENT);
+      CHECK(other.user == (void*)&bad && other.density_callback == flawed);
+    }
     memset(&cursor, 0, sizeof cursor);
     CHECK(kdm_query_classes(builtin, &q, &density, 1, bare, (uint8_t*)checked, 4096, &n_checked, &cursor,
                             NULL) == KDM_OK);
@@ -514,6 +531,14 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_classes(builtin, &q, densities, 9, points, classes, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_BAD_CLASS_COUNT && problem.value == 9);
+    kdm_query_problem_describe(&problem, (char*)single, sizeof single);
+    CHECK(strstr((const char*)single, "('class_count' = 9)") != NULL);
+    densities[2].density_bounds = ramp_bounds; /* bounds with no callback */
+    CHECK(kdm_query_classes(builtin, &q, densities, 3, points, classes, 4096, &written, &cursor, &problem) ==
+          KDM_INVALID_ARGUMENT);
+    CHECK(problem.kind == KDM_PROBLEM_BAD_DENSITY &&
+          strcmp(problem.parameter, "classes[2].density_callback") == 0);
+    densities[2].density_bounds = NULL;
     CHECK(kdm_query_classes(builtin, &q, NULL, 3, points, classes, 4096, &written, &cursor, &problem) ==
           KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_MISSING_ARGUMENT && strcmp(problem.parameter, "classes") == 0);

@@ -50,7 +50,7 @@ TEST(DensityCheckTest, AWrappedDensityThatFitsGivesTheSamePointsAndNoFinding) {
     QueryParams q = ramp_query(ramp, mode);
     const std::vector<QueryPoint> bare = run_query(q);
     DensityCheck check;
-    q.density = check.wrap(q.density);
+    ASSERT_EQ(check.wrap(&q.density), Status::kOk);
     const std::vector<QueryPoint> checked = run_query(q);
     EXPECT_GT(bare.size(), 10000u);
     EXPECT_TRUE(same_bits(bare, checked));
@@ -71,7 +71,7 @@ TEST(DensityCheckTest, TheFirstBadValueIsRecordedWithItsPosition) {
       QueryParams q = ramp_query(ramp, QueryMode::kStable);
       if (batch) q.density.callback = nullptr, q.density.batch_callback = &Ramp::batch;
       DensityCheck check;
-      q.density = check.wrap(q.density);
+      ASSERT_EQ(check.wrap(&q.density), Status::kOk);
       run_query(q);
       DensityFinding f;
       ASSERT_TRUE(check.failed(&f)) << bad << (batch ? " batch" : "");
@@ -108,20 +108,83 @@ TEST(DensityCheckTest, BoundsReachTheWrappedDensityWithItsOwnUser) {
   const std::vector<QueryPoint> bare = run_query(q);
   const int bare_calls = ramp.bounds_calls;
   DensityCheck check;
-  q.density = check.wrap(q.density);
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
   EXPECT_TRUE(same_bits(bare, run_query(q)));
   EXPECT_GT(bare_calls, 0);
   EXPECT_EQ(ramp.bounds_calls, 2 * bare_calls);
+  EXPECT_FALSE(check.failed());  // true bounds
+}
+
+// Bounds that claim more than the density has (lo too high where it drops) make extra points appear; the
+// check compares them with the density at 9 points of each rectangle asked.
+TEST(DensityCheckTest, BoundsTheDensityBreaksAreFound) {
+  Ramp ramp;
+  ramp.bad_from = 4, ramp.bad = 0.05;  // drops from 0.75 to 0.05 at x = 4, which the bounds ignore
+  QueryParams q = ramp_query(ramp, QueryMode::kStable);
+  q.density.bounds = &Ramp::bounds;
+  DensityCheck check;
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
+  run_query(q);
+  DensityFinding f;
+  ASSERT_TRUE(check.failed(&f));
+  EXPECT_EQ(f.kind, DensityFinding::Kind::kBounds);
+  EXPECT_EQ(f.value, 0.05);
+  EXPECT_GE(f.x, 4);
+  EXPECT_GE(f.x, f.rect[0]);
+  EXPECT_LE(f.x, f.rect[2]);
+  EXPECT_GT(f.lo, f.value);
+  char line[200];
+  check.describe(line, sizeof line);
+  EXPECT_EQ(std::string(line).rfind("density bounds gave [", 0), 0u) << line;
+  EXPECT_NE(std::string(line).find("but the density is 0.05 at ("), std::string::npos) << line;
+}
+
+// One check per density: another density is refused, where routing two through one check would have the
+// first read the second's function; the same density again (a new QueryParams per chunk, or the wrapped
+// one) is taken, with its bound; reset() frees the check for another.
+TEST(DensityCheckTest, OneCheckWrapsOneDensity) {
+  Ramp a, b;
+  QueryParams qa = ramp_query(a, QueryMode::kStable), qb = ramp_query(b, QueryMode::kStable);
+  const QueryDensity bare_a = qa.density;
+  DensityCheck check;
+  ASSERT_EQ(check.wrap(&qa.density), Status::kOk);
+  const QueryDensity before = qb.density;
+  EXPECT_EQ(check.wrap(&qb.density), Status::kInvalidArgument);
+  EXPECT_EQ(qb.density.user, before.user);  // refused: left as it was
+  EXPECT_EQ(qb.density.callback, before.callback);
+  EXPECT_EQ(check.wrap(nullptr), Status::kInvalidArgument);
+
+  QueryDensity again = qa.density;  // the wrapped one itself: no second layer (it would call itself)
+  again.callback_max = 0.5;
+  ASSERT_EQ(check.wrap(&again), Status::kOk);
+  EXPECT_EQ(again.user, qa.density.user);
+  EXPECT_EQ(again.callback, qa.density.callback);
+  QueryDensity chunk = bare_a;  // a fresh copy of the same density, with a lower bound
+  chunk.callback_max = 0.5;
+  ASSERT_EQ(check.wrap(&chunk), Status::kOk);
+  QueryParams q = qa;
+  q.density = chunk;
+  run_query(q);
+  DensityFinding f;
+  ASSERT_TRUE(check.failed(&f));  // the ramp passes 0.5 at x = 2
+  EXPECT_EQ(f.limit, 0.5);
+  EXPECT_GT(f.value, 0.5);
+
+  check.reset();
+  EXPECT_FALSE(check.failed());
+  ASSERT_EQ(check.wrap(&qb.density), Status::kOk);
+  EXPECT_TRUE(same_bits(run_query(ramp_query(b, QueryMode::kStable)), run_query(qb)));
+  EXPECT_FALSE(check.failed());
 }
 
 TEST(DensityCheckTest, AConstantOrImageDensityIsLeftAsItIs) {
   DensityCheck check;
   QueryDensity constant;
   constant.constant = 0.5;
-  const QueryDensity same = check.wrap(constant);
-  EXPECT_EQ(same.kind, QueryDensity::Kind::kConstant);
-  EXPECT_EQ(same.constant, 0.5);
-  EXPECT_EQ(same.user, nullptr);
+  ASSERT_EQ(check.wrap(&constant), Status::kOk);
+  EXPECT_EQ(constant.kind, QueryDensity::Kind::kConstant);
+  EXPECT_EQ(constant.constant, 0.5);
+  EXPECT_EQ(constant.user, nullptr);
 }
 
 TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
@@ -131,8 +194,10 @@ TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   ClassQueryParams c;
   c.query = ramp_query(good, QueryMode::kStable);
   c.class_count = 2;
-  c.classes[0] = good_check.wrap(c.query.density);
-  c.classes[1] = flawed_check.wrap(ramp_query(flawed, QueryMode::kStable).density);
+  c.classes[0] = c.query.density;
+  c.classes[1] = ramp_query(flawed, QueryMode::kStable).density;
+  ASSERT_EQ(good_check.wrap(&c.classes[0]), Status::kOk);
+  ASSERT_EQ(flawed_check.wrap(&c.classes[1]), Status::kOk);
   std::vector<QueryPoint> out(1 << 16);
   std::vector<std::uint8_t> classes(out.size());
   std::size_t written = 0;
@@ -150,7 +215,7 @@ TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   ASSERT_EQ(parallel.init(2), Status::kOk);
   DensityCheck check;
   QueryParams q = ramp_query(flawed, QueryMode::kSmooth);
-  q.density = check.wrap(q.density);
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
   ASSERT_EQ(parallel.run(Tileset::builtin(), q, out.data(), out.size(), &written, std_thread_runner()),
             Status::kOk);
   ASSERT_TRUE(check.failed(&f));
@@ -164,7 +229,7 @@ TEST(DensityCheckTest, DescribeCutsToTheBufferAndCountsTheWholeLine) {
   ramp.bad_from = 1, ramp.bad = 2;
   QueryParams q = ramp_query(ramp, QueryMode::kStable);
   DensityCheck check;
-  q.density = check.wrap(q.density);
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
   run_query(q);
   char whole[160], cut[12] = "untouched";
   const std::size_t length = check.describe(whole, sizeof whole);

@@ -1,7 +1,8 @@
 // A debugging aid for density callbacks. A query counts a callback's NaN, infinite and negative values as
-// 0 and treats values above callback_max as the bound (QueryDensity): a bug in a density function or its
-// bound then shows only as too few points somewhere. A DensityCheck wraps a callback density so that the
-// first such value is recorded, with where it was read, for the caller to report after the query.
+// 0, treats values above callback_max as the bound, and trusts its bounds (QueryDensity): a bug in a
+// density function, its bound or its bounds then shows only as too few or too many points somewhere. A
+// DensityCheck routes a callback density through itself and records the first value that does not fit,
+// or bounds that the density breaks, with where, for the caller to report after the query.
 #pragma once
 
 #include <atomic>
@@ -10,6 +11,7 @@
 
 #include "kdm/runtime/export.h"
 #include "kdm/runtime/query.h"
+#include "kdm/runtime/status.h"
 
 namespace kdm {
 
@@ -19,47 +21,64 @@ inline bool density_value_fits(double value, double max) {
   return value >= 0 && value <= max * (1 + 1e-9) && value < HUGE_VAL;
 }
 
-/// What a DensityCheck found: the first value that did not fit, where it was read and the bound it broke.
+/// What a DensityCheck found first.
 struct DensityFinding {
-  double value = 0;     ///< the value returned (NaN, infinite, negative or above `limit`)
-  double x = 0, y = 0;  ///< the world position it was read at
-  double limit = 0;     ///< the wrapped density's callback_max
+  enum class Kind : int {
+    kValue,   ///< the callback returned `value` at (x, y): NaN, infinite, negative or above `limit`
+    kBounds,  ///< the bounds gave [lo, hi] over `rect`, but the density is `value` at (x, y) in it
+  };
+  Kind kind = Kind::kValue;
+  double value = 0;
+  double x = 0, y = 0;            ///< the world position the value was read at
+  double limit = 0;               ///< the wrapped density's callback_max
+  double lo = 0, hi = 0;          ///< kBounds: the bounds given
+  double rect[4] = {0, 0, 0, 0};  ///< kBounds: x0, y0, x1, y1 they were asked for
 };
 
-/// Records the first value a wrapped callback density returns that does not fit (density_value_fits).
-/// Checking costs a comparison per value and one more indirect call per read; the points are those of the
-/// unwrapped density wherever the values fit. Thread-safe: parallel and concurrent queries may share one
-/// check. It must outlive every query using a density it wrapped, at the same address (not copyable).
+/// Records the first value a wrapped callback density returns that does not fit (density_value_fits),
+/// and bounds the density breaks: each bounds call is checked against the density at 9 points of its
+/// rectangle (corners, edge middles and centre), so bounds wrong over a large part of it are found. It
+/// costs a comparison and one more call per value read, and 9 reads per bounds call; the points are those
+/// of the unwrapped density. Thread-safe: parallel and concurrent queries may share one check. It must
+/// outlive every query using a density it wrapped, at the same address (not copyable).
 class KDM_RUNTIME_API DensityCheck {
  public:
   DensityCheck() = default;
   DensityCheck(const DensityCheck&) = delete;
   DensityCheck& operator=(const DensityCheck&) = delete;
 
-  /// `density` with its callback, batch callback and bounds routed through this check (which keeps a copy
-  /// of it): use the result in QueryParams::density or a class query's classes[k]. A density that is not
-  /// a callback (a constant, an image) is returned unchanged. Wrapping again replaces what was wrapped;
-  /// one check per density.
-  QueryDensity wrap(const QueryDensity& density);
+  /// Routes `*density`'s callback, batch callback and bounds through this check, which keeps a copy of
+  /// the density as it is now: wrap it last, once its functions, user and callback_max are final (a user
+  /// pointer set afterwards reaches the check's functions in place of the check). Wrapping the same
+  /// density again (a new QueryParams per chunk with the same functions and user, or the wrapped one
+  /// itself) takes its callback_max. kOk, also for a density that is not a callback (left as it is);
+  /// kInvalidArgument for a null `density`, or another density than the one this check wraps: one check
+  /// per density (a class query's classes each need their own), until reset().
+  Status wrap(QueryDensity* density);
 
-  /// True once a value that does not fit has been read; `*finding` (optional) receives the first.
+  /// True once the check found something; `*finding` (optional) receives the first finding.
   bool failed(DensityFinding* finding = nullptr) const;
 
   /// The finding in one line ("density callback returned nan at (2.5, 7)", "... returned 3 at (1, 1),
-  /// above its bound callback_max 2"), or "no bad density value". Writes at most `size` bytes, NUL
-  /// included, into `text` and returns the whole line's length, as snprintf does. Allocates nothing.
+  /// above its bound callback_max 2", "density bounds gave [0.3, 0.9] over (0, 0) to (8, 8), but the
+  /// density is 0.05 at (4, 8)"), or "no bad density value". Writes at most `size` bytes, NUL included,
+  /// into `text` and returns the whole line's length, as snprintf does. Allocates nothing.
   std::size_t describe(char* text, std::size_t size) const;
 
-  /// Forgets the finding (not while a query using this check runs).
+  /// Forgets the finding and the density wrapped, so that the check can wrap another (densities wrapped
+  /// before must no longer be queried). Not while a query using the check runs.
   void reset();
 
  private:
   static double call(void* user, double x, double y);
   static void call_batch(void* user, std::size_t n, const double* x, const double* y, double* out);
   static void call_bounds(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
+  bool routes(const QueryDensity& density) const;
+  void record(const DensityFinding& finding);
   void check(double value, double x, double y);
 
   QueryDensity inner_;
+  bool wrapping_ = false;
   std::atomic<int> state_{0};  // 0: nothing found; 1: a finding being written; 2: written
   DensityFinding finding_;
 };

@@ -94,7 +94,8 @@ typedef struct kdm_query {
   /* Added in 0.4: optional bounds of the callback's density over a world rectangle (*lo <= density <= *hi
    * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
    * called only where emission is in doubt (kdm::QueryDensity::bounds). NaN bounds, and *lo > *hi, are
-   * ignored; bounds that do not hold make points appear or vanish as if the density were *lo or *hi. */
+   * ignored; bounds that do not hold make points appear or vanish as if the density were *lo or *hi.
+ * Bounds with neither a callback nor an image are refused (KDM_PROBLEM_BAD_DENSITY, "density_callback"). */
   /* *lo and *hi hold NaN when it is called: a callback that writes neither gives no bounds there. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback (set one of the two), the density at n positions at once,
@@ -482,31 +483,39 @@ KDM_RUNTIME_API kdm_status kdm_parallel_query_class_images_compact(
     size_t capacity, size_t* written, size_t* needed, kdm_query_problem* problem);
 
 /* A debugging aid for density callbacks (kdm::DensityCheck). A query counts a callback's NaN, infinite and
- * negative values as 0 and treats values above density_max as density_max, so a bug in a density function
- * or its bound shows only as missing points. A check routes one density's callbacks through itself and
- * records the first value that is not finite, >= 0 and <= density_max, with the position it was read at.
- * It costs a comparison and an extra call per value read; the points are unchanged wherever the values fit.
- * Thread-safe (parallel queries may use it). Added in 0.5. */
+ * negative values as 0, treats values above density_max as density_max and trusts density_bounds, so a
+ * bug in a density function, its bound or its bounds shows only as missing or extra points. A check routes
+ * one density's functions through itself and records the first value that is not finite, >= 0 and <=
+ * density_max, or bounds that the density breaks (checked at 9 points of each rectangle asked), with where.
+ * It costs a comparison and an extra call per value read, 9 reads per bounds call; the points are
+ * unchanged. Thread-safe (parallel queries may use it). Added in 0.5. */
 typedef struct kdm_density_check kdm_density_check;
 
 /* A new check into *out: KDM_OK, KDM_INVALID_ARGUMENT for a NULL `out`, KDM_OUT_OF_MEMORY. */
 KDM_RUNTIME_API kdm_status kdm_density_check_create(kdm_density_check** out);
 /* Frees the check (NULL is ignored); no query may be using a density it wraps. */
 KDM_RUNTIME_API void kdm_density_check_free(kdm_density_check* check);
-/* Routes `query`'s density_callback, density_batch_callback and density_bounds through `check`: query->user
- * becomes the check, which keeps the originals (wrapping again replaces them: one check per density). A
- * query whose density is not a callback (a constant, or an image, which takes precedence) is left as it
- * is. KDM_OK, or KDM_INVALID_ARGUMENT for a NULL argument or a query->struct_size older than the first. */
+/* Routes `query`'s density_callback, density_batch_callback and density_bounds through `check`, which keeps
+ * a copy of them, query->user and density_max as they are now: wrap last, once they are final (a user set
+ * afterwards reaches the check's functions in place of the check). Wrapping the same density again (a new
+ * kdm_query per chunk with the same functions and user, or the wrapped query itself) takes its
+ * density_max. A query whose density is not a callback (a constant, or an image, which takes precedence)
+ * is left as it is. KDM_OK; KDM_INVALID_ARGUMENT for a NULL argument, a query->struct_size older than the
+ * first, or another density than the one the check wraps: one check per density (each class its own),
+ * until kdm_density_check_reset. */
 KDM_RUNTIME_API kdm_status kdm_density_check_wrap_query(kdm_density_check* check, kdm_query* query);
-/* The same for one class's density of kdm_query_classes (one check per class). */
+/* The same for one class's density of kdm_query_classes. */
 KDM_RUNTIME_API kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_density* density);
-/* 1 once a value that does not fit was read, with the first one's value and position in *value, *x, *y
- * (each optional); 0 otherwise (and for a NULL check). */
+/* 1 once the check found something, with the first finding's value and position in *value, *x, *y (each
+ * optional): a value that does not fit, or one outside the bounds given for a rectangle that holds it; 0
+ * otherwise (and for a NULL check). */
 KDM_RUNTIME_API int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y);
 /* The finding in one line ("density callback returned nan at (2.5, 7)", "... returned 3 at (1, 1), above
- * its bound callback_max 2", or "no bad density value"), as kdm_query_problem_describe writes its line. */
+ * its bound callback_max 2", "density bounds gave [0.3, 0.9] over (0, 0) to (8, 8), but the density is
+ * 0.05 at (4, 8)", or "no bad density value"), as kdm_query_problem_describe writes its line. */
 KDM_RUNTIME_API size_t kdm_density_check_describe(const kdm_density_check* check, char* text, size_t size);
-/* Forgets the finding (not while a query using the check runs). */
+/* Forgets the finding and the density wrapped, so that the check can wrap another (densities wrapped before
+ * must no longer be queried). Not while a query using the check runs. */
 KDM_RUNTIME_API void kdm_density_check_reset(kdm_density_check* check);
 
 /* A static English description of `status` / of a problem kind ("unknown ..." for a value not listed). */
