@@ -689,6 +689,12 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   p = problem_of(q);
   ASSERT_EQ(p.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_LT(p.limit, 5.76e17);
+  QueryParams collapsed = q;
+  collapsed.x1 = q.x0 + 64;  // rounds onto x0: refused as too far, not answered as an empty region
+  ASSERT_EQ(collapsed.x1, collapsed.x0);
+  const QueryProblem empty = problem_of(collapsed);
+  EXPECT_EQ(empty.kind, QueryProblem::Kind::kTooFarFromOrigin);
+  EXPECT_STREQ(empty.parameter, "x0");
   q.x0 = 0.9 * p.limit, q.x1 = q.x0 + 256;
   QueryCursor served;
   EXPECT_NE(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &served),

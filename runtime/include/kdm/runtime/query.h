@@ -251,7 +251,8 @@ KDM_RUNTIME_API std::uint64_t query_fingerprint(const QueryParams& params);
 /// written before it is known to be kept). Returns kOk when the region is complete (a finished cursor called
 /// again with the same params gives kOk and no points), kBufferFull when `out` filled up first or the call
 /// examined kMaxQueryCandidates points (and tiles) — call again with the same cursor and params. Empty or
-/// inverted regions and scale 0 give no points. kInvalidArgument, with `problem` (optional) saying which
+/// inverted regions and scale 0 give no points (a region past 9e15 tiles from the world origin, where its
+/// sides round together, is refused as too far). kInvalidArgument, with `problem` (optional) saying which
 /// parameter and limit, for: null arguments, non-finite params, tile_size <= 0, a negative scale, a bad
 /// mode, a missing image or callback (or both callbacks set), a region of more than kMaxQueryTiles tiles,
 /// a density beyond the density limit (scale · max density · tile_size² > query_density_limit: use smaller
