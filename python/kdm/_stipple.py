@@ -78,7 +78,8 @@ def stipple(
         more of the dots lie where the picture asks fewer points per tile than the set's coarsest level
         holds (a set of few levels), they come out clumpy there: a UserWarning says so, as kdm stipple does.
     output : str, os.PathLike or None
-        Also write .png (antialiased dots), .svg (circles) or .txt/.csv (points), as kdm stipple does
+        Also write .png (antialiased dots), .svg (circles, whole within a margin as wide as a dot around the
+        picture, at the PNG's pixel coordinates: a pen plotter's drawing) or .txt/.csv (points), as kdm stipple does
         (another extension, .npy too, is a ValueError: the dots are returned as an array).
     width, dot_size
         The picture's width in pixels (None: 1024, or what `height` makes it), and the dot radius in pixels (None: the size at which the

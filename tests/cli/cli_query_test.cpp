@@ -453,8 +453,16 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
           .status,
       0);
   const std::string printed = slurp(path("p.svg"));
-  EXPECT_NE(printed.find("width=\"150mm\" height=\"100mm\" viewBox=\"0 0 600 400\""), std::string::npos)
+  double x0 = 0, y0 = 0, drawn_w = 0, drawn_h = 0, printed_h = 0;  // the picture within a dot's margin
+  ASSERT_EQ(std::sscanf(printed.c_str() + printed.find("width=\"150mm\""),
+                        "width=\"150mm\" height=\"%lfmm\" viewBox=\"%lf %lf %lf %lf\"", &printed_h, &x0, &y0,
+                        &drawn_w, &drawn_h),
+            5)
       << printed.substr(0, 300);
+  EXPECT_TRUE(x0 == y0 && x0 < 0) << printed.substr(0, 300);
+  EXPECT_NEAR(drawn_w + 2 * x0, 600, 1e-9);
+  EXPECT_NEAR(drawn_h + 2 * x0, 400, 1e-9);
+  EXPECT_NEAR(printed_h, 150 * drawn_h / drawn_w, 1e-6);
   expect_error("stipple " + coffee + " --paper-width 150 -o '" + path("p.svg") + "'", "and a unit");
   expect_error("stipple " + coffee + " --paper-width 0mm -o '" + path("p.svg") + "'",
                "from 0.001 to 1000000");
@@ -631,6 +639,9 @@ TEST_F(CliTest, StippleSvgInPlottingOrder) {
   ASSERT_EQ(run.status, 0) << run.err;
   const std::string svg = slurp(path("p.svg"));
   EXPECT_EQ(svg.find("<rect"), std::string::npos);
+  double r_max = 0;  // the margin around the picture
+  ASSERT_EQ(std::sscanf(svg.c_str() + svg.find("viewBox="), "viewBox=\"%lf", &r_max), 1);
+  r_max = -r_max;
   std::size_t layers = 0;
   for (std::size_t at = svg.find("<g id="); at != std::string::npos;
        at = svg.find("<g id=", at + 1), ++layers) {
@@ -640,7 +651,8 @@ TEST_F(CliTest, StippleSvgInPlottingOrder) {
     for (std::size_t c = group.find("<circle"); c != std::string::npos; c = group.find("<circle", c + 1)) {
       double x = 0, y = 0, r = 0;
       ASSERT_EQ(std::sscanf(group.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
-      EXPECT_TRUE(x - r >= 0 && x + r <= 600 && y - r >= 0 && y + r <= 400) << x << "," << y;
+      EXPECT_TRUE(x - r >= -r_max && x + r <= 600 + r_max && y - r >= -r_max && y + r <= 400 + r_max)
+          << x << "," << y;
       if (dots++) travel += std::hypot(x - px, y - py);
       px = x, py = y;
     }
@@ -654,9 +666,7 @@ TEST_F(CliTest, StippleSvgInPlottingOrder) {
   ASSERT_EQ(
       kdm("stipple '" + path("c.png") + "' --colours rgb --points 2000 -o '" + path("r.svg") + "'").status,
       0);
-  EXPECT_NE(slurp(path("r.svg"))
-                .find("inkscape:label=\"% paper (not plotted)\"><rect width=\"100%\" "
-                      "height=\"100%\" fill=\"#000000\" stroke=\"none\"/>"),
+  EXPECT_NE(slurp(path("r.svg")).find("\" width=\"100%\" height=\"100%\" fill=\"#000000\" stroke=\"none\"/>"),
             std::string::npos);
 }
 
@@ -671,15 +681,19 @@ TEST_F(CliTest, StippleSvgDotsStayInsideAsPrinted) {
                             std::to_string(width) + " -o '" + path("b.svg") + "'");
     ASSERT_EQ(run.status, 0) << run.err;
     const std::string svg = slurp(path("b.svg"));
-    double w = 0, h = 0;
-    ASSERT_EQ(std::sscanf(svg.c_str() + svg.find("viewBox="), "viewBox=\"0 0 %lf %lf\"", &w, &h), 2);
+    double x0 = 0, w = 0, h = 0;  // the drawing: the picture within a margin of -x0
+    ASSERT_EQ(std::sscanf(svg.c_str() + svg.find("viewBox="), "viewBox=\"%lf %*f %lf %lf\"", &x0, &w, &h), 3);
+    ASSERT_LT(x0, 0);
+    w += x0, h += x0;  // the far edges (the near ones at x0)
     std::size_t dots = 0, edge = 0;
     const double near = 0.1 * std::sqrt(w * h / 20000);  // a tenth of the dots' spacing
     for (std::size_t c = svg.find("<circle"); c != std::string::npos;
          c = svg.find("<circle", c + 1), ++dots) {
       double x = 0, y = 0, r = 0;
       ASSERT_EQ(std::sscanf(svg.c_str() + c, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &x, &y, &r), 3);
-      EXPECT_TRUE(x - r >= 0 && x + r <= w && y - r >= 0 && y + r <= h) << x << "," << y << " r " << r;
+      const double ulps = 1e-9;  // of a reader's sums of the printed numbers
+      EXPECT_TRUE(x - r >= x0 - ulps && x + r <= w + ulps && y - r >= x0 - ulps && y + r <= h + ulps)
+          << x << "," << y << " r " << r;
       edge += x + r > w - near || y + r > h - near;
     }
     EXPECT_GT(dots, 19000u);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -207,7 +208,13 @@ TEST_F(CliTest, StipplePictureSidesStayWithinTheirRange) {
     const Outcome fits = kdm("stipple '" + path("tall.png") + "' --height 30000" + out);
     ASSERT_EQ(fits.status, 0) << fits.err;
   }
-  EXPECT_NE(slurp(path("s.svg")).find("width=\"30\" height=\"30000\""), std::string::npos);
+  const std::string svg = slurp(path("s.svg"));
+  double x0 = 0, drawn_w = 0, drawn_h = 0;  // the picture within a margin of -x0 (a dot's radius)
+  ASSERT_EQ(
+      std::sscanf(svg.c_str() + svg.find("viewBox=\""), "viewBox=\"%lf %*f %lf %lf", &x0, &drawn_w, &drawn_h),
+      3);
+  EXPECT_NEAR(drawn_w + 2 * x0, 30, 1e-9);
+  EXPECT_NEAR(drawn_h + 2 * x0, 30000, 1e-9);
   // kdm sample has no --height: its way out is a lower --width, said before the points are placed.
   expect_error("sample -n 100 --aspect 0.01 -o '" + path("s.svg") + "'",
                "a picture of 1024x102400 pixels is too tall (sides 1 to 65536 pixels); lower --width");
@@ -217,10 +224,16 @@ struct Circle {
   double x, y, r;
 };
 
-/// An SVG's picture size (its viewBox) and circles.
-std::vector<Circle> svg_circles(const std::string& svg, double& w, double& h) {
+/// An SVG's circles, and its picture's size: its viewBox less the margin it starts at (-margin, -margin).
+std::vector<Circle> svg_circles(const std::string& svg, double& w, double& h, double* margin = nullptr) {
   std::vector<Circle> circles;
-  std::sscanf(svg.c_str() + svg.find("viewBox=\"0 0 "), "viewBox=\"0 0 %lf %lf", &w, &h);
+  double x0 = 0, y0 = 0, drawn_w = 0, drawn_h = 0;
+  EXPECT_EQ(std::sscanf(svg.c_str() + svg.find("viewBox=\""), "viewBox=\"%lf %lf %lf %lf", &x0, &y0, &drawn_w,
+                        &drawn_h),
+            4);
+  EXPECT_EQ(x0, y0);
+  w = drawn_w + 2 * x0, h = drawn_h + 2 * x0;
+  if (margin) *margin = -x0;
   for (std::size_t at = svg.find("<circle "); at != std::string::npos; at = svg.find("<circle ", at + 1)) {
     Circle c{};
     if (std::sscanf(svg.c_str() + at, "<circle cx=\"%lf\" cy=\"%lf\" r=\"%lf\"", &c.x, &c.y, &c.r) == 3)
@@ -229,40 +242,46 @@ std::vector<Circle> svg_circles(const std::string& svg, double& w, double& h) {
   return circles;
 }
 
-// A plotter's SVG keeps whole circles inside the picture's edge by mapping each axis of the centres onto
-// [R, side - R], not by moving the dots within a radius of the edge onto a line there, which lined the
-// border with crowded dots: on a flat grey, 4-8% of the dots within a spacing of the edge had a neighbour
-// nearer than 0.6 d_hex (seeds 1-3), against about 1.3% inside. Per axis: one factor for both, from the
-// shorter side, left a 20:1 strip's ends blank over 24% of its width.
-TEST_F(CliTest, StippleSvgDotsKeepTheirSpacingAtTheEdge) {
-  write_bytes(path("grey.png"), grey_png(64, 64, 8, std::vector<std::uint16_t>(64 * 64, 128)));
-  for (int seed = 1; seed <= 3; ++seed) {
-    SCOPED_TRACE(seed);
-    const Outcome run = kdm("stipple '" + path("grey.png") + "' --points 5000 --seed " +
-                            std::to_string(seed) + " -o '" + path("g.svg") + "'");
-    ASSERT_EQ(run.status, 0) << run.err;
-    double w = 0, h = 0;
-    const std::vector<Circle> dots = svg_circles(slurp(path("g.svg")), w, h);
-    ASSERT_GT(dots.size(), 4900u);
-    const double spacing = std::sqrt(w * h / double(dots.size())),
-                 d_hex = spacing * std::sqrt(2 / std::sqrt(3.0));
-    std::size_t edge = 0, inside = 0, crowded_edge = 0, crowded_inside = 0;
+// A plotter's SVG keeps whole circles inside the drawing with a margin as wide as the largest dot around
+// the picture, each dot at its point: the circles' centres are the points file's positions in the PNG's
+// pixels (mapping the centres inward, as once, shrank the drawing by 1-3% and by half with large dots,
+// so that it no longer lay over the PNG).
+TEST_F(CliTest, StippleSvgDotsLieAtTheirPointsWithinTheMargin) {
+  write_bytes(path("grey.png"), grey_png(96, 64, 8, std::vector<std::uint16_t>(96 * 64, 128)));
+  for (const char* dot : {"", " --dot-size 40"}) {
+    SCOPED_TRACE(dot);
+    const std::string run = "stipple '" + path("grey.png") + "' --points 3000 --width 600" + dot;
+    ASSERT_EQ(kdm(run + " -o '" + path("g.svg") + "'").status, 0);
+    ASSERT_EQ(kdm(run + " -o '" + path("g.txt") + "'").status, 0);
+    double w = 0, h = 0, margin = 0;
+    const std::vector<Circle> dots = svg_circles(slurp(path("g.svg")), w, h, &margin);
+    EXPECT_NEAR(w, 600, 1e-9);
+    EXPECT_NEAR(h, 400, 1e-9);
+    std::vector<std::pair<double, double>> rows;  // the points file's positions, normalised to [0, 1]^2
+    std::istringstream text(slurp(path("g.txt")));
+    for (std::string line; std::getline(text, line);) {
+      double x = 0, y = 0;
+      if (line[0] != '#' && std::sscanf(line.c_str(), "%lf %lf", &x, &y) == 2) rows.push_back({x, y});
+    }
+    ASSERT_EQ(dots.size(), rows.size());
+    ASSERT_GT(dots.size(), 1000u);
+    double largest = 0;
+    std::vector<std::pair<double, double>> centres, points;
     for (std::size_t i = 0; i < dots.size(); ++i) {
       const Circle& c = dots[i];
-      const double margin = std::min({c.x, c.y, w - c.x, h - c.y});
-      EXPECT_GE(margin, c.r) << c.x << ", " << c.y;  // the whole circle inside
-      double nearest = HUGE_VAL;
-      for (std::size_t j = 0; j < dots.size(); ++j)
-        if (j != i) nearest = std::min(nearest, std::hypot(dots[j].x - c.x, dots[j].y - c.y));
-      const bool crowded = nearest < 0.6 * d_hex;
-      if (margin <= spacing) ++edge, crowded_edge += crowded;
-      if (margin > 2 * spacing) ++inside, crowded_inside += crowded;
+      largest = std::max(largest, c.r);
+      EXPECT_GE(std::min({c.x + margin, c.y + margin, w + margin - c.x, h + margin - c.y}), c.r)
+          << c.x << ", " << c.y;  // the whole circle inside the drawing
+      centres.push_back({c.x, c.y});
+      points.push_back({rows[i].first * w, (1 - rows[i].second) * h});  // y up in the points file
     }
-    ASSERT_GT(edge, 100u);
-    EXPECT_LE(double(crowded_edge) / double(edge),
-              std::max(0.02, 2.0 * double(crowded_inside) / double(inside)))
-        << crowded_edge << " of " << edge << " at the edge, " << crowded_inside << " of " << inside
-        << " inside";
+    EXPECT_EQ(margin, largest);
+    for (std::size_t i = 0; i < points.size(); ++i) {  // a circle at each point, to the 6 digits printed
+      double nearest = HUGE_VAL;
+      for (const auto& c : centres)
+        nearest = std::min(nearest, std::hypot(c.first - points[i].first, c.second - points[i].second));
+      ASSERT_LT(nearest, 0.003) << points[i].first << ", " << points[i].second;
+    }
   }
 }
 

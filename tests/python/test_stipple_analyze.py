@@ -21,7 +21,11 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     cli("stipple", SPHERE, "--points", 2000, "--paper-width", "7.5in", "-o", tmp_path / "cli.svg")
     kdm.stipple(str(SPHERE), points=2000, paper_width="7.5in", output=tmp_path / "py.svg")
     assert (tmp_path / "py.svg").read_bytes() == (tmp_path / "cli.svg").read_bytes()
-    assert b'width="7.5in" height="7.5in" viewBox="0 0 1024 1024"' in (tmp_path / "py.svg").read_bytes()
+    # The picture's 1024 x 1024 pixels within a dot's margin, printed 7.5 in wide.
+    svg = (tmp_path / "py.svg").read_text()
+    assert 'width="7.5in" height="7.5in" viewBox="-' in svg
+    x0, y0, w, h = (float(v) for v in svg.split('viewBox="')[1].split('"')[0].split())
+    assert x0 == y0 and 0 < -x0 < 10 and w + 2 * x0 == pytest.approx(1024) and h + 2 * x0 == pytest.approx(1024)
     # A picture sized by its height, as --height sizes it.
     cli("stipple", SPHERE, "--points", 2000, "--height", 300, "--region", "0,0,1,0.5", "-o", tmp_path / "cli.png")
     kdm.stipple(str(SPHERE), points=2000, height=300, region=(0, 0, 1, 0.5), output=tmp_path / "py.png")

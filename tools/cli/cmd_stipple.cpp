@@ -344,13 +344,15 @@ void add_stipple_command(CLI::App& app) {
          "in all (16384x16384): a picture larger than its dots need (about 4096x4096, or 64 pixels per dot, "
          "times the zoom squared; at most 2^26) is averaged down as it is read. '-': standard input")
       ->required();
-  cmd->add_option("-o,--output", a->output,
-                  "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
-                  "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...; - for standard "
-                  "output (with --format). For pen plotters, .svg has an Inkscape layer per ink, its dots in "
-                  "drawing order (each the nearest not yet drawn: short pen travel) and inside the picture's "
-                  "edge; white paper is no element (nothing to trace as a frame), other paper (rgb's black) "
-                  "a layer '% paper (not plotted)' that AxiDraw skips: hide it in other plotter software")
+  cmd->add_option(
+         "-o,--output", a->output,
+         "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
+         "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...; - for standard "
+         "output (with --format). For pen plotters, .svg has an Inkscape layer per ink, its dots in "
+         "drawing order (each the nearest not yet drawn: short pen travel), every dot whole within a "
+         "margin as wide as a dot around the picture (coordinates are the PNG's pixels); white paper is no "
+         "element (nothing to trace as a frame), other paper (rgb's black) "
+         "a layer '% paper (not plotted)' that AxiDraw skips: hide it in other plotter software")
       ->required();
   add_format_option(cmd, a->format, kStippleFormats);
   add_count_option(

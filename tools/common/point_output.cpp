@@ -32,15 +32,16 @@ double as_printed(double v) {
   return std::strtod(number(v).c_str(), nullptr);
 }
 
-/// A dot's centre `v` (in [r, side − r]) such that the printed circle, centre and radius as a reader
-/// parses them, lies within [0, side]: rounding to 6 digits could carry it past the edge by thousandths of
-/// a pixel, so there it is moved in by the last printed digit while it does. Other centres are kept.
-double printed_inside(double v, double side, double printed_r) {
+/// A dot's centre `v` (in [lo + r, hi − r], v >= 0) such that the printed circle, centre and radius as a
+/// reader parses them, lies within [lo, hi]: rounding to 6 digits could carry it past the edge by
+/// thousandths of a pixel, so there it is moved in by the last printed digit while it does. Other centres
+/// are kept.
+double printed_within(double v, double lo, double hi, double printed_r) {
   double p = as_printed(v);
-  if (p - printed_r >= 0 && p + printed_r <= side) return v;
-  for (int step = 0; step < 4 && p > 0 && (p - printed_r < 0 || p + printed_r > side); ++step) {
+  if (p - printed_r >= lo && p + printed_r <= hi) return v;
+  for (int step = 0; step < 4 && p > 0 && (p - printed_r < lo || p + printed_r > hi); ++step) {
     const double digit = std::pow(10.0, std::floor(std::log10(p)) - 5);
-    p = as_printed(p - printed_r < 0 ? p + digit : p - digit);
+    p = as_printed(p - printed_r < lo ? p + digit : p - digit);
   }
   return p;
 }
@@ -218,7 +219,7 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   const int w = std::max(1, style.width_px);
   const int h = check_picture_size(style.width_px, style.aspect, path, ext, style.height_px);
   const double r = style.dot_radius_px > 0 ? style.dot_radius_px : auto_radius(points, w, h);
-  if (svg && style.dots_inside && !(r <= max_dot_radius(w, h)))  // the dots would crowd into the middle
+  if (svg && style.dots_inside && !(r <= max_dot_radius(w, h)))  // margins half the picture wide
     throw std::invalid_argument("a dot radius of " + number(r) + " pixels is more than a quarter of the " +
                                 std::to_string(w) + "x" + std::to_string(h) + " picture's shorter side (" +
                                 number(max_dot_radius(w, h)) + " pixels)");
@@ -263,40 +264,47 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
   // element at all (a plotter would trace a rectangle's outline as a frame); paper of another colour is a
   // rectangle in a layer of its own whose name starts with % (AxiDraw's mark for a layer it does not plot;
   // hide it in other plotter software).
-  std::string width = std::to_string(w), height = std::to_string(h);
+  // For a plotter, a margin as wide as the largest dot around the picture holds every whole circle, each
+  // at its point: the drawing's coordinates stay the PNG's pixels (the viewBox starts at -margin).
+  double largest = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) largest = std::max(largest, radius(i));
+  const double margin = style.dots_inside ? as_printed(largest) : 0.0;
+  char text[64];
+  const auto print = [&](const char* format, double v, const char* unit = "") {
+    std::snprintf(text, sizeof text, format, v, unit);
+    return std::string(text);
+  };
+  const double drawn_w = w + 2 * margin, drawn_h = h + 2 * margin;
+  std::string width = print("%.10g%s", drawn_w), height = print("%.10g%s", drawn_h);
   if (!style.paper_width.empty()) {  // the same drawing, printed at a size: a plotter's or printer's units
     check_paper_width(style.paper_width);
     double value = 0;
     std::string unit;
     parse_paper_width(style.paper_width, value, unit);
-    char text[64];
-    std::snprintf(text, sizeof text, "%.10g%s", value, unit.c_str());
-    width = text;
-    std::snprintf(text, sizeof text, "%.10g%s", value * h / w, unit.c_str());
-    height = text;
+    width = print("%.10g%s", value, unit.c_str());
+    height = print("%.10g%s", value * drawn_h / drawn_w, unit.c_str());
   }
+  const std::string view_box = print("%.10g", margin > 0 ? -margin : 0.0) + ' ' +
+                               print("%.10g", margin > 0 ? -margin : 0.0) + ' ' + print("%.10g", drawn_w) +
+                               ' ' + print("%.10g", drawn_h);
   Ink paper;
   std::copy(style.background, style.background + 3, paper.rgb);
   const bool white = paper.hex() == "#ffffff";
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" "
          "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\""
-      << width << "\" height=\"" << height << "\" viewBox=\"0 0 " << w << ' ' << h << "\""
+      << width << "\" height=\"" << height << "\" viewBox=\"" << view_box << "\""
       << (white ? "" : " style=\"background-color:" + paper.hex() + "\"") << ">\n";
   for (const std::string& line : header) out << "<!-- " << comment_safe(line) << " -->\n";
   const auto layer = [&](const std::string& name, const std::string& label) {
     return "<g id=\"" + name + "\" inkscape:groupmode=\"layer\" inkscape:label=\"" + label + "\"";
   };
   if (!white)
-    out << layer("paper", "% paper (not plotted)") << "><rect width=\"100%\" height=\"100%\" fill=\""
+    out << layer("paper", "% paper (not plotted)") << "><rect x=\"" << view_box.substr(0, view_box.find(' '))
+        << "\" y=\"" << view_box.substr(0, view_box.find(' ')) << "\" width=\"100%\" height=\"100%\" fill=\""
         << paper.hex() << "\" stroke=\"none\"/></g>\n";
   out.precision(6);        // as number() prints
   std::vector<double> xy;  // a layer's dot centres in the picture's pixels
   std::vector<double> radii;
-  // Clamping each centre into [r, side − r] lined the edge with the dots within r of it; mapping each axis
-  // onto [R, side − R] (R the largest radius) keeps the blue noise's spacing there too. Per axis, not one
-  // factor for both, which left a long picture's ends blank (a 20:1 strip lost a quarter of its width).
-  double largest = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) largest = std::max(largest, radius(i));
   for (const std::size_t k : order) {
     const char* blend = style.blend == Blend::kMultiply ? " style=\"mix-blend-mode:multiply\""
                         : style.blend == Blend::kAdd    ? " style=\"mix-blend-mode:screen\""
@@ -307,10 +315,10 @@ void write_points(const std::string& path, const PointSet& points, const std::ve
     for (std::size_t i = 0; i < points.size(); ++i)
       if ((!classed || (*style.classes)[i] == k) && radius(i) > 0) {
         const double ri = radius(i);
-        const auto inside = [&](double v, double side) {
-          if (!style.dots_inside) return v;
-          const double drawn_in = largest + v * (1 - 2 * largest / side);  // (a point past [0, 1] clamped)
-          return printed_inside(std::clamp(drawn_in, ri, side - ri), side, as_printed(ri));
+        const auto inside = [&](double v, double side) {  // (a point past [0, 1] clamped onto the edge)
+          return style.dots_inside
+                     ? printed_within(std::clamp(v, 0.0, side), -margin, side + margin, as_printed(ri))
+                     : v;
         };
         xy.push_back(inside(points.coords[2 * i] * w, w));
         xy.push_back(inside((1 - points.coords[2 * i + 1]) * h, h));

@@ -40,15 +40,16 @@ struct DrawStyle {
   /// SVG only: the printed width, a number > 0 and a unit (mm, cm, in, pt, pc or px: "180mm"), the height
   /// in proportion; empty: width_px pixels. The drawing keeps its pixel coordinates (viewBox).
   std::string paper_width;
-  /// SVG only: every whole circle inside the picture's edge, its numbers as printed (a pen plotter draws
-  /// no further than the paper): each axis of the dots' centres is mapped from [0, side] onto [R, side −
-  /// R] (R the largest dot's radius, at most max_dot_radius), which keeps their spacing even up to the
-  /// edge and leaves a margin of R on every side. Off: every dot at its point.
+  /// SVG only: every whole circle inside the drawing, its numbers as printed (a pen plotter draws no
+  /// further than the paper): the drawing is the picture with a margin of R on every side (R the largest
+  /// dot's radius, at most max_dot_radius), its viewBox from (-R, -R), so that every dot stays at its
+  /// point in the PNG's pixel coordinates; the printed width (paper_width) is the whole drawing's. Off: the
+  /// picture alone, dots cut at its edge.
   bool dots_inside = false;
 };
 
-/// The largest dot radius a picture of `width_px` × `height_px` draws inside its edge (DrawStyle::
-/// dots_inside): a quarter of its shorter side, in pixels.
+/// The largest dot radius a plotter's SVG of a `width_px` × `height_px` picture takes (DrawStyle::
+/// dots_inside, whose margins are as wide): a quarter of its shorter side, in pixels.
 double max_dot_radius(int width_px, int height_px);
 
 /// An order of the points `xy` (x, y pairs) for a pen plotter's short travel: from the point nearest the
