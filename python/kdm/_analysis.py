@@ -47,6 +47,7 @@ def _class_densities(class_densities: Any, gamma: Any, invert: Any) -> List[Any]
     for k, d in enumerate(class_densities):
         name = f"class_densities[{k}]"
         if callable(d) and not isinstance(d, (np.ndarray, str)):
+            _checks.density_function(name, d, 2, None)  # classes are 2-D points' labels
             out.append(d)
             continue
         text = isinstance(d, (str, os.PathLike))
@@ -227,6 +228,8 @@ def analyze(
         function, spec = density, None
     else:
         spec = _checks.sampler_density(density, gamma, invert)
+    if function is not None:  # called with the points' coordinates
+        _checks.density_function("density", function, sets[0].shape[1], None)
     tile = 0.0 if tile_size is None else _checks.number("tile_size", tile_size, 0.0, strict=True)
     fmax = _checks.number("fmax", fmax, 0.0, strict=True)
     threads = _checks.threads(threads)

@@ -430,9 +430,10 @@ def other_name(wrong: str, right: str, why: str) -> Callable:
     return wrap
 
 
-def density_function(name: str, f: Any, dim: int, dim_name: str = "dim") -> None:
+def density_function(name: str, f: Any, dim: int, dim_name: Optional[str] = "dim") -> None:
     """Refuses (TypeError) a callable density that cannot take `dim` coordinates, f(x, y) or f(x, y, z), by
-    its signature before any call: a TypeError raised inside a callable that takes them stays its own."""
+    its signature before any call: a TypeError raised inside a callable that takes them stays its own.
+    `dim_name` names the argument that sets the dimension (None: the caller has none)."""
     try:
         signature = inspect.signature(f)
     except (TypeError, ValueError):  # some builtins have none to read: their calls will tell
@@ -441,8 +442,9 @@ def density_function(name: str, f: Any, dim: int, dim_name: str = "dim") -> None
         signature.bind(*([0.0] * dim))
     except TypeError:
         call = "f(x, y, z)" if dim == 3 else "f(x, y)"
-        raise TypeError(f"{name}: with {dim_name}={dim} the density is called as {call}, with {dim} "
-                        f"coordinates, but this callable takes {signature}") from None
+        given = f"with {dim_name}={dim} " if dim_name else ""
+        raise TypeError(f"{name}: {given}the density is called as {call}, with {dim} coordinates, but this "
+                        f"callable takes {signature}") from None
 
 
 def class_specs(classes: Any, gamma: Any, invert: Any) -> list:

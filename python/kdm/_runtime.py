@@ -561,6 +561,7 @@ def _class_args(classes: Any, gamma: Any, invert: Any, density_max: Any,
             bound = density_max[k] if per_class else density_max
             if bound is None:
                 raise ValueError(f"{name} is a callable: density_max must give an upper bound of its values")
+            _checks.density_function(name, d, 2, None)
             specs.append(_kdm.DensitySpec.constant(0.0))
             callables.append(d)
             maxima.append(_checks.number(f"density_max[{k}]" if per_class else "density_max", bound, 0.0,
@@ -594,6 +595,7 @@ def _density_arg(density: Any, gamma: Any, invert: Any) -> Tuple[Any, Any, Any]:
             raise ValueError("gamma and invert are the DensityMap's own: give them to DensityMap()")
         return density._spec, None, density._ready
     if _is_callable(density):
+        _checks.density_function("density", density, 2, None)
         return None, density, None
     spec = _checks.density_spec(density, gamma, invert, callable_ok=True)
     return (spec if spec is not None else _kdm.DensitySpec.constant(1.0)), None, None

@@ -79,6 +79,16 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
   }
   gen::Density target = gen::Density::constant();
   std::unique_ptr<PythonDensity> function_density;
+  if (density && !sets.empty()) {  // as kdm analyze --density refuses them
+    const bool volume = density->kind == tools::DensitySpec::Kind::kVolume;
+    if (volume && sets[0].dim != 3)
+      throw std::invalid_argument("density is a 3-D volume, and the points are " +
+                                  std::to_string(sets[0].dim) + "-D");
+    if (density->kind == tools::DensitySpec::Kind::kImage && sets[0].dim != 2)
+      throw std::invalid_argument("density is a 2-D image, and the points are " +
+                                  std::to_string(sets[0].dim) +
+                                  "-D: give a 3-D array (depth, rows, columns) or a function");
+  }
   if (density) {
     target = tools::to_generator_density(*density);
   } else if (!function.is_none()) {

@@ -157,8 +157,12 @@ def test_an_exception_in_the_callable_propagates():
         BUILTIN.query((0, 0, 2, 2), scale=100, density=f, density_max=1)
     with pytest.raises(TypeError, match=r"density callable returned str at \(.*\): a density must be a real number"):
         BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x, y: "dense", density_max=1)
-    with pytest.raises(TypeError):
+    # A callable of the wrong arity is told by its signature, before any call, as kdm.sample tells it.
+    with pytest.raises(TypeError, match=r"density: the density is called as f\(x, y\), with 2 coordinates, "
+                                        r"but this callable takes \(x\)"):
         BUILTIN.query((0, 0, 2, 2), scale=100, density=lambda x: 1.0, density_max=1)
+    with pytest.raises(TypeError, match=r"classes\[1\]: the density is called as f\(x, y\)"):
+        BUILTIN.query((0, 0, 2, 2), scale=100, classes=[1.0, lambda x, y, z: 1.0], density_max=[None, 1])
     # Still usable afterwards.
     assert len(BUILTIN.query((0, 0, 1, 1), scale=100)) > 0
 

@@ -441,6 +441,10 @@ def test_analyze_options_and_several_sets(gradient_png):
     wrong = kdm.analyze(sets[0], box=True, density=np.ones((2, 2)), energy=False)
     assert wrong["density"]["rms_z"] > 1.5
     assert kdm.analyze(kdm.sample(1000, dim=3), energy=False)["dim"] == 3
+    # A density of the other dimension is refused, as kdm analyze --density refuses it (a volume was read
+    # as its middle slice).
+    with pytest.raises(ValueError, match="density is a 3-D volume, and the points are 2-D"):
+        kdm.analyze(sets[0], density=np.ones((2, 3, 4)), energy=False)
     # Blue noise against random points: δmin far apart. (Seeds 1..10 at n = 2000: 0.53 to 0.70 for kdm,
     # 0.008 to 0.026 for uniform random points.)
     rng = np.random.default_rng(0)
@@ -463,6 +467,8 @@ def test_analyze_takes_a_function_as_the_density(gradient_png):
         kdm.analyze(points, density=lambda x, y: 1 / 0, energy=False)
     with pytest.raises(ValueError, match="density callable returned nan"):
         kdm.analyze(points, density=lambda x, y: float("nan"), energy=False)
+    with pytest.raises(TypeError, match=r"density: the density is called as f\(x, y\), with 2 coordinates"):
+        kdm.analyze(points, density=lambda x: 1.0, energy=False)
     with pytest.raises(ValueError, match="gamma and invert apply to image files only"):
         kdm.analyze(points, density=ramp, invert=True)
     # The bands and the holes' density floor need a density: without one they would do nothing.
@@ -507,7 +513,8 @@ def test_analyze_skips_the_2d_diagnostics_of_3d_points():
         function = kdm.analyze(p, density=lambda x, y, z: 100.0 ** -x, threads=1)
     assert given["energy_per_point"] == pytest.approx(function["energy_per_point"], rel=1e-6)
     assert given["energy_per_point"] < 0.5 * plain["energy_per_point"]  # measured: 1.6 against 15.9
-    with pytest.warns(UserWarning, match="2D only"), pytest.raises(ValueError, match="2D"):
+    with pytest.warns(UserWarning, match="2D only"), pytest.raises(
+            ValueError, match="density is a 2-D image, and the points are 3-D: give a 3-D array"):
         kdm.analyze(p, density=np.array([[1.0, 0.01]]), threads=1)
 
 
