@@ -50,7 +50,7 @@ def temperature(value: Any) -> float:
     value = number("temperature", value, 0.0)
     if value > 1000:
         raise ValueError("temperature must be at most 1000: past it nearly every move is refused and the points "
-                         "keep their starting places (300 already gives white noise)")
+                         "keep their starting places (100 and up already give near white noise)")
     return value
 
 

@@ -78,7 +78,7 @@ class BlueNoise(_Base):  # type: ignore[valid-type, misc]
     Each ``random(n)`` returns `n` fresh points (a whole set drawn with a new seed taken from the engine's
     generator, so it is blue noise by itself); ``reset()`` replays the same sets; ``fast_forward(n)``
     skips one set of n (its seed; its points are never computed). Points lie in [0, 1)^d, in the
-    sampler's order (kdm.sample: a prefix of a set is a patch of the domain). An engine pickles and
+    sampler's order (kdm.sample: a prefix of a set is a few patches of the domain, not a thinner set). An engine pickles and
     copies (a process pool's workers get it): its density is read again where it is unpickled, so an
     image file must be there too. A copy (``copy.copy``, ``copy.deepcopy`` or a pickle) is an engine of
     its own, its generator a copy at the same state: it draws the sets the original would draw next, so

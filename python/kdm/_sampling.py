@@ -126,7 +126,7 @@ def sample(
     numpy.ndarray
         (n, dim) float64 in [0, 1)^dim: the same bits as ``kdm sample`` with the same arguments. Rows come
         in the sampler's order, cell by cell of its grid, so neighbouring rows are neighbouring points: a
-        prefix ``x[:k]`` is a patch of the domain, not a thinner set (for k points, sample k; for a random
+        prefix ``x[:k]`` is a few patches of the domain (cells of the grid), not a thinner set (for k points, sample k; for a random
         subset, index by ``rng.permutation(n)[:k]``). With `classes`: ``(points, labels)``, the points
         (n, 2) class 0's first and labels (n,) uint8 each point's class. With `sets`: (sets, n, dim),
         ``x[k]`` the set of seed ``seed + k``.

@@ -1,17 +1,21 @@
 // Density callbacks checked as queries read them (density_check.h).
 #include "kdm/runtime/density_check.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace kdm {
 namespace {
 
-/// `v` in the fewest significant digits that read back as `v` (into a buffer of 32).
+/// `v` in the fewest significant digits that read back as `v` (into a buffer of 32), without an exponent
+/// from 10^-4 to 10^15 (50, not 5e+01).
 const char* shortest(double v, char (&text)[32]) {
+  const bool plain = std::fabs(v) >= 1e-4 && std::fabs(v) < 1e15;
   for (int digits = 1; digits <= 17; ++digits) {
     std::snprintf(text, sizeof text, "%.*g", digits, v);
-    if (std::strtod(text, nullptr) == v) break;
+    if (std::strtod(text, nullptr) == v && !(plain && std::strchr(text, 'e'))) break;
   }
   return text;  // NaN never reads back equal: printed as "nan" at 17 digits, the same text
 }
@@ -50,6 +54,10 @@ void DensityCheck::record(const DensityFinding& finding) {
 }
 
 void DensityCheck::check(double value, double x, double y) {
+  double seen = largest_.load(std::memory_order_relaxed);
+  while (value > seen && value < HUGE_VAL &&
+         !largest_.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+  }
   if (density_value_fits(value, inner_.callback_max)) return;
   DensityFinding f;
   f.value = value, f.x = x, f.y = y, f.limit = inner_.callback_max;
@@ -110,6 +118,12 @@ std::size_t DensityCheck::describe(char* text, std::size_t size) const {
   int n;
   if (!failed(&f)) {
     n = std::snprintf(line, sizeof line, "no bad density value");
+    const double most = largest();
+    if (most >= 0 && most < 0.5 * inner_.callback_max)
+      n += std::snprintf(line + n, sizeof line - std::size_t(n),
+                         "; the largest value read, %s, is under half of callback_max %s: a tighter bound "
+                         "makes queries faster",
+                         shortest(most, n0), shortest(inner_.callback_max, n1));
   } else if (f.kind == DensityFinding::Kind::kBounds) {
     n = std::snprintf(
         line, sizeof line,
@@ -130,6 +144,7 @@ std::size_t DensityCheck::describe(char* text, std::size_t size) const {
 
 void DensityCheck::reset() {
   wrapping_ = false;
+  largest_.store(-1, std::memory_order_relaxed);
   state_.store(0, std::memory_order_release);
 }
 

@@ -868,6 +868,10 @@ int kdm_density_check_failed(const kdm_density_check* check, double* value, doub
   return 1;
 }
 
+double kdm_density_check_largest(const kdm_density_check* check) {
+  return check ? check->check.largest() : -1;
+}
+
 size_t kdm_density_check_describe(const kdm_density_check* check, char* text, size_t size) {
   if (check) return check->check.describe(text, size);
   const char line[] = "no density check ('check' is NULL)";

@@ -463,6 +463,7 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, checked, 4096, &n_checked, &cursor, NULL) == KDM_OK);
     CHECK(n_bare > 300 && n_bare == n_checked && memcmp(bare, checked, n_bare * sizeof(kdm_point)) == 0);
     CHECK(kdm_density_check_failed(check, &value, &x, &y) == 0);
+    CHECK(kdm_density_check_largest(check) == 0.5 && kdm_density_check_largest(NULL) == -1);
     kdm_density_check_describe(check, line, sizeof line);
     CHECK(strcmp(line, "no bad density value") == 0);
     bad = NAN; /* the same wrapped query, now with a flaw */

@@ -93,6 +93,27 @@ TEST(DensityCheckTest, TheFirstBadValueIsRecordedWithItsPosition) {
   }
 }
 
+// A bound far above every value costs speed, not points: the check says what the values reach.
+TEST(DensityCheckTest, TheLargestValueReadShowsALooseBound) {
+  Ramp ramp;
+  QueryParams q = ramp_query(ramp, QueryMode::kStable);
+  q.density.callback_max = 50, q.scale = 500;  // within the set's density limit at the bound
+  DensityCheck check;
+  EXPECT_EQ(check.largest(), -1);
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
+  run_query(q);
+  EXPECT_FALSE(check.failed());
+  EXPECT_GT(check.largest(), 0.95);  // the ramp reaches 0.25 + 6/8 = 1 at the region's right side
+  EXPECT_LE(check.largest(), 1.0);
+  char line[240];
+  check.describe(line, sizeof line);
+  EXPECT_EQ(std::string(line).rfind("no bad density value; the largest value read, 0.9", 0), 0u) << line;
+  EXPECT_NE(std::string(line).find("is under half of callback_max 50: a tighter bound"), std::string::npos)
+      << line;
+  check.reset();
+  EXPECT_EQ(check.largest(), -1);
+}
+
 TEST(DensityCheckTest, AValueWithinRoundingOfTheBoundFits) {
   EXPECT_TRUE(density_value_fits(1 + 1e-12, 1));
   EXPECT_FALSE(density_value_fits(1 + 1e-6, 1));

@@ -314,7 +314,7 @@ void validate_options(const SamplerOptions& o) {
   if (o.temperature > kMaxTemperature)
     throw InvalidArgument(
         "temperature must be at most 1000: past it nearly every move is refused and the "
-        "points keep their starting places (300 already gives white noise)");
+        "points keep their starting places (100 and up already give near white noise)");
   if (!(std::isfinite(o.step) && o.step >= 0)) throw InvalidArgument("step must be a finite number >= 0");
   if (!(o.peak_density > 0 && o.peak_density <= 1)) throw InvalidArgument("peak density must be in (0, 1]");
   if (!(o.sigma_max == 0 || o.sigma_max >= 1))

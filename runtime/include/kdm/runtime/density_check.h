@@ -59,9 +59,15 @@ class KDM_RUNTIME_API DensityCheck {
   /// True once the check found something; `*finding` (optional) receives the first finding.
   bool failed(DensityFinding* finding = nullptr) const;
 
+  /// The largest finite value read so far (-1 before any): far under callback_max, a tighter bound lets
+  /// queries skip more candidates (one of 50 where the values reach 1 made a query 35 times slower).
+  double largest() const { return largest_.load(std::memory_order_relaxed); }
+
   /// The finding in one line ("density callback returned nan at (2.5, 7)", "... returned 3 at (1, 1),
   /// above its bound callback_max 2", "density bounds gave [0.3, 0.9] over (0, 0) to (8, 8), but the
-  /// density is 0.05 at (4, 8)"), or "no bad density value". Writes at most `size` bytes, NUL included,
+  /// density is 0.05 at (4, 8)"), or "no bad density value", followed where the largest value read is
+  /// under half the bound by "; the largest value read, 0.9, is under half of callback_max 50: a tighter
+  /// bound makes queries faster". Writes at most `size` bytes, NUL included,
   /// into `text` and returns the whole line's length, as snprintf does. Allocates nothing.
   std::size_t describe(char* text, std::size_t size) const;
 
@@ -80,6 +86,7 @@ class KDM_RUNTIME_API DensityCheck {
   QueryDensity inner_;
   bool wrapping_ = false;
   std::atomic<int> state_{0};  // 0: nothing found; 1: a finding being written; 2: written
+  std::atomic<double> largest_{-1};
   DensityFinding finding_;
 };
 

@@ -510,9 +510,13 @@ KDM_RUNTIME_API kdm_status kdm_density_check_wrap_class(kdm_density_check* check
  * optional): a value that does not fit, or one outside the bounds given for a rectangle that holds it; 0
  * otherwise (and for a NULL check). */
 KDM_RUNTIME_API int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y);
+/* The largest finite value the check has read (-1 before any, and for a NULL check): far under
+ * density_max, a tighter bound lets queries skip more candidates. */
+KDM_RUNTIME_API double kdm_density_check_largest(const kdm_density_check* check);
 /* The finding in one line ("density callback returned nan at (2.5, 7)", "... returned 3 at (1, 1), above
  * its bound callback_max 2", "density bounds gave [0.3, 0.9] over (0, 0) to (8, 8), but the density is
- * 0.05 at (4, 8)", or "no bad density value"), as kdm_query_problem_describe writes its line. */
+ * 0.05 at (4, 8)", or "no bad density value", with a hint where the largest value read is under half of
+ * density_max), as kdm_query_problem_describe writes its line. */
 KDM_RUNTIME_API size_t kdm_density_check_describe(const kdm_density_check* check, char* text, size_t size);
 /* Forgets the finding and the density wrapped, so that the check can wrap another (densities wrapped before
  * must no longer be queried). Not while a query using the check runs. */
