@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "kdm/runtime/density_check.h"
 #include "kdm/runtime/query.h"
 
 namespace kdm {
@@ -97,6 +98,42 @@ TEST(ConcurrencyTest, ThreadsQueryingOneTilesetMatchASingleThreadedRun) {
     EXPECT_GT(reference.size(), 1000u) << "case " << c;
     for (int t = 0; t < kThreads; ++t) EXPECT_TRUE(got[t][c] == reference) << "thread " << t << " case " << c;
   }
+}
+
+// NaN from x = 1 on: every thread finds it through one shared check, which keeps one whole finding.
+double flawed_wave(void* user, double x, double y) {
+  return x >= 1 ? std::nan("") : wave(user, x, y);
+}
+
+TEST(ConcurrencyTest, ThreadsShareOneDensityCheck) {
+  const double frequency = 2.5;
+  QueryParams q;
+  q.x0 = -1, q.y0 = -1, q.x1 = 2, q.y1 = 1;
+  q.scale = 4000;
+  q.density.kind = QueryDensity::Kind::kCallback;
+  q.density.callback = flawed_wave;
+  q.density.user = const_cast<double*>(&frequency);
+  q.density.callback_max = 1;
+  const std::vector<Emitted> bare = run(q);
+  DensityCheck check;
+  ASSERT_EQ(check.wrap(&q.density), Status::kOk);
+  constexpr int kThreads = 4;
+  std::atomic<bool> go{false};
+  std::vector<std::vector<Emitted>> got(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      while (!go.load()) std::this_thread::yield();
+      got[t] = run(q);
+    });
+  go = true;
+  for (std::thread& th : threads) th.join();
+  for (int t = 0; t < kThreads; ++t) EXPECT_TRUE(got[t] == bare) << "thread " << t;
+  DensityFinding f;
+  ASSERT_TRUE(check.failed(&f));
+  EXPECT_TRUE(std::isnan(f.value));
+  EXPECT_GE(f.x, 1);
+  EXPECT_GT(check.largest(), 0.5);
 }
 
 }  // namespace
