@@ -371,6 +371,24 @@ double density_bound(const QueryDensity& d, const QueryParams& q) {
   return d.callback_max;
 }
 
+/// The largest value density `d` takes anywhere (an image's over its whole rectangle, a callback's bound).
+double density_peak(const QueryDensity& d) {
+  if (d.kind == QueryDensity::Kind::kImage)
+    return d.image->max_over(d.image->x0, d.image->y0, d.image->x1, d.image->y1);
+  return density_bound(d, QueryParams{});
+}
+
+/// Warns (UserWarning) as kdm query does where the tile size is too small for the density's peak,
+/// `peak`, unless the region is empty. `level` frames up is the caller's line (the package's methods call
+/// these functions one or two frames below it).
+void warn_tile_size(const Tileset& set, double peak, const QueryParams& q, int level) {
+  if (!(q.x1 > q.x0 && q.y1 > q.y0)) return;
+  const std::string text =
+      tools::tile_size_warning(tile_size_advice(set, peak, q.scale, q.tile_size), "tile_size");
+  if (!text.empty() && PyErr_WarnEx(PyExc_UserWarning, text.c_str(), level) < 0)
+    throw py::error_already_set();
+}
+
 /// Room for a parallel query's points at density `rho` (a bound), with a margin for smooth mode's glide;
 /// ParallelQuery then says exactly what it needs if that was short.
 std::size_t room_for(double rho, const QueryParams& q) {
@@ -417,6 +435,7 @@ py::tuple query(const TilesetHandle& handle, const Rect& rect, double scale, con
           std::move(bounds), density_rect, density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
+  warn_tile_size(*handle.set, density_peak(q.density), q, 2);
   const std::unique_ptr<CallableDensity>& from_callable = prepared.from_callable;
   const Storage out(storage);
   Buffer buffer;  // an earlier result's memory while it has room, else new memory
@@ -494,6 +513,7 @@ py::tuple positions(const TilesetHandle& handle, const Rect& rect, double scale,
           std::move(bounds), density_rect, density_max, tile_size, mode, origin, threads);
   const QueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
+  warn_tile_size(*handle.set, density_peak(q.density), q, 2);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   const std::size_t m = fill_compact(
@@ -629,6 +649,13 @@ void prepare_classes(PreparedClasses& prepared, const Rect& rect, double scale,
   if (cache->used) q.image_sums = &cache->sums;
 }
 
+/// The largest the classes' summed density can be (their peaks summed).
+double classes_peak(const ClassQueryParams& q) {
+  double peak = 0;
+  for (std::uint32_t k = 0; k < q.class_count; ++k) peak += density_peak(q.classes[k]);
+  return peak;
+}
+
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
 /// query() returns them, then each point's class. New memory every call (no `storage`).
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
@@ -640,6 +667,7 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, ready, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin, threads);
+  warn_tile_size(*handle.set, classes_peak(prepared.q), prepared.q.query, 3);  // via _query_classes
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
@@ -685,6 +713,7 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
                   tile_size, mode, origin, threads);
   const ClassQueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
+  warn_tile_size(*handle.set, classes_peak(q), q.query, 2);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;

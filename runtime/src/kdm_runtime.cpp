@@ -208,6 +208,8 @@ kdm_status with_cursor(kdm_cursor* cursor, Query&& query) {
 
 static_assert(static_cast<int>(kdm::Status::kOutOfMemory) == KDM_OUT_OF_MEMORY, "one code for running out");
 static_assert(KDM_DENSITY_BATCH == kdm::kDensityBatch, "the C and C++ batch sizes agree");
+static_assert(static_cast<int>(kdm::TileSizeAdvice::Kind::kUnderOnePoint) == KDM_TILE_SIZE_UNDER_ONE_POINT,
+              "kdm_tile_size_advice's kinds mirror TileSizeAdvice::Kind");
 static_assert(static_cast<int>(kdm::QueryProblem::Kind::kRunnerIncomplete) == KDM_PROBLEM_RUNNER_INCOMPLETE,
               "kdm_problem_kind mirrors QueryProblem::Kind, the last kind included");
 
@@ -645,6 +647,15 @@ kdm_status kdm_key_threshold(const kdm_tileset* tileset, uint64_t key, int64_t n
       *tileset->set, kdm::point_id_of_key(*tileset->set, key, near_tile_x, near_tile_y));
   if (t < 0) return KDM_INVALID_ARGUMENT;
   *threshold = t;
+  return KDM_OK;
+}
+
+kdm_status kdm_tile_size_advise(const kdm_tileset* tileset, double max_density, double scale,
+                                double tile_size, kdm_tile_size_advice* advice) {
+  if (!tileset || !advice) return KDM_INVALID_ARGUMENT;
+  const kdm::TileSizeAdvice a = kdm::tile_size_advice(*tileset->set, max_density, scale, tile_size);
+  *advice =
+      kdm_tile_size_advice{static_cast<int>(a.kind), a.points_per_tile, a.coarsest, a.tile_size, a.tiles};
   return KDM_OK;
 }
 

@@ -556,6 +556,21 @@ double query_density_limit(const Tileset& tileset, QueryMode mode) {
   return top * std::pow(double(m), 2.0 * kMaxQueryDepth);
 }
 
+TileSizeAdvice tile_size_advice(const Tileset& tileset, double max_density, double scale, double tile_size) {
+  TileSizeAdvice advice;
+  const auto positive = [](double v) { return v > 0 && v < HUGE_VAL; };
+  if (tileset.empty() || !positive(max_density) || !positive(scale) || !positive(tile_size)) return advice;
+  advice.points_per_tile = max_density * scale * tile_size * tile_size;
+  advice.coarsest = tileset.data().level_nominal.empty() ? 0 : tileset.data().level_nominal.front();
+  advice.tiles = tileset.data().tiles.size();
+  advice.tile_size = std::sqrt(advice.coarsest / max_density) / std::sqrt(scale);  // apart: no overflow
+  if (advice.points_per_tile < 1)
+    advice.kind = TileSizeAdvice::Kind::kUnderOnePoint;
+  else if (advice.points_per_tile < advice.coarsest * (1 - 1e-9))  // the advised size itself, rounded, fits
+    advice.kind = TileSizeAdvice::Kind::kUnderCoarsestLevel;
+  return advice;
+}
+
 namespace {
 
 /// The index in data().tiles of the tile point `id` belongs to, at any depth; kNoTile for a depth the set

@@ -2,6 +2,7 @@
 saving and baking."""
 import math
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -828,7 +829,7 @@ def test_positions_refuse_bad_arguments():
         BUILTIN.positions((0, 0, 1, 1), scale=10, threads=1.5)
     with pytest.raises(TypeError, match="keys must be True or False"):
         BUILTIN.positions((0, 0, 1, 1), scale=10, keys=1)
-    xy, keys = BUILTIN.positions((0, 0, 1, 1), scale=10, keys=np.True_)  # numpy's bool is a bool
+    xy, keys = BUILTIN.positions((0, 0, 1, 1), scale=40, keys=np.True_)  # numpy's bool is a bool
     assert len(xy) == len(keys) > 0
     with pytest.raises(ValueError, match=r"scale= [0-9.]+ or less"):
         BUILTIN.positions((0, 0, 1, 1), scale=1e9)
@@ -920,8 +921,8 @@ def test_an_empty_or_inverted_region_has_no_points():
             assert tiles.positions(rect, scale=100, density=density, **bound).shape == (0, 2)
         assert len(tiles.query(rect, scale=100, classes=[np.ones((4, 4)), 0.2])) == 0
     # Classes may come as a 1-D array of constant densities.
-    assert np.array_equal(tiles.query((0, 0, 4, 4), scale=100, classes=np.array([0.1, 0.2])).classes,
-                          tiles.query((0, 0, 4, 4), scale=100, classes=[0.1, 0.2]).classes)
+    assert np.array_equal(tiles.query((0, 0, 4, 4), scale=200, classes=np.array([0.1, 0.2])).classes,
+                          tiles.query((0, 0, 4, 4), scale=200, classes=[0.1, 0.2]).classes)
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
@@ -982,7 +983,7 @@ def test_a_density_map_refuses_what_it_cannot_stand_for():
         kdm.DensityMap(np.ones((4, 4)), (0, 0, -1, 1))
     with pytest.raises(ValueError, match="finite and >= 0"):
         kdm.DensityMap(np.full((4, 4), -1.0), (0, 0, 1, 1))
-    assert len(t.query((0, 0, 10, 10), scale=5, density=kdm.DensityMap(2.0)).xy) > 100  # a constant: no rect
+    assert len(t.query((0, 0, 10, 10), scale=20, density=kdm.DensityMap(2.0)).xy) > 100  # a constant: no rect
 
 
 def test_a_density_map_reads_as_queries_do_and_pickles_what_it_holds(tmp_path):
@@ -1035,3 +1036,29 @@ def test_thresholds_of_positions_keys_are_their_points_thresholds():
         t.thresholds(keys)
     with pytest.raises(ValueError, match="near_tile is for keys only"):
         t.thresholds(records, near_tile=(0, 0))
+
+
+def test_a_tile_size_too_small_for_the_density_is_warned_of():
+    # As kdm query warns: under the built-in set's coarsest level (32 points per tile) a tile gives part of
+    # it, and below one point its count rounds to steps of 1/16 (0.05 per tile: +28% measured).
+    with pytest.warns(UserWarning, match=r"at most 20 points per tile, under the tile set's coarsest level "
+                                         r"\(32\).*tile_size of at least 1\.26") as said:
+        BUILTIN.query((0, 0, 4, 4), scale=20)
+    assert said[0].filename == __file__
+    with pytest.warns(UserWarning, match=r"at most 0\.05 points per tile; below 1 a tile's expected count rounds "
+                                         r"to steps of 1/16") as said:
+        xy = BUILTIN.positions((0, 0, 40, 40), scale=0.05)
+    assert said[0].filename == __file__ and len(xy) > 0
+    with pytest.warns(UserWarning, match="at most 30 points per tile") as said:  # the classes' sum
+        BUILTIN.query((0, 0, 4, 4), scale=100, classes=[0.1, 0.2])
+    assert said[0].filename == __file__
+    with pytest.warns(UserWarning, match="at most 20 points per tile") as said:
+        BUILTIN.positions((0, 0, 4, 4), scale=20, density=lambda x, y: 0.5 + 0.5 * x / 4, density_max=1.0)
+    assert said[0].filename == __file__
+    # A map's peak, not the region's, is what is judged: a sparse corner of a map is no mistake.
+    ramp = kdm.DensityMap(np.array([[0.01, 1.0]]), (0, 0, 10, 10))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        BUILTIN.query((0, 0, 1, 1), scale=100, density=ramp)
+        BUILTIN.query((0, 0, 0, 0), scale=1)  # an empty region emits nothing to warn of
+        BUILTIN.query((0, 0, 2, 2), scale=32)

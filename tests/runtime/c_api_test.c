@@ -442,6 +442,18 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
   }
+  /* A tile size too small for the density is told, with one that fits the coarsest level. */
+  {
+    kdm_tile_size_advice advice;
+    CHECK(kdm_tile_size_advise(builtin, 1, 1000, 0.01, &advice) == KDM_OK);
+    CHECK(advice.kind == KDM_TILE_SIZE_UNDER_ONE_POINT && advice.tiles == 16 && advice.coarsest == 32);
+    CHECK(fabs(advice.points_per_tile - 0.1) < 1e-12 && fabs(advice.tile_size - sqrt(0.032)) < 1e-12);
+    CHECK(kdm_tile_size_advise(builtin, 1, 1000, 0.1, &advice) == KDM_OK);
+    CHECK(advice.kind == KDM_TILE_SIZE_UNDER_COARSEST_LEVEL);
+    CHECK(kdm_tile_size_advise(builtin, 1, 1000, 1, &advice) == KDM_OK && advice.kind == KDM_TILE_SIZE_EVEN);
+    CHECK(kdm_tile_size_advise(NULL, 1, 1000, 1, &advice) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_tile_size_advise(builtin, 1, 1000, 1, NULL) == KDM_INVALID_ARGUMENT);
+  }
   /* A density check: the same points where the values fit; the first bad value and where it was read. */
   {
     static kdm_point bare[4096], checked[4096];

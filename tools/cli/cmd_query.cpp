@@ -136,22 +136,9 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   // sparse corner of a map is no mistake.
   double densest = 0;
   for (const auto& spec : specs) densest += spec->max_value();
-  const double per_tile = densest * a.scale * a.tile_size * a.tile_size;
-  // (a tile so small that its count underflows to 0 warns as well: its density is not 0)
-  // Below the coarsest level everywhere, no place gets even points: a tile size too small, said.
-  const double coarsest = tiles.data().level_nominal.empty() ? 0 : tiles.data().level_nominal.front();
-  if (per_tile < 1 && densest > 0 && a.scale > 0 && a.tile_size > 0)
-    std::fprintf(
-        stderr,
-        "kdm query: warning: at most %.3g points per tile; below 1 a tile's expected count rounds to "
-        "steps of 1/%zu of a point (use a larger --tile-size)\n",
-        per_tile, tiles.data().tiles.size());
-  else if (per_tile < coarsest && densest > 0 && a.scale > 0 && a.tile_size > 0)
-    std::fprintf(stderr,
-                 "kdm query: warning: at most %.3g points per tile, under the tile set's coarsest level "
-                 "(%.0f): a tile then gives part of that level, less even (use a --tile-size of at least "
-                 "%.3g)\n",
-                 per_tile, coarsest, a.tile_size * std::sqrt(coarsest / per_tile));
+  const std::string sparse =
+      tools::tile_size_warning(tile_size_advice(tiles, densest, a.scale, a.tile_size), "--tile-size");
+  if (!sparse.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", sparse.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;

@@ -14,6 +14,25 @@ std::string describe(const QueryProblem& p, const QueryParameterNames& names) {
   return text;
 }
 
+std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_size) {
+  char text[400];
+  if (advice.kind == TileSizeAdvice::Kind::kUnderOnePoint)
+    std::snprintf(
+        text, sizeof text,
+        "at most %.3g points per tile; below 1 a tile's expected count rounds to steps of 1/%zu of a "
+        "point (use a %s of at least %.3g)",
+        advice.points_per_tile, advice.tiles, tile_size, advice.tile_size);
+  else if (advice.kind == TileSizeAdvice::Kind::kUnderCoarsestLevel)
+    std::snprintf(
+        text, sizeof text,
+        "at most %.3g points per tile, under the tile set's coarsest level (%.0f): a tile then gives "
+        "part of that level, less even (use a %s of at least %.3g)",
+        advice.points_per_tile, advice.coarsest, tile_size, advice.tile_size);
+  else
+    return "";
+  return text;
+}
+
 namespace {
 
 /// A lower bound of the density's integral over the region (exact for a constant); NaN for a callback.

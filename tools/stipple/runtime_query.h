@@ -20,6 +20,10 @@ inline constexpr std::size_t kMaxCollectedPoints = std::size_t(1) << 25;
 /// A refused query's problem in one line (describe_query_problem's).
 std::string describe(const QueryProblem& problem, const QueryParameterNames& names = {});
 
+/// tile_size_advice's warning in one line without a prefix, "" where the tile size serves the density
+/// evenly; `tile_size` names the option ("--tile-size", "tile_size").
+std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_size);
+
 /// A lower bound of how many points a query of `params` emits: its density times scale over its region
 /// (exact for a constant; an image's min-mip over 64 × 64 blocks of the region, 0 where its maximum could
 /// not reach half of kMaxCollectedPoints), summed over the classes; NaN where nothing is known without

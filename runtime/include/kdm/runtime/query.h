@@ -206,6 +206,30 @@ struct QueryProblem {
 /// mode with a set that has a hand-over (TilesetShape::handover_zone), that times m^(2 · kMaxQueryDepth).
 KDM_RUNTIME_API double query_density_limit(const Tileset& tileset, QueryMode mode);
 
+/// How evenly a tile set serves a density on tiles of a size. A tile that expects fewer points than the
+/// set's coarsest level holds gives part of that level, less even; below one point a tile's expected count
+/// rounds to steps of 1/(the set's tile count) of a point (the built-in set: 0.05 points per tile give
+/// +25%, 0.02 none). A map whose sparse parts fall there is no mistake; a densest value there is a tile
+/// size too small for the density. kdm query and kdm.Tileset.query warn by it.
+struct TileSizeAdvice {
+  enum class Kind : int {
+    kEven = 0,            ///< the densest value fills at least the coarsest level
+    kUnderCoarsestLevel,  ///< the densest value asks under the coarsest level: less even everywhere
+    kUnderOnePoint,       ///< under one point per tile: counts off by up to tens of percent
+  };
+  Kind kind = Kind::kEven;
+  double points_per_tile = 0;  ///< the densest value's expected points per tile
+  double coarsest = 0;         ///< the set's coarsest level's points per tile
+  double tile_size = 0;        ///< the smallest tile size whose tiles hold the coarsest level at that density
+  std::size_t tiles = 0;       ///< the set's tile count (1/tiles: the step of a count below one point)
+};
+
+/// The advice for a query whose density is at most `max_density` (a constant's value, an image's or the
+/// classes' summed maximum, a callback's bound) at `scale` points per unit area on tiles of `tile_size`.
+/// kEven where any of them is not a positive finite number (nothing to advise), or for an empty set.
+KDM_RUNTIME_API TileSizeAdvice tile_size_advice(const Tileset& tileset, double max_density, double scale,
+                                                double tile_size);
+
 /// The tile (of data().tiles) that point `id` belongs to, at any depth: its rank indexes that tile's
 /// points, so its level is tile_of(…).level_of(id.rank). Null for a depth the set does not have (or tile
 /// coordinates beyond ±2^62, which no query emits).
