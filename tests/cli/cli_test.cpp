@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -783,6 +784,19 @@ TEST_F(CliTest, VerifyPassesTheShippedSetAndFailsADamagedOne) {
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
   EXPECT_NE(bad.err.find("failed"), std::string::npos) << bad.err;
   EXPECT_NE(bad.out.find("FAIL tile 3 level 2"), std::string::npos) << bad.out;
+  // A failed density names it as its table row prints it ("552.9", not "552"), so that the row is found.
+  std::size_t named = 0;
+  for (const char* failed : {"  FAIL at ", "  FAIL gliding at "})
+    for (std::size_t at = bad.out.find(failed); at != std::string::npos; at = bad.out.find(failed, at + 1)) {
+      const std::string number = bad.out.substr(
+          at + std::strlen(failed), bad.out.find(' ', at + std::strlen(failed)) - at - std::strlen(failed));
+      EXPECT_NE(number.find('.'), std::string::npos) << number;
+      EXPECT_NE(bad.out.find(std::string(11 - std::min<std::size_t>(11, number.size()), ' ') + number + " "),
+                std::string::npos)
+          << number;
+      ++named;
+    }
+  EXPECT_GT(named, 0u) << bad.out;
   // --quiet (build logs): the failed checks and the count, no tables.
   const Outcome quiet = kdm("verify --quiet '" + path("bad.kdmt") + "'" + quick);
   EXPECT_EQ(quiet.status, 2);
@@ -1094,6 +1108,10 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   expect_error("info '" + path("dir.png") + "'", "is a directory, not a tile set file");
   expect_error("query --tileset '" + path("dir.png") + "' --rect 0,0,1,1 -o '" + path("q.csv") + "'",
                "is a directory");
+  // An empty --tileset (an unset shell variable) is refused, as kdm info "" is, not read as the built-in set.
+  for (const char* command : {"query --rect 0,0,1,1", "stipple '" KDM_SOURCE_DIR "/examples/sphere.png'"})
+    expect_error(std::string(command) + " --tileset '' -o '" + path("q.csv") + "'",
+                 "--tileset: is empty: give a tile-set file, or leave the option out for the built-in set");
   expect_error("bake '" + path("dir.png") + "' -o '" + path("d.kdmt") + "'", "cannot read recipe");
   expect_error("bake '" + path("absent.recipe") + "' -o '" + path("d.kdmt") + "'",
                "cannot open recipe '" + path("absent.recipe") + "': No such file or directory");

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <initializer_list>
 #include <iterator>
@@ -239,6 +240,32 @@ TEST(BakeTest, ARecipeMadeInCodeIsCheckedAsItsTextWouldBe) {
   EXPECT_EQ(validation(BakeRecipe::parse("keyframes 2\nglide_sweeps 10\nseparation 0.3\nsplit_shared 0\n")),
             "");
   EXPECT_EQ(validation(small_recipe()), "");
+}
+
+// A hand-over whose subtiles hold fewer points than their parent's top level is refused with the counts
+// as points (once it printed the x, y arrays' lengths, twice as many) and the remedy; the remedy bakes.
+TEST(BakeTest, AHandOverShortOfPointsIsRefusedWithItsCounts) {
+  const std::string text =
+      "seed 3\ncolours 1\nlevels 3\nbase_points 32\nsweeps 10\nseparation 0.3\nseparation_push 0.55\n"
+      "split_shared 1\nkeyframes 24\nglide_sweeps 3\nhandover_zone 1\n";
+  std::string said;
+  try {
+    bake_tileset(BakeRecipe::parse(text), 1);
+  } catch (const InvalidArgument& e) {
+    said = e.what();
+  }
+  int tile = -1, top = 0, subtiles = 0, held = 0;
+  ASSERT_EQ(std::sscanf(said.c_str(),
+                        "hand-over: tile %d holds %d points at its top level, its %d subtiles only %d", &tile,
+                        &top, &subtiles, &held),
+            4)
+      << said;
+  EXPECT_EQ(subtiles, 16);
+  EXPECT_GT(top, held);
+  EXPECT_NEAR(top, 512, 16) << said;  // the top level: 512 nominal, 517 in this tile
+  EXPECT_LE(held, 16 * 34) << said;   // 16 subtiles at the hand-over keyframe's nominal 34 points at most
+  EXPECT_NE(said.find("a larger handover_slack (now 0)"), std::string::npos) << said;
+  EXPECT_NO_THROW(bake_tileset(BakeRecipe::parse(text + "handover_slack 1\n"), 1));
 }
 
 // A refusal of keys that do not fit together names the line of the key at fault, and a key that tunes

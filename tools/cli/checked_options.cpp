@@ -45,6 +45,13 @@ CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::stri
       ->check(CLI::Validator(in_range, ""));
 }
 
+CLI::Option* add_tileset_option(CLI::App* cmd, std::string& path, const std::string& description) {
+  auto named = [](std::string& text) -> std::string {
+    return text.empty() ? "is empty: give a tile-set file, or leave the option out for the built-in set" : "";
+  };
+  return cmd->add_option("--tileset", path, description)->check(CLI::Validator(named, ""));
+}
+
 CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,
                               const std::string& description) {
   // A transform sees the text before conversion: a whole number in float notation becomes its digits.

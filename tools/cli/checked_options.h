@@ -20,6 +20,10 @@ CLI::Option* add_threads_option(CLI::App* cmd, int& threads, const std::string& 
 /// Adds --seed to `cmd`, bound to `seed`: 0 to 2^64 - 1, anything else refused by name.
 CLI::Option* add_seed_option(CLI::App* cmd, std::uint64_t& seed, const std::string& description);
 
+/// Adds --tileset to `cmd`, bound to `path`: a file, or '-' for standard input; an empty path (an unset
+/// shell variable) refused by name, where it would silently mean the built-in set.
+CLI::Option* add_tileset_option(CLI::App* cmd, std::string& path, const std::string& description);
+
 /// Adds a count option (`names`, e.g. "-n,--n") to `cmd`, bound to `count`: an integer, also written as a
 /// whole number in float notation (1e5, 20000.0); a fraction or a number past 2^63 refused by name.
 CLI::Option* add_count_option(CLI::App* cmd, const std::string& names, std::int64_t& count,

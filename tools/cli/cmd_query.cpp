@@ -190,7 +190,7 @@ void run_query_command(const QueryArgs& a, bool density_given) {
 void add_query_command(CLI::App& app) {
   auto a = std::make_shared<QueryArgs>();
   CLI::App* cmd = app.add_subcommand("query", "Points of a world rectangle from a tile set (the runtime)");
-  cmd->add_option("--tileset", a->tileset, "Tile-set file ('-': standard input; default: the built-in set)");
+  add_tileset_option(cmd, a->tileset, "Tile-set file ('-': standard input; default: the built-in set)");
   cmd->add_option("--rect", a->rect, "World rectangle x0,y0,x1,y1 in world units (half-open)")->required();
   CLI::Option* density =
       cmd->add_option(

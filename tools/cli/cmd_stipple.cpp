@@ -438,8 +438,8 @@ void add_stipple_command(CLI::App& app) {
                   "Random seed: --method full's sampler; --method tiles, where the image lies in the tile "
                   "set's endless tiling (another seed, other dots; one seed, the same dots in every region "
                   "and frame)");
-  cmd->add_option("--tileset", a->tileset,
-                  "Tile-set file for --method tiles ('-': standard input; default: the built-in set)");
+  add_tileset_option(cmd, a->tileset,
+                     "Tile-set file for --method tiles ('-': standard input; default: the built-in set)");
   cmd->add_option("--mode", a->mode,
                   "--method tiles: smooth (dots glide with the density: good blue noise at every tone) or "
                   "stable (dots never move as the density or zoom changes)")

@@ -118,11 +118,12 @@ Matched match_tile(const TilesetData& set, std::size_t t) {
     }
   if (out.columns.size() < out.start.size()) {  // the passes that keep points apart removed too many
     const std::string k = std::to_string(set.keyframe_nominal[h]), s = std::to_string(set.handover_slack);
-    throw InvalidArgument("hand-over: tile " + std::to_string(t) + " holds " +
-                          std::to_string(out.start.size()) + " points at its top level, its " +
-                          std::to_string(m * m) + " subtiles only " + std::to_string(out.columns.size()) +
-                          " at the hand-over keyframe (" + k + " points per tile): a larger handover_slack " +
-                          "(now " + s + ") hands them over later, holding more");
+    // (start and columns hold x, y pairs)
+    throw InvalidArgument(
+        "hand-over: tile " + std::to_string(t) + " holds " + std::to_string(out.start.size() / 2) +
+        " points at its top level, its " + std::to_string(m * m) + " subtiles only " +
+        std::to_string(out.columns.size() / 2) + " together at the hand-over keyframe (nominally " + k +
+        " points per subtile): a larger handover_slack (now " + s + ") hands them over later, holding more");
   }
   out.column = match(out.start, out.columns, 2.5 / std::sqrt(top), kLongGlide / std::sqrt(top), t);
   return out;

@@ -119,11 +119,15 @@ void print_report(const Report& report, std::FILE* out, bool tables) {
   if (tables) std::fprintf(out, "\n");
   for (const TileResult& t : report.tiles)
     print_failures(t.checks, "tile " + std::to_string(t.tile) + " level " + std::to_string(t.level), out);
+  const auto per_tile = [](double v) {  // as the tables print it, so that a line finds its row
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", v);
+    return std::string(text);
+  };
   for (const DensityResult& d : report.densities)
-    print_failures(d.checks, "at " + std::to_string(int(d.points_per_tile)) + " points per tile", out);
+    print_failures(d.checks, "at " + per_tile(d.points_per_tile) + " points per tile", out);
   for (const KeyframeResult& k : report.keyframes)
-    print_failures(k.checks, "gliding at " + std::to_string(int(k.points_per_tile)) + " points per tile",
-                   out);
+    print_failures(k.checks, "gliding at " + per_tile(k.points_per_tile) + " points per tile", out);
   const std::size_t failed = report.failed_checks();
   if (failed) {
     std::fprintf(out, "%zu of %zu checks failed\n", failed, checks);
