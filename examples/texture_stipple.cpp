@@ -393,10 +393,13 @@ int main(int argc, char** argv) {
       depth = std::max(depth, p.id.depth);
       if (!visible) continue;
       ++shown;
-      // The fade weight (docs/runtime.md, "Fading objects in"): the count of the point's (sub)tile here
-      // against the count at which it appears.
+      // The fade weight (docs/runtime.md, "Fading objects in"): the count of the point's (sub)tile at its
+      // stable position, where the query reads it (not where the point has glided to), against the count
+      // at which it appears.
       const double side = tile_size / std::pow(subtiles, p.id.depth);
-      const double count = texture_density(&frame, p.x, p.y) * q.scale * side * side;
+      double ux = p.x, uy = p.y;
+      kdm::stable_position(tileset, p.id, tile_size, 0, 0, &ux, &uy);
+      const double count = texture_density(&frame, ux, uy) * q.scale * side * side;
       const double weight = std::clamp((count / kdm::emission_threshold(tileset, p.id) - 1) / fade, 0.0, 1.0);
       static constexpr unsigned char kBlack[3] = {0, 0, 0};
       if (weight > 0)

@@ -640,6 +640,14 @@ kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* poin
   return KDM_OK;
 }
 
+kdm_status kdm_point_stable_position(const kdm_tileset* tileset, const kdm_point* point, double tile_size,
+                                     double origin_x, double origin_y, double* x, double* y) {
+  if (!tileset || !point) return KDM_INVALID_ARGUMENT;
+  const kdm::PointId id{point->tile_x, point->tile_y, point->rank, point->depth};
+  return kdm::stable_position(*tileset->set, id, tile_size, origin_x, origin_y, x, y) ? KDM_OK
+                                                                                      : KDM_INVALID_ARGUMENT;
+}
+
 kdm_status kdm_key_threshold(const kdm_tileset* tileset, uint64_t key, int64_t near_tile_x,
                              int64_t near_tile_y, double* threshold) {
   if (!tileset || !threshold) return KDM_INVALID_ARGUMENT;

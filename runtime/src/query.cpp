@@ -610,7 +610,41 @@ double emission_threshold(const Tileset& tileset, const PointId& id) {
   const std::size_t type = tile_type_of(tileset, id);
   if (type == kNoTile) return -1;
   const auto& thresholds = detail::TilesetInternals::tables(tileset).thresholds[type];
-  return id.rank < thresholds.size() ? double(thresholds[id.rank]) : -1;
+  if (id.rank >= thresholds.size()) return -1;
+  const double own = thresholds[id.rank];
+  // Only ranks a subtile inherits (those present at the hand-over keyframe) come from its parent: later
+  // ones are its own, emitted by their own thresholds.
+  const QueryTables& tables = detail::TilesetInternals::tables(tileset);
+  if (id.depth == 0 || id.rank >= tables.points_at_keyframe[type][tables.handover_keyframe]) return own;
+  // A sub-point that no point of its parent glides onto appears in the parent's hand-over, at the count
+  // its place in the parent's appearing list gives (descent.cpp), whatever its own threshold (mostly far
+  // below): found by a scan of that list (m² K_h − N_top entries, about 900 in the built-in set).
+  const TilesetData& set = tileset.data();
+  const std::int64_t m = set.subtiles_per_side();
+  const std::int64_t cx = ((id.tile_x % m) + m) % m, cy = ((id.tile_y % m) + m) % m;
+  const std::size_t parent =
+      tile_type_of(tileset, PointId{(id.tile_x - cx) / m, (id.tile_y - cy) / m, 0, id.depth - 1});
+  if (parent == kNoTile || id.rank > 0xFFFF) return own;
+  const auto& listed = set.tiles[parent].appearing;
+  const std::uint32_t wanted = std::uint32_t(cy * m + cx) << 16 | id.rank;
+  const auto at = std::find(listed.begin(), listed.end(), wanted);
+  if (at == listed.end()) return own;
+  const double top = set.keyframe_nominal.back(), a = double(at - listed.begin());
+  const double appears = top + (a + 0.5) / double(listed.size()) * (set.appearing_end() - top);
+  return appears / double(m * m);  // in the sub-point's own tile's count
+}
+
+bool stable_position(const Tileset& tileset, const PointId& id, double tile_size, double origin_x,
+                     double origin_y, double* x, double* y) {
+  const Tile* tile = tile_of(tileset, id);
+  if (!tile || !x || !y || id.rank >= tile->points.size() || !(tile_size > 0 && tile_size < HUGE_VAL))
+    return false;
+  const double side = tile_size / std::pow(double(tileset.data().subtiles_per_side()), id.depth);
+  const TilePoint& p = tile->points[id.rank];
+  // The tile's corner less the origin first: far from the world's origin the tile's own digits survive.
+  *x = (double(id.tile_x) * side - origin_x) + p.unit_x() * side;
+  *y = (double(id.tile_y) * side - origin_y) + p.unit_y() * side;
+  return true;
 }
 
 std::uint64_t query_fingerprint(const QueryParams& q) {

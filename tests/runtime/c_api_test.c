@@ -442,6 +442,24 @@ int main(int argc, char** argv) {
     CHECK(kdm_query_points(builtin, &q, buffer, 16, &written, &cursor, &problem) == KDM_INVALID_ARGUMENT);
     CHECK(problem.kind == KDM_PROBLEM_CURSOR_MISMATCH);
   }
+  /* A point's stable position is where a stable query puts it. */
+  {
+    kdm_point points[64];
+    kdm_cursor cursor;
+    size_t n = 0, i;
+    double x = 0, y = 0;
+    q = uniform_query();
+    q.origin_x = 0.5, q.origin_y = -1;
+    memset(&cursor, 0, sizeof cursor);
+    CHECK(kdm_query_points(builtin, &q, points, 64, &n, &cursor, NULL) == KDM_BUFFER_FULL && n == 64);
+    for (i = 0; i < n; ++i) {
+      CHECK(kdm_point_stable_position(builtin, &points[i], 1, 0.5, -1, &x, &y) == KDM_OK);
+      CHECK(fabs(x - points[i].x) < 1e-12 && fabs(y - points[i].y) < 1e-12);
+    }
+    CHECK(kdm_point_stable_position(builtin, &points[0], 0, 0, 0, &x, &y) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_point_stable_position(builtin, NULL, 1, 0, 0, &x, &y) == KDM_INVALID_ARGUMENT);
+    CHECK(kdm_point_stable_position(builtin, &points[0], 1, 0, 0, NULL, &y) == KDM_INVALID_ARGUMENT);
+  }
   /* A tile size too small for the density is told, with one that fits the coarsest level. */
   {
     kdm_tile_size_advice advice;

@@ -78,6 +78,67 @@ TEST(EmissionThreshold, CountsInTheTilesOfEachDepth) {
   EXPECT_GT(highest[1], 0.9);  // the subtiles' own points, appearing up to the count
 }
 
+// Smooth mode in the hand-over (N_top to m² K_h per tile): a sub-point no point glides onto appears at its
+// place in its parent's list, far above its own threshold (a fade by the latter popped it in at once):
+// every point a rising count adds has its threshold, in its own tile's count, between the two counts.
+TEST(EmissionThreshold, IsWhereASubPointAppearsInTheHandOver) {
+  const Tileset& set = Tileset::builtin();
+  const double m = set.data().subtiles_per_side();
+  for (const auto& counts : {std::pair{33000.0, 33400.0}, std::pair{34000.0, 34500.0}}) {
+    QueryParams q = uniform(counts.first, QueryMode::kSmooth);
+    q.x0 = -0.4, q.y0 = -0.4, q.x1 = 2.4, q.y1 = 1.9;  // wider, for the points that glide into the region
+    std::set<Key> old;
+    for (const QueryPoint& p : testing::run_query(q)) old.insert(key(p.id));
+    q.x0 = 0.1, q.y0 = 0.1, q.x1 = 1.9, q.y1 = 1.4;
+    q.scale = counts.second;
+    std::size_t added = 0;
+    for (const QueryPoint& p : testing::run_query(q)) {
+      const double per_tile = std::pow(m * m, p.id.depth), t = emission_threshold(set, p.id) * per_tile;
+      ASSERT_LT(t, counts.second) << p.id.depth << " " << p.id.rank;
+      if (old.count(key(p.id))) continue;
+      ++added;
+      EXPECT_GE(t, counts.first * (1 - 1e-9)) << "depth " << p.id.depth << " rank " << p.id.rank;
+    }
+    EXPECT_GT(added, 100u);
+  }
+}
+
+// A point's stable position is where a stable query puts it, relative to the query's origin, at every
+// depth inside its own (sub)tile.
+TEST(EmissionThreshold, StablePositionIsWhereAStableQueryPutsAPoint) {
+  const Tileset& set = Tileset::builtin();
+  QueryParams q = uniform(2000, QueryMode::kStable);
+  q.tile_size = 2.5, q.origin_x = 1.25, q.origin_y = -3;
+  const std::vector<QueryPoint> points = testing::run_query(q);
+  ASSERT_GT(points.size(), 1000u);
+  for (const QueryPoint& p : points) {
+    double x = 0, y = 0;
+    ASSERT_TRUE(stable_position(set, p.id, q.tile_size, q.origin_x, q.origin_y, &x, &y));
+    ASSERT_NEAR(x, p.x, 1e-12) << p.id.rank;
+    ASSERT_NEAR(y, p.y, 1e-12) << p.id.rank;
+  }
+  const double m = set.data().subtiles_per_side();
+  QueryParams deep = uniform(48000, QueryMode::kSmooth);
+  deep.x0 = 0.2, deep.y0 = 0.2, deep.x1 = 0.8, deep.y1 = 0.8;
+  std::size_t sub_points = 0;
+  for (const QueryPoint& p : testing::run_query(deep)) {
+    double x = 0, y = 0;
+    ASSERT_TRUE(stable_position(set, p.id, 1, 0, 0, &x, &y));
+    const double side = std::pow(m, -double(p.id.depth));
+    EXPECT_GE(x, double(p.id.tile_x) * side);
+    EXPECT_LT(x, double(p.id.tile_x + 1) * side);
+    EXPECT_GE(y, double(p.id.tile_y) * side);
+    EXPECT_LT(y, double(p.id.tile_y + 1) * side);
+    sub_points += p.id.depth > 0;
+  }
+  EXPECT_GT(sub_points, 100u);
+  double x = 0, y = 0;
+  EXPECT_FALSE(stable_position(set, PointId{0, 0, 1u << 30, 0}, 1, 0, 0, &x, &y));
+  EXPECT_FALSE(stable_position(set, PointId{0, 0, 0, 0}, 0, 0, 0, &x, &y));
+  EXPECT_FALSE(stable_position(set, PointId{0, 0, 0, 0}, std::nan(""), 0, 0, &x, &y));
+  EXPECT_FALSE(stable_position(set, PointId{0, 0, 0, 0}, 1, 0, 0, nullptr, &y));
+}
+
 TEST(EmissionThreshold, IsNegativeForIdsTheSetDoesNotHave) {
   const Tileset& set = Tileset::builtin();
   EXPECT_LT(emission_threshold(set, PointId{0, 0, 1u << 30, 0}), 0);

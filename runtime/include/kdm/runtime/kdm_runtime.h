@@ -243,6 +243,14 @@ KDM_RUNTIME_API kdm_status kdm_tileset_get_info(const kdm_tileset* tileset, kdm_
    point the set does not have (a depth it does not reach, a rank past its tile's points). Added in 0.4. */
 KDM_RUNTIME_API kdm_status kdm_point_threshold(const kdm_tileset* tileset, const kdm_point* point,
                                                double* threshold);
+/* Where `point` lies unmoved (kdm::stable_position), for tiles of side tile_size, less (origin_x,
+   origin_y): where a stable query puts it, and where the density deciding its emission is read, so that a
+   fade weight by kdm_point_threshold read there follows the query's rule in smooth mode too.
+   KDM_INVALID_ARGUMENT for a NULL argument, a point the set does not have or a tile_size not finite and > 0.
+   Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_point_stable_position(const kdm_tileset* tileset, const kdm_point* point,
+                                                     double tile_size, double origin_x, double origin_y,
+                                                     double* x, double* y);
 /* The same for a point of the compact output known by its key (kdm::point_id_of_key): the key's tile is the
    one nearest (near_tile_x, near_tile_y), in tiles of side tile_size, such as floor(x0 / tile_size) and
    floor(y0 / tile_size) of the query's region (under 2^20 tiles across). Statuses as kdm_point_threshold's.

@@ -236,12 +236,23 @@ KDM_RUNTIME_API TileSizeAdvice tile_size_advice(const Tileset& tileset, double m
 KDM_RUNTIME_API const Tile* tile_of(const Tileset& tileset, const PointId& id);
 
 /// The expected count per tile above which point `id` is emitted: where its tile's expected count,
-/// ρ · scale · (tile_size / m^depth)² with ρ the density at the point's stable position, exceeds it (in
-/// smooth mode also only where the density at its glided position is above 0). A caller fading objects in
-/// as the density rises, so that they do not pop up, weighs each by (count / threshold − 1) / f clamped to
-/// [0, 1]: it appears at weight 0 and is fully shown once the density has risen a fraction f. Negative for
-/// an id the set does not have (a depth it does not reach, a rank past its tile's points).
+/// ρ · scale · (tile_size / m^depth)² with ρ the density at the point's stable position (stable_position),
+/// exceeds it (in smooth mode also only where the density at its glided position is above 0). A caller
+/// fading objects in as the density rises, so that they do not pop up, weighs each by (count / threshold −
+/// 1) / f clamped to [0, 1]: it appears at weight 0 and is fully shown once the density has risen a
+/// fraction f. Past the top level a sub-point that appears in its parent's hand-over has the count at
+/// which it appears there, found by a scan of the parent's list (about 900 entries in the built-in set);
+/// other ids cost a table lookup. Negative for an id the set does not have (a depth it does not reach, a
+/// rank past its tile's points).
 KDM_RUNTIME_API double emission_threshold(const Tileset& tileset, const PointId& id);
+
+/// Where point `id` lies unmoved, for tiles of side `tile_size` at depth 0, in world units less (origin_x,
+/// origin_y) as a query's output is: where a stable query puts it, where a smooth query's point glides
+/// from, and where the density that decides its emission is read, so that a fade weight (emission_threshold)
+/// read there follows the query's own rule even where a glide carries the point across a change of density.
+/// False (and *x, *y untouched) for an id the set does not have or a tile_size that is not finite and > 0.
+KDM_RUNTIME_API bool stable_position(const Tileset& tileset, const PointId& id, double tile_size,
+                                     double origin_x, double origin_y, double* x, double* y);
 
 /// A short English description of a problem kind (static storage).
 KDM_RUNTIME_API const char* query_problem_message(QueryProblem::Kind kind);
