@@ -1594,6 +1594,9 @@ TEST_F(CliTest, StippleFadeGrowsAppearingDots) {
     ink += (r / full) * (r / full);
     grown += r >= full * (1 - 1e-5);
   }
+  // Every dot present is drawn: its weight, read at its stable position where the query reads the
+  // density, is above 0 (read where it had glided to, some were 0).
+  EXPECT_EQ(fade.size(), plain.size());
   const double partial = 1 - double(grown) / double(plain.size());  // dots of size 0 are not drawn
   EXPECT_GT(partial, 0.12);
   EXPECT_LT(partial, 0.22);

@@ -241,9 +241,12 @@ PointSet TileStippler::with_sizes(const QueryParams& q, const double rect[4], do
   const double m = tiles_.data().subtiles_per_side();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const QueryPoint& p = points[i];
-    // The union's count at the dot (the inks together), in its own (sub)tile.
+    // The union's count (the inks together) in the dot's own (sub)tile, at its stable position, where the
+    // query reads it: where the dot has glided to, its weight would blink across a change of tone.
+    double x = q.origin_x + p.x, y = q.origin_y + p.y;
+    stable_position(tiles_, p.id, q.tile_size, 0, 0, &x, &y);
     double density = 0;
-    for (const auto& d : densities_) density += d->image.at(q.origin_x + p.x, q.origin_y + p.y);
+    for (const auto& d : densities_) density += d->image.at(x, y);
     const double side = q.tile_size / std::pow(m, p.id.depth);
     const double count = density * q.scale * side * side, threshold = emission_threshold(tiles_, p.id);
     const double weight = threshold > 0 ? std::clamp((count / threshold - 1) / fade, 0.0, 1.0) : 1.0;
