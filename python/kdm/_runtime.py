@@ -276,6 +276,22 @@ class Tileset:
             raise ValueError("near_tile is for keys only: a QueryResult holds its tiles")
         return self._handle.thresholds(result.tile, result.rank, result.points["depth"])
 
+    def stable_positions(self, result: Any, *, tile_size: float = 1.0, origin: Sequence[float] = (0.0, 0.0)
+                         ) -> np.ndarray:
+        """Each point's stable position: where a stable query puts it and where a smooth query's point
+        glides from, as (m, 2) float64 world positions minus `origin`, for the `tile_size` and `origin` the
+        query of `result` (a QueryResult of this set) was made with. The density that decides a point's
+        emission is read there: a fade weight by ``thresholds(result)`` read at these positions follows the
+        query's rule in smooth mode too, where the density at the shown position makes it blink as a point
+        glides across a change of density. Raises TypeError for anything but a QueryResult and ValueError
+        for a point this set does not have or a bad tile_size or origin.
+        """
+        if not isinstance(result, QueryResult):
+            raise TypeError(f"result must be a kdm.QueryResult, got {type(result).__name__}")
+        tile_size = _checks.number("tile_size", tile_size, 0.0, strict=True)
+        ox, oy = _checks.numbers_tuple("origin", origin, 2)
+        return self._handle.stable_positions(result.tile, result.rank, result.points["depth"], tile_size, ox, oy)
+
     def __repr__(self) -> str:
         i = self.info
         return (

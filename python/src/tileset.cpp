@@ -1,5 +1,6 @@
 // kdm._kdm.Tileset: loaded tile sets (the built-in one, a file, or one just baked) and what they hold;
 // kdm._kdm.bake: the tile baker. Queries on them are query.cpp's.
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <new>
@@ -185,30 +186,54 @@ py::array_t<double> key_thresholds(
   return out;
 }
 
-py::array_t<double> thresholds(
-    const TilesetHandle& h, const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& tile,
-    const py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>& rank,
-    const py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>& depth) {
+using TileArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+using CountArray = py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>;
+
+/// Calls f(i, id) for every id given as tile (m × 2), rank and depth (m each), the GIL released, until f
+/// returns false; then raises ValueError naming that point (not one of this set's).
+template <class F>
+void for_each_id(const TileArray& tile, const CountArray& rank, const CountArray& depth, F&& f) {
   const py::ssize_t n = rank.size();
   if (tile.ndim() != 2 || tile.shape(0) != n || tile.shape(1) != 2 || rank.ndim() != 1 || depth.ndim() != 1 ||
       depth.size() != n)
     throw std::invalid_argument("tile must be (m, 2) and rank, depth (m,), as a query's result holds them");
-  py::array_t<double> out(n);
   const std::int64_t* t = tile.data();
   const std::uint32_t *r = rank.data(), *d = depth.data();
-  double* o = out.mutable_data();
   py::ssize_t bad = -1;
   {
     py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i < n && bad < 0; ++i) {
-      o[i] = emission_threshold(*h.set, PointId{t[2 * i], t[2 * i + 1], r[i], d[i]});
-      if (o[i] < 0) bad = i;
-    }
+    for (py::ssize_t i = 0; i < n && bad < 0; ++i)
+      if (!f(i, PointId{t[2 * i], t[2 * i + 1], r[i], d[i]})) bad = i;
   }
   if (bad >= 0)
     throw std::invalid_argument("point " + std::to_string(bad) + " (tile " + std::to_string(t[2 * bad]) +
                                 ", " + std::to_string(t[2 * bad + 1]) + ", rank " + std::to_string(r[bad]) +
                                 ", depth " + std::to_string(d[bad]) + ") is not a point of this tile set");
+}
+
+py::array_t<double> thresholds(const TilesetHandle& h, const TileArray& tile, const CountArray& rank,
+                               const CountArray& depth) {
+  py::array_t<double> out(rank.size());
+  double* o = out.mutable_data();
+  for_each_id(tile, rank, depth, [&](py::ssize_t i, const PointId& id) {
+    o[i] = emission_threshold(*h.set, id);
+    return o[i] >= 0;
+  });
+  return out;
+}
+
+/// stable_position of every id, for tiles of `tile_size` less `origin`: (m × 2) float64.
+py::array_t<double> stable_positions(const TilesetHandle& h, const TileArray& tile, const CountArray& rank,
+                                     const CountArray& depth, double tile_size, double origin_x,
+                                     double origin_y) {
+  check_number("tile_size", tile_size, 0, true);
+  if (!(std::isfinite(origin_x) && std::isfinite(origin_y)))
+    throw std::invalid_argument("origin must be two finite numbers");
+  py::array_t<double> out({rank.size(), py::ssize_t(2)});
+  double* o = out.mutable_data();
+  for_each_id(tile, rank, depth, [&](py::ssize_t i, const PointId& id) {
+    return stable_position(*h.set, id, tile_size, origin_x, origin_y, &o[2 * i], &o[2 * i + 1]);
+  });
   return out;
 }
 
@@ -222,6 +247,8 @@ void bind_tileset(py::module_& m) {
       .def("to_bytes", &to_bytes)
       .def("save", &save, py::arg("path"))
       .def("thresholds", &thresholds, py::arg("tile"), py::arg("rank"), py::arg("depth"))
+      .def("stable_positions", &stable_positions, py::arg("tile"), py::arg("rank"), py::arg("depth"),
+           py::arg("tile_size"), py::arg("origin_x"), py::arg("origin_y"))
       .def("key_thresholds", &key_thresholds, py::arg("keys"), py::arg("near_x"), py::arg("near_y"))
       .def_property_readonly("info", &info);
   m.def("bake", &bake, py::arg("recipe_text"), py::arg("threads"));

@@ -29,7 +29,7 @@ def test_every_public_name_is_documented():
         obj = getattr(kdm, name)
         if name != "__version__":
             assert inspect.getdoc(obj) and len(inspect.getdoc(obj)) > 40, name
-    for method in ("builtin", "load", "save", "query", "thresholds"):
+    for method in ("builtin", "load", "save", "query", "thresholds", "stable_positions"):
         assert inspect.getdoc(getattr(kdm.Tileset, method)), method
     assert "row 0 at the TOP" in inspect.getdoc(kdm.sample)
 

@@ -1062,3 +1062,23 @@ def test_a_tile_size_too_small_for_the_density_is_warned_of():
         BUILTIN.query((0, 0, 1, 1), scale=100, density=ramp)
         BUILTIN.query((0, 0, 0, 0), scale=1)  # an empty region emits nothing to warn of
         BUILTIN.query((0, 0, 2, 2), scale=32)
+
+
+def test_stable_positions_are_where_a_stable_query_puts_the_points():
+    # And where a smooth query's points glide from: a fade weight read there follows the query's rule.
+    rect, origin = (0.2, 0.3, 3.2, 2.3), (1.5, -0.5)
+    stable = BUILTIN.query(rect, scale=400, tile_size=2.0, origin=origin, mode="stable")
+    np.testing.assert_allclose(BUILTIN.stable_positions(stable, tile_size=2.0, origin=origin), stable.xy,
+                               rtol=0, atol=1e-12)
+    ramp = kdm.DensityMap(np.array([[0.05, 1.0]]), (0, 0, 4, 4))
+    smooth = BUILTIN.query(rect, scale=400, tile_size=2.0, origin=origin, density=ramp, mode="smooth")
+    home = BUILTIN.stable_positions(smooth, tile_size=2.0, origin=origin)
+    assert not np.array_equal(home, smooth.xy)  # they glided
+    count = ramp.at(home[:, 0] + origin[0], home[:, 1] + origin[1]) * 400 * 2.0**2
+    assert (count > BUILTIN.thresholds(smooth)).all()  # every point present, by its threshold
+    with pytest.raises(ValueError, match="tile_size"):
+        BUILTIN.stable_positions(stable, tile_size=0)
+    with pytest.raises(TypeError, match="QueryResult"):
+        BUILTIN.stable_positions(stable.xy)
+    with pytest.raises(ValueError, match="origin"):
+        BUILTIN.stable_positions(stable, origin=(0, float("nan")))
