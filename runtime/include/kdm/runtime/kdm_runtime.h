@@ -95,7 +95,7 @@ typedef struct kdm_query {
    * there), asked once per tile (and, in stable mode, per sixteenth of a tile) so that the callback is
    * called only where emission is in doubt (kdm::QueryDensity::bounds). NaN bounds, and *lo > *hi, are
    * ignored; bounds that do not hold make points appear or vanish as if the density were *lo or *hi.
- * Bounds with neither a callback nor an image are refused (KDM_PROBLEM_BAD_DENSITY, "density_callback"). */
+   * Bounds with neither a callback nor an image are refused (KDM_PROBLEM_BAD_DENSITY, "density_callback"). */
   /* *lo and *hi hold NaN when it is called: a callback that writes neither gives no bounds there. */
   void (*density_bounds)(void* user, double x0, double y0, double x1, double y1, double* lo, double* hi);
   /* Added in 0.4: instead of density_callback (set one of the two), the density at n positions at once,
@@ -539,7 +539,8 @@ KDM_RUNTIME_API kdm_status kdm_density_check_wrap_class(kdm_density_check* check
 /* 1 once the check found something, with the first finding's value and position in *value, *x, *y (each
  * optional): a value that does not fit, or one outside the bounds given for a rectangle that holds it; 0
  * otherwise (and for a NULL check). */
-KDM_RUNTIME_API int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y);
+KDM_RUNTIME_API int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x,
+                                             double* y);
 /* The largest finite value the check has read (-1 before any, and for a NULL check): far under
  * density_max, a tighter bound lets queries skip more candidates. */
 KDM_RUNTIME_API double kdm_density_check_largest(const kdm_density_check* check);
