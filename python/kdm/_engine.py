@@ -60,9 +60,17 @@ class _Engine:
         """n integer points in [l_bounds, u_bounds) ([l_bounds, u_bounds] with endpoint), shape (n, d)."""
         if u_bounds is None:
             u_bounds, l_bounds = l_bounds, 0
-        low, high = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds) + (1 if endpoint else 0)
+        low, high = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds)
         if not (np.issubdtype(low.dtype, np.integer) and np.issubdtype(high.dtype, np.integer)):
             raise ValueError("'u_bounds' and 'l_bounds' must be integers or array-like of integers")
+        high = high + (1 if endpoint else 0)
+        try:  # SciPy's checks, in its words
+            low, high = np.broadcast_to(low, self.d), np.broadcast_to(high, self.d)
+        except ValueError:
+            raise ValueError("'l_bounds' and 'u_bounds' must be broadcastable and respect the sample "
+                             "dimension") from None
+        if np.any(low >= high):
+            raise ValueError("Bounds are not consistent 'l_bounds' < 'u_bounds'")
         return np.floor(self.random(n=n) * (high - low) + low).astype(np.int64)
 
 

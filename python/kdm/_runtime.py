@@ -49,7 +49,8 @@ class QueryResult:
     ``r[i]``, ``r[a:b]``, ``r[mask]`` and ``r[indices]`` give a new QueryResult of those points (copied);
     an integer past either end (``-len(r) <= i < len(r)``, as numpy's) is an IndexError. Iterating
     yields ``r[0]``, ``r[1]``, ...: one-point QueryResults (slow for many points; the arrays are the bulk
-    route). A result pickles its points alone, not the buffer a reused ``out`` left behind it.
+    route, and ``np.asarray(r)`` is a TypeError that names them). A result pickles its points alone, not
+    the buffer a reused ``out`` left behind it.
     """
 
     __slots__ = ("points", "xy", "tile", "rank", "level", "classes", "_storage")
@@ -106,6 +107,11 @@ class QueryResult:
 
     def __iter__(self) -> Iterator["QueryResult"]:
         return (self[i] for i in range(len(self)))
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        # Without it numpy would walk the one-point results as nested sequences, for minutes.
+        raise TypeError("a QueryResult is not an array: pass its .xy (positions less the origin), or .tile, "
+                        ".rank, .keys, .classes")
 
     def __repr__(self) -> str:
         return f"<kdm.QueryResult: {len(self)} points>"

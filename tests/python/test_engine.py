@@ -214,6 +214,14 @@ def test_without_scipy():
         e.reset()
         assert np.array_equal(e.random(256), first) and e.num_generated == 256
         assert e.integers(5, n=16).max() < 5
+        assert e.integers(5, u_bounds=6, n=8, endpoint=True).min() >= 5
+        for bad in ((5, 2), (5, 5), (True, None), (0, [3, 4, 5])):  # SciPy refuses each as well
+            try:
+                e.integers(bad[0], u_bounds=bad[1], n=3)
+            except ValueError:
+                pass
+            else:
+                raise AssertionError(f"integers{bad} drew")
         assert "scipy" not in sys.modules
         print("ok", kdm.__version__)
     """)

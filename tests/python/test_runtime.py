@@ -427,6 +427,10 @@ def test_result_index_past_either_end_is_an_index_error_and_iteration_ends():
     assert len(items) == m and all(isinstance(p, kdm.QueryResult) and len(p) == 1 for p in items)
     assert np.array_equal(np.concatenate([p.xy for p in items]), r.xy)
     assert list(r[:0]) == []
+    # Not an array: numpy and the measures refuse it at once instead of walking one-point results.
+    for convert in (np.asarray, kdm.analyze):
+        with pytest.raises(TypeError, match=r"\.xy"):
+            convert(r)
 
 
 def test_results_index_key_and_pickle_their_own_points():
