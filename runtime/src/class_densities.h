@@ -55,6 +55,8 @@ struct ClassDensities {
       j.densities(j.user, x, y, v);
     else
       j.batch_densities(j.user, 1, &x, &y, v);  // class k's value at v[k · 1 + 0]
+    for (std::uint32_t k = 0; k < params->class_count; ++k)
+      if (j.max[k] == 0) v[k] = 0;  // a class bounded by 0 has no points, as a callback class's
   }
   /// Class k's values at n positions into v[0 … n), as at() reads each: a batch callback's in one call.
   void values_of(std::uint32_t k, std::size_t n, const double* x, const double* y, double* v) const {
@@ -91,7 +93,7 @@ struct ClassDensities {
     }
     for (std::uint32_t k = 0; k < count; ++k)
       for (std::size_t i = 0; i < n; ++i)
-        sums[k][i] = (k > 0 ? sums[k - 1][i] : 0.0) + density_or_zero(v[k * n + i]);
+        sums[k][i] = (k > 0 ? sums[k - 1][i] : 0.0) + (j.max[k] == 0 ? 0.0 : density_or_zero(v[k * n + i]));
   }
   /// Bounds of every class's density over [x0, x1] × [y0, y1] into lo[k], hi[k], as query_points takes
   /// one density's.

@@ -580,6 +580,46 @@ TEST(ClassQueryTest, AJointDensityGivesTheSeparateClassesPoints) {
     }
 }
 
+/// A joint density of the constants 1, 2 and 4, or 1, 0 and 4 with `zero_middle`.
+void joint_constants(void* user, double, double, double* v) {
+  v[0] = 1, v[1] = *static_cast<const bool*>(user) ? 0 : 2, v[2] = 4;
+}
+void joint_constants_batch(void* user, std::size_t n, const double* x, const double* y, double* v) {
+  for (std::size_t i = 0; i < n; ++i) {
+    double one[3];
+    joint_constants(user, x[i], y[i], one);
+    for (std::size_t k = 0; k < 3; ++k) v[k * n + i] = one[k];
+  }
+}
+
+TEST(ClassQueryTest, AJointClassBoundedByZeroHasNoPoints) {
+  // Its values (2 here) are not read: the points and classes of a joint density giving it 0, through the
+  // single and the batch function, in both modes. Before, only the bounds' sum was honoured.
+  for (QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth})
+    for (bool batch : {false, true}) {
+      bool zero_middle = false, reference_zero = true;
+      ClassQueryParams bounded = three_constants(0, 0, 3, 3, 300, mode), reference = bounded;
+      bounded.joint.max[0] = 1, bounded.joint.max[1] = 0, bounded.joint.max[2] = 4;
+      reference.joint.max[0] = 1, reference.joint.max[1] = 2, reference.joint.max[2] = 4;
+      bounded.joint.user = &zero_middle, reference.joint.user = &reference_zero;
+      for (ClassQueryParams* q : {&bounded, &reference}) {
+        if (batch)
+          q->joint.batch_densities = joint_constants_batch;
+        else
+          q->joint.densities = joint_constants;
+      }
+      const Points a = run_classes(bounded), b = run_classes(reference);
+      ASSERT_GT(a.size(), 3000u);
+      expect_same(b, a, "a class bounded by 0 against one of density 0");
+      std::size_t middle = 0;
+      for (const auto& [id, e] : a) {
+        ASSERT_EQ(b.at(id).cls, e.cls);
+        middle += e.cls == 1;
+      }
+      EXPECT_EQ(middle, 0u);
+    }
+}
+
 /// query_classes_compact over `q` with keys, resumed through buffers of `capacity`: positions, keys and
 /// classes in output order.
 struct CompactRun {
