@@ -614,6 +614,22 @@ TEST_F(CliTest, StipplePensAsInksOneNumbering) {
     EXPECT_EQ(circles, dots.size()) << name;
   }
   EXPECT_EQ(colours, (std::set<std::string>{"#e00000", "#0000aa", "#000000", "#00aa00"}));
+  // The layers come in the pens' order as given (a plotter's pens stay put), not in class order.
+  const auto layer_at = [](const std::string& text, const char* hex) {
+    return text.find("fill=\"" + std::string(hex) + "\"");
+  };
+  EXPECT_LT(layer_at(svg, "#e00000"), layer_at(svg, "#0000aa"));
+  EXPECT_LT(layer_at(svg, "#0000aa"), layer_at(svg, "#000000"));
+  EXPECT_LT(layer_at(svg, "#000000"), layer_at(svg, "#00aa00"));
+  ASSERT_EQ(
+      kdm("stipple '" + path("c.png") + "' --colours '#00aa00,#000000,#0000aa,#e00000' --points 6000 -o '" +
+          path("reversed.svg") + "'")
+          .status,
+      0);
+  const std::string reversed = slurp(path("reversed.svg"));
+  EXPECT_LT(layer_at(reversed, "#00aa00"), layer_at(reversed, "#000000"));
+  EXPECT_LT(layer_at(reversed, "#000000"), layer_at(reversed, "#0000aa"));
+  EXPECT_LT(layer_at(reversed, "#0000aa"), layer_at(reversed, "#e00000"));
   EXPECT_NE(run.err.find("ink-0-"), std::string::npos);
   EXPECT_NE(svg.find("-black\""), std::string::npos);
   for (const char* bad : {"'#e00000,#12345'", "'#e00000,,#000000'", "'#ffffff'", "'#000000,#000000'",

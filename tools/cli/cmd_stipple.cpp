@@ -431,7 +431,8 @@ void add_stipple_command(CLI::App& app) {
       "blue-noise set; the run prints each class number with its ink's name and colour; .svg has a layer "
       "per ink named as printed (with N inks or pens ink-K-colour, K the class number; an empty layer for "
       "an ink no pixel uses), in class order, but for cmyk and rgb in their fixed printing order (cyan, "
-      "magenta, yellow, black; red, green, blue) so a plotter's pens stay put whatever the image; .csv a "
+      "magenta, yellow, black; red, green, blue) and for pens in the order given, so a plotter's pens "
+      "stay put whatever the image; .csv a "
       "class column; classes: least-used ink first (but inks under a tenth of all ink last), pens may be "
       "separated by ', ' (default: black dots of the image's darkness)");
   add_seed_option(cmd, a->seed,

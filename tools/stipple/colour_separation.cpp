@@ -374,13 +374,15 @@ std::vector<Vec3> parse_palette(const std::string& scheme) {
 }
 
 /// Inks named by one numbering, their class's (the unused after the used), and their colour, "ink-0-red":
-/// the SVG layer, the printed list and a .csv's class number say the same; layers in class order.
-void name_by_class(ColourSeparation& s) {
+/// the SVG layer, the printed list and a .csv's class number say the same. Layers in class order, but
+/// pens (`listed`) keep the order given, so that a plotter's pens stay put whatever the image.
+void name_by_class(ColourSeparation& s, bool listed) {
   int k = 0;
   for (auto* list : {&s.inks, &s.unused})
     for (Ink& i : *list) {
       i.name = "ink-" + std::to_string(k) + "-" + colour_word(i.rgb);
-      i.layer = k++;
+      if (!listed) i.layer = k;
+      ++k;
     }
 }
 
@@ -390,6 +392,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   if (!(gamma > 0) || !std::isfinite(gamma)) throw std::invalid_argument("gamma must be a finite number > 0");
   ColourSeparation s;
   bool numbered = false;  // inks named by their class number and colour, once the classes are ordered
+  bool listed = false;    // the user's pens, their layers in the order given
   if (scheme == "cmyk") {
     auto black = [](const float* p) { return 1.0 - std::max({double(p[0]), double(p[1]), double(p[2])}); };
     auto part = [&](int c) {
@@ -419,7 +422,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     s.blend = Blend::kAdd;
   } else {
     // N inks chosen for the image, or the user's own (a list of colours).
-    const bool listed = scheme.find('#') != std::string::npos || scheme.find(',') != std::string::npos;
+    listed = scheme.find('#') != std::string::npos || scheme.find(',') != std::string::npos;
     std::vector<Vec3> inks;
     if (listed) {
       inks = parse_palette(scheme);
@@ -475,7 +478,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
     }
   if (s.channels.empty()) {  // a blank image: no dots, every ink an empty layer
     s.unused = std::move(unused);
-    if (numbered) name_by_class(s);
+    if (numbered) name_by_class(s, listed);
     return s;
   }
   // A later class's dots are those its cumulative density adds to the earlier classes', so its tone carries
@@ -500,7 +503,7 @@ ColourSeparation separate_colours(const ColourImage& image, const std::string& s
   sorted.unused = std::move(unused);
   for (std::size_t c : order)
     sorted.channels.push_back(std::move(s.channels[c])), sorted.inks.push_back(s.inks[c]);
-  if (numbered) name_by_class(sorted);
+  if (numbered) name_by_class(sorted, listed);
   return sorted;
 }
 

@@ -44,7 +44,8 @@ struct ColourSeparation {
 /// side by side) whose Σ c_i (1 − ink_i) is nearest its absorbance 1 − rgb (least squares with a small
 /// ridge, so the split changes smoothly with the colour and a gradient is drawn by dots of several inks;
 /// traces under 1% dropped), near-greys as greys. Such inks are named by their class number and colour,
-/// "ink-0-red", after the ordering below, the unused after the used; their layers come in that order.
+/// "ink-0-red", after the ordering below, the unused after the used; N inks' layers come in that order,
+/// pens' in the order given.
 /// Each density is the coverage raised to `gamma` (> 0). The inks come in order of increasing mean coverage
 /// (a later class's tone carries the earlier classes' count errors, the more the smaller its share), except
 /// that inks under a tenth of the total coverage come last, most covering first (a sparse class early in
