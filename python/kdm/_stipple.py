@@ -82,7 +82,7 @@ def stipple(
         picture, at the PNG's pixel coordinates: a pen plotter's drawing) or .txt/.csv (points), as kdm stipple does
         (another extension, .npy too, is a ValueError: the dots are returned as an array).
     width, dot_size
-        The picture's width in pixels (None: 1024, or what `height` makes it; used with `output` only), and
+        The picture's width in pixels (None: 1024, or what `height` makes it; used with a .png or .svg `output` only, refused with a points file), and
         the dot radius in pixels (None or 0: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
         inks' summed coverage, so that the picture keeps the image's tone), at most a quarter of the
@@ -165,6 +165,9 @@ def stipple(
         output = _checks.path("output", output)
     if width is not None and height is not None:
         raise ValueError("give width or height, not both (the other follows the picture's shape)")
+    sized = [name for name, v in (("width", width), ("height", height), ("dot_size", dot_size)) if v is not None]
+    if sized and output is not None and os.path.splitext(output)[1].lower() not in (".png", ".svg"):
+        raise ValueError(f"{sized[0]} sizes pictures: write .png or .svg (points files hold positions only)")
     width = 1024 if width is None else _checks.integer("width", width, 1, 65536)
     height = 0 if height is None else _checks.integer("height", height, 1, 65536)
     dot_size = 0.0 if dot_size is None else _checks.number("dot_size", dot_size, 0.0)

@@ -250,8 +250,8 @@ TEST_F(CliTest, StippleSvgDotsLieAtTheirPointsWithinTheMargin) {
   write_bytes(path("grey.png"), grey_png(96, 64, 8, std::vector<std::uint16_t>(96 * 64, 128)));
   for (const char* dot : {"", " --dot-size 40"}) {
     SCOPED_TRACE(dot);
-    const std::string run = "stipple '" + path("grey.png") + "' --points 3000 --width 600" + dot;
-    ASSERT_EQ(kdm(run + " -o '" + path("g.svg") + "'").status, 0);
+    const std::string run = "stipple '" + path("grey.png") + "' --points 3000";
+    ASSERT_EQ(kdm(run + " --width 600" + dot + " -o '" + path("g.svg") + "'").status, 0);
     ASSERT_EQ(kdm(run + " -o '" + path("g.txt") + "'").status, 0);
     double w = 0, h = 0, margin = 0;
     const std::vector<Circle> dots = svg_circles(slurp(path("g.svg")), w, h, &margin);
@@ -320,8 +320,8 @@ TEST_F(CliTest, StippleRefusesDotsTooLargeForThePicture) {
             [](const Circle& a, const Circle& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   for (std::size_t i = 1; i < dots.size(); ++i)
     EXPECT_FALSE(dots[i].x == dots[i - 1].x && dots[i].y == dots[i - 1].y) << dots[i].x << ", " << dots[i].y;
-  // Points files have no dot size to refuse.
-  EXPECT_EQ(kdm(run + " --dot-size 120 -o '" + path("s.csv") + "'").status, 0);
+  // Points files have no dot size: one given is refused, not ignored.
+  expect_error(run + " --dot-size 120 -o '" + path("s.csv") + "'", "sizes pictures");
 }
 
 // A tile set of a narrow density range (2 levels: 1:4) places a picture's light tones under its coarsest

@@ -1074,6 +1074,21 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   expect_error("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png' --fade 0.2 -o '" +
                    path("f.csv") + "'",
                "--fade grows dots in pictures");
+  for (const char* picture_only : {"--width 300", "--height 300", "--dot-size 3"})  // were silently ignored
+    expect_error(
+        "stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png' " + picture_only + " -o '" +
+            path("f.csv") + "'",
+        std::string(picture_only).substr(0, std::string(picture_only).find(' ')) + " sizes pictures");
+  {  // A strip 1,000 times wider than high, at the default width: a picture 1 pixel high, said so.
+    std::string error;
+    ASSERT_TRUE(kdm::tools::write_png(path("strip.png"), kdm::tools::RgbImage(4000, 4, 100), error)) << error;
+    const Outcome strip = kdm("stipple '" + path("strip.png") + "' -o '" + path("strip-dots.png") + "'");
+    EXPECT_EQ(strip.status, 0) << strip.err;
+    EXPECT_NE(strip.err.find("too small to show on the 1024x1 picture"), std::string::npos) << strip.err;
+    const Outcome wide =
+        kdm("stipple '" + path("strip.png") + "' --width 60000 -o '" + path("strip-dots.png") + "'");
+    EXPECT_EQ(wide.err.find("too small"), std::string::npos) << wide.err;
+  }
   std::ofstream(path("empty.recipe")) << "# a comment only\n\n  # indented\n";  // not minutes of defaults
   expect_error("bake '" + path("empty.recipe") + "' -o '" + path("e.kdmt") + "'", "gives no key");
   // --gamma named as the option, in every command that takes it (grey and in colour).
@@ -1732,20 +1747,18 @@ TEST_F(CliTest, StippleFramesRejectBadCounts) {
   // A frame's printed region draws that frame again, though the first reach past the image; a zoom's end
   // must lie in it, and a region anywhere must meet it.
   const Outcome zoom =
-      kdm("stipple " + image + " --region 0.2,0.3,0.6,0.5 --frames 3 --width 200 -o '" + path("z.csv") + "'");
+      kdm("stipple " + image + " --region 0.2,0.3,0.6,0.5 --frames 3 -o '" + path("z.csv") + "'");
   ASSERT_EQ(zoom.status, 0) << zoom.err;
   const std::size_t at = zoom.err.find("region ") + 7;
   const std::string first = zoom.err.substr(at, zoom.err.find(' ', at) - at);
   EXPECT_EQ(first.rfind("-0.333", 0), 0u) << first;  // past the image's left side
-  ASSERT_EQ(
-      kdm("stipple " + image + " --region " + first + " --width 200 -o '" + path("again.csv") + "'").status,
-      0);
+  ASSERT_EQ(kdm("stipple " + image + " --region " + first + " -o '" + path("again.csv") + "'").status, 0);
   EXPECT_EQ(slurp(path("again.csv")), slurp(path("z_0000.csv")));
   expect_error("stipple " + image + " --region " + first + " --frames 3" + out, "for --frames");
   expect_error("stipple " + image + " --region 1.5,0,2,1" + out, "must meet the image");
   // Sides equal within rounding (0.75 - 0.55, 0.55 - 0.35) zoom out to the image exactly.
-  const Outcome square = kdm(
-      "stipple " + image + " --region 0.55,0.35,0.75,0.55 --frames 2 --width 100 -o '" + path("s.csv") + "'");
+  const Outcome square =
+      kdm("stipple " + image + " --region 0.55,0.35,0.75,0.55 --frames 2 -o '" + path("s.csv") + "'");
   EXPECT_NE(square.err.find("region 0,0,1,1 "), std::string::npos) << square.err;
   expect_error("stipple " + image + " --frames 5 --region 0,0,.2,.2 --mode stable" + out, "2× (");
   // Smooth mode descends into the built-in set's m × m subtiles, four depths deep: 2 · m^4 ×.

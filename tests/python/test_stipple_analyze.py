@@ -642,6 +642,9 @@ def test_stipple_refuses_what_kdm_stipple_refuses_before_placing_dots(tmp_path):
     coffee = str(SPHERE.parent / "coffee.png")
     with pytest.raises(ValueError, match="fade grows dots in pictures"):
         kdm.stipple(str(SPHERE), points=500, fade=0.2, output=tmp_path / "x.csv")
+    for sized in ({"width": 300}, {"height": 300}, {"dot_size": 2.0}):  # were silently ignored
+        with pytest.raises(ValueError, match=f"{next(iter(sized))} sizes pictures"):
+            kdm.stipple(str(SPHERE), points=500, output=tmp_path / "x.csv", **sized)
     with pytest.raises(ValueError, match="colours writes each dot's ink as a class"):
         kdm.stipple(coffee, points=500, colours="cmyk", output=tmp_path / "x.txt")
     with pytest.raises(ValueError, match="pixels is too tall .*give height"):

@@ -36,6 +36,7 @@ struct StippleArgs {
   std::int64_t frames = 0;  // wide, so that any count is refused by name, not by the option's parser
   int threads = 0;
   std::uint64_t seed = 1;
+  std::vector<std::string> picture_options;  // --width, --height, --dot-size as given: pictures only
 };
 
 /// "x0,y0,x1,y1" in UV units (y up): meeting [0, 1]² for one picture (past the image is blank paper, as a
@@ -94,6 +95,9 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
   if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
+  if (format != ".png" && format != ".svg" && !a.picture_options.empty())
+    throw CommandError(a.picture_options.front() +
+                       " sizes pictures: write .png or .svg (points files hold positions only)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.height_px >= 0 && a.height_px <= 65536)) throw CommandError("--height must be 1 to 65536 pixels");
   if (!a.paper_width.empty()) {
@@ -299,9 +303,15 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
       how = "runtime tiles";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (dot_radius <= 0)
+    if (dot_radius <= 0) {
       dot_radius =
           blank ? 1.0 : std::min(tools::stipple_dot_radius(whole_dots, width_px, aspect, specs), largest_dot);
+      if (dot_radius < 0.25 && (format == ".png" || format == ".svg"))  // a flat strip's default width
+        std::fprintf(stderr,
+                     "kdm stipple: warning: dots of radius %.2g pixels are too small to show on %s; raise "
+                     "--width or --height, or lower --points\n",
+                     dot_radius, picture.empty() ? "the picture" : ("the " + picture + " picture").c_str());
+    }
     tools::DrawStyle style;
     style.width_px = width_px;
     style.height_px = a.height_px;
@@ -460,6 +470,8 @@ void add_stipple_command(CLI::App& app) {
     if (cmd->get_option("--white")->count() > 0 && !(a->white > 0 && std::isfinite(a->white)))
       throw CommandError("--white must be a finite number > 0 (the luminance that is white), got " +
                          tools::shortest(a->white));
+    for (const char* picture_only : {"--width", "--height", "--dot-size"})
+      if (cmd->get_option(picture_only)->count() > 0) a->picture_options.push_back(picture_only);
     if (scale_given) a->points = 0;
     if (a->method == "full")  // options the full sampler would ignore
       for (const char* tiles_only : {"--mode", "--tileset"})
