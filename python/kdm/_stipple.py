@@ -82,8 +82,8 @@ def stipple(
         picture, at the PNG's pixel coordinates: a pen plotter's drawing) or .txt/.csv (points), as kdm stipple does
         (another extension, .npy too, is a ValueError: the dots are returned as an array).
     width, dot_size
-        The picture's width in pixels (None: 1024, or what `height` makes it; used with a .png or .svg `output` only, refused with a points file), and
-        the dot radius in pixels (None or 0: the size at which the
+        The picture's width in pixels (None: 1024, or what `height` makes it; for a .png or .svg `output`
+        only, refused with a points file), and the dot radius in pixels (None or 0: the size at which the
         whole image's dots cover as much of the picture as the image's mean darkness, in colour the
         inks' summed coverage, so that the picture keeps the image's tone), at most a quarter of the
         picture's shorter side.
