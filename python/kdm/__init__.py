@@ -20,12 +20,12 @@ from . import _kdm
 from ._analysis import analyze
 from ._runtime import DensityMap, QueryResult, Tileset, bake
 from ._sampling import sample
-from ._stipple import separate, stipple, zoom_regions
+from ._stipple import Ink, separate, stipple, zoom_regions
 
 __version__: str = _kdm.__version__
 
 __all__ = [
-    "BlueNoise", "DensityMap", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "zoom_regions",
+    "BlueNoise", "DensityMap", "Ink", "QueryResult", "Tileset", "analyze", "bake", "sample", "separate", "stipple", "zoom_regions",
     "__version__",
 ]
 

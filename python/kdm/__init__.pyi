@@ -131,6 +131,10 @@ class Tileset:
         classes: Optional[Sequence[_QueryDensity]] = ...,
     ) -> Union[npt.NDArray[np.float32], Tuple[npt.NDArray[Any], ...]]: ...
 
+class Ink(str):
+    colour: str
+    def __new__(cls, name: str, colour: str) -> Ink: ...
+
 def bake(recipe_text: str, *, threads: int = ...) -> Tileset: ...
 def zoom_regions(region: Sequence[float], frames: int) -> npt.NDArray[np.float64]: ...
 def separate(
@@ -139,7 +143,7 @@ def separate(
     colours: Union[str, int, Sequence[str]] = ...,
     gamma: float = ...,
     white: Optional[float] = ...,
-) -> Tuple[npt.NDArray[np.float32], List[str]]: ...
+) -> Tuple[npt.NDArray[np.float32], List[Ink]]: ...
 def stipple(
     image: Union[_Path, npt.ArrayLike],
     *,

@@ -10,6 +10,26 @@ from . import _checks, _kdm
 from ._runtime import Tileset
 
 
+class Ink(str):
+    """An ink's name as ``kdm stipple`` prints it and an SVG's layer is called ("cyan", "ink-0-red"), a
+    str, with its colour in pictures as ``.colour``, "#rrggbb": what a caller drawing the dots, or
+    choosing pens for them, needs."""
+
+    colour: str
+
+    def __new__(cls, name: str, colour: str) -> "Ink":
+        ink = super().__new__(cls, name)
+        ink.colour = colour
+        return ink
+
+    def __getnewargs__(self) -> Tuple[str, str]:  # type: ignore[override]
+        return str(self), self.colour
+
+
+def _inks(pairs: Any) -> List[Ink]:
+    return [Ink(name, colour) for name, colour in pairs]
+
+
 def stipple(
     image: Any,
     *,
@@ -116,7 +136,8 @@ def stipple(
     -------
     numpy.ndarray, or with `colours` a tuple (dots, classes, inks)
         dots: (m, 2) float64, normalised to the rendered image or region, [0, 1) on both axes, y up;
-        classes: (m,) uint8, each dot's ink; inks: the inks' names, in class order (separate()'s).
+        classes: (m,) uint8, each dot's ink; inks: the inks in class order (separate()'s), each an Ink:
+        its name, a str, with its colour as ``.colour`` ("#rrggbb").
     """
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     invert = _checks.flag("invert", invert)
@@ -188,10 +209,14 @@ def stipple(
     handle = tileset._handle if tileset is not None else None
     if spec is None:
         spec = _kdm.stipple_density(label, gamma, invert, points, scale, region, white)
-    return _kdm.stipple(
+    result = _kdm.stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
         colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height, white,
     )
+    if colours is None:
+        return result
+    dots, classes, inks = result
+    return dots, classes, _inks(inks)
 
 
 def zoom_regions(region: Sequence[float], frames: int) -> np.ndarray:
@@ -220,8 +245,8 @@ def separate(
     them, to preview or measure.
 
     Returns ``(channels, inks)``: channels a (k, height, width) float32 array, each ink's density in [0, 1]
-    (its coverage raised to `gamma`), row 0 at the top as in the picture; inks the inks' names, in class
-    order: the inks of least coverage first (a later class's tone carries the earlier classes' count
+    (its coverage raised to `gamma`), row 0 at the top as in the picture; inks the inks (Ink: a name with
+    its ``.colour``, "#rrggbb"), in class order: the inks of least coverage first (a later class's tone carries the earlier classes' count
     errors, the more the smaller its share), except that inks under a tenth of the total coverage come last.
     `white`: for a Radiance .hdr file, the luminance that is white, as in stipple().
     """
@@ -235,4 +260,4 @@ def separate(
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     colours = _checks.colour_scheme(colours)
     channels, inks = _kdm.separate(label, colours, gamma, rgb, alpha, white)
-    return channels, list(inks)
+    return channels, _inks(inks)

@@ -23,6 +23,13 @@ using tools::DensitySpec;
 using Region = std::array<double, 4>;
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 
+/// The used inks' (name, "#rrggbb") in class order, which Python makes its Ink names.
+py::list names_and_colours(const tools::ColourSeparation& inks) {
+  py::list out;
+  for (const tools::Ink& ink : inks.inks) out.append(py::make_tuple(ink.name, ink.hex()));
+  return out;
+}
+
 /// Refuses `white` (> 0: given) for the file `path` unless it is a Radiance picture, as kdm stipple --white
 /// does; an empty or missing file is left to the loader to name.
 void check_white(const std::string& path, double white) {
@@ -237,9 +244,7 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   const auto count = static_cast<py::ssize_t>(set.size());
   py::array_t<double> dots = owning_array(std::move(set.coords), {count, py::ssize_t(2)});
   if (!colours) return std::move(dots);
-  py::list names;
-  for (const tools::Ink& ink : inks.inks) names.append(ink.name);
-  return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names);
+  return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names_and_colours(inks));
 }
 
 /// The inks of an image file as kdm stipple --colours separates them: (k, height, width) float32 densities,
@@ -260,9 +265,7 @@ py::tuple separate(const std::string& path, const std::string& colours, double g
   for (std::size_t c = 0; c < inks.channels.size(); ++c)
     for (std::size_t y = 0; y < h; ++y)  // DensitySpec's rows run from the bottom
       std::copy_n(inks.channels[c].values.data() + (h - 1 - y) * w, w, out + (c * h + y) * w);
-  py::list names;
-  for (const tools::Ink& ink : inks.inks) names.append(ink.name);
-  return py::make_tuple(channels, names);
+  return py::make_tuple(channels, names_and_colours(inks));
 }
 
 }  // namespace

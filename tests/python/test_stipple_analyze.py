@@ -1,5 +1,7 @@
 """kdm.stipple and kdm.analyze: what `kdm stipple` draws and what `kdm analyze` measures."""
 import json
+import pickle
+import re
 import warnings
 
 import numpy as np
@@ -550,6 +552,19 @@ def test_stipple_in_colour_as_kdm_stipple_does(cli, tmp_path):
     assert np.array_equal(rows[:, :2], dots) and np.array_equal(rows[:, 2], classes)
     assert classes.dtype == np.uint8 and len(inks) == 4 and set(inks) == {"cyan", "magenta", "yellow", "black"}
     assert '<g id="%s"' % inks[0] in (tmp_path / "py.svg").read_text()
+    # Each ink is its name with its colour, the one the command line prints beside the name, and the
+    # one its SVG layer draws in; it pickles as itself.
+    printed = cli("stipple", coffee, "--colours", 3, "--points", 2000, "-o", tmp_path / "three.svg")
+    _, _, three = kdm.stipple(str(coffee), points=2000, colours=3, output=tmp_path / "py3.svg")
+    assert [type(ink) for ink in three] == [kdm.Ink] * len(three) and len(three) >= 2
+    for k, ink in enumerate(three):
+        assert f"{k} {ink} {ink.colour}" in printed and re.fullmatch("#[0-9a-f]{6}", ink.colour)
+        layer = (tmp_path / "py3.svg").read_text().split('<g id="%s"' % ink)[1].split("</g>")[0]
+        assert f'fill="{ink.colour}"' in layer
+    again = pickle.loads(pickle.dumps(three))
+    assert again == three and [i.colour for i in again] == [i.colour for i in three]
+    _, separated = kdm.separate(str(coffee), colours="cmyk")
+    assert {ink: ink.colour for ink in separated}["black"] == "#000000"
     # A grey picture: black holds every dot, but the SVG keeps a layer for each of the scheme's pens.
     _, grey_classes, grey_inks = kdm.stipple(str(SPHERE), points=2000, colours="cmyk", output=tmp_path / "g.svg")
     assert grey_inks == ["black"] and not grey_classes.any()
