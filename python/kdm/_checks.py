@@ -11,6 +11,7 @@ import math
 import numbers
 import os
 import re
+import warnings
 from typing import Any, Callable, Optional, Sequence, Tuple
 
 import numpy as np
@@ -290,6 +291,10 @@ def pil_pixels(value: Any) -> Any:
         a = np.asarray(value)
         if a.size and (a.min() < 0 or a.max() > 65535):
             raise ValueError("a PIL image of mode 'I' must hold 16-bit grey levels 0 to 65535")
+        if a.size and 0 < a.max() <= 255:  # an 8-bit image converted to "I" would be drawn near black
+            warnings.warn("a PIL image of mode 'I' is read as 16-bit grey (0 to 65535), but every level of this "
+                          "one is 255 or less: if they are 8-bit levels, pass image.convert('L')", UserWarning,
+                          stacklevel=3)  # the line that called stipple() or separate()
         return a.astype(np.uint16) if key is None else _keyed(a.astype(np.uint16), a == key)
     if mode in ("L", "I;16", "I;16L", "I;16B"):  # with a key: Pillow's convert("LA") ignores a 16-bit one
         a = np.asarray(value).astype(np.uint8 if mode == "L" else np.uint16)

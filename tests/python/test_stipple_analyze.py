@@ -193,6 +193,14 @@ def test_stipple_takes_a_pil_images_transparent_colour_as_its_file_does(tmp_path
                         kdm.stipple(str(path), points=3000, colours="cmyk")):
             np.testing.assert_array_equal(a, b)
         np.testing.assert_array_equal(kdm.separate(picture)[0], kdm.separate(str(path))[0])
+    # Mode "I" is read as 16-bit grey; an 8-bit picture converted to it (drawn near black) is warned of.
+    eight = Image.open(SPHERE).convert("I")
+    with pytest.warns(UserWarning, match=r"convert\('L'\)") as caught:
+        kdm.stipple(eight, points=500)
+    assert caught[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        kdm.stipple(Image.fromarray(grey.astype(np.int32) * 257, mode="I"), points=500)
 
 
 def test_stipple_takes_grey_and_alpha_as_a_file_of_them_is_read(tmp_path):
