@@ -118,7 +118,8 @@ def stipple(
     colours : {"cmyk", "rgb"}, int, str or list of pens, or None
         A colour stipple of the image, a file or an array (``kdm stipple --colours``): "cmyk" (black by under-colour
         removal), "rgb" (light on black), a number of inks, 2 to 8 (chosen among the image's own colours,
-        the set whose mixes draw it best; fewer if fewer do as well, one black ink for a grey image), or
+        the set whose mixes draw it best; fewer if another would draw it under 5% better, one black ink for
+        a grey image), or
         your own pens as "#e00000,#0000aa,#000000" or a list or tuple of them, ["#e00000", "#0000aa"]
         (1 to 8); each pixel's colour is split over the inks; one class of dots per ink, all of them one
         blue-noise set.

@@ -431,6 +431,27 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
     for (int k = 0; k < 3; ++k)
       EXPECT_NEAR(mean[k] / pixels * 255, half ? halves.pixels[32 * 3 + k] : 128, 12) << half << k;
   }
+  // A hue sweep, bright at the top and dark at the bottom, asked for 8 inks: its yellow and cyan among
+  // them, bright colours that no mix side by side draws, though the dark rows dominate the error. The
+  // coffee, one hue in many shades, keeps its 3.
+  kdm::tools::RgbImage sweep(256, 128);
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 256; ++x) {
+      const double h = x / 256.0 * 6, v = 1 - 0.8 * y / 127.0, f = h - std::floor(h);
+      const double rise = v * f, fall = v * (1 - f);
+      const double rgb[6][3] = {{v, rise, 0}, {fall, v, 0}, {0, v, rise},
+                                {0, fall, v}, {rise, 0, v}, {v, 0, fall}};
+      for (int k = 0; k < 3; ++k)
+        sweep.pixels[(y * 256 + x) * 3 + k] = static_cast<std::uint8_t>(std::lround(rgb[int(h)][k] * 255));
+    }
+  ASSERT_TRUE(kdm::tools::write_png(path("sweep.png"), sweep, error)) << error;
+  const Outcome eight =
+      kdm("stipple '" + path("sweep.png") + "' --colours 8 --points 20000 -o '" + path("sweep.svg") + "'");
+  ASSERT_EQ(eight.status, 0) << eight.err;
+  EXPECT_NE(eight.err.find("-yellow #"), std::string::npos) << eight.err;
+  EXPECT_NE(eight.err.find("-cyan #"), std::string::npos) << eight.err;
+  const Outcome shades = kdm("stipple " + coffee + " --colours 8 --points 8000 -o '" + path("c8.csv") + "'");
+  EXPECT_NE(shades.err.find("inks 3 of 8"), std::string::npos) << shades.err;
   ASSERT_EQ(kdm("stipple " + coffee + " --colours 3 --points 8000 -o '" + path("c.csv") + "'").status, 0);
   std::istringstream in(slurp(path("c.csv")));
   std::string line;

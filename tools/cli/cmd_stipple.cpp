@@ -434,7 +434,8 @@ void add_stipple_command(CLI::App& app) {
       "--colours", a->colours,
       "Colour stipple: cmyk (cyan, magenta, yellow, black on white, black by under-colour removal), rgb "
       "(red, green, blue on black), N (up to N = 2-8 inks chosen for the image: its own colours at full "
-      "strength, black where it has black, fewer if fewer draw it as well or an ink would hold under 1% of "
+      "strength, black where it has black, fewer if another would draw it under 5% better or an ink would "
+      "hold under 1% of "
       "the ink; one black for a grey image) or your pens as '#rrggbb,#rrggbb,...' (1 to 8). With N inks or "
       "pens each pixel's colour is split over them (the mix of inks side by side nearest its colour: a "
       "gradient is drawn by mixing dots of several inks). One class of dots per ink, all inks together one "

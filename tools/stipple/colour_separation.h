@@ -37,8 +37,9 @@ struct ColourSeparation {
 /// - "rgb": red, green and blue dots on black paper, each channel's intensity its density;
 /// - "N" (2 … 8): up to N inks on white paper chosen for the image: among its own colours at full
 ///   strength (strongest channel 0; a near-grey one black), greedily and then by swaps, the inks whose
-///   splits (below) draw the image's colours with the least squared error; fewer where more would not lower
-///   it by 1% of the blank paper's, none under 1% of the coverage (one black ink for a grey image);
+///   splits (below) draw the image's colours with the least squared error; fewer where another would not
+///   lower it by 5% and by 0.2% of the blank paper's, none under 1% of the coverage (one black ink for a
+///   grey image);
 /// - "#rrggbb,#rrggbb,…" (1 … 8): the user's own inks (pens) as given.
 /// With N inks or a list, each pixel's colour is split over the inks: the coverages c_i ≥ 0, Σ c_i ≤ 1 (dots
 /// side by side) whose Σ c_i (1 − ink_i) is nearest its absorbance 1 − rgb (least squares with a small
