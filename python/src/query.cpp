@@ -656,6 +656,18 @@ double classes_peak(const ClassQueryParams& q) {
   return peak;
 }
 
+/// warn_tile_size for the classes' sum, then the warning of a later class too sparse for its count.
+void warn_classes(const Tileset& set, const ClassQueryParams& q, int level) {
+  warn_tile_size(set, classes_peak(q), q.query, level);
+  if (!(q.query.x1 > q.query.x0 && q.query.y1 > q.query.y0)) return;
+  std::vector<double> peaks;
+  for (std::uint32_t k = 0; k < q.class_count; ++k) peaks.push_back(density_peak(q.classes[k]));
+  const std::string text =
+      tools::later_class_warning(set, peaks, q.query.scale, q.query.tile_size, "tile_size");
+  if (!text.empty() && PyErr_WarnEx(PyExc_UserWarning, text.c_str(), level) < 0)
+    throw py::error_already_set();
+}
+
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as
 /// query() returns them, then each point's class. New memory every call (no `storage`).
 py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double scale,
@@ -667,7 +679,7 @@ py::tuple query_classes(const TilesetHandle& handle, const Rect& rect, double sc
   PreparedClasses prepared;
   prepare_classes(prepared, rect, scale, specs, ready, callables, maxima, bounds, vectorized, density_rect,
                   tile_size, mode, origin, threads);
-  warn_tile_size(*handle.set, classes_peak(prepared.q), prepared.q.query, 3);  // via _query_classes
+  warn_classes(*handle.set, prepared.q, 3);  // via _query_classes
   std::vector<QueryPoint> points;
   std::vector<std::uint8_t> classes;
   Buffer buffer;
@@ -713,7 +725,7 @@ py::tuple class_positions(const TilesetHandle& handle, const Rect& rect, double 
                   tile_size, mode, origin, threads);
   const ClassQueryParams& q = prepared.q;
   tools::check_before_collecting(*handle.set, q, kKeywordNames);
-  warn_tile_size(*handle.set, classes_peak(q), q.query, 2);
+  warn_classes(*handle.set, q, 2);
   CompactBuffer buffer;
   buffer.with_keys = keys;
   std::vector<std::uint8_t> classes;

@@ -1059,6 +1059,15 @@ def test_a_tile_size_too_small_for_the_density_is_warned_of():
     with pytest.warns(UserWarning, match="at most 20 points per tile") as said:
         BUILTIN.positions((0, 0, 4, 4), scale=20, density=lambda x, y: 0.5 + 0.5 * x / 4, density_max=1.0)
     assert said[0].filename == __file__
+    # A rare class after dense ones (its count what theirs leave: twice its own, as kdm query's test
+    # measures), in both query paths; first, it gets its count, and nothing is said.
+    for call in (BUILTIN.query, BUILTIN.positions):
+        with pytest.warns(UserWarning, match=r"class 2 expects at most 1\.02 points per tile.*give it class 0") as said:
+            call((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.02, 0.1, 0.001])
+        assert said[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        BUILTIN.query((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.001, 0.02, 0.1])
     # A map's peak, not the region's, is what is judged: a sparse corner of a map is no mistake.
     ramp = kdm.DensityMap(np.array([[0.01, 1.0]]), (0, 0, 10, 10))
     with warnings.catch_warnings():

@@ -139,6 +139,10 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   const std::string sparse =
       tools::tile_size_warning(tile_size_advice(tiles, densest, a.scale, a.tile_size), "--tile-size");
   if (!sparse.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", sparse.c_str());
+  std::vector<double> peaks;
+  for (const auto& spec : specs) peaks.push_back(spec->max_value());
+  const std::string rare = tools::later_class_warning(tiles, peaks, a.scale, a.tile_size, "--tile-size");
+  if (!rare.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", rare.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;

@@ -33,6 +33,29 @@ std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_siz
   return text;
 }
 
+std::string later_class_warning(const Tileset& tileset, const std::vector<double>& peaks, double scale,
+                                double tile_size, const char* tile_size_name) {
+  if (tileset.empty() || tileset.data().level_nominal.empty()) return "";
+  const double area = scale * tile_size * tile_size, coarsest = tileset.data().level_nominal.front();
+  double before = 0;  // the classes before k, points per tile at their peaks
+  for (std::size_t k = 0; k < peaks.size(); ++k) {
+    const double own = peaks[k] * area;
+    if (k > 0 && own > 0 && own < kFewestForALaterClass && before >= coarsest) {
+      char text[400];
+      std::snprintf(
+          text, sizeof text,
+          "class %zu expects at most %.3g points per tile after up to %.3g of the classes before it: "
+          "a later class gets what their counts leave, off by up to about 2 points per tile where "
+          "they are constant; give it class 0, or query it on its own with a %s that gives it at "
+          "least %.0f",
+          k, own, before, tile_size_name, kFewestForALaterClass);
+      return text;
+    }
+    before += std::isfinite(own) ? own : 0;
+  }
+  return "";
+}
+
 namespace {
 
 /// A lower bound of the density's integral over the region (exact for a constant); NaN for a callback.

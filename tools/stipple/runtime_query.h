@@ -24,6 +24,18 @@ std::string describe(const QueryProblem& problem, const QueryParameterNames& nam
 /// evenly; `tile_size` names the option ("--tile-size", "tile_size").
 std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_size);
 
+/// Fewest points per tile a class after the first should expect, where the classes before it fill the
+/// coarsest level: a later class gets what the running sums' one-class counts leave, and those are off by
+/// up to about 2 points per tile where the densities are constant (docs/limits.md, "Several classes").
+inline constexpr double kFewestForALaterClass = 16;
+
+/// The warning, in one line without a prefix, for a class after the first expecting fewer than
+/// kFewestForALaterClass points per tile at its peak while the classes before it reach the coarsest level
+/// of `tileset`; "" for none. `peaks` are the classes' largest densities, class 0 first; `tile_size`
+/// names the option.
+std::string later_class_warning(const Tileset& tileset, const std::vector<double>& peaks, double scale,
+                                double tile_size, const char* tile_size_name);
+
 /// A lower bound of how many points a query of `params` emits: its density times scale over its region
 /// (exact for a constant; an image's min-mip over 64 × 64 blocks of the region, 0 where its maximum could
 /// not reach half of kMaxCollectedPoints), summed over the classes; NaN where nothing is known without
