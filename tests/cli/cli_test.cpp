@@ -533,6 +533,37 @@ TEST_F(CliTest, SampleTakesNumPyDensitiesAtAnyScale) {
   }
 }
 
+// A query counts a density's size: a .npy array's values as it holds them, past a float's range refused by
+// name (they were divided by their largest, as the sampler takes them: 1e300 everywhere gave the points of
+// 1, and one texel of 1e300 emptied the rest of the map).
+TEST_F(CliTest, QueryTakesNumPyDensitiesAtTheirSize) {
+  const auto query = [&](double fill, double spike) {
+    std::vector<double> values(8 * 8, fill);
+    values[0] = spike;
+    std::ofstream(path("d.npy"), std::ios::binary) << npy_volume(values, 0, 0, 0, "<f8", "8, 8");
+    return kdm("query --rect 0,0,4,4 --scale 100 --density '" + path("d.npy") + "' -o '" + path("d.csv") +
+               "'");
+  };
+  const auto rows = [&] {
+    const std::string text = slurp(path("d.csv"));
+    return std::count(text.begin(), text.end(), '\n') - 1;
+  };
+  ASSERT_EQ(query(1, 1).status, 0);
+  const auto unit = rows();
+  EXPECT_GT(unit, 1500);
+  for (double tiny : {1e-40, 1e-300}) {  // below what a query resolves: no points, as in Python
+    ASSERT_EQ(query(tiny, tiny).status, 0);
+    EXPECT_EQ(rows(), 0) << tiny;
+  }
+  ASSERT_EQ(query(0.5, 0.5).status, 0);
+  EXPECT_NEAR(double(rows()), 0.5 * double(unit), 0.05 * double(unit));
+  for (const auto& [fill, spike] : {std::pair{1e300, 1e300}, std::pair{1e39, 1e39}, std::pair{0.5, 1e300}}) {
+    const Outcome refused = query(fill, spike);
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_NE(refused.err.find("at most 3.4e38"), std::string::npos) << refused.err;
+  }
+}
+
 TEST_F(CliTest, BadVolumesAndSidesGiveOneLineErrors) {
   const std::string out = " -o '" + path("x.txt") + "'";
   std::ofstream(path("v.npy"), std::ios::binary) << npy_volume(std::vector<double>(8, 1.0), 2, 2, 2);

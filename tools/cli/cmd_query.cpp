@@ -135,12 +135,12 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   // Below a point per tile a tile's count rounds (docs/runtime.md, "Parameters"): said, not refused, since a
   // sparse corner of a map is no mistake.
   double densest = 0;
-  for (const auto& spec : specs) densest += spec->max_value();
+  for (const auto& spec : specs) densest += spec->max_value() * spec->divided_by;  // an array's own size
   const std::string sparse =
       tools::tile_size_warning(tile_size_advice(tiles, densest, a.scale, a.tile_size), "--tile-size");
   if (!sparse.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", sparse.c_str());
   std::vector<double> peaks;
-  for (const auto& spec : specs) peaks.push_back(spec->max_value());
+  for (const auto& spec : specs) peaks.push_back(spec->max_value() * spec->divided_by);
   const std::string rare = tools::later_class_warning(tiles, peaks, a.scale, a.tile_size, "--tile-size");
   if (!rare.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", rare.c_str());
   const auto t0 = std::chrono::steady_clock::now();

@@ -173,6 +173,7 @@ DensitySpec read_npy_density(const std::string& path, std::istream& in) {
   // by it in float64 before they become floats, as kdm.sample does with an array (the same bits).
   const double divisor = top > 0 && !(top >= 1e-30 && top <= 1e30) ? top : 1;
   each([&](double v, std::size_t i) { spec.values[i] = static_cast<float>(v / divisor); });
+  spec.divided_by = divisor;
   return spec;
 }
 

@@ -27,7 +27,10 @@ struct DensitySpec {
   std::vector<float> values;
   bool inverted = false;  ///< kImage: luminance is the density (else darkness)
   bool array = false;     ///< kImage, kVolume: read from a NumPy .npy array of densities (not a picture)
-  std::string text;       ///< what it was parsed from (for messages)
+  /// An array's divisor: values whose largest lies outside 1e-30 … 1e30 are kept divided by it (only
+  /// their shape matters to the sampler); a query, which counts their size, multiplies it back.
+  double divided_by = 1;
+  std::string text;  ///< what it was parsed from (for messages)
 
   /// Whether the density is a function of position (the test maps), not a constant, image or volume.
   bool analytic() const { return kind == Kind::kRamp || kind == Kind::kRadial; }

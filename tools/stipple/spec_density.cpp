@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -34,9 +35,25 @@ SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
     case Kind::kImage:
       break;
   }
+  image.values = spec.values.data();  // row 0 at y0, as DensityImageView has it
+  if (spec.divided_by != 1) {         // a query counts the values' size: back to what the array holds
+    undivided.resize(spec.values.size());
+    for (std::size_t i = 0; i < spec.values.size(); ++i) {
+      const double v = double(spec.values[i]) * spec.divided_by;
+      if (!(v <= std::numeric_limits<float>::max())) {
+        char message[256];
+        std::snprintf(message, sizeof message,
+                      "density '%s': a value of %g: a query's densities are points per unit area at scale "
+                      "1, at most 3.4e38 (kept as floats); scale the array down and --scale up",
+                      spec.text.c_str(), v);
+        throw std::invalid_argument(message);
+      }
+      undivided[i] = static_cast<float>(v);
+    }
+    image.values = undivided.data();
+  }
   image.width = spec.width, image.height = spec.height;
   image.x0 = r[0], image.y0 = r[1], image.x1 = r[2], image.y1 = r[3];
-  image.values = spec.values.data();  // row 0 at y0, as DensityImageView has it
   if (make_density_max_mip(image, mip) != Status::kOk) {
     const bool values_ok = std::all_of(spec.values.begin(), spec.values.end(),
                                        [](float v) { return v >= 0 && std::isfinite(v); });

@@ -12,9 +12,9 @@
 namespace kdm::tools {
 
 /// The runtime density for `spec` over the world rectangle r = (x0, y0, x1, y1): constant, the image's
-/// texels stretched over r (the spec's own, not a copy, with their max-mip), or a test map called back at
-/// every candidate. `spec` must outlive it; it does not move (queries keep pointers into it). Throws
-/// std::invalid_argument for an image the runtime refuses.
+/// texels stretched over r (the spec's own, not a copy, with their max-mip; an array kept divided, the
+/// values it holds), or a test map called back at every candidate. `spec` must outlive it; it does not move
+/// (queries keep pointers into it). Throws std::invalid_argument for an image the runtime refuses.
 struct SpecDensity {
   SpecDensity(const DensitySpec& spec, const double r[4]);
   SpecDensity(const SpecDensity&) = delete;
@@ -23,6 +23,7 @@ struct SpecDensity {
   QueryDensity density;
   DensityImageView image;
   std::vector<float> mip;
+  std::vector<float> undivided;  ///< an array's values times DensitySpec::divided_by, when that is not 1
   const DensitySpec& spec;
   double rect[4];
 };
