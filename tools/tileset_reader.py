@@ -333,6 +333,11 @@ def _validate(ts):
             start = end
     if all(len(tile.xs) == 0 for tile in ts.tiles):
         raise TilesetError("its tiles hold no points")
+    for k, nominal in enumerate(ts.level_nominal):
+        for t, tile in enumerate(ts.tiles):
+            if tile.level_end[k] > 4 * nominal + 64:
+                raise TilesetError(f"tile {t} holds {tile.level_end[k]} points in levels 0..{k}, more than 4 "
+                                   f"times their nominal {nominal} (+64)")
     if len(ts.keyframe_nominal) > MAX_KEYFRAMES:
         raise TilesetError(f"{len(ts.keyframe_nominal)} keyframes, more than {MAX_KEYFRAMES}")
     previous = 0

@@ -517,6 +517,17 @@ Status validate_tileset(const TilesetData& set, std::string* detail) {
   // A set of empty tiles emits nothing at any density: a damaged or forged file, not a tile set.
   if (std::all_of(set.tiles.begin(), set.tiles.end(), [](const Tile& t) { return t.points.empty(); }))
     return bad("its tiles hold no points");
+  // No tile holds far more than its levels promise (baked sets hold them within a few per cent): a forged
+  // file whose tile holds millions of points where its level promises 32 would make a query of a few
+  // points emit them all at one place.
+  for (std::uint32_t k = 0; k < set.levels; ++k)
+    for (std::size_t t = 0; t < set.tiles.size(); ++t) {
+      const std::uint64_t held = set.tiles[t].level_end[k], nominal = set.level_nominal[k];
+      if (held > 4 * nominal + 64)
+        return bad("tile " + std::to_string(t) + " holds " + std::to_string(held) + " points in levels 0.." +
+                   std::to_string(k) + ", more than 4 times their nominal " + std::to_string(nominal) +
+                   " (+64)");
+    }
   const std::size_t keyframes = set.keyframe_nominal.size();
   if (keyframes > kMaxKeyframes)
     return bad(std::to_string(keyframes) + " keyframes, more than " + std::to_string(kMaxKeyframes));

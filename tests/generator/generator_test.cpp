@@ -179,6 +179,23 @@ TEST(GeneratorTest, VerifierBlamesTheRecipeWhereMostOfTheGlideTrackFails) {
 // A tile whose points of one level are replaced by uniformly random ones: the statistics and the direct
 // check must flag it (white noise: δavg about .55 of a blue set's, E/n far above), and its neighbours'
 // tori, which hold it too, must not all pass either.
+// A level whose tiles hold under a quarter of its nominal count is refused before any sampling: a forged
+// file of 282 bytes declaring 4.29e9 points per tile had the references sample without end.
+TEST(GeneratorTest, VerifierRefusesLevelsTheirTilesDoNotHold) {
+  TilesetData set = shipped();
+  verify::VerifyOptions options;
+  options.levels = {0};
+  set.level_nominal[0] = 4 * 32 + 64 + 1;  // the tiles hold 31.8 on average
+  try {
+    verify::verify_tileset(set, options);
+    FAIL() << "verified";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("level 0 declares 193 points per tile, but its tiles hold 32"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(GeneratorTest, VerifierFlagsAWhiteNoiseTile) {
   TilesetData damaged = shipped();
   const std::uint32_t level = 2;

@@ -413,6 +413,20 @@ TEST(TilesetFormatTest, InvalidTileSetsAreNotWritten) {
   EXPECT_NE(why.find("hold no points"), std::string::npos) << why;
   set.tiles[1] = make_tileset().tiles[1];
   EXPECT_EQ(validate_tileset(set, &why), Status::kOk) << why;
+  // A tile of millions of points where its level promises 32 (a forged file of 16 KB): a query of one
+  // point per tile emitted them all at one place.
+  set = make_tileset();
+  set.tiles[0].level_end = {4 * 12 + 65, 4 * 12 + 65, 4 * 12 + 65};
+  set.tiles[0].points.assign(4 * 12 + 65, TilePoint{1, 1});
+  set.tiles[0].keys.assign(4 * 12 + 65, 7);
+  set.keyframe_nominal.clear();
+  for (Tile& tile : set.tiles) tile.glide.clear();
+  EXPECT_EQ(validate_tileset(set, &why), Status::kInvalidContent);
+  EXPECT_NE(why.find("tile 0 holds 113 points in levels 0..0, more than 4 times their nominal 12"),
+            std::string::npos)
+      << why;
+  set.tiles[0].level_end = {4 * 12 + 64, 4 * 12 + 65, 4 * 12 + 65};  // at the bound
+  EXPECT_EQ(validate_tileset(set, &why), Status::kOk) << why;
 }
 
 TEST(TilesetFormatTest, SavingIsAtomicAndReportsIoErrors) {

@@ -185,6 +185,19 @@ Report verify_tileset(const TilesetData& set, const VerifyOptions& options_in) {
     if (k >= set.levels)
       throw gen::InvalidArgument("verify: level " + std::to_string(k) + " is not in the tile set (it has " +
                                  std::to_string(set.levels) + ")");
+  // The references sample each level's nominal count: a set whose tiles hold far less (a forged file of
+  // 282 bytes declaring 4.29e9 points per tile) would have them sample without end what no tile holds.
+  for (std::uint32_t k : options.levels) {
+    double held = 0;
+    for (const Tile& tile : set.tiles) held += tile.level_end[k];
+    held /= double(set.tiles.size());
+    if (double(set.level_nominal[k]) > 4 * held + 64)
+      throw gen::InvalidArgument(
+          "verify: level " + std::to_string(k) + " declares " + std::to_string(set.level_nominal[k]) +
+          " points per tile, but its tiles hold " + std::to_string(std::llround(held)) +
+          " on average: not a set the baker made (its references would sample what no "
+          "tile holds)");
+  }
   double temperature = 0;  // the reference runs sample at the bake's temperature
   try {
     temperature = gen::BakeRecipe::parse(set.recipe).temperature;

@@ -197,7 +197,8 @@ struct Report {
 
 /// Runs the generator test on `set` (a valid set: validate_tileset passes). The recipe's temperature is
 /// the reference runs'. Throws std::invalid_argument (gen::InvalidArgument) for an unreadable recipe,
-/// fewer than 2 reference runs or an unknown level; never for a tile that fails (that is in the report).
+/// fewer than 2 reference runs, an unknown level or one whose tiles hold under a quarter of its nominal
+/// count (less 64); never for a tile that fails (that is in the report).
 Report verify_tileset(const TilesetData& set, const VerifyOptions& options = {});
 
 /// Writes `report` as tables (one row per tile and level, one per density; failing values marked '!'), then
