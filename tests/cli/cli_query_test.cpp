@@ -93,6 +93,11 @@ TEST_F(CliTest, OutputToStandardOutputIsTheFilesBytes) {
                    "/examples/sphere.png' -o - --format png --frames 3 --region 0,0,0.5,0.5",
                "--frames");
   expect_error("analyze - </dev/null", "standard input");
+  // Points stream from standard input as from a file: an endless bad input fails at its first line
+  // (read whole first, it was held in memory to the end: gigabytes, or never).
+  const Outcome endless = kdm("analyze -", "yes garbage |");
+  EXPECT_EQ(endless.status, 1) << endless.err;
+  EXPECT_NE(endless.err.find("standard input:1: header 'garbage'"), std::string::npos) << endless.err;
 }
 
 // --glide-together moves smooth points (same ids) and partitions still concatenate to the whole; stable

@@ -139,23 +139,34 @@ Shape parse_shape(const std::string& text, const std::string& what) {
   return shape;
 }
 
-/// Standard input read whole before the points are (they are then read from this copy), so that its
-/// header lines tell its domain as a file's do.
-class BufferedStandardInput {
+/// Standard input's first bytes read ahead, so that its header lines tell its domain as a file's do, and
+/// then served again before the rest: the points stream as a file's are (reading it whole first held
+/// gigabytes before a bad line was found).
+class BufferedStandardInput : private std::streambuf {
  public:
-  BufferedStandardInput()
-      : bytes_(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()),
-        copy_(bytes_),
-        old_(std::cin.rdbuf(copy_.rdbuf())) {}
-  ~BufferedStandardInput() { std::cin.rdbuf(old_); }
+  static constexpr std::size_t kAhead = 4096;  // the header lines lie in the first few
+  BufferedStandardInput() : rest_(std::cin.rdbuf()) {
+    ahead_.resize(kAhead);
+    ahead_.resize(static_cast<std::size_t>(rest_->sgetn(ahead_.data(), std::streamsize(kAhead))));
+    setg(ahead_.data(), ahead_.data(), ahead_.data() + ahead_.size());
+    std::cin.rdbuf(this);
+  }
+  ~BufferedStandardInput() override { std::cin.rdbuf(rest_); }
   BufferedStandardInput(const BufferedStandardInput&) = delete;
   BufferedStandardInput& operator=(const BufferedStandardInput&) = delete;
-  const std::string& bytes() const { return bytes_; }
+  const std::string& bytes() const { return ahead_; }  ///< the first kAhead bytes (fewer if that is all)
 
  private:
-  std::string bytes_;
-  std::istringstream copy_;
-  std::streambuf* old_;
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    const std::streamsize got = rest_->sgetn(chunk_, sizeof chunk_);
+    if (got <= 0) return traits_type::eof();
+    setg(chunk_, chunk_, chunk_ + got);
+    return traits_type::to_int_type(*gptr());
+  }
+  std::string ahead_;
+  std::streambuf* rest_;
+  char chunk_[1 << 16];
 };
 
 /// A file's domain as its header lines name it (domain_header.h): its shape, a square or cube when they say
@@ -170,7 +181,7 @@ SampledDomain sampled_domain(const std::string& path, const std::string& standar
   std::ifstream file;
   std::istringstream piped;
   if (path == "-")
-    piped.str(standard_input.substr(0, 4096));  // the header lines lie in the first few
+    piped.str(standard_input);  // BufferedStandardInput's first bytes
   else
     file.open(path);
   const tools::DomainHeader header =
