@@ -26,6 +26,30 @@ SpecDensity::SpecDensity(const DensitySpec& s, const double r[4]) : spec(s) {
         const double v = std::clamp((y - d.rect[1]) / (d.rect[3] - d.rect[1]), 0.0, 1.0);
         return d.spec.map_at(u, v);
       };
+      // Their bounds over a rectangle, from where it lies on the map (the ramp falls along u, the disc
+      // away from its centre), widened by 1e-12 for exp's rounding: a tile far from the map's peak is then
+      // judged without reading it (radial:1e9 over 4,096² tiles at 32,000 points per tile took hours).
+      density.bounds = [](void* user, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+        const SpecDensity& d = *static_cast<const SpecDensity*>(user);
+        const auto unit = [](double v, double from, double to) {
+          return std::clamp((v - from) / (to - from), 0.0, 1.0);
+        };
+        const double u0 = unit(x0, d.rect[0], d.rect[2]), u1 = unit(x1, d.rect[0], d.rect[2]);
+        const double v0 = unit(y0, d.rect[1], d.rect[3]), v1 = unit(y1, d.rect[1], d.rect[3]);
+        double near = 0, far = 0;  // along u for a ramp; distances from the centre for a disc
+        if (d.spec.kind == DensitySpec::Kind::kRamp) {
+          near = u0, far = u1;
+        } else {
+          const double nu = std::max({u0 - 0.5, 0.0, 0.5 - u1}), nv = std::max({v0 - 0.5, 0.0, 0.5 - v1});
+          const double fu = std::max(std::abs(u0 - 0.5), std::abs(u1 - 0.5));
+          const double fv = std::max(std::abs(v0 - 0.5), std::abs(v1 - 0.5));
+          near = std::sqrt(nu * nu + nv * nv), far = std::sqrt(fu * fu + fv * fv);
+        }
+        const double a = std::log(d.spec.range);
+        const double scaled = d.spec.kind == DensitySpec::Kind::kRamp ? 1.0 : 2.0;
+        *hi = std::exp(-a * std::min(1.0, scaled * near)) * (1 + 1e-12);
+        *lo = std::exp(-a * std::min(1.0, scaled * far)) * (1 - 1e-12);
+      };
       density.user = this;
       density.callback_max = 1;
       return;
