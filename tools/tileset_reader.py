@@ -202,6 +202,8 @@ def decode(data):
     if not FIXED_HEADER_BYTES <= header_size <= MAX_HEADER_BYTES:
         raise TilesetError(f"header size {header_size} is outside {FIXED_HEADER_BYTES}..{MAX_HEADER_BYTES}")
     if size < header_size:
+        if FIXED_HEADER_BYTES + _u32(data, 48) + _u32(data, 52) != header_size:
+            raise TilesetError(f"header size {header_size} disagrees with its texts' sizes: a damaged header")
         raise TilesetError(f"truncated: file ends inside the {header_size}-byte header")
     # Doc §2: the CRC of the whole header with its own field read as zero.
     header = bytearray(data[:header_size])

@@ -101,9 +101,10 @@ Status query_into(const Tileset& tileset, const QueryParams& q, Sink out, bool h
   const std::uint64_t fingerprint = query_fingerprint(q) ^ tables.identity;  // these parameters on this set
   if (cursor->started && cursor->fingerprint != fingerprint) return refuse(Kind::kCursorMismatch, "cursor");
   // Past 9e15 tiles out a region's sides round together ([x0, x0 + 64) at 1e18 is empty): too far, not empty.
+  // Sides given the wrong way round are the caller's empty region, however far.
   const double far_x = std::max(std::fabs(q.x0), std::fabs(q.x1)),
                far_y = std::max(std::fabs(q.y0), std::fabs(q.y1));
-  if (!cursor->finished && std::max(far_x, far_y) / q.tile_size > 9e15 && (!(q.x1 > q.x0) || !(q.y1 > q.y0)))
+  if (!cursor->finished && std::max(far_x, far_y) / q.tile_size > 9e15 && (q.x1 == q.x0 || q.y1 == q.y0))
     return refuse(Kind::kTooFarFromOrigin, far_x >= far_y ? "x0" : "y0", std::max(far_x, far_y),
                   9e15 * q.tile_size);
   if (cursor->finished || !(q.x1 > q.x0) || !(q.y1 > q.y0) || q.scale == 0) {

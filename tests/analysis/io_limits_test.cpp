@@ -206,6 +206,21 @@ TEST(ImageLimit, APngCutShortIsSaidSo) {
   }
 }
 
+// A PNG whose compressed pixels do not decode is named a corrupt PNG (stb's reason was another decoder's:
+// "Corrupt JPEG").
+TEST(ImageLimit, APngWhosePixelsDoNotDecodeIsSaidSo) {
+  std::vector<std::uint8_t> png =
+      read_bytes(std::string(KDM_SOURCE_DIR) + "/tests/fuzz/corpus/image/grey8.png");
+  const std::string text(png.begin(), png.end());
+  const std::size_t idat = text.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  png[idat + 4] = 0xff, png[idat + 5] = 0xff;  // no zlib header
+  GreyImage image;
+  std::string error;
+  EXPECT_FALSE(kdm::tools::load_grey_image_memory(png.data(), png.size(), image, error, "bad.png"));
+  EXPECT_TRUE(contains(error, "'bad.png': corrupt PNG (its compressed pixels do not decode)")) << error;
+}
+
 // Every image seed of the fuzzer (PNG 1/8/16-bit grey, grey+alpha, RGB, RGBA, palette and tRNS, Adam7;
 // JPEG, BMP, TGA, PGM, PPM) loads, the same from a path as from memory, with values in [0, 1].
 TEST(ImageLimit, PathAndMemoryLoadersAgreeOnTheSeeds) {

@@ -277,6 +277,11 @@ TEST(BakeTest, RecipeRefusalsNameTheLineTheLevelAndTheRemedy) {
             "recipe line 3: handover_slack needs handover_zone (a hand-over)");
   EXPECT_EQ(refusal("separation 0.5\nseparation_push 0.3\n"),
             "recipe line 2: separation_push 0.3 must be at least separation 0.5");
+  // Too many points at the top: both keys' doing, both lines named (only the first was).
+  EXPECT_EQ(refusal("levels 6\nbase_points 65536\n"),
+            "recipe lines 1 and 2: levels 6 from base_points 65536 make 67108864 points per tile at the top "
+            "level, more than 2^22 (4,194,304)");
+  EXPECT_EQ(refusal("# big\nbase_points 65536\n").rfind("recipe line 2: levels 6 from base_points", 0), 0u);
   for (const char* text :
        {"handover_level 0\n", "handover_slack 0\n", "split_shared 0\n", "glide_separation 0\n",
         "separation_fill 0\n", "separation 0\nseparation_push 0\n", "keyframes 0\nglide_late 0\n"})

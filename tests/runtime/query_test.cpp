@@ -695,6 +695,16 @@ TEST(QueryTest, RefusalsSayWhichParameterAndWhichLimit) {
   const QueryProblem empty = problem_of(collapsed);
   EXPECT_EQ(empty.kind, QueryProblem::Kind::kTooFarFromOrigin);
   EXPECT_STREQ(empty.parameter, "x0");
+  // Sides the wrong way round are an empty region, however far (QueryParams says so; it was refused).
+  for (const auto& [x0, x1] : {std::pair{1e308, -1e308}, std::pair{1e18 + 256, 1e18}}) {
+    QueryParams inverted = q;
+    inverted.x0 = x0, inverted.x1 = x1;
+    QueryCursor done;
+    written = 7;
+    EXPECT_EQ(query_points(Tileset::builtin(), inverted, buffer.data(), 16, &written, &done), Status::kOk)
+        << x0;
+    EXPECT_EQ(written, 0u);
+  }
   q.x0 = 0.9 * p.limit, q.x1 = q.x0 + 256;
   QueryCursor served;
   EXPECT_NE(query_points(Tileset::builtin(), q, buffer.data(), 16, &written, &served),

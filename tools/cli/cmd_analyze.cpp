@@ -518,7 +518,11 @@ void add_analyze_command(CLI::App& app) {
       "Output directory (created if missing) for metrics.json (classes.json for labelled points) and "
       "pictures; - writes metrics.json (with classes.json's as \"classes\") to standard output and "
       "the summary to standard error, no pictures (default: the summary is only printed)");
-  cmd->callback([args] { run_analyze(*args); });
+  cmd->callback([args, cmd] {
+    if (cmd->get_option("--aspect")->count() > 0 && args->aspect.empty())  // as kdm sample says it
+      parse_shape(args->aspect, "--aspect");
+    run_analyze(*args);
+  });
 }
 
 }  // namespace kdm::cli

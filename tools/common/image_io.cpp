@@ -738,7 +738,11 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
   // The decoder must return the header's size, so that the limit holds for what is kept.
   auto decoded = [&](const void* data) {
     if (!data) {
-      error = "cannot read image '" + name + "': " + stb_reason();
+      // stb's reason is its last decoder's, which for a PNG whose pixel data fails may be another format's
+      // ("Corrupt JPEG").
+      const bool png = size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0;
+      error = "cannot read image '" + name +
+              "': " + (png ? std::string("corrupt PNG (its compressed pixels do not decode)") : stb_reason());
       return false;
     }
     if (lw != w || lh != h || channels < 1 || channels > 4) {

@@ -433,9 +433,11 @@ bool read_npy(std::istream& in, const std::string& path, std::vector<PointSet>& 
       const double v = npy_scalar_value(chunk + k * width, type);
       if (!std::isfinite(v)) {
         const std::uint64_t at = done + k;
-        return fail("a non-finite coordinate in row " +
-                    std::to_string((fortran ? at % n : at % per_set / dim) + 1) +
-                    (several ? " of set " + std::to_string(at / per_set + 1) : std::string()));
+        // Its numpy index, [row, column] or [set, row, column], as numpy users count: from 0.
+        const std::uint64_t row = fortran ? at % n : at % per_set / dim, column = fortran ? at / n : at % dim;
+        return fail("a non-finite coordinate at [" +
+                    (several ? std::to_string(at / per_set) + ", " : std::string()) + std::to_string(row) +
+                    ", " + std::to_string(column) + "]");
       }
       set.coords.push_back(v);
       if (several && set.coords.size() == per_set) {

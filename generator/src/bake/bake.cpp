@@ -236,8 +236,15 @@ void check_together(const BakeRecipe& r, const std::map<std::string, int>* lines
         return "recipe line " + std::to_string(it->second) + ": ";
     return std::string("recipe: ");
   };
-  if (r.top_level_points() > (1u << 22))
-    throw InvalidArgument(at("levels") + "more than 2^22 points per tile");
+  if (r.top_level_points() > (1u << 22)) {  // both keys' doing: named together where both are given
+    std::string where = at(given("base_points") && !given("levels") ? "base_points" : "levels");
+    if (lines && lines->count("levels") && lines->count("base_points"))
+      where = "recipe lines " + std::to_string(lines->at("levels")) + " and " +
+              std::to_string(lines->at("base_points")) + ": ";
+    throw InvalidArgument(where + "levels " + std::to_string(r.levels) + " from base_points " +
+                          std::to_string(r.base_points) + " make " + std::to_string(r.top_level_points()) +
+                          " points per tile at the top level, more than 2^22 (4,194,304)");
+  }
   if (make_keyframe_nominal(r.nominal_counts(), r.keyframes_per_level).size() > kMaxKeyframes)
     throw InvalidArgument(at("keyframes") + "more than " + std::to_string(kMaxKeyframes) +
                           " keyframes in all");
