@@ -326,7 +326,9 @@ class Tileset:
         threads: Optional[int] = None,
     ) -> QueryResult:
         """The points of the world rectangle `rect` = (x0, y0, x1, y1), half-open (``kdm query``); none
-        when x1 <= x0 or y1 <= y0, as in C and C++.
+        when x1 <= x0 or y1 <= y0, as in C and C++. There is no seed: another draw is a rectangle
+        elsewhere, sharing the set's tiles (far from independent); for independent sets use sample()'s
+        seeds.
 
         Parameters
         ----------

@@ -224,7 +224,8 @@ InvalidArgument too_narrow(const SamplerOptions& o) {
   for (int k = 1; k < o.dim; ++k)
     min_extent = std::min(min_extent, o.extent[k]), max_extent = std::max(max_extent, o.extent[k]);
   std::ostringstream s;
-  s << "the domain is too narrow for " << o.n << " points: its long side is " << max_extent / min_extent
+  s << "the domain is too narrow for " << o.n << (o.n == 1 ? " point" : " points") << ": its long side is "
+    << max_extent / min_extent
     << " times its short side, which would be one grid node wide, and the sampler needs two ("
     << (o.dim == 2 ? "sides at most about 10 times the point count apart"
                    : "a short side of at least about 0.35 of a point spacing")
@@ -241,8 +242,8 @@ InvalidArgument too_thin(const SamplerOptions& o, double sides) {
   for (int k = 1; k < o.dim; ++k)
     min_extent = std::min(min_extent, o.extent[k]), max_extent = std::max(max_extent, o.extent[k]);
   std::ostringstream s;
-  s << "the domain is too narrow for " << o.n << " points: its long side is " << max_extent / min_extent
-    << " times its short sides, which would be " << std::setprecision(2) << sides
+  s << "the domain is too narrow for " << o.n << (o.n == 1 ? " point" : " points") << ": its long side is "
+    << max_extent / min_extent << " times its short sides, which would be " << std::setprecision(2) << sides
     << " of a point spacing across, and in 3D the "
     << "sampler needs " << kThinnestTube
     << " (a tube at most about 4.6 times the point count longer than "
