@@ -878,6 +878,19 @@ kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_dens
   return to_c(status);
 }
 
+kdm_status kdm_density_check_wrap_joint(kdm_density_check* check, kdm_joint_class_density* joint,
+                                        uint32_t class_count) {
+  if (!check || !joint) return KDM_INVALID_ARGUMENT;
+  kdm::JointClassDensity j;
+  j.densities = joint->densities, j.bounds = joint->density_bounds, j.user = joint->user;
+  j.batch_densities = joint->batch_densities;
+  std::copy(joint->density_max, joint->density_max + KDM_MAX_CLASSES, j.max);
+  const kdm::Status status = check->check.wrap(&j, class_count);
+  joint->densities = j.densities, joint->density_bounds = j.bounds, joint->user = j.user;
+  joint->batch_densities = j.batch_densities;
+  return to_c(status);
+}
+
 int kdm_density_check_failed(const kdm_density_check* check, double* value, double* x, double* y) {
   kdm::DensityFinding f;
   if (!check || !check->check.failed(&f)) return 0;

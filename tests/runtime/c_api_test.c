@@ -101,6 +101,11 @@ static void flawed_batch(void* user, size_t n, const double* x, const double* y,
   for (i = 0; i < n; ++i) out[i] = flawed(user, x[i], y[i]);
 }
 
+/* Two classes from one call: 0.25 everywhere, and class 1 `flawed`'s value. */
+static void flawed_joint(void* user, double x, double y, double* values) {
+  values[0] = 0.25, values[1] = flawed(user, x, y);
+}
+
 static kdm_query uniform_query(void) {
   kdm_query q;
   memset(&q, 0, sizeof q);
@@ -522,6 +527,25 @@ int main(int argc, char** argv) {
     CHECK(kdm_density_check_failed(check, &value, NULL, NULL) == 1 && value == 3);
     kdm_density_check_describe(check, line, sizeof line);
     CHECK(strstr(line, "above its bound callback_max 1") != NULL);
+    /* A joint density's class 1 NaN right of x = 1.5: found, its class named. */
+    kdm_density_check_reset(check);
+    {
+      kdm_joint_class_density joint;
+      memset(&joint, 0, sizeof joint);
+      bad = NAN;
+      joint.densities = flawed_joint, joint.user = &bad, joint.density_max[0] = 1, joint.density_max[1] = 1;
+      CHECK(kdm_density_check_wrap_joint(check, &joint, 0) == KDM_INVALID_ARGUMENT);
+      CHECK(kdm_density_check_wrap_joint(check, &joint, KDM_MAX_CLASSES + 1) == KDM_INVALID_ARGUMENT);
+      CHECK(kdm_density_check_wrap_joint(check, NULL, 2) == KDM_INVALID_ARGUMENT);
+      CHECK(joint.user == (void*)&bad);
+      CHECK(kdm_density_check_wrap_joint(check, &joint, 2) == KDM_OK && joint.user == (void*)check);
+      memset(&cursor, 0, sizeof cursor);
+      CHECK(kdm_query_classes_joint(builtin, &q, &joint, 2, bare, (uint8_t*)checked, 4096, &n_checked,
+                                    &cursor, NULL) == KDM_OK);
+      CHECK(kdm_density_check_failed(check, &value, &x, NULL) == 1 && value != value && x >= 1.5);
+      kdm_density_check_describe(check, line, sizeof line);
+      CHECK(strstr(line, "joint density's class 1 was nan at (") == line);
+    }
     /* Constants are left alone; NULL arguments are refused or told. */
     q = uniform_query();
     CHECK(kdm_density_check_wrap_query(check, &q) == KDM_OK && q.user == NULL && q.density_callback == NULL);

@@ -245,6 +245,144 @@ TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   EXPECT_EQ(f.limit, 1.25);
 }
 
+// A joint class density (three ramps from one call), with a flaw in one class right of x = `bad_from`
+// and bounds that may understate class 0 by `bounds_short`.
+struct JointRamps {
+  double bad_from = std::numeric_limits<double>::infinity(), bad = 0, bounds_short = 0;
+  static void at(void* self, double x, double y, double* v) {
+    const auto& j = *static_cast<JointRamps*>(self);
+    Ramp r;
+    v[0] = r.value(x) * 0.25, v[1] = x >= j.bad_from ? j.bad : r.value(x) * 0.5, v[2] = r.value(y) * 0.25;
+  }
+  static void batch(void* self, std::size_t n, const double* x, const double* y, double* v) {
+    for (std::size_t i = 0; i < n; ++i) {
+      double one[3];
+      at(self, x[i], y[i], one);
+      for (std::size_t k = 0; k < 3; ++k) v[k * n + i] = one[k];
+    }
+  }
+  static void bounds(void* self, double x0, double y0, double x1, double y1, double* lo, double* hi) {
+    const auto& j = *static_cast<JointRamps*>(self);
+    lo[0] = (0.25 + x0 / 8) * 0.25, hi[0] = (0.25 + x1 / 8) * 0.25 - j.bounds_short;
+    lo[1] = (0.25 + x0 / 8) * 0.5, hi[1] = (0.25 + x1 / 8) * 0.5;
+    lo[2] = (0.25 + y0 / 8) * 0.25, hi[2] = (0.25 + y1 / 8) * 0.25;
+  }
+};
+
+ClassQueryParams joint_query(JointRamps& ramps, QueryMode mode, bool batch) {
+  ClassQueryParams c;
+  Ramp unused;
+  c.query = ramp_query(unused, mode);
+  c.class_count = 3;
+  if (batch)
+    c.joint.batch_densities = &JointRamps::batch;
+  else
+    c.joint.densities = &JointRamps::at;
+  c.joint.bounds = &JointRamps::bounds;
+  c.joint.user = &ramps;
+  c.joint.max[0] = 1.25 * 0.25, c.joint.max[1] = 1.25 * 0.5, c.joint.max[2] = 1.25 * 0.25;
+  return c;
+}
+
+std::vector<std::pair<QueryPoint, std::uint8_t>> run_classes(const ClassQueryParams& c) {
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  std::size_t written = 0;
+  QueryCursor cursor;
+  EXPECT_EQ(query_classes(Tileset::builtin(), c, out.data(), classes.data(), out.size(), &written, &cursor),
+            Status::kOk);
+  std::vector<std::pair<QueryPoint, std::uint8_t>> points;
+  for (std::size_t i = 0; i < written; ++i) points.emplace_back(out[i], classes[i]);
+  return points;
+}
+
+bool same_classed(const std::vector<std::pair<QueryPoint, std::uint8_t>>& a,
+                  const std::vector<std::pair<QueryPoint, std::uint8_t>>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (!same_bits({a[i].first}, {b[i].first}) || a[i].second != b[i].second) return false;
+  return true;
+}
+
+TEST(DensityCheckTest, AJointClassDensityIsCheckedClassByClass) {
+  for (const bool batch : {false, true})
+    for (const QueryMode mode : {QueryMode::kStable, QueryMode::kSmooth}) {
+      SCOPED_TRACE(batch ? "batch" : "one position a call");
+      JointRamps fine;
+      ClassQueryParams c = joint_query(fine, mode, batch);
+      const auto bare = run_classes(c);
+      DensityCheck check;
+      ASSERT_EQ(check.wrap(&c.joint, c.class_count), Status::kOk);
+      EXPECT_GT(bare.size(), 10000u);
+      EXPECT_TRUE(same_classed(bare, run_classes(c)));  // the same points and classes, nothing found
+      EXPECT_FALSE(check.failed());
+      EXPECT_GT(check.largest(), 0.4);
+
+      JointRamps flawed;  // class 1 NaN right of x = 3
+      flawed.bad_from = 3, flawed.bad = std::nan("");
+      ClassQueryParams f = joint_query(flawed, mode, batch);
+      DensityCheck flawed_check;
+      ASSERT_EQ(flawed_check.wrap(&f.joint, f.class_count), Status::kOk);
+      run_classes(f);
+      DensityFinding finding;
+      ASSERT_TRUE(flawed_check.failed(&finding));
+      EXPECT_EQ(finding.kind, DensityFinding::Kind::kValue);
+      EXPECT_EQ(finding.cls, 1);
+      EXPECT_GE(finding.x, 3);
+      char line[200];
+      flawed_check.describe(line, sizeof line);
+      EXPECT_EQ(std::string(line).rfind("joint density's class 1 was nan at (", 0), 0u) << line;
+
+      JointRamps loose;  // class 0's upper bound a little short
+      loose.bounds_short = 0.01;
+      ClassQueryParams b = joint_query(loose, mode, batch);
+      DensityCheck bounds_check;
+      ASSERT_EQ(bounds_check.wrap(&b.joint, b.class_count), Status::kOk);
+      run_classes(b);
+      ASSERT_TRUE(bounds_check.failed(&finding));
+      EXPECT_EQ(finding.kind, DensityFinding::Kind::kBounds);
+      EXPECT_EQ(finding.cls, 0);
+      bounds_check.describe(line, sizeof line);
+      EXPECT_EQ(std::string(line).rfind("joint density's class 0 bounds gave [", 0), 0u) << line;
+      EXPECT_NE(std::string(line).find(", but it is "), std::string::npos) << line;
+    }
+}
+
+TEST(DensityCheckTest, OneCheckWrapsOneJointDensity) {
+  JointRamps a, b;
+  ClassQueryParams ca = joint_query(a, QueryMode::kStable, false),
+                   cb = joint_query(b, QueryMode::kStable, false);
+  DensityCheck check;
+  EXPECT_EQ(check.wrap(&ca.joint, 0), Status::kInvalidArgument);
+  EXPECT_EQ(check.wrap(&ca.joint, kMaxQueryClasses + 1), Status::kInvalidArgument);
+  EXPECT_EQ(check.wrap(static_cast<JointClassDensity*>(nullptr), 3), Status::kInvalidArgument);
+  const JointClassDensity bare = ca.joint;
+  ASSERT_EQ(check.wrap(&ca.joint, 3), Status::kOk);
+  JointClassDensity again = ca.joint;  // the wrapped one itself, with a lower bound: no second layer
+  again.max[1] = 0.01;
+  ASSERT_EQ(check.wrap(&again, 3), Status::kOk);
+  EXPECT_EQ(again.user, ca.joint.user);
+  JointClassDensity chunk = bare;  // a fresh copy of the same density, with the same lower bound
+  chunk.max[1] = 0.01;
+  ASSERT_EQ(check.wrap(&chunk, 3), Status::kOk);
+  EXPECT_EQ(check.wrap(&cb.joint, 3), Status::kInvalidArgument);  // another density
+  EXPECT_EQ(cb.joint.user, &b);                                   // refused: left as it was
+  Ramp ramp;
+  QueryParams q = ramp_query(ramp, QueryMode::kStable);
+  EXPECT_EQ(check.wrap(&q.density), Status::kInvalidArgument);  // one check, one density of either kind
+  ClassQueryParams lowered = ca;
+  lowered.joint = again;
+  run_classes(lowered);
+  DensityFinding f;
+  ASSERT_TRUE(check.failed(&f));  // class 1 passes 0.01 everywhere
+  EXPECT_EQ(f.cls, 1);
+  EXPECT_EQ(f.limit, 0.01);
+  check.reset();
+  DensityCheck single;
+  ASSERT_EQ(single.wrap(&q.density), Status::kOk);
+  EXPECT_EQ(single.wrap(&cb.joint, 3), Status::kInvalidArgument);
+}
+
 TEST(DensityCheckTest, DescribeCutsToTheBufferAndCountsTheWholeLine) {
   Ramp ramp;
   ramp.bad_from = 1, ramp.bad = 2;

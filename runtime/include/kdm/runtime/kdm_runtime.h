@@ -536,6 +536,11 @@ KDM_RUNTIME_API void kdm_density_check_free(kdm_density_check* check);
 KDM_RUNTIME_API kdm_status kdm_density_check_wrap_query(kdm_density_check* check, kdm_query* query);
 /* The same for one class's density of kdm_query_classes. */
 KDM_RUNTIME_API kdm_status kdm_density_check_wrap_class(kdm_density_check* check, kdm_class_density* density);
+/* The same for the joint density of kdm_query_classes_joint, of `class_count` classes: each class's values
+ * against its density_max[k], its density_bounds at the 9 points too; the finding names the class. Also
+ * KDM_INVALID_ARGUMENT for a class_count outside 1 ... KDM_MAX_CLASSES. Added in 0.5. */
+KDM_RUNTIME_API kdm_status kdm_density_check_wrap_joint(kdm_density_check* check,
+                                                        kdm_joint_class_density* joint, uint32_t class_count);
 /* 1 once the check found something, with the first finding's value and position in *value, *x, *y (each
  * optional): a value that does not fit, or one outside the bounds given for a rectangle that holds it; 0
  * otherwise (and for a NULL check). */
