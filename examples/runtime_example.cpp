@@ -7,6 +7,7 @@ std::vector<kdm::QueryPoint> scatter(double x0, double y0, double x1, double y1)
   q.x0 = x0, q.y0 = y0, q.x1 = x1, q.y1 = y1;  // half-open world rectangle
   q.scale = 50;                                // points per unit area at density 1
   q.density.constant = 0.8;                    // or an image (bilinear + max-mip) or a callback
+  q.tile_size = 1;                             // default: 0.8 · 50 · 1² = 40 points a tile (32–32,768)
   std::vector<kdm::QueryPoint> out(4096);
   kdm::QueryCursor cursor;
   std::size_t n = 0, total = 0;

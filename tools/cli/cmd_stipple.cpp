@@ -398,7 +398,7 @@ void add_stipple_command(CLI::App& app) {
          "--fade", a->fade,
          "Dots grow in as they appear instead of popping up: a dot's area grows from 0 where it "
          "appears to full once the density there is this fraction higher (e.g. 0.2 for a zoom "
-         "sequence; pictures only, which it lightens by about 1 - ln(1 + F) / F: 28% at 1, 61% at 5; a pen "
+         "sequence; pictures only, which it lightens by about 1 - ln(1 + F) / F: 31% at 1, 64% at 5; a pen "
          "plotter draws a shrunken dot at its pen's width, so leave it off for plots; 0: off)")
       ->capture_default_str();
   CLI::Option* width =
