@@ -1257,6 +1257,15 @@ TEST_F(CliTest, AnalyzeMeasuresASetInTheDomainItWasDrawnIn) {
   expect_error("analyze " + wide + " --aspect 2:1:1", "the points are 2D");
   expect_error("analyze " + wide + " --aspect 0", "--aspect must be a number > 0");
   expect_error("analyze " + wide + " --aspect 1:2:3:4", "two sides W:H or three sides X:Y:Z, got 4");
+  // A 3D set: W:H refused as kdm sample --dim 3 refuses it (it was read as an aspect), and the tiling
+  // diagnostics said to be skipped are skipped (they printed a seam test of a set that has no tiles).
+  ASSERT_EQ(kdm("sample --dim 3 --n 400 -o '" + path("c3.txt") + "'").status, 0);
+  expect_error("analyze '" + path("c3.txt") + "' --aspect 2:1", "the points are 3D");
+  const Outcome untiled = kdm("analyze '" + path("c3.txt") + "' --tile-size 0.25 --no-energy");
+  ASSERT_EQ(untiled.status, 0) << untiled.err;
+  EXPECT_NE(untiled.err.find("tiling diagnostics are 2D only; skipped"), std::string::npos) << untiled.err;
+  EXPECT_EQ(untiled.out.find("tiling"), std::string::npos) << untiled.out;
+  EXPECT_EQ(untiled.out.find("seams"), std::string::npos) << untiled.out;
   // W:H is the number W / H.
   const Outcome colon = kdm("analyze " + wide + " --aspect 4:2 --no-energy");
   ASSERT_EQ(colon.status, 0) << colon.err;

@@ -251,6 +251,10 @@ Shape measured_shape(const AnalyzeArgs& args, int dim, std::FILE* text,
       throw CommandError(
           "--aspect X:Y:Z gives a 3D domain's sides, and the points are 2D: give one number "
           "(width / height)");
+    if (dim == 3 && std::count(args.aspect.begin(), args.aspect.end(), ':') == 1)  // as kdm sample says
+      throw CommandError(
+          "--aspect W:H is a 2D domain's shape, and the points are 3D: give three sides X:Y:Z, or one "
+          "number (the x side over the others)");
     if (!given.square()) std::fprintf(text, "domain from --aspect: %s\n", given.text.c_str());
     for (std::size_t f = 0; f < read.size(); ++f)
       if (read[f].named && !read[f].same(given) && !(read[f].square() && given.square()))
@@ -375,10 +379,12 @@ void run_analyze(const AnalyzeArgs& args) {
         o.density = tools::analysis_density(target);
       }
     }
-    if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0))
+    if (sets.front().dim != 2 && (!args.density.empty() || args.tile_size != 0)) {
       std::fprintf(stderr,
                    "kdm: warning: density windows and tiling diagnostics are 2D only; skipped (a --density "
                    "still sets the energy)\n");
+      o.tile_size = 0;  // skipped indeed: measured on a 3D set they were numbers of nothing
+    }
     // -o -: metrics.json on standard output, the summary on standard error beside the warnings.
     const bool to_stdout = args.output == tools::kStandardOutput;
     std::FILE* text = to_stdout ? stderr : stdout;

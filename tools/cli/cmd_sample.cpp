@@ -30,7 +30,7 @@ struct SampleArgs {
   gen::SamplerOptions options;
   std::string density = "const:1";
   std::vector<std::string> classes;  ///< --class, repeated: one density per class, class 0 first
-  std::string domain;                // empty: box for images and ramps, torus otherwise
+  std::string domain;                // empty: box for images, arrays and ramps, torus otherwise
   std::string output, format;
   std::string aspect;  // empty: from the image or volume, or 1
   double gamma = 1;
@@ -306,8 +306,10 @@ void add_sample_command(CLI::App& app) {
   cmd->add_option("--dim", o.dim, "Dimension of the points (2 or 3)")
       ->capture_default_str()
       ->check(CLI::IsMember({2, 3}));
-  cmd->add_option("--domain", args->domain,
-                  "torus (periodic) or box (bounded); default: box for images and ramp:R, torus otherwise")
+  cmd->add_option(
+         "--domain", args->domain,
+         "torus (periodic) or box (bounded); default: box for images, .npy arrays and volumes and ramp:R, "
+         "torus otherwise")
       ->check(CLI::IsMember({"torus", "box"}));
   cmd->add_option(
       "--aspect", args->aspect,
