@@ -620,7 +620,18 @@ TEST_F(CliTest, SamplerCountsAndTemperaturesAtTheirLimits) {
   const std::string out = " -o '" + path("s.txt") + "'";
   expect_error("sample --n 0" + out, "resolution");          // n = 0 means "use --resolution"
   expect_error("sample --n 4000000000" + out, "too large");  // beyond 2^31 points
-  expect_error("sample --n 100000000" + out, "about 8.86e+06 points at most");  // over max_grid_nodes
+  // Over max_grid_nodes: the largest count that fits, the same figure whatever was asked (a constant's was
+  // the count scaled by the grid's nodes: 8.86e6 from 1e8, 8.48e6 from 2^31 - 1).
+  expect_error("sample --n 100000000" + out, "about 8.23e+06 points at most");
+  expect_error("sample --n 20000000" + out, "about 8.23e+06 points at most");
+  {  // A volume too: one dense voxel said 373 points at n = 5,000, then 14.7 at 373.
+    std::vector<double> spike(64 * 64 * 64, 0.0);
+    spike[(10 * 64 + 20) * 64 + 30] = 1;
+    std::ofstream(path("spike.npy"), std::ios::binary) << npy_volume(spike, 64, 64, 64, "<f8");
+    for (const char* n : {"5000", "100000"})
+      expect_error(std::string("sample --dim 3 --n ") + n + " --density '" + path("spike.npy") + "'" + out,
+                   "about 12 points at most");
+  }
   // Over max_grid_nodes by resolution: the largest resolution that fits, not "about 0 points at most".
   expect_error("sample --n 0 --resolution 100000" + out, "a resolution of at most 1");
   expect_error("sample --n 100 --temperature nan" + out, "temperature");

@@ -380,13 +380,18 @@ ModelSetup<D> build_model(const SamplerOptions& o, const Density& density) {
                       1.0 / D);
     };
     double shortest = shortest_for(total, peak_over_mean);
-    // An image's peak over its mean is known from its values, whatever the grid resolves of it: the
-    // largest count whose grid (at the image's full peak) fits, with the refinement's margin.
+    // An image's or a volume's peak over its mean is known from its values, whatever the grid resolves
+    // of it, and a constant's is 1: the largest count whose grid (at that full peak) fits, with the
+    // refinement's margin. (A volume's was a count scaled by the nodes: 373, then 14.7, for one voxel.)
     const auto most_points = [&] {
-      if (!density.image) return std::nan("");
+      const std::vector<float>* values = density.image    ? &density.image->values
+                                         : density.volume ? &density.volume->values
+                                                          : nullptr;
+      if (!values && density.function) return std::nan("");
       double sum = 0, mx = 0;
-      for (float v : density.image->values) sum += v, mx = std::max<double>(mx, v);
-      const double ratio = mx / (sum / double(density.image->values.size()));
+      if (values)
+        for (float v : *values) sum += v, mx = std::max<double>(mx, v);
+      const double ratio = values ? mx / (sum / double(values->size())) : 1.0;
       const auto fits = [&](double points) {
         double dims[D];
         int grid_levels = 0;
