@@ -208,6 +208,27 @@ TEST(DensityCheckTest, AConstantOrImageDensityIsLeftAsItIs) {
   EXPECT_EQ(constant.user, nullptr);
 }
 
+/// A class query of `c` run to its end: each point with its class.
+std::vector<std::pair<QueryPoint, std::uint8_t>> run_classes(const ClassQueryParams& c) {
+  std::vector<QueryPoint> out(1 << 16);
+  std::vector<std::uint8_t> classes(out.size());
+  std::size_t written = 0;
+  QueryCursor cursor;
+  EXPECT_EQ(query_classes(Tileset::builtin(), c, out.data(), classes.data(), out.size(), &written, &cursor),
+            Status::kOk);
+  std::vector<std::pair<QueryPoint, std::uint8_t>> points;
+  for (std::size_t i = 0; i < written; ++i) points.emplace_back(out[i], classes[i]);
+  return points;
+}
+
+bool same_classed(const std::vector<std::pair<QueryPoint, std::uint8_t>>& a,
+                  const std::vector<std::pair<QueryPoint, std::uint8_t>>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (!same_bits({a[i].first}, {b[i].first}) || a[i].second != b[i].second) return false;
+  return true;
+}
+
 TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   Ramp good, flawed;
   flawed.bad_from = 3, flawed.bad = -1;
@@ -219,12 +240,7 @@ TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   c.classes[1] = ramp_query(flawed, QueryMode::kStable).density;
   ASSERT_EQ(good_check.wrap(&c.classes[0]), Status::kOk);
   ASSERT_EQ(flawed_check.wrap(&c.classes[1]), Status::kOk);
-  std::vector<QueryPoint> out(1 << 16);
-  std::vector<std::uint8_t> classes(out.size());
-  std::size_t written = 0;
-  QueryCursor cursor;
-  ASSERT_EQ(query_classes(Tileset::builtin(), c, out.data(), classes.data(), out.size(), &written, &cursor),
-            Status::kOk);
+  EXPECT_FALSE(run_classes(c).empty());
   EXPECT_FALSE(good_check.failed());
   DensityFinding f;
   ASSERT_TRUE(flawed_check.failed(&f));
@@ -237,6 +253,8 @@ TEST(DensityCheckTest, ClassesAndParallelQueriesAreChecked) {
   DensityCheck check;
   QueryParams q = ramp_query(flawed, QueryMode::kSmooth);
   ASSERT_EQ(check.wrap(&q.density), Status::kOk);
+  std::vector<QueryPoint> out(1 << 16);
+  std::size_t written = 0;
   ASSERT_EQ(parallel.run(Tileset::builtin(), q, out.data(), out.size(), &written, std_thread_runner()),
             Status::kOk);
   ASSERT_TRUE(check.failed(&f));
@@ -282,26 +300,6 @@ ClassQueryParams joint_query(JointRamps& ramps, QueryMode mode, bool batch) {
   c.joint.user = &ramps;
   c.joint.max[0] = 1.25 * 0.25, c.joint.max[1] = 1.25 * 0.5, c.joint.max[2] = 1.25 * 0.25;
   return c;
-}
-
-std::vector<std::pair<QueryPoint, std::uint8_t>> run_classes(const ClassQueryParams& c) {
-  std::vector<QueryPoint> out(1 << 16);
-  std::vector<std::uint8_t> classes(out.size());
-  std::size_t written = 0;
-  QueryCursor cursor;
-  EXPECT_EQ(query_classes(Tileset::builtin(), c, out.data(), classes.data(), out.size(), &written, &cursor),
-            Status::kOk);
-  std::vector<std::pair<QueryPoint, std::uint8_t>> points;
-  for (std::size_t i = 0; i < written; ++i) points.emplace_back(out[i], classes[i]);
-  return points;
-}
-
-bool same_classed(const std::vector<std::pair<QueryPoint, std::uint8_t>>& a,
-                  const std::vector<std::pair<QueryPoint, std::uint8_t>>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (!same_bits({a[i].first}, {b[i].first}) || a[i].second != b[i].second) return false;
-  return true;
 }
 
 TEST(DensityCheckTest, AJointClassDensityIsCheckedClassByClass) {
