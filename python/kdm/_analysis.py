@@ -179,7 +179,10 @@ def analyze(
         arrays, and its nulls as NaN, but tiling.lattice_power_ratio as inf for a strictly periodic set
         (no power off the tile lattice; NaN when no lattice frequency lies in the spectrum). The nearest-
         neighbour histogram's last bin counts every distance from histogram_max on (histogram_overflow of
-        them). spectrum.nonuniform, present for a set that is not uniform, says why: its spectrum then
+        them). spectrum.periodogram is the set-averaged periodogram P(k) = |Σ_j exp(-2πi k·x_j)|² / n itself,
+        a (2 ky + 1, 2 kx + 1) array, P(kx, ky) at row ky + ky_max and column kx + kx_max (integer
+        frequencies of the unit square, over each side's length in a longer domain; NaN outside the disc
+        |k| <= kmax that is computed), the spectrum's measures are taken from. spectrum.nonuniform, present for a set that is not uniform, says why: its spectrum then
         measures its density's variation, not blue-noise quality. A min_expected above a set's count leaves one window (z = 0) and warns. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
         their count): with ``box=True`` circles centred within two spacings of a side are left out.
     """
@@ -268,9 +271,12 @@ def analyze(
         if runs != len(own):
             raise ValueError(f"class_densities holds {len(own)} densit{'y' if len(own) == 1 else 'ies'}, but the classes run 0 to {runs - 1} "
                              f"({runs} classes): give one per class, class 0 first")
-    text, classes_text = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy, labels,
-                                      min_expected, density_bands, holes_min_density, own, extent)
+    text, classes_text, periodogram = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy,
+                                                   labels, min_expected, density_bands, holes_min_density, own,
+                                                   extent)
     result = _arrays(json.loads(text))
+    if periodogram is not None and "spectrum" in result:
+        result["spectrum"]["periodogram"] = periodogram
     _infinite_lattice(result)
     density_result = result.get("density")
     if density_result and density_result["mean_expected"] < min_expected:

@@ -124,6 +124,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     return false;
   };
   std::string metrics, classes;
+  analysis::Periodogram spectrum;  // the set-averaged periodogram, for the caller's own measures
   try {
     py::gil_scoped_release release;
     auto energy_of = [&](const std::vector<tools::PointSet>& of, const gen::Density& under) {
@@ -136,6 +137,7 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
     analysis::AnalysisReport report = analysis::analyze(sets, o);
     if (energy) report.energy_per_point = energy_of(sets, target), report.has_energy = true;
     metrics = analysis::metrics_json(report, names);
+    if (report.has_spectrum) spectrum = std::move(report.spectrum);
     if (!labels.empty()) {
       analysis::ClassEnergy class_energy;
       if (energy)
@@ -150,7 +152,14 @@ py::tuple analyze(const std::vector<Array>& arrays, const std::vector<std::strin
   }
   if (function_density) function_density->rethrow();
   for (const auto& f : class_functions) f->rethrow();
-  return py::make_tuple(metrics, labels.empty() ? py::object(py::none()) : py::object(py::str(classes)));
+  py::object power = py::none();
+  if (!spectrum.power.empty()) {
+    py::array_t<double> grid({py::ssize_t(spectrum.height()), py::ssize_t(spectrum.width())});
+    std::copy(spectrum.power.begin(), spectrum.power.end(), grid.mutable_data());
+    power = grid;
+  }
+  return py::make_tuple(metrics, labels.empty() ? py::object(py::none()) : py::object(py::str(classes)),
+                        power);
 }
 
 }  // namespace
