@@ -183,6 +183,7 @@ def analyze(
     density_bands: int = ...,
     holes_min_density: float = ...,
     aspect: Union[None, float, Tuple[float, float, float]] = ...,  # the domain's shape, as kdm.sample's
+    periodogram: bool = ...,
 ) -> Dict[str, Any]: ...
 
 _Seed = Union[None, int, np.random.Generator, np.random.RandomState, np.random.SeedSequence, np.random.BitGenerator]

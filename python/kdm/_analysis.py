@@ -96,6 +96,7 @@ def analyze(
     density_bands: int = 10,
     holes_min_density: float = 0.0,
     aspect: Any = None,
+    periodogram: bool = False,
 ) -> Dict[str, Any]:
     """Measure point sets as ``kdm analyze`` does, returning what it writes to metrics.json.
 
@@ -162,6 +163,12 @@ def analyze(
         result's "sides" gives its sides. None or 1: the unit square (cube). ValueError for a side that is
         not > 0, or with `tile_size` or `classes` (square tiles and the classes' closest pair need the
         square); TypeError for a value that is no number or sequence.
+    periodogram : bool
+        Also return the set-averaged periodogram the spectrum's measures come from, as
+        spectrum.periodogram (a key metrics.json does not hold): P(k) = |Σ_j exp(-2πi k·x_j)|² / n, a
+        (2 ky_max + 1, 2 kx_max + 1) array, P(kx, ky) at row ky + ky_max and column kx + kx_max (integer
+        frequencies of the unit square, over each side's length in a longer domain; NaN outside the disc
+        |k| <= kmax that is computed). 2-D sets only.
     min_expected, density_bands, holes_min_density
         As ``kdm analyze --min-expected/--density-bands/--holes-min-density``: the density test's
         windows expect at least that many points; its bias table has that many bands; empty circles
@@ -179,10 +186,7 @@ def analyze(
         arrays, and its nulls as NaN, but tiling.lattice_power_ratio as inf for a strictly periodic set
         (no power off the tile lattice; NaN when no lattice frequency lies in the spectrum). The nearest-
         neighbour histogram's last bin counts every distance from histogram_max on (histogram_overflow of
-        them). spectrum.periodogram is the set-averaged periodogram P(k) = |Σ_j exp(-2πi k·x_j)|² / n itself,
-        a (2 ky + 1, 2 kx + 1) array, P(kx, ky) at row ky + ky_max and column kx + kx_max (integer
-        frequencies of the unit square, over each side's length in a longer domain; NaN outside the disc
-        |k| <= kmax that is computed), the spectrum's measures are taken from. spectrum.nonuniform, present for a set that is not uniform, says why: its spectrum then
+        them). spectrum.nonuniform, present for a set that is not uniform, says why: its spectrum then
         measures its density's variation, not blue-noise quality. A min_expected above a set's count leaves one window (z = 0) and warns. Empty circles' rates per 10^5 points are per point their judged triangles stand for (half
         their count): with ``box=True`` circles centred within two spacings of a side are left out.
     """
@@ -237,6 +241,7 @@ def analyze(
     fmax = _checks.number("fmax", fmax, 0.0, strict=True)
     threads = _checks.threads(threads)
     energy = _checks.flag("energy", energy)
+    periodogram = _checks.flag("periodogram", periodogram)
     if sets[0].shape[1] == 3 and (spec is not None or function is not None or tile_size is not None):
         warnings.warn("density windows and tiling diagnostics are 2D only; skipped (a density still sets "
                       "the energy, as kdm analyze's does)", stacklevel=2)
@@ -271,12 +276,12 @@ def analyze(
         if runs != len(own):
             raise ValueError(f"class_densities holds {len(own)} densit{'y' if len(own) == 1 else 'ies'}, but the classes run 0 to {runs - 1} "
                              f"({runs} classes): give one per class, class 0 first")
-    text, classes_text, periodogram = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy,
+    text, classes_text, power = _kdm.analyze(sets, names, box, spec, function, tile, fmax, threads, energy,
                                                    labels, min_expected, density_bands, holes_min_density, own,
                                                    extent)
     result = _arrays(json.loads(text))
-    if periodogram is not None and "spectrum" in result:
-        result["spectrum"]["periodogram"] = periodogram
+    if periodogram and power is not None and "spectrum" in result:
+        result["spectrum"]["periodogram"] = power
     _infinite_lattice(result)
     density_result = result.get("density")
     if density_result and density_result["mean_expected"] < min_expected:

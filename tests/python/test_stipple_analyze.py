@@ -328,8 +328,9 @@ def test_analyze_gives_the_periodogram_its_spectrum_measures_come_from():
     # P(k) = |Σ exp(-2πi k·x)|² / n at integer k, row ky + ky_max and column kx + kx_max, as computed here;
     # the mean over several sets; none for a 3-D set, which gets no spectrum.
     sets = [kdm.sample(1024, seed=s) for s in (1, 2)]
-    one = kdm.analyze(sets[0])["spectrum"]["periodogram"]
-    both = kdm.analyze(sets)["spectrum"]["periodogram"]
+    one = kdm.analyze(sets[0], periodogram=True)["spectrum"]["periodogram"]
+    both = kdm.analyze(sets, periodogram=True)["spectrum"]["periodogram"]
+    assert "periodogram" not in kdm.analyze(sets[0])["spectrum"]  # metrics.json's keys unless asked
     ky_max, kx_max = (one.shape[0] - 1) // 2, (one.shape[1] - 1) // 2
     assert one.shape == (2 * ky_max + 1, 2 * kx_max + 1) and kx_max >= 40
     def direct(p, kx, ky):
@@ -339,7 +340,7 @@ def test_analyze_gives_the_periodogram_its_spectrum_measures_come_from():
         mean = (direct(sets[0], kx, ky) + direct(sets[1], kx, ky)) / 2
         assert both[ky + ky_max, kx + kx_max] == pytest.approx(mean, rel=1e-9, abs=1e-9)
     assert np.isnan(one[0, 0])  # a corner outside the disc computed
-    assert "spectrum" not in kdm.analyze(kdm.sample(300, dim=3, seed=1))
+    assert "spectrum" not in kdm.analyze(kdm.sample(300, dim=3, seed=1), periodogram=True)
 
 
 def test_analyze_classes_and_options_as_the_command_line(cli, tmp_path, gradient_png):
