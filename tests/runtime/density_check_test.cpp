@@ -316,33 +316,35 @@ TEST(DensityCheckTest, AJointClassDensityIsCheckedClassByClass) {
       EXPECT_FALSE(check.failed());
       EXPECT_GT(check.largest(), 0.4);
 
-      JointRamps flawed;  // class 1 NaN right of x = 3
-      flawed.bad_from = 3, flawed.bad = std::nan("");
-      ClassQueryParams f = joint_query(flawed, mode, batch);
-      DensityCheck flawed_check;
-      ASSERT_EQ(flawed_check.wrap(&f.joint, f.class_count), Status::kOk);
-      run_classes(f);
-      DensityFinding finding;
-      ASSERT_TRUE(flawed_check.failed(&finding));
-      EXPECT_EQ(finding.kind, DensityFinding::Kind::kValue);
-      EXPECT_EQ(finding.cls, 1);
-      EXPECT_GE(finding.x, 3);
-      char line[200];
-      flawed_check.describe(line, sizeof line);
-      EXPECT_EQ(std::string(line).rfind("joint density's class 1 was nan at (", 0), 0u) << line;
-
-      JointRamps loose;  // class 0's upper bound a little short
-      loose.bounds_short = 0.01;
-      ClassQueryParams b = joint_query(loose, mode, batch);
-      DensityCheck bounds_check;
-      ASSERT_EQ(bounds_check.wrap(&b.joint, b.class_count), Status::kOk);
-      run_classes(b);
-      ASSERT_TRUE(bounds_check.failed(&finding));
-      EXPECT_EQ(finding.kind, DensityFinding::Kind::kBounds);
-      EXPECT_EQ(finding.cls, 0);
-      bounds_check.describe(line, sizeof line);
-      EXPECT_EQ(std::string(line).rfind("joint density's class 0 bounds gave [", 0), 0u) << line;
-      EXPECT_NE(std::string(line).find(", but it is "), std::string::npos) << line;
+      // Class 1 NaN right of x = 3, then class 0's upper bound a little short: each found, its class named.
+      struct Flaw {
+        JointRamps ramps;
+        DensityFinding::Kind kind;
+        int cls;
+        const char* line;
+      } flaws[] = {{JointRamps{3, std::nan(""), 0}, DensityFinding::Kind::kValue, 1,
+                    "joint density's class 1 was nan at ("},
+                   {JointRamps{HUGE_VAL, 0, 0.01}, DensityFinding::Kind::kBounds, 0,
+                    "joint density's class 0 bounds gave ["}};
+      for (Flaw& flaw : flaws) {
+        ClassQueryParams flawed = joint_query(flaw.ramps, mode, batch);
+        DensityCheck flawed_check;
+        ASSERT_EQ(flawed_check.wrap(&flawed.joint, flawed.class_count), Status::kOk);
+        run_classes(flawed);
+        DensityFinding finding;
+        ASSERT_TRUE(flawed_check.failed(&finding)) << flaw.line;
+        EXPECT_EQ(finding.kind, flaw.kind);
+        EXPECT_EQ(finding.cls, flaw.cls);
+        if (flaw.kind == DensityFinding::Kind::kValue) {
+          EXPECT_GE(finding.x, 3);
+        }
+        char line[200];
+        flawed_check.describe(line, sizeof line);
+        EXPECT_EQ(std::string(line).rfind(flaw.line, 0), 0u) << line;
+        if (flaw.kind == DensityFinding::Kind::kBounds) {
+          EXPECT_NE(std::string(line).find(", but it is "), std::string::npos) << line;
+        }
+      }
     }
 }
 
