@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "atomic_file.h"
 #include "bindings.h"
-#include "image_io.h"
 #include "kdm/generator/bake.h"
 #include "kdm/runtime/compact_query.h"
 #include "kdm/runtime/query.h"

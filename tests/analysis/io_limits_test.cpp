@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "atomic_file.h"
 #include "image_io.h"
 #include "point_io.h"
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "image_io.h"
+#include "picture.h"
 #include "point_output.h"
 
 namespace kdm::tools {

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "point_io.h"
+
 namespace kdm_cli_test {
 
 namespace fs = std::filesystem;
@@ -168,6 +170,43 @@ inline std::vector<std::uint8_t> ramp_png() {
   std::vector<std::uint16_t> v(64 * 64);
   for (int i = 0; i < 64 * 64; ++i) v[i] = static_cast<std::uint16_t>(4 * (i % 64));
   return grey_png(64, 64, 8, v);
+}
+
+/// `values` (depth × height × width, in numpy's C order) as np.save writes a 3-D array of `descr` ('<f8',
+/// '<f4', big-endian '>f8' or '>f4', or '|u1'); `shape` overrides the header's shape.
+inline std::string npy_volume(const std::vector<double>& values, int depth, int height, int width,
+                              const std::string& descr = "<f4", const std::string& shape = "") {
+  const std::string dims =
+      shape.empty() ? std::to_string(depth) + ", " + std::to_string(height) + ", " + std::to_string(width)
+                    : shape;
+  std::string header = "{'descr': '" + descr + "', 'fortran_order': False, 'shape': (" + dims + "), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  for (double v : values) {
+    const std::size_t at = bytes.size();
+    if (descr.substr(1) == "f8") {
+      bytes.append(reinterpret_cast<const char*>(&v), 8);  // x86-64: little-endian already
+    } else if (descr.substr(1) == "f4") {
+      const float f = static_cast<float>(v);
+      bytes.append(reinterpret_cast<const char*>(&f), 4);
+    } else {
+      bytes += static_cast<char>(static_cast<unsigned char>(v));
+    }
+    if (descr[0] == '>') std::reverse(bytes.begin() + std::ptrdiff_t(at), bytes.end());
+  }
+  return bytes;
+}
+
+/// The first point set of `file` (empty, with a test failure, if it does not read).
+inline kdm::tools::PointSet first_set(const std::string& file) {
+  std::vector<kdm::tools::PointSet> sets;
+  std::string error;
+  EXPECT_TRUE(kdm::tools::read_point_sets(file, sets, error) && !sets.empty()) << file << ": " << error;
+  return sets.empty() ? kdm::tools::PointSet{} : sets[0];
 }
 
 }  // namespace kdm_cli_test

@@ -21,6 +21,7 @@
 #include "image_io.h"
 #include "kdm/runtime/tileset.h"
 #include "kdm/runtime/tileset_format.h"
+#include "picture.h"
 
 namespace {
 

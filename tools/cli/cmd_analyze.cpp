@@ -18,11 +18,11 @@
 #include <system_error>
 #include <vector>
 
+#include "atomic_file.h"
 #include "checked_options.h"
 #include "commands.h"
 #include "density_arg.h"
 #include "generator_density.h"
-#include "image_io.h"
 #include "kdm/analysis/classes.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/json.h"
@@ -30,6 +30,7 @@
 #include "kdm/analysis/report.h"
 #include "kdm/generator/multiclass.h"
 #include "kdm/generator/sampler.h"
+#include "picture.h"
 #include "sampler_density.h"
 
 namespace kdm::cli {

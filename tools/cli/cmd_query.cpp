@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <memory>
 
+#include "atomic_file.h"
 #include "checked_options.h"
 #include "commands.h"
 #include "density_arg.h"
-#include "image_io.h"
 #include "point_output.h"
 #include "runtime_args.h"
 

@@ -7,8 +7,8 @@
 #include <new>
 #include <string>
 
+#include "atomic_file.h"
 #include "commands.h"
-#include "image_io.h"
 #include "kdm/runtime/version.h"
 
 namespace {

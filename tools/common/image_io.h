@@ -1,5 +1,6 @@
-// Image input and output for the command line: greyscale loading (8/16-bit PNG and whatever else
-// stb_image reads) and PNG writing. Not thread-safe to call concurrently on the same path.
+// Image input for the command line and the Python package: greyscale and colour loading (8/16-bit PNG,
+// Radiance .hdr and whatever else stb_image reads), safe on untrusted bytes. Pictures are written by
+// picture.h.
 #pragma once
 
 #include <cstddef>
@@ -25,16 +26,6 @@ struct ColourImage {
   int height = 0;
   std::vector<float> pixels;  ///< composited on white paper
   std::vector<float> alpha;   ///< coverage in [0, 1] per pixel; empty for a file without alpha
-};
-
-/// An 8-bit RGB image, row-major, row 0 at the top.
-struct RgbImage {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> pixels;  // 3 bytes per pixel
-  RgbImage() = default;
-  RgbImage(int w, int h, std::uint8_t fill = 255)
-      : width(w), height(h), pixels(static_cast<std::size_t>(w) * h * 3, fill) {}
 };
 
 /// The largest image the loaders accept, in pixels (width · height): 2^26, e.g. 8192 × 8192. Images are
@@ -90,44 +81,5 @@ bool read_standard_input(std::vector<std::uint8_t>& bytes, std::string& error);
 
 /// Whether `data` begins as a Radiance (.hdr) image does ("#?RADIANCE" or "#?RGBE" and a line break).
 bool is_radiance(const void* data, std::size_t size);
-
-/// Writes `image` as PNG atomically (temporary file, then rename). Returns false with `error` set on failure.
-bool write_png(const std::string& path, const RgbImage& image, std::string& error);
-
-/// Draws an antialiased filled disc of radius `r` pixels centred at (cx, cy) (pixel units, y down): painted
-/// over what is there, or with `mode` 1 multiplied into it (inks on paper), 2 added to it (light). Its
-/// pixels' coverages sum to its area π r², a disc under a pixel's size included (it is then a grey pixel
-/// or a few).
-void draw_disc(RgbImage& image, double cx, double cy, double r, const std::uint8_t rgb[3], int mode = 0);
-
-/// How much of each pixel one ink's dots cover, 0 … 65535 for 0 … 1. Dots add their coverage (saturating):
-/// dots side by side fill the pixel they share, and dots under a pixel's size darken it by their area, so
-/// that a stipple keeps its tone at any picture size (dots laid over each other would lighten both).
-struct CoverageImage {
-  int width = 0, height = 0;
-  std::vector<std::uint16_t> values;
-  CoverageImage(int w, int h) : width(w), height(h), values(static_cast<std::size_t>(w) * h, 0) {}
-};
-
-/// Adds a disc as draw_disc draws it (same coverage) to `layer`.
-void add_disc(CoverageImage& layer, double cx, double cy, double r);
-
-/// Lays `rgb` over `image` where `layer` covers it, by its coverage (`mode` as draw_disc's).
-void composite(RgbImage& image, const CoverageImage& layer, const std::uint8_t rgb[3], int mode = 0);
-
-/// Writes `text` (any bytes) to `path` atomically (temporary file, then rename), every write checked; "-"
-/// is standard output.
-bool write_text_file_atomic(const std::string& path, const std::string& text, std::string& error);
-
-/// For a program that writes its files in turn from one thread (the command line): from now on SIGINT,
-/// SIGTERM and SIGHUP remove the temporary file write_text_file_atomic is writing, if any, before they end
-/// the process as they would have; a signal the process ignores stays ignored. A library's host (Python)
-/// keeps its own handlers: it does not call this.
-void remove_temporary_files_on_signals();
-
-namespace detail {
-/// The temporary file being written, as write_text_file_atomic marks it (null: none); for tests.
-void mark_temporary_file(const char* path);
-}  // namespace detail
 
 }  // namespace kdm::tools

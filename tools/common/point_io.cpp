@@ -11,7 +11,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "image_io.h"
+#include "atomic_file.h"
 
 namespace kdm::tools {
 

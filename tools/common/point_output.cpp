@@ -10,7 +10,8 @@
 #include <string>
 
 #include <stdexcept>
-#include "image_io.h"
+#include "atomic_file.h"
+#include "picture.h"
 
 namespace kdm::tools {
 namespace {

@@ -3,9 +3,9 @@
 // Text is drawn with stb_easy_font (public-domain bitmap-segment font from libstb).
 #pragma once
 
-#include "image_io.h"
 #include "kdm/analysis/common.h"
 #include "kdm/analysis/periodogram.h"
+#include "picture.h"
 #include "point_io.h"
 
 namespace kdm::analysis {
