@@ -76,7 +76,10 @@ def stipple(
     points : int
         Dots over the whole image (ignored when `scale` is given).
     scale : float or None
-        Dots per unit area at full darkness (image height = 1 unit), instead of `points`.
+        Dots per unit area at full darkness (image height = 1 unit), instead of `points`. With tiles
+        the dots then depend on `scale` and `seed`, not on the image (where its inks sum to at most full
+        darkness): the frames of an animated image keep their dots where their tone stays, which
+        `points` (rescaled by each frame's mean tone) does not.
     method : {"tiles", "full"}
         tiles: the runtime and a tile set (fast, zoom-coherent); full: the full KDM sampler (best, slow).
     mode : {"smooth", "stable"} or None

@@ -372,8 +372,11 @@ void add_stipple_command(CLI::App& app) {
       "dot's spacing get fewer, docs/limits.md; a few dozen may be 10% off, and 1 may give none). A pale "
       "image gets as many as a dark one: --scale keeps the tone's absolute darkness");
   cmd->add_option("--scale", a->scale,
-                  "Dots per unit area at full darkness (image height = 1 unit); overrides --points "
-                  "(default: unset, --points decides)");
+                  "Dots per unit area at full darkness (image height = 1 unit); overrides --points. With "
+                  "tiles the dots then depend on the scale and seed, not on the picture (where its inks sum "
+                  "to at most full darkness): for an animated picture, frames keep their dots where their "
+                  "tone stays (--points rescales each frame by its mean tone) (default: unset, --points "
+                  "decides)");
   cmd->add_option("--method", a->method, "tiles: runtime + tile set (fast); full: the full KDM sampler")
       ->check(CLI::IsMember({"tiles", "full"}))
       ->capture_default_str();

@@ -148,10 +148,12 @@ TileStippler::TileStippler(const std::vector<const DensitySpec*>& inks, const Ti
   scale_ = points > 0 ? points / (mean * aspect_) : scale;
   // Tiles small enough that the image's peak density, zoomed kStippleZoomRoom times, fits the top level
   // (past it, smooth mode descends into subtiles). The tile size depends on the whole image only, so
-  // every region and frame sees the same dots.
+  // every region and frame sees the same dots. With a scale given, it is set for full darkness unless the
+  // inks sum to more: then it depends on the scale alone, and an animated picture keeps its dots where its
+  // tones stay (with the image's own peak, one darker pixel would move every dot).
   double peak_count = tiles_.max_points_per_tile() / (kStippleZoomRoom * kStippleZoomRoom);
   if (mode == QueryMode::kSmooth) peak_count = between_keyframes(tiles_, peak_count);
-  tile_size_ = std::sqrt(peak_count / (scale_ * peak));
+  tile_size_ = std::sqrt(peak_count / (scale_ * (points > 0 ? peak : std::max(peak, 1.0))));
   // Said in the caller's terms (dots, scale) before a query would name the tile size derived from them.
   const double dots = scale_ * mean * aspect_;
   char text[160];

@@ -79,8 +79,10 @@ class TileStippler {
   /// The image `spec` (kImage, with some ink) over the world [0, aspect] × [0, 1], aspect its width /
   /// height. `points` dots over the whole image (> 0), or, when points is 0, `scale` dots per unit area at
   /// full darkness. `seed` picks where in the tile set's endless tiling the image lies (another seed, other
-  /// dots; one seed, the same dots in every region and frame). `tileset` must outlive the stippler; so must
-  /// `spec`. Throws std::invalid_argument.
+  /// dots; one seed, the same dots in every region and frame). With `scale`, the tiling depends on the scale
+  /// and seed only, not on the image, where its inks sum to at most 1 (every grey image): frames of an
+  /// animated image keep their dots where their tone stays, and a darker tone adds dots to a lighter one's
+  /// (stable mode). `tileset` must outlive the stippler; so must `spec`. Throws std::invalid_argument.
   TileStippler(const DensitySpec& spec, const Tileset& tileset, double points, double scale, QueryMode mode,
                std::uint64_t seed);
   /// Several inks (1 … kMaxQueryClasses images of one size, highest priority first): `points` and `scale`
