@@ -579,6 +579,32 @@ TEST_F(CliTest, HelpDescribesEveryOption) {
   }
 }
 
+// An unset shell variable gives an option an empty value, which CLI11 reads as 0 or as no value ("-T $T"
+// sampled at temperature 0): every option that takes a value refuses it by name.
+TEST_F(CliTest, EmptyValuesAreRefusedByEveryOption) {
+  int checked = 0;
+  for (const char* sub : {"sample", "stipple", "query", "analyze", "bake", "info", "verify"}) {
+    std::istringstream lines(kdm(std::string(sub) + " --help").out);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("  -", 0) != 0) continue;
+      std::istringstream words(line);
+      std::string names, type;
+      words >> names >> type;
+      type = type.substr(0, type.find_first_of(":="));
+      if (type.empty() || !std::all_of(type.begin(), type.end(), [](char c) { return std::isupper(c); }))
+        continue;                                                   // a flag
+      const std::string name = names.substr(names.rfind(',') + 1);  // "-o,--output": --output
+      const Outcome r = kdm(std::string(sub) + " " + name + " ''");
+      EXPECT_EQ(r.status, 1) << sub << " " << name;
+      // "--scale: is empty", or an option's own refusal ("--mode:  not in {stable,smooth}"), never another
+      // option's "is required" (the empty value taken).
+      EXPECT_EQ(r.err.rfind("kdm: error: " + name + ": ", 0), 0u) << sub << " " << name << ": " << r.err;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 60);  // the commands' value options, all of them read from --help
+}
+
 // Every density a NumPy .npy array can give says so in its command's help, and the command reads one.
 TEST_F(CliTest, HelpNamesNpyWhereADensityReadsOne) {
   std::vector<double> values(4 * 6);

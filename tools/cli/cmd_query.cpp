@@ -221,11 +221,7 @@ void add_query_command(CLI::App& app) {
       "exactly the region's points. Past it the map's edge goes on");
   cmd->add_option("--gamma", a->gamma, "Exponent applied to image darkness")->capture_default_str();
   cmd->add_flag("--invert", a->invert, "Bright image areas are dense");
-  cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")
-      ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& text) { return text.empty() ? std::string("is empty (an unset variable?)") : ""; },
-          ""));  // CLI11 reads "" as 0, a query of no points
+  cmd->add_option("--scale", a->scale, "Points per world unit area at density 1")->capture_default_str();
   cmd->add_option("--tile-size", a->tile_size, "World units per tile side")->capture_default_str();
   cmd->add_option("--mode", a->mode,
                   "stable: points never move once they appear (placing objects); smooth: points glide with "

@@ -61,6 +61,16 @@ void read_integers_as_decimal(CLI::App& app) {
     }
 }
 
+// CLI11 reads an empty word as 0 or as no value: "-T $T" with T unset sampled at temperature 0, "--sweeps
+// ''" ran no sweeps. Every option's value, and every positional, must be a word.
+void refuse_empty_values(CLI::App& app) {
+  const CLI::Validator non_empty(
+      [](std::string& word) { return word.empty() ? std::string("is empty (an unset variable?)") : ""; }, "");
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* opt : sub->get_options())
+      if (opt->get_expected_min() > 0) opt->check(non_empty);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,6 +86,7 @@ int main(int argc, char** argv) {
   kdm::cli::add_analyze_command(app);
   kdm::cli::add_verify_command(app);
   read_integers_as_decimal(app);
+  refuse_empty_values(app);
   try {
     if (const std::string error = option_given_as_value(app, argc, argv); !error.empty()) {
       std::fprintf(stderr, "kdm: error: %s (see kdm %s --help)\n", error.c_str(), argv[1]);
