@@ -70,6 +70,23 @@ TEST_F(CliTest, OutputsThroughSymbolicLinksReplaceTheirTargets) {
   }
 }
 
+// A full disk behind > fails what a command prints, as it fails -o -: `kdm info SET > info.txt` in a
+// Makefile must not leave an empty file behind a success.
+TEST_F(CliTest, PrintingToAFullStandardOutputIsAnError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string set = std::string(KDM_SOURCE_DIR) + "/tilesets/default.kdmt";
+  ASSERT_EQ(kdm("sample --n 64 -o '" + path("s.txt") + "'").status, 0);
+  for (const std::string& args : {"info '" + set + "'", "sample --n 64 --timing -o '" + path("t.txt") + "'",
+                                  "analyze '" + path("s.txt") + "' -o '" + path("an") + "'"}) {
+    const std::string command =
+        "'" + std::string(KDM_EXECUTABLE) + "' " + args + " >/dev/full 2>'" + path("err") + "'";
+    const int raw = std::system(command.c_str());
+    EXPECT_EQ(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, 1) << args;
+    EXPECT_NE(slurp(path("err")).find("kdm: error: cannot write to standard output"), std::string::npos)
+        << args << ": " << slurp(path("err"));
+  }
+}
+
 TEST_F(CliTest, UnwritableOutputsGiveOneLineErrors) {
   // A path below a regular file cannot be created, even by root (CI runs as root).
   write_bytes(path("file"), {'x'});

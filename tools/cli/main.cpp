@@ -2,8 +2,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
+#include <iostream>
 #include <new>
 #include <string>
 
@@ -93,6 +96,13 @@ int main(int argc, char** argv) {
       return 1;
     }
     app.parse(argc, argv);
+    // What a command printed (info, verify's tables, analyze's summary) must have reached its reader: a
+    // full disk or a closed file behind > is a failure, as for -o -.
+    std::cout.flush();
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+      std::fprintf(stderr, "kdm: error: cannot write to standard output: %s\n", std::strerror(errno));
+      return 1;
+    }
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // Bad command lines get the same one-line error as every other failure (CLI11 would add a hint line).
