@@ -54,6 +54,8 @@ def sample(
         array: density values (finite, >= 0, not all zero; at any scale: the scale does not change the
         points' distribution, but one that is not a power of two rounds the values differently, so the
         points differ; an array whose largest value lies outside 1e-30 ... 1e30 is divided by it first),
+        bilinear between pixel centres (not piecewise constant: a step between two columns is a ramp one
+        pixel wide, so 4 × 8 pixels of 1 and 3 put 0.734 of the points in the right half, not 0.75),
         stretched over the domain, with row 0 at the TOP, as pictures are stored (and as an image file is
         read). A 3-D array
         of shape (depth, height, width), with dim=3: a volume of densities (values as a 2-D array's),
@@ -65,8 +67,9 @@ def sample(
         2 or 3 (images and 2-D arrays are 2-D, 3-D arrays 3-D).
     domain : {"torus", "box"} or None
         Periodic or bounded. None: a box for images, arrays, volumes, callables and "ramp:R", a torus for None,
-        a number, "const:V" and "radial:R". For Monte Carlo integration: the torus is unbiased
-        and best for periodic integrands; a smooth integrand that is not periodic has a 3-6x lower error
+        a number, "const:V" and "radial:R". For Monte Carlo integration: the torus is unbiased over
+        the square (sets under about 256 points keep a faint ripple of the sampler's grid, period
+        1/(4 sqrt(n)), which a random shift modulo 1 per set removes) and best for periodic integrands; a smooth integrand that is not periodic has a 3-6x lower error
         in a box, whose sets of up to a few hundred points are nearly the same grid for every seed and
         bias sharp features (docs/limits.md, "The full sampler in a box").
     temperature : float
