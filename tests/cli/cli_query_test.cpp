@@ -526,7 +526,8 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
                "from 0.001 to 1000000");
   expect_error("stipple " + coffee + " --paper-width 0x10mm -o '" + path("p.svg") + "'",
                "from 0.001 to 1000000");
-  expect_error("stipple " + coffee + " --paper-width '' -o '" + path("p.svg") + "'", "got ''");
+  expect_error("stipple " + coffee + " --paper-width '' -o '" + path("p.svg") + "'",
+               "--paper-width: is empty");
   expect_error("stipple " + coffee + " --paper-width 150mm -o '" + path("p.png") + "'", "write .svg");
   expect_error("stipple " + coffee + " --colours 9 -o '" + path("x.png") + "'", "from 2 to 8");
   expect_error("stipple " + coffee + " --colours cmy -o '" + path("x.png") + "'", "cmyk, rgb");

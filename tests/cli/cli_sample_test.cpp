@@ -387,4 +387,14 @@ TEST_F(CliTest, DefaultThreadsFollowTheEnvironmentAndTheAffinityMask) {
   }
 }
 
+// --width and --dot-size size pictures: with a points file they are refused, not silently ignored (as
+// kdm stipple refuses them).
+TEST_F(CliTest, SamplePictureOptionsWithAPointsFileAreRefused) {
+  for (const char* out : {"x.txt", "x.csv", "x.npy"}) {
+    expect_error("sample --n 20 --width 300 -o '" + path(out) + "'", "--width sizes pictures");
+    expect_error("sample --n 20 --dot-size 2 -o '" + path(out) + "'", "--dot-size sizes pictures");
+  }
+  EXPECT_EQ(kdm("sample --n 20 --width 300 --dot-size 2 -o '" + path("x.png") + "'").status, 0);
+}
+
 }  // namespace

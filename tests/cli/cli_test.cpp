@@ -436,8 +436,8 @@ TEST_F(CliTest, SmallRefusalsNameTheRealProblem) {
   // Values that would be silently dropped: a tile size of 0 and an empty -o, --fade for a points file.
   const std::string reference = "'" + std::string(KDM_TEST_DATA_DIR) + "/reference/ref_T0.5_n4096_01.txt'";
   expect_error("analyze " + reference + " --tile-size 0", "--tile-size must be > 0");
-  expect_error("analyze " + reference + " -o ''", "-o names no directory");
-  expect_error("analyze " + reference + " --aspect ''", "--aspect must be a number > 0");  // was ignored
+  expect_error("analyze " + reference + " -o ''", "--output: is empty");
+  expect_error("analyze " + reference + " --aspect ''", "--aspect: is empty");  // was ignored
   expect_error("stipple '" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png' --fade 0.2 -o '" +
                    path("f.csv") + "'",
                "--fade grows dots in pictures");

@@ -119,4 +119,17 @@ std::vector<double> parse_sides(const std::string& text, const std::string& what
   return sides;
 }
 
+std::vector<std::string> options_given(const CLI::App* cmd, const std::vector<const char*>& picture_only) {
+  std::vector<std::string> given;
+  for (const char* name : picture_only)
+    if (cmd->get_option(name)->count() > 0) given.push_back(name);
+  return given;
+}
+
+void refuse_picture_options(const std::vector<std::string>& given, const std::string& format) {
+  if (format != ".png" && format != ".svg" && !given.empty())
+    throw CommandError(given.front() +
+                       " sizes pictures: write .png or .svg (points files hold positions only)");
+}
+
 }  // namespace kdm::cli

@@ -47,4 +47,11 @@ std::string check_output_option(const std::string& path, const std::vector<const
 CLI::Option* add_format_option(CLI::App* cmd, std::string& format,
                                const std::vector<const char*>& extensions);
 
+/// The options among `picture_only` (--width, --dot-size, …) given on `cmd`'s command line, in that order.
+std::vector<std::string> options_given(const CLI::App* cmd, const std::vector<const char*>& picture_only);
+
+/// Refuses picture options that were `given` (options_given) while the output `format` (".csv") is no
+/// picture (.png, .svg): a points file would silently ignore them. Throws CommandError naming the first.
+void refuse_picture_options(const std::vector<std::string>& given, const std::string& format);
+
 }  // namespace kdm::cli

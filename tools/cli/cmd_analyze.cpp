@@ -52,7 +52,7 @@ struct AnalyzeArgs {
   int threads = 0;
   std::string aspect;  ///< --aspect: empty, the files' headers say the shape
   std::string output;
-  bool tile_size_given = false, output_given = false;  // 0 and "" given are mistakes, not the defaults
+  bool tile_size_given = false;  // 0 given is a mistake, not the default
 };
 
 void save_png(const std::string& path, const tools::RgbImage& image) {
@@ -301,8 +301,6 @@ void run_analyze(const AnalyzeArgs& args) {
   if (!(args.min_expected > 0)) throw CommandError("--min-expected must be positive");
   if (args.tile_size_given && args.tile_size == 0)
     throw CommandError("--tile-size must be > 0 (leave it out for no tiling diagnostics)");
-  if (args.output_given && args.output.empty())
-    throw CommandError("-o names no directory (leave it out to print the summary only)");
   analysis::AnalysisOptions o;
   o.fmax = args.fmax;
   o.min_expected = args.min_expected;
@@ -520,16 +518,12 @@ void add_analyze_command(CLI::App& app) {
       "square (default: what the files' .txt headers say, as kdm sample --aspect, query and stipple "
       "write it; else, as for CSV and .npy files, the unit square or cube)");
   add_threads_option(cmd, args->threads, "results do not depend on it");
-  cmd->add_option_function<std::string>(
-      "-o,--output", [a = args.get()](const std::string& o) { a->output = o, a->output_given = true; },
+  cmd->add_option(
+      "-o,--output", args->output,
       "Output directory (created if missing) for metrics.json (classes.json for labelled points) and "
       "pictures; - writes metrics.json (with classes.json's as \"classes\") to standard output and "
       "the summary to standard error, no pictures (default: the summary is only printed)");
-  cmd->callback([args, cmd] {
-    if (cmd->get_option("--aspect")->count() > 0 && args->aspect.empty())  // as kdm sample says it
-      parse_shape(args->aspect, "--aspect");
-    run_analyze(*args);
-  });
+  cmd->callback([args] { run_analyze(*args); });
 }
 
 }  // namespace kdm::cli

@@ -39,7 +39,8 @@ struct SampleArgs {
   bool timing = false;
   int width_px = 1024;
   double dot_radius = 0;
-  std::int64_t sets = 1;  ///< --sets: point sets, seeds --seed, --seed + 1, ...
+  std::int64_t sets = 1;                     ///< --sets: point sets, seeds --seed, --seed + 1, ...
+  std::vector<std::string> picture_options;  ///< --width, --dot-size as given: pictures only
 };
 
 /// --aspect: one number, the x side over the others, or in 3D three sides X:Y:Z (their ratios count).
@@ -137,6 +138,7 @@ void run_sets(const SampleArgs& args, const gen::SamplerOptions& o, const gen::D
 void run_sample(const SampleArgs& args, bool density_given, bool aspect_given) {
   const std::string format =
       check_output_option(args.output, kSampleFormats, args.format);  // before sampling
+  refuse_picture_options(args.picture_options, format);
   if (args.timing && args.output == tools::kStandardOutput)
     throw CommandError("--timing prints on standard output, which -o - writes the points to: drop one");
   // Range checks here rather than CLI11's validators, whose messages print the whole double range.
@@ -383,6 +385,7 @@ void add_sample_command(CLI::App& app) {
       ->required();
   add_format_option(cmd, args->format, kSampleFormats);
   cmd->callback([args, cmd] {
+    args->picture_options = options_given(cmd, {"--width", "--dot-size"});
     run_sample(*args, cmd->get_option("--density")->count() > 0, cmd->get_option("--aspect")->count() > 0);
   });
 }

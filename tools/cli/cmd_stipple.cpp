@@ -73,6 +73,7 @@ std::string frame_path(const std::string& output, int i) {
 
 void run_stipple(const StippleArgs& a, bool scale_given) {
   const std::string format = check_output_option(a.output, kStippleFormats, a.format);  // before the dots
+  refuse_picture_options(a.picture_options, format);
   if (a.frames < 0 || a.frames == 1 || a.frames > 10000)  // before anything loops over them
     throw CommandError("--frames must be 0 (one picture) or a count from 2 to 10000, got " +
                        std::to_string(a.frames));
@@ -95,9 +96,6 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
   if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
-  if (format != ".png" && format != ".svg" && !a.picture_options.empty())
-    throw CommandError(a.picture_options.front() +
-                       " sizes pictures: write .png or .svg (points files hold positions only)");
   if (!(a.width_px >= 1 && a.width_px <= 65536)) throw CommandError("--width must be 1 to 65536 pixels");
   if (!(a.height_px >= 0 && a.height_px <= 65536)) throw CommandError("--height must be 1 to 65536 pixels");
   if (!a.paper_width.empty()) {
@@ -464,18 +462,13 @@ void add_stipple_command(CLI::App& app) {
                      "--method full's sampler (the dots do not depend on it; tiles use one)");
   cmd->callback([a, cmd] {
     const bool scale_given = cmd->get_option("--scale")->count() > 0;
-    if (cmd->get_option("--colours")->count() > 0 && a->colours.empty())
-      throw CommandError("--colours must be cmyk, rgb, a count of inks (2-8) or inks as #rrggbb,..., got ''");
-    // Given empty or 0, these read as unset: say so rather than draw at the default size.
+    // Given as 0, --height reads as unset: say so rather than draw at the default size.
     if (cmd->get_option("--height")->count() > 0 && a->height_px < 1)
       throw CommandError("--height must be 1 to 65536 pixels");
-    if (cmd->get_option("--paper-width")->count() > 0 && a->paper_width.empty())
-      throw CommandError("--paper-width must be a number and a unit (180mm, 7.5in), got ''");
     if (cmd->get_option("--white")->count() > 0 && !(a->white > 0 && std::isfinite(a->white)))
       throw CommandError("--white must be a finite number > 0 (the luminance that is white), got " +
                          tools::shortest(a->white));
-    for (const char* picture_only : {"--width", "--height", "--dot-size"})
-      if (cmd->get_option(picture_only)->count() > 0) a->picture_options.push_back(picture_only);
+    a->picture_options = options_given(cmd, {"--width", "--height", "--dot-size"});
     if (scale_given) a->points = 0;
     if (a->method == "full")  // options the full sampler would ignore
       for (const char* tiles_only : {"--mode", "--tileset"})
