@@ -334,4 +334,38 @@ TEST_F(CliTest, RadianceImagesCutShortOrOtherwiseOrientedAreRefused) {
   EXPECT_NE(error.find("FORMAT=32-bit_rle_rgbe"), std::string::npos) << error;
 }
 
+// A PNG's gAMA chunk says how its samples encode light: a linear file (gAMA 1.0, as compositing software
+// saves it) is read as the sRGB value a viewer shows for it, not as if it were sRGB-encoded; sRGB's own
+// exponent, an sRGB chunk or an ICC profile (which take precedence) leave the values as they are.
+TEST_F(CliTest, PngGammaChunksAreReadAsTheyShow) {
+  const auto with_chunks = [](std::uint16_t grey,
+                              const std::vector<std::pair<std::string, std::uint32_t>>& extra) {
+    std::vector<std::uint8_t> png = grey_png(4, 4, 8, std::vector<std::uint16_t>(16, grey));
+    std::vector<std::uint8_t> chunks;
+    for (const auto& [type, value] : extra) {
+      std::vector<std::uint8_t> data;
+      if (type == "gAMA") put32(data, value);
+      if (type == "sRGB") data.push_back(0);
+      if (type == "iCCP") data = {'x', 0, 0, 0x78, 0x9c, 0x03, 0, 0, 0, 0, 1};  // a name, method 0, zlib
+      chunk(chunks, type.c_str(), data);
+    }
+    png.insert(png.begin() + 33, chunks.begin(), chunks.end());  // after the signature and IHDR
+    return png;
+  };
+  const auto value = [&](const std::vector<std::uint8_t>& png) {
+    kdm::tools::GreyImage image;
+    std::string error;
+    EXPECT_TRUE(kdm::tools::load_grey_image_memory(png.data(), png.size(), image, error)) << error;
+    return image.pixels.empty() ? -1.0 : double(image.pixels[0]);
+  };
+  const double encoded = 128.0 / 255;
+  EXPECT_NEAR(value(with_chunks(128, {})), encoded, 1e-7);
+  EXPECT_NEAR(value(with_chunks(128, {{"gAMA", 100000}})), std::pow(encoded, 1 / 2.2), 1e-6);  // 0.731
+  EXPECT_NEAR(value(with_chunks(128, {{"gAMA", 45455}})), encoded, 1e-7);
+  EXPECT_NEAR(value(with_chunks(128, {{"gAMA", 100000}, {"sRGB", 0}})), encoded, 1e-7);
+  EXPECT_NEAR(value(with_chunks(128, {{"gAMA", 100000}, {"iCCP", 0}})), encoded, 1e-7);
+  EXPECT_NEAR(value(with_chunks(0, {{"gAMA", 100000}})), 0.0, 1e-7);  // black and white stay
+  EXPECT_NEAR(value(with_chunks(255, {{"gAMA", 100000}})), 1.0, 1e-7);
+}
+
 }  // namespace

@@ -118,19 +118,27 @@ bool png_truncated(const std::uint8_t* data, std::size_t size) {
 
 }  // namespace
 
-// Whether a PNG holds a chunk of `type` before its first IDAT (false for anything else).
-bool png_has_chunk(const std::uint8_t* data, std::size_t size, const char type[4]) {
+bool png_chunk(const std::uint8_t* data, std::size_t size, const char type[4], std::size_t& at,
+               std::size_t& length) {
   static const std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   if (size < 8 || std::memcmp(data, kSignature, 8) != 0) return false;
   for (std::size_t pos = 8; size - pos >= 8;) {
-    const std::uint32_t length = std::uint32_t(data[pos]) << 24 | std::uint32_t(data[pos + 1]) << 16 |
-                                 std::uint32_t(data[pos + 2]) << 8 | data[pos + 3];
-    if (std::memcmp(data + pos + 4, type, 4) == 0) return true;
-    if (std::memcmp(data + pos + 4, "IDAT", 4) == 0 || length > size - pos - 8) return false;
-    pos += 12 + std::size_t(length);
+    const std::uint32_t n = std::uint32_t(data[pos]) << 24 | std::uint32_t(data[pos + 1]) << 16 |
+                            std::uint32_t(data[pos + 2]) << 8 | data[pos + 3];
+    if (std::memcmp(data + pos + 4, type, 4) == 0) {
+      at = pos + 8, length = std::min<std::size_t>(n, size - pos - 8);  // a chunk cut short: what is there
+      return true;
+    }
+    if (std::memcmp(data + pos + 4, "IDAT", 4) == 0 || n > size - pos - 8) return false;
+    pos += 12 + std::size_t(n);
     if (pos > size) return false;
   }
   return false;
+}
+
+bool png_has_chunk(const std::uint8_t* data, std::size_t size, const char type[4]) {
+  std::size_t at = 0, length = 0;
+  return png_chunk(data, size, type, at, length);
 }
 
 // A PNG's size from its IHDR chunk (the first), or false: stb refuses to read even the header of a PNG

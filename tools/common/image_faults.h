@@ -9,6 +9,11 @@
 
 namespace kdm::tools {
 
+// The first chunk of `type` before a PNG's first IDAT: its data's offset and length (of a chunk cut short,
+// what is there), or false (for anything else too).
+bool png_chunk(const std::uint8_t* data, std::size_t size, const char type[4], std::size_t& at,
+               std::size_t& length);
+
 // Whether a PNG holds a chunk of `type` before its first IDAT (false for anything else).
 bool png_has_chunk(const std::uint8_t* data, std::size_t size, const char type[4]);
 

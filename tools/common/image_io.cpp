@@ -52,13 +52,47 @@ std::string unread_format(const std::uint8_t* bytes, std::size_t size) {
          "PNG";
 }
 
+// How a colour sample becomes a value in [0, 1]: divided by its full scale, or, for a PNG whose gAMA chunk
+// says it is encoded otherwise than sRGB, through `curve` (one entry per integer sample) to the value an
+// sRGB display shows for it.
+struct SampleScale {
+  float full = 1;
+  const std::vector<float>* curve = nullptr;
+  /// Sample `c` of a pixel of `channels` (the last of 2 or 4 is alpha, which is linear).
+  template <class Sample>
+  float value(Sample sample, int c, int channels) const {
+    if constexpr (std::is_integral_v<Sample>)
+      if (curve && !(c == channels - 1 && (channels == 2 || channels == 4)))
+        return (*curve)[std::size_t(sample)];
+    return static_cast<float>(sample) / full;
+  }
+};
+
+// A PNG's gAMA chunk as a curve from its samples (0 … full) to sRGB-encoded values, or an empty one where
+// it has none, or sRGB or an ICC profile (which take precedence), or where it says sRGB's exponent: a
+// sample s shows light (s / full)^(1 / g), g = gAMA / 100000, which a 2.2 display encodes as its 1 / 2.2th
+// power. A linear file (gAMA 100000) saved by compositing software is then as dark as a viewer shows it.
+std::vector<float> png_gamma_curve(const std::uint8_t* bytes, std::size_t size, float full) {
+  std::size_t at = 0, length = 0;
+  if (!png_chunk(bytes, size, "gAMA", at, length) || length != 4 || png_has_chunk(bytes, size, "sRGB") ||
+      png_has_chunk(bytes, size, "iCCP"))
+    return {};
+  const std::uint32_t gama = std::uint32_t(bytes[at]) << 24 | std::uint32_t(bytes[at + 1]) << 16 |
+                             std::uint32_t(bytes[at + 2]) << 8 | bytes[at + 3];
+  const double exponent = 100000.0 / (2.2 * gama);
+  if (gama == 0 || std::abs(exponent - 1) < 0.01) return {};  // none, or sRGB's 45455
+  std::vector<float> curve(std::size_t(full) + 1);
+  for (std::size_t s = 0; s < curve.size(); ++s) curve[s] = float(std::pow(double(s) / full, exponent));
+  return curve;
+}
+
 // Luminance of `channels`-channel samples of full scale `full`, composited on white paper. The samples are
 // converted to float and divided first, as kdm always did, so that outputs stay bit for bit the same.
 template <class Sample>
-void to_luminance(const Sample* data, int channels, float full, std::vector<float>& pixels) {
+void to_luminance(const Sample* data, int channels, const SampleScale& scale, std::vector<float>& pixels) {
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     float p[4] = {0, 0, 0, 1};
-    for (int c = 0; c < channels; ++c) p[c] = static_cast<float>(data[i * channels + c]) / full;
+    for (int c = 0; c < channels; ++c) p[c] = scale.value(data[i * channels + c], c, channels);
     float lum = 0, alpha = 1;
     switch (channels) {
       case 1:
@@ -82,10 +116,10 @@ void to_luminance(const Sample* data, int channels, float full, std::vector<floa
 
 // Red, green and blue in [0, 1] composited on white paper (grey images give three equal values).
 template <class Sample>
-void to_rgb(const Sample* data, int channels, float full, std::vector<float>& pixels) {
+void to_rgb(const Sample* data, int channels, const SampleScale& scale, std::vector<float>& pixels) {
   for (std::size_t i = 0; i < pixels.size() / 3; ++i) {
     float p[4] = {0, 0, 0, 1};
-    for (int c = 0; c < channels; ++c) p[c] = static_cast<float>(data[i * channels + c]) / full;
+    for (int c = 0; c < channels; ++c) p[c] = scale.value(data[i * channels + c], c, channels);
     const bool grey = channels < 3;
     const float alpha = channels == 2 ? p[1] : channels == 4 ? p[3] : 1.0f;
     for (int c = 0; c < 3; ++c)
@@ -109,13 +143,13 @@ void to_alpha(const Sample* data, int channels, float full, std::vector<float>& 
 }
 
 template <class Sample, class Image>
-void convert(const Sample* data, int channels, float full, Image& image) {
+void convert(const Sample* data, int channels, const SampleScale& scale, Image& image) {
   if constexpr (std::is_same_v<Image, GreyImage>)
-    to_luminance(data, channels, full, image.pixels);
+    to_luminance(data, channels, scale, image.pixels);
   else
-    to_rgb(data, channels, full, image.pixels);
+    to_rgb(data, channels, scale, image.pixels);
   image.alpha.resize(image.pixels.size() / channels_of(image));
-  to_alpha(data, channels, full, image.alpha);
+  to_alpha(data, channels, scale.full, image.alpha);
 }
 
 // One axis of an area-weighted reduction of n source pixels to m <= n: source pixel i, covering [i, i + 1),
@@ -138,7 +172,7 @@ struct BoxAxis {
 // (values composited as `convert` does them, so averages keep the tone on paper) and summed into the kept
 // rows it meets, so that no full-size copy of floats is made.
 template <class Sample, class Image>
-void convert_reduced(const Sample* data, int channels, float full, int w, int h, int kw, int kh,
+void convert_reduced(const Sample* data, int channels, const SampleScale& scale, int w, int h, int kw, int kh,
                      Image& image) {
   const std::size_t c = channels_of(image), stride = c + 1;  // the values, then alpha, per kept pixel
   const bool has_alpha = channels == 2 || channels == 4;
@@ -162,7 +196,7 @@ void convert_reduced(const Sample* data, int channels, float full, int w, int h,
   };
   int flushed = 0;
   for (int y = 0; y < h; ++y) {
-    convert(data + std::size_t(y) * w * channels, channels, full, row);
+    convert(data + std::size_t(y) * w * channels, channels, scale, row);
     const int j = ay.first[std::size_t(y)];
     while (flushed < j) flush(flushed++);
     for (int dy = 0; dy < 2 && j + dy < kh; ++dy) {
@@ -385,11 +419,14 @@ bool load_image(const std::uint8_t* bytes, std::size_t size, const std::string& 
     if (kw == w && kh == h) image.pixels.resize(pixels * channels_of(image));
     return true;
   };
+  std::vector<float> curve;  // a PNG's gAMA, for its colour samples
   const auto convert_kept = [&](const auto* data, float full) {
+    if (!hdr) curve = png_gamma_curve(bytes, size, full);
+    const SampleScale scale{full, curve.empty() ? nullptr : &curve};
     if (kw == w && kh == h)
-      convert(data, channels, full, image);
+      convert(data, channels, scale, image);
     else
-      convert_reduced(data, channels, full, w, h, kw, kh, image);
+      convert_reduced(data, channels, scale, w, h, kw, kh, image);
   };
   if (hdr) {
     // Radiance files hold linear values of any range: scaled by `white`, or else by the brightest pixel's
