@@ -165,6 +165,7 @@ def stipple(
     paper_width: Optional[str] = ...,
     height: Optional[int] = ...,
     white: Optional[float] = ...,
+    ids: bool = ...,
 ) -> Any: ...
 def analyze(
     points: Union[npt.ArrayLike, Sequence[npt.NDArray[np.float64]]],

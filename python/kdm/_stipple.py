@@ -51,6 +51,7 @@ def stipple(
     paper_width: Optional[str] = None,
     height: Optional[int] = None,
     white: Optional[float] = None,
+    ids: bool = False,
 ) -> Any:
     """Stipple an image: its darkness becomes dot density (``kdm stipple``).
 
@@ -136,12 +137,18 @@ def stipple(
         For a Radiance .hdr file: the luminance that is white paper, brighter clipped to white (``kdm stipple
         --white``). None: its brightest pixel's. Refused for other images.
 
+    ids : bool
+        Also return each dot's id (method "tiles"): a uint64 that names the dot in every region, frame
+        and tone of the image, as the id column of ``kdm stipple``'s .csv does, for following dots across
+        the frames of a zoom or an animation (motion blur, instancing). Refused with method "full",
+        whose dots are placed anew for every picture.
+
     Returns
     -------
-    numpy.ndarray, or with `colours` a tuple (dots, classes, inks)
+    numpy.ndarray, or with `colours` a tuple (dots, classes, inks); with `ids`, the ids after them
         dots: (m, 2) float64, normalised to the rendered image or region, [0, 1) on both axes, y up;
         classes: (m,) uint8, each dot's ink; inks: the inks in class order (separate()'s), each an Ink:
-        its name, a str, with its colour as ``.colour`` ("#rrggbb").
+        its name, a str, with its colour as ``.colour`` ("#rrggbb"); ids: (m,) uint64.
     """
     gamma = _checks.number("gamma", gamma, 0.0, strict=True)
     invert = _checks.flag("invert", invert)
@@ -202,6 +209,9 @@ def stipple(
         raise ValueError(f"fade must be a fraction of density from 0 (off) to 10, got {fade}")
     if fade > 0 and method == "full":
         raise ValueError("fade needs method='tiles' (dots that appear)")
+    ids = _checks.flag("ids", ids)
+    if ids and method == "full":
+        raise ValueError("ids name the tiles' dots: method='full' places its dots anew for every picture")
     if colours is not None:
         if invert:
             raise ValueError("invert does not apply to colours (each ink has its own channel)")
@@ -217,9 +227,17 @@ def stipple(
         spec, label, points, scale, method, mode, region, seed, handle, output, width, dot_size, threads,
         colours, gamma, fade, rgb, alpha, "" if paper_width is None else paper_width, height, white,
     )
+    dots, classes, inks, keys = result
+    if ids:
+        # An empty picture has no dots to name, whatever the method.
+        if keys is None and len(dots):
+            raise ValueError("ids: the tile set's tiles hold more than 2^19 points, more than an id names")
+        keys = np.zeros(0, np.uint64) if keys is None else keys
+        if colours is None:
+            return dots, keys
+        return dots, classes, _inks(inks), keys
     if colours is None:
-        return result
-    dots, classes, inks = result
+        return dots
     return dots, classes, _inks(inks)
 
 

@@ -243,8 +243,12 @@ py::object stipple(const DensitySpec& spec, const std::string& label, std::int64
   if (!thin.empty() && PyErr_WarnEx(PyExc_UserWarning, thin.c_str(), 2) < 0) throw py::error_already_set();
   const auto count = static_cast<py::ssize_t>(set.size());
   py::array_t<double> dots = owning_array(std::move(set.coords), {count, py::ssize_t(2)});
-  if (!colours) return std::move(dots);
-  return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names_and_colours(inks));
+  // Ids where the tiles name the dots (empty from the full sampler); kdm.stipple returns what was asked.
+  py::object ids = py::none();
+  if (!set.ids.empty() && set.ids.size() == std::size_t(count))
+    ids = owning_array(std::move(set.ids), {count});
+  if (!colours) return py::make_tuple(dots, py::none(), py::none(), ids);
+  return py::make_tuple(dots, owning_array(std::move(set.classes), {count}), names_and_colours(inks), ids);
 }
 
 /// The inks of an image file as kdm stipple --colours separates them: (k, height, width) float32 densities,

@@ -262,7 +262,7 @@ TEST(Tiling, SeamClassification) {
   split_by_seam(c, 2, nn, 0.5, seam, interior);
   EXPECT_EQ(seam.size(), 4u);
   EXPECT_EQ(interior.size(), 2u);
-  const SeamStats s = seam_stats({tools::PointSet{2, c, {}, {}}}, true, 0.5);
+  const SeamStats s = seam_stats({tools::PointSet{2, c, {}, {}, {}}}, true, 0.5);
   EXPECT_NEAR(s.seam.dmin, 0.01 / hex_spacing(6), 1e-9);
   EXPECT_NEAR(s.interior.davg, 0.02 / hex_spacing(6), 1e-9);
 }

@@ -34,6 +34,27 @@ def test_stipple_writes_what_kdm_stipple_writes(cli, tmp_path):
     assert (tmp_path / "py.png").read_bytes() == (tmp_path / "cli.png").read_bytes()
 
 
+def test_stipple_ids_name_the_dots_in_every_region(cli, tmp_path):
+    # The ids of kdm stipple's .csv, the same dots; a zoomed region keeps every stable dot by id, in place.
+    dots, ids = kdm.stipple(str(SPHERE), points=3000, mode="stable", ids=True)
+    assert ids.dtype == np.uint64 and ids.shape == (len(dots),) and len(np.unique(ids)) == len(ids)
+    cli("stipple", SPHERE, "--points", 3000, "--mode", "stable", "-o", tmp_path / "s.csv")
+    rows = np.loadtxt(tmp_path / "s.csv", delimiter=",", skiprows=1, dtype=np.float64)
+    assert np.array_equal(rows[:, :2], dots)
+    assert np.array_equal(np.loadtxt(tmp_path / "s.csv", delimiter=",", skiprows=1, usecols=2, dtype=np.uint64), ids)
+    zoomed, zoomed_ids = kdm.stipple(str(SPHERE), points=3000, mode="stable", region=(0.25, 0.25, 0.75, 0.75), ids=True)
+    where = dict(zip(zoomed_ids.tolist(), 0.25 + 0.5 * zoomed))
+    inside = np.all((dots > 0.25) & (dots < 0.75), axis=1)
+    assert inside.sum() > 500
+    for dot, key in zip(dots[inside], ids[inside].tolist()):
+        assert np.allclose(where[key], dot, atol=1e-6)
+    dots, classes, inks, ids = kdm.stipple(str(SPHERE), points=2000, colours="cmyk", ids=True)
+    assert len(ids) == len(dots) == len(classes)
+    assert isinstance(kdm.stipple(str(SPHERE), points=2000), np.ndarray)  # without ids, as before
+    with pytest.raises(ValueError, match="ids name the tiles' dots"):
+        kdm.stipple(str(SPHERE), points=200, method="full", ids=True)
+
+
 def test_zoom_regions_are_the_frames_of_kdm_stipple(cli, tmp_path):
     cli("stipple", SPHERE, "--points", 3000, "--region", "0.55,0.3,0.6,0.34", "--frames", 4,
         "-o", tmp_path / "z.txt")

@@ -355,7 +355,9 @@ void add_stipple_command(CLI::App& app) {
   cmd->add_option(
          "-o,--output", a->output,
          "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
-         "rendered rectangle); with --frames, OUT_0000.png, OUT_0001.png, ...; - for standard "
+         "rendered rectangle; with tiles a .csv's id column names each dot in every region, frame and "
+         "tone, to follow dots across frames); with --frames, OUT_0000.png, OUT_0001.png, ...; - for "
+         "standard "
          "output (with --format). For pen plotters, .svg has an Inkscape layer per ink, its dots in "
          "drawing order (each the nearest not yet drawn: short pen travel), every dot whole within a "
          "margin as wide as a dot around the picture (coordinates are the PNG's pixels); white paper is no "

@@ -619,6 +619,7 @@ void append_points(std::string& out, const PointSet& set, char sep) {
       out.append(number, written.ptr);
     }
     if (!set.classes.empty()) out += ',' + std::to_string(set.classes[i]);
+    if (sep == ',' && set.ids.size() == set.size()) out += ',' + std::to_string(set.ids[i]);
     out += '\n';
   }
 }
@@ -648,7 +649,8 @@ bool write_point_set(const std::string& path, const PointSet& set, const std::ve
   std::string out;
   out.reserve(64 + header.size() * 80 + set.coords.size() * 25);
   if (csv) {
-    out += set.dim == 3 ? "x,y,z\n" : labelled ? "x,y,class\n" : "x,y\n";
+    out += set.dim == 3 ? "x,y,z" : labelled ? "x,y,class" : "x,y";
+    out += set.ids.size() == set.size() && !set.ids.empty() ? ",id\n" : "\n";
   } else {
     for (const std::string& h : header) out += "# " + comment_safe(h) + '\n';
   }

@@ -23,6 +23,9 @@ struct PointSet {
   std::vector<std::uint8_t> classes;  ///< empty, or one class (0 … 255) per point
   /// Empty, or each point's dot radius as a fraction (0 … 1) of the picture's (pictures only).
   std::vector<float> sizes;
+  /// Empty, or a number per point that names it wherever it shows (kdm stipple's tiles: the runtime's
+  /// point key, the same in every frame): a .csv's id column.
+  std::vector<std::uint64_t> ids;
   std::size_t size() const { return dim > 0 ? coords.size() / dim : 0; }
 };
 

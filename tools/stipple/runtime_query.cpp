@@ -210,26 +210,41 @@ void query_all(const Tileset& tileset, const QueryParams& params, std::vector<Qu
 }
 
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
-                  const QueryParameterNames& names) {
+                  std::vector<std::uint64_t>* keys, const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
+  if (keys) keys->clear();
   collect(xy, 2, names,
           [&](std::size_t from, std::size_t room, std::size_t* written, QueryCursor* cursor,
               QueryProblem* problem) {
-            return query_points_compact(tileset, params, CompactPoints{xy.data() + 2 * from, nullptr}, room,
-                                        written, cursor, problem);
+            if (keys) keys->resize(from + room);
+            const Status s = query_points_compact(
+                tileset, params, CompactPoints{xy.data() + 2 * from, keys ? keys->data() + from : nullptr},
+                room, written, cursor, problem);
+            if (keys) keys->resize(from + *written);
+            return s;
           });
 }
 
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
-                  std::vector<std::uint8_t>& classes, const QueryParameterNames& names) {
+                  std::vector<std::uint8_t>& classes, std::vector<std::uint64_t>* keys,
+                  const QueryParameterNames& names) {
   check_before_collecting(tileset, params, names);
+  if (keys) keys->clear();
   collect_classes(xy, 2, classes, names,
                   [&](std::size_t from, std::size_t room, std::uint8_t* to, std::size_t* written,
                       QueryCursor* cursor, QueryProblem* problem) {
-                    return query_classes_compact(tileset, params,
-                                                 CompactPoints{xy.data() + 2 * from, nullptr}, to, room,
-                                                 written, cursor, problem);
+                    if (keys) keys->resize(from + room);
+                    const Status s = query_classes_compact(
+                        tileset, params,
+                        CompactPoints{xy.data() + 2 * from, keys ? keys->data() + from : nullptr}, to, room,
+                        written, cursor, problem);
+                    if (keys) keys->resize(from + *written);
+                    return s;
                   });
+}
+
+bool keys_fit(const Tileset& tileset) {
+  return tileset.max_points_per_tile() <= (std::uint64_t(1) << kKeyRankBits);
 }
 
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,

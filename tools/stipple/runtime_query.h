@@ -58,15 +58,20 @@ void check_before_collecting(const Tileset& tileset, const ClassQueryParams& par
 void query_all(const Tileset& tileset, const QueryParams& params, std::vector<QueryPoint>& out,
                const QueryParameterNames& names = {});
 /// The same into the compact output (compact_query.h): positions only, `xy` (replaced) holding x, y
-/// pairs relative to the query origin, as fast as the runtime writes them.
+/// pairs relative to the query origin, as fast as the runtime writes them; with `keys`, each point's
+/// point_key too (replaced; the set's tiles must hold at most 2^19 points: keys_fit).
 void query_all_xy(const Tileset& tileset, const QueryParams& params, std::vector<float>& xy,
-                  const QueryParameterNames& names = {});
+                  std::vector<std::uint64_t>* keys = nullptr, const QueryParameterNames& names = {});
 /// The same for several classes: `classes` (replaced) receives each point's class.
 void query_all(const Tileset& tileset, const ClassQueryParams& params, std::vector<QueryPoint>& out,
                std::vector<std::uint8_t>& classes, const QueryParameterNames& names = {});
-/// The same into the compact output: x, y pairs and each point's class.
+/// The same into the compact output: x, y pairs and each point's class (and key, with `keys`).
 void query_all_xy(const Tileset& tileset, const ClassQueryParams& params, std::vector<float>& xy,
-                  std::vector<std::uint8_t>& classes, const QueryParameterNames& names = {});
+                  std::vector<std::uint8_t>& classes, std::vector<std::uint64_t>* keys = nullptr,
+                  const QueryParameterNames& names = {});
+
+/// Whether the compact output can key `tileset`'s points (its tiles hold at most 2^19 points).
+bool keys_fit(const Tileset& tileset);
 
 /// Query points whose origin is the corner (r[0], r[1]) of the world rectangle r (x0, y0, x1, y1), as a 2D
 /// point set normalised to it: [0, 1) on both axes.

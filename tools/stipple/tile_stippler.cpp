@@ -240,6 +240,8 @@ PointSet TileStippler::with_sizes(const QueryParams& q, const double rect[4], do
   PointSet set = normalise_to_rect(points, rect);
   set.classes = std::move(classes);
   set.sizes.resize(points.size());
+  if (keys_fit(tiles_))
+    for (const QueryPoint& p : points) set.ids.push_back(point_key(p.id));
   const double m = tiles_.data().subtiles_per_side();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const QueryPoint& p = points[i];
@@ -273,15 +275,17 @@ PointSet TileStippler::render(const double uv[4], double fade) const {
   q.glide_together = true;  // a picture's tone changes from dot to dot
   const double rect[4] = {uv[0] * aspect_, uv[1], uv[2] * aspect_, uv[3]};
   if (fade > 0) return with_sizes(q, rect, fade);
-  std::vector<float> xy;  // positions only: the compact output
-  if (densities_.size() == 1) {
-    query_all_xy(tiles_, q, xy);
-    return normalise_to_rect(xy, rect);
-  }
+  std::vector<float> xy;  // positions and keys: the compact output
+  std::vector<std::uint64_t> keys;
   std::vector<std::uint8_t> classes;
-  query_all_xy(tiles_, class_params(q), xy, classes);
+  std::vector<std::uint64_t>* keyed = keys_fit(tiles_) ? &keys : nullptr;
+  if (densities_.size() == 1)
+    query_all_xy(tiles_, q, xy, keyed);
+  else
+    query_all_xy(tiles_, class_params(q), xy, classes, keyed);
   PointSet set = normalise_to_rect(xy, rect);
   set.classes = std::move(classes);
+  set.ids = std::move(keys);
   return set;
 }
 

@@ -121,7 +121,7 @@ Relaxed relax(const std::vector<double>& own, const std::vector<double>& others,
 }
 
 void TorusHoles::add(const std::vector<double>& coords) {
-  if (coords.size() >= 6) tori_.push_back({2, coords, {}, {}});
+  if (coords.size() >= 6) tori_.push_back({2, coords, {}, {}, {}});
 }
 
 void TorusHoles::measure(int threads, Holes& holes) const {
