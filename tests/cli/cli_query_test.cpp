@@ -493,10 +493,11 @@ TEST_F(CliTest, StippleColoursSeparateInksIntoClasses) {
   std::istringstream in(slurp(path("c.csv")));
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "x,y,class");
+  EXPECT_EQ(line, "x,y,class,id");  // tiles name their dots
   std::size_t counts[3] = {}, rows = 0;
   while (std::getline(in, line)) {
-    const int k = std::atoi(line.c_str() + line.rfind(',') + 1);
+    const std::size_t third = line.find(',', line.find(',') + 1) + 1;
+    const int k = std::atoi(line.c_str() + third);
     ASSERT_TRUE(k >= 0 && k < 3) << line;
     ++counts[k], ++rows;
   }

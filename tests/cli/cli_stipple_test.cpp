@@ -103,12 +103,15 @@ TEST_F(CliTest, StippleColourHdrWhiteIsTheBrightestPixelsLuminance) {
   EXPECT_NEAR(grey, expected, 0.05 * expected);
   ASSERT_EQ(kdm(run + " --colours cmyk").status, 0);
   // The grey's ink, black, holds most dots (inks are numbered by coverage): the strip is drawn in others.
-  std::map<std::string, std::size_t> per_ink;
-  const std::string text = slurp(path("s.csv"));
-  for (std::size_t at = text.find('\n'); at != std::string::npos && at + 1 < text.size();
-       at = text.find('\n', at + 1))
-    ++per_ink[text.substr(text.rfind(',', text.find('\n', at + 1)) + 1,
-                          text.find('\n', at + 1) - text.rfind(',', text.find('\n', at + 1)) - 1)];
+  std::map<int, std::size_t> per_ink;
+  std::istringstream rows(slurp(path("s.csv")));
+  std::string line;
+  std::getline(rows, line);
+  ASSERT_EQ(line, "x,y,class,id");
+  double x, y;
+  int ink;
+  while (std::getline(rows, line) && std::sscanf(line.c_str(), "%lf,%lf,%d", &x, &y, &ink) == 3)
+    ++per_ink[ink];
   std::size_t black = 0;
   for (const auto& [ink, count] : per_ink) black = std::max(black, count);
   EXPECT_NEAR(double(black), grey, 0.05 * grey);

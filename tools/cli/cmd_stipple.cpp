@@ -92,7 +92,8 @@ void run_stipple(const StippleArgs& a, bool scale_given) {
     throw CommandError(message);
   }
   if (!a.colours.empty() && format == ".txt")  // said before the dots are placed
-    throw CommandError("--colours writes each dot's ink as a class: write .csv (x,y,class), .svg or .png");
+    throw CommandError(
+        "--colours writes each dot's ink as a class: write .csv (x,y,class[,id]), .svg or .png");
   if (a.fade > 0 && a.method == "full") throw CommandError("--fade needs --method tiles (dots that appear)");
   if (a.fade > 0 && format != ".png" && format != ".svg")
     throw CommandError("--fade grows dots in pictures: write .png or .svg (points files have no dot sizes)");
