@@ -390,4 +390,18 @@ TEST_F(CliTest, StippleDotsKeepTheirIdsInEveryRegion) {
   }
 }
 
+// Frames are numbered before the extension, or where a printf-style number in the name says, as ffmpeg
+// reads a sequence ("frame_%04d.png").
+TEST_F(CliTest, StippleFramesTakeAPrintfStyleNumber) {
+  const std::string image = "'" + std::string(KDM_SOURCE_DIR) + "/examples/sphere.png'";
+  const std::string zoom = " --points 500 --region 0.3,0.3,0.7,0.7 --frames 3 -o ";
+  ASSERT_EQ(kdm("stipple " + image + zoom + "'" + path("f_%03d.txt") + "'").status, 0);
+  ASSERT_EQ(kdm("stipple " + image + zoom + "'" + path("g%d.csv") + "'").status, 0);
+  ASSERT_EQ(kdm("stipple " + image + zoom + "'" + path("h.txt") + "'").status, 0);
+  for (const char* name : {"f_000.txt", "f_002.txt", "g0.csv", "g2.csv", "h_0000.txt", "h_0002.txt"})
+    EXPECT_TRUE(fs::exists(path(name))) << name;
+  for (const char* name : {"f_003.txt", "f_%03d.txt", "f_%03d_0000.txt", "g3.csv", "h_0003.txt"})
+    EXPECT_FALSE(fs::exists(path(name))) << name;
+}
+
 }  // namespace

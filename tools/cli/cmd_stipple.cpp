@@ -3,10 +3,12 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -61,9 +63,25 @@ std::string first_bytes(const std::string& path, std::size_t n) {
   return bytes;
 }
 
-/// OUT.png -> OUT_0007.png (the frame number before the extension).
+/// OUT.png -> OUT_0007.png (the frame number before the extension); a name holding a printf-style
+/// number, as ffmpeg takes it ("frame_%04d.png", "f%d.png"), gets the number there instead.
 std::string frame_path(const std::string& output, int i) {
-  const std::size_t slash = output.find_last_of('/'), dot = output.find_last_of('.');
+  const std::size_t slash = output.find_last_of('/');
+  const std::size_t percent = output.find('%', slash == std::string::npos ? 0 : slash + 1);
+  if (percent != std::string::npos) {
+    std::size_t end = percent + 1;
+    if (end < output.size() && output[end] == '0') ++end;
+    while (end < output.size() && end - percent < 4 && std::isdigit(static_cast<unsigned char>(output[end])))
+      ++end;
+    if (end < output.size() && output[end] == 'd') {
+      const int width =
+          end > percent + 1 ? std::atoi(output.c_str() + percent + (output[percent + 1] == '0' ? 2 : 1)) : 0;
+      char number[24];
+      std::snprintf(number, sizeof number, output[percent + 1] == '0' ? "%0*d" : "%*d", width, i);
+      return output.substr(0, percent) + number + output.substr(end + 1);
+    }
+  }
+  const std::size_t dot = output.find_last_of('.');
   const std::size_t at =
       dot != std::string::npos && (slash == std::string::npos || dot > slash) ? dot : output.size();
   char number[16];
@@ -357,7 +375,8 @@ void add_stipple_command(CLI::App& app) {
          "-o,--output", a->output,
          "Output: .png (antialiased dots), .svg (circles) or .txt/.csv points (normalised to the "
          "rendered rectangle; with tiles a .csv's id column names each dot in every region, frame and "
-         "tone, to follow dots across frames); with --frames, OUT_0000.png, OUT_0001.png, ...; - for "
+         "tone, to follow dots across frames); with --frames, OUT_0000.png, OUT_0001.png, ... (or the number "
+         "where a printf-style %04d in the name says, as ffmpeg reads a sequence); - for "
          "standard "
          "output (with --format). For pen plotters, .svg has an Inkscape layer per ink, its dots in "
          "drawing order (each the nearest not yet drawn: short pen travel), every dot whole within a "
