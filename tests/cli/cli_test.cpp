@@ -185,6 +185,7 @@ TEST_F(CliTest, BadCommandLinesGiveOneLineErrors) {
   const std::string out = " -o '" + path("x.txt") + "'";
   expect_error("", "subcommand");
   expect_error("frobnicate", "unknown subcommand 'frobnicate'");
+  expect_error("query --rect 0,0,1,1 --width 300" + out, "not expected: --width 300");  // in their order
   expect_error("sample --n abc" + out, "--n");
   expect_error("sample --n -5" + out, "--n");
   // Counts also in float notation when whole (1e3); a fraction or past 2^63 refused by name.

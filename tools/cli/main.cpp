@@ -7,8 +7,11 @@
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <iterator>
 #include <new>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "atomic_file.h"
 #include "commands.h"
@@ -107,6 +110,16 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // Bad command lines get the same one-line error as every other failure (CLI11 would add a hint line).
     std::string message = e.what(), help = "kdm --help";
+    // CLI11 lists unexpected words last first ("300 --width"): put them back in the command line's order.
+    if (const std::size_t colon = message.find(": ");
+        dynamic_cast<const CLI::ExtrasError*>(&e) && colon != std::string::npos) {
+      std::istringstream words(message.substr(colon + 2));
+      std::vector<std::string> given{std::istream_iterator<std::string>(words), {}};
+      std::string in_order;
+      for (auto word = given.rbegin(); word != given.rend(); ++word)
+        in_order += (in_order.empty() ? "" : " ") + *word;
+      message = message.substr(0, colon + 2) + in_order;
+    }
     if (argc > 1 && argv[1][0] != '-') {  // CLI11 calls an unknown subcommand "a subcommand is required"
       bool known = false;
       for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
