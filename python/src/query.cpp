@@ -656,16 +656,16 @@ double classes_peak(const ClassQueryParams& q) {
   return peak;
 }
 
-/// warn_tile_size for the classes' sum, then the warning of a later class too sparse for its count.
+/// warn_tile_size for the classes' sum, then the warning of a class the tiles serve unevenly
+/// (class_count_warnings).
 void warn_classes(const Tileset& set, const ClassQueryParams& q, int level) {
   warn_tile_size(set, classes_peak(q), q.query, level);
   if (!(q.query.x1 > q.query.x0 && q.query.y1 > q.query.y0)) return;
   std::vector<double> peaks;
   for (std::uint32_t k = 0; k < q.class_count; ++k) peaks.push_back(density_peak(q.classes[k]));
-  const std::string text =
-      tools::later_class_warning(set, peaks, q.query.scale, q.query.tile_size, "tile_size");
-  if (!text.empty() && PyErr_WarnEx(PyExc_UserWarning, text.c_str(), level) < 0)
-    throw py::error_already_set();
+  for (const std::string& text :
+       tools::class_count_warnings(set, peaks, q.query.scale, q.query.tile_size, "tile_size"))
+    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), level) < 0) throw py::error_already_set();
 }
 
 /// Several classes (kdm/runtime/class_query.h), each density a spec: the records, views and levels as

@@ -935,8 +935,8 @@ def test_an_empty_or_inverted_region_has_no_points():
             assert tiles.positions(rect, scale=100, density=density, **bound).shape == (0, 2)
         assert len(tiles.query(rect, scale=100, classes=[np.ones((4, 4)), 0.2])) == 0
     # Classes may come as a 1-D array of constant densities.
-    assert np.array_equal(tiles.query((0, 0, 4, 4), scale=200, classes=np.array([0.1, 0.2])).classes,
-                          tiles.query((0, 0, 4, 4), scale=200, classes=[0.1, 0.2]).classes)
+    assert np.array_equal(tiles.query((0, 0, 4, 4), scale=400, classes=np.array([0.1, 0.2])).classes,
+                          tiles.query((0, 0, 4, 4), scale=400, classes=[0.1, 0.2]).classes)
 
 
 @pytest.mark.parametrize("mode", ["stable", "smooth"])
@@ -1071,14 +1071,18 @@ def test_a_tile_size_too_small_for_the_density_is_warned_of():
         BUILTIN.positions((0, 0, 4, 4), scale=20, density=lambda x, y: 0.5 + 0.5 * x / 4, density_max=1.0)
     assert said[0].filename == __file__
     # A rare class after dense ones (its count what theirs leave: twice its own, as kdm query's test
-    # measures), in both query paths; first, it gets its count, and nothing is said.
+    # measures), in both query paths; first, it gets its count but the same few places in every tile.
     for call in (BUILTIN.query, BUILTIN.positions):
-        with pytest.warns(UserWarning, match=r"class 2 expects at most 1\.02 points per tile.*give it class 0") as said:
+        with pytest.warns(UserWarning, match=r"class 2 expects at most 1\.02 points per tile.*on its own") as said:
             call((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.02, 0.1, 0.001])
+        assert said[0].filename == __file__
+        with pytest.warns(UserWarning, match=r"class 0 expects at most 1\.02 points per tile.*tile_size of at "
+                                             r"least 179") as said:
+            call((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.001, 0.02, 0.1])
         assert said[0].filename == __file__
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        BUILTIN.query((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.001, 0.02, 0.1])
+        BUILTIN.query((0, 0, 64, 64), scale=1, tile_size=32, classes=[0.04, 0.02, 0.1])  # class 0: 41 a tile
     # A map's peak, not the region's, is what is judged: a sparse corner of a map is no mistake.
     ramp = kdm.DensityMap(np.array([[0.01, 1.0]]), (0, 0, 10, 10))
     with warnings.catch_warnings():

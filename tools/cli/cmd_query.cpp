@@ -115,6 +115,20 @@ void run_query_command(const QueryArgs& a, bool density_given) {
     throw CommandError("--density-rect needs an image or a test map (--density or --class)");
   if (a.density_rect.empty()) {
     std::copy(r, r + 4, dr);  // the image stretched over the rectangle queried
+    // A chunk of a map queried without the map's rectangle gets the whole map squeezed into it: where the
+    // shapes differ, that is seldom what was meant.
+    for (const auto& spec : specs)
+      if (spec->kind == tools::DensitySpec::Kind::kImage && spec->height > 0) {
+        const double map = double(spec->width) / spec->height, rect = (r[2] - r[0]) / (r[3] - r[1]);
+        if (std::abs(std::log(map / rect)) > 0.01) {
+          std::fprintf(stderr,
+                       "kdm query: warning: the %dx%d map is stretched over --rect, whose shape (%.4g wide "
+                       "per tall) is not the map's (%.4g): to query a part of a map, give the map's whole "
+                       "world rectangle as --density-rect\n",
+                       spec->width, spec->height, rect, map);
+          break;
+        }
+      }
   } else {
     parse_rect(a.density_rect, "--density-rect", dr);
   }
@@ -141,8 +155,9 @@ void run_query_command(const QueryArgs& a, bool density_given) {
   if (!sparse.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", sparse.c_str());
   std::vector<double> peaks;
   for (const auto& spec : specs) peaks.push_back(spec->max_value() * spec->divided_by);
-  const std::string rare = tools::later_class_warning(tiles, peaks, a.scale, a.tile_size, "--tile-size");
-  if (!rare.empty()) std::fprintf(stderr, "kdm query: warning: %s\n", rare.c_str());
+  for (const std::string& uneven :
+       tools::class_count_warnings(tiles, peaks, a.scale, a.tile_size, "--tile-size"))
+    std::fprintf(stderr, "kdm query: warning: %s\n", uneven.c_str());
   const auto t0 = std::chrono::steady_clock::now();
   // Origin 0: positions are world coordinates, the same bits in any query.
   std::vector<QueryPoint> points;

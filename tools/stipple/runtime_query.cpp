@@ -20,23 +20,41 @@ std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_siz
     std::snprintf(
         text, sizeof text,
         "at most %.3g points per tile; below 1 a tile's expected count rounds to steps of 1/%zu of a "
-        "point (use a %s of at least %.3g)",
-        advice.points_per_tile, advice.tiles, tile_size, advice.tile_size);
+        "point%s (use a %s of at least %.3g)",
+        advice.points_per_tile, advice.tiles,
+        advice.points_per_tile < 0.5 / double(advice.tiles) ? ", and this one to none" : "", tile_size,
+        advice.tile_size);
   else if (advice.kind == TileSizeAdvice::Kind::kUnderCoarsestLevel)
     std::snprintf(
         text, sizeof text,
         "at most %.3g points per tile, under the tile set's coarsest level (%.0f): a tile then gives "
-        "part of that level, less even (use a %s of at least %.3g)",
+        "part of that level, the same few places in every tile where the density is that low, a pattern "
+        "that repeats with the tiles (use a %s of at least %.3g)",
         advice.points_per_tile, advice.coarsest, tile_size, advice.tile_size);
   else
     return "";
   return text;
 }
 
-std::string later_class_warning(const Tileset& tileset, const std::vector<double>& peaks, double scale,
-                                double tile_size, const char* tile_size_name) {
-  if (tileset.empty() || tileset.data().level_nominal.empty()) return "";
+std::vector<std::string> class_count_warnings(const Tileset& tileset, const std::vector<double>& peaks,
+                                              double scale, double tile_size, const char* tile_size_name) {
+  std::vector<std::string> warnings;
+  if (tileset.empty() || tileset.data().level_nominal.empty()) return warnings;
   const double area = scale * tile_size * tile_size, coarsest = tileset.data().level_nominal.front();
+  // Class 0 is the one-class query at its own density: too sparse for the coarsest level, it takes the
+  // same few places in every tile, and the classes' summed peak keeps the tiles from growing to fit it.
+  const TileSizeAdvice own_advice = tile_size_advice(tileset, peaks.empty() ? 0 : peaks[0], scale, tile_size);
+  if (peaks.size() > 1 && own_advice.kind != TileSizeAdvice::Kind::kEven) {
+    char text[480];
+    std::snprintf(text, sizeof text,
+                  "class 0 expects at most %.3g points per tile, under the tile set's coarsest level (%.0f): "
+                  "its points take the same few places in every tile, a pattern that repeats with the tiles; "
+                  "query it on its own with a %s of at least %.3g (one query serves classes within about "
+                  "1:%.0f of the classes' summed peak)",
+                  own_advice.points_per_tile, coarsest, tile_size_name, own_advice.tile_size,
+                  tileset.max_points_per_tile() / coarsest);
+    warnings.push_back(text);
+  }
   double before = 0;  // the classes before k, points per tile at their peaks
   for (std::size_t k = 0; k < peaks.size(); ++k) {
     const double own = peaks[k] * area;
@@ -46,14 +64,14 @@ std::string later_class_warning(const Tileset& tileset, const std::vector<double
           text, sizeof text,
           "class %zu expects at most %.3g points per tile after up to %.3g of the classes before it: "
           "a later class gets what their counts leave, off by up to about 2 points per tile where "
-          "they are constant; give it class 0, or query it on its own with a %s that gives it at "
-          "least %.0f",
-          k, own, before, tile_size_name, kFewestForALaterClass);
-      return text;
+          "they are constant; query it on its own with a %s that gives it at least %.0f",
+          k, own, before, tile_size_name, coarsest);
+      warnings.push_back(text);
+      break;  // the first such class: the others share its cause
     }
     before += std::isfinite(own) ? own : 0;
   }
-  return "";
+  return warnings;
 }
 
 namespace {

@@ -29,12 +29,13 @@ std::string tile_size_warning(const TileSizeAdvice& advice, const char* tile_siz
 /// up to about 2 points per tile where the densities are constant (docs/limits.md, "Several classes").
 inline constexpr double kFewestForALaterClass = 16;
 
-/// The warning, in one line without a prefix, for a class after the first expecting fewer than
-/// kFewestForALaterClass points per tile at its peak while the classes before it reach the coarsest level
-/// of `tileset`; "" for none. `peaks` are the classes' largest densities, class 0 first; `tile_size`
-/// names the option.
-std::string later_class_warning(const Tileset& tileset, const std::vector<double>& peaks, double scale,
-                                double tile_size, const char* tile_size_name);
+/// The warnings, each one line without a prefix, for the classes the tiles serve unevenly: class 0
+/// (of several) under the coarsest level of `tileset` at its peak (its points then repeat with the
+/// tiles), or a later class expecting fewer than kFewestForALaterClass points per tile at its peak while
+/// the classes before it reach the coarsest level (the first such); none where they are served evenly.
+/// `peaks` are the classes' largest densities, class 0 first; `tile_size` names the option.
+std::vector<std::string> class_count_warnings(const Tileset& tileset, const std::vector<double>& peaks,
+                                              double scale, double tile_size, const char* tile_size_name);
 
 /// A lower bound of how many points a query of `params` emits: its density times scale over its region
 /// (exact for a constant; an image's min-mip over 64 × 64 blocks of the region, 0 where its maximum could

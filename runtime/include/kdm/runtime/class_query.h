@@ -15,9 +15,10 @@
 // to 0 (and the sum's does not) its points may show up to about a spacing inside the zero side; no point
 // shows where the sum is 0. Objects that must keep out of an area exactly are placed in stable mode.
 // Choose priorities largest objects first: class 0 is the best spread, a later class fills the gaps. But
-// give a rare class (under about 16 points per tile) class 0: a later one gets what the counts at two
-// running sums leave, which are off by up to about 2 points per tile where the densities are constant
-// (docs/limits.md, "Several classes").
+// query rare objects (under about 32 points per tile) on their own with larger tiles: a later class gets
+// what the counts at two running sums leave, which are off by up to about 2 points per tile where the
+// densities are constant, and class 0 under the coarsest level stands at the same few places of every
+// tile (docs/limits.md, "Several classes").
 // Give a callback class its bounds (QueryDensity::bounds): the union's are their sum, and a tile's bounds
 // settle most of its points' classes without reading any density. Classes whose densities come from one
 // computation are best given by one function (ClassQueryParams::joint): the query then makes one call per
