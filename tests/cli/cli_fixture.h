@@ -65,6 +65,17 @@ class CliTest : public ::testing::Test {
     EXPECT_NE(r.err.find(naming), std::string::npos) << "kdm " << args << "\nstderr: " << r.err;
   }
 
+  // Asserts that `kdm ARGS` succeeds and that its standard error mentions `text` (a warning) or, with
+  // `said` false, does not. Returns the outcome for further checks.
+  Outcome expect_success_saying(const std::string& args, const std::string& text, bool said = true) const {
+    const Outcome r = kdm(args);
+    EXPECT_EQ(r.status, 0) << "kdm " << args << "\nstderr: " << r.err;
+    EXPECT_EQ(r.err.find(text) != std::string::npos, said)
+        << "kdm " << args << (said ? "\nshould say: " : "\nshould not say: ") << text
+        << "\nstderr: " << r.err;
+    return r;
+  }
+
   fs::path dir_;
 };
 
